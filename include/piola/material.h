@@ -1,0 +1,109 @@
+/* piola: isotropic constitutive models in diagonal form (paper section 6).
+ *
+ * A model is a function of the diagonal Fhat of the invertible diagonalization
+ * F = U Fhat V^T: it gives the diagonal first Piola-Kirchhoff stress Phat (Pa), the energy
+ * density psi (J/m^3 = Pa) and the 3x3 derivative dPhat_i/dFhat_j (Pa). The full stress
+ * is P = U diag(Phat) V^T.
+ *
+ * Inversion extension: below the compression threshold c on any entry of Fhat the model is
+ * replaced, in that entry, by its value at the clamped point (PIOLA_INVERSION_CLAMP, C0) or
+ * by its first-order Taylor expansion around the clamped point (PIOLA_INVERSION_LINEAR, C1,
+ * the default), continued through zero into negative (inverted) entries. The result is
+ * finite everywhere and always pushes an inverted element back. See docs/materials.md.
+ *
+ * Usage:
+ *   piola_material_def def = piola_default_material_def();
+ *   def.model = PIOLA_MODEL_NEOHOOKEAN;
+ *   def.youngs_modulus = 1e5;   // Pa
+ *   def.poisson_ratio = 0.45;
+ *   piola_material mat;
+ *   if (piola_material_init(&def, &mat) != PIOLA_OK) puts(piola_last_error());
+ *   piola_material_stress(&mat, fhat, phat); */
+#ifndef PIOLA_MATERIAL_H
+#define PIOLA_MATERIAL_H
+
+#include <stdbool.h>
+
+#include "piola/export.h"
+#include "piola/status.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+typedef enum piola_material_model {
+  PIOLA_MODEL_ROTATED_LINEAR = 0, /* Phat = 2 mu (Fhat - I) + lambda tr(Fhat - I) I (paper) */
+  PIOLA_MODEL_COROTATED,          /* 2 mu (Fhat - I) + lambda (J - 1) J Fhat^-1 */
+  PIOLA_MODEL_STVK,               /* St. Venant-Kirchhoff: Fhat (2 mu E + lambda tr(E) I) */
+  PIOLA_MODEL_NEOHOOKEAN,         /* mu (Fhat - Fhat^-1) + lambda ln(J) Fhat^-1 */
+  PIOLA_MODEL_SPLINE,             /* the paper's "biological" model: see piola_spline_def */
+  PIOLA_MODEL_COUNT
+} piola_material_model;
+
+typedef enum piola_inversion_mode {
+  PIOLA_INVERSION_LINEAR = 0, /* C1: first-order Taylor expansion at the threshold (default) */
+  PIOLA_INVERSION_CLAMP,      /* C0: the stress at the clamped point */
+} piola_inversion_mode;
+
+/* Shape of the spline ("biological") model: soft near rest, stiffer past the thresholds. */
+typedef struct piola_spline_def {
+  double compression_stretch; /* dimensionless, in (threshold, 1): stiff below it. Default 0.8 */
+  double elongation_stretch;  /* dimensionless, > 1: stiff above it. Default 1.2 */
+  double stiffening;          /* dimensionless, >= 1: slope outside the thresholds divided by
+                                 the slope at rest. Default 10 */
+} piola_spline_def;
+
+typedef struct piola_material_def {
+  piola_material_model model;
+  double youngs_modulus;      /* Pa, > 0. Default 1e5 */
+  double poisson_ratio;       /* dimensionless, in (-1, 0.5). Default 0.3 */
+  double inversion_threshold; /* dimensionless, in (0, 1): compression threshold c. Default 0.3 */
+  piola_inversion_mode inversion_mode; /* Default PIOLA_INVERSION_LINEAR */
+  piola_spline_def spline;    /* used by PIOLA_MODEL_SPLINE only */
+} piola_material_def;
+
+/* The defaults above, written once. */
+PIOLA_API piola_material_def piola_default_material_def(void);
+
+/* Young's modulus (Pa) and Poisson's ratio from Lame parameters mu, lambda (Pa). */
+PIOLA_API piola_status piola_youngs_poisson_from_lame(double mu, double lambda,
+                                                      double *youngs_modulus,
+                                                      double *poisson_ratio);
+
+/* A validated model, ready to evaluate. Plain data: copy it freely. */
+typedef struct piola_material {
+  piola_material_model model;
+  double mu;                  /* Pa, Lame's second parameter (shear modulus) */
+  double lambda;              /* Pa, Lame's first parameter */
+  double threshold;           /* dimensionless compression threshold c */
+  piola_inversion_mode inversion_mode;
+  double spline_coefficients[16]; /* precomputed spline pieces, model-internal */
+} piola_material;
+
+/* Checks def (E > 0, nu in (-1, 0.5), threshold in (0, 1), spline shape) and fills out.
+ * On error returns PIOLA_ERROR_INVALID_ARGUMENT with a message naming the parameter. */
+PIOLA_API piola_status piola_material_init(const piola_material_def *def, piola_material *out);
+
+/* Diagonal stress Phat (Pa) at the diagonal deformation fhat, extension included. */
+PIOLA_API void piola_material_stress(const piola_material *material, const double fhat[3],
+                                     double phat[3]);
+
+/* Energy density (J/m^3) at fhat, extension included (see docs/materials.md for what it
+ * means past the threshold). Zero at rest. */
+PIOLA_API double piola_material_energy_density(const piola_material *material, const double fhat[3]);
+
+/* dPhat_i / dFhat_j (Pa), extension included. */
+PIOLA_API void piola_material_stress_derivative(const piola_material *material,
+                                                const double fhat[3], double dphat[3][3]);
+
+/* Name used in scene files: "rotated_linear", "corotated", "stvk", "neohookean", "spline". */
+PIOLA_API const char *piola_material_model_name(piola_material_model model);
+
+/* Parses a scene-file name; false if unknown. */
+PIOLA_API bool piola_material_model_from_name(const char *name, piola_material_model *model);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif

@@ -1,0 +1,15 @@
+/* The table of `piola` subcommands. Each lives in its own cli_<name>.c file and returns the
+ * process exit code: 0 success, 1 runtime failure, 2 bad usage or bad input. */
+#ifndef PIOLA_CLI_COMMANDS_H
+#define PIOLA_CLI_COMMANDS_H
+
+#define PIOLA_VERSION_STRING "0.1.0"
+
+typedef struct cli_command {
+  const char *name;
+  int (*run)(int argc, char **argv); /* argv[0] is the command name */
+} cli_command;
+
+extern const cli_command cli_commands[];
+
+#endif

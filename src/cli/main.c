@@ -1,0 +1,38 @@
+/* The `piola` command-line program: dispatches to subcommands. Uses only the public API. */
+#include <stdio.h>
+#include <string.h>
+
+#include "cli/commands.h"
+
+static void print_usage(FILE *out) {
+  fprintf(out,
+          "usage: piola <command> [options]\n"
+          "\n"
+          "commands:\n"
+          "  run SCENE.json -o DIR     simulate a scene and write frames\n"
+          "  mesh info|convert|generate  inspect, convert or generate meshes\n"
+          "  version                   print the version\n"
+          "\n"
+          "Run `piola <command> --help` for the options of a command.\n");
+}
+
+int main(int argc, char **argv) {
+  if (argc < 2) {
+    print_usage(stderr);
+    return 2;
+  }
+  const char *command = argv[1];
+  for (const cli_command *c = cli_commands; c->name; ++c)
+    if (strcmp(c->name, command) == 0) return c->run(argc - 1, argv + 1);
+  if (strcmp(command, "--help") == 0 || strcmp(command, "-h") == 0 || strcmp(command, "help") == 0) {
+    print_usage(stdout);
+    return 0;
+  }
+  if (strcmp(command, "version") == 0 || strcmp(command, "--version") == 0) {
+    printf("piola %s\n", PIOLA_VERSION_STRING);
+    return 0;
+  }
+  fprintf(stderr, "piola: unknown command '%s'\n", command);
+  print_usage(stderr);
+  return 2;
+}

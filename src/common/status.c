@@ -1,0 +1,34 @@
+/* Per-thread last-error message. A thread-local buffer keeps error reporting free of
+ * allocation (it must work when allocation itself failed) and safe under OpenMP. */
+#include "common/status_internal.h"
+
+#include <stdarg.h>
+#include <stdio.h>
+
+static _Thread_local char last_error_message[1024];
+
+const char *piola_status_name(piola_status status) {
+  switch (status) {
+    case PIOLA_OK: return "ok";
+    case PIOLA_ERROR_INVALID_ARGUMENT: return "invalid argument";
+    case PIOLA_ERROR_NOT_FINITE: return "not finite";
+    case PIOLA_ERROR_DEGENERATE_ELEMENT: return "degenerate element";
+    case PIOLA_ERROR_OUT_OF_MEMORY: return "out of memory";
+    case PIOLA_ERROR_IO: return "input/output error";
+    case PIOLA_ERROR_PARSE: return "parse error";
+    case PIOLA_ERROR_UNSUPPORTED: return "unsupported";
+  }
+  return "unknown status";
+}
+
+const char *piola_last_error(void) { return last_error_message; }
+
+void piola_clear_error(void) { last_error_message[0] = '\0'; }
+
+piola_status piola__fail(piola_status status, const char *format, ...) {
+  va_list args;
+  va_start(args, format);
+  vsnprintf(last_error_message, sizeof last_error_message, format, args);
+  va_end(args);
+  return status;
+}

@@ -1,0 +1,48 @@
+#include "test_support.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+
+double test_scale(void) {
+  const char *s = getenv("PIOLA_TEST_SCALE");
+  if (!s) return 1.0;
+  double v = atof(s);
+  return v < 1e-3 ? 1e-3 : v;
+}
+
+long test_samples(long n, long minimum) {
+  long scaled = (long)((double)n * test_scale());
+  return scaled < minimum ? minimum : scaled;
+}
+
+test_rng test_rng_seeded(uint64_t seed) {
+  test_rng rng = {seed * 0x9E3779B97F4A7C15ull + 0x2545F4914F6CDD1Dull};
+  if (rng.state == 0) rng.state = 1;
+  return rng;
+}
+
+uint64_t test_rng_next(test_rng *rng) {
+  uint64_t x = rng->state;
+  x ^= x << 13;
+  x ^= x >> 7;
+  x ^= x << 17;
+  rng->state = x;
+  return x * 0x2545F4914F6CDD1Dull;
+}
+
+double test_rng_uniform(test_rng *rng, double lo, double hi) {
+  double u = (double)(test_rng_next(rng) >> 11) * 0x1.0p-53;
+  return lo + (hi - lo) * u;
+}
+
+double test_rng_normal(test_rng *rng) {
+  double u1 = test_rng_uniform(rng, 1e-300, 1.0), u2 = test_rng_uniform(rng, 0.0, 1.0);
+  return sqrt(-2.0 * log(u1)) * cos(6.283185307179586 * u2);
+}
+
+const char *test_data_path(const char *relative) {
+  static char path[4096];
+  snprintf(path, sizeof path, "%s/%s", PIOLA_DATA_DIR, relative);
+  return path;
+}

@@ -1,0 +1,40 @@
+/* Shared helpers for the cmocka unit tests. */
+#ifndef PIOLA_TEST_SUPPORT_H
+#define PIOLA_TEST_SUPPORT_H
+
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+/* cmocka.h needs the headers above first. */
+#include <cmocka.h>
+
+/* Multiplier for the sample counts of heavy property tests: 1 normally, smaller under
+ * the sanitizers (PIOLA_TEST_SCALE in the environment). Never returns less than 1e-3. */
+double test_scale(void);
+
+/* Sample count n scaled by test_scale(), at least `minimum`. */
+long test_samples(long n, long minimum);
+
+/* Deterministic xorshift random numbers, so failures reproduce. */
+typedef struct test_rng {
+  uint64_t state;
+} test_rng;
+test_rng test_rng_seeded(uint64_t seed);
+uint64_t test_rng_next(test_rng *rng);
+double test_rng_uniform(test_rng *rng, double lo, double hi); /* in [lo, hi) */
+double test_rng_normal(test_rng *rng);                         /* standard normal */
+
+/* Asserts |a - b| <= tol with a message that prints both values. */
+#define assert_close(a, b, tol)                                                            \
+  do {                                                                                     \
+    double assert_close_a_ = (a), assert_close_b_ = (b), assert_close_t_ = (tol);          \
+    if (!(fabs(assert_close_a_ - assert_close_b_) <= assert_close_t_))                     \
+      fail_msg("%s = %.17g and %s = %.17g differ by more than %g", #a, assert_close_a_, #b, \
+               assert_close_b_, assert_close_t_);                                          \
+  } while (0)
+
+/* Path of a file in ../shared/data (static buffer, valid until the next call). */
+const char *test_data_path(const char *relative);
+
+#endif

@@ -1,0 +1,58 @@
+/* piola: reading and writing mesh files.
+ *
+ * The format is chosen by file extension:
+ *   tetrahedral meshes  .node/.ele (TetGen; give either file), .msh (Gmsh 2.2 and 4.1, ASCII
+ *                       and binary), .mesh (Medit), .veg (Vega, TET elements), .vtu (VTK)
+ *   triangle surfaces   .obj, .off, .stl (ASCII and binary; vertices welded)
+ * Readers never crash on malformed input: they return PIOLA_ERROR_PARSE (or _IO,
+ * _UNSUPPORTED) with a message naming the file and the line or byte offset. Loaded tets are
+ * oriented positively (piola_tet_mesh_orient). See docs/file-formats.md.
+ *
+ * Writers write the whole file or nothing: they write a temporary file in the same folder
+ * and rename it over the target only once it is complete. */
+#ifndef PIOLA_MESH_IO_H
+#define PIOLA_MESH_IO_H
+
+#include "piola/export.h"
+#include "piola/mesh.h"
+#include "piola/status.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+PIOLA_API piola_status piola_tet_mesh_read(const char *path, piola_tet_mesh *out);
+PIOLA_API piola_status piola_tri_mesh_read(const char *path, piola_tri_mesh *out);
+
+/* .msh (Gmsh 4.1 ASCII), .vtu, .obj (the boundary surface), .node (writes .node and .ele),
+ * .mesh (Medit). */
+PIOLA_API piola_status piola_tet_mesh_write(const char *path, const piola_tet_mesh *mesh);
+/* .obj, .off, .stl (binary) */
+PIOLA_API piola_status piola_tri_mesh_write(const char *path, const piola_tri_mesh *mesh);
+
+/* A named field of doubles for VTU output: `components` values per point or per cell. */
+typedef struct piola_vtu_field {
+  const char *name;
+  int components;          /* 1 (scalar) or 3 (vector) */
+  const double *values;    /* components * count values */
+} piola_vtu_field;
+
+/* Tetrahedra (and optional triangles, e.g. shells) with point and cell fields, as VTK
+ * UnstructuredGrid XML (appended raw binary). Cell fields cover the tets first, then the
+ * triangles. positions override mesh->positions when not NULL (current state). */
+typedef struct piola_vtu_frame {
+  const piola_tet_mesh *tets;          /* may be NULL */
+  const piola_tri_mesh *triangles;     /* may be NULL */
+  const piola_vtu_field *point_fields;
+  int point_field_count;
+  const piola_vtu_field *cell_fields;
+  int cell_field_count;
+} piola_vtu_frame;
+
+PIOLA_API piola_status piola_vtu_write(const char *path, const piola_vtu_frame *frame);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif

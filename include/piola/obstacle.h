@@ -1,0 +1,62 @@
+/* piola: rigid obstacles as implicit surfaces, and collision processing (paper section 9).
+ *
+ * An obstacle is a signed distance function (negative inside) with an outward normal and a
+ * velocity at any point, moving by a scripted rigid motion. Collision processing projects
+ * every node that is inside an obstacle to its surface, takes the normal velocity from the
+ * obstacle unless the node already separates, and applies friction:
+ *   vT <- max(0, 1 - mu (dvN + dxN / dt) / |vT|) vT
+ * with dvN and dxN the changes of normal velocity and position the projection caused. */
+#ifndef PIOLA_OBSTACLE_H
+#define PIOLA_OBSTACLE_H
+
+#include <stdbool.h>
+#include <stdint.h>
+
+#include "piola/export.h"
+#include "piola/keyframes.h"
+#include "piola/math_types.h"
+#include "piola/mesh.h"
+#include "piola/status.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+typedef enum piola_obstacle_type {
+  PIOLA_OBSTACLE_PLANE = 0, /* point, normal */
+  PIOLA_OBSTACLE_SPHERE,    /* center, radius */
+  PIOLA_OBSTACLE_BOX,       /* center, half_extents (rotated by the motion's orientation) */
+  PIOLA_OBSTACLE_CYLINDER,  /* center, axis, radius, half_length (capped) */
+  PIOLA_OBSTACLE_CAPSULE,   /* center, axis, radius, half_length (segment half length) */
+  PIOLA_OBSTACLE_TORUS,     /* center, axis, major radius, minor radius */
+  PIOLA_OBSTACLE_GEAR,      /* center, axis, radius (pitch), tooth count/depth, half_length */
+  PIOLA_OBSTACLE_MESH,      /* closed triangle mesh */
+  PIOLA_OBSTACLE_TYPE_COUNT
+} piola_obstacle_type;
+
+typedef struct piola_obstacle piola_obstacle;
+
+/* Signed distance (m, negative inside) at world point p and time t (s); the outward unit
+ * normal and the obstacle's velocity (m/s) there are written when not NULL. */
+PIOLA_API double piola_obstacle_signed_distance(const piola_obstacle *obstacle, double t,
+                                                piola_vec3 p, piola_vec3 *normal,
+                                                piola_vec3 *velocity);
+
+PIOLA_API double piola_obstacle_friction(const piola_obstacle *obstacle);
+
+PIOLA_API void piola_obstacle_destroy(piola_obstacle *obstacle);
+
+/* Section 9 collision processing for node_count nodes at time t (s) after a position
+ * update of length dt (s). x (m) and v (m/s) are 3 * node_count and are modified in place.
+ * colliding (node_count, may be NULL) is set to 1 for nodes that were projected, else 0;
+ * normals (3 * node_count, may be NULL) receives their obstacle normals, for holding the
+ * normal velocity fixed in the final solve. Returns the number of colliding nodes. */
+PIOLA_API int32_t piola_obstacles_collide(piola_obstacle *const *obstacles, int32_t obstacle_count,
+                                          double t, double dt, int32_t node_count, double *x,
+                                          double *v, uint8_t *colliding, double *normals);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif

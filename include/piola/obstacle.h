@@ -16,6 +16,7 @@
 #include "piola/keyframes.h"
 #include "piola/math_types.h"
 #include "piola/mesh.h"
+#include "piola/rigid_motion.h"
 #include "piola/status.h"
 
 #ifdef __cplusplus
@@ -35,6 +36,29 @@ typedef enum piola_obstacle_type {
 } piola_obstacle_type;
 
 typedef struct piola_obstacle piola_obstacle;
+
+/* Shapes are given at t = 0 in world space and then move by `motion`. */
+typedef struct piola_obstacle_def {
+  piola_obstacle_type type;
+  piola_vec3 center;        /* m: plane: a point on it; others: the centre */
+  piola_vec3 axis;          /* unit: plane: its normal; cylinder, capsule, torus, gear: axis.
+                               Default (0, 0, 1) */
+  double radius;            /* m: sphere, cylinder, capsule; torus: major radius; gear: radius
+                               at the tooth tips */
+  double minor_radius;      /* m: torus tube radius */
+  double half_length;       /* m: cylinder and gear half height, capsule segment half length */
+  piola_vec3 half_extents;  /* m: box */
+  int tooth_count;          /* gear: number of teeth, >= 3 */
+  double tooth_depth;       /* m: gear: radial depth of the teeth, < radius */
+  const piola_tri_mesh *mesh; /* mesh obstacle: a closed triangle surface, copied */
+  double friction;          /* Coulomb coefficient mu, >= 0. Default 0 */
+  piola_rigid_motion_def motion; /* default: at rest */
+} piola_obstacle_def;
+
+PIOLA_API piola_obstacle_def piola_default_obstacle_def(void);
+
+/* Validates def (positive sizes, unit axis, closed mesh) and builds the obstacle. */
+PIOLA_API piola_status piola_obstacle_create(const piola_obstacle_def *def, piola_obstacle **out);
 
 /* Signed distance (m, negative inside) at world point p and time t (s); the outward unit
  * normal and the obstacle's velocity (m/s) there are written when not NULL. */

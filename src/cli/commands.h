@@ -12,4 +12,7 @@ typedef struct cli_command {
 
 extern const cli_command cli_commands[];
 
+/* `piola mesh generate ...` (argv[0] is "generate"), called by the `mesh` command. */
+int cli_mesh_generate(int argc, char **argv);
+
 #endif

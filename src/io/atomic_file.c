@@ -1,0 +1,53 @@
+#include "io/atomic_file.h"
+
+#include <errno.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+#include "common/status_internal.h"
+
+piola_status atomic_file_open(atomic_file *file, const char *path) {
+  memset(file, 0, sizeof *file);
+  size_t n = strlen(path);
+  if (n == 0 || n + 16 >= sizeof file->target)
+    return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "output path is empty or too long: '%s'", path);
+  memcpy(file->target, path, n + 1);
+  snprintf(file->temporary, sizeof file->temporary, "%s.tmpXXXXXX", path);
+  int fd = mkstemp(file->temporary);
+  if (fd < 0)
+    return PIOLA_FAIL(PIOLA_ERROR_IO, "%s: cannot create a temporary file: %s", path, strerror(errno));
+  file->stream = fdopen(fd, "wb");
+  if (!file->stream) {
+    close(fd);
+    unlink(file->temporary);
+    return PIOLA_FAIL(PIOLA_ERROR_IO, "%s: cannot open for writing: %s", path, strerror(errno));
+  }
+  return PIOLA_OK;
+}
+
+piola_status atomic_file_commit(atomic_file *file) {
+  int failed = ferror(file->stream) || fflush(file->stream) != 0;
+  int err = errno;
+  if (fclose(file->stream) != 0 && !failed) {
+    failed = 1;
+    err = errno;
+  }
+  file->stream = NULL;
+  if (failed) {
+    unlink(file->temporary);
+    return PIOLA_FAIL(PIOLA_ERROR_IO, "%s: write failed: %s", file->target, strerror(err));
+  }
+  if (rename(file->temporary, file->target) != 0) {
+    err = errno;
+    unlink(file->temporary);
+    return PIOLA_FAIL(PIOLA_ERROR_IO, "%s: cannot move into place: %s", file->target, strerror(err));
+  }
+  return PIOLA_OK;
+}
+
+void atomic_file_abort(atomic_file *file) {
+  if (file->stream) fclose(file->stream);
+  file->stream = NULL;
+  if (file->temporary[0]) unlink(file->temporary);
+}

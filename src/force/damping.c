@@ -17,10 +17,11 @@
 #include <math.h>
 
 #include "force/elastic_body_internal.h"
+#include "force/svd_kernel.h"
 
 #define B PIOLA_TET_BLOCK
 
-static void damping_block(const piola_elastic_body *body, const double *vel, double beta,
+PIOLA_WIDE_VECTORS static void damping_block(const piola_elastic_body *body, const double *vel, double beta,
                           double alpha, int32_t block) {
   const int32_t base = block * B;
   const int32_t *i0 = body->tet_vertices[0] + base, *i1 = body->tet_vertices[1] + base;

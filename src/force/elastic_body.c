@@ -81,7 +81,7 @@ void piola__elastic_body_gather_forces(const piola_elastic_body *body, double *f
 }
 
 /* One block of B tets: F, SVD, stress, forces into the per-tet buffer, block statistics. */
-static void update_block(piola_elastic_body *body, const double *x, double stiffness_scale,
+PIOLA_WIDE_VECTORS static void update_block(piola_elastic_body *body, const double *x, double stiffness_scale,
                          int32_t block) {
   const int32_t base = block * B;
   double f[9][B], detf[B];

@@ -4,7 +4,7 @@
 
 #define BATCH_LANES 8
 
-void piola__svd3_kernel_batch(int32_t n, const double *f, double *u, double *fhat, double *v) {
+PIOLA_WIDE_VECTORS void piola__svd3_kernel_batch(int32_t n, const double *f, double *u, double *fhat, double *v) {
   int32_t full = n - n % BATCH_LANES;
   for (int32_t base = 0; base < full; base += BATCH_LANES) {
     double fl[9][BATCH_LANES], ul[9][BATCH_LANES], vl[9][BATCH_LANES], sl[3][BATCH_LANES];

@@ -13,9 +13,9 @@
  *
  * Scaling: F is first multiplied by a power of two (exact) so its largest entry lies in
  * [0.5, 1); dot products then neither overflow nor lose the large entries, and the result is
- * scaled back at the end. Columns whose norm is below 2^-250 of that are too small for their
- * squared norms to be trusted; they are left uncoupled (their whole size is below 1e-75 |F|,
- * so leaving them is invisible at the promised 1e-12).
+ * scaled back at the end. Columns whose norm is below 2^-150 of that are too small for the
+ * squares in a rotation to be trusted; they are left uncoupled (their whole size is below
+ * 1e-45 |F|, so leaving them is invisible at the promised 1e-12).
  *
  * Building U: u1 is b1 normalized (b1 is the longest column and, after scaling, never tiny),
  * u2 is the part of b2 orthogonal to u1, normalized (Gram-Schmidt done twice, so u2 stays
@@ -40,13 +40,14 @@
 
 enum { MAX_SWEEPS = 20 };
 
-/* Two columns count as orthogonal when |b_i . b_j| <= TOL |b_i| |b_j|. A few ulps: the dot
- * product itself carries about that much rounding, so asking for less would only spin. */
-static const double ORTHOGONALITY_TOL = 4.0 * DBL_EPSILON;
+/* Two columns count as orthogonal when |b_i . b_j| <= TOL |b_i| |b_j|, TOL = 4 DBL_EPSILON
+ * (squared here). A few ulps: the dot product itself carries about that much rounding, so
+ * asking for less would only spin. */
+static const double ORTHOGONALITY_TOL2 = 16.0 * DBL_EPSILON * DBL_EPSILON;
 
-/* Squared column norms below this (relative to a largest entry in [0.5, 1)) are not rotated:
- * the product of two of them would underflow. 2^-500, i.e. column norms below 2^-250. */
-static const double NEGLIGIBLE_NORM2 = 0x1p-500;
+/* Squared column norms below this (relative to a largest entry in [0.5, 1)) are not rotated,
+ * so no square in the rotation underflows: 2^-300, i.e. column norms below 2^-150 = 7e-46. */
+static const double NEGLIGIBLE_NORM2 = 0x1p-300;
 
 /* A direction is taken from a vector only if its largest entry is at least this (2^-1020):
  * smaller vectors are subnormal-ish and 1 / max would overflow. */
@@ -73,6 +74,8 @@ static inline pow2_scale pow2_scale_make(int k) {
 
 static inline double pow2_scale_apply(pow2_scale s, double x) { return x * s.first * s.second; }
 
+static inline double max_of(double a, double b) { return a > b ? a : b; }
+
 static inline double dot3(const double *a, const double *b) {
   return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
 }
@@ -92,14 +95,16 @@ static inline void rotate_pair(double *x, double *y, int n, double c, double s) 
 static inline int orthogonalize_columns(double (*b)[3], double (*v)[3], int nv, int i, int j) {
   double alpha = dot3(b[i], b[i]), beta = dot3(b[j], b[j]), gamma = dot3(b[i], b[j]);
   if (alpha < NEGLIGIBLE_NORM2 || beta < NEGLIGIBLE_NORM2) return 0;
-  if (fabs(gamma) <= ORTHOGONALITY_TOL * sqrt(alpha * beta)) return 0;
-  /* The rotation angle theta solves tan(2 theta) = 2 gamma / (beta - alpha); t = tan(theta) is
-   * the root of t^2 + 2 zeta t - 1 = 0 of smaller magnitude (|theta| <= pi/4), which keeps the
-   * columns in place as they converge. */
-  double zeta = (beta - alpha) / (2.0 * gamma);
-  double t = fabs(zeta) < 1e100 ? copysign(1.0, zeta) / (fabs(zeta) + sqrt(1.0 + zeta * zeta))
-                                : 0.5 / zeta;
-  double c = 1.0 / sqrt(1.0 + t * t), s = c * t;
+  if (gamma * gamma <= ORTHOGONALITY_TOL2 * alpha * beta) return 0;
+  /* The rotation (c x - s y, s x + c y) with tan(2 theta) = q / p, p = beta - alpha,
+   * q = 2 gamma, |theta| <= pi/4 (the small angle keeps the columns in place as they converge):
+   * with r = sqrt(p^2 + q^2) and w = r + |p|, c = w / sqrt(2 r w) and s = sign(p) q / sqrt(2 r w).
+   * One sqrt on the critical path fewer than the textbook tan(theta) form. No underflow: alpha,
+   * beta >= 2^-300 and gamma^2 > TOL^2 alpha beta keep q^2 above 1e-215. */
+  double p = beta - alpha, q = 2.0 * gamma;
+  double r = sqrt(p * p + q * q), w = r + fabs(p);
+  double k = 1.0 / sqrt(2.0 * r * w);
+  double c = w * k, s = copysign(1.0, p) * q * k;
   rotate_pair(b[i], b[j], 3, c, s);
   rotate_pair(v[i], v[j], nv, c, s);
   return 1;
@@ -136,7 +141,15 @@ static inline void any_orthogonal_unit(const double *u, double *out) {
 static inline void orthogonal_direction(const double *u, const double *b, double *out) {
   double w[3], d = dot3(u, b);
   for (int r = 0; r < 3; ++r) w[r] = b[r] - d * u[r];
-  double m = fmax(fabs(w[0]), fmax(fabs(w[1]), fabs(w[2])));
+  /* The common case: b is not tiny and mostly orthogonal to u already (as after Jacobi), so one
+   * Gram-Schmidt pass is accurate to a few ulps and the squares cannot underflow. */
+  double wn2 = dot3(w, w), bn2 = dot3(b, b);
+  if (bn2 >= 0x1p-600 && wn2 >= 0.25 * bn2) {
+    double inv = 1.0 / sqrt(wn2);
+    for (int r = 0; r < 3; ++r) out[r] = w[r] * inv;
+    return;
+  }
+  double m = max_of(fabs(w[0]), max_of(fabs(w[1]), fabs(w[2])));
   if (!(m >= SMALLEST_DIRECTION)) {
     any_orthogonal_unit(u, out);
     return;
@@ -168,11 +181,17 @@ static void set_identity_outputs3x2(piola_mat3x2 *u, double fhat[2], piola_mat2 
   fhat[0] = fhat[1] = 0;
 }
 
-/* Exponent e with max |entry| = f 2^e, f in [0.5, 1); entries are assumed finite, m > 0. */
+/* Exponent e with max_abs = f 2^e, f in [0.5, 1), for finite max_abs > 0: read from the bits
+ * (what frexp does, without the call). Subnormals are first lifted by 2^64. */
 static inline int scale_exponent(double max_abs) {
-  int e;
-  (void)frexp(max_abs, &e);
-  return e;
+  int lift = 0;
+  if (max_abs < DBL_MIN) {
+    max_abs *= 0x1p64;
+    lift = 64;
+  }
+  uint64_t bits;
+  memcpy(&bits, &max_abs, sizeof bits);
+  return (int)((bits >> 52) & 0x7ff) - 1022 - lift;
 }
 
 /* ------------------------------------------------------------------------------------ 3x3 */
@@ -189,7 +208,7 @@ piola_status piola_diagonalize3(const piola_mat3 *f, piola_mat3 *u, piola_vec3 *
                           "diagonalize3: deformation gradient entry F[%d][%d] = %g is not finite",
                           i, j, x);
       }
-      max_abs = fmax(max_abs, fabs(x));
+      max_abs = max_of(max_abs, fabs(x));
     }
   if (max_abs == 0) { /* the element is a point: the paper's U = I */
     set_identity_outputs3(u, fhat, v);
@@ -299,7 +318,7 @@ piola_status piola_diagonalize3x2(const piola_mat3x2 *f, piola_mat3x2 *u, double
                           "finite",
                           i, j, x);
       }
-      max_abs = fmax(max_abs, fabs(x));
+      max_abs = max_of(max_abs, fabs(x));
     }
   if (max_abs == 0) { /* a triangle collapsed to a point */
     set_identity_outputs3x2(u, fhat, v);

@@ -1,0 +1,229 @@
+/* Constitutive models in diagonal form: the inline kernels (one source of truth).
+ *
+ * Why this header is shaped like this
+ * -----------------------------------
+ * The force loop evaluates Phat(Fhat) once per tetrahedron per step, for millions of
+ * tetrahedra. It runs over blocks of tets in a `#pragma omp simd` loop, with the switch on
+ * the model hoisted out of the loop. For that loop to vectorize, everything it calls must be
+ * inline, take and return plain doubles, and avoid data-dependent branches: the inversion
+ * extension is written with fmax/fmin and selects (`cond ? a : b` on values both computed),
+ * which compilers turn into blends, never into jumps. The model argument of
+ * material_model_parts() is a compile-time constant in each per-model kernel
+ * (neohookean_stress() and friends), so after inlining its switch folds away; the one place
+ * where the model is a run-time value is material_stress_kernel(), meant for scalar callers
+ * and for the public API.
+ *
+ * Every model is written in one shape (see docs/materials.md):
+ *     psi(f) = sum_i A(f_i) + kappa/2 (q(f) - q0)^2
+ * a separable per-entry energy A plus a quadratic penalty on one invariant q (the trace, the
+ * sum of squares, the determinant J or ln J). Stress P_i = A'(f_i) + kappa (q - q0) dq/df_i,
+ * derivative K = diag(A'') + kappa (g g^T + (q - q0) H) with g, H the gradient and Hessian
+ * of q. Writing the five models in this shape gives the derivative (needed by the C1
+ * extension, which is a Taylor expansion) and the third derivative (needed for the exact
+ * derivative of the extended stress) from a handful of one-line pieces instead of five
+ * hand-derived tensors, and makes the models easy to check against each other.
+ *
+ * The inversion extension lives here too, because it is part of the hot stress evaluation:
+ * entries below the threshold c are clamped to c (fc = max(f, c), d = f - fc <= 0) and the
+ * stress is P(fc) + K'(fc) d, with the slope K' of the clamped rows made safe (positive
+ * diagonal, at least steep enough that the stress is compressive at and past zero; no
+ * negative coupling between clamped entries). The public functions in material.c call the
+ * same functions, so the force loop and the API cannot drift apart. */
+#ifndef PIOLA_MATERIAL_KERNELS_H
+#define PIOLA_MATERIAL_KERNELS_H
+
+#include <math.h>
+
+#include "piola/material.h"
+
+/* Slots of piola_material.spline_coefficients (filled by piola_material_init). */
+enum {
+  SPLINE_K0 = 0,     /* Pa: slope of the 1D stress curve at rest (2 mu) */
+  SPLINE_DK = 1,     /* Pa: stiff slope minus rest slope (k1 - k0 >= 0) */
+  SPLINE_WE = 2,     /* elongation transition width: elongation_stretch - 1 */
+  SPLINE_WC = 3,     /* compression transition width: 1 - compression_stretch */
+  SPLINE_INV_WE = 4, /* 1 / SPLINE_WE */
+  SPLINE_INV_WC = 5  /* 1 / SPLINE_WC */
+};
+
+/* Value and derivative of the model at a point with all entries >= threshold > 0. */
+typedef struct material_parts {
+  double p[3];    /* Pa: Phat */
+  double k[3][3]; /* Pa: dPhat_i / dFhat_j */
+} material_parts;
+
+/* --------------------------------------------------------------- per-entry pieces */
+
+/* A'(f) and A''(f) of the separable energy of each model. */
+static inline void entry_slope_curvature(piola_material_model model, const piola_material *m,
+                                         double f, double *a1, double *a2) {
+  const double mu = m->mu;
+  switch (model) {
+    case PIOLA_MODEL_STVK: /* A = mu/4 (f^2 - 1)^2 */
+      *a1 = mu * f * (f * f - 1.0);
+      *a2 = mu * (3.0 * f * f - 1.0);
+      return;
+    case PIOLA_MODEL_NEOHOOKEAN: { /* A = mu (f^2 - 1)/2 - mu ln f */
+      const double inv = 1.0 / f;
+      *a1 = mu * (f - inv);
+      *a2 = mu * (1.0 + inv * inv);
+      return;
+    }
+    case PIOLA_MODEL_SPLINE: { /* A' = the 1D stress curve (C1 Hermite spline) */
+      const double *s = m->spline_coefficients;
+      const double u = f - 1.0;
+      const double t = fmax(u, 0.0), tc = fmin(t, s[SPLINE_WE]);
+      const double c = fmax(-u, 0.0), cc = fmin(c, s[SPLINE_WC]);
+      *a1 = s[SPLINE_K0] * u +
+            s[SPLINE_DK] * (0.5 * tc * tc * s[SPLINE_INV_WE] + (t - tc)) -
+            s[SPLINE_DK] * (0.5 * cc * cc * s[SPLINE_INV_WC] + (c - cc));
+      *a2 = s[SPLINE_K0] + s[SPLINE_DK] * (tc * s[SPLINE_INV_WE] + cc * s[SPLINE_INV_WC]);
+      return;
+    }
+    case PIOLA_MODEL_ROTATED_LINEAR:
+    case PIOLA_MODEL_COROTATED:
+    default: /* A = mu (f - 1)^2 */
+      *a1 = 2.0 * mu * (f - 1.0);
+      *a2 = 2.0 * mu;
+      return;
+  }
+}
+
+/* --------------------------------------------------------------- the invariant term */
+
+/* kappa, q - q0, g = dq/df and H = d2q/df2 at f (all entries > 0). */
+static inline double invariant_terms(piola_material_model model, const piola_material *m,
+                                     double f0, double f1, double f2, double g[3],
+                                     double h[3][3], double *kappa) {
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j) h[i][j] = 0.0;
+  switch (model) {
+    case PIOLA_MODEL_ROTATED_LINEAR: /* q = tr Fhat, kappa = lambda */
+      *kappa = m->lambda;
+      g[0] = g[1] = g[2] = 1.0;
+      return f0 + f1 + f2 - 3.0;
+    case PIOLA_MODEL_STVK: /* q = |Fhat|^2, kappa = lambda/4: lambda/2 tr(E)^2 */
+      *kappa = 0.25 * m->lambda;
+      g[0] = 2.0 * f0, g[1] = 2.0 * f1, g[2] = 2.0 * f2;
+      h[0][0] = h[1][1] = h[2][2] = 2.0;
+      return f0 * f0 + f1 * f1 + f2 * f2 - 3.0;
+    case PIOLA_MODEL_NEOHOOKEAN: { /* q = ln J, kappa = lambda */
+      *kappa = m->lambda;
+      const double i0 = 1.0 / f0, i1 = 1.0 / f1, i2 = 1.0 / f2;
+      g[0] = i0, g[1] = i1, g[2] = i2;
+      h[0][0] = -i0 * i0, h[1][1] = -i1 * i1, h[2][2] = -i2 * i2;
+      return log(f0 * f1 * f2);
+    }
+    case PIOLA_MODEL_COROTATED:
+    case PIOLA_MODEL_SPLINE:
+    default: /* q = J, kappa = lambda: the linear pressure lambda (J - 1) dJ/dFhat */
+      *kappa = m->lambda;
+      g[0] = f1 * f2, g[1] = f0 * f2, g[2] = f0 * f1;
+      h[0][1] = h[1][0] = f2;
+      h[0][2] = h[2][0] = f1;
+      h[1][2] = h[2][1] = f0;
+      return f0 * f1 * f2 - 1.0;
+  }
+}
+
+/* Phat and dPhat/dFhat of the unextended model at f (all entries > 0). */
+static inline void material_model_parts(piola_material_model model, const piola_material *m,
+                                        double f0, double f1, double f2,
+                                        material_parts *out) {
+  double g[3], h[3][3], kappa;
+  const double qm = invariant_terms(model, m, f0, f1, f2, g, h, &kappa);
+  const double f[3] = {f0, f1, f2};
+  for (int i = 0; i < 3; ++i) {
+    double a1, a2;
+    entry_slope_curvature(model, m, f[i], &a1, &a2);
+    out->p[i] = a1 + kappa * qm * g[i];
+    for (int j = 0; j < 3; ++j) out->k[i][j] = kappa * (g[i] * g[j] + qm * h[i][j]);
+    out->k[i][i] += a2;
+  }
+}
+
+/* --------------------------------------------------------------- the extension */
+
+/* Diagonal slope used for a clamped entry i whose value at the clamped point is p and whose
+ * Taylor slope is kii. LINEAR: the Taylor slope, raised where needed so that the stress is
+ * at most -mu c at f_i = 0 (restoring) and at least mu (never softening past the
+ * threshold). CLAMP: zero (constant stress), unless the clamped stress is not already
+ * compressive enough, in which case the ramp that reaches -mu c at zero. */
+static inline double extension_diagonal_slope(const piola_material *m, double p, double kii) {
+  const double c = m->threshold, floor_slope = m->mu;
+  return m->inversion_mode == PIOLA_INVERSION_CLAMP
+             ? fmax(0.0, p / c + floor_slope)
+             : fmax(kii, floor_slope + fmax(p, 0.0) / c);
+}
+
+/* Extended stress from the parts at the clamped point and the offsets d = f - fc <= 0
+ * (zero for entries at or above the threshold). */
+static inline void material_extend(const piola_material *m, const material_parts *parts,
+                                   const double d[3], double p[3]) {
+  const int linear = m->inversion_mode != PIOLA_INVERSION_CLAMP;
+  for (int i = 0; i < 3; ++i) {
+    const int clamped = d[i] < 0.0;
+    const double s = extension_diagonal_slope(m, parts->p[i], parts->k[i][i]);
+    double coupling = 0.0;
+    for (int j = 0; j < 3; ++j) {
+      if (j == i) continue;
+      const double kij = parts->k[i][j];
+      /* Clamped rows never take a negative coupling to other clamped entries (it could
+       * pull an inverted entry further); unclamped rows keep the Taylor coupling. */
+      coupling += (clamped ? fmax(kij, 0.0) : kij) * d[j];
+    }
+    p[i] = parts->p[i] + s * d[i] + (linear ? coupling : 0.0);
+  }
+}
+
+/* The hot entry point for one model known at compile time. */
+static inline void material_extended_stress(piola_material_model model,
+                                            const piola_material *m, double f0, double f1,
+                                            double f2, double *p0, double *p1, double *p2) {
+  const double c = m->threshold;
+  const double fc0 = fmax(f0, c), fc1 = fmax(f1, c), fc2 = fmax(f2, c);
+  const double d[3] = {f0 - fc0, f1 - fc1, f2 - fc2};
+  material_parts parts;
+  material_model_parts(model, m, fc0, fc1, fc2, &parts);
+  double p[3];
+  material_extend(m, &parts, d, p);
+  *p0 = p[0], *p1 = p[1], *p2 = p[2];
+}
+
+/* Per-model kernels: the model is a constant, so each compiles to straight-line code. */
+static inline void rotated_linear_stress(const piola_material *m, double f0, double f1,
+                                         double f2, double *p0, double *p1, double *p2) {
+  material_extended_stress(PIOLA_MODEL_ROTATED_LINEAR, m, f0, f1, f2, p0, p1, p2);
+}
+static inline void corotated_stress(const piola_material *m, double f0, double f1, double f2,
+                                    double *p0, double *p1, double *p2) {
+  material_extended_stress(PIOLA_MODEL_COROTATED, m, f0, f1, f2, p0, p1, p2);
+}
+static inline void stvk_stress(const piola_material *m, double f0, double f1, double f2,
+                               double *p0, double *p1, double *p2) {
+  material_extended_stress(PIOLA_MODEL_STVK, m, f0, f1, f2, p0, p1, p2);
+}
+static inline void neohookean_stress(const piola_material *m, double f0, double f1, double f2,
+                                     double *p0, double *p1, double *p2) {
+  material_extended_stress(PIOLA_MODEL_NEOHOOKEAN, m, f0, f1, f2, p0, p1, p2);
+}
+static inline void spline_stress(const piola_material *m, double f0, double f1, double f2,
+                                 double *p0, double *p1, double *p2) {
+  material_extended_stress(PIOLA_MODEL_SPLINE, m, f0, f1, f2, p0, p1, p2);
+}
+
+/* Run-time dispatch, for scalar callers. In a loop, switch on m->model outside the loop and
+ * call the per-model kernel inside. */
+static inline void material_stress_kernel(const piola_material *m, double f0, double f1,
+                                          double f2, double *p0, double *p1, double *p2) {
+  switch (m->model) {
+    case PIOLA_MODEL_COROTATED: corotated_stress(m, f0, f1, f2, p0, p1, p2); return;
+    case PIOLA_MODEL_STVK: stvk_stress(m, f0, f1, f2, p0, p1, p2); return;
+    case PIOLA_MODEL_NEOHOOKEAN: neohookean_stress(m, f0, f1, f2, p0, p1, p2); return;
+    case PIOLA_MODEL_SPLINE: spline_stress(m, f0, f1, f2, p0, p1, p2); return;
+    case PIOLA_MODEL_ROTATED_LINEAR:
+    default: rotated_linear_stress(m, f0, f1, f2, p0, p1, p2); return;
+  }
+}
+
+#endif

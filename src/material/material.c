@@ -140,7 +140,7 @@ typedef struct extension_point {
 static extension_point extension_point_at(const piola_material *m, const double f[3]) {
   extension_point e;
   for (int i = 0; i < 3; ++i) {
-    e.fc[i] = fmax(f[i], m->threshold);
+    e.fc[i] = kernel_max(f[i], m->threshold);
     e.d[i] = f[i] - e.fc[i];
     e.clamped[i] = e.d[i] < 0.0;
   }
@@ -161,9 +161,9 @@ static double entry_energy(const piola_material *m, double f) {
       const double u = f - 1.0;
       double extra = 0.0;
       const double widths[2] = {s[SPLINE_WE], s[SPLINE_WC]};
-      const double amounts[2] = {fmax(u, 0.0), fmax(-u, 0.0)};
+      const double amounts[2] = {kernel_max(u, 0.0), kernel_max(-u, 0.0)};
       for (int side = 0; side < 2; ++side) {
-        const double t = amounts[side], w = widths[side], tc = fmin(t, w);
+        const double t = amounts[side], w = widths[side], tc = kernel_min(t, w);
         extra += tc * tc * tc / (6.0 * w) + (t - tc) * 0.5 * w + 0.5 * (t - tc) * (t - tc);
       }
       return 0.5 * s[SPLINE_K0] * u * u + s[SPLINE_DK] * extra;
@@ -232,7 +232,7 @@ double piola_material_energy_density(const piola_material *material, const doubl
     psi += 0.5 * s * e.d[i] * e.d[i];
     if (!linear) continue;
     for (int j = i + 1; j < 3; ++j)
-      if (e.clamped[j]) psi += fmax(e.parts.k[i][j], 0.0) * e.d[i] * e.d[j];
+      if (e.clamped[j]) psi += kernel_max(e.parts.k[i][j], 0.0) * e.d[i] * e.d[j];
   }
   return psi;
 }
@@ -263,13 +263,13 @@ void piola_material_stress_derivative(const piola_material *material, const doub
         }
       } else if (e.clamped[j]) {
         /* Clamped row and column: the extension's own slopes. */
-        v = (i == j) ? s : (linear ? fmax(pa->k[i][j], 0.0) : 0.0);
+        v = (i == j) ? s : (linear ? kernel_max(pa->k[i][j], 0.0) : 0.0);
       } else {
         /* Clamped row, unclamped column j: fc_j = f_j moves p_i, K_ii, K_ik. */
         v = pa->k[i][j];
         double ds = 0.0; /* d s / d f_j */
         if (linear) {
-          const double raised = floor_slope + fmax(pa->p[i], 0.0) / c;
+          const double raised = floor_slope + kernel_max(pa->p[i], 0.0) / c;
           if (pa->k[i][i] >= raised)
             ds = t[i][i][j];
           else if (pa->p[i] > 0.0)

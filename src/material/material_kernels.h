@@ -7,7 +7,8 @@
  * the model hoisted out of the loop. For that loop to vectorize, everything it calls must be
  * inline, take and return plain doubles, and avoid data-dependent branches: the inversion
  * extension is written with fmax/fmin and selects (`cond ? a : b` on values both computed),
- * which compilers turn into blends, never into jumps. The model argument of
+ * which compilers turn into blends (fmax/fmin
+ * themselves are avoided: see kernel_max), never into jumps. The model argument of
  * material_model_parts() is a compile-time constant in each per-model kernel
  * (neohookean_stress() and friends), so after inlining its switch folds away; the one place
  * where the model is a run-time value is material_stress_kernel(), meant for scalar callers
@@ -46,6 +47,13 @@ enum {
   SPLINE_INV_WC = 5  /* 1 / SPLINE_WC */
 };
 
+/* max and min as selects. C's fmax/fmin must return the non-NaN operand, which x86 vector
+ * max/min instructions do not do, so GCC refuses to vectorize them without
+ * -ffinite-math-only; a compare-and-select maps onto those instructions directly. With a NaN
+ * operand these return b; a NaN in Fhat still comes out as NaN in Phat (through f - fc). */
+static inline double kernel_max(double a, double b) { return a > b ? a : b; }
+static inline double kernel_min(double a, double b) { return a < b ? a : b; }
+
 /* Value and derivative of the model at a point with all entries >= threshold > 0. */
 typedef struct material_parts {
   double p[3];    /* Pa: Phat */
@@ -72,8 +80,8 @@ static inline void entry_slope_curvature(piola_material_model model, const piola
     case PIOLA_MODEL_SPLINE: { /* A' = the 1D stress curve (C1 Hermite spline) */
       const double *s = m->spline_coefficients;
       const double u = f - 1.0;
-      const double t = fmax(u, 0.0), tc = fmin(t, s[SPLINE_WE]);
-      const double c = fmax(-u, 0.0), cc = fmin(c, s[SPLINE_WC]);
+      const double t = kernel_max(u, 0.0), tc = kernel_min(t, s[SPLINE_WE]);
+      const double c = kernel_max(-u, 0.0), cc = kernel_min(c, s[SPLINE_WC]);
       *a1 = s[SPLINE_K0] * u +
             s[SPLINE_DK] * (0.5 * tc * tc * s[SPLINE_INV_WE] + (t - tc)) -
             s[SPLINE_DK] * (0.5 * cc * cc * s[SPLINE_INV_WC] + (c - cc));
@@ -151,29 +159,37 @@ static inline void material_model_parts(piola_material_model model, const piola_
  * compressive enough, in which case the ramp that reaches -mu c at zero. */
 static inline double extension_diagonal_slope(const piola_material *m, double p, double kii) {
   const double c = m->threshold, floor_slope = m->mu;
-  return m->inversion_mode == PIOLA_INVERSION_CLAMP
-             ? fmax(0.0, p / c + floor_slope)
-             : fmax(kii, floor_slope + fmax(p, 0.0) / c);
+  /* Both variants are computed and blended by a 0/1 factor: a select on a loop-invariant
+   * integer between doubles is one of the statements GCC's vectorizer rejects. */
+  const double linear = (double)(m->inversion_mode != PIOLA_INVERSION_CLAMP);
+  const double taylor = kernel_max(kii, floor_slope + kernel_max(p, 0.0) / c);
+  const double ramp = kernel_max(0.0, p / c + floor_slope);
+  return linear * taylor + (1.0 - linear) * ramp;
 }
 
-/* Extended stress from the parts at the clamped point and the offsets d = f - fc <= 0
- * (zero for entries at or above the threshold). */
-static inline void material_extend(const piola_material *m, const material_parts *parts,
-                                   const double d[3], double p[3]) {
-  const int linear = m->inversion_mode != PIOLA_INVERSION_CLAMP;
-  for (int i = 0; i < 3; ++i) {
-    const int clamped = d[i] < 0.0;
-    const double s = extension_diagonal_slope(m, parts->p[i], parts->k[i][i]);
-    double coupling = 0.0;
-    for (int j = 0; j < 3; ++j) {
-      if (j == i) continue;
-      const double kij = parts->k[i][j];
-      /* Clamped rows never take a negative coupling to other clamped entries (it could
-       * pull an inverted entry further); unclamped rows keep the Taylor coupling. */
-      coupling += (clamped ? fmax(kij, 0.0) : kij) * d[j];
-    }
-    p[i] = parts->p[i] + s * d[i] + (linear ? coupling : 0.0);
-  }
+/* One entry of the extended stress: entry i with value p and slopes kii, kij, kik at the
+ * clamped point, offsets di, dj, dk = f - fc <= 0 (zero at or above the threshold). Written
+ * on scalars with selects, not loops over arrays with branches: GCC vectorizes the force
+ * loop only in this form. */
+static inline double extended_entry(const piola_material *m, double p, double kii, double kij,
+                                    double kik, double di, double dj, double dk) {
+  const double s = extension_diagonal_slope(m, p, kii);
+  /* Clamped rows never take a negative coupling to other clamped entries (it could pull an
+   * inverted entry further); unclamped rows keep the Taylor coupling. An unclamped entry
+   * has d = 0, so its coupling term vanishes either way. */
+  const double cij = di < 0.0 ? kernel_max(kij, 0.0) : kij;
+  const double cik = di < 0.0 ? kernel_max(kik, 0.0) : kik;
+  const double linear = (double)(m->inversion_mode != PIOLA_INVERSION_CLAMP);
+  return p + s * di + linear * (cij * dj + cik * dk);
+}
+
+/* Extended stress from the parts at the clamped point and the offsets d = f - fc. */
+static inline void material_extend(const piola_material *m, const material_parts *pa,
+                                   double d0, double d1, double d2, double *p0, double *p1,
+                                   double *p2) {
+  *p0 = extended_entry(m, pa->p[0], pa->k[0][0], pa->k[0][1], pa->k[0][2], d0, d1, d2);
+  *p1 = extended_entry(m, pa->p[1], pa->k[1][1], pa->k[1][0], pa->k[1][2], d1, d0, d2);
+  *p2 = extended_entry(m, pa->p[2], pa->k[2][2], pa->k[2][0], pa->k[2][1], d2, d0, d1);
 }
 
 /* The hot entry point for one model known at compile time. */
@@ -181,13 +197,10 @@ static inline void material_extended_stress(piola_material_model model,
                                             const piola_material *m, double f0, double f1,
                                             double f2, double *p0, double *p1, double *p2) {
   const double c = m->threshold;
-  const double fc0 = fmax(f0, c), fc1 = fmax(f1, c), fc2 = fmax(f2, c);
-  const double d[3] = {f0 - fc0, f1 - fc1, f2 - fc2};
+  const double fc0 = kernel_max(f0, c), fc1 = kernel_max(f1, c), fc2 = kernel_max(f2, c);
   material_parts parts;
   material_model_parts(model, m, fc0, fc1, fc2, &parts);
-  double p[3];
-  material_extend(m, &parts, d, p);
-  *p0 = p[0], *p1 = p[1], *p2 = p[2];
+  material_extend(m, &parts, f0 - fc0, f1 - fc1, f2 - fc2, p0, p1, p2);
 }
 
 /* Per-model kernels: the model is a constant, so each compiles to straight-line code. */

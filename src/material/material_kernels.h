@@ -34,6 +34,8 @@
 #define PIOLA_MATERIAL_KERNELS_H
 
 #include <math.h>
+#include <stdint.h>
+#include <string.h>
 
 #include "piola/material.h"
 
@@ -53,6 +55,44 @@ enum {
  * operand these return b; a NaN in Fhat still comes out as NaN in Phat (through f - fc). */
 static inline double kernel_max(double a, double b) { return a > b ? a : b; }
 static inline double kernel_min(double a, double b) { return a < b ? a : b; }
+
+/* Natural logarithm of x > 0 (normal or subnormal; piola calls it on clamped entries only,
+ * which are >= threshold > 0), accurate to a few ulp, written so that GCC can vectorize it:
+ * libm's log is a call the vectorizer cannot widen (glibc declares its vector variants only
+ * under -ffast-math, which piola does not use). x = 2^e m with m in [sqrt(1/2), sqrt(2)),
+ * ln m = 2 atanh(s) with s = (m - 1)/(m + 1), |s| < 0.172, from its odd series to s^23.
+ * The exponent is turned into a double with the 2^52 trick (integer shifts and ors only,
+ * no 64-bit integer-to-double conversion, which AVX2 lacks). */
+static inline double kernel_log(double x) {
+  const int tiny = x < 2.2250738585072014e-308; /* subnormal: scale into the normal range */
+  const double xs = tiny ? x * 18014398509481984.0 : x; /* 2^54 */
+  uint64_t bits;
+  memcpy(&bits, &xs, sizeof bits);
+  const uint64_t mbits = (bits & 0x000fffffffffffffull) | 0x3ff0000000000000ull;
+  const uint64_t ebits = 0x4330000000000000ull | (bits >> 52); /* 2^52 + biased exponent */
+  double m, e;
+  memcpy(&m, &mbits, sizeof m);
+  memcpy(&e, &ebits, sizeof e);
+  e -= 4503599627370496.0 + 1023.0 + (tiny ? 54.0 : 0.0);
+  const int big = m > 1.4142135623730951;
+  m = big ? 0.5 * m : m;
+  e = big ? e + 1.0 : e;
+  const double s = (m - 1.0) / (m + 1.0), s2 = s * s;
+  double poly = 1.0 / 23.0;
+  poly = poly * s2 + 1.0 / 21.0;
+  poly = poly * s2 + 1.0 / 19.0;
+  poly = poly * s2 + 1.0 / 17.0;
+  poly = poly * s2 + 1.0 / 15.0;
+  poly = poly * s2 + 1.0 / 13.0;
+  poly = poly * s2 + 1.0 / 11.0;
+  poly = poly * s2 + 1.0 / 9.0;
+  poly = poly * s2 + 1.0 / 7.0;
+  poly = poly * s2 + 1.0 / 5.0;
+  poly = poly * s2 + 1.0 / 3.0;
+  const double ln2_hi = 6.93147180369123816490e-01, ln2_lo = 1.90821492927058770002e-10;
+  /* 2 s (1 + s2 poly) = 2 s + 2 s s2 poly, the small part added last. */
+  return e * ln2_hi + (2.0 * s + (2.0 * s * s2 * poly + e * ln2_lo));
+}
 
 /* Value and derivative of the model at a point with all entries >= threshold > 0. */
 typedef struct material_parts {
@@ -120,7 +160,8 @@ static inline double invariant_terms(piola_material_model model, const piola_mat
       const double i0 = 1.0 / f0, i1 = 1.0 / f1, i2 = 1.0 / f2;
       g[0] = i0, g[1] = i1, g[2] = i2;
       h[0][0] = -i0 * i0, h[1][1] = -i1 * i1, h[2][2] = -i2 * i2;
-      return log(f0 * f1 * f2);
+      /* Three logs, not log(J): J can underflow or overflow where each entry does not. */
+      return kernel_log(f0) + kernel_log(f1) + kernel_log(f2);
     }
     case PIOLA_MODEL_COROTATED:
     case PIOLA_MODEL_SPLINE:

@@ -39,6 +39,14 @@
 
 #include "piola/material.h"
 
+/* Every kernel is forced inline: clang's inliner otherwise keeps the big model switch as a
+ * call (before the constant model folds it away), and a call stops the simd loop. */
+#if defined(__GNUC__) || defined(__clang__)
+#define MATERIAL_KERNEL static inline __attribute__((always_inline))
+#else
+#define MATERIAL_KERNEL static inline
+#endif
+
 /* Slots of piola_material.spline_coefficients (filled by piola_material_init). */
 enum {
   SPLINE_K0 = 0,     /* Pa: slope of the 1D stress curve at rest (2 mu) */
@@ -53,8 +61,8 @@ enum {
  * max/min instructions do not do, so GCC refuses to vectorize them without
  * -ffinite-math-only; a compare-and-select maps onto those instructions directly. With a NaN
  * operand these return b; a NaN in Fhat still comes out as NaN in Phat (through f - fc). */
-static inline double kernel_max(double a, double b) { return a > b ? a : b; }
-static inline double kernel_min(double a, double b) { return a < b ? a : b; }
+MATERIAL_KERNEL double kernel_max(double a, double b) { return a > b ? a : b; }
+MATERIAL_KERNEL double kernel_min(double a, double b) { return a < b ? a : b; }
 
 /* Natural logarithm of x > 0 (normal or subnormal; piola calls it on clamped entries only,
  * which are >= threshold > 0), accurate to a few ulp, written so that GCC can vectorize it:
@@ -63,7 +71,7 @@ static inline double kernel_min(double a, double b) { return a < b ? a : b; }
  * ln m = 2 atanh(s) with s = (m - 1)/(m + 1), |s| < 0.172, from its odd series to s^23.
  * The exponent is turned into a double with the 2^52 trick (integer shifts and ors only,
  * no 64-bit integer-to-double conversion, which AVX2 lacks). */
-static inline double kernel_log(double x) {
+MATERIAL_KERNEL double kernel_log(double x) {
   const int tiny = x < 2.2250738585072014e-308; /* subnormal: scale into the normal range */
   const double xs = tiny ? x * 18014398509481984.0 : x; /* 2^54 */
   uint64_t bits;
@@ -103,7 +111,7 @@ typedef struct material_parts {
 /* --------------------------------------------------------------- per-entry pieces */
 
 /* A'(f) and A''(f) of the separable energy of each model. */
-static inline void entry_slope_curvature(piola_material_model model, const piola_material *m,
+MATERIAL_KERNEL void entry_slope_curvature(piola_material_model model, const piola_material *m,
                                          double f, double *a1, double *a2) {
   const double mu = m->mu;
   switch (model) {
@@ -140,11 +148,10 @@ static inline void entry_slope_curvature(piola_material_model model, const piola
 /* --------------------------------------------------------------- the invariant term */
 
 /* kappa, q - q0, g = dq/df and H = d2q/df2 at f (all entries > 0). */
-static inline double invariant_terms(piola_material_model model, const piola_material *m,
+MATERIAL_KERNEL double invariant_terms(piola_material_model model, const piola_material *m,
                                      double f0, double f1, double f2, double g[3],
                                      double h[3][3], double *kappa) {
-  for (int i = 0; i < 3; ++i)
-    for (int j = 0; j < 3; ++j) h[i][j] = 0.0;
+  h[0][0] = h[0][1] = h[0][2] = h[1][0] = h[1][1] = h[1][2] = h[2][0] = h[2][1] = h[2][2] = 0.0;
   switch (model) {
     case PIOLA_MODEL_ROTATED_LINEAR: /* q = tr Fhat, kappa = lambda */
       *kappa = m->lambda;
@@ -176,19 +183,27 @@ static inline double invariant_terms(piola_material_model model, const piola_mat
 }
 
 /* Phat and dPhat/dFhat of the unextended model at f (all entries > 0). */
-static inline void material_model_parts(piola_material_model model, const piola_material *m,
+MATERIAL_KERNEL void material_model_parts(piola_material_model model, const piola_material *m,
                                         double f0, double f1, double f2,
                                         material_parts *out) {
   double g[3], h[3][3], kappa;
   const double qm = invariant_terms(model, m, f0, f1, f2, g, h, &kappa);
-  const double f[3] = {f0, f1, f2};
-  for (int i = 0; i < 3; ++i) {
-    double a1, a2;
-    entry_slope_curvature(model, m, f[i], &a1, &a2);
-    out->p[i] = a1 + kappa * qm * g[i];
-    for (int j = 0; j < 3; ++j) out->k[i][j] = kappa * (g[i] * g[j] + qm * h[i][j]);
-    out->k[i][i] += a2;
-  }
+  /* Written out, not looped: clang does not always unroll a loop around the spline's entry
+   * function, and a loop over small local arrays left in a simd loop blocks vectorization. */
+  double a1[3], a2[3];
+  entry_slope_curvature(model, m, f0, &a1[0], &a2[0]);
+  entry_slope_curvature(model, m, f1, &a1[1], &a2[1]);
+  entry_slope_curvature(model, m, f2, &a1[2], &a2[2]);
+  const double kq = kappa * qm;
+  out->p[0] = a1[0] + kq * g[0];
+  out->p[1] = a1[1] + kq * g[1];
+  out->p[2] = a1[2] + kq * g[2];
+  out->k[0][0] = a2[0] + kappa * g[0] * g[0] + kq * h[0][0];
+  out->k[1][1] = a2[1] + kappa * g[1] * g[1] + kq * h[1][1];
+  out->k[2][2] = a2[2] + kappa * g[2] * g[2] + kq * h[2][2];
+  out->k[0][1] = out->k[1][0] = kappa * g[0] * g[1] + kq * h[0][1];
+  out->k[0][2] = out->k[2][0] = kappa * g[0] * g[2] + kq * h[0][2];
+  out->k[1][2] = out->k[2][1] = kappa * g[1] * g[2] + kq * h[1][2];
 }
 
 /* --------------------------------------------------------------- the extension */
@@ -198,7 +213,7 @@ static inline void material_model_parts(piola_material_model model, const piola_
  * at most -mu c at f_i = 0 (restoring) and at least mu (never softening past the
  * threshold). CLAMP: zero (constant stress), unless the clamped stress is not already
  * compressive enough, in which case the ramp that reaches -mu c at zero. */
-static inline double extension_diagonal_slope(const piola_material *m, double p, double kii) {
+MATERIAL_KERNEL double extension_diagonal_slope(const piola_material *m, double p, double kii) {
   const double c = m->threshold, floor_slope = m->mu;
   /* Both variants are computed and blended by a 0/1 factor: a select on a loop-invariant
    * integer between doubles is one of the statements GCC's vectorizer rejects. */
@@ -212,7 +227,7 @@ static inline double extension_diagonal_slope(const piola_material *m, double p,
  * clamped point, offsets di, dj, dk = f - fc <= 0 (zero at or above the threshold). Written
  * on scalars with selects, not loops over arrays with branches: GCC vectorizes the force
  * loop only in this form. */
-static inline double extended_entry(const piola_material *m, double p, double kii, double kij,
+MATERIAL_KERNEL double extended_entry(const piola_material *m, double p, double kii, double kij,
                                     double kik, double di, double dj, double dk) {
   const double s = extension_diagonal_slope(m, p, kii);
   /* Clamped rows never take a negative coupling to other clamped entries (it could pull an
@@ -225,7 +240,7 @@ static inline double extended_entry(const piola_material *m, double p, double ki
 }
 
 /* Extended stress from the parts at the clamped point and the offsets d = f - fc. */
-static inline void material_extend(const piola_material *m, const material_parts *pa,
+MATERIAL_KERNEL void material_extend(const piola_material *m, const material_parts *pa,
                                    double d0, double d1, double d2, double *p0, double *p1,
                                    double *p2) {
   *p0 = extended_entry(m, pa->p[0], pa->k[0][0], pa->k[0][1], pa->k[0][2], d0, d1, d2);
@@ -234,7 +249,7 @@ static inline void material_extend(const piola_material *m, const material_parts
 }
 
 /* The hot entry point for one model known at compile time. */
-static inline void material_extended_stress(piola_material_model model,
+MATERIAL_KERNEL void material_extended_stress(piola_material_model model,
                                             const piola_material *m, double f0, double f1,
                                             double f2, double *p0, double *p1, double *p2) {
   const double c = m->threshold;
@@ -245,30 +260,30 @@ static inline void material_extended_stress(piola_material_model model,
 }
 
 /* Per-model kernels: the model is a constant, so each compiles to straight-line code. */
-static inline void rotated_linear_stress(const piola_material *m, double f0, double f1,
+MATERIAL_KERNEL void rotated_linear_stress(const piola_material *m, double f0, double f1,
                                          double f2, double *p0, double *p1, double *p2) {
   material_extended_stress(PIOLA_MODEL_ROTATED_LINEAR, m, f0, f1, f2, p0, p1, p2);
 }
-static inline void corotated_stress(const piola_material *m, double f0, double f1, double f2,
+MATERIAL_KERNEL void corotated_stress(const piola_material *m, double f0, double f1, double f2,
                                     double *p0, double *p1, double *p2) {
   material_extended_stress(PIOLA_MODEL_COROTATED, m, f0, f1, f2, p0, p1, p2);
 }
-static inline void stvk_stress(const piola_material *m, double f0, double f1, double f2,
+MATERIAL_KERNEL void stvk_stress(const piola_material *m, double f0, double f1, double f2,
                                double *p0, double *p1, double *p2) {
   material_extended_stress(PIOLA_MODEL_STVK, m, f0, f1, f2, p0, p1, p2);
 }
-static inline void neohookean_stress(const piola_material *m, double f0, double f1, double f2,
+MATERIAL_KERNEL void neohookean_stress(const piola_material *m, double f0, double f1, double f2,
                                      double *p0, double *p1, double *p2) {
   material_extended_stress(PIOLA_MODEL_NEOHOOKEAN, m, f0, f1, f2, p0, p1, p2);
 }
-static inline void spline_stress(const piola_material *m, double f0, double f1, double f2,
+MATERIAL_KERNEL void spline_stress(const piola_material *m, double f0, double f1, double f2,
                                  double *p0, double *p1, double *p2) {
   material_extended_stress(PIOLA_MODEL_SPLINE, m, f0, f1, f2, p0, p1, p2);
 }
 
 /* Run-time dispatch, for scalar callers. In a loop, switch on m->model outside the loop and
  * call the per-model kernel inside. */
-static inline void material_stress_kernel(const piola_material *m, double f0, double f1,
+MATERIAL_KERNEL void material_stress_kernel(const piola_material *m, double f0, double f1,
                                           double f2, double *p0, double *p1, double *p2) {
   switch (m->model) {
     case PIOLA_MODEL_COROTATED: corotated_stress(m, f0, f1, f2, p0, p1, p2); return;

@@ -495,6 +495,14 @@ static void names_and_lame_parameters_round_trip(void **state) {
   assert_false(piola_material_model_from_name(NULL, &back));
   assert_string_equal(piola_material_model_name(PIOLA_MODEL_NEOHOOKEAN), "neohookean");
   assert_string_equal(piola_material_model_name(PIOLA_MODEL_SPLINE), "spline");
+  for (int mode = 0; mode < N_MODES; ++mode) {
+    piola_inversion_mode parsed;
+    assert_true(piola_inversion_mode_from_name(piola_inversion_mode_name(modes[mode]), &parsed));
+    assert_int_equal(parsed, modes[mode]);
+  }
+  piola_inversion_mode parsed_mode;
+  assert_string_equal(piola_inversion_mode_name(PIOLA_INVERSION_LINEAR), "linear");
+  assert_false(piola_inversion_mode_from_name("C1", &parsed_mode));
 
   const double nus[] = {-0.9, -0.1, 0.0, 0.3, 0.499};
   for (size_t n = 0; n < sizeof nus / sizeof nus[0]; ++n) {

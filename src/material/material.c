@@ -122,6 +122,22 @@ bool piola_material_model_from_name(const char *name, piola_material_model *mode
   return false;
 }
 
+const char *piola_inversion_mode_name(piola_inversion_mode mode) {
+  switch (mode) {
+    case PIOLA_INVERSION_LINEAR: return "linear";
+    case PIOLA_INVERSION_CLAMP: return "clamp";
+    default: return "unknown";
+  }
+}
+
+bool piola_inversion_mode_from_name(const char *name, piola_inversion_mode *mode) {
+  if (!name || !mode) return false;
+  if (strcmp(name, "linear") == 0) *mode = PIOLA_INVERSION_LINEAR;
+  else if (strcmp(name, "clamp") == 0) *mode = PIOLA_INVERSION_CLAMP;
+  else return false;
+  return true;
+}
+
 /* ------------------------------------------------------------------ evaluation */
 
 void piola_material_stress(const piola_material *material, const double fhat[3],

@@ -23,21 +23,27 @@ static int compare_doubles(const void *a, const void *b) {
 }
 
 static void simd_block(const piola_material *m, long n, const double *restrict f0,
-                       const double *restrict f1, const double *restrict f2,
-                       double *restrict p0, double *restrict p1, double *restrict p2) {
+                       const double *restrict f1, const double *restrict f2, double *restrict p0,
+                       double *restrict p1, double *restrict p2) {
   switch (m->model) { /* the switch is hoisted: one simd loop per model */
-#define PIOLA_BENCH_LOOP(fn)                                               \
-  {                                                                        \
-    _Pragma("omp simd") for (long i = 0; i < n; ++i)                       \
-        fn(m, f0[i], f1[i], f2[i], &p0[i], &p1[i], &p2[i]);                \
-  }                                                                        \
+#define PIOLA_BENCH_LOOP(fn)                                \
+  {                                                         \
+    _Pragma("omp simd") for (long i = 0; i < n; ++i)        \
+        fn(m, f0[i], f1[i], f2[i], &p0[i], &p1[i], &p2[i]); \
+  }                                                         \
   break;
-    case PIOLA_MODEL_ROTATED_LINEAR: PIOLA_BENCH_LOOP(rotated_linear_stress)
-    case PIOLA_MODEL_COROTATED: PIOLA_BENCH_LOOP(corotated_stress)
-    case PIOLA_MODEL_STVK: PIOLA_BENCH_LOOP(stvk_stress)
-    case PIOLA_MODEL_NEOHOOKEAN: PIOLA_BENCH_LOOP(neohookean_stress)
-    case PIOLA_MODEL_SPLINE: PIOLA_BENCH_LOOP(spline_stress)
-    default: break;
+    case PIOLA_MODEL_ROTATED_LINEAR:
+      PIOLA_BENCH_LOOP(rotated_linear_stress)
+    case PIOLA_MODEL_COROTATED:
+      PIOLA_BENCH_LOOP(corotated_stress)
+    case PIOLA_MODEL_STVK:
+      PIOLA_BENCH_LOOP(stvk_stress)
+    case PIOLA_MODEL_NEOHOOKEAN:
+      PIOLA_BENCH_LOOP(neohookean_stress)
+    case PIOLA_MODEL_SPLINE:
+      PIOLA_BENCH_LOOP(spline_stress)
+    default:
+      break;
 #undef PIOLA_BENCH_LOOP
   }
 }

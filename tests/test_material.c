@@ -124,8 +124,11 @@ static void stress_is_energy_gradient_above_threshold(void **state) {
   test_rng rng = test_rng_seeded(11);
   const long samples = test_samples(400, 20);
   for (int model = 0; model < PIOLA_MODEL_COUNT; ++model)
-    for (int mode = 0; mode < N_MODES; ++mode) {
-      const piola_material m = make((piola_material_model)model, modes[mode], 0.4);
+    for (int variant = 0; variant < 2 * N_MODES; ++variant) {
+      /* Both modes, with a positive and a negative lambda (auxetic, nu < 0). */
+      const int mode = variant % N_MODES;
+      const piola_material m =
+          make((piola_material_model)model, modes[mode], variant < N_MODES ? 0.4 : -0.3);
       for (long s = 0; s < samples; ++s) {
         double f[3], p[3];
         random_point(&rng, m.threshold + 0.01, 2.5, f);
@@ -145,8 +148,11 @@ static void stress_is_energy_gradient_along_clamped_entries(void **state) {
   test_rng rng = test_rng_seeded(12);
   const long samples = test_samples(400, 20);
   for (int model = 0; model < PIOLA_MODEL_COUNT; ++model)
-    for (int mode = 0; mode < N_MODES; ++mode) {
-      const piola_material m = make((piola_material_model)model, modes[mode], 0.4);
+    for (int variant = 0; variant < 2 * N_MODES; ++variant) {
+      /* Both modes, with a positive and a negative lambda (auxetic, nu < 0). */
+      const int mode = variant % N_MODES;
+      const piola_material m =
+          make((piola_material_model)model, modes[mode], variant < N_MODES ? 0.4 : -0.3);
       for (long s = 0; s < samples; ++s) {
         double f[3], p[3];
         random_point(&rng, -3.0, 2.5, f);
@@ -165,8 +171,11 @@ static void derivative_matches_finite_differences_everywhere(void **state) {
   test_rng rng = test_rng_seeded(13);
   const long samples = test_samples(600, 30);
   for (int model = 0; model < PIOLA_MODEL_COUNT; ++model)
-    for (int mode = 0; mode < N_MODES; ++mode) {
-      const piola_material m = make((piola_material_model)model, modes[mode], 0.4);
+    for (int variant = 0; variant < 2 * N_MODES; ++variant) {
+      /* Both modes, with a positive and a negative lambda (auxetic, nu < 0). */
+      const int mode = variant % N_MODES;
+      const piola_material m =
+          make((piola_material_model)model, modes[mode], variant < N_MODES ? 0.4 : -0.3);
       long checked = 0;
       for (long s = 0; s < samples; ++s) {
         double f[3], k[3][3], col[3];
@@ -179,8 +188,8 @@ static void derivative_matches_finite_differences_everywhere(void **state) {
           for (int i = 0; i < 3; ++i) {
             if (fabs(col[i] - k[i][j]) > tol)
               fail_msg("%s mode %d at (%g, %g, %g): dP[%d][%d] = %.10g, finite difference %.10g",
-                       piola_material_model_name(m.model), (int)m.inversion_mode, f[0], f[1],
-                       f[2], i, j, k[i][j], col[i]);
+                       piola_material_model_name(m.model), (int)m.inversion_mode, f[0], f[1], f[2],
+                       i, j, k[i][j], col[i]);
           }
         }
         ++checked;
@@ -259,7 +268,8 @@ static void extension_is_continuous_at_the_threshold(void **state) {
         ++slope_checked;
       }
       if (m.inversion_mode == PIOLA_INVERSION_LINEAR && slope_checked <= samples / 4)
-        fail_msg("%s: C1 checked at only %ld of %ld points", piola_material_model_name(m.model), slope_checked, samples);
+        fail_msg("%s: C1 checked at only %ld of %ld points", piola_material_model_name(m.model),
+                 slope_checked, samples);
     }
 }
 
@@ -284,10 +294,11 @@ static void check_finite_and_restoring(const piola_material *m, const double f[3
 
 static void flat_and_inverted_entries_are_finite_and_pushed_back(void **state) {
   (void)state;
-  const double fixed[][3] = {{0, 0, 0},      {-1, -1, -1},     {-1e6, -1e6, -1e6}, {0, 1, 1},
-                             {-0.5, 1, 1},   {-1e6, 1, 1},     {0, 0, 1},          {-2, 0, 3},
-                             {-0.01, 5, 5},  {-0.01, 10, 10},  {0, 10, 0.1},       {-3, -2, 8},
-                             {-1e-300, 1, 1}, {-0.2, 0.3, 0.3}, {1e3, -1e3, 1e3},   {0.1, 0.2, -50}};
+  const double fixed[][3] = {
+      {0, 0, 0},       {-1, -1, -1},     {-1e6, -1e6, -1e6}, {0, 1, 1},
+      {-0.5, 1, 1},    {-1e6, 1, 1},     {0, 0, 1},          {-2, 0, 3},
+      {-0.01, 5, 5},   {-0.01, 10, 10},  {0, 10, 0.1},       {-3, -2, 8},
+      {-1e-300, 1, 1}, {-0.2, 0.3, 0.3}, {1e3, -1e3, 1e3},   {0.1, 0.2, -50}};
   test_rng rng = test_rng_seeded(16);
   const long samples = test_samples(2000, 50);
   const double nus[] = {-0.5, 0.3, 0.49};
@@ -377,8 +388,8 @@ static void spline_is_soft_at_rest_and_stiff_past_its_stretches(void **state) {
     double k[3][3], p[3];
     piola_material_stress_derivative(&m, f, k);
     piola_material_stress(&m, f, p);
-    const double a2 = k[0][0] - m.lambda;              /* slope of the 1D curve */
-    const double a1 = p[0] - m.lambda * (f0 - 1.0);     /* the 1D curve itself */
+    const double a2 = k[0][0] - m.lambda;           /* slope of the 1D curve */
+    const double a1 = p[0] - m.lambda * (f0 - 1.0); /* the 1D curve itself */
     if (f0 < def.spline.compression_stretch - 1e-9 || f0 > def.spline.elongation_stretch + 1e-9)
       assert_close(a2, stiff_slope, 1e-9 * stiff_slope);
     else
@@ -398,19 +409,20 @@ static void spline_is_soft_at_rest_and_stiff_past_its_stretches(void **state) {
   }
 }
 
-
 /* The vectorizable logarithm the neo-Hookean kernel uses agrees with libm's to a few ulp. */
 static void kernel_log_matches_libm(void **state) {
   (void)state;
   test_rng rng = test_rng_seeded(19);
   const long samples = test_samples(200000, 1000);
-  const double special[] = {1.0, 2.0, 0.5, 1.4142135623730951, 1.4142135623730954, 0.3,
-                            1e-310, 4.9e-324, 1.7976931348623157e308, 1.0 + 1e-15, 1.0 - 1e-16};
+  const double special[] = {
+      1.0,        2.0,    0.5,      1.4142135623730951,     1.4142135623730954,
+      0.3,        1e-310, 4.9e-324, 1.7976931348623157e308, 1.0 + 1e-15,
+      1.0 - 1e-16};
   for (size_t i = 0; i < sizeof special / sizeof special[0]; ++i)
     assert_close(kernel_log(special[i]), log(special[i]), 4 * 2.2e-16 * fabs(log(special[i])));
   for (long s = 0; s < samples; ++s) {
-    const double x = s % 2 ? exp(test_rng_uniform(&rng, -740.0, 709.0))
-                           : test_rng_uniform(&rng, 0.0, 4.0);
+    const double x =
+        s % 2 ? exp(test_rng_uniform(&rng, -740.0, 709.0)) : test_rng_uniform(&rng, 0.0, 4.0);
     const double ref = log(x);
     assert_close(kernel_log(x), ref, 4 * 2.2e-16 * fabs(ref) + 1e-300);
   }
@@ -470,7 +482,8 @@ static void invalid_parameters_are_rejected_by_name(void **state) {
   d = base, d.model = PIOLA_MODEL_COUNT, expect_rejected(d, "model", "5");
   d = base, d.model = PIOLA_MODEL_SPLINE;
   piola_material_def e;
-  e = d, e.spline.compression_stretch = 0.25, expect_rejected(e, "spline.compression_stretch", "0.25");
+  e = d, e.spline.compression_stretch = 0.25,
+  expect_rejected(e, "spline.compression_stretch", "0.25");
   e = d, e.spline.compression_stretch = 1.0, expect_rejected(e, "spline.compression_stretch", "1");
   e = d, e.spline.elongation_stretch = 1.0, expect_rejected(e, "spline.elongation_stretch", "1");
   e = d, e.spline.stiffening = 0.5, expect_rejected(e, "spline.stiffening", "0.5");
@@ -514,7 +527,8 @@ static void names_and_lame_parameters_round_trip(void **state) {
   }
   double e, nu;
   assert_int_equal(piola_youngs_poisson_from_lame(0.0, 1.0, &e, &nu), PIOLA_ERROR_INVALID_ARGUMENT);
-  assert_int_equal(piola_youngs_poisson_from_lame(1.0, -1.0, &e, &nu), PIOLA_ERROR_INVALID_ARGUMENT);
+  assert_int_equal(piola_youngs_poisson_from_lame(1.0, -1.0, &e, &nu),
+                   PIOLA_ERROR_INVALID_ARGUMENT);
   assert_int_equal(piola_youngs_poisson_from_lame(NAN, 1.0, &e, &nu), PIOLA_ERROR_NOT_FINITE);
 }
 

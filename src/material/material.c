@@ -29,15 +29,15 @@ piola_status piola_youngs_poisson_from_lame(double mu, double lambda, double *yo
   if (!youngs_modulus || !poisson_ratio)
     return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "youngs_poisson_from_lame: NULL output");
   if (!isfinite(mu) || !isfinite(lambda))
-    return PIOLA_FAIL(PIOLA_ERROR_NOT_FINITE, "lame parameters must be finite, got mu = %g, lambda = %g",
-                      mu, lambda);
+    return PIOLA_FAIL(PIOLA_ERROR_NOT_FINITE,
+                      "lame parameters must be finite, got mu = %g, lambda = %g", mu, lambda);
   if (!(mu > 0.0))
     return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "lame mu must be > 0 Pa, got %g", mu);
   /* nu > -1 <=> bulk modulus lambda + 2 mu / 3 > 0. */
   if (!(3.0 * lambda + 2.0 * mu > 0.0))
-    return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT,
-                      "lame lambda must be > -2 mu / 3 (positive bulk modulus), got %g with mu = %g",
-                      lambda, mu);
+    return PIOLA_FAIL(
+        PIOLA_ERROR_INVALID_ARGUMENT,
+        "lame lambda must be > -2 mu / 3 (positive bulk modulus), got %g with mu = %g", lambda, mu);
   *youngs_modulus = mu * (3.0 * lambda + 2.0 * mu) / (lambda + mu);
   *poisson_ratio = lambda / (2.0 * (lambda + mu));
   return PIOLA_OK;
@@ -52,7 +52,8 @@ static piola_status check_finite(const char *key, double value) {
 piola_status piola_material_init(const piola_material_def *def, piola_material *out) {
   if (!def || !out) return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "material_init: NULL argument");
   if ((int)def->model < 0 || def->model >= PIOLA_MODEL_COUNT)
-    return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "model: unknown material model %d", (int)def->model);
+    return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "model: unknown material model %d",
+                      (int)def->model);
   if (def->inversion_mode != PIOLA_INVERSION_LINEAR && def->inversion_mode != PIOLA_INVERSION_CLAMP)
     return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "inversion.mode: unknown mode %d",
                       (int)def->inversion_mode);
@@ -63,11 +64,11 @@ piola_status piola_material_init(const piola_material_def *def, piola_material *
   if (!(e > 0.0))
     return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "youngs_modulus must be > 0 Pa, got %g", e);
   if (!(nu > -1.0 && nu < 0.5))
-    return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT,
-                      "poisson_ratio must be in (-1, 0.5), got %g", nu);
+    return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "poisson_ratio must be in (-1, 0.5), got %g",
+                      nu);
   if (!(c > 0.0 && c < 1.0))
-    return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT,
-                      "inversion.threshold must be in (0, 1), got %g", c);
+    return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "inversion.threshold must be in (0, 1), got %g",
+                      c);
 
   piola_material m;
   memset(&m, 0, sizeof m);
@@ -84,9 +85,9 @@ piola_status piola_material_init(const piola_material_def *def, piola_material *
     PIOLA_TRY(check_finite("spline.elongation_stretch", b));
     PIOLA_TRY(check_finite("spline.stiffening", st));
     if (!(a > c && a < 1.0))
-      return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT,
-                        "spline.compression_stretch must be in (inversion.threshold = %g, 1), got %g",
-                        c, a);
+      return PIOLA_FAIL(
+          PIOLA_ERROR_INVALID_ARGUMENT,
+          "spline.compression_stretch must be in (inversion.threshold = %g, 1), got %g", c, a);
     if (!(b > 1.0))
       return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT,
                         "spline.elongation_stretch must be > 1, got %g", b);
@@ -104,8 +105,8 @@ piola_status piola_material_init(const piola_material_def *def, piola_material *
   return PIOLA_OK;
 }
 
-static const char *const model_names[PIOLA_MODEL_COUNT] = {
-    "rotated_linear", "corotated", "stvk", "neohookean", "spline"};
+static const char *const model_names[PIOLA_MODEL_COUNT] = {"rotated_linear", "corotated", "stvk",
+                                                           "neohookean", "spline"};
 
 const char *piola_material_model_name(piola_material_model model) {
   if ((int)model < 0 || model >= PIOLA_MODEL_COUNT) return "unknown";
@@ -124,24 +125,29 @@ bool piola_material_model_from_name(const char *name, piola_material_model *mode
 
 const char *piola_inversion_mode_name(piola_inversion_mode mode) {
   switch (mode) {
-    case PIOLA_INVERSION_LINEAR: return "linear";
-    case PIOLA_INVERSION_CLAMP: return "clamp";
-    default: return "unknown";
+    case PIOLA_INVERSION_LINEAR:
+      return "linear";
+    case PIOLA_INVERSION_CLAMP:
+      return "clamp";
+    default:
+      return "unknown";
   }
 }
 
 bool piola_inversion_mode_from_name(const char *name, piola_inversion_mode *mode) {
   if (!name || !mode) return false;
-  if (strcmp(name, "linear") == 0) *mode = PIOLA_INVERSION_LINEAR;
-  else if (strcmp(name, "clamp") == 0) *mode = PIOLA_INVERSION_CLAMP;
-  else return false;
+  if (strcmp(name, "linear") == 0)
+    *mode = PIOLA_INVERSION_LINEAR;
+  else if (strcmp(name, "clamp") == 0)
+    *mode = PIOLA_INVERSION_CLAMP;
+  else
+    return false;
   return true;
 }
 
 /* ------------------------------------------------------------------ evaluation */
 
-void piola_material_stress(const piola_material *material, const double fhat[3],
-                           double phat[3]) {
+void piola_material_stress(const piola_material *material, const double fhat[3], double phat[3]) {
   material_stress_kernel(material, fhat[0], fhat[1], fhat[2], &phat[0], &phat[1], &phat[2]);
 }
 
@@ -168,8 +174,10 @@ static extension_point extension_point_at(const piola_material *m, const double 
 static double entry_energy(const piola_material *m, double f) {
   const double mu = m->mu;
   switch (m->model) {
-    case PIOLA_MODEL_STVK: return 0.25 * mu * (f * f - 1.0) * (f * f - 1.0);
-    case PIOLA_MODEL_NEOHOOKEAN: return mu * (0.5 * (f * f - 1.0) - log(f));
+    case PIOLA_MODEL_STVK:
+      return 0.25 * mu * (f * f - 1.0) * (f * f - 1.0);
+    case PIOLA_MODEL_NEOHOOKEAN:
+      return mu * (0.5 * (f * f - 1.0) - log(f));
     case PIOLA_MODEL_SPLINE: {
       /* Integral from 1 to f of the 1D stress curve; G(t, w) integrates the transition
        * (slope rising linearly over width w) followed by the stiff straight part. */
@@ -186,15 +194,18 @@ static double entry_energy(const piola_material *m, double f) {
     }
     case PIOLA_MODEL_ROTATED_LINEAR:
     case PIOLA_MODEL_COROTATED:
-    default: return mu * (f - 1.0) * (f - 1.0);
+    default:
+      return mu * (f - 1.0) * (f - 1.0);
   }
 }
 
 /* A'''(f): the third derivative of the separable energy. */
 static double entry_third(const piola_material *m, double f) {
   switch (m->model) {
-    case PIOLA_MODEL_STVK: return 6.0 * m->mu * f;
-    case PIOLA_MODEL_NEOHOOKEAN: return -2.0 * m->mu / (f * f * f);
+    case PIOLA_MODEL_STVK:
+      return 6.0 * m->mu * f;
+    case PIOLA_MODEL_NEOHOOKEAN:
+      return -2.0 * m->mu / (f * f * f);
     case PIOLA_MODEL_SPLINE: {
       const double *s = m->spline_coefficients;
       const double u = f - 1.0;
@@ -202,7 +213,8 @@ static double entry_third(const piola_material *m, double f) {
       const double down = (u < 0.0 && -u < s[SPLINE_WC]) ? s[SPLINE_INV_WC] : 0.0;
       return s[SPLINE_DK] * (up - down);
     }
-    default: return 0.0;
+    default:
+      return 0.0;
   }
 }
 
@@ -216,8 +228,7 @@ static double model_energy(const piola_material *m, const double f[3]) {
 }
 
 /* T_ijk = d3 psi / df_i df_j df_k of the unextended model at f (all entries > 0). */
-static void model_third_derivative(const piola_material *m, const double f[3],
-                                   double t[3][3][3]) {
+static void model_third_derivative(const piola_material *m, const double f[3], double t[3][3][3]) {
   double g[3], h[3][3], kappa;
   const double qm = invariant_terms(m->model, m, f[0], f[1], f[2], g, h, &kappa);
   for (int i = 0; i < 3; ++i)
@@ -226,8 +237,8 @@ static void model_third_derivative(const piola_material *m, const double f[3],
         double tq = 0.0; /* third derivative of the invariant q */
         if (m->model == PIOLA_MODEL_NEOHOOKEAN && i == j && j == k)
           tq = 2.0 / (f[i] * f[i] * f[i]);
-        else if ((m->model == PIOLA_MODEL_COROTATED || m->model == PIOLA_MODEL_SPLINE) &&
-                 i != j && j != k && i != k)
+        else if ((m->model == PIOLA_MODEL_COROTATED || m->model == PIOLA_MODEL_SPLINE) && i != j &&
+                 j != k && i != k)
           tq = 1.0;
         t[i][j][k] = kappa * (h[i][j] * g[k] + h[i][k] * g[j] + h[j][k] * g[i] + qm * tq);
       }

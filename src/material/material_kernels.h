@@ -72,7 +72,7 @@ MATERIAL_KERNEL double kernel_min(double a, double b) { return a < b ? a : b; }
  * The exponent is turned into a double with the 2^52 trick (integer shifts and ors only,
  * no 64-bit integer-to-double conversion, which AVX2 lacks). */
 MATERIAL_KERNEL double kernel_log(double x) {
-  const int tiny = x < 2.2250738585072014e-308; /* subnormal: scale into the normal range */
+  const int tiny = x < 2.2250738585072014e-308;         /* subnormal: scale into the normal range */
   const double xs = tiny ? x * 18014398509481984.0 : x; /* 2^54 */
   uint64_t bits;
   memcpy(&bits, &xs, sizeof bits);
@@ -112,7 +112,7 @@ typedef struct material_parts {
 
 /* A'(f) and A''(f) of the separable energy of each model. */
 MATERIAL_KERNEL void entry_slope_curvature(piola_material_model model, const piola_material *m,
-                                         double f, double *a1, double *a2) {
+                                           double f, double *a1, double *a2) {
   const double mu = m->mu;
   switch (model) {
     case PIOLA_MODEL_STVK: /* A = mu/4 (f^2 - 1)^2 */
@@ -130,8 +130,7 @@ MATERIAL_KERNEL void entry_slope_curvature(piola_material_model model, const pio
       const double u = f - 1.0;
       const double t = kernel_max(u, 0.0), tc = kernel_min(t, s[SPLINE_WE]);
       const double c = kernel_max(-u, 0.0), cc = kernel_min(c, s[SPLINE_WC]);
-      *a1 = s[SPLINE_K0] * u +
-            s[SPLINE_DK] * (0.5 * tc * tc * s[SPLINE_INV_WE] + (t - tc)) -
+      *a1 = s[SPLINE_K0] * u + s[SPLINE_DK] * (0.5 * tc * tc * s[SPLINE_INV_WE] + (t - tc)) -
             s[SPLINE_DK] * (0.5 * cc * cc * s[SPLINE_INV_WC] + (c - cc));
       *a2 = s[SPLINE_K0] + s[SPLINE_DK] * (tc * s[SPLINE_INV_WE] + cc * s[SPLINE_INV_WC]);
       return;
@@ -149,8 +148,8 @@ MATERIAL_KERNEL void entry_slope_curvature(piola_material_model model, const pio
 
 /* kappa, q - q0, g = dq/df and H = d2q/df2 at f (all entries > 0). */
 MATERIAL_KERNEL double invariant_terms(piola_material_model model, const piola_material *m,
-                                     double f0, double f1, double f2, double g[3],
-                                     double h[3][3], double *kappa) {
+                                       double f0, double f1, double f2, double g[3], double h[3][3],
+                                       double *kappa) {
   h[0][0] = h[0][1] = h[0][2] = h[1][0] = h[1][1] = h[1][2] = h[2][0] = h[2][1] = h[2][2] = 0.0;
   switch (model) {
     case PIOLA_MODEL_ROTATED_LINEAR: /* q = tr Fhat, kappa = lambda */
@@ -184,8 +183,7 @@ MATERIAL_KERNEL double invariant_terms(piola_material_model model, const piola_m
 
 /* Phat and dPhat/dFhat of the unextended model at f (all entries > 0). */
 MATERIAL_KERNEL void material_model_parts(piola_material_model model, const piola_material *m,
-                                        double f0, double f1, double f2,
-                                        material_parts *out) {
+                                          double f0, double f1, double f2, material_parts *out) {
   double g[3], h[3][3], kappa;
   const double qm = invariant_terms(model, m, f0, f1, f2, g, h, &kappa);
   /* Written out, not looped: clang does not always unroll a loop around the spline's entry
@@ -228,7 +226,7 @@ MATERIAL_KERNEL double extension_diagonal_slope(const piola_material *m, double 
  * on scalars with selects, not loops over arrays with branches: GCC vectorizes the force
  * loop only in this form. */
 MATERIAL_KERNEL double extended_entry(const piola_material *m, double p, double kii, double kij,
-                                    double kik, double di, double dj, double dk) {
+                                      double kik, double di, double dj, double dk) {
   const double s = extension_diagonal_slope(m, p, kii);
   /* Clamped rows never take a negative coupling to other clamped entries (it could pull an
    * inverted entry further); unclamped rows keep the Taylor coupling. An unclamped entry
@@ -240,18 +238,17 @@ MATERIAL_KERNEL double extended_entry(const piola_material *m, double p, double 
 }
 
 /* Extended stress from the parts at the clamped point and the offsets d = f - fc. */
-MATERIAL_KERNEL void material_extend(const piola_material *m, const material_parts *pa,
-                                   double d0, double d1, double d2, double *p0, double *p1,
-                                   double *p2) {
+MATERIAL_KERNEL void material_extend(const piola_material *m, const material_parts *pa, double d0,
+                                     double d1, double d2, double *p0, double *p1, double *p2) {
   *p0 = extended_entry(m, pa->p[0], pa->k[0][0], pa->k[0][1], pa->k[0][2], d0, d1, d2);
   *p1 = extended_entry(m, pa->p[1], pa->k[1][1], pa->k[1][0], pa->k[1][2], d1, d0, d2);
   *p2 = extended_entry(m, pa->p[2], pa->k[2][2], pa->k[2][0], pa->k[2][1], d2, d0, d1);
 }
 
 /* The hot entry point for one model known at compile time. */
-MATERIAL_KERNEL void material_extended_stress(piola_material_model model,
-                                            const piola_material *m, double f0, double f1,
-                                            double f2, double *p0, double *p1, double *p2) {
+MATERIAL_KERNEL void material_extended_stress(piola_material_model model, const piola_material *m,
+                                              double f0, double f1, double f2, double *p0,
+                                              double *p1, double *p2) {
   const double c = m->threshold;
   const double fc0 = kernel_max(f0, c), fc1 = kernel_max(f1, c), fc2 = kernel_max(f2, c);
   material_parts parts;
@@ -260,38 +257,48 @@ MATERIAL_KERNEL void material_extended_stress(piola_material_model model,
 }
 
 /* Per-model kernels: the model is a constant, so each compiles to straight-line code. */
-MATERIAL_KERNEL void rotated_linear_stress(const piola_material *m, double f0, double f1,
-                                         double f2, double *p0, double *p1, double *p2) {
+MATERIAL_KERNEL void rotated_linear_stress(const piola_material *m, double f0, double f1, double f2,
+                                           double *p0, double *p1, double *p2) {
   material_extended_stress(PIOLA_MODEL_ROTATED_LINEAR, m, f0, f1, f2, p0, p1, p2);
 }
 MATERIAL_KERNEL void corotated_stress(const piola_material *m, double f0, double f1, double f2,
-                                    double *p0, double *p1, double *p2) {
+                                      double *p0, double *p1, double *p2) {
   material_extended_stress(PIOLA_MODEL_COROTATED, m, f0, f1, f2, p0, p1, p2);
 }
 MATERIAL_KERNEL void stvk_stress(const piola_material *m, double f0, double f1, double f2,
-                               double *p0, double *p1, double *p2) {
+                                 double *p0, double *p1, double *p2) {
   material_extended_stress(PIOLA_MODEL_STVK, m, f0, f1, f2, p0, p1, p2);
 }
 MATERIAL_KERNEL void neohookean_stress(const piola_material *m, double f0, double f1, double f2,
-                                     double *p0, double *p1, double *p2) {
+                                       double *p0, double *p1, double *p2) {
   material_extended_stress(PIOLA_MODEL_NEOHOOKEAN, m, f0, f1, f2, p0, p1, p2);
 }
 MATERIAL_KERNEL void spline_stress(const piola_material *m, double f0, double f1, double f2,
-                                 double *p0, double *p1, double *p2) {
+                                   double *p0, double *p1, double *p2) {
   material_extended_stress(PIOLA_MODEL_SPLINE, m, f0, f1, f2, p0, p1, p2);
 }
 
 /* Run-time dispatch, for scalar callers. In a loop, switch on m->model outside the loop and
  * call the per-model kernel inside. */
 MATERIAL_KERNEL void material_stress_kernel(const piola_material *m, double f0, double f1,
-                                          double f2, double *p0, double *p1, double *p2) {
+                                            double f2, double *p0, double *p1, double *p2) {
   switch (m->model) {
-    case PIOLA_MODEL_COROTATED: corotated_stress(m, f0, f1, f2, p0, p1, p2); return;
-    case PIOLA_MODEL_STVK: stvk_stress(m, f0, f1, f2, p0, p1, p2); return;
-    case PIOLA_MODEL_NEOHOOKEAN: neohookean_stress(m, f0, f1, f2, p0, p1, p2); return;
-    case PIOLA_MODEL_SPLINE: spline_stress(m, f0, f1, f2, p0, p1, p2); return;
+    case PIOLA_MODEL_COROTATED:
+      corotated_stress(m, f0, f1, f2, p0, p1, p2);
+      return;
+    case PIOLA_MODEL_STVK:
+      stvk_stress(m, f0, f1, f2, p0, p1, p2);
+      return;
+    case PIOLA_MODEL_NEOHOOKEAN:
+      neohookean_stress(m, f0, f1, f2, p0, p1, p2);
+      return;
+    case PIOLA_MODEL_SPLINE:
+      spline_stress(m, f0, f1, f2, p0, p1, p2);
+      return;
     case PIOLA_MODEL_ROTATED_LINEAR:
-    default: rotated_linear_stress(m, f0, f1, f2, p0, p1, p2); return;
+    default:
+      rotated_linear_stress(m, f0, f1, f2, p0, p1, p2);
+      return;
   }
 }
 

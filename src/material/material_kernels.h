@@ -4,15 +4,28 @@
  * -----------------------------------
  * The force loop evaluates Phat(Fhat) once per tetrahedron per step, for millions of
  * tetrahedra. It runs over blocks of tets in a `#pragma omp simd` loop, with the switch on
- * the model hoisted out of the loop. For that loop to vectorize, everything it calls must be
- * inline, take and return plain doubles, and avoid data-dependent branches: the inversion
- * extension is written with fmax/fmin and selects (`cond ? a : b` on values both computed),
- * which compilers turn into blends (fmax/fmin
- * themselves are avoided: see kernel_max), never into jumps. The model argument of
- * material_model_parts() is a compile-time constant in each per-model kernel
- * (neohookean_stress() and friends), so after inlining its switch folds away; the one place
- * where the model is a run-time value is material_stress_kernel(), meant for scalar callers
- * and for the public API.
+ * the model hoisted out of the loop:
+ *
+ *     switch (material.model) {
+ *       case PIOLA_MODEL_NEOHOOKEAN:
+ *         #pragma omp simd
+ *         for (i = 0; i < n; ++i) neohookean_stress(&material, f0[i], f1[i], f2[i],
+ *                                                   &p0[i], &p1[i], &p2[i]);
+ *         break;
+ *       ...
+ *     }
+ *
+ * For that loop to vectorize, everything it calls must be inline (forced: clang otherwise
+ * keeps the model switch as a call), take and return plain doubles (no loops over small
+ * local arrays, which stay in memory), and have no data-dependent branches: the inversion
+ * extension is written with compare-and-selects (`cond ? a : b` on values both computed,
+ * kernel_max/kernel_min; C's fmax is avoided, see kernel_max) that compilers turn into
+ * blends, and the logarithm of neo-Hookean is kernel_log, not a libm call. GCC and clang
+ * vectorize all five per-model kernels in such a loop (bench/bench_material.c is one). The
+ * model argument of material_model_parts() is a compile-time constant in each per-model
+ * kernel (neohookean_stress() and friends), so after inlining its switch folds away; the
+ * one place where the model is a run-time value is material_stress_kernel(), meant for
+ * scalar callers and for the public API.
  *
  * Every model is written in one shape (see docs/materials.md):
  *     psi(f) = sum_i A(f_i) + kappa/2 (q(f) - q0)^2

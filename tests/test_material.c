@@ -273,6 +273,54 @@ static void extension_is_continuous_at_the_threshold(void **state) {
     }
 }
 
+/* The definition itself: below the threshold the stress is P(fc) + K(fc) (f - fc) (LINEAR) or
+ * P(fc) (CLAMP), computed here from the public values at the clamped point, wherever the
+ * restoring safeguards are inactive (all couplings nonnegative and the diagonal slope not
+ * raised; for CLAMP the clamped stress already compressive enough). */
+static void extension_is_the_taylor_expansion_where_no_safeguard_acts(void **state) {
+  (void)state;
+  test_rng rng = test_rng_seeded(20);
+  const long samples = test_samples(400, 20);
+  for (int model = 0; model < PIOLA_MODEL_COUNT; ++model)
+    for (int mode = 0; mode < N_MODES; ++mode) {
+      const piola_material m = make((piola_material_model)model, modes[mode], 0.3);
+      const double c = m.threshold;
+      long checked = 0;
+      for (long s = 0; s < samples; ++s) {
+        double f[3], fc[3], d[3], p[3], pc[3], kc[3][3];
+        random_point(&rng, 0.5, 1.5, f);
+        const int n_clamped = 1 + (int)(s % 3);
+        for (int i = 0; i < n_clamped; ++i) f[i] = test_rng_uniform(&rng, -2.0, c - 1e-3);
+        for (int i = 0; i < 3; ++i) fc[i] = f[i] < c ? c : f[i], d[i] = f[i] - fc[i];
+        piola_material_stress(&m, fc, pc);
+        piola_material_stress_derivative(&m, fc, kc);
+        int safe = 1;
+        for (int i = 0; i < n_clamped; ++i) {
+          if (m.inversion_mode == PIOLA_INVERSION_CLAMP) {
+            safe &= pc[i] <= -m.mu * c;
+          } else {
+            safe &= kc[i][i] >= m.mu + fmax(pc[i], 0.0) / c;
+            for (int j = 0; j < n_clamped; ++j) safe &= (i == j) || kc[i][j] >= 0.0;
+          }
+        }
+        if (!safe) continue;
+        piola_material_stress(&m, f, p);
+        for (int i = 0; i < 3; ++i) {
+          double expected = pc[i];
+          if (m.inversion_mode == PIOLA_INVERSION_LINEAR)
+            for (int j = 0; j < 3; ++j) expected += kc[i][j] * d[j];
+          assert_close(p[i], expected, 1e-10 * stress_scale(&m, f));
+        }
+        ++checked;
+      }
+      /* StVK's slope at c = 0.3 is always raised (LINEAR); everything else must be checked. */
+      if (!(m.model == PIOLA_MODEL_STVK && m.inversion_mode == PIOLA_INVERSION_LINEAR) &&
+          checked < samples / 10)
+        fail_msg("%s mode %d: only %ld of %ld samples free of safeguards",
+                 piola_material_model_name(m.model), (int)m.inversion_mode, checked, samples);
+    }
+}
+
 static void check_finite_and_restoring(const piola_material *m, const double f[3]) {
   double p[3], k[3][3];
   piola_material_stress(m, f, p);
@@ -541,6 +589,7 @@ int main(void) {
       cmocka_unit_test(derivative_matches_finite_differences_everywhere),
       cmocka_unit_test(derivative_is_symmetric_where_a_potential_exists),
       cmocka_unit_test(extension_is_continuous_at_the_threshold),
+      cmocka_unit_test(extension_is_the_taylor_expansion_where_no_safeguard_acts),
       cmocka_unit_test(flat_and_inverted_entries_are_finite_and_pushed_back),
       cmocka_unit_test(stvk_pushes_back_where_the_plain_model_would_not),
       cmocka_unit_test(stress_commutes_with_permutations),

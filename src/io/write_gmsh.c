@@ -70,7 +70,7 @@ piola_status piola__write_gmsh41(const char *path, const piola_tet_mesh *mesh) {
   for (size_t t = 0; t < nt;) {
     int32_t region = mesh->tet_regions ? mesh->tet_regions[t] : 0;
     size_t e = t + 1;
-    while (e < nt && mesh->tet_regions && mesh->tet_regions[e] == region) ++e;
+    while (e < nt && (!mesh->tet_regions || mesh->tet_regions[e] == region)) ++e;
     size_t entity = 0;
     while (ids[entity] != region) ++entity;
     fprintf(o, "3 %zu 4 %zu\n", entity + 1, e - t);

@@ -37,6 +37,7 @@ typedef struct gmsh_reader {
   /* tets, with node tags until mapped */
   uint64_t *tet_nodes;
   int32_t *tet_regions;
+  int32_t *tet_lines; /* ASCII files: line of each tet */
   size_t tet_count, tet_capacity;
 } gmsh_reader;
 
@@ -122,6 +123,10 @@ static piola_status add_tet(gmsh_reader *g, const uint64_t *nodes, int32_t regio
   int32_t *r = realloc(g->tet_regions, cap * sizeof(int32_t));
   if (!r) return PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "%s: out of memory", g->s.name);
   g->tet_regions = r;
+  int32_t *l = realloc(g->tet_lines, cap * sizeof(int32_t));
+  if (!l) return PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "%s: out of memory", g->s.name);
+  g->tet_lines = l;
+  g->tet_lines[g->tet_count] = (int32_t)g->s.line;
   memcpy(g->tet_nodes + 4 * g->tet_count, nodes, 4 * sizeof(uint64_t));
   g->tet_regions[g->tet_count++] = region;
   return PIOLA_OK;
@@ -546,7 +551,7 @@ static piola_status parse(gmsh_reader *g, piola_tet_mesh *out) {
     out->positions = malloc(1);
     if (!out->positions) return PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "%s: out of memory", g->s.name);
   }
-  return piola__tet_mesh_finish(out, g->s.name);
+  return piola__tet_mesh_finish(out, g->s.name, g->binary ? NULL : g->tet_lines);
 }
 
 piola_status piola__read_gmsh_mem(const char *name, const char *data, size_t size, piola_tet_mesh *out) {
@@ -561,6 +566,7 @@ piola_status piola__read_gmsh_mem(const char *name, const char *data, size_t siz
   free(g.positions);
   free(g.tet_nodes);
   free(g.tet_regions);
+  free(g.tet_lines);
   if (status != PIOLA_OK) piola_tet_mesh_free(out);
   return status;
 }

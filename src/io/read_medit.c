@@ -26,7 +26,7 @@ static const section_kind skipped[] = {
     {"Tangents", 3},       {"NormalAtVertices", 2}, {"TangentAtVertices", 2}, {"Identifier", 0},
 };
 
-static piola_status parse(text_scanner *s, piola_tet_mesh *out) {
+static piola_status parse(text_scanner *s, piola_tet_mesh *out, int32_t **lines) {
   int have_vertices = 0, have_tets = 0;
   while (piola__scan_skip(s)) {
     const char *tok;
@@ -70,9 +70,12 @@ static piola_status parse(text_scanner *s, piola_tet_mesh *out) {
         return piola__scan_error(s, PIOLA_ERROR_PARSE, "tet count %lld does not fit the file", (long long)n);
       out->tets = malloc((size_t)n * 4 * sizeof(int32_t) + 1);
       out->tet_regions = malloc((size_t)n * sizeof(int32_t) + 1);
-      if (!out->tets || !out->tet_regions) return PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "%s: out of memory", s->name);
+      *lines = malloc((size_t)n * sizeof(int32_t) + 1);
+      if (!out->tets || !out->tet_regions || !*lines) return PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "%s: out of memory", s->name);
       out->tet_count = (int32_t)n;
       for (int64_t t = 0; t < n; ++t) {
+        piola__scan_skip(s);
+        (*lines)[t] = (int32_t)s->line;
         for (int k = 0; k < 4; ++k) {
           int64_t v;
           PIOLA_TRY(piola__scan_int64(s, &v, "vertex index"));
@@ -105,14 +108,16 @@ static piola_status parse(text_scanner *s, piola_tet_mesh *out) {
   }
   if (!have_vertices) return PIOLA_FAIL(PIOLA_ERROR_PARSE, "%s: no Vertices section", s->name);
   if (!have_tets) return PIOLA_FAIL(PIOLA_ERROR_PARSE, "%s: no Tetrahedra section (the mesh has no tetrahedra)", s->name);
-  return piola__tet_mesh_finish(out, s->name);
+  return piola__tet_mesh_finish(out, s->name, *lines);
 }
 
 piola_status piola__read_medit_mem(const char *name, const char *data, size_t size, piola_tet_mesh *out) {
   memset(out, 0, sizeof *out);
   text_scanner s;
   piola__scanner_init(&s, name, data, size, '#');
-  piola_status status = parse(&s, out);
+  int32_t *lines = NULL;
+  piola_status status = parse(&s, out, &lines);
+  free(lines);
   if (status != PIOLA_OK) piola_tet_mesh_free(out);
   return status;
 }

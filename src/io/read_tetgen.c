@@ -47,7 +47,7 @@ static piola_status read_nodes(text_scanner *s, piola_tet_mesh *out, int64_t *ba
   return PIOLA_OK;
 }
 
-static piola_status read_tets(text_scanner *s, piola_tet_mesh *out, int64_t base) {
+static piola_status read_tets(text_scanner *s, piola_tet_mesh *out, int64_t base, int32_t **lines) {
   int64_t n, npe, nattr;
   PIOLA_TRY(piola__scan_int64(s, &n, "tet count"));
   PIOLA_TRY(piola__scan_int64(s, &npe, "nodes per tet"));
@@ -58,6 +58,8 @@ static piola_status read_tets(text_scanner *s, piola_tet_mesh *out, int64_t base
   if (n <= 0 || n > INT32_MAX || (uint64_t)n > (uint64_t)(s->end - s->p) / 10)
     return piola__scan_error(s, PIOLA_ERROR_PARSE, "tet count %lld does not fit the file", (long long)n);
   out->tets = malloc((size_t)n * 4 * sizeof(int32_t));
+  *lines = malloc((size_t)n * sizeof(int32_t));
+  if (!*lines) return PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "%s: out of memory", s->name);
   if (nattr > 0) out->tet_regions = malloc((size_t)n * sizeof(int32_t));
   if (!out->tets || (nattr > 0 && !out->tet_regions))
     return PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "%s: out of memory", s->name);
@@ -66,6 +68,7 @@ static piola_status read_tets(text_scanner *s, piola_tet_mesh *out, int64_t base
   for (int64_t t = 0; t < n; ++t) {
     int64_t id;
     PIOLA_TRY(piola__scan_int64(s, &id, "tet id"));
+    (*lines)[t] = (int32_t)s->line;
     if (t == 0) first = id;
     if (id != first + t)
       return piola__scan_error(s, PIOLA_ERROR_PARSE, "tet id %lld out of sequence, expected %lld", (long long)id,
@@ -98,13 +101,15 @@ piola_status piola__read_tetgen_mem(const char *node_name, const char *node_data
   memset(out, 0, sizeof *out);
   text_scanner s;
   int64_t base = 0;
+  int32_t *lines = NULL;
   piola__scanner_init(&s, node_name, node_data, node_size, '#');
   piola_status status = read_nodes(&s, out, &base);
   if (status == PIOLA_OK) {
     piola__scanner_init(&s, ele_name, ele_data, ele_size, '#');
-    status = read_tets(&s, out, base);
+    status = read_tets(&s, out, base, &lines);
   }
-  if (status == PIOLA_OK) status = piola__tet_mesh_finish(out, ele_name);
+  if (status == PIOLA_OK) status = piola__tet_mesh_finish(out, ele_name, lines);
+  free(lines);
   if (status != PIOLA_OK) piola_tet_mesh_free(out);
   return status;
 }

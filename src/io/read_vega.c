@@ -30,6 +30,7 @@ typedef struct vega_region {
 
 typedef struct vega_reader {
   text_scanner s;
+  int32_t *lines; /* per tet */
   vega_set *sets;
   size_t set_count, set_capacity;
   vega_region *regions;
@@ -96,11 +97,13 @@ static piola_status read_elements(vega_reader *r, piola_tet_mesh *out) {
   if (n <= 0 || n > INT32_MAX || (uint64_t)n > (uint64_t)(s->end - s->p) / 10)
     return piola__scan_error(s, PIOLA_ERROR_PARSE, "element count %lld does not fit the file", (long long)n);
   out->tets = malloc((size_t)n * 4 * sizeof(int32_t));
-  if (!out->tets) return PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "%s: out of memory", s->name);
+  r->lines = malloc((size_t)n * sizeof(int32_t));
+  if (!out->tets || !r->lines) return PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "%s: out of memory", s->name);
   out->tet_count = (int32_t)n;
   for (int64_t t = 0; t < n; ++t) {
     int64_t id;
     PIOLA_TRY(piola__scan_int64(s, &id, "element id"));
+    r->lines[t] = (int32_t)s->line;
     if (id != t + 1)
       return piola__scan_error(s, PIOLA_ERROR_PARSE, "element id %lld out of sequence, expected %lld", (long long)id,
                                (long long)(t + 1));
@@ -217,7 +220,7 @@ static piola_status parse(vega_reader *r, piola_tet_mesh *out) {
   if (!out->positions) return PIOLA_FAIL(PIOLA_ERROR_PARSE, "%s: no *VERTICES section", s->name);
   if (!out->tets) return PIOLA_FAIL(PIOLA_ERROR_PARSE, "%s: no *ELEMENTS section (the mesh has no tetrahedra)", s->name);
   PIOLA_TRY(resolve_regions(r, out));
-  return piola__tet_mesh_finish(out, s->name);
+  return piola__tet_mesh_finish(out, s->name, r->lines);
 }
 
 piola_status piola__read_vega_mem(const char *name, const char *data, size_t size, piola_tet_mesh *out,
@@ -233,6 +236,7 @@ piola_status piola__read_vega_mem(const char *name, const char *data, size_t siz
   for (size_t i = 0; i < r.set_count; ++i) free(r.sets[i].ids);
   free(r.sets);
   free(r.regions);
+  free(r.lines);
   if (status == PIOLA_OK) {
     *materials = r.materials;
     *material_count = (int32_t)r.material_count;

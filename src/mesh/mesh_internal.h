@@ -26,7 +26,8 @@ extern const int piola__tet_faces[4][3];
 
 /* Checks a loaded tet mesh (names `source` in messages): finite positions, index ranges,
  * degenerate tets (zero volume relative to their size) and duplicated tets; then orients
- * all tets positively. Used by every reader. */
-piola_status piola__tet_mesh_finish(piola_tet_mesh *mesh, const char *source);
+ * all tets positively. Used by every reader. lines[t], when not NULL, is the line of tet t
+ * in the file, for messages. */
+piola_status piola__tet_mesh_finish(piola_tet_mesh *mesh, const char *source, const int32_t *lines);
 
 #endif

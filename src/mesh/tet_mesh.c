@@ -1,5 +1,6 @@
 /* Tetrahedral mesh core: ownership, validation, orientation and the boundary surface. */
 #include <math.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -195,7 +196,15 @@ done:
   return status;
 }
 
-piola_status piola__tet_mesh_finish(piola_tet_mesh *mesh, const char *source) {
+/* "file:line" when the line is known, else "file". */
+static const char *where(char *buf, size_t size, const char *source, const int32_t *lines, int32_t t) {
+  if (lines) snprintf(buf, size, "%s:%d", source, (int)lines[t]);
+  else snprintf(buf, size, "%s", source);
+  return buf;
+}
+
+piola_status piola__tet_mesh_finish(piola_tet_mesh *mesh, const char *source, const int32_t *lines) {
+  char at[1024];
   if (mesh->tet_count == 0)
     return PIOLA_FAIL(PIOLA_ERROR_PARSE, "%s: the mesh has no tetrahedra", source);
   for (int32_t i = 0; i < 3 * mesh->vertex_count; ++i)
@@ -209,7 +218,7 @@ piola_status piola__tet_mesh_finish(piola_tet_mesh *mesh, const char *source) {
       for (int j = 0; j < k; ++j)
         if (c[j] == c[k])
           return PIOLA_FAIL(PIOLA_ERROR_DEGENERATE_ELEMENT, "%s: tet %d (element %d in the file) repeats a vertex",
-                            source, (int)t, (int)t + 1);
+                            where(at, sizeof at, source, lines, t), (int)t, (int)t + 1);
     }
     /* Zero volume relative to the tet's size: |6V| <= 1e-12 * (longest edge)^3. */
     double lmax2 = 0;
@@ -222,8 +231,8 @@ piola_status piola__tet_mesh_finish(piola_tet_mesh *mesh, const char *source) {
     double v6 = fabs(6.0 * piola_tet_mesh_signed_volume(mesh, t));
     if (!(v6 > 1e-12 * lmax2 * sqrt(lmax2)))
       return PIOLA_FAIL(PIOLA_ERROR_DEGENERATE_ELEMENT,
-                        "%s: tet %d (element %d in the file) is degenerate (zero volume)", source, (int)t,
-                        (int)t + 1);
+                        "%s: tet %d (element %d in the file) is degenerate (zero volume)",
+                        where(at, sizeof at, source, lines, t), (int)t, (int)t + 1);
   }
   /* Duplicated tets: same vertex set twice. */
   size_t nt = (size_t)mesh->tet_count;
@@ -241,8 +250,10 @@ piola_status piola__tet_mesh_finish(piola_tet_mesh *mesh, const char *source) {
     } else {
       for (size_t i = 0; i + 1 < nt; ++i)
         if (keys_equal(keys, 4, order[i], order[i + 1])) {
-          status = PIOLA_FAIL(PIOLA_ERROR_PARSE, "%s: tet %d (element %d in the file) duplicates tet %d", source,
-                              (int)order[i + 1], (int)order[i + 1] + 1, (int)order[i]);
+          int32_t a = order[i] < order[i + 1] ? order[i] : order[i + 1];
+          int32_t b = order[i] < order[i + 1] ? order[i + 1] : order[i];
+          status = PIOLA_FAIL(PIOLA_ERROR_PARSE, "%s: tet %d (element %d in the file) duplicates tet %d",
+                              where(at, sizeof at, source, lines, b), (int)b, (int)b + 1, (int)a);
           break;
         }
     }

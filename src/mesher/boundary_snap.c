@@ -46,7 +46,11 @@ static int guarded_move(snap_context *c, int32_t v, vec3 goal, int require_impro
   return 0;
 }
 
-static void smooth_near_boundary(snap_context *c, const int32_t *list, int32_t count) {
+/* Moves each listed node toward the mean of its neighbours (of class `ring`, or all when
+ * ring is 0) when that raises the worst angle around it; on_surface re-projects the goal so
+ * boundary nodes slide along the surface. */
+static void smooth(snap_context *c, const int32_t *list, int32_t count, const uint8_t *ring_of,
+                   int ring, const piola__shape_union *on_surface) {
   const double *p = c->mesh->positions;
   for (int32_t i = 0; i < count; ++i) {
     int32_t v = list[i];
@@ -55,13 +59,15 @@ static void smooth_near_boundary(snap_context *c, const int32_t *list, int32_t c
     for (int32_t j = c->vertex_tets.offsets[v]; j < c->vertex_tets.offsets[v + 1]; ++j) {
       const int32_t *tet = c->mesh->tets + 4 * (size_t)c->vertex_tets.items[j];
       for (int k = 0; k < 4; ++k)
-        if (tet[k] != v) {
+        if (tet[k] != v && (ring == 0 || ring_of[tet[k]] == ring)) {
           sum = vec3_add(sum, vec3_load(p + 3 * (size_t)tet[k]));
           n++;
         }
     }
     if (n == 0) continue;
-    guarded_move(c, v, vec3_scale(sum, 1.0 / n), 1);
+    vec3 goal = vec3_scale(sum, 1.0 / n);
+    if (on_surface) goal = piola__shape_union_project(on_surface, goal);
+    guarded_move(c, v, goal, 1);
   }
 }
 
@@ -102,7 +108,7 @@ piola_status piola__boundary_snap(piola_tet_mesh *mesh, const piola__shape_union
     if (ring[v] == 1) boundary[nb++] = v;
     if (ring[v] == 2) inner[ni++] = v;
   }
-  const double remaining[] = {0.25, 1.0 / 3.0, 0.5, 1.0, 1.0, 1.0};
+  const double remaining[] = {0.25, 1.0 / 3.0, 0.5, 1.0, 1.0, 1.0, 1.0, 1.0, 1.0};
   for (size_t stage = 0; stage < sizeof(remaining) / sizeof(remaining[0]); ++stage) {
 #pragma omp parallel for schedule(dynamic, 256)
     for (int32_t i = 0; i < nb; ++i)
@@ -111,7 +117,8 @@ piola_status piola__boundary_snap(piola_tet_mesh *mesh, const piola__shape_union
       vec3 x = vec3_load(mesh->positions + 3 * (size_t)boundary[i]);
       guarded_move(&c, boundary[i], vec3_add(x, vec3_scale(vec3_sub(target[i], x), remaining[stage])), 0);
     }
-    smooth_near_boundary(&c, inner, ni);
+    smooth(&c, inner, ni, ring, 0, NULL);
+    if (stage >= 3) smooth(&c, boundary, nb, ring, 1, shapes);
   }
   free(neighbor);
   free(ring);

@@ -267,11 +267,110 @@ static void capsule_is_meshed(void **state) {
   check_primitive(s, 0.08, 0, M_PI * 0.25 * 1.6 + 4.0 / 3.0 * M_PI * 0.125, 2, 0.01);
 }
 
+/* Refinement: conforming (boundary faces all on the surface, every interior face shared
+ * by two tets, closed manifold boundary), fine tets near the surface, coarse lattice tets
+ * untouched deep inside, and more tets than the unrefined lattice. */
+static void refinement_is_conforming_and_graded(void **state) {
+  (void)state;
+  piola_shape s = base_shape(PIOLA_SHAPE_SPHERE);
+  s.radius = 1.0;
+  double h = 0.25;
+  int levels = 2;
+  check_primitive(s, h, levels, 4.0 / 3.0 * M_PI, 2, 0.01);
+  piola_mesher_def def = piola_default_mesher_def();
+  def.shapes[0] = s;
+  def.shape_count = 1;
+  def.cell_size = h;
+  piola_tet_mesh coarse, fine;
+  assert_int_equal(piola_mesher_generate(&def, &coarse), PIOLA_OK);
+  def.refinement_levels = levels;
+  assert_int_equal(piola_mesher_generate(&def, &fine), PIOLA_OK);
+  assert_true(fine.tet_count > 4 * coarse.tet_count);
+  double lattice_volume = h * h * h / 12;
+  int deep = 0, deep_coarse = 0;
+  for (int32_t t = 0; t < fine.tet_count; ++t) {
+    vec3 x[4], c = {0, 0, 0};
+    for (int k = 0; k < 4; ++k) {
+      x[k] = node(&fine, fine.tets[4 * t + k]);
+      c = vec3_add(c, vec3_scale(x[k], 0.25));
+    }
+    double vol = vec3_dot(vec3_sub(x[1], x[0]), vec3_cross(vec3_sub(x[2], x[0]), vec3_sub(x[3], x[0]))) / 6;
+    if (shape_distance(c, &s) < -2.5 * h) {
+      deep++;
+      deep_coarse += fabs(vol - lattice_volume) < 1e-9 * lattice_volume;
+    }
+  }
+  mesh_report rc = analyse(&coarse, NULL), rf = analyse(&fine, NULL);
+  printf("  refinement: %d tets (unrefined %d, uniform refinement would give %d); %d of %d deep "
+         "tets are coarse lattice tets; boundary faces %d -> %d\n",
+         (int)fine.tet_count, (int)coarse.tet_count, (int)coarse.tet_count * 64, deep_coarse, deep,
+         rc.boundary_faces, rf.boundary_faces);
+  /* Deep inside, the coarse lattice is untouched. */
+  assert_true(deep > 0);
+  assert_int_equal(deep_coarse, deep);
+  /* At the surface the faces are two levels finer: 4 times smaller per level. */
+  assert_true(rf.boundary_faces > 10 * rc.boundary_faces);
+  /* And far fewer tets than refining everything. */
+  assert_true(fine.tet_count < 32 * coarse.tet_count);
+  free_tet_mesh(&coarse);
+  free_tet_mesh(&fine);
+}
+
+static void union_of_shapes_is_meshed(void **state) {
+  (void)state;
+  /* Two overlapping spheres: volume of the union by the lens formula. */
+  piola_mesher_def def = piola_default_mesher_def();
+  def.shapes[0] = base_shape(PIOLA_SHAPE_SPHERE);
+  def.shapes[0].center = vec3_make(0, 0, 0);
+  def.shapes[1] = def.shapes[0];
+  def.shapes[1].center = vec3_make(1.0, 0, 0);
+  def.shape_count = 2;
+  def.cell_size = 0.1;
+  piola_tet_mesh mesh;
+  assert_int_equal(piola_mesher_generate(&def, &mesh), PIOLA_OK);
+  mesh_report r = analyse(&mesh, NULL);
+  double R = 1, dd = 1;
+  double lens = M_PI * (4 * R + dd) * (2 * R - dd) * (2 * R - dd) / 12;
+  double exact = 2 * 4.0 / 3.0 * M_PI - lens;
+  printf("  union: %d tets volume %.5g exact %.5g (%.3f%%) dihedral [%.2f, %.2f] chi %d\n",
+         (int)mesh.tet_count, r.volume, exact, 100 * (r.volume - exact) / exact, r.min_dihedral,
+         r.max_dihedral, r.euler);
+  assert_true(r.min_dihedral >= MIN_DIHEDRAL_DEG - 1e-9);
+  assert_int_equal(r.nonmanifold_edges, 0);
+  assert_int_equal(r.euler, 2);
+  assert_true(fabs(r.volume - exact) < 0.01 * exact);
+  free_tet_mesh(&mesh);
+}
+
+static void bad_arguments_are_refused(void **state) {
+  (void)state;
+  piola_mesher_def def = piola_default_mesher_def();
+  piola_tet_mesh mesh;
+  def.shape_count = 1;
+  def.cell_size = 0;
+  assert_int_equal(piola_mesher_generate(&def, &mesh), PIOLA_ERROR_INVALID_ARGUMENT);
+  assert_non_null(strstr(piola_last_error(), "cell_size"));
+  def.cell_size = 0.1;
+  def.shapes[0].radius = -1;
+  assert_int_equal(piola_mesher_generate(&def, &mesh), PIOLA_ERROR_INVALID_ARGUMENT);
+  assert_non_null(strstr(piola_last_error(), "radius"));
+  def.shapes[0].radius = 1;
+  def.refinement_levels = 99;
+  assert_int_equal(piola_mesher_generate(&def, &mesh), PIOLA_ERROR_INVALID_ARGUMENT);
+  def.refinement_levels = 0;
+  def.cell_size = 1e-7;
+  assert_int_equal(piola_mesher_generate(&def, &mesh), PIOLA_ERROR_INVALID_ARGUMENT);
+  def.shape_count = 0;
+  def.cell_size = 0.1;
+  assert_int_equal(piola_mesher_generate(&def, &mesh), PIOLA_ERROR_INVALID_ARGUMENT);
+}
+
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(sphere_is_meshed),   cmocka_unit_test(box_is_meshed),
       cmocka_unit_test(torus_is_meshed),    cmocka_unit_test(cylinder_is_meshed),
-      cmocka_unit_test(capsule_is_meshed),
+      cmocka_unit_test(capsule_is_meshed),  cmocka_unit_test(refinement_is_conforming_and_graded),
+      cmocka_unit_test(union_of_shapes_is_meshed), cmocka_unit_test(bad_arguments_are_refused),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
 }

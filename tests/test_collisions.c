@@ -237,7 +237,7 @@ static void many_nodes_end_outside_and_results_do_not_depend_on_threads(void **s
   int32_t hits2 = piola_obstacles_collide(obstacles, 2, 0.7, 0.005, n, x2, v2, c2, NULL);
   omp_set_num_threads(threads);
   assert_int_equal(hits, hits2);
-  assert_true(hits > n / 20);
+  assert_true(hits > n / 50); /* the obstacles fill about 6 % of the sampled cube */
   assert_memory_equal(x, x2, sizeof(double) * 3 * (size_t)n);
   assert_memory_equal(v, v2, sizeof(double) * 3 * (size_t)n);
   assert_memory_equal(c, c2, (size_t)n);

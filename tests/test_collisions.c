@@ -268,6 +268,67 @@ static void many_nodes_end_outside_and_results_do_not_depend_on_threads(void **s
   free(normals);
 }
 
+/* Every shape, turning: random nodes in and around it all end outside or on it, and exactly
+ * the nodes that were inside are flagged (the bounding-sphere early out misses none). */
+static void every_shape_leaves_no_node_inside(void **state) {
+  (void)state;
+  static const int32_t cube_tris[36] = {0, 2, 1, 0, 3, 2, 4, 5, 6, 4, 6, 7, 0, 1, 5, 0, 5, 4,
+                                        2, 3, 7, 2, 7, 6, 1, 2, 6, 1, 6, 5, 0, 4, 7, 0, 7, 3};
+  double cube_positions[24];
+  for (int i = 0; i < 8; ++i) {
+    int xb = (i == 1 || i == 2 || i == 5 || i == 6), yb = (i == 2 || i == 3 || i == 6 || i == 7);
+    cube_positions[3 * i] = xb ? 0.4 : -0.3;
+    cube_positions[3 * i + 1] = yb ? 0.2 : -0.5;
+    cube_positions[3 * i + 2] = i >= 4 ? 0.35 : -0.25;
+  }
+  piola_tri_mesh cube = {8, cube_positions, 12, (int32_t *)cube_tris};
+  int32_t n = (int32_t)test_samples(4000, 400);
+  double *x = malloc(sizeof(double) * 3 * (size_t)n), *v = malloc(sizeof(double) * 3 * (size_t)n);
+  double *before = malloc(sizeof(double) * 3 * (size_t)n);
+  uint8_t *c = malloc((size_t)n);
+  for (int type = 0; type < PIOLA_OBSTACLE_TYPE_COUNT; ++type) {
+    piola_obstacle_def d = piola_default_obstacle_def();
+    d.type = (piola_obstacle_type)type;
+    d.center = vec3_make(0.05, 0, -0.02);
+    d.axis = vec3_make(0, 0.6, 0.8);
+    d.radius = 0.4;
+    d.minor_radius = 0.1;
+    d.half_length = 0.2;
+    d.half_extents = vec3_make(0.3, 0.2, 0.4);
+    d.tooth_count = 11;
+    d.tooth_depth = 0.08;
+    d.mesh = &cube;
+    d.friction = 0.2;
+    d.motion.axis = vec3_make(1, 0, 0);
+    d.motion.angular_speed = piola_track_constant(1.3);
+    d.motion.velocity[1] = piola_track_constant(0.2);
+    piola_obstacle *o = make(&d);
+    test_rng rng = test_rng_seeded(500 + (uint64_t)type);
+    int32_t inside = 0;
+    for (int32_t i = 0; i < n; ++i) {
+      for (int k = 0; k < 3; ++k) {
+        before[3 * i + k] = x[3 * i + k] = test_rng_uniform(&rng, -0.7, 0.7);
+        v[3 * i + k] = test_rng_normal(&rng);
+      }
+      inside += piola_obstacle_signed_distance(o, 0.4, vec3_load(x + 3 * i), NULL, NULL) < 0;
+    }
+    int32_t hits = piola_obstacles_collide(&o, 1, 0.4, 0.01, n, x, v, c, NULL);
+    assert_int_equal(hits, inside);
+    assert_true(type == PIOLA_OBSTACLE_PLANE || hits < n);
+    assert_true(hits > 0);
+    for (int32_t i = 0; i < n; ++i) {
+      double phi = piola_obstacle_signed_distance(o, 0.4, vec3_load(x + 3 * i), NULL, NULL);
+      if (!(phi >= -1e-12)) fail_msg("type %d node %d left inside at %g", type, (int)i, phi);
+      if (!c[i]) assert_memory_equal(x + 3 * i, before + 3 * i, 3 * sizeof(double));
+    }
+    piola_obstacle_destroy(o);
+  }
+  free(x);
+  free(v);
+  free(before);
+  free(c);
+}
+
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(node_below_plane_is_projected_and_stops_approaching),
@@ -279,6 +340,7 @@ int main(void) {
       cmocka_unit_test(spinning_cylinder_drags_with_surface_velocity),
       cmocka_unit_test(deep_interior_nodes_are_projected),
       cmocka_unit_test(node_in_two_obstacles_leaves_both),
+      cmocka_unit_test(every_shape_leaves_no_node_inside),
       cmocka_unit_test(many_nodes_end_outside_and_results_do_not_depend_on_threads),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);

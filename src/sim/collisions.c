@@ -14,7 +14,8 @@
  * last obstacle in the order wins. The stored normal is that of the last projection.
  *
  * Each node is independent, so the loop is parallel over nodes with a result that does not
- * depend on the thread count. Obstacle poses are computed once per call. */
+ * depend on the thread count. Obstacle poses are computed once per call, and a bounding
+ * sphere per obstacle skips the distance for nodes that are far from it. */
 #include <math.h>
 #include <stdlib.h>
 
@@ -30,6 +31,7 @@
  * the node is not inside. */
 static bool collide_node(const piola_obstacle *o, const piola__rigid_state *state, double dt,
                          vec3 *x, vec3 *v, vec3 *normal_out) {
+  if (!piola__obstacle_may_contain(o, state, *x)) return false;
   vec3 n;
   double phi = piola__obstacle_distance_posed(o, state, *x, &n, NULL);
   if (!(phi < 0)) return false;

@@ -79,6 +79,46 @@ static piola_status validate_motion(const piola_rigid_motion_def *motion,
   return piola__obstacle_unit_axis(motion->axis, "motion axis", &out->axis);
 }
 
+static void set_bounding_sphere(piola_obstacle *o) {
+  o->bound_center = vec3_make(0, 0, 0);
+  o->bound_radius = INFINITY;
+  switch (o->type) {
+    case PIOLA_OBSTACLE_SPHERE:
+      o->bound_center = o->shape.sphere.center;
+      o->bound_radius = o->shape.sphere.radius;
+      break;
+    case PIOLA_OBSTACLE_BOX:
+      o->bound_center = o->shape.box.center;
+      o->bound_radius = vec3_norm(o->shape.box.half_extents);
+      break;
+    case PIOLA_OBSTACLE_CYLINDER:
+      o->bound_center = o->shape.cylinder.center;
+      o->bound_radius = hypot(o->shape.cylinder.radius, o->shape.cylinder.half_length);
+      break;
+    case PIOLA_OBSTACLE_CAPSULE:
+      o->bound_center = o->shape.capsule.center;
+      o->bound_radius = o->shape.capsule.radius + o->shape.capsule.half_length;
+      break;
+    case PIOLA_OBSTACLE_TORUS:
+      o->bound_center = o->shape.torus.center;
+      o->bound_radius = o->shape.torus.major_radius + o->shape.torus.minor_radius;
+      break;
+    case PIOLA_OBSTACLE_GEAR:
+      o->bound_center = o->shape.gear.center;
+      o->bound_radius = hypot(o->shape.gear.tip_radius, o->shape.gear.half_length);
+      break;
+    case PIOLA_OBSTACLE_MESH: {
+      const piola__mesh_shape *m = &o->shape.mesh;
+      o->bound_center = vec3_scale(vec3_add(m->box_min, m->box_max), 0.5);
+      o->bound_radius = 0.5 * vec3_norm(vec3_sub(m->box_max, m->box_min));
+      break;
+    }
+    default: break;
+  }
+  /* Rounding: a point exactly on the surface may evaluate a hair inside. */
+  o->bound_radius *= 1.0 + 1e-9;
+}
+
 piola_status piola_obstacle_create(const piola_obstacle_def *def, piola_obstacle **out) {
   if (!def || !out) return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "obstacle: NULL argument");
   *out = NULL;
@@ -112,6 +152,7 @@ piola_status piola_obstacle_create(const piola_obstacle_def *def, piola_obstacle
     piola_obstacle_destroy(o);
     return s;
   }
+  set_bounding_sphere(o);
   *out = o;
   return PIOLA_OK;
 }

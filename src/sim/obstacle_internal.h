@@ -15,6 +15,10 @@ struct piola_obstacle {
   piola_obstacle_type type;
   double friction;
   piola_rigid_motion_def motion;
+  /* A sphere holding the shape in its t = 0 frame (radius INFINITY for the plane): nodes
+   * outside it are not inside, which collision processing checks before the distance. */
+  vec3 bound_center;
+  double bound_radius;
   union {
     piola__plane_shape plane;
     piola__sphere_shape sphere;
@@ -32,5 +36,13 @@ struct piola_obstacle {
 double piola__obstacle_distance_posed(const piola_obstacle *obstacle,
                                       const piola__rigid_state *state, vec3 p, vec3 *normal,
                                       vec3 *velocity);
+
+/* False when p (world, at the pose of state) is certainly outside the obstacle. */
+static inline bool piola__obstacle_may_contain(const piola_obstacle *obstacle,
+                                               const piola__rigid_state *state, vec3 p) {
+  vec3 p0 = mat3_transpose_mul_vec(state->rotation, vec3_sub(p, state->translation));
+  return vec3_norm2(vec3_sub(p0, obstacle->bound_center)) <
+         obstacle->bound_radius * obstacle->bound_radius;
+}
 
 #endif

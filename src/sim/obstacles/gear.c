@@ -13,9 +13,11 @@
  *       crosses", the winding test for this polygon);
  *   3D: with d2 the 2D distance and dh = |height| - half_length, max(d2, dh) when both are
  *       <= 0, else the length of (max(d2, 0), max(dh, 0)): exact for an extrusion.
- * Only the edges of the nearest tooth and its two neighbours are searched; every other edge
- * is at least rho sin(min(P, pi/2)) away (rho = distance from the axis), and when the best
- * distance found is larger than that bound all edges are searched, so the result is exact.
+ * Teeth are searched in order of angular separation from the point and the search stops
+ * when a lower bound on the distance to the remaining teeth (from their angular separation
+ * and the annulus that holds every edge) reaches the best distance found: exact, and only a
+ * few teeth for points near the gear. Inside the inscribed disk a thin gear's distance is
+ * the axial one whenever that is provably nearer than the outline, with no edge search.
  *
  * Tooth 0 is centred on the direction e1 of shape_frame(axis) (for axis z that is +x), and
  * teeth follow counter-clockwise about the axis. The top land (2 TIP_HALF of a period) is
@@ -55,6 +57,23 @@ double piola__gear_profile_radius(const piola__gear_shape *shape, double phi) {
   return profile_radius_u(u, shape->tip_radius, shape->root_radius);
 }
 
+typedef struct nearest2 {
+  double dist2;   /* squared distance to the nearest point found */
+  double cx, cy;  /* that point */
+  int32_t edge;   /* its edge (start vertex index) */
+} nearest2;
+
+static void visit_edge(const piola__gear_shape *shape, int32_t i, double x, double y, nearest2 *best) {
+  int32_t j = i + 1 == shape->vertex_count ? 0 : i + 1;
+  double ax = shape->outline[2 * i], ay = shape->outline[2 * i + 1];
+  double ex = shape->outline[2 * j] - ax, ey = shape->outline[2 * j + 1] - ay;
+  double s = ((x - ax) * ex + (y - ay) * ey) / (ex * ex + ey * ey);
+  s = s < 0 ? 0 : (s > 1 ? 1 : s);
+  double cx = ax + s * ex, cy = ay + s * ey;
+  double d2 = (x - cx) * (x - cx) + (y - cy) * (y - cy);
+  if (d2 < best->dist2) *best = (nearest2){d2, cx, cy, i};
+}
+
 piola_status piola__gear_init(const piola_obstacle_def *def, piola__gear_shape *shape) {
   shape->outline = NULL;
   PIOLA_TRY(piola__obstacle_positive(def->radius, "gear radius"));
@@ -91,29 +110,19 @@ piola_status piola__gear_init(const piola_obstacle_def *def, piola__gear_shape *
       shape->outline[2 * (j * v + k) + 1] = r * sin(phi);
     }
   }
+  /* The largest disk about the centre inside the outline: the nearest edge to the centre. */
+  shape->inner_radius = shape->tip_radius;
+  for (int32_t i = 0; i < shape->vertex_count; ++i) {
+    nearest2 to_centre = {INFINITY, 0, 0, 0};
+    visit_edge(shape, i, 0.0, 0.0, &to_centre);
+    shape->inner_radius = fmin(shape->inner_radius, sqrt(to_centre.dist2));
+  }
   return PIOLA_OK;
 }
 
 void piola__gear_free(piola__gear_shape *shape) {
   free(shape->outline);
   shape->outline = NULL;
-}
-
-typedef struct nearest2 {
-  double dist2;   /* squared distance to the nearest point found */
-  double cx, cy;  /* that point */
-  int32_t edge;   /* its edge (start vertex index) */
-} nearest2;
-
-static void visit_edge(const piola__gear_shape *shape, int32_t i, double x, double y, nearest2 *best) {
-  int32_t j = i + 1 == shape->vertex_count ? 0 : i + 1;
-  double ax = shape->outline[2 * i], ay = shape->outline[2 * i + 1];
-  double ex = shape->outline[2 * j] - ax, ey = shape->outline[2 * j + 1] - ay;
-  double s = ((x - ax) * ex + (y - ay) * ey) / (ex * ex + ey * ey);
-  s = s < 0 ? 0 : (s > 1 ? 1 : s);
-  double cx = ax + s * ex, cy = ay + s * ey;
-  double d2 = (x - cx) * (x - cx) + (y - cy) * (y - cy);
-  if (d2 < best->dist2) *best = (nearest2){d2, cx, cy, i};
 }
 
 /* Signed 2D distance to the outline at (x, y) in the gear plane; (nx, ny) outward normal. */
@@ -128,15 +137,21 @@ static double outline_distance(const piola__gear_shape *shape, double x, double 
   u = u < -0.5 ? -0.5 : (u > 0.5 ? 0.5 : u);
   int32_t k0 = ((int32_t)k_real % n + n) % n;
 
+  /* Teeth in order of angular separation from the point: tooth k0 + m and k0 - m are at
+   * least beta = (m - 1/2 - |u|) P away in angle, and every edge lies in the annulus
+   * [inner_radius, tip_radius], so no point of them is nearer than the bound below; stop at
+   * the first m whose bound cannot beat the best distance found. */
   nearest2 best = {INFINITY, 0, 0, 0};
-  int32_t teeth = n < 3 ? n : 3;
-  for (int32_t t = 0; t < teeth; ++t) {
-    int32_t tooth = (k0 + n - 1 + t) % n;
-    for (int32_t k = 0; k < v; ++k) visit_edge(shape, tooth * v + k, x, y, &best);
+  for (int32_t m = 0; 2 * m <= n; ++m) {
+    double beta = fmin(fmax((m - 0.5 - fabs(u)) * period, 0.0), M_PI);
+    double r = fmin(fmax(rho * cos(beta), shape->inner_radius), shape->tip_radius);
+    double bound2 = r * r + rho * rho - 2.0 * rho * r * cos(beta);
+    if (m > 0 && bound2 >= best.dist2) break;
+    int32_t plus = (k0 + m) % n, minus = ((k0 - m) % n + n) % n;
+    for (int32_t k = 0; k < v; ++k) visit_edge(shape, plus * v + k, x, y, &best);
+    if (minus != plus)
+      for (int32_t k = 0; k < v; ++k) visit_edge(shape, minus * v + k, x, y, &best);
   }
-  double bound = rho * sin(fmin(period, 0.5 * M_PI));
-  if (n > 3 && best.dist2 > bound * bound)
-    for (int32_t i = 0; i < shape->vertex_count; ++i) visit_edge(shape, i, x, y, &best);
 
   /* Inside test: the outline is star-shaped about the centre, so the point is inside iff it
    * is left of the edge of tooth k0 that the ray from the centre through it crosses. */
@@ -169,11 +184,18 @@ static double outline_distance(const piola__gear_shape *shape, double x, double 
 double piola__gear_distance(const piola__gear_shape *shape, vec3 p, vec3 *normal) {
   vec3 q = vec3_sub(p, shape->center);
   double x = vec3_dot(q, shape->e1), y = vec3_dot(q, shape->e2), h = vec3_dot(q, shape->axis);
+  double dh = fabs(h) - shape->half_length;
+  vec3 axial_n = h < 0 ? vec3_neg(shape->axis) : shape->axis;
+  /* Inside the inscribed disk the outline is at least inner_radius - rho away; when the face
+   * is nearer than that (or the point is beyond the face) the axial distance is the answer. */
+  double rho = hypot(x, y);
+  if (rho < shape->inner_radius && dh >= rho - shape->inner_radius) {
+    if (normal) *normal = axial_n;
+    return dh;
+  }
   double nx, ny;
   double d2 = outline_distance(shape, x, y, &nx, &ny);
-  double dh = fabs(h) - shape->half_length;
   vec3 radial_n = vec3_add(vec3_scale(shape->e1, nx), vec3_scale(shape->e2, ny));
-  vec3 axial_n = h < 0 ? vec3_neg(shape->axis) : shape->axis;
   if (d2 <= 0 && dh <= 0) {
     if (normal) *normal = d2 >= dh ? radial_n : axial_n;
     return fmax(d2, dh);

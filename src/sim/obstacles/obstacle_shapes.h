@@ -47,6 +47,7 @@ typedef struct piola__torus_shape {
 typedef struct piola__gear_shape {
   vec3 center, axis, e1, e2;
   double half_length, tip_radius, root_radius;
+  double inner_radius; /* distance from the centre to the nearest outline edge, m */
   int32_t tooth_count;
   int32_t vertex_count;
   double *outline;

@@ -166,6 +166,22 @@ static void velocity_is_the_time_derivative_of_material_points(void **state) {
   }
 }
 
+static void angular_velocity_vector_sets_axis_and_speed(void **state) {
+  (void)state;
+  piola_rigid_motion_def m = piola_default_rigid_motion_def();
+  piola_rigid_motion_set_angular_velocity(&m, vec3_make(0, 3, -4));
+  assert_close(m.axis.y, 0.6, 1e-15);
+  assert_close(m.axis.z, -0.8, 1e-15);
+  assert_close(piola_track_eval(&m.angular_speed, 1.0), 5, 1e-15);
+  /* The velocity of a point is omega x (x - pivot). */
+  vec3 v = piola_rigid_motion_velocity(&m, 0.0, vec3_make(1, 0, 0));
+  vec3 expected = vec3_cross(vec3_make(0, 3, -4), vec3_make(1, 0, 0));
+  assert_close(vec3_norm(vec3_sub(v, expected)), 0, 1e-14);
+  piola_rigid_motion_set_angular_velocity(&m, vec3_make(0, 0, 0));
+  assert_close(piola_track_eval(&m.angular_speed, 1.0), 0, 0);
+  assert_close(vec3_norm(m.axis), 1, 1e-15);
+}
+
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(default_motion_is_rest),
@@ -173,6 +189,7 @@ int main(void) {
       cmocka_unit_test(keyframed_angular_speed_integrates_exactly),
       cmocka_unit_test(rotation_is_rodrigues_about_the_axis),
       cmocka_unit_test(pose_keys_are_the_pose),
+      cmocka_unit_test(angular_velocity_vector_sets_axis_and_speed),
       cmocka_unit_test(velocity_is_the_time_derivative_of_material_points),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);

@@ -84,7 +84,7 @@ int32_t piola_obstacles_collide(piola_obstacle *const *obstacles, int32_t obstac
     return -1;
   }
   for (int32_t k = 0; k < obstacle_count; ++k)
-    piola__rigid_motion_state(&obstacles[k]->motion, t, &states[k]);
+    if (obstacles[k]) piola__rigid_motion_state(&obstacles[k]->motion, t, &states[k]);
 
   int32_t count = 0;
 #pragma omp parallel for schedule(static) reduction(+ : count)
@@ -94,7 +94,7 @@ int32_t piola_obstacles_collide(piola_obstacle *const *obstacles, int32_t obstac
     for (int sweep = 0; sweep < COLLISION_SWEEPS; ++sweep) {
       bool any = false;
       for (int32_t k = 0; k < obstacle_count; ++k)
-        if (collide_node(obstacles[k], &states[k], dt, &xi, &vi, &ni)) any = true;
+        if (obstacles[k] && collide_node(obstacles[k], &states[k], dt, &xi, &vi, &ni)) any = true;
       if (!any) break;
       hit = true;
     }

@@ -22,6 +22,13 @@ piola_rigid_motion_def piola_default_rigid_motion_def(void) {
   return def;
 }
 
+void piola_rigid_motion_set_angular_velocity(piola_rigid_motion_def *motion,
+                                             piola_vec3 angular_velocity) {
+  double speed = vec3_norm(angular_velocity);
+  if (speed > 0 && isfinite(speed)) motion->axis = vec3_scale(angular_velocity, 1.0 / speed);
+  motion->angular_speed = piola_track_constant(isfinite(speed) ? speed : NAN);
+}
+
 /* Antiderivative F with F(times[0]) = 0 (F(0) = 0 for a constant track). */
 static double track_antiderivative(const piola_track *track, double t) {
   int32_t n = track->key_count;

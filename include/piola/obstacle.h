@@ -30,7 +30,7 @@ typedef enum piola_obstacle_type {
   PIOLA_OBSTACLE_CYLINDER,  /* center, axis, radius, half_length (capped) */
   PIOLA_OBSTACLE_CAPSULE,   /* center, axis, radius, half_length (segment half length) */
   PIOLA_OBSTACLE_TORUS,     /* center, axis, major radius, minor radius */
-  PIOLA_OBSTACLE_GEAR,      /* center, axis, radius (pitch), tooth count/depth, half_length */
+  PIOLA_OBSTACLE_GEAR,      /* center, axis, radius (tips), tooth count/depth, half_length */
   PIOLA_OBSTACLE_MESH,      /* closed triangle mesh */
   PIOLA_OBSTACLE_TYPE_COUNT
 } piola_obstacle_type;

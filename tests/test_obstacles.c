@@ -191,6 +191,52 @@ static void mesh_cube_equals_box(void **state) {
   piola_obstacle_destroy(box);
 }
 
+/* The octahedron |x| + |y| + |z| <= 1 (8 triangles, outward): inside a convex solid the
+ * distance is that to the nearest face plane, (|x| + |y| + |z| - 1) / sqrt(3); outside it is
+ * at least that. */
+static void mesh_octahedron_matches_its_face_planes(void **state) {
+  (void)state;
+  double positions[18] = {1, 0, 0, -1, 0, 0, 0, 1, 0, 0, -1, 0, 0, 0, 1, 0, 0, -1};
+  int32_t triangles[24];
+  int t = 0;
+  for (int sx = 0; sx < 2; ++sx)
+    for (int sy = 0; sy < 2; ++sy)
+      for (int sz = 0; sz < 2; ++sz) {
+        int32_t a = sx, b = 2 + sy, c = 4 + sz;
+        /* Outward when (a, b, c) has the orientation of the octant's sign product. */
+        int positive = ((sx == 0) + (sy == 0) + (sz == 0)) % 2 == 1;
+        triangles[3 * t] = a;
+        triangles[3 * t + 1] = positive ? b : c;
+        triangles[3 * t + 2] = positive ? c : b;
+        ++t;
+      }
+  piola_tri_mesh octa = {6, positions, 8, triangles};
+  piola_obstacle_def d = piola_default_obstacle_def();
+  d.type = PIOLA_OBSTACLE_MESH;
+  d.mesh = &octa;
+  piola_obstacle *o = make(&d);
+  test_rng rng = test_rng_seeded(21);
+  for (long k = 0; k < test_samples(2000, 100); ++k) {
+    vec3 p = vec3_make(test_rng_uniform(&rng, -1.5, 1.5), test_rng_uniform(&rng, -1.5, 1.5),
+                       test_rng_uniform(&rng, -1.5, 1.5));
+    double plane = (fabs(p.x) + fabs(p.y) + fabs(p.z) - 1) / sqrt(3.0);
+    vec3 n;
+    double dist = piola_obstacle_signed_distance(o, 0, p, &n, NULL);
+    if (plane < 0) {
+      assert_close(dist, plane, 1e-14);
+      /* The normal of the nearest face: (sign x, sign y, sign z) / sqrt 3. */
+      assert_close(fabs(n.x), 1 / sqrt(3.0), 1e-12);
+      assert_close(fabs(n.y), 1 / sqrt(3.0), 1e-12);
+    } else {
+      assert_true(dist >= plane - 1e-14);
+    }
+    assert_close(phi(o, p.x - dist * n.x, p.y - dist * n.y, p.z - dist * n.z), 0, 1e-14);
+  }
+  assert_close(phi(o, 0, 0, 0), -1 / sqrt(3.0), 1e-15);
+  assert_close(phi(o, 0, 0, 3), 2, 1e-15); /* off a vertex */
+  piola_obstacle_destroy(o);
+}
+
 static piola_obstacle_def random_def(piola_obstacle_type type, piola_tri_mesh *cube) {
   piola_obstacle_def d = piola_default_obstacle_def();
   d.type = type;
@@ -470,6 +516,7 @@ int main(void) {
       cmocka_unit_test(capsule_distances),
       cmocka_unit_test(torus_distances),
       cmocka_unit_test(mesh_cube_equals_box),
+      cmocka_unit_test(mesh_octahedron_matches_its_face_planes),
       cmocka_unit_test(normals_are_gradients_and_eikonal),
       cmocka_unit_test(distances_are_one_lipschitz),
       cmocka_unit_test(moving_obstacles_carry_their_distance),

@@ -57,7 +57,17 @@ double piola_elastic_body_max_wave_speed(const piola_elastic_body *body) {
   return body->max_wave_speed;
 }
 const double *piola_elastic_body_det_f(const piola_elastic_body *body) { return body->det_f; }
+/* Computed here, on first request after an update without stats: the energy is not needed
+ * to step, so the force loop skips it unless asked. */
 const double *piola_elastic_body_energy_density(const piola_elastic_body *body) {
+  if (!body->energy_valid) {
+    piola_elastic_body *mutable_body = (piola_elastic_body *)body;
+    for (int32_t t = 0; t < body->tet_count; ++t)
+      mutable_body->energy_density[t] =
+          body->last_stiffness_scale *
+          piola_material_energy_density(&body->materials[body->tet_material[t]], body->fhat + 3 * t);
+    mutable_body->energy_valid = 1;
+  }
   return body->energy_density;
 }
 const double *piola_elastic_body_fhat(const piola_elastic_body *body) { return body->fhat; }
@@ -82,7 +92,7 @@ void piola__elastic_body_gather_forces(const piola_elastic_body *body, double *f
 
 /* One block of B tets: F, SVD, stress, forces into the per-tet buffer, block statistics. */
 PIOLA_WIDE_VECTORS static void update_block(piola_elastic_body *body, const double *x, double stiffness_scale,
-                         int32_t block) {
+                         int want_energy, int32_t block) {
   const int32_t base = block * B;
   double f[9][B], detf[B];
   const int32_t *i0 = body->tet_vertices[0] + base, *i1 = body->tet_vertices[1] + base;
@@ -114,7 +124,13 @@ PIOLA_WIDE_VECTORS static void update_block(piola_elastic_body *body, const doub
   for (int l = 0; l < B; ++l) piola__svd3_kernel(&f[0][l], B, &u[0][l], &fhat[0][l], &v[0][l], B);
 
   double phat[3][B], psi[B];
-  piola__material_lanes(body, base, fhat, phat, psi);
+  piola__material_stress_lanes(body, base, fhat, phat);
+  for (int l = 0; l < B; ++l) psi[l] = 0.0;
+  if (want_energy)
+    for (int l = 0; l < B; ++l) {
+      double fh[3] = {fhat[0][l], fhat[1][l], fhat[2][l]};
+      psi[l] = piola_material_energy_density(&body->materials[body->tet_material[base + l]], fh);
+    }
 
   double g[9][B];
   const double *volume = body->rest_volume + base;
@@ -197,9 +213,11 @@ piola_status piola_elastic_body_update(piola_elastic_body *body, const double *x
   }
   int32_t blocks = body->padded_tet_count / B;
 #pragma omp parallel for schedule(static) num_threads(piola__thread_count())
-  for (int32_t b = 0; b < blocks; ++b) update_block(body, x, stiffness_scale, b);
+  for (int32_t b = 0; b < blocks; ++b) update_block(body, x, stiffness_scale, stats != NULL, b);
   piola__elastic_body_gather_forces(body, forces);
   body->has_state = 1;
+  body->energy_valid = stats != NULL;
+  body->last_stiffness_scale = stiffness_scale;
   if (stats) {
     double energy = 0, min_det = INFINITY;
     int32_t inverted = 0;

@@ -19,6 +19,9 @@
  * the same place, so forces are bit-for-bit identical for any thread count, without atomics.
  * Statistics are summed per block and then serially over blocks for the same reason.
  *
+ * The energy density is computed only when asked for (stats or the getter): stepping needs
+ * forces, not energy, and the energy goes through the (scalar) public material function.
+ *
  * Padding tets (the tail of the last block) have Dm^-1 = 0 and V0 = 0 and point at vertex 0:
  * F = 0, forces 0, and they are excluded from statistics. */
 #ifndef PIOLA_FORCE_ELASTIC_BODY_INTERNAL_H
@@ -73,6 +76,9 @@ struct piola_elastic_body {
   double min_rest_altitude;
   double max_wave_speed;
   int has_state;            /* an update has run: U, V are valid */
+  int energy_valid;         /* energy_density matches the last update (it is computed only
+                               when stats are requested, or lazily by the getter) */
+  double last_stiffness_scale;
 };
 
 /* Builds the rest state of body from def (rest_state.c): validates def, reorients, fills

@@ -208,5 +208,7 @@ piola_status piola__elastic_body_build_rest_state(piola_elastic_body *body,
     body->fhat[3 * t] = body->fhat[3 * t + 1] = body->fhat[3 * t + 2] = 1.0;
     body->det_f[t] = 1.0;
   }
+  body->energy_valid = 1; /* zero at rest */
+  body->last_stiffness_scale = 1.0;
   return PIOLA_OK;
 }

@@ -72,6 +72,7 @@ struct piola_elastic_body {
   int32_t *tets;            /* 4 * tet_count, public AoS copy after reorientation */
   double *rest_positions;   /* 3 * vertex_count */
   double *masses;           /* vertex_count */
+  double *positions;        /* 3 * vertex_count: x of the last update (damping needs it) */
   double density;
   double min_rest_altitude;
   double max_wave_speed;

@@ -40,6 +40,7 @@ void piola__elastic_body_free_arrays(piola_elastic_body *body) {
   free(body->tets);
   free(body->rest_positions);
   free(body->masses);
+  free(body->positions);
   memset(body, 0, sizeof *body);
 }
 
@@ -131,10 +132,12 @@ piola_status piola__elastic_body_build_rest_state(piola_elastic_body *body,
   ok &= (body->tets = alloc_array(4 * (size_t)nt, sizeof(int32_t))) != NULL;
   ok &= (body->rest_positions = alloc_array(3 * (size_t)nv, sizeof(double))) != NULL;
   ok &= (body->masses = alloc_array((size_t)nv, sizeof(double))) != NULL;
+  ok &= (body->positions = alloc_array(3 * (size_t)nv, sizeof(double))) != NULL;
   if (!ok) return PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "elastic body with %d tets: out of memory", (int)nt);
 
   memcpy(body->materials, def->materials, sizeof(piola_material) * (size_t)def->material_count);
   memcpy(body->rest_positions, mesh->positions, sizeof(double) * 3 * (size_t)nv);
+  memcpy(body->positions, mesh->positions, sizeof(double) * 3 * (size_t)nv);
   body->uniform_material = def->tet_materials ? def->tet_materials[0] : 0;
 
   double min_altitude = INFINITY;

@@ -25,7 +25,6 @@
  * eps = 1e-12 tr(R^T R) regularizes tets collapsed to a line or a point, whose R^T R is
  * singular (for a point R = 0 and P = I: all corners coincide, so there is no torque). */
 #include <math.h>
-#include <string.h>
 
 #include "force/elastic_body_internal.h"
 #include "force/svd_kernel.h"
@@ -106,14 +105,22 @@ static void tet_damping(const piola_elastic_body *body, int32_t t, const double 
     }
 }
 
+/* Writes tet t's 12 force components into the blocked per-tet buffer. */
+static void store_tet_forces(const piola_elastic_body *body, int32_t t, const double out[12]) {
+  for (int c = 0; c < 4; ++c) {
+    double *o = body->tet_forces + piola__tet_force_offset(t, c);
+    for (int i = 0; i < 3; ++i) o[i * B] = out[3 * c + i];
+  }
+}
+
 static void damping_block(const piola_elastic_body *body, const double *vel, double beta,
                           double alpha, int32_t block) {
   const int32_t base = block * B;
   for (int l = 0; l < B; ++l) {
     const int32_t t = base + l;
-    double *out = body->tet_forces + 12 * (size_t)t;
+    double out[12] = {0};
     if (t >= body->tet_count) {
-      memset(out, 0, 12 * sizeof(double));
+      store_tet_forces(body, t, out);
       continue;
     }
     double pt[12], vt[12];
@@ -127,6 +134,7 @@ static void damping_block(const piola_elastic_body *body, const double *vel, dou
     remove_rotation(pt, vt);
     tet_damping(body, t, vt, beta, alpha, out);
     remove_rotation(pt, out);
+    store_tet_forces(body, t, out);
   }
 }
 

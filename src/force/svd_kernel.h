@@ -160,9 +160,10 @@ PIOLA_KERNEL_INLINE double piola__rsqrt_rough(double x) {
 /* F = U diag(fhat) V^T with U, V proper rotations, |fhat_0| >= |fhat_1| >= |fhat_2|,
  * fhat_0, fhat_1 >= 0, sign(fhat_2) = sign(det F). Entry k (row-major, k = 3 row + col) of
  * F is f[k * in_stride]; of U and V, u[k * out_stride] and v[k * out_stride]; fhat entry i
- * is fhat[i * out_stride]. Strides let the caller read and write SoA lanes directly. */
+ * is fhat[i * fhat_stride]. Strides let the caller read and write SoA lanes directly. */
 PIOLA_KERNEL_INLINE void piola__svd3_kernel(const double *f, long in_stride, double *u,
-                                            double *fhat, double *v, long out_stride) {
+                                            double *v, long out_stride, double *fhat,
+                                            long fhat_stride) {
   double a00 = f[0 * in_stride], a01 = f[1 * in_stride], a02 = f[2 * in_stride];
   double a10 = f[3 * in_stride], a11 = f[4 * in_stride], a12 = f[5 * in_stride];
   double a20 = f[6 * in_stride], a21 = f[7 * in_stride], a22 = f[8 * in_stride];
@@ -261,8 +262,8 @@ PIOLA_KERNEL_INLINE void piola__svd3_kernel(const double *f, long in_stride, dou
   b22 = r22;
 
   fhat[0] = b00 * scale;
-  fhat[out_stride] = b11 * scale;
-  fhat[2 * out_stride] = b22 * scale;
+  fhat[fhat_stride] = b11 * scale;
+  fhat[2 * fhat_stride] = b22 * scale;
   u[0] = u00; u[out_stride] = u01; u[2 * out_stride] = u02;
   u[3 * out_stride] = u10; u[4 * out_stride] = u11; u[5 * out_stride] = u12;
   u[6 * out_stride] = u20; u[7 * out_stride] = u21; u[8 * out_stride] = u22;

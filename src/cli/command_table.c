@@ -4,5 +4,6 @@
 #include <stddef.h>
 
 const cli_command cli_commands[] = {
+    {"run", cli_run},
     {NULL, NULL},
 };

@@ -84,6 +84,48 @@ static int32_t damping_solve(const piola_world *w, world_solid *s, double h, dou
   return piola__cg_solve(&pb, rhs, v, s->work);
 }
 
+/* Friction for the second half of the step's contact impulse.
+ *
+ * Collision processing (step 3) applies friction with the normal velocity change it causes,
+ * dvN + dxN/dt; in resting contact that is the half-step of normal acceleration that
+ * carried the node into the obstacle through v~. The final solve then holds the normal
+ * velocity, which removes the normal impulse of the other half, dt/2 a^n+1 . n; without
+ * friction for it a block on an incline would feel half its Coulomb friction. Here that
+ * impulse, dt/2 (f^n+1 + f_ext + D v^n+1) . n / m when it presses into the obstacle, limits
+ * the relative tangential velocity the same way: vT <- max(0, 1 - mu dvN / |vT|) vT. */
+static void contact_friction(const piola_world *w, world_solid *s, double t1, double h,
+                             const double *g1, const double *av) {
+  for (int32_t i = 0; i < s->n; ++i) {
+    if (!s->colliding[i] || s->flags[i] != SOLID_FREE) continue;
+    const double *nrm = s->normals + 3 * i;
+    double *vi = s->v + 3 * i;
+    /* normal impulse per unit mass of the n+1 half: h (f + m g).n + (h D v).n, where
+     * h D v = M v - A v */
+    double push = 0;
+    for (int k = 0; k < 3; ++k)
+      push += nrm[k] * (h * (s->force[3 * i + k] + s->mass[i] * g1[k]) + s->mass[i] * vi[k] - av[3 * i + k]);
+    double dvn = -push / s->mass[i];
+    if (!(dvn > 0)) continue;
+    /* the obstacle the node touches: the one nearest to it */
+    piola_vec3 p = {s->x[3 * i], s->x[3 * i + 1], s->x[3 * i + 2]};
+    double best = INFINITY, mu = 0;
+    piola_vec3 vo = {0, 0, 0};
+    for (int32_t o = 0; o < w->obstacle_count; ++o) {
+      piola_vec3 vel;
+      double phi = fabs(piola_obstacle_signed_distance(w->obstacles[o], t1, p, NULL, &vel));
+      if (phi < best) best = phi, mu = piola_obstacle_friction(w->obstacles[o]), vo = vel;
+    }
+    if (!(mu > 0)) continue;
+    double rel[3] = {vi[0] - vo.x, vi[1] - vo.y, vi[2] - vo.z};
+    double rn = rel[0] * nrm[0] + rel[1] * nrm[1] + rel[2] * nrm[2];
+    double vt[3] = {rel[0] - rn * nrm[0], rel[1] - rn * nrm[1], rel[2] - rn * nrm[2]};
+    double vtn = sqrt(vt[0] * vt[0] + vt[1] * vt[1] + vt[2] * vt[2]);
+    if (!(vtn > 0)) continue;
+    double keep = fmax(0.0, 1.0 - mu * dvn / vtn);
+    for (int k = 0; k < 3; ++k) vi[k] -= (1.0 - keep) * vt[k];
+  }
+}
+
 static double stiffness_bound(const world_solid *s, double t0, double t1) {
   /* the largest stiffness scale over [t0, t1]: the tracks are piecewise linear, so the
    * maximum is at an end or at a key inside */
@@ -184,6 +226,19 @@ static piola_status step_solid(piola_world *w, world_solid *s, double t, double 
     for (int k = 0; k < 3; ++k)
       s->rhs[3 * i + k] += h * (s->force[3 * i + k] + s->mass[i] * g1[k]);
   stats->cg_iterations += damping_solve(w, s, h, t1, 1, s->rhs, s->v);
+  if (colliding > 0) {
+    /* A v^n+1 for the friction of the held normal impulse (tmp and rhs are free now) */
+    double beta1 = piola_track_eval(&s->shear_viscosity, t1);
+    double alpha1 = piola_track_eval(&s->bulk_viscosity, t1);
+    damping_system d = {s, h, beta1, alpha1, 1, s->tmp};
+    if (beta1 != 0 || alpha1 != 0) {
+      damping_apply(&d, s->v, s->rhs);
+    } else {
+      for (int32_t i = 0; i < n; ++i)
+        for (int k = 0; k < 3; ++k) s->rhs[3 * i + k] = s->mass[i] * s->v[3 * i + k];
+    }
+    contact_friction(w, s, t1, h, g1, s->rhs);
+  }
   for (int64_t j = 0; j < m; ++j)
     if (!isfinite(s->v[j])) {
       restore(s, t);

@@ -172,7 +172,8 @@ piola_status piola_output_write_frame(piola_output *o, const piola_world *world,
                               {"inverted", 1, o->inverted},
                               {"energy_density", 1, o->energy},
                               {"solid", 1, o->solid}};
-  piola_vtu_frame frame = {&o->tets, NULL, points, 2, cells, 4};
+  piola_vtu_frame frame = {.tets = &o->tets, .triangles = NULL, .point_fields = points,
+                           .point_field_count = 2, .cell_fields = cells, .cell_field_count = 4};
   snprintf(path, sizeof path, "%s/frames/frame_%04d.vtu", o->dir, (int)info->frame);
   PIOLA_TRY(piola_vtu_write(path, &frame));
   o->surface.positions = o->tets.positions; /* same numbering; borrowed for the write */

@@ -342,11 +342,27 @@ static void check_finite_and_restoring(const piola_material *m, const double f[3
 
 static void flat_and_inverted_entries_are_finite_and_pushed_back(void **state) {
   (void)state;
-  const double fixed[][3] = {
-      {0, 0, 0},       {-1, -1, -1},     {-1e6, -1e6, -1e6}, {0, 1, 1},
-      {-0.5, 1, 1},    {-1e6, 1, 1},     {0, 0, 1},          {-2, 0, 3},
-      {-0.01, 5, 5},   {-0.01, 10, 10},  {0, 10, 0.1},       {-3, -2, 8},
-      {-1e-300, 1, 1}, {-0.2, 0.3, 0.3}, {1e3, -1e3, 1e3},   {0.1, 0.2, -50}};
+  const double fixed[][3] = {{0, 0, 0},
+                             {-1, -1, -1},
+                             {-1e6, -1e6, -1e6},
+                             {0, 1, 1},
+                             {-0.5, 1, 1},
+                             {-1e6, 1, 1},
+                             {0, 0, 1},
+                             {-2, 0, 3},
+                             {-0.01, 5, 5},
+                             {-0.01, 10, 10},
+                             {0, 10, 0.1},
+                             {-3, -2, 8},
+                             {-1e-300, 1, 1},
+                             {-0.2, 0.3, 0.3},
+                             {1e3, -1e3, 1e3},
+                             {0.1, 0.2, -50},
+                             /* The documented range of finiteness: |f| up to 1e30. */
+                             {1e30, 1e30, 1e30},
+                             {-1e30, 1e30, 1e30},
+                             {-1e30, -1e30, -1e30},
+                             {-1e30, 1e-30, 1e30}};
   test_rng rng = test_rng_seeded(16);
   const long samples = test_samples(2000, 50);
   const double nus[] = {-0.5, 0.3, 0.49};

@@ -479,12 +479,12 @@ static void invalid_definitions_are_rejected(void **state) {
   cube_mesh(&cube, vec3_make(0, 0, 0), vec3_make(1, 1, 1), 0);
   d.mesh = &cube;
   cube.triangle_count = 11; /* a hole */
-  expect_error(&d, PIOLA_ERROR_INVALID_ARGUMENT, "not closed");
+  expect_error(&d, PIOLA_ERROR_INVALID_ARGUMENT, "open");
   cube.triangle_count = 12;
   int32_t keep = cube.triangles[1];
   cube.triangles[1] = cube.triangles[2]; /* one face wound against its neighbours */
   cube.triangles[2] = keep;
-  expect_error(&d, PIOLA_ERROR_INVALID_ARGUMENT, "mesh obstacle");
+  expect_error(&d, PIOLA_ERROR_INVALID_ARGUMENT, "mesh obstacle: surface is not consistently oriented");
   cube.triangles[2] = cube.triangles[1];
   cube.triangles[1] = keep;
   cube.triangles[5] = 8;

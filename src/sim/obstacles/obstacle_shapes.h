@@ -53,13 +53,13 @@ typedef struct piola__gear_shape {
   double *outline;
 } piola__gear_shape;
 
-/* A closed triangle surface (copied). */
+struct piola__surface_distance;
+
+/* A closed triangle surface (copied into the distance structure, wound outward). */
 typedef struct piola__mesh_shape {
   int32_t vertex_count, triangle_count;
-  double *positions;   /* 3 * vertex_count */
-  int32_t *triangles;  /* 3 * triangle_count */
   vec3 box_min, box_max;
-  void *accel;         /* the closest-point structure, or NULL for brute force */
+  struct piola__surface_distance *accel; /* geometry/surface_distance: BVH + winding number */
 } piola__mesh_shape;
 
 /* Vertices per tooth of the gear outline (see gear.c for the profile). */

@@ -79,3 +79,7 @@ void piola__mesh_obstacle_free(piola__mesh_shape *shape) {
 double piola__mesh_obstacle_distance(const piola__mesh_shape *shape, vec3 p, vec3 *normal) {
   return piola__surface_signed_distance(shape->accel, p, normal, NULL);
 }
+
+bool piola__mesh_obstacle_contains(const piola__mesh_shape *shape, vec3 p) {
+  return piola__surface_winding_number(shape->accel, p) > 0.5;
+}

@@ -13,6 +13,7 @@
 #ifndef PIOLA_SIM_OBSTACLES_OBSTACLE_SHAPES_H
 #define PIOLA_SIM_OBSTACLES_OBSTACLE_SHAPES_H
 
+#include <stdbool.h>
 #include <stdint.h>
 
 #include "math/mat3.h"
@@ -93,6 +94,9 @@ double piola__gear_profile_radius(const piola__gear_shape *shape, double phi);
 piola_status piola__mesh_obstacle_init(const piola_obstacle_def *def, piola__mesh_shape *shape);
 double piola__mesh_obstacle_distance(const piola__mesh_shape *shape, vec3 p, vec3 *normal);
 void piola__mesh_obstacle_free(piola__mesh_shape *shape);
+/* Whether p is inside by the winding number alone: much cheaper than the distance far from
+ * the surface, where the nearest-triangle search cannot prune. */
+bool piola__mesh_obstacle_contains(const piola__mesh_shape *shape, vec3 p);
 
 /* Shared validation: the axis normalized if its length is within 1e-3 of 1, else an error
  * naming `what`. */

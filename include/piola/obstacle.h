@@ -71,7 +71,7 @@ PIOLA_API double piola_obstacle_friction(const piola_obstacle *obstacle);
 PIOLA_API void piola_obstacle_destroy(piola_obstacle *obstacle);
 
 /* Section 9 collision processing for node_count nodes at time t (s) after a position
- * update of length dt (s). x (m) and v (m/s) are 3 * node_count and are modified in place.
+ * update of length dt (s; with dt <= 0 the dxN / dt friction term is dropped). x (m) and v (m/s) are 3 * node_count and are modified in place.
  * colliding (node_count, may be NULL) is set to 1 for nodes that were projected, else 0;
  * normals (3 * node_count, may be NULL) receives their obstacle normals, for holding the
  * normal velocity fixed in the final solve. Returns the number of colliding nodes, or -1

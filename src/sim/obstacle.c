@@ -167,7 +167,9 @@ void piola_obstacle_destroy(piola_obstacle *obstacle) {
   free(obstacle);
 }
 
-double piola_obstacle_friction(const piola_obstacle *obstacle) { return obstacle->friction; }
+double piola_obstacle_friction(const piola_obstacle *obstacle) {
+  return obstacle ? obstacle->friction : 0.0;
+}
 
 /* The shape's distance in its t = 0 frame. */
 static double shape_distance(const piola_obstacle *o, vec3 p, vec3 *normal) {
@@ -200,6 +202,11 @@ double piola__obstacle_distance_posed(const piola_obstacle *obstacle,
 
 double piola_obstacle_signed_distance(const piola_obstacle *obstacle, double t, piola_vec3 p,
                                       piola_vec3 *normal, piola_vec3 *velocity) {
+  if (!obstacle) { /* nothing is inside no obstacle */
+    if (normal) *normal = vec3_make(0, 0, 1);
+    if (velocity) *velocity = vec3_make(0, 0, 0);
+    return INFINITY;
+  }
   piola__rigid_state state;
   piola__rigid_motion_state(&obstacle->motion, t, &state);
   return piola__obstacle_distance_posed(obstacle, &state, p, normal, velocity);

@@ -31,8 +31,9 @@ int main(int argc, char **argv) {
   if (!x0 || !x || !v) return 1;
   piola_tri_mesh bunny = {0};
   piola_status read = piola_tri_mesh_read(PIOLA_DATA_DIR "/surface/bunny_10k.obj", &bunny);
-  static const char *const names[] = {"plane", "sphere", "box", "cylinder", "capsule",
-                                      "torus", "gear (24 teeth)", "mesh (bunny_10k)"};
+  static const char *const names[] = {"plane",           "sphere",          "box",
+                                      "cylinder",        "capsule",         "torus",
+                                      "gear (24 teeth)", "mesh (bunny_10k)"};
   printf("%d nodes, %d threads, median of 7 runs\n", n, omp_get_max_threads());
   printf("| obstacle | ns/node | nodes inside |\n|---|---|---|\n");
   for (int type = 0; type < PIOLA_OBSTACLE_TYPE_COUNT; ++type) {

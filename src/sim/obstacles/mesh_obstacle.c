@@ -9,8 +9,8 @@
  * triangle normal on the surface.
  *
  * Creation validates (indices, finite positions, closed, manifold and consistently oriented,
- * by the shared surface check, with messages naming the mesh obstacle) and winds an inward-wound surface outward, since the
- * winding number of an inward surface is -1 inside. */
+ * by the shared surface check, with messages naming the mesh obstacle) and winds an inward-wound
+ * surface outward, since the winding number of an inward surface is -1 inside. */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>

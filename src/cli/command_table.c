@@ -3,6 +3,9 @@
 
 #include <stddef.h>
 
+int cli_mesh(int argc, char **argv);
+
 const cli_command cli_commands[] = {
+    {"mesh", cli_mesh},
     {NULL, NULL},
 };

@@ -401,6 +401,40 @@ static void integer_matrices_with_zeros(void **state) {
   report("integers with zeros", &w);
 }
 
+/* Physics: Fhat depends only on the shape, not on rotations of world or material space, and
+ * mirroring the world (-F) flips exactly the sign of the smallest entry. */
+static void fhat_is_invariant_under_rotations(void **state) {
+  (void)state;
+  test_rng r = test_rng_seeded(1010);
+  long n = test_samples(200000, 200);
+  double worst = 0;
+  for (long i = 0; i < n; ++i) {
+    mat3 f = (i % 2) ? gaussian3(&r)
+                     : rotated_diagonal(&r, 1.0, log_uniform(&r, -6, 0),
+                                        random_sign(&r) * log_uniform(&r, -12, 0));
+    mat3 g = mat3_mul(mat3_mul(random_rotation(&r), f), mat3_transpose(random_rotation(&r)));
+    mat3 h = mat3_scale(f, -1.0);
+    mat3 u, v;
+    piola_vec3 df, dg, dh;
+    assert_int_equal(piola_diagonalize3(&f, &u, &df, &v), PIOLA_OK);
+    assert_int_equal(piola_diagonalize3(&g, &u, &dg, &v), PIOLA_OK);
+    assert_int_equal(piola_diagonalize3(&h, &u, &dh, &v), PIOLA_OK);
+    double nf = mat3_norm(f);
+    double a[3] = {df.x, df.y, df.z}, b[3] = {dg.x, dg.y, dg.z}, c[3] = {dh.x, dh.y, dh.z};
+    int sign_known = fabs(mat3_det(f)) > 1e-12 * nf * nf * nf;
+    for (int k = 0; k < 3; ++k) {
+      double e = fmax(fabs(fabs(a[k]) - fabs(b[k])), fabs(fabs(a[k]) - fabs(c[k]))) / nf;
+      worst = fmax(worst, e);
+      assert_true(e <= 1e-13);
+    }
+    if (sign_known) {
+      assert_true((a[2] > 0) == (b[2] > 0));
+      assert_true((a[2] > 0) == (c[2] < 0));
+    }
+  }
+  print_message("rotation invariance: %ld triples, worst |fhat| change %.2e |F|\n", n, worst);
+}
+
 /* ------------------------------------------------------------------------ 3x3 explicit */
 
 static void zero_gives_identity_frames(void **state) {
@@ -655,6 +689,37 @@ static void shells_property(void **state) {
   report("3x2 scales 1e-318..1e300", &wb);
 }
 
+static void shell_fhat_is_invariant_under_rotations(void **state) {
+  (void)state;
+  test_rng r = test_rng_seeded(1212);
+  long n = test_samples(200000, 200);
+  double worst = 0;
+  for (long i = 0; i < n; ++i) {
+    mat3x2 f, g, u;
+    mat2 v;
+    for (int k = 0; k < 6; ++k) f.m[k / 2][k % 2] = gauss(&r);
+    mat3 q = random_rotation(&r);
+    mat2 p = rotation2(test_rng_uniform(&r, -4, 4));
+    for (int a = 0; a < 3; ++a)
+      for (int b = 0; b < 2; ++b) {
+        double x = 0;
+        for (int k = 0; k < 3; ++k)
+          for (int l = 0; l < 2; ++l) x += q.m[a][k] * f.m[k][l] * p.m[b][l];
+        g.m[a][b] = x;
+      }
+    double df[2], dg[2];
+    assert_int_equal(piola_diagonalize3x2(&f, &u, df, &v), PIOLA_OK);
+    assert_int_equal(piola_diagonalize3x2(&g, &u, dg, &v), PIOLA_OK);
+    double nf = mat3x2_norm(f);
+    for (int k = 0; k < 2; ++k) {
+      double e = fabs(df[k] - dg[k]) / nf;
+      worst = fmax(worst, e);
+      assert_true(e <= 1e-13);
+    }
+  }
+  print_message("3x2 rotation invariance: %ld pairs, worst fhat change %.2e |F|\n", n, worst);
+}
+
 static void shells_explicit(void **state) {
   (void)state;
   mat3x2 f = {{{0, 0}, {0, 0}, {0, 0}}}, u;
@@ -716,8 +781,10 @@ int main(void) {
       cmocka_unit_test(perturbed_identity_and_reflections),
       cmocka_unit_test(extreme_scales),
       cmocka_unit_test(integer_matrices_with_zeros),
+      cmocka_unit_test(fhat_is_invariant_under_rotations),
       cmocka_unit_test(shells_explicit),
       cmocka_unit_test(shells_property),
+      cmocka_unit_test(shell_fhat_is_invariant_under_rotations),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
 }

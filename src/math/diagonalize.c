@@ -18,9 +18,10 @@
  * 1e-45 |F|, so leaving them is invisible at the promised 1e-12).
  *
  * Building U: u1 is b1 normalized (b1 is the longest column and, after scaling, never tiny),
- * u2 is the part of b2 orthogonal to u1, normalized (Gram-Schmidt done twice, so u2 stays
- * orthogonal even when b2 is mostly noise), or, when b2 has no usable direction, any unit
- * vector orthogonal to u1 (the completion of a collapsed element). For 3x3, u3 = u1 x u2,
+ * u2 is the part of b2 orthogonal to u1, normalized (one Gram-Schmidt pass after Jacobi; a
+ * second pass when b2 is tiny or nearly parallel to u1, so u2 stays orthogonal even when b2 is
+ * mostly noise), or, when b2 has no usable direction, any unit vector orthogonal to u1 (the
+ * completion of a collapsed element). For 3x3, u3 = u1 x u2,
  * which makes det U = +1 by construction; fhat3 = u3 . b3 then carries the sign of det F by
  * itself: det F = det B = |b1| |b2| (u1 x u2) . b3. That is the paper's "negate the smallest
  * entry and its column of U" without a separate reflection test.

@@ -133,6 +133,56 @@ static void writers_never_leave_partial_files(void **state) {
   piola_tet_mesh_free(&a);
 }
 
+/* A VTU with tets, triangles, point and cell fields, checked by VTK's own reader (through
+ * Debian's python3-vtk9) when it is installed. */
+static void vtu_with_fields_is_read_by_vtk(void **state) {
+  (void)state;
+  piola_tet_mesh tets;
+  load("gmsh/cube.msh", &tets);
+  piola_tri_mesh shell;
+  assert_int_equal(piola_tet_mesh_boundary(&tets, &shell), PIOLA_OK);
+  int32_t np = tets.vertex_count + shell.vertex_count, nc = tets.tet_count + shell.triangle_count;
+  double *temperature = malloc((size_t)np * sizeof(double));
+  double *velocity = malloc(3 * (size_t)np * sizeof(double));
+  double *stress = malloc((size_t)nc * sizeof(double));
+  for (int32_t i = 0; i < np; ++i) {
+    temperature[i] = 300.0 + i;
+    for (int k = 0; k < 3; ++k) velocity[3 * i + k] = 0.5 * i + k;
+  }
+  for (int32_t i = 0; i < nc; ++i) stress[i] = 1e6 * (i + 1);
+  piola_vtu_field point_fields[2] = {{"temperature", 1, temperature}, {"velocity", 3, velocity}};
+  piola_vtu_field cell_fields[1] = {{"stress", 1, stress}};
+  piola_vtu_frame frame = {0};
+  frame.tets = &tets;
+  frame.triangles = &shell;
+  frame.point_fields = point_fields;
+  frame.point_field_count = 2;
+  frame.cell_fields = cell_fields;
+  frame.cell_field_count = 1;
+  assert_int_equal(piola_vtu_write(tmp("frame.vtu"), &frame), PIOLA_OK);
+  if (access("/usr/bin/python3", X_OK) == 0 &&
+      system("/usr/bin/python3 -c 'import vtk' > /dev/null 2>&1") == 0) {
+    char cmd[2048];
+    snprintf(cmd, sizeof cmd,
+             "/usr/bin/python3 -c \""
+             "import vtk, sys\n"
+             "r = vtk.vtkXMLUnstructuredGridReader(); r.SetFileName('%s'); r.Update(); g = r.GetOutput()\n"
+             "ok = g.GetNumberOfPoints() == %d and g.GetNumberOfCells() == %d\n"
+             "ok = ok and [g.GetCellType(i) for i in (0, %d)] == [10, 5]\n"
+             "t = g.GetPointData().GetArray('temperature'); v = g.GetPointData().GetArray('velocity')\n"
+             "s = g.GetCellData().GetArray('stress')\n"
+             "ok = ok and t.GetValue(%d) == %.1f and v.GetTuple3(2) == (1.0, 2.0, 3.0) and s.GetValue(%d) == %.1f\n"
+             "sys.exit(0 if ok else 1)\"",
+             tmp("frame.vtu"), np, nc, nc - 1, np - 1, 300.0 + np - 1, nc - 1, 1e6 * nc);
+    assert_int_equal(system(cmd), 0);
+  }
+  free(temperature);
+  free(velocity);
+  free(stress);
+  piola_tri_mesh_free(&shell);
+  piola_tet_mesh_free(&tets);
+}
+
 static int ulps_apart(double a, double b) {
   if (a == b) return 0;
   int64_t x, y;
@@ -287,6 +337,7 @@ int main(void) {
       cmocka_unit_test(boundary_obj_is_the_closed_boundary),
       cmocka_unit_test(surface_writers_round_trip),
       cmocka_unit_test(writers_never_leave_partial_files),
+      cmocka_unit_test(vtu_with_fields_is_read_by_vtk),
       cmocka_unit_test(decimal_parser_is_within_one_ulp_of_strtod),
       cmocka_unit_test(malformed_input_is_refused_with_file_and_line),
       cmocka_unit_test(mixed_face_forms_and_polygons_in_obj),

@@ -108,7 +108,7 @@ static void describe_token(const text_scanner *s, char *out, size_t size) {
   out[len] = '\0';
 }
 
-piola_status piola__scan_int64(text_scanner *s, int64_t *value, const char *what) {
+piola_status piola__scan_int64_full(text_scanner *s, int64_t *value, const char *what) {
   if (!piola__scan_skip(s)) return piola__scan_error(s, PIOLA_ERROR_PARSE, "unexpected end of file, expected %s", what);
   const char *p = s->p, *end = s->end;
   int negative = 0;
@@ -247,7 +247,7 @@ size_t piola__parse_double(const char *p, const char *end, double *value) {
   return (size_t)(p - b);
 }
 
-piola_status piola__scan_double(text_scanner *s, double *value, const char *what) {
+piola_status piola__scan_double_full(text_scanner *s, double *value, const char *what) {
   if (!piola__scan_skip(s)) return piola__scan_error(s, PIOLA_ERROR_PARSE, "unexpected end of file, expected %s", what);
   size_t n = piola__parse_double(s->p, s->end, value);
   if (n == 0 || (s->p + n < s->end && is_token_char(s, s->p[n]))) {

@@ -9,6 +9,7 @@
 #include "common/status_internal.h"
 #include "mesher/bcc_lattice.h"
 #include "mesher/boundary_snap.h"
+#include "mesher/lattice_phi.h"
 #include "mesher/red_green.h"
 #include "mesher/shape_union.h"
 #include "mesher/tet_topology.h"
@@ -278,9 +279,10 @@ piola_status piola_mesher_generate(const piola_mesher_def *def, piola_tet_mesh *
     status = PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "mesher: level set values");
     goto done;
   }
-#pragma omp parallel for schedule(dynamic, 1024)
-  for (int32_t v = 0; v < soup.vertex_count; ++v)
-    soup.phi[v] = piola__shape_union_phi(&shapes, vec3_load(soup.positions + 3 * (size_t)v), NULL);
+  /* The band must exceed the longest lattice edge (h) for the far-field sign rule. */
+  status = piola__lattice_phi(&shapes, soup.positions, soup.vertex_count, soup.tets,
+                              soup.tet_count, 1.5 * h, soup.phi);
+  if (status != PIOLA_OK) goto done;
   if (def->refinement_levels > 0) {
     status = piola__red_green_refine(&soup, &shapes, def->refinement_levels, h);
     if (status != PIOLA_OK) goto done;

@@ -8,8 +8,13 @@
  * Inversion extension: below the compression threshold c on any entry of Fhat the model is
  * replaced, in that entry, by its value at the clamped point (PIOLA_INVERSION_CLAMP, C0) or
  * by its first-order Taylor expansion around the clamped point (PIOLA_INVERSION_LINEAR, C1,
- * the default), continued through zero into negative (inverted) entries. The result is
- * finite everywhere and always pushes an inverted element back. See docs/materials.md.
+ * the default), continued through zero into negative (inverted) entries; all entries below c
+ * are expanded together. In clamped entries the slope is raised where the plain expansion
+ * would not push back (e.g. St. Venant-Kirchhoff, whose own slope there is negative), so the
+ * result is finite for every Fhat with entries up to 1e30 in magnitude (flat, collapsed and
+ * inverted included; only the models' own growth, e.g. corotated's energy ~ f^6, overflows
+ * far beyond that), and every entry f_i <= 0 gets Phat_i < 0: an inverted element is always
+ * pushed back. See docs/materials.md.
  *
  * Usage:
  *   piola_material_def def = piola_default_material_def();
@@ -92,7 +97,8 @@ PIOLA_API void piola_material_stress(const piola_material *material, const doubl
  * means past the threshold). Zero at rest. */
 PIOLA_API double piola_material_energy_density(const piola_material *material, const double fhat[3]);
 
-/* dPhat_i / dFhat_j (Pa), extension included. */
+/* dPhat_i / dFhat_j (Pa): the exact derivative of the extended stress. Symmetric where the
+ * stress has a potential (no entry below the threshold, or all three below it). */
 PIOLA_API void piola_material_stress_derivative(const piola_material *material,
                                                 const double fhat[3], double dphat[3][3]);
 
@@ -101,6 +107,12 @@ PIOLA_API const char *piola_material_model_name(piola_material_model model);
 
 /* Parses a scene-file name; false if unknown. */
 PIOLA_API bool piola_material_model_from_name(const char *name, piola_material_model *model);
+
+/* Name used in scene files for the inversion mode: "linear" (C1) or "clamp" (C0). */
+PIOLA_API const char *piola_inversion_mode_name(piola_inversion_mode mode);
+
+/* Parses "linear" or "clamp"; false if unknown. */
+PIOLA_API bool piola_inversion_mode_from_name(const char *name, piola_inversion_mode *mode);
 
 #ifdef __cplusplus
 }

@@ -38,8 +38,10 @@ typedef struct piola_vtu_field {
 } piola_vtu_field;
 
 /* Tetrahedra (and optional triangles, e.g. shells) with point and cell fields, as VTK
- * UnstructuredGrid XML (appended raw binary). Cell fields cover the tets first, then the
- * triangles. positions override mesh->positions when not NULL (current state). */
+ * UnstructuredGrid XML (appended raw binary). Points are the tet mesh's vertices followed by
+ * the triangle mesh's vertices (when both are given they are written as separate pieces of
+ * one point list); point fields cover the same list. Cell fields cover the tets first, then
+ * the triangles. positions override the meshes' positions when not NULL (current state). */
 typedef struct piola_vtu_frame {
   const piola_tet_mesh *tets;          /* may be NULL */
   const piola_tri_mesh *triangles;     /* may be NULL */
@@ -47,9 +49,26 @@ typedef struct piola_vtu_frame {
   int point_field_count;
   const piola_vtu_field *cell_fields;
   int cell_field_count;
+  const double *positions;             /* 3 * point count, m, or NULL */
 } piola_vtu_frame;
 
 PIOLA_API piola_status piola_vtu_write(const char *path, const piola_vtu_frame *frame);
+
+/* A material of a Vega .veg file (*MATERIAL name, ENU density E nu). Other material kinds
+ * keep their name and kind with density/E/nu set to 0. */
+typedef struct piola_vega_material {
+  char name[64];
+  char kind[32];            /* "ENU", ... */
+  double density;           /* kg/m^3 */
+  double youngs_modulus;    /* Pa */
+  double poisson_ratio;     /* dimensionless */
+} piola_vega_material;
+
+/* Reads a .veg file with its materials. mesh->tet_regions[t] is the index into *materials
+ * of the material that a *REGION assigns to tet t, or -1 when no region covers it.
+ * *materials is malloc'ed (free it with free()); it may be NULL when there are none. */
+PIOLA_API piola_status piola_vega_read(const char *path, piola_tet_mesh *mesh, piola_vega_material **materials,
+                                       int32_t *material_count);
 
 #ifdef __cplusplus
 }

@@ -36,6 +36,12 @@ typedef struct piola_rigid_motion_def {
 /* No motion: everything 0, axis (0, 0, 1). */
 PIOLA_API piola_rigid_motion_def piola_default_rigid_motion_def(void);
 
+/* Constant angular velocity (rad/s) given as a vector, axis * speed: sets axis to its
+ * direction and angular_speed to its length (a zero vector sets the speed to 0 and keeps the
+ * axis). How the scene key `angular_velocity` maps onto the definition. */
+PIOLA_API void piola_rigid_motion_set_angular_velocity(piola_rigid_motion_def *motion,
+                                                       piola_vec3 angular_velocity);
+
 /* The pose at time t (s): rotation R and translation so that x(t) = R x0 + translation. */
 PIOLA_API void piola_rigid_motion_pose(const piola_rigid_motion_def *motion, double t,
                                        piola_mat3 *rotation, piola_vec3 *translation);

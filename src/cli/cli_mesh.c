@@ -1,0 +1,253 @@
+/* `piola mesh info|convert|generate`: inspect, convert and generate meshes. */
+#include <cjson/cJSON.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <strings.h>
+
+#include "cli/commands.h"
+#include "piola/mesh.h"
+#include "piola/mesh_io.h"
+#include "piola/mesh_quality.h"
+
+static void usage(FILE *out) {
+  fprintf(out,
+          "usage: piola mesh info FILE [--json]   counts, volume, regions, quality, boundary checks\n"
+          "       piola mesh convert IN OUT        convert by extension (.node/.ele .msh .mesh .veg\n"
+          "                                        .vtu .obj .off .stl)\n"
+          "       piola mesh generate ...          see `piola mesh generate --help`\n");
+}
+
+/* 2 for bad input (malformed, unsupported, degenerate), 1 for other failures (I/O, memory). */
+static int fail(piola_status s) {
+  fprintf(stderr, "piola mesh: %s\n", piola_last_error());
+  return (s == PIOLA_ERROR_IO || s == PIOLA_ERROR_OUT_OF_MEMORY) ? 1 : 2;
+}
+
+static int is_surface_path(const char *path) {
+  const char *dot = strrchr(path, '.');
+  const char *slash = strrchr(path, '/');
+  if (!dot || (slash && dot < slash)) return 0;
+  return strcasecmp(dot, ".obj") == 0 || strcasecmp(dot, ".off") == 0 || strcasecmp(dot, ".stl") == 0;
+}
+
+static int cmp_int32(const void *a, const void *b) {
+  int32_t x = *(const int32_t *)a, y = *(const int32_t *)b;
+  return (x > y) - (x < y);
+}
+
+static void add_topology(cJSON *o, const piola_surface_topology *t) {
+  cJSON_AddBoolToObject(o, "closed", t->closed);
+  cJSON_AddBoolToObject(o, "manifold", t->manifold);
+  cJSON_AddBoolToObject(o, "oriented", t->oriented);
+  cJSON_AddNumberToObject(o, "euler_characteristic", t->euler_characteristic);
+  cJSON_AddNumberToObject(o, "open_edges", t->open_edges);
+  cJSON_AddNumberToObject(o, "nonmanifold_edges", t->nonmanifold_edges);
+}
+
+static void print_topology(const piola_surface_topology *t) {
+  printf("boundary:         %s, %s, %s (Euler characteristic %d; %d open, %d non-manifold edges)\n",
+         t->closed ? "closed" : "open", t->manifold ? "manifold" : "NOT manifold",
+         t->oriented ? "consistently oriented" : "NOT consistently oriented", t->euler_characteristic, t->open_edges,
+         t->nonmanifold_edges);
+}
+
+static int print_json(cJSON *o) {
+  char *text = cJSON_Print(o);
+  cJSON_Delete(o);
+  if (!text) {
+    fprintf(stderr, "piola mesh: out of memory\n");
+    return 1;
+  }
+  printf("%s\n", text);
+  free(text);
+  return 0;
+}
+
+static int info_surface(const char *path, int json) {
+  piola_tri_mesh m;
+  piola_status s = piola_tri_mesh_read(path, &m);
+  if (s != PIOLA_OK) return fail(s);
+  piola_surface_topology topo;
+  s = piola_tri_mesh_topology(&m, &topo);
+  if (s != PIOLA_OK) {
+    piola_tri_mesh_free(&m);
+    return fail(s);
+  }
+  double volume = piola_tri_mesh_enclosed_volume(&m);
+  int rc = 0;
+  if (json) {
+    cJSON *o = cJSON_CreateObject();
+    cJSON_AddStringToObject(o, "file", path);
+    cJSON_AddStringToObject(o, "kind", "surface");
+    cJSON_AddNumberToObject(o, "vertices", m.vertex_count);
+    cJSON_AddNumberToObject(o, "triangles", m.triangle_count);
+    cJSON_AddNumberToObject(o, "boundary_faces", m.triangle_count);
+    cJSON_AddNumberToObject(o, "volume", volume);
+    add_topology(o, &topo);
+    rc = print_json(o);
+  } else {
+    printf("file:             %s (triangle surface)\n", path);
+    printf("vertices:         %d\n", (int)m.vertex_count);
+    printf("triangles:        %d\n", (int)m.triangle_count);
+    printf("enclosed volume:  %.9g m^3\n", volume);
+    print_topology(&topo);
+  }
+  piola_tri_mesh_free(&m);
+  return rc;
+}
+
+static int info_tets(const char *path, int json) {
+  piola_tet_mesh m;
+  piola_status s = piola_tet_mesh_read(path, &m);
+  if (s != PIOLA_OK) return fail(s);
+  piola_tri_mesh boundary;
+  piola_tet_mesh_quality q;
+  piola_surface_topology topo;
+  s = piola_tet_mesh_boundary(&m, &boundary);
+  if (s != PIOLA_OK) {
+    piola_tet_mesh_free(&m);
+    return fail(s);
+  }
+  s = piola_tet_mesh_measure(&m, &q);
+  if (s == PIOLA_OK) s = piola_tri_mesh_topology(&boundary, &topo);
+  /* Regions: sorted ids with counts. */
+  int32_t *ids = malloc((size_t)m.tet_count * sizeof(int32_t) + 1);
+  if (s != PIOLA_OK || !ids) {
+    free(ids);
+    piola_tri_mesh_free(&boundary);
+    piola_tet_mesh_free(&m);
+    if (s == PIOLA_OK) {
+      fprintf(stderr, "piola mesh: out of memory\n");
+      return 1;
+    }
+    return fail(s);
+  }
+  for (int32_t t = 0; t < m.tet_count; ++t) ids[t] = m.tet_regions ? m.tet_regions[t] : 0;
+  qsort(ids, (size_t)m.tet_count, sizeof(int32_t), cmp_int32);
+  int rc = 0;
+  if (json) {
+    cJSON *o = cJSON_CreateObject();
+    cJSON_AddStringToObject(o, "file", path);
+    cJSON_AddStringToObject(o, "kind", "tets");
+    cJSON_AddNumberToObject(o, "vertices", m.vertex_count);
+    cJSON_AddNumberToObject(o, "tets", m.tet_count);
+    cJSON_AddNumberToObject(o, "boundary_faces", boundary.triangle_count);
+    cJSON_AddNumberToObject(o, "volume", q.volume);
+    cJSON_AddNumberToObject(o, "min_tet_volume", q.min_volume);
+    cJSON_AddNumberToObject(o, "max_tet_volume", q.max_volume);
+    cJSON_AddNumberToObject(o, "min_dihedral_degrees", q.min_dihedral_degrees);
+    cJSON_AddNumberToObject(o, "max_dihedral_degrees", q.max_dihedral_degrees);
+    cJSON_AddNumberToObject(o, "min_mean_ratio", q.min_mean_ratio);
+    cJSON *worst = cJSON_AddArrayToObject(o, "worst_aspect_ratios");
+    for (int i = 0; i < q.worst_count; ++i) {
+      cJSON *w = cJSON_CreateObject();
+      cJSON_AddNumberToObject(w, "tet", q.worst_tets[i]);
+      cJSON_AddNumberToObject(w, "aspect_ratio", q.worst_aspect[i]);
+      cJSON_AddItemToArray(worst, w);
+    }
+    cJSON *regions = cJSON_AddArrayToObject(o, "regions");
+    for (int32_t i = 0; i < m.tet_count;) {
+      int32_t j = i + 1;
+      while (j < m.tet_count && ids[j] == ids[i]) ++j;
+      cJSON *r = cJSON_CreateObject();
+      cJSON_AddNumberToObject(r, "id", ids[i]);
+      cJSON_AddNumberToObject(r, "tets", j - i);
+      cJSON_AddItemToArray(regions, r);
+      i = j;
+    }
+    add_topology(o, &topo);
+    rc = print_json(o);
+  } else {
+    printf("file:             %s\n", path);
+    printf("vertices:         %d\n", (int)m.vertex_count);
+    printf("tets:             %d\n", (int)m.tet_count);
+    printf("boundary faces:   %d\n", (int)boundary.triangle_count);
+    printf("volume:           %.9g m^3 (tets from %.3g to %.3g m^3)\n", q.volume, q.min_volume, q.max_volume);
+    printf("regions:         ");
+    for (int32_t i = 0; i < m.tet_count;) {
+      int32_t j = i + 1;
+      while (j < m.tet_count && ids[j] == ids[i]) ++j;
+      printf(" %d: %d tets%s", (int)ids[i], (int)(j - i), j < m.tet_count ? "," : "");
+      i = j;
+    }
+    printf("\n");
+    printf("dihedral angles:  min %.2f, max %.2f degrees\n", q.min_dihedral_degrees, q.max_dihedral_degrees);
+    printf("mean ratio:       min %.4f (1 = regular tet)\n", q.min_mean_ratio);
+    printf("worst aspect:    ");
+    for (int i = 0; i < q.worst_count; ++i)
+      printf(" tet %d: %.3g%s", (int)q.worst_tets[i], q.worst_aspect[i], i + 1 < q.worst_count ? "," : "");
+    printf(" (1 = regular tet)\n");
+    print_topology(&topo);
+  }
+  free(ids);
+  piola_tri_mesh_free(&boundary);
+  piola_tet_mesh_free(&m);
+  return rc;
+}
+
+static int convert(const char *in, const char *out) {
+  piola_status s;
+  if (is_surface_path(in)) {
+    piola_tri_mesh m;
+    s = piola_tri_mesh_read(in, &m);
+    if (s != PIOLA_OK) return fail(s);
+    s = piola_tri_mesh_write(out, &m);
+    piola_tri_mesh_free(&m);
+  } else {
+    piola_tet_mesh m;
+    s = piola_tet_mesh_read(in, &m);
+    if (s != PIOLA_OK) return fail(s);
+    s = piola_tet_mesh_write(out, &m);
+    piola_tet_mesh_free(&m);
+  }
+  return s == PIOLA_OK ? 0 : fail(s);
+}
+
+int cli_mesh(int argc, char **argv);
+int cli_mesh(int argc, char **argv) {
+  if (argc < 2) {
+    usage(stderr);
+    return 2;
+  }
+  const char *sub = argv[1];
+  if (strcmp(sub, "--help") == 0 || strcmp(sub, "-h") == 0 || strcmp(sub, "help") == 0) {
+    usage(stdout);
+    return 0;
+  }
+  if (strcmp(sub, "generate") == 0) return cli_mesh_generate(argc - 1, argv + 1);
+  if (strcmp(sub, "info") == 0) {
+    const char *path = NULL;
+    int json = 0;
+    for (int i = 2; i < argc; ++i) {
+      if (strcmp(argv[i], "--json") == 0) json = 1;
+      else if (strcmp(argv[i], "--help") == 0 || strcmp(argv[i], "-h") == 0) {
+        usage(stdout);
+        return 0;
+      } else if (argv[i][0] == '-' && argv[i][1]) {
+        fprintf(stderr, "piola mesh info: unknown option '%s'\n", argv[i]);
+        return 2;
+      } else if (!path) path = argv[i];
+      else {
+        fprintf(stderr, "piola mesh info: more than one file given\n");
+        return 2;
+      }
+    }
+    if (!path) {
+      usage(stderr);
+      return 2;
+    }
+    return is_surface_path(path) ? info_surface(path, json) : info_tets(path, json);
+  }
+  if (strcmp(sub, "convert") == 0) {
+    if (argc != 4) {
+      usage(stderr);
+      return 2;
+    }
+    return convert(argv[2], argv[3]);
+  }
+  fprintf(stderr, "piola mesh: unknown subcommand '%s'\n", sub);
+  usage(stderr);
+  return 2;
+}

@@ -1,0 +1,432 @@
+/* Constitutive models in diagonal form: the inline kernels (one source of truth).
+ *
+ * Why this header is shaped like this
+ * -----------------------------------
+ * The force loop evaluates Phat(Fhat) once per tetrahedron per step, for millions of
+ * tetrahedra. It runs over blocks of tets in a `#pragma omp simd` loop, with the switch on
+ * the model hoisted out of the loop:
+ *
+ *     switch (material.model) {
+ *       case PIOLA_MODEL_NEOHOOKEAN:
+ *         #pragma omp simd
+ *         for (i = 0; i < n; ++i) neohookean_stress(&material, f0[i], f1[i], f2[i],
+ *                                                   &p0[i], &p1[i], &p2[i]);
+ *         break;
+ *       ...
+ *     }
+ *
+ * For that loop to vectorize, everything it calls must be inline (forced: clang otherwise
+ * keeps the model switch as a call), take and return plain doubles (no loops over small
+ * local arrays, which stay in memory), and have no data-dependent branches: the inversion
+ * extension is written with compare-and-selects (`cond ? a : b` on values both computed,
+ * kernel_max/kernel_min; C's fmax is avoided, see kernel_max) that compilers turn into
+ * blends, and the logarithm of neo-Hookean is kernel_log, not a libm call. GCC and clang
+ * vectorize all five per-model kernels in such a loop (bench/bench_material.c is one). The
+ * model argument of material_model_parts() is a compile-time constant in each per-model
+ * kernel (neohookean_stress() and friends), so after inlining its switch folds away; the
+ * one place where the model is a run-time value is material_stress_kernel(), meant for
+ * scalar callers and for the public API.
+ *
+ * Every model is written in one shape (see docs/materials.md):
+ *     psi(f) = sum_i A(f_i) + kappa/2 (q(f) - q0)^2
+ * a separable per-entry energy A plus a quadratic penalty on one invariant q (the trace, the
+ * sum of squares, the determinant J or ln J). Stress P_i = A'(f_i) + kappa (q - q0) dq/df_i,
+ * derivative K = diag(A'') + kappa (g g^T + (q - q0) H) with g, H the gradient and Hessian
+ * of q. Writing the five models in this shape gives the derivative (needed by the C1
+ * extension, which is a Taylor expansion) and the third derivative (needed for the exact
+ * derivative of the extended stress) from a handful of one-line pieces instead of five
+ * hand-derived tensors, and makes the models easy to check against each other.
+ *
+ * The inversion extension lives here too, because it is part of the hot stress evaluation:
+ * entries below the threshold c are clamped to c (fc = max(f, c), d = f - fc <= 0) and the
+ * stress is P(fc) + K'(fc) d, with the slope K' of the clamped rows made safe (positive
+ * diagonal, at least steep enough that the stress is compressive at and past zero; no
+ * negative coupling between clamped entries). The public functions in material.c call the
+ * same functions, so the force loop and the API cannot drift apart. */
+#ifndef PIOLA_MATERIAL_KERNELS_H
+#define PIOLA_MATERIAL_KERNELS_H
+
+#include <math.h>
+#include <stdint.h>
+#include <string.h>
+
+#include "piola/material.h"
+
+/* Every kernel is forced inline: clang's inliner otherwise keeps the big model switch as a
+ * call (before the constant model folds it away), and a call stops the simd loop. */
+#if defined(__GNUC__) || defined(__clang__)
+#define MATERIAL_KERNEL static inline __attribute__((always_inline))
+#else
+#define MATERIAL_KERNEL static inline
+#endif
+
+/* Slots of piola_material.spline_coefficients (filled by piola_material_init). */
+enum {
+  SPLINE_K0 = 0,     /* Pa: slope of the 1D stress curve at rest (2 mu) */
+  SPLINE_DK = 1,     /* Pa: stiff slope minus rest slope (k1 - k0 >= 0) */
+  SPLINE_WE = 2,     /* elongation transition width: elongation_stretch - 1 */
+  SPLINE_WC = 3,     /* compression transition width: 1 - compression_stretch */
+  SPLINE_INV_WE = 4, /* 1 / SPLINE_WE */
+  SPLINE_INV_WC = 5  /* 1 / SPLINE_WC */
+};
+
+/* max and min as selects. C's fmax/fmin must return the non-NaN operand, which x86 vector
+ * max/min instructions do not do, so GCC refuses to vectorize them without
+ * -ffinite-math-only; a compare-and-select maps onto those instructions directly. With a NaN
+ * operand these return b; a NaN in Fhat still comes out as NaN in Phat (through f - fc). */
+MATERIAL_KERNEL double kernel_max(double a, double b) { return a > b ? a : b; }
+MATERIAL_KERNEL double kernel_min(double a, double b) { return a < b ? a : b; }
+
+/* Natural logarithm of x > 0 (normal or subnormal; piola calls it on clamped entries only,
+ * which are >= threshold > 0), accurate to a few ulp, written so that GCC can vectorize it:
+ * libm's log is a call the vectorizer cannot widen (glibc declares its vector variants only
+ * under -ffast-math, which piola does not use). x = 2^e m with m in [sqrt(1/2), sqrt(2)),
+ * ln m = 2 atanh(s) with s = (m - 1)/(m + 1), |s| < 0.172, from its odd series to s^23.
+ * The exponent is turned into a double with the 2^52 trick (integer shifts and ors only,
+ * no 64-bit integer-to-double conversion, which AVX2 lacks). */
+MATERIAL_KERNEL double kernel_log(double x) {
+  const int tiny = x < 2.2250738585072014e-308;         /* subnormal: scale into the normal range */
+  const double xs = tiny ? x * 18014398509481984.0 : x; /* 2^54 */
+  uint64_t bits;
+  memcpy(&bits, &xs, sizeof bits);
+  const uint64_t mbits = (bits & 0x000fffffffffffffull) | 0x3ff0000000000000ull;
+  const uint64_t ebits = 0x4330000000000000ull | (bits >> 52); /* 2^52 + biased exponent */
+  double m, e;
+  memcpy(&m, &mbits, sizeof m);
+  memcpy(&e, &ebits, sizeof e);
+  e -= 4503599627370496.0 + 1023.0 + (tiny ? 54.0 : 0.0);
+  const int big = m > 1.4142135623730951;
+  m = big ? 0.5 * m : m;
+  e = big ? e + 1.0 : e;
+  const double s = (m - 1.0) / (m + 1.0), s2 = s * s;
+  double poly = 1.0 / 23.0;
+  poly = poly * s2 + 1.0 / 21.0;
+  poly = poly * s2 + 1.0 / 19.0;
+  poly = poly * s2 + 1.0 / 17.0;
+  poly = poly * s2 + 1.0 / 15.0;
+  poly = poly * s2 + 1.0 / 13.0;
+  poly = poly * s2 + 1.0 / 11.0;
+  poly = poly * s2 + 1.0 / 9.0;
+  poly = poly * s2 + 1.0 / 7.0;
+  poly = poly * s2 + 1.0 / 5.0;
+  poly = poly * s2 + 1.0 / 3.0;
+  const double ln2_hi = 6.93147180369123816490e-01, ln2_lo = 1.90821492927058770002e-10;
+  /* 2 s (1 + s2 poly) = 2 s + 2 s s2 poly, the small part added last. */
+  return e * ln2_hi + (2.0 * s + (2.0 * s * s2 * poly + e * ln2_lo));
+}
+
+/* Value and derivative of the model at a point with all entries >= threshold > 0. */
+typedef struct material_parts {
+  double p[3];    /* Pa: Phat */
+  double k[3][3]; /* Pa: dPhat_i / dFhat_j */
+} material_parts;
+
+/* --------------------------------------------------------------- per-entry pieces */
+
+/* A'(f) and A''(f) of the separable energy of each model. */
+MATERIAL_KERNEL void entry_slope_curvature(piola_material_model model, const piola_material *m,
+                                           double f, double *a1, double *a2) {
+  const double mu = m->mu;
+  switch (model) {
+    case PIOLA_MODEL_STVK: /* A = mu/4 (f^2 - 1)^2 */
+      *a1 = mu * f * (f * f - 1.0);
+      *a2 = mu * (3.0 * f * f - 1.0);
+      return;
+    case PIOLA_MODEL_NEOHOOKEAN: { /* A = mu (f^2 - 1)/2 - mu ln f */
+      const double inv = 1.0 / f;
+      *a1 = mu * (f - inv);
+      *a2 = mu * (1.0 + inv * inv);
+      return;
+    }
+    case PIOLA_MODEL_SPLINE: { /* A' = the 1D stress curve (C1 Hermite spline) */
+      const double *s = m->spline_coefficients;
+      const double u = f - 1.0;
+      const double t = kernel_max(u, 0.0), tc = kernel_min(t, s[SPLINE_WE]);
+      const double c = kernel_max(-u, 0.0), cc = kernel_min(c, s[SPLINE_WC]);
+      *a1 = s[SPLINE_K0] * u + s[SPLINE_DK] * (0.5 * tc * tc * s[SPLINE_INV_WE] + (t - tc)) -
+            s[SPLINE_DK] * (0.5 * cc * cc * s[SPLINE_INV_WC] + (c - cc));
+      *a2 = s[SPLINE_K0] + s[SPLINE_DK] * (tc * s[SPLINE_INV_WE] + cc * s[SPLINE_INV_WC]);
+      return;
+    }
+    case PIOLA_MODEL_ROTATED_LINEAR:
+    case PIOLA_MODEL_COROTATED:
+    default: /* A = mu (f - 1)^2 */
+      *a1 = 2.0 * mu * (f - 1.0);
+      *a2 = 2.0 * mu;
+      return;
+  }
+}
+
+/* --------------------------------------------------------------- the invariant term */
+
+/* kappa, q - q0, g = dq/df and H = d2q/df2 at f (all entries > 0). */
+MATERIAL_KERNEL double invariant_terms(piola_material_model model, const piola_material *m,
+                                       double f0, double f1, double f2, double g[3], double h[3][3],
+                                       double *kappa) {
+  h[0][0] = h[0][1] = h[0][2] = h[1][0] = h[1][1] = h[1][2] = h[2][0] = h[2][1] = h[2][2] = 0.0;
+  switch (model) {
+    case PIOLA_MODEL_ROTATED_LINEAR: /* q = tr Fhat, kappa = lambda */
+      *kappa = m->lambda;
+      g[0] = g[1] = g[2] = 1.0;
+      return f0 + f1 + f2 - 3.0;
+    case PIOLA_MODEL_STVK: /* q = |Fhat|^2, kappa = lambda/4: lambda/2 tr(E)^2 */
+      *kappa = 0.25 * m->lambda;
+      g[0] = 2.0 * f0, g[1] = 2.0 * f1, g[2] = 2.0 * f2;
+      h[0][0] = h[1][1] = h[2][2] = 2.0;
+      return f0 * f0 + f1 * f1 + f2 * f2 - 3.0;
+    case PIOLA_MODEL_NEOHOOKEAN: { /* q = ln J, kappa = lambda */
+      *kappa = m->lambda;
+      const double i0 = 1.0 / f0, i1 = 1.0 / f1, i2 = 1.0 / f2;
+      g[0] = i0, g[1] = i1, g[2] = i2;
+      h[0][0] = -i0 * i0, h[1][1] = -i1 * i1, h[2][2] = -i2 * i2;
+      /* Three logs, not log(J): J can underflow or overflow where each entry does not. */
+      return kernel_log(f0) + kernel_log(f1) + kernel_log(f2);
+    }
+    case PIOLA_MODEL_COROTATED:
+    case PIOLA_MODEL_SPLINE:
+    default: /* q = J, kappa = lambda: the linear pressure lambda (J - 1) dJ/dFhat */
+      *kappa = m->lambda;
+      g[0] = f1 * f2, g[1] = f0 * f2, g[2] = f0 * f1;
+      h[0][1] = h[1][0] = f2;
+      h[0][2] = h[2][0] = f1;
+      h[1][2] = h[2][1] = f0;
+      return f0 * f1 * f2 - 1.0;
+  }
+}
+
+/* Phat and dPhat/dFhat of the unextended model at f (all entries > 0). */
+MATERIAL_KERNEL void material_model_parts(piola_material_model model, const piola_material *m,
+                                          double f0, double f1, double f2, material_parts *out) {
+  double g[3], h[3][3], kappa;
+  const double qm = invariant_terms(model, m, f0, f1, f2, g, h, &kappa);
+  /* Written out, not looped: clang does not always unroll a loop around the spline's entry
+   * function, and a loop over small local arrays left in a simd loop blocks vectorization. */
+  double a1[3], a2[3];
+  entry_slope_curvature(model, m, f0, &a1[0], &a2[0]);
+  entry_slope_curvature(model, m, f1, &a1[1], &a2[1]);
+  entry_slope_curvature(model, m, f2, &a1[2], &a2[2]);
+  const double kq = kappa * qm;
+  out->p[0] = a1[0] + kq * g[0];
+  out->p[1] = a1[1] + kq * g[1];
+  out->p[2] = a1[2] + kq * g[2];
+  out->k[0][0] = a2[0] + kappa * g[0] * g[0] + kq * h[0][0];
+  out->k[1][1] = a2[1] + kappa * g[1] * g[1] + kq * h[1][1];
+  out->k[2][2] = a2[2] + kappa * g[2] * g[2] + kq * h[2][2];
+  out->k[0][1] = out->k[1][0] = kappa * g[0] * g[1] + kq * h[0][1];
+  out->k[0][2] = out->k[2][0] = kappa * g[0] * g[2] + kq * h[0][2];
+  out->k[1][2] = out->k[2][1] = kappa * g[1] * g[2] + kq * h[1][2];
+}
+
+/* --------------------------------------------------------------- the extension */
+
+/* Diagonal slope used for a clamped entry i whose value at the clamped point is p and whose
+ * Taylor slope is kii. LINEAR: the Taylor slope, raised where needed so that the stress is
+ * at most -mu c at f_i = 0 (restoring) and at least mu (never softening past the
+ * threshold). CLAMP: zero (constant stress), unless the clamped stress is not already
+ * compressive enough, in which case the ramp that reaches -mu c at zero. */
+MATERIAL_KERNEL double extension_diagonal_slope(const piola_material *m, double p, double kii) {
+  const double c = m->threshold, floor_slope = m->mu;
+  /* Both variants are computed and blended by a 0/1 factor: a select on a loop-invariant
+   * integer between doubles is one of the statements GCC's vectorizer rejects. */
+  const double linear = (double)(m->inversion_mode != PIOLA_INVERSION_CLAMP);
+  const double taylor = kernel_max(kii, floor_slope + kernel_max(p, 0.0) / c);
+  const double ramp = kernel_max(0.0, p / c + floor_slope);
+  return linear * taylor + (1.0 - linear) * ramp;
+}
+
+/* One entry of the extended stress: entry i with value p and slopes kii, kij, kik at the
+ * clamped point, offsets di, dj, dk = f - fc <= 0 (zero at or above the threshold). Written
+ * on scalars with selects, not loops over arrays with branches: GCC vectorizes the force
+ * loop only in this form. */
+MATERIAL_KERNEL double extended_entry(const piola_material *m, double p, double kii, double kij,
+                                      double kik, double di, double dj, double dk) {
+  const double s = extension_diagonal_slope(m, p, kii);
+  /* Clamped rows never take a negative coupling to other clamped entries (it could pull an
+   * inverted entry further); unclamped rows keep the Taylor coupling. An unclamped entry
+   * has d = 0, so its coupling term vanishes either way. */
+  const double cij = di < 0.0 ? kernel_max(kij, 0.0) : kij;
+  const double cik = di < 0.0 ? kernel_max(kik, 0.0) : kik;
+  const double linear = (double)(m->inversion_mode != PIOLA_INVERSION_CLAMP);
+  return p + s * di + linear * (cij * dj + cik * dk);
+}
+
+/* Extended stress from the parts at the clamped point and the offsets d = f - fc. */
+MATERIAL_KERNEL void material_extend(const piola_material *m, const material_parts *pa, double d0,
+                                     double d1, double d2, double *p0, double *p1, double *p2) {
+  *p0 = extended_entry(m, pa->p[0], pa->k[0][0], pa->k[0][1], pa->k[0][2], d0, d1, d2);
+  *p1 = extended_entry(m, pa->p[1], pa->k[1][1], pa->k[1][0], pa->k[1][2], d1, d0, d2);
+  *p2 = extended_entry(m, pa->p[2], pa->k[2][2], pa->k[2][0], pa->k[2][1], d2, d0, d1);
+}
+
+/* The hot entry point for one model known at compile time. */
+MATERIAL_KERNEL void material_extended_stress(piola_material_model model, const piola_material *m,
+                                              double f0, double f1, double f2, double *p0,
+                                              double *p1, double *p2) {
+  const double c = m->threshold;
+  const double fc0 = kernel_max(f0, c), fc1 = kernel_max(f1, c), fc2 = kernel_max(f2, c);
+  material_parts parts;
+  material_model_parts(model, m, fc0, fc1, fc2, &parts);
+  material_extend(m, &parts, f0 - fc0, f1 - fc1, f2 - fc2, p0, p1, p2);
+}
+
+/* A(f): the separable energy of each model (see entry_slope_curvature). */
+MATERIAL_KERNEL double entry_energy(piola_material_model model, const piola_material *m, double f) {
+  const double mu = m->mu;
+  switch (model) {
+    case PIOLA_MODEL_STVK:
+      return 0.25 * mu * (f * f - 1.0) * (f * f - 1.0);
+    case PIOLA_MODEL_NEOHOOKEAN:
+      return mu * (0.5 * (f * f - 1.0) - kernel_log(f));
+    case PIOLA_MODEL_SPLINE: {
+      /* Integral from 1 to f of the 1D stress curve. Each side (t = stretch or compression
+       * beyond rest, w = its transition width) contributes tc^3 / (6 w) over the transition,
+       * where the slope rises linearly, then the straight stiff part. */
+      const double *s = m->spline_coefficients;
+      const double u = f - 1.0;
+      const double t = kernel_max(u, 0.0), tc = kernel_min(t, s[SPLINE_WE]);
+      const double c = kernel_max(-u, 0.0), cc = kernel_min(c, s[SPLINE_WC]);
+      const double te = t - tc, ce = c - cc;
+      const double tension =
+          tc * tc * tc * s[SPLINE_INV_WE] / 6.0 + te * (0.5 * s[SPLINE_WE] + 0.5 * te);
+      const double compression =
+          cc * cc * cc * s[SPLINE_INV_WC] / 6.0 + ce * (0.5 * s[SPLINE_WC] + 0.5 * ce);
+      return 0.5 * s[SPLINE_K0] * u * u + s[SPLINE_DK] * (tension + compression);
+    }
+    case PIOLA_MODEL_ROTATED_LINEAR:
+    case PIOLA_MODEL_COROTATED:
+    default:
+      return mu * (f - 1.0) * (f - 1.0);
+  }
+}
+
+/* Energy density of the unextended model at f (all entries > 0). */
+MATERIAL_KERNEL double material_model_energy(piola_material_model model, const piola_material *m,
+                                             double f0, double f1, double f2) {
+  double g[3], h[3][3], kappa;
+  const double qm = invariant_terms(model, m, f0, f1, f2, g, h, &kappa);
+  return entry_energy(model, m, f0) + entry_energy(model, m, f1) + entry_energy(model, m, f2) +
+         0.5 * kappa * qm * qm;
+}
+
+/* Extended stress and energy density in one pass (the force loop wants both; the clamped
+ * point's parts are shared). Energy past the threshold: psi(fc) + p.d + 1/2 d^T K'' d over
+ * the clamped entries, with the same slopes as the stress, so that d psi / d f_i = Phat_i
+ * for every clamped entry (docs/materials.md). Unclamped entries have d = 0 and drop out of
+ * every product, which keeps this branch-free. */
+MATERIAL_KERNEL void material_extended_stress_energy(piola_material_model model,
+                                                     const piola_material *m, double f0, double f1,
+                                                     double f2, double *p0, double *p1, double *p2,
+                                                     double *psi) {
+  const double c = m->threshold;
+  const double fc0 = kernel_max(f0, c), fc1 = kernel_max(f1, c), fc2 = kernel_max(f2, c);
+  const double d0 = f0 - fc0, d1 = f1 - fc1, d2 = f2 - fc2;
+  material_parts pa;
+  material_model_parts(model, m, fc0, fc1, fc2, &pa);
+  material_extend(m, &pa, d0, d1, d2, p0, p1, p2);
+  const double linear = (double)(m->inversion_mode != PIOLA_INVERSION_CLAMP);
+  const double s0 = extension_diagonal_slope(m, pa.p[0], pa.k[0][0]);
+  const double s1 = extension_diagonal_slope(m, pa.p[1], pa.k[1][1]);
+  const double s2 = extension_diagonal_slope(m, pa.p[2], pa.k[2][2]);
+  const double first = pa.p[0] * d0 + pa.p[1] * d1 + pa.p[2] * d2;
+  const double second =
+      0.5 * (s0 * d0 * d0 + s1 * d1 * d1 + s2 * d2 * d2) +
+      linear * (kernel_max(pa.k[0][1], 0.0) * d0 * d1 + kernel_max(pa.k[0][2], 0.0) * d0 * d2 +
+                kernel_max(pa.k[1][2], 0.0) * d1 * d2);
+  *psi = material_model_energy(model, m, fc0, fc1, fc2) + first + second;
+}
+
+/* Per-model kernels: the model is a constant, so each compiles to straight-line code. */
+MATERIAL_KERNEL void rotated_linear_stress(const piola_material *m, double f0, double f1, double f2,
+                                           double *p0, double *p1, double *p2) {
+  material_extended_stress(PIOLA_MODEL_ROTATED_LINEAR, m, f0, f1, f2, p0, p1, p2);
+}
+MATERIAL_KERNEL void corotated_stress(const piola_material *m, double f0, double f1, double f2,
+                                      double *p0, double *p1, double *p2) {
+  material_extended_stress(PIOLA_MODEL_COROTATED, m, f0, f1, f2, p0, p1, p2);
+}
+MATERIAL_KERNEL void stvk_stress(const piola_material *m, double f0, double f1, double f2,
+                                 double *p0, double *p1, double *p2) {
+  material_extended_stress(PIOLA_MODEL_STVK, m, f0, f1, f2, p0, p1, p2);
+}
+MATERIAL_KERNEL void neohookean_stress(const piola_material *m, double f0, double f1, double f2,
+                                       double *p0, double *p1, double *p2) {
+  material_extended_stress(PIOLA_MODEL_NEOHOOKEAN, m, f0, f1, f2, p0, p1, p2);
+}
+MATERIAL_KERNEL void spline_stress(const piola_material *m, double f0, double f1, double f2,
+                                   double *p0, double *p1, double *p2) {
+  material_extended_stress(PIOLA_MODEL_SPLINE, m, f0, f1, f2, p0, p1, p2);
+}
+
+/* Run-time dispatch, for scalar callers. In a loop, switch on m->model outside the loop and
+ * call the per-model kernel inside. */
+MATERIAL_KERNEL void material_stress_kernel(const piola_material *m, double f0, double f1,
+                                            double f2, double *p0, double *p1, double *p2) {
+  switch (m->model) {
+    case PIOLA_MODEL_COROTATED:
+      corotated_stress(m, f0, f1, f2, p0, p1, p2);
+      return;
+    case PIOLA_MODEL_STVK:
+      stvk_stress(m, f0, f1, f2, p0, p1, p2);
+      return;
+    case PIOLA_MODEL_NEOHOOKEAN:
+      neohookean_stress(m, f0, f1, f2, p0, p1, p2);
+      return;
+    case PIOLA_MODEL_SPLINE:
+      spline_stress(m, f0, f1, f2, p0, p1, p2);
+      return;
+    case PIOLA_MODEL_ROTATED_LINEAR:
+    default:
+      rotated_linear_stress(m, f0, f1, f2, p0, p1, p2);
+      return;
+  }
+}
+
+MATERIAL_KERNEL void rotated_linear_stress_energy(const piola_material *m, double f0, double f1,
+                                                  double f2, double *p0, double *p1, double *p2,
+                                                  double *psi) {
+  material_extended_stress_energy(PIOLA_MODEL_ROTATED_LINEAR, m, f0, f1, f2, p0, p1, p2, psi);
+}
+MATERIAL_KERNEL void corotated_stress_energy(const piola_material *m, double f0, double f1,
+                                             double f2, double *p0, double *p1, double *p2,
+                                             double *psi) {
+  material_extended_stress_energy(PIOLA_MODEL_COROTATED, m, f0, f1, f2, p0, p1, p2, psi);
+}
+MATERIAL_KERNEL void stvk_stress_energy(const piola_material *m, double f0, double f1, double f2,
+                                        double *p0, double *p1, double *p2, double *psi) {
+  material_extended_stress_energy(PIOLA_MODEL_STVK, m, f0, f1, f2, p0, p1, p2, psi);
+}
+MATERIAL_KERNEL void neohookean_stress_energy(const piola_material *m, double f0, double f1,
+                                              double f2, double *p0, double *p1, double *p2,
+                                              double *psi) {
+  material_extended_stress_energy(PIOLA_MODEL_NEOHOOKEAN, m, f0, f1, f2, p0, p1, p2, psi);
+}
+MATERIAL_KERNEL void spline_stress_energy(const piola_material *m, double f0, double f1, double f2,
+                                          double *p0, double *p1, double *p2, double *psi) {
+  material_extended_stress_energy(PIOLA_MODEL_SPLINE, m, f0, f1, f2, p0, p1, p2, psi);
+}
+
+/* Run-time dispatch of the stress-and-energy kernels (same use as material_stress_kernel). */
+MATERIAL_KERNEL void material_stress_energy_kernel(const piola_material *m, double f0, double f1,
+                                                   double f2, double *p0, double *p1, double *p2,
+                                                   double *psi) {
+  switch (m->model) {
+    case PIOLA_MODEL_COROTATED:
+      corotated_stress_energy(m, f0, f1, f2, p0, p1, p2, psi);
+      return;
+    case PIOLA_MODEL_STVK:
+      stvk_stress_energy(m, f0, f1, f2, p0, p1, p2, psi);
+      return;
+    case PIOLA_MODEL_NEOHOOKEAN:
+      neohookean_stress_energy(m, f0, f1, f2, p0, p1, p2, psi);
+      return;
+    case PIOLA_MODEL_SPLINE:
+      spline_stress_energy(m, f0, f1, f2, p0, p1, p2, psi);
+      return;
+    case PIOLA_MODEL_ROTATED_LINEAR:
+    default:
+      rotated_linear_stress_energy(m, f0, f1, f2, p0, p1, p2, psi);
+      return;
+  }
+}
+
+#endif

@@ -317,6 +317,40 @@ static void mixed_face_forms_and_polygons_in_obj(void **state) {
   piola_tri_mesh_free(&m);
 }
 
+static void ascii_stl_is_welded_and_off_polygons_split(void **state) {
+  (void)state;
+  /* The unit tet's surface, wound outward, corners repeated per facet. */
+  const char *stl = "solid tet\n"
+                    " facet normal 0 0 -1\n  outer loop\n   vertex 0 0 0\n   vertex 0 1 0\n   vertex 1 0 0\n"
+                    "  endloop\n endfacet\n"
+                    " facet normal 0 -1 0\n  outer loop\n   vertex 0 0 0\n   vertex 1 0 0\n   vertex 0 0 1\n"
+                    "  endloop\n endfacet\n"
+                    " facet normal -1 0 0\n  outer loop\n   vertex 0 0 0\n   vertex 0 0 1\n   vertex -0 1 0\n"
+                    "  endloop\n endfacet\n"
+                    " facet normal 1 1 1\n  outer loop\n   vertex 1 0 0\n   vertex 0 1 0\n   vertex 0 0 1\n"
+                    "  endloop\n endfacet\n"
+                    "endsolid tet\n";
+  piola_tri_mesh m;
+  if (piola__read_stl_mem("tet.stl", stl, strlen(stl), &m) != PIOLA_OK) fail_msg("%s", piola_last_error());
+  assert_int_equal(m.vertex_count, 4); /* 12 corners welded, -0 with +0 */
+  assert_int_equal(m.triangle_count, 4);
+  piola_surface_topology topo;
+  assert_int_equal(piola_tri_mesh_topology(&m, &topo), PIOLA_OK);
+  assert_true(topo.closed && topo.manifold && topo.oriented);
+  assert_int_equal(topo.euler_characteristic, 2);
+  assert_close(piola_tri_mesh_enclosed_volume(&m), 1.0 / 6.0, 1e-15);
+  piola_tri_mesh_free(&m);
+  /* A cube as six quads: 12 triangles, closed, volume 1. */
+  const char *off = "OFF\n# cube\n8 6 12\n0 0 0\n1 0 0\n1 1 0\n0 1 0\n0 0 1\n1 0 1\n1 1 1\n0 1 1\n"
+                    "4 0 3 2 1\n4 4 5 6 7\n4 0 1 5 4\n4 1 2 6 5\n4 2 3 7 6\n4 3 0 4 7 255 0 0\n";
+  assert_int_equal(piola__read_off_mem("cube.off", off, strlen(off), &m), PIOLA_OK);
+  assert_int_equal(m.triangle_count, 12);
+  assert_int_equal(piola_tri_mesh_topology(&m, &topo), PIOLA_OK);
+  assert_true(topo.closed && topo.manifold && topo.oriented);
+  assert_close(piola_tri_mesh_enclosed_volume(&m), 1.0, 1e-15);
+  piola_tri_mesh_free(&m);
+}
+
 static void loaded_tets_are_oriented_positively(void **state) {
   (void)state;
   /* The second tet is stored inverted; the reader flips it. */
@@ -342,6 +376,7 @@ int main(void) {
       cmocka_unit_test(malformed_input_is_refused_with_file_and_line),
       cmocka_unit_test(mixed_face_forms_and_polygons_in_obj),
       cmocka_unit_test(loaded_tets_are_oriented_positively),
+      cmocka_unit_test(ascii_stl_is_welded_and_off_polygons_split),
   };
   return cmocka_run_group_tests(tests, setup, teardown);
 }

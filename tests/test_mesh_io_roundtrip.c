@@ -54,14 +54,14 @@ static void tet_writers_round_trip_exactly(void **state) {
   (void)state;
   const char *sources[] = {"gmsh/cubes_v41.msh", "medit/cube_medium_tetra.mesh", "tetgen/armadillo_4k.node",
                            "vega/asianDragon.veg"};
-  const char *outputs[] = {"out.msh", "out.mesh", "out.node"};
+  const char *outputs[] = {"out.msh", "out.mesh", "out.node", "out.vtu"};
   for (size_t i = 0; i < 4; ++i) {
     piola_tet_mesh a;
     load(sources[i], &a);
     /* Gmsh physical tags must be positive: shift Vega's material indices. */
     if (a.tet_regions)
       for (int32_t t = 0; t < a.tet_count; ++t) a.tet_regions[t] += 1;
-    for (size_t k = 0; k < 3; ++k) {
+    for (size_t k = 0; k < 4; ++k) {
       if (piola_tet_mesh_write(tmp(outputs[k]), &a) != PIOLA_OK) fail_msg("%s", piola_last_error());
       piola_tet_mesh b;
       if (piola_tet_mesh_read(tmp(outputs[k]), &b) != PIOLA_OK) fail_msg("%s", piola_last_error());
@@ -70,6 +70,29 @@ static void tet_writers_round_trip_exactly(void **state) {
     }
     piola_tet_mesh_free(&a);
   }
+}
+
+/* The same five-tet mesh as VTU written by piola (appended raw) and by meshio (ascii and
+ * inline base64) reads like the Gmsh original. */
+static void vtu_variants_read_like_the_original(void **state) {
+  (void)state;
+  piola_tet_mesh original;
+  load("gmsh/msh_test/22_ascii.msh", &original);
+  const char *files[] = {"five_tets_raw.vtu", "five_tets_ascii.vtu", "five_tets_base64.vtu"};
+  for (int i = 0; i < 3; ++i) {
+    char path[1024];
+    snprintf(path, sizeof path, "%s/tests/data/%s", PIOLA_SOURCE_DIR, files[i]);
+    piola_tet_mesh m;
+    if (piola_tet_mesh_read(path, &m) != PIOLA_OK) fail_msg("%s", piola_last_error());
+    assert_int_equal(m.vertex_count, original.vertex_count);
+    assert_int_equal(m.tet_count, original.tet_count);
+    for (int32_t t = 0; t < m.tet_count; ++t)
+      for (int k = 0; k < 4; ++k)
+        for (int d = 0; d < 3; ++d)
+          assert_close(m.positions[3 * m.tets[4 * t + k] + d], original.positions[3 * original.tets[4 * t + k] + d], 0);
+    piola_tet_mesh_free(&m);
+  }
+  piola_tet_mesh_free(&original);
 }
 
 static void boundary_obj_is_the_closed_boundary(void **state) {
@@ -368,6 +391,7 @@ static void loaded_tets_are_oriented_positively(void **state) {
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(tet_writers_round_trip_exactly),
+      cmocka_unit_test(vtu_variants_read_like_the_original),
       cmocka_unit_test(boundary_obj_is_the_closed_boundary),
       cmocka_unit_test(surface_writers_round_trip),
       cmocka_unit_test(writers_never_leave_partial_files),

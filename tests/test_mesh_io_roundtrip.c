@@ -9,6 +9,7 @@
 #include "test_support.h"
 
 #include "io/mesh_io_internal.h"
+#include "io/mesh_writers.h"
 #include "io/text_scanner.h"
 #include "piola/mesh.h"
 #include "piola/mesh_io.h"
@@ -248,6 +249,29 @@ static void decimal_parser_is_within_one_ulp_of_strtod(void **state) {
   }
 }
 
+static void written_doubles_read_back_exactly(void **state) {
+  (void)state;
+  test_rng rng = test_rng_seeded(11);
+  long n = test_samples(200000, 2000);
+  for (long i = 0; i < n; ++i) {
+    double v;
+    if (i % 3 == 0) { /* arbitrary bit patterns, finite */
+      uint64_t bits = test_rng_next(&rng);
+      memcpy(&v, &bits, 8);
+      if (!isfinite(v)) continue;
+    } else if (i % 3 == 1) {
+      v = test_rng_uniform(&rng, -1, 1) * pow(10.0, test_rng_uniform(&rng, -40, 40));
+    } else { /* short decimals, as in hand-written files */
+      v = (double)(int64_t)test_rng_uniform(&rng, -1e6, 1e6) / 1000.0;
+    }
+    char buf[32];
+    int len = piola__format_double(buf, v);
+    assert_true(len > 0 && len < 32);
+    if (strtod(buf, NULL) != v) fail_msg("%.17g written as '%s'", v, buf);
+    if (i % 3 == 2) assert_true(len <= 12); /* short values stay short */
+  }
+}
+
 typedef struct bad_case {
   const char *name; /* decides the reader */
   const char *text;
@@ -397,6 +421,7 @@ int main(void) {
       cmocka_unit_test(writers_never_leave_partial_files),
       cmocka_unit_test(vtu_with_fields_is_read_by_vtk),
       cmocka_unit_test(decimal_parser_is_within_one_ulp_of_strtod),
+      cmocka_unit_test(written_doubles_read_back_exactly),
       cmocka_unit_test(malformed_input_is_refused_with_file_and_line),
       cmocka_unit_test(mixed_face_forms_and_polygons_in_obj),
       cmocka_unit_test(loaded_tets_are_oriented_positively),

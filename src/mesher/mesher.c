@@ -17,6 +17,7 @@
 #define MAX_LATTICE_TETS 120000000LL
 #define MAX_REFINEMENT_LEVELS 6
 #define MAX_REPAIR_ROUNDS 64
+#define PRUNE_ROUNDS 3
 
 piola_mesher_def piola_default_mesher_def(void) {
   piola_mesher_def def;
@@ -202,6 +203,43 @@ static piola_status repair_manifold(const piola__tet_soup *soup, uint8_t *keep) 
   return status;
 }
 
+/* Drops kept tets whose four nodes all lie on the boundary: snapping would flatten them
+ * onto the surface (MBTF03 prunes them for the same reason). Returns how many were dropped,
+ * or -1 when out of memory. */
+static int64_t drop_boundary_only_tets(const piola__tet_soup *soup, uint8_t *keep) {
+  int32_t nv = soup->vertex_count, nt = soup->tet_count;
+  piola__csr vt = {0};
+  if (piola__vertex_tets(nv, soup->tets, nt, keep, &vt) != PIOLA_OK) return -1;
+  int32_t *neighbor = malloc((size_t)nt * 4 * sizeof(int32_t));
+  uint8_t *on_boundary = calloc((size_t)nv + 1, 1);
+  if (!neighbor || !on_boundary) {
+    free(neighbor);
+    free(on_boundary);
+    piola__csr_free(&vt);
+    return -1;
+  }
+  piola__face_neighbors(soup->tets, nt, keep, &vt, neighbor);
+  for (int32_t t = 0; t < nt; ++t) {
+    if (!keep[t]) continue;
+    for (int f = 0; f < 4; ++f)
+      if (neighbor[4 * t + f] == -1)
+        for (int k = 0; k < 3; ++k) on_boundary[soup->tets[4 * t + piola__tet_face[f][k]]] = 1;
+  }
+  int64_t dropped = 0;
+  for (int32_t t = 0; t < nt; ++t) {
+    if (!keep[t]) continue;
+    const int32_t *tet = soup->tets + 4 * (size_t)t;
+    if (on_boundary[tet[0]] && on_boundary[tet[1]] && on_boundary[tet[2]] && on_boundary[tet[3]]) {
+      keep[t] = 0;
+      dropped++;
+    }
+  }
+  free(neighbor);
+  free(on_boundary);
+  piola__csr_free(&vt);
+  return dropped;
+}
+
 static piola_status extract(const piola__tet_soup *soup, const uint8_t *keep, piola_tet_mesh *out) {
   int32_t *map = malloc((size_t)soup->vertex_count * sizeof(int32_t));
   if (!map) return PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "mesher: output");
@@ -300,6 +338,12 @@ piola_status piola_mesher_generate(const piola_mesher_def *def, piola_tet_mesh *
     keep[t] = mean < 0;
   }
   status = repair_manifold(&soup, keep);
+  for (int round = 0; round < PRUNE_ROUNDS && status == PIOLA_OK; ++round) {
+    int64_t dropped = drop_boundary_only_tets(&soup, keep);
+    if (dropped < 0) status = PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "mesher: pruning");
+    if (dropped <= 0) break;
+    status = repair_manifold(&soup, keep);
+  }
   if (status != PIOLA_OK) goto done;
   status = extract(&soup, keep, out);
   if (status != PIOLA_OK) goto done;

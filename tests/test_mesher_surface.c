@@ -10,59 +10,18 @@
 #include <string.h>
 
 #include "geometry/surface_distance.h"
+#include "piola/mesh_io.h"
 #include "piola/mesher.h"
 
 #define MIN_DIHEDRAL_DEG 10.0
 
-/* A minimal OBJ reader for the test data (v and f lines; f a/b/c and a//c forms), so these
- * tests do not depend on the library's readers. */
 static int read_obj(const char *path, piola_tri_mesh *m) {
-  FILE *f = fopen(path, "r");
-  if (!f) return 0;
-  memset(m, 0, sizeof(*m));
-  int vcap = 1024, tcap = 1024;
-  m->positions = malloc(3 * sizeof(double) * (size_t)vcap);
-  m->triangles = malloc(3 * sizeof(int32_t) * (size_t)tcap);
-  char line[1024];
-  while (fgets(line, sizeof line, f)) {
-    if (line[0] == 'v' && line[1] == ' ') {
-      if (m->vertex_count == vcap) {
-        vcap *= 2;
-        m->positions = realloc(m->positions, 3 * sizeof(double) * (size_t)vcap);
-      }
-      double *p = m->positions + 3 * (size_t)m->vertex_count++;
-      if (sscanf(line + 2, "%lf %lf %lf", &p[0], &p[1], &p[2]) != 3) return 0;
-    } else if (line[0] == 'f' && line[1] == ' ') {
-      int32_t idx[16];
-      int n = 0;
-      char *s = line + 2;
-      while (n < 16) {
-        while (*s == ' ' || *s == '\t') ++s;
-        if (*s == '\0' || *s == '\n' || *s == '\r') break;
-        idx[n++] = (int32_t)strtol(s, &s, 10) - 1;
-        while (*s && *s != ' ' && *s != '\t' && *s != '\n') ++s;
-      }
-      for (int k = 1; k + 1 < n; ++k) {
-        if (m->triangle_count == tcap) {
-          tcap *= 2;
-          m->triangles = realloc(m->triangles, 3 * sizeof(int32_t) * (size_t)tcap);
-        }
-        int32_t *t = m->triangles + 3 * (size_t)m->triangle_count++;
-        t[0] = idx[0];
-        t[1] = idx[k];
-        t[2] = idx[k + 1];
-      }
-    }
-  }
-  fclose(f);
-  return 1;
+  piola_status st = piola_tri_mesh_read(path, m);
+  if (st != PIOLA_OK) printf("cannot read %s: %s\n", path, piola_last_error());
+  return st == PIOLA_OK;
 }
 
-static void free_tri(piola_tri_mesh *m) {
-  free(m->positions);
-  free(m->triangles);
-  memset(m, 0, sizeof(*m));
-}
+static void free_tri(piola_tri_mesh *m) { piola_tri_mesh_free(m); }
 
 static double divergence_volume(const piola_tri_mesh *m) {
   double v = 0;
@@ -253,7 +212,13 @@ static void torus_surface_is_meshed(void **state) {
 
 static void bunny_surface_is_meshed(void **state) {
   (void)state;
-  check_surface_mesh("surface/bunny_10k.obj", 30, 0, 0.01);
+  check_surface_mesh("surface/bunny_10k.obj", 45, 0, 0.01);
+}
+
+static void starfish_stl_is_meshed(void **state) {
+  (void)state;
+  /* 150 x 150 x 25 units: 12 cells across the thickness. */
+  check_surface_mesh("surface/starfish.stl", 72, 0, 0.01);
 }
 
 static void armadillo_surface_is_meshed(void **state) {
@@ -270,6 +235,7 @@ int main(void) {
       cmocka_unit_test(torus_surface_is_meshed),
       cmocka_unit_test(bunny_surface_is_meshed),
       cmocka_unit_test(armadillo_surface_is_meshed),
+      cmocka_unit_test(starfish_stl_is_meshed),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
 }

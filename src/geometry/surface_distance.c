@@ -267,15 +267,21 @@ static vec3 closest_on_triangle(vec3 p, vec3 a, vec3 b, vec3 c) {
 }
 
 static double box_distance2(vec3 p, vec3 lo, vec3 hi) {
-  double dx = fmax(fmax(lo.x - p.x, 0), p.x - hi.x);
-  double dy = fmax(fmax(lo.y - p.y, 0), p.y - hi.y);
-  double dz = fmax(fmax(lo.z - p.z, 0), p.z - hi.z);
+  double dx = lo.x - p.x > 0 ? lo.x - p.x : (p.x - hi.x > 0 ? p.x - hi.x : 0);
+  double dy = lo.y - p.y > 0 ? lo.y - p.y : (p.y - hi.y > 0 ? p.y - hi.y : 0);
+  double dz = lo.z - p.z > 0 ? lo.z - p.z : (p.z - hi.z > 0 ? p.z - hi.z : 0);
   return dx * dx + dy * dy + dz * dz;
 }
 
 double piola__surface_closest_point(const piola__surface_distance *s, vec3 p, vec3 *closest,
                                     int32_t *triangle) {
-  double best = INFINITY;
+  return piola__surface_closest_point_within(s, p, INFINITY, closest, triangle);
+}
+
+double piola__surface_closest_point_within(const piola__surface_distance *s, vec3 p,
+                                           double max_distance, vec3 *closest,
+                                           int32_t *triangle) {
+  double best = max_distance * max_distance;
   vec3 best_point = p;
   int32_t best_tri = -1;
   int32_t stack[STACK_DEPTH];
@@ -311,7 +317,7 @@ double piola__surface_closest_point(const piola__surface_distance *s, vec3 p, ve
   }
   if (closest) *closest = best_point;
   if (triangle) *triangle = best_tri;
-  return sqrt(best);
+  return best_tri < 0 ? INFINITY : sqrt(best);
 }
 
 static double triangle_solid_angle(vec3 p, vec3 a, vec3 b, vec3 c) {

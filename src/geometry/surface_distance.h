@@ -46,6 +46,13 @@ void piola__surface_distance_destroy(piola__surface_distance *surface);
 double piola__surface_closest_point(const piola__surface_distance *surface, vec3 p,
                                     vec3 *closest, int32_t *triangle);
 
+/* The same, but only triangles closer than max_distance (m) are considered: returns
+ * INFINITY (closest = p, triangle = -1) when there are none. Much
+ * faster far from the surface, where only the sign matters. */
+double piola__surface_closest_point_within(const piola__surface_distance *surface, vec3 p,
+                                           double max_distance, vec3 *closest,
+                                           int32_t *triangle);
+
 /* Generalized winding number at p: about 1 inside, 0 outside. */
 double piola__surface_winding_number(const piola__surface_distance *surface, vec3 p);
 

@@ -10,20 +10,21 @@
 typedef struct snap_context {
   piola_tet_mesh *mesh;
   piola__csr vertex_tets;
-  double guard; /* radians */
+  double guard_cosine; /* cosine of the guard angle */
 } snap_context;
 
-/* Worst (smallest) dihedral angle of the tets around v, with v placed at x. */
-static double worst_angle_around(const snap_context *c, int32_t v, vec3 x) {
-  double worst = M_PI;
+/* Cosine of the worst (smallest) dihedral angle of the tets around v, with v placed at x:
+ * larger is worse, 2 means a tet is inverted or flat. */
+static double worst_cosine_around(const snap_context *c, int32_t v, vec3 x) {
+  double worst = -1;
   const double *p = c->mesh->positions;
   for (int32_t i = c->vertex_tets.offsets[v]; i < c->vertex_tets.offsets[v + 1]; ++i) {
     const int32_t *tet = c->mesh->tets + 4 * (size_t)c->vertex_tets.items[i];
     vec3 y[4];
     for (int k = 0; k < 4; ++k) y[k] = tet[k] == v ? x : vec3_load(p + 3 * (size_t)tet[k]);
-    double a = piola__tet_dihedral_range(y[0], y[1], y[2], y[3], NULL);
-    if (a < worst) worst = a;
-    if (worst < 0) break;
+    double a = piola__tet_min_dihedral_cosine(y[0], y[1], y[2], y[3]);
+    if (a > worst) worst = a;
+    if (worst > 1) break;
   }
   return worst;
 }
@@ -32,13 +33,13 @@ static double worst_angle_around(const snap_context *c, int32_t v, vec3 x) {
  * around it at or above the guard (or not worse than now). Returns 1 if it moved. */
 static int guarded_move(snap_context *c, int32_t v, vec3 goal, int require_improvement) {
   vec3 x = vec3_load(c->mesh->positions + 3 * (size_t)v);
-  double now = worst_angle_around(c, v, x);
-  double need = require_improvement ? now : fmin(now, c->guard);
+  double now = worst_cosine_around(c, v, x);
+  double need = require_improvement ? now : fmax(now, c->guard_cosine);
   double fraction = 1.0;
   for (int attempt = 0; attempt < 5; ++attempt, fraction *= 0.5) {
     vec3 y = vec3_add(x, vec3_scale(vec3_sub(goal, x), fraction));
-    double after = worst_angle_around(c, v, y);
-    if (after >= need && (!require_improvement || after > now + 1e-12)) {
+    double after = worst_cosine_around(c, v, y);
+    if (after <= need && (!require_improvement || after < now - 1e-12)) {
       vec3_store(c->mesh->positions + 3 * (size_t)v, y);
       return 1;
     }
@@ -73,8 +74,7 @@ static void smooth(snap_context *c, const int32_t *list, int32_t count, const ui
 
 piola_status piola__boundary_snap(piola_tet_mesh *mesh, const piola__shape_union *shapes,
                                   double h) {
-  (void)h;
-  snap_context c = {.mesh = mesh, .guard = PIOLA__SNAP_MIN_DIHEDRAL_DEG * M_PI / 180.0};
+  snap_context c = {.mesh = mesh, .guard_cosine = cos(PIOLA__SNAP_MIN_DIHEDRAL_DEG * M_PI / 180.0)};
   int32_t nv = mesh->vertex_count, nt = mesh->tet_count;
   PIOLA_TRY(piola__vertex_tets(nv, mesh->tets, nt, NULL, &c.vertex_tets));
   int32_t *neighbor = malloc((size_t)nt * 4 * sizeof(int32_t));
@@ -115,6 +115,7 @@ piola_status piola__boundary_snap(piola_tet_mesh *mesh, const piola__shape_union
       target[i] = piola__shape_union_project(shapes, vec3_load(mesh->positions + 3 * (size_t)boundary[i]));
     for (int32_t i = 0; i < nb; ++i) {
       vec3 x = vec3_load(mesh->positions + 3 * (size_t)boundary[i]);
+      if (vec3_norm2(vec3_sub(target[i], x)) < 1e-20 * h * h) continue; /* already there */
       guarded_move(&c, boundary[i], vec3_add(x, vec3_scale(vec3_sub(target[i], x), remaining[stage])), 0);
     }
     smooth(&c, inner, ni, ring, 0, NULL);

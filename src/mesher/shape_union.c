@@ -144,6 +144,13 @@ double piola__shape_union_phi(const piola__shape_union *u, vec3 p, vec3 *normal)
   return best;
 }
 
+double piola__shape_union_phi_analytic(const piola__shape_union *u, vec3 p) {
+  double best = INFINITY;
+  for (int i = 0; i < u->count; ++i)
+    if (u->shapes[i].type != PIOLA_SHAPE_SURFACE) best = fmin(best, shape_phi(u, i, p, NULL));
+  return best;
+}
+
 vec3 piola__shape_union_project(const piola__shape_union *u, vec3 p) {
   if (u->count == 1 && u->shapes[0].type == PIOLA_SHAPE_SURFACE) {
     vec3 q;

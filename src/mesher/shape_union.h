@@ -27,6 +27,9 @@ void piola__shape_union_bounds(const piola__shape_union *u, vec3 *lo, vec3 *hi);
 /* phi(p) (m) and its gradient, the outward unit normal (may be NULL). */
 double piola__shape_union_phi(const piola__shape_union *u, vec3 p, vec3 *normal);
 
+/* phi of the analytic shapes only (INFINITY when there are none). */
+double piola__shape_union_phi_analytic(const piola__shape_union *u, vec3 p);
+
 /* The point of the surface phi = 0 nearest to p (a few Newton steps p - phi grad phi). */
 vec3 piola__shape_union_project(const piola__shape_union *u, vec3 p);
 

@@ -47,4 +47,8 @@ static inline double piola__tet_volume(vec3 a, vec3 b, vec3 c, vec3 d) {
  * when the tet is not positively oriented (then max is set to pi). */
 double piola__tet_dihedral_range(vec3 a, vec3 b, vec3 c, vec3 d, double *max_angle);
 
+/* Cosine of the smallest dihedral angle (larger = worse), or 2 when the tet is not
+ * positively oriented: the same order as the angle without any acos, for inner loops. */
+double piola__tet_min_dihedral_cosine(vec3 a, vec3 b, vec3 c, vec3 d);
+
 #endif

@@ -273,8 +273,8 @@ static void extension_is_continuous_at_the_threshold(void **state) {
     }
 }
 
-/* The definition itself: below the threshold the stress is P(fc) + K(fc) (f - fc) (LINEAR) or
- * P(fc) (CLAMP), computed here from the public values at the clamped point, wherever the
+/* The definition itself: below the threshold the stress is the relaxed and saturated Taylor
+ * expansion around fc (LINEAR, see below and docs/materials.md) or P(fc) (CLAMP), computed here from the public values at the clamped point, wherever the
  * restoring safeguards are inactive (all couplings nonnegative and the diagonal slope not
  * raised; for CLAMP the clamped stress already compressive enough). */
 static void extension_is_the_taylor_expansion_where_no_safeguard_acts(void **state) {
@@ -305,10 +305,24 @@ static void extension_is_the_taylor_expansion_where_no_safeguard_acts(void **sta
         }
         if (!safe) continue;
         piola_material_stress(&m, f, p);
+        /* LINEAR (docs/materials.md): the Taylor expansion with the diagonal slope relaxing
+         * from K_ii to s_far = max(min(K_ii, 2 mu + lambda), mu + max(p, 0)/c) and the
+         * couplings into unclamped rows saturating, through q(d) = d w / (w - d), w = c/4. */
+        const double w = 0.25 * c;
         for (int i = 0; i < 3; ++i) {
           double expected = pc[i];
-          if (m.inversion_mode == PIOLA_INVERSION_LINEAR)
-            for (int j = 0; j < 3; ++j) expected += kc[i][j] * d[j];
+          if (m.inversion_mode == PIOLA_INVERSION_LINEAR) {
+            const double qi = d[i] * w / (w - d[i]);
+            if (d[i] < 0.0) {
+              const double far = fmax(fmin(kc[i][i], 2.0 * m.mu + m.lambda),
+                                      m.mu + fmax(pc[i], 0.0) / c);
+              expected += far * d[i] + (kc[i][i] - far) * qi;
+              for (int j = 0; j < 3; ++j)
+                if (j != i) expected += kc[i][j] * d[j];
+            } else {
+              for (int j = 0; j < 3; ++j) expected += kc[i][j] * d[j] * w / (w - d[j]);
+            }
+          }
           assert_close(p[i], expected, 1e-10 * stress_scale(&m, f));
         }
         ++checked;

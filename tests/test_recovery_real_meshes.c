@@ -15,10 +15,9 @@
  * diagonalization of the cross-covariance), are within 1e-3 m (0.1% of the size) of rest; no tet is
  * inverted; every Fhat entry is within 1e-3 of 1 (the slowest mode still decays at 12 s).
  *
- * Collapses use the default LINEAR extension for every model. Scrambles use the CLAMP
- * extension for every model, and LINEAR for rotated linear: with LINEAR, neo-Hookean can
- * settle in a tangled equilibrium and corotated can expand without bound from a scramble of
- * this mesh (docs/materials.md, "Tangled equilibria" and "Known problem"). */
+ * Collapses use the default LINEAR extension; scrambles both LINEAR and CLAMP. All asserted,
+ * except neo-Hookean with LINEAR from a scramble, which can settle in a tangled equilibrium
+ * (docs/materials.md, "Tangled equilibria"): there only "finite at every step" is checked. */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -180,18 +179,21 @@ static void recover_file(const char *relative, int scrambles, uint64_t seed) {
   double *x = malloc(sizeof(double) * 3 * (size_t)mesh.vertex_count);
   const double beta = 1000.0, alpha = 300.0, density = 1000.0; /* Pa s, Pa s, kg/m^3 */
   const double duration = 12.0;                                  /* s */
-  for (size_t m = 0; m < sizeof models / sizeof models[0]; ++m) {
+  /* all five models normally; under the sanitizers (PIOLA_TEST_SCALE small) fewer */
+  const size_t model_count = (size_t)test_samples(5, 1);
+  for (size_t m = 0; m < model_count; ++m) {
     for (int kind = COLLAPSE_POINT; kind <= SCRAMBLE; ++kind) {
       const int runs = kind == SCRAMBLE ? scrambles : 1;
-      /* Scrambles: every model with the CLAMP extension; rotated linear also with the
-       * default LINEAR one. With LINEAR, neo-Hookean can stop in a tangled equilibrium and
-       * corotated (and the spline, same volume term) can expand without bound on this mesh:
-       * docs/materials.md, "Tangled equilibria" and "Known problem". */
-      const int modes = (kind == SCRAMBLE && models[m] == PIOLA_MODEL_ROTATED_LINEAR) ? 2 : 1;
+      /* Scrambles: every model with both extensions. Neo-Hookean with LINEAR can settle in a
+       * tangled equilibrium (docs/materials.md, "Tangled equilibria"): for it the run must
+       * stay finite, and its outcome is printed, not asserted. */
+      const int modes = kind == SCRAMBLE ? 2 : 1;
       for (int mode_index = 0; mode_index < modes; ++mode_index) {
         const piola_inversion_mode mode = kind == SCRAMBLE && mode_index == 0
                                               ? PIOLA_INVERSION_CLAMP
                                               : PIOLA_INVERSION_LINEAR;
+        const int asserted = !(kind == SCRAMBLE && models[m] == PIOLA_MODEL_NEOHOOKEAN &&
+                               mode == PIOLA_INVERSION_LINEAR);
         piola_material material = recovery_material(models[m], mode);
         piola_elastic_body *body = fixture_body(&mesh, &material);
         const double h = piola_elastic_body_min_rest_altitude(body);
@@ -209,7 +211,7 @@ static void recover_file(const char *relative, int scrambles, uint64_t seed) {
                         relative, piola_material_model_name(models[m]),
                         piola_inversion_mode_name(mode), start_name[kind], o.position_error,
                         o.fhat_error, (int)o.inverted, steps);
-          if (!(o.position_error <= 1e-3 && o.fhat_error <= 1e-3 && o.inverted == 0))
+          if (asserted && !(o.position_error <= 1e-3 && o.fhat_error <= 1e-3 && o.inverted == 0))
             fail_msg("%s, %s (%s) from a %s: position error %g m, max |fhat - 1| = %g, "
                      "%d inverted after %d steps",
                      relative, piola_material_model_name(models[m]),

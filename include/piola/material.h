@@ -8,8 +8,11 @@
  * Inversion extension: below the compression threshold c on any entry of Fhat the model is
  * replaced, in that entry, by its value at the clamped point (PIOLA_INVERSION_CLAMP, C0) or
  * by its first-order Taylor expansion around the clamped point (PIOLA_INVERSION_LINEAR, C1,
- * the default), continued through zero into negative (inverted) entries; all entries below c
- * are expanded together. In clamped entries the slope is raised where the plain expansion
+ * the default), continued through zero into negative (inverted) entries, with the slope
+ * relaxing towards at most the rest stiffness and the cross terms into unclamped entries
+ * saturating away from the threshold (exact Taylor value and slope at it); all entries below
+ * c are expanded together. Neo-Hookean bodies that may start scrambled or tangled should use
+ * CLAMP: with LINEAR they can stop in a tangled equilibrium (docs/materials.md). In clamped entries the slope is raised where the plain expansion
  * would not push back (e.g. St. Venant-Kirchhoff, whose own slope there is negative), so the
  * result is finite for every Fhat with entries up to 1e30 in magnitude (flat, collapsed and
  * inverted included; only the models' own growth, e.g. corotated's energy ~ f^6, overflows

@@ -223,39 +223,49 @@ void piola_material_stress_derivative(const piola_material *material, const doub
   double t[3][3][3] = {{{0}}};
   if (any_clamped) model_third_derivative(m, e.fc, t);
   const double c = m->threshold, floor_slope = m->mu;
+  const double w = 0.25 * c, cap = fmax(2.0 * m->mu + m->lambda, floor_slope);
+  double q[3], dq[3]; /* saturated offsets and their derivatives, 1 / (1 - d / w)^2 */
+  for (int k = 0; k < 3; ++k) {
+    q[k] = extension_saturation(m, e.d[k]);
+    const double r = w / (w - e.d[k]);
+    dq[k] = r * r;
+  }
 
   for (int i = 0; i < 3; ++i) {
-    const double s = extension_diagonal_slope(m, pa->p[i], pa->k[i][i]);
+    const double kii = pa->k[i][i], p = pa->p[i];
+    const double s = extension_diagonal_slope(m, p, kii);
+    const double s_far = extension_far_slope(m, p, kii);
+    const double raised = floor_slope + fmax(p, 0.0) / c;
     for (int j = 0; j < 3; ++j) {
       double v;
       if (!e.clamped[i]) {
-        /* Unclamped row: P_i = p_i(fc) + [LINEAR] sum_k K_ik(fc) d_k. */
+        /* Unclamped row: P_i = p_i(fc) + [LINEAR] sum_k K_ik(fc) q(d_k). */
         if (e.clamped[j]) {
-          v = linear ? pa->k[i][j] : 0.0;
+          v = linear ? pa->k[i][j] * dq[j] : 0.0;
         } else {
           v = pa->k[i][j];
           if (linear)
-            for (int k = 0; k < 3; ++k) v += t[i][j][k] * e.d[k];
+            for (int k = 0; k < 3; ++k) v += t[i][j][k] * q[k];
         }
       } else if (e.clamped[j]) {
         /* Clamped row and column: the extension's own slopes. */
-        v = (i == j) ? s : (linear ? kernel_max(pa->k[i][j], 0.0) : 0.0);
+        v = (i == j) ? (linear ? s_far + (s - s_far) * dq[i] : s_far)
+                     : (linear ? kernel_max(pa->k[i][j], 0.0) : 0.0);
       } else {
-        /* Clamped row, unclamped column j: fc_j = f_j moves p_i, K_ii, K_ik. */
+        /* Clamped row, unclamped column j: fc_j = f_j moves p_i, K_ii, K_ik, hence the
+         * slopes s and s_far. P_i = p_i + s_far d_i + (s - s_far) q_i + couplings. */
         v = pa->k[i][j];
-        double ds = 0.0; /* d s / d f_j */
+        const double draised = p > 0.0 ? pa->k[i][j] / c : 0.0;
         if (linear) {
-          const double raised = floor_slope + kernel_max(pa->p[i], 0.0) / c;
-          if (pa->k[i][i] >= raised)
-            ds = t[i][i][j];
-          else if (pa->p[i] > 0.0)
-            ds = pa->k[i][j] / c;
+          const double ds = kii >= raised ? t[i][i][j] : draised;
+          const double dcapped = kii < cap ? t[i][i][j] : 0.0; /* of min(K_ii, cap) */
+          const double ds_far = fmin(kii, cap) >= raised ? dcapped : draised;
+          v += ds_far * (e.d[i] - q[i]) + ds * q[i];
           for (int k = 0; k < 3; ++k)
             if (k != i && e.clamped[k] && pa->k[i][k] > 0.0) v += t[i][k][j] * e.d[k];
-        } else if (pa->p[i] / c + floor_slope > 0.0) {
-          ds = pa->k[i][j] / c;
+        } else if (p / c + floor_slope > 0.0) {
+          v += pa->k[i][j] / c * e.d[i]; /* the ramp p / c + mu */
         }
-        v += ds * e.d[i];
       }
       dphat[i][j] = v;
     }

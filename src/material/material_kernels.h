@@ -219,9 +219,9 @@ MATERIAL_KERNEL void material_model_parts(piola_material_model model, const piol
 
 /* --------------------------------------------------------------- the extension */
 
-/* Diagonal slope used for a clamped entry i whose value at the clamped point is p and whose
- * Taylor slope is kii. LINEAR: the Taylor slope, raised where needed so that the stress is
- * at most -mu c at f_i = 0 (restoring) and at least mu (never softening past the
+/* Diagonal slope at the threshold for a clamped entry i whose value at the clamped point is p
+ * and whose Taylor slope is kii. LINEAR: the Taylor slope, raised where needed so that the
+ * stress is at most -mu c at f_i = 0 (restoring) and at least mu (never softening past the
  * threshold). CLAMP: zero (constant stress), unless the clamped stress is not already
  * compressive enough, in which case the ramp that reaches -mu c at zero. */
 MATERIAL_KERNEL double extension_diagonal_slope(const piola_material *m, double p, double kii) {
@@ -234,28 +234,67 @@ MATERIAL_KERNEL double extension_diagonal_slope(const piola_material *m, double 
   return linear * taylor + (1.0 - linear) * ramp;
 }
 
-/* One entry of the extended stress: entry i with value p and slopes kii, kij, kik at the
- * clamped point, offsets di, dj, dk = f - fc <= 0 (zero at or above the threshold). Written
- * on scalars with selects, not loops over arrays with branches: GCC vectorizes the force
- * loop only in this form. */
-MATERIAL_KERNEL double extended_entry(const piola_material *m, double p, double kii, double kij,
-                                      double kik, double di, double dj, double dk) {
-  const double s = extension_diagonal_slope(m, p, kii);
-  /* Clamped rows never take a negative coupling to other clamped entries (it could pull an
-   * inverted entry further); unclamped rows keep the Taylor coupling. An unclamped entry
-   * has d = 0, so its coupling term vanishes either way. */
-  const double cij = di < 0.0 ? kernel_max(kij, 0.0) : kij;
-  const double cik = di < 0.0 ? kernel_max(kik, 0.0) : kik;
+/* LINEAR: the slope far past the threshold, which the diagonal slope relaxes to (see
+ * extension_saturation): the threshold slope capped at the rest stiffness 2 mu + lambda (never
+ * below the restoring floor mu + max(p, 0)/c, nor below mu). Equal to the threshold slope for
+ * models whose slope there is already moderate; neo-Hookean's is ~14x its rest stiffness, and
+ * continued linearly that steep slope makes tangled meshes stable (docs/materials.md). CLAMP:
+ * the ramp itself. */
+MATERIAL_KERNEL double extension_far_slope(const piola_material *m, double p, double kii) {
+  const double c = m->threshold, floor_slope = m->mu;
   const double linear = (double)(m->inversion_mode != PIOLA_INVERSION_CLAMP);
-  return p + s * di + linear * (cij * dj + cik * dk);
+  const double cap = kernel_max(2.0 * m->mu + m->lambda, floor_slope);
+  const double far = kernel_max(kernel_min(kii, cap), floor_slope + kernel_max(p, 0.0) / c);
+  const double ramp = kernel_max(0.0, p / c + floor_slope);
+  return linear * far + (1.0 - linear) * ramp;
+}
+
+/* The saturating offset q(d) = d / (1 - d / w), w = c / 4, for d = f - fc <= 0: q(0) = 0,
+ * q'(0) = 1 (so the extension keeps the Taylor value and slope at the threshold: C1), and
+ * -w < q <= 0 (so what is multiplied by q stays bounded however deep the inversion). */
+MATERIAL_KERNEL double extension_saturation(const piola_material *m, double d) {
+  const double w = 0.25 * m->threshold;
+  return d * w / (w - d);
+}
+
+/* One entry of the extended stress: entry i with value p and slopes kii, kij, kik at the
+ * clamped point, offsets di, dj, dk = f - fc <= 0 (zero at or above the threshold) and their
+ * saturated values qi, qj, qk. Written on scalars with selects, not loops over arrays with
+ * branches: GCC vectorizes the force loop only in this form.
+ *   clamped row:   p + s_far di + (s - s_far) qi + max(kij, 0) dj + max(kik, 0) dk
+ *   unclamped row: p + kij qj + kik qk
+ * The diagonal slope starts at s (Taylor) at the threshold and relaxes to s_far; couplings
+ * into unclamped rows saturate: their Taylor extrapolation overshoots (corotated's lateral
+ * stress turns compressive past f_k < c/2 and grows with the lateral stretch, a feedback
+ * that expands a body without bound). Clamped rows never take a negative coupling to other
+ * clamped entries (it could pull an inverted entry further). CLAMP: p + ramp di. */
+MATERIAL_KERNEL double extended_entry(const piola_material *m, double p, double kii, double kij,
+                                      double kik, double di, double dj, double dk, double qi,
+                                      double qj, double qk) {
+  const double s = extension_diagonal_slope(m, p, kii);
+  const double s_far = extension_far_slope(m, p, kii);
+  const double clamped_row = kernel_max(kij, 0.0) * dj + kernel_max(kik, 0.0) * dk;
+  const double free_row = kij * qj + kik * qk;
+  const double coupling = di < 0.0 ? clamped_row : free_row;
+  const double linear = (double)(m->inversion_mode != PIOLA_INVERSION_CLAMP);
+  return p + s_far * di + linear * ((s - s_far) * qi + coupling);
 }
 
 /* Extended stress from the parts at the clamped point and the offsets d = f - fc. */
 MATERIAL_KERNEL void material_extend(const piola_material *m, const material_parts *pa, double d0,
                                      double d1, double d2, double *p0, double *p1, double *p2) {
-  *p0 = extended_entry(m, pa->p[0], pa->k[0][0], pa->k[0][1], pa->k[0][2], d0, d1, d2);
-  *p1 = extended_entry(m, pa->p[1], pa->k[1][1], pa->k[1][0], pa->k[1][2], d1, d0, d2);
-  *p2 = extended_entry(m, pa->p[2], pa->k[2][2], pa->k[2][0], pa->k[2][1], d2, d0, d1);
+  const double q0 = extension_saturation(m, d0), q1 = extension_saturation(m, d1),
+               q2 = extension_saturation(m, d2);
+  *p0 = extended_entry(m, pa->p[0], pa->k[0][0], pa->k[0][1], pa->k[0][2], d0, d1, d2, q0, q1, q2);
+  *p1 = extended_entry(m, pa->p[1], pa->k[1][1], pa->k[1][0], pa->k[1][2], d1, d0, d2, q1, q0, q2);
+  *p2 = extended_entry(m, pa->p[2], pa->k[2][2], pa->k[2][0], pa->k[2][1], d2, d0, d1, q2, q0, q1);
+}
+
+/* Integral from 0 to d of the saturating offset: -w d - w^2 ln(1 - d / w) (d <= 0, so the
+ * logarithm's argument is >= 1). */
+MATERIAL_KERNEL double extension_saturation_integral(const piola_material *m, double d) {
+  const double w = 0.25 * m->threshold;
+  return -w * d - w * w * kernel_log(1.0 - d / w);
 }
 
 /* The hot entry point for one model known at compile time. */
@@ -309,8 +348,9 @@ MATERIAL_KERNEL double material_model_energy(piola_material_model model, const p
 }
 
 /* Extended stress and energy density in one pass (the force loop wants both; the clamped
- * point's parts are shared). Energy past the threshold: psi(fc) + p.d + 1/2 d^T K'' d over
- * the clamped entries, with the same slopes as the stress, so that d psi / d f_i = Phat_i
+ * point's parts are shared). Energy past the threshold: psi(fc) + p.d + sum over clamped i of
+ * (1/2 s_far d_i^2 + (s - s_far) Q(d_i)), Q the integral of the saturating offset, plus the
+ * clamped-clamped couplings max(K_ij, 0) d_i d_j: the same slopes as the stress, so that d psi / d f_i = Phat_i
  * for every clamped entry (docs/materials.md). Unclamped entries have d = 0 and drop out of
  * every product, which keeps this branch-free. */
 MATERIAL_KERNEL void material_extended_stress_energy(piola_material_model model,
@@ -327,9 +367,15 @@ MATERIAL_KERNEL void material_extended_stress_energy(piola_material_model model,
   const double s0 = extension_diagonal_slope(m, pa.p[0], pa.k[0][0]);
   const double s1 = extension_diagonal_slope(m, pa.p[1], pa.k[1][1]);
   const double s2 = extension_diagonal_slope(m, pa.p[2], pa.k[2][2]);
+  const double r0 = extension_far_slope(m, pa.p[0], pa.k[0][0]);
+  const double r1 = extension_far_slope(m, pa.p[1], pa.k[1][1]);
+  const double r2 = extension_far_slope(m, pa.p[2], pa.k[2][2]);
   const double first = pa.p[0] * d0 + pa.p[1] * d1 + pa.p[2] * d2;
   const double second =
-      0.5 * (s0 * d0 * d0 + s1 * d1 * d1 + s2 * d2 * d2) +
+      0.5 * (r0 * d0 * d0 + r1 * d1 * d1 + r2 * d2 * d2) +
+      linear * ((s0 - r0) * extension_saturation_integral(m, d0) +
+                (s1 - r1) * extension_saturation_integral(m, d1) +
+                (s2 - r2) * extension_saturation_integral(m, d2)) +
       linear * (kernel_max(pa.k[0][1], 0.0) * d0 * d1 + kernel_max(pa.k[0][2], 0.0) * d0 * d2 +
                 kernel_max(pa.k[1][2], 0.0) * d1 * d2);
   *psi = material_model_energy(model, m, fc0, fc1, fc2) + first + second;

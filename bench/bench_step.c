@@ -64,8 +64,8 @@ int main(int argc, char **argv) {
       sd.material.model = PIOLA_MODEL_NEOHOOKEAN;
       sd.material.youngs_modulus = 1e5;
       sd.material.poisson_ratio = 0.4;
-      sd.shear_viscosity = piola_track_constant(2e-3 * 1000 * size * size / 1e-4);
-      sd.bulk_viscosity = piola_track_constant(2e-3 * 1000 * size * size / 1e-4);
+      sd.shear_viscosity = piola_track_constant(2e-5 * 1000 * size * size / 1e-4);
+      sd.bulk_viscosity = piola_track_constant(2e-5 * 1000 * size * size / 1e-4);
       sd.scramble_radius = 1e-3 * size;
       sd.velocity = (piola_vec3){0, 0, -1};
       piola_obstacle_def ground = piola_default_obstacle_def();

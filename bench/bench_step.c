@@ -8,7 +8,10 @@
  * gravity onto a plane through its lowest point, with shear and bulk viscosities chosen so
  * the two solves of a step take about 20 CG iterations together. Each timing is 10 steps of
  * fixed dt = 1e-4 s; the table gives the median over `repeats` (default 5) for 1 and 2
- * threads, with CG iterations per step. */
+ * threads: wall and process CPU time per step (CPU time is less disturbed by a loaded
+ * machine; with 2 threads it counts both), CG iterations per step, and the two kernels a
+ * step is made of timed alone: one elastic update and one damping-force evaluation (a step
+ * costs one update plus about one damping evaluation per CG iteration). */
 #include <math.h>
 #include <omp.h>
 #include <stdio.h>
@@ -48,11 +51,15 @@ int main(int argc, char **argv) {
   double size = xmax - xmin;
   printf("bench_step: %s, %d vertices, %d tets, size %.3g m\n", path, (int)mesh.vertex_count,
          (int)mesh.tet_count, size);
-  printf("%8s %14s %14s %10s\n", "threads", "ms/step", "CG iter/step", "steps/s");
+  printf("%8s %10s %14s %14s %12s %14s\n", "threads", "ms/step", "CPU ms/step", "CG iter/step",
+         "ms/update", "ms/damping");
   for (int threads = 1; threads <= 2; ++threads) {
     piola_set_thread_count(threads);
     omp_set_num_threads(threads);
     double *times = malloc((size_t)repeats * sizeof *times);
+    double *cpu = malloc((size_t)repeats * sizeof *cpu);
+    double *upd = malloc((size_t)repeats * sizeof *upd);
+    double *damp = malloc((size_t)repeats * sizeof *damp);
     double cg_per_step = 0;
     for (int r = 0; r < repeats; ++r) {
       piola_world_def wd = piola_default_world_def();
@@ -83,6 +90,7 @@ int main(int argc, char **argv) {
       const int steps = 10;
       int cg = 0;
       double t0 = now_seconds();
+      clock_t c0 = clock();
       for (int s = 0; s < steps; ++s) {
         if (piola_world_step(world, 1e-4, &st) != PIOLA_OK) {
           fprintf(stderr, "bench_step: %s\n", piola_last_error());
@@ -91,13 +99,36 @@ int main(int argc, char **argv) {
         cg += st.cg_iterations;
       }
       times[r] = (now_seconds() - t0) / steps;
+      cpu[r] = (double)(clock() - c0) / CLOCKS_PER_SEC / steps;
       cg_per_step = (double)cg / steps;
+      /* the two kernels of a step alone, on this state: one elastic update, one damping apply */
+      const piola_elastic_body *body = piola_world_solid_body(world, 0);
+      int32_t n = piola_elastic_body_vertex_count(body);
+      double *f = malloc(3 * (size_t)n * sizeof *f);
+      double *x = malloc(3 * (size_t)n * sizeof *x);
+      memcpy(x, piola_world_solid_positions(world, 0), 3 * (size_t)n * sizeof *x);
+      piola_elastic_body *mut = (piola_elastic_body *)body; /* the world's own body, same state */
+      double u0 = now_seconds();
+      for (int k = 0; k < 3; ++k) piola_elastic_body_update(mut, x, 1.0, f, NULL);
+      upd[r] = (now_seconds() - u0) / 3;
+      double d0 = now_seconds();
+      for (int k = 0; k < 5; ++k)
+        piola_elastic_body_damping_forces(body, piola_world_solid_velocities(world, 0), 1, 1, f);
+      damp[r] = (now_seconds() - d0) / 5;
+      free(f);
+      free(x);
       piola_world_destroy(world);
     }
     qsort(times, (size_t)repeats, sizeof *times, compare_doubles);
-    double med = times[repeats / 2];
-    printf("%8d %14.2f %14.1f %10.1f\n", threads, 1e3 * med, cg_per_step, 1.0 / med);
+    qsort(cpu, (size_t)repeats, sizeof *cpu, compare_doubles);
+    qsort(upd, (size_t)repeats, sizeof *upd, compare_doubles);
+    qsort(damp, (size_t)repeats, sizeof *damp, compare_doubles);
+    printf("%8d %10.2f %14.2f %14.1f %12.2f %14.2f\n", threads, 1e3 * times[repeats / 2],
+           1e3 * cpu[repeats / 2], cg_per_step, 1e3 * upd[repeats / 2], 1e3 * damp[repeats / 2]);
     free(times);
+    free(cpu);
+    free(upd);
+    free(damp);
   }
   piola_tet_mesh_free(&mesh);
   return 0;

@@ -48,13 +48,45 @@ static void simd_block(const piola_material *m, long n, const double *restrict f
   }
 }
 
+static void simd_block_energy(const piola_material *m, long n, const double *restrict f0,
+                              const double *restrict f1, const double *restrict f2,
+                              double *restrict p0, double *restrict p1, double *restrict p2,
+                              double *restrict psi) {
+  switch (m->model) {
+#define PIOLA_BENCH_LOOP(fn)                                         \
+  {                                                                  \
+    _Pragma("omp simd") for (long i = 0; i < n; ++i)                 \
+        fn(m, f0[i], f1[i], f2[i], &p0[i], &p1[i], &p2[i], &psi[i]); \
+  }                                                                  \
+  break;
+    case PIOLA_MODEL_ROTATED_LINEAR:
+      PIOLA_BENCH_LOOP(rotated_linear_stress_energy)
+    case PIOLA_MODEL_COROTATED:
+      PIOLA_BENCH_LOOP(corotated_stress_energy)
+    case PIOLA_MODEL_STVK:
+      PIOLA_BENCH_LOOP(stvk_stress_energy)
+    case PIOLA_MODEL_NEOHOOKEAN:
+      PIOLA_BENCH_LOOP(neohookean_stress_energy)
+    case PIOLA_MODEL_SPLINE:
+      PIOLA_BENCH_LOOP(spline_stress_energy)
+    default:
+      break;
+#undef PIOLA_BENCH_LOOP
+  }
+}
+
+static double median(double *v, int n) {
+  qsort(v, (size_t)n, sizeof(double), compare_doubles);
+  return v[n / 2];
+}
+
 int main(int argc, char **argv) {
   const long n = argc > 1 ? atol(argv[1]) : 65536;
   if (n <= 0) return 1;
-  double *buf = malloc(sizeof(double) * 6 * (size_t)n);
+  double *buf = malloc(sizeof(double) * 7 * (size_t)n);
   if (!buf) return 1;
   double *f0 = buf, *f1 = buf + n, *f2 = buf + 2 * n, *p0 = buf + 3 * n, *p1 = buf + 4 * n,
-         *p2 = buf + 5 * n;
+         *p2 = buf + 5 * n, *psi = buf + 6 * n;
   unsigned long long state = 88172645463325252ull;
   for (long i = 0; i < 3 * n; ++i) {
     state ^= state << 13, state ^= state >> 7, state ^= state << 17;
@@ -62,14 +94,16 @@ int main(int argc, char **argv) {
     buf[i] = (i % 10 == 0) ? -0.5 + 0.7 * u : 0.6 + 0.9 * u;
   }
   enum { RUNS = 9 };
-  printf("| model | public function, ns/tet | simd kernel loop, ns/tet |\n|---|---|---|\n");
+  printf(
+      "| model | public stress | simd stress | public stress + energy | simd stress + energy |\n");
+  printf("|---|---|---|---|---|\n");
   double sink = 0;
   for (int model = 0; model < PIOLA_MODEL_COUNT; ++model) {
     piola_material_def def = piola_default_material_def();
     def.model = (piola_material_model)model;
     piola_material m;
     if (piola_material_init(&def, &m) != PIOLA_OK) return 1;
-    double scalar[RUNS], simd[RUNS];
+    double t_pub[RUNS], t_simd[RUNS], t_pub_e[RUNS], t_simd_e[RUNS];
     for (int r = 0; r < RUNS; ++r) {
       double t = now_seconds();
       for (long i = 0; i < n; ++i) {
@@ -78,17 +112,30 @@ int main(int argc, char **argv) {
         piola_material_stress(&m, f, p);
         p0[i] = p[0], p1[i] = p[1], p2[i] = p[2];
       }
-      scalar[r] = (now_seconds() - t) / (double)n * 1e9;
+      t_pub[r] = (now_seconds() - t) / (double)n * 1e9;
       sink += p0[n / 2];
       t = now_seconds();
       simd_block(&m, n, f0, f1, f2, p0, p1, p2);
-      simd[r] = (now_seconds() - t) / (double)n * 1e9;
+      t_simd[r] = (now_seconds() - t) / (double)n * 1e9;
       sink += p1[n / 3];
+      t = now_seconds();
+      for (long i = 0; i < n; ++i) {
+        const double f[3] = {f0[i], f1[i], f2[i]};
+        double p[3];
+        piola_material_stress(&m, f, p);
+        psi[i] = piola_material_energy_density(&m, f);
+        p0[i] = p[0], p1[i] = p[1], p2[i] = p[2];
+      }
+      t_pub_e[r] = (now_seconds() - t) / (double)n * 1e9;
+      sink += psi[n / 2];
+      t = now_seconds();
+      simd_block_energy(&m, n, f0, f1, f2, p0, p1, p2, psi);
+      t_simd_e[r] = (now_seconds() - t) / (double)n * 1e9;
+      sink += psi[n / 3];
     }
-    qsort(scalar, RUNS, sizeof(double), compare_doubles);
-    qsort(simd, RUNS, sizeof(double), compare_doubles);
-    printf("| %s | %.2f | %.2f |\n", piola_material_model_name(m.model), scalar[RUNS / 2],
-           simd[RUNS / 2]);
+    printf("| %s | %.1f | %.1f | %.1f | %.1f |\n", piola_material_model_name(m.model),
+           median(t_pub, RUNS), median(t_simd, RUNS), median(t_pub_e, RUNS),
+           median(t_simd_e, RUNS));
   }
   fprintf(stderr, "(checksum %g)\n", sink);
   free(buf);

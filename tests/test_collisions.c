@@ -247,7 +247,8 @@ static void many_nodes_end_outside_and_results_do_not_depend_on_threads(void **s
     bool separates = false;
     for (int k = 0; k < 2; ++k) {
       vec3 vel;
-      double phi = piola_obstacle_signed_distance(obstacles[k], 0.7, vec3_load(x + 3 * i), NULL, &vel);
+      double phi =
+          piola_obstacle_signed_distance(obstacles[k], 0.7, vec3_load(x + 3 * i), NULL, &vel);
       assert_true(phi >= -1e-12);
       /* A node left on an obstacle does not move into it along the normal it was given. */
       if (c[i] && phi < 1e-12 &&

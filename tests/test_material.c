@@ -342,11 +342,27 @@ static void check_finite_and_restoring(const piola_material *m, const double f[3
 
 static void flat_and_inverted_entries_are_finite_and_pushed_back(void **state) {
   (void)state;
-  const double fixed[][3] = {
-      {0, 0, 0},       {-1, -1, -1},     {-1e6, -1e6, -1e6}, {0, 1, 1},
-      {-0.5, 1, 1},    {-1e6, 1, 1},     {0, 0, 1},          {-2, 0, 3},
-      {-0.01, 5, 5},   {-0.01, 10, 10},  {0, 10, 0.1},       {-3, -2, 8},
-      {-1e-300, 1, 1}, {-0.2, 0.3, 0.3}, {1e3, -1e3, 1e3},   {0.1, 0.2, -50}};
+  const double fixed[][3] = {{0, 0, 0},
+                             {-1, -1, -1},
+                             {-1e6, -1e6, -1e6},
+                             {0, 1, 1},
+                             {-0.5, 1, 1},
+                             {-1e6, 1, 1},
+                             {0, 0, 1},
+                             {-2, 0, 3},
+                             {-0.01, 5, 5},
+                             {-0.01, 10, 10},
+                             {0, 10, 0.1},
+                             {-3, -2, 8},
+                             {-1e-300, 1, 1},
+                             {-0.2, 0.3, 0.3},
+                             {1e3, -1e3, 1e3},
+                             {0.1, 0.2, -50},
+                             /* The documented range of finiteness: |f| up to 1e30. */
+                             {1e30, 1e30, 1e30},
+                             {-1e30, 1e30, 1e30},
+                             {-1e30, -1e30, -1e30},
+                             {-1e30, 1e-30, 1e30}};
   test_rng rng = test_rng_seeded(16);
   const long samples = test_samples(2000, 50);
   const double nus[] = {-0.5, 0.3, 0.49};
@@ -484,20 +500,32 @@ static void kernels_and_public_functions_agree_bitwise(void **state) {
                          double *);
   const kernel kernels[PIOLA_MODEL_COUNT] = {rotated_linear_stress, corotated_stress, stvk_stress,
                                              neohookean_stress, spline_stress};
+  typedef void (*energy_kernel)(const piola_material *, double, double, double, double *, double *,
+                                double *, double *);
+  const energy_kernel energy_kernels[PIOLA_MODEL_COUNT] = {
+      rotated_linear_stress_energy, corotated_stress_energy, stvk_stress_energy,
+      neohookean_stress_energy, spline_stress_energy};
   test_rng rng = test_rng_seeded(18);
   for (int model = 0; model < PIOLA_MODEL_COUNT; ++model)
     for (int mode = 0; mode < N_MODES; ++mode) {
       const piola_material m = make((piola_material_model)model, modes[mode], 0.3);
       for (int s = 0; s < 50; ++s) {
-        double f[3], p[3], q[3], r[3];
+        double f[3], p[3], q[3], r[3], e[3], g[3], psi_e, psi_g;
         random_point(&rng, -2.0, 3.0, f);
         piola_material_stress(&m, f, p);
         kernels[model](&m, f[0], f[1], f[2], &q[0], &q[1], &q[2]);
         material_stress_kernel(&m, f[0], f[1], f[2], &r[0], &r[1], &r[2]);
+        energy_kernels[model](&m, f[0], f[1], f[2], &e[0], &e[1], &e[2], &psi_e);
+        material_stress_energy_kernel(&m, f[0], f[1], f[2], &g[0], &g[1], &g[2], &psi_g);
+        const double psi = piola_material_energy_density(&m, f);
         for (int i = 0; i < 3; ++i) {
           assert_true(p[i] == q[i]);
           assert_true(p[i] == r[i]);
+          assert_true(p[i] == e[i]);
+          assert_true(p[i] == g[i]);
         }
+        assert_true(psi == psi_e);
+        assert_true(psi == psi_g);
       }
     }
 }

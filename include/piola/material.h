@@ -11,8 +11,10 @@
  * the default), continued through zero into negative (inverted) entries; all entries below c
  * are expanded together. In clamped entries the slope is raised where the plain expansion
  * would not push back (e.g. St. Venant-Kirchhoff, whose own slope there is negative), so the
- * result is finite for every finite Fhat and every entry f_i <= 0 gets Phat_i < 0: an
- * inverted element is always pushed back. See docs/materials.md.
+ * result is finite for every Fhat with entries up to 1e30 in magnitude (flat, collapsed and
+ * inverted included; only the models' own growth, e.g. corotated's energy ~ f^6, overflows
+ * far beyond that), and every entry f_i <= 0 gets Phat_i < 0: an inverted element is always
+ * pushed back. See docs/materials.md.
  *
  * Usage:
  *   piola_material_def def = piola_default_material_def();

@@ -14,7 +14,7 @@ extern "C" {
 #endif
 
 /* The six interior dihedral angles of the tet (x0..x3, 3 doubles each), in degrees, at
- * edges (0,1), (0,2), (0,3), (1,2), (1,3), (2,3). 90/180-free degenerate tets give 0/180. */
+ * edges (0,1), (0,2), (0,3), (1,2), (1,3), (2,3). Flat tets give angles of 0 or 180. */
 PIOLA_API void piola_tet_dihedral_angles(const double *x0, const double *x1, const double *x2, const double *x3,
                                          double angles_degrees[6]);
 

@@ -71,13 +71,14 @@ PIOLA_API double piola_obstacle_friction(const piola_obstacle *obstacle);
 PIOLA_API void piola_obstacle_destroy(piola_obstacle *obstacle);
 
 /* Section 9 collision processing for node_count nodes at time t (s) after a position
- * update of length dt (s). x (m) and v (m/s) are 3 * node_count and are modified in place.
- * colliding (node_count, may be NULL) is set to 1 for nodes that were projected, else 0;
- * normals (3 * node_count, may be NULL) receives their obstacle normals, for holding the
- * normal velocity fixed in the final solve. Returns the number of colliding nodes, or -1
- * (with piola_last_error set) when memory for more than 8 obstacle poses cannot be had.
- * A node inside several obstacles is projected out of each in order, sweeping the list up to
- * 4 times; the normal stored is that of its last projection. */
+ * update of length dt (s; with dt <= 0 the dxN / dt friction term is dropped). x (m) and
+ * v (m/s) are 3 * node_count and are modified in place. colliding (node_count, may be NULL)
+ * is set to 1 for nodes that were projected, else 0; normals (3 * node_count, may be NULL)
+ * receives their obstacle normals, for holding the normal velocity fixed in the final
+ * solve (entries of other nodes are left alone). Returns the number of colliding nodes, or
+ * -1 (with piola_last_error set) when memory for more than 8 obstacle poses cannot be had.
+ * A node inside several obstacles is projected out of each in order, sweeping the list up
+ * to 4 times; the normal stored is that of its last projection. NULL entries are skipped. */
 PIOLA_API int32_t piola_obstacles_collide(piola_obstacle *const *obstacles, int32_t obstacle_count,
                                           double t, double dt, int32_t node_count, double *x,
                                           double *v, uint8_t *colliding, double *normals);

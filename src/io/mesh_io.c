@@ -4,6 +4,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include <strings.h>
+#include <sys/mman.h>
 #include <sys/stat.h>
 
 #include "common/status_internal.h"
@@ -55,6 +56,39 @@ piola_status piola__read_file(const char *path, char **data, size_t *size) {
   return PIOLA_OK;
 }
 
+/* A whole input file, memory-mapped when possible: mapping skips the copy into a fresh
+ * buffer and the zeroing of its pages, which cost as much as parsing for big files. */
+typedef struct loaded_file {
+  char *data;
+  size_t size;
+  int mapped;
+} loaded_file;
+
+static piola_status load_file(const char *path, loaded_file *f) {
+  memset(f, 0, sizeof *f);
+  FILE *stream = fopen(path, "rb");
+  if (!stream) return PIOLA_FAIL(PIOLA_ERROR_IO, "%s: cannot open: %s", path, strerror(errno));
+  struct stat st;
+  if (fstat(fileno(stream), &st) == 0 && S_ISREG(st.st_mode) && st.st_size > 0) {
+    void *p = mmap(NULL, (size_t)st.st_size, PROT_READ, MAP_PRIVATE, fileno(stream), 0);
+    if (p != MAP_FAILED) {
+      fclose(stream);
+      f->data = p;
+      f->size = (size_t)st.st_size;
+      f->mapped = 1;
+      return PIOLA_OK;
+    }
+  }
+  fclose(stream);
+  return piola__read_file(path, &f->data, &f->size);
+}
+
+static void unload_file(loaded_file *f) {
+  if (f->mapped) munmap(f->data, f->size);
+  else free(f->data);
+  memset(f, 0, sizeof *f);
+}
+
 static const char *extension(const char *path) {
   const char *slash = strrchr(path, '/');
   const char *dot = strrchr(path, '.');
@@ -66,8 +100,7 @@ static const char *extension(const char *path) {
 static piola_status read_tetgen(const char *path, piola_tet_mesh *out) {
   size_t n = strlen(path);
   char *node_path = malloc(n + 8), *ele_path = malloc(n + 8);
-  char *node = NULL, *ele = NULL;
-  size_t node_size = 0, ele_size = 0;
+  loaded_file node = {0}, ele = {0};
   piola_status status = PIOLA_OK;
   if (!node_path || !ele_path) {
     status = PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "out of memory");
@@ -78,15 +111,15 @@ static piola_status read_tetgen(const char *path, piola_tet_mesh *out) {
   memcpy(ele_path, path, stem);
   strcpy(node_path + stem, ".node");
   strcpy(ele_path + stem, ".ele");
-  status = piola__read_file(node_path, &node, &node_size);
-  if (status == PIOLA_OK) status = piola__read_file(ele_path, &ele, &ele_size);
+  status = load_file(node_path, &node);
+  if (status == PIOLA_OK) status = load_file(ele_path, &ele);
   if (status == PIOLA_OK)
-    status = piola__read_tetgen_mem(node_path, node, node_size, ele_path, ele, ele_size, out);
+    status = piola__read_tetgen_mem(node_path, node.data, node.size, ele_path, ele.data, ele.size, out);
 done:
   free(node_path);
   free(ele_path);
-  free(node);
-  free(ele);
+  unload_file(&node);
+  unload_file(&ele);
   return status;
 }
 
@@ -105,17 +138,15 @@ piola_status piola_tet_mesh_read(const char *path, piola_tet_mesh *out) {
   piola_status (*reader)(const char *, const char *, size_t, piola_tet_mesh *) = NULL;
   if (strcasecmp(ext, ".msh") == 0) reader = piola__read_gmsh_mem;
   else if (strcasecmp(ext, ".mesh") == 0) reader = piola__read_medit_mem;
-  else if (strcasecmp(ext, ".vtu") == 0)
-    return PIOLA_FAIL(PIOLA_ERROR_UNSUPPORTED, "%s: reading .vtu is not supported (piola only writes it)", path);
+  else if (strcasecmp(ext, ".vtu") == 0) reader = piola__read_vtu_mem;
   else
     return PIOLA_FAIL(PIOLA_ERROR_UNSUPPORTED,
                       "%s: unknown tet mesh extension '%s' (expected .node, .ele, .msh, .mesh, .veg, .vtu)", path,
                       ext);
-  char *data = NULL;
-  size_t size = 0;
-  PIOLA_TRY(piola__read_file(path, &data, &size));
-  piola_status s = reader(path, data, size, out);
-  free(data);
+  loaded_file f;
+  PIOLA_TRY(load_file(path, &f));
+  piola_status s = reader(path, f.data, f.size, out);
+  unload_file(&f);
   return s;
 }
 
@@ -126,11 +157,10 @@ piola_status piola_vega_read(const char *path, piola_tet_mesh *mesh, piola_vega_
   memset(mesh, 0, sizeof *mesh);
   *materials = NULL;
   *material_count = 0;
-  char *data = NULL;
-  size_t size = 0;
-  PIOLA_TRY(piola__read_file(path, &data, &size));
-  piola_status s = piola__read_vega_mem(path, data, size, mesh, materials, material_count);
-  free(data);
+  loaded_file f;
+  PIOLA_TRY(load_file(path, &f));
+  piola_status s = piola__read_vega_mem(path, f.data, f.size, mesh, materials, material_count);
+  unload_file(&f);
   return s;
 }
 
@@ -145,11 +175,10 @@ piola_status piola_tri_mesh_read(const char *path, piola_tri_mesh *out) {
   else
     return PIOLA_FAIL(PIOLA_ERROR_UNSUPPORTED, "%s: unknown surface extension '%s' (expected .obj, .off, .stl)",
                       path, ext);
-  char *data = NULL;
-  size_t size = 0;
-  PIOLA_TRY(piola__read_file(path, &data, &size));
-  piola_status s = reader(path, data, size, out);
-  free(data);
+  loaded_file f;
+  PIOLA_TRY(load_file(path, &f));
+  piola_status s = reader(path, f.data, f.size, out);
+  unload_file(&f);
   return s;
 }
 

@@ -116,16 +116,22 @@ static int nodes_of_type(int32_t type) {
 
 static int is_tet_type(int32_t type) { return type == 4 || type == 11 || type == 29 || type == 30 || type == 31; }
 
-static piola_status add_tet(gmsh_reader *g, const uint64_t *nodes, int32_t region) {
-  if (piola__grow((void **)&g->tet_nodes, &g->tet_capacity, g->tet_count + 1, 4 * sizeof(uint64_t)) != 0)
-    return PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "%s: out of memory", g->s.name);
+static piola_status reserve_tets(gmsh_reader *g, size_t more) {
   size_t cap = g->tet_capacity;
+  if (piola__grow((void **)&g->tet_nodes, &cap, g->tet_count + more, 4 * sizeof(uint64_t)) != 0)
+    return PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "%s: out of memory", g->s.name);
+  g->tet_capacity = cap;
   int32_t *r = realloc(g->tet_regions, cap * sizeof(int32_t));
   if (!r) return PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "%s: out of memory", g->s.name);
   g->tet_regions = r;
   int32_t *l = realloc(g->tet_lines, cap * sizeof(int32_t));
   if (!l) return PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "%s: out of memory", g->s.name);
   g->tet_lines = l;
+  return PIOLA_OK;
+}
+
+static piola_status add_tet(gmsh_reader *g, const uint64_t *nodes, int32_t region) {
+  if (g->tet_count + 1 > g->tet_capacity) PIOLA_TRY(reserve_tets(g, g->tet_capacity + 1));
   g->tet_lines[g->tet_count] = (int32_t)g->s.line;
   memcpy(g->tet_nodes + 4 * g->tet_count, nodes, 4 * sizeof(uint64_t));
   g->tet_regions[g->tet_count++] = region;
@@ -217,7 +223,7 @@ static void to_binary_data(gmsh_reader *g) {
 
 static piola_status read_entities(gmsh_reader *g) {
   to_binary_data(g);
-  uint64_t counts[4];
+  uint64_t counts[4] = {0, 0, 0, 0};
   for (int d = 0; d < 4; ++d) PIOLA_TRY(get_size(g, &counts[d], "entity count"));
   for (int d = 0; d < 4; ++d) PIOLA_TRY(check_count(g, counts[d], 8, "entity count"));
   g->volume_tags = malloc((counts[3] + 1) * sizeof(int64_t));
@@ -229,7 +235,7 @@ static piola_status read_entities(gmsh_reader *g) {
       double ignored;
       PIOLA_TRY(get_int(g, &tag, "entity tag"));
       for (int k = 0; k < (d == 0 ? 3 : 6); ++k) PIOLA_TRY(get_double(g, &ignored, "entity bounding box"));
-      uint64_t nphys;
+      uint64_t nphys = 0;
       PIOLA_TRY(get_size(g, &nphys, "physical tag count"));
       PIOLA_TRY(check_count(g, nphys, 2, "physical tag count"));
       int32_t first_physical = 0;
@@ -244,7 +250,7 @@ static piola_status read_entities(gmsh_reader *g) {
         ++g->volume_count;
       }
       if (d > 0) {
-        uint64_t nbound;
+        uint64_t nbound = 0;
         PIOLA_TRY(get_size(g, &nbound, "bounding entity count"));
         PIOLA_TRY(check_count(g, nbound, 2, "bounding entity count"));
         for (uint64_t k = 0; k < nbound; ++k) {
@@ -260,7 +266,7 @@ static piola_status read_entities(gmsh_reader *g) {
 
 static piola_status read_nodes_v4(gmsh_reader *g) {
   to_binary_data(g);
-  uint64_t blocks, total, min_tag, max_tag;
+  uint64_t blocks = 0, total = 0, min_tag = 0, max_tag = 0;
   PIOLA_TRY(get_size(g, &blocks, "node block count"));
   PIOLA_TRY(get_size(g, &total, "node count"));
   PIOLA_TRY(get_size(g, &min_tag, "minimum node tag"));
@@ -270,7 +276,7 @@ static piola_status read_nodes_v4(gmsh_reader *g) {
   PIOLA_TRY(reserve_nodes(g, total));
   for (uint64_t b = 0; b < blocks; ++b) {
     int32_t dim, entity, parametric;
-    uint64_t n;
+    uint64_t n = 0;
     PIOLA_TRY(get_int(g, &dim, "entity dimension"));
     PIOLA_TRY(get_int(g, &entity, "entity tag"));
     PIOLA_TRY(get_int(g, &parametric, "parametric flag"));
@@ -283,7 +289,7 @@ static piola_status read_nodes_v4(gmsh_reader *g) {
     PIOLA_TRY(reserve_nodes(g, n));
     size_t first = g->node_count;
     for (uint64_t i = 0; i < n; ++i) {
-      uint64_t tag;
+      uint64_t tag = 0;
       PIOLA_TRY(get_size(g, &tag, "node tag"));
       g->node_tags[first + i] = tag;
     }
@@ -311,17 +317,18 @@ static int32_t region_of_entity(const gmsh_reader *g, int32_t entity) {
 
 static piola_status read_elements_v4(gmsh_reader *g) {
   to_binary_data(g);
-  uint64_t blocks, total, min_tag, max_tag;
+  uint64_t blocks = 0, total = 0, min_tag = 0, max_tag = 0;
   PIOLA_TRY(get_size(g, &blocks, "element block count"));
   PIOLA_TRY(get_size(g, &total, "element count"));
   PIOLA_TRY(get_size(g, &min_tag, "minimum element tag"));
   PIOLA_TRY(get_size(g, &max_tag, "maximum element tag"));
   PIOLA_TRY(check_count(g, blocks, 8, "element block count"));
   PIOLA_TRY(check_count(g, total, 4, "element count"));
+  PIOLA_TRY(reserve_tets(g, total));
   uint64_t seen = 0;
   for (uint64_t b = 0; b < blocks; ++b) {
     int32_t dim, entity, type;
-    uint64_t n;
+    uint64_t n = 0;
     PIOLA_TRY(get_int(g, &dim, "entity dimension"));
     PIOLA_TRY(get_int(g, &entity, "entity tag"));
     PIOLA_TRY(get_int(g, &type, "element type"));
@@ -336,10 +343,10 @@ static piola_status read_elements_v4(gmsh_reader *g) {
     int keep = is_tet_type(type);
     int32_t region = keep ? (g->have_entities ? region_of_entity(g, entity) : entity) : 0;
     for (uint64_t e = 0; e < n; ++e) {
-      uint64_t tag, nodes[4];
+      uint64_t tag = 0, nodes[4] = {0, 0, 0, 0};
       PIOLA_TRY(get_size(g, &tag, "element tag"));
       for (int k = 0; k < npe; ++k) {
-        uint64_t v;
+        uint64_t v = 0;
         PIOLA_TRY(get_size(g, &v, "element node"));
         if (k < 4) nodes[k] = v;
       }
@@ -354,7 +361,7 @@ static piola_status read_elements_v4(gmsh_reader *g) {
 }
 
 static piola_status read_nodes_v2(gmsh_reader *g) {
-  uint64_t n;
+  uint64_t n = 0;
   PIOLA_TRY(piola__scan_int64(&g->s, (int64_t *)&n, "node count"));
   PIOLA_TRY(check_count(g, n, 8, "node count"));
   to_binary_data(g);
@@ -402,7 +409,7 @@ static piola_status read_element_body_v2(gmsh_reader *g, int32_t type, int32_t n
 }
 
 static piola_status read_elements_v2(gmsh_reader *g) {
-  uint64_t n;
+  uint64_t n = 0;
   PIOLA_TRY(piola__scan_int64(&g->s, (int64_t *)&n, "element count"));
   PIOLA_TRY(check_count(g, n, 8, "element count"));
   to_binary_data(g);

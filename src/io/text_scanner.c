@@ -108,7 +108,7 @@ static void describe_token(const text_scanner *s, char *out, size_t size) {
   out[len] = '\0';
 }
 
-piola_status piola__scan_int64(text_scanner *s, int64_t *value, const char *what) {
+piola_status piola__scan_int64_full(text_scanner *s, int64_t *value, const char *what) {
   if (!piola__scan_skip(s)) return piola__scan_error(s, PIOLA_ERROR_PARSE, "unexpected end of file, expected %s", what);
   const char *p = s->p, *end = s->end;
   int negative = 0;
@@ -165,7 +165,12 @@ static size_t parse_slow(const char *p, const char *end, double *value) {
 }
 
 size_t piola__parse_double(const char *p, const char *end, double *value) {
+  return piola__parse_double_checked(p, end, value, NULL);
+}
+
+size_t piola__parse_double_checked(const char *p, const char *end, double *value, int *exact) {
   const char *b = p;
+  if (exact) *exact = 0;
   int negative = 0;
   if (p < end && (*p == '-' || *p == '+')) {
     negative = *p == '-';
@@ -228,10 +233,12 @@ size_t piola__parse_double(const char *p, const char *end, double *value) {
   double v;
   if (mantissa == 0) {
     v = 0.0;
+    if (exact) *exact = 1;
   } else if (mantissa <= (UINT64_C(1) << 53) && exponent >= -22 && exponent <= 22) {
     /* Both operands exact: one correctly rounded operation. */
     v = (double)mantissa;
     v = exponent < 0 ? v / exact_powers[-exponent] : v * exact_powers[exponent];
+    if (exact) *exact = 1;
   } else if (exponent >= -27 && exponent <= 27 && sizeof(long double) > sizeof(double)) {
     /* 64-bit mantissas and 10^27 are exact in x87 extended precision; one extended
      * rounding then one to double: within one ulp. */
@@ -247,7 +254,7 @@ size_t piola__parse_double(const char *p, const char *end, double *value) {
   return (size_t)(p - b);
 }
 
-piola_status piola__scan_double(text_scanner *s, double *value, const char *what) {
+piola_status piola__scan_double_full(text_scanner *s, double *value, const char *what) {
   if (!piola__scan_skip(s)) return piola__scan_error(s, PIOLA_ERROR_PARSE, "unexpected end of file, expected %s", what);
   size_t n = piola__parse_double(s->p, s->end, value);
   if (n == 0 || (s->p + n < s->end && is_token_char(s, s->p[n]))) {

@@ -43,13 +43,58 @@ piola_status piola__scan_token(text_scanner *s, const char **token, size_t *leng
 /* 1 if the next token equals `word` (case-insensitive when ignore_case); consumes it then. */
 int piola__scan_accept(text_scanner *s, const char *word, int ignore_case);
 
-piola_status piola__scan_int64(text_scanner *s, int64_t *value, const char *what);
+/* Out-of-line versions: comments, errors, unusual number forms. */
+piola_status piola__scan_int64_full(text_scanner *s, int64_t *value, const char *what);
+piola_status piola__scan_double_full(text_scanner *s, double *value, const char *what);
 piola_status piola__scan_int32(text_scanner *s, int32_t *value, const char *what);
-piola_status piola__scan_double(text_scanner *s, double *value, const char *what);
 
-/* Parses a decimal number from [p, end); returns the number of bytes used, 0 if none.
- * Non-finite results are returned as they are (callers refuse them). */
+/* Inline fast paths for the common case (plain separators, plain numbers); anything else
+ * goes to the _full versions, which handle it and report errors. */
+static inline int piola__scan_fast_blank(const char *p, const text_scanner *s) {
+  return p < s->end && (*p == ' ' || *p == '\n' || *p == '\t' || *p == '\r');
+}
+
+static inline piola_status piola__scan_int64(text_scanner *s, int64_t *value, const char *what) {
+  const char *p = s->p, *end = s->end;
+  long lines = 0;
+  while (p < end && (*p == ' ' || *p == '\n' || *p == '\t')) lines += *p++ == '\n';
+  const char *b = p;
+  uint64_t v = 0;
+  while (p < end && (unsigned)(*p - '0') < 10u && p - b < 18) v = v * 10 + (uint64_t)(*p++ - '0');
+  if (p > b && (p == end || *p == ' ' || *p == '\n' || *p == '\t' || *p == '\r')) {
+    s->p = p;
+    s->line += lines;
+    *value = (int64_t)v;
+    return PIOLA_OK;
+  }
+  return piola__scan_int64_full(s, value, what);
+}
+
 size_t piola__parse_double(const char *p, const char *end, double *value);
+/* The same, and *exact = 1 when the result is known to be correctly rounded (Clinger's
+ * fast path or zero); 0 when it may be one ulp off or came from strtod. */
+size_t piola__parse_double_checked(const char *p, const char *end, double *value, int *exact);
+
+static inline piola_status piola__scan_double(text_scanner *s, double *value, const char *what) {
+  const char *p = s->p, *end = s->end;
+  long lines = 0;
+  while (p < end && (*p == ' ' || *p == '\n' || *p == '\t')) lines += *p++ == '\n';
+  if (p < end && ((unsigned)(*p - '0') < 10u || *p == '-' || *p == '.')) {
+    double v;
+    size_t n = piola__parse_double(p, end, &v);
+    const char *q = p + n;
+    if (n > 0 && (q == end || *q == ' ' || *q == '\n' || *q == '\t' || *q == '\r') && v - v == 0) {
+      s->p = q;
+      s->line += lines;
+      *value = v;
+      return PIOLA_OK;
+    }
+  }
+  return piola__scan_double_full(s, value, what);
+}
+
+/* piola__parse_double (declared above): parses a decimal number from [p, end); returns the
+ * number of bytes used, 0 if none. Non-finite results are returned as they are. */
 
 /* Reports "file:line: message". */
 piola_status piola__scan_error(const text_scanner *s, piola_status status, const char *format, ...)

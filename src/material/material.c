@@ -170,35 +170,6 @@ static extension_point extension_point_at(const piola_material *m, const double 
   return e;
 }
 
-/* Separable energy A(f) of each model (see entry_slope_curvature). */
-static double entry_energy(const piola_material *m, double f) {
-  const double mu = m->mu;
-  switch (m->model) {
-    case PIOLA_MODEL_STVK:
-      return 0.25 * mu * (f * f - 1.0) * (f * f - 1.0);
-    case PIOLA_MODEL_NEOHOOKEAN:
-      return mu * (0.5 * (f * f - 1.0) - log(f));
-    case PIOLA_MODEL_SPLINE: {
-      /* Integral from 1 to f of the 1D stress curve; G(t, w) integrates the transition
-       * (slope rising linearly over width w) followed by the stiff straight part. */
-      const double *s = m->spline_coefficients;
-      const double u = f - 1.0;
-      double extra = 0.0;
-      const double widths[2] = {s[SPLINE_WE], s[SPLINE_WC]};
-      const double amounts[2] = {kernel_max(u, 0.0), kernel_max(-u, 0.0)};
-      for (int side = 0; side < 2; ++side) {
-        const double t = amounts[side], w = widths[side], tc = kernel_min(t, w);
-        extra += tc * tc * tc / (6.0 * w) + (t - tc) * 0.5 * w + 0.5 * (t - tc) * (t - tc);
-      }
-      return 0.5 * s[SPLINE_K0] * u * u + s[SPLINE_DK] * extra;
-    }
-    case PIOLA_MODEL_ROTATED_LINEAR:
-    case PIOLA_MODEL_COROTATED:
-    default:
-      return mu * (f - 1.0) * (f - 1.0);
-  }
-}
-
 /* A'''(f): the third derivative of the separable energy. */
 static double entry_third(const piola_material *m, double f) {
   switch (m->model) {
@@ -216,15 +187,6 @@ static double entry_third(const piola_material *m, double f) {
     default:
       return 0.0;
   }
-}
-
-/* Energy of the unextended model at f (all entries > 0). */
-static double model_energy(const piola_material *m, const double f[3]) {
-  double g[3], h[3][3], kappa;
-  const double qm = invariant_terms(m->model, m, f[0], f[1], f[2], g, h, &kappa);
-  double psi = 0.5 * kappa * qm * qm;
-  for (int i = 0; i < 3; ++i) psi += entry_energy(m, f[i]);
-  return psi;
 }
 
 /* T_ijk = d3 psi / df_i df_j df_k of the unextended model at f (all entries > 0). */
@@ -246,21 +208,8 @@ static void model_third_derivative(const piola_material *m, const double f[3], d
 }
 
 double piola_material_energy_density(const piola_material *material, const double fhat[3]) {
-  const piola_material *m = material;
-  const extension_point e = extension_point_at(m, fhat);
-  /* psi(fc) + P(fc).d + 1/2 d^T K' d over the clamped block, with exactly the slopes the
-   * stress uses, so that d psi / d f_i = Phat_i exactly for every clamped entry i. */
-  double psi = model_energy(m, e.fc);
-  const int linear = m->inversion_mode != PIOLA_INVERSION_CLAMP;
-  for (int i = 0; i < 3; ++i) {
-    if (!e.clamped[i]) continue;
-    psi += e.parts.p[i] * e.d[i];
-    const double s = extension_diagonal_slope(m, e.parts.p[i], e.parts.k[i][i]);
-    psi += 0.5 * s * e.d[i] * e.d[i];
-    if (!linear) continue;
-    for (int j = i + 1; j < 3; ++j)
-      if (e.clamped[j]) psi += kernel_max(e.parts.k[i][j], 0.0) * e.d[i] * e.d[j];
-  }
+  double p[3], psi;
+  material_stress_energy_kernel(material, fhat[0], fhat[1], fhat[2], &p[0], &p[1], &p[2], &psi);
   return psi;
 }
 

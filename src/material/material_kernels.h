@@ -269,6 +269,72 @@ MATERIAL_KERNEL void material_extended_stress(piola_material_model model, const 
   material_extend(m, &parts, f0 - fc0, f1 - fc1, f2 - fc2, p0, p1, p2);
 }
 
+/* A(f): the separable energy of each model (see entry_slope_curvature). */
+MATERIAL_KERNEL double entry_energy(piola_material_model model, const piola_material *m, double f) {
+  const double mu = m->mu;
+  switch (model) {
+    case PIOLA_MODEL_STVK:
+      return 0.25 * mu * (f * f - 1.0) * (f * f - 1.0);
+    case PIOLA_MODEL_NEOHOOKEAN:
+      return mu * (0.5 * (f * f - 1.0) - kernel_log(f));
+    case PIOLA_MODEL_SPLINE: {
+      /* Integral from 1 to f of the 1D stress curve. Each side (t = stretch or compression
+       * beyond rest, w = its transition width) contributes tc^3 / (6 w) over the transition,
+       * where the slope rises linearly, then the straight stiff part. */
+      const double *s = m->spline_coefficients;
+      const double u = f - 1.0;
+      const double t = kernel_max(u, 0.0), tc = kernel_min(t, s[SPLINE_WE]);
+      const double c = kernel_max(-u, 0.0), cc = kernel_min(c, s[SPLINE_WC]);
+      const double te = t - tc, ce = c - cc;
+      const double tension =
+          tc * tc * tc * s[SPLINE_INV_WE] / 6.0 + te * (0.5 * s[SPLINE_WE] + 0.5 * te);
+      const double compression =
+          cc * cc * cc * s[SPLINE_INV_WC] / 6.0 + ce * (0.5 * s[SPLINE_WC] + 0.5 * ce);
+      return 0.5 * s[SPLINE_K0] * u * u + s[SPLINE_DK] * (tension + compression);
+    }
+    case PIOLA_MODEL_ROTATED_LINEAR:
+    case PIOLA_MODEL_COROTATED:
+    default:
+      return mu * (f - 1.0) * (f - 1.0);
+  }
+}
+
+/* Energy density of the unextended model at f (all entries > 0). */
+MATERIAL_KERNEL double material_model_energy(piola_material_model model, const piola_material *m,
+                                             double f0, double f1, double f2) {
+  double g[3], h[3][3], kappa;
+  const double qm = invariant_terms(model, m, f0, f1, f2, g, h, &kappa);
+  return entry_energy(model, m, f0) + entry_energy(model, m, f1) + entry_energy(model, m, f2) +
+         0.5 * kappa * qm * qm;
+}
+
+/* Extended stress and energy density in one pass (the force loop wants both; the clamped
+ * point's parts are shared). Energy past the threshold: psi(fc) + p.d + 1/2 d^T K'' d over
+ * the clamped entries, with the same slopes as the stress, so that d psi / d f_i = Phat_i
+ * for every clamped entry (docs/materials.md). Unclamped entries have d = 0 and drop out of
+ * every product, which keeps this branch-free. */
+MATERIAL_KERNEL void material_extended_stress_energy(piola_material_model model,
+                                                     const piola_material *m, double f0, double f1,
+                                                     double f2, double *p0, double *p1, double *p2,
+                                                     double *psi) {
+  const double c = m->threshold;
+  const double fc0 = kernel_max(f0, c), fc1 = kernel_max(f1, c), fc2 = kernel_max(f2, c);
+  const double d0 = f0 - fc0, d1 = f1 - fc1, d2 = f2 - fc2;
+  material_parts pa;
+  material_model_parts(model, m, fc0, fc1, fc2, &pa);
+  material_extend(m, &pa, d0, d1, d2, p0, p1, p2);
+  const double linear = (double)(m->inversion_mode != PIOLA_INVERSION_CLAMP);
+  const double s0 = extension_diagonal_slope(m, pa.p[0], pa.k[0][0]);
+  const double s1 = extension_diagonal_slope(m, pa.p[1], pa.k[1][1]);
+  const double s2 = extension_diagonal_slope(m, pa.p[2], pa.k[2][2]);
+  const double first = pa.p[0] * d0 + pa.p[1] * d1 + pa.p[2] * d2;
+  const double second =
+      0.5 * (s0 * d0 * d0 + s1 * d1 * d1 + s2 * d2 * d2) +
+      linear * (kernel_max(pa.k[0][1], 0.0) * d0 * d1 + kernel_max(pa.k[0][2], 0.0) * d0 * d2 +
+                kernel_max(pa.k[1][2], 0.0) * d1 * d2);
+  *psi = material_model_energy(model, m, fc0, fc1, fc2) + first + second;
+}
+
 /* Per-model kernels: the model is a constant, so each compiles to straight-line code. */
 MATERIAL_KERNEL void rotated_linear_stress(const piola_material *m, double f0, double f1, double f2,
                                            double *p0, double *p1, double *p2) {
@@ -311,6 +377,54 @@ MATERIAL_KERNEL void material_stress_kernel(const piola_material *m, double f0, 
     case PIOLA_MODEL_ROTATED_LINEAR:
     default:
       rotated_linear_stress(m, f0, f1, f2, p0, p1, p2);
+      return;
+  }
+}
+
+MATERIAL_KERNEL void rotated_linear_stress_energy(const piola_material *m, double f0, double f1,
+                                                  double f2, double *p0, double *p1, double *p2,
+                                                  double *psi) {
+  material_extended_stress_energy(PIOLA_MODEL_ROTATED_LINEAR, m, f0, f1, f2, p0, p1, p2, psi);
+}
+MATERIAL_KERNEL void corotated_stress_energy(const piola_material *m, double f0, double f1,
+                                             double f2, double *p0, double *p1, double *p2,
+                                             double *psi) {
+  material_extended_stress_energy(PIOLA_MODEL_COROTATED, m, f0, f1, f2, p0, p1, p2, psi);
+}
+MATERIAL_KERNEL void stvk_stress_energy(const piola_material *m, double f0, double f1, double f2,
+                                        double *p0, double *p1, double *p2, double *psi) {
+  material_extended_stress_energy(PIOLA_MODEL_STVK, m, f0, f1, f2, p0, p1, p2, psi);
+}
+MATERIAL_KERNEL void neohookean_stress_energy(const piola_material *m, double f0, double f1,
+                                              double f2, double *p0, double *p1, double *p2,
+                                              double *psi) {
+  material_extended_stress_energy(PIOLA_MODEL_NEOHOOKEAN, m, f0, f1, f2, p0, p1, p2, psi);
+}
+MATERIAL_KERNEL void spline_stress_energy(const piola_material *m, double f0, double f1, double f2,
+                                          double *p0, double *p1, double *p2, double *psi) {
+  material_extended_stress_energy(PIOLA_MODEL_SPLINE, m, f0, f1, f2, p0, p1, p2, psi);
+}
+
+/* Run-time dispatch of the stress-and-energy kernels (same use as material_stress_kernel). */
+MATERIAL_KERNEL void material_stress_energy_kernel(const piola_material *m, double f0, double f1,
+                                                   double f2, double *p0, double *p1, double *p2,
+                                                   double *psi) {
+  switch (m->model) {
+    case PIOLA_MODEL_COROTATED:
+      corotated_stress_energy(m, f0, f1, f2, p0, p1, p2, psi);
+      return;
+    case PIOLA_MODEL_STVK:
+      stvk_stress_energy(m, f0, f1, f2, p0, p1, p2, psi);
+      return;
+    case PIOLA_MODEL_NEOHOOKEAN:
+      neohookean_stress_energy(m, f0, f1, f2, p0, p1, p2, psi);
+      return;
+    case PIOLA_MODEL_SPLINE:
+      spline_stress_energy(m, f0, f1, f2, p0, p1, p2, psi);
+      return;
+    case PIOLA_MODEL_ROTATED_LINEAR:
+    default:
+      rotated_linear_stress_energy(m, f0, f1, f2, p0, p1, p2, psi);
       return;
   }
 }

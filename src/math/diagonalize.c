@@ -18,9 +18,10 @@
  * 1e-45 |F|, so leaving them is invisible at the promised 1e-12).
  *
  * Building U: u1 is b1 normalized (b1 is the longest column and, after scaling, never tiny),
- * u2 is the part of b2 orthogonal to u1, normalized (Gram-Schmidt done twice, so u2 stays
- * orthogonal even when b2 is mostly noise), or, when b2 has no usable direction, any unit
- * vector orthogonal to u1 (the completion of a collapsed element). For 3x3, u3 = u1 x u2,
+ * u2 is the part of b2 orthogonal to u1, normalized (one Gram-Schmidt pass after Jacobi; a
+ * second pass when b2 is tiny or nearly parallel to u1, so u2 stays orthogonal even when b2 is
+ * mostly noise), or, when b2 has no usable direction, any unit vector orthogonal to u1 (the
+ * completion of a collapsed element). For 3x3, u3 = u1 x u2,
  * which makes det U = +1 by construction; fhat3 = u3 . b3 then carries the sign of det F by
  * itself: det F = det B = |b1| |b2| (u1 x u2) . b3. That is the paper's "negate the smallest
  * entry and its column of U" without a separate reflection test.
@@ -75,6 +76,14 @@ static inline pow2_scale pow2_scale_make(int k) {
 static inline double pow2_scale_apply(pow2_scale s, double x) { return x * s.first * s.second; }
 
 static inline double max_of(double a, double b) { return a > b ? a : b; }
+
+/* An entry of Fhat scaled back to F's units. An entry that is nonzero but underflows (only
+ * for F near the bottom of the double range) becomes the smallest subnormal of its sign, so
+ * the sign of det F is never lost; + 0.0 turns -0 into +0. */
+static inline double unscale_entry(pow2_scale up, double d) {
+  double x = pow2_scale_apply(up, d) + 0.0;
+  return (x == 0 && d != 0) ? copysign(DBL_TRUE_MIN, d) : x;
+}
 
 static inline double dot3(const double *a, const double *b) {
   return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
@@ -286,7 +295,7 @@ piola_status piola_diagonalize3(const piola_mat3 *f, piola_mat3 *u, piola_vec3 *
 
   pow2_scale up = pow2_scale_make(e);
   double out[3];
-  for (int k = 0; k < 3; ++k) out[k] = pow2_scale_apply(up, d[k]) + 0.0; /* + 0.0: no -0 */
+  for (int k = 0; k < 3; ++k) out[k] = unscale_entry(up, d[k]);
   if (!isfinite(out[0])) {
     set_identity_outputs3(u, fhat, v);
     return PIOLA_FAIL(PIOLA_ERROR_NOT_FINITE,
@@ -368,7 +377,7 @@ piola_status piola_diagonalize3x2(const piola_mat3x2 *f, piola_mat3x2 *u, double
   }
 
   pow2_scale up = pow2_scale_make(e);
-  double out0 = pow2_scale_apply(up, d[0]) + 0.0, out1 = pow2_scale_apply(up, d[1]) + 0.0;
+  double out0 = unscale_entry(up, d[0]), out1 = unscale_entry(up, d[1]);
   if (!isfinite(out0)) {
     set_identity_outputs3x2(u, fhat, v);
     return PIOLA_FAIL(PIOLA_ERROR_NOT_FINITE,

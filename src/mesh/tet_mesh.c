@@ -221,15 +221,14 @@ piola_status piola__tet_mesh_finish(piola_tet_mesh *mesh, const char *source, co
                             where(at, sizeof at, source, lines, t), (int)t, (int)t + 1);
     }
     /* Zero volume relative to the tet's size: |6V| <= 1e-12 * (longest edge)^3. */
-    double lmax2 = 0;
-    for (int a = 0; a < 4; ++a)
-      for (int b = a + 1; b < 4; ++b) {
-        double d = vec3_norm2(vec3_sub(vec3_load(mesh->positions + 3 * (size_t)c[a]),
-                                       vec3_load(mesh->positions + 3 * (size_t)c[b])));
-        if (d > lmax2) lmax2 = d;
-      }
-    double v6 = fabs(6.0 * piola_tet_mesh_signed_volume(mesh, t));
-    if (!(v6 > 1e-12 * lmax2 * sqrt(lmax2)))
+    vec3 x0 = vec3_load(mesh->positions + 3 * (size_t)c[0]);
+    vec3 e1 = vec3_sub(vec3_load(mesh->positions + 3 * (size_t)c[1]), x0);
+    vec3 e2 = vec3_sub(vec3_load(mesh->positions + 3 * (size_t)c[2]), x0);
+    vec3 e3 = vec3_sub(vec3_load(mesh->positions + 3 * (size_t)c[3]), x0);
+    double lmax2 = fmax(fmax(fmax(vec3_norm2(e1), vec3_norm2(e2)), fmax(vec3_norm2(e3), vec3_norm2(vec3_sub(e2, e1)))),
+                        fmax(vec3_norm2(vec3_sub(e3, e1)), vec3_norm2(vec3_sub(e3, e2))));
+    double v6 = vec3_dot(e1, vec3_cross(e2, e3));
+    if (!(v6 * v6 > 1e-24 * lmax2 * lmax2 * lmax2))
       return PIOLA_FAIL(PIOLA_ERROR_DEGENERATE_ELEMENT,
                         "%s: tet %d (element %d in the file) is degenerate (zero volume)",
                         where(at, sizeof at, source, lines, t), (int)t, (int)t + 1);

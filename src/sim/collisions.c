@@ -66,8 +66,8 @@ static bool collide_node(const piola_obstacle *o, const piola__rigid_state *stat
   return true;
 }
 
-int32_t piola_obstacles_collide(piola_obstacle *const *obstacles, int32_t obstacle_count,
-                                double t, double dt, int32_t node_count, double *x, double *v,
+int32_t piola_obstacles_collide(piola_obstacle *const *obstacles, int32_t obstacle_count, double t,
+                                double dt, int32_t node_count, double *x, double *v,
                                 uint8_t *colliding, double *normals) {
   if (node_count <= 0) return 0;
   if (obstacle_count <= 0 || !obstacles) {
@@ -76,8 +76,9 @@ int32_t piola_obstacles_collide(piola_obstacle *const *obstacles, int32_t obstac
     return 0;
   }
   piola__rigid_state states_small[8];
-  piola__rigid_state *states =
-      obstacle_count <= 8 ? states_small : malloc(sizeof(piola__rigid_state) * (size_t)obstacle_count);
+  piola__rigid_state *states = obstacle_count <= 8
+                                   ? states_small
+                                   : malloc(sizeof(piola__rigid_state) * (size_t)obstacle_count);
   if (!states) {
     (void)PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "collision poses for %d obstacles",
                      (int)obstacle_count);

@@ -113,7 +113,8 @@ static void set_bounding_sphere(piola_obstacle *o) {
       o->bound_radius = 0.5 * vec3_norm(vec3_sub(m->box_max, m->box_min));
       break;
     }
-    default: break;
+    default:
+      break;
   }
   /* Rounding: a point exactly on the surface may evaluate a hair inside. */
   o->bound_radius *= 1.0 + 1e-9;
@@ -125,8 +126,8 @@ piola_status piola_obstacle_create(const piola_obstacle_def *def, piola_obstacle
   if (!vec3_finite(def->center))
     return PIOLA_FAIL(PIOLA_ERROR_NOT_FINITE, "obstacle center must be finite");
   if (!(def->friction >= 0) || !isfinite(def->friction))
-    return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "obstacle friction must be finite and >= 0, got %g",
-                      def->friction);
+    return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT,
+                      "obstacle friction must be finite and >= 0, got %g", def->friction);
   piola_obstacle *o = calloc(1, sizeof *o);
   if (!o) return PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "obstacle");
   o->type = def->type;
@@ -134,14 +135,30 @@ piola_status piola_obstacle_create(const piola_obstacle_def *def, piola_obstacle
   piola_status s = validate_motion(&def->motion, &o->motion);
   if (s == PIOLA_OK) {
     switch (def->type) {
-      case PIOLA_OBSTACLE_PLANE: s = piola__plane_init(def, &o->shape.plane); break;
-      case PIOLA_OBSTACLE_SPHERE: s = piola__sphere_init(def, &o->shape.sphere); break;
-      case PIOLA_OBSTACLE_BOX: s = piola__box_init(def, &o->shape.box); break;
-      case PIOLA_OBSTACLE_CYLINDER: s = piola__cylinder_init(def, &o->shape.cylinder); break;
-      case PIOLA_OBSTACLE_CAPSULE: s = piola__capsule_init(def, &o->shape.capsule); break;
-      case PIOLA_OBSTACLE_TORUS: s = piola__torus_init(def, &o->shape.torus); break;
-      case PIOLA_OBSTACLE_GEAR: s = piola__gear_init(def, &o->shape.gear); break;
-      case PIOLA_OBSTACLE_MESH: s = piola__mesh_obstacle_init(def, &o->shape.mesh); break;
+      case PIOLA_OBSTACLE_PLANE:
+        s = piola__plane_init(def, &o->shape.plane);
+        break;
+      case PIOLA_OBSTACLE_SPHERE:
+        s = piola__sphere_init(def, &o->shape.sphere);
+        break;
+      case PIOLA_OBSTACLE_BOX:
+        s = piola__box_init(def, &o->shape.box);
+        break;
+      case PIOLA_OBSTACLE_CYLINDER:
+        s = piola__cylinder_init(def, &o->shape.cylinder);
+        break;
+      case PIOLA_OBSTACLE_CAPSULE:
+        s = piola__capsule_init(def, &o->shape.capsule);
+        break;
+      case PIOLA_OBSTACLE_TORUS:
+        s = piola__torus_init(def, &o->shape.torus);
+        break;
+      case PIOLA_OBSTACLE_GEAR:
+        s = piola__gear_init(def, &o->shape.gear);
+        break;
+      case PIOLA_OBSTACLE_MESH:
+        s = piola__mesh_obstacle_init(def, &o->shape.mesh);
+        break;
       default:
         s = PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "obstacle type %d is unknown", (int)def->type);
         o->type = PIOLA_OBSTACLE_TYPE_COUNT; /* nothing to free */
@@ -160,27 +177,43 @@ piola_status piola_obstacle_create(const piola_obstacle_def *def, piola_obstacle
 void piola_obstacle_destroy(piola_obstacle *obstacle) {
   if (!obstacle) return;
   switch (obstacle->type) {
-    case PIOLA_OBSTACLE_GEAR: piola__gear_free(&obstacle->shape.gear); break;
-    case PIOLA_OBSTACLE_MESH: piola__mesh_obstacle_free(&obstacle->shape.mesh); break;
-    default: break;
+    case PIOLA_OBSTACLE_GEAR:
+      piola__gear_free(&obstacle->shape.gear);
+      break;
+    case PIOLA_OBSTACLE_MESH:
+      piola__mesh_obstacle_free(&obstacle->shape.mesh);
+      break;
+    default:
+      break;
   }
   free(obstacle);
 }
 
-double piola_obstacle_friction(const piola_obstacle *obstacle) { return obstacle->friction; }
+double piola_obstacle_friction(const piola_obstacle *obstacle) {
+  return obstacle ? obstacle->friction : 0.0;
+}
 
 /* The shape's distance in its t = 0 frame. */
 static double shape_distance(const piola_obstacle *o, vec3 p, vec3 *normal) {
   switch (o->type) {
-    case PIOLA_OBSTACLE_PLANE: return piola__plane_distance(&o->shape.plane, p, normal);
-    case PIOLA_OBSTACLE_SPHERE: return piola__sphere_distance(&o->shape.sphere, p, normal);
-    case PIOLA_OBSTACLE_BOX: return piola__box_distance(&o->shape.box, p, normal);
-    case PIOLA_OBSTACLE_CYLINDER: return piola__cylinder_distance(&o->shape.cylinder, p, normal);
-    case PIOLA_OBSTACLE_CAPSULE: return piola__capsule_distance(&o->shape.capsule, p, normal);
-    case PIOLA_OBSTACLE_TORUS: return piola__torus_distance(&o->shape.torus, p, normal);
-    case PIOLA_OBSTACLE_GEAR: return piola__gear_distance(&o->shape.gear, p, normal);
-    case PIOLA_OBSTACLE_MESH: return piola__mesh_obstacle_distance(&o->shape.mesh, p, normal);
-    default: break;
+    case PIOLA_OBSTACLE_PLANE:
+      return piola__plane_distance(&o->shape.plane, p, normal);
+    case PIOLA_OBSTACLE_SPHERE:
+      return piola__sphere_distance(&o->shape.sphere, p, normal);
+    case PIOLA_OBSTACLE_BOX:
+      return piola__box_distance(&o->shape.box, p, normal);
+    case PIOLA_OBSTACLE_CYLINDER:
+      return piola__cylinder_distance(&o->shape.cylinder, p, normal);
+    case PIOLA_OBSTACLE_CAPSULE:
+      return piola__capsule_distance(&o->shape.capsule, p, normal);
+    case PIOLA_OBSTACLE_TORUS:
+      return piola__torus_distance(&o->shape.torus, p, normal);
+    case PIOLA_OBSTACLE_GEAR:
+      return piola__gear_distance(&o->shape.gear, p, normal);
+    case PIOLA_OBSTACLE_MESH:
+      return piola__mesh_obstacle_distance(&o->shape.mesh, p, normal);
+    default:
+      break;
   }
   if (normal) *normal = vec3_make(0, 0, 1);
   return INFINITY;
@@ -200,6 +233,11 @@ double piola__obstacle_distance_posed(const piola_obstacle *obstacle,
 
 double piola_obstacle_signed_distance(const piola_obstacle *obstacle, double t, piola_vec3 p,
                                       piola_vec3 *normal, piola_vec3 *velocity) {
+  if (!obstacle) { /* nothing is inside no obstacle */
+    if (normal) *normal = vec3_make(0, 0, 1);
+    if (velocity) *velocity = vec3_make(0, 0, 0);
+    return INFINITY;
+  }
   piola__rigid_state state;
   piola__rigid_motion_state(&obstacle->motion, t, &state);
   return piola__obstacle_distance_posed(obstacle, &state, p, normal, velocity);

@@ -11,11 +11,11 @@
 #include "piola/rigid_motion.h"
 
 typedef struct piola__rigid_state {
-  mat3 rotation;      /* R(t) */
-  vec3 translation;   /* x(t) = R x0 + translation, m */
-  vec3 pivot;         /* where the t = 0 pivot is at time t, m */
-  vec3 velocity;      /* velocity of the pivot, m/s */
-  vec3 omega;         /* angular velocity vector (axis * angular speed), rad/s */
+  mat3 rotation;    /* R(t) */
+  vec3 translation; /* x(t) = R x0 + translation, m */
+  vec3 pivot;       /* where the t = 0 pivot is at time t, m */
+  vec3 velocity;    /* velocity of the pivot, m/s */
+  vec3 omega;       /* angular velocity vector (axis * angular speed), rad/s */
 } piola__rigid_state;
 
 void piola__rigid_motion_state(const piola_rigid_motion_def *motion, double t,

@@ -58,12 +58,13 @@ double piola__gear_profile_radius(const piola__gear_shape *shape, double phi) {
 }
 
 typedef struct nearest2 {
-  double dist2;   /* squared distance to the nearest point found */
-  double cx, cy;  /* that point */
-  int32_t edge;   /* its edge (start vertex index) */
+  double dist2;  /* squared distance to the nearest point found */
+  double cx, cy; /* that point */
+  int32_t edge;  /* its edge (start vertex index) */
 } nearest2;
 
-static void visit_edge(const piola__gear_shape *shape, int32_t i, double x, double y, nearest2 *best) {
+static void visit_edge(const piola__gear_shape *shape, int32_t i, double x, double y,
+                       nearest2 *best) {
   int32_t j = i + 1 == shape->vertex_count ? 0 : i + 1;
   double ax = shape->outline[2 * i], ay = shape->outline[2 * i + 1];
   double ex = shape->outline[2 * j] - ax, ey = shape->outline[2 * j + 1] - ay;
@@ -80,8 +81,8 @@ piola_status piola__gear_init(const piola_obstacle_def *def, piola__gear_shape *
   PIOLA_TRY(piola__obstacle_positive(def->half_length, "gear half_length"));
   PIOLA_TRY(piola__obstacle_positive(def->tooth_depth, "gear tooth_depth"));
   if (def->tooth_count < 3 || def->tooth_count > 100000)
-    return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "gear tooth_count must be in [3, 100000], got %d",
-                      def->tooth_count);
+    return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT,
+                      "gear tooth_count must be in [3, 100000], got %d", def->tooth_count);
   if (!(def->tooth_depth < def->radius))
     return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT,
                       "gear tooth_depth (%g m) must be < radius (%g m)", def->tooth_depth,
@@ -98,7 +99,8 @@ piola_status piola__gear_init(const piola_obstacle_def *def, piola__gear_shape *
   shape->vertex_count = v * def->tooth_count;
   shape->outline = malloc(sizeof(double) * 2 * (size_t)shape->vertex_count);
   if (!shape->outline)
-    return PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "gear outline of %d vertices", shape->vertex_count);
+    return PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "gear outline of %d vertices",
+                      shape->vertex_count);
   double u[PIOLA_GEAR_VERTICES_PER_TOOTH + 1];
   tooth_vertex_u(u);
   double period = 2.0 * M_PI / def->tooth_count;

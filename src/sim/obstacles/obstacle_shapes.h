@@ -13,6 +13,7 @@
 #ifndef PIOLA_SIM_OBSTACLES_OBSTACLE_SHAPES_H
 #define PIOLA_SIM_OBSTACLES_OBSTACLE_SHAPES_H
 
+#include <stdbool.h>
 #include <stdint.h>
 
 #include "math/mat3.h"
@@ -53,13 +54,13 @@ typedef struct piola__gear_shape {
   double *outline;
 } piola__gear_shape;
 
-/* A closed triangle surface (copied). */
+struct piola__surface_distance;
+
+/* A closed triangle surface (copied into the distance structure, wound outward). */
 typedef struct piola__mesh_shape {
   int32_t vertex_count, triangle_count;
-  double *positions;   /* 3 * vertex_count */
-  int32_t *triangles;  /* 3 * triangle_count */
   vec3 box_min, box_max;
-  void *accel;         /* the closest-point structure, or NULL for brute force */
+  struct piola__surface_distance *accel; /* geometry/surface_distance: BVH + winding number */
 } piola__mesh_shape;
 
 /* Vertices per tooth of the gear outline (see gear.c for the profile). */
@@ -93,6 +94,9 @@ double piola__gear_profile_radius(const piola__gear_shape *shape, double phi);
 piola_status piola__mesh_obstacle_init(const piola_obstacle_def *def, piola__mesh_shape *shape);
 double piola__mesh_obstacle_distance(const piola__mesh_shape *shape, vec3 p, vec3 *normal);
 void piola__mesh_obstacle_free(piola__mesh_shape *shape);
+/* Whether p is inside by the winding number alone: much cheaper than the distance far from
+ * the surface, where the nearest-triangle search cannot prune. */
+bool piola__mesh_obstacle_contains(const piola__mesh_shape *shape, vec3 p);
 
 /* Shared validation: the axis normalized if its length is within 1e-3 of 1, else an error
  * naming `what`. */

@@ -1,0 +1,229 @@
+/* Benchmark of the elastic force loop (tets per second) and of the vectorized SVD kernel.
+ *
+ *   build/<dir>/bench_forces [repeats]
+ *
+ * Meshes: a generated structured grid of ~105K tets, and Vega's torus-easy.veg (97,878 tets)
+ * when the mesh reader is available. Each is deformed by a small random perturbation plus
+ * mirroring one corner of ~1% of the tets through the plane of the other three, so a few
+ * percent of tets are inverted, as in a simulation recovering from collisions. Reports the
+ * median of `repeats` (default 7) timings of piola_elastic_body_update (forces, no stats:
+ * the energy is computed only on request) with 1 and 2 threads, as wall time and as process
+ * CPU time divided by the thread count (the machine is shared; see docs/bench-notes). */
+#include <math.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+#include "force/elastic_body_internal.h"
+#include "force/svd_kernel.h"
+#include "piola/elastic_body.h"
+#include "piola/mesh_io.h"
+
+static double now_seconds(void) {
+  struct timespec ts;
+  clock_gettime(CLOCK_MONOTONIC, &ts);
+  return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+/* CPU time of the whole process (all threads): on a loaded machine wall time mostly
+ * measures the other processes; CPU time / threads estimates the time with the cores free. */
+static double cpu_seconds(void) {
+  struct timespec ts;
+  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
+  return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+static uint64_t rng_state = 0x9E3779B97F4A7C15ull;
+static double uniform(double lo, double hi) {
+  rng_state ^= rng_state << 13;
+  rng_state ^= rng_state >> 7;
+  rng_state ^= rng_state << 17;
+  return lo + (hi - lo) * (double)(rng_state >> 11) * 0x1.0p-53;
+}
+
+static int compare_doubles(const void *a, const void *b) {
+  double x = *(const double *)a, y = *(const double *)b;
+  return (x > y) - (x < y);
+}
+
+static double median(double *v, int n) {
+  qsort(v, (size_t)n, sizeof *v, compare_doubles);
+  return v[n / 2];
+}
+
+/* n^3 cubes, 6 tets each, edge h. */
+static piola_tet_mesh grid_mesh(int n, double h) {
+  piola_tet_mesh mesh;
+  memset(&mesh, 0, sizeof mesh);
+  int nv1 = n + 1;
+  mesh.vertex_count = nv1 * nv1 * nv1;
+  mesh.tet_count = 6 * n * n * n;
+  mesh.positions = malloc(sizeof(double) * 3 * (size_t)mesh.vertex_count);
+  mesh.tets = malloc(sizeof(int32_t) * 4 * (size_t)mesh.tet_count);
+  for (int k = 0; k < nv1; ++k)
+    for (int j = 0; j < nv1; ++j)
+      for (int i = 0; i < nv1; ++i) {
+        int v = (k * nv1 + j) * nv1 + i;
+        mesh.positions[3 * v] = i * h;
+        mesh.positions[3 * v + 1] = j * h;
+        mesh.positions[3 * v + 2] = k * h;
+      }
+  static const int perms[6][3] = {{0, 1, 2}, {0, 2, 1}, {1, 0, 2}, {1, 2, 0}, {2, 0, 1}, {2, 1, 0}};
+  int t = 0;
+  for (int k = 0; k < n; ++k)
+    for (int j = 0; j < n; ++j)
+      for (int i = 0; i < n; ++i)
+        for (int p = 0; p < 6; ++p) {
+          int c[3] = {i, j, k};
+          mesh.tets[4 * t] = (c[2] * nv1 + c[1]) * nv1 + c[0];
+          for (int s = 0; s < 3; ++s) {
+            c[perms[p][s]]++;
+            mesh.tets[4 * t + 1 + s] = (c[2] * nv1 + c[1]) * nv1 + c[0];
+          }
+          ++t;
+        }
+  return mesh;
+}
+
+/* Deformed positions: rest + noise (1% of the mean edge), then ~1% of tets get corner 0
+ * mirrored through the plane of corners 1..3. */
+static double *deformed_positions(const piola_elastic_body *body) {
+  int32_t nv = piola_elastic_body_vertex_count(body), nt = piola_elastic_body_tet_count(body);
+  const double *rest = piola_elastic_body_rest_positions(body);
+  const int32_t *tets = piola_elastic_body_tets(body);
+  double edge = 0;
+  for (int32_t t = 0; t < nt; ++t) {
+    const double *a = rest + 3 * tets[4 * t], *b = rest + 3 * tets[4 * t + 1];
+    edge += sqrt((a[0] - b[0]) * (a[0] - b[0]) + (a[1] - b[1]) * (a[1] - b[1]) + (a[2] - b[2]) * (a[2] - b[2]));
+  }
+  edge /= nt;
+  double *x = malloc(sizeof(double) * 3 * (size_t)nv);
+  for (int32_t i = 0; i < 3 * nv; ++i) x[i] = rest[i] + 0.01 * edge * uniform(-1, 1);
+  for (int32_t t = 0; t < nt; ++t) {
+    if (uniform(0, 1) > 0.01) continue;
+    const int32_t *c = tets + 4 * t;
+    double *p = x + 3 * c[0], *a = x + 3 * c[1], *b = x + 3 * c[2], *d = x + 3 * c[3];
+    double e1[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]}, e2[3] = {d[0] - a[0], d[1] - a[1], d[2] - a[2]};
+    double nrm[3] = {e1[1] * e2[2] - e1[2] * e2[1], e1[2] * e2[0] - e1[0] * e2[2], e1[0] * e2[1] - e1[1] * e2[0]};
+    double nn = nrm[0] * nrm[0] + nrm[1] * nrm[1] + nrm[2] * nrm[2];
+    if (nn == 0) continue;
+    double dist = ((p[0] - a[0]) * nrm[0] + (p[1] - a[1]) * nrm[1] + (p[2] - a[2]) * nrm[2]) / nn;
+    for (int i = 0; i < 3; ++i) p[i] -= 2 * dist * nrm[i];
+  }
+  return x;
+}
+
+static void bench_mesh(const char *name, const piola_tet_mesh *mesh, int repeats) {
+  static const piola_material_model models[] = {PIOLA_MODEL_NEOHOOKEAN, PIOLA_MODEL_COROTATED,
+                                                PIOLA_MODEL_ROTATED_LINEAR, PIOLA_MODEL_STVK,
+                                                PIOLA_MODEL_SPLINE};
+  for (size_t m = 0; m < sizeof models / sizeof models[0]; ++m) {
+    piola_material_def mdef = piola_default_material_def();
+    mdef.model = models[m];
+    piola_material material;
+    if (piola_material_init(&mdef, &material) != PIOLA_OK) return;
+    piola_elastic_body_def def = piola_default_elastic_body_def();
+    def.rest_mesh = mesh;
+    def.materials = &material;
+    def.material_count = 1;
+    piola_elastic_body *body;
+    if (piola_elastic_body_create(&def, &body) != PIOLA_OK) {
+      printf("%s: %s\n", name, piola_last_error());
+      return;
+    }
+    double *x = deformed_positions(body);
+    double *f = malloc(sizeof(double) * 3 * (size_t)mesh->vertex_count);
+    piola_elastic_stats stats;
+    piola_elastic_body_update(body, x, 1.0, f, &stats);
+    for (int threads = 1; threads <= 2; ++threads) {
+      piola_set_thread_count(threads);
+      double times[64], cpu[64];
+      int n = repeats < 64 ? repeats : 64;
+      piola_elastic_body_update(body, x, 1.0, f, NULL); /* warm up */
+      for (int r = 0; r < n; ++r) {
+        double t0 = now_seconds(), c0 = cpu_seconds();
+        piola_elastic_body_update(body, x, 1.0, f, NULL);
+        times[r] = now_seconds() - t0;
+        cpu[r] = (cpu_seconds() - c0) / threads;
+      }
+      double t = median(times, n), c = median(cpu, n);
+      printf("| %-14s | %-14s | %7d | %5.2f%% | %d | %8.3f | %7.2f | %7.2f |\n", name,
+             piola_material_model_name(models[m]), (int)mesh->tet_count,
+             100.0 * stats.inverted_count / mesh->tet_count, threads, 1e3 * t,
+             mesh->tet_count / t * 1e-6, mesh->tet_count / c * 1e-6);
+    }
+    /* the scalar reference loop (public piola_diagonalize3 + piola_material_stress per tet,
+     * serial), for a speedup that does not depend on how loaded the machine is */
+    {
+      double times[64], cpu[64];
+      int n = repeats < 64 ? repeats : 64;
+      for (int r = 0; r < n; ++r) {
+        double t0 = now_seconds(), c0 = cpu_seconds();
+        piola__elastic_body_update_reference(body, x, 1.0, f, NULL);
+        times[r] = now_seconds() - t0;
+        cpu[r] = cpu_seconds() - c0;
+      }
+      double t = median(times, n), c = median(cpu, n);
+      printf("| %-14s | %-14s | %7d |        | 1 | %8.3f | %7.2f | %7.2f | (scalar reference)\n",
+             name, piola_material_model_name(models[m]), (int)mesh->tet_count, 1e3 * t,
+             mesh->tet_count / t * 1e-6, mesh->tet_count / c * 1e-6);
+    }
+    /* damping, 2 threads */
+    double times[64];
+    int n = repeats < 64 ? repeats : 64;
+    for (int r = 0; r < n; ++r) {
+      double t0 = now_seconds();
+      piola_elastic_body_damping_forces(body, x, 1.0, 0.5, f);
+      times[r] = now_seconds() - t0;
+    }
+    if (m == 0)
+      printf("| %-14s | damping        | %7d |        | 2 | %8.3f | %7.2f |         |\n", name,
+             (int)mesh->tet_count, 1e3 * median(times, n), mesh->tet_count / median(times, n) * 1e-6);
+    piola_set_thread_count(0);
+    free(x);
+    free(f);
+    piola_elastic_body_destroy(body);
+  }
+}
+
+static void bench_svd(int repeats) {
+  int n = 1 << 16;
+  double *f = malloc(sizeof(double) * 9 * (size_t)n), *u = malloc(sizeof(double) * 9 * (size_t)n);
+  double *v = malloc(sizeof(double) * 9 * (size_t)n), *s = malloc(sizeof(double) * 3 * (size_t)n);
+  for (int i = 0; i < 9 * n; ++i) f[i] = (i % 4 == 0 ? 1.0 : 0.0) + uniform(-0.3, 0.3);
+  double times[64];
+  int r_count = repeats < 64 ? repeats : 64;
+  for (int r = 0; r < r_count; ++r) {
+    double t0 = now_seconds();
+    piola__svd3_kernel_batch(n, f, u, s, v);
+    times[r] = now_seconds() - t0;
+  }
+  printf("\nvectorized SVD kernel (%d sweeps), 1 thread: %.1f ns/matrix (median of %d)\n",
+         PIOLA_SVD_JACOBI_SWEEPS, 1e9 * median(times, r_count) / n, r_count);
+  free(f);
+  free(u);
+  free(v);
+  free(s);
+}
+
+int main(int argc, char **argv) {
+  int repeats = argc > 1 ? atoi(argv[1]) : 7;
+  if (repeats < 1) repeats = 1;
+  printf("| mesh           | model          |    tets | inverted | threads | ms (wall) | M tets/s (wall) | M tets/s (CPU time) |\n");
+  printf("|---|---|---|---|---|---|---|---|\n");
+  piola_tet_mesh grid = grid_mesh(26, 0.01);
+  bench_mesh("grid 26^3x6", &grid, repeats);
+  free(grid.positions);
+  free(grid.tets);
+  piola_tet_mesh torus;
+  if (piola_tet_mesh_read(PIOLA_DATA_DIR "/vega/torus-easy.veg", &torus) == PIOLA_OK) {
+    bench_mesh("torus-easy.veg", &torus, repeats);
+    piola_tet_mesh_free(&torus);
+  } else {
+    printf("torus-easy.veg: %s\n", piola_last_error());
+  }
+  bench_svd(repeats);
+  return 0;
+}

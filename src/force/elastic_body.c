@@ -1,0 +1,278 @@
+/* The elastic body object and its force loops: the fast blocked loop that piola uses and
+ * the scalar reference loop the tests compare it with. Layout and determinism design are
+ * explained in elastic_body_internal.h; the SVD kernel in svd_kernel.h. */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "common/status_internal.h"
+#include "force/elastic_body_internal.h"
+#include "force/material_lanes.h"
+#include "force/svd_kernel.h"
+#include "math/mat3.h"
+#include "piola/diagonalize.h"
+
+#define B PIOLA_TET_BLOCK
+
+piola_elastic_body_def piola_default_elastic_body_def(void) {
+  piola_elastic_body_def def;
+  memset(&def, 0, sizeof def);
+  def.density = 1000.0;
+  return def;
+}
+
+piola_status piola_elastic_body_create(const piola_elastic_body_def *def,
+                                       piola_elastic_body **out) {
+  if (!out) return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "elastic body out is NULL");
+  *out = NULL;
+  piola_elastic_body *body = calloc(1, sizeof *body);
+  if (!body) return PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "elastic body: out of memory");
+  piola_status status = piola__elastic_body_build_rest_state(body, def);
+  if (status != PIOLA_OK) {
+    piola__elastic_body_free_arrays(body);
+    free(body);
+    return status;
+  }
+  *out = body;
+  return PIOLA_OK;
+}
+
+void piola_elastic_body_destroy(piola_elastic_body *body) {
+  if (!body) return;
+  piola__elastic_body_free_arrays(body);
+  free(body);
+}
+
+int32_t piola_elastic_body_vertex_count(const piola_elastic_body *body) { return body->vertex_count; }
+int32_t piola_elastic_body_tet_count(const piola_elastic_body *body) { return body->tet_count; }
+const int32_t *piola_elastic_body_tets(const piola_elastic_body *body) { return body->tets; }
+const double *piola_elastic_body_rest_positions(const piola_elastic_body *body) {
+  return body->rest_positions;
+}
+const double *piola_elastic_body_masses(const piola_elastic_body *body) { return body->masses; }
+double piola_elastic_body_min_rest_altitude(const piola_elastic_body *body) {
+  return body->min_rest_altitude;
+}
+double piola_elastic_body_max_wave_speed(const piola_elastic_body *body) {
+  return body->max_wave_speed;
+}
+const double *piola_elastic_body_det_f(const piola_elastic_body *body) { return body->det_f; }
+/* Computed here, on first request after an update without stats: the energy is not needed
+ * to step, so the force loop skips it unless asked. */
+const double *piola_elastic_body_energy_density(const piola_elastic_body *body) {
+  if (!body->energy_valid) {
+    piola_elastic_body *mutable_body = (piola_elastic_body *)body;
+    for (int32_t t = 0; t < body->tet_count; ++t)
+      mutable_body->energy_density[t] =
+          body->last_stiffness_scale *
+          piola_material_energy_density(&body->materials[body->tet_material[t]], body->fhat + 3 * t);
+    mutable_body->energy_valid = 1;
+  }
+  return body->energy_density;
+}
+const double *piola_elastic_body_fhat(const piola_elastic_body *body) { return body->fhat; }
+
+void piola__elastic_body_gather_forces(const piola_elastic_body *body, double *forces) {
+  const int32_t *start = body->incidence_start, *inc = body->incidence;
+  const double *tf = body->tet_forces;
+#pragma omp parallel for schedule(static) num_threads(piola__thread_count())
+  for (int32_t i = 0; i < body->vertex_count; ++i) {
+    double fx = 0, fy = 0, fz = 0;
+    for (int32_t e = start[i]; e < start[i + 1]; ++e) {
+      const double *g = tf + inc[e];
+      fx += g[0];
+      fy += g[B];
+      fz += g[2 * B];
+    }
+    forces[3 * i] = fx;
+    forces[3 * i + 1] = fy;
+    forces[3 * i + 2] = fz;
+  }
+}
+
+/* One block of B tets: F, SVD, stress, forces into the per-tet buffer, block statistics. */
+PIOLA_WIDE_VECTORS static void update_block(piola_elastic_body *body, const double *x, double stiffness_scale,
+                         int want_energy, int32_t block) {
+  const int32_t base = block * B;
+  double f[9][B], detf[B];
+  const int32_t *i0 = body->tet_vertices[0] + base, *i1 = body->tet_vertices[1] + base;
+  const int32_t *i2 = body->tet_vertices[2] + base, *i3 = body->tet_vertices[3] + base;
+  double *const *dmi = body->dm_inv;
+#pragma omp simd
+  for (int l = 0; l < B; ++l) {
+    /* index arithmetic, not pointers, so GCC emits vector gathers */
+    const int32_t a = 3 * i0[l], b = 3 * i1[l], c = 3 * i2[l], d = 3 * i3[l];
+    double d00 = x[b] - x[a], d01 = x[c] - x[a], d02 = x[d] - x[a];
+    double d10 = x[b + 1] - x[a + 1], d11 = x[c + 1] - x[a + 1], d12 = x[d + 1] - x[a + 1];
+    double d20 = x[b + 2] - x[a + 2], d21 = x[c + 2] - x[a + 2], d22 = x[d + 2] - x[a + 2];
+    double m00 = dmi[0][base + l], m01 = dmi[1][base + l], m02 = dmi[2][base + l];
+    double m10 = dmi[3][base + l], m11 = dmi[4][base + l], m12 = dmi[5][base + l];
+    double m20 = dmi[6][base + l], m21 = dmi[7][base + l], m22 = dmi[8][base + l];
+    double f00 = d00 * m00 + d01 * m10 + d02 * m20, f01 = d00 * m01 + d01 * m11 + d02 * m21;
+    double f02 = d00 * m02 + d01 * m12 + d02 * m22, f10 = d10 * m00 + d11 * m10 + d12 * m20;
+    double f11 = d10 * m01 + d11 * m11 + d12 * m21, f12 = d10 * m02 + d11 * m12 + d12 * m22;
+    double f20 = d20 * m00 + d21 * m10 + d22 * m20, f21 = d20 * m01 + d21 * m11 + d22 * m21;
+    double f22 = d20 * m02 + d21 * m12 + d22 * m22;
+    f[0][l] = f00; f[1][l] = f01; f[2][l] = f02;
+    f[3][l] = f10; f[4][l] = f11; f[5][l] = f12;
+    f[6][l] = f20; f[7][l] = f21; f[8][l] = f22;
+    detf[l] = f00 * (f11 * f22 - f12 * f21) - f01 * (f10 * f22 - f12 * f20) +
+              f02 * (f10 * f21 - f11 * f20);
+  }
+
+  /* U and V go straight into the body's SoA arrays (stride padded_tet_count) */
+  double fhat[3][B];
+  double *uo = body->u[0] + base, *vo = body->v[0] + base;
+  const long stride = body->padded_tet_count;
+#pragma omp simd
+  for (int l = 0; l < B; ++l) piola__svd3_kernel(&f[0][l], B, uo + l, vo + l, stride, &fhat[0][l], B);
+
+  double phat[3][B], psi[B];
+  piola__material_stress_lanes(body, base, fhat, phat);
+  for (int l = 0; l < B; ++l) psi[l] = 0.0;
+  if (want_energy)
+    for (int l = 0; l < B; ++l) {
+      double fh[3] = {fhat[0][l], fhat[1][l], fhat[2][l]};
+      psi[l] = piola_material_energy_density(&body->materials[body->tet_material[base + l]], fh);
+    }
+
+  const double *volume = body->rest_volume + base;
+  double *tf = body->tet_forces + 12 * (size_t)base; /* this block's 12 rows of B lanes */
+#pragma omp simd
+  for (int l = 0; l < B; ++l) {
+    double p0 = phat[0][l] * stiffness_scale, p1 = phat[1][l] * stiffness_scale,
+           p2 = phat[2][l] * stiffness_scale;
+    /* P = U diag(phat) V^T */
+    double pm[3][3];
+    PIOLA_UNROLL
+    for (int i = 0; i < 3; ++i)
+      PIOLA_UNROLL
+      for (int j = 0; j < 3; ++j)
+        pm[i][j] = uo[3 * i * stride + l] * p0 * vo[3 * j * stride + l] +
+                   uo[(3 * i + 1) * stride + l] * p1 * vo[(3 * j + 1) * stride + l] +
+                   uo[(3 * i + 2) * stride + l] * p2 * vo[(3 * j + 2) * stride + l];
+    /* G = P Bm = -V0 P Dm^-T: column j is the force on corner j + 1; corner 0 balances */
+    double w = -volume[l];
+    PIOLA_UNROLL
+    for (int i = 0; i < 3; ++i) {
+      double g0 = 0.0;
+      PIOLA_UNROLL
+      for (int j = 0; j < 3; ++j) {
+        double g = w * (pm[i][0] * dmi[3 * j][base + l] + pm[i][1] * dmi[3 * j + 1][base + l] +
+                        pm[i][2] * dmi[3 * j + 2][base + l]);
+        tf[(3 * (j + 1) + i) * B + l] = g;
+        g0 -= g;
+      }
+      tf[i * B + l] = g0;
+    }
+  }
+
+  int32_t real = body->tet_count - base < B ? body->tet_count - base : B;
+  double energy = 0, min_det = INFINITY;
+  int32_t inverted = 0;
+  for (int l = 0; l < B; ++l) {
+    int32_t t = base + l;
+    for (int k = 0; k < 3; ++k) body->fhat[3 * t + k] = fhat[k][l];
+    body->det_f[t] = detf[l];
+    body->energy_density[t] = psi[l] * stiffness_scale;
+    if (l < real) {
+      energy += volume[l] * psi[l] * stiffness_scale;
+      inverted += detf[l] < 0;
+      min_det = fmin(min_det, detf[l]);
+    }
+  }
+  body->block_energy[block] = energy;
+  body->block_inverted[block] = inverted;
+  body->block_min_det[block] = min_det;
+}
+
+static int positions_are_finite(const double *x, int32_t n) {
+  int finite = 1;
+  for (int32_t i = 0; i < n; ++i) finite &= isfinite(x[i]);
+  return finite;
+}
+
+piola_status piola_elastic_body_update(piola_elastic_body *body, const double *x,
+                                       double stiffness_scale, double *forces,
+                                       piola_elastic_stats *stats) {
+  if (!body || !x || !forces)
+    return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "elastic body update: NULL argument");
+  if (!(stiffness_scale >= 0) || !isfinite(stiffness_scale))
+    return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "stiffness_scale must be >= 0, got %g",
+                      stiffness_scale);
+  if (!positions_are_finite(x, 3 * body->vertex_count)) {
+    for (int32_t i = 0; i < 3 * body->vertex_count; ++i)
+      if (!isfinite(x[i]))
+        return PIOLA_FAIL(PIOLA_ERROR_NOT_FINITE, "position of vertex %d is not finite",
+                          (int)(i / 3));
+  }
+  int32_t blocks = body->padded_tet_count / B;
+#pragma omp parallel for schedule(static) num_threads(piola__thread_count())
+  for (int32_t b = 0; b < blocks; ++b) update_block(body, x, stiffness_scale, stats != NULL, b);
+  piola__elastic_body_gather_forces(body, forces);
+  body->has_state = 1;
+  memcpy(body->positions, x, sizeof(double) * 3 * (size_t)body->vertex_count);
+  body->energy_valid = stats != NULL;
+  body->last_stiffness_scale = stiffness_scale;
+  if (stats) {
+    double energy = 0, min_det = INFINITY;
+    int32_t inverted = 0;
+    for (int32_t b = 0; b < blocks; ++b) {
+      energy += body->block_energy[b];
+      inverted += body->block_inverted[b];
+      min_det = fmin(min_det, body->block_min_det[b]);
+    }
+    stats->elastic_energy = energy;
+    stats->inverted_count = inverted;
+    stats->min_det_f = min_det;
+  }
+  return PIOLA_OK;
+}
+
+piola_status piola__elastic_body_update_reference(const piola_elastic_body *body,
+                                                  const double *x, double stiffness_scale,
+                                                  double *forces, piola_elastic_stats *stats) {
+  for (int32_t i = 0; i < 3 * body->vertex_count; ++i) {
+    if (!isfinite(x[i]))
+      return PIOLA_FAIL(PIOLA_ERROR_NOT_FINITE, "position of vertex %d is not finite", (int)(i / 3));
+    forces[i] = 0;
+  }
+  double energy = 0, min_det = INFINITY;
+  int32_t inverted = 0;
+  for (int32_t t = 0; t < body->tet_count; ++t) {
+    const int32_t *idx = body->tets + 4 * t;
+    vec3 x0 = vec3_load(x + 3 * idx[0]);
+    mat3 ds = mat3_from_columns(vec3_sub(vec3_load(x + 3 * idx[1]), x0),
+                                vec3_sub(vec3_load(x + 3 * idx[2]), x0),
+                                vec3_sub(vec3_load(x + 3 * idx[3]), x0));
+    mat3 dm_inv;
+    for (int k = 0; k < 9; ++k) dm_inv.m[k / 3][k % 3] = body->dm_inv[k][t];
+    mat3 f = mat3_mul(ds, dm_inv);
+    mat3 u, v;
+    vec3 fhat;
+    PIOLA_TRY(piola_diagonalize3(&f, &u, &fhat, &v));
+    const piola_material *material = &body->materials[body->tet_material[t]];
+    double fh[3] = {fhat.x, fhat.y, fhat.z}, ph[3];
+    piola_material_stress(material, fh, ph);
+    double psi = piola_material_energy_density(material, fh) * stiffness_scale;
+    mat3 p = mat3_mul_diag_transpose(u, vec3_scale(vec3_make(ph[0], ph[1], ph[2]), stiffness_scale), v);
+    mat3 g = mat3_scale(mat3_mul_transpose_b(p, dm_inv), -body->rest_volume[t]);
+    vec3 g0 = vec3_make(0, 0, 0);
+    for (int c = 1; c < 4; ++c) {
+      vec3 gc = mat3_column(g, c - 1);
+      g0 = vec3_sub(g0, gc);
+      for (int i = 0; i < 3; ++i) forces[3 * idx[c] + i] += vec3_get(gc, i);
+    }
+    for (int i = 0; i < 3; ++i) forces[3 * idx[0] + i] += vec3_get(g0, i);
+    double det = mat3_det(f);
+    energy += body->rest_volume[t] * psi;
+    inverted += det < 0;
+    min_det = fmin(min_det, det);
+  }
+  if (stats) {
+    stats->elastic_energy = energy;
+    stats->inverted_count = inverted;
+    stats->min_det_f = min_det;
+  }
+  return PIOLA_OK;
+}

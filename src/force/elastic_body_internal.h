@@ -1,0 +1,115 @@
+/* The elastic body's internal layout, shared by the rest state, the force loops and damping.
+ *
+ * Why it looks like this. The force loop is the hottest code in piola: every time step
+ * evaluates F, its diagonalization, the stress and the nodal forces of every tet, and the
+ * damping force is evaluated again inside every conjugate-gradient iteration. So the data it
+ * reads per tet is kept in structure-of-arrays form (one array per matrix entry: Dm^-1 as 9
+ * arrays, the rotations U and V as 9 arrays each), padded to a multiple of
+ * PIOLA_TET_BLOCK tets. A block of PIOLA_TET_BLOCK consecutive tets is one set of SIMD lanes
+ * (8 doubles = one AVX-512 register): entry k of the tets of a block sits in consecutive
+ * memory, so loads and stores are plain vector moves and the compiler can vectorize the
+ * straight-line per-tet math across the block. Bm = -V0 Dm^-T is not stored: it is the same
+ * 9 numbers as Dm^-1 times -V0, and reading 8 fewer doubles per tet is worth more than the
+ * 9 multiplies it costs. Cold data (rest positions, masses, the public AoS copy of the tets)
+ * lives apart and the loop never touches it.
+ *
+ * Determinism. Tets write their four nodal forces into a per-tet buffer (12 doubles); a
+ * second pass gives each vertex the sum of its incident (tet, corner) entries, read from a
+ * CSR incidence list sorted by tet index. Each sum has a fixed order and no two threads write
+ * the same place, so forces are bit-for-bit identical for any thread count, without atomics.
+ * Statistics are summed per block and then serially over blocks for the same reason.
+ *
+ * The energy density is computed only when asked for (stats or the getter): stepping needs
+ * forces, not energy, and the energy goes through the (scalar) public material function.
+ *
+ * Padding tets (the tail of the last block) have Dm^-1 = 0 and V0 = 0 and point at vertex 0:
+ * F = 0, forces 0, and they are excluded from statistics. */
+#ifndef PIOLA_FORCE_ELASTIC_BODY_INTERNAL_H
+#define PIOLA_FORCE_ELASTIC_BODY_INTERNAL_H
+
+#include <stdint.h>
+
+#include "piola/elastic_body.h"
+
+#define PIOLA_TET_BLOCK 8
+
+struct piola_elastic_body {
+  /* sizes */
+  int32_t vertex_count;
+  int32_t tet_count;
+  int32_t padded_tet_count; /* multiple of PIOLA_TET_BLOCK */
+
+  /* hot, per padded tet (SoA) */
+  int32_t *tet_vertices[4]; /* vertex index of each corner */
+  double *dm_inv[9];        /* Dm^-1, row-major entry k = 3 * row + col */
+  double *rest_volume;      /* V0, m^3 */
+  int32_t *tet_material;    /* material index */
+
+  /* per padded tet state from the last update (SoA) */
+  double *u[9];             /* u[k] = u[0] + k * padded_tet_count: one allocation, so the
+                               SVD kernel writes all 9 entries with one stride */
+  double *v[9];
+  double *fhat;             /* 3 per tet, AoS (public) */
+  double *det_f;
+  double *energy_density;
+  double *tet_forces;       /* 12 per tet, blocked like the SIMD lanes: component i of
+                               corner c of tet t is at piola__tet_force_offset(t, c) + 8 i */
+
+  /* incidence: vertex i's (tet, corner) pairs are incidence[incidence_start[i] ..
+   * incidence_start[i + 1]), in increasing tet order, each stored as its offset in
+   * tet_forces (piola__tet_force_offset) */
+  int32_t *incidence_start;
+  int32_t *incidence;
+
+  /* per block statistics scratch */
+  double *block_energy;
+  int32_t *block_inverted;
+  double *block_min_det;
+
+  /* materials */
+  piola_material *materials;
+  int32_t material_count;
+  int32_t uniform_material; /* index used by every tet, or -1 when they differ */
+
+  /* cold */
+  int32_t *tets;            /* 4 * tet_count, public AoS copy after reorientation */
+  double *rest_positions;   /* 3 * vertex_count */
+  double *masses;           /* vertex_count */
+  double *positions;        /* 3 * vertex_count: x of the last update (damping needs it) */
+  double density;
+  double min_rest_altitude;
+  double max_wave_speed;
+  int has_state;            /* an update has run: U, V are valid */
+  int energy_valid;         /* energy_density matches the last update (it is computed only
+                               when stats are requested, or lazily by the getter) */
+  double last_stiffness_scale;
+};
+
+/* Where tet t's corner c force starts in tet_forces: blocks of PIOLA_TET_BLOCK tets hold
+ * 12 rows (3 c + i) of PIOLA_TET_BLOCK lanes, so the force loop stores whole vectors. */
+static inline int32_t piola__tet_force_offset(int32_t t, int c) {
+  return (t / PIOLA_TET_BLOCK) * 12 * PIOLA_TET_BLOCK + 3 * c * PIOLA_TET_BLOCK + t % PIOLA_TET_BLOCK;
+}
+
+/* Builds the rest state of body from def (rest_state.c): validates def, reorients, fills
+ * the SoA arrays, masses, incidence, altitude and wave speed. body must be zeroed. */
+piola_status piola__elastic_body_build_rest_state(piola_elastic_body *body,
+                                                  const piola_elastic_body_def *def);
+
+/* Frees everything body owns (not body itself). */
+void piola__elastic_body_free_arrays(piola_elastic_body *body);
+
+/* Scalar reference force loop for the tests: per tet F = Ds Dm^-1, the public
+ * piola_diagonalize3, piola_material_stress and piola_material_energy_density, forces summed
+ * serially. Writes forces and stats only; does not touch the stored per-tet state. */
+piola_status piola__elastic_body_update_reference(const piola_elastic_body *body,
+                                                  const double *x, double stiffness_scale,
+                                                  double *forces, piola_elastic_stats *stats);
+
+/* Sums the per-tet force buffer into per-vertex forces, in parallel, deterministically. */
+void piola__elastic_body_gather_forces(const piola_elastic_body *body, double *forces);
+
+/* The number of threads a parallel loop should use (threads.c). */
+int piola__thread_count(void);
+
+#endif

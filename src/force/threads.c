@@ -1,0 +1,13 @@
+/* The thread count piola's parallel loops use. Results never depend on it (see
+ * elastic_body_internal.h); only speed does. */
+#include <omp.h>
+
+#include "force/elastic_body_internal.h"
+
+static int requested_threads = 0;
+
+void piola_set_thread_count(int threads) { requested_threads = threads > 0 ? threads : 0; }
+
+int piola__thread_count(void) {
+  return requested_threads > 0 ? requested_threads : omp_get_max_threads();
+}

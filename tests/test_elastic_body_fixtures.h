@@ -1,0 +1,126 @@
+/* Small meshes and materials built in code for the elastic body tests (the mesh readers are
+ * tested elsewhere). Header-only: each test executable includes it once. */
+#ifndef PIOLA_TESTS_ELASTIC_BODY_FIXTURES_H
+#define PIOLA_TESTS_ELASTIC_BODY_FIXTURES_H
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "piola/elastic_body.h"
+#include "test_support.h"
+
+/* n x n x n unit-size cubes of edge h, each split into 6 tets around its main diagonal
+ * (a conforming triangulation). Orientation is left to the body. */
+static inline piola_tet_mesh fixture_grid(int n, double h) {
+  piola_tet_mesh mesh;
+  memset(&mesh, 0, sizeof mesh);
+  int nv1 = n + 1;
+  mesh.vertex_count = nv1 * nv1 * nv1;
+  mesh.tet_count = 6 * n * n * n;
+  mesh.positions = malloc(sizeof(double) * 3 * (size_t)mesh.vertex_count);
+  mesh.tets = malloc(sizeof(int32_t) * 4 * (size_t)mesh.tet_count);
+  for (int k = 0; k < nv1; ++k)
+    for (int j = 0; j < nv1; ++j)
+      for (int i = 0; i < nv1; ++i) {
+        int v = (k * nv1 + j) * nv1 + i;
+        mesh.positions[3 * v] = i * h;
+        mesh.positions[3 * v + 1] = j * h;
+        mesh.positions[3 * v + 2] = k * h;
+      }
+  static const int perms[6][3] = {{0, 1, 2}, {0, 2, 1}, {1, 0, 2}, {1, 2, 0}, {2, 0, 1}, {2, 1, 0}};
+  int t = 0;
+  for (int k = 0; k < n; ++k)
+    for (int j = 0; j < n; ++j)
+      for (int i = 0; i < n; ++i)
+        for (int p = 0; p < 6; ++p) {
+          int c[3] = {i, j, k};
+          mesh.tets[4 * t] = (c[2] * nv1 + c[1]) * nv1 + c[0];
+          for (int s = 0; s < 3; ++s) {
+            c[perms[p][s]]++;
+            mesh.tets[4 * t + 1 + s] = (c[2] * nv1 + c[1]) * nv1 + c[0];
+          }
+          ++t;
+        }
+  return mesh;
+}
+
+/* The unit right tet (0,0,0), (1,0,0), (0,1,0), (0,0,1), scaled by h. */
+static inline piola_tet_mesh fixture_single_tet(double h) {
+  piola_tet_mesh mesh;
+  memset(&mesh, 0, sizeof mesh);
+  mesh.vertex_count = 4;
+  mesh.tet_count = 1;
+  mesh.positions = calloc(12, sizeof(double));
+  mesh.tets = malloc(sizeof(int32_t) * 4);
+  mesh.positions[3] = h;
+  mesh.positions[7] = h;
+  mesh.positions[11] = h;
+  for (int c = 0; c < 4; ++c) mesh.tets[c] = c;
+  return mesh;
+}
+
+static inline void fixture_mesh_free(piola_tet_mesh *mesh) {
+  free(mesh->positions);
+  free(mesh->tets);
+  free(mesh->tet_regions);
+  memset(mesh, 0, sizeof *mesh);
+}
+
+static inline piola_material fixture_material(piola_material_model model) {
+  piola_material_def def = piola_default_material_def();
+  def.model = model;
+  def.youngs_modulus = 1e4;
+  def.poisson_ratio = 0.3;
+  piola_material material;
+  assert_int_equal(piola_material_init(&def, &material), PIOLA_OK);
+  return material;
+}
+
+static inline piola_elastic_body *fixture_body(const piola_tet_mesh *mesh,
+                                               const piola_material *material) {
+  piola_elastic_body_def def = piola_default_elastic_body_def();
+  def.rest_mesh = mesh;
+  def.materials = material;
+  def.material_count = 1;
+  def.density = 1000;
+  piola_elastic_body *body = NULL;
+  piola_status status = piola_elastic_body_create(&def, &body);
+  if (status != PIOLA_OK) fail_msg("create failed: %s", piola_last_error());
+  return body;
+}
+
+/* A uniformly random rotation (row-major) from a random unit quaternion. */
+static inline void fixture_random_rotation(test_rng *rng, double r[9]) {
+  double q[4], n = 0;
+  for (int i = 0; i < 4; ++i) {
+    q[i] = test_rng_normal(rng);
+    n += q[i] * q[i];
+  }
+  n = sqrt(n);
+  double w = q[0] / n, x = q[1] / n, y = q[2] / n, z = q[3] / n;
+  double m[9] = {1 - 2 * (y * y + z * z), 2 * (x * y - w * z),     2 * (x * z + w * y),
+                 2 * (x * y + w * z),     1 - 2 * (x * x + z * z), 2 * (y * z - w * x),
+                 2 * (x * z - w * y),     2 * (y * z + w * x),     1 - 2 * (x * x + y * y)};
+  memcpy(r, m, sizeof m);
+}
+
+static inline double fixture_max_abs(const double *a, int n) {
+  double m = 0;
+  for (int i = 0; i < n; ++i) m = fmax(m, fabs(a[i]));
+  return m;
+}
+
+static inline double fixture_signed_volume(const double *x, const int32_t *tet) {
+  const double *a = x + 3 * tet[0], *b = x + 3 * tet[1], *c = x + 3 * tet[2], *d = x + 3 * tet[3];
+  double e1[3], e2[3], e3[3];
+  for (int i = 0; i < 3; ++i) {
+    e1[i] = b[i] - a[i];
+    e2[i] = c[i] - a[i];
+    e3[i] = d[i] - a[i];
+  }
+  return (e1[0] * (e2[1] * e3[2] - e2[2] * e3[1]) - e1[1] * (e2[0] * e3[2] - e2[2] * e3[0]) +
+          e1[2] * (e2[0] * e3[1] - e2[1] * e3[0])) / 6.0;
+}
+
+#endif

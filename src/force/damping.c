@@ -23,7 +23,20 @@
  *     w . f(v) = -sum V0 [beta/2 (A + A^T):(B + B^T) + alpha tr A tr B].
  *     So the implicit step's M - dt/2 D is symmetric positive definite and CG applies.
  * eps = 1e-12 tr(R^T R) regularizes tets collapsed to a line or a point, whose R^T R is
- * singular (for a point R = 0 and P = I: all corners coincide, so there is no torque). */
+ * singular (for a point R = 0 and P = I: all corners coincide, so there is no torque).
+ *
+ * Speed. The implicit step applies this operator in every conjugate-gradient iteration, about
+ * 20 times per elastic update, so the work is split. Once per update (lazily, on the first
+ * damping call after it) each tet's record is prepared: the rotation Q = U V^T (the stress
+ * needs only it: U Phat(U^T Fdot V) V^T = beta (Fdot + Q Fdot^T Q) + alpha tr(Q^T Fdot) Q),
+ * the corner offsets from the centroid r_1..r_3 (r_0 = -(r_1 + r_2 + r_3)), the 6 entries of
+ * (R^T R + eps I)^-1 and sqrt(V0) Dm^-1 (V0 split evenly between the two sides keeps the
+ * operator symmetric in rounding too). The apply then streams 33 doubles per tet, blocked by
+ * PIOLA_TET_BLOCK lanes like the force buffer, through branch-free straight-line code that
+ * the compiler vectorizes across the lanes. Both projections are written in terms of the
+ * edge vectors: R^T y = sum_j r_j x (y_j - y_0), and for forces g with g_0 = -sum g_j,
+ * R^T g = sum_j (r_j - r_0) x g_j. A scalar reference of the original per-tet formulation
+ * (piola__elastic_body_damping_reference) is kept for the tests. */
 #include <math.h>
 
 #include "force/elastic_body_internal.h"
@@ -31,9 +44,209 @@
 
 #define B PIOLA_TET_BLOCK
 
+/* Rows of a tet record (each row holds PIOLA_TET_BLOCK lanes). */
+enum {
+  ROW_Q = 0,     /* 9: Q = U V^T, row-major */
+  ROW_R = 9,     /* 9: r_1, r_2, r_3 (x, y, z each), centroid-relative corners */
+  ROW_MINV = 18, /* 6: (R^T R + eps I)^-1: xx, xy, xz, yy, yz, zz */
+  ROW_DM = 24,   /* 9: sqrt(V0) Dm^-1, row-major */
+  ROW_COUNT = 33
+};
+_Static_assert(ROW_COUNT == PIOLA_DAMPING_FIELDS, "damping record size");
+
+/* Prepares the records of one block from the last update's U, V and positions. */
+PIOLA_WIDE_VECTORS static void prepare_block(piola_elastic_body *body, int32_t block) {
+  const int32_t base = block * B;
+  const double *x = body->positions;
+  const int32_t *i0 = body->tet_vertices[0] + base, *i1 = body->tet_vertices[1] + base;
+  const int32_t *i2 = body->tet_vertices[2] + base, *i3 = body->tet_vertices[3] + base;
+  double *const *u = body->u, *const *v = body->v, *const *dmi = body->dm_inv;
+  const double *volume = body->rest_volume;
+  double *rec = body->damping_data + (size_t)block * ROW_COUNT * B;
+#pragma omp simd
+  for (int l = 0; l < B; ++l) {
+    const int32_t t = base + l;
+    const int32_t ia = 3 * i0[l], ib = 3 * i1[l], ic = 3 * i2[l], id = 3 * i3[l];
+    double r[4][3];
+    PIOLA_UNROLL
+    for (int k = 0; k < 3; ++k) {
+      double c = 0.25 * (x[ia + k] + x[ib + k] + x[ic + k] + x[id + k]);
+      r[1][k] = x[ib + k] - c;
+      r[2][k] = x[ic + k] - c;
+      r[3][k] = x[id + k] - c;
+      r[0][k] = -(r[1][k] + r[2][k] + r[3][k]); /* exactly what the apply uses */
+    }
+    /* m = R^T R = sum_a |r_a|^2 I - r_a r_a^T */
+    double mxx = 0, mxy = 0, mxz = 0, myy = 0, myz = 0, mzz = 0;
+    PIOLA_UNROLL
+    for (int a = 0; a < 4; ++a) {
+      double rx = r[a][0], ry = r[a][1], rz = r[a][2];
+      mxx += ry * ry + rz * rz;
+      myy += rx * rx + rz * rz;
+      mzz += rx * rx + ry * ry;
+      mxy -= rx * ry;
+      mxz -= rx * rz;
+      myz -= ry * rz;
+    }
+    double eps = 1e-12 * (mxx + myy + mzz);
+    mxx += eps;
+    myy += eps;
+    mzz += eps;
+    double cxx = myy * mzz - myz * myz, cxy = mxz * myz - mxy * mzz, cxz = mxy * myz - myy * mxz;
+    double cyy = mxx * mzz - mxz * mxz, cyz = mxy * mxz - mxx * myz, czz = mxx * myy - mxy * mxy;
+    double det = mxx * cxx + mxy * cxy + mxz * cxz;
+    /* all corners at one point (or a padding tet): no rotation to remove */
+    double inv = eps > 0 ? 1.0 / (eps > 0 ? det : 1.0) : 0.0;
+    rec[(ROW_MINV + 0) * B + l] = cxx * inv;
+    rec[(ROW_MINV + 1) * B + l] = cxy * inv;
+    rec[(ROW_MINV + 2) * B + l] = cxz * inv;
+    rec[(ROW_MINV + 3) * B + l] = cyy * inv;
+    rec[(ROW_MINV + 4) * B + l] = cyz * inv;
+    rec[(ROW_MINV + 5) * B + l] = czz * inv;
+    PIOLA_UNROLL
+    for (int j = 0; j < 3; ++j)
+      PIOLA_UNROLL
+      for (int k = 0; k < 3; ++k) rec[(ROW_R + 3 * j + k) * B + l] = r[j + 1][k];
+    PIOLA_UNROLL
+    for (int i = 0; i < 3; ++i)
+      PIOLA_UNROLL
+      for (int j = 0; j < 3; ++j)
+        rec[(ROW_Q + 3 * i + j) * B + l] = u[3 * i][t] * v[3 * j][t] + u[3 * i + 1][t] * v[3 * j + 1][t] +
+                                           u[3 * i + 2][t] * v[3 * j + 2][t];
+    double sv = sqrt(volume[t]);
+    PIOLA_UNROLL
+    for (int k = 0; k < 9; ++k) rec[(ROW_DM + k) * B + l] = sv * dmi[k][t];
+  }
+}
+
+/* The damping forces of one block of tets into the per-tet buffer. */
+PIOLA_WIDE_VECTORS static void apply_block(const piola_elastic_body *body, const double *vel, double beta,
+                                           double alpha, int32_t block) {
+  const int32_t base = block * B;
+  const int32_t *i0 = body->tet_vertices[0] + base, *i1 = body->tet_vertices[1] + base;
+  const int32_t *i2 = body->tet_vertices[2] + base, *i3 = body->tet_vertices[3] + base;
+  const double *rec = body->damping_data + (size_t)block * ROW_COUNT * B;
+  double *tf = body->tet_forces + 12 * (size_t)base;
+#pragma omp simd
+  for (int l = 0; l < B; ++l) {
+    const int32_t ia = 3 * i0[l], ib = 3 * i1[l], ic = 3 * i2[l], id = 3 * i3[l];
+    /* edge velocities d[j] = v_{j+1} - v_0 and corner offsets */
+    /* index arithmetic, not pointers or loops, so GCC emits vector gathers */
+    double d[3][3], r[4][3], e[3][3];
+    d[0][0] = vel[ib] - vel[ia], d[1][0] = vel[ic] - vel[ia], d[2][0] = vel[id] - vel[ia];
+    d[0][1] = vel[ib + 1] - vel[ia + 1], d[1][1] = vel[ic + 1] - vel[ia + 1], d[2][1] = vel[id + 1] - vel[ia + 1];
+    d[0][2] = vel[ib + 2] - vel[ia + 2], d[1][2] = vel[ic + 2] - vel[ia + 2], d[2][2] = vel[id + 2] - vel[ia + 2];
+    PIOLA_UNROLL
+    for (int j = 0; j < 3; ++j)
+      PIOLA_UNROLL
+      for (int k = 0; k < 3; ++k) r[j + 1][k] = rec[(ROW_R + 3 * j + k) * B + l];
+    PIOLA_UNROLL
+    for (int k = 0; k < 3; ++k) r[0][k] = -(r[1][k] + r[2][k] + r[3][k]);
+    PIOLA_UNROLL
+    for (int j = 0; j < 3; ++j)
+      PIOLA_UNROLL
+      for (int k = 0; k < 3; ++k) e[j][k] = r[j + 1][k] - r[0][k]; /* edge x_{j+1} - x_0 */
+    const double mxx = rec[(ROW_MINV + 0) * B + l], mxy = rec[(ROW_MINV + 1) * B + l];
+    const double mxz = rec[(ROW_MINV + 2) * B + l], myy = rec[(ROW_MINV + 3) * B + l];
+    const double myz = rec[(ROW_MINV + 4) * B + l], mzz = rec[(ROW_MINV + 5) * B + l];
+
+    /* remove the rigid rotation: tau = R^T v = sum_j r_j x d_j, omega = Minv tau,
+     * d_j -= omega x e_j */
+    double tx = 0, ty = 0, tz = 0;
+    PIOLA_UNROLL
+    for (int j = 0; j < 3; ++j) {
+      tx += r[j + 1][1] * d[j][2] - r[j + 1][2] * d[j][1];
+      ty += r[j + 1][2] * d[j][0] - r[j + 1][0] * d[j][2];
+      tz += r[j + 1][0] * d[j][1] - r[j + 1][1] * d[j][0];
+    }
+    double wx = mxx * tx + mxy * ty + mxz * tz;
+    double wy = mxy * tx + myy * ty + myz * tz;
+    double wz = mxz * tx + myz * ty + mzz * tz;
+    PIOLA_UNROLL
+    for (int j = 0; j < 3; ++j) {
+      d[j][0] -= wy * e[j][2] - wz * e[j][1];
+      d[j][1] -= wz * e[j][0] - wx * e[j][2];
+      d[j][2] -= wx * e[j][1] - wy * e[j][0];
+    }
+
+    /* Fdot (times sqrt V0) = Ds_dot Dm^-1: fd[i][k] = sum_j d[j][i] dm[j][k] */
+    double dm[3][3], q[3][3], fd[3][3];
+    PIOLA_UNROLL
+    for (int k = 0; k < 9; ++k) {
+      dm[k / 3][k % 3] = rec[(ROW_DM + k) * B + l];
+      q[k / 3][k % 3] = rec[(ROW_Q + k) * B + l];
+    }
+    PIOLA_UNROLL
+    for (int i = 0; i < 3; ++i)
+      PIOLA_UNROLL
+      for (int k = 0; k < 3; ++k) fd[i][k] = d[0][i] * dm[0][k] + d[1][i] * dm[1][k] + d[2][i] * dm[2][k];
+    /* A = Q^T Fdot; S = beta (A + A^T) + alpha tr(A) I; P = Q S */
+    double a[3][3];
+    PIOLA_UNROLL
+    for (int i = 0; i < 3; ++i)
+      PIOLA_UNROLL
+      for (int k = 0; k < 3; ++k) a[i][k] = q[0][i] * fd[0][k] + q[1][i] * fd[1][k] + q[2][i] * fd[2][k];
+    double tr = alpha * (a[0][0] + a[1][1] + a[2][2]);
+    double s00 = 2 * beta * a[0][0] + tr, s11 = 2 * beta * a[1][1] + tr, s22 = 2 * beta * a[2][2] + tr;
+    double s01 = beta * (a[0][1] + a[1][0]), s02 = beta * (a[0][2] + a[2][0]), s12 = beta * (a[1][2] + a[2][1]);
+    double p[3][3];
+    PIOLA_UNROLL
+    for (int i = 0; i < 3; ++i) {
+      p[i][0] = q[i][0] * s00 + q[i][1] * s01 + q[i][2] * s02;
+      p[i][1] = q[i][0] * s01 + q[i][1] * s11 + q[i][2] * s12;
+      p[i][2] = q[i][0] * s02 + q[i][1] * s12 + q[i][2] * s22;
+    }
+    /* forces on corners j + 1: g_j = -P (sqrt V0 Dm^-T) column j; corner 0 balances */
+    double g[4][3];
+    PIOLA_UNROLL
+    for (int j = 0; j < 3; ++j)
+      PIOLA_UNROLL
+      for (int i = 0; i < 3; ++i) g[j + 1][i] = -(p[i][0] * dm[j][0] + p[i][1] * dm[j][1] + p[i][2] * dm[j][2]);
+    PIOLA_UNROLL
+    for (int i = 0; i < 3; ++i) g[0][i] = -(g[1][i] + g[2][i] + g[3][i]);
+
+    /* remove the torque: tau = R^T g = sum_j e_j x g_j, omega = Minv tau, g_a -= omega x r_a */
+    tx = ty = tz = 0;
+    PIOLA_UNROLL
+    for (int j = 0; j < 3; ++j) {
+      tx += e[j][1] * g[j + 1][2] - e[j][2] * g[j + 1][1];
+      ty += e[j][2] * g[j + 1][0] - e[j][0] * g[j + 1][2];
+      tz += e[j][0] * g[j + 1][1] - e[j][1] * g[j + 1][0];
+    }
+    wx = mxx * tx + mxy * ty + mxz * tz;
+    wy = mxy * tx + myy * ty + myz * tz;
+    wz = mxz * tx + myz * ty + mzz * tz;
+    PIOLA_UNROLL
+    for (int c = 0; c < 4; ++c) {
+      tf[(3 * c + 0) * B + l] = g[c][0] - (wy * r[c][2] - wz * r[c][1]);
+      tf[(3 * c + 1) * B + l] = g[c][1] - (wz * r[c][0] - wx * r[c][2]);
+      tf[(3 * c + 2) * B + l] = g[c][2] - (wx * r[c][1] - wy * r[c][0]);
+    }
+  }
+}
+
+void piola_elastic_body_damping_forces(const piola_elastic_body *body, const double *v,
+                                       double shear_viscosity, double bulk_viscosity,
+                                       double *forces) {
+  if (!body || !v || !forces) return;
+  int32_t blocks = body->padded_tet_count / B;
+  /* the per-tet buffers are scratch shared with the elastic update: concurrent calls on one
+   * body are not allowed (the records are prepared in place, like the lazy energy) */
+  piola_elastic_body *mutable_body = (piola_elastic_body *)body;
+  if (!body->damping_ready) {
+#pragma omp parallel for schedule(static) num_threads(piola__thread_count()) \
+    if (blocks >= PIOLA_PARALLEL_MIN_BLOCKS)
+    for (int32_t b = 0; b < blocks; ++b) prepare_block(mutable_body, b);
+    mutable_body->damping_ready = 1;
+  }
+#pragma omp parallel for schedule(static) num_threads(piola__thread_count()) \
+    if (blocks >= PIOLA_PARALLEL_MIN_BLOCKS)
+  for (int32_t b = 0; b < blocks; ++b) apply_block(body, v, shear_viscosity, bulk_viscosity, b);
+  piola__elastic_body_gather_forces(body, forces);
+}
 /* Removes from the 4 corner vectors y (12) their rigid-rotation part about the centroid
  * of positions p (12). */
-static void remove_rotation(const double p[12], double y[12]) {
+static void reference_remove_rotation(const double p[12], double y[12]) {
   double c[3] = {0, 0, 0};
   for (int a = 0; a < 4; ++a)
     for (int i = 0; i < 3; ++i) c[i] += 0.25 * p[3 * a + i];
@@ -67,7 +280,7 @@ static void remove_rotation(const double p[12], double y[12]) {
 }
 
 /* The damping forces of tet t at corner velocities vt (12, already projected). */
-static void tet_damping(const piola_elastic_body *body, int32_t t, const double vt[12], double beta,
+static void reference_tet_damping(const piola_elastic_body *body, int32_t t, const double vt[12], double beta,
                         double alpha, double out[12]) {
   double *const *dmi = body->dm_inv;
   double d[3][3], fd[3][3], fv[3][3], a[3][3], ph[3][3], p[3][3], u[3][3], v[3][3], dm[3][3];
@@ -105,49 +318,23 @@ static void tet_damping(const piola_elastic_body *body, int32_t t, const double 
     }
 }
 
-/* Writes tet t's 12 force components into the blocked per-tet buffer. */
-static void store_tet_forces(const piola_elastic_body *body, int32_t t, const double out[12]) {
-  for (int c = 0; c < 4; ++c) {
-    double *o = body->tet_forces + piola__tet_force_offset(t, c);
-    for (int i = 0; i < 3; ++i) o[i * B] = out[3 * c + i];
-  }
-}
-
-static void damping_block(const piola_elastic_body *body, const double *vel, double beta,
-                          double alpha, int32_t block) {
-  const int32_t base = block * B;
-  for (int l = 0; l < B; ++l) {
-    const int32_t t = base + l;
-    double out[12] = {0};
-    if (t >= body->tet_count) {
-      store_tet_forces(body, t, out);
-      continue;
-    }
-    double pt[12], vt[12];
+void piola__elastic_body_damping_reference(const piola_elastic_body *body, const double *v,
+                                           double shear_viscosity, double bulk_viscosity,
+                                           double *forces) {
+  for (int32_t i = 0; i < 3 * body->vertex_count; ++i) forces[i] = 0.0;
+  for (int32_t t = 0; t < body->tet_count; ++t) {
+    double pt[12], vt[12], out[12];
     for (int c = 0; c < 4; ++c) {
       int32_t i = body->tet_vertices[c][t];
       for (int k = 0; k < 3; ++k) {
         pt[3 * c + k] = body->positions[3 * i + k];
-        vt[3 * c + k] = vel[3 * i + k];
+        vt[3 * c + k] = v[3 * i + k];
       }
     }
-    remove_rotation(pt, vt);
-    tet_damping(body, t, vt, beta, alpha, out);
-    remove_rotation(pt, out);
-    store_tet_forces(body, t, out);
+    reference_remove_rotation(pt, vt);
+    reference_tet_damping(body, t, vt, shear_viscosity, bulk_viscosity, out);
+    reference_remove_rotation(pt, out);
+    for (int c = 0; c < 4; ++c)
+      for (int k = 0; k < 3; ++k) forces[3 * body->tet_vertices[c][t] + k] += out[3 * c + k];
   }
-}
-
-void piola_elastic_body_damping_forces(const piola_elastic_body *body, const double *v,
-                                       double shear_viscosity, double bulk_viscosity,
-                                       double *forces) {
-  if (!body || !v || !forces) return;
-  int32_t blocks = body->padded_tet_count / B;
-  /* the per-tet buffer is scratch shared with the elastic update: concurrent calls on one
-   * body are not allowed */
-#pragma omp parallel for schedule(static) num_threads(piola__thread_count()) \
-    if (blocks >= PIOLA_PARALLEL_MIN_BLOCKS)
-  for (int32_t b = 0; b < blocks; ++b)
-    damping_block(body, v, shear_viscosity, bulk_viscosity, b);
-  piola__elastic_body_gather_forces(body, forces);
 }

@@ -127,15 +127,23 @@ PIOLA_WIDE_VECTORS static void apply_block(const piola_elastic_body *body, const
   const int32_t *i2 = body->tet_vertices[2] + base, *i3 = body->tet_vertices[3] + base;
   const double *rec = body->damping_data + (size_t)block * ROW_COUNT * B;
   double *tf = body->tet_forces + 12 * (size_t)base;
+  /* the gathers in a loop of their own: GCC vectorizes loops with int32-indexed gathers at
+   * 256 bits, the arithmetic below runs at 512 */
+  double dv[9][B];
 #pragma omp simd
   for (int l = 0; l < B; ++l) {
-    const int32_t ia = 3 * i0[l], ib = 3 * i1[l], ic = 3 * i2[l], id = 3 * i3[l];
-    /* edge velocities d[j] = v_{j+1} - v_0 and corner offsets */
     /* index arithmetic, not pointers or loops, so GCC emits vector gathers */
+    const int32_t ia = 3 * i0[l], ib = 3 * i1[l], ic = 3 * i2[l], id = 3 * i3[l];
+    dv[0][l] = vel[ib] - vel[ia], dv[1][l] = vel[ib + 1] - vel[ia + 1], dv[2][l] = vel[ib + 2] - vel[ia + 2];
+    dv[3][l] = vel[ic] - vel[ia], dv[4][l] = vel[ic + 1] - vel[ia + 1], dv[5][l] = vel[ic + 2] - vel[ia + 2];
+    dv[6][l] = vel[id] - vel[ia], dv[7][l] = vel[id + 1] - vel[ia + 1], dv[8][l] = vel[id + 2] - vel[ia + 2];
+  }
+#pragma omp simd
+  for (int l = 0; l < B; ++l) {
+    /* edge velocities d[j] = v_{j+1} - v_0 and corner offsets */
     double d[3][3], r[4][3], e[3][3];
-    d[0][0] = vel[ib] - vel[ia], d[1][0] = vel[ic] - vel[ia], d[2][0] = vel[id] - vel[ia];
-    d[0][1] = vel[ib + 1] - vel[ia + 1], d[1][1] = vel[ic + 1] - vel[ia + 1], d[2][1] = vel[id + 1] - vel[ia + 1];
-    d[0][2] = vel[ib + 2] - vel[ia + 2], d[1][2] = vel[ic + 2] - vel[ia + 2], d[2][2] = vel[id + 2] - vel[ia + 2];
+    PIOLA_UNROLL
+    for (int k = 0; k < 9; ++k) d[k / 3][k % 3] = dv[k][l];
     PIOLA_UNROLL
     for (int j = 0; j < 3; ++j)
       PIOLA_UNROLL

@@ -213,8 +213,9 @@ static void fast_damping_matches_the_reference(void **state) {
       piola__elastic_body_damping_reference(body, v, beta, alpha, ref);
       double scale = fixture_max_abs(ref, n);
       assert_true(scale > 0);
+      /* the fast records hold Q and Dm^-1 in float (damping.c): 6e-8 relative each */
       for (int i = 0; i < n; ++i)
-        if (!(fabs(fast[i] - ref[i]) <= 1e-11 * scale))
+        if (!(fabs(fast[i] - ref[i]) <= 2e-6 * scale))
           fail_msg("config %d sample %ld entry %d: fast %.17g, reference %.17g", config, s, i, fast[i], ref[i]);
     }
     free(v);

@@ -44,15 +44,33 @@
 
 #define B PIOLA_TET_BLOCK
 
-/* Rows of a tet record (each row holds PIOLA_TET_BLOCK lanes). */
-enum {
-  ROW_Q = 0,     /* 9: Q = U V^T, row-major */
-  ROW_R = 9,     /* 9: r_1, r_2, r_3 (x, y, z each), centroid-relative corners */
-  ROW_MINV = 18, /* 6: (R^T R + eps I)^-1: xx, xy, xz, yy, yz, zz */
-  ROW_DM = 24,   /* 9: sqrt(V0) Dm^-1, row-major */
-  ROW_COUNT = 33
-};
-_Static_assert(ROW_COUNT == PIOLA_DAMPING_FIELDS, "damping record size");
+/* A block's record: 9 rows of doubles (r_1, r_2, r_3: x, y, z each, centroid-relative
+ * corners), then 18 rows of damping_real (Q = U V^T and sqrt(V0) Dm^-1, row-major); each row
+ * holds PIOLA_TET_BLOCK lanes. The offsets must stay exact (the projections have to remove
+ * the rotations about the true corners to rounding), so they are doubles; Q and Dm^-1 only
+ * set the size of the viscous stress, where float's 6e-8 relative rounding is far below
+ * anything a viscosity is known to, and halving them cuts the bytes the apply streams per
+ * tet from 216 to 144 (the apply is bound by memory traffic, not arithmetic). The operator
+ * stays exactly symmetric: both sides use the same stored numbers. Set PIOLA_DAMPING_DOUBLE
+ * to 1 to store them as doubles. */
+#ifndef PIOLA_DAMPING_DOUBLE
+#define PIOLA_DAMPING_DOUBLE 0
+#endif
+#if PIOLA_DAMPING_DOUBLE
+typedef double damping_real;
+#else
+typedef float damping_real;
+#endif
+enum { ROWS_R = 9, ROWS_Q = 0, ROWS_DM = 9, ROWS_REAL = 18 };
+#define BLOCK_BYTES (ROWS_R * B * sizeof(double) + ROWS_REAL * B * sizeof(damping_real))
+_Static_assert(BLOCK_BYTES <= PIOLA_DAMPING_FIELDS * B * sizeof(double), "damping record size");
+
+static inline double *block_offsets(const piola_elastic_body *body, int32_t block) {
+  return (double *)((char *)body->damping_data + (size_t)block * BLOCK_BYTES);
+}
+static inline damping_real *block_reals(const piola_elastic_body *body, int32_t block) {
+  return (damping_real *)((char *)body->damping_data + (size_t)block * BLOCK_BYTES + ROWS_R * B * sizeof(double));
+}
 
 /* Prepares the records of one block from the last update's U, V and positions. */
 PIOLA_WIDE_VECTORS static void prepare_block(piola_elastic_body *body, int32_t block) {
@@ -62,60 +80,33 @@ PIOLA_WIDE_VECTORS static void prepare_block(piola_elastic_body *body, int32_t b
   const int32_t *i2 = body->tet_vertices[2] + base, *i3 = body->tet_vertices[3] + base;
   double *const *u = body->u, *const *v = body->v, *const *dmi = body->dm_inv;
   const double *volume = body->rest_volume;
-  double *rec = body->damping_data + (size_t)block * ROW_COUNT * B;
+  double *ro = block_offsets(body, block);
+  damping_real *rq = block_reals(body, block);
 #pragma omp simd
   for (int l = 0; l < B; ++l) {
     const int32_t t = base + l;
     const int32_t ia = 3 * i0[l], ib = 3 * i1[l], ic = 3 * i2[l], id = 3 * i3[l];
-    double r[4][3];
+    double r[4][3]; /* r[0] = -(r[1] + r[2] + r[3]) is recomputed by the apply */
     PIOLA_UNROLL
     for (int k = 0; k < 3; ++k) {
       double c = 0.25 * (x[ia + k] + x[ib + k] + x[ic + k] + x[id + k]);
       r[1][k] = x[ib + k] - c;
       r[2][k] = x[ic + k] - c;
       r[3][k] = x[id + k] - c;
-      r[0][k] = -(r[1][k] + r[2][k] + r[3][k]); /* exactly what the apply uses */
     }
-    /* m = R^T R = sum_a |r_a|^2 I - r_a r_a^T */
-    double mxx = 0, mxy = 0, mxz = 0, myy = 0, myz = 0, mzz = 0;
-    PIOLA_UNROLL
-    for (int a = 0; a < 4; ++a) {
-      double rx = r[a][0], ry = r[a][1], rz = r[a][2];
-      mxx += ry * ry + rz * rz;
-      myy += rx * rx + rz * rz;
-      mzz += rx * rx + ry * ry;
-      mxy -= rx * ry;
-      mxz -= rx * rz;
-      myz -= ry * rz;
-    }
-    double eps = 1e-12 * (mxx + myy + mzz);
-    mxx += eps;
-    myy += eps;
-    mzz += eps;
-    double cxx = myy * mzz - myz * myz, cxy = mxz * myz - mxy * mzz, cxz = mxy * myz - myy * mxz;
-    double cyy = mxx * mzz - mxz * mxz, cyz = mxy * mxz - mxx * myz, czz = mxx * myy - mxy * mxy;
-    double det = mxx * cxx + mxy * cxy + mxz * cxz;
-    /* all corners at one point (or a padding tet): no rotation to remove */
-    double inv = eps > 0 ? 1.0 / (eps > 0 ? det : 1.0) : 0.0;
-    rec[(ROW_MINV + 0) * B + l] = cxx * inv;
-    rec[(ROW_MINV + 1) * B + l] = cxy * inv;
-    rec[(ROW_MINV + 2) * B + l] = cxz * inv;
-    rec[(ROW_MINV + 3) * B + l] = cyy * inv;
-    rec[(ROW_MINV + 4) * B + l] = cyz * inv;
-    rec[(ROW_MINV + 5) * B + l] = czz * inv;
     PIOLA_UNROLL
     for (int j = 0; j < 3; ++j)
       PIOLA_UNROLL
-      for (int k = 0; k < 3; ++k) rec[(ROW_R + 3 * j + k) * B + l] = r[j + 1][k];
+      for (int k = 0; k < 3; ++k) ro[(3 * j + k) * B + l] = r[j + 1][k];
     PIOLA_UNROLL
     for (int i = 0; i < 3; ++i)
       PIOLA_UNROLL
       for (int j = 0; j < 3; ++j)
-        rec[(ROW_Q + 3 * i + j) * B + l] = u[3 * i][t] * v[3 * j][t] + u[3 * i + 1][t] * v[3 * j + 1][t] +
-                                           u[3 * i + 2][t] * v[3 * j + 2][t];
+        rq[(ROWS_Q + 3 * i + j) * B + l] = (damping_real)(u[3 * i][t] * v[3 * j][t] + u[3 * i + 1][t] * v[3 * j + 1][t] +
+                                                          u[3 * i + 2][t] * v[3 * j + 2][t]);
     double sv = sqrt(volume[t]);
     PIOLA_UNROLL
-    for (int k = 0; k < 9; ++k) rec[(ROW_DM + k) * B + l] = sv * dmi[k][t];
+    for (int k = 0; k < 9; ++k) rq[(ROWS_DM + k) * B + l] = (damping_real)(sv * dmi[k][t]);
   }
 }
 
@@ -125,7 +116,8 @@ PIOLA_WIDE_VECTORS static void apply_block(const piola_elastic_body *body, const
   const int32_t base = block * B;
   const int32_t *i0 = body->tet_vertices[0] + base, *i1 = body->tet_vertices[1] + base;
   const int32_t *i2 = body->tet_vertices[2] + base, *i3 = body->tet_vertices[3] + base;
-  const double *rec = body->damping_data + (size_t)block * ROW_COUNT * B;
+  const double *ro = block_offsets(body, block);
+  const damping_real *rq = block_reals(body, block);
   double *tf = body->tet_forces + 12 * (size_t)base;
   /* the gathers in a loop of their own: GCC vectorizes loops with int32-indexed gathers at
    * 256 bits, the arithmetic below runs at 512 */
@@ -138,6 +130,12 @@ PIOLA_WIDE_VECTORS static void apply_block(const piola_elastic_body *body, const
     dv[3][l] = vel[ic] - vel[ia], dv[4][l] = vel[ic + 1] - vel[ia + 1], dv[5][l] = vel[ic + 2] - vel[ia + 2];
     dv[6][l] = vel[id] - vel[ia], dv[7][l] = vel[id + 1] - vel[ia + 1], dv[8][l] = vel[id + 2] - vel[ia + 2];
   }
+  /* widened in a loop of their own too, so the one below is all doubles (512 bits) */
+  double qd[ROWS_REAL][B];
+  PIOLA_UNROLL
+  for (int k = 0; k < ROWS_REAL; ++k)
+#pragma omp simd
+    for (int l = 0; l < B; ++l) qd[k][l] = rq[k * B + l];
 #pragma omp simd
   for (int l = 0; l < B; ++l) {
     /* edge velocities d[j] = v_{j+1} - v_0 and corner offsets */
@@ -147,16 +145,39 @@ PIOLA_WIDE_VECTORS static void apply_block(const piola_elastic_body *body, const
     PIOLA_UNROLL
     for (int j = 0; j < 3; ++j)
       PIOLA_UNROLL
-      for (int k = 0; k < 3; ++k) r[j + 1][k] = rec[(ROW_R + 3 * j + k) * B + l];
+      for (int k = 0; k < 3; ++k) r[j + 1][k] = ro[(3 * j + k) * B + l];
     PIOLA_UNROLL
     for (int k = 0; k < 3; ++k) r[0][k] = -(r[1][k] + r[2][k] + r[3][k]);
     PIOLA_UNROLL
     for (int j = 0; j < 3; ++j)
       PIOLA_UNROLL
       for (int k = 0; k < 3; ++k) e[j][k] = r[j + 1][k] - r[0][k]; /* edge x_{j+1} - x_0 */
-    const double mxx = rec[(ROW_MINV + 0) * B + l], mxy = rec[(ROW_MINV + 1) * B + l];
-    const double mxz = rec[(ROW_MINV + 2) * B + l], myy = rec[(ROW_MINV + 3) * B + l];
-    const double myz = rec[(ROW_MINV + 4) * B + l], mzz = rec[(ROW_MINV + 5) * B + l];
+    /* Minv = (R^T R + eps I)^-1, recomputed here from r: ~70 flops cost less than streaming
+     * 6 more doubles per tet. R^T R = sum_a |r_a|^2 I - r_a r_a^T */
+    double mxx = 0, mxy = 0, mxz = 0, myy = 0, myz = 0, mzz = 0;
+    PIOLA_UNROLL
+    for (int c = 0; c < 4; ++c) {
+      double rx = r[c][0], ry = r[c][1], rz = r[c][2];
+      mxx += ry * ry + rz * rz;
+      myy += rx * rx + rz * rz;
+      mzz += rx * rx + ry * ry;
+      mxy -= rx * ry;
+      mxz -= rx * rz;
+      myz -= ry * rz;
+    }
+    {
+      double eps = 1e-12 * (mxx + myy + mzz);
+      mxx += eps;
+      myy += eps;
+      mzz += eps;
+      double cxx = myy * mzz - myz * myz, cxy = mxz * myz - mxy * mzz, cxz = mxy * myz - myy * mxz;
+      double cyy = mxx * mzz - mxz * mxz, cyz = mxy * mxz - mxx * myz, czz = mxx * myy - mxy * mxy;
+      double det = mxx * cxx + mxy * cxy + mxz * cxz;
+      /* all corners at one point (or a padding tet): no rotation to remove */
+      double inv = eps > 0 ? 1.0 / (eps > 0 ? det : 1.0) : 0.0;
+      mxx = cxx * inv, mxy = cxy * inv, mxz = cxz * inv;
+      myy = cyy * inv, myz = cyz * inv, mzz = czz * inv;
+    }
 
     /* remove the rigid rotation: tau = R^T v = sum_j r_j x d_j, omega = Minv tau,
      * d_j -= omega x e_j */
@@ -181,8 +202,8 @@ PIOLA_WIDE_VECTORS static void apply_block(const piola_elastic_body *body, const
     double dm[3][3], q[3][3], fd[3][3];
     PIOLA_UNROLL
     for (int k = 0; k < 9; ++k) {
-      dm[k / 3][k % 3] = rec[(ROW_DM + k) * B + l];
-      q[k / 3][k % 3] = rec[(ROW_Q + k) * B + l];
+      dm[k / 3][k % 3] = qd[ROWS_DM + k][l];
+      q[k / 3][k % 3] = qd[ROWS_Q + k][l];
     }
     PIOLA_UNROLL
     for (int i = 0; i < 3; ++i)

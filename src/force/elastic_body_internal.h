@@ -91,13 +91,13 @@ struct piola_elastic_body {
   double last_stiffness_scale;
 
   /* damping (damping.c): per-tet operator data, prepared from the last update by the first
-   * damping call after it; blocked like tet_forces: PIOLA_DAMPING_FIELDS rows of
-   * PIOLA_TET_BLOCK lanes per block */
+   * damping call after it; per block of PIOLA_TET_BLOCK tets at most PIOLA_DAMPING_FIELDS
+   * rows of PIOLA_TET_BLOCK doubles (layout in damping.c) */
   double *damping_data;
   int damping_ready;        /* damping_data matches the last update (cleared by the update) */
 };
 
-#define PIOLA_DAMPING_FIELDS 33
+#define PIOLA_DAMPING_FIELDS 27
 
 /* Where tet t's corner c force starts in tet_forces: blocks of PIOLA_TET_BLOCK tets hold
  * 12 rows (3 c + i) of PIOLA_TET_BLOCK lanes, so the force loop stores whole vectors. */

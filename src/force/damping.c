@@ -110,15 +110,15 @@ PIOLA_WIDE_VECTORS static void prepare_block(piola_elastic_body *body, int32_t b
   }
 }
 
-/* The damping forces of one block of tets into the per-tet buffer. */
+/* Adds the damping forces of one block of tets to forces, tet by tet in order. */
 PIOLA_WIDE_VECTORS static void apply_block(const piola_elastic_body *body, const double *vel, double beta,
-                                           double alpha, int32_t block) {
+                                           double alpha, int32_t block, double *forces) {
   const int32_t base = block * B;
   const int32_t *i0 = body->tet_vertices[0] + base, *i1 = body->tet_vertices[1] + base;
   const int32_t *i2 = body->tet_vertices[2] + base, *i3 = body->tet_vertices[3] + base;
   const double *ro = block_offsets(body, block);
   const damping_real *rq = block_reals(body, block);
-  double *tf = body->tet_forces + 12 * (size_t)base;
+  double tf[12 * B];
   /* the gathers in a loop of their own: GCC vectorizes loops with int32-indexed gathers at
    * 256 bits, the arithmetic below runs at 512 */
   double dv[9][B];
@@ -252,15 +252,23 @@ PIOLA_WIDE_VECTORS static void apply_block(const piola_elastic_body *body, const
       tf[(3 * c + 2) * B + l] = g[c][2] - (wx * r[c][1] - wy * r[c][0]);
     }
   }
+  /* scalar scatter in tet order (lanes may share vertices); padding tets add nothing */
+  const int32_t lanes = body->tet_count - base < B ? body->tet_count - base : B;
+  for (int l = 0; l < lanes; ++l) {
+    const int32_t corner[4] = {i0[l], i1[l], i2[l], i3[l]};
+    for (int c = 0; c < 4; ++c)
+      for (int k = 0; k < 3; ++k) forces[3 * corner[c] + k] += tf[(3 * c + k) * B + l];
+  }
 }
 
 void piola_elastic_body_damping_forces(const piola_elastic_body *body, const double *v,
                                        double shear_viscosity, double bulk_viscosity,
                                        double *forces) {
   if (!body || !v || !forces) return;
-  int32_t blocks = body->padded_tet_count / B;
-  /* the per-tet buffers are scratch shared with the elastic update: concurrent calls on one
-   * body are not allowed (the records are prepared in place, like the lazy energy) */
+  const int32_t blocks = body->padded_tet_count / B;
+  const int64_t n = 3 * (int64_t)body->vertex_count;
+  /* the records and partial sums are prepared in place, like the lazy energy: concurrent
+   * calls on one body are not allowed */
   piola_elastic_body *mutable_body = (piola_elastic_body *)body;
   if (!body->damping_ready) {
 #pragma omp parallel for schedule(static) num_threads(piola__thread_count()) \
@@ -268,11 +276,34 @@ void piola_elastic_body_damping_forces(const piola_elastic_body *body, const dou
     for (int32_t b = 0; b < blocks; ++b) prepare_block(mutable_body, b);
     mutable_body->damping_ready = 1;
   }
-#pragma omp parallel for schedule(static) num_threads(piola__thread_count()) \
-    if (blocks >= PIOLA_PARALLEL_MIN_BLOCKS)
-  for (int32_t b = 0; b < blocks; ++b) apply_block(body, v, shear_viscosity, bulk_viscosity, b);
-  piola__elastic_body_gather_forces(body, forces);
+  if (blocks < PIOLA_PARALLEL_MIN_BLOCKS || !body->damping_chunk_forces) {
+    for (int64_t i = 0; i < n; ++i) forces[i] = 0.0;
+    for (int32_t b = 0; b < blocks; ++b) apply_block(body, v, shear_viscosity, bulk_viscosity, b, forces);
+    return;
+  }
+  /* Determinism without a per-tet buffer: PIOLA_DAMPING_CHUNKS fixed ranges of blocks, each
+   * summed in tet order into its own array, and the arrays added in chunk order. Which
+   * thread runs a chunk changes nothing. */
+  double *partial = body->damping_chunk_forces;
+#pragma omp parallel num_threads(piola__thread_count())
+  {
+#pragma omp for schedule(static)
+    for (int k = 0; k < PIOLA_DAMPING_CHUNKS; ++k) {
+      double *fk = partial + (size_t)k * (size_t)n;
+      for (int64_t i = 0; i < n; ++i) fk[i] = 0.0;
+      int32_t b0 = (int32_t)((int64_t)blocks * k / PIOLA_DAMPING_CHUNKS);
+      int32_t b1 = (int32_t)((int64_t)blocks * (k + 1) / PIOLA_DAMPING_CHUNKS);
+      for (int32_t b = b0; b < b1; ++b) apply_block(body, v, shear_viscosity, bulk_viscosity, b, fk);
+    }
+#pragma omp for schedule(static)
+    for (int64_t i = 0; i < n; ++i) {
+      double sum = partial[i];
+      for (int k = 1; k < PIOLA_DAMPING_CHUNKS; ++k) sum += partial[(size_t)k * (size_t)n + i];
+      forces[i] = sum;
+    }
+  }
 }
+
 /* Removes from the 4 corner vectors y (12) their rigid-rotation part about the centroid
  * of positions p (12). */
 static void reference_remove_rotation(const double p[12], double y[12]) {

@@ -94,9 +94,13 @@ struct piola_elastic_body {
    * damping call after it; per block of PIOLA_TET_BLOCK tets at most PIOLA_DAMPING_FIELDS
    * rows of PIOLA_TET_BLOCK doubles (layout in damping.c) */
   double *damping_data;
-  int damping_ready;        /* damping_data matches the last update (cleared by the update) */
+  double *damping_chunk_forces;  /* PIOLA_DAMPING_CHUNKS * 3 * vertex_count partial sums */
+  int damping_ready;             /* damping_data matches the last update (cleared by it) */
 };
 
+/* Bodies of at least PIOLA_PARALLEL_MIN_BLOCKS blocks sum their damping forces in this many
+ * fixed tet ranges (each its own partial sum), whatever the thread count. */
+#define PIOLA_DAMPING_CHUNKS 4
 #define PIOLA_DAMPING_FIELDS 27
 
 /* Where tet t's corner c force starts in tet_forces: blocks of PIOLA_TET_BLOCK tets hold

@@ -54,6 +54,11 @@ PIOLA_API piola_status piola_image_contact_sheet(const piola_image *images, cons
                                                  int32_t count, int32_t columns, int32_t cell_width,
                                                  piola_image *out);
 
+/* Draws text in the built-in 5x7 bitmap font at (x, y) (top left, pixels) on a dark box, with
+ * `scale` pixels per font dot; characters as for contact-sheet labels. */
+PIOLA_API void piola_image_draw_label(piola_image *image, int32_t x, int32_t y, int32_t scale,
+                                      const char *text);
+
 typedef enum piola_render_color {
   PIOLA_RENDER_COLOR_PLAIN = 0, /* one colour per part (solid), shaded */
   PIOLA_RENDER_COLOR_INVERTED,  /* plain, with faces of inverted elements in red */

@@ -63,3 +63,12 @@ int piola__render_text(piola_image *image, int x, int y, int scale, const char *
   }
   return x - x0;
 }
+
+void piola_image_draw_label(piola_image *image, int32_t x, int32_t y, int32_t scale, const char *text) {
+  if (!image || !image->rgb || !text) return;
+  if (scale < 1) scale = 1;
+  if (scale > 16) scale = 16;
+  int w = piola__render_text_width(text, scale);
+  piola__render_fill_rect(image, x, y, w + 6 * scale, 11 * scale, 30, 30, 30);
+  piola__render_text(image, x + 3 * scale, y + 2 * scale, scale, text, 240, 240, 240);
+}

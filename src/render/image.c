@@ -165,11 +165,7 @@ piola_status piola_image_contact_sheet(const piola_image *images, const char *co
   for (int32_t i = 0; i < count; ++i) {
     int x0 = gap + (i % columns) * (cell_width + gap), y0 = gap + (i / columns) * (cell_height + gap);
     downscale_into(&images[i], out, x0, y0, cell_width, cell_height);
-    if (labels && labels[i]) {
-      int tw = piola__render_text_width(labels[i], scale);
-      piola__render_fill_rect(out, x0, y0, tw + 6 * scale, 11 * scale, 30, 30, 30);
-      piola__render_text(out, x0 + 3 * scale, y0 + 2 * scale, scale, labels[i], 240, 240, 240);
-    }
+    if (labels && labels[i]) piola_image_draw_label(out, x0, y0, scale, labels[i]);
   }
   return PIOLA_OK;
 }

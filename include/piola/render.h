@@ -117,7 +117,9 @@ PIOLA_API int32_t piola_renderer_obstacle_count(const piola_renderer *renderer);
 
 /* Chooses the camera so the box [lo, hi] (m) fills the view, looking from the front right
  * and above, unless the def set a camera; also places the fallback ground at the box's
- * lowest point along `up`. */
+ * lowest point along `up`. The box is grown by the bounding spheres (at t = 0) of the
+ * obstacles added so far that are no larger than the box and near it, so add obstacles
+ * first. */
 PIOLA_API void piola_renderer_fit_camera(piola_renderer *renderer, piola_vec3 lo, piola_vec3 hi);
 
 /* The camera in use (after fit_camera or from the def). */
@@ -148,6 +150,24 @@ PIOLA_API bool piola_render_frame_has_field(const piola_render_frame *frame, con
 PIOLA_API int32_t piola_render_frame_inverted_count(const piola_render_frame *frame);
 /* Bounding box of the frame's points, m. */
 PIOLA_API void piola_render_frame_bounds(const piola_render_frame *frame, piola_vec3 *lo, piola_vec3 *hi);
+
+/* Previews written while `piola run` writes an output folder DIR:
+ *   DIR/scene.json             a copy of the scene, relative mesh paths made absolute, so
+ *                              `piola render DIR` finds the obstacles later
+ *   DIR/render/frame_NNNN.png  every frame as it is written, when every_frame is set (the
+ *                              camera is fitted to frame 0 and then holds still)
+ *   DIR/preview.png            the last frame, written by piola_preview_close
+ * Frames are read back from DIR/frames/frame_NNNN.vtu, so the preview shows exactly what
+ * was saved. Inverted elements are drawn in red. */
+typedef struct piola_preview piola_preview;
+
+/* scene_path may be NULL (no obstacles, no copy). */
+PIOLA_API piola_status piola_preview_open(const char *dir, const char *scene_path, bool every_frame,
+                                          piola_preview **out);
+/* Call after frame `frame` (time in s) was written to DIR. */
+PIOLA_API piola_status piola_preview_frame_written(piola_preview *preview, int32_t frame, double time);
+/* Writes DIR/preview.png of the last frame written (if any) and frees the preview. */
+PIOLA_API piola_status piola_preview_close(piola_preview *preview);
 
 #ifdef __cplusplus
 }

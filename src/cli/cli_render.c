@@ -516,34 +516,20 @@ int cli_render(int argc, char **argv) {
   }
   if (!(lo.x <= hi.x)) lo = hi = (piola_vec3){0, 0, 0}; /* empty surfaces */
 
+  /* obstacles: --scene FILE, else the copy `piola run` leaves in DIR */
+  char scene_path[4200];
+  if (scene) snprintf(scene_path, sizeof scene_path, "%s", scene);
+  else snprintf(scene_path, sizeof scene_path, "%s/scene.json", dir);
+  bool use_scene = scene || is_file(scene_path);
   /* camera: the automatic one, with whatever the flags set replacing its parts */
   piola_renderer *r = NULL;
-  if (piola_renderer_create(&def, &r) != PIOLA_OK) {
-    fprintf(stderr, "piola render: %s\n", piola_last_error());
-    free(frames), free(pvd);
-    return 2;
-  }
-  piola_renderer_fit_camera(r, lo, hi);
-  if (have_pos || have_target) {
-    piola_vec3 auto_pos, auto_target;
-    piola_renderer_camera(r, &auto_pos, &auto_target);
-    piola_renderer_destroy(r);
-    def.camera_set = true;
-    def.camera_position = have_pos ? pos : auto_pos;
-    def.camera_target = have_target ? target : auto_target;
+  for (int pass = 0; pass < 2; ++pass) {
     if (piola_renderer_create(&def, &r) != PIOLA_OK) {
       fprintf(stderr, "piola render: %s\n", piola_last_error());
       free(frames), free(pvd);
       return 2;
     }
-    piola_renderer_fit_camera(r, lo, hi);
-  }
-  /* obstacles */
-  char scene_path[4200];
-  if (scene) snprintf(scene_path, sizeof scene_path, "%s", scene);
-  else snprintf(scene_path, sizeof scene_path, "%s/scene.json", dir);
-  if (scene || is_file(scene_path)) {
-    if (piola_renderer_load_scene_obstacles(r, scene_path) != PIOLA_OK) {
+    if (use_scene && piola_renderer_load_scene_obstacles(r, scene_path) != PIOLA_OK) {
       fprintf(stderr, "piola render: %s\n", piola_last_error());
       if (scene) {
         piola_renderer_destroy(r);
@@ -551,7 +537,16 @@ int cli_render(int argc, char **argv) {
         return 2;
       }
       fprintf(stderr, "piola render: drawing without the scene's obstacles\n");
+      use_scene = false;
     }
+    piola_renderer_fit_camera(r, lo, hi);
+    if (pass == 1 || !(have_pos || have_target)) break;
+    piola_vec3 auto_pos, auto_target;
+    piola_renderer_camera(r, &auto_pos, &auto_target);
+    piola_renderer_destroy(r);
+    def.camera_set = true;
+    def.camera_position = have_pos ? pos : auto_pos;
+    def.camera_target = have_target ? target : auto_target;
   }
 
   char render_dir[4200];

@@ -86,8 +86,9 @@ piola_status piola__render_triangles(const render_camera *cam, const piola_rende
       vec3 pos = vec3_load(x + 3 * (size_t)c[k]);
       vec3 n = vec3_load(vn + 3 * (size_t)c[k]);
       double nl = vec3_norm(n);
-      /* a vertex normal that disagrees with the face (creases, folds) gives way to it */
-      n = (nl > 0 && vec3_dot(n, fn) > 0.35 * nl) ? vec3_scale(n, 1.0 / nl) : fn;
+      /* a vertex normal more than ~35 degrees off the face (creases, folds, box edges)
+       * gives way to it: smooth surfaces look smooth and sharp edges stay sharp */
+      n = (nl > 0 && vec3_dot(n, fn) > 0.82 * nl) ? vec3_scale(n, 1.0 / nl) : fn;
       n = vec3_scale(n, flip);
       vec3 eye = vec3_sub(cam->position, pos);
       double el = vec3_norm(eye);

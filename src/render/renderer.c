@@ -7,6 +7,7 @@
 
 #include "common/status_internal.h"
 #include "render/render_internal.h"
+#include "sim/obstacle_internal.h"
 
 piola_render_def piola_default_render_def(void) {
   piola_render_def d;
@@ -106,6 +107,24 @@ void piola_renderer_fit_camera(piola_renderer *r, piola_vec3 lo, piola_vec3 hi) 
   vec3 center = vec3_scale(vec3_add(lo, hi), 0.5);
   double radius = 0.5 * vec3_norm(vec3_sub(hi, lo));
   if (!(radius > 1e-9)) radius = 0.5;
+  /* Obstacles the solids meet belong in the picture: grow the box by the bounding sphere
+   * (at t = 0) of each bounded obstacle of comparable size near it. Big or far ones (a
+   * floor slab, a distant wall) would shrink the solids to a speck and are left out. */
+  vec3 glo = lo, ghi = hi;
+  for (int32_t i = 0; i < r->obstacle_count; ++i) {
+    const piola_obstacle *o = r->obstacles[i];
+    if (!(o->bound_radius < 2 * radius)) continue;
+    piola__rigid_state st;
+    piola__rigid_motion_state(&o->motion, 0, &st);
+    vec3 c = vec3_add(mat3_mul_vec(st.rotation, o->bound_center), st.translation);
+    if (!(vec3_norm(vec3_sub(c, center)) < 3 * radius)) continue;
+    double b = o->bound_radius;
+    glo = (vec3){fmin(glo.x, c.x - b), fmin(glo.y, c.y - b), fmin(glo.z, c.z - b)};
+    ghi = (vec3){fmax(ghi.x, c.x + b), fmax(ghi.y, c.y + b), fmax(ghi.z, c.z + b)};
+  }
+  lo = glo, hi = ghi;
+  center = vec3_scale(vec3_add(lo, hi), 0.5);
+  radius = 0.5 * vec3_norm(vec3_sub(hi, lo));
   /* lowest corner of the box along up: the fallback ground */
   double low = INFINITY;
   for (int k = 0; k < 8; ++k) {

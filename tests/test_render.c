@@ -345,6 +345,60 @@ static void test_auto_camera_frames_the_object(void **state) {
   }
 }
 
+/* A mesh obstacle (a closed sphere surface) covers its projected disk like the analytic
+ * sphere, and both follow their scripted motion: moving at v for t seconds shifts the
+ * silhouette's centroid by the projected v t. */
+static double centroid_x(const piola_image *empty, const piola_image *full, long *count) {
+  double sx = 0;
+  long n = 0;
+  for (int y = 0; y < full->height; ++y)
+    for (int x = 0; x < full->width; ++x) {
+      size_t i = 3 * ((size_t)y * (size_t)full->width + (size_t)x);
+      if (memcmp(empty->rgb + i, full->rgb + i, 3) != 0) sx += x + 0.5, ++n;
+    }
+  *count = n;
+  return n ? sx / n : NAN;
+}
+
+static void test_mesh_and_moving_obstacles(void **state) {
+  (void)state;
+  double R = 0.4, D = 3, v = 0.5, t = 0.6;
+  piola_render_def def = axis_camera(D, 40);
+  test_sphere s = test_uv_sphere(128, 64, R, 0, 0, 0);
+  piola_tri_mesh tm = {s.vertex_count, s.positions, s.triangle_count, s.triangles};
+  for (int kind = 0; kind < 2; ++kind) {
+    piola_obstacle_def ob = piola_default_obstacle_def();
+    ob.type = kind ? PIOLA_OBSTACLE_MESH : PIOLA_OBSTACLE_SPHERE;
+    ob.radius = R;
+    ob.mesh = kind ? &tm : NULL;
+    ob.motion.velocity[0] = piola_track_constant(v); /* along +x: to the right in the image */
+    piola_renderer *r;
+    piola_image empty = {0}, at0 = {0}, at_t = {0};
+    assert_int_equal(piola_renderer_create(&def, &r), PIOLA_OK);
+    assert_int_equal(piola_renderer_render(r, NULL, &empty), PIOLA_OK);
+    assert_int_equal(piola_renderer_add_obstacle(r, &ob), PIOLA_OK);
+    piola_render_mesh none = {0, NULL, 0, NULL, NULL, NULL, NULL, 0};
+    assert_int_equal(piola_renderer_render(r, &none, &at0), PIOLA_OK);
+    none.time = t;
+    assert_int_equal(piola_renderer_render(r, &none, &at_t), PIOLA_OK);
+    piola_renderer_destroy(r);
+    if (kind) keep("mesh_obstacle", &at0);
+    long n0, nt;
+    double c0 = centroid_x(&empty, &at0, &n0), ct = centroid_x(&empty, &at_t, &nt);
+    double expected = disk_area(&def, R, D);
+    assert_true(fabs(n0 - expected) <= 0.02 * expected);
+    assert_close(c0, 0.5 * def.width, 0.5);
+    /* the centre moved to x = v t at depth D: f v t / D pixels to the right (the outline of
+       an off-axis sphere is an ellipse, whose centroid lies a little further out) */
+    double f = 0.5 * def.height / tan(20 * M_PI / 180);
+    assert_close(ct - c0, f * v * t / D, 0.03 * f * v * t / D);
+    piola_image_free(&empty);
+    piola_image_free(&at0);
+    piola_image_free(&at_t);
+  }
+  test_sphere_free(&s);
+}
+
 /* Same input, same bytes, for 1 and 2 threads and on a repeat. */
 static void test_deterministic_for_any_thread_count(void **state) {
   (void)state;
@@ -429,6 +483,7 @@ int main(void) {
       cmocka_unit_test(test_inverted_highlight_present_exactly_when_flagged),
       cmocka_unit_test(test_value_colors_and_color_bar),
       cmocka_unit_test(test_auto_camera_frames_the_object),
+      cmocka_unit_test(test_mesh_and_moving_obstacles),
       cmocka_unit_test(test_deterministic_for_any_thread_count),
       cmocka_unit_test(test_bad_arguments_are_refused),
   };

@@ -52,6 +52,7 @@ void piola__render_ray_pass(const piola_renderer *r, const render_camera *cam, d
     const piola_obstacle *o = r->obstacles[i];
     piola__rigid_state st;
     piola__rigid_motion_state(&o->motion, time, &st);
+    if (o->type == PIOLA_OBSTACLE_MESH) continue; /* rasterized with the triangles */
     if (o->type == PIOLA_OBSTACLE_PLANE) {
       if (np == MAX_PLANES) continue;
       vec3 n;
@@ -133,9 +134,9 @@ void piola__render_ray_pass(const piola_renderer *r, const render_camera *cam, d
         best = s / dir_len;
         float spec;
         float light = render_light(cam, n, vec3_neg(dn), &spec);
-        col[0] = 178 * light + 255 * spec;
-        col[1] = 170 * light + 255 * spec;
-        col[2] = 156 * light + 255 * spec;
+        col[0] = RENDER_OBSTACLE_R * light + 255 * spec;
+        col[1] = RENDER_OBSTACLE_G * light + 255 * spec;
+        col[2] = RENDER_OBSTACLE_B * light + 255 * spec;
       }
       size_t i = (size_t)y * (size_t)W + (size_t)x;
       depth[i] = (float)best;

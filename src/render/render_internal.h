@@ -31,6 +31,9 @@
 #define RENDER_INVERTED_R 230
 #define RENDER_INVERTED_G 28
 #define RENDER_INVERTED_B 36
+#define RENDER_OBSTACLE_R 178
+#define RENDER_OBSTACLE_G 170
+#define RENDER_OBSTACLE_B 156
 
 typedef struct render_rgb {
   float r, g, b; /* 0..255 */
@@ -45,6 +48,9 @@ typedef struct render_camera {
 struct piola_renderer {
   piola_render_def def;
   char label[128];
+  /* Mesh obstacles are also kept as triangles (t = 0 pose): they are rasterized, since
+   * tracing a mesh's distance field costs tens of microseconds per query. */
+  piola_tri_mesh *obstacle_meshes; /* per obstacle; empty for analytic shapes */
   piola_obstacle **obstacles;
   int32_t obstacle_count, obstacle_capacity;
   vec3 camera_position, camera_target;

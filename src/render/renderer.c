@@ -78,8 +78,12 @@ piola_status piola_renderer_create(const piola_render_def *def, piola_renderer *
 
 void piola_renderer_destroy(piola_renderer *r) {
   if (!r) return;
-  for (int32_t i = 0; i < r->obstacle_count; ++i) piola_obstacle_destroy(r->obstacles[i]);
+  for (int32_t i = 0; i < r->obstacle_count; ++i) {
+    piola_obstacle_destroy(r->obstacles[i]);
+    piola_tri_mesh_free(&r->obstacle_meshes[i]);
+  }
   free(r->obstacles);
+  free(r->obstacle_meshes);
   free(r->depth);
   free(r);
 }
@@ -89,12 +93,30 @@ piola_status piola_renderer_add_obstacle(piola_renderer *r, const piola_obstacle
   if (r->obstacle_count == r->obstacle_capacity) {
     int32_t cap = r->obstacle_capacity ? 2 * r->obstacle_capacity : 8;
     piola_obstacle **grown = realloc(r->obstacles, (size_t)cap * sizeof *grown);
-    if (!grown) return PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "renderer: out of memory");
-    r->obstacles = grown;
+    if (grown) r->obstacles = grown;
+    piola_tri_mesh *grown_meshes = realloc(r->obstacle_meshes, (size_t)cap * sizeof *grown_meshes);
+    if (grown_meshes) r->obstacle_meshes = grown_meshes;
+    if (!grown || !grown_meshes) return PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "renderer: out of memory");
     r->obstacle_capacity = cap;
   }
   piola_obstacle *o = NULL;
   PIOLA_TRY(piola_obstacle_create(def, &o));
+  piola_tri_mesh copy = {0};
+  if (def->type == PIOLA_OBSTACLE_MESH) { /* validated by piola_obstacle_create */
+    const piola_tri_mesh *m = def->mesh;
+    copy.vertex_count = m->vertex_count;
+    copy.triangle_count = m->triangle_count;
+    copy.positions = malloc(3 * (size_t)m->vertex_count * sizeof *copy.positions);
+    copy.triangles = malloc(3 * (size_t)m->triangle_count * sizeof *copy.triangles);
+    if (!copy.positions || !copy.triangles) {
+      piola_tri_mesh_free(&copy);
+      piola_obstacle_destroy(o);
+      return PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "renderer: out of memory");
+    }
+    memcpy(copy.positions, m->positions, 3 * (size_t)m->vertex_count * sizeof *copy.positions);
+    memcpy(copy.triangles, m->triangles, 3 * (size_t)m->triangle_count * sizeof *copy.triangles);
+  }
+  r->obstacle_meshes[r->obstacle_count] = copy;
   r->obstacles[r->obstacle_count++] = o;
   return PIOLA_OK;
 }
@@ -235,6 +257,27 @@ piola_status piola_renderer_render(piola_renderer *r, const piola_render_mesh *m
   render_camera cam = piola__render_camera(r);
   piola__render_ray_pass(r, &cam, time, r->depth, image->rgb);
 
+  for (int32_t i = 0; i < r->obstacle_count; ++i) {
+    const piola_tri_mesh *om = &r->obstacle_meshes[i];
+    if (om->triangle_count == 0) continue;
+    piola__rigid_state st;
+    piola__rigid_motion_state(&r->obstacles[i]->motion, time, &st);
+    double *x = malloc(3 * (size_t)om->vertex_count * sizeof *x);
+    float *face_rgb = malloc(3 * (size_t)om->triangle_count * sizeof *face_rgb);
+    if (!x || !face_rgb) {
+      free(x), free(face_rgb);
+      return PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "render: out of memory");
+    }
+    for (int32_t v = 0; v < om->vertex_count; ++v)
+      vec3_store(x + 3 * (size_t)v, vec3_add(mat3_mul_vec(st.rotation, vec3_load(om->positions + 3 * (size_t)v)),
+                                             st.translation));
+    for (int32_t t = 0; t < om->triangle_count; ++t)
+      face_rgb[3 * t] = RENDER_OBSTACLE_R, face_rgb[3 * t + 1] = RENDER_OBSTACLE_G, face_rgb[3 * t + 2] = RENDER_OBSTACLE_B;
+    piola_render_mesh posed = {om->vertex_count, x, om->triangle_count, om->triangles, NULL, NULL, NULL, time};
+    piola_status st_draw = piola__render_triangles(&cam, &posed, face_rgb, r->depth, image->rgb);
+    free(x), free(face_rgb);
+    PIOLA_TRY(st_draw);
+  }
   double lo = r->def.value_min, hi = r->def.value_max;
   int32_t nt = mesh ? mesh->triangle_count : 0;
   if (nt > 0) {

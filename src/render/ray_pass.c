@@ -14,6 +14,7 @@
 typedef struct ground_plane {
   vec3 normal, t1, t2, point; /* unit normal; in-plane axes; a point on it */
   double camera_height;       /* signed distance of the camera above the plane, m */
+  float light;                /* diffuse light of the plane: one value, lights are directional */
 } ground_plane;
 
 typedef struct traced_obstacle {
@@ -23,7 +24,7 @@ typedef struct traced_obstacle {
   double radius;
 } traced_obstacle;
 
-static ground_plane make_plane(vec3 point, vec3 n, vec3 camera) {
+static ground_plane make_plane(const render_camera *cam, vec3 point, vec3 n, vec3 camera) {
   ground_plane g;
   g.normal = n;
   g.point = point;
@@ -32,6 +33,8 @@ static ground_plane make_plane(vec3 point, vec3 n, vec3 camera) {
   g.t1 = vec3_scale(g.t1, 1.0 / vec3_norm(g.t1));
   g.t2 = vec3_cross(n, g.t1);
   g.camera_height = vec3_dot(vec3_sub(camera, point), n);
+  float spec;
+  g.light = render_light(cam, n, vec3_neg(cam->forward), &spec);
   return g;
 }
 
@@ -58,7 +61,7 @@ void piola__render_ray_pass(const piola_renderer *r, const render_camera *cam, d
       vec3 n;
       double d = piola__obstacle_distance_posed(o, &st, cam->position, &n, NULL);
       vec3 foot = vec3_sub(cam->position, vec3_scale(n, d));
-      planes[np++] = make_plane(foot, n, cam->position);
+      planes[np++] = make_plane(cam, foot, n, cam->position);
     } else if (nt < MAX_TRACED) {
       traced_obstacle *t = &traced[nt++];
       t->obstacle = o;
@@ -68,7 +71,7 @@ void piola__render_ray_pass(const piola_renderer *r, const render_camera *cam, d
     }
   }
   if (np == 0 && r->def.ground)
-    planes[np++] = make_plane(vec3_scale(r->def.up, r->ground_height), r->def.up, cam->position);
+    planes[np++] = make_plane(cam, vec3_scale(r->def.up, r->ground_height), r->def.up, cam->position);
 
   const double checker = r->checker_size, fog = 10 * (r->scene_size > 0 ? r->scene_size : 1);
   const double inv_f = 1.0 / cam->focal_px;
@@ -100,10 +103,9 @@ void piola__render_ray_pass(const piola_renderer *r, const render_camera *cam, d
         double footprint = s * dir_len * inv_f / fabs(vec3_dot(dn, g->normal)) / checker;
         float w = (float)fmin(1.0, footprint);
         base = base * (1 - w) + 183.f * w;
-        float spec;
-        float light = render_light(cam, g->normal, vec3_neg(dn), &spec);
-        float fade = (float)(1 - exp(-(s * dir_len / fog) * (s * dir_len / fog)));
-        float lit = base * (0.55f + 0.45f * light);
+        double q = s * dir_len / fog;
+        float fade = q < 1e-3 ? 0.f : (float)(1 - exp(-q * q));
+        float lit = base * (0.55f + 0.45f * g->light);
         col[0] = lit * (1 - fade) + bg[0] * fade;
         col[1] = lit * (1 - fade) + bg[1] * fade;
         col[2] = (lit + 4) * (1 - fade) + bg[2] * fade;

@@ -41,6 +41,7 @@ typedef struct render_rgb {
 
 typedef struct render_camera {
   vec3 position, forward, right, up; /* orthonormal forward, right, up */
+  vec3 key, fill;                    /* unit directions towards the lights (view-fixed) */
   double focal_px;                   /* focal length in pixels */
   int32_t width, height;
 } render_camera;
@@ -70,10 +71,7 @@ render_camera piola__render_camera(const piola_renderer *r);
  * the specular highlight (0..1, white). */
 static inline float render_light(const render_camera *c, vec3 n, vec3 to_eye, float *spec) {
   if (vec3_dot(n, to_eye) < 0) n = vec3_neg(n);
-  vec3 key = vec3_add(vec3_add(vec3_scale(c->right, -0.45), vec3_scale(c->up, 0.7)), vec3_scale(c->forward, -0.55));
-  key = vec3_scale(key, 1.0 / vec3_norm(key));
-  vec3 fill = vec3_add(vec3_add(vec3_scale(c->right, 0.7), vec3_scale(c->up, -0.2)), vec3_scale(c->forward, -0.68));
-  fill = vec3_scale(fill, 1.0 / vec3_norm(fill));
+  const vec3 key = c->key, fill = c->fill;
   double kd = vec3_dot(n, key), fd = vec3_dot(n, fill);
   vec3 h = vec3_add(key, to_eye);
   double hn = vec3_norm(h);

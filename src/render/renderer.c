@@ -194,6 +194,11 @@ render_camera piola__render_camera(const piola_renderer *r) {
   }
   c.right = vec3_scale(right, 1.0 / vec3_norm(right));
   c.up = vec3_cross(c.right, c.forward);
+  /* key light from the upper left of the view, fill from the right */
+  c.key = vec3_add(vec3_add(vec3_scale(c.right, -0.45), vec3_scale(c.up, 0.7)), vec3_scale(c.forward, -0.55));
+  c.key = vec3_scale(c.key, 1.0 / vec3_norm(c.key));
+  c.fill = vec3_add(vec3_add(vec3_scale(c.right, 0.7), vec3_scale(c.up, -0.2)), vec3_scale(c.forward, -0.68));
+  c.fill = vec3_scale(c.fill, 1.0 / vec3_norm(c.fill));
   c.width = r->def.width;
   c.height = r->def.height;
   c.focal_px = 0.5 * r->def.height / tan(0.5 * r->def.fov_degrees * M_PI / 180);

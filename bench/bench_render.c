@@ -47,7 +47,8 @@ int main(int argc, char **argv) {
   int32_t k = 0;
   for (int i = 0; i < n; ++i)
     for (int j = 0; j < m; ++j) {
-      int32_t a = i * m + j, b = ((i + 1) % n) * m + j, c = ((i + 1) % n) * m + (j + 1) % m, d = i * m + (j + 1) % m;
+      int32_t a = i * m + j, b = ((i + 1) % n) * m + j, c = ((i + 1) % n) * m + (j + 1) % m,
+              d = i * m + (j + 1) % m;
       tri[3 * k] = a, tri[3 * k + 1] = b, tri[3 * k + 2] = c, flags[k] = (i % 17) == 0, ++k;
       tri[3 * k] = a, tri[3 * k + 1] = c, tri[3 * k + 2] = d, flags[k] = (i % 17) == 0, ++k;
     }
@@ -58,8 +59,8 @@ int main(int argc, char **argv) {
   ball.type = PIOLA_OBSTACLE_SPHERE;
   ball.center = (piola_vec3){0.55, 0.2, 0.1};
   ball.radius = 0.1;
-  printf("torus of %d triangles at %d x %d, %d threads, median of 9 renders\n", (int)nt, width, height,
-         omp_get_max_threads());
+  printf("torus of %d triangles at %d x %d, %d threads, median of 9 renders\n", (int)nt, width,
+         height, omp_get_max_threads());
   printf("| case | ms/frame |\n|---|---|\n");
   enum { RUNS = 9 };
   for (int mode = 0; mode < 3; ++mode) {
@@ -91,7 +92,8 @@ int main(int argc, char **argv) {
     }
     qsort(t, RUNS, sizeof t[0], compare_doubles);
     qsort(tpng, RUNS, sizeof tpng[0], compare_doubles);
-    static const char *const names[] = {"plain, plane ground + sphere obstacle", "inverted colouring, same scene",
+    static const char *const names[] = {"plain, plane ground + sphere obstacle",
+                                        "inverted colouring, same scene",
                                         "plain, fallback ground only"};
     printf("| %s | %.1f |\n", names[mode], 1e3 * t[RUNS / 2]);
     if (mode == 0) printf("| PNG write (level 3) of that frame | %.1f |\n", 1e3 * tpng[RUNS / 2]);

@@ -265,7 +265,8 @@ static void test_value_colors_and_color_bar(void **state) {
   double *values = malloc((size_t)s.triangle_count * sizeof *values);
   for (int32_t t = 0; t < s.triangle_count; ++t) {
     values[t] = 0;
-    for (int k = 0; k < 3; ++k) values[t] += s.positions[3 * (size_t)s.triangles[3 * t + k] + 2] / 3;
+    for (int k = 0; k < 3; ++k)
+      values[t] += s.positions[3 * (size_t)s.triangles[3 * t + k] + 2] / 3;
   }
   m.values = values;
   piola_renderer *r;
@@ -276,8 +277,10 @@ static void test_value_colors_and_color_bar(void **state) {
   keep("value_height", &img);
   int W = img.width, H = img.height;
   double f = 0.5 * H / tan(20 * M_PI / 180), rpx = f * tan(asin(0.5 / 3));
-  const uint8_t *top = img.rgb + 3 * ((size_t)(H / 2 - (int)(0.8 * rpx)) * (size_t)W + (size_t)(W / 2));
-  const uint8_t *bottom = img.rgb + 3 * ((size_t)(H / 2 + (int)(0.8 * rpx)) * (size_t)W + (size_t)(W / 2));
+  const uint8_t *top =
+      img.rgb + 3 * ((size_t)(H / 2 - (int)(0.8 * rpx)) * (size_t)W + (size_t)(W / 2));
+  const uint8_t *bottom =
+      img.rgb + 3 * ((size_t)(H / 2 + (int)(0.8 * rpx)) * (size_t)W + (size_t)(W / 2));
   assert_true(top[1] > top[2] + 40);       /* yellow-green: green over blue */
   assert_true(bottom[2] > bottom[1] + 20); /* dark blue-violet: blue over green */
   /* the colour bar holds both ends of the map, right of the sphere */
@@ -306,9 +309,11 @@ static void test_value_colors_and_color_bar(void **state) {
  * border, and fills a fair part of it. */
 static void test_auto_camera_frames_the_object(void **state) {
   (void)state;
-  const double boxes[3][6] = {{-1, -1, 0, 1, 1, 2}, {10, 20, 5, 10.4, 20.6, 5.3}, {-50, -5, 0, 50, 5, 3}};
+  const double boxes[3][6] = {
+      {-1, -1, 0, 1, 1, 2}, {10, 20, 5, 10.4, 20.6, 5.3}, {-50, -5, 0, 50, 5, 3}};
   for (int b = 0; b < 3; ++b) {
-    piola_vec3 lo = {boxes[b][0], boxes[b][1], boxes[b][2]}, hi = {boxes[b][3], boxes[b][4], boxes[b][5]};
+    piola_vec3 lo = {boxes[b][0], boxes[b][1], boxes[b][2]},
+               hi = {boxes[b][3], boxes[b][4], boxes[b][5]};
     piola_vec3 c = {0.5 * (lo.x + hi.x), 0.5 * (lo.y + hi.y), 0.5 * (lo.z + hi.z)};
     double R = 0.5 * fmin(hi.x - lo.x, fmin(hi.y - lo.y, hi.z - lo.z));
     test_sphere s = test_uv_sphere(64, 32, R, c.x, c.y, c.z);

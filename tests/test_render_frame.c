@@ -71,8 +71,10 @@ static void write_frame(const char *path, const piola_tet_mesh *m, bool with_inv
     energy[t] = t;
     solid[t] = 0;
   }
-  piola_vtu_field cells[3] = {{"inverted", 1, inverted}, {"energy_density", 1, energy}, {"solid", 1, solid}};
-  piola_vtu_frame frame = {.tets = m, .cell_fields = with_inverted_field ? cells : cells + 1,
+  piola_vtu_field cells[3] = {
+      {"inverted", 1, inverted}, {"energy_density", 1, energy}, {"solid", 1, solid}};
+  piola_vtu_frame frame = {.tets = m,
+                           .cell_fields = with_inverted_field ? cells : cells + 1,
                            .cell_field_count = with_inverted_field ? 3 : 2};
   assert_int_equal(piola_vtu_write(path, &frame), PIOLA_OK);
   free(inverted), free(energy), free(solid);
@@ -96,10 +98,12 @@ static void test_boundary_of_cube_grids(void **state) {
     /* faces are wound outward: the signed volume enclosed is the cube's */
     double vol = 0;
     for (int32_t t = 0; t < rm.triangle_count; ++t) {
-      const double *a = rm.positions + 3 * rm.triangles[3 * t], *b = rm.positions + 3 * rm.triangles[3 * t + 1],
+      const double *a = rm.positions + 3 * rm.triangles[3 * t],
+                   *b = rm.positions + 3 * rm.triangles[3 * t + 1],
                    *c = rm.positions + 3 * rm.triangles[3 * t + 2];
       vol += (a[0] * (b[1] * c[2] - b[2] * c[1]) - a[1] * (b[0] * c[2] - b[2] * c[0]) +
-              a[2] * (b[0] * c[1] - b[1] * c[0])) / 6;
+              a[2] * (b[0] * c[1] - b[1] * c[0])) /
+             6;
     }
     assert_close(vol, pow(0.1 * n, 3), 1e-12);
     /* per-face values come from the face's tet */
@@ -230,10 +234,13 @@ static void test_png_round_trip_and_contact_sheet(void **state) {
   for (int y = 0; y < 24; ++y)
     for (int x = 0; x < 32; ++x)
       for (int c = 0; c < 3; ++c)
-        mean_tile += sheet.rgb[3 * ((size_t)(4 + 24 + 4 + y) * (size_t)sheet.width + (size_t)(4 + 32 + 4 + x)) + c];
+        mean_tile += sheet.rgb[3 * ((size_t)(4 + 24 + 4 + y) * (size_t)sheet.width +
+                                    (size_t)(4 + 32 + 4 + x)) +
+                               c];
   mean_tile /= 3 * 32 * 24;
   assert_close(mean_tile, mean_src, 1.0);
-  assert_int_equal(piola_image_contact_sheet(imgs, NULL, 0, 3, 32, &sheet), PIOLA_ERROR_INVALID_ARGUMENT);
+  assert_int_equal(piola_image_contact_sheet(imgs, NULL, 0, 3, 32, &sheet),
+                   PIOLA_ERROR_INVALID_ARGUMENT);
   assert_int_equal(piola_image_read_png("/nonexistent.png", &back), PIOLA_ERROR_IO);
   for (int i = 0; i < 5; ++i) piola_image_free(&imgs[i]);
   piola_image_free(&back);

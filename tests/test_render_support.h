@@ -17,13 +17,13 @@ typedef struct test_sphere {
 
 /* A latitude-longitude sphere: `slices` around the pole axis (z), `stacks` from pole to
  * pole, 2 * slices * (stacks - 1) triangles wound outward, vertices on the sphere. */
-static inline test_sphere test_uv_sphere(int slices, int stacks, double radius, double cx, double cy,
-                                         double cz) {
+static inline test_sphere test_uv_sphere(int slices, int stacks, double radius, double cx,
+                                         double cy, double cz) {
   int32_t nv = 2 + slices * (stacks - 1), nt = 2 * slices * (stacks - 1);
   double *x = malloc(3 * (size_t)nv * sizeof *x);
   int32_t *tri = malloc(3 * (size_t)nt * sizeof *tri);
-  x[0] = cx, x[1] = cy, x[2] = cz + radius;        /* north pole */
-  x[3] = cx, x[4] = cy, x[5] = cz - radius;        /* south pole */
+  x[0] = cx, x[1] = cy, x[2] = cz + radius; /* north pole */
+  x[3] = cx, x[4] = cy, x[5] = cz - radius; /* south pole */
   for (int i = 1; i < stacks; ++i) {
     double th = M_PI * i / stacks;
     for (int j = 0; j < slices; ++j) {
@@ -34,11 +34,12 @@ static inline test_sphere test_uv_sphere(int slices, int stacks, double radius, 
       p[2] = cz + radius * cos(th);
     }
   }
-#define RING(i, j) (2 + ((i) - 1) * slices + ((j) % slices))
+#define RING(i, j) (2 + ((i)-1) * slices + ((j) % slices))
   int32_t k = 0;
   for (int j = 0; j < slices; ++j) {
     tri[3 * k] = 0, tri[3 * k + 1] = RING(1, j), tri[3 * k + 2] = RING(1, j + 1), ++k;
-    tri[3 * k] = 1, tri[3 * k + 1] = RING(stacks - 1, j + 1), tri[3 * k + 2] = RING(stacks - 1, j), ++k;
+    tri[3 * k] = 1, tri[3 * k + 1] = RING(stacks - 1, j + 1), tri[3 * k + 2] = RING(stacks - 1, j),
+            ++k;
   }
   for (int i = 1; i < stacks - 1; ++i)
     for (int j = 0; j < slices; ++j) {

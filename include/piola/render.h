@@ -50,8 +50,9 @@ PIOLA_API piola_status piola_image_read_png(const char *path, piola_image *image
 /* A grid of `count` images, scaled down to tiles cell_width pixels wide (height following
  * the first image's aspect ratio), `columns` per row, each labelled with labels[i] (digits,
  * letters, '.', '-', '+', ':' and space; may be NULL). */
-PIOLA_API piola_status piola_image_contact_sheet(const piola_image *images, const char *const *labels,
-                                                 int32_t count, int32_t columns, int32_t cell_width,
+PIOLA_API piola_status piola_image_contact_sheet(const piola_image *images,
+                                                 const char *const *labels, int32_t count,
+                                                 int32_t columns, int32_t cell_width,
                                                  piola_image *out);
 
 /* Draws text in the built-in 5x7 bitmap font at (x, y) (top left, pixels) on a dark box, with
@@ -66,8 +67,8 @@ typedef enum piola_render_color {
 } piola_render_color;
 
 typedef struct piola_render_def {
-  int32_t width, height;      /* pixels, 16..16384. Default 1280 x 720 */
-  piola_render_color color;   /* Default PIOLA_RENDER_COLOR_PLAIN */
+  int32_t width, height;    /* pixels, 16..16384. Default 1280 x 720 */
+  piola_render_color color; /* Default PIOLA_RENDER_COLOR_PLAIN */
   /* Camera. With camera_set false, piola_renderer_fit_camera chooses one (a 3/4 view from
    * the front right, above) and these are ignored. */
   bool camera_set;            /* Default false */
@@ -78,12 +79,12 @@ typedef struct piola_render_def {
   /* A checkerboard ground: where the scene has a plane obstacle it is drawn as the ground;
    * otherwise, with ground set, a ground plane is drawn through the lowest point given to
    * piola_renderer_fit_camera (or at ground_height when that was not called). */
-  bool ground;                /* Default true */
-  double ground_height;       /* m along `up`. Default 0 */
+  bool ground;          /* Default true */
+  double ground_height; /* m along `up`. Default 0 */
   /* Colour-map range of PIOLA_RENDER_COLOR_VALUE; value_min >= value_max chooses the range
    * from each frame's values (0 to their 99th percentile). */
   double value_min, value_max;
-  const char *value_label;    /* caption above the colour bar (copied), or NULL */
+  const char *value_label; /* caption above the colour bar (copied), or NULL */
 } piola_render_def;
 
 PIOLA_API piola_render_def piola_default_render_def(void);
@@ -92,13 +93,13 @@ PIOLA_API piola_render_def piola_default_render_def(void);
  * shells may be wound either way, both sides are lit. */
 typedef struct piola_render_mesh {
   int32_t vertex_count;
-  const double *positions;     /* 3 * vertex_count, m */
+  const double *positions; /* 3 * vertex_count, m */
   int32_t triangle_count;
-  const int32_t *triangles;    /* 3 * triangle_count vertex indices */
-  const uint8_t *inverted;     /* per triangle: nonzero on a face of an inverted element, or NULL */
-  const double *values;        /* per triangle scalar for PIOLA_RENDER_COLOR_VALUE, or NULL */
-  const int32_t *parts;        /* per triangle part (solid) index for the plain colours, or NULL */
-  double time;                 /* s: where scripted obstacles are */
+  const int32_t *triangles; /* 3 * triangle_count vertex indices */
+  const uint8_t *inverted;  /* per triangle: nonzero on a face of an inverted element, or NULL */
+  const double *values;     /* per triangle scalar for PIOLA_RENDER_COLOR_VALUE, or NULL */
+  const int32_t *parts;     /* per triangle part (solid) index for the plain colours, or NULL */
+  double time;              /* s: where scripted obstacles are */
 } piola_render_mesh;
 
 typedef struct piola_renderer piola_renderer;
@@ -127,8 +128,8 @@ PIOLA_API void piola_renderer_camera(const piola_renderer *renderer, piola_vec3 
                                      piola_vec3 *target);
 
 /* Renders mesh (may be NULL: obstacles and ground only) into image (allocated or resized). */
-PIOLA_API piola_status piola_renderer_render(piola_renderer *renderer, const piola_render_mesh *mesh,
-                                             piola_image *image);
+PIOLA_API piola_status piola_renderer_render(piola_renderer *renderer,
+                                             const piola_render_mesh *mesh, piola_image *image);
 
 /* A frame written by `piola run` (DIR/frames/frame_NNNN.vtu): the boundary surface of its
  * tets (and its triangles, for shells), with per-face flags of inverted elements and any
@@ -143,13 +144,15 @@ PIOLA_API void piola_render_frame_destroy(piola_render_frame *frame);
 /* The frame's surface; `value_field` names a per-cell scalar to colour by (NULL: none).
  * Fails with PIOLA_ERROR_INVALID_ARGUMENT when the frame has no such field. Pointers stay
  * valid while the frame lives. */
-PIOLA_API piola_status piola_render_frame_mesh(const piola_render_frame *frame, const char *value_field,
-                                               double time, piola_render_mesh *out);
+PIOLA_API piola_status piola_render_frame_mesh(const piola_render_frame *frame,
+                                               const char *value_field, double time,
+                                               piola_render_mesh *out);
 PIOLA_API bool piola_render_frame_has_field(const piola_render_frame *frame, const char *name);
 /* Number of inverted elements (tets and triangles) in the frame. */
 PIOLA_API int32_t piola_render_frame_inverted_count(const piola_render_frame *frame);
 /* Bounding box of the frame's points, m. */
-PIOLA_API void piola_render_frame_bounds(const piola_render_frame *frame, piola_vec3 *lo, piola_vec3 *hi);
+PIOLA_API void piola_render_frame_bounds(const piola_render_frame *frame, piola_vec3 *lo,
+                                         piola_vec3 *hi);
 
 /* Previews written while `piola run` writes an output folder DIR:
  *   DIR/scene.json             a copy of the scene, relative mesh paths made absolute, so
@@ -165,7 +168,8 @@ typedef struct piola_preview piola_preview;
 PIOLA_API piola_status piola_preview_open(const char *dir, const char *scene_path, bool every_frame,
                                           piola_preview **out);
 /* Call after frame `frame` (time in s) was written to DIR. */
-PIOLA_API piola_status piola_preview_frame_written(piola_preview *preview, int32_t frame, double time);
+PIOLA_API piola_status piola_preview_frame_written(piola_preview *preview, int32_t frame,
+                                                   double time);
 /* Writes DIR/preview.png of the last frame written (if any) and frees the preview. */
 PIOLA_API piola_status piola_preview_close(piola_preview *preview);
 

@@ -102,7 +102,8 @@ static int list_frames(const char *folder, const char *suffix, int **out) {
   for (struct dirent *e; (e = readdir(d));) {
     const char *name = e->d_name;
     size_t len = strlen(name);
-    if (len <= 6 + sl || strncmp(name, "frame_", 6) != 0 || strcmp(name + len - sl, suffix) != 0) continue;
+    if (len <= 6 + sl || strncmp(name, "frame_", 6) != 0 || strcmp(name + len - sl, suffix) != 0)
+      continue;
     bool digits = true;
     for (size_t i = 6; i < len - sl; ++i) digits = digits && name[i] >= '0' && name[i] <= '9';
     if (!digits || len - sl - 6 > 9) continue;
@@ -145,7 +146,8 @@ static char *read_text(const char *path) {
   long n = -1;
   if (fseek(f, 0, SEEK_END) == 0) n = ftell(f);
   if (n >= 0 && fseek(f, 0, SEEK_SET) == 0) buf = malloc((size_t)n + 1);
-  if (buf && fread(buf, 1, (size_t)n, f) == (size_t)n) buf[n] = '\0';
+  if (buf && fread(buf, 1, (size_t)n, f) == (size_t)n)
+    buf[n] = '\0';
   else {
     free(buf);
     buf = NULL;
@@ -167,7 +169,8 @@ static void loaded_free(loaded_frame *lf) {
 }
 
 /* Loads frame f (VTU or OBJ) and its mesh with the value field (may be NULL). */
-static int load_frame(const char *dir, bool vtu, int f, const char *field, double time, loaded_frame *lf) {
+static int load_frame(const char *dir, bool vtu, int f, const char *field, double time,
+                      loaded_frame *lf) {
   char path[4200];
   memset(lf, 0, sizeof *lf);
   if (vtu) {
@@ -185,8 +188,14 @@ static int load_frame(const char *dir, bool vtu, int f, const char *field, doubl
       loaded_free(lf);
       return -1;
     }
-    lf->mesh = (piola_render_mesh){lf->obj.vertex_count, lf->obj.positions, lf->obj.triangle_count,
-                                   lf->obj.triangles, NULL, NULL, NULL, time};
+    lf->mesh = (piola_render_mesh){lf->obj.vertex_count,
+                                   lf->obj.positions,
+                                   lf->obj.triangle_count,
+                                   lf->obj.triangles,
+                                   NULL,
+                                   NULL,
+                                   NULL,
+                                   time};
   }
   return 0;
 }
@@ -268,7 +277,8 @@ static int run_in(const char *cwd, char *const argv[], const char *log) {
 /* The rendered PNGs, linked as a gap-free sequence (ffmpeg's image reader needs one), are
  * encoded with H.264 (yuv420p, the format every player takes), or MPEG-4 part 2 when this
  * ffmpeg has no libx264. Returns 0 on success. */
-static int make_movie(const char *render_dir, const int *frames, int count, double fps, const char **encoder) {
+static int make_movie(const char *render_dir, const int *frames, int count, double fps,
+                      const char **encoder) {
   char seq[4300], path[4400], target[64], fps_s[32], log[4400], tmp[4400], final_path[4400];
   snprintf(seq, sizeof seq, "%s/.movie_frames", render_dir);
   snprintf(log, sizeof log, "%s/ffmpeg.log", render_dir);
@@ -328,13 +338,13 @@ int cli_render(int argc, char **argv) {
   for (int i = 1; i < argc; ++i) {
     const char *a = argv[i];
     const char *v = i + 1 < argc ? argv[i + 1] : NULL;
-#define NEEDS(ok, what)                                                  \
-  do {                                                                   \
-    if (!v || !(ok)) {                                                   \
-      fprintf(stderr, "piola render: %s needs %s\n", a, what);           \
-      return 2;                                                          \
-    }                                                                    \
-    ++i;                                                                 \
+#define NEEDS(ok, what)                                        \
+  do {                                                         \
+    if (!v || !(ok)) {                                         \
+      fprintf(stderr, "piola render: %s needs %s\n", a, what); \
+      return 2;                                                \
+    }                                                          \
+    ++i;                                                       \
   } while (0)
     if (strcmp(a, "-h") == 0 || strcmp(a, "--help") == 0) {
       usage(stdout);
@@ -353,7 +363,8 @@ int cli_render(int argc, char **argv) {
       if (comma) {
         char lo[64];
         snprintf(lo, sizeof lo, "%.*s", (int)(comma - v), v);
-        ok = parse_double(lo, &range[0]) && parse_double(comma + 1, &range[1]) && range[1] > range[0];
+        ok = parse_double(lo, &range[0]) && parse_double(comma + 1, &range[1]) &&
+             range[1] > range[0];
       }
       NEEDS(ok, "MIN,MAX with MIN < MAX");
       have_range = true;
@@ -371,7 +382,8 @@ int cli_render(int argc, char **argv) {
       NEEDS(parse_double(v, &def.fov_degrees) && def.fov_degrees > 1 && def.fov_degrees < 170,
             "degrees in (1, 170)");
     } else if (strcmp(a, "--up") == 0) {
-      NEEDS(parse_vec3(v, &def.up) && (def.up.x != 0 || def.up.y != 0 || def.up.z != 0), "a nonzero X,Y,Z");
+      NEEDS(parse_vec3(v, &def.up) && (def.up.x != 0 || def.up.y != 0 || def.up.z != 0),
+            "a nonzero X,Y,Z");
     } else if (strcmp(a, "--every") == 0) {
       NEEDS(parse_int(v, 1, 1000000, &every), "an integer >= 1");
     } else if (strcmp(a, "--scene") == 0) {
@@ -432,7 +444,9 @@ int cli_render(int argc, char **argv) {
     return 1;
   }
   if (count == 0) {
-    fprintf(stderr, "piola render: %s has no frames (frames/frame_NNNN.vtu or surface/frame_NNNN.obj)\n", dir);
+    fprintf(stderr,
+            "piola render: %s has no frames (frames/frame_NNNN.vtu or surface/frame_NNNN.obj)\n",
+            dir);
     return 2;
   }
   int kept = 0;
@@ -449,7 +463,8 @@ int cli_render(int argc, char **argv) {
   }
   if (value_field || strcmp(color, "stress") == 0) {
     if (!vtu) {
-      fprintf(stderr, "piola render: colouring by a field needs the VTU frames in %s/frames\n", dir);
+      fprintf(stderr, "piola render: colouring by a field needs the VTU frames in %s/frames\n",
+              dir);
       free(frames);
       return 2;
     }
@@ -481,7 +496,8 @@ int cli_render(int argc, char **argv) {
       loaded_free(&lf);
       if (!value_field) {
         fprintf(stderr,
-                "piola render: the frames have no stress field (von_mises_stress, von_mises or stress); "
+                "piola render: the frames have no stress field (von_mises_stress, von_mises or "
+                "stress); "
                 "use --color energy, or --field NAME for another cell field\n");
         rc = 2;
         break;
@@ -508,7 +524,8 @@ int cli_render(int argc, char **argv) {
   if (value_field) {
     if (!label[0]) snprintf(label, sizeof label, "%s", value_field);
     def.value_label = label;
-    if (have_range) def.value_min = range[0], def.value_max = range[1];
+    if (have_range)
+      def.value_min = range[0], def.value_max = range[1];
     else {
       def.value_min = vmin < 0 ? vmin : 0;
       def.value_max = vmax > def.value_min ? vmax : def.value_min + 1;
@@ -518,8 +535,10 @@ int cli_render(int argc, char **argv) {
 
   /* obstacles: --scene FILE, else the copy `piola run` leaves in DIR */
   char scene_path[4200];
-  if (scene) snprintf(scene_path, sizeof scene_path, "%s", scene);
-  else snprintf(scene_path, sizeof scene_path, "%s/scene.json", dir);
+  if (scene)
+    snprintf(scene_path, sizeof scene_path, "%s", scene);
+  else
+    snprintf(scene_path, sizeof scene_path, "%s/scene.json", dir);
   bool use_scene = scene || is_file(scene_path);
   /* camera: the automatic one, with whatever the flags set replacing its parts */
   piola_renderer *r = NULL;
@@ -560,11 +579,14 @@ int cli_render(int argc, char **argv) {
   remove_old_pngs(render_dir);
 
   int sheet_count = sheet ? (count < sheet_frames ? count : (int)sheet_frames) : 0;
-  piola_image *sheet_images = calloc((size_t)(sheet_count > 0 ? sheet_count : 1), sizeof *sheet_images);
-  char (*sheet_labels)[48] = calloc((size_t)(sheet_count > 0 ? sheet_count : 1), sizeof *sheet_labels);
+  piola_image *sheet_images =
+      calloc((size_t)(sheet_count > 0 ? sheet_count : 1), sizeof *sheet_images);
+  char(*sheet_labels)[48] =
+      calloc((size_t)(sheet_count > 0 ? sheet_count : 1), sizeof *sheet_labels);
   if (!sheet_images || !sheet_labels) rc = 1;
-  fprintf(stderr, "piola render: %d frames of %s -> %s (%d x %d, %s%s%s)\n", count, dir, render_dir, (int)def.width,
-          (int)def.height, color, value_field ? ": " : "", value_field ? value_field : "");
+  fprintf(stderr, "piola render: %d frames of %s -> %s (%d x %d, %s%s%s)\n", count, dir, render_dir,
+          (int)def.width, (int)def.height, color, value_field ? ": " : "",
+          value_field ? value_field : "");
   piola_image img = {0};
   int next_sheet = 0, label_scale = def.height >= 600 ? 2 : 1;
   double t_start = now_seconds();
@@ -587,7 +609,8 @@ int cli_render(int argc, char **argv) {
     char text[96];
     if (def.color == PIOLA_RENDER_COLOR_INVERTED)
       snprintf(text, sizeof text, "FRAME %d  T = %.3f S  INVERTED %d", frames[i], t, inverted);
-    else snprintf(text, sizeof text, "FRAME %d  T = %.3f S", frames[i], t);
+    else
+      snprintf(text, sizeof text, "FRAME %d  T = %.3f S", frames[i], t);
     piola_image_draw_label(&img, 8 * label_scale, 8 * label_scale, label_scale, text);
     char path[4400];
     snprintf(path, sizeof path, "%s/frame_%04d.png", render_dir, frames[i]);
@@ -602,7 +625,8 @@ int cli_render(int argc, char **argv) {
       if (i == want) {
         sheet_images[next_sheet] = img;
         img = (piola_image){0};
-        snprintf(sheet_labels[next_sheet], sizeof sheet_labels[0], "FRAME %d  T = %.3f S", frames[i], t);
+        snprintf(sheet_labels[next_sheet], sizeof sheet_labels[0], "FRAME %d  T = %.3f S",
+                 frames[i], t);
         ++next_sheet;
       }
     }
@@ -611,7 +635,8 @@ int cli_render(int argc, char **argv) {
   piola_image_free(&img);
   piola_renderer_destroy(r);
   free(pvd);
-  if (rc == 0) fprintf(stderr, "piola render: %d PNGs written (%.3f s per frame)\n", count, per_frame);
+  if (rc == 0)
+    fprintf(stderr, "piola render: %d PNGs written (%.3f s per frame)\n", count, per_frame);
 
   if (rc == 0 && sheet_count > 0) {
     const char *labels[100];
@@ -621,7 +646,8 @@ int cli_render(int argc, char **argv) {
     piola_image out = {0};
     char path[4400];
     snprintf(path, sizeof path, "%s/contact_sheet.png", render_dir);
-    if (piola_image_contact_sheet(sheet_images, labels, sheet_count, columns, 480, &out) != PIOLA_OK ||
+    if (piola_image_contact_sheet(sheet_images, labels, sheet_count, columns, 480, &out) !=
+            PIOLA_OK ||
         piola_image_write_png(path, &out) != PIOLA_OK) {
       fprintf(stderr, "piola render: contact sheet: %s\n", piola_last_error());
       rc = 1;
@@ -636,13 +662,15 @@ int cli_render(int argc, char **argv) {
 
   if (rc == 0 && movie != 0) {
     if (!find_in_path("ffmpeg")) {
-      fprintf(stderr, "piola render: ffmpeg not found on PATH: no movie (scripts/install-deps.sh installs it)\n");
+      fprintf(stderr,
+              "piola render: ffmpeg not found on PATH: no movie (scripts/install-deps.sh installs "
+              "it)\n");
       if (movie == 1) rc = 1;
     } else {
       const char *encoder = NULL;
       if (make_movie(render_dir, frames, count, fps, &encoder) == 0) {
-        fprintf(stderr, "piola render: movie of %d frames at %g fps (%s): %s/movie.mp4\n", count, fps, encoder,
-                render_dir);
+        fprintf(stderr, "piola render: movie of %d frames at %g fps (%s): %s/movie.mp4\n", count,
+                fps, encoder, render_dir);
       } else {
         fprintf(stderr, "piola render: ffmpeg failed; see %s/ffmpeg.log\n", render_dir);
         rc = 1;

@@ -24,9 +24,12 @@ render_rgb piola__render_colormap(double s) {
 
 static void format_value(double v, char *buf, size_t n) {
   double a = fabs(v);
-  if (v == 0) snprintf(buf, n, "0");
-  else if (a >= 1e-2 && a < 1e4) snprintf(buf, n, "%.3g", v);
-  else snprintf(buf, n, "%.2e", v);
+  if (v == 0)
+    snprintf(buf, n, "0");
+  else if (a >= 1e-2 && a < 1e4)
+    snprintf(buf, n, "%.3g", v);
+  else
+    snprintf(buf, n, "%.2e", v);
 }
 
 void piola__render_color_bar(piola_image *image, double lo, double hi, const char *label) {
@@ -35,7 +38,8 @@ void piola__render_color_bar(piola_image *image, double lo, double hi, const cha
   int x0 = image->width - bar_w - 70 * scale, y0 = (image->height - bar_h) / 2;
   if (x0 < 0 || bar_h < 8) return;
   /* a dark frame, then the ramp with the top at hi */
-  piola__render_fill_rect(image, x0 - scale, y0 - scale, bar_w + 2 * scale, bar_h + 2 * scale, 20, 20, 20);
+  piola__render_fill_rect(image, x0 - scale, y0 - scale, bar_w + 2 * scale, bar_h + 2 * scale, 20,
+                          20, 20);
   for (int y = 0; y < bar_h; ++y) {
     render_rgb c = piola__render_colormap(1.0 - (y + 0.5) / bar_h);
     piola__render_fill_rect(image, x0, y0 + y, bar_w, 1, (uint8_t)lrintf(c.r), (uint8_t)lrintf(c.g),
@@ -47,8 +51,9 @@ void piola__render_color_bar(piola_image *image, double lo, double hi, const cha
     double v = hi + (lo - hi) * k / 2.0;
     format_value(v, text, sizeof text);
     int ty = y0 + k * (bar_h - 1) / 2 - 3 * scale;
-    piola__render_fill_rect(image, tx - scale, ty - scale, piola__render_text_width(text, scale) + 2 * scale,
-                            9 * scale, 245, 245, 245);
+    piola__render_fill_rect(image, tx - scale, ty - scale,
+                            piola__render_text_width(text, scale) + 2 * scale, 9 * scale, 245, 245,
+                            245);
     piola__render_text(image, tx, ty, scale, text, 20, 20, 20);
   }
   if (label && label[0]) {

@@ -98,12 +98,14 @@ static void sort3(int32_t v[3]) {
   if (v[0] > v[1]) t = v[0], v[0] = v[1], v[1] = t;
 }
 
-static piola_status build_surface(piola_render_frame *f, const int64_t *conn, const int64_t *offsets,
-                                  const uint8_t *types, const char *path) {
+static piola_status build_surface(piola_render_frame *f, const int64_t *conn,
+                                  const int64_t *offsets, const uint8_t *types, const char *path) {
   int64_t tets = 0, tris = 0;
   for (int64_t c = 0; c < f->cell_count; ++c) {
-    if (types[c] == 10) ++tets;
-    else if (types[c] == 5) ++tris;
+    if (types[c] == 10)
+      ++tets;
+    else if (types[c] == 5)
+      ++tris;
   }
   if (4 * tets + tris > INT32_MAX / 4)
     return PIOLA_FAIL(PIOLA_ERROR_UNSUPPORTED, "%s: too many cells to render", path);
@@ -160,14 +162,17 @@ static double signed_volume(const double *x, const int64_t *t) {
 static piola_status parse(piola_render_frame *f, const char *buf, size_t size, const char *path) {
   const char *end = buf + size;
   const char *data = find_in(buf, end, "<AppendedData");
-  if (!data) return PIOLA_FAIL(PIOLA_ERROR_PARSE, "%s: no <AppendedData> (not a frame piola wrote)", path);
+  if (!data)
+    return PIOLA_FAIL(PIOLA_ERROR_PARSE, "%s: no <AppendedData> (not a frame piola wrote)", path);
   const char *underscore = memchr(data, '_', (size_t)(end - data));
-  if (!underscore) return PIOLA_FAIL(PIOLA_ERROR_PARSE, "%s: appended data has no '_' marker", path);
+  if (!underscore)
+    return PIOLA_FAIL(PIOLA_ERROR_PARSE, "%s: appended data has no '_' marker", path);
   const char *base = underscore + 1;
   const char *head = find_in(buf, data, "<VTKFile");
   char value[128];
   int header_bytes = 8;
-  if (head && attribute(head, data, "header_type", value, sizeof value) && strcmp(value, "UInt32") == 0)
+  if (head && attribute(head, data, "header_type", value, sizeof value) &&
+      strcmp(value, "UInt32") == 0)
     header_bytes = 4;
   const char *piece = find_in(buf, data, "<Piece");
   if (!piece) return PIOLA_FAIL(PIOLA_ERROR_PARSE, "%s: no <Piece>", path);
@@ -189,17 +194,23 @@ static piola_status parse(piola_render_frame *f, const char *buf, size_t size, c
     if (!lt) break;
     const char *gt = memchr(lt, '>', (size_t)(data - lt));
     if (!gt) break;
-    if (strncmp(lt, "<PointData", 10) == 0) section = 0;
-    else if (strncmp(lt, "<CellData", 9) == 0) section = 1;
-    else if (strncmp(lt, "<Points", 7) == 0) section = 2;
-    else if (strncmp(lt, "<Cells", 6) == 0) section = 3;
+    if (strncmp(lt, "<PointData", 10) == 0)
+      section = 0;
+    else if (strncmp(lt, "<CellData", 9) == 0)
+      section = 1;
+    else if (strncmp(lt, "<Points", 7) == 0)
+      section = 2;
+    else if (strncmp(lt, "<Cells", 6) == 0)
+      section = 3;
     else if (strncmp(lt, "<DataArray", 10) == 0 && na < 64) {
       vtu_array *a = &arrays[na];
       char comps[16] = "1", off[32], format[32];
       if (!attribute(lt, gt, "Name", a->name, sizeof a->name)) a->name[0] = '\0';
-      if (!attribute(lt, gt, "type", a->type, sizeof a->type) || !attribute(lt, gt, "offset", off, sizeof off) ||
+      if (!attribute(lt, gt, "type", a->type, sizeof a->type) ||
+          !attribute(lt, gt, "offset", off, sizeof off) ||
           !attribute(lt, gt, "format", format, sizeof format) || strcmp(format, "appended") != 0)
-        return PIOLA_FAIL(PIOLA_ERROR_PARSE, "%s: DataArray '%s' is not appended data with a type and offset", path,
+        return PIOLA_FAIL(PIOLA_ERROR_PARSE,
+                          "%s: DataArray '%s' is not appended data with a type and offset", path,
                           a->name);
       attribute(lt, gt, "NumberOfComponents", comps, sizeof comps);
       a->components = atoi(comps);
@@ -210,17 +221,20 @@ static piola_status parse(piola_render_frame *f, const char *buf, size_t size, c
     p = gt + 1;
   }
   /* Locates array a's block, checking its size against the file and the expected count. */
-#define BLOCK(a, elem, count, ptr)                                                                            \
-  do {                                                                                                        \
-    uint64_t bytes_ = 0;                                                                                      \
-    if ((a)->offset > (uint64_t)(end - base) || (uint64_t)(end - base) - (a)->offset < (uint64_t)header_bytes) \
-      return PIOLA_FAIL(PIOLA_ERROR_PARSE, "%s: array '%s' lies past the end of the file", path, (a)->name);   \
-    memcpy(&bytes_, base + (a)->offset, (size_t)header_bytes);                                                \
-    if (bytes_ != (uint64_t)(elem) * (uint64_t)(count) ||                                                     \
-        bytes_ > (uint64_t)(end - base) - (a)->offset - (uint64_t)header_bytes)                               \
-      return PIOLA_FAIL(PIOLA_ERROR_PARSE, "%s: array '%s' has %llu bytes, expected %llu", path, (a)->name,    \
-                        (unsigned long long)bytes_, (unsigned long long)((uint64_t)(elem) * (uint64_t)(count))); \
-    (ptr) = base + (a)->offset + header_bytes;                                                                \
+#define BLOCK(a, elem, count, ptr)                                                               \
+  do {                                                                                           \
+    uint64_t bytes_ = 0;                                                                         \
+    if ((a)->offset > (uint64_t)(end - base) ||                                                  \
+        (uint64_t)(end - base) - (a)->offset < (uint64_t)header_bytes)                           \
+      return PIOLA_FAIL(PIOLA_ERROR_PARSE, "%s: array '%s' lies past the end of the file", path, \
+                        (a)->name);                                                              \
+    memcpy(&bytes_, base + (a)->offset, (size_t)header_bytes);                                   \
+    if (bytes_ != (uint64_t)(elem) * (uint64_t)(count) ||                                        \
+        bytes_ > (uint64_t)(end - base) - (a)->offset - (uint64_t)header_bytes)                  \
+      return PIOLA_FAIL(PIOLA_ERROR_PARSE, "%s: array '%s' has %llu bytes, expected %llu", path, \
+                        (a)->name, (unsigned long long)bytes_,                                   \
+                        (unsigned long long)((uint64_t)(elem) * (uint64_t)(count)));             \
+    (ptr) = base + (a)->offset + header_bytes;                                                   \
   } while (0)
 
   const char *pts = NULL, *offs = NULL, *types = NULL;
@@ -232,10 +246,12 @@ static piola_status parse(piola_render_frame *f, const char *buf, size_t size, c
         return PIOLA_FAIL(PIOLA_ERROR_UNSUPPORTED, "%s: points must be Float64 x 3", path);
       BLOCK(a, 24, f->point_count, pts);
     } else if (a->section == 3 && strcmp(a->name, "offsets") == 0) {
-      if (strcmp(a->type, "Int64") != 0) return PIOLA_FAIL(PIOLA_ERROR_UNSUPPORTED, "%s: offsets must be Int64", path);
+      if (strcmp(a->type, "Int64") != 0)
+        return PIOLA_FAIL(PIOLA_ERROR_UNSUPPORTED, "%s: offsets must be Int64", path);
       BLOCK(a, 8, f->cell_count, offs);
     } else if (a->section == 3 && strcmp(a->name, "types") == 0) {
-      if (strcmp(a->type, "UInt8") != 0) return PIOLA_FAIL(PIOLA_ERROR_UNSUPPORTED, "%s: types must be UInt8", path);
+      if (strcmp(a->type, "UInt8") != 0)
+        return PIOLA_FAIL(PIOLA_ERROR_UNSUPPORTED, "%s: types must be UInt8", path);
       BLOCK(a, 1, f->cell_count, types);
     } else if (a->section == 3 && strcmp(a->name, "connectivity") == 0) {
       if (strcmp(a->type, "Int64") != 0)
@@ -244,7 +260,8 @@ static piola_status parse(piola_render_frame *f, const char *buf, size_t size, c
     }
   }
   if (!pts || !offs || !types || !conn_a)
-    return PIOLA_FAIL(PIOLA_ERROR_PARSE, "%s: missing points, connectivity, offsets or types", path);
+    return PIOLA_FAIL(PIOLA_ERROR_PARSE, "%s: missing points, connectivity, offsets or types",
+                      path);
   int64_t *offsets = malloc((size_t)(f->cell_count > 0 ? f->cell_count : 1) * sizeof *offsets);
   uint8_t *type_v = malloc((size_t)(f->cell_count > 0 ? f->cell_count : 1));
   f->points = malloc(3 * (size_t)(f->point_count > 0 ? f->point_count : 1) * sizeof *f->points);
@@ -258,47 +275,58 @@ static piola_status parse(piola_render_frame *f, const char *buf, size_t size, c
   int64_t conn_len = f->cell_count > 0 ? offsets[f->cell_count - 1] : 0;
   piola_status st = PIOLA_OK;
   int64_t *conn_v = NULL;
-  if (conn_len < 0 || conn_len > ((int64_t)1 << 32)) st = PIOLA_FAIL(PIOLA_ERROR_PARSE, "%s: bad offsets", path);
+  if (conn_len < 0 || conn_len > ((int64_t)1 << 32))
+    st = PIOLA_FAIL(PIOLA_ERROR_PARSE, "%s: bad offsets", path);
   for (int64_t c = 0; st == PIOLA_OK && c < f->cell_count; ++c) {
     int64_t prev = c > 0 ? offsets[c - 1] : 0;
     int64_t want = type_v[c] == 10 ? 4 : type_v[c] == 5 ? 3 : -1;
     if (offsets[c] < prev || (want > 0 && offsets[c] - prev != want))
-      st = PIOLA_FAIL(PIOLA_ERROR_PARSE, "%s: cell %lld has a bad offset for its type %d", path, (long long)c,
-                      (int)type_v[c]);
+      st = PIOLA_FAIL(PIOLA_ERROR_PARSE, "%s: cell %lld has a bad offset for its type %d", path,
+                      (long long)c, (int)type_v[c]);
   }
   if (st == PIOLA_OK) {
     const char *cp = NULL;
     uint64_t bytes = 0;
-    if (conn_a->offset > (uint64_t)(end - base) || (uint64_t)(end - base) - conn_a->offset < (uint64_t)header_bytes)
+    if (conn_a->offset > (uint64_t)(end - base) ||
+        (uint64_t)(end - base) - conn_a->offset < (uint64_t)header_bytes)
       st = PIOLA_FAIL(PIOLA_ERROR_PARSE, "%s: connectivity lies past the end of the file", path);
     else {
       memcpy(&bytes, base + conn_a->offset, (size_t)header_bytes);
-      if (bytes != 8 * (uint64_t)conn_len || bytes > (uint64_t)(end - base) - conn_a->offset - header_bytes)
+      if (bytes != 8 * (uint64_t)conn_len ||
+          bytes > (uint64_t)(end - base) - conn_a->offset - header_bytes)
         st = PIOLA_FAIL(PIOLA_ERROR_PARSE, "%s: connectivity has %llu bytes, expected %llu", path,
                         (unsigned long long)bytes, (unsigned long long)(8 * conn_len));
-      else cp = base + conn_a->offset + header_bytes;
+      else
+        cp = base + conn_a->offset + header_bytes;
     }
     if (st == PIOLA_OK) {
       conn_v = malloc((size_t)(conn_len > 0 ? conn_len : 1) * 8);
-      if (!conn_v) st = PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "%s: out of memory", path);
-      else memcpy(conn_v, cp, (size_t)conn_len * 8);
+      if (!conn_v)
+        st = PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "%s: out of memory", path);
+      else
+        memcpy(conn_v, cp, (size_t)conn_len * 8);
     }
     for (int64_t k = 0; st == PIOLA_OK && k < conn_len; ++k)
       if (conn_v[k] < 0 || conn_v[k] >= f->point_count)
-        st = PIOLA_FAIL(PIOLA_ERROR_PARSE, "%s: connectivity entry %lld out of range", path, (long long)k);
+        st = PIOLA_FAIL(PIOLA_ERROR_PARSE, "%s: connectivity entry %lld out of range", path,
+                        (long long)k);
   }
   /* per-cell scalar fields */
   for (int i = 0; st == PIOLA_OK && i < na; ++i) {
     vtu_array *a = &arrays[i];
-    if (a->section != 1 || a->components != 1 || strcmp(a->type, "Float64") != 0 || !a->name[0]) continue;
+    if (a->section != 1 || a->components != 1 || strcmp(a->type, "Float64") != 0 || !a->name[0])
+      continue;
     const char *vp = NULL;
     uint64_t bytes = 0;
-    if (a->offset > (uint64_t)(end - base) || (uint64_t)(end - base) - a->offset < (uint64_t)header_bytes) {
-      st = PIOLA_FAIL(PIOLA_ERROR_PARSE, "%s: array '%s' lies past the end of the file", path, a->name);
+    if (a->offset > (uint64_t)(end - base) ||
+        (uint64_t)(end - base) - a->offset < (uint64_t)header_bytes) {
+      st = PIOLA_FAIL(PIOLA_ERROR_PARSE, "%s: array '%s' lies past the end of the file", path,
+                      a->name);
       break;
     }
     memcpy(&bytes, base + a->offset, (size_t)header_bytes);
-    if (bytes != 8 * (uint64_t)f->cell_count || bytes > (uint64_t)(end - base) - a->offset - header_bytes) {
+    if (bytes != 8 * (uint64_t)f->cell_count ||
+        bytes > (uint64_t)(end - base) - a->offset - header_bytes) {
       st = PIOLA_FAIL(PIOLA_ERROR_PARSE, "%s: cell field '%s' has the wrong size", path, a->name);
       break;
     }
@@ -325,7 +353,8 @@ static piola_status parse(piola_render_frame *f, const char *buf, size_t size, c
     for (int i = 0; i < f->field_count; ++i)
       if (strcmp(f->fields[i].name, "inverted") == 0) inv = f->fields[i].values;
     for (int64_t c = 0; c < f->cell_count; ++c) {
-      bool flag = inv ? inv[c] > 0.5 : (type_v[c] == 10 && signed_volume(f->points, conn_v + offsets[c] - 4) < 0);
+      bool flag = inv ? inv[c] > 0.5
+                      : (type_v[c] == 10 && signed_volume(f->points, conn_v + offsets[c] - 4) < 0);
       f->cell_inverted[c] = flag;
       f->inverted_count += flag;
     }
@@ -376,7 +405,9 @@ bool piola_render_frame_has_field(const piola_render_frame *f, const char *name)
   return f && name && field(f, name) != NULL;
 }
 
-int32_t piola_render_frame_inverted_count(const piola_render_frame *f) { return f ? f->inverted_count : 0; }
+int32_t piola_render_frame_inverted_count(const piola_render_frame *f) {
+  return f ? f->inverted_count : 0;
+}
 
 void piola_render_frame_bounds(const piola_render_frame *f, piola_vec3 *lo, piola_vec3 *hi) {
   vec3 a = {INFINITY, INFINITY, INFINITY}, b = {-INFINITY, -INFINITY, -INFINITY};
@@ -389,8 +420,8 @@ void piola_render_frame_bounds(const piola_render_frame *f, piola_vec3 *lo, piol
   if (hi) *hi = b;
 }
 
-piola_status piola_render_frame_mesh(const piola_render_frame *cf, const char *value_field, double time,
-                                     piola_render_mesh *out) {
+piola_status piola_render_frame_mesh(const piola_render_frame *cf, const char *value_field,
+                                     double time, piola_render_mesh *out) {
   if (!cf || !out) return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "render frame: NULL argument");
   piola_render_frame *f = (piola_render_frame *)cf; /* the per-face arrays are a cache */
   const double *values = NULL;

@@ -18,11 +18,13 @@ void piola_image_free(piola_image *image) {
 
 piola_status piola__image_resize(piola_image *image, int32_t width, int32_t height) {
   if (width <= 0 || height <= 0 || width > 16384 || height > 16384)
-    return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "image size %d x %d out of range 1..16384", (int)width,
-                      (int)height);
+    return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "image size %d x %d out of range 1..16384",
+                      (int)width, (int)height);
   if (image->rgb && image->width == width && image->height == height) return PIOLA_OK;
   uint8_t *p = realloc(image->rgb, 3 * (size_t)width * (size_t)height);
-  if (!p) return PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "image %d x %d: out of memory", (int)width, (int)height);
+  if (!p)
+    return PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "image %d x %d: out of memory", (int)width,
+                      (int)height);
   image->rgb = p;
   image->width = width;
   image->height = height;
@@ -54,7 +56,8 @@ static void png_warning_quiet(png_structp png, png_const_charp message) {
 }
 
 static int png_write_stream(FILE *stream, const piola_image *image) {
-  png_structp png = png_create_write_struct(PNG_LIBPNG_VER_STRING, NULL, png_error_quiet, png_warning_quiet);
+  png_structp png =
+      png_create_write_struct(PNG_LIBPNG_VER_STRING, NULL, png_error_quiet, png_warning_quiet);
   if (!png) return -1;
   png_infop info = png_create_info_struct(png);
   if (!info || setjmp(png_jmpbuf(png))) {
@@ -63,8 +66,9 @@ static int png_write_stream(FILE *stream, const piola_image *image) {
   }
   png_init_io(png, stream);
   png_set_compression_level(png, 3); /* previews: fast over small */
-  png_set_IHDR(png, info, (png_uint_32)image->width, (png_uint_32)image->height, 8, PNG_COLOR_TYPE_RGB,
-               PNG_INTERLACE_NONE, PNG_COMPRESSION_TYPE_DEFAULT, PNG_FILTER_TYPE_DEFAULT);
+  png_set_IHDR(png, info, (png_uint_32)image->width, (png_uint_32)image->height, 8,
+               PNG_COLOR_TYPE_RGB, PNG_INTERLACE_NONE, PNG_COMPRESSION_TYPE_DEFAULT,
+               PNG_FILTER_TYPE_DEFAULT);
   png_write_info(png, info);
   for (int32_t y = 0; y < image->height; ++y)
     png_write_row(png, image->rgb + 3 * (size_t)y * (size_t)image->width);
@@ -86,7 +90,8 @@ piola_status piola_image_write_png(const char *path, const piola_image *image) {
 }
 
 static int png_read_stream(FILE *stream, piola_image *image) {
-  png_structp png = png_create_read_struct(PNG_LIBPNG_VER_STRING, NULL, png_error_quiet, png_warning_quiet);
+  png_structp png =
+      png_create_read_struct(PNG_LIBPNG_VER_STRING, NULL, png_error_quiet, png_warning_quiet);
   if (!png) return -1;
   png_infop info = png_create_info_struct(png);
   if (!info || setjmp(png_jmpbuf(png))) {
@@ -163,7 +168,8 @@ piola_status piola_image_contact_sheet(const piola_image *images, const char *co
   memset(out->rgb, 40, 3 * (size_t)out->width * (size_t)out->height);
   int scale = cell_width >= 480 ? 2 : 1;
   for (int32_t i = 0; i < count; ++i) {
-    int x0 = gap + (i % columns) * (cell_width + gap), y0 = gap + (i / columns) * (cell_height + gap);
+    int x0 = gap + (i % columns) * (cell_width + gap),
+        y0 = gap + (i / columns) * (cell_height + gap);
     downscale_into(&images[i], out, x0, y0, cell_width, cell_height);
     if (labels && labels[i]) piola_image_draw_label(out, x0, y0, scale, labels[i]);
   }

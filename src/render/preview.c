@@ -30,7 +30,9 @@ struct piola_preview {
 
 /* Makes a relative path string absolute against folder. */
 static void make_absolute(cJSON *item, const char *folder) {
-  if (!cJSON_IsString(item) || !item->valuestring || item->valuestring[0] == '/' || !item->valuestring[0]) return;
+  if (!cJSON_IsString(item) || !item->valuestring || item->valuestring[0] == '/' ||
+      !item->valuestring[0])
+    return;
   char buf[PATH_MAX + 512];
   snprintf(buf, sizeof buf, "%s/%s", folder, item->valuestring);
   cJSON_SetValuestring(item, buf);
@@ -58,15 +60,19 @@ static piola_status copy_scene(const char *scene_path, const char *dir) {
   char tmp[PATH_MAX];
   snprintf(tmp, sizeof tmp, "%s", scene_path);
   char *slash = strrchr(tmp, '/');
-  if (slash) *slash = '\0';
-  else snprintf(tmp, sizeof tmp, ".");
+  if (slash)
+    *slash = '\0';
+  else
+    snprintf(tmp, sizeof tmp, ".");
   if (!tmp[0]) snprintf(tmp, sizeof tmp, "/");
   if (!realpath(tmp, folder)) snprintf(folder, sizeof folder, "%s", tmp);
   cJSON *solids = cJSON_GetObjectItemCaseSensitive(root, "solids");
   cJSON *it;
-  cJSON_ArrayForEach(it, solids) make_absolute(cJSON_GetObjectItemCaseSensitive(it, "mesh"), folder);
+  cJSON_ArrayForEach(it, solids)
+      make_absolute(cJSON_GetObjectItemCaseSensitive(it, "mesh"), folder);
   cJSON *obstacles = cJSON_GetObjectItemCaseSensitive(root, "obstacles");
-  cJSON_ArrayForEach(it, obstacles) make_absolute(cJSON_GetObjectItemCaseSensitive(it, "path"), folder);
+  cJSON_ArrayForEach(it, obstacles)
+      make_absolute(cJSON_GetObjectItemCaseSensitive(it, "path"), folder);
   char *out = cJSON_Print(root);
   cJSON_Delete(root);
   if (!out) return PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "scene copy: out of memory");
@@ -83,10 +89,12 @@ static piola_status copy_scene(const char *scene_path, const char *dir) {
   return st;
 }
 
-piola_status piola_preview_open(const char *dir, const char *scene_path, bool every_frame, piola_preview **out) {
+piola_status piola_preview_open(const char *dir, const char *scene_path, bool every_frame,
+                                piola_preview **out) {
   if (!dir || !out) return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "preview: NULL argument");
   *out = NULL;
-  if (strlen(dir) >= 3500) return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "preview: path too long");
+  if (strlen(dir) >= 3500)
+    return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "preview: path too long");
   piola_preview *p = calloc(1, sizeof *p);
   if (!p) return PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "preview: out of memory");
   snprintf(p->dir, sizeof p->dir, "%s", dir);
@@ -124,8 +132,8 @@ piola_status piola_preview_open(const char *dir, const char *scene_path, bool ev
 }
 
 /* Renders frame `frame` of the folder to png with renderer r (created on first use). */
-static piola_status render_to(piola_preview *p, piola_renderer **r, bool fit_union, int32_t frame, double time,
-                              const char *png) {
+static piola_status render_to(piola_preview *p, piola_renderer **r, bool fit_union, int32_t frame,
+                              double time, const char *png) {
   char path[4096];
   snprintf(path, sizeof path, "%s/frames/frame_%04d.vtu", p->dir, (int)frame);
   piola_render_frame *f;
@@ -150,8 +158,10 @@ static piola_status render_to(piola_preview *p, piola_renderer **r, bool fit_uni
         hi = (piola_vec3){fmax(hi.x, p->hi0.x), fmax(hi.y, p->hi0.y), fmax(hi.z, p->hi0.z)};
       } else {
         piola_vec3 c = {0.5 * (lo.x + hi.x), 0.5 * (lo.y + hi.y), 0.5 * (lo.z + hi.z)};
-        lo = (piola_vec3){c.x + 1.3 * (lo.x - c.x), c.y + 1.3 * (lo.y - c.y), c.z + 1.3 * (lo.z - c.z)};
-        hi = (piola_vec3){c.x + 1.3 * (hi.x - c.x), c.y + 1.3 * (hi.y - c.y), c.z + 1.3 * (hi.z - c.z)};
+        lo = (piola_vec3){c.x + 1.3 * (lo.x - c.x), c.y + 1.3 * (lo.y - c.y),
+                          c.z + 1.3 * (lo.z - c.z)};
+        hi = (piola_vec3){c.x + 1.3 * (hi.x - c.x), c.y + 1.3 * (hi.y - c.y),
+                          c.z + 1.3 * (hi.z - c.z)};
       }
       if (lo.x <= hi.x) piola_renderer_fit_camera(*r, lo, hi);
     }

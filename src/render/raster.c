@@ -15,7 +15,7 @@
 enum { BAND_ROWS = 16 };
 
 typedef struct tri_setup {
-  float rgb[3][3]; /* lit colour at each corner, 0..255 */
+  float rgb[3][3];        /* lit colour at each corner, 0..255 */
   int32_t x0, x1, y0, y1; /* pixel bounding box, inclusive; y0 > y1 when culled */
 } tri_setup;
 
@@ -47,7 +47,8 @@ piola_status piola__render_triangles(const render_camera *cam, const piola_rende
   /* area-weighted vertex normals, summed in triangle order (deterministic) */
   for (int32_t t = 0; t < nt; ++t) {
     const int32_t *c = tri + 3 * (size_t)t;
-    vec3 a = vec3_load(x + 3 * (size_t)c[0]), b = vec3_load(x + 3 * (size_t)c[1]), e = vec3_load(x + 3 * (size_t)c[2]);
+    vec3 a = vec3_load(x + 3 * (size_t)c[0]), b = vec3_load(x + 3 * (size_t)c[1]),
+         e = vec3_load(x + 3 * (size_t)c[2]);
     vec3 n = vec3_cross(vec3_sub(b, a), vec3_sub(e, a));
     for (int k = 0; k < 3; ++k) {
       double *p = vn + 3 * (size_t)c[k];
@@ -61,20 +62,23 @@ piola_status piola__render_triangles(const render_camera *cam, const piola_rende
     tri_setup *s = &setup[t];
     s->y0 = 1, s->y1 = 0;
     const int32_t *c = tri + 3 * (size_t)t;
-    const double *p0 = proj + 3 * (size_t)c[0], *p1 = proj + 3 * (size_t)c[1], *p2 = proj + 3 * (size_t)c[2];
+    const double *p0 = proj + 3 * (size_t)c[0], *p1 = proj + 3 * (size_t)c[1],
+                 *p2 = proj + 3 * (size_t)c[2];
     if (!(p0[2] > near_z && p1[2] > near_z && p2[2] > near_z)) continue; /* behind or at the eye */
     double area = (p1[0] - p0[0]) * (p2[1] - p0[1]) - (p1[1] - p0[1]) * (p2[0] - p0[0]);
     if (!(area != 0) || !isfinite(area)) continue;
     double fx0 = fmin(p0[0], fmin(p1[0], p2[0])), fx1 = fmax(p0[0], fmax(p1[0], p2[0]));
     double fy0 = fmin(p0[1], fmin(p1[1], p2[1])), fy1 = fmax(p0[1], fmax(p1[1], p2[1]));
     /* pixels whose centres (i + 0.5) can be inside */
-    double ix0 = ceil(fx0 - 0.5), ix1 = floor(fx1 - 0.5), iy0 = ceil(fy0 - 0.5), iy1 = floor(fy1 - 0.5);
+    double ix0 = ceil(fx0 - 0.5), ix1 = floor(fx1 - 0.5), iy0 = ceil(fy0 - 0.5),
+           iy1 = floor(fy1 - 0.5);
     if (ix0 < 0) ix0 = 0;
     if (iy0 < 0) iy0 = 0;
     if (ix1 > W - 1) ix1 = W - 1;
     if (iy1 > H - 1) iy1 = H - 1;
     if (ix0 > ix1 || iy0 > iy1) continue;
-    vec3 a = vec3_load(x + 3 * (size_t)c[0]), b = vec3_load(x + 3 * (size_t)c[1]), e = vec3_load(x + 3 * (size_t)c[2]);
+    vec3 a = vec3_load(x + 3 * (size_t)c[0]), b = vec3_load(x + 3 * (size_t)c[1]),
+         e = vec3_load(x + 3 * (size_t)c[2]);
     vec3 fn = vec3_cross(vec3_sub(b, a), vec3_sub(e, a));
     double fl = vec3_norm(fn);
     fn = fl > 0 ? vec3_scale(fn, 1.0 / fl) : cam->forward;
@@ -103,18 +107,22 @@ piola_status piola__render_triangles(const render_camera *cam, const piola_rende
   /* bin: count, prefix sum, fill in triangle order */
   for (int32_t t = 0; t < nt; ++t)
     if (setup[t].y0 <= setup[t].y1)
-      for (int32_t b = setup[t].y0 / BAND_ROWS; b <= setup[t].y1 / BAND_ROWS; ++b) ++band_start[b + 1];
+      for (int32_t b = setup[t].y0 / BAND_ROWS; b <= setup[t].y1 / BAND_ROWS; ++b)
+        ++band_start[b + 1];
   for (int32_t b = 0; b < band_count; ++b) band_start[b + 1] += band_start[b];
-  int32_t *binned = malloc((size_t)(band_start[band_count] > 0 ? band_start[band_count] : 1) * sizeof *binned);
+  int32_t *binned =
+      malloc((size_t)(band_start[band_count] > 0 ? band_start[band_count] : 1) * sizeof *binned);
   int64_t *fill = malloc((size_t)band_count * sizeof *fill);
   if (!binned || !fill) {
     free(proj), free(vn), free(setup), free(band_start), free(binned), free(fill);
-    return PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "render: out of memory binning %d triangles", (int)nt);
+    return PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "render: out of memory binning %d triangles",
+                      (int)nt);
   }
   memcpy(fill, band_start, (size_t)band_count * sizeof *fill);
   for (int32_t t = 0; t < nt; ++t)
     if (setup[t].y0 <= setup[t].y1)
-      for (int32_t b = setup[t].y0 / BAND_ROWS; b <= setup[t].y1 / BAND_ROWS; ++b) binned[fill[b]++] = t;
+      for (int32_t b = setup[t].y0 / BAND_ROWS; b <= setup[t].y1 / BAND_ROWS; ++b)
+        binned[fill[b]++] = t;
 
 #pragma omp parallel for schedule(dynamic, 1)
   for (int32_t b = 0; b < band_count; ++b) {
@@ -124,8 +132,10 @@ piola_status piola__render_triangles(const render_camera *cam, const piola_rende
       int32_t t = binned[k];
       const tri_setup *s = &setup[t];
       const int32_t *c = tri + 3 * (size_t)t;
-      const double *p[3] = {proj + 3 * (size_t)c[0], proj + 3 * (size_t)c[1], proj + 3 * (size_t)c[2]};
-      double area = (p[1][0] - p[0][0]) * (p[2][1] - p[0][1]) - (p[1][1] - p[0][1]) * (p[2][0] - p[0][0]);
+      const double *p[3] = {proj + 3 * (size_t)c[0], proj + 3 * (size_t)c[1],
+                            proj + 3 * (size_t)c[2]};
+      double area =
+          (p[1][0] - p[0][0]) * (p[2][1] - p[0][1]) - (p[1][1] - p[0][1]) * (p[2][0] - p[0][0]);
       double inv_area = 1.0 / area;
       /* barycentric weight of corner k: edge function of the opposite edge / area */
       double A[3], B[3], C[3];

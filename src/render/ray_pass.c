@@ -45,8 +45,8 @@ static void background(const render_camera *c, int y, float out[3]) {
   out[2] = 244 - 28 * s;
 }
 
-void piola__render_ray_pass(const piola_renderer *r, const render_camera *cam, double time, float *depth,
-                            uint8_t *rgb) {
+void piola__render_ray_pass(const piola_renderer *r, const render_camera *cam, double time,
+                            float *depth, uint8_t *rgb) {
   enum { MAX_PLANES = 16, MAX_TRACED = 64 };
   ground_plane planes[MAX_PLANES];
   traced_obstacle traced[MAX_TRACED];
@@ -71,7 +71,8 @@ void piola__render_ray_pass(const piola_renderer *r, const render_camera *cam, d
     }
   }
   if (np == 0 && r->def.ground)
-    planes[np++] = make_plane(cam, vec3_scale(r->def.up, r->ground_height), r->def.up, cam->position);
+    planes[np++] =
+        make_plane(cam, vec3_scale(r->def.up, r->ground_height), r->def.up, cam->position);
 
   const double checker = r->checker_size, fog = 10 * (r->scene_size > 0 ? r->scene_size : 1);
   const double inv_f = 1.0 / cam->focal_px;
@@ -81,8 +82,9 @@ void piola__render_ray_pass(const piola_renderer *r, const render_camera *cam, d
     float bg[3];
     background(cam, y, bg);
     for (int x = 0; x < W; ++x) {
-      vec3 dir = vec3_add(cam->forward, vec3_add(vec3_scale(cam->right, (x + 0.5 - 0.5 * W) * inv_f),
-                                                 vec3_scale(cam->up, -(y + 0.5 - 0.5 * H) * inv_f)));
+      vec3 dir =
+          vec3_add(cam->forward, vec3_add(vec3_scale(cam->right, (x + 0.5 - 0.5 * W) * inv_f),
+                                          vec3_scale(cam->up, -(y + 0.5 - 0.5 * H) * inv_f)));
       double dir_len = vec3_norm(dir);
       vec3 dn = vec3_scale(dir, 1.0 / dir_len);
       double best = INFINITY; /* view depth, m */

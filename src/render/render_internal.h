@@ -98,8 +98,8 @@ void piola__render_color_bar(piola_image *image, double lo, double hi, const cha
 
 /* Text in the built-in 5x7 bitmap font; scale is the pixel size of one font dot. Unknown
  * characters are drawn as blanks. Returns the width drawn, pixels. */
-int piola__render_text(piola_image *image, int x, int y, int scale, const char *text,
-                       uint8_t r, uint8_t g, uint8_t b);
+int piola__render_text(piola_image *image, int x, int y, int scale, const char *text, uint8_t r,
+                       uint8_t g, uint8_t b);
 int piola__render_text_width(const char *text, int scale);
 
 /* Fills a rectangle, clipped to the image. */

@@ -42,25 +42,29 @@ piola_status piola_renderer_create(const piola_render_def *def, piola_renderer *
   if (!def || !out) return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "renderer: NULL argument");
   *out = NULL;
   if (def->width < 16 || def->width > 16384 || def->height < 16 || def->height > 16384)
-    return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "render: width and height must be in 16..16384, got %d x %d",
-                      (int)def->width, (int)def->height);
+    return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT,
+                      "render: width and height must be in 16..16384, got %d x %d", (int)def->width,
+                      (int)def->height);
   if (!(def->fov_degrees > 1 && def->fov_degrees < 170))
-    return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "render: fov_degrees must be in (1, 170), got %g",
-                      def->fov_degrees);
+    return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT,
+                      "render: fov_degrees must be in (1, 170), got %g", def->fov_degrees);
   if ((unsigned)def->color > PIOLA_RENDER_COLOR_VALUE)
-    return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "render: unknown colour mode %d", (int)def->color);
+    return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "render: unknown colour mode %d",
+                      (int)def->color);
   double un = vec3_norm(def->up);
   if (!(un > 0) || !finite3(def->up))
     return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "render: up must be a nonzero finite vector");
   if (def->camera_set) {
     if (!finite3(def->camera_position) || !finite3(def->camera_target))
-      return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "render: camera position and target must be finite");
+      return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT,
+                        "render: camera position and target must be finite");
     vec3 f = vec3_sub(def->camera_target, def->camera_position);
     if (!(vec3_norm(f) > 0))
       return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "render: camera position equals its target");
   }
   if (!isfinite(def->ground_height) || !isfinite(def->value_min) || !isfinite(def->value_max))
-    return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "render: ground_height and value range must be finite");
+    return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT,
+                      "render: ground_height and value range must be finite");
   piola_renderer *r = calloc(1, sizeof *r);
   if (!r) return PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "renderer: out of memory");
   r->def = *def;
@@ -70,7 +74,8 @@ piola_status piola_renderer_create(const piola_render_def *def, piola_renderer *
   r->camera_position = def->camera_position;
   r->camera_target = def->camera_target;
   r->ground_height = def->ground_height;
-  r->scene_size = def->camera_set ? vec3_norm(vec3_sub(def->camera_target, def->camera_position)) : 1.0;
+  r->scene_size =
+      def->camera_set ? vec3_norm(vec3_sub(def->camera_target, def->camera_position)) : 1.0;
   r->checker_size = nice_length(r->scene_size / 6);
   *out = r;
   return PIOLA_OK;
@@ -96,7 +101,8 @@ piola_status piola_renderer_add_obstacle(piola_renderer *r, const piola_obstacle
     if (grown) r->obstacles = grown;
     piola_tri_mesh *grown_meshes = realloc(r->obstacle_meshes, (size_t)cap * sizeof *grown_meshes);
     if (grown_meshes) r->obstacle_meshes = grown_meshes;
-    if (!grown || !grown_meshes) return PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "renderer: out of memory");
+    if (!grown || !grown_meshes)
+      return PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "renderer: out of memory");
     r->obstacle_capacity = cap;
   }
   piola_obstacle *o = NULL;
@@ -164,7 +170,8 @@ void piola_renderer_fit_camera(piola_renderer *r, piola_vec3 lo, piola_vec3 hi) 
   vec3 side = vec3_cross(a, up);
   side = vec3_scale(side, 1.0 / vec3_norm(side)); /* +x for z up */
   vec3 front = vec3_cross(up, side);              /* +y for z up */
-  vec3 dir = vec3_add(vec3_add(vec3_scale(side, 0.5), vec3_scale(front, -0.866)), vec3_scale(up, 0.0));
+  vec3 dir =
+      vec3_add(vec3_add(vec3_scale(side, 0.5), vec3_scale(front, -0.866)), vec3_scale(up, 0.0));
   double elev = 25.0 * M_PI / 180;
   dir = vec3_add(vec3_scale(dir, cos(elev)), vec3_scale(up, sin(elev)));
   double vfov = r->def.fov_degrees * M_PI / 180;
@@ -195,9 +202,11 @@ render_camera piola__render_camera(const piola_renderer *r) {
   c.right = vec3_scale(right, 1.0 / vec3_norm(right));
   c.up = vec3_cross(c.right, c.forward);
   /* key light from the upper left of the view, fill from the right */
-  c.key = vec3_add(vec3_add(vec3_scale(c.right, -0.45), vec3_scale(c.up, 0.7)), vec3_scale(c.forward, -0.55));
+  c.key = vec3_add(vec3_add(vec3_scale(c.right, -0.45), vec3_scale(c.up, 0.7)),
+                   vec3_scale(c.forward, -0.55));
   c.key = vec3_scale(c.key, 1.0 / vec3_norm(c.key));
-  c.fill = vec3_add(vec3_add(vec3_scale(c.right, 0.7), vec3_scale(c.up, -0.2)), vec3_scale(c.forward, -0.68));
+  c.fill = vec3_add(vec3_add(vec3_scale(c.right, 0.7), vec3_scale(c.up, -0.2)),
+                    vec3_scale(c.forward, -0.68));
   c.fill = vec3_scale(c.fill, 1.0 / vec3_norm(c.fill));
   c.width = r->def.width;
   c.height = r->def.height;
@@ -234,10 +243,11 @@ static void auto_range(const double *v, int32_t n, double *lo, double *hi) {
   free(s);
 }
 
-static const float part_palette[6][3] = {{86, 140, 205}, {64, 170, 160}, {226, 186, 84},
+static const float part_palette[6][3] = {{86, 140, 205},  {64, 170, 160}, {226, 186, 84},
                                          {150, 128, 205}, {120, 184, 92}, {200, 200, 210}};
 
-piola_status piola_renderer_render(piola_renderer *r, const piola_render_mesh *mesh, piola_image *image) {
+piola_status piola_renderer_render(piola_renderer *r, const piola_render_mesh *mesh,
+                                   piola_image *image) {
   if (!r || !image) return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "render: NULL argument");
   if (mesh) {
     if (mesh->triangle_count < 0 || mesh->vertex_count < 0 ||
@@ -245,10 +255,11 @@ piola_status piola_renderer_render(piola_renderer *r, const piola_render_mesh *m
       return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "render: mesh needs positions and triangles");
     for (int64_t i = 0; i < 3 * (int64_t)mesh->triangle_count; ++i)
       if (mesh->triangles[i] < 0 || mesh->triangles[i] >= mesh->vertex_count)
-        return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "render: triangle %lld has a vertex out of range",
-                          (long long)(i / 3));
+        return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT,
+                          "render: triangle %lld has a vertex out of range", (long long)(i / 3));
     if (r->def.color == PIOLA_RENDER_COLOR_VALUE && mesh->triangle_count > 0 && !mesh->values)
-      return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "render: value colouring needs per-face values");
+      return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT,
+                        "render: value colouring needs per-face values");
   }
   double time = mesh ? mesh->time : 0;
   PIOLA_TRY(piola__image_resize(image, r->def.width, r->def.height));
@@ -274,11 +285,14 @@ piola_status piola_renderer_render(piola_renderer *r, const piola_render_mesh *m
       return PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "render: out of memory");
     }
     for (int32_t v = 0; v < om->vertex_count; ++v)
-      vec3_store(x + 3 * (size_t)v, vec3_add(mat3_mul_vec(st.rotation, vec3_load(om->positions + 3 * (size_t)v)),
-                                             st.translation));
+      vec3_store(x + 3 * (size_t)v,
+                 vec3_add(mat3_mul_vec(st.rotation, vec3_load(om->positions + 3 * (size_t)v)),
+                          st.translation));
     for (int32_t t = 0; t < om->triangle_count; ++t)
-      face_rgb[3 * t] = RENDER_OBSTACLE_R, face_rgb[3 * t + 1] = RENDER_OBSTACLE_G, face_rgb[3 * t + 2] = RENDER_OBSTACLE_B;
-    piola_render_mesh posed = {om->vertex_count, x, om->triangle_count, om->triangles, NULL, NULL, NULL, time};
+      face_rgb[3 * t] = RENDER_OBSTACLE_R, face_rgb[3 * t + 1] = RENDER_OBSTACLE_G,
+                   face_rgb[3 * t + 2] = RENDER_OBSTACLE_B;
+    piola_render_mesh posed = {
+        om->vertex_count, x, om->triangle_count, om->triangles, NULL, NULL, NULL, time};
     piola_status st_draw = piola__render_triangles(&cam, &posed, face_rgb, r->depth, image->rgb);
     free(x), free(face_rgb);
     PIOLA_TRY(st_draw);
@@ -288,7 +302,8 @@ piola_status piola_renderer_render(piola_renderer *r, const piola_render_mesh *m
   if (nt > 0) {
     float *face_rgb = malloc(3 * (size_t)nt * sizeof *face_rgb);
     if (!face_rgb) return PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "render: out of memory");
-    if (r->def.color == PIOLA_RENDER_COLOR_VALUE && !(hi > lo)) auto_range(mesh->values, nt, &lo, &hi);
+    if (r->def.color == PIOLA_RENDER_COLOR_VALUE && !(hi > lo))
+      auto_range(mesh->values, nt, &lo, &hi);
     for (int32_t t = 0; t < nt; ++t) {
       float *c = face_rgb + 3 * (size_t)t;
       if (r->def.color == PIOLA_RENDER_COLOR_VALUE) {

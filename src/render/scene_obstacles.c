@@ -44,8 +44,10 @@ piola_status piola_renderer_load_scene_obstacles(piola_renderer *r, const char *
   char dir[SCENE_PATH_MAX];
   snprintf(dir, sizeof dir, "%s", path);
   char *slash = strrchr(dir, '/');
-  if (slash) *slash = '\0';
-  else snprintf(dir, sizeof dir, ".");
+  if (slash)
+    *slash = '\0';
+  else
+    snprintf(dir, sizeof dir, ".");
   if (dir[0] == '\0') snprintf(dir, sizeof dir, "/");
   scene_desc desc;
   piola_status st = piola__scene_parse(text, dir, path, &desc);

@@ -404,6 +404,54 @@ static void test_mesh_and_moving_obstacles(void **state) {
   test_sphere_free(&s);
 }
 
+/* A sphere above the ground, out of the camera's view (behind a camera looking straight
+ * down), casts a shadow: under parallel light at angle theta from the vertical, an ellipse of
+ * area pi R^2 / cos(theta), where the light through the centre meets the ground. */
+static void test_shadow_of_a_sphere_on_the_ground(void **state) {
+  (void)state;
+  piola_render_def def = piola_default_render_def();
+  def.width = 640;
+  def.height = 480;
+  def.fov_degrees = 60;
+  def.camera_set = true;
+  def.camera_position = (piola_vec3){0, 0, 2};
+  def.camera_target = (piola_vec3){0, 0, 0};
+  def.ground = true;
+  def.ground_height = 0;
+  piola_renderer *r;
+  assert_int_equal(piola_renderer_create(&def, &r), PIOLA_OK);
+  render_camera cam = piola__render_camera(r);
+  piola_vec3 sun = piola__render_sun(&cam, def.up);
+  double cos_theta = sun.z, R = 0.3, h = 3;
+  assert_true(cos_theta > 0.5 && cos_theta < 1);
+  /* centre so that its shadow falls on the origin */
+  test_sphere s = test_uv_sphere(128, 64, R, sun.x * h / sun.z, sun.y * h / sun.z, h);
+  piola_render_mesh m = sphere_mesh(&s);
+  piola_image bare = {0}, shaded = {0};
+  assert_int_equal(piola_renderer_render(r, NULL, &bare), PIOLA_OK);
+  assert_int_equal(piola_renderer_render(r, &m, &shaded), PIOLA_OK);
+  keep("shadow", &shaded);
+  double f = 0.5 * def.height / tan(30 * M_PI / 180), metres_per_pixel = 2 / f;
+  double expected = M_PI * R * R / cos_theta / (metres_per_pixel * metres_per_pixel);
+  long n;
+  double cx = centroid_x(&bare, &shaded, &n);
+  assert_true(fabs(n - expected) <= 0.03 * expected);
+  assert_close(cx, 0.5 * def.width, 1.0);
+  /* darker, never lighter */
+  for (size_t i = 0; i < 3 * (size_t)def.width * (size_t)def.height; ++i)
+    assert_true(shaded.rgb[i] <= bare.rgb[i]);
+  piola_renderer_destroy(r);
+  /* without shadows nothing changes */
+  def.shadows = false;
+  assert_int_equal(piola_renderer_create(&def, &r), PIOLA_OK);
+  assert_int_equal(piola_renderer_render(r, &m, &shaded), PIOLA_OK);
+  assert_int_equal(test_count_differing(&bare, &shaded), 0);
+  piola_renderer_destroy(r);
+  piola_image_free(&bare);
+  piola_image_free(&shaded);
+  test_sphere_free(&s);
+}
+
 /* Same input, same bytes, for 1 and 2 threads and on a repeat. */
 static void test_deterministic_for_any_thread_count(void **state) {
   (void)state;
@@ -489,6 +537,7 @@ int main(void) {
       cmocka_unit_test(test_value_colors_and_color_bar),
       cmocka_unit_test(test_auto_camera_frames_the_object),
       cmocka_unit_test(test_mesh_and_moving_obstacles),
+      cmocka_unit_test(test_shadow_of_a_sphere_on_the_ground),
       cmocka_unit_test(test_deterministic_for_any_thread_count),
       cmocka_unit_test(test_bad_arguments_are_refused),
   };

@@ -81,6 +81,7 @@ typedef struct piola_render_def {
    * piola_renderer_fit_camera (or at ground_height when that was not called). */
   bool ground;          /* Default true */
   double ground_height; /* m along `up`. Default 0 */
+  bool shadows;         /* the surfaces cast shadows on the ground. Default true */
   /* Colour-map range of PIOLA_RENDER_COLOR_VALUE; value_min >= value_max chooses the range
    * from each frame's values (0 to their 99th percentile). */
   double value_min, value_max;

@@ -46,7 +46,7 @@ static void background(const render_camera *c, int y, float out[3]) {
 }
 
 void piola__render_ray_pass(const piola_renderer *r, const render_camera *cam, double time,
-                            float *depth, uint8_t *rgb) {
+                            const render_shadow *shadow, float *depth, uint8_t *rgb) {
   enum { MAX_PLANES = 16, MAX_TRACED = 64 };
   ground_plane planes[MAX_PLANES];
   traced_obstacle traced[MAX_TRACED];
@@ -108,6 +108,7 @@ void piola__render_ray_pass(const piola_renderer *r, const render_camera *cam, d
         double q = s * dir_len / fog;
         float fade = q < 1e-3 ? 0.f : (float)(1 - exp(-q * q));
         float lit = base * (0.55f + 0.45f * g->light);
+        if (shadow->size > 0) lit *= (float)(1 - 0.42 * piola__render_shadow_at(shadow, p));
         col[0] = lit * (1 - fade) + bg[0] * fade;
         col[1] = lit * (1 - fade) + bg[1] * fade;
         col[2] = (lit + 4) * (1 - fade) + bg[2] * fade;

@@ -82,9 +82,29 @@ static inline float render_light(const render_camera *c, vec3 n, vec3 to_eye, fl
   return (float)(0.30 + 0.62 * (kd > 0 ? kd : 0) + 0.16 * (fd > 0 ? fd : 0));
 }
 
-/* Pass 1: background, ground and obstacles for every pixel; fills depth (m) and rgb. */
+/* Shadows on the ground (shadow_map.c): heights of the surfaces along the sun direction on
+ * a square grid; size 0 means no shadows. */
+typedef struct render_shadow {
+  vec3 sun, u, v; /* unit direction towards the sun; grid axes */
+  double u0, v0;  /* m: grid origin along u, v */
+  double texel;   /* m */
+  int size;       /* texels per side, 0: none */
+  float *height;  /* size * size, m along sun; -inf where no surface */
+} render_shadow;
+
+/* The sun: `up` tilted towards the key light's side. */
+vec3 piola__render_sun(const render_camera *cam, vec3 up);
+/* Builds the map of mesh (NULL or empty: none). Never fails for lack of memory: then no
+ * shadows are drawn. */
+piola_status piola__render_shadow_build(vec3 sun, const piola_render_mesh *mesh, render_shadow *s);
+void piola__render_shadow_free(render_shadow *s);
+/* Fraction (0..1) of shadow at world point p. */
+double piola__render_shadow_at(const render_shadow *s, vec3 p);
+
+/* Pass 1: background, ground and obstacles for every pixel; fills depth (m) and rgb. The
+ * ground is darkened where `shadow` says so. */
 void piola__render_ray_pass(const piola_renderer *r, const render_camera *cam, double time,
-                            float *depth, uint8_t *rgb);
+                            const render_shadow *shadow, float *depth, uint8_t *rgb);
 
 /* Pass 2: the surface triangles, with per-face base colours (3 floats each, 0..255). */
 piola_status piola__render_triangles(const render_camera *cam, const piola_render_mesh *mesh,

@@ -22,6 +22,7 @@ piola_render_def piola_default_render_def(void) {
   d.fov_degrees = 40;
   d.ground = true;
   d.ground_height = 0;
+  d.shadows = true;
   d.value_min = 0;
   d.value_max = 0;
   d.value_label = NULL;
@@ -271,7 +272,10 @@ piola_status piola_renderer_render(piola_renderer *r, const piola_render_mesh *m
     r->depth_capacity = pixels;
   }
   render_camera cam = piola__render_camera(r);
-  piola__render_ray_pass(r, &cam, time, r->depth, image->rgb);
+  render_shadow shadow = {.size = 0};
+  if (r->def.shadows) piola__render_shadow_build(piola__render_sun(&cam, r->def.up), mesh, &shadow);
+  piola__render_ray_pass(r, &cam, time, &shadow, r->depth, image->rgb);
+  piola__render_shadow_free(&shadow);
 
   for (int32_t i = 0; i < r->obstacle_count; ++i) {
     const piola_tri_mesh *om = &r->obstacle_meshes[i];

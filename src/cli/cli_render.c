@@ -42,7 +42,8 @@ static void usage(FILE *out) {
           "  --contact-sheet         also write DIR/render/contact_sheet.png\n"
           "  --sheet-frames N        frames on the contact sheet (default 12)\n"
           "  --movie, --no-movie     write DIR/render/movie.mp4 with ffmpeg (default: when found)\n"
-          "  --fps F                 movie frame rate (default 30)\n"
+          "  --fps F                 movie frame rate (default: real time, from the frame times\n"
+          "                          in DIR/sim.pvd and --every; 30 without them)\n"
           "  -h, --help              this text\n");
 }
 
@@ -334,7 +335,7 @@ int cli_render(int argc, char **argv) {
   bool have_pos = false, have_target = false, sheet = false, have_range = false;
   int movie = -1; /* -1: when ffmpeg is found */
   long every = 1, sheet_frames = 12, w = def.width, h = def.height;
-  double fps = 30, range[2] = {0, 0};
+  double fps = NAN, range[2] = {0, 0};
   piola_vec3 pos = {0, 0, 0}, target = {0, 0, 0};
   for (int i = 1; i < argc; ++i) {
     const char *a = argv[i];
@@ -590,12 +591,15 @@ int cli_render(int argc, char **argv) {
   fprintf(stderr, "piola render: %d frames of %s -> %s (%d x %d, %s%s%s)\n", count, dir, render_dir,
           (int)def.width, (int)def.height, color, value_field ? ": " : "",
           value_field ? value_field : "");
+  double first_gap_time = NAN, first_time = NAN;
   piola_image img = {0};
   int next_sheet = 0, label_scale = def.height >= 600 ? 2 : 1;
   double t_start = now_seconds();
   for (int i = 0; rc == 0 && i < count; ++i) {
     double t = frame_time_from_pvd(pvd, frames[i]);
-    if (!isfinite(t)) t = frames[i] / fps;
+    if (!isfinite(t)) t = frames[i] / (isfinite(fps) ? fps : 30.0);
+    if (i == 0) first_time = t;
+    if (i == 1) first_gap_time = t - first_time;
     loaded_frame lf;
     if (load_frame(dir, vtu, frames[i], value_field, t, &lf) != 0) {
       rc = 1;
@@ -663,6 +667,13 @@ int cli_render(int argc, char **argv) {
   free(sheet_images);
   free(sheet_labels);
 
+  if (rc == 0 && movie != 0 && !isfinite(fps)) {
+    /* real time: the simulation's frame spacing, times the thinning of --every */
+    fps = 30;
+    if (count >= 2 && first_gap_time > 0) fps = 1.0 / first_gap_time;
+    if (!(fps >= 1)) fps = 1;
+    if (fps > 120) fps = 120;
+  }
   if (rc == 0 && movie != 0) {
     if (!find_in_path("ffmpeg")) {
       fprintf(stderr,

@@ -63,17 +63,18 @@ int main(int argc, char **argv) {
          height, omp_get_max_threads());
   printf("| case | ms/frame |\n|---|---|\n");
   enum { RUNS = 9 };
-  for (int mode = 0; mode < 3; ++mode) {
+  for (int mode = 0; mode < 4; ++mode) {
     piola_render_def def = piola_default_render_def();
     def.width = width;
     def.height = height;
     def.color = mode == 1 ? PIOLA_RENDER_COLOR_INVERTED : PIOLA_RENDER_COLOR_PLAIN;
+    def.shadows = mode != 3;
     piola_renderer *rd;
     if (piola_renderer_create(&def, &rd) != PIOLA_OK) {
       printf("%s\n", piola_last_error());
       return 1;
     }
-    if (mode < 2) {
+    if (mode != 2) {
       piola_renderer_add_obstacle(rd, &plane);
       piola_renderer_add_obstacle(rd, &ball);
     }
@@ -94,7 +95,7 @@ int main(int argc, char **argv) {
     qsort(tpng, RUNS, sizeof tpng[0], compare_doubles);
     static const char *const names[] = {"plain, plane ground + sphere obstacle",
                                         "inverted colouring, same scene",
-                                        "plain, fallback ground only"};
+                                        "plain, fallback ground only", "plain, obstacles, no shadows"};
     printf("| %s | %.1f |\n", names[mode], 1e3 * t[RUNS / 2]);
     if (mode == 0) printf("| PNG write (level 3) of that frame | %.1f |\n", 1e3 * tpng[RUNS / 2]);
     unlink(png);

@@ -12,7 +12,7 @@
 
 #include "render/render_internal.h"
 
-enum { SHADOW_SIZE = 1024 };
+enum { SHADOW_SIZE = 640 }; /* texels per side: soft enough, and cheap next to the ray pass */
 
 vec3 piola__render_sun(const render_camera *cam, vec3 up) {
   vec3 k = cam->key;
@@ -71,18 +71,25 @@ piola_status piola__render_shadow_build(vec3 sun, const piola_render_mesh *mesh,
     if (j0 < 0) j0 = 0;
     if (i1 > n - 1) i1 = n - 1;
     if (j1 > n - 1) j1 = n - 1;
-    double inv = 1.0 / area;
-    for (int j = j0; j <= j1; ++j)
-      for (int i = i0; i <= i1; ++i) {
-        double cu = i + 0.5, cv = j + 0.5;
-        double w0 = ((pu[1] - cu) * (pv[2] - cv) - (pv[1] - cv) * (pu[2] - cu)) * inv;
-        double w1 = ((pu[2] - cu) * (pv[0] - cv) - (pv[2] - cv) * (pu[0] - cu)) * inv;
+    /* barycentric weights are affine in (cu, cv): w_k = A_k cu + B_k cv + C_k */
+    double inv = 1.0 / area, A[2], B[2], C[2];
+    for (int k = 0; k < 2; ++k) {
+      int a1 = (k + 1) % 3, a2 = (k + 2) % 3;
+      A[k] = (pv[a1] - pv[a2]) * inv;
+      B[k] = (pu[a2] - pu[a1]) * inv;
+      C[k] = (pu[a1] * pv[a2] - pu[a2] * pv[a1]) * inv;
+    }
+    for (int j = j0; j <= j1; ++j) {
+      double cv = j + 0.5;
+      double w0 = A[0] * (i0 + 0.5) + B[0] * cv + C[0], w1 = A[1] * (i0 + 0.5) + B[1] * cv + C[1];
+      float *row = h + (size_t)j * n;
+      for (int i = i0; i <= i1; ++i, w0 += A[0], w1 += A[1]) {
         double w2 = 1 - w0 - w1;
         if (w0 < 0 || w1 < 0 || w2 < 0) continue;
         float z = (float)(w0 * ph[0] + w1 * ph[1] + w2 * ph[2]);
-        float *cell = h + (size_t)j * n + i;
-        if (z > *cell) *cell = z;
+        if (z > row[i]) row[i] = z;
       }
+    }
   }
   s->height = h;
   s->size = n;

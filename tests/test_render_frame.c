@@ -176,6 +176,41 @@ static void test_inverted_colouring_follows_the_frame(void **state) {
   }
 }
 
+/* Shells: triangle cells are drawn as they are, next to the boundary of the tets, and take
+ * their own cell data. */
+static void test_triangle_cells_are_drawn(void **state) {
+  (void)state;
+  piola_tet_mesh m = cube_grid(1, 0.1);
+  double sx[12] = {0, 0, 0.3, 0.2, 0, 0.3, 0, 0.2, 0.3, 0.2, 0.2, 0.3};
+  int32_t st[6] = {0, 1, 2, 1, 3, 2};
+  piola_tri_mesh shell = {4, sx, 2, st};
+  int32_t nc = m.tet_count + 2;
+  double *energy = malloc((size_t)nc * sizeof(double));
+  for (int32_t c = 0; c < nc; ++c) energy[c] = c;
+  piola_vtu_field cells[1] = {{"energy_density", 1, energy}};
+  piola_vtu_frame frame = {
+      .tets = &m, .triangles = &shell, .cell_fields = cells, .cell_field_count = 1};
+  char path[512];
+  snprintf(path, sizeof path, "%s/shell.vtu", folder);
+  assert_int_equal(piola_vtu_write(path, &frame), PIOLA_OK);
+  piola_render_frame *f;
+  assert_int_equal(piola_render_frame_read(path, &f), PIOLA_OK);
+  piola_render_mesh rm;
+  assert_int_equal(piola_render_frame_mesh(f, "energy_density", 0, &rm), PIOLA_OK);
+  assert_int_equal(rm.triangle_count, 12 + 2);
+  assert_int_equal(rm.vertex_count, m.vertex_count + 4);
+  /* the last two faces are the shell's, numbered after the tet points, with their cells' data */
+  for (int t = 12; t < 14; ++t) {
+    for (int k = 0; k < 3; ++k)
+      assert_int_equal(rm.triangles[3 * t + k], m.vertex_count + st[3 * (t - 12) + k]);
+    assert_close(rm.values[t], m.tet_count + (t - 12), 0);
+  }
+  assert_int_equal(piola_render_frame_inverted_count(f), 0);
+  piola_render_frame_destroy(f);
+  free(energy);
+  piola_tet_mesh_free(&m);
+}
+
 static void test_truncated_and_foreign_files_fail_cleanly(void **state) {
   (void)state;
   piola_tet_mesh m = cube_grid(1, 0.1);
@@ -251,6 +286,7 @@ int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_boundary_of_cube_grids),
       cmocka_unit_test(test_inverted_colouring_follows_the_frame),
+      cmocka_unit_test(test_triangle_cells_are_drawn),
       cmocka_unit_test(test_truncated_and_foreign_files_fail_cleanly),
       cmocka_unit_test(test_png_round_trip_and_contact_sheet),
   };

@@ -211,6 +211,118 @@ static void test_triangle_cells_are_drawn(void **state) {
   piola_tet_mesh_free(&m);
 }
 
+/* Stresses from a frame: a grid deformed homogeneously by F (written with its displacement
+ * field) has in every tet the von Mises equivalent of Phat at the singular values of F, for
+ * any rotation applied on top; a mirror (inverted) stays finite; the solid index picks the
+ * material; no displacements or too few materials are errors. */
+static double von_mises_of(const piola_material_def *def, double a, double b, double c) {
+  piola_material m;
+  assert_int_equal(piola_material_init(def, &m), PIOLA_OK);
+  double fhat[3] = {a, b, c}, p[3];
+  piola_material_stress(&m, fhat, p);
+  return sqrt(0.5 * ((p[0] - p[1]) * (p[0] - p[1]) + (p[1] - p[2]) * (p[1] - p[2]) +
+                     (p[2] - p[0]) * (p[2] - p[0])));
+}
+
+static piola_render_frame *deformed_frame(const double F[3][3], bool with_displacement,
+                                          double solid_index) {
+  piola_tet_mesh m = cube_grid(2, 0.1);
+  double *rest = malloc(3 * (size_t)m.vertex_count * sizeof(double));
+  double *disp = malloc(3 * (size_t)m.vertex_count * sizeof(double));
+  double *solid = malloc((size_t)m.tet_count * sizeof(double));
+  for (int32_t v = 0; v < m.vertex_count; ++v) {
+    double *x = m.positions + 3 * (size_t)v, X[3] = {x[0], x[1], x[2]};
+    for (int i = 0; i < 3; ++i) {
+      rest[3 * v + i] = X[i];
+      x[i] = F[i][0] * X[0] + F[i][1] * X[1] + F[i][2] * X[2] + 0.3 * i;
+      disp[3 * v + i] = x[i] - X[i];
+    }
+  }
+  for (int32_t t = 0; t < m.tet_count; ++t) solid[t] = solid_index;
+  piola_vtu_field points[1] = {{"displacement", 3, disp}};
+  piola_vtu_field cells[1] = {{"solid", 1, solid}};
+  piola_vtu_frame frame = {.tets = &m,
+                           .point_fields = points,
+                           .point_field_count = with_displacement ? 1 : 0,
+                           .cell_fields = cells,
+                           .cell_field_count = 1};
+  char path[512];
+  snprintf(path, sizeof path, "%s/stress.vtu", folder);
+  assert_int_equal(piola_vtu_write(path, &frame), PIOLA_OK);
+  piola_render_frame *f;
+  assert_int_equal(piola_render_frame_read(path, &f), PIOLA_OK);
+  free(rest), free(disp), free(solid);
+  piola_tet_mesh_free(&m);
+  return f;
+}
+
+static void test_stress_from_displacements(void **state) {
+  (void)state;
+  piola_material_def mats[2] = {piola_default_material_def(), piola_default_material_def()};
+  mats[1].model = PIOLA_MODEL_NEOHOOKEAN;
+  mats[1].youngs_modulus = 3e6;
+  const double c = cos(0.7), s = sin(0.7);
+  /* stretch 1.2 along x, squash 0.9 along z, then a rotation about z */
+  const double cases[3][3][3] = {{{1.2, 0, 0}, {0, 1, 0}, {0, 0, 0.9}},
+                                 {{1.2 * c, -s, 0}, {1.2 * s, c, 0}, {0, 0, 0.9}},
+                                 {{-1.2, 0, 0}, {0, 1, 0}, {0, 0, 0.9}}}; /* mirrored: inverted */
+  for (int which = 0; which < 2; ++which)
+    for (int k = 0; k < 3; ++k) {
+      piola_render_frame *f = deformed_frame(cases[k], true, which);
+      assert_true(piola_render_frame_has_rest_positions(f));
+      assert_int_equal(piola_render_frame_add_stress(f, mats, 2), PIOLA_OK);
+      assert_true(piola_render_frame_has_field(f, "von_mises_stress"));
+      piola_render_mesh rm;
+      assert_int_equal(piola_render_frame_mesh(f, "von_mises_stress", 0, &rm), PIOLA_OK);
+      double expected = k < 2 ? von_mises_of(&mats[which], 1.2, 1, 0.9) : NAN;
+      for (int32_t t = 0; t < rm.triangle_count; ++t) {
+        assert_true(isfinite(rm.values[t]) && rm.values[t] > 0);
+        if (k < 2)
+          assert_close(rm.values[t], expected, 1e-9 * expected);
+        else
+          assert_close(rm.values[t], rm.values[0], 1e-9 * rm.values[0]); /* homogeneous */
+      }
+      if (k == 2) assert_int_equal(piola_render_frame_inverted_count(f), 48);
+      piola_render_frame_destroy(f);
+    }
+  /* the two materials differ, so the index matters */
+  assert_true(fabs(von_mises_of(&mats[0], 1.2, 1, 0.9) - von_mises_of(&mats[1], 1.2, 1, 0.9)) >
+              1e3);
+  piola_render_frame *f = deformed_frame(cases[0], false, 0);
+  assert_false(piola_render_frame_has_rest_positions(f));
+  assert_int_equal(piola_render_frame_add_stress(f, mats, 2), PIOLA_ERROR_INVALID_ARGUMENT);
+  piola_render_frame_destroy(f);
+  f = deformed_frame(cases[0], true, 1);
+  assert_int_equal(piola_render_frame_add_stress(f, mats, 1), PIOLA_ERROR_INVALID_ARGUMENT);
+  piola_render_frame_destroy(f);
+}
+
+/* Materials come from a scene's solids, in order (only the parser runs: mesh files need not
+ * exist). */
+static void test_scene_materials(void **state) {
+  (void)state;
+  char path[512];
+  snprintf(path, sizeof path, "%s/scene.json", folder);
+  FILE *out = fopen(path, "w");
+  fputs(
+      "{\"solids\": [{\"mesh\": \"missing.msh\", \"material\": {\"youngs_modulus\": 2e5}},\n"
+      " {\"mesh\": \"other.msh\", \"material\": {\"model\": \"neohookean\", \"youngs_modulus\": "
+      "7e6, "
+      "\"poisson_ratio\": 0.45}}]}\n",
+      out);
+  fclose(out);
+  piola_material_def mats[4];
+  int32_t n = -1;
+  assert_int_equal(piola_render_scene_materials(path, mats, 4, &n), PIOLA_OK);
+  assert_int_equal(n, 2);
+  assert_close(mats[0].youngs_modulus, 2e5, 0);
+  assert_close(mats[1].youngs_modulus, 7e6, 0);
+  assert_close(mats[1].poisson_ratio, 0.45, 0);
+  assert_int_equal(mats[1].model, PIOLA_MODEL_NEOHOOKEAN);
+  assert_int_equal(piola_render_scene_materials("/nonexistent/scene.json", mats, 4, &n),
+                   PIOLA_ERROR_IO);
+}
+
 static void test_truncated_and_foreign_files_fail_cleanly(void **state) {
   (void)state;
   piola_tet_mesh m = cube_grid(1, 0.1);
@@ -287,6 +399,8 @@ int main(void) {
       cmocka_unit_test(test_boundary_of_cube_grids),
       cmocka_unit_test(test_inverted_colouring_follows_the_frame),
       cmocka_unit_test(test_triangle_cells_are_drawn),
+      cmocka_unit_test(test_stress_from_displacements),
+      cmocka_unit_test(test_scene_materials),
       cmocka_unit_test(test_truncated_and_foreign_files_fail_cleanly),
       cmocka_unit_test(test_png_round_trip_and_contact_sheet),
   };

@@ -27,6 +27,7 @@
 #include <stdint.h>
 
 #include "piola/export.h"
+#include "piola/material.h"
 #include "piola/math_types.h"
 #include "piola/obstacle.h"
 #include "piola/status.h"
@@ -151,6 +152,24 @@ PIOLA_API piola_status piola_render_frame_mesh(const piola_render_frame *frame,
 PIOLA_API bool piola_render_frame_has_field(const piola_render_frame *frame, const char *name);
 /* Number of inverted elements (tets and triangles) in the frame. */
 PIOLA_API int32_t piola_render_frame_inverted_count(const piola_render_frame *frame);
+/* Whether the frame has a `displacement` point field, so rest positions are known. */
+PIOLA_API bool piola_render_frame_has_rest_positions(const piola_render_frame *frame);
+/* Adds the per-cell field "von_mises_stress" (Pa): the von Mises equivalent
+ * sqrt(((P1 - P2)^2 + (P2 - P3)^2 + (P3 - P1)^2) / 2) of the principal first Piola-Kirchhoff
+ * stresses of each tet, from its deformation gradient (rest positions are the points minus
+ * the frame's `displacement` point field) and the material of its solid: materials[s] for
+ * the tets whose `solid` cell field is s (0 without that field). Finite for flat and inverted
+ * tets. A frame knows no plastic flow or keyframed stiffness: for such solids this is the
+ * stress of the total deformation at unit stiffness scale. Triangle cells get 0.
+ * PIOLA_ERROR_INVALID_ARGUMENT without a displacement field or when a solid has no material. */
+PIOLA_API piola_status piola_render_frame_add_stress(piola_render_frame *frame,
+                                                     const piola_material_def *materials,
+                                                     int32_t material_count);
+/* The materials of a scene file's solids, in order: the first `capacity` are written to
+ * materials and *count receives the number of solids. Only the parser runs. */
+PIOLA_API piola_status piola_render_scene_materials(const char *scene_path,
+                                                    piola_material_def *materials, int32_t capacity,
+                                                    int32_t *count);
 /* Bounding box of the frame's points, m. */
 PIOLA_API void piola_render_frame_bounds(const piola_render_frame *frame, piola_vec3 *lo,
                                          piola_vec3 *hi);

@@ -170,14 +170,23 @@ static void loaded_free(loaded_frame *lf) {
   memset(lf, 0, sizeof *lf);
 }
 
-/* Loads frame f (VTU or OBJ) and its mesh with the value field (may be NULL). */
+/* Materials of the scene's solids, when stresses are computed from the frames. */
+typedef struct stress_source {
+  piola_material_def materials[256];
+  int32_t count; /* 0: the frames are not given a stress field */
+} stress_source;
+
+/* Loads frame f (VTU or OBJ) and its mesh with the value field (may be NULL), computing the
+ * von_mises_stress field first when stress has materials. */
 static int load_frame(const char *dir, bool vtu, int f, const char *field, double time,
-                      loaded_frame *lf) {
+                      const stress_source *stress, loaded_frame *lf) {
   char path[4200];
   memset(lf, 0, sizeof *lf);
   if (vtu) {
     snprintf(path, sizeof path, "%s/frames/frame_%04d.vtu", dir, f);
     if (piola_render_frame_read(path, &lf->vtu) != PIOLA_OK ||
+        (stress && stress->count > 0 &&
+         piola_render_frame_add_stress(lf->vtu, stress->materials, stress->count) != PIOLA_OK) ||
         piola_render_frame_mesh(lf->vtu, field, time, &lf->mesh) != PIOLA_OK) {
       fprintf(stderr, "piola render: %s\n", piola_last_error());
       loaded_free(lf);
@@ -483,6 +492,16 @@ int cli_render(int argc, char **argv) {
   }
   /* Sample up to 16 frames (first and last included) for the camera's box and the colour
    * range, so the view and the colours hold still through the movie. */
+  /* the scene (obstacles, and materials for stresses): --scene FILE, else the copy `piola run`
+   * leaves in DIR */
+  char scene_path[4200];
+  if (scene)
+    snprintf(scene_path, sizeof scene_path, "%s", scene);
+  else
+    snprintf(scene_path, sizeof scene_path, "%s/scene.json", dir);
+  bool use_scene = scene || is_file(scene_path);
+  static stress_source stress;
+  stress.count = 0;
   piola_vec3 lo = {INFINITY, INFINITY, INFINITY}, hi = {-INFINITY, -INFINITY, -INFINITY};
   double vmax = -INFINITY, vmin = INFINITY;
   int samples = count < 16 ? count : 16;
@@ -490,25 +509,48 @@ int cli_render(int argc, char **argv) {
     int idx = samples > 1 ? (int)((long)s * (count - 1) / (samples - 1)) : 0;
     loaded_frame lf;
     if (s == 0 && strcmp(color, "stress") == 0 && !field) {
-      if (load_frame(dir, vtu, frames[idx], NULL, 0, &lf) != 0) {
+      if (load_frame(dir, vtu, frames[idx], NULL, 0, NULL, &lf) != 0) {
         rc = 2;
         break;
       }
       static const char *const names[] = {"von_mises_stress", "von_mises", "stress"};
       for (int k = 0; k < 3 && !value_field; ++k)
         if (piola_render_frame_has_field(lf.vtu, names[k])) value_field = names[k];
+      bool has_displacement = lf.vtu && piola_render_frame_has_rest_positions(lf.vtu);
       loaded_free(&lf);
       if (!value_field) {
-        fprintf(stderr,
-                "piola render: the frames have no stress field (von_mises_stress, von_mises or "
-                "stress); "
-                "use --color energy, or --field NAME for another cell field\n");
-        rc = 2;
-        break;
+        /* compute it from the frames' displacements and the scene's materials */
+        int32_t n = 0;
+        if (!use_scene) {
+          fprintf(stderr,
+                  "piola render: stress colouring needs the scene's materials: %s/scene.json is "
+                  "missing, give --scene FILE\n",
+                  dir);
+          rc = 2;
+          break;
+        }
+        if (!has_displacement) {
+          fprintf(stderr,
+                  "piola render: the frames have neither a stress field nor displacements; "
+                  "use --color energy\n");
+          rc = 2;
+          break;
+        }
+        if (piola_render_scene_materials(scene_path, stress.materials, 256, &n) != PIOLA_OK ||
+            n < 1 || n > 256) {
+          fprintf(stderr, "piola render: materials for stress colouring: %s\n",
+                  n > 256 ? "more than 256 solids"
+                  : n < 1 ? "the scene has no solids"
+                          : piola_last_error());
+          rc = 2;
+          break;
+        }
+        stress.count = n;
+        value_field = "von_mises_stress";
       }
       snprintf(label, sizeof label, "STRESS (PA)");
     }
-    if (load_frame(dir, vtu, frames[idx], value_field, 0, &lf) != 0) {
+    if (load_frame(dir, vtu, frames[idx], value_field, 0, &stress, &lf) != 0) {
       rc = 2;
       break;
     }
@@ -537,13 +579,6 @@ int cli_render(int argc, char **argv) {
   }
   if (!(lo.x <= hi.x)) lo = hi = (piola_vec3){0, 0, 0}; /* empty surfaces */
 
-  /* obstacles: --scene FILE, else the copy `piola run` leaves in DIR */
-  char scene_path[4200];
-  if (scene)
-    snprintf(scene_path, sizeof scene_path, "%s", scene);
-  else
-    snprintf(scene_path, sizeof scene_path, "%s/scene.json", dir);
-  bool use_scene = scene || is_file(scene_path);
   /* camera: the automatic one, with whatever the flags set replacing its parts */
   piola_renderer *r = NULL;
   for (int pass = 0; pass < 2; ++pass) {
@@ -601,7 +636,7 @@ int cli_render(int argc, char **argv) {
     if (i == 0) first_time = t;
     if (i == 1) first_gap_time = t - first_time;
     loaded_frame lf;
-    if (load_frame(dir, vtu, frames[i], value_field, t, &lf) != 0) {
+    if (load_frame(dir, vtu, frames[i], value_field, t, &stress, &lf) != 0) {
       rc = 1;
       break;
     }

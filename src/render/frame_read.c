@@ -24,31 +24,11 @@ typedef struct vtu_array {
   int section; /* 0 point data, 1 cell data, 2 points, 3 cells */
 } vtu_array;
 
-typedef struct cell_field {
-  char name[64];
-  double *values; /* per cell */
-} cell_field;
-
-struct piola_render_frame {
-  int64_t point_count, cell_count;
-  double *points;
-  int32_t *surface;      /* 3 * surface_count vertex indices */
-  int32_t *surface_cell; /* owning cell of each face */
-  int32_t surface_count;
-  uint8_t *cell_inverted;
-  int32_t inverted_count;
-  cell_field *fields;
-  int field_count;
-  /* filled per call of piola_render_frame_mesh */
-  uint8_t *face_inverted;
-  double *face_values;
-  int32_t *face_parts;
-};
-
 void piola_render_frame_destroy(piola_render_frame *f) {
   if (!f) return;
   for (int i = 0; i < f->field_count; ++i) free(f->fields[i].values);
   free(f->fields), free(f->points), free(f->surface), free(f->surface_cell), free(f->cell_inverted);
+  free(f->rest), free(f->tets), free(f->tet_cell);
   free(f->face_inverted), free(f->face_values), free(f->face_parts);
   free(f);
 }
@@ -331,7 +311,7 @@ static piola_status parse(piola_render_frame *f, const char *buf, size_t size, c
       break;
     }
     vp = base + a->offset + header_bytes;
-    cell_field *grown = realloc(f->fields, (size_t)(f->field_count + 1) * sizeof *grown);
+    render_cell_field *grown = realloc(f->fields, (size_t)(f->field_count + 1) * sizeof *grown);
     double *values = malloc((size_t)(f->cell_count > 0 ? f->cell_count : 1) * sizeof *values);
     if (grown) f->fields = grown;
     if (!grown || !values) {
@@ -358,6 +338,49 @@ static piola_status parse(piola_render_frame *f, const char *buf, size_t size, c
       f->cell_inverted[c] = flag;
       f->inverted_count += flag;
     }
+  }
+  /* the tets (for stresses) and the rest positions, when the frame has displacements */
+  if (st == PIOLA_OK) {
+    int64_t nt = 0;
+    for (int64_t c = 0; c < f->cell_count; ++c) nt += type_v[c] == 10;
+    f->tets = malloc(4 * (size_t)(nt > 0 ? nt : 1) * sizeof *f->tets);
+    f->tet_cell = malloc((size_t)(nt > 0 ? nt : 1) * sizeof *f->tet_cell);
+    if (!f->tets || !f->tet_cell)
+      st = PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "%s: out of memory", path);
+    for (int64_t c = 0; st == PIOLA_OK && c < f->cell_count; ++c)
+      if (type_v[c] == 10) {
+        for (int k = 0; k < 4; ++k)
+          f->tets[4 * (size_t)f->tet_count + (size_t)k] = (int32_t)conn_v[offsets[c] - 4 + k];
+        f->tet_cell[f->tet_count++] = (int32_t)c;
+      }
+  }
+  for (int i = 0; st == PIOLA_OK && i < na; ++i) {
+    vtu_array *a = &arrays[i];
+    if (a->section != 0 || a->components != 3 || strcmp(a->type, "Float64") != 0 ||
+        strcmp(a->name, "displacement") != 0)
+      continue;
+    const char *vp = NULL;
+    uint64_t bytes = 0;
+    if (a->offset > (uint64_t)(end - base) ||
+        (uint64_t)(end - base) - a->offset < (uint64_t)header_bytes) {
+      st = PIOLA_FAIL(PIOLA_ERROR_PARSE, "%s: array '%s' lies past the end of the file", path,
+                      a->name);
+      break;
+    }
+    memcpy(&bytes, base + a->offset, (size_t)header_bytes);
+    if (bytes != 24 * (uint64_t)f->point_count ||
+        bytes > (uint64_t)(end - base) - a->offset - header_bytes) {
+      st = PIOLA_FAIL(PIOLA_ERROR_PARSE, "%s: point field '%s' has the wrong size", path, a->name);
+      break;
+    }
+    vp = base + a->offset + header_bytes;
+    f->rest = malloc(3 * (size_t)(f->point_count > 0 ? f->point_count : 1) * sizeof *f->rest);
+    if (!f->rest) {
+      st = PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "%s: out of memory", path);
+      break;
+    }
+    memcpy(f->rest, vp, 3 * (size_t)f->point_count * sizeof *f->rest);
+    for (int64_t k = 0; k < 3 * f->point_count; ++k) f->rest[k] = f->points[k] - f->rest[k];
   }
   free(offsets), free(type_v), free(conn_v);
 #undef BLOCK

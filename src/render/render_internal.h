@@ -126,6 +126,32 @@ int piola__render_text_width(const char *text, int scale);
 void piola__render_fill_rect(piola_image *image, int x0, int y0, int w, int h, uint8_t r, uint8_t g,
                              uint8_t b);
 
+/* A frame read from a VTU file (frame_read.c). */
+typedef struct render_cell_field {
+  char name[64];
+  double *values; /* per cell */
+} render_cell_field;
+
+struct piola_render_frame {
+  int64_t point_count, cell_count;
+  double *points;    /* 3 * point_count, m */
+  double *rest;      /* 3 * point_count rest positions (points - displacement), or NULL */
+  int32_t *tets;     /* 4 * tet_count vertex indices */
+  int32_t *tet_cell; /* cell index of each tet */
+  int32_t tet_count;
+  int32_t *surface;      /* 3 * surface_count vertex indices */
+  int32_t *surface_cell; /* owning cell of each face */
+  int32_t surface_count;
+  uint8_t *cell_inverted;
+  int32_t inverted_count;
+  render_cell_field *fields;
+  int field_count;
+  /* filled per call of piola_render_frame_mesh */
+  uint8_t *face_inverted;
+  double *face_values;
+  int32_t *face_parts;
+};
+
 /* Allocates (or reuses) image storage for width x height. */
 piola_status piola__image_resize(piola_image *image, int32_t width, int32_t height);
 

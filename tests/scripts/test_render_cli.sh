@@ -2,7 +2,7 @@
 # `piola run` leaves a preview (DIR/preview.png, DIR/scene.json, and with --render one PNG per
 # frame); `piola render DIR` writes PNGs of the requested size, a contact sheet and an MP4
 # that ffprobe decodes to exactly one frame per PNG; --every thins both; obstacles from the
-# scene copy are drawn; the inverted colouring shows red exactly for a frame with inverted
+# scene copy are drawn; stress colouring works with the scene; the inverted colouring shows red exactly for a frame with inverted
 # tets (pixels decoded by ffmpeg, an independent PNG reader); bad input exits 2.
 set -euo pipefail
 : "${PIOLA:?path of the piola program}"
@@ -82,8 +82,12 @@ if command -v ffmpeg >/dev/null; then
   [[ $(red_pixels "$work/mirror/render/frame_0000.png") -eq 0 ]] || fail "plain colouring shows red"
 fi
 
-# energy colouring works; stress needs a field the frames do not have
+# energy colouring works; stress is computed from the displacements and the scene's
+# materials, so it needs the scene
 "$PIOLA" render "$out" --width 160 --height 120 --no-movie --color energy >/dev/null 2>&1 || fail "--color energy"
+"$PIOLA" render "$out" --width 160 --height 120 --no-movie --color stress --scene "$work/tiny.json" >"$work/log" 2>&1 ||
+  { cat "$work/log"; fail "--color stress --scene"; }
+rm -f "$out/scene.json"
 expect2() {
   set +e
   "$PIOLA" render "$@" >"$work/log" 2>&1

@@ -615,7 +615,15 @@ int cli_render(int argc, char **argv) {
     free(frames), free(pvd);
     return 1;
   }
+  /* this command's earlier outputs go, so the folder matches what it writes now */
   remove_old_pngs(render_dir);
+  {
+    char old[4400];
+    snprintf(old, sizeof old, "%s/contact_sheet.png", render_dir);
+    unlink(old);
+    snprintf(old, sizeof old, "%s/movie.mp4", render_dir);
+    unlink(old);
+  }
 
   int sheet_count = sheet ? (count < sheet_frames ? count : (int)sheet_frames) : 0;
   piola_image *sheet_images =

@@ -50,6 +50,7 @@ fi
 # --every 2: frames 0 and 2 only; the earlier PNGs are gone
 "$PIOLA" render "$out" --width 160 --height 120 --every 2 >"$work/log" 2>&1 || { cat "$work/log"; fail "--every 2"; }
 pngs=$(cd "$out/render" && ls frame_*.png | tr '\n' ' ')
+[[ ! -e "$out/render/contact_sheet.png" ]] || fail "a stale contact sheet was kept"
 [[ $pngs == "frame_0000.png frame_0002.png " ]] || fail "--every 2 left: $pngs"
 if command -v ffprobe >/dev/null; then
   n=$(frames_in "$out/render/movie.mp4")

@@ -452,6 +452,44 @@ static void test_shadow_of_a_sphere_on_the_ground(void **state) {
   test_sphere_free(&s);
 }
 
+/* Antialiasing is exactly the average (rounded) of s x s blocks of a render s times the
+ * size, so it inherits that render's geometry; s out of 1..4 is refused. */
+static void test_supersampling_averages_a_larger_render(void **state) {
+  (void)state;
+  piola_render_def def = axis_camera(3, 40);
+  def.width = 240, def.height = 180;
+  test_sphere s = test_uv_sphere(128, 64, 0.5, 0, 0, 0);
+  piola_render_mesh m = sphere_mesh(&s);
+  piola_render_def big_def = def;
+  big_def.width *= 2, big_def.height *= 2;
+  def.supersample = 2;
+  piola_image aa = {0}, big = {0};
+  piola_renderer *r;
+  assert_int_equal(piola_renderer_create(&def, &r), PIOLA_OK);
+  assert_int_equal(piola_renderer_render(r, &m, &aa), PIOLA_OK);
+  piola_renderer_destroy(r);
+  assert_int_equal(piola_renderer_create(&big_def, &r), PIOLA_OK);
+  assert_int_equal(piola_renderer_render(r, &m, &big), PIOLA_OK);
+  piola_renderer_destroy(r);
+  assert_int_equal(aa.width, 240);
+  assert_int_equal(aa.height, 180);
+  for (int y = 0; y < aa.height; ++y)
+    for (int x = 0; x < aa.width; ++x)
+      for (int c = 0; c < 3; ++c) {
+        unsigned sum = 0;
+        for (int k = 0; k < 4; ++k)
+          sum +=
+              big.rgb[3 * ((size_t)(2 * y + k / 2) * (size_t)big.width + (size_t)(2 * x + k % 2)) +
+                      c];
+        assert_int_equal(aa.rgb[3 * ((size_t)y * (size_t)aa.width + (size_t)x) + c], (sum + 2) / 4);
+      }
+  def.supersample = 5;
+  assert_int_equal(piola_renderer_create(&def, &r), PIOLA_ERROR_INVALID_ARGUMENT);
+  piola_image_free(&aa);
+  piola_image_free(&big);
+  test_sphere_free(&s);
+}
+
 /* Same input, same bytes, for 1 and 2 threads and on a repeat. */
 static void test_deterministic_for_any_thread_count(void **state) {
   (void)state;
@@ -538,6 +576,7 @@ int main(void) {
       cmocka_unit_test(test_auto_camera_frames_the_object),
       cmocka_unit_test(test_mesh_and_moving_obstacles),
       cmocka_unit_test(test_shadow_of_a_sphere_on_the_ground),
+      cmocka_unit_test(test_supersampling_averages_a_larger_render),
       cmocka_unit_test(test_deterministic_for_any_thread_count),
       cmocka_unit_test(test_bad_arguments_are_refused),
   };

@@ -83,6 +83,8 @@ typedef struct piola_render_def {
   bool ground;          /* Default true */
   double ground_height; /* m along `up`. Default 0 */
   bool shadows;         /* the surfaces cast shadows on the ground. Default true */
+  int32_t supersample;  /* 1..4: antialiasing by rendering s x s samples per pixel and
+                           averaging them (s^2 times the cost). Default 1 */
   /* Colour-map range of PIOLA_RENDER_COLOR_VALUE; value_min >= value_max chooses the range
    * from each frame's values (0 to their 99th percentile). */
   double value_min, value_max;

@@ -29,14 +29,18 @@
  * 20 times per elastic update, so the work is split. Once per update (lazily, on the first
  * damping call after it) each tet's record is prepared: the rotation Q = U V^T (the stress
  * needs only it: U Phat(U^T Fdot V) V^T = beta (Fdot + Q Fdot^T Q) + alpha tr(Q^T Fdot) Q),
- * the corner offsets from the centroid r_1..r_3 (r_0 = -(r_1 + r_2 + r_3)), the 6 entries of
- * (R^T R + eps I)^-1 and sqrt(V0) Dm^-1 (V0 split evenly between the two sides keeps the
- * operator symmetric in rounding too). The apply then streams 33 doubles per tet, blocked by
- * PIOLA_TET_BLOCK lanes like the force buffer, through branch-free straight-line code that
- * the compiler vectorizes across the lanes. Both projections are written in terms of the
- * edge vectors: R^T y = sum_j r_j x (y_j - y_0), and for forces g with g_0 = -sum g_j,
- * R^T g = sum_j (r_j - r_0) x g_j. A scalar reference of the original per-tet formulation
- * (piola__elastic_body_damping_reference) is kept for the tests. */
+ * the corner offsets from the centroid r_1..r_3 (r_0 = -(r_1 + r_2 + r_3)) and sqrt(V0) Dm^-1
+ * (V0 split evenly between the two sides keeps the operator symmetric in rounding too). The
+ * apply is bound by memory traffic, not arithmetic, so the record is small (144 bytes, see
+ * the layout below) and (R^T R + eps I)^-1 is recomputed from r in the apply rather than
+ * stored. The apply runs branch-free straight-line code vectorized across blocks of
+ * PIOLA_TET_BLOCK tets, then adds each block's forces straight into per-vertex sums: one of
+ * PIOLA_DAMPING_CHUNKS partial-sum arrays per fixed range of tets, added in chunk order at
+ * the end, so the result is the same for any thread count without the elastic loop's
+ * per-tet buffer (writing and re-reading it was half of the traffic). Both projections are
+ * written in terms of the edge vectors: R^T y = sum_j r_j x (y_j - y_0), and for forces g
+ * with g_0 = -sum g_j, R^T g = sum_j (r_j - r_0) x g_j. A scalar reference of the original
+ * per-tet formulation (piola__elastic_body_damping_reference) is kept for the tests. */
 #include <math.h>
 
 #include "force/elastic_body_internal.h"

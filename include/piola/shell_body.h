@@ -15,11 +15,12 @@
  * gradient of the signed dihedral angle theta, with magnitude proportional to
  * sin(theta/2) - sin(theta0/2). The geometric weight |e|^2 / (|N1| + |N2|) is taken at rest,
  * which makes the force exactly -grad of the energy
- *     E = 3 D |e0|^2 / (A1 + A2) * (Phi(theta) - Phi(theta0)),
+ *     E = D w (Phi(theta) - Phi(theta0)),  w = 2 |e0|^2 / (A1 + A2),
  *     Phi(theta) = -2 cos(theta / 2) - theta sin(theta0 / 2),
- * with D the flexural rigidity (N m). For small angles E ~ 3/4 D |e0|^2/(A1+A2) (theta -
- * theta0)^2, which on an equilateral mesh bent into a cylinder of curvature k gives D/2 k^2
- * per unit area, the plate energy. See docs/shells.md.
+ * with D the flexural rigidity (N m). For small angles E ~ D |e0|^2/(2 (A1+A2)) (theta -
+ * theta0)^2; the factor 2 in w is calibrated so that an equilateral mesh bent into a
+ * cylinder of curvature k in any direction has D k^2 / 2 per unit area, the plate energy
+ * (tested). See docs/shells.md.
  *
  * Forces are computed in parallel with OpenMP and are bit-for-bit identical whatever the
  * number of threads (per-element buffers gathered per vertex in a fixed order).
@@ -180,7 +181,7 @@ PIOLA_API piola_status piola_shell_body_update(piola_shell_body *body, const dou
  * gradients of the last update: in-plane, Phat = beta (A + A^T) + alpha tr(A) I with
  * A = U^T Fdot V (2x2; shear viscosity beta and bulk viscosity alpha in Pa s), and for
  * each hinge -(damping * w / 2) (grad theta . v) grad theta with the hinge's rest weight
- * w = 3 |e0|^2 / (A1 + A2). Linear in v, symmetric, dissipative. forces (N) overwritten. */
+ * w = 2 |e0|^2 / (A1 + A2). Linear in v, symmetric, dissipative. forces (N) overwritten. */
 PIOLA_API void piola_shell_body_damping_forces(const piola_shell_body *body, const double *v,
                                                double shear_viscosity, double bulk_viscosity,
                                                double *forces);

@@ -14,8 +14,8 @@
  *
  * Energy: w D (Phi(theta) - Phi(theta0)) with Phi(theta) = -2 cos(theta/2) - theta
  * sin(theta0/2), so the force is -w D (sin(theta/2) - sin(theta0/2)) grad theta: BMF03's
- * magnitude with the geometric weight |e|^2/(|N1| + |N2|) taken at rest (as w = 3 |e0|^2 /
- * (A1 + A2)). Freezing the weight is what makes the force exactly conservative; with it
+ * magnitude with the geometric weight |e|^2/(|N1| + |N2|) taken at rest (as w = 2 |e0|^2 /
+ * (A1 + A2), calibrated against the plate energy, docs/shells.md). Freezing the weight is what makes the force exactly conservative; with it
  * varying, the BMF03 force is not the gradient of anything. See docs/shells.md. */
 #include <math.h>
 #include <string.h>

@@ -310,7 +310,8 @@ piola_status piola__shell_body_build(piola_shell_body *body, const piola_shell_b
     }
     double a1 = tri_area(p[0], p[2], p[3]), a2 = tri_area(p[1], p[2], p[3]);
     vec3 e = vec3_sub(vec3_load(p[3]), vec3_load(p[2]));
-    hg->weight = 3.0 * vec3_dot(e, e) / (a1 + a2);
+    /* 2, not BMF03's 1/2 (|N| = 2 A): calibrated so that D is the plate's flexural rigidity */
+    hg->weight = 2.0 * vec3_dot(e, e) / (a1 + a2);
     hg->rest_angle = piola__hinge_angle(p[0], p[1], p[2], p[3], hg->grad);
     hg->angle = hg->rest_angle;
     body->rest_angles[h] = body->angles[h] = hg->rest_angle;

@@ -42,7 +42,7 @@ typedef struct shell_triangle {
 
 typedef struct shell_hinge {
   int32_t v[4];          /* x1, x2 opposite corners; x3 -> x4 the edge */
-  double weight;         /* w = 3 |e0|^2 / (A1 + A2), dimensionless */
+  double weight;         /* w = 2 |e0|^2 / (A1 + A2), dimensionless */
   double rest_angle;     /* theta0, rad */
   /* state of the last update */
   double angle;          /* theta, rad */

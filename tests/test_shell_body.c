@@ -331,7 +331,8 @@ static void triangles_inverted_against_reference_are_pushed_back(void **state) {
 
 static void forces_do_not_depend_on_thread_count(void **state) {
   (void)state;
-  piola_tri_mesh mesh = shell_sheet(1.0, 1.0, 30, 30);
+  /* large enough that every loop runs in parallel (small bodies run on one thread) */
+  piola_tri_mesh mesh = shell_sheet(1.0, 1.0, 70, 70);
   int n = mesh.vertex_count;
   double *x = malloc(sizeof(double) * 3 * n), *f1 = malloc(sizeof(double) * 3 * n),
          *f2 = malloc(sizeof(double) * 3 * n);

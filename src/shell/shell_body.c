@@ -12,6 +12,10 @@
 #include "piola/diagonalize.h"
 #include "shell/shell_body_internal.h"
 
+/* Bodies smaller than this many elements run their loops on one thread: waking a team
+ * costs more than the work (a 200-triangle cloth step is a few microseconds). */
+#define SHELL_PARALLEL_MIN_ELEMENTS 4096
+
 /* A triangle whose signed fhat[1] is below this counts as degenerate in the statistics. */
 #define DEGENERATE_FHAT 1e-3
 
@@ -107,7 +111,8 @@ void piola__shell_body_gather(const piola_shell_body *body, double *forces) {
   const int32_t *ts = body->tri_start, *ti = body->tri_incidence;
   const int32_t *hs = body->hinge_start, *hi = body->hinge_incidence;
   const double *tf = body->triangle_forces, *hf = body->hinge_forces;
-#pragma omp parallel for schedule(static) num_threads(piola__thread_count())
+#pragma omp parallel for schedule(static) num_threads(piola__thread_count()) \
+    if (body->vertex_count > SHELL_PARALLEL_MIN_ELEMENTS)
   for (int32_t i = 0; i < body->vertex_count; ++i) {
     double fx = 0, fy = 0, fz = 0;
     for (int32_t e = ts[i]; e < ts[i + 1]; ++e) {
@@ -214,7 +219,7 @@ piola_status piola_shell_body_update(piola_shell_body *body, const double *x,
       return PIOLA_FAIL(PIOLA_ERROR_NOT_FINITE, "position of shell vertex %d is not finite",
                         (int)(i / 3));
   const int threads = piola__thread_count();
-#pragma omp parallel num_threads(threads)
+#pragma omp parallel num_threads(threads) if (body->triangle_count > SHELL_PARALLEL_MIN_ELEMENTS)
   {
 #pragma omp for schedule(static) nowait
     for (int32_t t = 0; t < body->triangle_count; ++t) update_triangle(body, x, stiffness_scale, t);
@@ -299,7 +304,8 @@ void piola_shell_body_damping_forces(const piola_shell_body *body, const double 
   /* the per-element buffers are scratch shared with the update: one call at a time per body */
   piola_shell_body *b = (piola_shell_body *)body;
   const double eta = body->bending.damping;
-#pragma omp parallel num_threads(piola__thread_count())
+#pragma omp parallel num_threads(piola__thread_count()) \
+    if (body->triangle_count > SHELL_PARALLEL_MIN_ELEMENTS)
   {
 #pragma omp for schedule(static) nowait
     for (int32_t t = 0; t < body->triangle_count; ++t)

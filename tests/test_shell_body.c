@@ -6,7 +6,9 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "piola/diagonalize.h"
 #include "piola/elastic_body.h"
+#include "shell/svd3x2.h"
 #include "test_shell_fixtures.h"
 
 static void rest_state_of_a_sheet(void **state) {
@@ -115,6 +117,53 @@ static void membrane_is_plane_stress_near_rest(void **state) {
     piola_membrane_stress(&material, f, p);
     assert_close(p[0], 1e5 * eps, 1e5 * eps * 1e-4);
     assert_close(p[1], 0.0, 1e5 * eps * 1e-4);
+  }
+}
+
+/* The force loop's closed-form 3x2 diagonalization: F = U diag(fhat) V^T, U^T U = I,
+ * V a rotation, fhat sorted and equal to the robust public one's, for well-shaped, thin
+ * (fast path) and collapsed (fallback) F at scales from 1e-8 to 1e8. */
+static void fast_svd3x2_matches_the_robust_one(void **state) {
+  (void)state;
+  test_rng rng = test_rng_seeded(41);
+  long samples = test_samples(20000, 200);
+  for (long s = 0; s < samples; ++s) {
+    double f[3][2];
+    for (int i = 0; i < 3; ++i)
+      for (int j = 0; j < 2; ++j) f[i][j] = test_rng_normal(&rng);
+    int kind = (int)(s % 4);
+    if (kind >= 1) { /* second column nearly parallel to the first */
+      double eps = kind == 1 ? 1e-3 : kind == 2 ? 1e-7 : 0.0;
+      for (int i = 0; i < 3; ++i) f[i][1] = 0.7 * f[i][0] + eps * f[i][1];
+    }
+    double scale = pow(10.0, test_rng_uniform(&rng, -8, 8));
+    for (int i = 0; i < 3; ++i)
+      for (int j = 0; j < 2; ++j) f[i][j] *= scale;
+    double u[6], v[4], fhat[2];
+    assert_int_equal(piola__svd3x2(f, u, fhat, v), 0);
+    double norm = 0;
+    for (int i = 0; i < 3; ++i)
+      for (int j = 0; j < 2; ++j) {
+        norm += f[i][j] * f[i][j];
+        double r = u[2 * i] * fhat[0] * v[2 * j] + u[2 * i + 1] * fhat[1] * v[2 * j + 1];
+        assert_close(r, f[i][j], 1e-13 * scale * 4);
+      }
+    for (int a = 0; a < 2; ++a)
+      for (int b = 0; b < 2; ++b) {
+        double dot = u[a] * u[b] + u[2 + a] * u[2 + b] + u[4 + a] * u[4 + b];
+        assert_close(dot, a == b ? 1.0 : 0.0, 1e-13);
+      }
+    assert_close(v[0] * v[3] - v[1] * v[2], 1.0, 1e-13);
+    assert_true(fhat[0] >= fhat[1] && fhat[1] >= 0);
+    piola_mat3x2 fm, um;
+    piola_mat2 vm;
+    double ref[2];
+    for (int i = 0; i < 3; ++i)
+      for (int j = 0; j < 2; ++j) fm.m[i][j] = f[i][j];
+    assert_int_equal(piola_diagonalize3x2(&fm, &um, ref, &vm), PIOLA_OK);
+    assert_close(fhat[0], ref[0], 1e-13 * ref[0]);
+    /* the small value to the accuracy F's rounding allows; relative where well separated */
+    assert_close(fhat[1], ref[1], 1e-13 * ref[0] + (kind == 0 ? 1e-12 * ref[1] : 0));
   }
 }
 
@@ -453,6 +502,7 @@ int main(void) {
       cmocka_unit_test(rest_state_of_a_sheet),
       cmocka_unit_test(generated_sheets_are_valid),
       cmocka_unit_test(membrane_stress_is_energy_derivative),
+      cmocka_unit_test(fast_svd3x2_matches_the_robust_one),
       cmocka_unit_test(membrane_is_plane_stress_near_rest),
       cmocka_unit_test(inplane_forces_are_energy_gradient),
       cmocka_unit_test(inplane_forces_are_invariant),

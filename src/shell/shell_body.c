@@ -11,6 +11,7 @@
 #include "math/mat3.h"
 #include "piola/diagonalize.h"
 #include "shell/shell_body_internal.h"
+#include "shell/svd3x2.h"
 
 /* Bodies smaller than this many elements run their loops on one thread: waking a team
  * costs more than the work (a 200-triangle cloth step is a few microseconds). */
@@ -152,18 +153,17 @@ static void update_triangle(piola_shell_body *body, const double *x, double scal
   double e1[3] = {x1[0] - x0[0], x1[1] - x0[1], x1[2] - x0[2]};
   double e2[3] = {x2[0] - x0[0], x2[1] - x0[1], x2[2] - x0[2]};
   const double *d = tri->dm_inv_eff;
-  piola_mat3x2 f;
+  double f[3][2];
   for (int i = 0; i < 3; ++i) {
-    f.m[i][0] = e1[i] * d[0] + e2[i] * d[2];
-    f.m[i][1] = e1[i] * d[1] + e2[i] * d[3];
+    f[i][0] = e1[i] * d[0] + e2[i] * d[2];
+    f[i][1] = e1[i] * d[1] + e2[i] * d[3];
   }
-  piola_mat3x2 u;
-  piola_mat2 v;
-  double fhat[2];
-  /* positions were checked finite, so this succeeds unless F overflows the double range */
-  if (piola_diagonalize3x2(&f, &u, fhat, &v) != PIOLA_OK) {
-    u = (piola_mat3x2){{{1, 0}, {0, 1}, {0, 0}}};
-    v = (piola_mat2){{{1, 0}, {0, 1}}};
+  double u[6], v[4], fhat[2];
+  /* positions were checked finite, so this fails only if F overflows the double range */
+  if (piola__svd3x2(f, u, fhat, v)) {
+    static const double u_identity[6] = {1, 0, 0, 1, 0, 0}, v_identity[4] = {1, 0, 0, 1};
+    memcpy(u, u_identity, sizeof u);
+    memcpy(v, v_identity, sizeof v);
     fhat[0] = fhat[1] = 0;
   }
   if (body->use_reference_normals) {
@@ -174,7 +174,7 @@ static void update_triangle(piola_shell_body *body, const double *x, double scal
            n2 = e1[0] * e2[1] - e1[1] * e2[0];
     if (n0 * tri->reference[0] + n1 * tri->reference[1] + n2 * tri->reference[2] < 0) {
       fhat[1] = -fhat[1];
-      for (int i = 0; i < 3; ++i) u.m[i][1] = -u.m[i][1];
+      for (int i = 0; i < 3; ++i) u[2 * i + 1] = -u[2 * i + 1];
     }
   }
   double p0, p1, psi;
@@ -183,12 +183,10 @@ static void update_triangle(piola_shell_body *body, const double *x, double scal
   p1 *= scale;
   double p[3][2];
   for (int i = 0; i < 3; ++i)
-    for (int j = 0; j < 2; ++j) p[i][j] = u.m[i][0] * p0 * v.m[j][0] + u.m[i][1] * p1 * v.m[j][1];
+    for (int j = 0; j < 2; ++j) p[i][j] = u[2 * i] * p0 * v[2 * j] + u[2 * i + 1] * p1 * v[2 * j + 1];
   triangle_nodal_forces(tri, p, body->triangle_forces + 9 * (size_t)t);
-  for (int i = 0; i < 3; ++i)
-    for (int j = 0; j < 2; ++j) tri->u[2 * i + j] = u.m[i][j];
-  for (int i = 0; i < 2; ++i)
-    for (int j = 0; j < 2; ++j) tri->vrot[2 * i + j] = v.m[i][j];
+  memcpy(tri->u, u, sizeof u);
+  memcpy(tri->vrot, v, sizeof v);
   tri->fhat[0] = body->fhat[2 * t] = fhat[0];
   tri->fhat[1] = body->fhat[2 * t + 1] = fhat[1];
   tri->energy_density = psi * scale;

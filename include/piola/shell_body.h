@@ -191,8 +191,8 @@ PIOLA_API void piola_shell_body_damping_forces(const piola_shell_body *body, con
  * triangles plus hinges that flowed. */
 PIOLA_API int32_t piola_shell_body_plastic_flow(piola_shell_body *body, double dt);
 
-/* Per-triangle values from the last update: signed Fhat (2 per triangle; fhat[1] < 0 for a
- * triangle inverted with respect to its reference normal) and energy density (J/m^3). */
+/* Signed Fhat of the last update, 2 per triangle (fhat[1] < 0 for a triangle inverted with
+ * respect to its reference normal). */
 PIOLA_API const double *piola_shell_body_fhat(const piola_shell_body *body);
 /* Plastic deformation Fp^-1 per triangle (4 per triangle, row-major 2x2). */
 PIOLA_API const double *piola_shell_body_fp_inverse(const piola_shell_body *body);

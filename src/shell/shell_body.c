@@ -147,7 +147,8 @@ static void triangle_nodal_forces(const shell_triangle *tri, double p[3][2], dou
   }
 }
 
-static void update_triangle(piola_shell_body *body, const double *x, double scale, int32_t t) {
+static void update_triangle(piola_shell_body *body, const double *x, double scale, int want_energy,
+                            int32_t t) {
   shell_triangle *tri = &body->triangles[t];
   const double *x0 = x + 3 * tri->v[0], *x1 = x + 3 * tri->v[1], *x2 = x + 3 * tri->v[2];
   double e1[3] = {x1[0] - x0[0], x1[1] - x0[1], x1[2] - x0[2]};
@@ -177,8 +178,12 @@ static void update_triangle(piola_shell_body *body, const double *x, double scal
       for (int i = 0; i < 3; ++i) u[2 * i + 1] = -u[2 * i + 1];
     }
   }
-  double p0, p1, psi;
-  membrane_stress_energy_kernel(&body->materials[tri->material], fhat[0], fhat[1], &p0, &p1, &psi);
+  /* the energy only when statistics ask for it: stepping needs forces */
+  double p0, p1, psi = 0;
+  if (want_energy)
+    membrane_stress_energy_kernel(&body->materials[tri->material], fhat[0], fhat[1], &p0, &p1, &psi);
+  else
+    membrane_stress_kernel(&body->materials[tri->material], fhat[0], fhat[1], &p0, &p1);
   p0 *= scale;
   p1 *= scale;
   double p[3][2];
@@ -220,10 +225,16 @@ piola_status piola_shell_body_update(piola_shell_body *body, const double *x,
 #pragma omp parallel num_threads(threads) if (body->triangle_count > SHELL_PARALLEL_MIN_ELEMENTS)
   {
 #pragma omp for schedule(static) nowait
-    for (int32_t t = 0; t < body->triangle_count; ++t) update_triangle(body, x, stiffness_scale, t);
+    for (int32_t t = 0; t < body->triangle_count; ++t)
+      update_triangle(body, x, stiffness_scale, stats != NULL, t);
     const double stiffness = stiffness_scale * body->bending.stiffness;
+    /* without stiffness, damping or plastic bending the hinges have nothing to do */
+    const int32_t hinges = body->bending.stiffness > 0 || body->bending.damping > 0 ||
+                                   isfinite(body->bending.yield_angle)
+                               ? body->hinge_count
+                               : 0;
 #pragma omp for schedule(static)
-    for (int32_t h = 0; h < body->hinge_count; ++h) update_hinge(body, x, stiffness, h);
+    for (int32_t h = 0; h < hinges; ++h) update_hinge(body, x, stiffness, h);
   }
   piola__shell_body_gather(body, forces);
   body->last_stiffness_scale = stiffness_scale;

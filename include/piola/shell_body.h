@@ -142,6 +142,9 @@ PIOLA_API double piola_shell_body_max_wave_speed(const piola_shell_body *body);
  * Explicit bending is stable for steps up to about this; INFINITY without bending. */
 PIOLA_API double piola_shell_body_bending_time_scale(const piola_shell_body *body);
 
+/* The bending damping (viscosity) of the definition, N m s. */
+PIOLA_API double piola_shell_body_bending_damping(const piola_shell_body *body);
+
 /* Hinges (interior edges shared by exactly two triangles; other edges do not bend). */
 PIOLA_API int32_t piola_shell_body_hinge_count(const piola_shell_body *body);
 /* 4 * hinge_count vertices (x1, x2, x3, x4) per hinge: x3 -> x4 is the shared edge, x1 and

@@ -74,6 +74,9 @@ double piola_shell_body_max_wave_speed(const piola_shell_body *body) {
 double piola_shell_body_bending_time_scale(const piola_shell_body *body) {
   return body->bending_time_scale;
 }
+double piola_shell_body_bending_damping(const piola_shell_body *body) {
+  return body->bending.damping;
+}
 int32_t piola_shell_body_hinge_count(const piola_shell_body *body) { return body->hinge_count; }
 const int32_t *piola_shell_body_hinges(const piola_shell_body *body) { return body->hinge_indices; }
 const double *piola_shell_body_rest_angles(const piola_shell_body *body) {

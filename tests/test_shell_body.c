@@ -64,7 +64,32 @@ static void generated_sheets_are_valid(void **state) {
   piola_shell_body_destroy(body);
   piola_tri_mesh_free(&disk);
 
+  /* tori, closed and half: area near 4 pi^2 R r (times the sweep), normals out of the tube */
+  for (int half = 0; half < 2; ++half) {
+    piola_tri_mesh torus;
+    assert_int_equal(piola_tri_mesh_torus(1.0, 0.25, 64, 32, half ? 180 : 360, &torus), PIOLA_OK);
+    double torus_area = 0;
+    for (int t = 0; t < torus.triangle_count; ++t) {
+      const double *a = torus.positions + 3 * torus.triangles[3 * t];
+      const double *b = torus.positions + 3 * torus.triangles[3 * t + 1];
+      const double *c = torus.positions + 3 * torus.triangles[3 * t + 2];
+      double e1[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]}, e2[3] = {c[0] - a[0], c[1] - a[1], c[2] - a[2]};
+      double n[3] = {e1[1] * e2[2] - e1[2] * e2[1], e1[2] * e2[0] - e1[0] * e2[2],
+                     e1[0] * e2[1] - e1[1] * e2[0]};
+      torus_area += 0.5 * sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+      /* from the tube's centre circle to the centroid */
+      double g[3] = {(a[0] + b[0] + c[0]) / 3, (a[1] + b[1] + c[1]) / 3, (a[2] + b[2] + c[2]) / 3};
+      double rho = sqrt(g[0] * g[0] + g[1] * g[1]);
+      double out[3] = {g[0] - g[0] / rho, g[1] - g[1] / rho, g[2]};
+      assert_true(n[0] * out[0] + n[1] * out[1] + n[2] * out[2] > 0);
+    }
+    double expected = 4 * M_PI * M_PI * 0.25 * (half ? 0.5 : 1.0);
+    assert_close(torus_area, expected, 0.01 * expected);
+    piola_tri_mesh_free(&torus);
+  }
+
   piola_tri_mesh bad;
+  assert_int_equal(piola_tri_mesh_torus(1, 1, 8, 8, 360, &bad), PIOLA_ERROR_INVALID_ARGUMENT);
   assert_int_equal(piola_tri_mesh_rectangle(1, 0, 3, 3, &bad), PIOLA_ERROR_INVALID_ARGUMENT);
   assert_int_equal(piola_tri_mesh_rectangle(1, 1, 0, 3, &bad), PIOLA_ERROR_INVALID_ARGUMENT);
   assert_int_equal(piola_tri_mesh_disk(1, 0, &bad), PIOLA_ERROR_INVALID_ARGUMENT);

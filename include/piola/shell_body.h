@@ -73,6 +73,15 @@ PIOLA_API piola_status piola_tri_mesh_rectangle(double width, double height, int
  * are nearly equilateral. Counterclockwise seen from +z. */
 PIOLA_API piola_status piola_tri_mesh_disk(double radius, int32_t rings, piola_tri_mesh *out);
 
+/* The surface of a torus around the z axis, centred at the origin: major radius R, tube
+ * radius r < R (m), `around` (>= 3) segments along the ring and `tube` (>= 3) around the
+ * tube. sweep_degrees in (0, 360]: 360 gives the closed torus, less an open piece of it
+ * from angle 0 to the sweep (e.g. 180: half a torus, the paper's Figure 8), with
+ * around + 1 vertex rings. Triangles wind so that normals point out of the tube. */
+PIOLA_API piola_status piola_tri_mesh_torus(double major_radius, double minor_radius,
+                                            int32_t around, int32_t tube, double sweep_degrees,
+                                            piola_tri_mesh *out);
+
 /* ------------------------------------------------------------------ the shell body */
 
 typedef struct piola_shell_body piola_shell_body;

@@ -38,6 +38,9 @@ static piola_status build_shell(piola_world *world, const scene_shell_desc *d) {
     st = piola_tri_mesh_rectangle(d->size[0], d->size[1], d->resolution[0], d->resolution[1], &mesh);
   else if (d->generator == 2)
     st = piola_tri_mesh_disk(d->radius, d->resolution[0], &mesh);
+  else if (d->generator == 3)
+    st = piola_tri_mesh_torus(d->radius, d->minor_radius, d->resolution[0], d->resolution[1],
+                              d->sweep_degrees, &mesh);
   else
     st = piola_tri_mesh_read(d->base.mesh_path, &mesh);
   if (st == PIOLA_OK && mesh.triangle_count < 1)

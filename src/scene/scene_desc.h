@@ -35,10 +35,12 @@ typedef struct scene_solid_desc {
 typedef struct scene_shell_desc {
   scene_solid_desc base;
   piola_shell_def def;            /* thickness, bending, plasticity, reference normals */
-  int generator;                  /* 0 file (base.mesh_path), 1 rectangle, 2 disk */
+  int generator;                  /* 0 file (base.mesh_path), 1 rectangle, 2 disk, 3 torus */
   double size[2];                 /* rectangle: m */
-  int32_t resolution[2];          /* rectangle: cells; disk: rings in [0] */
-  double radius;                  /* disk: m */
+  int32_t resolution[2];          /* rectangle: cells; disk: rings in [0]; torus: segments */
+  double radius;                  /* disk, torus: m */
+  double minor_radius;            /* torus: m */
+  double sweep_degrees;           /* torus */
 } scene_shell_desc;
 
 typedef struct scene_obstacle_desc {

@@ -676,8 +676,9 @@ static piola_status parse_obstacle(parser *p, const cJSON *obj, scene_obstacle_d
 /* ------------------------------------------------------------------ shells */
 
 /* A shell's mesh: a triangle surface file, or {"generate": "rectangle", "size": [w, h],
- * "resolution": [nx, ny]} / {"generate": "disk", "radius": r, "rings": n}, in the z = 0
- * plane centred at the origin before the transform. */
+ * "resolution": [nx, ny]} / {"generate": "disk", "radius": r, "rings": n} in the z = 0
+ * plane centred at the origin, or {"generate": "torus", "radius": R, "minor_radius": r,
+ * "segments": [around, tube], "sweep_degrees": s} around the z axis, before the transform. */
 static piola_status parse_shell_mesh(parser *p, const cJSON *v, scene_shell_desc *d) {
   size_t old = push_key(p, "mesh");
   if (cJSON_IsString(v)) {
@@ -723,9 +724,37 @@ static piola_status parse_shell_mesh(parser *p, const cJSON *v, scene_shell_desc
     int64_t rings = 1;
     PIOLA_TRY(opt_int(p, v, "rings", 1, 20000, &rings));
     d->resolution[0] = (int32_t)rings;
+  } else if (cJSON_IsString(g) && strcmp(g->valuestring, "torus") == 0) {
+    static const char *const keys[] = {"generate", "radius", "minor_radius", "segments",
+                                       "sweep_degrees", NULL};
+    PIOLA_TRY(check_keys(p, v, keys));
+    PIOLA_TRY(required(p, v, "radius"));
+    PIOLA_TRY(required(p, v, "minor_radius"));
+    PIOLA_TRY(required(p, v, "segments"));
+    d->generator = 3;
+    d->sweep_degrees = 360;
+    PIOLA_TRY(opt_number(p, v, "radius", POSITIVE, &d->radius));
+    PIOLA_TRY(opt_number(p, v, "minor_radius", POSITIVE, &d->minor_radius));
+    PIOLA_TRY(opt_number(p, v, "sweep_degrees", (range){0, 360, 1, 0}, &d->sweep_degrees));
+    if (!(d->minor_radius < d->radius)) {
+      push_key(p, "minor_radius");
+      return fail(p, BAD_VALUE, "must be smaller than radius (%g m), got %g", d->radius, d->minor_radius);
+    }
+    const cJSON *seg = get(v, "segments");
+    size_t o2 = push_key(p, "segments");
+    if (!cJSON_IsArray(seg) || cJSON_GetArraySize(seg) != 2)
+      return fail(p, PIOLA_ERROR_PARSE, "must be [segments around the ring, segments around the tube]");
+    int k = 0;
+    for (const cJSON *e = seg->child; e; e = e->next, ++k) {
+      if (!cJSON_IsNumber(e) || e->valuedouble != floor(e->valuedouble) || e->valuedouble < 3 ||
+          e->valuedouble > 100000)
+        return fail(p, BAD_VALUE, "must be two integers in 3..100000");
+      d->resolution[k] = (int32_t)e->valuedouble;
+    }
+    pop(p, o2);
   } else {
     push_key(p, "generate");
-    return fail(p, BAD_VALUE, "must be \"rectangle\" or \"disk\"");
+    return fail(p, BAD_VALUE, "must be \"rectangle\", \"disk\" or \"torus\"");
   }
   pop(p, old);
   return PIOLA_OK;

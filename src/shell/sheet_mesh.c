@@ -1,5 +1,5 @@
-/* Generated flat sheets for cloth scenes and tests: a rectangle with alternating diagonals
- * and a disk of concentric rings. */
+/* Generated sheets for cloth and shell scenes and tests: a rectangle with alternating
+ * diagonals, a disk of concentric rings, and a (piece of a) torus surface. */
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -99,5 +99,48 @@ piola_status piola_tri_mesh_disk(double radius, int32_t rings, piola_tri_mesh *o
         }
       }
   }
+  return PIOLA_OK;
+}
+
+piola_status piola_tri_mesh_torus(double major_radius, double minor_radius, int32_t around,
+                                  int32_t tube, double sweep_degrees, piola_tri_mesh *out) {
+  if (!out) return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "torus: out is NULL");
+  memset(out, 0, sizeof *out);
+  if (!(minor_radius > 0) || !(major_radius > minor_radius) || !isfinite(major_radius))
+    return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT,
+                      "torus radii must satisfy 0 < minor_radius < radius, got %g and %g m",
+                      minor_radius, major_radius);
+  if (around < 3 || tube < 3 || around > 100000 || tube > 100000)
+    return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT,
+                      "torus segments must be in 3..100000, got %d around and %d tube",
+                      (int)around, (int)tube);
+  if (!(sweep_degrees > 0 && sweep_degrees <= 360))
+    return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "torus sweep must be in (0, 360] degrees, got %g",
+                      sweep_degrees);
+  const int closed = sweep_degrees == 360;
+  const int32_t rings = closed ? around : around + 1;
+  PIOLA_TRY(allocate((int64_t)rings * tube, 2 * (int64_t)around * tube, out));
+  const double sweep = sweep_degrees * M_PI / 180.0;
+  for (int32_t i = 0; i < rings; ++i) {
+    double u = sweep * i / around;
+    for (int32_t j = 0; j < tube; ++j) {
+      double w = 2.0 * M_PI * j / tube;
+      double rho = major_radius + minor_radius * cos(w);
+      double *p = out->positions + 3 * ((size_t)i * tube + j);
+      p[0] = rho * cos(u);
+      p[1] = rho * sin(u);
+      p[2] = minor_radius * sin(w);
+    }
+  }
+  int32_t *t = out->triangles;
+  for (int32_t i = 0; i < around; ++i)
+    for (int32_t j = 0; j < tube; ++j) {
+      int32_t i1 = (i + 1) % rings, j1 = (j + 1) % tube;
+      int32_t a = i * tube + j, b = i1 * tube + j, c = i * tube + j1, d = i1 * tube + j1;
+      /* (a, b, c) spans d/du x d/dw, which points out of the tube */
+      t[0] = a, t[1] = b, t[2] = c;
+      t[3] = b, t[4] = d, t[5] = c;
+      t += 6;
+    }
   return PIOLA_OK;
 }

@@ -8,9 +8,10 @@
  * 2 threads, of
  *   - piola_shell_body_update without bending (in-plane only) and with bending,
  *   - piola_shell_body_damping_forces (in-plane and bending damping: the CG's operator),
- *   - one cloth step: update, damping, explicit velocity/position update and collision
- *     processing against a sphere and a plane (the world's implicit step costs a few
- *     damping applications more; see docs/bench-notes/shells.md). */
+ *   - one explicit cloth step: update, damping, velocity/position update and collision
+ *     processing against a sphere and a plane,
+ *   - one world step (piola_world_step: the Newmark scheme with the two implicit damping
+ *     solves, collisions, plastic flow) of the same cloth falling on the sphere. */
 #include <math.h>
 #include <stdint.h>
 #include <stdio.h>
@@ -21,6 +22,7 @@
 #include "piola/elastic_body.h"
 #include "piola/obstacle.h"
 #include "piola/shell_body.h"
+#include "piola/world_shells.h"
 
 static double now_seconds(void) {
   struct timespec ts;
@@ -187,6 +189,56 @@ int main(int argc, char **argv) {
     }
     double m = median(times, repeats), mc = median(cpu, repeats);
     printf("| explicit step | %d | %.2f | %.3g | %.2f |\n", threads, 1e3 * m, 1 / m, 1e3 * mc);
+  }
+  /* world steps: the same cloth, pinned at two corners, over the sphere */
+  {
+    piola_world_def wdef = piola_default_world_def();
+    wdef.max_dt = 1e-3;
+    piola_world *world = NULL;
+    piola_world_create(&wdef, &world);
+    piola_world_add_obstacle(world, &sphere, NULL);
+    piola_world_add_obstacle(world, &ground, NULL);
+    piola_tri_mesh lifted = mesh;
+    lifted.positions = c.x;
+    for (int32_t i = 0; i < n; ++i) {
+      c.x[3 * i] = mesh.positions[3 * i];
+      c.x[3 * i + 1] = mesh.positions[3 * i + 1];
+      c.x[3 * i + 2] = 0.3;
+    }
+    piola_shell_def sdef = piola_default_shell_def();
+    sdef.mesh = &lifted;
+    sdef.material = mdef;
+    sdef.thickness = 5e-4;
+    sdef.density = 300;
+    sdef.bending.stiffness = 1e-5;
+    sdef.bending.damping = 1e-7;
+    sdef.shear_viscosity.value = 0.1;
+    sdef.bulk_viscosity.value = 0.1;
+    if (piola_world_add_shell(world, &sdef, NULL) != PIOLA_OK) {
+      fprintf(stderr, "bench_shells: %s\n", piola_last_error());
+      return 1;
+    }
+    printf("\n| world step (100K triangles, Newmark, implicit damping) | threads | wall ms/step | "
+           "steps/s | CPU ms/step | dt (s) | CG iterations/step |\n|---|---|---|---|---|---|---|\n");
+    for (int threads = 1; threads <= 2; ++threads) {
+      piola_set_thread_count(threads);
+      int cg = 0, steps = 0;
+      double last_dt = 0;
+      for (int r = 0; r < repeats; ++r) {
+        double t0 = now_seconds(), c0 = cpu_seconds();
+        piola_step_stats st;
+        piola_world_step(world, 0, &st);
+        times[r] = now_seconds() - t0;
+        cpu[r] = cpu_seconds() - c0;
+        cg += st.cg_iterations;
+        steps++;
+        last_dt = st.last_dt;
+      }
+      double m = median(times, repeats), mc = median(cpu, repeats);
+      printf("| world step | %d | %.1f | %.3g | %.1f | %.2g | %.1f |\n", threads, 1e3 * m, 1 / m,
+             1e3 * mc, last_dt, (double)cg / steps);
+    }
+    piola_world_destroy(world);
   }
   piola_obstacle_destroy(c.obstacles[0]);
   piola_obstacle_destroy(c.obstacles[1]);

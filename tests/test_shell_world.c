@@ -86,6 +86,84 @@ static void cloth_swings_onto_a_sphere(void **state) {
   piola_tri_mesh_free(&mesh);
 }
 
+/* One-way coupling: a cloth dropped on a soft block (a simulated solid, fixed at its base)
+ * never ends a step inside the block's boundary, and drapes over it. */
+static void cloth_stays_outside_a_simulated_solid(void **state) {
+  (void)state;
+  piola_world *world = make_world(2e-3);
+  /* a 0.4 x 0.4 x 0.2 block of 2 x 2 x 1 cubes, 6 tets each */
+  piola_tet_mesh block;
+  memset(&block, 0, sizeof block);
+  block.vertex_count = 18;
+  block.tet_count = 24;
+  block.positions = malloc(sizeof(double) * 54);
+  block.tets = malloc(sizeof(int32_t) * 96);
+  for (int k = 0; k < 2; ++k)
+    for (int j = 0; j < 3; ++j)
+      for (int i = 0; i < 3; ++i) {
+        double *p = block.positions + 3 * ((k * 3 + j) * 3 + i);
+        p[0] = -0.2 + 0.2 * i, p[1] = -0.2 + 0.2 * j, p[2] = 0.2 * k;
+      }
+  static const int perms[6][3] = {{0, 1, 2}, {0, 2, 1}, {1, 0, 2}, {1, 2, 0}, {2, 0, 1}, {2, 1, 0}};
+  int t = 0;
+  for (int j = 0; j < 2; ++j)
+    for (int i = 0; i < 2; ++i)
+      for (int q = 0; q < 6; ++q) {
+        int c[3] = {i, j, 0};
+        block.tets[4 * t] = (c[2] * 3 + c[1]) * 3 + c[0];
+        for (int s = 0; s < 3; ++s) {
+          c[perms[q][s]]++;
+          block.tets[4 * t + 1 + s] = (c[2] * 3 + c[1]) * 3 + c[0];
+        }
+        ++t;
+      }
+  piola_solid_def sdef = piola_default_solid_def();
+  sdef.mesh = &block;
+  sdef.material.youngs_modulus = 2e5;
+  sdef.shear_viscosity.value = 10;
+  piola_constraint_def base;
+  memset(&base, 0, sizeof base);
+  base.selector.type = PIOLA_SELECT_BOX;
+  base.selector.box_min = (piola_vec3){-1, -1, -0.01};
+  base.selector.box_max = (piola_vec3){1, 1, 0.01};
+  sdef.constraints = &base;
+  sdef.constraint_count = 1;
+  assert_int_equal(piola_world_add_solid(world, &sdef, NULL), PIOLA_OK);
+  piola_tri_mesh cloth = shell_sheet(0.8, 0.8, 12, 12);
+  for (int i = 0; i < cloth.vertex_count; ++i) cloth.positions[3 * i + 2] = 0.3;
+  piola_shell_def def = piola_default_shell_def();
+  def.mesh = &cloth;
+  def.material.youngs_modulus = 1e5;
+  def.density = 200;
+  def.bending.stiffness = 1e-5;
+  def.shear_viscosity.value = 0.5;
+  def.collide_with_solids = true;
+  assert_int_equal(piola_world_add_shell(world, &def, NULL), PIOLA_OK);
+  int steps = 0;
+  while (piola_world_time(world) < 0.3) {
+    assert_int_equal(piola_world_step(world, 0, NULL), PIOLA_OK);
+    ++steps;
+    const double *x = piola_world_shell_positions(world, 0);
+    const double *b = piola_world_solid_positions(world, 0);
+    double top = 0; /* the block's current top (its top nodes) */
+    for (int i = 9; i < 18; ++i) top += b[3 * i + 2] / 9;
+    for (int i = 0; i < cloth.vertex_count; ++i) {
+      const double *p = x + 3 * i;
+      assert_true(isfinite(p[0]) && isfinite(p[1]) && isfinite(p[2]));
+      int inside = fabs(p[0]) < 0.19 && fabs(p[1]) < 0.19 && p[2] < top - 0.01 && p[2] > 0.01;
+      if (inside) fail_msg("step %d: cloth node %d at (%g, %g, %g) is inside the block (top %g)", steps,
+                           i, p[0], p[1], p[2], top);
+    }
+  }
+  const double *x = piola_world_shell_positions(world, 0);
+  assert_true(x[3 * (6 * 13 + 6) + 2] > 0.15); /* the centre rests on the block */
+  assert_true(x[2] < x[3 * (6 * 13 + 6) + 2] - 0.02); /* a corner already hangs lower */
+  piola_world_destroy(world);
+  free(block.positions);
+  free(block.tets);
+  piola_tri_mesh_free(&cloth);
+}
+
 static void bad_shells_are_rejected(void **state) {
   (void)state;
   piola_world *world = make_world(1e-3);
@@ -107,6 +185,7 @@ static void bad_shells_are_rejected(void **state) {
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(cloth_swings_onto_a_sphere),
+      cmocka_unit_test(cloth_stays_outside_a_simulated_solid),
       cmocka_unit_test(bad_shells_are_rejected),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);

@@ -5,6 +5,17 @@
  * damping join the implicit damping solves, it collides with the world's obstacles and
  * follows the same constraints. After each step's force update, plastic flow (in-plane and
  * bending) runs for the step's dt. Shells have their own index space (0 .. shell_count - 1).
+ *
+ * One-way coupling with solids (paper section 9, the cape on the Buddha): with
+ * collide_with_solids, after the obstacles each free node of the shell is also pushed out of
+ * the solids' moving boundary surfaces: the closest point p on the current boundary
+ * triangles (face, edge or vertex) decides inside or outside by the side of that triangle's
+ * outward normal; a node inside moves to p, its normal velocity becomes at least the
+ * surface's (interpolated from the solid's nodal velocities), and friction acts as for
+ * obstacles. The normal used is the direction between the node and p, whichever way points
+ * outward. Only the part of a node's path within the longest boundary edge of the surface
+ * is searched, so a node that got deeper than that is not found. The solids do not feel the
+ * shell.
 
  *
  *   piola_shell_def def = piola_default_shell_def();
@@ -41,6 +52,8 @@ typedef struct piola_shell_def {
   piola_vec3 velocity;            /* m/s, initial velocity of every free node. Default 0 */
   const piola_constraint_def *constraints; /* constraint_count constraints, copied */
   int32_t constraint_count;
+  bool collide_with_solids;       /* one-way coupling to the solids' surfaces. Default false */
+  double solid_friction;          /* Coulomb mu against the solids, >= 0. Default 0.3 */
 } piola_shell_def;
 
 PIOLA_API piola_shell_def piola_default_shell_def(void);

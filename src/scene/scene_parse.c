@@ -763,7 +763,8 @@ static piola_status parse_shell_mesh(parser *p, const cJSON *v, scene_shell_desc
 static piola_status parse_shell(parser *p, const cJSON *obj, int index, scene_shell_desc *d) {
   static const char *const allowed[] = {"name", "mesh", "transform", "thickness", "density",
                                         "material", "damping", "bending", "plasticity",
-                                        "reference_normals", "velocity", "fixed", "driven", NULL};
+                                        "reference_normals", "velocity", "fixed", "driven",
+                                        "collide_with_solids", "solid_friction", NULL};
   PIOLA_TRY(check_keys(p, obj, allowed));
   PIOLA_TRY(required(p, obj, "mesh"));
   d->def = piola_default_shell_def();
@@ -827,6 +828,13 @@ static piola_status parse_shell(parser *p, const cJSON *obj, int index, scene_sh
     d->def.use_reference_normals = cJSON_IsTrue(v);
     pop(p, old);
   }
+  if ((v = get(obj, "collide_with_solids"))) {
+    size_t old = push_key(p, "collide_with_solids");
+    if (!cJSON_IsBool(v)) return fail(p, PIOLA_ERROR_PARSE, "must be true or false, got %s", type_name(v));
+    d->def.collide_with_solids = cJSON_IsTrue(v);
+    pop(p, old);
+  }
+  PIOLA_TRY(opt_number(p, obj, "solid_friction", NONNEGATIVE, &d->def.solid_friction));
   PIOLA_TRY(opt_vec3(p, obj, "velocity", ANY, &d->base.def.velocity));
   PIOLA_TRY(parse_constraints(p, obj, "fixed", 0, &d->base));
   PIOLA_TRY(parse_constraints(p, obj, "driven", 1, &d->base));

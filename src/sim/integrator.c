@@ -199,6 +199,7 @@ static piola_status step_solid(piola_world *w, world_solid *s, double t, double 
   if (w->obstacle_count > 0)
     colliding = piola_obstacles_collide(w->obstacles, w->obstacle_count, t1, dt, n, s->x, s->v,
                                         s->colliding, s->normals);
+  if (s->shell && s->collide_with_solids) colliding += piola__shell_collide_with_solids(w, s, t1, dt);
   for (int32_t i = 0; i < n; ++i) {
     if (s->flags[i] == SOLID_FREE) continue;
     if (s->colliding[i]) colliding--;

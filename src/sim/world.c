@@ -44,6 +44,8 @@ void piola__solid_free(world_solid *s) {
   free(s->name);
   piola_elastic_body_destroy(s->body);
   piola_shell_body_destroy(s->shell);
+  if (s->boundary) piola_tri_mesh_free(s->boundary);
+  free(s->boundary);
   free(s->x), free(s->v), free(s->mass), free(s->inverse_mass), free(s->force), free(s->start), free(s->flags);
   free(s->motion_of), free(s->motions);
   free(s->x_old), free(s->v_old), free(s->force_old), free(s->rhs), free(s->work), free(s->tmp);

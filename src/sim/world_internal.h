@@ -20,6 +20,10 @@ typedef struct world_solid {
   piola_elastic_body *body;  /* a tetrahedral solid, or NULL for a shell */
   piola_shell_body *shell;   /* a shell (world_shells.c), or NULL */
   piola_shell_stats shell_stats; /* of the last update, shells only */
+  int collide_with_solids;   /* shells: one-way coupling to the solids' surfaces */
+  double solid_friction;     /* shells: Coulomb mu against solids */
+  piola_tri_mesh *boundary;  /* solids: boundary surface, built when a shell first needs it */
+  double boundary_reach;     /* solids: longest boundary edge, m */
   int32_t n;                 /* vertex count */
   double *x, *v;             /* 3n current state */
   double *mass;              /* n lumped masses, kg */
@@ -69,6 +73,10 @@ void piola__solid_damping_forces(const world_solid *s, const double *v, double b
 int piola__solid_undamped(const world_solid *s, double beta, double alpha);
 /* Elastic force update of a shell (called by piola__solid_update_forces). */
 piola_status piola__shell_update_forces(world_solid *s, double t);
+/* One-way coupling (world_shells.c): pushes the free nodes of shell s out of the solids'
+ * current boundary surfaces at t1 after a step of dt, as obstacle collisions do; flags and
+ * normals are set for the final solve. Returns the number of nodes it moved. */
+int32_t piola__shell_collide_with_solids(piola_world *w, world_solid *s, double t1, double dt);
 /* The step bound of a shell (in-plane CFL and bending time scale), s. */
 double piola__shell_stable_dt(const piola_world *w, const world_solid *s, double scale);
 

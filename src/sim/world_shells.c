@@ -8,6 +8,7 @@
 #include <string.h>
 
 #include "common/status_internal.h"
+#include "math/mat3.h"
 #include "sim/world_internal.h"
 
 piola_shell_def piola_default_shell_def(void) {
@@ -20,6 +21,7 @@ piola_shell_def piola_default_shell_def(void) {
   def.bending = body.bending;
   def.plasticity = body.plasticity;
   def.stiffness_scale.value = 1.0;
+  def.solid_friction = 0.3;
   return def;
 }
 
@@ -71,6 +73,9 @@ piola_status piola_world_add_shell(piola_world *world, const piola_shell_def *de
     return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "shell %d: viscosities must be >= 0 Pa s", (int)id);
   if (!isfinite(def->velocity.x) || !isfinite(def->velocity.y) || !isfinite(def->velocity.z))
     return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "shell %d: velocity must be finite", (int)id);
+  if (!(def->solid_friction >= 0) || !isfinite(def->solid_friction))
+    return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "shell %d: solid_friction must be >= 0, got %g",
+                      (int)id, def->solid_friction);
   piola_material material;
   PIOLA_TRY(piola_material_init(&def->material, &material));
   piola_shell_body_def bdef = piola_default_shell_body_def();
@@ -125,6 +130,8 @@ piola_status piola_world_add_shell(piola_world *world, const piola_shell_def *de
   s->stiffness_scale = def->stiffness_scale;
   s->shear_viscosity = def->shear_viscosity;
   s->bulk_viscosity = def->bulk_viscosity;
+  s->collide_with_solids = def->collide_with_solids;
+  s->solid_friction = def->solid_friction;
   st = piola__solid_apply_constraints(s, rest, def->constraints, def->constraint_count);
   if (st != PIOLA_OK) {
     piola__solid_free(s);
@@ -192,4 +199,134 @@ piola_world_shell_stats piola_world_shell_get_stats(const piola_world *world, in
   st.inverted_count = s->shell_stats.inverted_count;
   st.degenerate_count = s->shell_stats.degenerate_count;
   return st;
+}
+
+/* ------------------------------------------------------------------ one-way coupling */
+
+/* The closest point to p on triangle (a, b, c), with its barycentric weights (Voronoi
+ * regions of the vertices, then the edges, then the face). */
+static vec3 closest_on_triangle(vec3 p, vec3 a, vec3 b, vec3 c, double w[3]) {
+  vec3 ab = vec3_sub(b, a), ac = vec3_sub(c, a), ap = vec3_sub(p, a);
+  double d1 = vec3_dot(ab, ap), d2 = vec3_dot(ac, ap);
+  if (d1 <= 0 && d2 <= 0) return w[0] = 1, w[1] = w[2] = 0, a;
+  vec3 bp = vec3_sub(p, b);
+  double d3 = vec3_dot(ab, bp), d4 = vec3_dot(ac, bp);
+  if (d3 >= 0 && d4 <= d3) return w[1] = 1, w[0] = w[2] = 0, b;
+  double vc = d1 * d4 - d3 * d2;
+  if (vc <= 0 && d1 >= 0 && d3 <= 0) {
+    double t = d1 / (d1 - d3);
+    w[0] = 1 - t, w[1] = t, w[2] = 0;
+    return vec3_add(a, vec3_scale(ab, t));
+  }
+  vec3 cp = vec3_sub(p, c);
+  double d5 = vec3_dot(ab, cp), d6 = vec3_dot(ac, cp);
+  if (d6 >= 0 && d5 <= d6) return w[2] = 1, w[0] = w[1] = 0, c;
+  double vb = d5 * d2 - d1 * d6;
+  if (vb <= 0 && d2 >= 0 && d6 <= 0) {
+    double t = d2 / (d2 - d6);
+    w[0] = 1 - t, w[1] = 0, w[2] = t;
+    return vec3_add(a, vec3_scale(ac, t));
+  }
+  double va = d3 * d6 - d5 * d4;
+  if (va <= 0 && (d4 - d3) >= 0 && (d5 - d6) >= 0) {
+    double t = (d4 - d3) / ((d4 - d3) + (d5 - d6));
+    w[0] = 0, w[1] = 1 - t, w[2] = t;
+    return vec3_add(b, vec3_scale(vec3_sub(c, b), t));
+  }
+  double denom = 1.0 / (va + vb + vc), v = vb * denom, u = vc * denom;
+  w[0] = 1 - v - u, w[1] = v, w[2] = u;
+  return vec3_add(a, vec3_add(vec3_scale(ab, v), vec3_scale(ac, u)));
+}
+
+/* The boundary surface of a solid, built once (rest topology; positions are read live). */
+static piola_status solid_boundary(world_solid *solid) {
+  if (solid->boundary) return PIOLA_OK;
+  const piola_elastic_body *b = solid->body;
+  piola_tet_mesh tets = {piola_elastic_body_vertex_count(b),
+                         (double *)piola_elastic_body_rest_positions(b),
+                         piola_elastic_body_tet_count(b), (int32_t *)piola_elastic_body_tets(b), NULL};
+  piola_tri_mesh *surface = calloc(1, sizeof *surface);
+  if (!surface) return PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "solid boundary: out of memory");
+  piola_status st = piola_tet_mesh_boundary(&tets, surface);
+  if (st != PIOLA_OK) {
+    free(surface);
+    return st;
+  }
+  double reach = 0;
+  for (int32_t t = 0; t < surface->triangle_count; ++t)
+    for (int k = 0; k < 3; ++k) {
+      vec3 p = vec3_load(tets.positions + 3 * surface->triangles[3 * t + k]);
+      vec3 q = vec3_load(tets.positions + 3 * surface->triangles[3 * t + (k + 1) % 3]);
+      reach = fmax(reach, vec3_norm(vec3_sub(p, q)));
+    }
+  solid->boundary = surface;
+  solid->boundary_reach = reach;
+  return PIOLA_OK;
+}
+
+int32_t piola__shell_collide_with_solids(piola_world *w, world_solid *s, double t1, double dt) {
+  (void)t1;
+  int32_t moved = 0;
+  for (int32_t k = 0; k < w->solid_count; ++k) {
+    world_solid *solid = &w->solids[k];
+    if (solid_boundary(solid) != PIOLA_OK) return moved;
+    const piola_tri_mesh *surface = solid->boundary;
+    const double *sx = solid->x, *sv = solid->v;
+    /* the solid's current bounding box, grown by the search reach */
+    double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+    for (int32_t i = 0; i < solid->n; ++i)
+      for (int a = 0; a < 3; ++a) lo[a] = fmin(lo[a], sx[3 * i + a]), hi[a] = fmax(hi[a], sx[3 * i + a]);
+    const double reach = solid->boundary_reach;
+    for (int32_t i = 0; i < s->n; ++i) {
+      if (s->flags[i] != SOLID_FREE) continue;
+      vec3 x = vec3_load(s->x + 3 * i);
+      if (x.x < lo[0] - reach || x.x > hi[0] + reach || x.y < lo[1] - reach || x.y > hi[1] + reach ||
+          x.z < lo[2] - reach || x.z > hi[2] + reach)
+        continue;
+      double best = reach * reach, weights[3] = {0, 0, 0};
+      int32_t best_t = -1;
+      vec3 best_p = x;
+      for (int32_t t = 0; t < surface->triangle_count; ++t) {
+        const int32_t *tri = surface->triangles + 3 * t;
+        vec3 a = vec3_load(sx + 3 * tri[0]), b = vec3_load(sx + 3 * tri[1]), c = vec3_load(sx + 3 * tri[2]);
+        /* cheap rejection: the triangle's box is farther than the best distance so far */
+        double r = sqrt(best);
+        if (fmin(a.x, fmin(b.x, c.x)) > x.x + r || fmax(a.x, fmax(b.x, c.x)) < x.x - r ||
+            fmin(a.y, fmin(b.y, c.y)) > x.y + r || fmax(a.y, fmax(b.y, c.y)) < x.y - r ||
+            fmin(a.z, fmin(b.z, c.z)) > x.z + r || fmax(a.z, fmax(b.z, c.z)) < x.z - r)
+          continue;
+        double wt[3];
+        vec3 p = closest_on_triangle(x, a, b, c, wt);
+        double d2 = vec3_norm2(vec3_sub(x, p));
+        if (d2 < best) best = d2, best_t = t, best_p = p, weights[0] = wt[0], weights[1] = wt[1], weights[2] = wt[2];
+      }
+      if (best_t < 0) continue;
+      const int32_t *tri = surface->triangles + 3 * best_t;
+      vec3 a = vec3_load(sx + 3 * tri[0]), b = vec3_load(sx + 3 * tri[1]), c = vec3_load(sx + 3 * tri[2]);
+      vec3 face = vec3_cross(vec3_sub(b, a), vec3_sub(c, a)); /* outward: boundary faces wind outward */
+      vec3 d = vec3_sub(x, best_p);
+      double side = vec3_dot(d, face);
+      if (side >= 0) continue; /* outside (or on) the surface */
+      /* the normal: along the node-to-surface direction, pointing outward */
+      double dn = vec3_norm(d);
+      vec3 normal = dn > 1e-14 * reach ? vec3_scale(d, -1.0 / dn) : vec3_scale(face, 1.0 / vec3_norm(face));
+      vec3 vs = vec3_add(vec3_add(vec3_scale(vec3_load(sv + 3 * tri[0]), weights[0]),
+                                  vec3_scale(vec3_load(sv + 3 * tri[1]), weights[1])),
+                         vec3_scale(vec3_load(sv + 3 * tri[2]), weights[2]));
+      vec3 v = vec3_load(s->v + 3 * i);
+      vec3 rel = vec3_sub(v, vs);
+      double rn = vec3_dot(rel, normal);
+      double dvn = rn < 0 ? -rn : 0; /* normal velocity change: take the surface's */
+      vec3 vt = vec3_sub(rel, vec3_scale(normal, rn));
+      double vtn = vec3_norm(vt), push = dvn + (dt > 0 ? dn / dt : 0);
+      double keep = vtn > 0 ? fmax(0.0, 1.0 - s->solid_friction * push / vtn) : 0.0;
+      vec3 rel_new = vec3_add(vec3_scale(normal, rn < 0 ? 0.0 : rn), vec3_scale(vt, keep));
+      vec3_store(s->v + 3 * i, vec3_add(vs, rel_new));
+      vec3_store(s->x + 3 * i, best_p);
+      vec3_store(s->normals + 3 * i, normal);
+      if (!s->colliding[i]) ++moved;
+      s->colliding[i] = 1;
+    }
+  }
+  return moved;
 }

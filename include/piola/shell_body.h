@@ -142,13 +142,15 @@ PIOLA_API const double *piola_shell_body_rest_positions(const piola_shell_body *
 /* vertex_count lumped masses, kg: a third of density * thickness * area of each incident
  * rest triangle. */
 PIOLA_API const double *piola_shell_body_masses(const piola_shell_body *body);
-/* Smallest rest altitude over all triangles, m (the CFL length). */
+/* Smallest rest altitude over all triangles, m (the CFL length); with in-plane plasticity
+ * divided by max_plastic_stretch, the most plastic flow can shrink it. */
 PIOLA_API double piola_shell_body_min_rest_altitude(const piola_shell_body *body);
 /* Largest in-plane wave speed sqrt((lambda* + 2 mu) / density) over the materials, m/s. */
 PIOLA_API double piola_shell_body_max_wave_speed(const piola_shell_body *body);
-/* Time scale of the stiffest hinge, s: min over hinges and their corners i of
- * sqrt(m_i / k_i), k_i = (D w / 2) |grad_i theta|^2 at rest (w the hinge weight below).
- * Explicit bending is stable for steps up to about this; INFINITY without bending. */
+/* Bending time scale 1 / omega, s, with omega^2 a Gershgorin bound on the largest
+ * eigenvalue of M^-1 K for the hinges' rest stiffness K = sum (D w / 2) grad theta grad
+ * theta^T (w the hinge weight below). Explicit bending is stable for steps below about
+ * 2 / omega; INFINITY without bending. */
 PIOLA_API double piola_shell_body_bending_time_scale(const piola_shell_body *body);
 
 /* The bending damping (viscosity) of the definition, N m s. */

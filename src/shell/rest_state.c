@@ -289,7 +289,10 @@ piola_status piola__shell_body_build(piola_shell_body *body, const piola_shell_b
     for (int c = 0; c < 3; ++c) body->masses[tri->v[c]] += def->density * tri->volume / 3.0;
     min_altitude = fmin(min_altitude, 2.0 * area / longest);
   }
-  body->min_rest_altitude = min_altitude;
+  /* plastic flow can shrink the effective rest shape by up to max_plastic_stretch */
+  body->min_rest_altitude = isfinite(def->plasticity.yield_strain)
+                                ? min_altitude / def->plasticity.max_plastic_stretch
+                                : min_altitude;
 
   PIOLA_TRY(build_hinges(body));
   const int32_t nh = body->hinge_count;
@@ -300,7 +303,11 @@ piola_status piola__shell_body_build(piola_shell_body *body, const piola_shell_b
   if (!ok)
     return PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "shell body with %d hinges: out of memory",
                       (int)nh);
-  double time_scale = INFINITY;
+  /* bending stability: the hinge stiffness D w/2 g g^T summed over hinges, bounded per
+   * vertex a by Gershgorin on M^-1/2 K M^-1/2: omega^2 <= max_a sum_h (D w/2) |g_a| / sqrt(m_a)
+   * sum_b |g_b| / sqrt(m_b). The time scale is 1 / omega. */
+  double *omega2 = alloc_array((size_t)nv, sizeof(double));
+  if (!omega2) return PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "shell body: out of memory");
   for (int32_t h = 0; h < nh; ++h) {
     shell_hinge *hg = &body->hinges[h];
     const double *p[4];
@@ -315,15 +322,19 @@ piola_status piola__shell_body_build(piola_shell_body *body, const piola_shell_b
     hg->rest_angle = piola__hinge_angle(p[0], p[1], p[2], p[3], hg->grad);
     hg->angle = hg->rest_angle;
     body->rest_angles[h] = body->angles[h] = hg->rest_angle;
-    if (def->bending.stiffness > 0)
-      for (int k = 0; k < 4; ++k) {
-        const double *g = hg->grad + 3 * k;
-        double stiffness = 0.5 * def->bending.stiffness * hg->weight *
-                           (g[0] * g[0] + g[1] * g[1] + g[2] * g[2]);
-        if (stiffness > 0) time_scale = fmin(time_scale, sqrt(body->masses[hg->v[k]] / stiffness));
-      }
+    double norms[4], sum = 0;
+    for (int k = 0; k < 4; ++k) {
+      const double *g = hg->grad + 3 * k;
+      norms[k] = sqrt(g[0] * g[0] + g[1] * g[1] + g[2] * g[2]) / sqrt(body->masses[hg->v[k]]);
+      sum += norms[k];
+    }
+    for (int k = 0; k < 4; ++k)
+      omega2[hg->v[k]] += 0.5 * def->bending.stiffness * hg->weight * norms[k] * sum;
   }
-  body->bending_time_scale = time_scale;
+  double largest = 0;
+  for (int32_t i = 0; i < nv; ++i) largest = fmax(largest, omega2[i]);
+  free(omega2);
+  body->bending_time_scale = largest > 0 ? 1.0 / sqrt(largest) : INFINITY;
 
   PIOLA_TRY(build_incidence(nv, nt, 3, body->triangle_indices, &body->tri_start,
                             &body->tri_incidence));

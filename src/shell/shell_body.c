@@ -202,8 +202,14 @@ static void update_triangle(piola_shell_body *body, const double *x, double scal
 
 static void update_hinge(piola_shell_body *body, const double *x, double stiffness, int32_t h) {
   shell_hinge *hg = &body->hinges[h];
-  hg->angle = piola__hinge_angle(x + 3 * hg->v[0], x + 3 * hg->v[1], x + 3 * hg->v[2],
-                                 x + 3 * hg->v[3], hg->grad);
+  double theta = piola__hinge_angle(x + 3 * hg->v[0], x + 3 * hg->v[1], x + 3 * hg->v[2],
+                                   x + 3 * hg->v[3], hg->grad);
+  /* the branch of the angle nearest the rest angle: a hinge whose rest angle is near +-pi
+   * (folded, e.g. by plastic bending) then bends smoothly through the seam instead of
+   * seeing sin(theta/2) flip sign there */
+  if (theta - hg->rest_angle > M_PI) theta -= 2.0 * M_PI;
+  if (theta - hg->rest_angle < -M_PI) theta += 2.0 * M_PI;
+  hg->angle = theta;
   body->angles[h] = hg->angle;
   double slope;
   piola__bending_potential(hg->angle, hg->rest_angle, &slope);

@@ -53,7 +53,7 @@ static void cloth_swings_onto_a_sphere(void **state) {
   assert_int_equal(piola_world_shell_count(world), 1);
   assert_string_equal(piola_world_shell_name(world, 0), "cloth");
   int n = mesh.vertex_count;
-  double frames = 36 * test_scale() < 20 ? 20 : 36 * test_scale();
+  const double frames = 36; /* fixed simulated time: the end state is checked */
   int touched = 0;
   for (int f = 1; f <= (int)frames; ++f) {
     double t_end = f / 30.0;

@@ -135,6 +135,11 @@ piola_status piola_output_open(const char *dir, bool force, const piola_world *w
   memcpy(o->tets.positions, o->rest, 3 * (size_t)(nv + snv) * sizeof(double));
   piola_status st = PIOLA_OK;
   if (nt > 0) st = piola_tet_mesh_boundary(&o->tets, &o->surface);
+  if (st == PIOLA_OK) {
+    /* the surface shares the tets' numbering: each frame lends it the current positions */
+    free(o->surface.positions);
+    o->surface.positions = NULL;
+  }
   if (st == PIOLA_OK && snt > 0) {
     /* the OBJ surface: the solids' boundary, then the shells' triangles */
     int32_t base = o->surface.triangle_count;

@@ -20,7 +20,8 @@ static const char *FULL =
     "  \"damping\": {\"shear\": 0.5, \"bulk\": 0.25},\n"
     "  \"bending\": {\"stiffness\": 1e-4, \"damping\": 2e-5, \"plasticity\": {\"yield_angle_degrees\": 10, \"rate\": 5}},\n"
     "  \"plasticity\": {\"yield_strain\": 0.05, \"rate\": 7, \"max_plastic_stretch\": 3},\n"
-    "  \"reference_normals\": true, \"velocity\": [0, 1, 0],\n"
+    "  \"reference_normals\": true, \"velocity\": [0, 1, 0], \"collide_with_solids\": true,\n"
+    "  \"solid_friction\": 0.1,\n"
     "  \"fixed\": [{\"indices\": [0, 4]}]},\n"
     " {\"mesh\": {\"generate\": \"disk\", \"radius\": 0.5, \"rings\": 3}},\n"
     " {\"mesh\": {\"generate\": \"torus\", \"radius\": 0.5, \"minor_radius\": 0.1, \"segments\": [8, 6], "
@@ -54,6 +55,8 @@ static void every_shell_key_reaches_its_definition(void **state) {
   assert_close(s->def.plasticity.rate, 7, 0);
   assert_close(s->def.plasticity.max_plastic_stretch, 3, 0);
   assert_true(s->def.use_reference_normals);
+  assert_true(s->def.collide_with_solids);
+  assert_close(s->def.solid_friction, 0.1, 0);
   assert_close(s->base.def.velocity.y, 1, 0);
   assert_int_equal(s->base.constraint_count, 1);
   /* defaults */
@@ -66,6 +69,8 @@ static void every_shell_key_reaches_its_definition(void **state) {
   assert_true(isinf(s->def.bending.yield_angle));
   assert_true(isinf(s->def.plasticity.yield_strain));
   assert_false(s->def.use_reference_normals);
+  assert_false(s->def.collide_with_solids);
+  assert_close(s->def.solid_friction, 0.3, 0);
   assert_int_equal(d.shells[2].generator, 3);
   assert_close(d.shells[2].sweep_degrees, 180, 0);
   assert_int_equal(d.shells[3].generator, 0);

@@ -1,0 +1,534 @@
+/* Collision surfaces: construction, detection passes, repulsion and impact impulses, and the
+ * three-stage processing of BFA02 (see piola/collision_surface.h and contact_internal.h). */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "common/status_internal.h"
+#include "contact/ccd.h"
+#include "contact/contact_internal.h"
+#include "contact/proximity.h"
+
+enum { QUERY_BLOCK = 256 };
+
+piola_collision_body_def piola_default_collision_body_def(void) {
+  return (piola_collision_body_def){.thickness = 1e-3, .friction = 0.3};
+}
+
+piola_collision_surface_def piola_default_collision_surface_def(void) {
+  return (piola_collision_surface_def){0};
+}
+
+piola_collision_settings piola_default_collision_settings(void) {
+  return (piola_collision_settings){.repulsion = 1,
+                                    .repulsion_stiffness = INFINITY,
+                                    .collision_iterations = 5,
+                                    .max_zone_iterations = 200};
+}
+
+int piola__contact_list_push(piola__contact_list *list, const piola__contact *c) {
+  if (list->count == list->capacity) {
+    int64_t capacity = list->capacity ? 2 * list->capacity : 32;
+    piola__contact *items = realloc(list->items, sizeof(*items) * (size_t)capacity);
+    if (!items) return -1;
+    list->items = items, list->capacity = capacity;
+  }
+  list->items[list->count++] = *c;
+  return 0;
+}
+
+static int compare_edges(const void *a, const void *b) {
+  const int32_t *x = a, *y = b;
+  if (x[0] != y[0]) return (x[0] > y[0]) - (x[0] < y[0]);
+  return (x[1] > y[1]) - (x[1] < y[1]);
+}
+
+void piola_collision_surface_destroy(piola_collision_surface *s) {
+  if (!s) return;
+  free(s->triangles);
+  free(s->edges);
+  free(s->vertex_body);
+  free(s->bodies);
+  free(s->inverse_mass);
+  free(s->vertex_thickness);
+  free(s->vertex_boxes);
+  free(s->triangle_boxes);
+  free(s->edge_boxes);
+  piola__bvh_free(&s->triangle_tree);
+  piola__bvh_free(&s->edge_tree);
+  if (s->blocks)
+    for (int32_t b = 0; b < s->block_count; ++b) free(s->blocks[b].items);
+  free(s->blocks);
+  free(s->found.items);
+  free(s->zone_parent);
+  free(s->in_zone);
+  free(s->zone_order);
+  free(s);
+}
+
+int32_t piola_collision_surface_vertex_count(const piola_collision_surface *s) {
+  return s ? s->vertex_count : 0;
+}
+
+int32_t piola_collision_surface_edge_count(const piola_collision_surface *s) {
+  return s ? s->edge_count : 0;
+}
+
+piola_status piola_collision_surface_create(const piola_collision_surface_def *def,
+                                            piola_collision_surface **out) {
+  if (!out) return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "collision surface: out is NULL");
+  *out = NULL;
+  if (!def) return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "collision surface: def is NULL");
+  const int32_t nv = def->vertex_count, nt = def->triangle_count;
+  if (nv < 0 || nt < 0 || (nt > 0 && !def->triangles))
+    return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT,
+                      "collision surface: vertex_count %d, triangle_count %d (triangles %s)", nv,
+                      nt, def->triangles ? "given" : "NULL");
+  if (nt > INT32_MAX / 3)
+    return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "collision surface: too many triangles (%d)",
+                      nt);
+  if (def->body_count < 1 || !def->bodies)
+    return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT,
+                      "collision surface: body_count must be >= 1 with bodies given, got %d",
+                      def->body_count);
+  for (int32_t b = 0; b < def->body_count; ++b) {
+    const piola_collision_body_def *body = &def->bodies[b];
+    if (!(body->thickness > 0.0) || !isfinite(body->thickness))
+      return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT,
+                        "collision surface: body %d thickness must be > 0 m and finite, got %g", b,
+                        body->thickness);
+    if (!(body->friction >= 0.0) || !isfinite(body->friction))
+      return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT,
+                        "collision surface: body %d friction must be >= 0 and finite, got %g", b,
+                        body->friction);
+  }
+  for (int32_t t = 0; t < nt; ++t) {
+    const int32_t *tri = def->triangles + 3 * t;
+    for (int k = 0; k < 3; ++k)
+      if (tri[k] < 0 || tri[k] >= nv)
+        return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT,
+                          "collision surface: triangle %d vertex %d is %d, outside [0, %d)", t, k,
+                          tri[k], nv);
+    if (tri[0] == tri[1] || tri[1] == tri[2] || tri[0] == tri[2])
+      return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT,
+                        "collision surface: triangle %d repeats a vertex (%d %d %d)", t, tri[0],
+                        tri[1], tri[2]);
+  }
+  if (def->vertex_body)
+    for (int32_t i = 0; i < nv; ++i)
+      if (def->vertex_body[i] < 0 || def->vertex_body[i] >= def->body_count)
+        return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT,
+                          "collision surface: vertex %d body %d, outside [0, %d)", i,
+                          def->vertex_body[i], def->body_count);
+
+  piola_collision_surface *s = calloc(1, sizeof(*s));
+  if (!s) return PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "collision surface: out of memory");
+  s->vertex_count = nv, s->triangle_count = nt, s->body_count = def->body_count;
+  const size_t nv1 = (size_t)(nv > 0 ? nv : 1), nt1 = (size_t)(nt > 0 ? nt : 1);
+  s->triangles = malloc(sizeof(int32_t) * 3 * nt1);
+  s->edges = malloc(sizeof(int32_t) * 6 * nt1);
+  s->vertex_body = calloc(nv1, sizeof(int32_t));
+  s->bodies = malloc(sizeof(*s->bodies) * (size_t)def->body_count);
+  s->inverse_mass = malloc(sizeof(double) * nv1);
+  s->vertex_thickness = malloc(sizeof(double) * nv1);
+  s->vertex_boxes = malloc(sizeof(piola__box) * nv1);
+  s->triangle_boxes = malloc(sizeof(piola__box) * nt1);
+  s->edge_boxes = malloc(sizeof(piola__box) * 3 * nt1);
+  s->zone_parent = malloc(sizeof(int32_t) * nv1);
+  s->in_zone = malloc(nv1);
+  s->zone_order = malloc(sizeof(int32_t) * nv1);
+  if (!s->triangles || !s->edges || !s->vertex_body || !s->bodies || !s->inverse_mass ||
+      !s->vertex_thickness || !s->vertex_boxes || !s->triangle_boxes || !s->edge_boxes ||
+      !s->zone_parent || !s->in_zone || !s->zone_order) {
+    piola_collision_surface_destroy(s);
+    return PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "collision surface: out of memory");
+  }
+  if (nt > 0) memcpy(s->triangles, def->triangles, sizeof(int32_t) * 3 * (size_t)nt);
+  if (def->vertex_body && nv > 0) memcpy(s->vertex_body, def->vertex_body, sizeof(int32_t) * (size_t)nv);
+  memcpy(s->bodies, def->bodies, sizeof(*s->bodies) * (size_t)def->body_count);
+  for (int32_t i = 0; i < nv; ++i) s->vertex_thickness[i] = s->bodies[s->vertex_body[i]].thickness;
+
+  /* Unique edges: every triangle side with the lower index first, sorted, duplicates dropped. */
+  int32_t ne = 0;
+  for (int32_t t = 0; t < nt; ++t)
+    for (int k = 0; k < 3; ++k) {
+      int32_t a = s->triangles[3 * t + k], b = s->triangles[3 * t + (k + 1) % 3];
+      s->edges[2 * ne] = a < b ? a : b;
+      s->edges[2 * ne + 1] = a < b ? b : a;
+      ++ne;
+    }
+  qsort(s->edges, (size_t)ne, 2 * sizeof(int32_t), compare_edges);
+  int32_t unique = 0;
+  for (int32_t e = 0; e < ne; ++e) {
+    if (unique > 0 && s->edges[2 * e] == s->edges[2 * unique - 2] &&
+        s->edges[2 * e + 1] == s->edges[2 * unique - 1])
+      continue;
+    s->edges[2 * unique] = s->edges[2 * e], s->edges[2 * unique + 1] = s->edges[2 * e + 1];
+    ++unique;
+  }
+  s->edge_count = unique;
+  s->block_count = (nv + QUERY_BLOCK - 1) / QUERY_BLOCK + (unique + QUERY_BLOCK - 1) / QUERY_BLOCK;
+  s->blocks = calloc((size_t)(s->block_count > 0 ? s->block_count : 1), sizeof(*s->blocks));
+  if (!s->blocks) {
+    piola_collision_surface_destroy(s);
+    return PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "collision surface: out of memory");
+  }
+  *out = s;
+  return PIOLA_OK;
+}
+
+/* ------------------------------------------------------------------ detection */
+
+typedef enum detect_mode { DETECT_PROXIMITY, DETECT_CCD } detect_mode;
+
+static double max3(double a, double b, double c) { return fmax(a, fmax(b, c)); }
+
+static void box_of_vertex(piola__box *box, const double *x0, const double *v, double dt,
+                          double pad) {
+  for (int k = 0; k < 3; ++k) {
+    double a = x0[k], b = v ? x0[k] + dt * v[k] : a;
+    box->lo[k] = fmin(a, b) - pad;
+    box->hi[k] = fmax(a, b) + pad;
+  }
+}
+
+static void box_union_of(piola__box *out, const piola__box *a, const piola__box *b) {
+  for (int k = 0; k < 3; ++k) {
+    out->lo[k] = fmin(a->lo[k], b->lo[k]);
+    out->hi[k] = fmax(a->hi[k], b->hi[k]);
+  }
+}
+
+/* Vertex, triangle and edge boxes: at x0 padded by the thickness (proximity), or swept over
+ * the step padded by the detection tolerance (continuous detection). */
+static void compute_boxes(piola_collision_surface *s, const double *x0, const double *v,
+                          double dt, detect_mode mode) {
+#pragma omp parallel
+  {
+#pragma omp for schedule(static)
+    for (int32_t i = 0; i < s->vertex_count; ++i) {
+      double h = s->vertex_thickness[i];
+      box_of_vertex(&s->vertex_boxes[i], x0 + 3 * i, mode == DETECT_CCD ? v + 3 * i : NULL, dt,
+                    mode == DETECT_CCD ? 2.0 * PIOLA__CCD_TOLERANCE * h : h);
+    }
+#pragma omp for schedule(static)
+    for (int32_t t = 0; t < s->triangle_count; ++t) {
+      const int32_t *tri = s->triangles + 3 * t;
+      box_union_of(&s->triangle_boxes[t], &s->vertex_boxes[tri[0]], &s->vertex_boxes[tri[1]]);
+      box_union_of(&s->triangle_boxes[t], &s->triangle_boxes[t], &s->vertex_boxes[tri[2]]);
+    }
+#pragma omp for schedule(static)
+    for (int32_t e = 0; e < s->edge_count; ++e)
+      box_union_of(&s->edge_boxes[e], &s->vertex_boxes[s->edges[2 * e]],
+                   &s->vertex_boxes[s->edges[2 * e + 1]]);
+  }
+}
+
+static double pair_thickness(const piola_collision_surface *s, const int32_t v[4]) {
+  return fmax(max3(s->vertex_thickness[v[0]], s->vertex_thickness[v[1]], s->vertex_thickness[v[2]]),
+              s->vertex_thickness[v[3]]);
+}
+
+static double pair_friction(const piola_collision_surface *s, const int32_t v[4]) {
+  return 0.5 * (s->bodies[s->vertex_body[v[0]]].friction + s->bodies[s->vertex_body[v[3]]].friction);
+}
+
+static int all_pinned(const piola_collision_surface *s, const int32_t v[4]) {
+  return s->inverse_mass[v[0]] == 0.0 && s->inverse_mass[v[1]] == 0.0 &&
+         s->inverse_mass[v[2]] == 0.0 && s->inverse_mass[v[3]] == 0.0;
+}
+
+static vec3 unit(vec3 a) {
+  double len = vec3_norm(a);
+  return len > 0.0 ? vec3_scale(a, 1.0 / len) : a;
+}
+
+/* Narrow phase of one pair. Returns 1 and fills c when the pair is in contact (proximity) or
+ * collides during the step (continuous detection). */
+static int narrow_phase(const piola_collision_surface *s, const double *x0, const double *v,
+                        double dt, detect_mode mode, int edge_edge, piola__contact *c) {
+  vec3 x[4];
+  for (int k = 0; k < 4; ++k) x[k] = vec3_load(x0 + 3 * c->v[k]);
+  c->thickness = pair_thickness(s, c->v);
+  c->friction = pair_friction(s, c->v);
+  if (mode == DETECT_PROXIMITY) {
+    double dist2;
+    vec3 fallback;
+    if (!edge_edge) {
+      double b[3];
+      dist2 = piola__point_triangle_closest(x[0], x[1], x[2], x[3], b);
+      c->w[0] = 1.0, c->w[1] = -b[0], c->w[2] = -b[1], c->w[3] = -b[2];
+      fallback = vec3_cross(vec3_sub(x[2], x[1]), vec3_sub(x[3], x[1]));
+    } else {
+      double a, b;
+      dist2 = piola__segment_segment_closest(x[0], x[1], x[2], x[3], &a, &b);
+      c->w[0] = 1.0 - a, c->w[1] = a, c->w[2] = -(1.0 - b), c->w[3] = -b;
+      fallback = vec3_cross(vec3_sub(x[1], x[0]), vec3_sub(x[3], x[2]));
+    }
+    if (!(dist2 < c->thickness * c->thickness)) return 0;
+    vec3 r = {0, 0, 0};
+    for (int k = 0; k < 4; ++k) r = vec3_add(r, vec3_scale(x[k], c->w[k]));
+    vec3 n = unit(r);
+    if (vec3_norm2(n) == 0.0) n = unit(fallback);
+    if (vec3_norm2(n) == 0.0) return 0;
+    c->normal = n;
+    c->gap = vec3_dot(r, n);
+    return 1;
+  }
+  vec3 d[4];
+  for (int k = 0; k < 4; ++k) d[k] = vec3_scale(vec3_load(v + 3 * c->v[k]), dt);
+  piola__ccd_hit hit;
+  double eps = PIOLA__CCD_TOLERANCE * c->thickness;
+  int found = edge_edge ? piola__ccd_edge_edge(x, d, eps, &hit)
+                        : piola__ccd_point_triangle(x, d, eps, &hit);
+  if (!found) return 0;
+  memcpy(c->w, hit.w, sizeof(c->w));
+  c->normal = hit.normal;
+  vec3 r = {0, 0, 0};
+  for (int k = 0; k < 4; ++k) r = vec3_add(r, vec3_scale(x[k], c->w[k]));
+  c->gap = vec3_dot(r, hit.normal);
+  return 1;
+}
+
+/* All contacts (proximity) or collisions (continuous detection) into s->found, in an order
+ * that does not depend on the thread count. Returns 0, or -1 out of memory. */
+static int detect(piola_collision_surface *s, const double *x0, const double *v, double dt,
+                  detect_mode mode, int *tree_built) {
+  compute_boxes(s, x0, v, dt, mode);
+  if (!*tree_built) {
+    if (piola__bvh_build(&s->triangle_tree, s->triangle_boxes, s->triangle_count) ||
+        piola__bvh_build(&s->edge_tree, s->edge_boxes, s->edge_count))
+      return -1;
+    *tree_built = 1;
+  } else {
+    piola__bvh_refit(&s->triangle_tree, s->triangle_boxes);
+    piola__bvh_refit(&s->edge_tree, s->edge_boxes);
+  }
+  const int32_t vertex_blocks = (s->vertex_count + QUERY_BLOCK - 1) / QUERY_BLOCK;
+  const int32_t blocks = s->block_count;
+  int failed = 0;
+#pragma omp parallel reduction(| : failed)
+  {
+    piola__index_list candidates = {0};
+#pragma omp for schedule(dynamic, 1)
+    for (int32_t b = 0; b < blocks; ++b) {
+      piola__contact_list *list = &s->blocks[b];
+      list->count = 0;
+      if (failed) continue;
+      const int edge_edge = b >= vertex_blocks;
+      const int32_t first = (edge_edge ? b - vertex_blocks : b) * QUERY_BLOCK;
+      const int32_t end_limit = edge_edge ? s->edge_count : s->vertex_count;
+      const int32_t end = first + QUERY_BLOCK < end_limit ? first + QUERY_BLOCK : end_limit;
+      for (int32_t q = first; q < end && !failed; ++q) {
+        candidates.count = 0;
+        if (!edge_edge) {
+          if (piola__bvh_query(&s->triangle_tree, s->triangle_boxes, &s->vertex_boxes[q],
+                               &candidates)) {
+            failed = 1;
+            break;
+          }
+          for (int64_t j = 0; j < candidates.count; ++j) {
+            const int32_t *tri = s->triangles + 3 * candidates.items[j];
+            if (tri[0] == q || tri[1] == q || tri[2] == q) continue;
+            piola__contact c = {.v = {q, tri[0], tri[1], tri[2]}};
+            if (all_pinned(s, c.v)) continue;
+            if (narrow_phase(s, x0, v, dt, mode, 0, &c) && piola__contact_list_push(list, &c)) {
+              failed = 1;
+              break;
+            }
+          }
+        } else {
+          if (piola__bvh_query(&s->edge_tree, s->edge_boxes, &s->edge_boxes[q], &candidates)) {
+            failed = 1;
+            break;
+          }
+          const int32_t a0 = s->edges[2 * q], a1 = s->edges[2 * q + 1];
+          for (int64_t j = 0; j < candidates.count; ++j) {
+            const int32_t e = candidates.items[j];
+            if (e <= q) continue;
+            const int32_t b0 = s->edges[2 * e], b1 = s->edges[2 * e + 1];
+            if (a0 == b0 || a0 == b1 || a1 == b0 || a1 == b1) continue;
+            piola__contact c = {.v = {a0, a1, b0, b1}};
+            if (all_pinned(s, c.v)) continue;
+            if (narrow_phase(s, x0, v, dt, mode, 1, &c) && piola__contact_list_push(list, &c)) {
+              failed = 1;
+              break;
+            }
+          }
+        }
+      }
+    }
+    free(candidates.items);
+  }
+  if (failed) return -1;
+  s->found.count = 0;
+  for (int32_t b = 0; b < blocks; ++b) {
+    /* Candidates of a query come out in tree order; that order is fixed by the build, which
+     * is itself deterministic, so no sort is needed. */
+    for (int64_t i = 0; i < s->blocks[b].count; ++i)
+      if (piola__contact_list_push(&s->found, &s->blocks[b].items[i])) return -1;
+  }
+  return 0;
+}
+
+/* ------------------------------------------------------------------ impulses */
+
+/* Changes the pair's relative velocity by dn along the normal plus Coulomb friction, which
+ * takes mu dn off the tangential relative velocity but never reverses it. */
+static void apply_relative_change(const piola_collision_surface *s, const piola__contact *c,
+                                  double *v, double dn, double denom) {
+  vec3 rel = {0, 0, 0};
+  for (int k = 0; k < 4; ++k) rel = vec3_add(rel, vec3_scale(vec3_load(v + 3 * c->v[k]), c->w[k]));
+  vec3 tangential = vec3_sub(rel, vec3_scale(c->normal, vec3_dot(rel, c->normal)));
+  double vt = vec3_norm(tangential);
+  vec3 change = vec3_scale(c->normal, dn);
+  if (vt > 0.0 && c->friction > 0.0) {
+    double fraction = fmin(1.0, c->friction * dn / vt);
+    change = vec3_sub(change, vec3_scale(tangential, fraction));
+  }
+  vec3 impulse = vec3_scale(change, 1.0 / denom); /* kg m/s per unit weight */
+  for (int k = 0; k < 4; ++k) {
+    double f = c->w[k] * s->inverse_mass[c->v[k]];
+    if (f == 0.0) continue;
+    double *vk = v + 3 * c->v[k];
+    vk[0] += f * impulse.x, vk[1] += f * impulse.y, vk[2] += f * impulse.z;
+  }
+}
+
+static double weight_denominator(const piola_collision_surface *s, const piola__contact *c) {
+  double denom = 0.0;
+  for (int k = 0; k < 4; ++k) denom += c->w[k] * c->w[k] * s->inverse_mass[c->v[k]];
+  return denom;
+}
+
+static double normal_velocity(const piola__contact *c, const double *v) {
+  vec3 rel = {0, 0, 0};
+  for (int k = 0; k < 4; ++k) rel = vec3_add(rel, vec3_scale(vec3_load(v + 3 * c->v[k]), c->w[k]));
+  return vec3_dot(rel, c->normal);
+}
+
+/* BFA02 repulsion of a pair closer than its thickness: an inelastic impulse that stops the
+ * approach, then a repulsion that brings the separating speed up to 0.1 d / dt (d the overlap
+ * with the thickness), limited to the spring impulse dt k d. Returns 1 when it acted. */
+static int apply_repulsion(const piola_collision_surface *s, const piola__contact *c, double *v,
+                           double dt, double stiffness) {
+  double denom = weight_denominator(s, c);
+  if (!(denom > 0.0)) return 0;
+  double vn = normal_velocity(c, v);
+  double overlap = c->thickness - c->gap;
+  double dn = vn < 0.0 ? -vn : 0.0;
+  double target = 0.1 * overlap / dt, after = vn + dn;
+  if (after < target) {
+    double push = target - after;
+    if (isfinite(stiffness)) push = fmin(push, dt * stiffness * overlap * denom);
+    dn += push;
+  }
+  if (!(dn > 0.0)) return 0;
+  apply_relative_change(s, c, v, dn, denom);
+  return 1;
+}
+
+/* Impact of a pair found by continuous detection: the smallest change of normal velocity
+ * that ends the step with the pair's contact points a small gap apart along the normal
+ * (no bounce), with friction. Returns 1 when it acted. */
+static int apply_impact(const piola_collision_surface *s, const piola__contact *c, double *v,
+                        double dt) {
+  double denom = weight_denominator(s, c);
+  if (!(denom > 0.0)) return 0;
+  double vn = normal_velocity(c, v);
+  double target = (PIOLA__CCD_TARGET_GAP * c->thickness - c->gap) / dt;
+  if (!(vn < target)) return 0;
+  apply_relative_change(s, c, v, target - vn, denom);
+  return 1;
+}
+
+/* ------------------------------------------------------------------ processing */
+
+static int same_zone(piola_collision_surface *s, const piola__contact *c) {
+  if (!s->in_zone[c->v[0]]) return 0;
+  int32_t root = piola__zone_root(s->zone_parent, c->v[0]);
+  for (int k = 1; k < 4; ++k)
+    if (!s->in_zone[c->v[k]] || piola__zone_root(s->zone_parent, c->v[k]) != root) return 0;
+  return 1;
+}
+
+piola_status piola_collision_surface_process(piola_collision_surface *s, const double *x0,
+                                             double *v, const double *mass, double dt,
+                                             const piola_collision_settings *settings,
+                                             piola_collision_stats *stats) {
+  if (!s || !x0 || !v || !mass)
+    return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT,
+                      "collision processing: surface, x0, v and mass must not be NULL");
+  piola_collision_settings set = settings ? *settings : piola_default_collision_settings();
+  if (!(dt > 0.0) || !isfinite(dt))
+    return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "collision processing: dt must be > 0 s, got %g",
+                      dt);
+  if (set.collision_iterations < 0 || set.max_zone_iterations < 1 ||
+      !(set.repulsion_stiffness > 0.0))
+    return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT,
+                      "collision processing: settings need collision_iterations >= 0 (got %d), "
+                      "max_zone_iterations >= 1 (got %d), repulsion_stiffness > 0 N/m (got %g)",
+                      set.collision_iterations, set.max_zone_iterations, set.repulsion_stiffness);
+  for (int32_t i = 0; i < s->vertex_count; ++i) {
+    for (int k = 0; k < 3; ++k)
+      if (!isfinite(x0[3 * i + k]) || !isfinite(v[3 * i + k]))
+        return PIOLA_FAIL(PIOLA_ERROR_NOT_FINITE,
+                          "collision processing: vertex %d has a non-finite position or velocity",
+                          i);
+    if (!(mass[i] > 0.0))
+      return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT,
+                        "collision processing: vertex %d mass must be > 0 kg or INFINITY, got %g", i,
+                        mass[i]);
+    s->inverse_mass[i] = isinf(mass[i]) ? 0.0 : 1.0 / mass[i];
+  }
+  piola_collision_stats st = {0};
+  int tree_built = 0;
+  const double *v_now = v;
+
+  /* Stage 1: repulsion of pairs closer than their thickness at x0. */
+  if (set.repulsion) {
+    if (detect(s, x0, v_now, dt, DETECT_PROXIMITY, &tree_built)) goto out_of_memory;
+    for (int64_t i = 0; i < s->found.count; ++i)
+      st.contacts += apply_repulsion(s, &s->found.items[i], v, dt, set.repulsion_stiffness);
+  }
+
+  /* Stage 2: continuous detection and impacts, a few passes. */
+  int clean = 0;
+  for (int pass = 0; pass < set.collision_iterations; ++pass) {
+    if (detect(s, x0, v, dt, DETECT_CCD, &tree_built)) goto out_of_memory;
+    ++st.collision_passes;
+    if (s->found.count == 0) {
+      clean = 1;
+      break;
+    }
+    for (int64_t i = 0; i < s->found.count; ++i) st.impacts += apply_impact(s, &s->found.items[i], v, dt);
+  }
+
+  /* Stage 3: rigid impact zones until no collision is left. */
+  if (!clean) {
+    for (int32_t i = 0; i < s->vertex_count; ++i) s->zone_parent[i] = i, s->in_zone[i] = 0;
+    for (int pass = 0; pass < set.max_zone_iterations; ++pass) {
+      if (detect(s, x0, v, dt, DETECT_CCD, &tree_built)) goto out_of_memory;
+      ++st.zone_passes;
+      /* Collisions inside one zone cannot be fixed by making it rigid again (and the rigid
+         motion cannot bring its own pairs closer), so only the rest count. */
+      int64_t kept = 0;
+      for (int64_t i = 0; i < s->found.count; ++i)
+        if (!same_zone(s, &s->found.items[i])) s->found.items[kept++] = s->found.items[i];
+      s->found.count = kept;
+      if (kept == 0) {
+        clean = 1;
+        break;
+      }
+      int32_t zones = piola__impact_zones_apply(s, &s->found, x0, v, &st.zone_vertices);
+      if (zones < 0) goto out_of_memory;
+      st.impact_zones = zones;
+    }
+  }
+  st.resolved = clean;
+  if (stats) *stats = st;
+  return PIOLA_OK;
+
+out_of_memory:
+  return PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "collision processing: out of memory");
+}

@@ -5,7 +5,7 @@
 
 #include "contact/proximity.h"
 
-enum { MAX_CANDIDATES = 24 };
+enum { MAX_CANDIDATES = 32 };
 
 /* Real roots of a s^2 + b s + c in [0, 1] (to within 1e-12). When the discriminant is
  * negative the vertex of the parabola is returned instead: it is where the quadratic comes
@@ -134,6 +134,26 @@ static vec3 common_plane_normal(const vec3 x[4], const vec3 d[4]) {
   return len > 0.0 ? vec3_scale(best, 1.0 / len) : best;
 }
 
+/* All four points on one line: the times at which two of them pass each other along it. */
+static int collinear_meetings(const vec3 x[4], const vec3 d[4], double out[12]) {
+  vec3 dir = {0, 0, 0};
+  for (int k = 0; k <= 2; ++k)
+    for (int i = 0; i < 4; ++i)
+      for (int j = i + 1; j < 4; ++j) {
+        vec3 a = vec3_sub(at(x[i], d[i], 0.5 * k), at(x[j], d[j], 0.5 * k));
+        if (vec3_norm2(a) > vec3_norm2(dir)) dir = a;
+      }
+  int n = 0;
+  for (int i = 0; i < 4; ++i)
+    for (int j = i + 1; j < 4; ++j) {
+      double g0 = vec3_dot(vec3_sub(x[i], x[j]), dir), g1 = vec3_dot(vec3_sub(d[i], d[j]), dir);
+      if (g1 == 0.0) continue;
+      double s = -g0 / g1;
+      if (s >= 0.0 && s <= 1.0) out[n++] = s;
+    }
+  return n;
+}
+
 /* Orients and stores the normal of a hit (see piola__ccd_hit). */
 static void orient_normal(const vec3 x[4], const vec3 d[4], vec3 n, piola__ccd_hit *hit) {
   vec3 rel0 = {0, 0, 0}, drel = {0, 0, 0};
@@ -194,6 +214,7 @@ static int ccd_pair(pair_kind kind, const vec3 x[4], const vec3 d[4], double eps
   int n = piola__coplanarity_times(u, du, times);
   if (is_flat(u, du)) {
     vec3 nrm = common_plane_normal(x, d);
+    if (vec3_norm2(nrm) == 0.0) n += collinear_meetings(x, d, times + n);
     double r[2];
     int m;
     if (kind == POINT_TRIANGLE) {

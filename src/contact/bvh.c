@@ -102,7 +102,7 @@ int piola__bvh_build(piola__bvh *bvh, const piola__box *boxes, int32_t n) {
 void piola__bvh_refit(piola__bvh *bvh, const piola__box *boxes) {
   const int32_t count = bvh->node_count;
   piola__bvh_node *nodes = bvh->nodes;
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(static) if (count >= 4096)
   for (int32_t i = 0; i < count; ++i) {
     if (nodes[i].count == 0) continue;
     piola__box b = boxes[bvh->order[nodes[i].first]];

@@ -62,6 +62,7 @@ void piola_collision_surface_destroy(piola_collision_surface *s) {
   free(s->found.items);
   free(s->zone_parent);
   free(s->in_zone);
+  free(s->dirty);
   free(s->zone_order);
   free(s);
 }
@@ -136,10 +137,11 @@ piola_status piola_collision_surface_create(const piola_collision_surface_def *d
   s->edge_boxes = malloc(sizeof(piola__box) * 3 * nt1);
   s->zone_parent = malloc(sizeof(int32_t) * nv1);
   s->in_zone = malloc(nv1);
+  s->dirty = calloc(nv1, 1);
   s->zone_order = malloc(sizeof(int32_t) * nv1);
   if (!s->triangles || !s->edges || !s->vertex_body || !s->bodies || !s->inverse_mass ||
       !s->vertex_thickness || !s->vertex_boxes || !s->triangle_boxes || !s->edge_boxes ||
-      !s->zone_parent || !s->in_zone || !s->zone_order) {
+      !s->zone_parent || !s->in_zone || !s->zone_order || !s->dirty) {
     piola_collision_surface_destroy(s);
     return PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "collision surface: out of memory");
   }
@@ -203,7 +205,7 @@ static void box_union_of(piola__box *out, const piola__box *a, const piola__box 
  * the step padded by the detection tolerance (continuous detection). */
 static void compute_boxes(piola_collision_surface *s, const double *x0, const double *v,
                           double dt, detect_mode mode) {
-#pragma omp parallel
+#pragma omp parallel if (s->vertex_count + s->edge_count >= 4096)
   {
 #pragma omp for schedule(static)
     for (int32_t i = 0; i < s->vertex_count; ++i) {
@@ -236,6 +238,11 @@ static double pair_friction(const piola_collision_surface *s, const int32_t v[4]
 static int all_pinned(const piola_collision_surface *s, const int32_t v[4]) {
   return s->inverse_mass[v[0]] == 0.0 && s->inverse_mass[v[1]] == 0.0 &&
          s->inverse_mass[v[2]] == 0.0 && s->inverse_mass[v[3]] == 0.0;
+}
+
+/* Pairs none of whose vertices changed velocity since the last pass were tested then. */
+static int any_dirty(const uint8_t *dirty, const int32_t v[4]) {
+  return !dirty || dirty[v[0]] || dirty[v[1]] || dirty[v[2]] || dirty[v[3]];
 }
 
 static vec3 unit(vec3 a) {
@@ -279,6 +286,21 @@ static int narrow_phase(const piola_collision_surface *s, const double *x0, cons
   for (int k = 0; k < 4; ++k) d[k] = vec3_scale(vec3_load(v + 3 * c->v[k]), dt);
   piola__ccd_hit hit;
   double eps = PIOLA__CCD_TOLERANCE * c->thickness;
+  /* Separation bound: any two points of the pair (fixed barycentric weights) move apart or
+   * together by at most the largest relative displacement of a vertex of one side and a
+   * vertex of the other, so a pair farther apart than that at the start cannot touch. */
+  double start2, move2 = 0.0;
+  if (!edge_edge) {
+    double b[3];
+    start2 = piola__point_triangle_closest(x[0], x[1], x[2], x[3], b);
+    for (int k = 1; k < 4; ++k) move2 = fmax(move2, vec3_norm2(vec3_sub(d[0], d[k])));
+  } else {
+    double a, b;
+    start2 = piola__segment_segment_closest(x[0], x[1], x[2], x[3], &a, &b);
+    for (int i = 0; i < 2; ++i)
+      for (int k = 2; k < 4; ++k) move2 = fmax(move2, vec3_norm2(vec3_sub(d[i], d[k])));
+  }
+  if (sqrt(start2) > sqrt(move2) + 2.0 * eps) return 0;
   int found = edge_edge ? piola__ccd_edge_edge(x, d, eps, &hit)
                         : piola__ccd_point_triangle(x, d, eps, &hit);
   if (!found) return 0;
@@ -293,7 +315,7 @@ static int narrow_phase(const piola_collision_surface *s, const double *x0, cons
 /* All contacts (proximity) or collisions (continuous detection) into s->found, in an order
  * that does not depend on the thread count. Returns 0, or -1 out of memory. */
 static int detect(piola_collision_surface *s, const double *x0, const double *v, double dt,
-                  detect_mode mode, int *tree_built) {
+                  detect_mode mode, int *tree_built, const uint8_t *dirty) {
   compute_boxes(s, x0, v, dt, mode);
   if (!*tree_built) {
     if (piola__bvh_build(&s->triangle_tree, s->triangle_boxes, s->triangle_count) ||
@@ -307,7 +329,7 @@ static int detect(piola_collision_surface *s, const double *x0, const double *v,
   const int32_t vertex_blocks = (s->vertex_count + QUERY_BLOCK - 1) / QUERY_BLOCK;
   const int32_t blocks = s->block_count;
   int failed = 0;
-#pragma omp parallel reduction(| : failed)
+#pragma omp parallel reduction(| : failed) if (blocks >= 16)
   {
     piola__index_list candidates = {0};
 #pragma omp for schedule(dynamic, 1)
@@ -331,7 +353,7 @@ static int detect(piola_collision_surface *s, const double *x0, const double *v,
             const int32_t *tri = s->triangles + 3 * candidates.items[j];
             if (tri[0] == q || tri[1] == q || tri[2] == q) continue;
             piola__contact c = {.v = {q, tri[0], tri[1], tri[2]}};
-            if (all_pinned(s, c.v)) continue;
+            if (all_pinned(s, c.v) || !any_dirty(dirty, c.v)) continue;
             if (narrow_phase(s, x0, v, dt, mode, 0, &c) && piola__contact_list_push(list, &c)) {
               failed = 1;
               break;
@@ -349,7 +371,7 @@ static int detect(piola_collision_surface *s, const double *x0, const double *v,
             const int32_t b0 = s->edges[2 * e], b1 = s->edges[2 * e + 1];
             if (a0 == b0 || a0 == b1 || a1 == b0 || a1 == b1) continue;
             piola__contact c = {.v = {a0, a1, b0, b1}};
-            if (all_pinned(s, c.v)) continue;
+            if (all_pinned(s, c.v) || !any_dirty(dirty, c.v)) continue;
             if (narrow_phase(s, x0, v, dt, mode, 1, &c) && piola__contact_list_push(list, &c)) {
               failed = 1;
               break;
@@ -375,7 +397,7 @@ static int detect(piola_collision_surface *s, const double *x0, const double *v,
 
 /* Changes the pair's relative velocity by dn along the normal plus Coulomb friction, which
  * takes mu dn off the tangential relative velocity but never reverses it. */
-static void apply_relative_change(const piola_collision_surface *s, const piola__contact *c,
+static void apply_relative_change(piola_collision_surface *s, const piola__contact *c,
                                   double *v, double dn, double denom) {
   vec3 rel = {0, 0, 0};
   for (int k = 0; k < 4; ++k) rel = vec3_add(rel, vec3_scale(vec3_load(v + 3 * c->v[k]), c->w[k]));
@@ -392,6 +414,7 @@ static void apply_relative_change(const piola_collision_surface *s, const piola_
     if (f == 0.0) continue;
     double *vk = v + 3 * c->v[k];
     vk[0] += f * impulse.x, vk[1] += f * impulse.y, vk[2] += f * impulse.z;
+    s->dirty[c->v[k]] = 1;
   }
 }
 
@@ -410,7 +433,7 @@ static double normal_velocity(const piola__contact *c, const double *v) {
 /* BFA02 repulsion of a pair closer than its thickness: an inelastic impulse that stops the
  * approach, then a repulsion that brings the separating speed up to 0.1 d / dt (d the overlap
  * with the thickness), limited to the spring impulse dt k d. Returns 1 when it acted. */
-static int apply_repulsion(const piola_collision_surface *s, const piola__contact *c, double *v,
+static int apply_repulsion(piola_collision_surface *s, const piola__contact *c, double *v,
                            double dt, double stiffness) {
   double denom = weight_denominator(s, c);
   if (!(denom > 0.0)) return 0;
@@ -431,7 +454,7 @@ static int apply_repulsion(const piola_collision_surface *s, const piola__contac
 /* Impact of a pair found by continuous detection: the smallest change of normal velocity
  * that ends the step with the pair's contact points a small gap apart along the normal
  * (no bounce), with friction. Returns 1 when it acted. */
-static int apply_impact(const piola_collision_surface *s, const piola__contact *c, double *v,
+static int apply_impact(piola_collision_surface *s, const piola__contact *c, double *v,
                         double dt) {
   double denom = weight_denominator(s, c);
   if (!(denom > 0.0)) return 0;
@@ -483,32 +506,42 @@ piola_status piola_collision_surface_process(piola_collision_surface *s, const d
   }
   piola_collision_stats st = {0};
   int tree_built = 0;
-  const double *v_now = v;
 
   /* Stage 1: repulsion of pairs closer than their thickness at x0. */
   if (set.repulsion) {
-    if (detect(s, x0, v_now, dt, DETECT_PROXIMITY, &tree_built)) goto out_of_memory;
+    if (detect(s, x0, v, dt, DETECT_PROXIMITY, &tree_built, NULL)) goto out_of_memory;
     for (int64_t i = 0; i < s->found.count; ++i)
       st.contacts += apply_repulsion(s, &s->found.items[i], v, dt, set.repulsion_stiffness);
   }
 
-  /* Stage 2: continuous detection and impacts, a few passes. */
-  int clean = 0;
+  /* Stage 2: continuous detection and impacts, a few passes. After the first pass only pairs
+   * with a vertex whose velocity changed (or that collided without being fixed) can have
+   * changed their answer, so only those are tested again. */
+  int clean = 0, first_pass = 1;
   for (int pass = 0; pass < set.collision_iterations; ++pass) {
-    if (detect(s, x0, v, dt, DETECT_CCD, &tree_built)) goto out_of_memory;
+    if (detect(s, x0, v, dt, DETECT_CCD, &tree_built, first_pass ? NULL : s->dirty))
+      goto out_of_memory;
+    first_pass = 0;
     ++st.collision_passes;
     if (s->found.count == 0) {
       clean = 1;
       break;
     }
-    for (int64_t i = 0; i < s->found.count; ++i) st.impacts += apply_impact(s, &s->found.items[i], v, dt);
+    memset(s->dirty, 0, (size_t)s->vertex_count);
+    for (int64_t i = 0; i < s->found.count; ++i) {
+      const piola__contact *c = &s->found.items[i];
+      if (apply_impact(s, c, v, dt)) ++st.impacts;
+      else for (int k = 0; k < 4; ++k) s->dirty[c->v[k]] = 1;
+    }
   }
 
   /* Stage 3: rigid impact zones until no collision is left. */
   if (!clean) {
     for (int32_t i = 0; i < s->vertex_count; ++i) s->zone_parent[i] = i, s->in_zone[i] = 0;
     for (int pass = 0; pass < set.max_zone_iterations; ++pass) {
-      if (detect(s, x0, v, dt, DETECT_CCD, &tree_built)) goto out_of_memory;
+      if (detect(s, x0, v, dt, DETECT_CCD, &tree_built, first_pass ? NULL : s->dirty))
+        goto out_of_memory;
+      first_pass = 0;
       ++st.zone_passes;
       /* Collisions inside one zone cannot be fixed by making it rigid again (and the rigid
          motion cannot bring its own pairs closer), so only the rest count. */
@@ -520,6 +553,7 @@ piola_status piola_collision_surface_process(piola_collision_surface *s, const d
         clean = 1;
         break;
       }
+      memset(s->dirty, 0, (size_t)s->vertex_count);
       int32_t zones = piola__impact_zones_apply(s, &s->found, x0, v, &st.zone_vertices);
       if (zones < 0) goto out_of_memory;
       st.impact_zones = zones;

@@ -64,6 +64,7 @@ struct piola_collision_surface {
   piola__contact_list found;
   int32_t *zone_parent;
   uint8_t *in_zone;
+  uint8_t *dirty;           /* velocity changed since the last detection pass */
   int32_t *zone_order;      /* vertices grouped by zone */
 };
 

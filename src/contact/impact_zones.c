@@ -107,9 +107,13 @@ int32_t piola__impact_zones_apply(piola_collision_surface *s, const piola__conta
     vec3 omega = solve_inertia(inertia, angular);
     for (int32_t j = 0; j < end - begin; ++j) {
       const int32_t i = ids[j];
-      if (s->inverse_mass[i] == 0.0) continue;
+      if (s->inverse_mass[i] == 0.0) {
+        s->dirty[i] = 1; /* a pinned vertex in a new zone: its pairs are tested again */
+        continue;
+      }
       vec3 r = vec3_sub(vec3_load(x0 + 3 * i), centre);
       vec3_store(v + 3 * i, vec3_add(v_centre, vec3_cross(omega, r)));
+      s->dirty[i] = 1;
     }
   }
   free(start);

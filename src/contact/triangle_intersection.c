@@ -27,6 +27,7 @@ static void two_product(double a, double b, double *x, double *y) {
 
 /* e += b, dropping zero components. */
 static void grow(expansion *e, double b) {
+  if (b == 0.0) return;
   double q = b;
   int m = 0;
   for (int i = 0; i < e->n; ++i) {
@@ -44,6 +45,7 @@ static void add_triple_product(expansion *out, double sign, const double x[2], c
                                const double z[2]) {
   for (int i = 0; i < 2; ++i)
     for (int j = 0; j < 2; ++j) {
+      if (x[i] == 0.0 || y[j] == 0.0) continue;
       double xy[2];
       two_product(x[i], y[j], &xy[0], &xy[1]);
       for (int a = 0; a < 2; ++a)

@@ -56,6 +56,8 @@ void piola_collision_surface_destroy(piola_collision_surface *s) {
   free(s->edge_boxes);
   piola__bvh_free(&s->triangle_tree);
   piola__bvh_free(&s->edge_tree);
+  piola__bvh_free(&s->vertex_tree);
+  free(s->queries);
   if (s->blocks)
     for (int32_t b = 0; b < s->block_count; ++b) free(s->blocks[b].items);
   free(s->blocks);
@@ -169,9 +171,10 @@ piola_status piola_collision_surface_create(const piola_collision_surface_def *d
     ++unique;
   }
   s->edge_count = unique;
-  s->block_count = (nv + QUERY_BLOCK - 1) / QUERY_BLOCK + (unique + QUERY_BLOCK - 1) / QUERY_BLOCK;
+  s->block_count = (nv + nt + unique) / QUERY_BLOCK + 3;
+  s->queries = malloc(sizeof(int32_t) * ((size_t)nv + (size_t)nt + (size_t)unique + 1));
   s->blocks = calloc((size_t)(s->block_count > 0 ? s->block_count : 1), sizeof(*s->blocks));
-  if (!s->blocks) {
+  if (!s->blocks || !s->queries) {
     piola_collision_surface_destroy(s);
     return PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "collision surface: out of memory");
   }
@@ -182,6 +185,10 @@ piola_status piola_collision_surface_create(const piola_collision_surface_def *d
 /* ------------------------------------------------------------------ detection */
 
 typedef enum detect_mode { DETECT_PROXIMITY, DETECT_CCD } detect_mode;
+
+/* What a query primitive is tested against: a vertex against triangles, a triangle against
+ * vertices, an edge against edges. */
+typedef enum query_kind { QUERY_VERTEX, QUERY_TRIANGLE, QUERY_EDGE } query_kind;
 
 static double max3(double a, double b, double c) { return fmax(a, fmax(b, c)); }
 
@@ -312,22 +319,100 @@ static int narrow_phase(const piola_collision_surface *s, const double *x0, cons
   return 1;
 }
 
+/* Pairs of one query primitive with the candidates the tree returns for its box; appends
+ * the contacts found to list. Returns 0, or -1 out of memory. */
+static int query_pairs(piola_collision_surface *s, const double *x0, const double *v, double dt,
+                       detect_mode mode, const uint8_t *dirty, query_kind kind, int32_t q,
+                       piola__index_list *candidates, piola__contact_list *list) {
+  candidates->count = 0;
+  if (kind == QUERY_VERTEX) {
+    if (piola__bvh_query(&s->triangle_tree, s->triangle_boxes, &s->vertex_boxes[q], candidates))
+      return -1;
+    for (int64_t j = 0; j < candidates->count; ++j) {
+      const int32_t *tri = s->triangles + 3 * candidates->items[j];
+      if (tri[0] == q || tri[1] == q || tri[2] == q) continue;
+      piola__contact c = {.v = {q, tri[0], tri[1], tri[2]}};
+      if (all_pinned(s, c.v) || !any_dirty(dirty, c.v)) continue;
+      if (narrow_phase(s, x0, v, dt, mode, 0, &c) && piola__contact_list_push(list, &c)) return -1;
+    }
+  } else if (kind == QUERY_TRIANGLE) {
+    /* Only with a dirty triangle, and only clean vertices: dirty ones query themselves. */
+    if (piola__bvh_query(&s->vertex_tree, s->vertex_boxes, &s->triangle_boxes[q], candidates))
+      return -1;
+    const int32_t *tri = s->triangles + 3 * q;
+    for (int64_t j = 0; j < candidates->count; ++j) {
+      const int32_t p = candidates->items[j];
+      if (dirty[p] || tri[0] == p || tri[1] == p || tri[2] == p) continue;
+      piola__contact c = {.v = {p, tri[0], tri[1], tri[2]}};
+      if (all_pinned(s, c.v)) continue;
+      if (narrow_phase(s, x0, v, dt, mode, 0, &c) && piola__contact_list_push(list, &c)) return -1;
+    }
+  } else {
+    if (piola__bvh_query(&s->edge_tree, s->edge_boxes, &s->edge_boxes[q], candidates)) return -1;
+    const int32_t a0 = s->edges[2 * q], a1 = s->edges[2 * q + 1];
+    for (int64_t j = 0; j < candidates->count; ++j) {
+      const int32_t e = candidates->items[j];
+      const int32_t b0 = s->edges[2 * e], b1 = s->edges[2 * e + 1];
+      /* Each pair once: from the lower index, or from the dirty edge when only one is. */
+      if (e == q) continue;
+      if (!dirty && e < q) continue;
+      if (dirty && e < q && (dirty[b0] || dirty[b1])) continue;
+      if (a0 == b0 || a0 == b1 || a1 == b0 || a1 == b1) continue;
+      piola__contact c = {.v = {a0, a1, b0, b1}};
+      if (all_pinned(s, c.v)) continue;
+      if (narrow_phase(s, x0, v, dt, mode, 1, &c) && piola__contact_list_push(list, &c)) return -1;
+    }
+  }
+  return 0;
+}
+
 /* All contacts (proximity) or collisions (continuous detection) into s->found, in an order
- * that does not depend on the thread count. Returns 0, or -1 out of memory. */
+ * that does not depend on the thread count. With dirty given, only pairs with a vertex whose
+ * velocity changed are tested: they are found from the dirty vertices, from the triangles
+ * and edges that touch one, against the trees of the other primitives. Returns 0, or -1 out
+ * of memory. */
 static int detect(piola_collision_surface *s, const double *x0, const double *v, double dt,
                   detect_mode mode, int *tree_built, const uint8_t *dirty) {
   compute_boxes(s, x0, v, dt, mode);
   if (!*tree_built) {
     if (piola__bvh_build(&s->triangle_tree, s->triangle_boxes, s->triangle_count) ||
-        piola__bvh_build(&s->edge_tree, s->edge_boxes, s->edge_count))
+        piola__bvh_build(&s->edge_tree, s->edge_boxes, s->edge_count) ||
+        piola__bvh_build(&s->vertex_tree, s->vertex_boxes, s->vertex_count))
       return -1;
     *tree_built = 1;
   } else {
     piola__bvh_refit(&s->triangle_tree, s->triangle_boxes);
     piola__bvh_refit(&s->edge_tree, s->edge_boxes);
+    piola__bvh_refit(&s->vertex_tree, s->vertex_boxes);
   }
-  const int32_t vertex_blocks = (s->vertex_count + QUERY_BLOCK - 1) / QUERY_BLOCK;
-  const int32_t blocks = s->block_count;
+  /* The queries: (kind, primitive) in three runs. */
+  int32_t runs[3] = {0, 0, 0}, n = 0;
+  if (!dirty) {
+    for (int32_t i = 0; i < s->vertex_count; ++i) s->queries[n++] = i;
+    runs[0] = n;
+    runs[1] = n;
+    for (int32_t e = 0; e < s->edge_count; ++e) s->queries[n++] = e;
+    runs[2] = n;
+  } else {
+    for (int32_t i = 0; i < s->vertex_count; ++i)
+      if (dirty[i]) s->queries[n++] = i;
+    runs[0] = n;
+    for (int32_t t = 0; t < s->triangle_count; ++t) {
+      const int32_t *tri = s->triangles + 3 * t;
+      if (dirty[tri[0]] || dirty[tri[1]] || dirty[tri[2]]) s->queries[n++] = t;
+    }
+    runs[1] = n;
+    for (int32_t e = 0; e < s->edge_count; ++e)
+      if (dirty[s->edges[2 * e]] || dirty[s->edges[2 * e + 1]]) s->queries[n++] = e;
+    runs[2] = n;
+  }
+  /* Blocks never straddle two runs, so each block has one kind. */
+  int32_t block_start[3], blocks = 0;
+  for (int r = 0; r < 3; ++r) {
+    block_start[r] = blocks;
+    int32_t len = runs[r] - (r ? runs[r - 1] : 0);
+    blocks += (len + QUERY_BLOCK - 1) / QUERY_BLOCK;
+  }
   int failed = 0;
 #pragma omp parallel reduction(| : failed) if (blocks >= 16)
   {
@@ -337,48 +422,16 @@ static int detect(piola_collision_surface *s, const double *x0, const double *v,
       piola__contact_list *list = &s->blocks[b];
       list->count = 0;
       if (failed) continue;
-      const int edge_edge = b >= vertex_blocks;
-      const int32_t first = (edge_edge ? b - vertex_blocks : b) * QUERY_BLOCK;
-      const int32_t end_limit = edge_edge ? s->edge_count : s->vertex_count;
-      const int32_t end = first + QUERY_BLOCK < end_limit ? first + QUERY_BLOCK : end_limit;
-      for (int32_t q = first; q < end && !failed; ++q) {
-        candidates.count = 0;
-        if (!edge_edge) {
-          if (piola__bvh_query(&s->triangle_tree, s->triangle_boxes, &s->vertex_boxes[q],
-                               &candidates)) {
-            failed = 1;
-            break;
-          }
-          for (int64_t j = 0; j < candidates.count; ++j) {
-            const int32_t *tri = s->triangles + 3 * candidates.items[j];
-            if (tri[0] == q || tri[1] == q || tri[2] == q) continue;
-            piola__contact c = {.v = {q, tri[0], tri[1], tri[2]}};
-            if (all_pinned(s, c.v) || !any_dirty(dirty, c.v)) continue;
-            if (narrow_phase(s, x0, v, dt, mode, 0, &c) && piola__contact_list_push(list, &c)) {
-              failed = 1;
-              break;
-            }
-          }
-        } else {
-          if (piola__bvh_query(&s->edge_tree, s->edge_boxes, &s->edge_boxes[q], &candidates)) {
-            failed = 1;
-            break;
-          }
-          const int32_t a0 = s->edges[2 * q], a1 = s->edges[2 * q + 1];
-          for (int64_t j = 0; j < candidates.count; ++j) {
-            const int32_t e = candidates.items[j];
-            if (e <= q) continue;
-            const int32_t b0 = s->edges[2 * e], b1 = s->edges[2 * e + 1];
-            if (a0 == b0 || a0 == b1 || a1 == b0 || a1 == b1) continue;
-            piola__contact c = {.v = {a0, a1, b0, b1}};
-            if (all_pinned(s, c.v) || !any_dirty(dirty, c.v)) continue;
-            if (narrow_phase(s, x0, v, dt, mode, 1, &c) && piola__contact_list_push(list, &c)) {
-              failed = 1;
-              break;
-            }
-          }
+      int r = b >= block_start[2] ? 2 : (b >= block_start[1] ? 1 : 0);
+      const query_kind kind = r == 0 ? QUERY_VERTEX : (r == 1 ? QUERY_TRIANGLE : QUERY_EDGE);
+      const int32_t run_begin = r ? runs[r - 1] : 0;
+      const int32_t first = run_begin + (b - block_start[r]) * QUERY_BLOCK;
+      const int32_t end = first + QUERY_BLOCK < runs[r] ? first + QUERY_BLOCK : runs[r];
+      for (int32_t i = first; i < end; ++i)
+        if (query_pairs(s, x0, v, dt, mode, dirty, kind, s->queries[i], &candidates, list)) {
+          failed = 1;
+          break;
         }
-      }
     }
     free(candidates.items);
   }

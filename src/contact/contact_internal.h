@@ -58,8 +58,9 @@ struct piola_collision_surface {
   double *inverse_mass;
   double *vertex_thickness;
   piola__box *vertex_boxes, *triangle_boxes, *edge_boxes;
-  piola__bvh triangle_tree, edge_tree;
-  int32_t block_count;      /* query blocks: vertices, then edges */
+  piola__bvh triangle_tree, edge_tree, vertex_tree;
+  int32_t *queries;         /* query primitives of a detection pass */
+  int32_t block_count;      /* capacity of blocks */
   piola__contact_list *blocks;
   piola__contact_list found;
   int32_t *zone_parent;

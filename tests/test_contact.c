@@ -504,6 +504,23 @@ static void bad_input_is_reported(void **state) {
   piola_collision_surface_destroy(s);
 }
 
+/* Interior nodes of a solid are in the vertex arrays but in no boundary triangle. */
+static void vertices_in_no_triangle_take_no_part(void **state) {
+  (void)state;
+  scene s = {0};
+  int32_t a = add_vertex(&s, 0, 0, 0, 0), b = add_vertex(&s, 1, 0, 0, 0), c = add_vertex(&s, 0, 1, 0, 0);
+  add_triangle(&s, a, b, c);
+  int32_t inner = add_vertex(&s, 0.2, 0.2, 1e-4, 0);
+  s.v[3 * inner + 2] = -1.0;
+  piola_collision_surface *surface = make_surface(&s, 1, 1e-3, 0.3);
+  piola_collision_stats st;
+  assert_int_equal(piola_collision_surface_process(surface, s.x, s.v, s.m, 0.01, NULL, &st), PIOLA_OK);
+  assert_int_equal(st.contacts + st.impacts + st.impact_zones, 0);
+  assert_true(s.v[3 * inner + 2] == -1.0);
+  piola_collision_surface_destroy(surface);
+  scene_free(&s);
+}
+
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(two_sheets_driven_into_each_other),
@@ -516,6 +533,7 @@ int main(void) {
       cmocka_unit_test(pinned_sheet_is_not_moved),
       cmocka_unit_test(result_does_not_depend_on_thread_count),
       cmocka_unit_test(bad_input_is_reported),
+      cmocka_unit_test(vertices_in_no_triangle_take_no_part),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -94,8 +94,9 @@ PIOLA_API int32_t piola_collision_surface_edge_count(const piola_collision_surfa
  * 3 * vertex_count): proposed velocities, changed in place; mass (kg, vertex_count): > 0, or
  * INFINITY for a pinned vertex, whose velocity is never changed; dt (s) > 0. settings and
  * stats may be NULL (defaults; no statistics). Fails with PIOLA_ERROR_NOT_FINITE on NaN/Inf
- * in x0 or v, PIOLA_ERROR_INVALID_ARGUMENT on a bad mass, dt or setting, and
- * PIOLA_ERROR_OUT_OF_MEMORY; v is unchanged on failure. */
+ * in x0 or v and PIOLA_ERROR_INVALID_ARGUMENT on a bad mass, dt or setting, leaving v
+ * unchanged; after PIOLA_ERROR_OUT_OF_MEMORY v may hold partly processed velocities (each
+ * stage leaves v finite). The result does not depend on the number of threads. */
 PIOLA_API piola_status piola_collision_surface_process(piola_collision_surface *surface,
                                                        const double *x0, double *v,
                                                        const double *mass, double dt,

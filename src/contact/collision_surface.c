@@ -9,7 +9,7 @@
 #include "contact/contact_internal.h"
 #include "contact/proximity.h"
 
-enum { QUERY_BLOCK = 256 };
+enum { QUERY_BLOCK = 256, REBUILD_PERIOD = 8 };
 
 piola_collision_body_def piola_default_collision_body_def(void) {
   return (piola_collision_body_def){.thickness = 1e-3, .friction = 0.3};
@@ -65,6 +65,7 @@ void piola_collision_surface_destroy(piola_collision_surface *s) {
   free(s->zone_parent);
   free(s->in_zone);
   free(s->dirty);
+  free(s->on_surface);
   free(s->zone_order);
   free(s);
 }
@@ -140,14 +141,17 @@ piola_status piola_collision_surface_create(const piola_collision_surface_def *d
   s->zone_parent = malloc(sizeof(int32_t) * nv1);
   s->in_zone = malloc(nv1);
   s->dirty = calloc(nv1, 1);
+  s->on_surface = calloc(nv1, 1);
   s->zone_order = malloc(sizeof(int32_t) * nv1);
   if (!s->triangles || !s->edges || !s->vertex_body || !s->bodies || !s->inverse_mass ||
       !s->vertex_thickness || !s->vertex_boxes || !s->triangle_boxes || !s->edge_boxes ||
-      !s->zone_parent || !s->in_zone || !s->zone_order || !s->dirty) {
+      !s->zone_parent || !s->in_zone || !s->zone_order || !s->dirty || !s->on_surface) {
     piola_collision_surface_destroy(s);
     return PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "collision surface: out of memory");
   }
   if (nt > 0) memcpy(s->triangles, def->triangles, sizeof(int32_t) * 3 * (size_t)nt);
+  /* Vertices in no triangle (e.g. interior nodes of a solid) take no part. */
+  for (int32_t i = 0; i < 3 * nt; ++i) s->on_surface[s->triangles[i]] = 1;
   if (def->vertex_body && nv > 0) memcpy(s->vertex_body, def->vertex_body, sizeof(int32_t) * (size_t)nv);
   memcpy(s->bodies, def->bodies, sizeof(*s->bodies) * (size_t)def->body_count);
   for (int32_t i = 0; i < nv; ++i) s->vertex_thickness[i] = s->bodies[s->vertex_body[i]].thickness;
@@ -342,7 +346,7 @@ static int query_pairs(piola_collision_surface *s, const double *x0, const doubl
     const int32_t *tri = s->triangles + 3 * q;
     for (int64_t j = 0; j < candidates->count; ++j) {
       const int32_t p = candidates->items[j];
-      if (dirty[p] || tri[0] == p || tri[1] == p || tri[2] == p) continue;
+      if (dirty[p] || !s->on_surface[p] || tri[0] == p || tri[1] == p || tri[2] == p) continue;
       piola__contact c = {.v = {p, tri[0], tri[1], tri[2]}};
       if (all_pinned(s, c.v)) continue;
       if (narrow_phase(s, x0, v, dt, mode, 0, &c) && piola__contact_list_push(list, &c)) return -1;
@@ -374,7 +378,11 @@ static int query_pairs(piola_collision_surface *s, const double *x0, const doubl
 static int detect(piola_collision_surface *s, const double *x0, const double *v, double dt,
                   detect_mode mode, int *tree_built, const uint8_t *dirty) {
   compute_boxes(s, x0, v, dt, mode);
+  /* A tree built in an earlier call is refit as long as it is young: its shape came from
+   * positions close to these; every REBUILD_PERIOD calls it is rebuilt from scratch. */
+  if (!*tree_built && s->tree_age > 0 && s->tree_age < REBUILD_PERIOD) *tree_built = 1;
   if (!*tree_built) {
+    s->tree_age = 0;
     if (piola__bvh_build(&s->triangle_tree, s->triangle_boxes, s->triangle_count) ||
         piola__bvh_build(&s->edge_tree, s->edge_boxes, s->edge_count) ||
         piola__bvh_build(&s->vertex_tree, s->vertex_boxes, s->vertex_count))
@@ -388,14 +396,15 @@ static int detect(piola_collision_surface *s, const double *x0, const double *v,
   /* The queries: (kind, primitive) in three runs. */
   int32_t runs[3] = {0, 0, 0}, n = 0;
   if (!dirty) {
-    for (int32_t i = 0; i < s->vertex_count; ++i) s->queries[n++] = i;
+    for (int32_t i = 0; i < s->vertex_count; ++i)
+      if (s->on_surface[i]) s->queries[n++] = i;
     runs[0] = n;
     runs[1] = n;
     for (int32_t e = 0; e < s->edge_count; ++e) s->queries[n++] = e;
     runs[2] = n;
   } else {
     for (int32_t i = 0; i < s->vertex_count; ++i)
-      if (dirty[i]) s->queries[n++] = i;
+      if (dirty[i] && s->on_surface[i]) s->queries[n++] = i;
     runs[0] = n;
     for (int32_t t = 0; t < s->triangle_count; ++t) {
       const int32_t *tri = s->triangles + 3 * t;
@@ -613,6 +622,7 @@ piola_status piola_collision_surface_process(piola_collision_surface *s, const d
     }
   }
   st.resolved = clean;
+  ++s->tree_age;
   if (stats) *stats = st;
   return PIOLA_OK;
 

@@ -66,6 +66,8 @@ struct piola_collision_surface {
   int32_t *zone_parent;
   uint8_t *in_zone;
   uint8_t *dirty;           /* velocity changed since the last detection pass */
+  uint8_t *on_surface;      /* vertex of at least one triangle */
+  int32_t tree_age;         /* calls since the trees were last built (0: never built) */
   int32_t *zone_order;      /* vertices grouped by zone */
 };
 

@@ -60,8 +60,8 @@ typedef struct piola_collision_settings {
                                     impulse only brings the approach speed to 0.1 d / dt as in
                                     BFA02. Default INFINITY */
   int collision_iterations;      /* stage 2 passes before rigid impact zones, >= 0. Default 5 */
-  int max_zone_iterations;       /* stage 3 passes, >= 1: after them every vertex still in a
-                                    collision joins one zone per connected set. Default 200 */
+  int max_zone_iterations;       /* stage 3 passes, >= 1; each merges or grows zones, and
+                                    when they run out stats.resolved is 0. Default 200 */
 } piola_collision_settings;
 
 PIOLA_API piola_collision_settings piola_default_collision_settings(void);
@@ -74,8 +74,9 @@ typedef struct piola_collision_stats {
   int32_t zone_vertices; /* vertices moved rigidly in those zones */
   int32_t collision_passes; /* stage 2 passes run */
   int32_t zone_passes;   /* stage 3 passes run */
-  int32_t resolved;      /* 1 when the final check found no collision; 0 means a zone had
-                            pinned vertices that do not move rigidly together */
+  int32_t resolved;      /* 1 when the final check found no collision; 0 when the zone
+                            passes ran out, or a zone holds pinned vertices that do not move
+                            rigidly together (so the zone cannot follow them all) */
 } piola_collision_stats;
 
 typedef struct piola_collision_surface piola_collision_surface;

@@ -598,6 +598,7 @@ piola_status piola_collision_surface_process(piola_collision_surface *s, const d
   }
 
   /* Stage 3: rigid impact zones until no collision is left. */
+  s->zone_misfit = 0;
   if (!clean) {
     for (int32_t i = 0; i < s->vertex_count; ++i) s->zone_parent[i] = i, s->in_zone[i] = 0;
     for (int pass = 0; pass < set.max_zone_iterations; ++pass) {
@@ -621,7 +622,7 @@ piola_status piola_collision_surface_process(piola_collision_surface *s, const d
       st.impact_zones = zones;
     }
   }
-  st.resolved = clean;
+  st.resolved = clean && !s->zone_misfit;
   ++s->tree_age;
   if (stats) *stats = st;
   return PIOLA_OK;

@@ -67,6 +67,7 @@ struct piola_collision_surface {
   uint8_t *in_zone;
   uint8_t *dirty;           /* velocity changed since the last detection pass */
   uint8_t *on_surface;      /* vertex of at least one triangle */
+  int32_t zone_misfit;      /* a zone could not follow its pinned vertices (this call) */
   int32_t tree_age;         /* calls since the trees were last built (0: never built) */
   int32_t *zone_order;      /* vertices grouped by zone */
 };

@@ -105,6 +105,19 @@ int32_t piola__impact_zones_apply(piola_collision_surface *s, const piola__conta
       inertia = mat3_add(inertia, point_inertia(r, m));
     }
     vec3 omega = solve_inertia(inertia, angular);
+    if (pinned > 1) {
+      /* Can the zone follow all its pinned vertices? */
+      double scale = 0.0, misfit = 0.0;
+      for (int32_t j = 0; j < end - begin; ++j) {
+        const int32_t i = ids[j];
+        if (s->inverse_mass[i] != 0.0) continue;
+        vec3 vi = vec3_load(v + 3 * i);
+        vec3 fit = vec3_add(v_centre, vec3_cross(omega, vec3_sub(vec3_load(x0 + 3 * i), centre)));
+        scale = fmax(scale, vec3_norm(vi));
+        misfit = fmax(misfit, vec3_norm(vec3_sub(vi, fit)));
+      }
+      if (misfit > 1e-9 * scale + 1e-300) s->zone_misfit = 1;
+    }
     for (int32_t j = 0; j < end - begin; ++j) {
       const int32_t i = ids[j];
       if (s->inverse_mass[i] == 0.0) {

@@ -35,7 +35,8 @@ extern "C" {
 #endif
 
 typedef struct piola_collision_body_def {
-  double thickness; /* m, > 0: pairs closer than this repel. Default 1e-3 */
+  double thickness; /* m, > 0: pairs within the body closer than this repel; between two
+                       bodies the mean of their thicknesses applies. Default 1e-3 */
   double friction;  /* Coulomb coefficient mu, >= 0. Default 0.3 */
 } piola_collision_body_def;
 

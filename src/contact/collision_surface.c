@@ -212,8 +212,9 @@ static void box_union_of(piola__box *out, const piola__box *a, const piola__box 
   }
 }
 
-/* Vertex, triangle and edge boxes: at x0 padded by the thickness (proximity), or swept over
- * the step padded by the detection tolerance (continuous detection). */
+/* Vertex, triangle and edge boxes: at x0 padded by half the thickness (proximity), or swept
+ * over the step padded by the detection tolerance (continuous detection); two primitives
+ * within their pair's thickness (or tolerance) then always have overlapping boxes. */
 static void compute_boxes(piola_collision_surface *s, const double *x0, const double *v,
                           double dt, detect_mode mode) {
 #pragma omp parallel if (s->vertex_count + s->edge_count >= 4096)
@@ -222,7 +223,7 @@ static void compute_boxes(piola_collision_surface *s, const double *x0, const do
     for (int32_t i = 0; i < s->vertex_count; ++i) {
       double h = s->vertex_thickness[i];
       box_of_vertex(&s->vertex_boxes[i], x0 + 3 * i, mode == DETECT_CCD ? v + 3 * i : NULL, dt,
-                    mode == DETECT_CCD ? 2.0 * PIOLA__CCD_TOLERANCE * h : h);
+                    mode == DETECT_CCD ? PIOLA__CCD_TOLERANCE * h : 0.5 * h);
     }
 #pragma omp for schedule(static)
     for (int32_t t = 0; t < s->triangle_count; ++t) {
@@ -237,9 +238,13 @@ static void compute_boxes(piola_collision_surface *s, const double *x0, const do
   }
 }
 
-static double pair_thickness(const piola_collision_surface *s, const int32_t v[4]) {
-  return fmax(max3(s->vertex_thickness[v[0]], s->vertex_thickness[v[1]], s->vertex_thickness[v[2]]),
-              s->vertex_thickness[v[3]]);
+/* Each side of a pair keeps half its body's thickness: the pair keeps the sum, which within
+ * one body is that body's thickness. */
+static double pair_thickness(const piola_collision_surface *s, const int32_t v[4], int edge_edge) {
+  const double *h = s->vertex_thickness;
+  double side_a = edge_edge ? fmax(h[v[0]], h[v[1]]) : h[v[0]];
+  double side_b = edge_edge ? fmax(h[v[2]], h[v[3]]) : max3(h[v[1]], h[v[2]], h[v[3]]);
+  return 0.5 * (side_a + side_b);
 }
 
 static double pair_friction(const piola_collision_surface *s, const int32_t v[4]) {
@@ -267,7 +272,7 @@ static int narrow_phase(const piola_collision_surface *s, const double *x0, cons
                         double dt, detect_mode mode, int edge_edge, piola__contact *c) {
   vec3 x[4];
   for (int k = 0; k < 4; ++k) x[k] = vec3_load(x0 + 3 * c->v[k]);
-  c->thickness = pair_thickness(s, c->v);
+  c->thickness = pair_thickness(s, c->v, edge_edge);
   c->friction = pair_friction(s, c->v);
   if (mode == DETECT_PROXIMITY) {
     double dist2;
@@ -321,6 +326,175 @@ static int narrow_phase(const piola_collision_surface *s, const double *x0, cons
   for (int k = 0; k < 4; ++k) r = vec3_add(r, vec3_scale(x[k], c->w[k]));
   c->gap = vec3_dot(r, hit.normal);
   return 1;
+}
+
+/* Narrow phase of vertex p against triangle t, and of edges a and b; push on a hit. Return 0,
+ * or -1 out of memory. */
+static int emit_vertex_triangle(const piola_collision_surface *s, const double *x0,
+                                const double *v, double dt, detect_mode mode, int32_t p,
+                                int32_t t, piola__contact_list *list) {
+  const int32_t *tri = s->triangles + 3 * t;
+  if (!s->on_surface[p] || tri[0] == p || tri[1] == p || tri[2] == p) return 0;
+  piola__contact c = {.v = {p, tri[0], tri[1], tri[2]}};
+  if (all_pinned(s, c.v)) return 0;
+  if (narrow_phase(s, x0, v, dt, mode, 0, &c) && piola__contact_list_push(list, &c)) return -1;
+  return 0;
+}
+
+static int emit_edge_edge(const piola_collision_surface *s, const double *x0, const double *v,
+                          double dt, detect_mode mode, int32_t a, int32_t b,
+                          piola__contact_list *list) {
+  const int32_t a0 = s->edges[2 * a], a1 = s->edges[2 * a + 1];
+  const int32_t b0 = s->edges[2 * b], b1 = s->edges[2 * b + 1];
+  if (a0 == b0 || a0 == b1 || a1 == b0 || a1 == b1) return 0;
+  piola__contact c = {.v = {a0, a1, b0, b1}};
+  if (all_pinned(s, c.v)) return 0;
+  if (narrow_phase(s, x0, v, dt, mode, 1, &c) && piola__contact_list_push(list, &c)) return -1;
+  return 0;
+}
+
+/* ---------------------------------------------------------- tree against tree (full passes)
+ * A full pass finds all pairs by descending two trees together (a vertex tree against the
+ * triangle tree, the edge tree against itself), which visits each overlapping node pair once
+ * instead of descending from the root for every primitive. The top of the descent is done
+ * sequentially, into a fixed number of independent tasks (node pairs), which then run in
+ * parallel, each into its own list; lists are joined in task order, so the result does not
+ * depend on the thread count. */
+
+typedef struct node_pair {
+  int32_t a, b; /* node indices; a == b means the pairs within one subtree (same tree) */
+} node_pair;
+
+enum { TARGET_TASKS = 512 };
+
+/* Size of a node for deciding which side of a pair to descend: its box's half perimeter. */
+static double node_size(const piola__bvh *t, int32_t n) {
+  const piola__box *b = &t->nodes[n].box;
+  return (b->hi[0] - b->lo[0]) + (b->hi[1] - b->lo[1]) + (b->hi[2] - b->lo[2]);
+}
+
+/* Splits one task into its children tasks (appended to out); returns how many, or -1 when
+ * the task is a leaf-leaf pair that cannot be split. */
+static int split_task(const piola__bvh *ta, const piola__bvh *tb, int same_tree, node_pair task,
+                      node_pair out[3]) {
+  const piola__bvh_node *na = &ta->nodes[task.a], *nb = &tb->nodes[task.b];
+  if (same_tree && task.a == task.b) {
+    if (na->count > 0) return -1;
+    int32_t l = task.a + 1, r = na->first;
+    out[0] = (node_pair){l, l}, out[1] = (node_pair){r, r}, out[2] = (node_pair){l, r};
+    return 3;
+  }
+  if (!piola__boxes_overlap(&na->box, &nb->box)) return 0;
+  if (na->count > 0 && nb->count > 0) return -1;
+  int split_a = nb->count > 0 || (na->count == 0 && node_size(ta, task.a) >= node_size(tb, task.b));
+  if (split_a) {
+    out[0] = (node_pair){task.a + 1, task.b}, out[1] = (node_pair){na->first, task.b};
+  } else {
+    out[0] = (node_pair){task.a, task.b + 1}, out[1] = (node_pair){task.a, nb->first};
+  }
+  return 2;
+}
+
+/* Breadth-first expansion of the root task into about TARGET_TASKS tasks. */
+static node_pair *make_tasks(const piola__bvh *ta, const piola__bvh *tb, int same_tree,
+                             int32_t *count) {
+  *count = 0;
+  if (ta->node_count == 0 || tb->node_count == 0) return malloc(sizeof(node_pair));
+  int32_t cap = 4 * TARGET_TASKS + 16, n = 1;
+  node_pair *tasks = malloc(sizeof(node_pair) * (size_t)cap);
+  node_pair *next = malloc(sizeof(node_pair) * (size_t)cap);
+  if (!tasks || !next) {
+    free(tasks), free(next);
+    return NULL;
+  }
+  tasks[0] = (node_pair){0, 0};
+  for (int round = 0; round < 64 && n < TARGET_TASKS; ++round) {
+    int32_t m = 0, split_any = 0;
+    for (int32_t i = 0; i < n; ++i) {
+      node_pair kids[3];
+      int k = m + 3 * (n - i) < cap ? split_task(ta, tb, same_tree, tasks[i], kids) : -1;
+      if (k < 0) {
+        next[m++] = tasks[i];
+        continue;
+      }
+      split_any = 1;
+      for (int j = 0; j < k; ++j) next[m++] = kids[j];
+    }
+    node_pair *t = tasks;
+    tasks = next, next = t, n = m;
+    if (!split_any) break;
+  }
+  free(next);
+  *count = n;
+  return tasks;
+}
+
+/* Runs one task to the end with an explicit stack. Returns 0, or -1 out of memory. */
+static int run_task(const piola_collision_surface *s, const double *x0, const double *v,
+                    double dt, detect_mode mode, const piola__bvh *ta, const piola__bvh *tb,
+                    int same_tree, node_pair task, piola__contact_list *list) {
+  node_pair stack[256];
+  int top = 0;
+  stack[top++] = task;
+  while (top > 0) {
+    node_pair t = stack[--top];
+    node_pair kids[3];
+    int k = split_task(ta, tb, same_tree, t, kids);
+    if (k == 0) continue;
+    if (k > 0 && top + k <= 256) {
+      /* Pushed in reverse so they are taken in order (the order is part of the result). */
+      for (int j = k - 1; j >= 0; --j) stack[top++] = kids[j];
+      continue;
+    }
+    if (k > 0) return -1; /* cannot happen: depth is bounded by the two trees' depths */
+    const piola__bvh_node *na = &ta->nodes[t.a], *nb = &tb->nodes[t.b];
+    for (int32_t i = 0; i < na->count; ++i) {
+      const int32_t pa = ta->order[na->first + i];
+      for (int32_t j = (same_tree && t.a == t.b) ? i + 1 : 0; j < nb->count; ++j) {
+        const int32_t pb = tb->order[nb->first + j];
+        int failed;
+        if (same_tree) {
+          if (!piola__boxes_overlap(&s->edge_boxes[pa], &s->edge_boxes[pb])) continue;
+          failed = emit_edge_edge(s, x0, v, dt, mode, pa < pb ? pa : pb, pa < pb ? pb : pa, list);
+        } else {
+          if (!piola__boxes_overlap(&s->vertex_boxes[pa], &s->triangle_boxes[pb])) continue;
+          failed = emit_vertex_triangle(s, x0, v, dt, mode, pa, pb, list);
+        }
+        if (failed) return -1;
+      }
+    }
+  }
+  return 0;
+}
+
+/* Full pass by tree descents into s->found. Returns 0, or -1 out of memory. */
+static int detect_all(piola_collision_surface *s, const double *x0, const double *v, double dt,
+                      detect_mode mode) {
+  int32_t nvt, nee;
+  node_pair *vt = make_tasks(&s->vertex_tree, &s->triangle_tree, 0, &nvt);
+  node_pair *ee = make_tasks(&s->edge_tree, &s->edge_tree, 1, &nee);
+  int failed = !vt || !ee;
+  const int32_t total = failed ? 0 : nvt + nee;
+  piola__contact_list *lists = failed ? NULL : calloc((size_t)total + 1, sizeof(*lists));
+  if (!failed && !lists) failed = 1;
+  if (!failed) {
+#pragma omp parallel for schedule(dynamic, 1) reduction(| : failed) if (total >= 64 && s->triangle_count >= 2048)
+    for (int32_t i = 0; i < total; ++i) {
+      if (failed) continue;
+      if (i < nvt)
+        failed |= run_task(s, x0, v, dt, mode, &s->vertex_tree, &s->triangle_tree, 0, vt[i], &lists[i]) != 0;
+      else
+        failed |= run_task(s, x0, v, dt, mode, &s->edge_tree, &s->edge_tree, 1, ee[i - nvt], &lists[i]) != 0;
+    }
+  }
+  s->found.count = 0;
+  for (int32_t i = 0; i < total && !failed; ++i)
+    for (int64_t j = 0; j < lists[i].count; ++j)
+      if (piola__contact_list_push(&s->found, &lists[i].items[j])) failed = 1;
+  if (lists)
+    for (int32_t i = 0; i < total; ++i) free(lists[i].items);
+  free(lists), free(vt), free(ee);
+  return failed ? -1 : 0;
 }
 
 /* Pairs of one query primitive with the candidates the tree returns for its box; appends
@@ -393,6 +567,7 @@ static int detect(piola_collision_surface *s, const double *x0, const double *v,
     piola__bvh_refit(&s->edge_tree, s->edge_boxes);
     piola__bvh_refit(&s->vertex_tree, s->vertex_boxes);
   }
+  if (!dirty) return detect_all(s, x0, v, dt, mode);
   /* The queries: (kind, primitive) in three runs. */
   int32_t runs[3] = {0, 0, 0}, n = 0;
   if (!dirty) {

@@ -152,23 +152,25 @@ int main(int argc, char **argv) {
       {"Gmsh 4.1 binary (.msh)", bin, NULL, 0, 1},
       {"VTU appended raw (.vtu)", vtu, NULL, 1, 0},
   };
-  printf("%-26s %8s %10s %10s %10s %10s %12s %12s\n", "format", "size MB", "write s", "write MB/s", "read s",
-         "read MB/s", "read cpu s", "cpu MB/s");
+  printf("%-26s %8s %9s %10s %11s %9s %10s %11s\n", "format", "size MB", "write s", "write MB/s",
+         "w. cpu MB/s", "read s", "read MB/s", "r. cpu MB/s");
   int status = 0;
   double *times = malloc((size_t)runs * sizeof(double));
   double *cpu = malloc((size_t)runs * sizeof(double));
   for (size_t r = 0; r < sizeof rows / sizeof rows[0]; ++r) {
-    double wt = 0, rt = 0, rc = 0;
+    double wt = 0, wc = 0, rt = 0, rc = 0;
     if (rows[r].write_with_piola) {
       for (int i = 0; i < runs; ++i) {
-        double t0 = now();
+        double t0 = now(), c0 = cpu_now();
         if (piola_tet_mesh_write(rows[r].path, &mesh) != PIOLA_OK) {
           fprintf(stderr, "%s\n", piola_last_error());
           status = 1;
         }
         times[i] = now() - t0;
+        cpu[i] = cpu_now() - c0;
       }
       wt = median(times, runs);
+      wc = median(cpu, runs);
     } else if (write_msh_binary(rows[r].path, &mesh) != 0) {
       status = 1;
     }
@@ -191,10 +193,10 @@ int main(int argc, char **argv) {
     }
     double mb = size / 1e6;
     printf("%-26s %8.1f ", rows[r].name, mb);
-    if (wt > 0) printf("%10.3f %10.1f ", wt, mb / wt);
-    else printf("%10s %10s ", "-", "-");
-    if (rt > 0) printf("%10.3f %10.1f %12.3f %12.1f\n", rt, mb / rt, rc, mb / rc);
-    else printf("%10s %10s %12s %12s\n", "-", "-", "-", "-");
+    if (wt > 0) printf("%9.3f %10.1f %11.1f ", wt, mb / wt, mb / wc);
+    else printf("%9s %10s %11s ", "-", "-", "-");
+    if (rt > 0) printf("%9.3f %10.1f %11.1f\n", rt, mb / rt, mb / rc);
+    else printf("%9s %10s %11s\n", "-", "-", "-");
     unlink(rows[r].path);
     if (rows[r].extra) unlink(rows[r].extra);
   }

@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Fills a fuzzer's seed corpus: small files (<= 200 KB) of the fuzzer's format from the shared
 # data folder plus the malformed files in tests/data/bad.
-# usage: seed_from_data.sh NAME DIR   (NAME: gmsh medit vega tetgen obj off stl)
+# usage: seed_from_data.sh NAME DIR   (NAME: gmsh medit vega tetgen obj off stl vtu)
 set -euo pipefail
 name=$1; dir=$2
 root="$(cd "$(dirname "$0")/.." && pwd)"
@@ -17,6 +17,7 @@ case "$name" in
   obj) copy_ext obj ;;
   off) copy_ext off ;;
   stl) copy_ext stl ;;
+  vtu) for f in "$root"/tests/data/*.vtu; do cp "$f" "$dir/"; done ;;
   tetgen)
     # node + "%%" + ele in one input
     for node in $(small "$data" "$bad" -name "*.node"); do

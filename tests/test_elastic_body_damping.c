@@ -1,5 +1,6 @@
-/* Damping forces (section 6.2, the robust variant): linear, symmetric negative
- * semi-definite, zero for rigid velocities at rest, nonzero on flat and inverted tets. */
+/* Damping forces (section 6.2, the robust variant with rigid rotations projected out):
+ * linear, symmetric negative semi-definite, torque-free, zero for rigid velocities, nonzero
+ * on flat and inverted tets. */
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -67,6 +68,53 @@ static void damping_is_linear_symmetric_and_dissipative(void **state) {
     piola_elastic_body_destroy(body);
     fixture_mesh_free(&mesh);
   }
+}
+
+/* Each tet's damping forces have zero net force and zero torque about the origin at the
+ * positions of the last update, also for deformed, flat and inverted tets; and a rigid
+ * rotation of a deformed body is not damped. */
+static void damping_conserves_momentum_and_angular_momentum(void **state) {
+  (void)state;
+  test_rng rng = test_rng_seeded(23);
+  piola_tet_mesh mesh = fixture_single_tet(1.0);
+  piola_material material = fixture_material(PIOLA_MODEL_NEOHOOKEAN);
+  piola_elastic_body *body = fixture_body(&mesh, &material);
+  long samples = test_samples(300, 20);
+  for (long s = 0; s < samples; ++s) {
+    double x[12], v[12], f[12], d[12];
+    random_vector(&rng, x, 12);
+    if (s % 4 == 0) /* flat */
+      for (int i = 0; i < 3; ++i) x[9 + i] = 0.5 * x[i] + 0.5 * x[3 + i];
+    random_vector(&rng, v, 12);
+    assert_int_equal(piola_elastic_body_update(body, x, 1.0, f, NULL), PIOLA_OK);
+    piola_elastic_body_damping_forces(body, v, 1.5, 0.5, d);
+    double scale = fixture_max_abs(d, 12) * (fixture_max_abs(x, 12) + 1.0) + 1e-300;
+    double torque[3] = {0, 0, 0};
+    for (int c = 0; c < 4; ++c) {
+      const double *p = x + 3 * c, *g = d + 3 * c;
+      torque[0] += p[1] * g[2] - p[2] * g[1];
+      torque[1] += p[2] * g[0] - p[0] * g[2];
+      torque[2] += p[0] * g[1] - p[1] * g[0];
+    }
+    for (int i = 0; i < 3; ++i) {
+      assert_true(fabs(d[i] + d[3 + i] + d[6 + i] + d[9 + i]) <= 1e-12 * scale);
+      if (!(fabs(torque[i]) <= 1e-9 * scale)) fail_msg("sample %ld: torque %g, scale %g", s, torque[i], scale);
+    }
+    /* rigid rotation about a random axis through a random point */
+    double w[3], o[3];
+    random_vector(&rng, w, 3);
+    random_vector(&rng, o, 3);
+    for (int c = 0; c < 4; ++c) {
+      double q[3] = {x[3 * c] - o[0], x[3 * c + 1] - o[1], x[3 * c + 2] - o[2]};
+      v[3 * c] = w[1] * q[2] - w[2] * q[1];
+      v[3 * c + 1] = w[2] * q[0] - w[0] * q[2];
+      v[3 * c + 2] = w[0] * q[1] - w[1] * q[0];
+    }
+    piola_elastic_body_damping_forces(body, v, 1.5, 0.5, d);
+    assert_true(fixture_max_abs(d, 12) <= 1e-9 * (fixture_max_abs(v, 12) + 1e-300) * 10.0);
+  }
+  piola_elastic_body_destroy(body);
+  fixture_mesh_free(&mesh);
 }
 
 static void rigid_velocities_are_not_damped_at_rest(void **state) {
@@ -142,6 +190,7 @@ static void flat_and_inverted_tets_are_still_damped(void **state) {
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(damping_is_linear_symmetric_and_dissipative),
+      cmocka_unit_test(damping_conserves_momentum_and_angular_momentum),
       cmocka_unit_test(rigid_velocities_are_not_damped_at_rest),
       cmocka_unit_test(flat_and_inverted_tets_are_still_damped),
   };

@@ -9,6 +9,7 @@
 #include "test_support.h"
 
 #include "io/mesh_io_internal.h"
+#include "io/mesh_writers.h"
 #include "io/text_scanner.h"
 #include "piola/mesh.h"
 #include "piola/mesh_io.h"
@@ -54,14 +55,14 @@ static void tet_writers_round_trip_exactly(void **state) {
   (void)state;
   const char *sources[] = {"gmsh/cubes_v41.msh", "medit/cube_medium_tetra.mesh", "tetgen/armadillo_4k.node",
                            "vega/asianDragon.veg"};
-  const char *outputs[] = {"out.msh", "out.mesh", "out.node"};
+  const char *outputs[] = {"out.msh", "out.mesh", "out.node", "out.vtu"};
   for (size_t i = 0; i < 4; ++i) {
     piola_tet_mesh a;
     load(sources[i], &a);
     /* Gmsh physical tags must be positive: shift Vega's material indices. */
     if (a.tet_regions)
       for (int32_t t = 0; t < a.tet_count; ++t) a.tet_regions[t] += 1;
-    for (size_t k = 0; k < 3; ++k) {
+    for (size_t k = 0; k < 4; ++k) {
       if (piola_tet_mesh_write(tmp(outputs[k]), &a) != PIOLA_OK) fail_msg("%s", piola_last_error());
       piola_tet_mesh b;
       if (piola_tet_mesh_read(tmp(outputs[k]), &b) != PIOLA_OK) fail_msg("%s", piola_last_error());
@@ -70,6 +71,29 @@ static void tet_writers_round_trip_exactly(void **state) {
     }
     piola_tet_mesh_free(&a);
   }
+}
+
+/* The same five-tet mesh as VTU written by piola (appended raw) and by meshio (ascii and
+ * inline base64) reads like the Gmsh original. */
+static void vtu_variants_read_like_the_original(void **state) {
+  (void)state;
+  piola_tet_mesh original;
+  load("gmsh/msh_test/22_ascii.msh", &original);
+  const char *files[] = {"five_tets_raw.vtu", "five_tets_ascii.vtu", "five_tets_base64.vtu"};
+  for (int i = 0; i < 3; ++i) {
+    char path[1024];
+    snprintf(path, sizeof path, "%s/tests/data/%s", PIOLA_SOURCE_DIR, files[i]);
+    piola_tet_mesh m;
+    if (piola_tet_mesh_read(path, &m) != PIOLA_OK) fail_msg("%s", piola_last_error());
+    assert_int_equal(m.vertex_count, original.vertex_count);
+    assert_int_equal(m.tet_count, original.tet_count);
+    for (int32_t t = 0; t < m.tet_count; ++t)
+      for (int k = 0; k < 4; ++k)
+        for (int d = 0; d < 3; ++d)
+          assert_close(m.positions[3 * m.tets[4 * t + k] + d], original.positions[3 * original.tets[4 * t + k] + d], 0);
+    piola_tet_mesh_free(&m);
+  }
+  piola_tet_mesh_free(&original);
 }
 
 static void boundary_obj_is_the_closed_boundary(void **state) {
@@ -225,6 +249,29 @@ static void decimal_parser_is_within_one_ulp_of_strtod(void **state) {
   }
 }
 
+static void written_doubles_read_back_exactly(void **state) {
+  (void)state;
+  test_rng rng = test_rng_seeded(11);
+  long n = test_samples(200000, 2000);
+  for (long i = 0; i < n; ++i) {
+    double v;
+    if (i % 3 == 0) { /* arbitrary bit patterns, finite */
+      uint64_t bits = test_rng_next(&rng);
+      memcpy(&v, &bits, 8);
+      if (!isfinite(v)) continue;
+    } else if (i % 3 == 1) {
+      v = test_rng_uniform(&rng, -1, 1) * pow(10.0, test_rng_uniform(&rng, -40, 40));
+    } else { /* short decimals, as in hand-written files */
+      v = (double)(int64_t)test_rng_uniform(&rng, -1e6, 1e6) / 1000.0;
+    }
+    char buf[32];
+    int len = piola__format_double(buf, v);
+    assert_true(len > 0 && len < 32);
+    if (strtod(buf, NULL) != v) fail_msg("%.17g written as '%s'", v, buf);
+    if (i % 3 == 2) assert_true(len <= 12); /* short values stay short */
+  }
+}
+
 typedef struct bad_case {
   const char *name; /* decides the reader */
   const char *text;
@@ -317,6 +364,40 @@ static void mixed_face_forms_and_polygons_in_obj(void **state) {
   piola_tri_mesh_free(&m);
 }
 
+static void ascii_stl_is_welded_and_off_polygons_split(void **state) {
+  (void)state;
+  /* The unit tet's surface, wound outward, corners repeated per facet. */
+  const char *stl = "solid tet\n"
+                    " facet normal 0 0 -1\n  outer loop\n   vertex 0 0 0\n   vertex 0 1 0\n   vertex 1 0 0\n"
+                    "  endloop\n endfacet\n"
+                    " facet normal 0 -1 0\n  outer loop\n   vertex 0 0 0\n   vertex 1 0 0\n   vertex 0 0 1\n"
+                    "  endloop\n endfacet\n"
+                    " facet normal -1 0 0\n  outer loop\n   vertex 0 0 0\n   vertex 0 0 1\n   vertex -0 1 0\n"
+                    "  endloop\n endfacet\n"
+                    " facet normal 1 1 1\n  outer loop\n   vertex 1 0 0\n   vertex 0 1 0\n   vertex 0 0 1\n"
+                    "  endloop\n endfacet\n"
+                    "endsolid tet\n";
+  piola_tri_mesh m;
+  if (piola__read_stl_mem("tet.stl", stl, strlen(stl), &m) != PIOLA_OK) fail_msg("%s", piola_last_error());
+  assert_int_equal(m.vertex_count, 4); /* 12 corners welded, -0 with +0 */
+  assert_int_equal(m.triangle_count, 4);
+  piola_surface_topology topo;
+  assert_int_equal(piola_tri_mesh_topology(&m, &topo), PIOLA_OK);
+  assert_true(topo.closed && topo.manifold && topo.oriented);
+  assert_int_equal(topo.euler_characteristic, 2);
+  assert_close(piola_tri_mesh_enclosed_volume(&m), 1.0 / 6.0, 1e-15);
+  piola_tri_mesh_free(&m);
+  /* A cube as six quads: 12 triangles, closed, volume 1. */
+  const char *off = "OFF\n# cube\n8 6 12\n0 0 0\n1 0 0\n1 1 0\n0 1 0\n0 0 1\n1 0 1\n1 1 1\n0 1 1\n"
+                    "4 0 3 2 1\n4 4 5 6 7\n4 0 1 5 4\n4 1 2 6 5\n4 2 3 7 6\n4 3 0 4 7 255 0 0\n";
+  assert_int_equal(piola__read_off_mem("cube.off", off, strlen(off), &m), PIOLA_OK);
+  assert_int_equal(m.triangle_count, 12);
+  assert_int_equal(piola_tri_mesh_topology(&m, &topo), PIOLA_OK);
+  assert_true(topo.closed && topo.manifold && topo.oriented);
+  assert_close(piola_tri_mesh_enclosed_volume(&m), 1.0, 1e-15);
+  piola_tri_mesh_free(&m);
+}
+
 static void loaded_tets_are_oriented_positively(void **state) {
   (void)state;
   /* The second tet is stored inverted; the reader flips it. */
@@ -334,14 +415,17 @@ static void loaded_tets_are_oriented_positively(void **state) {
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(tet_writers_round_trip_exactly),
+      cmocka_unit_test(vtu_variants_read_like_the_original),
       cmocka_unit_test(boundary_obj_is_the_closed_boundary),
       cmocka_unit_test(surface_writers_round_trip),
       cmocka_unit_test(writers_never_leave_partial_files),
       cmocka_unit_test(vtu_with_fields_is_read_by_vtk),
       cmocka_unit_test(decimal_parser_is_within_one_ulp_of_strtod),
+      cmocka_unit_test(written_doubles_read_back_exactly),
       cmocka_unit_test(malformed_input_is_refused_with_file_and_line),
       cmocka_unit_test(mixed_face_forms_and_polygons_in_obj),
       cmocka_unit_test(loaded_tets_are_oriented_positively),
+      cmocka_unit_test(ascii_stl_is_welded_and_off_polygons_split),
   };
   return cmocka_run_group_tests(tests, setup, teardown);
 }

@@ -212,7 +212,7 @@ static void torus_surface_is_meshed(void **state) {
 
 static void bunny_surface_is_meshed(void **state) {
   (void)state;
-  check_surface_mesh("surface/bunny_10k.obj", 30, 0, 0.01);
+  check_surface_mesh("surface/bunny_10k.obj", 45, 0, 0.01);
 }
 
 static void starfish_stl_is_meshed(void **state) {

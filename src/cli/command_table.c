@@ -6,6 +6,7 @@
 int cli_mesh(int argc, char **argv);
 
 const cli_command cli_commands[] = {
+    {"run", cli_run},
     {"mesh", cli_mesh},
     {NULL, NULL},
 };

@@ -12,6 +12,9 @@ typedef struct cli_command {
 
 extern const cli_command cli_commands[];
 
+/* `piola run SCENE.json -o DIR ...` (src/cli/cli_run.c). */
+int cli_run(int argc, char **argv);
+
 /* `piola mesh generate ...` (argv[0] is "generate"), called by the `mesh` command. */
 int cli_mesh_generate(int argc, char **argv);
 

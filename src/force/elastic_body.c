@@ -79,10 +79,10 @@ void piola__elastic_body_gather_forces(const piola_elastic_body *body, double *f
   for (int32_t i = 0; i < body->vertex_count; ++i) {
     double fx = 0, fy = 0, fz = 0;
     for (int32_t e = start[i]; e < start[i + 1]; ++e) {
-      const double *g = tf + 3 * (size_t)inc[e]; /* 12 t + 3 corner = 3 (4 t + corner) */
+      const double *g = tf + inc[e];
       fx += g[0];
-      fy += g[1];
-      fz += g[2];
+      fy += g[B];
+      fz += g[2 * B];
     }
     forces[3 * i] = fx;
     forces[3 * i + 1] = fy;
@@ -100,10 +100,11 @@ PIOLA_WIDE_VECTORS static void update_block(piola_elastic_body *body, const doub
   double *const *dmi = body->dm_inv;
 #pragma omp simd
   for (int l = 0; l < B; ++l) {
-    const double *p0 = x + 3 * i0[l], *p1 = x + 3 * i1[l], *p2 = x + 3 * i2[l], *p3 = x + 3 * i3[l];
-    double d00 = p1[0] - p0[0], d01 = p2[0] - p0[0], d02 = p3[0] - p0[0];
-    double d10 = p1[1] - p0[1], d11 = p2[1] - p0[1], d12 = p3[1] - p0[1];
-    double d20 = p1[2] - p0[2], d21 = p2[2] - p0[2], d22 = p3[2] - p0[2];
+    /* index arithmetic, not pointers, so GCC emits vector gathers */
+    const int32_t a = 3 * i0[l], b = 3 * i1[l], c = 3 * i2[l], d = 3 * i3[l];
+    double d00 = x[b] - x[a], d01 = x[c] - x[a], d02 = x[d] - x[a];
+    double d10 = x[b + 1] - x[a + 1], d11 = x[c + 1] - x[a + 1], d12 = x[d + 1] - x[a + 1];
+    double d20 = x[b + 2] - x[a + 2], d21 = x[c + 2] - x[a + 2], d22 = x[d + 2] - x[a + 2];
     double m00 = dmi[0][base + l], m01 = dmi[1][base + l], m02 = dmi[2][base + l];
     double m10 = dmi[3][base + l], m11 = dmi[4][base + l], m12 = dmi[5][base + l];
     double m20 = dmi[6][base + l], m21 = dmi[7][base + l], m22 = dmi[8][base + l];
@@ -119,9 +120,12 @@ PIOLA_WIDE_VECTORS static void update_block(piola_elastic_body *body, const doub
               f02 * (f10 * f21 - f11 * f20);
   }
 
-  double u[9][B], v[9][B], fhat[3][B];
+  /* U and V go straight into the body's SoA arrays (stride padded_tet_count) */
+  double fhat[3][B];
+  double *uo = body->u[0] + base, *vo = body->v[0] + base;
+  const long stride = body->padded_tet_count;
 #pragma omp simd
-  for (int l = 0; l < B; ++l) piola__svd3_kernel(&f[0][l], B, &u[0][l], &fhat[0][l], &v[0][l], B);
+  for (int l = 0; l < B; ++l) piola__svd3_kernel(&f[0][l], B, uo + l, vo + l, stride, &fhat[0][l], B);
 
   double phat[3][B], psi[B];
   piola__material_stress_lanes(body, base, fhat, phat);
@@ -132,8 +136,8 @@ PIOLA_WIDE_VECTORS static void update_block(piola_elastic_body *body, const doub
       psi[l] = piola_material_energy_density(&body->materials[body->tet_material[base + l]], fh);
     }
 
-  double g[9][B];
   const double *volume = body->rest_volume + base;
+  double *tf = body->tet_forces + 12 * (size_t)base; /* this block's 12 rows of B lanes */
 #pragma omp simd
   for (int l = 0; l < B; ++l) {
     double p0 = phat[0][l] * stiffness_scale, p1 = phat[1][l] * stiffness_scale,
@@ -144,27 +148,22 @@ PIOLA_WIDE_VECTORS static void update_block(piola_elastic_body *body, const doub
     for (int i = 0; i < 3; ++i)
       PIOLA_UNROLL
       for (int j = 0; j < 3; ++j)
-        pm[i][j] = u[3 * i][l] * p0 * v[3 * j][l] + u[3 * i + 1][l] * p1 * v[3 * j + 1][l] +
-                   u[3 * i + 2][l] * p2 * v[3 * j + 2][l];
-    /* G = P Bm = -V0 P Dm^-T: column j is the force on corner j + 1 */
+        pm[i][j] = uo[3 * i * stride + l] * p0 * vo[3 * j * stride + l] +
+                   uo[(3 * i + 1) * stride + l] * p1 * vo[(3 * j + 1) * stride + l] +
+                   uo[(3 * i + 2) * stride + l] * p2 * vo[(3 * j + 2) * stride + l];
+    /* G = P Bm = -V0 P Dm^-T: column j is the force on corner j + 1; corner 0 balances */
     double w = -volume[l];
     PIOLA_UNROLL
-    for (int i = 0; i < 3; ++i)
-      PIOLA_UNROLL
-      for (int j = 0; j < 3; ++j)
-        g[3 * i + j][l] = w * (pm[i][0] * dmi[3 * j][base + l] + pm[i][1] * dmi[3 * j + 1][base + l] +
-                               pm[i][2] * dmi[3 * j + 2][base + l]);
-  }
-
-  double *tf = body->tet_forces + 12 * (size_t)base;
-  for (int l = 0; l < B; ++l) {
-    double *o = tf + 12 * l;
     for (int i = 0; i < 3; ++i) {
-      double a = g[3 * i][l], b = g[3 * i + 1][l], c = g[3 * i + 2][l];
-      o[i] = -(a + b + c);
-      o[3 + i] = a;
-      o[6 + i] = b;
-      o[9 + i] = c;
+      double g0 = 0.0;
+      PIOLA_UNROLL
+      for (int j = 0; j < 3; ++j) {
+        double g = w * (pm[i][0] * dmi[3 * j][base + l] + pm[i][1] * dmi[3 * j + 1][base + l] +
+                        pm[i][2] * dmi[3 * j + 2][base + l]);
+        tf[(3 * (j + 1) + i) * B + l] = g;
+        g0 -= g;
+      }
+      tf[i * B + l] = g0;
     }
   }
 
@@ -173,10 +172,6 @@ PIOLA_WIDE_VECTORS static void update_block(piola_elastic_body *body, const doub
   int32_t inverted = 0;
   for (int l = 0; l < B; ++l) {
     int32_t t = base + l;
-    for (int k = 0; k < 9; ++k) {
-      body->u[k][t] = u[k][l];
-      body->v[k][t] = v[k][l];
-    }
     for (int k = 0; k < 3; ++k) body->fhat[3 * t + k] = fhat[k][l];
     body->det_f[t] = detf[l];
     body->energy_density[t] = psi[l] * stiffness_scale;
@@ -216,6 +211,7 @@ piola_status piola_elastic_body_update(piola_elastic_body *body, const double *x
   for (int32_t b = 0; b < blocks; ++b) update_block(body, x, stiffness_scale, stats != NULL, b);
   piola__elastic_body_gather_forces(body, forces);
   body->has_state = 1;
+  memcpy(body->positions, x, sizeof(double) * 3 * (size_t)body->vertex_count);
   body->energy_valid = stats != NULL;
   body->last_stiffness_scale = stiffness_scale;
   if (stats) {

@@ -46,15 +46,18 @@ struct piola_elastic_body {
   int32_t *tet_material;    /* material index */
 
   /* per padded tet state from the last update (SoA) */
-  double *u[9];
+  double *u[9];             /* u[k] = u[0] + k * padded_tet_count: one allocation, so the
+                               SVD kernel writes all 9 entries with one stride */
   double *v[9];
   double *fhat;             /* 3 per tet, AoS (public) */
   double *det_f;
   double *energy_density;
-  double *tet_forces;       /* 12 per tet: corner c, component i at 3 * c + i */
+  double *tet_forces;       /* 12 per tet, blocked like the SIMD lanes: component i of
+                               corner c of tet t is at piola__tet_force_offset(t, c) + 8 i */
 
   /* incidence: vertex i's (tet, corner) pairs are incidence[incidence_start[i] ..
-   * incidence_start[i + 1]), encoded as 4 * tet + corner, sorted */
+   * incidence_start[i + 1]), in increasing tet order, each stored as its offset in
+   * tet_forces (piola__tet_force_offset) */
   int32_t *incidence_start;
   int32_t *incidence;
 
@@ -72,6 +75,7 @@ struct piola_elastic_body {
   int32_t *tets;            /* 4 * tet_count, public AoS copy after reorientation */
   double *rest_positions;   /* 3 * vertex_count */
   double *masses;           /* vertex_count */
+  double *positions;        /* 3 * vertex_count: x of the last update (damping needs it) */
   double density;
   double min_rest_altitude;
   double max_wave_speed;
@@ -80,6 +84,12 @@ struct piola_elastic_body {
                                when stats are requested, or lazily by the getter) */
   double last_stiffness_scale;
 };
+
+/* Where tet t's corner c force starts in tet_forces: blocks of PIOLA_TET_BLOCK tets hold
+ * 12 rows (3 c + i) of PIOLA_TET_BLOCK lanes, so the force loop stores whole vectors. */
+static inline int32_t piola__tet_force_offset(int32_t t, int c) {
+  return (t / PIOLA_TET_BLOCK) * 12 * PIOLA_TET_BLOCK + 3 * c * PIOLA_TET_BLOCK + t % PIOLA_TET_BLOCK;
+}
 
 /* Builds the rest state of body from def (rest_state.c): validates def, reorients, fills
  * the SoA arrays, masses, incidence, altitude and wave speed. body must be zeroed. */

@@ -22,9 +22,9 @@ void piola__elastic_body_free_arrays(piola_elastic_body *body) {
   for (int k = 0; k < 4; ++k) free(body->tet_vertices[k]);
   for (int k = 0; k < 9; ++k) {
     free(body->dm_inv[k]);
-    free(body->u[k]);
-    free(body->v[k]);
   }
+  free(body->u[0]);
+  free(body->v[0]);
   free(body->rest_volume);
   free(body->tet_material);
   free(body->fhat);
@@ -40,6 +40,7 @@ void piola__elastic_body_free_arrays(piola_elastic_body *body) {
   free(body->tets);
   free(body->rest_positions);
   free(body->masses);
+  free(body->positions);
   memset(body, 0, sizeof *body);
 }
 
@@ -112,10 +113,15 @@ piola_status piola__elastic_body_build_rest_state(piola_elastic_body *body,
   for (int k = 0; k < 4; ++k) ok &= (body->tet_vertices[k] = alloc_array((size_t)np, sizeof(int32_t))) != NULL;
   for (int k = 0; k < 9; ++k) {
     ok &= (body->dm_inv[k] = alloc_array((size_t)np, sizeof(double))) != NULL;
-    ok &= (body->u[k] = alloc_array((size_t)np, sizeof(double))) != NULL;
-    ok &= (body->v[k] = alloc_array((size_t)np, sizeof(double))) != NULL;
   }
   size_t nb = (size_t)np / PIOLA_TET_BLOCK;
+  ok &= (body->u[0] = alloc_array(9 * (size_t)np, sizeof(double))) != NULL;
+  ok &= (body->v[0] = alloc_array(9 * (size_t)np, sizeof(double))) != NULL;
+  if (ok)
+    for (int k = 1; k < 9; ++k) {
+      body->u[k] = body->u[0] + (size_t)k * (size_t)np;
+      body->v[k] = body->v[0] + (size_t)k * (size_t)np;
+    }
   ok &= (body->rest_volume = alloc_array((size_t)np, sizeof(double))) != NULL;
   ok &= (body->tet_material = alloc_array((size_t)np, sizeof(int32_t))) != NULL;
   ok &= (body->fhat = alloc_array(3 * (size_t)np, sizeof(double))) != NULL;
@@ -131,10 +137,12 @@ piola_status piola__elastic_body_build_rest_state(piola_elastic_body *body,
   ok &= (body->tets = alloc_array(4 * (size_t)nt, sizeof(int32_t))) != NULL;
   ok &= (body->rest_positions = alloc_array(3 * (size_t)nv, sizeof(double))) != NULL;
   ok &= (body->masses = alloc_array((size_t)nv, sizeof(double))) != NULL;
+  ok &= (body->positions = alloc_array(3 * (size_t)nv, sizeof(double))) != NULL;
   if (!ok) return PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "elastic body with %d tets: out of memory", (int)nt);
 
   memcpy(body->materials, def->materials, sizeof(piola_material) * (size_t)def->material_count);
   memcpy(body->rest_positions, mesh->positions, sizeof(double) * 3 * (size_t)nv);
+  memcpy(body->positions, mesh->positions, sizeof(double) * 3 * (size_t)nv);
   body->uniform_material = def->tet_materials ? def->tet_materials[0] : 0;
 
   double min_altitude = INFINITY;
@@ -192,7 +200,7 @@ piola_status piola__elastic_body_build_rest_state(piola_elastic_body *body,
   for (int32_t t = 0; t < nt; ++t)
     for (int c = 0; c < 4; ++c) {
       int32_t v = body->tets[4 * t + c];
-      body->incidence[body->incidence_start[v] + fill[v]++] = 4 * t + c;
+      body->incidence[body->incidence_start[v] + fill[v]++] = piola__tet_force_offset(t, c);
     }
   free(fill);
 

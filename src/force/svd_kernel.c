@@ -12,7 +12,8 @@ PIOLA_WIDE_VECTORS void piola__svd3_kernel_batch(int32_t n, const double *f, dou
       for (int l = 0; l < BATCH_LANES; ++l) fl[k][l] = f[9 * (base + l) + k];
 #pragma omp simd
     for (int l = 0; l < BATCH_LANES; ++l)
-      piola__svd3_kernel(&fl[0][l], BATCH_LANES, &ul[0][l], &sl[0][l], &vl[0][l], BATCH_LANES);
+      piola__svd3_kernel(&fl[0][l], BATCH_LANES, &ul[0][l], &vl[0][l], BATCH_LANES, &sl[0][l],
+                         BATCH_LANES);
     for (int l = 0; l < BATCH_LANES; ++l) {
       for (int k = 0; k < 9; ++k) {
         u[9 * (base + l) + k] = ul[k][l];
@@ -21,5 +22,6 @@ PIOLA_WIDE_VECTORS void piola__svd3_kernel_batch(int32_t n, const double *f, dou
       for (int k = 0; k < 3; ++k) fhat[3 * (base + l) + k] = sl[k][l];
     }
   }
-  for (int32_t t = full; t < n; ++t) piola__svd3_kernel(f + 9 * t, 1, u + 9 * t, fhat + 3 * t, v + 9 * t, 1);
+  for (int32_t t = full; t < n; ++t)
+    piola__svd3_kernel(f + 9 * t, 1, u + 9 * t, v + 9 * t, 1, fhat + 3 * t, 1);
 }

@@ -2,25 +2,32 @@
  * across SIMD lanes (one matrix per lane) by the compiler.
  *
  * Why a second diagonalization besides the public piola_diagonalize3: that one is written
- * for robustness at any scale and to 1e-12, with branches; the force loop runs it for every
- * tet every step and needs it fast. This kernel follows the approach of McAdams et al. 2011
- * ("Computing the singular value decomposition of 3x3 matrices with minimal branching and
- * elementary floating point operations"), in double precision and written from the method's
- * description:
- *   1. normalize F by its largest entry (the kernel is then scale invariant);
- *   2. symmetric eigenproblem of S = F^T F by cyclic Jacobi with a fixed number of sweeps,
- *      each rotation from the approximate Givens half-angle (ch, sh) = (2 (s_pp - s_qq), s_pq),
- *      clamped to pi/8 when the off-diagonal dominates; V accumulates the rotations;
+ * for robustness at any scale and to 1e-12, with branches; the force loop runs a
+ * diagonalization for every tet every step and needs it fast and branch-free. The approach
+ * is that of McAdams et al. 2011 ("Computing the singular value decomposition of 3x3
+ * matrices with minimal branching and elementary floating point operations"), adapted to
+ * double precision and written from the method's description:
+ *   1. normalize F by its largest entry (the kernel is then scale invariant), and flush
+ *      entries below 1e-100 of it to zero (no denormals anywhere downstream);
+ *   2. symmetric eigenproblem of S = F^T F by cyclic Jacobi with a fixed number of sweeps
+ *      (4). Unlike McAdams' approximate Givens angles (which need more sweeps in double),
+ *      each rotation uses the exact Jacobi angle, but computed cheaply: only the angle
+ *      matters, so the square roots in it are rough (Newton-refined bit-level guesses) and
+ *      the rotation is kept an exact rotation times a scale, which leaves the eigenvectors
+ *      alone; V is normalized once at the end;
  *   3. B = F V, columns sorted by decreasing norm (a swap negates one column so det V = +1);
- *   4. QR of B by three Givens rotations: U = Q, Fhat = diag(R). R_00, R_11 >= 0 and R_22
- *      carries the sign of det F, so an inverted element gets one negative entry, the one of
- *      smallest magnitude.
+ *   4. U by Gram-Schmidt on B's columns, which is QR without the rotations: u0 = b0/|b0|,
+ *      u1 = b1 minus its u0 part (twice), normalized, u2 = u0 x u1 so det U = +1;
+ *      Fhat = (|b0|, |b1'|, u2 . b2), the last carrying the sign of det F: an inverted
+ *      element gets one negative entry, the one of smallest magnitude. A zero b0 (F = 0)
+ *      gives U = I; a zero b1 (rank <= 1) gets a completed u1.
  * Reciprocal square roots come from a bit-level first guess refined by Newton steps (no
- * divides, no sqrt). Near-zero rotations (an entry of S or a column of B below 1e-150 of
- * the normalized scale) are replaced by the identity, so F = 0 gives U = V = I and a
- * collapsed element gets a completed, proper U. The measured accuracy is in docs/forces.md
- * (reconstruction |U Fhat V^T - F| / |F| and orthogonality ~1e-15 with the sweep count
- * below). Every function is static inline so that it can sit inside an `omp simd` loop. */
+ * sqrt, one divide per matrix for the normalization).
+ * Measured accuracy (tests/test_elastic_body.c, docs/forces.md): worst relative
+ * reconstruction |U Fhat V^T - F| / |F| and orthogonality |U^T U - I|, |V^T V - I| about
+ * 2e-15 over random, rank-2, rank-1, zero, near-identity, tiny and huge matrices. Every
+ * function is inline and written on named scalars so that it can sit inside an `omp simd`
+ * loop. */
 #ifndef PIOLA_FORCE_SVD_KERNEL_H
 #define PIOLA_FORCE_SVD_KERNEL_H
 
@@ -153,9 +160,10 @@ PIOLA_KERNEL_INLINE double piola__rsqrt_rough(double x) {
 /* F = U diag(fhat) V^T with U, V proper rotations, |fhat_0| >= |fhat_1| >= |fhat_2|,
  * fhat_0, fhat_1 >= 0, sign(fhat_2) = sign(det F). Entry k (row-major, k = 3 row + col) of
  * F is f[k * in_stride]; of U and V, u[k * out_stride] and v[k * out_stride]; fhat entry i
- * is fhat[i * out_stride]. Strides let the caller read and write SoA lanes directly. */
+ * is fhat[i * fhat_stride]. Strides let the caller read and write SoA lanes directly. */
 PIOLA_KERNEL_INLINE void piola__svd3_kernel(const double *f, long in_stride, double *u,
-                                            double *fhat, double *v, long out_stride) {
+                                            double *v, long out_stride, double *fhat,
+                                            long fhat_stride) {
   double a00 = f[0 * in_stride], a01 = f[1 * in_stride], a02 = f[2 * in_stride];
   double a10 = f[3 * in_stride], a11 = f[4 * in_stride], a12 = f[5 * in_stride];
   double a20 = f[6 * in_stride], a21 = f[7 * in_stride], a22 = f[8 * in_stride];
@@ -254,8 +262,8 @@ PIOLA_KERNEL_INLINE void piola__svd3_kernel(const double *f, long in_stride, dou
   b22 = r22;
 
   fhat[0] = b00 * scale;
-  fhat[out_stride] = b11 * scale;
-  fhat[2 * out_stride] = b22 * scale;
+  fhat[fhat_stride] = b11 * scale;
+  fhat[2 * fhat_stride] = b22 * scale;
   u[0] = u00; u[out_stride] = u01; u[2 * out_stride] = u02;
   u[3 * out_stride] = u10; u[4 * out_stride] = u11; u[5 * out_stride] = u12;
   u[6 * out_stride] = u20; u[7 * out_stride] = u21; u[8 * out_stride] = u22;

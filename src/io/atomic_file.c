@@ -3,6 +3,7 @@
 #include <errno.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include "common/status_internal.h"
@@ -17,6 +18,11 @@ piola_status atomic_file_open(atomic_file *file, const char *path) {
   int fd = mkstemp(file->temporary);
   if (fd < 0)
     return PIOLA_FAIL(PIOLA_ERROR_IO, "%s: cannot create a temporary file: %s", path, strerror(errno));
+  /* mkstemp creates the file 0600; give the result the usual permissions (0666 less the
+   * umask) as a plain fopen would. Reading the umask means setting it; restore at once. */
+  mode_t mask = umask(0);
+  umask(mask);
+  fchmod(fd, 0666 & ~mask);
   file->stream = fdopen(fd, "wb");
   if (!file->stream) {
     close(fd);

@@ -138,8 +138,7 @@ piola_status piola_tet_mesh_read(const char *path, piola_tet_mesh *out) {
   piola_status (*reader)(const char *, const char *, size_t, piola_tet_mesh *) = NULL;
   if (strcasecmp(ext, ".msh") == 0) reader = piola__read_gmsh_mem;
   else if (strcasecmp(ext, ".mesh") == 0) reader = piola__read_medit_mem;
-  else if (strcasecmp(ext, ".vtu") == 0)
-    return PIOLA_FAIL(PIOLA_ERROR_UNSUPPORTED, "%s: reading .vtu is not supported (piola only writes it)", path);
+  else if (strcasecmp(ext, ".vtu") == 0) reader = piola__read_vtu_mem;
   else
     return PIOLA_FAIL(PIOLA_ERROR_UNSUPPORTED,
                       "%s: unknown tet mesh extension '%s' (expected .node, .ele, .msh, .mesh, .veg, .vtu)", path,

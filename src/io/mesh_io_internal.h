@@ -17,6 +17,7 @@ piola_status piola__read_tetgen_mem(const char *node_name, const char *node_data
                                     const char *ele_name, const char *ele_data, size_t ele_size,
                                     piola_tet_mesh *out);
 piola_status piola__read_gmsh_mem(const char *name, const char *data, size_t size, piola_tet_mesh *out);
+piola_status piola__read_vtu_mem(const char *name, const char *data, size_t size, piola_tet_mesh *out);
 piola_status piola__read_medit_mem(const char *name, const char *data, size_t size, piola_tet_mesh *out);
 piola_status piola__read_vega_mem(const char *name, const char *data, size_t size, piola_tet_mesh *out,
                                   piola_vega_material **materials, int32_t *material_count);

@@ -165,7 +165,12 @@ static size_t parse_slow(const char *p, const char *end, double *value) {
 }
 
 size_t piola__parse_double(const char *p, const char *end, double *value) {
+  return piola__parse_double_checked(p, end, value, NULL);
+}
+
+size_t piola__parse_double_checked(const char *p, const char *end, double *value, int *exact) {
   const char *b = p;
+  if (exact) *exact = 0;
   int negative = 0;
   if (p < end && (*p == '-' || *p == '+')) {
     negative = *p == '-';
@@ -228,10 +233,12 @@ size_t piola__parse_double(const char *p, const char *end, double *value) {
   double v;
   if (mantissa == 0) {
     v = 0.0;
+    if (exact) *exact = 1;
   } else if (mantissa <= (UINT64_C(1) << 53) && exponent >= -22 && exponent <= 22) {
     /* Both operands exact: one correctly rounded operation. */
     v = (double)mantissa;
     v = exponent < 0 ? v / exact_powers[-exponent] : v * exact_powers[exponent];
+    if (exact) *exact = 1;
   } else if (exponent >= -27 && exponent <= 27 && sizeof(long double) > sizeof(double)) {
     /* 64-bit mantissas and 10^27 are exact in x87 extended precision; one extended
      * rounding then one to double: within one ulp. */

@@ -71,6 +71,9 @@ static inline piola_status piola__scan_int64(text_scanner *s, int64_t *value, co
 }
 
 size_t piola__parse_double(const char *p, const char *end, double *value);
+/* The same, and *exact = 1 when the result is known to be correctly rounded (Clinger's
+ * fast path or zero); 0 when it may be one ulp off or came from strtod. */
+size_t piola__parse_double_checked(const char *p, const char *end, double *value, int *exact);
 
 static inline piola_status piola__scan_double(text_scanner *s, double *value, const char *what) {
   const char *p = s->p, *end = s->end;

@@ -10,6 +10,7 @@
 #include "common/status_internal.h"
 #include "io/atomic_file.h"
 #include "io/mesh_writers.h"
+#include "io/text_writer.h"
 
 static int cmp_int32(const void *a, const void *b) {
   int32_t x = *(const int32_t *)a, y = *(const int32_t *)b;
@@ -39,10 +40,8 @@ piola_status piola__write_gmsh41(const char *path, const piola_tet_mesh *mesh) {
     return s;
   }
   FILE *o = f.stream;
-  char a[32], b[32], c[32];
   fprintf(o, "$MeshFormat\n4.1 0 8\n$EndMeshFormat\n");
   fprintf(o, "$Entities\n0 0 0 %zu\n", regions);
-  piola__format_double(a, lo[0]);
   for (size_t r = 0; r < regions; ++r) {
     char box[6][32];
     for (int k = 0; k < 3; ++k) {
@@ -55,13 +54,24 @@ piola_status piola__write_gmsh41(const char *path, const piola_tet_mesh *mesh) {
   }
   fprintf(o, "$EndEntities\n");
   fprintf(o, "$Nodes\n1 %zu 1 %zu\n3 1 0 %zu\n", nv, nv, nv);
-  for (size_t v = 0; v < nv; ++v) fprintf(o, "%zu\n", v + 1);
-  for (size_t v = 0; v < nv; ++v) {
-    piola__format_double(a, mesh->positions[3 * v]);
-    piola__format_double(b, mesh->positions[3 * v + 1]);
-    piola__format_double(c, mesh->positions[3 * v + 2]);
-    fprintf(o, "%s %s %s\n", a, b, c);
+  text_writer *w = malloc(sizeof *w);
+  if (!w) {
+    free(ids);
+    atomic_file_abort(&f);
+    return PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "%s: out of memory", path);
   }
+  piola__tw_init(w, o);
+  for (size_t v = 0; v < nv; ++v) {
+    piola__tw_int(w, (int64_t)v + 1);
+    piola__tw_char(w, '\n');
+  }
+  for (size_t v = 0; v < nv; ++v) {
+    for (int k = 0; k < 3; ++k) {
+      piola__tw_double(w, mesh->positions[3 * v + (size_t)k]);
+      piola__tw_char(w, k < 2 ? ' ' : '\n');
+    }
+  }
+  piola__tw_flush(w);
   fprintf(o, "$EndNodes\n");
   size_t blocks = 0;
   for (size_t t = 0; t < nt; ++t)
@@ -76,11 +86,18 @@ piola_status piola__write_gmsh41(const char *path, const piola_tet_mesh *mesh) {
     fprintf(o, "3 %zu 4 %zu\n", entity + 1, e - t);
     for (size_t k = t; k < e; ++k) {
       const int32_t *q = mesh->tets + 4 * k;
-      fprintf(o, "%zu %d %d %d %d\n", k + 1, q[0] + 1, q[1] + 1, q[2] + 1, q[3] + 1);
+      piola__tw_int(w, (int64_t)k + 1);
+      for (int j = 0; j < 4; ++j) {
+        piola__tw_char(w, ' ');
+        piola__tw_int(w, (int64_t)q[j] + 1);
+      }
+      piola__tw_char(w, '\n');
     }
+    piola__tw_flush(w);
     t = e;
   }
   fprintf(o, "$EndElements\n");
+  free(w);
   free(ids);
   return atomic_file_commit(&f);
 }

@@ -1,26 +1,45 @@
 /* Medit .mesh writer (ASCII, version 2; tet ref = region, 0 without regions). */
+#include <stdlib.h>
+
 #include "common/status_internal.h"
 #include "io/atomic_file.h"
 #include "io/mesh_writers.h"
+#include "io/text_writer.h"
 
 piola_status piola__write_medit(const char *path, const piola_tet_mesh *mesh) {
+  text_writer *w = malloc(sizeof *w);
+  if (!w) return PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "%s: out of memory", path);
   atomic_file f;
-  PIOLA_TRY(atomic_file_open(&f, path));
-  FILE *o = f.stream;
-  char a[32], b[32], c[32];
-  fprintf(o, "MeshVersionFormatted 2\nDimension 3\nVertices\n%d\n", (int)mesh->vertex_count);
-  for (int32_t v = 0; v < mesh->vertex_count; ++v) {
-    piola__format_double(a, mesh->positions[3 * v]);
-    piola__format_double(b, mesh->positions[3 * v + 1]);
-    piola__format_double(c, mesh->positions[3 * v + 2]);
-    fprintf(o, "%s %s %s 0\n", a, b, c);
+  piola_status s = atomic_file_open(&f, path);
+  if (s != PIOLA_OK) {
+    free(w);
+    return s;
   }
-  fprintf(o, "Tetrahedra\n%d\n", (int)mesh->tet_count);
+  piola__tw_init(w, f.stream);
+  piola__tw_str(w, "MeshVersionFormatted 2\nDimension 3\nVertices\n");
+  piola__tw_int(w, mesh->vertex_count);
+  piola__tw_char(w, '\n');
+  for (int32_t v = 0; v < mesh->vertex_count; ++v) {
+    for (int k = 0; k < 3; ++k) {
+      piola__tw_double(w, mesh->positions[3 * (size_t)v + (size_t)k]);
+      piola__tw_char(w, ' ');
+    }
+    piola__tw_str(w, "0\n");
+  }
+  piola__tw_str(w, "Tetrahedra\n");
+  piola__tw_int(w, mesh->tet_count);
+  piola__tw_char(w, '\n');
   for (int32_t t = 0; t < mesh->tet_count; ++t) {
     const int32_t *q = mesh->tets + 4 * (size_t)t;
-    fprintf(o, "%d %d %d %d %d\n", q[0] + 1, q[1] + 1, q[2] + 1, q[3] + 1,
-            mesh->tet_regions ? (int)mesh->tet_regions[t] : 0);
+    for (int k = 0; k < 4; ++k) {
+      piola__tw_int(w, (int64_t)q[k] + 1);
+      piola__tw_char(w, ' ');
+    }
+    piola__tw_int(w, mesh->tet_regions ? mesh->tet_regions[t] : 0);
+    piola__tw_char(w, '\n');
   }
-  fprintf(o, "End\n");
+  piola__tw_str(w, "End\n");
+  piola__tw_flush(w);
+  free(w);
   return atomic_file_commit(&f);
 }

@@ -5,6 +5,7 @@
 #include "common/status_internal.h"
 #include "io/atomic_file.h"
 #include "io/mesh_writers.h"
+#include "io/text_writer.h"
 
 piola_status piola__write_tetgen(const char *path, const piola_tet_mesh *mesh) {
   size_t n = strlen(path);
@@ -20,33 +21,47 @@ piola_status piola__write_tetgen(const char *path, const piola_tet_mesh *mesh) {
   memcpy(ele_path, path, stem);
   strcpy(node_path + stem, ".node");
   strcpy(ele_path + stem, ".ele");
+  text_writer *w = malloc(sizeof *w);
   atomic_file f;
-  piola_status s = atomic_file_open(&f, node_path);
+  piola_status s = w ? atomic_file_open(&f, node_path) : PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "%s: out of memory", path);
   if (s == PIOLA_OK) {
-    char a[32], b[32], c[32];
     fprintf(f.stream, "%d 3 0 0\n", (int)mesh->vertex_count);
+    piola__tw_init(w, f.stream);
     for (int32_t v = 0; v < mesh->vertex_count; ++v) {
-      piola__format_double(a, mesh->positions[3 * v]);
-      piola__format_double(b, mesh->positions[3 * v + 1]);
-      piola__format_double(c, mesh->positions[3 * v + 2]);
-      fprintf(f.stream, "%d %s %s %s\n", (int)v + 1, a, b, c);
+      piola__tw_int(w, (int64_t)v + 1);
+      for (int k = 0; k < 3; ++k) {
+        piola__tw_char(w, ' ');
+        piola__tw_double(w, mesh->positions[3 * (size_t)v + (size_t)k]);
+      }
+      piola__tw_char(w, '\n');
     }
-    fprintf(f.stream, "# written by piola\n");
+    piola__tw_str(w, "# written by piola\n");
+    piola__tw_flush(w);
     s = atomic_file_commit(&f);
   }
   if (s == PIOLA_OK) s = atomic_file_open(&f, ele_path);
   if (s == PIOLA_OK) {
     int attr = mesh->tet_regions != NULL;
     fprintf(f.stream, "%d 4 %d\n", (int)mesh->tet_count, attr);
+    piola__tw_init(w, f.stream);
     for (int32_t t = 0; t < mesh->tet_count; ++t) {
       const int32_t *q = mesh->tets + 4 * (size_t)t;
-      fprintf(f.stream, "%d %d %d %d %d", (int)t + 1, q[0] + 1, q[1] + 1, q[2] + 1, q[3] + 1);
-      if (attr) fprintf(f.stream, " %d", (int)mesh->tet_regions[t]);
-      fputc('\n', f.stream);
+      piola__tw_int(w, (int64_t)t + 1);
+      for (int k = 0; k < 4; ++k) {
+        piola__tw_char(w, ' ');
+        piola__tw_int(w, (int64_t)q[k] + 1);
+      }
+      if (attr) {
+        piola__tw_char(w, ' ');
+        piola__tw_int(w, mesh->tet_regions[t]);
+      }
+      piola__tw_char(w, '\n');
     }
-    fprintf(f.stream, "# written by piola\n");
+    piola__tw_str(w, "# written by piola\n");
+    piola__tw_flush(w);
     s = atomic_file_commit(&f);
   }
+  free(w);
   free(node_path);
   free(ele_path);
   return s;

@@ -17,6 +17,7 @@
 #define MAX_LATTICE_TETS 120000000LL
 #define MAX_REFINEMENT_LEVELS 6
 #define MAX_REPAIR_ROUNDS 64
+#define PRUNE_ROUNDS 3
 
 piola_mesher_def piola_default_mesher_def(void) {
   piola_mesher_def def;
@@ -42,6 +43,18 @@ void piola__tet_soup_free(piola__tet_soup *soup) {
   memset(soup, 0, sizeof(*soup));
 }
 
+/* Adjacency of the whole lattice (kept or not), built once: the boundary of any kept subset
+ * is then the faces whose neighbour is missing or not kept. */
+typedef struct lattice_topology {
+  piola__csr vertex_tets;
+  int32_t *neighbor; /* 4 per tet */
+} lattice_topology;
+
+static int is_open_face(const lattice_topology *topo, const uint8_t *keep, int64_t face) {
+  int32_t n = topo->neighbor[face];
+  return n == -1 || (n >= 0 && !keep[n]);
+}
+
 static int compare_u64(const void *pa, const void *pb) {
   uint64_t a = *(const uint64_t *)pa, b = *(const uint64_t *)pb;
   return a < b ? -1 : (a > b);
@@ -51,26 +64,18 @@ static int compare_u64(const void *pa, const void *pb) {
  * on a boundary edge used by other than 2 boundary faces, or where the boundary faces
  * around a vertex form more than one fan. Returns the number of marked vertices, or -1 when
  * out of memory. */
-static int64_t mark_nonmanifold(const piola__tet_soup *soup, const uint8_t *keep, uint8_t *bad) {
+static int64_t mark_nonmanifold(const piola__tet_soup *soup, const lattice_topology *topo,
+                                const uint8_t *keep, uint8_t *bad) {
   int32_t nv = soup->vertex_count, nt = soup->tet_count;
-  piola__csr vt = {0};
-  if (piola__vertex_tets(nv, soup->tets, nt, keep, &vt) != PIOLA_OK) return -1;
-  int32_t *neighbor = malloc((size_t)nt * 4 * sizeof(int32_t));
-  if (!neighbor) {
-    piola__csr_free(&vt);
-    return -1;
-  }
-  piola__face_neighbors(soup->tets, nt, keep, &vt, neighbor);
+  const int32_t *neighbor = topo->neighbor;
   int64_t faces = 0;
   for (int64_t i = 0; i < (int64_t)nt * 4; ++i)
-    if (neighbor[i] == -1 && keep[i / 4]) faces++;
+    if (keep[i / 4] && is_open_face(topo, keep, i)) faces++;
   int32_t *tri = malloc((size_t)(faces + 1) * 3 * sizeof(int32_t));
   uint64_t *edges = malloc((size_t)(faces + 1) * 3 * sizeof(uint64_t));
   if (!tri || !edges) {
     free(tri);
     free(edges);
-    free(neighbor);
-    piola__csr_free(&vt);
     return -1;
   }
   memset(bad, 0, (size_t)nv);
@@ -80,13 +85,11 @@ static int64_t mark_nonmanifold(const piola__tet_soup *soup, const uint8_t *keep
     for (int f = 0; f < 4; ++f) {
       if (neighbor[4 * t + f] == -2)
         for (int k = 0; k < 3; ++k) bad[soup->tets[4 * t + piola__tet_face[f][k]]] = 1;
-      if (neighbor[4 * t + f] != -1) continue;
+      if (!is_open_face(topo, keep, 4 * (int64_t)t + f)) continue;
       for (int k = 0; k < 3; ++k) tri[3 * nf + k] = soup->tets[4 * t + piola__tet_face[f][k]];
       nf++;
     }
   }
-  free(neighbor);
-  piola__csr_free(&vt);
   for (int64_t f = 0; f < nf; ++f)
     for (int k = 0; k < 3; ++k) {
       uint64_t a = (uint64_t)tri[3 * f + k], b = (uint64_t)tri[3 * f + (k + 1) % 3];
@@ -167,17 +170,14 @@ static int64_t mark_nonmanifold(const piola__tet_soup *soup, const uint8_t *keep
 }
 
 /* Adds back every tet around a vertex where the boundary is not manifold, until it is. */
-static piola_status repair_manifold(const piola__tet_soup *soup, uint8_t *keep) {
-  piola__csr all = {0};
-  PIOLA_TRY(piola__vertex_tets(soup->vertex_count, soup->tets, soup->tet_count, NULL, &all));
+static piola_status repair_manifold(const piola__tet_soup *soup, const lattice_topology *topo,
+                                    uint8_t *keep) {
+  const piola__csr all = topo->vertex_tets;
   uint8_t *bad = malloc((size_t)soup->vertex_count + 1);
-  if (!bad) {
-    piola__csr_free(&all);
-    return PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "mesher: manifold repair");
-  }
+  if (!bad) return PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "mesher: manifold repair");
   piola_status status = PIOLA_OK;
   for (int round = 0;; ++round) {
-    int64_t marked = mark_nonmanifold(soup, keep, bad);
+    int64_t marked = mark_nonmanifold(soup, topo, keep, bad);
     if (marked < 0) {
       status = PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "mesher: manifold repair");
       break;
@@ -198,8 +198,34 @@ static piola_status repair_manifold(const piola__tet_soup *soup, uint8_t *keep) 
     }
   }
   free(bad);
-  piola__csr_free(&all);
   return status;
+}
+
+/* Drops kept tets whose four nodes all lie on the boundary: snapping would flatten them
+ * onto the surface (MBTF03 prunes them for the same reason). Returns how many were dropped,
+ * or -1 when out of memory. */
+static int64_t drop_boundary_only_tets(const piola__tet_soup *soup, const lattice_topology *topo,
+                                       uint8_t *keep) {
+  int32_t nv = soup->vertex_count, nt = soup->tet_count;
+  uint8_t *on_boundary = calloc((size_t)nv + 1, 1);
+  if (!on_boundary) return -1;
+  for (int32_t t = 0; t < nt; ++t) {
+    if (!keep[t]) continue;
+    for (int f = 0; f < 4; ++f)
+      if (is_open_face(topo, keep, 4 * (int64_t)t + f))
+        for (int k = 0; k < 3; ++k) on_boundary[soup->tets[4 * t + piola__tet_face[f][k]]] = 1;
+  }
+  int64_t dropped = 0;
+  for (int32_t t = 0; t < nt; ++t) {
+    if (!keep[t]) continue;
+    const int32_t *tet = soup->tets + 4 * (size_t)t;
+    if (on_boundary[tet[0]] && on_boundary[tet[1]] && on_boundary[tet[2]] && on_boundary[tet[3]]) {
+      keep[t] = 0;
+      dropped++;
+    }
+  }
+  free(on_boundary);
+  return dropped;
 }
 
 static piola_status extract(const piola__tet_soup *soup, const uint8_t *keep, piola_tet_mesh *out) {
@@ -275,6 +301,7 @@ piola_status piola_mesher_generate(const piola_mesher_def *def, piola_tet_mesh *
   soup.tets = lattice.tets;
   soup.phi = malloc((size_t)soup.vertex_count * sizeof(double));
   uint8_t *keep = NULL;
+  lattice_topology topo = {0};
   if (!soup.phi) {
     status = PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "mesher: level set values");
     goto done;
@@ -299,7 +326,21 @@ piola_status piola_mesher_generate(const piola_mesher_def *def, piola_tet_mesh *
     double mean = soup.phi[tet[0]] + soup.phi[tet[1]] + soup.phi[tet[2]] + soup.phi[tet[3]];
     keep[t] = mean < 0;
   }
-  status = repair_manifold(&soup, keep);
+  status = piola__vertex_tets(soup.vertex_count, soup.tets, soup.tet_count, NULL, &topo.vertex_tets);
+  if (status != PIOLA_OK) goto done;
+  topo.neighbor = malloc((size_t)soup.tet_count * 4 * sizeof(int32_t) + 1);
+  if (!topo.neighbor) {
+    status = PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "mesher: lattice adjacency");
+    goto done;
+  }
+  piola__face_neighbors(soup.tets, soup.tet_count, NULL, &topo.vertex_tets, topo.neighbor);
+  status = repair_manifold(&soup, &topo, keep);
+  for (int round = 0; round < PRUNE_ROUNDS && status == PIOLA_OK; ++round) {
+    int64_t dropped = drop_boundary_only_tets(&soup, &topo, keep);
+    if (dropped < 0) status = PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "mesher: pruning");
+    if (dropped <= 0) break;
+    status = repair_manifold(&soup, &topo, keep);
+  }
   if (status != PIOLA_OK) goto done;
   status = extract(&soup, keep, out);
   if (status != PIOLA_OK) goto done;
@@ -310,6 +351,8 @@ piola_status piola_mesher_generate(const piola_mesher_def *def, piola_tet_mesh *
     memset(out, 0, sizeof(*out));
   }
 done:
+  piola__csr_free(&topo.vertex_tets);
+  free(topo.neighbor);
   free(keep);
   piola__tet_soup_free(&soup);
   piola__shape_union_destroy(&shapes);

@@ -118,6 +118,17 @@ try:
             check(sum(len(c.data) for c in m.cells if c.type == "triangle") == infos[0]["boundary_faces"],
                   f"{stem} -> boundary .{ext} -> meshio: triangle count")
 
+    # ---- second-order tets (Gmsh type 11): piola keeps the corners
+    for fmt in ["msh41", "msh22"]:
+        out = os.path.join(work, f"box_order2_{fmt}.msh")
+        run("gmsh", "-3", "-order", "2", os.path.join(DATA, "box.geo"), "-format", fmt, "-o", out)
+        m = meshio.read(out)
+        tet10 = sum(len(c.data) for c in m.cells if c.type == "tetra10")
+        j = info(out)
+        check(tet10 > 0 and j["tets"] == tet10 and j["vertices"] == len(m.points),
+              f"box order 2 {fmt}: {j['tets']} tets from {tet10} tetra10, {j['vertices']} vertices")
+        check(abs(j["volume"] - 1.0) < 1e-9 and j["closed"], f"box order 2 {fmt}: corner tets fill the box")
+
     # ---- tetgen-made meshes, 1-based and 0-based (-z)
     for flags, label in [("-pqQ", "1-based"), ("-pqQz", "0-based")]:
         sub = os.path.join(work, label)

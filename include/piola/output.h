@@ -1,0 +1,63 @@
+/* piola: writing a simulation's results to a folder.
+ *
+ * Layout of an output folder DIR:
+ *   DIR/frames/frame_NNNN.vtu   every solid's tets: per-cell det_f, inverted (0/1),
+ *                               energy_density (J/m^3) and solid (index); per-point velocity
+ *                               (m/s) and displacement (m, from the rest position)
+ *   DIR/surface/frame_NNNN.obj  the boundary surface of every solid
+ *   DIR/stats.csv               one row per frame (see docs/cli.md for the columns)
+ *   DIR/sim.pvd                 ParaView collection of the VTU frames with their times
+ *   DIR/failure_report.txt      only when a run stops on a non-finite state
+ * Every file is written whole or not at all (a temporary file renamed into place), and
+ * stats.csv and sim.pvd are rewritten after each frame, so a stopped run leaves a
+ * consistent folder of every good frame. */
+#ifndef PIOLA_OUTPUT_H
+#define PIOLA_OUTPUT_H
+
+#include <stdbool.h>
+#include <stdint.h>
+
+#include "piola/export.h"
+#include "piola/status.h"
+#include "piola/world.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+typedef struct piola_output piola_output;
+
+/* Whether results may be written to dir without touching anything: OK when dir does not
+ * exist or is an empty folder, or when force is set and dir is a folder. Otherwise
+ * PIOLA_ERROR_INVALID_ARGUMENT with a message saying why. */
+PIOLA_API piola_status piola_output_check_folder(const char *dir, bool force);
+
+/* Creates dir, dir/frames and dir/surface (after piola_output_check_folder), removing the
+ * results of an earlier run there (only files piola writes) when force is set. */
+PIOLA_API piola_status piola_output_open(const char *dir, bool force, const piola_world *world,
+                                         piola_output **out);
+PIOLA_API void piola_output_close(piola_output *output);
+
+typedef struct piola_frame_info {
+  int32_t frame;          /* frame number, 0 is the initial state */
+  int32_t substeps;       /* steps taken since the previous frame */
+  int32_t cg_iterations;  /* CG iterations since the previous frame */
+  double wall_seconds;    /* wall time spent since the previous frame, s */
+} piola_frame_info;
+
+/* Writes the VTU and OBJ of the world's current state and appends a row to stats.csv and
+ * an entry to sim.pvd. */
+PIOLA_API piola_status piola_output_write_frame(piola_output *output, const piola_world *world,
+                                                const piola_frame_info *info);
+
+/* Writes DIR/failure_report.txt: the message and the worst elements of each solid (smallest
+ * det F, largest energy density) at the last good state. */
+PIOLA_API piola_status piola_output_write_failure_report(piola_output *output,
+                                                         const piola_world *world,
+                                                         const char *message);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif

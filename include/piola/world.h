@@ -1,0 +1,161 @@
+/* piola: a world of elastic solids and rigid obstacles, advanced in time.
+ *
+ * A world holds independent solids (tetrahedral elastic bodies with a material, damping,
+ * gravity, initial state and constraints) and obstacles they collide with. It advances by
+ * the Newmark scheme of paper section 9 (see docs/time-stepping.md): explicit elastic
+ * forces, implicit damping solved by a matrix-free conjugate gradient, collisions between
+ * the position and the final velocity update, and a trapezoidal final velocity. The step
+ * size is variable: the smallest of a user cap, a CFL bound and the time left to a target.
+ *
+ *   piola_world_def wdef = piola_default_world_def();
+ *   piola_world *world;
+ *   piola_world_create(&wdef, &world);
+ *   piola_solid_def sdef = piola_default_solid_def();
+ *   sdef.mesh = &mesh;                    // rest shape, world space, m
+ *   piola_world_add_solid(world, &sdef, NULL);
+ *   piola_obstacle_def ground = piola_default_obstacle_def();   // a plane z = 0
+ *   piola_world_add_obstacle(world, &ground, NULL);
+ *   piola_step_stats stats;
+ *   if (piola_world_advance_to(world, 1.0 / 30, &stats) != PIOLA_OK) puts(piola_last_error());
+ */
+#ifndef PIOLA_WORLD_H
+#define PIOLA_WORLD_H
+
+#include <stdbool.h>
+#include <stdint.h>
+
+#include "piola/elastic_body.h"
+#include "piola/export.h"
+#include "piola/keyframes.h"
+#include "piola/material.h"
+#include "piola/math_types.h"
+#include "piola/mesh.h"
+#include "piola/obstacle.h"
+#include "piola/rigid_motion.h"
+#include "piola/status.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+typedef struct piola_world piola_world;
+
+typedef struct piola_world_def {
+  piola_track gravity[3];    /* m/s^2, keyframable. Default (0, 0, -9.81): z is up */
+  double max_dt;             /* s, > 0: the user's cap on the step size. Default 1e-3 */
+  double cfl;                /* dimensionless, in (0, 2]: dt <= cfl * min altitude / wave
+                                speed. Default 0.5 */
+  double cg_tolerance;       /* relative residual of the damping solves, > 0. Default 1e-8 */
+  int32_t cg_max_iterations; /* >= 1. Default 200 */
+} piola_world_def;
+
+PIOLA_API piola_world_def piola_default_world_def(void);
+
+/* Which nodes a constraint holds, chosen by their rest positions (world space). */
+typedef enum piola_selector_type {
+  PIOLA_SELECT_BOX = 0, /* box_min <= X <= box_max componentwise */
+  PIOLA_SELECT_SPHERE,  /* |X - center| <= radius */
+  PIOLA_SELECT_INDICES, /* the listed vertex indices */
+} piola_selector_type;
+
+typedef struct piola_selector {
+  piola_selector_type type;
+  piola_vec3 box_min, box_max; /* m */
+  piola_vec3 center;           /* m */
+  double radius;               /* m, >= 0 */
+  const int32_t *indices;      /* index_count vertex indices, copied */
+  int32_t index_count;
+} piola_selector;
+
+/* Constrained nodes start at their rest positions (the solid's `initial` deformation does
+ * not move them). A fixed node stays there; a driven node follows `motion` from there. */
+typedef struct piola_constraint_def {
+  piola_selector selector;
+  bool driven;                   /* false: fixed. Default false */
+  piola_rigid_motion_def motion; /* used when driven */
+} piola_constraint_def;
+
+typedef struct piola_solid_def {
+  const char *name;               /* copied; NULL gives "solid<i>" */
+  const piola_tet_mesh *mesh;     /* rest shape in world space (m), copied. Required */
+  piola_material_def material;    /* default piola_default_material_def() */
+  piola_track stiffness_scale;    /* dimensionless, >= 0, multiplies every stress. Default 1 */
+  double density;                 /* kg/m^3, > 0. Default 1000 */
+  piola_track shear_viscosity;    /* Pa s, >= 0: beta of section 6.2. Default 0 */
+  piola_track bulk_viscosity;     /* Pa s, >= 0: alpha of section 6.2. Default 0 */
+  piola_vec3 velocity;            /* m/s, initial velocity of every free node. Default 0 */
+  const piola_constraint_def *constraints; /* constraint_count constraints, copied */
+  int32_t constraint_count;
+  /* Initial positions: x = c + A (X - c) + scramble, with c the centroid of the rest
+   * positions X. A is any 3x3 matrix (singular and mirroring ones included). Default I. */
+  piola_mat3 initial_matrix;
+  double scramble_radius;         /* m, >= 0: each free node moves by a uniformly random
+                                     point of a ball of this radius. Default 0 */
+  uint64_t scramble_seed;         /* the random sequence is fixed by this seed. Default 1 */
+} piola_solid_def;
+
+PIOLA_API piola_solid_def piola_default_solid_def(void);
+
+PIOLA_API piola_status piola_world_create(const piola_world_def *def, piola_world **out);
+PIOLA_API void piola_world_destroy(piola_world *world);
+
+/* Adds a solid at the world's current time; index (may be NULL) receives its index. */
+PIOLA_API piola_status piola_world_add_solid(piola_world *world, const piola_solid_def *def,
+                                             int32_t *index);
+/* Adds an obstacle (see piola/obstacle.h); index may be NULL. */
+PIOLA_API piola_status piola_world_add_obstacle(piola_world *world, const piola_obstacle_def *def,
+                                                int32_t *index);
+
+typedef struct piola_step_stats {
+  int32_t substeps;       /* steps taken */
+  int32_t cg_iterations;  /* conjugate-gradient iterations, both solves of every step */
+  int32_t colliding;      /* colliding nodes in the last step */
+  double last_dt;         /* s */
+} piola_step_stats;
+
+/* The step size the next step would take with no target time: min(max_dt, CFL bound), s. */
+PIOLA_API double piola_world_stable_dt(const piola_world *world);
+
+/* One step of min(stable dt, dt_limit) seconds. stats (may be NULL) is overwritten. If the
+ * state becomes NaN or Inf, returns PIOLA_ERROR_NOT_FINITE and restores the state before
+ * the step. */
+PIOLA_API piola_status piola_world_step(piola_world *world, double dt_limit,
+                                        piola_step_stats *stats);
+
+/* Steps until the world time equals t_end (s) exactly. stats (may be NULL) accumulates. */
+PIOLA_API piola_status piola_world_advance_to(piola_world *world, double t_end,
+                                              piola_step_stats *stats);
+
+PIOLA_API double piola_world_time(const piola_world *world); /* s */
+PIOLA_API int32_t piola_world_solid_count(const piola_world *world);
+PIOLA_API int32_t piola_world_obstacle_count(const piola_world *world);
+
+/* Per-solid data; pointers stay valid until the next step or set_state. */
+PIOLA_API const char *piola_world_solid_name(const piola_world *world, int32_t solid);
+PIOLA_API const piola_elastic_body *piola_world_solid_body(const piola_world *world, int32_t solid);
+PIOLA_API const double *piola_world_solid_positions(const piola_world *world, int32_t solid);  /* m */
+PIOLA_API const double *piola_world_solid_velocities(const piola_world *world, int32_t solid); /* m/s */
+/* Vertex flags: 0 free, 1 fixed, 2 driven. */
+PIOLA_API const uint8_t *piola_world_solid_constraint_flags(const piola_world *world, int32_t solid);
+
+/* Replaces positions (m) and/or velocities (m/s) of a solid (either may be NULL) and
+ * recomputes its elastic forces. */
+PIOLA_API piola_status piola_world_solid_set_state(piola_world *world, int32_t solid,
+                                                   const double *positions,
+                                                   const double *velocities);
+
+typedef struct piola_solid_stats {
+  double kinetic_energy;  /* J */
+  double elastic_energy;  /* J */
+  int32_t inverted_count; /* tets with det F < 0 */
+  double min_det_f;
+} piola_solid_stats;
+
+/* Stats of one solid at the current state. */
+PIOLA_API piola_solid_stats piola_world_solid_stats(const piola_world *world, int32_t solid);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif

@@ -1,0 +1,197 @@
+/* `piola run SCENE.json -o DIR [--threads N] [--frames N] [--force]`: simulate a scene and
+ * write its frames. Uses only the public API.
+ *
+ * Everything that can be wrong with the input (arguments, the scene, its meshes, the output
+ * folder) is checked before anything is written, so a bad run exits 2 and leaves the output
+ * folder untouched. A state that turns NaN or Inf stops the run with exit code 1, keeping
+ * every frame written so far and a failure report. */
+#include <math.h>
+#include <omp.h>
+#include <stdbool.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+#include <unistd.h>
+
+#include "cli/commands.h"
+#include "piola/elastic_body.h"
+#include "piola/output.h"
+#include "piola/scene.h"
+#include "piola/world.h"
+
+static void usage(FILE *out) {
+  fprintf(out,
+          "usage: piola run SCENE.json -o DIR [--threads N] [--frames N] [--force]\n"
+          "\n"
+          "  -o, --output DIR   folder for frames/, surface/, stats.csv and sim.pvd\n"
+          "  --threads N        worker threads (default: all cores)\n"
+          "  --frames N         write N frames instead of the scene's `frames`\n"
+          "  --force            write into DIR even if it holds earlier results\n"
+          "                     (earlier frames, stats.csv and sim.pvd are removed)\n"
+          "  -h, --help         this text\n");
+}
+
+static double now_seconds(void) {
+  struct timespec ts;
+  clock_gettime(CLOCK_MONOTONIC, &ts);
+  return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+static bool parse_count(const char *s, long lo, long hi, long *out) {
+  char *end;
+  long v = strtol(s, &end, 10);
+  if (!*s || *end || v < lo || v > hi) return false;
+  *out = v;
+  return true;
+}
+
+static void format_duration(double s, char *buf, size_t n) {
+  if (!isfinite(s) || s < 0) {
+    snprintf(buf, n, "--:--");
+    return;
+  }
+  long t = (long)(s + 0.5);
+  if (t >= 3600) snprintf(buf, n, "%ld:%02ld:%02ld", t / 3600, (t / 60) % 60, t % 60);
+  else snprintf(buf, n, "%02ld:%02ld", t / 60, t % 60);
+}
+
+static void progress(bool tty, int frame, int frames, double t, double elapsed, int substeps,
+                     int inverted) {
+  double eta = frame > 0 ? elapsed / frame * (frames - frame) : NAN;
+  char eta_s[32], el_s[32];
+  format_duration(eta, eta_s, sizeof eta_s);
+  format_duration(elapsed, el_s, sizeof el_s);
+  if (tty) {
+    int width = 30, filled = frames > 0 ? width * frame / frames : width;
+    char bar[64];
+    for (int i = 0; i < width; ++i) bar[i] = i < filled ? '#' : '.';
+    bar[width] = '\0';
+    fprintf(stderr, "\r[%s] frame %d/%d  t = %.3f s  elapsed %s  ETA %s  ", bar, frame, frames, t,
+            el_s, eta_s);
+    if (frame == frames) fputc('\n', stderr);
+  } else {
+    fprintf(stderr, "frame %d/%d t=%.4f s substeps=%d inverted=%d elapsed=%s eta=%s\n", frame,
+            frames, t, substeps, inverted, el_s, eta_s);
+  }
+  fflush(stderr);
+}
+
+int cli_run(int argc, char **argv) {
+  const char *scene_path = NULL, *out_dir = NULL;
+  long threads = 0, frames_override = -1;
+  bool force = false;
+  for (int i = 1; i < argc; ++i) {
+    const char *a = argv[i];
+    if (strcmp(a, "-h") == 0 || strcmp(a, "--help") == 0) {
+      usage(stdout);
+      return 0;
+    } else if (strcmp(a, "-o") == 0 || strcmp(a, "--output") == 0) {
+      if (++i >= argc) return fprintf(stderr, "piola run: %s needs a folder\n", a), 2;
+      out_dir = argv[i];
+    } else if (strcmp(a, "--threads") == 0) {
+      if (++i >= argc || !parse_count(argv[i], 1, 1024, &threads))
+        return fprintf(stderr, "piola run: --threads needs an integer in [1, 1024]\n"), 2;
+    } else if (strcmp(a, "--frames") == 0) {
+      if (++i >= argc || !parse_count(argv[i], 0, 1000000, &frames_override))
+        return fprintf(stderr, "piola run: --frames needs an integer in [0, 1000000]\n"), 2;
+    } else if (strcmp(a, "--force") == 0) {
+      force = true;
+    } else if (a[0] == '-' && a[1]) {
+      fprintf(stderr, "piola run: unknown option '%s'\n", a);
+      usage(stderr);
+      return 2;
+    } else if (!scene_path) {
+      scene_path = a;
+    } else {
+      fprintf(stderr, "piola run: more than one scene given ('%s' and '%s')\n", scene_path, a);
+      return 2;
+    }
+  }
+  if (!scene_path || !out_dir) {
+    fprintf(stderr, "piola run: %s\n", !scene_path ? "no scene file given" : "no output folder given (-o DIR)");
+    usage(stderr);
+    return 2;
+  }
+  if (piola_output_check_folder(out_dir, force) != PIOLA_OK) {
+    fprintf(stderr, "piola run: %s\n", piola_last_error());
+    return 2;
+  }
+  if (threads > 0) {
+    piola_set_thread_count((int)threads);
+    omp_set_num_threads((int)threads); /* also the OpenMP loops outside the force loop */
+  }
+  double t_start = now_seconds();
+  piola_scene *scene = NULL;
+  if (piola_scene_load(scene_path, &scene) != PIOLA_OK) {
+    fprintf(stderr, "piola run: %s\n", piola_last_error());
+    return 2;
+  }
+  piola_world *world = piola_scene_world(scene);
+  int frames = frames_override >= 0 ? (int)frames_override : (int)piola_scene_frames(scene);
+  double fps = piola_scene_fps(scene);
+  piola_output *out = NULL;
+  if (piola_output_open(out_dir, force, world, &out) != PIOLA_OK) {
+    fprintf(stderr, "piola run: %s\n", piola_last_error());
+    piola_scene_destroy(scene);
+    return 1;
+  }
+  bool tty = isatty(STDERR_FILENO);
+  fprintf(stderr, "piola run: %s -> %s: %d frames at %g fps, %d solids, %d obstacles, first dt %.3g s\n",
+          scene_path, out_dir, frames, fps, (int)piola_world_solid_count(world),
+          (int)piola_world_obstacle_count(world), piola_world_stable_dt(world));
+  int rc = 0;
+  long long total_steps = 0, total_cg = 0;
+  int max_inverted = 0;
+  double sim_start = now_seconds();
+  piola_frame_info info = {0, 0, 0, 0};
+  if (piola_output_write_frame(out, world, &info) != PIOLA_OK) {
+    fprintf(stderr, "piola run: %s\n", piola_last_error());
+    rc = 1;
+  }
+  int frame = 0;
+  for (frame = 1; rc == 0 && frame <= frames; ++frame) {
+    double t0 = now_seconds();
+    piola_step_stats st = {0, 0, 0, 0};
+    if (piola_world_advance_to(world, frame / fps, &st) != PIOLA_OK) {
+      char message[1024];
+      snprintf(message, sizeof message, "%s", piola_last_error());
+      if (tty) fputc('\n', stderr);
+      fprintf(stderr, "piola run: stopped at frame %d: %s\n", frame, message);
+      if (piola_output_write_failure_report(out, world, message) == PIOLA_OK)
+        fprintf(stderr, "piola run: frames 0..%d are kept; see %s/failure_report.txt\n", frame - 1, out_dir);
+      else
+        fprintf(stderr, "piola run: could not write the failure report: %s\n", piola_last_error());
+      rc = 1;
+      break;
+    }
+    info.frame = frame;
+    info.substeps = st.substeps;
+    info.cg_iterations = st.cg_iterations;
+    info.wall_seconds = now_seconds() - t0;
+    total_steps += st.substeps;
+    total_cg += st.cg_iterations;
+    int inverted = 0;
+    for (int32_t s = 0; s < piola_world_solid_count(world); ++s)
+      inverted += piola_world_solid_stats(world, s).inverted_count;
+    if (inverted > max_inverted) max_inverted = inverted;
+    if (piola_output_write_frame(out, world, &info) != PIOLA_OK) {
+      if (tty) fputc('\n', stderr);
+      fprintf(stderr, "piola run: %s\n", piola_last_error());
+      rc = 1;
+      break;
+    }
+    progress(tty, frame, frames, piola_world_time(world), now_seconds() - sim_start, st.substeps, inverted);
+  }
+  double wall = now_seconds() - t_start;
+  double sim_wall = now_seconds() - sim_start;
+  int written = rc == 0 ? frames : frame - 1;
+  fprintf(stderr,
+          "piola run: %s. %d frames (%.3f s simulated) in %.2f s wall (%.2f frames/s), %lld steps, "
+          "%lld CG iterations, at most %d inverted tets in a frame. Open %s/sim.pvd in ParaView.\n",
+          rc == 0 ? "done" : "stopped", written, written / fps, wall,
+          sim_wall > 0 ? written / sim_wall : 0.0, total_steps, total_cg, max_inverted, out_dir);
+  piola_output_close(out);
+  piola_scene_destroy(scene);
+  return rc;
+}

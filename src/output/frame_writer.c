@@ -1,0 +1,259 @@
+/* Frame output: one VTU of every solid's tets, one OBJ of their boundary surfaces, a row of
+ * stats.csv and an entry in sim.pvd per frame, each written whole or not at all.
+ *
+ * The solids of a world are concatenated into one mesh per frame (with a per-cell `solid`
+ * index) so a viewer loads one file per frame. Topology and the boundary surface are built
+ * once when the output opens; each frame only refreshes positions and fields. stats.csv and
+ * sim.pvd are kept in memory and rewritten atomically after every frame, so the files on disk
+ * always describe exactly the frames that exist. */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "common/status_internal.h"
+#include "io/atomic_file.h"
+#include "output/output_internal.h"
+#include "piola/mesh_io.h"
+
+typedef struct pvd_entry {
+  int32_t frame;
+  double time;
+} pvd_entry;
+
+struct piola_output {
+  char dir[4096];
+  piola_tet_mesh tets;      /* concatenated; positions refreshed per frame */
+  piola_tri_mesh surface;   /* concatenated boundary, shares vertex numbering with tets */
+  double *rest;             /* 3 * vertex_count */
+  double *velocity, *displacement, *det_f, *inverted, *energy, *solid;
+  char *csv;
+  size_t csv_len, csv_cap;
+  pvd_entry *pvd;
+  int32_t pvd_count, pvd_cap;
+};
+
+static piola_status csv_append(piola_output *o, const char *line) {
+  size_t n = strlen(line);
+  if (o->csv_len + n + 1 > o->csv_cap) {
+    size_t cap = o->csv_cap ? o->csv_cap * 2 : 4096;
+    while (cap < o->csv_len + n + 1) cap *= 2;
+    char *grown = realloc(o->csv, cap);
+    if (!grown) return PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "stats.csv: out of memory");
+    o->csv = grown;
+    o->csv_cap = cap;
+  }
+  memcpy(o->csv + o->csv_len, line, n + 1);
+  o->csv_len += n;
+  return PIOLA_OK;
+}
+
+void piola_output_close(piola_output *o) {
+  if (!o) return;
+  piola_tet_mesh_free(&o->tets);
+  piola_tri_mesh_free(&o->surface);
+  free(o->rest), free(o->velocity), free(o->displacement), free(o->det_f), free(o->inverted);
+  free(o->energy), free(o->solid), free(o->csv), free(o->pvd);
+  free(o);
+}
+
+piola_status piola_output_open(const char *dir, bool force, const piola_world *world,
+                               piola_output **out) {
+  if (!dir || !world || !out) return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "output: NULL argument");
+  *out = NULL;
+  if (strlen(dir) > 3500) return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "output: path too long");
+  piola_output *o = calloc(1, sizeof *o);
+  if (!o) return PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "output: out of memory");
+  snprintf(o->dir, sizeof o->dir, "%s", dir);
+  int32_t nv = 0, nt = 0, ns = piola_world_solid_count(world);
+  for (int32_t s = 0; s < ns; ++s) {
+    const piola_elastic_body *b = piola_world_solid_body(world, s);
+    nv += piola_elastic_body_vertex_count(b);
+    nt += piola_elastic_body_tet_count(b);
+  }
+  size_t v3 = 3 * (size_t)(nv > 0 ? nv : 1) * sizeof(double);
+  size_t tc = (size_t)(nt > 0 ? nt : 1);
+  o->tets.vertex_count = nv;
+  o->tets.tet_count = nt;
+  o->tets.positions = malloc(v3);
+  o->tets.tets = malloc(4 * tc * sizeof(int32_t));
+  o->rest = malloc(v3), o->velocity = malloc(v3), o->displacement = malloc(v3);
+  o->det_f = malloc(tc * sizeof(double)), o->inverted = malloc(tc * sizeof(double));
+  o->energy = malloc(tc * sizeof(double)), o->solid = malloc(tc * sizeof(double));
+  if (!o->tets.positions || !o->tets.tets || !o->rest || !o->velocity || !o->displacement ||
+      !o->det_f || !o->inverted || !o->energy || !o->solid) {
+    piola_output_close(o);
+    return PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "output: out of memory");
+  }
+  int32_t voff = 0, toff = 0;
+  for (int32_t s = 0; s < ns; ++s) {
+    const piola_elastic_body *b = piola_world_solid_body(world, s);
+    int32_t n = piola_elastic_body_vertex_count(b), t = piola_elastic_body_tet_count(b);
+    memcpy(o->rest + 3 * (size_t)voff, piola_elastic_body_rest_positions(b), 3 * (size_t)n * sizeof(double));
+    const int32_t *tets = piola_elastic_body_tets(b);
+    for (int64_t k = 0; k < 4 * (int64_t)t; ++k) o->tets.tets[4 * (int64_t)toff + k] = tets[k] + voff;
+    for (int32_t k = 0; k < t; ++k) o->solid[toff + k] = s;
+    voff += n;
+    toff += t;
+  }
+  memcpy(o->tets.positions, o->rest, 3 * (size_t)nv * sizeof(double));
+  piola_status st = piola_tet_mesh_boundary(&o->tets, &o->surface);
+  if (st == PIOLA_OK) st = piola__output_prepare_folder(dir, force);
+  if (st == PIOLA_OK) st = csv_append(o, "frame,time,substeps,cg_iterations,kinetic_energy,elastic_energy,"
+                                         "inverted,min_det_f,wall_seconds\n");
+  if (st != PIOLA_OK) {
+    piola_output_close(o);
+    return st;
+  }
+  *out = o;
+  return PIOLA_OK;
+}
+
+static piola_status write_text(const char *path, const char *text, size_t len) {
+  atomic_file f;
+  PIOLA_TRY(atomic_file_open(&f, path));
+  if (len && fwrite(text, 1, len, f.stream) != len) {
+    atomic_file_abort(&f);
+    return PIOLA_FAIL(PIOLA_ERROR_IO, "%s: write failed", path);
+  }
+  return atomic_file_commit(&f);
+}
+
+static piola_status write_pvd(piola_output *o) {
+  char path[4200];
+  snprintf(path, sizeof path, "%s/sim.pvd", o->dir);
+  atomic_file f;
+  PIOLA_TRY(atomic_file_open(&f, path));
+  fprintf(f.stream, "<?xml version=\"1.0\"?>\n<VTKFile type=\"Collection\" version=\"0.1\" "
+                    "byte_order=\"LittleEndian\">\n  <Collection>\n");
+  for (int32_t i = 0; i < o->pvd_count; ++i)
+    fprintf(f.stream, "    <DataSet timestep=\"%.17g\" group=\"\" part=\"0\" file=\"frames/frame_%04d.vtu\"/>\n",
+            o->pvd[i].time, (int)o->pvd[i].frame);
+  fprintf(f.stream, "  </Collection>\n</VTKFile>\n");
+  return atomic_file_commit(&f);
+}
+
+piola_status piola_output_write_frame(piola_output *o, const piola_world *world,
+                                      const piola_frame_info *info) {
+  if (!o || !world || !info) return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "output: NULL argument");
+  int32_t ns = piola_world_solid_count(world);
+  int32_t voff = 0, toff = 0;
+  double ke = 0, ee = 0, min_det = INFINITY;
+  long long inverted = 0;
+  for (int32_t s = 0; s < ns; ++s) {
+    const piola_elastic_body *b = piola_world_solid_body(world, s);
+    int32_t n = piola_elastic_body_vertex_count(b), t = piola_elastic_body_tet_count(b);
+    const double *x = piola_world_solid_positions(world, s);
+    const double *v = piola_world_solid_velocities(world, s);
+    for (int64_t k = 0; k < 3 * (int64_t)n; ++k) {
+      int64_t g = 3 * (int64_t)voff + k;
+      o->tets.positions[g] = x[k];
+      o->velocity[g] = v[k];
+      o->displacement[g] = x[k] - o->rest[g];
+    }
+    const double *det = piola_elastic_body_det_f(b);
+    const double *psi = piola_elastic_body_energy_density(b);
+    for (int32_t k = 0; k < t; ++k) {
+      o->det_f[toff + k] = det[k];
+      o->inverted[toff + k] = det[k] < 0 ? 1.0 : 0.0;
+      o->energy[toff + k] = psi[k];
+    }
+    piola_solid_stats st = piola_world_solid_stats(world, s);
+    ke += st.kinetic_energy;
+    ee += st.elastic_energy;
+    inverted += st.inverted_count;
+    if (st.min_det_f < min_det) min_det = st.min_det_f;
+    voff += n;
+    toff += t;
+  }
+  char path[4200];
+  piola_vtu_field points[2] = {{"velocity", 3, o->velocity}, {"displacement", 3, o->displacement}};
+  piola_vtu_field cells[4] = {{"det_f", 1, o->det_f},
+                              {"inverted", 1, o->inverted},
+                              {"energy_density", 1, o->energy},
+                              {"solid", 1, o->solid}};
+  piola_vtu_frame frame = {.tets = &o->tets, .triangles = NULL, .point_fields = points,
+                           .point_field_count = 2, .cell_fields = cells, .cell_field_count = 4};
+  snprintf(path, sizeof path, "%s/frames/frame_%04d.vtu", o->dir, (int)info->frame);
+  PIOLA_TRY(piola_vtu_write(path, &frame));
+  o->surface.positions = o->tets.positions; /* same numbering; borrowed for the write */
+  snprintf(path, sizeof path, "%s/surface/frame_%04d.obj", o->dir, (int)info->frame);
+  piola_status st = piola_tri_mesh_write(path, &o->surface);
+  o->surface.positions = NULL;
+  PIOLA_TRY(st);
+
+  char line[512];
+  snprintf(line, sizeof line, "%d,%.17g,%d,%d,%.17g,%.17g,%lld,%.17g,%.6f\n", (int)info->frame,
+           piola_world_time(world), (int)info->substeps, (int)info->cg_iterations, ke, ee, inverted,
+           ns > 0 ? min_det : 1.0, info->wall_seconds);
+  PIOLA_TRY(csv_append(o, line));
+  snprintf(path, sizeof path, "%s/stats.csv", o->dir);
+  PIOLA_TRY(write_text(path, o->csv, o->csv_len));
+  if (o->pvd_count == o->pvd_cap) {
+    int32_t cap = o->pvd_cap ? 2 * o->pvd_cap : 64;
+    pvd_entry *grown = realloc(o->pvd, (size_t)cap * sizeof *grown);
+    if (!grown) return PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "sim.pvd: out of memory");
+    o->pvd = grown;
+    o->pvd_cap = cap;
+  }
+  o->pvd[o->pvd_count++] = (pvd_entry){info->frame, piola_world_time(world)};
+  return write_pvd(o);
+}
+
+typedef struct ranked {
+  int32_t tet;
+  double key;
+} ranked;
+
+static int by_key(const void *a, const void *b) {
+  double x = ((const ranked *)a)->key, y = ((const ranked *)b)->key;
+  return (x > y) - (x < y);
+}
+
+piola_status piola_output_write_failure_report(piola_output *o, const piola_world *world,
+                                               const char *message) {
+  char path[4200];
+  snprintf(path, sizeof path, "%s/failure_report.txt", o->dir);
+  atomic_file f;
+  PIOLA_TRY(atomic_file_open(&f, path));
+  fprintf(f.stream, "piola run stopped: %s\n", message ? message : "(no message)");
+  fprintf(f.stream, "last good state: t = %.9g s (frames written up to that point are complete)\n\n",
+          piola_world_time(world));
+  enum { WORST = 10 };
+  for (int32_t s = 0; s < piola_world_solid_count(world); ++s) {
+    const piola_elastic_body *b = piola_world_solid_body(world, s);
+    int32_t t = piola_elastic_body_tet_count(b);
+    const double *det = piola_elastic_body_det_f(b);
+    const double *psi = piola_elastic_body_energy_density(b);
+    const double *fhat = piola_elastic_body_fhat(b);
+    const int32_t *tets = piola_elastic_body_tets(b);
+    piola_solid_stats st = piola_world_solid_stats(world, s);
+    fprintf(f.stream, "solid '%s': %d tets, %d inverted, min det F %.6g, kinetic %.6g J, elastic %.6g J\n",
+            piola_world_solid_name(world, s), (int)t, (int)st.inverted_count, st.min_det_f,
+            st.kinetic_energy, st.elastic_energy);
+    ranked *r = malloc((size_t)(t > 0 ? t : 1) * sizeof *r);
+    if (!r) {
+      atomic_file_abort(&f);
+      return PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "failure report: out of memory");
+    }
+    for (int pass = 0; pass < 2; ++pass) {
+      for (int32_t k = 0; k < t; ++k) {
+        r[k].tet = k;
+        double key = pass == 0 ? det[k] : -psi[k];
+        r[k].key = isfinite(key) ? key : -INFINITY; /* non-finite values rank worst */
+      }
+      qsort(r, (size_t)t, sizeof *r, by_key);
+      fprintf(f.stream, "  worst by %s:\n", pass == 0 ? "smallest det F" : "largest energy density");
+      for (int32_t k = 0; k < t && k < WORST; ++k) {
+        int32_t e = r[k].tet;
+        fprintf(f.stream,
+                "    tet %d (vertices %d %d %d %d): det F %.6g, energy density %.6g J/m^3, "
+                "Fhat (%.4g, %.4g, %.4g)\n",
+                (int)e, (int)tets[4 * e], (int)tets[4 * e + 1], (int)tets[4 * e + 2],
+                (int)tets[4 * e + 3], det[e], psi[e], fhat[3 * e], fhat[3 * e + 1], fhat[3 * e + 2]);
+      }
+    }
+    free(r);
+  }
+  return atomic_file_commit(&f);
+}

@@ -1,0 +1,81 @@
+/* Scene building: read or generate each solid's mesh, place it by its transform, and add
+ * solids and obstacles to a new world. Errors name the key path of the solid or obstacle. */
+#include <math.h>
+#include <string.h>
+
+#include "common/status_internal.h"
+#include "math/mat3.h"
+#include "piola/mesh_io.h"
+#include "piola/mesher.h"
+#include "scene/scene_desc.h"
+
+/* R = Rz(c) Ry(b) Rx(a): rotate about x first, then y, then z (fixed axes). */
+static mat3 euler_xyz_degrees(piola_vec3 deg) {
+  double k = M_PI / 180.0;
+  double a = deg.x * k, b = deg.y * k, c = deg.z * k;
+  mat3 rx = {{{1, 0, 0}, {0, cos(a), -sin(a)}, {0, sin(a), cos(a)}}};
+  mat3 ry = {{{cos(b), 0, sin(b)}, {0, 1, 0}, {-sin(b), 0, cos(b)}}};
+  mat3 rz = {{{cos(c), -sin(c), 0}, {sin(c), cos(c), 0}, {0, 0, 1}}};
+  return mat3_mul(rz, mat3_mul(ry, rx));
+}
+
+static void place(piola_tet_mesh *mesh, const scene_solid_desc *d) {
+  mat3 r = euler_xyz_degrees(d->rotate_degrees);
+  for (int32_t i = 0; i < mesh->vertex_count; ++i) {
+    double *p = mesh->positions + 3 * i;
+    vec3 s = {p[0] * d->scale.x, p[1] * d->scale.y, p[2] * d->scale.z};
+    vec3_store(p, vec3_add(mat3_mul_vec(r, s), d->translate));
+  }
+}
+
+piola_status piola__scene_build(const scene_desc *desc, const char *label, piola_world **out) {
+  *out = NULL;
+  if (!label) label = "scene";
+  piola_world *world = NULL;
+  if (piola_world_create(&desc->world, &world) != PIOLA_OK)
+    return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "%s: integrator: %s", label, piola_last_error());
+  for (int32_t i = 0; i < desc->solid_count; ++i) {
+    const scene_solid_desc *d = &desc->solids[i];
+    piola_tet_mesh mesh;
+    memset(&mesh, 0, sizeof mesh);
+    piola_status st = d->mesh_generated ? piola_mesher_generate(&d->mesher, &mesh)
+                                        : piola_tet_mesh_read(d->mesh_path, &mesh);
+    if (st == PIOLA_OK && mesh.tet_count < 1) st = PIOLA_FAIL(PIOLA_ERROR_PARSE, "the mesh has no tetrahedra");
+    if (st != PIOLA_OK) {
+      piola_tet_mesh_free(&mesh);
+      piola_world_destroy(world);
+      return PIOLA_FAIL(st, "%s: solids[%d].mesh: %s", label, (int)i, piola_last_error());
+    }
+    place(&mesh, d);
+    piola_solid_def def = d->def;
+    def.mesh = &mesh;
+    def.name = d->name;
+    def.constraints = d->constraints;
+    def.constraint_count = d->constraint_count;
+    st = piola_world_add_solid(world, &def, NULL);
+    piola_tet_mesh_free(&mesh);
+    if (st != PIOLA_OK) {
+      piola_world_destroy(world);
+      return PIOLA_FAIL(st, "%s: solids[%d]: %s", label, (int)i, piola_last_error());
+    }
+  }
+  for (int32_t i = 0; i < desc->obstacle_count; ++i) {
+    const scene_obstacle_desc *d = &desc->obstacles[i];
+    piola_obstacle_def def = d->def;
+    piola_tri_mesh surface;
+    memset(&surface, 0, sizeof surface);
+    piola_status st = PIOLA_OK;
+    if (def.type == PIOLA_OBSTACLE_MESH) {
+      st = piola_tri_mesh_read(d->mesh_path, &surface);
+      def.mesh = &surface;
+    }
+    if (st == PIOLA_OK) st = piola_world_add_obstacle(world, &def, NULL);
+    piola_tri_mesh_free(&surface);
+    if (st != PIOLA_OK) {
+      piola_world_destroy(world);
+      return PIOLA_FAIL(st, "%s: obstacles[%d]: %s", label, (int)i, piola_last_error());
+    }
+  }
+  *out = world;
+  return PIOLA_OK;
+}

@@ -1,0 +1,55 @@
+/* A parsed scene, before any mesh is read: the definition structs of the world, its solids
+ * and obstacles, plus where each mesh comes from and how it is placed.
+ *
+ * Parsing (scene_parse.c) and building (scene_build.c) are split so that every syntactic
+ * and range error is found, with its key path, before any file is opened, and so the
+ * parser can be tested alone. */
+#ifndef PIOLA_SCENE_SCENE_DESC_H
+#define PIOLA_SCENE_SCENE_DESC_H
+
+#include <stdint.h>
+
+#include "piola/mesher.h"
+#include "piola/obstacle.h"
+#include "piola/world.h"
+
+#define SCENE_PATH_MAX 4096
+
+typedef struct scene_solid_desc {
+  piola_solid_def def;            /* mesh, name and constraints are filled in by the builder */
+  char name[128];
+  int mesh_generated;             /* 1: mesher, 0: file */
+  char mesh_path[SCENE_PATH_MAX]; /* resolved against the scene's folder */
+  piola_mesher_def mesher;
+  piola_vec3 translate;           /* m */
+  piola_vec3 rotate_degrees;      /* XYZ Euler angles, degrees */
+  piola_vec3 scale;               /* per axis */
+  piola_constraint_def *constraints;
+  int32_t constraint_count;
+  int32_t **index_lists;          /* owned index arrays, one per constraint (or NULL) */
+} scene_solid_desc;
+
+typedef struct scene_obstacle_desc {
+  piola_obstacle_def def;
+  char mesh_path[SCENE_PATH_MAX]; /* mesh obstacles */
+} scene_obstacle_desc;
+
+typedef struct scene_desc {
+  double fps;
+  int32_t frames;
+  piola_world_def world;
+  scene_solid_desc *solids;
+  int32_t solid_count;
+  scene_obstacle_desc *obstacles;
+  int32_t obstacle_count;
+} scene_desc;
+
+/* Parses and validates JSON text; label prefixes error messages. */
+piola_status piola__scene_parse(const char *json, const char *base_dir, const char *label,
+                                scene_desc *out);
+void piola__scene_desc_free(scene_desc *desc);
+
+/* Reads or generates the meshes, places them and builds the world. */
+piola_status piola__scene_build(const scene_desc *desc, const char *label, piola_world **out);
+
+#endif

@@ -1,0 +1,771 @@
+/* Scene files: JSON (cJSON) -> definition structs, with every error naming its key path.
+ *
+ * A small parser context carries the key path of the value being read ("solids[0].material")
+ * so each check can say exactly where the problem is. Every object's keys are checked against
+ * the list the format allows, so a misspelt key is an error rather than a silently ignored
+ * setting. */
+#include <cjson/cJSON.h>
+#include <math.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "common/status_internal.h"
+#include "math/mat3.h"
+#include "scene/scene_desc.h"
+
+typedef struct parser {
+  const char *label;
+  const char *base_dir;
+  char path[512];
+  size_t len;
+} parser;
+
+static size_t push_key(parser *p, const char *key) {
+  size_t old = p->len;
+  int n = snprintf(p->path + p->len, sizeof p->path - p->len, "%s%s", p->len ? "." : "", key);
+  if (n > 0) p->len = strlen(p->path);
+  return old;
+}
+
+static size_t push_index(parser *p, int i) {
+  size_t old = p->len;
+  int n = snprintf(p->path + p->len, sizeof p->path - p->len, "[%d]", i);
+  if (n > 0) p->len = strlen(p->path);
+  return old;
+}
+
+static void pop(parser *p, size_t old) {
+  p->len = old;
+  p->path[old] = '\0';
+}
+
+static piola_status fail(parser *p, piola_status status, const char *format, ...)
+    PIOLA_PRINTF_LIKE(3, 4);
+static piola_status fail(parser *p, piola_status status, const char *format, ...) {
+  char msg[512];
+  va_list ap;
+  va_start(ap, format);
+  vsnprintf(msg, sizeof msg, format, ap);
+  va_end(ap);
+  return PIOLA_FAIL(status, "%s: %s: %s", p->label, p->len ? p->path : "(top level)", msg);
+}
+
+#define BAD_VALUE PIOLA_ERROR_INVALID_ARGUMENT
+
+static const char *type_name(const cJSON *v) {
+  if (cJSON_IsNumber(v)) return "a number";
+  if (cJSON_IsString(v)) return "a string";
+  if (cJSON_IsBool(v)) return "a boolean";
+  if (cJSON_IsNull(v)) return "null";
+  if (cJSON_IsArray(v)) return "an array";
+  if (cJSON_IsObject(v)) return "an object";
+  return "invalid";
+}
+
+/* Unknown and duplicate keys of obj (the path points at obj). */
+static piola_status check_keys(parser *p, const cJSON *obj, const char *const *allowed) {
+  if (!cJSON_IsObject(obj)) return fail(p, PIOLA_ERROR_PARSE, "must be an object, got %s", type_name(obj));
+  for (const cJSON *c = obj->child; c; c = c->next) {
+    int ok = 0;
+    for (const char *const *a = allowed; *a; ++a)
+      if (strcmp(*a, c->string) == 0) ok = 1;
+    size_t old = push_key(p, c->string);
+    if (!ok) {
+      char list[512] = "";
+      for (const char *const *a = allowed; *a; ++a) {
+        strncat(list, *a, sizeof list - strlen(list) - 1);
+        if (a[1]) strncat(list, ", ", sizeof list - strlen(list) - 1);
+      }
+      return fail(p, PIOLA_ERROR_PARSE, "unknown key (allowed here: %s)", list);
+    }
+    for (const cJSON *d = obj->child; d != c; d = d->next)
+      if (strcmp(d->string, c->string) == 0) return fail(p, PIOLA_ERROR_PARSE, "duplicate key");
+    pop(p, old);
+  }
+  return PIOLA_OK;
+}
+
+static const cJSON *get(const cJSON *obj, const char *key) {
+  return cJSON_GetObjectItemCaseSensitive(obj, key);
+}
+
+/* Range kinds for numbers. */
+typedef struct range {
+  double lo, hi;
+  int lo_open, hi_open;
+} range;
+static const range ANY = {-INFINITY, INFINITY, 0, 0};
+static const range POSITIVE = {0, INFINITY, 1, 0};
+static const range NONNEGATIVE = {0, INFINITY, 0, 0};
+
+static piola_status check_range(parser *p, double v, range r) {
+  if (!isfinite(v)) return fail(p, BAD_VALUE, "must be finite, got %g", v);
+  int ok = (r.lo_open ? v > r.lo : v >= r.lo) && (r.hi_open ? v < r.hi : v <= r.hi);
+  if (ok) return PIOLA_OK;
+  if (isinf(r.hi) && r.lo == 0) return fail(p, BAD_VALUE, "must be %s 0, got %g", r.lo_open ? ">" : ">=", v);
+  return fail(p, BAD_VALUE, "must be in %c%g, %g%c, got %g", r.lo_open ? '(' : '[', r.lo, r.hi,
+              r.hi_open ? ')' : ']', v);
+}
+
+/* A plain number (keyframes not allowed) at the current path. */
+static piola_status number_value(parser *p, const cJSON *v, range r, double *out) {
+  if (cJSON_IsObject(v) && get(v, "keys"))
+    return fail(p, PIOLA_ERROR_PARSE, "must be a constant number here (keyframes are not supported for this key)");
+  if (!cJSON_IsNumber(v)) return fail(p, PIOLA_ERROR_PARSE, "must be a number, got %s", type_name(v));
+  PIOLA_TRY(check_range(p, v->valuedouble, r));
+  *out = v->valuedouble;
+  return PIOLA_OK;
+}
+
+/* obj.key as a number if present (else *out keeps its default). */
+static piola_status opt_number(parser *p, const cJSON *obj, const char *key, range r, double *out) {
+  const cJSON *v = get(obj, key);
+  if (!v) return PIOLA_OK;
+  size_t old = push_key(p, key);
+  PIOLA_TRY(number_value(p, v, r, out));
+  pop(p, old);
+  return PIOLA_OK;
+}
+
+static piola_status opt_int(parser *p, const cJSON *obj, const char *key, double lo, double hi,
+                            int64_t *out) {
+  const cJSON *v = get(obj, key);
+  if (!v) return PIOLA_OK;
+  size_t old = push_key(p, key);
+  double d;
+  PIOLA_TRY(number_value(p, v, (range){lo, hi, 0, 0}, &d));
+  if (d != floor(d)) return fail(p, PIOLA_ERROR_PARSE, "must be an integer, got %g", d);
+  *out = (int64_t)d;
+  pop(p, old);
+  return PIOLA_OK;
+}
+
+/* A scalar or {"keys": [[t, v], ...]} at the current path. */
+static piola_status track_value(parser *p, const cJSON *v, range r, piola_track *out) {
+  if (cJSON_IsNumber(v)) {
+    PIOLA_TRY(check_range(p, v->valuedouble, r));
+    *out = piola_track_constant(v->valuedouble);
+    return PIOLA_OK;
+  }
+  if (!cJSON_IsObject(v))
+    return fail(p, PIOLA_ERROR_PARSE, "must be a number or {\"keys\": [[t, v], ...]}, got %s", type_name(v));
+  static const char *const allowed[] = {"keys", NULL};
+  PIOLA_TRY(check_keys(p, v, allowed));
+  const cJSON *keys = get(v, "keys");
+  size_t old = push_key(p, "keys");
+  if (!cJSON_IsArray(keys)) return fail(p, PIOLA_ERROR_PARSE, "must be an array of [time, value] pairs");
+  int count = cJSON_GetArraySize(keys);
+  if (count < 1 || count > PIOLA_MAX_KEYS)
+    return fail(p, BAD_VALUE, "must hold 1 to %d keys, got %d", PIOLA_MAX_KEYS, count);
+  double times[PIOLA_MAX_KEYS], values[PIOLA_MAX_KEYS];
+  int i = 0;
+  for (const cJSON *k = keys->child; k; k = k->next, ++i) {
+    size_t o2 = push_index(p, i);
+    if (!cJSON_IsArray(k) || cJSON_GetArraySize(k) != 2 || !cJSON_IsNumber(k->child) ||
+        !cJSON_IsNumber(k->child->next))
+      return fail(p, PIOLA_ERROR_PARSE, "must be a pair [time in s, value] of numbers");
+    times[i] = k->child->valuedouble;
+    values[i] = k->child->next->valuedouble;
+    if (!isfinite(times[i])) return fail(p, BAD_VALUE, "time must be finite");
+    if (i > 0 && !(times[i] > times[i - 1]))
+      return fail(p, BAD_VALUE, "times must increase strictly (%g after %g)", times[i], times[i - 1]);
+    PIOLA_TRY(check_range(p, values[i], r));
+    pop(p, o2);
+  }
+  pop(p, old);
+  if (piola_track_from_keys(times, values, count, out) != PIOLA_OK)
+    return fail(p, BAD_VALUE, "%s", piola_last_error());
+  return PIOLA_OK;
+}
+
+static piola_status opt_track(parser *p, const cJSON *obj, const char *key, range r, piola_track *out) {
+  const cJSON *v = get(obj, key);
+  if (!v) return PIOLA_OK;
+  size_t old = push_key(p, key);
+  PIOLA_TRY(track_value(p, v, r, out));
+  pop(p, old);
+  return PIOLA_OK;
+}
+
+static piola_status vec3_value(parser *p, const cJSON *v, range r, piola_vec3 *out) {
+  if (!cJSON_IsArray(v) || cJSON_GetArraySize(v) != 3)
+    return fail(p, PIOLA_ERROR_PARSE, "must be an array of 3 numbers, got %s", type_name(v));
+  double c[3];
+  int i = 0;
+  for (const cJSON *e = v->child; e; e = e->next, ++i) {
+    size_t old = push_index(p, i);
+    PIOLA_TRY(number_value(p, e, r, &c[i]));
+    pop(p, old);
+  }
+  *out = (piola_vec3){c[0], c[1], c[2]};
+  return PIOLA_OK;
+}
+
+static piola_status opt_vec3(parser *p, const cJSON *obj, const char *key, range r, piola_vec3 *out) {
+  const cJSON *v = get(obj, key);
+  if (!v) return PIOLA_OK;
+  size_t old = push_key(p, key);
+  PIOLA_TRY(vec3_value(p, v, r, out));
+  pop(p, old);
+  return PIOLA_OK;
+}
+
+/* A unit direction: nonzero, normalized. */
+static piola_status opt_direction(parser *p, const cJSON *obj, const char *key, piola_vec3 *out) {
+  const cJSON *v = get(obj, key);
+  if (!v) return PIOLA_OK;
+  size_t old = push_key(p, key);
+  piola_vec3 d;
+  PIOLA_TRY(vec3_value(p, v, ANY, &d));
+  double len = vec3_norm(d);
+  if (!(len > 1e-300)) return fail(p, BAD_VALUE, "must be a nonzero vector");
+  *out = vec3_scale(d, 1.0 / len);
+  pop(p, old);
+  return PIOLA_OK;
+}
+
+static piola_status opt_vec3_tracks(parser *p, const cJSON *obj, const char *key, piola_track out[3]) {
+  const cJSON *v = get(obj, key);
+  if (!v) return PIOLA_OK;
+  size_t old = push_key(p, key);
+  if (!cJSON_IsArray(v) || cJSON_GetArraySize(v) != 3)
+    return fail(p, PIOLA_ERROR_PARSE, "must be an array of 3 numbers (or keyframes), got %s", type_name(v));
+  int i = 0;
+  for (const cJSON *e = v->child; e; e = e->next, ++i) {
+    size_t o2 = push_index(p, i);
+    PIOLA_TRY(track_value(p, e, ANY, &out[i]));
+    pop(p, o2);
+  }
+  pop(p, old);
+  return PIOLA_OK;
+}
+
+static piola_status required(parser *p, const cJSON *obj, const char *key) {
+  if (get(obj, key)) return PIOLA_OK;
+  size_t old = push_key(p, key);
+  piola_status s = fail(p, PIOLA_ERROR_PARSE, "is required");
+  pop(p, old);
+  return s;
+}
+
+static piola_status resolve_path(parser *p, const cJSON *v, char *out) {
+  if (!cJSON_IsString(v) || !v->valuestring[0])
+    return fail(p, PIOLA_ERROR_PARSE, "must be a file path (string), got %s", type_name(v));
+  int n;
+  if (v->valuestring[0] == '/' || !p->base_dir || !p->base_dir[0])
+    n = snprintf(out, SCENE_PATH_MAX, "%s", v->valuestring);
+  else
+    n = snprintf(out, SCENE_PATH_MAX, "%s/%s", p->base_dir, v->valuestring);
+  if (n < 0 || n >= SCENE_PATH_MAX) return fail(p, BAD_VALUE, "path is too long");
+  return PIOLA_OK;
+}
+
+/* ------------------------------------------------------------------ motion */
+
+static piola_status parse_motion(parser *p, const cJSON *obj, piola_vec3 default_pivot,
+                                 piola_rigid_motion_def *out) {
+  static const char *const allowed[] = {"velocity", "angular_speed", "translation", "angle",
+                                        "axis", "pivot", NULL};
+  PIOLA_TRY(check_keys(p, obj, allowed));
+  *out = piola_default_rigid_motion_def();
+  out->pivot = default_pivot;
+  int velocity_kind = get(obj, "velocity") || get(obj, "angular_speed");
+  int pose_kind = get(obj, "translation") || get(obj, "angle");
+  if (velocity_kind && pose_kind)
+    return fail(p, PIOLA_ERROR_PARSE,
+                "give either velocity/angular_speed or translation/angle, not both");
+  out->kind = pose_kind ? PIOLA_MOTION_POSE : PIOLA_MOTION_VELOCITY;
+  PIOLA_TRY(opt_vec3_tracks(p, obj, "velocity", out->velocity));
+  PIOLA_TRY(opt_track(p, obj, "angular_speed", ANY, &out->angular_speed));
+  PIOLA_TRY(opt_vec3_tracks(p, obj, "translation", out->translation));
+  PIOLA_TRY(opt_track(p, obj, "angle", ANY, &out->angle));
+  PIOLA_TRY(opt_direction(p, obj, "axis", &out->axis));
+  PIOLA_TRY(opt_vec3(p, obj, "pivot", ANY, &out->pivot));
+  return PIOLA_OK;
+}
+
+/* ------------------------------------------------------------------ solids */
+
+static piola_status parse_selector(parser *p, const cJSON *obj, int driven, piola_constraint_def *out,
+                                   int32_t **indices_out) {
+  static const char *const fixed_keys[] = {"box", "sphere", "indices", NULL};
+  static const char *const driven_keys[] = {"box", "sphere", "indices", "motion", NULL};
+  PIOLA_TRY(check_keys(p, obj, driven ? driven_keys : fixed_keys));
+  memset(out, 0, sizeof *out);
+  out->driven = driven;
+  out->motion = piola_default_rigid_motion_def();
+  int kinds = !!get(obj, "box") + !!get(obj, "sphere") + !!get(obj, "indices");
+  if (kinds != 1) return fail(p, PIOLA_ERROR_PARSE, "needs exactly one of box, sphere or indices");
+  const cJSON *v;
+  if ((v = get(obj, "box"))) {
+    size_t old = push_key(p, "box");
+    if (!cJSON_IsArray(v) || cJSON_GetArraySize(v) != 2)
+      return fail(p, PIOLA_ERROR_PARSE, "must be [[x0, y0, z0], [x1, y1, z1]]");
+    out->selector.type = PIOLA_SELECT_BOX;
+    size_t o2 = push_index(p, 0);
+    PIOLA_TRY(vec3_value(p, v->child, ANY, &out->selector.box_min));
+    pop(p, o2);
+    o2 = push_index(p, 1);
+    PIOLA_TRY(vec3_value(p, v->child->next, ANY, &out->selector.box_max));
+    pop(p, o2);
+    piola_vec3 a = out->selector.box_min, b = out->selector.box_max;
+    if (a.x > b.x || a.y > b.y || a.z > b.z)
+      return fail(p, BAD_VALUE, "the first corner must be <= the second in every coordinate");
+    pop(p, old);
+  } else if ((v = get(obj, "sphere"))) {
+    size_t old = push_key(p, "sphere");
+    static const char *const keys[] = {"center", "radius", NULL};
+    PIOLA_TRY(check_keys(p, v, keys));
+    PIOLA_TRY(required(p, v, "radius"));
+    out->selector.type = PIOLA_SELECT_SPHERE;
+    PIOLA_TRY(opt_vec3(p, v, "center", ANY, &out->selector.center));
+    PIOLA_TRY(opt_number(p, v, "radius", NONNEGATIVE, &out->selector.radius));
+    pop(p, old);
+  } else {
+    v = get(obj, "indices");
+    size_t old = push_key(p, "indices");
+    if (!cJSON_IsArray(v)) return fail(p, PIOLA_ERROR_PARSE, "must be an array of vertex indices");
+    int count = cJSON_GetArraySize(v);
+    int32_t *idx = malloc((size_t)(count > 0 ? count : 1) * sizeof *idx);
+    if (!idx) return fail(p, PIOLA_ERROR_OUT_OF_MEMORY, "out of memory");
+    *indices_out = idx;
+    int i = 0;
+    for (const cJSON *e = v->child; e; e = e->next, ++i) {
+      size_t o2 = push_index(p, i);
+      if (!cJSON_IsNumber(e) || e->valuedouble != floor(e->valuedouble) || e->valuedouble < 0 ||
+          e->valuedouble > 2147483647.0)
+        return fail(p, BAD_VALUE, "must be a vertex index (an integer >= 0)");
+      idx[i] = (int32_t)e->valuedouble;
+      pop(p, o2);
+    }
+    out->selector.type = PIOLA_SELECT_INDICES;
+    out->selector.indices = idx;
+    out->selector.index_count = count;
+    pop(p, old);
+  }
+  if (driven) {
+    PIOLA_TRY(required(p, obj, "motion"));
+    size_t old = push_key(p, "motion");
+    PIOLA_TRY(parse_motion(p, get(obj, "motion"), (piola_vec3){0, 0, 0}, &out->motion));
+    pop(p, old);
+  }
+  return PIOLA_OK;
+}
+
+static piola_status parse_constraints(parser *p, const cJSON *solid, const char *key, int driven,
+                                      scene_solid_desc *d) {
+  const cJSON *list = get(solid, key);
+  if (!list) return PIOLA_OK;
+  size_t old = push_key(p, key);
+  if (!cJSON_IsArray(list)) return fail(p, PIOLA_ERROR_PARSE, "must be an array of selectors");
+  int count = cJSON_GetArraySize(list);
+  int total = d->constraint_count + count;
+  piola_constraint_def *c = realloc(d->constraints, (size_t)(total > 0 ? total : 1) * sizeof *c);
+  if (!c) return fail(p, PIOLA_ERROR_OUT_OF_MEMORY, "out of memory");
+  d->constraints = c;
+  int32_t **lists = realloc(d->index_lists, (size_t)(total > 0 ? total : 1) * sizeof *lists);
+  if (!lists) return fail(p, PIOLA_ERROR_OUT_OF_MEMORY, "out of memory");
+  d->index_lists = lists;
+  int i = 0;
+  for (const cJSON *e = list->child; e; e = e->next, ++i) {
+    size_t o2 = push_index(p, i);
+    int32_t slot = d->constraint_count++;
+    d->index_lists[slot] = NULL;
+    memset(&d->constraints[slot], 0, sizeof d->constraints[slot]);
+    PIOLA_TRY(parse_selector(p, e, driven, &d->constraints[slot], &d->index_lists[slot]));
+    pop(p, o2);
+  }
+  pop(p, old);
+  return PIOLA_OK;
+}
+
+static piola_status parse_generator(parser *p, const cJSON *obj, piola_mesher_def *m) {
+  static const char *const allowed[] = {"generate", "center", "axis", "radius", "minor_radius",
+                                        "half_length", "half_extents", "cell_size",
+                                        "refinement_levels", NULL};
+  PIOLA_TRY(check_keys(p, obj, allowed));
+  PIOLA_TRY(required(p, obj, "generate"));
+  PIOLA_TRY(required(p, obj, "cell_size"));
+  *m = piola_default_mesher_def();
+  m->shape_count = 1;
+  piola_shape *s = &m->shapes[0];
+  memset(s, 0, sizeof *s);
+  s->axis = (piola_vec3){0, 0, 1};
+  const cJSON *g = get(obj, "generate");
+  size_t old = push_key(p, "generate");
+  static const char *const names[] = {"sphere", "box", "torus", "cylinder", "capsule", NULL};
+  static const piola_shape_type types[] = {PIOLA_SHAPE_SPHERE, PIOLA_SHAPE_BOX, PIOLA_SHAPE_TORUS,
+                                           PIOLA_SHAPE_CYLINDER, PIOLA_SHAPE_CAPSULE};
+  int found = -1;
+  if (cJSON_IsString(g))
+    for (int i = 0; names[i]; ++i)
+      if (strcmp(g->valuestring, names[i]) == 0) found = i;
+  if (found < 0)
+    return fail(p, BAD_VALUE, "must be one of \"sphere\", \"box\", \"torus\", \"cylinder\", \"capsule\"");
+  s->type = types[found];
+  pop(p, old);
+  const char *need[3] = {NULL, NULL, NULL};
+  switch (s->type) {
+    case PIOLA_SHAPE_SPHERE: need[0] = "radius"; break;
+    case PIOLA_SHAPE_BOX: need[0] = "half_extents"; break;
+    case PIOLA_SHAPE_TORUS: need[0] = "radius", need[1] = "minor_radius"; break;
+    default: need[0] = "radius", need[1] = "half_length"; break;
+  }
+  for (int i = 0; need[i]; ++i) PIOLA_TRY(required(p, obj, need[i]));
+  PIOLA_TRY(opt_vec3(p, obj, "center", ANY, &s->center));
+  PIOLA_TRY(opt_direction(p, obj, "axis", &s->axis));
+  PIOLA_TRY(opt_number(p, obj, "radius", POSITIVE, &s->radius));
+  PIOLA_TRY(opt_number(p, obj, "minor_radius", POSITIVE, &s->minor_radius));
+  PIOLA_TRY(opt_number(p, obj, "half_length", POSITIVE, &s->half_length));
+  PIOLA_TRY(opt_vec3(p, obj, "half_extents", POSITIVE, &s->half_extents));
+  PIOLA_TRY(opt_number(p, obj, "cell_size", POSITIVE, &m->cell_size));
+  int64_t levels = m->refinement_levels;
+  PIOLA_TRY(opt_int(p, obj, "refinement_levels", 0, 8, &levels));
+  m->refinement_levels = (int)levels;
+  if (s->type == PIOLA_SHAPE_TORUS && !(s->minor_radius < s->radius)) {
+    push_key(p, "minor_radius");
+    return fail(p, BAD_VALUE, "must be smaller than radius (%g m), got %g", s->radius, s->minor_radius);
+  }
+  return PIOLA_OK;
+}
+
+static piola_status parse_material(parser *p, const cJSON *obj, scene_solid_desc *d) {
+  static const char *const allowed[] = {"model", "youngs_modulus", "poisson_ratio", "stiffness_scale",
+                                        "inversion", "spline", NULL};
+  PIOLA_TRY(check_keys(p, obj, allowed));
+  piola_material_def *m = &d->def.material;
+  const cJSON *model = get(obj, "model");
+  if (model) {
+    size_t old = push_key(p, "model");
+    static const char *const names[] = {"rotated_linear", "corotated", "stvk", "neohookean", "spline", NULL};
+    static const piola_material_model models[] = {PIOLA_MODEL_ROTATED_LINEAR, PIOLA_MODEL_COROTATED,
+                                                  PIOLA_MODEL_STVK, PIOLA_MODEL_NEOHOOKEAN,
+                                                  PIOLA_MODEL_SPLINE};
+    int found = -1;
+    if (cJSON_IsString(model))
+      for (int i = 0; names[i]; ++i)
+        if (strcmp(model->valuestring, names[i]) == 0) found = i;
+    if (found < 0)
+      return fail(p, BAD_VALUE,
+                  "must be one of \"rotated_linear\", \"corotated\", \"stvk\", \"neohookean\", \"spline\"");
+    m->model = models[found];
+    pop(p, old);
+  }
+  PIOLA_TRY(opt_number(p, obj, "youngs_modulus", POSITIVE, &m->youngs_modulus));
+  PIOLA_TRY(opt_number(p, obj, "poisson_ratio", (range){-1, 0.5, 1, 1}, &m->poisson_ratio));
+  PIOLA_TRY(opt_track(p, obj, "stiffness_scale", NONNEGATIVE, &d->def.stiffness_scale));
+  const cJSON *inv = get(obj, "inversion");
+  if (inv) {
+    size_t old = push_key(p, "inversion");
+    static const char *const keys[] = {"threshold", "mode", NULL};
+    PIOLA_TRY(check_keys(p, inv, keys));
+    PIOLA_TRY(opt_number(p, inv, "threshold", (range){0, 1, 1, 1}, &m->inversion_threshold));
+    const cJSON *mode = get(inv, "mode");
+    if (mode) {
+      size_t o2 = push_key(p, "mode");
+      if (cJSON_IsString(mode) && strcmp(mode->valuestring, "linear") == 0)
+        m->inversion_mode = PIOLA_INVERSION_LINEAR;
+      else if (cJSON_IsString(mode) && strcmp(mode->valuestring, "clamp") == 0)
+        m->inversion_mode = PIOLA_INVERSION_CLAMP;
+      else
+        return fail(p, BAD_VALUE, "must be \"linear\" or \"clamp\"");
+      pop(p, o2);
+    }
+    pop(p, old);
+  }
+  const cJSON *sp = get(obj, "spline");
+  if (sp) {
+    size_t old = push_key(p, "spline");
+    static const char *const keys[] = {"compression_stretch", "elongation_stretch", "stiffening", NULL};
+    PIOLA_TRY(check_keys(p, sp, keys));
+    PIOLA_TRY(opt_number(p, sp, "compression_stretch", (range){0, 1, 1, 1}, &m->spline.compression_stretch));
+    PIOLA_TRY(opt_number(p, sp, "elongation_stretch", (range){1, INFINITY, 1, 0}, &m->spline.elongation_stretch));
+    PIOLA_TRY(opt_number(p, sp, "stiffening", (range){1, INFINITY, 0, 0}, &m->spline.stiffening));
+    pop(p, old);
+  }
+  return PIOLA_OK;
+}
+
+static piola_status parse_solid(parser *p, const cJSON *obj, int index, scene_solid_desc *d) {
+  static const char *const allowed[] = {"name", "mesh", "transform", "density", "material",
+                                        "damping", "velocity", "fixed", "driven", "initial", NULL};
+  PIOLA_TRY(check_keys(p, obj, allowed));
+  PIOLA_TRY(required(p, obj, "mesh"));
+  d->def = piola_default_solid_def();
+  d->scale = (piola_vec3){1, 1, 1};
+  snprintf(d->name, sizeof d->name, "solid%d", index);
+  const cJSON *v;
+  if ((v = get(obj, "name"))) {
+    size_t old = push_key(p, "name");
+    if (!cJSON_IsString(v) || !v->valuestring[0] || strlen(v->valuestring) >= sizeof d->name)
+      return fail(p, PIOLA_ERROR_PARSE, "must be a non-empty string of at most %d characters",
+                  (int)sizeof d->name - 1);
+    snprintf(d->name, sizeof d->name, "%s", v->valuestring);
+    pop(p, old);
+  }
+  v = get(obj, "mesh");
+  size_t old = push_key(p, "mesh");
+  if (cJSON_IsObject(v)) {
+    d->mesh_generated = 1;
+    PIOLA_TRY(parse_generator(p, v, &d->mesher));
+  } else {
+    if (!cJSON_IsString(v))
+      return fail(p, PIOLA_ERROR_PARSE, "must be a file path or a generator object, got %s", type_name(v));
+    PIOLA_TRY(resolve_path(p, v, d->mesh_path));
+  }
+  pop(p, old);
+  if ((v = get(obj, "transform"))) {
+    old = push_key(p, "transform");
+    static const char *const keys[] = {"translate", "rotate_degrees", "scale", NULL};
+    PIOLA_TRY(check_keys(p, v, keys));
+    PIOLA_TRY(opt_vec3(p, v, "translate", ANY, &d->translate));
+    PIOLA_TRY(opt_vec3(p, v, "rotate_degrees", ANY, &d->rotate_degrees));
+    const cJSON *sc = get(v, "scale");
+    if (sc) {
+      size_t o2 = push_key(p, "scale");
+      if (cJSON_IsNumber(sc)) {
+        double s;
+        PIOLA_TRY(number_value(p, sc, POSITIVE, &s));
+        d->scale = (piola_vec3){s, s, s};
+      } else {
+        PIOLA_TRY(vec3_value(p, sc, POSITIVE, &d->scale));
+      }
+      pop(p, o2);
+    }
+    pop(p, old);
+  }
+  PIOLA_TRY(opt_number(p, obj, "density", POSITIVE, &d->def.density));
+  if ((v = get(obj, "material"))) {
+    old = push_key(p, "material");
+    PIOLA_TRY(parse_material(p, v, d));
+    pop(p, old);
+  }
+  if ((v = get(obj, "damping"))) {
+    old = push_key(p, "damping");
+    static const char *const keys[] = {"shear", "bulk", NULL};
+    PIOLA_TRY(check_keys(p, v, keys));
+    PIOLA_TRY(opt_track(p, v, "shear", NONNEGATIVE, &d->def.shear_viscosity));
+    PIOLA_TRY(opt_track(p, v, "bulk", NONNEGATIVE, &d->def.bulk_viscosity));
+    pop(p, old);
+  }
+  PIOLA_TRY(opt_vec3(p, obj, "velocity", ANY, &d->def.velocity));
+  PIOLA_TRY(parse_constraints(p, obj, "fixed", 0, d));
+  PIOLA_TRY(parse_constraints(p, obj, "driven", 1, d));
+  if ((v = get(obj, "initial"))) {
+    old = push_key(p, "initial");
+    static const char *const keys[] = {"matrix", "scramble", "seed", NULL};
+    PIOLA_TRY(check_keys(p, v, keys));
+    const cJSON *mat = get(v, "matrix");
+    if (mat) {
+      size_t o2 = push_key(p, "matrix");
+      if (!cJSON_IsArray(mat) || cJSON_GetArraySize(mat) != 3)
+        return fail(p, PIOLA_ERROR_PARSE, "must be a 3x3 matrix given as 3 rows of 3 numbers");
+      int r = 0;
+      for (const cJSON *row = mat->child; row; row = row->next, ++r) {
+        size_t o3 = push_index(p, r);
+        piola_vec3 rv;
+        PIOLA_TRY(vec3_value(p, row, ANY, &rv));
+        d->def.initial_matrix.m[r][0] = rv.x;
+        d->def.initial_matrix.m[r][1] = rv.y;
+        d->def.initial_matrix.m[r][2] = rv.z;
+        pop(p, o3);
+      }
+      pop(p, o2);
+    }
+    PIOLA_TRY(opt_number(p, v, "scramble", NONNEGATIVE, &d->def.scramble_radius));
+    int64_t seed = 1;
+    PIOLA_TRY(opt_int(p, v, "seed", 0, 9007199254740991.0, &seed));
+    d->def.scramble_seed = (uint64_t)seed;
+    pop(p, old);
+  }
+  return PIOLA_OK;
+}
+
+/* ------------------------------------------------------------------ obstacles */
+
+static piola_status parse_obstacle(parser *p, const cJSON *obj, scene_obstacle_desc *d) {
+  static const char *const names[] = {"plane", "sphere", "box", "cylinder", "capsule", "torus",
+                                      "gear", "mesh", NULL};
+  static const char *const keysets[][10] = {
+      {"type", "point", "normal", "friction", "motion", NULL},
+      {"type", "center", "radius", "friction", "motion", NULL},
+      {"type", "center", "half_extents", "friction", "motion", NULL},
+      {"type", "center", "axis", "radius", "half_length", "friction", "motion", NULL},
+      {"type", "center", "axis", "radius", "half_length", "friction", "motion", NULL},
+      {"type", "center", "axis", "radius", "minor_radius", "friction", "motion", NULL},
+      {"type", "center", "axis", "radius", "half_length", "teeth", "tooth_depth", "friction", "motion", NULL},
+      {"type", "path", "friction", "motion", NULL},
+  };
+  static const char *const required_keys[][4] = {
+      {"point", "normal", NULL},          {"radius", NULL},
+      {"half_extents", NULL},             {"radius", "half_length", NULL},
+      {"radius", "half_length", NULL},    {"radius", "minor_radius", NULL},
+      {"radius", "half_length", "teeth", NULL}, {"path", NULL},
+  };
+  if (!cJSON_IsObject(obj)) return fail(p, PIOLA_ERROR_PARSE, "must be an object, got %s", type_name(obj));
+  PIOLA_TRY(required(p, obj, "type"));
+  const cJSON *t = get(obj, "type");
+  size_t old = push_key(p, "type");
+  int found = -1;
+  if (cJSON_IsString(t))
+    for (int i = 0; names[i]; ++i)
+      if (strcmp(t->valuestring, names[i]) == 0) found = i;
+  if (found < 0)
+    return fail(p, BAD_VALUE,
+                "must be one of \"plane\", \"sphere\", \"box\", \"cylinder\", \"capsule\", \"torus\", "
+                "\"gear\", \"mesh\"");
+  pop(p, old);
+  PIOLA_TRY(check_keys(p, obj, keysets[found]));
+  for (int i = 0; required_keys[found][i]; ++i) PIOLA_TRY(required(p, obj, required_keys[found][i]));
+  piola_obstacle_def *o = &d->def;
+  *o = piola_default_obstacle_def();
+  o->type = (piola_obstacle_type)(PIOLA_OBSTACLE_PLANE + found);
+  o->axis = (piola_vec3){0, 0, 1};
+  if (o->type == PIOLA_OBSTACLE_PLANE) {
+    PIOLA_TRY(opt_vec3(p, obj, "point", ANY, &o->center));
+    PIOLA_TRY(opt_direction(p, obj, "normal", &o->axis));
+  } else {
+    PIOLA_TRY(opt_vec3(p, obj, "center", ANY, &o->center));
+    PIOLA_TRY(opt_direction(p, obj, "axis", &o->axis));
+  }
+  PIOLA_TRY(opt_number(p, obj, "radius", POSITIVE, &o->radius));
+  PIOLA_TRY(opt_number(p, obj, "minor_radius", POSITIVE, &o->minor_radius));
+  PIOLA_TRY(opt_number(p, obj, "half_length", POSITIVE, &o->half_length));
+  PIOLA_TRY(opt_vec3(p, obj, "half_extents", POSITIVE, &o->half_extents));
+  int64_t teeth = 0;
+  PIOLA_TRY(opt_int(p, obj, "teeth", 3, 10000, &teeth));
+  o->tooth_count = (int)teeth;
+  if (o->type == PIOLA_OBSTACLE_GEAR) o->tooth_depth = 0.2 * o->radius;
+  PIOLA_TRY(opt_number(p, obj, "tooth_depth", POSITIVE, &o->tooth_depth));
+  if (o->type == PIOLA_OBSTACLE_GEAR && !(o->tooth_depth < o->radius)) {
+    push_key(p, "tooth_depth");
+    return fail(p, BAD_VALUE, "must be smaller than radius (%g m), got %g", o->radius, o->tooth_depth);
+  }
+  if (o->type == PIOLA_OBSTACLE_TORUS && !(o->minor_radius < o->radius)) {
+    push_key(p, "minor_radius");
+    return fail(p, BAD_VALUE, "must be smaller than radius (%g m), got %g", o->radius, o->minor_radius);
+  }
+  PIOLA_TRY(opt_number(p, obj, "friction", NONNEGATIVE, &o->friction));
+  if (o->type == PIOLA_OBSTACLE_MESH) {
+    old = push_key(p, "path");
+    PIOLA_TRY(resolve_path(p, get(obj, "path"), d->mesh_path));
+    pop(p, old);
+  }
+  const cJSON *mo = get(obj, "motion");
+  if (mo) {
+    old = push_key(p, "motion");
+    PIOLA_TRY(parse_motion(p, mo, o->center, &o->motion));
+    pop(p, old);
+  } else {
+    o->motion = piola_default_rigid_motion_def();
+    o->motion.pivot = o->center;
+  }
+  return PIOLA_OK;
+}
+
+/* ------------------------------------------------------------------ top level */
+
+static piola_status parse_top(parser *p, const cJSON *root, scene_desc *out) {
+  static const char *const allowed[] = {"description", "fps", "frames", "gravity", "integrator",
+                                        "solids", "obstacles", NULL};
+  PIOLA_TRY(check_keys(p, root, allowed));
+  const cJSON *v;
+  if ((v = get(root, "description")) && !cJSON_IsString(v)) {
+    push_key(p, "description");
+    return fail(p, PIOLA_ERROR_PARSE, "must be a string, got %s", type_name(v));
+  }
+  PIOLA_TRY(opt_number(p, root, "fps", (range){0, 10000, 1, 0}, &out->fps));
+  int64_t frames = out->frames;
+  PIOLA_TRY(opt_int(p, root, "frames", 0, 1000000, &frames));
+  out->frames = (int32_t)frames;
+  PIOLA_TRY(opt_vec3_tracks(p, root, "gravity", out->world.gravity));
+  if ((v = get(root, "integrator"))) {
+    size_t old = push_key(p, "integrator");
+    static const char *const keys[] = {"max_dt", "cfl", "cg_tolerance", "cg_max_iterations", NULL};
+    PIOLA_TRY(check_keys(p, v, keys));
+    PIOLA_TRY(opt_number(p, v, "max_dt", (range){0, 1, 1, 0}, &out->world.max_dt));
+    PIOLA_TRY(opt_number(p, v, "cfl", (range){0, 2, 1, 0}, &out->world.cfl));
+    PIOLA_TRY(opt_number(p, v, "cg_tolerance", (range){0, 1, 1, 1}, &out->world.cg_tolerance));
+    int64_t it = out->world.cg_max_iterations;
+    PIOLA_TRY(opt_int(p, v, "cg_max_iterations", 1, 1000000, &it));
+    out->world.cg_max_iterations = (int32_t)it;
+    pop(p, old);
+  }
+  PIOLA_TRY(required(p, root, "solids"));
+  v = get(root, "solids");
+  size_t old = push_key(p, "solids");
+  if (!cJSON_IsArray(v) || cJSON_GetArraySize(v) < 1)
+    return fail(p, PIOLA_ERROR_PARSE, "must be a non-empty array of solids");
+  int count = cJSON_GetArraySize(v);
+  out->solids = calloc((size_t)count, sizeof *out->solids);
+  if (!out->solids) return fail(p, PIOLA_ERROR_OUT_OF_MEMORY, "out of memory");
+  int i = 0;
+  for (const cJSON *e = v->child; e; e = e->next, ++i) {
+    size_t o2 = push_index(p, i);
+    out->solid_count = i + 1;
+    PIOLA_TRY(parse_solid(p, e, i, &out->solids[i]));
+    for (int j = 0; j < i; ++j)
+      if (strcmp(out->solids[j].name, out->solids[i].name) == 0) {
+        push_key(p, "name");
+        return fail(p, BAD_VALUE, "\"%s\" is already the name of solids[%d]", out->solids[i].name, j);
+      }
+    pop(p, o2);
+  }
+  pop(p, old);
+  if ((v = get(root, "obstacles"))) {
+    old = push_key(p, "obstacles");
+    if (!cJSON_IsArray(v)) return fail(p, PIOLA_ERROR_PARSE, "must be an array of obstacles");
+    count = cJSON_GetArraySize(v);
+    out->obstacles = calloc((size_t)(count > 0 ? count : 1), sizeof *out->obstacles);
+    if (!out->obstacles) return fail(p, PIOLA_ERROR_OUT_OF_MEMORY, "out of memory");
+    i = 0;
+    for (const cJSON *e = v->child; e; e = e->next, ++i) {
+      size_t o2 = push_index(p, i);
+      out->obstacle_count = i + 1;
+      PIOLA_TRY(parse_obstacle(p, e, &out->obstacles[i]));
+      pop(p, o2);
+    }
+    pop(p, old);
+  }
+  return PIOLA_OK;
+}
+
+void piola__scene_desc_free(scene_desc *desc) {
+  if (!desc) return;
+  for (int32_t i = 0; i < desc->solid_count; ++i) {
+    scene_solid_desc *s = &desc->solids[i];
+    for (int32_t c = 0; c < s->constraint_count; ++c) free(s->index_lists[c]);
+    free(s->index_lists);
+    free(s->constraints);
+  }
+  free(desc->solids);
+  free(desc->obstacles);
+  memset(desc, 0, sizeof *desc);
+}
+
+piola_status piola__scene_parse(const char *json, const char *base_dir, const char *label,
+                                scene_desc *out) {
+  memset(out, 0, sizeof *out);
+  out->fps = 30;
+  out->frames = 60;
+  out->world = piola_default_world_def();
+  parser p = {label ? label : "scene", base_dir, "", 0};
+  if (!json) return fail(&p, PIOLA_ERROR_INVALID_ARGUMENT, "no text");
+  const char *end = NULL;
+  cJSON *root = cJSON_ParseWithOpts(json, &end, 1);
+  if (!root) {
+    int line = 1, col = 1;
+    const char *at = end ? end : json;
+    for (const char *c = json; c < at && *c; ++c) {
+      if (*c == '\n') ++line, col = 1;
+      else ++col;
+    }
+    return PIOLA_FAIL(PIOLA_ERROR_PARSE, "%s: line %d, column %d: invalid JSON", p.label, line, col);
+  }
+  piola_status st = parse_top(&p, root, out);
+  cJSON_Delete(root);
+  if (st != PIOLA_OK) piola__scene_desc_free(out);
+  return st;
+}

@@ -1,0 +1,30 @@
+/* A matrix-free, filtered, diagonally preconditioned conjugate gradient.
+ *
+ * The damping solves of the step loop are (M - h D) v = b with M the lumped mass and D the
+ * linear damping operator: symmetric, and positive definite because damping only removes
+ * energy. The operator is applied through a callback so the matrix is never assembled.
+ * Constrained nodes and the normal velocity of colliding nodes are held at the values of
+ * the initial guess by a filter S that projects those components out of every residual and
+ * search direction (Baraff and Witkin's modified conjugate gradient). The preconditioner is
+ * the inverse lumped mass, which commutes with the per-node filter. Dot products are summed
+ * serially in index order so results do not depend on the thread count. */
+#ifndef PIOLA_SIM_CONJUGATE_GRADIENT_H
+#define PIOLA_SIM_CONJUGATE_GRADIENT_H
+
+#include <stdint.h>
+
+typedef struct cg_problem {
+  int32_t n;                                  /* nodes; vectors are 3n */
+  void (*apply)(void *ctx, const double *p, double *out); /* out = A p */
+  void (*filter)(void *ctx, double *r);       /* projects constrained components to zero */
+  void *ctx;
+  const double *inverse_mass;                 /* n, the preconditioner */
+  double tolerance;                           /* relative, in the M^-1 norm */
+  int32_t max_iterations;
+} cg_problem;
+
+/* Solves A x = b starting from x (whose filtered components are kept). work holds 4 * 3n
+ * doubles. Returns the iterations used. */
+int32_t piola__cg_solve(const cg_problem *problem, const double *b, double *x, double *work);
+
+#endif

@@ -1,0 +1,84 @@
+/* Constraints: nodes fixed in place or driven by a keyframed rigid motion, chosen by a box,
+ * a sphere or an index list over the rest positions. Later constraints override earlier
+ * ones on nodes they both select. */
+#include <stdlib.h>
+
+#include "common/status_internal.h"
+#include "math/mat3.h"
+#include "sim/world_internal.h"
+
+static int selects(const piola_selector *sel, const double *p) {
+  switch (sel->type) {
+    case PIOLA_SELECT_BOX:
+      return p[0] >= sel->box_min.x && p[0] <= sel->box_max.x && p[1] >= sel->box_min.y &&
+             p[1] <= sel->box_max.y && p[2] >= sel->box_min.z && p[2] <= sel->box_max.z;
+    case PIOLA_SELECT_SPHERE:
+      return vec3_norm2(vec3_sub(vec3_load(p), sel->center)) <= sel->radius * sel->radius;
+    case PIOLA_SELECT_INDICES:
+      return 0;
+  }
+  return 0;
+}
+
+piola_status piola__solid_apply_constraints(world_solid *s, const double *rest,
+                                            const piola_constraint_def *constraints,
+                                            int32_t count) {
+  if (count < 0 || (count > 0 && !constraints))
+    return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "constraints: bad count %d", (int)count);
+  int32_t driven = 0;
+  for (int32_t c = 0; c < count; ++c) driven += constraints[c].driven ? 1 : 0;
+  if (driven) {
+    s->motions = calloc((size_t)driven, sizeof *s->motions);
+    if (!s->motions) return PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "constraints: out of memory");
+  }
+  for (int32_t c = 0; c < count; ++c) {
+    const piola_constraint_def *con = &constraints[c];
+    const piola_selector *sel = &con->selector;
+    if (sel->type == PIOLA_SELECT_SPHERE && !(sel->radius >= 0))
+      return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "constraints[%d]: sphere radius must be >= 0 m",
+                        (int)c);
+    uint8_t flag = con->driven ? SOLID_DRIVEN : SOLID_FIXED;
+    int32_t motion = -1;
+    if (con->driven) {
+      motion = s->motion_count++;
+      s->motions[motion] = con->motion;
+    }
+    if (sel->type == PIOLA_SELECT_INDICES) {
+      if (sel->index_count > 0 && !sel->indices)
+        return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "constraints[%d]: indices missing", (int)c);
+      for (int32_t k = 0; k < sel->index_count; ++k) {
+        int32_t i = sel->indices[k];
+        if (i < 0 || i >= s->n)
+          return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT,
+                            "constraints[%d].indices[%d]: vertex %d is out of range [0, %d)", (int)c,
+                            (int)k, (int)i, (int)s->n);
+        s->flags[i] = flag;
+        s->motion_of[i] = motion;
+      }
+    } else {
+      for (int32_t i = 0; i < s->n; ++i)
+        if (selects(sel, rest + 3 * i)) {
+          s->flags[i] = flag;
+          s->motion_of[i] = motion;
+        }
+    }
+  }
+  return PIOLA_OK;
+}
+
+void piola__solid_constrained_state(const world_solid *s, int32_t i, double t, double x[3],
+                                    double v[3]) {
+  const double *p0 = s->start + 3 * i;
+  if (s->flags[i] != SOLID_DRIVEN) {
+    x[0] = p0[0], x[1] = p0[1], x[2] = p0[2];
+    v[0] = v[1] = v[2] = 0;
+    return;
+  }
+  const piola_rigid_motion_def *m = &s->motions[s->motion_of[i]];
+  piola_mat3 r;
+  piola_vec3 c;
+  piola_rigid_motion_pose(m, t, &r, &c);
+  vec3 p = vec3_add(mat3_mul_vec(r, vec3_load(p0)), c);
+  vec3_store(x, p);
+  vec3_store(v, piola_rigid_motion_velocity(m, t, p));
+}

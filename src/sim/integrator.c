@@ -1,0 +1,293 @@
+/* The step loop: the Newmark scheme of paper section 9 (see docs/time-stepping.md).
+ *
+ * From (x^n, v^n), with the elastic force f^n = f_e(x^n) and the rotations of x^n already
+ * held by the body:
+ *  1. (M - dt/2 D_n) v~ = M v^n + dt/2 (f^n + f_ext(t^n))            damping implicit (CG)
+ *  2. x~ = x^n + dt v~
+ *  3. collisions with x~ and v^n give x^n+1 and v'; colliding nodes are flagged
+ *  4. (M - dt/2 D_n+1) v^n+1 = M v' + dt/2 (f^n + D_n v' + f_ext(t^n))
+ *                                   + dt/2 (f^n+1 + f_ext(t^n+1))   with normal velocity of
+ *     colliding nodes held at v' (filtered CG)
+ * F, its diagonalization and f^n+1 are computed once, between steps 3 and 4, and reused by
+ * the next step's step 1. Constrained nodes follow their prescribed positions exactly:
+ * their v~ is the secant velocity to the prescribed position and v^n+1 the prescribed
+ * velocity. */
+#include <math.h>
+#include <string.h>
+
+#include "common/status_internal.h"
+#include "math/mat3.h"
+#include "sim/conjugate_gradient.h"
+#include "sim/world_internal.h"
+
+typedef struct damping_system {
+  const world_solid *s;
+  double h;              /* dt / 2 */
+  double beta, alpha;    /* shear and bulk viscosity, Pa s */
+  int hold_normals;      /* filter the normal components of colliding nodes too */
+  double *scratch;       /* 3n */
+} damping_system;
+
+static void damping_apply(void *ctx, const double *p, double *out) {
+  const damping_system *d = ctx;
+  const world_solid *s = d->s;
+  piola_elastic_body_damping_forces(s->body, p, d->beta, d->alpha, d->scratch);
+  for (int32_t i = 0; i < s->n; ++i)
+    for (int k = 0; k < 3; ++k)
+      out[3 * i + k] = s->mass[i] * p[3 * i + k] - d->h * d->scratch[3 * i + k];
+}
+
+static void damping_filter(void *ctx, double *r) {
+  const damping_system *d = ctx;
+  const world_solid *s = d->s;
+  for (int32_t i = 0; i < s->n; ++i) {
+    double *ri = r + 3 * i;
+    if (s->flags[i] != SOLID_FREE) {
+      ri[0] = ri[1] = ri[2] = 0;
+    } else if (d->hold_normals && s->colliding[i]) {
+      const double *nrm = s->normals + 3 * i;
+      double dn = ri[0] * nrm[0] + ri[1] * nrm[1] + ri[2] * nrm[2];
+      for (int k = 0; k < 3; ++k) ri[k] -= dn * nrm[k];
+    }
+  }
+}
+
+/* Solves (M - h D) v = rhs, keeping the filtered components of the guess in v. */
+static int32_t damping_solve(const piola_world *w, world_solid *s, double h, double t,
+                             int hold_normals, const double *rhs, double *v) {
+  double beta = piola_track_eval(&s->shear_viscosity, t);
+  double alpha = piola_track_eval(&s->bulk_viscosity, t);
+  damping_system d = {s, h, beta, alpha, hold_normals, s->tmp};
+  if (beta == 0 && alpha == 0) {
+    /* M is diagonal: the filtered solve is exact in one pass */
+    for (int32_t i = 0; i < s->n; ++i) {
+      if (s->flags[i] != SOLID_FREE) continue;
+      double *vi = v + 3 * i;
+      double old[3] = {vi[0], vi[1], vi[2]};
+      for (int k = 0; k < 3; ++k) vi[k] = rhs[3 * i + k] / s->mass[i];
+      if (hold_normals && s->colliding[i]) {
+        const double *nrm = s->normals + 3 * i;
+        double dn = (vi[0] - old[0]) * nrm[0] + (vi[1] - old[1]) * nrm[1] + (vi[2] - old[2]) * nrm[2];
+        for (int k = 0; k < 3; ++k) vi[k] -= dn * nrm[k];
+      }
+    }
+    return 0;
+  }
+  cg_problem pb;
+  pb.n = s->n;
+  pb.apply = damping_apply;
+  pb.filter = damping_filter;
+  pb.ctx = &d;
+  pb.inverse_mass = s->inverse_mass;
+  pb.tolerance = w->def.cg_tolerance;
+  pb.max_iterations = w->def.cg_max_iterations;
+  return piola__cg_solve(&pb, rhs, v, s->work);
+}
+
+/* Friction for the second half of the step's contact impulse.
+ *
+ * Collision processing (step 3) applies friction with the normal velocity change it causes,
+ * dvN + dxN/dt; in resting contact that is the half-step of normal acceleration that
+ * carried the node into the obstacle through v~. The final solve then holds the normal
+ * velocity, which removes the normal impulse of the other half, dt/2 a^n+1 . n; without
+ * friction for it a block on an incline would feel half its Coulomb friction. Here that
+ * impulse, dt/2 (f^n+1 + f_ext + D v^n+1) . n / m when it presses into the obstacle, limits
+ * the relative tangential velocity the same way: vT <- max(0, 1 - mu dvN / |vT|) vT. */
+static void contact_friction(const piola_world *w, world_solid *s, double t1, double h,
+                             const double *g1, const double *av) {
+  for (int32_t i = 0; i < s->n; ++i) {
+    if (!s->colliding[i] || s->flags[i] != SOLID_FREE) continue;
+    const double *nrm = s->normals + 3 * i;
+    double *vi = s->v + 3 * i;
+    /* normal impulse per unit mass of the n+1 half: h (f + m g).n + (h D v).n, where
+     * h D v = M v - A v */
+    double push = 0;
+    for (int k = 0; k < 3; ++k)
+      push += nrm[k] * (h * (s->force[3 * i + k] + s->mass[i] * g1[k]) + s->mass[i] * vi[k] - av[3 * i + k]);
+    double dvn = -push / s->mass[i];
+    if (!(dvn > 0)) continue;
+    /* the obstacle the node touches: the one nearest to it */
+    piola_vec3 p = {s->x[3 * i], s->x[3 * i + 1], s->x[3 * i + 2]};
+    double best = INFINITY, mu = 0;
+    piola_vec3 vo = {0, 0, 0};
+    for (int32_t o = 0; o < w->obstacle_count; ++o) {
+      piola_vec3 vel;
+      double phi = fabs(piola_obstacle_signed_distance(w->obstacles[o], t1, p, NULL, &vel));
+      if (phi < best) best = phi, mu = piola_obstacle_friction(w->obstacles[o]), vo = vel;
+    }
+    if (!(mu > 0)) continue;
+    double rel[3] = {vi[0] - vo.x, vi[1] - vo.y, vi[2] - vo.z};
+    double rn = rel[0] * nrm[0] + rel[1] * nrm[1] + rel[2] * nrm[2];
+    double vt[3] = {rel[0] - rn * nrm[0], rel[1] - rn * nrm[1], rel[2] - rn * nrm[2]};
+    double vtn = sqrt(vt[0] * vt[0] + vt[1] * vt[1] + vt[2] * vt[2]);
+    if (!(vtn > 0)) continue;
+    double keep = fmax(0.0, 1.0 - mu * dvn / vtn);
+    for (int k = 0; k < 3; ++k) vi[k] -= (1.0 - keep) * vt[k];
+  }
+}
+
+static double stiffness_bound(const world_solid *s, double t0, double t1) {
+  /* the largest stiffness scale over [t0, t1]: the tracks are piecewise linear, so the
+   * maximum is at an end or at a key inside */
+  double m = fmax(piola_track_eval(&s->stiffness_scale, t0), piola_track_eval(&s->stiffness_scale, t1));
+  for (int32_t k = 0; k < s->stiffness_scale.key_count; ++k)
+    if (s->stiffness_scale.times[k] > t0 && s->stiffness_scale.times[k] < t1)
+      m = fmax(m, s->stiffness_scale.values[k]);
+  return m;
+}
+
+double piola_world_stable_dt(const piola_world *w) {
+  double dt = w->def.max_dt;
+  for (int32_t i = 0; i < w->solid_count; ++i) {
+    const world_solid *s = &w->solids[i];
+    double scale = stiffness_bound(s, w->time, w->time + w->def.max_dt);
+    double speed = piola_elastic_body_max_wave_speed(s->body) * sqrt(scale);
+    double h = piola_elastic_body_min_rest_altitude(s->body);
+    if (speed > 0 && h > 0) dt = fmin(dt, w->def.cfl * h / speed);
+  }
+  return dt;
+}
+
+static void gravity_at(const piola_world *w, double t, double g[3]) {
+  for (int k = 0; k < 3; ++k) g[k] = piola_track_eval(&w->def.gravity[k], t);
+}
+
+static void restore(world_solid *s, double t) {
+  size_t v3 = 3 * (size_t)s->n * sizeof(double);
+  memcpy(s->x, s->x_old, v3);
+  memcpy(s->v, s->v_old, v3);
+  memcpy(s->force, s->force_old, v3);
+  (void)piola__solid_update_forces(s, t);
+}
+
+static piola_status step_solid(piola_world *w, world_solid *s, double t, double dt,
+                               piola_step_stats *stats) {
+  const int32_t n = s->n > 0 ? s->n : 0;
+  const int64_t m = 3 * (int64_t)n;
+  const double h = 0.5 * dt, t1 = t + dt;
+  size_t v3 = (size_t)m * sizeof(double);
+  double g0[3], g1[3];
+  gravity_at(w, t, g0);
+  gravity_at(w, t1, g1);
+  memcpy(s->x_old, s->x, v3);
+  memcpy(s->v_old, s->v, v3);
+  memcpy(s->force_old, s->force, v3);
+
+  /* 1. v~ */
+  for (int32_t i = 0; i < n; ++i)
+    for (int k = 0; k < 3; ++k)
+      s->rhs[3 * i + k] = s->mass[i] * s->v[3 * i + k] + h * (s->force[3 * i + k] + s->mass[i] * g0[k]);
+  if (n > 0) memset(s->colliding, 0, (size_t)n);
+  for (int32_t i = 0; i < n; ++i) {
+    if (s->flags[i] == SOLID_FREE) continue;
+    double xp[3], vp[3];
+    piola__solid_constrained_state(s, i, t1, xp, vp);
+    for (int k = 0; k < 3; ++k) s->v[3 * i + k] = (xp[k] - s->x[3 * i + k]) / dt;
+  }
+  stats->cg_iterations += damping_solve(w, s, h, t, 0, s->rhs, s->v);
+
+  /* 2. x~ */
+  for (int64_t j = 0; j < m; ++j) s->x[j] += dt * s->v[j];
+
+  /* 3. collisions with x~ and v^n */
+  memcpy(s->v, s->v_old, v3);
+  int32_t colliding = 0;
+  if (w->obstacle_count > 0)
+    colliding = piola_obstacles_collide(w->obstacles, w->obstacle_count, t1, dt, n, s->x, s->v,
+                                        s->colliding, s->normals);
+  for (int32_t i = 0; i < n; ++i) {
+    if (s->flags[i] == SOLID_FREE) continue;
+    if (s->colliding[i]) colliding--;
+    s->colliding[i] = 0;
+    piola__solid_constrained_state(s, i, t1, s->x + 3 * i, s->v + 3 * i);
+  }
+  stats->colliding += colliding;
+  /* damping at (x^n, v') while the body still holds the rotations of x^n */
+  double beta0 = piola_track_eval(&s->shear_viscosity, t);
+  double alpha0 = piola_track_eval(&s->bulk_viscosity, t);
+  if (beta0 != 0 || alpha0 != 0)
+    piola_elastic_body_damping_forces(s->body, s->v, beta0, alpha0, s->tmp);
+  else
+    memset(s->tmp, 0, v3);
+  for (int32_t i = 0; i < n; ++i)
+    for (int k = 0; k < 3; ++k)
+      s->rhs[3 * i + k] = s->mass[i] * s->v[3 * i + k] +
+                          h * (s->force_old[3 * i + k] + s->tmp[3 * i + k] + s->mass[i] * g0[k]);
+
+  /* F, diagonalization and elastic force at x^n+1, once per step */
+  piola_status st = piola__solid_update_forces(s, t1);
+  if (st != PIOLA_OK) {
+    restore(s, t);
+    return st;
+  }
+
+  /* 4. trapezoidal velocity, damping at n+1 implicit, normal velocity of contacts held */
+  for (int32_t i = 0; i < n; ++i)
+    for (int k = 0; k < 3; ++k)
+      s->rhs[3 * i + k] += h * (s->force[3 * i + k] + s->mass[i] * g1[k]);
+  stats->cg_iterations += damping_solve(w, s, h, t1, 1, s->rhs, s->v);
+  if (colliding > 0) {
+    /* A v^n+1 for the friction of the held normal impulse (tmp and rhs are free now) */
+    double beta1 = piola_track_eval(&s->shear_viscosity, t1);
+    double alpha1 = piola_track_eval(&s->bulk_viscosity, t1);
+    damping_system d = {s, h, beta1, alpha1, 1, s->tmp};
+    if (beta1 != 0 || alpha1 != 0) {
+      damping_apply(&d, s->v, s->rhs);
+    } else {
+      for (int32_t i = 0; i < n; ++i)
+        for (int k = 0; k < 3; ++k) s->rhs[3 * i + k] = s->mass[i] * s->v[3 * i + k];
+    }
+    contact_friction(w, s, t1, h, g1, s->rhs);
+  }
+  for (int64_t j = 0; j < m; ++j)
+    if (!isfinite(s->v[j])) {
+      restore(s, t);
+      return PIOLA_FAIL(PIOLA_ERROR_NOT_FINITE,
+                        "solid '%s': velocity of vertex %lld became non-finite at t = %g s", s->name,
+                        (long long)(j / 3), t1);
+    }
+  return PIOLA_OK;
+}
+
+piola_status piola_world_step(piola_world *w, double dt_limit, piola_step_stats *stats) {
+  piola_step_stats local = {0, 0, 0, 0};
+  double dt = piola_world_stable_dt(w);
+  if (dt_limit > 0 && dt_limit < dt) dt = dt_limit;
+  if (!(dt > 0)) return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "step: dt must be > 0, got %g", dt);
+  for (int32_t i = 0; i < w->solid_count; ++i) {
+    piola_status st = step_solid(w, &w->solids[i], w->time, dt, &local);
+    if (st != PIOLA_OK) {
+      for (int32_t j = 0; j < i; ++j) restore(&w->solids[j], w->time);
+      if (stats) *stats = local;
+      return st;
+    }
+  }
+  w->time += dt;
+  local.substeps = 1;
+  local.last_dt = dt;
+  if (stats) *stats = local;
+  return PIOLA_OK;
+}
+
+piola_status piola_world_advance_to(piola_world *w, double t_end, piola_step_stats *stats) {
+  if (!isfinite(t_end))
+    return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "advance_to: t_end must be finite");
+  while (w->time < t_end) {
+    double left = t_end - w->time;
+    /* avoid a sliver step after a full one: split the last two evenly */
+    double dt = piola_world_stable_dt(w);
+    double limit = left;
+    if (left > dt && left < 2 * dt) limit = 0.5 * left;
+    piola_step_stats one;
+    piola_status st = piola_world_step(w, limit, &one);
+    if (stats) {
+      stats->substeps += one.substeps;
+      stats->cg_iterations += one.cg_iterations;
+      stats->colliding = one.colliding;
+      if (one.substeps) stats->last_dt = one.last_dt;
+    }
+    if (st != PIOLA_OK) return st;
+    if (one.last_dt == left) w->time = t_end; /* land exactly on the target, no rounding drift */
+  }
+  return PIOLA_OK;
+}

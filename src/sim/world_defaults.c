@@ -1,0 +1,32 @@
+/* Defaults of the world and solid definitions, written once. Kept apart from world.c so
+ * that code that only builds definitions (the scene parser) does not pull in the solver. */
+#include <string.h>
+
+#include "math/mat3.h"
+#include "piola/world.h"
+
+piola_world_def piola_default_world_def(void) {
+  piola_world_def def;
+  memset(&def, 0, sizeof def);
+  def.gravity[0] = piola_track_constant(0);
+  def.gravity[1] = piola_track_constant(0);
+  def.gravity[2] = piola_track_constant(-9.81);
+  def.max_dt = 1e-3;
+  def.cfl = 0.5;
+  def.cg_tolerance = 1e-8;
+  def.cg_max_iterations = 200;
+  return def;
+}
+
+piola_solid_def piola_default_solid_def(void) {
+  piola_solid_def def;
+  memset(&def, 0, sizeof def);
+  def.material = piola_default_material_def();
+  def.stiffness_scale = piola_track_constant(1);
+  def.density = 1000;
+  def.shear_viscosity = piola_track_constant(0);
+  def.bulk_viscosity = piola_track_constant(0);
+  def.initial_matrix = mat3_identity();
+  def.scramble_seed = 1;
+  return def;
+}

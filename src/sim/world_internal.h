@@ -1,0 +1,57 @@
+/* The world's state, shared by world.c (setup, accessors), constraints.c and integrator.c.
+ *
+ * Each solid keeps its hot per-node arrays (positions, velocities, inverse masses, the
+ * elastic force at the current positions) as flat xyz arrays so the step loop and the
+ * conjugate gradient are plain loops over doubles. The elastic force and the diagonalization
+ * inside the body always belong to the current positions: they are computed once per step,
+ * after collisions, and reused by the next step's first solve. */
+#ifndef PIOLA_SIM_WORLD_INTERNAL_H
+#define PIOLA_SIM_WORLD_INTERNAL_H
+
+#include <stdint.h>
+
+#include "piola/world.h"
+
+enum { SOLID_FREE = 0, SOLID_FIXED = 1, SOLID_DRIVEN = 2 };
+
+typedef struct world_solid {
+  char *name;
+  piola_elastic_body *body;
+  int32_t n;                 /* vertex count */
+  double *x, *v;             /* 3n current state */
+  double *mass;              /* n lumped masses, kg */
+  double *inverse_mass;      /* n, 0 for massless (isolated) vertices, which are held fixed */
+  double *force;             /* 3n elastic force at x, N */
+  double *start;             /* 3n positions of constrained nodes at t = 0 */
+  uint8_t *flags;            /* n: SOLID_FREE / FIXED / DRIVEN */
+  int32_t *motion_of;        /* n: index into motions for driven nodes, else -1 */
+  piola_rigid_motion_def *motions;
+  int32_t motion_count;
+  piola_track stiffness_scale, shear_viscosity, bulk_viscosity;
+  piola_elastic_stats elastic;  /* of the last update */
+  /* scratch for the step */
+  double *x_old, *v_old, *force_old, *rhs, *work, *tmp;
+  uint8_t *colliding;
+  double *normals;
+} world_solid;
+
+struct piola_world {
+  piola_world_def def;
+  double time;
+  world_solid *solids;
+  int32_t solid_count, solid_capacity;
+  piola_obstacle **obstacles;
+  int32_t obstacle_count, obstacle_capacity;
+};
+
+/* Marks constrained nodes of s from its constraint defs (rest positions rest, 3n). */
+piola_status piola__solid_apply_constraints(world_solid *s, const double *rest,
+                                            const piola_constraint_def *constraints,
+                                            int32_t count);
+/* Prescribed position (m) and velocity (m/s) of constrained node i at time t. */
+void piola__solid_constrained_state(const world_solid *s, int32_t i, double t, double x[3],
+                                    double v[3]);
+/* Recomputes the elastic force of s at its positions x and time t (stiffness scale). */
+piola_status piola__solid_update_forces(world_solid *s, double t);
+
+#endif

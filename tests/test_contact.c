@@ -504,6 +504,43 @@ static void bad_input_is_reported(void **state) {
   piola_collision_surface_destroy(s);
 }
 
+/* A zone with pinned vertices moves with them when they move rigidly, and reports that it
+ * could not when they do not. */
+static void zones_with_pinned_vertices(void **state) {
+  (void)state;
+  piola_collision_settings set = piola_default_collision_settings();
+  set.repulsion = 0, set.collision_iterations = 0;
+  for (int stretch = 0; stretch < 2; ++stretch) {
+    scene s = {0};
+    int32_t a = add_vertex(&s, -1, -1, 0, 0), b = add_vertex(&s, 2, -1, 0, 0), c = add_vertex(&s, -1, 2, 0, 0);
+    add_triangle(&s, a, b, c);
+    int32_t p = add_vertex(&s, 0.2, 0.3, -0.05, 0);
+    add_triangle(&s, p, add_vertex(&s, 0.2, 0.3, -1.0, 0), add_vertex(&s, 0.3, 0.3, -1.0, 0));
+    s.m[a] = s.m[b] = s.m[c] = INFINITY;
+    /* The pinned triangle sweeps down through the point; with stretch, it also grows. */
+    for (int k = 0; k < 3; ++k) {
+      int32_t i = k == 0 ? a : (k == 1 ? b : c);
+      s.v[3 * i + 2] = -10.0;
+      if (stretch) s.v[3 * i] = 20.0 * s.x[3 * i], s.v[3 * i + 1] = 20.0 * s.x[3 * i + 1];
+    }
+    piola_collision_surface *surface = make_surface(&s, 1, 1e-3, 0.0);
+    piola_collision_stats st;
+    assert_int_equal(piola_collision_surface_process(surface, s.x, s.v, s.m, 0.01, &set, &st), PIOLA_OK);
+    assert_true(st.impact_zones >= 1);
+    assert_int_equal(st.resolved, stretch ? 0 : 1);
+    /* Pinned vertices keep their velocities either way. */
+    assert_true(s.v[3 * a + 2] == -10.0 && s.v[3 * b + 2] == -10.0 && s.v[3 * c + 2] == -10.0);
+    if (!stretch) {
+      /* The point is carried along with the triangle. */
+      assert_close(s.v[3 * p + 2], -10.0, 1e-12);
+      for (int32_t i = 0; i < 3 * s.nv; ++i) s.x[i] += 0.01 * s.v[i];
+      assert_int_equal(count_intersections(&s, s.x, NULL), 0);
+    }
+    piola_collision_surface_destroy(surface);
+    scene_free(&s);
+  }
+}
+
 /* Interior nodes of a solid are in the vertex arrays but in no boundary triangle. */
 static void vertices_in_no_triangle_take_no_part(void **state) {
   (void)state;
@@ -534,6 +571,7 @@ int main(void) {
       cmocka_unit_test(result_does_not_depend_on_thread_count),
       cmocka_unit_test(bad_input_is_reported),
       cmocka_unit_test(vertices_in_no_triangle_take_no_part),
+      cmocka_unit_test(zones_with_pinned_vertices),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
 }

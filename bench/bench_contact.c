@@ -54,15 +54,17 @@ int main(int argc, char **argv) {
   static const int targets[] = {10000, 25000, 50000, 100000, 200000};
   printf("folding cloth, 8 steps measured after 2 warm-up steps, %d threads, median per step\n",
          omp_get_max_threads());
-  printf("| triangles | vertices | wall ms/step | CPU ms/step | CPU ns/triangle | contacts | impacts "
-         "| zone vertices |\n");
+  printf(
+      "| triangles | vertices | wall ms/step | CPU ms/step | CPU ns/triangle | contacts | impacts "
+      "| zone vertices |\n");
   printf("|---|---|---|---|---|---|---|---|\n");
   for (size_t t = 0; t < sizeof targets / sizeof targets[0]; ++t) {
     if (targets[t] > max_triangles) break;
     const int n = (int)lround(sqrt(targets[t] / 2.0)) + 1;
     const int nv = n * n, nt = 2 * (n - 1) * (n - 1);
     int32_t *tris = malloc(sizeof(int32_t) * 3 * (size_t)nt);
-    double *x = malloc(sizeof(double) * 3 * (size_t)nv), *v = malloc(sizeof(double) * 3 * (size_t)nv);
+    double *x = malloc(sizeof(double) * 3 * (size_t)nv),
+           *v = malloc(sizeof(double) * 3 * (size_t)nv);
     double *m = malloc(sizeof(double) * (size_t)nv);
     if (!tris || !x || !v || !m) return 1;
     int k = 0;
@@ -101,7 +103,10 @@ int main(int argc, char **argv) {
       double t0 = now_seconds(), c0 = cpu_seconds();
       if (piola_collision_surface_process(surface, x, v, m, dt, NULL, &st) != PIOLA_OK) return 1;
       double elapsed = now_seconds() - t0, cpu_elapsed = cpu_seconds() - c0;
-      if (getenv("BENCH_TRACE")) fprintf(stderr, "step %d: %.1f ms contacts %lld impacts %lld passes %d zone passes %d\n", step, 1e3 * elapsed, (long long)st.contacts, (long long)st.impacts, st.collision_passes, st.zone_passes);
+      if (getenv("BENCH_TRACE"))
+        fprintf(stderr, "step %d: %.1f ms contacts %lld impacts %lld passes %d zone passes %d\n",
+                step, 1e3 * elapsed, (long long)st.contacts, (long long)st.impacts,
+                st.collision_passes, st.zone_passes);
       for (int i = 0; i < 3 * nv; ++i) x[i] += dt * v[i];
       theta += dtheta;
       if (step >= 2) {

@@ -55,7 +55,8 @@ static void add_triangle(scene *s, int32_t a, int32_t b, int32_t c) {
  * vertex index. */
 typedef void (*grid_position)(int i, int j, double out[3], const void *ctx);
 
-static int32_t add_grid(scene *s, int nx, int ny, grid_position pos, const void *ctx, int32_t body) {
+static int32_t add_grid(scene *s, int nx, int ny, grid_position pos, const void *ctx,
+                        int32_t body) {
   int32_t first = s->nv;
   for (int j = 0; j < ny; ++j)
     for (int i = 0; i < nx; ++i) {
@@ -66,8 +67,10 @@ static int32_t add_grid(scene *s, int nx, int ny, grid_position pos, const void 
   for (int j = 0; j + 1 < ny; ++j)
     for (int i = 0; i + 1 < nx; ++i) {
       int32_t a = first + j * nx + i, b = a + 1, c = a + nx, d = c + 1;
-      if ((i + j) % 2) add_triangle(s, a, b, d), add_triangle(s, a, d, c);
-      else add_triangle(s, a, b, c), add_triangle(s, b, d, c);
+      if ((i + j) % 2)
+        add_triangle(s, a, b, d), add_triangle(s, a, d, c);
+      else
+        add_triangle(s, a, b, c), add_triangle(s, b, d, c);
     }
   return first;
 }
@@ -85,7 +88,8 @@ static void flat_position(int i, int j, double out[3], const void *ctx) {
  * (both degenerate) are counted in *undecided. */
 static long count_intersections(const scene *s, const double *x, long *undecided) {
   const int32_t nt = s->nt;
-  double *lo = malloc(sizeof(double) * 3 * (size_t)nt), *hi = malloc(sizeof(double) * 3 * (size_t)nt);
+  double *lo = malloc(sizeof(double) * 3 * (size_t)nt),
+         *hi = malloc(sizeof(double) * 3 * (size_t)nt);
   assert_non_null(lo), assert_non_null(hi);
   for (int32_t t = 0; t < nt; ++t)
     for (int k = 0; k < 3; ++k) {
@@ -97,7 +101,8 @@ static long count_intersections(const scene *s, const double *x, long *undecided
   for (int32_t a = 0; a < nt; ++a)
     for (int32_t b = a + 1; b < nt; ++b) {
       int apart = 0;
-      for (int k = 0; k < 3; ++k) apart |= hi[3 * a + k] < lo[3 * b + k] || hi[3 * b + k] < lo[3 * a + k];
+      for (int k = 0; k < 3; ++k)
+        apart |= hi[3 * a + k] < lo[3 * b + k] || hi[3 * b + k] < lo[3 * a + k];
       if (apart) continue;
       const int32_t *ta = s->tris + 3 * a, *tb = s->tris + 3 * b;
       int shared = 0;
@@ -157,9 +162,10 @@ static run_totals run_scene(scene *s, piola_collision_surface *surface, int step
     if (bad) fail_msg("step %d: %ld intersecting triangle pairs", step, bad);
     assert_int_equal(undecided, 0);
     if (getenv("PIOLA_CONTACT_TRACE"))
-      print_message("step %d: contacts %lld impacts %lld passes %d zones %d (%d vertices) zone passes %d\n",
-                    step, (long long)st.contacts, (long long)st.impacts, st.collision_passes,
-                    st.impact_zones, st.zone_vertices, st.zone_passes);
+      print_message(
+          "step %d: contacts %lld impacts %lld passes %d zones %d (%d vertices) zone passes %d\n",
+          step, (long long)st.contacts, (long long)st.impacts, st.collision_passes, st.impact_zones,
+          st.zone_vertices, st.zone_passes);
     totals.contacts += st.contacts, totals.impacts += st.impacts, totals.zones += st.impact_zones;
     totals.steps_with_zones += st.impact_zones > 0;
   }
@@ -238,7 +244,8 @@ static void cloth_pushed_through_itself(void **state) {
   fold_ctx ctx = {24, 0.01, 0.01};
   add_grid(&s, ctx.nx, 12, fold_position, &ctx, 0);
   piola_collision_surface *surface = make_surface(&s, 1, 0.001, 0.0);
-  run_totals t = run_scene(&s, surface, (int)test_samples(8, 3), 0.02, fold_velocity, &ctx, 5, NULL);
+  run_totals t =
+      run_scene(&s, surface, (int)test_samples(8, 3), 0.02, fold_velocity, &ctx, 5, NULL);
   assert_true(t.impacts > 0);
   piola_collision_surface_destroy(surface);
   scene_free(&s);
@@ -251,7 +258,8 @@ static void crumple_velocity(scene *s, int step, test_rng *rng, const void *ctx)
   /* A few random plane waves with wavelengths of a few cells. */
   double k[4][3], amp[4][3], phase[4];
   for (int w = 0; w < 4; ++w) {
-    for (int c = 0; c < 3; ++c) k[w][c] = test_rng_uniform(rng, -150, 150), amp[w][c] = test_rng_uniform(rng, -0.4, 0.4);
+    for (int c = 0; c < 3; ++c)
+      k[w][c] = test_rng_uniform(rng, -150, 150), amp[w][c] = test_rng_uniform(rng, -0.4, 0.4);
     phase[w] = test_rng_uniform(rng, 0, 6.283185307179586);
   }
   for (int32_t i = 0; i < s->nv; ++i) {
@@ -273,7 +281,8 @@ static void crumpled_sheet(void **state) {
   flat_sheet sheet = {0.01, 0, 0, 0};
   add_grid(&s, 21, 21, flat_position, &sheet, 0);
   piola_collision_surface *surface = make_surface(&s, 1, 0.001, 0.3);
-  run_totals t = run_scene(&s, surface, (int)test_samples(20, 4), 0.02, crumple_velocity, NULL, 9, NULL);
+  run_totals t =
+      run_scene(&s, surface, (int)test_samples(20, 4), 0.02, crumple_velocity, NULL, 9, NULL);
   assert_true(t.impacts + t.contacts > 0);
   piola_collision_surface_destroy(surface);
   scene_free(&s);
@@ -351,7 +360,8 @@ static void impact_zones_conserve_momentum(void **state) {
     for (int32_t i = 0; i < s.nv; ++i)
       for (int32_t j = i + 1; j < s.nv; ++j) {
         if (!surface->in_zone[i] || !surface->in_zone[j]) continue;
-        if (piola__zone_root(surface->zone_parent, i) != piola__zone_root(surface->zone_parent, j)) continue;
+        if (piola__zone_root(surface->zone_parent, i) != piola__zone_root(surface->zone_parent, j))
+          continue;
         double dot = 0.0;
         for (int k = 0; k < 3; ++k)
           dot += (s.x[3 * i + k] - s.x[3 * j + k]) * (s.v[3 * i + k] - s.v[3 * j + k]);
@@ -377,7 +387,8 @@ static void processing_conserves_linear_momentum(void **state) {
   double lin0[3], ang0[3], lin1[3], ang1[3];
   momenta(&s, s.v, lin0, ang0);
   piola_collision_stats st;
-  assert_int_equal(piola_collision_surface_process(surface, s.x, s.v, s.m, 0.02, NULL, &st), PIOLA_OK);
+  assert_int_equal(piola_collision_surface_process(surface, s.x, s.v, s.m, 0.02, NULL, &st),
+                   PIOLA_OK);
   assert_true(st.contacts + st.impacts > 0);
   momenta(&s, s.v, lin1, ang1);
   for (int k = 0; k < 3; ++k) assert_close(lin1[k], lin0[k], 1e-14);
@@ -390,7 +401,8 @@ static void processing_conserves_linear_momentum(void **state) {
 static void repulsion_friction_reduces_tangential_velocity(void **state) {
   (void)state;
   scene s = {0};
-  int32_t a = add_vertex(&s, -1, -1, 0, 0), b = add_vertex(&s, 2, -1, 0, 0), c = add_vertex(&s, -1, 2, 0, 0);
+  int32_t a = add_vertex(&s, -1, -1, 0, 0), b = add_vertex(&s, 2, -1, 0, 0),
+          c = add_vertex(&s, -1, 2, 0, 0);
   add_triangle(&s, a, b, c);
   int32_t p = add_vertex(&s, 0.2, 0.3, 0.0004, 0);
   add_triangle(&s, p, add_vertex(&s, 0.2, 0.3, 0.5, 0), add_vertex(&s, 0.3, 0.3, 0.5, 0));
@@ -401,7 +413,8 @@ static void repulsion_friction_reduces_tangential_velocity(void **state) {
   s.v[3 * 3] = 0.3;
   piola_collision_surface *surface = make_surface(&s, 1, h, mu);
   piola_collision_stats st;
-  assert_int_equal(piola_collision_surface_process(surface, s.x, s.v, s.m, dt, NULL, &st), PIOLA_OK);
+  assert_int_equal(piola_collision_surface_process(surface, s.x, s.v, s.m, dt, NULL, &st),
+                   PIOLA_OK);
   assert_true(st.contacts >= 1);
   /* Normal: the approach is stopped and replaced by 0.1 d / dt with d = h - 0.0004. */
   double dn = 0.1 * (h - 0.0004) / dt - vn;
@@ -415,7 +428,8 @@ static void repulsion_friction_reduces_tangential_velocity(void **state) {
   piola_collision_surface_destroy(surface);
   for (int i = 3; i < 6; ++i) s.v[3 * i + 2] = vn, s.v[3 * i] = 0.3, s.v[3 * i + 1] = 0.0;
   surface = make_surface(&s, 1, h, 100.0);
-  assert_int_equal(piola_collision_surface_process(surface, s.x, s.v, s.m, dt, NULL, &st), PIOLA_OK);
+  assert_int_equal(piola_collision_surface_process(surface, s.x, s.v, s.m, dt, NULL, &st),
+                   PIOLA_OK);
   assert_close(s.v[3 * p], 0.0, 1e-12);
   piola_collision_surface_destroy(surface);
   scene_free(&s);
@@ -437,7 +451,8 @@ static void pinned_sheet_is_not_moved(void **state) {
     sheets_velocity(&s, step, &rng, &ctx);
     for (int32_t i = 0; i < 3 * split; ++i) s.v[i] = 0.0;
     piola_collision_stats st;
-    assert_int_equal(piola_collision_surface_process(surface, s.x, s.v, s.m, 0.02, NULL, &st), PIOLA_OK);
+    assert_int_equal(piola_collision_surface_process(surface, s.x, s.v, s.m, 0.02, NULL, &st),
+                     PIOLA_OK);
     assert_int_equal(st.resolved, 1);
     for (int32_t i = 0; i < 3 * split; ++i) assert_true(s.v[i] == 0.0);
     for (int32_t i = 0; i < 3 * s.nv; ++i) s.x[i] += 0.02 * s.v[i];
@@ -478,7 +493,8 @@ static void bad_input_is_reported(void **state) {
   int32_t tri[3] = {0, 1, 5};
   piola_collision_body_def body = piola_default_collision_body_def();
   piola_collision_surface_def def = piola_default_collision_surface_def();
-  def.vertex_count = 3, def.triangle_count = 1, def.triangles = tri, def.body_count = 1, def.bodies = &body;
+  def.vertex_count = 3, def.triangle_count = 1, def.triangles = tri, def.body_count = 1,
+  def.bodies = &body;
   piola_collision_surface *s = NULL;
   assert_int_equal(piola_collision_surface_create(&def, &s), PIOLA_ERROR_INVALID_ARGUMENT);
   assert_null(s);
@@ -491,11 +507,14 @@ static void bad_input_is_reported(void **state) {
   assert_int_equal(piola_collision_surface_create(&def, &s), PIOLA_OK);
   assert_int_equal(piola_collision_surface_edge_count(s), 3);
   double x[9] = {0, 0, 0, 1, 0, 0, 0, 1, 0}, v[9] = {0}, m[3] = {1, 1, 1};
-  assert_int_equal(piola_collision_surface_process(s, x, v, m, 0.0, NULL, NULL), PIOLA_ERROR_INVALID_ARGUMENT);
+  assert_int_equal(piola_collision_surface_process(s, x, v, m, 0.0, NULL, NULL),
+                   PIOLA_ERROR_INVALID_ARGUMENT);
   v[4] = NAN;
-  assert_int_equal(piola_collision_surface_process(s, x, v, m, 0.01, NULL, NULL), PIOLA_ERROR_NOT_FINITE);
+  assert_int_equal(piola_collision_surface_process(s, x, v, m, 0.01, NULL, NULL),
+                   PIOLA_ERROR_NOT_FINITE);
   v[4] = 0.0, m[1] = -1.0;
-  assert_int_equal(piola_collision_surface_process(s, x, v, m, 0.01, NULL, NULL), PIOLA_ERROR_INVALID_ARGUMENT);
+  assert_int_equal(piola_collision_surface_process(s, x, v, m, 0.01, NULL, NULL),
+                   PIOLA_ERROR_INVALID_ARGUMENT);
   m[1] = 1.0;
   piola_collision_stats st;
   assert_int_equal(piola_collision_surface_process(s, x, v, m, 0.01, NULL, &st), PIOLA_OK);
@@ -512,7 +531,8 @@ static void zones_with_pinned_vertices(void **state) {
   set.repulsion = 0, set.collision_iterations = 0;
   for (int stretch = 0; stretch < 2; ++stretch) {
     scene s = {0};
-    int32_t a = add_vertex(&s, -1, -1, 0, 0), b = add_vertex(&s, 2, -1, 0, 0), c = add_vertex(&s, -1, 2, 0, 0);
+    int32_t a = add_vertex(&s, -1, -1, 0, 0), b = add_vertex(&s, 2, -1, 0, 0),
+            c = add_vertex(&s, -1, 2, 0, 0);
     add_triangle(&s, a, b, c);
     int32_t p = add_vertex(&s, 0.2, 0.3, -0.05, 0);
     add_triangle(&s, p, add_vertex(&s, 0.2, 0.3, -1.0, 0), add_vertex(&s, 0.3, 0.3, -1.0, 0));
@@ -525,7 +545,8 @@ static void zones_with_pinned_vertices(void **state) {
     }
     piola_collision_surface *surface = make_surface(&s, 1, 1e-3, 0.0);
     piola_collision_stats st;
-    assert_int_equal(piola_collision_surface_process(surface, s.x, s.v, s.m, 0.01, &set, &st), PIOLA_OK);
+    assert_int_equal(piola_collision_surface_process(surface, s.x, s.v, s.m, 0.01, &set, &st),
+                     PIOLA_OK);
     assert_true(st.impact_zones >= 1);
     assert_int_equal(st.resolved, stretch ? 0 : 1);
     /* Pinned vertices keep their velocities either way. */
@@ -545,13 +566,15 @@ static void zones_with_pinned_vertices(void **state) {
 static void vertices_in_no_triangle_take_no_part(void **state) {
   (void)state;
   scene s = {0};
-  int32_t a = add_vertex(&s, 0, 0, 0, 0), b = add_vertex(&s, 1, 0, 0, 0), c = add_vertex(&s, 0, 1, 0, 0);
+  int32_t a = add_vertex(&s, 0, 0, 0, 0), b = add_vertex(&s, 1, 0, 0, 0),
+          c = add_vertex(&s, 0, 1, 0, 0);
   add_triangle(&s, a, b, c);
   int32_t inner = add_vertex(&s, 0.2, 0.2, 1e-4, 0);
   s.v[3 * inner + 2] = -1.0;
   piola_collision_surface *surface = make_surface(&s, 1, 1e-3, 0.3);
   piola_collision_stats st;
-  assert_int_equal(piola_collision_surface_process(surface, s.x, s.v, s.m, 0.01, NULL, &st), PIOLA_OK);
+  assert_int_equal(piola_collision_surface_process(surface, s.x, s.v, s.m, 0.01, NULL, &st),
+                   PIOLA_OK);
   assert_int_equal(st.contacts + st.impacts + st.impact_zones, 0);
   assert_true(s.v[3 * inner + 2] == -1.0);
   piola_collision_surface_destroy(surface);

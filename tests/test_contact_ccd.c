@@ -208,8 +208,10 @@ static void random_point_triangle_crossings(void **state) {
       if ((flo < 0) == (fhi < 0)) continue;
       for (int b = 0; b < 80; ++b) {
         double mid = 0.5 * (lo + hi), fm = coplanarity(x, d, mid);
-        if ((fm < 0) == (flo < 0)) lo = mid, flo = fm;
-        else hi = mid;
+        if ((fm < 0) == (flo < 0))
+          lo = mid, flo = fm;
+        else
+          hi = mid;
       }
       double s = 0.5 * (lo + hi), bary[3];
       vec3 p[4];
@@ -263,14 +265,17 @@ static void random_edge_edge_crossings(void **state) {
         p[k] = vec3_add(x[k], vec3_scale(d[k], lo));
         q[k] = vec3_add(x[k], vec3_scale(d[k], hi));
       }
-      double flo = vec3_dot(vec3_cross(vec3_sub(p[1], p[0]), vec3_sub(p[3], p[2])), vec3_sub(p[2], p[0]));
-      double fhi = vec3_dot(vec3_cross(vec3_sub(q[1], q[0]), vec3_sub(q[3], q[2])), vec3_sub(q[2], q[0]));
+      double flo =
+          vec3_dot(vec3_cross(vec3_sub(p[1], p[0]), vec3_sub(p[3], p[2])), vec3_sub(p[2], p[0]));
+      double fhi =
+          vec3_dot(vec3_cross(vec3_sub(q[1], q[0]), vec3_sub(q[3], q[2])), vec3_sub(q[2], q[0]));
       if ((flo < 0) == (fhi < 0)) continue;
       double dist = piola__segment_segment_closest(q[0], q[1], q[2], q[3], &sa, &sb);
       /* Crossing with both closest points well inside their edges, and not near-parallel. */
       vec3 cr = vec3_cross(vec3_sub(q[1], q[0]), vec3_sub(q[3], q[2]));
       if (sa > 0.02 && sa < 0.98 && sb > 0.02 && sb < 0.98 &&
-          vec3_norm(cr) > 0.05 * vec3_norm(vec3_sub(q[1], q[0])) * vec3_norm(vec3_sub(q[3], q[2])) &&
+          vec3_norm(cr) >
+              0.05 * vec3_norm(vec3_sub(q[1], q[0])) * vec3_norm(vec3_sub(q[3], q[2])) &&
           sqrt(dist) < 1e-2) {
         ++crossings;
         assert_int_equal(found, 1);

@@ -94,10 +94,12 @@ static void random_pairs_agree_with_plane_separation(void **state) {
   for (long it = 0; it < n; ++it) {
     double p[3][3], q[3][3];
     for (int i = 0; i < 3; ++i)
-      for (int k = 0; k < 3; ++k) p[i][k] = test_rng_uniform(&rng, -1, 1), q[i][k] = test_rng_uniform(&rng, -1, 1);
+      for (int k = 0; k < 3; ++k)
+        p[i][k] = test_rng_uniform(&rng, -1, 1), q[i][k] = test_rng_uniform(&rng, -1, 1);
     double u[3], v[3];
     for (int k = 0; k < 3; ++k) u[k] = p[1][k] - p[0][k], v[k] = p[2][k] - p[0][k];
-    double nrm[3] = {u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2], u[0] * v[1] - u[1] * v[0]};
+    double nrm[3] = {u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2],
+                     u[0] * v[1] - u[1] * v[0]};
     double dist[3];
     for (int i = 0; i < 3; ++i) {
       dist[i] = 0;

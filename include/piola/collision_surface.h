@@ -45,39 +45,39 @@ PIOLA_API piola_collision_body_def piola_default_collision_body_def(void);
 typedef struct piola_collision_surface_def {
   int32_t vertex_count;
   int32_t triangle_count;
-  const int32_t *triangles;    /* 3 * triangle_count vertex indices, copied */
-  int32_t body_count;          /* >= 1 */
+  const int32_t *triangles;               /* 3 * triangle_count vertex indices, copied */
+  int32_t body_count;                     /* >= 1 */
   const piola_collision_body_def *bodies; /* body_count entries, copied */
-  const int32_t *vertex_body;  /* vertex_count body indices, copied; NULL: all in body 0 */
+  const int32_t *vertex_body; /* vertex_count body indices, copied; NULL: all in body 0 */
 } piola_collision_surface_def;
 
 PIOLA_API piola_collision_surface_def piola_default_collision_surface_def(void);
 
 /* Tunable parts of processing. All have defaults; none needs changing for correctness. */
 typedef struct piola_collision_settings {
-  int repulsion;                 /* 1: stage 1 runs; 0: it is skipped. Default 1 */
-  double repulsion_stiffness;    /* N/m: spring constant k that limits the repulsion impulse to
-                                    dt k d (d the overlap with the thickness); INFINITY: the
-                                    impulse only brings the approach speed to 0.1 d / dt as in
-                                    BFA02. Default INFINITY */
-  int collision_iterations;      /* stage 2 passes before rigid impact zones, >= 0. Default 5 */
-  int max_zone_iterations;       /* stage 3 passes, >= 1; each merges or grows zones, and
-                                    when they run out stats.resolved is 0. Default 200 */
+  int repulsion;              /* 1: stage 1 runs; 0: it is skipped. Default 1 */
+  double repulsion_stiffness; /* N/m: spring constant k that limits the repulsion impulse to
+                                 dt k d (d the overlap with the thickness); INFINITY: the
+                                 impulse only brings the approach speed to 0.1 d / dt as in
+                                 BFA02. Default INFINITY */
+  int collision_iterations;   /* stage 2 passes before rigid impact zones, >= 0. Default 5 */
+  int max_zone_iterations;    /* stage 3 passes, >= 1; each merges or grows zones, and
+                                 when they run out stats.resolved is 0. Default 200 */
 } piola_collision_settings;
 
 PIOLA_API piola_collision_settings piola_default_collision_settings(void);
 
 /* What one call did. */
 typedef struct piola_collision_stats {
-  int64_t contacts;      /* stage 1 pairs within the thickness that got an impulse */
-  int64_t impacts;       /* stage 2 collisions resolved by impulses (summed over passes) */
-  int32_t impact_zones;  /* stage 3 zones at the end (0 when stage 2 sufficed) */
-  int32_t zone_vertices; /* vertices moved rigidly in those zones */
+  int64_t contacts;         /* stage 1 pairs within the thickness that got an impulse */
+  int64_t impacts;          /* stage 2 collisions resolved by impulses (summed over passes) */
+  int32_t impact_zones;     /* stage 3 zones at the end (0 when stage 2 sufficed) */
+  int32_t zone_vertices;    /* vertices moved rigidly in those zones */
   int32_t collision_passes; /* stage 2 passes run */
-  int32_t zone_passes;   /* stage 3 passes run */
-  int32_t resolved;      /* 1 when the final check found no collision; 0 when the zone
-                            passes ran out, or a zone holds pinned vertices that do not move
-                            rigidly together (so the zone cannot follow them all) */
+  int32_t zone_passes;      /* stage 3 passes run */
+  int32_t resolved;         /* 1 when the final check found no collision; 0 when the zone
+                               passes ran out, or a zone holds pinned vertices that do not move
+                               rigidly together (so the zone cannot follow them all) */
 } piola_collision_stats;
 
 typedef struct piola_collision_surface piola_collision_surface;

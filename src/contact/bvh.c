@@ -43,9 +43,12 @@ static void select_kth(int32_t *order, int32_t lo, int32_t hi, int32_t k, const 
         ++i;
       }
     }
-    if (k < lt) hi = lt;
-    else if (k >= gt) lo = gt;
-    else return;
+    if (k < lt)
+      hi = lt;
+    else if (k >= gt)
+      lo = gt;
+    else
+      return;
   }
 }
 
@@ -106,7 +109,8 @@ void piola__bvh_refit(piola__bvh *bvh, const piola__box *boxes) {
   for (int32_t i = 0; i < count; ++i) {
     if (nodes[i].count == 0) continue;
     piola__box b = boxes[bvh->order[nodes[i].first]];
-    for (int32_t j = 1; j < nodes[i].count; ++j) box_union(&b, &boxes[bvh->order[nodes[i].first + j]]);
+    for (int32_t j = 1; j < nodes[i].count; ++j)
+      box_union(&b, &boxes[bvh->order[nodes[i].first + j]]);
     nodes[i].box = b;
   }
   for (int32_t i = count - 1; i >= 0; --i) {

@@ -86,8 +86,10 @@ int piola__coplanarity_times(const vec3 u[3], const vec3 du[3], double times[8])
         lo = hi = mid;
         break;
       }
-      if ((fm < 0.0) == (flo < 0.0)) lo = mid, flo = fm;
-      else hi = mid;
+      if ((fm < 0.0) == (flo < 0.0))
+        lo = mid, flo = fm;
+      else
+        hi = mid;
     }
     times[n++] = 0.5 * (lo + hi);
   }

@@ -152,7 +152,8 @@ piola_status piola_collision_surface_create(const piola_collision_surface_def *d
   if (nt > 0) memcpy(s->triangles, def->triangles, sizeof(int32_t) * 3 * (size_t)nt);
   /* Vertices in no triangle (e.g. interior nodes of a solid) take no part. */
   for (int32_t i = 0; i < 3 * nt; ++i) s->on_surface[s->triangles[i]] = 1;
-  if (def->vertex_body && nv > 0) memcpy(s->vertex_body, def->vertex_body, sizeof(int32_t) * (size_t)nv);
+  if (def->vertex_body && nv > 0)
+    memcpy(s->vertex_body, def->vertex_body, sizeof(int32_t) * (size_t)nv);
   memcpy(s->bodies, def->bodies, sizeof(*s->bodies) * (size_t)def->body_count);
   for (int32_t i = 0; i < nv; ++i) s->vertex_thickness[i] = s->bodies[s->vertex_body[i]].thickness;
 
@@ -215,8 +216,8 @@ static void box_union_of(piola__box *out, const piola__box *a, const piola__box 
 /* Vertex, triangle and edge boxes: at x0 padded by half the thickness (proximity), or swept
  * over the step padded by the detection tolerance (continuous detection); two primitives
  * within their pair's thickness (or tolerance) then always have overlapping boxes. */
-static void compute_boxes(piola_collision_surface *s, const double *x0, const double *v,
-                          double dt, detect_mode mode) {
+static void compute_boxes(piola_collision_surface *s, const double *x0, const double *v, double dt,
+                          detect_mode mode) {
 #pragma omp parallel if (s->vertex_count + s->edge_count >= 4096)
   {
 #pragma omp for schedule(static)
@@ -248,7 +249,8 @@ static double pair_thickness(const piola_collision_surface *s, const int32_t v[4
 }
 
 static double pair_friction(const piola_collision_surface *s, const int32_t v[4]) {
-  return 0.5 * (s->bodies[s->vertex_body[v[0]]].friction + s->bodies[s->vertex_body[v[3]]].friction);
+  return 0.5 *
+         (s->bodies[s->vertex_body[v[0]]].friction + s->bodies[s->vertex_body[v[3]]].friction);
 }
 
 static int all_pinned(const piola_collision_surface *s, const int32_t v[4]) {
@@ -330,9 +332,9 @@ static int narrow_phase(const piola_collision_surface *s, const double *x0, cons
 
 /* Narrow phase of vertex p against triangle t, and of edges a and b; push on a hit. Return 0,
  * or -1 out of memory. */
-static int emit_vertex_triangle(const piola_collision_surface *s, const double *x0,
-                                const double *v, double dt, detect_mode mode, int32_t p,
-                                int32_t t, piola__contact_list *list) {
+static int emit_vertex_triangle(const piola_collision_surface *s, const double *x0, const double *v,
+                                double dt, detect_mode mode, int32_t p, int32_t t,
+                                piola__contact_list *list) {
   const int32_t *tri = s->triangles + 3 * t;
   if (!s->on_surface[p] || tri[0] == p || tri[1] == p || tri[2] == p) return 0;
   piola__contact c = {.v = {p, tri[0], tri[1], tri[2]}};
@@ -430,9 +432,9 @@ static node_pair *make_tasks(const piola__bvh *ta, const piola__bvh *tb, int sam
 }
 
 /* Runs one task to the end with an explicit stack. Returns 0, or -1 out of memory. */
-static int run_task(const piola_collision_surface *s, const double *x0, const double *v,
-                    double dt, detect_mode mode, const piola__bvh *ta, const piola__bvh *tb,
-                    int same_tree, node_pair task, piola__contact_list *list) {
+static int run_task(const piola_collision_surface *s, const double *x0, const double *v, double dt,
+                    detect_mode mode, const piola__bvh *ta, const piola__bvh *tb, int same_tree,
+                    node_pair task, piola__contact_list *list) {
   node_pair stack[256];
   int top = 0;
   stack[top++] = task;
@@ -478,13 +480,17 @@ static int detect_all(piola_collision_surface *s, const double *x0, const double
   piola__contact_list *lists = failed ? NULL : calloc((size_t)total + 1, sizeof(*lists));
   if (!failed && !lists) failed = 1;
   if (!failed) {
-#pragma omp parallel for schedule(dynamic, 1) reduction(| : failed) if (total >= 64 && s->triangle_count >= 2048)
+#pragma omp parallel for schedule(dynamic, 1) \
+    reduction(|                               \
+              : failed) if (total >= 64 && s->triangle_count >= 2048)
     for (int32_t i = 0; i < total; ++i) {
       if (failed) continue;
       if (i < nvt)
-        failed |= run_task(s, x0, v, dt, mode, &s->vertex_tree, &s->triangle_tree, 0, vt[i], &lists[i]) != 0;
+        failed |= run_task(s, x0, v, dt, mode, &s->vertex_tree, &s->triangle_tree, 0, vt[i],
+                           &lists[i]) != 0;
       else
-        failed |= run_task(s, x0, v, dt, mode, &s->edge_tree, &s->edge_tree, 1, ee[i - nvt], &lists[i]) != 0;
+        failed |= run_task(s, x0, v, dt, mode, &s->edge_tree, &s->edge_tree, 1, ee[i - nvt],
+                           &lists[i]) != 0;
     }
   }
   s->found.count = 0;
@@ -634,8 +640,8 @@ static int detect(piola_collision_surface *s, const double *x0, const double *v,
 
 /* Changes the pair's relative velocity by dn along the normal plus Coulomb friction, which
  * takes mu dn off the tangential relative velocity but never reverses it. */
-static void apply_relative_change(piola_collision_surface *s, const piola__contact *c,
-                                  double *v, double dn, double denom) {
+static void apply_relative_change(piola_collision_surface *s, const piola__contact *c, double *v,
+                                  double dn, double denom) {
   vec3 rel = {0, 0, 0};
   for (int k = 0; k < 4; ++k) rel = vec3_add(rel, vec3_scale(vec3_load(v + 3 * c->v[k]), c->w[k]));
   vec3 tangential = vec3_sub(rel, vec3_scale(c->normal, vec3_dot(rel, c->normal)));
@@ -691,8 +697,7 @@ static int apply_repulsion(piola_collision_surface *s, const piola__contact *c, 
 /* Impact of a pair found by continuous detection: the smallest change of normal velocity
  * that ends the step with the pair's contact points a small gap apart along the normal
  * (no bounce), with friction. Returns 1 when it acted. */
-static int apply_impact(piola_collision_surface *s, const piola__contact *c, double *v,
-                        double dt) {
+static int apply_impact(piola_collision_surface *s, const piola__contact *c, double *v, double dt) {
   double denom = weight_denominator(s, c);
   if (!(denom > 0.0)) return 0;
   double vn = normal_velocity(c, v);
@@ -721,8 +726,8 @@ piola_status piola_collision_surface_process(piola_collision_surface *s, const d
                       "collision processing: surface, x0, v and mass must not be NULL");
   piola_collision_settings set = settings ? *settings : piola_default_collision_settings();
   if (!(dt > 0.0) || !isfinite(dt))
-    return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "collision processing: dt must be > 0 s, got %g",
-                      dt);
+    return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT,
+                      "collision processing: dt must be > 0 s, got %g", dt);
   if (set.collision_iterations < 0 || set.max_zone_iterations < 1 ||
       !(set.repulsion_stiffness > 0.0))
     return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT,
@@ -737,8 +742,8 @@ piola_status piola_collision_surface_process(piola_collision_surface *s, const d
                           i);
     if (!(mass[i] > 0.0))
       return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT,
-                        "collision processing: vertex %d mass must be > 0 kg or INFINITY, got %g", i,
-                        mass[i]);
+                        "collision processing: vertex %d mass must be > 0 kg or INFINITY, got %g",
+                        i, mass[i]);
     s->inverse_mass[i] = isinf(mass[i]) ? 0.0 : 1.0 / mass[i];
   }
   piola_collision_stats st = {0};
@@ -767,8 +772,10 @@ piola_status piola_collision_surface_process(piola_collision_surface *s, const d
     memset(s->dirty, 0, (size_t)s->vertex_count);
     for (int64_t i = 0; i < s->found.count; ++i) {
       const piola__contact *c = &s->found.items[i];
-      if (apply_impact(s, c, v, dt)) ++st.impacts;
-      else for (int k = 0; k < 4; ++k) s->dirty[c->v[k]] = 1;
+      if (apply_impact(s, c, v, dt))
+        ++st.impacts;
+      else
+        for (int k = 0; k < 4; ++k) s->dirty[c->v[k]] = 1;
     }
   }
 

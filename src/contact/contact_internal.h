@@ -33,12 +33,12 @@
 
 /* One pair and what is needed to push it apart. */
 typedef struct piola__contact {
-  int32_t v[4];    /* vertices: point then triangle, or edge then edge */
-  double w[4];     /* relative position r = sum w[k] x[k] */
-  vec3 normal;     /* unit; r has a non-negative component along it at the start */
-  double gap;      /* m: r . normal at the start of the step */
+  int32_t v[4];     /* vertices: point then triangle, or edge then edge */
+  double w[4];      /* relative position r = sum w[k] x[k] */
+  vec3 normal;      /* unit; r has a non-negative component along it at the start */
+  double gap;       /* m: r . normal at the start of the step */
   double thickness; /* m: of the pair */
-  double friction; /* Coulomb coefficient of the pair */
+  double friction;  /* Coulomb coefficient of the pair */
 } piola__contact;
 
 typedef struct piola__contact_list {
@@ -50,8 +50,8 @@ int piola__contact_list_push(piola__contact_list *list, const piola__contact *c)
 
 struct piola_collision_surface {
   int32_t vertex_count, triangle_count, edge_count, body_count;
-  int32_t *triangles;       /* 3 per triangle */
-  int32_t *edges;           /* 2 per edge, lower index first, sorted */
+  int32_t *triangles; /* 3 per triangle */
+  int32_t *edges;     /* 2 per edge, lower index first, sorted */
   int32_t *vertex_body;
   piola_collision_body_def *bodies;
   /* Workspace, sized at creation and reused by every call. */
@@ -59,17 +59,17 @@ struct piola_collision_surface {
   double *vertex_thickness;
   piola__box *vertex_boxes, *triangle_boxes, *edge_boxes;
   piola__bvh triangle_tree, edge_tree, vertex_tree;
-  int32_t *queries;         /* query primitives of a detection pass */
-  int32_t block_count;      /* capacity of blocks */
+  int32_t *queries;    /* query primitives of a detection pass */
+  int32_t block_count; /* capacity of blocks */
   piola__contact_list *blocks;
   piola__contact_list found;
   int32_t *zone_parent;
   uint8_t *in_zone;
-  uint8_t *dirty;           /* velocity changed since the last detection pass */
-  uint8_t *on_surface;      /* vertex of at least one triangle */
-  int32_t zone_misfit;      /* a zone could not follow its pinned vertices (this call) */
-  int32_t tree_age;         /* calls since the trees were last built (0: never built) */
-  int32_t *zone_order;      /* vertices grouped by zone */
+  uint8_t *dirty;      /* velocity changed since the last detection pass */
+  uint8_t *on_surface; /* vertex of at least one triangle */
+  int32_t zone_misfit; /* a zone could not follow its pinned vertices (this call) */
+  int32_t tree_age;    /* calls since the trees were last built (0: never built) */
+  int32_t *zone_order; /* vertices grouped by zone */
 };
 
 /* Velocity field of rigid impact zones: merges the vertices of every contact in `hits` into

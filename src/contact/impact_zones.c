@@ -16,8 +16,10 @@ int32_t piola__zone_root(int32_t *parent, int32_t i) {
 static void zone_union(int32_t *parent, int32_t a, int32_t b) {
   a = piola__zone_root(parent, a), b = piola__zone_root(parent, b);
   if (a == b) return;
-  if (a < b) parent[b] = a;
-  else parent[a] = b;
+  if (a < b)
+    parent[b] = a;
+  else
+    parent[a] = b;
 }
 
 /* Solves m w = b for the symmetric positive semi-definite inertia-like matrix m; when it is
@@ -101,7 +103,8 @@ int32_t piola__impact_zones_apply(piola_collision_surface *s, const piola__conta
       if (pinned ? im != 0.0 : im == 0.0) continue;
       double m = pinned ? 1.0 : 1.0 / im;
       vec3 r = vec3_sub(vec3_load(x0 + 3 * i), centre);
-      angular = vec3_add(angular, vec3_scale(vec3_cross(r, vec3_sub(vec3_load(v + 3 * i), v_centre)), m));
+      angular =
+          vec3_add(angular, vec3_scale(vec3_cross(r, vec3_sub(vec3_load(v + 3 * i), v_centre)), m));
       inertia = mat3_add(inertia, point_inertia(r, m));
     }
     vec3 omega = solve_inertia(inertia, angular);

@@ -166,7 +166,8 @@ static void projection_plane(const double *const t[3], int *i, int *j) {
 
 /* Closed segment (s, e) against the closed non-degenerate triangle t. */
 static int segment_hits_triangle(const double *s, const double *e, const double *const t[3]) {
-  int o1 = piola__orient3d_sign(t[0], t[1], t[2], s), o2 = piola__orient3d_sign(t[0], t[1], t[2], e);
+  int o1 = piola__orient3d_sign(t[0], t[1], t[2], s),
+      o2 = piola__orient3d_sign(t[0], t[1], t[2], e);
   if ((o1 > 0 && o2 > 0) || (o1 < 0 && o2 < 0)) return 0;
   if (o1 == 0 && o2 == 0) {
     int i, j;

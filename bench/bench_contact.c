@@ -6,7 +6,10 @@
  * CPU time of all threads, which is steadier on a shared machine), with contacts,
  * impacts and impact-zone vertices per step.
  *
- *   build/NAME/bench_contact [max_triangles]     (OMP_NUM_THREADS sets the threads) */
+ *   build/NAME/bench_contact [max_triangles [closing]]   (OMP_NUM_THREADS sets the threads)
+ *
+ * closing: how many thicknesses the far edge moves towards the lower layer per step (default
+ * 1: mostly repulsion; 8: the layers are driven through each other, impacts and zones). */
 #include <math.h>
 #include <omp.h>
 #include <stdio.h>
@@ -52,8 +55,12 @@ static void folded(int n, int i, int j, double theta, double *p) {
 int main(int argc, char **argv) {
   const int max_triangles = argc > 1 ? atoi(argv[1]) : 200000;
   static const int targets[] = {10000, 25000, 50000, 100000, 200000};
-  printf("folding cloth, 8 steps measured after 2 warm-up steps, %d threads, median per step\n",
-         omp_get_max_threads());
+  const double closing = argc > 2 ? atof(argv[2]) : 1.0;
+  if (!(closing > 0.0)) return 1;
+  printf(
+      "folding cloth closing by %g thickness per step, 8 steps measured after 2 warm-up "
+      "steps, %d threads, median per step\n",
+      closing, omp_get_max_threads());
   printf(
       "| triangles | vertices | wall ms/step | CPU ms/step | CPU ns/triangle | contacts | impacts "
       "| zone vertices |\n");
@@ -89,7 +96,7 @@ int main(int argc, char **argv) {
     double times[8], cpu[8];
     long long contacts = 0, impacts = 0, zone_vertices = 0;
     for (int step = 0; step < 10; ++step) {
-      const double dtheta = h / 0.5;
+      const double dtheta = closing * h / 0.5;
       for (int j = 0; j < n; ++j)
         for (int i = 0; i < n; ++i) {
           double next[3], *u = v + 3 * (j * n + i);

@@ -100,10 +100,11 @@ static void recover_mesh(const piola_tet_mesh *mesh, double tolerance, int steps
       double worst = simulate(body, x, dt, steps, beta, alpha, &inverted);
       print_message("%-14s from a %-9s: max |fhat - 1| = %.3g, %d inverted, %d steps\n",
                     piola_material_model_name(models[m]), start_name[kind], worst, (int)inverted, steps);
-      /* Known limitation, reported: neo-Hookean (and, for some seeds, corotated) from a
-       * random scramble can settle in a tangled equilibrium (tets all positive or nearly so,
-       * forces ~0, energy high). For it this start checks only that the run stays finite
-       * (simulate asserts that). The collapses recover for every model. */
+      /* Known limitation, reported: neo-Hookean with the LINEAR extension from a random
+       * scramble can settle in a tangled equilibrium (a true static equilibrium: forces ~0,
+       * energy high, a few tets flat or inverted; docs/materials.md "Tangled equilibria").
+       * For it this start checks only that the run stays finite (simulate asserts that). The
+       * collapses recover for every model, the scrambles for every other model. */
       if (kind == SCRAMBLE && models[m] == PIOLA_MODEL_NEOHOOKEAN) continue;
       if (!(worst <= tolerance && inverted == 0))
         fail_msg("%s from a %s: max |fhat - 1| = %g, %d inverted after %d steps",

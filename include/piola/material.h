@@ -12,7 +12,8 @@
  * relaxing towards at most the rest stiffness and the cross terms into unclamped entries
  * saturating away from the threshold (exact Taylor value and slope at it); all entries below
  * c are expanded together. Neo-Hookean bodies that may start scrambled or tangled should use
- * CLAMP: with LINEAR they can stop in a tangled equilibrium (docs/materials.md). In clamped entries the slope is raised where the plain expansion
+ * threshold 0.5 or CLAMP: with LINEAR at 0.3 they can stop in a tangled equilibrium
+ * (docs/materials.md). In clamped entries the slope is raised where the plain expansion
  * would not push back (e.g. St. Venant-Kirchhoff, whose own slope there is negative), so the
  * result is finite for every Fhat with entries up to 1e30 in magnitude (flat, collapsed and
  * inverted included; only the models' own growth, e.g. corotated's energy ~ f^6, overflows

@@ -42,6 +42,7 @@ piola_status piola_world_create(const piola_world_def *def, piola_world **out) {
 
 static void solid_free(world_solid *s) {
   free(s->name);
+  piola_plastic_state_destroy(s->plastic);
   piola_elastic_body_destroy(s->body);
   free(s->x), free(s->v), free(s->mass), free(s->inverse_mass), free(s->force), free(s->start), free(s->flags);
   free(s->motion_of), free(s->motions);
@@ -151,6 +152,7 @@ piola_status piola_world_add_solid(piola_world *world, const piola_solid_def *de
   s->shear_viscosity = def->shear_viscosity;
   s->bulk_viscosity = def->bulk_viscosity;
   st = piola__solid_apply_constraints(s, rest, def->constraints, def->constraint_count);
+  if (st == PIOLA_OK) st = piola__solid_plastic_create(s, def);
   if (st != PIOLA_OK) {
     solid_free(s);
     return st;

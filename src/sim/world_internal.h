@@ -29,6 +29,8 @@ typedef struct world_solid {
   int32_t motion_count;
   piola_track stiffness_scale, shear_viscosity, bulk_viscosity;
   piola_elastic_stats elastic;  /* of the last update */
+  piola_plastic_state *plastic; /* NULL for an elastic solid (world_plasticity.c) */
+  piola_plastic_stats plastic_stats; /* of the last plastic update */
   /* scratch for the step */
   double *x_old, *v_old, *force_old, *rhs, *work, *tmp;
   uint8_t *colliding;
@@ -53,5 +55,13 @@ void piola__solid_constrained_state(const world_solid *s, int32_t i, double t, d
                                     double v[3]);
 /* Recomputes the elastic force of s at its positions x and time t (stiffness scale). */
 piola_status piola__solid_update_forces(world_solid *s, double t);
+
+/* Plasticity of a solid (world_plasticity.c). Creation binds a plastic state to s->body
+ * when def asks for one; the update runs once per step, after the whole step succeeded,
+ * from the diagonalization of the step's force evaluation; the stiffening factor (>= 1)
+ * divides the CFL step. */
+piola_status piola__solid_plastic_create(world_solid *s, const piola_solid_def *def);
+void piola__solid_plastic_update(world_solid *s, double dt);
+double piola__solid_plastic_stiffening(const world_solid *s);
 
 #endif

@@ -123,6 +123,7 @@ piola_status piola_plastic_state_create(piola_elastic_body *body, const piola_pl
   int32_t nt = s->tet_count = piola_elastic_body_tet_count(body);
   size_t n = nt > 0 ? (size_t)nt : 1;
   s->params = (plastic_params){def->yield, def->hardening, def->limit, def->volume_preserving};
+  s->limit_cap = exp(def->limit);
   s->controlled = def->control.goal != PIOLA_PLASTIC_GOAL_NONE;
   s->strength = def->control.strength;
   s->rest_dm_inv = malloc(9 * n * sizeof(double));
@@ -224,8 +225,7 @@ static int update_tet(piola_plastic_state *s, const double *fhat_all, int32_t t,
     s->alpha[t] += dl;
     if (s->params.hardening > 0) set_quick_bounds(s, t);
     double lower, upper = singular_bounds(a, &lower);
-    double cap = exp(s->params.limit);
-    if (!(upper <= cap && lower >= 1.0 / cap)) {
+    if (!(upper <= s->limit_cap && lower >= 1.0 / s->limit_cap)) {
       upper = exact_limit(a, &s->params);
       *limited += 1;
     }

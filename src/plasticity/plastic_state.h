@@ -23,6 +23,7 @@ struct piola_plastic_state {
   piola_elastic_body *body;
   int32_t tet_count;
   plastic_params params;
+  double limit_cap;       /* e^limit */
   double *rest_dm_inv;    /* 9 per tet: the body's Dm^-1 at creation */
   double *fp_inv;         /* 9 per tet */
   double *alpha;          /* accumulated plastic strain */

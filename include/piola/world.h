@@ -93,8 +93,8 @@ typedef struct piola_solid_def {
   double scramble_radius;         /* m, >= 0: each free node moves by a uniformly random
                                      point of a ball of this radius. Default 0 */
   uint64_t scramble_seed;         /* the random sequence is fixed by this seed. Default 1 */
-  const piola_plasticity_def *plasticity; /* NULL (default): purely elastic. Read (and a
-                                     control goal mesh copied) by add_solid */
+  const piola_plasticity_def *plasticity; /* NULL (default): purely elastic. Read by
+                                     add_solid only (goal positions included) */
 } piola_solid_def;
 
 PIOLA_API piola_solid_def piola_default_solid_def(void);

@@ -1,6 +1,10 @@
 /* The elastic body object and its force loops: the fast blocked loop that piola uses and
  * the scalar reference loop the tests compare it with. Layout and determinism design are
  * explained in elastic_body_internal.h; the SVD kernel in svd_kernel.h. */
+/* Fused multiply-adds in this file's kernels (see "Fused multiply-adds" in svd_kernel.h). */
+#if defined(__GNUC__) && !defined(__clang__)
+#pragma GCC optimize("fp-contract=fast")
+#endif
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -125,8 +129,7 @@ PIOLA_WIDE_VECTORS static void update_block(piola_elastic_body *body, const doub
   double fhat[3][B];
   double *uo = body->u[0] + base, *vo = body->v[0] + base;
   const long stride = body->padded_tet_count;
-#pragma omp simd
-  for (int l = 0; l < B; ++l) piola__svd3_kernel(&f[0][l], B, uo + l, vo + l, stride, &fhat[0][l], B);
+  piola__svd3_kernel_v8(&f[0][0], B, uo, vo, stride, &fhat[0][0], B);
 
   double phat[3][B], psi[B];
   piola__material_stress_lanes(body, base, fhat, phat);

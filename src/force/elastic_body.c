@@ -133,7 +133,6 @@ PIOLA_WIDE_VECTORS static void update_block(piola_elastic_body *body, const doub
 
   double phat[3][B], psi[B];
   piola__material_stress_lanes(body, base, fhat, phat);
-  for (int l = 0; l < B; ++l) psi[l] = 0.0;
   if (want_energy)
     for (int l = 0; l < B; ++l) {
       double fh[3] = {fhat[0][l], fhat[1][l], fhat[2][l]};
@@ -171,14 +170,22 @@ PIOLA_WIDE_VECTORS static void update_block(piola_elastic_body *body, const doub
     }
   }
 
+  /* per-tet state for the getters (fhat AoS as the public API has it), then statistics,
+   * which only a caller asking for stats needs */
+  double *fhat_out = body->fhat + 3 * (size_t)base, *det_out = body->det_f + base;
+#pragma omp simd
+  for (int l = 0; l < B; ++l) {
+    fhat_out[3 * l] = fhat[0][l];
+    fhat_out[3 * l + 1] = fhat[1][l];
+    fhat_out[3 * l + 2] = fhat[2][l];
+    det_out[l] = detf[l];
+  }
+  if (!want_energy) return;
   int32_t real = body->tet_count - base < B ? body->tet_count - base : B;
   double energy = 0, min_det = INFINITY;
   int32_t inverted = 0;
   for (int l = 0; l < B; ++l) {
-    int32_t t = base + l;
-    for (int k = 0; k < 3; ++k) body->fhat[3 * t + k] = fhat[k][l];
-    body->det_f[t] = detf[l];
-    body->energy_density[t] = psi[l] * stiffness_scale;
+    body->energy_density[base + l] = psi[l] * stiffness_scale;
     if (l < real) {
       energy += volume[l] * psi[l] * stiffness_scale;
       inverted += detf[l] < 0;

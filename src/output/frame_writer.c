@@ -98,6 +98,11 @@ piola_status piola_output_open(const char *dir, bool force, const piola_world *w
   }
   memcpy(o->tets.positions, o->rest, 3 * (size_t)nv * sizeof(double));
   piola_status st = piola_tet_mesh_boundary(&o->tets, &o->surface);
+  if (st == PIOLA_OK) {
+    /* the surface shares the tets' numbering: each frame lends it the current positions */
+    free(o->surface.positions);
+    o->surface.positions = NULL;
+  }
   if (st == PIOLA_OK) st = piola__output_prepare_folder(dir, force);
   if (st == PIOLA_OK) st = csv_append(o, "frame,time,substeps,cg_iterations,kinetic_energy,elastic_energy,"
                                          "inverted,min_det_f,wall_seconds\n");

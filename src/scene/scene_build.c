@@ -46,6 +46,23 @@ piola_status piola__scene_build(const scene_desc *desc, const char *label, piola
       piola_world_destroy(world);
       return PIOLA_FAIL(st, "%s: solids[%d].mesh: %s", label, (int)i, piola_last_error());
     }
+    /* index selectors can only be checked against the mesh: name the scene key */
+    for (int32_t c = 0; c < d->constraint_count; ++c) {
+      const piola_selector *sel = &d->constraints[c].selector;
+      if (sel->type != PIOLA_SELECT_INDICES) continue;
+      for (int32_t k = 0; k < sel->index_count; ++k)
+        if (sel->indices[k] >= mesh.vertex_count) {
+          int fixed = c < d->fixed_count;
+          piola_status bad = PIOLA_FAIL(
+              PIOLA_ERROR_INVALID_ARGUMENT,
+              "%s: solids[%d].%s[%d].indices[%d]: vertex %d is out of range (the mesh has %d vertices)",
+              label, (int)i, fixed ? "fixed" : "driven", (int)(fixed ? c : c - d->fixed_count), (int)k,
+              (int)sel->indices[k], (int)mesh.vertex_count);
+          piola_tet_mesh_free(&mesh);
+          piola_world_destroy(world);
+          return bad;
+        }
+    }
     place(&mesh, d);
     piola_solid_def def = d->def;
     def.mesh = &mesh;

@@ -26,6 +26,8 @@ typedef struct scene_solid_desc {
   piola_vec3 scale;               /* per axis */
   piola_constraint_def *constraints;
   int32_t constraint_count;
+  int32_t fixed_count;            /* constraints[0, fixed_count) come from `fixed`, the rest
+                                     from `driven` */
   int32_t **index_lists;          /* owned index arrays, one per constraint (or NULL) */
 } scene_solid_desc;
 

@@ -552,6 +552,7 @@ static piola_status parse_solid(parser *p, const cJSON *obj, int index, scene_so
   }
   PIOLA_TRY(opt_vec3(p, obj, "velocity", ANY, &d->def.velocity));
   PIOLA_TRY(parse_constraints(p, obj, "fixed", 0, d));
+  d->fixed_count = d->constraint_count;
   PIOLA_TRY(parse_constraints(p, obj, "driven", 1, d));
   if ((v = get(obj, "initial"))) {
     old = push_key(p, "initial");

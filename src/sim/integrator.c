@@ -246,6 +246,16 @@ static piola_status step_solid(piola_world *w, world_solid *s, double t, double 
                         "solid '%s': velocity of vertex %lld became non-finite at t = %g s", s->name,
                         (long long)(j / 3), t1);
     }
+  /* a state whose energies overflow has blown up even if each coordinate is still finite */
+  double kinetic = 0;
+  for (int32_t i = 0; i < n; ++i)
+    for (int k = 0; k < 3; ++k) kinetic += s->mass[i] * s->v[3 * i + k] * s->v[3 * i + k];
+  if (!isfinite(kinetic) || !isfinite(s->elastic.elastic_energy)) {
+    restore(s, t);
+    return PIOLA_FAIL(PIOLA_ERROR_NOT_FINITE,
+                      "solid '%s': the %s energy became non-finite at t = %g s (the state blew up)",
+                      s->name, isfinite(kinetic) ? "elastic" : "kinetic", t1);
+  }
   return PIOLA_OK;
 }
 

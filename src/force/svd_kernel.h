@@ -81,10 +81,10 @@
  * Elsewhere the estimate is the bit-level guess refined by two Newton steps (error 5e-6),
  * so both paths meet the same bound. Selections are bit masks (C has no vector ?:). */
 /* The kernel is always inlined, so the ABI of passing these vectors by value (which GCC
- * warns about where the target has no 512-bit registers) never applies. GCC reports it at
+ * and clang warn about where the target has no 512-bit registers) never applies. GCC reports it at
  * the end of the translation unit, so the note stays off for the rest of the includer
  * (which passes no vectors by value itself). */
-#if defined(__GNUC__) && !defined(__clang__)
+#if defined(__GNUC__)
 #pragma GCC diagnostic ignored "-Wpsabi"
 #endif
 typedef double piola_v8d __attribute__((vector_size(64)));

@@ -1,5 +1,5 @@
-/* A branch-free 3x3 SVD with the invertible sign convention, written to be vectorized
- * across SIMD lanes (one matrix per lane) by the compiler.
+/* A branch-free 3x3 SVD with the invertible sign convention, on 8 matrices at once (one
+ * per SIMD lane, written on explicit GCC/clang vectors).
  *
  * Why a second diagonalization besides the public piola_diagonalize3: that one is written
  * for robustness at any scale and to 1e-12, with branches; the force loop runs a
@@ -8,11 +8,11 @@
  * matrices with minimal branching and elementary floating point operations"), adapted to
  * double precision and written from the method's description:
  *   1. normalize F by its largest entry (the kernel is then scale invariant), and flush
- *      entries below 1e-100 of it to zero (no denormals anywhere downstream);
+ *      entries below 1e-100 of it to zero (no denormals downstream);
  *   2. symmetric eigenproblem of S = F^T F by cyclic Jacobi with a fixed number of sweeps
- *      (4). Unlike McAdams' approximate Givens angles (which need more sweeps in double),
- *      each rotation uses the exact Jacobi angle, but computed cheaply: only the angle
- *      matters, so the square roots in it are rough (Newton-refined bit-level guesses) and
+ *      (4; 3 leave a worst random case at 1e-5). Unlike McAdams' approximate Givens angles
+ *      (which need more sweeps in double), each rotation uses the exact Jacobi angle, but
+ *      computed cheaply: only the angle matters, so the square roots in it are rough and
  *      the rotation is kept an exact rotation times a scale, which leaves the eigenvectors
  *      alone; V is normalized once at the end;
  *   3. B = F V, columns sorted by decreasing norm (a swap negates one column so det V = +1);
@@ -20,14 +20,22 @@
  *      u1 = b1 minus its u0 part (twice), normalized, u2 = u0 x u1 so det U = +1;
  *      Fhat = (|b0|, |b1'|, u2 . b2), the last carrying the sign of det F: an inverted
  *      element gets one negative entry, the one of smallest magnitude. A zero b0 (F = 0)
- *      gives U = I; a zero b1 (rank <= 1) gets a completed u1.
- * Reciprocal square roots come from a bit-level first guess refined by Newton steps (no
- * sqrt, one divide per matrix for the normalization).
+ *      gives U = I; a b1 that is zero or below 1e-14 of itself after the projection
+ *      (rank <= 1) gets a completed u1.
+ * No sqrt and one divide per matrix (the normalization): reciprocal square roots start from
+ * the hardware estimate where the build targets AVX-512 (vrsqrt14pd, 2^-14) and otherwise
+ * from a bit-level guess plus two Newton steps, then as many Newton steps as each use needs
+ * (none for the rotation's normalization, whose error the scale m absorbs exactly).
+ *
+ * Fused multiply-adds. The files that inline the kernel ask GCC for fp-contract=fast
+ * (GCC's -std=c17 otherwise turns contraction off, and the kernel is mostly a*b + c): about
+ * a third fewer floating-point instructions. Results stay deterministic (contraction is
+ * decided at compile time) and identical for any thread count.
+ *
  * Measured accuracy (tests/test_elastic_body.c, docs/forces.md): worst relative
- * reconstruction |U Fhat V^T - F| / |F| and orthogonality |U^T U - I|, |V^T V - I| about
- * 2e-15 over random, rank-2, rank-1, zero, near-identity, tiny and huge matrices. Every
- * function is inline and written on named scalars so that it can sit inside an `omp simd`
- * loop. */
+ * reconstruction |U Fhat V^T - F| / |F| 2e-15 (7e-15 for rank-2 matrices) and orthogonality
+ * |U^T U - I|, |V^T V - I| 2.5e-15 over random, rank-2, rank-1, zero, near-identity, tiny
+ * and huge matrices, on both the AVX-512 and the fallback path. */
 #ifndef PIOLA_FORCE_SVD_KERNEL_H
 #define PIOLA_FORCE_SVD_KERNEL_H
 
@@ -119,6 +127,10 @@ PIOLA_KERNEL_INLINE piola_v8d piola__v8_rsqrt_estimate(piola_v8d x) {
   return piola__v8_rsqrt_newton(x, y);
 #endif
 }
+/* Estimate and one Newton step: relative error below 6e-9. */
+PIOLA_KERNEL_INLINE piola_v8d piola__v8_rsqrt_refined(piola_v8d x) {
+  return piola__v8_rsqrt_newton(x, piola__v8_rsqrt_estimate(x));
+}
 /* To about 1 ulp (estimate, then two Newton steps: 6.2e-5 -> 6e-9 -> 5e-17). */
 PIOLA_KERNEL_INLINE piola_v8d piola__v8_rsqrt(piola_v8d x) {
   piola_v8d y = piola__v8_rsqrt_estimate(x);
@@ -126,18 +138,24 @@ PIOLA_KERNEL_INLINE piola_v8d piola__v8_rsqrt(piola_v8d x) {
   return piola__v8_rsqrt_newton(x, y);
 }
 
-/* One Jacobi rotation, as PIOLA_SVD_JACOBI but on vectors, with cheaper square roots:
- * r from the estimate plus one Newton step (error 6e-9: it only tilts the angle, and the
- * next sweep corrects that), the normalization k of (c, s) from the bare estimate, so that
- * c^2 + s^2 = 1 + delta with |delta| < 1.3e-4, and the scale m = sqrt(1 + delta) of the
- * transform from its series to third order (error 5 delta^4 / 128 < 1e-17). */
-#define PIOLA_V8_JACOBI(spp, sqq, skk, spq, spk, sqk, v0p, v0q, v0k, v1p, v1q, v1k, v2p, v2q, \
-                        v2k)                                                                \
+/* One Jacobi rotation in the (p, q) plane of the symmetric S (k the third index), on 8
+ * lanes, with the exact Jacobi angle tan(2 theta) = e / d, d = s_pp - s_qq, e = 2 s_pq,
+ * taken with |2 theta| <= pi/2: tan(theta) = sgn(d) e / (|d| + r), r = sqrt(d^2 + e^2).
+ * Only the angle decides the eigenvectors, so the square roots are cheap: r from
+ * rsqrt_r (an error in r only tilts the angle, which a later sweep corrects), and the
+ * normalization k of (c, s) from the bare estimate, so that c^2 + s^2 = 1 + delta with
+ * |delta| < 1.3e-4. The transform is then G = m R, R an exact rotation, m = sqrt(1 + delta)
+ * from its series to third order (error 5 delta^4 / 128 < 1e-17), and the third axis is
+ * scaled by the same m: S <- G^T S G = m^2 R^T S R keeps its eigenvectors, V <- V G stays
+ * a scaled rotation and is normalized once at the end. No branch, no divide, no mask:
+ * d = e = 0 (a diagonal or zero S) gives c = 1, s = 0 through the 1e-300 floor. */
+#define PIOLA_V8_JACOBI(rsqrt_r, spp, sqq, skk, spq, spk, sqk, v0p, v0q, v0k, v1p, v1q, v1k,  \
+                        v2p, v2q, v2k)                                                      \
   do {                                                                                      \
     piola_v8d d_ = spp - sqq, e_ = 2.0 * spq;                                               \
     /* + 1e-300: d = e = 0 gives r, c ~ 1e-150 and so c = 1, s = 0 after normalization */   \
     piola_v8d r2_ = d_ * d_ + e_ * e_ + 1e-300;                                             \
-    piola_v8d r_ = r2_ * piola__v8_rsqrt_newton(r2_, piola__v8_rsqrt_estimate(r2_));        \
+    piola_v8d r_ = r2_ * rsqrt_r(r2_);                                                      \
     piola_v8d c_ = piola__v8_abs(d_) + r_;                                                  \
     piola_v8l dsign_ = (piola_v8l)d_ & INT64_MIN; /* s = d >= 0 ? e : -e */                 \
     piola_v8d s_ = (piola_v8d)((piola_v8l)e_ ^ dsign_);                                     \
@@ -206,12 +224,18 @@ PIOLA_KERNEL_INLINE void piola__svd3_kernel_v8(const double *f, long in_stride, 
   piola_v8d s12 = a01 * a02 + a11 * a12 + a21 * a22;
   piola_v8d v00 = one, v01 = zero, v02 = zero, v10 = zero, v11 = one, v12 = zero, v20 = zero,
             v21 = zero, v22 = one;
+  /* r = sqrt(d^2 + e^2) only tilts the angle: the first sweeps take it from the bare
+   * estimate (angle off by ~1e-4 of itself, which later sweeps correct), the third refines
+   * it once (6e-9), the last to an ulp (worst random-matrix reconstruction 1e-14 -> 2e-15) */
+#define PIOLA_V8_SWEEP(rsqrt_r)                                                                   \
+  PIOLA_V8_JACOBI(rsqrt_r, s00, s11, s22, s01, s02, s12, v00, v01, v02, v10, v11, v12, v20, v21, v22); \
+  PIOLA_V8_JACOBI(rsqrt_r, s00, s22, s11, s02, s01, s12, v00, v02, v01, v10, v12, v11, v20, v22, v21); \
+  PIOLA_V8_JACOBI(rsqrt_r, s11, s22, s00, s12, s01, s02, v01, v02, v00, v11, v12, v10, v21, v22, v20)
   PIOLA_UNROLL
-  for (int sweep = 0; sweep < PIOLA_SVD_JACOBI_SWEEPS; ++sweep) {
-    PIOLA_V8_JACOBI(s00, s11, s22, s01, s02, s12, v00, v01, v02, v10, v11, v12, v20, v21, v22);
-    PIOLA_V8_JACOBI(s00, s22, s11, s02, s01, s12, v00, v02, v01, v10, v12, v11, v20, v22, v21);
-    PIOLA_V8_JACOBI(s11, s22, s00, s12, s01, s02, v01, v02, v00, v11, v12, v10, v21, v22, v20);
-  }
+  for (int sweep = 2; sweep < PIOLA_SVD_JACOBI_SWEEPS; ++sweep) { PIOLA_V8_SWEEP(piola__v8_rsqrt_estimate); }
+  PIOLA_V8_SWEEP(piola__v8_rsqrt_refined);
+  PIOLA_V8_SWEEP(piola__v8_rsqrt);
+#undef PIOLA_V8_SWEEP
 
   piola_v8d kv = piola__v8_rsqrt(v00 * v00 + v10 * v10 + v20 * v20);
   v00 *= kv; v01 *= kv; v02 *= kv;

@@ -97,6 +97,7 @@
 #endif
 typedef double piola_v8d __attribute__((vector_size(64)));
 typedef int64_t piola_v8l __attribute__((vector_size(64)));
+typedef uint64_t piola_v8u __attribute__((vector_size(64)));
 
 #define PIOLA_V8_SELECT(mask, a, b) \
   ((piola_v8d)(((mask) & (piola_v8l)(a)) | (~(mask) & (piola_v8l)(b))))
@@ -121,7 +122,8 @@ PIOLA_KERNEL_INLINE piola_v8d piola__v8_rsqrt_estimate(piola_v8d x) {
 #if defined(__AVX512F__)
   return (piola_v8d)_mm512_rsqrt14_pd((__m512d)x);
 #else
-  piola_v8l i = INT64_C(0x5fe6eb50c7b537a9) - ((piola_v8l)x >> 1);
+  /* unsigned shift: x > 0, and AVX2 has no 64-bit arithmetic shift */
+  piola_v8u i = UINT64_C(0x5fe6eb50c7b537a9) - ((piola_v8u)x >> 1);
   piola_v8d y = (piola_v8d)i;
   y = piola__v8_rsqrt_newton(x, y);
   return piola__v8_rsqrt_newton(x, y);

@@ -97,7 +97,7 @@ void piola__elastic_body_gather_forces(const piola_elastic_body *body, double *f
 
 /* One block of B tets: F, SVD, stress, forces into the per-tet buffer, block statistics. */
 PIOLA_WIDE_VECTORS static void update_block(piola_elastic_body *body, const double *x, double stiffness_scale,
-                         int want_energy, int32_t block) {
+                         int want_energy, int32_t block, double *out) {
   const int32_t base = block * B;
   double f[9][B], detf[B];
   const int32_t *i0 = body->tet_vertices[0] + base, *i1 = body->tet_vertices[1] + base;
@@ -140,7 +140,7 @@ PIOLA_WIDE_VECTORS static void update_block(piola_elastic_body *body, const doub
     }
 
   const double *volume = body->rest_volume + base;
-  double *tf = body->tet_forces + 12 * (size_t)base; /* this block's 12 rows of B lanes */
+  double tf[12 * B]; /* this block's 12 rows (3 corner + component) of B lanes */
 #pragma omp simd
   for (int l = 0; l < B; ++l) {
     double p0 = phat[0][l] * stiffness_scale, p1 = phat[1][l] * stiffness_scale,
@@ -169,6 +169,16 @@ PIOLA_WIDE_VECTORS static void update_block(piola_elastic_body *body, const doub
       tf[i * B + l] = g0;
     }
   }
+
+  /* add the block's forces into out, tet by tet in order (padding tets are skipped) */
+  int32_t real_tets = body->tet_count - base < B ? body->tet_count - base : B;
+  for (int l = 0; l < real_tets; ++l)
+    for (int c = 0; c < 4; ++c) {
+      double *o = out + 3 * (size_t)body->tet_vertices[c][base + l];
+      o[0] += tf[(3 * c) * B + l];
+      o[1] += tf[(3 * c + 1) * B + l];
+      o[2] += tf[(3 * c + 2) * B + l];
+    }
 
   /* per-tet state for the getters (fhat AoS as the public API has it), then statistics,
    * which only a caller asking for stats needs */
@@ -218,10 +228,33 @@ piola_status piola_elastic_body_update(piola_elastic_body *body, const double *x
                           (int)(i / 3));
   }
   int32_t blocks = body->padded_tet_count / B;
-#pragma omp parallel for schedule(static) num_threads(piola__thread_count()) \
-    if (blocks >= PIOLA_PARALLEL_MIN_BLOCKS)
-  for (int32_t b = 0; b < blocks; ++b) update_block(body, x, stiffness_scale, stats != NULL, b);
-  piola__elastic_body_gather_forces(body, forces);
+  const int64_t n = 3 * (int64_t)body->vertex_count;
+  if (blocks < PIOLA_PARALLEL_MIN_BLOCKS || !body->damping_chunk_forces) {
+    for (int64_t i = 0; i < n; ++i) forces[i] = 0.0;
+    for (int32_t b = 0; b < blocks; ++b) update_block(body, x, stiffness_scale, stats != NULL, b, forces);
+  } else {
+    /* Determinism without a per-tet buffer (as in damping.c): PIOLA_DAMPING_CHUNKS fixed
+     * ranges of blocks, each summed in tet order into its own array, the arrays added in
+     * chunk order; which thread runs a chunk changes nothing. */
+    double *partial = body->damping_chunk_forces;
+#pragma omp parallel num_threads(piola__thread_count())
+    {
+#pragma omp for schedule(static)
+      for (int k = 0; k < PIOLA_DAMPING_CHUNKS; ++k) {
+        double *fk = partial + (size_t)k * (size_t)n;
+        for (int64_t i = 0; i < n; ++i) fk[i] = 0.0;
+        int32_t b0 = (int32_t)((int64_t)blocks * k / PIOLA_DAMPING_CHUNKS);
+        int32_t b1 = (int32_t)((int64_t)blocks * (k + 1) / PIOLA_DAMPING_CHUNKS);
+        for (int32_t b = b0; b < b1; ++b) update_block(body, x, stiffness_scale, stats != NULL, b, fk);
+      }
+#pragma omp for schedule(static)
+      for (int64_t i = 0; i < n; ++i) {
+        double sum = partial[i];
+        for (int k = 1; k < PIOLA_DAMPING_CHUNKS; ++k) sum += partial[(size_t)k * (size_t)n + i];
+        forces[i] = sum;
+      }
+    }
+  }
   body->has_state = 1;
   body->damping_ready = 0;
   memcpy(body->positions, x, sizeof(double) * 3 * (size_t)body->vertex_count);

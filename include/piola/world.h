@@ -31,6 +31,7 @@
 #include "piola/math_types.h"
 #include "piola/mesh.h"
 #include "piola/obstacle.h"
+#include "piola/plasticity.h"
 #include "piola/rigid_motion.h"
 #include "piola/status.h"
 
@@ -92,6 +93,8 @@ typedef struct piola_solid_def {
   double scramble_radius;         /* m, >= 0: each free node moves by a uniformly random
                                      point of a ball of this radius. Default 0 */
   uint64_t scramble_seed;         /* the random sequence is fixed by this seed. Default 1 */
+  const piola_plasticity_def *plasticity; /* NULL (default): purely elastic. Read by
+                                     add_solid only (goal positions included) */
 } piola_solid_def;
 
 PIOLA_API piola_solid_def piola_default_solid_def(void);
@@ -150,6 +153,13 @@ typedef struct piola_solid_stats {
   int32_t inverted_count; /* tets with det F < 0 */
   double min_det_f;
 } piola_solid_stats;
+
+/* The plastic state of a plastic solid (NULL for an elastic one), and the statistics of its
+ * last plastic update (zeros before the first step). See piola/plasticity.h. */
+PIOLA_API const piola_plastic_state *piola_world_solid_plastic_state(const piola_world *world,
+                                                                     int32_t solid);
+PIOLA_API piola_plastic_stats piola_world_solid_plastic_stats(const piola_world *world,
+                                                              int32_t solid);
 
 /* Stats of one solid at the current state. */
 PIOLA_API piola_solid_stats piola_world_solid_stats(const piola_world *world, int32_t solid);

@@ -154,7 +154,7 @@ piola_status piola_output_open(const char *dir, bool force, const piola_world *w
   }
   if (st == PIOLA_OK) st = piola__output_prepare_folder(dir, force);
   if (st == PIOLA_OK) st = csv_append(o, "frame,time,substeps,cg_iterations,kinetic_energy,elastic_energy,"
-                                         "inverted,min_det_f,wall_seconds\n");
+                                         "inverted,min_det_f,wall_seconds,plastic_yielded,max_fp_log_stretch\n");
   if (st != PIOLA_OK) {
     piola_output_close(o);
     return st;
@@ -193,7 +193,8 @@ piola_status piola_output_write_frame(piola_output *o, const piola_world *world,
   int32_t ns = piola_world_solid_count(world);
   int32_t voff = 0, toff = 0;
   double ke = 0, ee = 0, min_det = INFINITY;
-  long long inverted = 0;
+  long long inverted = 0, yielded = 0;
+  double max_fp_log = 0; /* plastic solids: yielded tets in the last step, largest |log stretch| of Fp */
   for (int32_t s = 0; s < ns; ++s) {
     const piola_elastic_body *b = piola_world_solid_body(world, s);
     int32_t n = piola_elastic_body_vertex_count(b), t = piola_elastic_body_tet_count(b);
@@ -217,6 +218,13 @@ piola_status piola_output_write_frame(piola_output *o, const piola_world *world,
     ee += st.elastic_energy;
     inverted += st.inverted_count;
     if (st.min_det_f < min_det) min_det = st.min_det_f;
+    const piola_plastic_state *plastic = piola_world_solid_plastic_state(world, s);
+    if (plastic) {
+      double largest;
+      piola_plastic_state_measure(plastic, &largest, NULL);
+      if (largest > max_fp_log) max_fp_log = largest;
+      yielded += piola_world_solid_plastic_stats(world, s).yielded_count;
+    }
     voff += n;
     toff += t;
   }
@@ -265,9 +273,9 @@ piola_status piola_output_write_frame(piola_output *o, const piola_world *world,
   PIOLA_TRY(st);
 
   char line[512];
-  snprintf(line, sizeof line, "%d,%.17g,%d,%d,%.17g,%.17g,%lld,%.17g,%.6f\n", (int)info->frame,
+  snprintf(line, sizeof line, "%d,%.17g,%d,%d,%.17g,%.17g,%lld,%.17g,%.6f,%lld,%.17g\n", (int)info->frame,
            piola_world_time(world), (int)info->substeps, (int)info->cg_iterations, ke, ee, inverted,
-           ns > 0 ? min_det : 1.0, info->wall_seconds);
+           ns > 0 ? min_det : 1.0, info->wall_seconds, yielded, max_fp_log);
   PIOLA_TRY(csv_append(o, line));
   snprintf(path, sizeof path, "%s/stats.csv", o->dir);
   PIOLA_TRY(write_text(path, o->csv, o->csv_len));

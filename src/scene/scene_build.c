@@ -29,6 +29,22 @@ static void place(piola_tet_mesh *mesh, const scene_solid_desc *d) {
   }
 }
 
+piola_status piola__scene_read_goal_mesh(const scene_solid_desc *d, const piola_tet_mesh *rest,
+                                         piola_tet_mesh *goal) {
+  PIOLA_TRY(piola_tet_mesh_read(d->goal_mesh_path, goal));
+  if (goal->vertex_count != rest->vertex_count || goal->tet_count != rest->tet_count)
+    return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT,
+                      "the goal mesh has %d vertices and %d tets, the solid %d and %d: it must have the "
+                      "same connectivity", (int)goal->vertex_count, (int)goal->tet_count,
+                      (int)rest->vertex_count, (int)rest->tet_count);
+  for (int64_t k = 0; k < 4 * (int64_t)rest->tet_count; ++k)
+    if (goal->tets[k] != rest->tets[k])
+      return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT,
+                        "tet %lld of the goal mesh has other vertices than the solid's", (long long)(k / 4));
+  place(goal, d);
+  return PIOLA_OK;
+}
+
 /* Shells: read or generate the triangle mesh, place it, add the shell. */
 static piola_status build_shell(piola_world *world, const scene_shell_desc *d) {
   piola_tri_mesh mesh;
@@ -112,8 +128,28 @@ piola_status piola__scene_build(const scene_desc *desc, const char *label, piola
     def.name = d->name;
     def.constraints = d->constraints;
     def.constraint_count = d->constraint_count;
+    piola_plasticity_def plasticity;
+    piola_tet_mesh goal;
+    memset(&goal, 0, sizeof goal);
+    if (d->plastic) {
+      plasticity = d->plasticity;
+      def.plasticity = &plasticity;
+      if (plasticity.control.goal == PIOLA_PLASTIC_GOAL_MESH) {
+        st = piola__scene_read_goal_mesh(d, &mesh, &goal);
+        if (st != PIOLA_OK) {
+          piola_tet_mesh_free(&mesh);
+          piola_tet_mesh_free(&goal);
+          piola_world_destroy(world);
+          return PIOLA_FAIL(st, "%s: solids[%d].plasticity.control.goal.mesh: %s", label, (int)i,
+                            piola_last_error());
+        }
+        plasticity.control.goal_positions = goal.positions;
+        plasticity.control.goal_vertex_count = goal.vertex_count;
+      }
+    }
     st = piola_world_add_solid(world, &def, NULL);
     piola_tet_mesh_free(&mesh);
+    piola_tet_mesh_free(&goal);
     if (st != PIOLA_OK) {
       piola_world_destroy(world);
       return PIOLA_FAIL(st, "%s: solids[%d]: %s", label, (int)i, piola_last_error());

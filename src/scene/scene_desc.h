@@ -30,6 +30,9 @@ typedef struct scene_solid_desc {
   int32_t fixed_count;            /* constraints[0, fixed_count) come from `fixed`, the rest
                                      from `driven` */
   int32_t **index_lists;          /* owned index arrays, one per constraint (or NULL) */
+  int plastic;                    /* 1: "plasticity" given */
+  piola_plasticity_def plasticity;
+  char goal_mesh_path[SCENE_PATH_MAX]; /* plasticity.control.goal.mesh, resolved */
 } scene_solid_desc;
 
 /* A shell: the solid fields it shares (name, transform, density, material, damping,
@@ -66,6 +69,11 @@ typedef struct scene_desc {
 piola_status piola__scene_parse(const char *json, const char *base_dir, const char *label,
                                 scene_desc *out);
 void piola__scene_desc_free(scene_desc *desc);
+
+/* Reads the goal mesh of a controlled plastic solid and places it like the solid; it must
+ * have the rest mesh's vertices and tets (scene_build.c). */
+piola_status piola__scene_read_goal_mesh(const scene_solid_desc *d, const piola_tet_mesh *rest,
+                                         piola_tet_mesh *goal);
 
 /* Reads or generates the meshes, places them and builds the world. */
 piola_status piola__scene_build(const scene_desc *desc, const char *label, piola_world **out);

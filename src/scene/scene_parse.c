@@ -488,6 +488,78 @@ static piola_status parse_material(parser *p, const cJSON *obj, scene_solid_desc
   return PIOLA_OK;
 }
 
+/* ------------------------------------------------------------------ plasticity */
+
+/* A 3x3 matrix given as 3 rows of 3 numbers, at the current path. */
+static piola_status mat3_value(parser *p, const cJSON *mat, piola_mat3 *out) {
+  if (!cJSON_IsArray(mat) || cJSON_GetArraySize(mat) != 3)
+    return fail(p, PIOLA_ERROR_PARSE, "must be a 3x3 matrix given as 3 rows of 3 numbers");
+  int r = 0;
+  for (const cJSON *row = mat->child; row; row = row->next, ++r) {
+    size_t old = push_index(p, r);
+    piola_vec3 rv;
+    PIOLA_TRY(vec3_value(p, row, ANY, &rv));
+    out->m[r][0] = rv.x, out->m[r][1] = rv.y, out->m[r][2] = rv.z;
+    pop(p, old);
+  }
+  return PIOLA_OK;
+}
+
+/* "plasticity": {yield, limit, hardening, volume_preserving, control: {goal: {map | mesh},
+ * strength}} (docs/scene-format.md, docs/plasticity.md). */
+static piola_status parse_plasticity(parser *p, const cJSON *obj, scene_solid_desc *d) {
+  static const char *const allowed[] = {"yield", "limit", "hardening", "volume_preserving", "control", NULL};
+  PIOLA_TRY(check_keys(p, obj, allowed));
+  piola_plasticity_def *def = &d->plasticity;
+  *def = piola_default_plasticity_def();
+  d->plastic = 1;
+  PIOLA_TRY(opt_number(p, obj, "yield", POSITIVE, &def->yield));
+  static const range LIMIT = {0, 20, 1, 0};
+  PIOLA_TRY(opt_number(p, obj, "limit", LIMIT, &def->limit));
+  PIOLA_TRY(opt_number(p, obj, "hardening", NONNEGATIVE, &def->hardening));
+  const cJSON *v = get(obj, "volume_preserving");
+  if (v) {
+    size_t old = push_key(p, "volume_preserving");
+    if (!cJSON_IsBool(v)) return fail(p, PIOLA_ERROR_PARSE, "must be true or false, got %s", type_name(v));
+    def->volume_preserving = cJSON_IsTrue(v);
+    pop(p, old);
+  }
+  const cJSON *c = get(obj, "control");
+  if (!c) return PIOLA_OK;
+  size_t old = push_key(p, "control");
+  static const char *const control_keys[] = {"goal", "strength", NULL};
+  PIOLA_TRY(check_keys(p, c, control_keys));
+  PIOLA_TRY(required(p, c, "goal"));
+  if (def->volume_preserving)
+    return fail(p, BAD_VALUE, "cannot be used with volume_preserving: true (the goal rarely preserves volume)");
+  PIOLA_TRY(opt_number(p, c, "strength", NONNEGATIVE, &def->control.strength));
+  const cJSON *g = get(c, "goal");
+  size_t o2 = push_key(p, "goal");
+  static const char *const goal_keys[] = {"map", "mesh", NULL};
+  PIOLA_TRY(check_keys(p, g, goal_keys));
+  const cJSON *map = get(g, "map"), *mesh = get(g, "mesh");
+  if ((map != NULL) == (mesh != NULL)) return fail(p, PIOLA_ERROR_PARSE, "needs exactly one of \"map\" and \"mesh\"");
+  if (map) {
+    size_t o3 = push_key(p, "map");
+    def->control.goal = PIOLA_PLASTIC_GOAL_MAP;
+    PIOLA_TRY(mat3_value(p, map, &def->control.goal_map));
+    const piola_mat3 *a = &def->control.goal_map;
+    double det = a->m[0][0] * (a->m[1][1] * a->m[2][2] - a->m[1][2] * a->m[2][1]) -
+                 a->m[0][1] * (a->m[1][0] * a->m[2][2] - a->m[1][2] * a->m[2][0]) +
+                 a->m[0][2] * (a->m[1][0] * a->m[2][1] - a->m[1][1] * a->m[2][0]);
+    if (!(det > 0)) return fail(p, BAD_VALUE, "must have a positive determinant, got %g", det);
+    pop(p, o3);
+  } else {
+    size_t o3 = push_key(p, "mesh");
+    def->control.goal = PIOLA_PLASTIC_GOAL_MESH;
+    PIOLA_TRY(resolve_path(p, mesh, d->goal_mesh_path));
+    pop(p, o3);
+  }
+  pop(p, o2);
+  pop(p, old);
+  return PIOLA_OK;
+}
+
 static piola_status parse_transform(parser *p, const cJSON *v, scene_solid_desc *d) {
   size_t old = push_key(p, "transform");
   static const char *const keys[] = {"translate", "rotate_degrees", "scale", NULL};
@@ -510,6 +582,8 @@ static piola_status parse_transform(parser *p, const cJSON *v, scene_solid_desc 
   return PIOLA_OK;
 }
 
+/* ------------------------------------------------------------------ solids */
+
 /* The name key of a solid or a shell. */
 static piola_status parse_name(parser *p, const cJSON *obj, scene_solid_desc *d) {
   const cJSON *v = get(obj, "name");
@@ -525,7 +599,8 @@ static piola_status parse_name(parser *p, const cJSON *obj, scene_solid_desc *d)
 
 static piola_status parse_solid(parser *p, const cJSON *obj, int index, scene_solid_desc *d) {
   static const char *const allowed[] = {"name", "mesh", "transform", "density", "material",
-                                        "damping", "velocity", "fixed", "driven", "initial", NULL};
+                                        "damping", "velocity", "fixed", "driven", "initial",
+                                        "plasticity", NULL};
   PIOLA_TRY(check_keys(p, obj, allowed));
   PIOLA_TRY(required(p, obj, "mesh"));
   d->def = piola_default_solid_def();
@@ -559,6 +634,11 @@ static piola_status parse_solid(parser *p, const cJSON *obj, int index, scene_so
     pop(p, old);
   }
   PIOLA_TRY(opt_vec3(p, obj, "velocity", ANY, &d->def.velocity));
+  if ((v = get(obj, "plasticity"))) {
+    old = push_key(p, "plasticity");
+    PIOLA_TRY(parse_plasticity(p, v, d));
+    pop(p, old);
+  }
   PIOLA_TRY(parse_constraints(p, obj, "fixed", 0, d));
   d->fixed_count = d->constraint_count;
   PIOLA_TRY(parse_constraints(p, obj, "driven", 1, d));

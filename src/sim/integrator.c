@@ -11,7 +11,9 @@
  * F, its diagonalization and f^n+1 are computed once, between steps 3 and 4, and reused by
  * the next step's step 1. Constrained nodes follow their prescribed positions exactly:
  * their v~ is the secant velocity to the prescribed position and v^n+1 the prescribed
- * velocity. */
+ * velocity. Once every solid has stepped, plastic solids run their return mapping from the
+ * diagonalization at x^n+1 (world_plasticity.c); the new Fp acts from the next force
+ * evaluation. */
 #include <math.h>
 #include <string.h>
 
@@ -142,7 +144,7 @@ double piola_world_stable_dt(const piola_world *w) {
     const world_solid *s = &w->solids[i];
     double scale = stiffness_bound(s, w->time, w->time + w->def.max_dt);
     double speed = piola_elastic_body_max_wave_speed(s->body) * sqrt(scale);
-    double h = piola_elastic_body_min_rest_altitude(s->body);
+    double h = piola_elastic_body_min_rest_altitude(s->body) / piola__solid_plastic_stiffening(s);
     if (speed > 0 && h > 0) dt = fmin(dt, w->def.cfl * h / speed);
   }
   for (int32_t i = 0; i < w->shell_count; ++i) {
@@ -280,6 +282,7 @@ piola_status piola_world_step(piola_world *w, double dt_limit, piola_step_stats 
       return st;
     }
   }
+  for (int32_t i = 0; i < w->solid_count; ++i) piola__solid_plastic_update(&w->solids[i], dt);
   w->time += dt;
   local.substeps = 1;
   local.last_dt = dt;

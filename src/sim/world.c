@@ -42,6 +42,7 @@ piola_status piola_world_create(const piola_world_def *def, piola_world **out) {
 
 void piola__solid_free(world_solid *s) {
   free(s->name);
+  piola_plastic_state_destroy(s->plastic);
   piola_elastic_body_destroy(s->body);
   piola_shell_body_destroy(s->shell);
   if (s->boundary) piola_tri_mesh_free(s->boundary);
@@ -157,6 +158,7 @@ piola_status piola_world_add_solid(piola_world *world, const piola_solid_def *de
   s->shear_viscosity = def->shear_viscosity;
   s->bulk_viscosity = def->bulk_viscosity;
   st = piola__solid_apply_constraints(s, rest, def->constraints, def->constraint_count);
+  if (st == PIOLA_OK) st = piola__solid_plastic_create(s, def);
   if (st != PIOLA_OK) {
     piola__solid_free(s);
     return st;

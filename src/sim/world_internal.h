@@ -36,6 +36,8 @@ typedef struct world_solid {
   int32_t motion_count;
   piola_track stiffness_scale, shear_viscosity, bulk_viscosity;
   piola_elastic_stats elastic;  /* of the last update */
+  piola_plastic_state *plastic; /* NULL for an elastic solid (world_plasticity.c) */
+  piola_plastic_stats plastic_stats; /* of the last plastic update */
   /* scratch for the step */
   double *x_old, *v_old, *force_old, *rhs, *work, *tmp;
   uint8_t *colliding;
@@ -79,5 +81,13 @@ piola_status piola__shell_update_forces(world_solid *s, double t);
 int32_t piola__shell_collide_with_solids(piola_world *w, world_solid *s, double t1, double dt);
 /* The step bound of a shell (in-plane CFL and bending time scale), s. */
 double piola__shell_stable_dt(const piola_world *w, const world_solid *s, double scale);
+
+/* Plasticity of a solid (world_plasticity.c). Creation binds a plastic state to s->body
+ * when def asks for one; the update runs once per step, after the whole step succeeded,
+ * from the diagonalization of the step's force evaluation; the stiffening factor (>= 1)
+ * divides the CFL step. */
+piola_status piola__solid_plastic_create(world_solid *s, const piola_solid_def *def);
+void piola__solid_plastic_update(world_solid *s, double dt);
+double piola__solid_plastic_stiffening(const world_solid *s);
 
 #endif

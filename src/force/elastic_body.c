@@ -1,6 +1,10 @@
 /* The elastic body object and its force loops: the fast blocked loop that piola uses and
  * the scalar reference loop the tests compare it with. Layout and determinism design are
  * explained in elastic_body_internal.h; the SVD kernel in svd_kernel.h. */
+/* Fused multiply-adds in this file's kernels (see "Fused multiply-adds" in svd_kernel.h). */
+#if defined(__GNUC__) && !defined(__clang__)
+#pragma GCC optimize("fp-contract=fast")
+#endif
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -93,7 +97,7 @@ void piola__elastic_body_gather_forces(const piola_elastic_body *body, double *f
 
 /* One block of B tets: F, SVD, stress, forces into the per-tet buffer, block statistics. */
 PIOLA_WIDE_VECTORS static void update_block(piola_elastic_body *body, const double *x, double stiffness_scale,
-                         int want_energy, int32_t block) {
+                         int want_energy, int32_t block, double *out) {
   const int32_t base = block * B;
   double f[9][B], detf[B];
   const int32_t *i0 = body->tet_vertices[0] + base, *i1 = body->tet_vertices[1] + base;
@@ -125,12 +129,10 @@ PIOLA_WIDE_VECTORS static void update_block(piola_elastic_body *body, const doub
   double fhat[3][B];
   double *uo = body->u[0] + base, *vo = body->v[0] + base;
   const long stride = body->padded_tet_count;
-#pragma omp simd
-  for (int l = 0; l < B; ++l) piola__svd3_kernel(&f[0][l], B, uo + l, vo + l, stride, &fhat[0][l], B);
+  piola__svd3_kernel_v8(&f[0][0], B, uo, vo, stride, &fhat[0][0], B);
 
   double phat[3][B], psi[B];
   piola__material_stress_lanes(body, base, fhat, phat);
-  for (int l = 0; l < B; ++l) psi[l] = 0.0;
   if (want_energy)
     for (int l = 0; l < B; ++l) {
       double fh[3] = {fhat[0][l], fhat[1][l], fhat[2][l]};
@@ -138,7 +140,7 @@ PIOLA_WIDE_VECTORS static void update_block(piola_elastic_body *body, const doub
     }
 
   const double *volume = body->rest_volume + base;
-  double *tf = body->tet_forces + 12 * (size_t)base; /* this block's 12 rows of B lanes */
+  double tf[12 * B]; /* this block's 12 rows (3 corner + component) of B lanes */
 #pragma omp simd
   for (int l = 0; l < B; ++l) {
     double p0 = phat[0][l] * stiffness_scale, p1 = phat[1][l] * stiffness_scale,
@@ -168,14 +170,32 @@ PIOLA_WIDE_VECTORS static void update_block(piola_elastic_body *body, const doub
     }
   }
 
+  /* add the block's forces into out, tet by tet in order (padding tets are skipped) */
+  int32_t real_tets = body->tet_count - base < B ? body->tet_count - base : B;
+  for (int l = 0; l < real_tets; ++l)
+    for (int c = 0; c < 4; ++c) {
+      double *o = out + 3 * (size_t)body->tet_vertices[c][base + l];
+      o[0] += tf[(3 * c) * B + l];
+      o[1] += tf[(3 * c + 1) * B + l];
+      o[2] += tf[(3 * c + 2) * B + l];
+    }
+
+  /* per-tet state for the getters (fhat AoS as the public API has it), then statistics,
+   * which only a caller asking for stats needs */
+  double *fhat_out = body->fhat + 3 * (size_t)base, *det_out = body->det_f + base;
+#pragma omp simd
+  for (int l = 0; l < B; ++l) {
+    fhat_out[3 * l] = fhat[0][l];
+    fhat_out[3 * l + 1] = fhat[1][l];
+    fhat_out[3 * l + 2] = fhat[2][l];
+    det_out[l] = detf[l];
+  }
+  if (!want_energy) return;
   int32_t real = body->tet_count - base < B ? body->tet_count - base : B;
   double energy = 0, min_det = INFINITY;
   int32_t inverted = 0;
   for (int l = 0; l < B; ++l) {
-    int32_t t = base + l;
-    for (int k = 0; k < 3; ++k) body->fhat[3 * t + k] = fhat[k][l];
-    body->det_f[t] = detf[l];
-    body->energy_density[t] = psi[l] * stiffness_scale;
+    body->energy_density[base + l] = psi[l] * stiffness_scale;
     if (l < real) {
       energy += volume[l] * psi[l] * stiffness_scale;
       inverted += detf[l] < 0;
@@ -208,10 +228,33 @@ piola_status piola_elastic_body_update(piola_elastic_body *body, const double *x
                           (int)(i / 3));
   }
   int32_t blocks = body->padded_tet_count / B;
-#pragma omp parallel for schedule(static) num_threads(piola__thread_count()) \
-    if (blocks >= PIOLA_PARALLEL_MIN_BLOCKS)
-  for (int32_t b = 0; b < blocks; ++b) update_block(body, x, stiffness_scale, stats != NULL, b);
-  piola__elastic_body_gather_forces(body, forces);
+  const int64_t n = 3 * (int64_t)body->vertex_count;
+  if (blocks < PIOLA_PARALLEL_MIN_BLOCKS || !body->damping_chunk_forces) {
+    for (int64_t i = 0; i < n; ++i) forces[i] = 0.0;
+    for (int32_t b = 0; b < blocks; ++b) update_block(body, x, stiffness_scale, stats != NULL, b, forces);
+  } else {
+    /* Determinism without a per-tet buffer (as in damping.c): PIOLA_DAMPING_CHUNKS fixed
+     * ranges of blocks, each summed in tet order into its own array, the arrays added in
+     * chunk order; which thread runs a chunk changes nothing. */
+    double *partial = body->damping_chunk_forces;
+#pragma omp parallel num_threads(piola__thread_count())
+    {
+#pragma omp for schedule(static)
+      for (int k = 0; k < PIOLA_DAMPING_CHUNKS; ++k) {
+        double *fk = partial + (size_t)k * (size_t)n;
+        for (int64_t i = 0; i < n; ++i) fk[i] = 0.0;
+        int32_t b0 = (int32_t)((int64_t)blocks * k / PIOLA_DAMPING_CHUNKS);
+        int32_t b1 = (int32_t)((int64_t)blocks * (k + 1) / PIOLA_DAMPING_CHUNKS);
+        for (int32_t b = b0; b < b1; ++b) update_block(body, x, stiffness_scale, stats != NULL, b, fk);
+      }
+#pragma omp for schedule(static)
+      for (int64_t i = 0; i < n; ++i) {
+        double sum = partial[i];
+        for (int k = 1; k < PIOLA_DAMPING_CHUNKS; ++k) sum += partial[(size_t)k * (size_t)n + i];
+        forces[i] = sum;
+      }
+    }
+  }
   body->has_state = 1;
   body->damping_ready = 0;
   memcpy(body->positions, x, sizeof(double) * 3 * (size_t)body->vertex_count);

@@ -13,10 +13,12 @@
  * 9 multiplies it costs. Cold data (rest positions, masses, the public AoS copy of the tets)
  * lives apart and the loop never touches it.
  *
- * Determinism. Tets write their four nodal forces into a per-tet buffer (12 doubles); a
- * second pass gives each vertex the sum of its incident (tet, corner) entries, read from a
- * CSR incidence list sorted by tet index. Each sum has a fixed order and no two threads write
- * the same place, so forces are bit-for-bit identical for any thread count, without atomics.
+ * Determinism. The force loop splits the tets into PIOLA_DAMPING_CHUNKS fixed ranges of
+ * blocks (whatever the thread count); each range adds its tets' forces in tet order into its
+ * own per-vertex array (damping_chunk_forces, shared scratch with damping), and the arrays
+ * are added in range order. Each sum has a fixed order and no two threads write the same
+ * place, so forces are bit-for-bit identical for any thread count, without atomics. (The
+ * per-tet buffer tet_forces and the incidence list below were the previous scheme.)
  * Statistics are summed per block and then serially over blocks for the same reason.
  *
  * The energy density is computed only when asked for (stats or the getter): stepping needs

@@ -13,13 +13,13 @@
  * step is made of timed alone: one elastic update and one damping-force evaluation (a step
  * costs one update plus about one damping evaluation per CG iteration). */
 #include <math.h>
-#include <omp.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <time.h>
 
 #include "piola/mesh_io.h"
+#include "piola/threads.h"
 #include "piola/world.h"
 
 static double now_seconds(void) {
@@ -55,7 +55,6 @@ int main(int argc, char **argv) {
          "ms/update", "ms/damping");
   for (int threads = 1; threads <= 2; ++threads) {
     piola_set_thread_count(threads);
-    omp_set_num_threads(threads);
     double *times = malloc((size_t)repeats * sizeof *times);
     double *cpu = malloc((size_t)repeats * sizeof *cpu);
     double *upd = malloc((size_t)repeats * sizeof *upd);

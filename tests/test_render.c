@@ -5,12 +5,12 @@
  * colour bar, camera framing keeps the object inside the image, and output is deterministic
  * for any thread count. Set PIOLA_TEST_RENDER_OUT=folder to keep the images. */
 #include <math.h>
-#include <omp.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
 #include "piola/render.h"
+#include "piola/threads.h"
 #include "render/render_internal.h"
 #include "test_render_support.h"
 #include "test_support.h"
@@ -509,9 +509,8 @@ static void test_deterministic_for_any_thread_count(void **state) {
   box.center = (piola_vec3){0.6, 0.2, 0.15};
   box.half_extents = (piola_vec3){0.15, 0.15, 0.15};
   piola_image a = {0}, b = {0};
-  int saved = omp_get_max_threads();
   for (int threads = 1; threads <= 2; ++threads) {
-    omp_set_num_threads(threads);
+    piola_set_thread_count(threads);
     piola_renderer *r;
     assert_int_equal(piola_renderer_create(&def, &r), PIOLA_OK);
     assert_int_equal(piola_renderer_add_obstacle(r, &plane), PIOLA_OK);
@@ -526,7 +525,7 @@ static void test_deterministic_for_any_thread_count(void **state) {
     }
     piola_renderer_destroy(r);
   }
-  omp_set_num_threads(saved);
+  piola_set_thread_count(0);
   keep("determinism_scene", &a);
   assert_memory_equal(a.rgb, b.rgb, 3 * (size_t)a.width * (size_t)a.height);
   piola_image_free(&a);

@@ -29,6 +29,7 @@
 
 #include <stdint.h>
 
+#include "common/threads.h"
 #include "piola/elastic_body.h"
 
 #define PIOLA_TET_BLOCK 8
@@ -115,7 +116,7 @@ piola_status piola__elastic_body_update_reference(const piola_elastic_body *body
 /* Sums the per-tet force buffer into per-vertex forces, in parallel, deterministically. */
 void piola__elastic_body_gather_forces(const piola_elastic_body *body, double *forces);
 
-/* The number of threads a parallel loop should use (threads.c). */
-int piola__thread_count(void);
+/* piola__thread_count, the number of threads a parallel loop should use, is in
+ * common/threads.h (included above). */
 
 #endif

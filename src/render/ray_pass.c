@@ -8,6 +8,7 @@
 #include <math.h>
 #include <stdlib.h>
 
+#include "common/threads.h"
 #include "render/render_internal.h"
 #include "sim/obstacle_internal.h"
 
@@ -77,7 +78,7 @@ void piola__render_ray_pass(const piola_renderer *r, const render_camera *cam, d
   const double checker = r->checker_size, fog = 10 * (r->scene_size > 0 ? r->scene_size : 1);
   const double inv_f = 1.0 / cam->focal_px;
   const int W = cam->width, H = cam->height;
-#pragma omp parallel for schedule(dynamic, 4)
+#pragma omp parallel for schedule(dynamic, 4) num_threads(piola__thread_count())
   for (int y = 0; y < H; ++y) {
     float bg[3];
     background(cam, y, bg);

@@ -19,6 +19,7 @@
 #include "piola/render.h"
 #include "piola/threads.h"
 #include "piola/scene.h"
+#include "piola/world_shells.h"
 #include "piola/world.h"
 
 static void usage(FILE *out) {
@@ -139,9 +140,10 @@ int cli_run(int argc, char **argv) {
     return 1;
   }
   bool tty = isatty(STDERR_FILENO);
-  fprintf(stderr, "piola run: %s -> %s: %d frames at %g fps, %d solids, %d obstacles, first dt %.3g s\n",
+  fprintf(stderr, "piola run: %s -> %s: %d frames at %g fps, %d solids, %d shells, %d obstacles, first dt %.3g s\n",
           scene_path, out_dir, frames, fps, (int)piola_world_solid_count(world),
-          (int)piola_world_obstacle_count(world), piola_world_stable_dt(world));
+          (int)piola_world_shell_count(world), (int)piola_world_obstacle_count(world),
+          piola_world_stable_dt(world));
   /* previews (src/render): DIR/scene.json, DIR/preview.png and, with --render, every frame */
   piola_preview *preview = NULL;
   if (piola_preview_open(out_dir, scene_path, render_frames, &preview) != PIOLA_OK)

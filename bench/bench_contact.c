@@ -1,0 +1,134 @@
+/* Cost of collision processing (BFA02: repulsion, continuous detection, impact zones) per
+ * step against surface size: a square cloth grid folded over its middle line, its upper half
+ * closing onto the lower one a little more every step (with some random velocity on top), so
+ * that the layers come into contact along the fold and then over the whole overlap. Prints,
+ * for each size, the median over the measured steps of the processing time (wall clock, and
+ * CPU time of all threads, which is steadier on a shared machine), with contacts,
+ * impacts and impact-zone vertices per step.
+ *
+ *   build/NAME/bench_contact [max_triangles [closing]]   (OMP_NUM_THREADS sets the threads)
+ *
+ * closing: how many thicknesses the far edge moves towards the lower layer per step (default
+ * 1: mostly repulsion; 8: the layers are driven through each other, impacts and zones). */
+#include <math.h>
+#include <omp.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <time.h>
+
+#include "piola/collision_surface.h"
+
+static double now_seconds(void) {
+  struct timespec t;
+  clock_gettime(CLOCK_MONOTONIC, &t);
+  return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
+}
+
+static double cpu_seconds(void) {
+  struct timespec t;
+  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
+  return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
+}
+
+static int compare_doubles(const void *a, const void *b) {
+  const double x = *(const double *)a, y = *(const double *)b;
+  return (x > y) - (x < y);
+}
+
+static unsigned long long rng_state = 88172645463325252ull;
+static double uniform(void) {
+  rng_state ^= rng_state << 13, rng_state ^= rng_state >> 7, rng_state ^= rng_state << 17;
+  return (double)(rng_state >> 11) * 0x1.0p-53;
+}
+
+/* Grid vertex (i, j) of an n x n sheet of side 1 m folded by angle theta about x = 0.5. */
+static void folded(int n, int i, int j, double theta, double *p) {
+  double x = (double)i / (n - 1), y = (double)j / (n - 1);
+  if (x <= 0.5) {
+    p[0] = x, p[1] = y, p[2] = 0.0;
+  } else {
+    double r = x - 0.5;
+    p[0] = 0.5 + r * cos(theta), p[1] = y, p[2] = r * sin(theta);
+  }
+}
+
+int main(int argc, char **argv) {
+  const int max_triangles = argc > 1 ? atoi(argv[1]) : 200000;
+  static const int targets[] = {10000, 25000, 50000, 100000, 200000};
+  const double closing = argc > 2 ? atof(argv[2]) : 1.0;
+  if (!(closing > 0.0)) return 1;
+  printf(
+      "folding cloth closing by %g thickness per step, 8 steps measured after 2 warm-up "
+      "steps, %d threads, median per step\n",
+      closing, omp_get_max_threads());
+  printf(
+      "| triangles | vertices | wall ms/step | CPU ms/step | CPU ns/triangle | contacts | impacts "
+      "| zone vertices |\n");
+  printf("|---|---|---|---|---|---|---|---|\n");
+  for (size_t t = 0; t < sizeof targets / sizeof targets[0]; ++t) {
+    if (targets[t] > max_triangles) break;
+    const int n = (int)lround(sqrt(targets[t] / 2.0)) + 1;
+    const int nv = n * n, nt = 2 * (n - 1) * (n - 1);
+    int32_t *tris = malloc(sizeof(int32_t) * 3 * (size_t)nt);
+    double *x = malloc(sizeof(double) * 3 * (size_t)nv),
+           *v = malloc(sizeof(double) * 3 * (size_t)nv);
+    double *m = malloc(sizeof(double) * (size_t)nv);
+    if (!tris || !x || !v || !m) return 1;
+    int k = 0;
+    for (int j = 0; j + 1 < n; ++j)
+      for (int i = 0; i + 1 < n; ++i) {
+        int32_t a = j * n + i, b = a + 1, c = a + n, d = c + 1;
+        tris[k++] = a, tris[k++] = b, tris[k++] = d, tris[k++] = a, tris[k++] = d, tris[k++] = c;
+      }
+    const double spacing = 1.0 / (n - 1), h = 0.25 * spacing, dt = 1e-3;
+    piola_collision_body_def body = piola_default_collision_body_def();
+    body.thickness = h, body.friction = 0.3;
+    piola_collision_surface_def def = piola_default_collision_surface_def();
+    def.vertex_count = nv, def.triangle_count = nt, def.triangles = tris, def.body_count = 1;
+    def.bodies = &body;
+    piola_collision_surface *surface = NULL;
+    if (piola_collision_surface_create(&def, &surface) != PIOLA_OK) return 1;
+    /* Start folded to within 4 thicknesses at the far edge; close by one thickness a step. */
+    double theta = M_PI - 4.0 * h / 0.5;
+    for (int j = 0; j < n; ++j)
+      for (int i = 0; i < n; ++i) folded(n, i, j, theta, x + 3 * (j * n + i));
+    for (int i = 0; i < nv; ++i) m[i] = 1e-4;
+    double times[8], cpu[8];
+    long long contacts = 0, impacts = 0, zone_vertices = 0;
+    for (int step = 0; step < 10; ++step) {
+      const double dtheta = closing * h / 0.5;
+      for (int j = 0; j < n; ++j)
+        for (int i = 0; i < n; ++i) {
+          double next[3], *u = v + 3 * (j * n + i);
+          folded(n, i, j, theta + dtheta, next);
+          double here[3];
+          folded(n, i, j, theta, here);
+          for (int c = 0; c < 3; ++c)
+            u[c] = (next[c] - here[c]) / dt + 0.2 * spacing / dt * (uniform() - 0.5);
+        }
+      piola_collision_stats st;
+      double t0 = now_seconds(), c0 = cpu_seconds();
+      if (piola_collision_surface_process(surface, x, v, m, dt, NULL, &st) != PIOLA_OK) return 1;
+      double elapsed = now_seconds() - t0, cpu_elapsed = cpu_seconds() - c0;
+      if (getenv("BENCH_TRACE"))
+        fprintf(stderr, "step %d: %.1f ms contacts %lld impacts %lld passes %d zone passes %d\n",
+                step, 1e3 * elapsed, (long long)st.contacts, (long long)st.impacts,
+                st.collision_passes, st.zone_passes);
+      for (int i = 0; i < 3 * nv; ++i) x[i] += dt * v[i];
+      theta += dtheta;
+      if (step >= 2) {
+        times[step - 2] = elapsed, cpu[step - 2] = cpu_elapsed;
+        contacts += st.contacts, impacts += st.impacts, zone_vertices += st.zone_vertices;
+      }
+    }
+    qsort(times, 8, sizeof(double), compare_doubles);
+    qsort(cpu, 8, sizeof(double), compare_doubles);
+    double median = 0.5 * (times[3] + times[4]), cpu_median = 0.5 * (cpu[3] + cpu[4]);
+    printf("| %d | %d | %.1f | %.1f | %.0f | %lld | %lld | %lld |\n", nt, nv, 1e3 * median,
+           1e3 * cpu_median, 1e9 * cpu_median / nt, contacts / 8, impacts / 8, zone_vertices / 8);
+    fflush(stdout);
+    piola_collision_surface_destroy(surface);
+    free(tris), free(x), free(v), free(m);
+  }
+  return 0;
+}

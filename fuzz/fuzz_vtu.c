@@ -14,7 +14,9 @@ static void check_cells(const int32_t *v, const int32_t *cells, int32_t count, i
                         const piola_vtu_data *d) {
   for (int32_t i = 0; i < count; ++i) {
     for (int k = 0; k < corners; ++k)
-      if (v[corners * (size_t)i + (size_t)k] < 0 || v[corners * (size_t)i + (size_t)k] >= d->point_count) abort();
+      if (v[corners * (size_t)i + (size_t)k] < 0 ||
+          v[corners * (size_t)i + (size_t)k] >= d->point_count)
+        abort();
     if (cells[i] < 0 || cells[i] >= d->cell_count || (i > 0 && cells[i] <= cells[i - 1])) abort();
   }
 }
@@ -34,10 +36,12 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
     volatile double sum = 0;
     for (int32_t i = 0; i < d.point_field_count; ++i) /* the last value is there (ASan) */
       if (d.point_count > 0)
-        sum += d.point_fields[i].values[(size_t)d.point_fields[i].components * (size_t)d.point_count - 1];
+        sum += d.point_fields[i]
+                   .values[(size_t)d.point_fields[i].components * (size_t)d.point_count - 1];
     for (int32_t i = 0; i < d.cell_field_count; ++i)
       if (d.cell_count > 0)
-        sum += d.cell_fields[i].values[(size_t)d.cell_fields[i].components * (size_t)d.cell_count - 1];
+        sum +=
+            d.cell_fields[i].values[(size_t)d.cell_fields[i].components * (size_t)d.cell_count - 1];
     (void)sum;
     piola_vtu_data_free(&d);
   }

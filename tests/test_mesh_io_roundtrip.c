@@ -223,12 +223,15 @@ static void vtu_fields_round_trip_exactly(void **state) {
   double *vector = malloc(3 * (size_t)np * sizeof(double));
   double *energy = malloc((size_t)nc * sizeof(double));
   double *stretch = malloc(3 * (size_t)nc * sizeof(double));
-  for (int32_t i = 0; i < 3 * np; ++i) x[i] = test_rng_normal(&rng), vector[i] = test_rng_normal(&rng) * 1e-300;
-  for (int32_t i = 0; i < np; ++i) scalar[i] = i % 7 == 0 ? -0.0 : test_rng_uniform(&rng, -1e300, 1e300);
+  for (int32_t i = 0; i < 3 * np; ++i)
+    x[i] = test_rng_normal(&rng), vector[i] = test_rng_normal(&rng) * 1e-300;
+  for (int32_t i = 0; i < np; ++i)
+    scalar[i] = i % 7 == 0 ? -0.0 : test_rng_uniform(&rng, -1e300, 1e300);
   for (int32_t i = 0; i < nc; ++i) energy[i] = i % 5 == 0 ? 5e-324 : test_rng_normal(&rng);
   for (int32_t i = 0; i < 3 * nc; ++i) stretch[i] = test_rng_normal(&rng) / 3;
   piola_vtu_field point_fields[2] = {{"temperature", 1, scalar}, {"velocity", 3, vector}};
-  piola_vtu_field cell_fields[2] = {{"energy_density", 1, energy}, {"principal_stretch", 3, stretch}};
+  piola_vtu_field cell_fields[2] = {{"energy_density", 1, energy},
+                                    {"principal_stretch", 3, stretch}};
   piola_vtu_frame frame = {0};
   frame.tets = &tets;
   frame.triangles = &shell;
@@ -254,10 +257,12 @@ static void vtu_fields_round_trip_exactly(void **state) {
   }
   assert_int_equal(d.point_field_count, 2);
   assert_int_equal(d.cell_field_count, 2);
-  const piola_vtu_field *written[4] = {&point_fields[0], &point_fields[1], &cell_fields[0], &cell_fields[1]};
+  const piola_vtu_field *written[4] = {&point_fields[0], &point_fields[1], &cell_fields[0],
+                                       &cell_fields[1]};
   for (int i = 0; i < 4; ++i) {
-    const piola_vtu_array *a = i < 2 ? piola_vtu_find_field(d.point_fields, d.point_field_count, written[i]->name)
-                                     : piola_vtu_find_field(d.cell_fields, d.cell_field_count, written[i]->name);
+    const piola_vtu_array *a =
+        i < 2 ? piola_vtu_find_field(d.point_fields, d.point_field_count, written[i]->name)
+              : piola_vtu_find_field(d.cell_fields, d.cell_field_count, written[i]->name);
     assert_non_null(a);
     assert_int_equal(a->components, written[i]->components);
     size_t count = (size_t)(i < 2 ? np : nc) * (size_t)a->components;
@@ -285,7 +290,8 @@ static void vtu_fields_round_trip_exactly(void **state) {
     fclose(out);
     piola_status cut_status = piola_vtu_read(tmp("cut.vtu"), &d);
     /* a cut inside the opening tags may read as another dataset type (UNSUPPORTED) */
-    if (cut_status != PIOLA_ERROR_PARSE && cut_status != PIOLA_ERROR_UNSUPPORTED) fail_msg("cut at %ld of %ld: %d %s", keep, size, (int)cut_status, piola_last_error());
+    if (cut_status != PIOLA_ERROR_PARSE && cut_status != PIOLA_ERROR_UNSUPPORTED)
+      fail_msg("cut at %ld of %ld: %d %s", keep, size, (int)cut_status, piola_last_error());
     assert_null(d.positions);
     assert_int_equal(d.point_field_count, 0);
   }

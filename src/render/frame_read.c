@@ -43,7 +43,8 @@ static void sort3(int32_t v[3]) {
   if (v[0] > v[1]) t = v[0], v[0] = v[1], v[1] = t;
 }
 
-static piola_status build_surface(piola_render_frame *f, const piola_vtu_data *d, const char *path) {
+static piola_status build_surface(piola_render_frame *f, const piola_vtu_data *d,
+                                  const char *path) {
   if (4 * (int64_t)d->tet_count + d->triangle_count > INT32_MAX / 4)
     return PIOLA_FAIL(PIOLA_ERROR_UNSUPPORTED, "%s: too many cells to render", path);
   int64_t nf = 4 * (int64_t)d->tet_count;
@@ -88,7 +89,8 @@ static piola_status build_surface(piola_render_frame *f, const piola_vtu_data *d
 
 static double signed_volume(const double *x, const int32_t *t) {
   vec3 a = vec3_load(x + 3 * (size_t)t[0]);
-  vec3 e1 = vec3_sub(vec3_load(x + 3 * (size_t)t[1]), a), e2 = vec3_sub(vec3_load(x + 3 * (size_t)t[2]), a);
+  vec3 e1 = vec3_sub(vec3_load(x + 3 * (size_t)t[1]), a),
+       e2 = vec3_sub(vec3_load(x + 3 * (size_t)t[2]), a);
   vec3 e3 = vec3_sub(vec3_load(x + 3 * (size_t)t[3]), a);
   return vec3_dot(e1, vec3_cross(e2, e3)) / 6;
 }
@@ -119,7 +121,8 @@ static piola_status build_frame(piola_render_frame *f, piola_vtu_data *d, const 
     for (int64_t c = 0; c < f->cell_count; ++c) f->cell_inverted[c] = inv[c] > 0.5;
   } else {
     for (int32_t t = 0; t < d->tet_count; ++t)
-      if (signed_volume(f->points, d->tets + 4 * (size_t)t) < 0) f->cell_inverted[d->tet_cells[t]] = 1;
+      if (signed_volume(f->points, d->tets + 4 * (size_t)t) < 0)
+        f->cell_inverted[d->tet_cells[t]] = 1;
   }
   for (int64_t c = 0; c < f->cell_count; ++c) f->inverted_count += f->cell_inverted[c];
   /* the tets (for stresses) and the rest positions, when the frame has displacements */

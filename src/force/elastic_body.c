@@ -213,6 +213,7 @@ piola_status piola_elastic_body_update(piola_elastic_body *body, const double *x
   for (int32_t b = 0; b < blocks; ++b) update_block(body, x, stiffness_scale, stats != NULL, b);
   piola__elastic_body_gather_forces(body, forces);
   body->has_state = 1;
+  body->damping_ready = 0;
   memcpy(body->positions, x, sizeof(double) * 3 * (size_t)body->vertex_count);
   body->energy_valid = stats != NULL;
   body->last_stiffness_scale = stiffness_scale;

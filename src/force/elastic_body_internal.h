@@ -90,7 +90,19 @@ struct piola_elastic_body {
   int energy_valid;         /* energy_density matches the last update (it is computed only
                                when stats are requested, or lazily by the getter) */
   double last_stiffness_scale;
+
+  /* damping (damping.c): per-tet operator data, prepared from the last update by the first
+   * damping call after it; per block of PIOLA_TET_BLOCK tets at most PIOLA_DAMPING_FIELDS
+   * rows of PIOLA_TET_BLOCK doubles (layout in damping.c) */
+  double *damping_data;
+  double *damping_chunk_forces;  /* PIOLA_DAMPING_CHUNKS * 3 * vertex_count partial sums */
+  int damping_ready;             /* damping_data matches the last update (cleared by it) */
 };
+
+/* Bodies of at least PIOLA_PARALLEL_MIN_BLOCKS blocks sum their damping forces in this many
+ * fixed tet ranges (each its own partial sum), whatever the thread count. */
+#define PIOLA_DAMPING_CHUNKS 4
+#define PIOLA_DAMPING_FIELDS 27
 
 /* Where tet t's corner c force starts in tet_forces: blocks of PIOLA_TET_BLOCK tets hold
  * 12 rows (3 c + i) of PIOLA_TET_BLOCK lanes, so the force loop stores whole vectors. */
@@ -112,6 +124,13 @@ void piola__elastic_body_free_arrays(piola_elastic_body *body);
 piola_status piola__elastic_body_update_reference(const piola_elastic_body *body,
                                                   const double *x, double stiffness_scale,
                                                   double *forces, piola_elastic_stats *stats);
+
+/* Scalar reference of the damping forces for the tests (damping.c): the original per-tet
+ * formulation (U, V and the projections recomputed per tet), summed serially. Reads the
+ * state of the last update like piola_elastic_body_damping_forces. */
+void piola__elastic_body_damping_reference(const piola_elastic_body *body, const double *v,
+                                           double shear_viscosity, double bulk_viscosity,
+                                           double *forces);
 
 /* Sums the per-tet force buffer into per-vertex forces, in parallel, deterministically. */
 void piola__elastic_body_gather_forces(const piola_elastic_body *body, double *forces);

@@ -1,0 +1,133 @@
+/* Benchmark of the damping operator, the kernel that each conjugate-gradient iteration of the
+ * implicit step applies (about 20 times per elastic update).
+ *
+ *   build/<dir>/bench_damping [repeats] [mesh]
+ *
+ * Mesh: Vega's torus-easy.veg (97,878 tets) unless another is given. The body is updated at
+ * its rest positions plus a random perturbation of 2% of the mean edge length (a busy,
+ * rotated-frame state), then, for 1 and 2 threads, each repeat updates once more and times
+ * the first damping call after it (which prepares the per-tet records: "first") and then 20
+ * applies ("apply", per call). Reports medians over `repeats` (default 7) of wall time and
+ * of process CPU time (all threads together), and the least CPU time per apply seen: on a
+ * loaded machine wall time mostly measures the other processes, and even CPU time grows
+ * when another process shares the core's caches and memory bandwidth. For instruction counts, which do not depend on the load, run one
+ * repeat under valgrind --tool=callgrind --toggle-collect=piola_elastic_body_damping_forces
+ * (see docs/bench-notes/damping.md). Uses only the public API, so older versions build it. */
+#include <math.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+#include "piola/elastic_body.h"
+#include "piola/mesh_io.h"
+
+static double now_seconds(void) {
+  struct timespec ts;
+  clock_gettime(CLOCK_MONOTONIC, &ts);
+  return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+static double cpu_seconds(void) {
+  struct timespec ts;
+  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
+  return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+static uint64_t rng_state = 0x9E3779B97F4A7C15ull;
+static double uniform(double lo, double hi) {
+  rng_state ^= rng_state << 13;
+  rng_state ^= rng_state >> 7;
+  rng_state ^= rng_state << 17;
+  return lo + (hi - lo) * (double)(rng_state >> 11) * 0x1.0p-53;
+}
+
+static int compare_doubles(const void *a, const void *b) {
+  double x = *(const double *)a, y = *(const double *)b;
+  return (x > y) - (x < y);
+}
+
+static double median(double *v, int n) {
+  qsort(v, (size_t)n, sizeof *v, compare_doubles);
+  return v[n / 2];
+}
+
+int main(int argc, char **argv) {
+  int repeats = argc > 1 ? atoi(argv[1]) : 7;
+  if (repeats < 1) repeats = 1;
+  const char *path = argc > 2 ? argv[2] : PIOLA_DATA_DIR "/vega/torus-easy.veg";
+  piola_tet_mesh mesh;
+  if (piola_tet_mesh_read(path, &mesh) != PIOLA_OK) {
+    fprintf(stderr, "bench_damping: %s\n", piola_last_error());
+    return 1;
+  }
+  piola_material_def mdef = piola_default_material_def();
+  mdef.model = PIOLA_MODEL_NEOHOOKEAN;
+  piola_material material;
+  piola_elastic_body_def def = piola_default_elastic_body_def();
+  def.rest_mesh = &mesh;
+  def.materials = &material;
+  def.material_count = 1;
+  piola_elastic_body *body = NULL;
+  if (piola_material_init(&mdef, &material) != PIOLA_OK || piola_elastic_body_create(&def, &body) != PIOLA_OK) {
+    fprintf(stderr, "bench_damping: %s\n", piola_last_error());
+    return 1;
+  }
+  int32_t nv = mesh.vertex_count, n = 3 * nv;
+  double edge = 0;
+  for (int32_t t = 0; t < mesh.tet_count; ++t) {
+    const int32_t *tet = mesh.tets + 4 * t;
+    double e2 = 0;
+    for (int k = 0; k < 3; ++k) {
+      double dk = mesh.positions[3 * tet[1] + k] - mesh.positions[3 * tet[0] + k];
+      e2 += dk * dk;
+    }
+    edge += sqrt(e2);
+  }
+  edge /= mesh.tet_count;
+  double *x = malloc(sizeof(double) * (size_t)n), *v = malloc(sizeof(double) * (size_t)n);
+  double *f = malloc(sizeof(double) * (size_t)n);
+  for (int32_t i = 0; i < n; ++i) {
+    x[i] = mesh.positions[i] + 0.02 * edge * uniform(-1, 1);
+    v[i] = uniform(-1, 1);
+  }
+  printf("bench_damping: %s, %d vertices, %d tets\n", path, (int)nv, (int)mesh.tet_count);
+  printf("%8s %14s %14s %14s %16s %16s\n", "threads", "ms/apply", "CPU ms/apply", "min CPU ms",
+         "ms/first call", "CPU ms/first");
+  const int applies = 20;
+  double *wall = malloc(sizeof(double) * (size_t)repeats), *cpu = malloc(sizeof(double) * (size_t)repeats);
+  double *wall1 = malloc(sizeof(double) * (size_t)repeats), *cpu1 = malloc(sizeof(double) * (size_t)repeats);
+  for (int threads = 1; threads <= 2; ++threads) {
+    piola_set_thread_count(threads);
+    for (int r = 0; r < repeats; ++r) {
+      if (piola_elastic_body_update(body, x, 1.0, f, NULL) != PIOLA_OK) {
+        fprintf(stderr, "bench_damping: %s\n", piola_last_error());
+        return 1;
+      }
+      double w0 = now_seconds(), c0 = cpu_seconds();
+      piola_elastic_body_damping_forces(body, v, 1.0, 0.5, f);
+      wall1[r] = now_seconds() - w0;
+      cpu1[r] = cpu_seconds() - c0;
+      w0 = now_seconds();
+      c0 = cpu_seconds();
+      for (int k = 0; k < applies; ++k) piola_elastic_body_damping_forces(body, v, 1.0, 0.5, f);
+      wall[r] = (now_seconds() - w0) / applies;
+      cpu[r] = (cpu_seconds() - c0) / applies;
+    }
+    double cpu_median = median(cpu, repeats); /* sorts cpu: cpu[0] is the least */
+    printf("%8d %14.3f %14.3f %14.3f %16.3f %16.3f\n", threads, 1e3 * median(wall, repeats),
+           1e3 * cpu_median, 1e3 * cpu[0], 1e3 * median(wall1, repeats), 1e3 * median(cpu1, repeats));
+  }
+  piola_set_thread_count(0);
+  free(wall);
+  free(cpu);
+  free(wall1);
+  free(cpu1);
+  free(x);
+  free(v);
+  free(f);
+  piola_elastic_body_destroy(body);
+  piola_tet_mesh_free(&mesh);
+  return 0;
+}

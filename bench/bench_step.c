@@ -15,13 +15,13 @@
  * excludes the first call after the update, which also prepares per-tet records once per
  * step). bench_damping times the damping operator alone, in CPU time too. */
 #include <math.h>
-#include <omp.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <time.h>
 
 #include "piola/mesh_io.h"
+#include "piola/threads.h"
 #include "piola/world.h"
 
 static double now_seconds(void) {
@@ -57,7 +57,6 @@ int main(int argc, char **argv) {
          "ms/update", "ms/damping");
   for (int threads = 1; threads <= 2; ++threads) {
     piola_set_thread_count(threads);
-    omp_set_num_threads(threads);
     double *times = malloc((size_t)repeats * sizeof *times);
     double *cpu = malloc((size_t)repeats * sizeof *cpu);
     double *upd = malloc((size_t)repeats * sizeof *upd);

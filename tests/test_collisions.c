@@ -10,6 +10,7 @@
 
 #include "math/mat3.h"
 #include "piola/obstacle.h"
+#include "piola/threads.h"
 
 static piola_obstacle *make(const piola_obstacle_def *def) {
   piola_obstacle *o = NULL;
@@ -231,11 +232,11 @@ static void many_nodes_end_outside_and_results_do_not_depend_on_threads(void **s
   memcpy(x2, x, sizeof(double) * 3 * (size_t)n);
   memcpy(v2, v, sizeof(double) * 3 * (size_t)n);
   int threads = omp_get_max_threads();
-  omp_set_num_threads(1);
+  piola_set_thread_count(1);
   int32_t hits = piola_obstacles_collide(obstacles, 2, 0.7, 0.005, n, x, v, c, normals);
-  omp_set_num_threads(threads > 1 ? threads : 2);
+  piola_set_thread_count(threads > 1 ? threads : 2);
   int32_t hits2 = piola_obstacles_collide(obstacles, 2, 0.7, 0.005, n, x2, v2, c2, NULL);
-  omp_set_num_threads(threads);
+  piola_set_thread_count(0);
   assert_int_equal(hits, hits2);
   assert_true(hits > n / 50); /* the obstacles fill about 6 % of the sampled cube */
   assert_memory_equal(x, x2, sizeof(double) * 3 * (size_t)n);

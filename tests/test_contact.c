@@ -5,13 +5,13 @@
 #include "test_support.h"
 
 #include <math.h>
-#include <omp.h>
 #include <stdlib.h>
 #include <string.h>
 
 #include "contact/contact_internal.h"
 #include "contact/triangle_intersection.h"
 #include "piola/collision_surface.h"
+#include "piola/threads.h"
 
 typedef struct scene {
   int32_t nv, nt, vcap, tcap;
@@ -469,7 +469,7 @@ static void result_does_not_depend_on_thread_count(void **state) {
   double *results[2] = {NULL, NULL};
   int32_t nv = 0;
   for (int run = 0; run < 2; ++run) {
-    omp_set_num_threads(run == 0 ? 1 : 3);
+    piola_set_thread_count(run == 0 ? 1 : 3);
     scene s = {0};
     flat_sheet lower = {0.01, 0, 0, 0}, upper = {0.01, 0.003, 0.004, 0.012};
     add_grid(&s, 14, 14, flat_position, &lower, 0);
@@ -483,7 +483,7 @@ static void result_does_not_depend_on_thread_count(void **state) {
     piola_collision_surface_destroy(surface);
     scene_free(&s);
   }
-  omp_set_num_threads(omp_get_num_procs());
+  piola_set_thread_count(0);
   assert_memory_equal(results[0], results[1], sizeof(double) * 3 * (size_t)nv);
   free(results[0]), free(results[1]);
 }

@@ -8,11 +8,11 @@
 #include "test_support.h"
 
 #include <math.h>
-#include <omp.h>
 #include <stdlib.h>
 #include <string.h>
 
 #include "piola/world.h"
+#include "piola/threads.h"
 
 /* A box [0,a]x[0,b]x[0,c] of nx*ny*nz cubes, each split into 6 tets around its diagonal. */
 static piola_tet_mesh block(int nx, int ny, int nz, double a, double b, double c) {
@@ -366,8 +366,7 @@ static void initial_state_is_deformed_as_asked(void **state) {
 int main(void) {
   /* tiny meshes: one thread avoids OpenMP barrier overhead on a shared machine; forces are
    * identical whatever the thread count */
-  piola_set_thread_count(1);
-  omp_set_num_threads(1); /* OpenMP loops outside the force loop (collisions) too */
+  piola_set_thread_count(1); /* every parallel loop of piola, collisions included */
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(free_flight_conserves_momentum),
       cmocka_unit_test(undamped_bounce_gains_no_energy),

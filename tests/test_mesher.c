@@ -8,13 +8,13 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include <omp.h>
 
 #include "geometry/analytic_shapes.h"
 #include "mesher/bcc_lattice.h"
 #include "mesher/lattice_phi.h"
 #include "mesher/red_green.h"
 #include "piola/mesher.h"
+#include "piola/threads.h"
 
 /* The dihedral-angle bound the mesher documents (docs/mesher.md). */
 #define MIN_DIHEDRAL_DEG 10.0
@@ -436,13 +436,12 @@ static void output_is_independent_of_thread_count(void **state) {
   def.shape_count = 1;
   def.cell_size = 0.12;
   def.refinement_levels = 1;
-  int saved = omp_get_max_threads();
   piola_tet_mesh one, many;
-  omp_set_num_threads(1);
+  piola_set_thread_count(1);
   assert_int_equal(piola_mesher_generate(&def, &one), PIOLA_OK);
-  omp_set_num_threads(4);
+  piola_set_thread_count(4);
   assert_int_equal(piola_mesher_generate(&def, &many), PIOLA_OK);
-  omp_set_num_threads(saved);
+  piola_set_thread_count(0);
   assert_int_equal(one.tet_count, many.tet_count);
   assert_int_equal(one.vertex_count, many.vertex_count);
   assert_memory_equal(one.tets, many.tets, (size_t)one.tet_count * 4 * sizeof(int32_t));

@@ -5,12 +5,12 @@
  * colour bar, camera framing keeps the object inside the image, and output is deterministic
  * for any thread count. Set PIOLA_TEST_RENDER_OUT=folder to keep the images. */
 #include <math.h>
-#include <omp.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
 #include "piola/render.h"
+#include "piola/threads.h"
 #include "render/render_internal.h"
 #include "test_render_support.h"
 #include "test_support.h"
@@ -188,6 +188,59 @@ static void test_ground_fills_the_view_below_the_horizon(void **state) {
     piola_image_free(&sky);
     piola_image_free(&img);
   }
+}
+
+/* A flat patch lying exactly on the ground (every node at z = 0, as a solid squashed into a
+ * puddle on a plane obstacle is) is drawn over the ground, not hidden by it: every pixel
+ * around its projected centre differs from the empty ground, for a plane obstacle and for
+ * the fallback ground, from a steep and from a grazing camera. */
+static void test_patch_lying_on_the_ground_is_visible(void **state) {
+  (void)state;
+  enum { N = 24 };
+  double x[3 * (N + 1) * (N + 1)];
+  int32_t tri[6 * N * N];
+  for (int j = 0; j <= N; ++j)
+    for (int i = 0; i <= N; ++i) {
+      double *p = x + 3 * (j * (N + 1) + i);
+      p[0] = -0.5 + (double)i / N, p[1] = -0.5 + (double)j / N, p[2] = 0;
+    }
+  for (int j = 0; j < N; ++j)
+    for (int i = 0; i < N; ++i) {
+      int32_t a = j * (N + 1) + i, b = a + 1, c = a + N + 1, d = c + 1, *t = tri + 6 * (j * N + i);
+      t[0] = a, t[1] = b, t[2] = d, t[3] = a, t[4] = d, t[5] = c;
+    }
+  piola_render_mesh m = {(N + 1) * (N + 1), x, 2 * N * N, tri, NULL, NULL, NULL, 0};
+  const double heights[2] = {2.0, 0.25};
+  for (int fallback = 0; fallback < 2; ++fallback)
+    for (int h = 0; h < 2; ++h) {
+      piola_render_def def = axis_camera(3, 40);
+      def.camera_position = (piola_vec3){0.1, -3, heights[h]};
+      def.ground = fallback == 1;
+      def.ground_height = 0;
+      piola_obstacle_def plane = piola_default_obstacle_def(); /* z = 0, normal +z */
+      plane.type = PIOLA_OBSTACLE_PLANE;
+      plane.center = (piola_vec3){0, 0, 0};
+      plane.axis = (piola_vec3){0, 0, 1};
+      piola_image ground = {0}, patch = {0};
+      render_pair(&def, &m, fallback ? NULL : &plane, &ground, &patch);
+      if (!fallback) {
+        /* render_pair drew the empty image before adding the plane: redraw it with it */
+        piola_renderer *r;
+        assert_int_equal(piola_renderer_create(&def, &r), PIOLA_OK);
+        assert_int_equal(piola_renderer_add_obstacle(r, &plane), PIOLA_OK);
+        assert_int_equal(piola_renderer_render(r, NULL, &ground), PIOLA_OK);
+        piola_renderer_destroy(r);
+      }
+      if (h == 0 && !fallback) keep("patch_on_ground", &patch);
+      /* the target (origin, the patch centre) projects to the image centre; the patch
+       * covers at least +-12 x +-4 pixels around it from both cameras */
+      int W = def.width, H = def.height;
+      for (int y = H / 2 - 4; y <= H / 2 + 4; ++y)
+        for (int px = W / 2 - 12; px <= W / 2 + 12; ++px)
+          assert_false(same_rgb(&ground, &patch, px, y));
+      piola_image_free(&ground);
+      piola_image_free(&patch);
+    }
 }
 
 /* The highlight colour appears exactly when faces are flagged, and where they are. */
@@ -509,9 +562,8 @@ static void test_deterministic_for_any_thread_count(void **state) {
   box.center = (piola_vec3){0.6, 0.2, 0.15};
   box.half_extents = (piola_vec3){0.15, 0.15, 0.15};
   piola_image a = {0}, b = {0};
-  int saved = omp_get_max_threads();
   for (int threads = 1; threads <= 2; ++threads) {
-    omp_set_num_threads(threads);
+    piola_set_thread_count(threads);
     piola_renderer *r;
     assert_int_equal(piola_renderer_create(&def, &r), PIOLA_OK);
     assert_int_equal(piola_renderer_add_obstacle(r, &plane), PIOLA_OK);
@@ -526,7 +578,7 @@ static void test_deterministic_for_any_thread_count(void **state) {
     }
     piola_renderer_destroy(r);
   }
-  omp_set_num_threads(saved);
+  piola_set_thread_count(0);
   keep("determinism_scene", &a);
   assert_memory_equal(a.rgb, b.rgb, 3 * (size_t)a.width * (size_t)a.height);
   piola_image_free(&a);
@@ -570,6 +622,7 @@ int main(void) {
       cmocka_unit_test(test_mesh_sphere_silhouette_area),
       cmocka_unit_test(test_obstacle_sphere_silhouette_area),
       cmocka_unit_test(test_depth_compositing_of_mesh_and_obstacle),
+      cmocka_unit_test(test_patch_lying_on_the_ground_is_visible),
       cmocka_unit_test(test_ground_fills_the_view_below_the_horizon),
       cmocka_unit_test(test_inverted_highlight_present_exactly_when_flagged),
       cmocka_unit_test(test_value_colors_and_color_bar),

@@ -24,6 +24,7 @@
 #include "piola/material.h"
 #include "piola/mesh.h"
 #include "piola/status.h"
+#include "piola/threads.h"
 
 #ifdef __cplusplus
 extern "C" {
@@ -88,8 +89,8 @@ PIOLA_API const double *piola_elastic_body_det_f(const piola_elastic_body *body)
 PIOLA_API const double *piola_elastic_body_energy_density(const piola_elastic_body *body);
 PIOLA_API const double *piola_elastic_body_fhat(const piola_elastic_body *body);
 
-/* Number of OpenMP threads piola uses (0 = OpenMP's default). */
-PIOLA_API void piola_set_thread_count(int threads);
+/* piola_set_thread_count (the number of threads piola uses) is in piola/threads.h, included
+ * above. */
 
 #ifdef __cplusplus
 }

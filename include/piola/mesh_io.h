@@ -54,6 +54,46 @@ typedef struct piola_vtu_frame {
 
 PIOLA_API piola_status piola_vtu_write(const char *path, const piola_vtu_frame *frame);
 
+/* A named field read from a VTU file: `components` values per point or per cell, converted
+ * to double whatever their stored type. */
+typedef struct piola_vtu_array {
+  char name[64];           /* "" when the DataArray has no (or a too long) Name */
+  int components;          /* 1..64 */
+  double *values;          /* components * count values */
+} piola_vtu_array;
+
+/* Everything piola_vtu_read takes from a VTU file. Cells keep the file's vertex order (they
+ * are not reoriented, so inverted elements stay inverted). Tets are VTK type 10 and the
+ * corners of quadratic tets (24); triangles are type 5 and the corners of quadratic
+ * triangles (22); other cells count in cell_count but are not kept. tet_cells and
+ * triangle_cells give each element's index among all cells, which is what cell fields are
+ * indexed by. Fields of non-numeric type (String) are skipped. */
+typedef struct piola_vtu_data {
+  int32_t point_count;
+  double *positions;               /* 3 * point_count, m */
+  int32_t cell_count;              /* all cells of the file */
+  int32_t tet_count;
+  int32_t *tets;                   /* 4 * tet_count vertex indices */
+  int32_t *tet_cells;              /* tet_count cell indices */
+  int32_t triangle_count;
+  int32_t *triangles;              /* 3 * triangle_count vertex indices */
+  int32_t *triangle_cells;         /* triangle_count cell indices */
+  piola_vtu_array *point_fields;   /* values per point */
+  int32_t point_field_count;
+  piola_vtu_array *cell_fields;    /* values per cell (cell_count of them) */
+  int32_t cell_field_count;
+} piola_vtu_data;
+
+/* Reads a VTK XML UnstructuredGrid file (one Piece; ascii, base64 or appended raw data;
+ * little-endian; not compressed) with its point and cell fields. Every count and offset is
+ * checked against the file, so a truncated file (a frame still being written) fails with
+ * PIOLA_ERROR_PARSE; on failure *out is empty. Free with piola_vtu_data_free. */
+PIOLA_API piola_status piola_vtu_read(const char *path, piola_vtu_data *out);
+PIOLA_API void piola_vtu_data_free(piola_vtu_data *data);
+/* The field named `name` among `fields`, or NULL. */
+PIOLA_API const piola_vtu_array *piola_vtu_find_field(const piola_vtu_array *fields, int32_t count,
+                                                      const char *name);
+
 /* A material of a Vega .veg file (*MATERIAL name, ENU density E nu). Other material kinds
  * keep their name and kind with density/E/nu set to 0. */
 typedef struct piola_vega_material {

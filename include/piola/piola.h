@@ -17,6 +17,7 @@
 #include "piola/rigid_motion.h"
 #include "piola/scene.h"
 #include "piola/status.h"
+#include "piola/threads.h"
 #include "piola/world.h"
 
 #endif

@@ -6,7 +6,6 @@
  * folder untouched. A state that turns NaN or Inf stops the run with exit code 1, keeping
  * every frame written so far and a failure report. */
 #include <math.h>
-#include <omp.h>
 #include <stdbool.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -18,6 +17,7 @@
 #include "piola/elastic_body.h"
 #include "piola/output.h"
 #include "piola/render.h"
+#include "piola/threads.h"
 #include "piola/scene.h"
 #include "piola/world_shells.h"
 #include "piola/world.h"
@@ -123,10 +123,7 @@ int cli_run(int argc, char **argv) {
     fprintf(stderr, "piola run: %s\n", piola_last_error());
     return 2;
   }
-  if (threads > 0) {
-    piola_set_thread_count((int)threads);
-    omp_set_num_threads((int)threads); /* also the OpenMP loops outside the force loop */
-  }
+  if (threads > 0) piola_set_thread_count((int)threads); /* every parallel loop of piola */
   double t_start = now_seconds();
   piola_scene *scene = NULL;
   if (piola_scene_load(scene_path, &scene) != PIOLA_OK) {

@@ -3,6 +3,8 @@
 
 #include <stdlib.h>
 
+#include "common/threads.h"
+
 enum { LEAF_SIZE = 4, MAX_DEPTH = 128 };
 
 static void box_union(piola__box *a, const piola__box *b) {
@@ -105,7 +107,7 @@ int piola__bvh_build(piola__bvh *bvh, const piola__box *boxes, int32_t n) {
 void piola__bvh_refit(piola__bvh *bvh, const piola__box *boxes) {
   const int32_t count = bvh->node_count;
   piola__bvh_node *nodes = bvh->nodes;
-#pragma omp parallel for schedule(static) if (count >= 4096)
+#pragma omp parallel for schedule(static) num_threads(piola__thread_count()) if (count >= 4096)
   for (int32_t i = 0; i < count; ++i) {
     if (nodes[i].count == 0) continue;
     piola__box b = boxes[bvh->order[nodes[i].first]];

@@ -5,6 +5,7 @@
 #include <string.h>
 
 #include "common/status_internal.h"
+#include "common/threads.h"
 #include "contact/ccd.h"
 #include "contact/contact_internal.h"
 #include "contact/proximity.h"
@@ -218,7 +219,7 @@ static void box_union_of(piola__box *out, const piola__box *a, const piola__box 
  * within their pair's thickness (or tolerance) then always have overlapping boxes. */
 static void compute_boxes(piola_collision_surface *s, const double *x0, const double *v, double dt,
                           detect_mode mode) {
-#pragma omp parallel if (s->vertex_count + s->edge_count >= 4096)
+#pragma omp parallel num_threads(piola__thread_count()) if (s->vertex_count + s->edge_count >= 4096)
   {
 #pragma omp for schedule(static)
     for (int32_t i = 0; i < s->vertex_count; ++i) {
@@ -480,7 +481,7 @@ static int detect_all(piola_collision_surface *s, const double *x0, const double
   piola__contact_list *lists = failed ? NULL : calloc((size_t)total + 1, sizeof(*lists));
   if (!failed && !lists) failed = 1;
   if (!failed) {
-#pragma omp parallel for schedule(dynamic, 1) \
+#pragma omp parallel for schedule(dynamic, 1) num_threads(piola__thread_count()) \
     reduction(|                               \
               : failed) if (total >= 64 && s->triangle_count >= 2048)
     for (int32_t i = 0; i < total; ++i) {
@@ -604,7 +605,7 @@ static int detect(piola_collision_surface *s, const double *x0, const double *v,
     blocks += (len + QUERY_BLOCK - 1) / QUERY_BLOCK;
   }
   int failed = 0;
-#pragma omp parallel reduction(| : failed) if (blocks >= 16)
+#pragma omp parallel num_threads(piola__thread_count()) reduction(| : failed) if (blocks >= 16)
   {
     piola__index_list candidates = {0};
 #pragma omp for schedule(dynamic, 1)

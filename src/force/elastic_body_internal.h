@@ -31,6 +31,7 @@
 
 #include <stdint.h>
 
+#include "common/threads.h"
 #include "piola/elastic_body.h"
 
 #define PIOLA_TET_BLOCK 8
@@ -136,7 +137,7 @@ void piola__elastic_body_damping_reference(const piola_elastic_body *body, const
 /* Sums the per-tet force buffer into per-vertex forces, in parallel, deterministically. */
 void piola__elastic_body_gather_forces(const piola_elastic_body *body, double *forces);
 
-/* The number of threads a parallel loop should use (threads.c). */
-int piola__thread_count(void);
+/* piola__thread_count, the number of threads a parallel loop should use, is in
+ * common/threads.h (included above). */
 
 #endif

@@ -18,6 +18,8 @@ piola_status piola__read_tetgen_mem(const char *node_name, const char *node_data
                                     piola_tet_mesh *out);
 piola_status piola__read_gmsh_mem(const char *name, const char *data, size_t size, piola_tet_mesh *out);
 piola_status piola__read_vtu_mem(const char *name, const char *data, size_t size, piola_tet_mesh *out);
+/* The whole content of a VTU file (cells as in the file, fields); see piola_vtu_read. */
+piola_status piola__vtu_read_mem(const char *name, const char *data, size_t size, piola_vtu_data *out);
 piola_status piola__read_medit_mem(const char *name, const char *data, size_t size, piola_tet_mesh *out);
 piola_status piola__read_vega_mem(const char *name, const char *data, size_t size, piola_tet_mesh *out,
                                   piola_vega_material **materials, int32_t *material_count);

@@ -1,13 +1,18 @@
-/* VTK XML UnstructuredGrid (.vtu) reader.
+/* VTK XML UnstructuredGrid (.vtu) reader: the one reader of the format in piola.
  *
  * Reads what piola and the usual tools write without compression: one Piece, DataArrays
  * in ascii, inline base64 ("binary") or appended raw format, little-endian, UInt32 or
- * UInt64 headers. Tets (VTK type 10) are kept, and the corners of quadratic tets (type 24);
- * other cells (triangles, lines, ...) are skipped. A cell array named "region" (any numeric
- * type) becomes tet_regions. The XML is scanned for the few tags needed, not parsed in
- * full: this is an exchange format reader, not a general XML parser. Refused: compressed
- * data, big-endian data, appended base64, other dataset types. */
+ * UInt64 headers. piola_vtu_read returns the cells as in the file (tets: VTK type 10 and
+ * the corners of quadratic tets, 24; triangles: 5 and the corners of 22) with every
+ * numeric point and cell field; the renderer builds its frames from it. The tet mesh reader
+ * (piola_tet_mesh_read) sits on top: it keeps the tets, turns a cell field named "region"
+ * into tet_regions and orients the mesh. Every count and offset is checked against the
+ * file size before anything is read or allocated, so a truncated frame of a running
+ * simulation fails cleanly. The XML is scanned for the few tags needed, not parsed in full:
+ * this is an exchange format reader, not a general XML parser. Refused: compressed data,
+ * big-endian data, appended base64, other dataset types. */
 #include <math.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -167,6 +172,10 @@ static piola_status read_array(vtu_reader *r, const char *tag, size_t count, dou
   const char *body = memchr(tag, '>', (size_t)(r->end - tag));
   if (!body) return error_at(r, tag, PIOLA_ERROR_PARSE, "unterminated DataArray tag", NULL);
   ++body;
+  /* every value takes at least one byte of the file in any format: a count beyond the file
+   * size is a damaged header, refused before allocating for it */
+  if (count > (size_t)(r->end - r->data))
+    return error_at(r, tag, PIOLA_ERROR_PARSE, "DataArray longer than the file: ", what);
   *out = malloc(count * sizeof(double) + 1);
   if (!*out) return PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "%s: out of memory", r->name);
   int size = type_size(type);
@@ -225,7 +234,42 @@ static const char *find_array(const char *from, const char *to, const char *name
   return NULL;
 }
 
-static piola_status parse(vtu_reader *r, piola_tet_mesh *out) {
+/* Reads every numeric DataArray of the <PointData> or <CellData> section (`section` is the
+ * tag name without '<') in [piece, xml_end), `count` tuples each. */
+static piola_status read_fields(vtu_reader *r, const char *piece, const char *xml_end, const char *section,
+                                size_t count, piola_vtu_array **fields, int32_t *field_count) {
+  char open_tag[32], close_tag[32];
+  snprintf(open_tag, sizeof open_tag, "<%s", section);
+  snprintf(close_tag, sizeof close_tag, "</%s>", section);
+  const char *tag = find(piece, xml_end, open_tag);
+  if (!tag) return PIOLA_OK;
+  const char *tag_end = memchr(tag, '>', (size_t)(xml_end - tag));
+  if (!tag_end) return error_at(r, tag, PIOLA_ERROR_PARSE, "unterminated tag ", open_tag);
+  if (tag_end[-1] == '/') return PIOLA_OK; /* <PointData/> */
+  const char *end = find(tag_end, xml_end, close_tag);
+  if (!end) return error_at(r, tag, PIOLA_ERROR_PARSE, "missing ", close_tag);
+  for (const char *p = find(tag_end, end, "<DataArray"); p; p = find(p + 1, end, "<DataArray")) {
+    char type[32] = "", components_text[32] = "1";
+    if (!attribute(p, end, "type", type, sizeof type) || type_size(type) == 0) continue; /* String */
+    attribute(p, end, "NumberOfComponents", components_text, sizeof components_text);
+    char *stop;
+    long components = strtol(components_text, &stop, 10);
+    if (*stop || components < 1 || components > 64)
+      return error_at(r, p, PIOLA_ERROR_PARSE, "NumberOfComponents must be 1..64, not ", components_text);
+    piola_vtu_array *grown = realloc(*fields, (size_t)(*field_count + 1) * sizeof *grown);
+    if (!grown) return PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "%s: out of memory", r->name);
+    *fields = grown;
+    piola_vtu_array *a = &grown[*field_count];
+    memset(a, 0, sizeof *a);
+    if (!attribute(p, end, "Name", a->name, sizeof a->name)) a->name[0] = '\0';
+    a->components = (int)components;
+    ++*field_count; /* counted before reading, so a failure frees what was allocated */
+    PIOLA_TRY(read_array(r, p, (size_t)components * count, &a->values));
+  }
+  return PIOLA_OK;
+}
+
+static piola_status parse(vtu_reader *r, piola_vtu_data *out) {
   const char *file = find(r->data, r->end, "<VTKFile");
   if (!file) return PIOLA_FAIL(PIOLA_ERROR_PARSE, "%s:1: not a VTK XML file (no <VTKFile>)", r->name);
   char value[64];
@@ -256,7 +300,7 @@ static piola_status parse(vtu_reader *r, piola_tet_mesh *out) {
   char *stop1, *stop2;
   unsigned long long np = strtoull(np_text, &stop1, 10), nc = strtoull(nc_text, &stop2, 10);
   size_t file_size = (size_t)(r->end - r->data);
-  if (*stop1 || *stop2 || np > INT32_MAX || nc > INT32_MAX || np > file_size || nc > file_size)
+  if (*stop1 || *stop2 || np > INT32_MAX / 4 || nc > INT32_MAX / 4 || np > file_size || nc > file_size)
     return error_at(r, piece, PIOLA_ERROR_PARSE, "point or cell count does not fit the file", NULL);
   const char *points = find(piece, xml_end, "<Points"), *cells = find(piece, xml_end, "<Cells");
   const char *points_end = points ? find(points, xml_end, "</Points>") : NULL;
@@ -268,8 +312,10 @@ static piola_status parse(vtu_reader *r, piola_tet_mesh *out) {
   const char *type_array = find_array(cells, cells_end, "types");
   if (!point_array || !conn_array || !offs_array || !type_array)
     return error_at(r, cells, PIOLA_ERROR_PARSE, "missing points, connectivity, offsets or types", NULL);
-  double *xyz = NULL, *offsets = NULL, *types = NULL, *conn = NULL, *region = NULL;
-  piola_status status = read_array(r, point_array, 3 * (size_t)np, &xyz);
+  out->point_count = (int32_t)np;
+  out->cell_count = (int32_t)nc;
+  double *offsets = NULL, *types = NULL, *conn = NULL;
+  piola_status status = read_array(r, point_array, 3 * (size_t)np, &out->positions);
   if (status == PIOLA_OK) status = read_array(r, offs_array, (size_t)nc, &offsets);
   if (status == PIOLA_OK) status = read_array(r, type_array, (size_t)nc, &types);
   size_t nconn = 0;
@@ -280,61 +326,120 @@ static piola_status parse(vtu_reader *r, piola_tet_mesh *out) {
       nconn = (size_t)offsets[nc - 1];
   }
   if (status == PIOLA_OK) status = read_array(r, conn_array, nconn, &conn);
-  const char *cell_data = find(piece, xml_end, "<CellData");
-  const char *cell_data_end = cell_data ? find(cell_data, xml_end, "</CellData>") : NULL;
-  const char *region_array = cell_data_end ? find_array(cell_data, cell_data_end, "region") : NULL;
-  if (status == PIOLA_OK && region_array) status = read_array(r, region_array, (size_t)nc, &region);
+  if (status == PIOLA_OK)
+    status = read_fields(r, piece, xml_end, "PointData", (size_t)np, &out->point_fields, &out->point_field_count);
+  if (status == PIOLA_OK)
+    status = read_fields(r, piece, xml_end, "CellData", (size_t)nc, &out->cell_fields, &out->cell_field_count);
   if (status == PIOLA_OK) {
-    out->vertex_count = (int32_t)np;
-    out->positions = xyz;
-    xyz = NULL;
     out->tets = malloc(4 * (size_t)nc * sizeof(int32_t) + 1);
-    out->tet_regions = malloc((size_t)nc * sizeof(int32_t) + 1);
-    if (!out->tets || !out->tet_regions) status = PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "%s: out of memory", r->name);
-    double previous = 0;
-    for (size_t c = 0; status == PIOLA_OK && c < nc; ++c) {
-      double begin = previous, finish = offsets[c];
-      previous = finish;
-      if (!(finish >= begin && finish <= (double)nconn)) {
-        status = error_at(r, offs_array, PIOLA_ERROR_PARSE, "offsets are not increasing", NULL);
-        break;
-      }
-      int type = (int)types[c];
-      if (type != 10 && type != 24) continue;
-      if (finish - begin != (type == 10 ? 4 : 10)) {
-        status = error_at(r, offs_array, PIOLA_ERROR_PARSE, "a tet cell does not have the right node count", NULL);
-        break;
-      }
-      for (int k = 0; k < 4; ++k) {
-        double v = conn[(size_t)begin + (size_t)k];
-        if (!(v >= 0 && v < (double)np)) {
-          status = error_at(r, conn_array, PIOLA_ERROR_PARSE, "connectivity index out of range", NULL);
-          break;
-        }
-        out->tets[4 * (size_t)out->tet_count + (size_t)k] = (int32_t)v;
-      }
-      double reg = region ? region[c] : 0;
-      out->tet_regions[out->tet_count++] = fabs(reg) < 2e9 ? (int32_t)lround(reg) : 0;
-    }
+    out->tet_cells = malloc((size_t)nc * sizeof(int32_t) + 1);
+    out->triangles = malloc(3 * (size_t)nc * sizeof(int32_t) + 1);
+    out->triangle_cells = malloc((size_t)nc * sizeof(int32_t) + 1);
+    if (!out->tets || !out->tet_cells || !out->triangles || !out->triangle_cells)
+      status = PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "%s: out of memory", r->name);
   }
-  free(xyz);
+  double previous = 0;
+  for (size_t c = 0; status == PIOLA_OK && c < nc; ++c) {
+    double begin = previous, finish = offsets[c];
+    previous = finish;
+    if (!(finish >= begin && finish <= (double)nconn)) {
+      status = error_at(r, offs_array, PIOLA_ERROR_PARSE, "offsets are not increasing", NULL);
+      break;
+    }
+    int type = (int)types[c], corners = 0, nodes = 0;
+    if (type == 10 || type == 24) corners = 4, nodes = type == 10 ? 4 : 10;
+    if (type == 5 || type == 22) corners = 3, nodes = type == 5 ? 3 : 6;
+    if (!corners) continue;
+    if (finish - begin != nodes) {
+      status = error_at(r, offs_array, PIOLA_ERROR_PARSE,
+                        corners == 4 ? "a tet cell does not have the right node count"
+                                     : "a triangle cell does not have the right node count",
+                        NULL);
+      break;
+    }
+    int32_t *dest = corners == 4 ? out->tets + 4 * (size_t)out->tet_count
+                                 : out->triangles + 3 * (size_t)out->triangle_count;
+    for (int k = 0; k < corners; ++k) {
+      double v = conn[(size_t)begin + (size_t)k];
+      if (!(v >= 0 && v < (double)np)) {
+        status = error_at(r, conn_array, PIOLA_ERROR_PARSE, "connectivity index out of range", NULL);
+        break;
+      }
+      dest[k] = (int32_t)v;
+    }
+    if (corners == 4)
+      out->tet_cells[out->tet_count++] = (int32_t)c;
+    else
+      out->triangle_cells[out->triangle_count++] = (int32_t)c;
+  }
   free(offsets);
   free(types);
   free(conn);
-  int had_region = region != NULL;
-  free(region);
-  if (status != PIOLA_OK) return status;
-  if (!had_region) {
-    free(out->tet_regions);
-    out->tet_regions = NULL;
-  }
-  return piola__tet_mesh_finish(out, r->name, NULL);
+  return status;
 }
 
-piola_status piola__read_vtu_mem(const char *name, const char *data, size_t size, piola_tet_mesh *out) {
+void piola_vtu_data_free(piola_vtu_data *data) {
+  if (!data) return;
+  for (int32_t i = 0; i < data->point_field_count; ++i) free(data->point_fields[i].values);
+  for (int32_t i = 0; i < data->cell_field_count; ++i) free(data->cell_fields[i].values);
+  free(data->point_fields);
+  free(data->cell_fields);
+  free(data->positions);
+  free(data->tets);
+  free(data->tet_cells);
+  free(data->triangles);
+  free(data->triangle_cells);
+  memset(data, 0, sizeof *data);
+}
+
+const piola_vtu_array *piola_vtu_find_field(const piola_vtu_array *fields, int32_t count, const char *name) {
+  for (int32_t i = 0; fields && name && i < count; ++i)
+    if (strcmp(fields[i].name, name) == 0) return &fields[i];
+  return NULL;
+}
+
+piola_status piola__vtu_read_mem(const char *name, const char *data, size_t size, piola_vtu_data *out) {
   memset(out, 0, sizeof *out);
   vtu_reader r = {name, data, data + size, 0, NULL};
   piola_status status = parse(&r, out);
+  if (status != PIOLA_OK) piola_vtu_data_free(out);
+  return status;
+}
+
+piola_status piola_vtu_read(const char *path, piola_vtu_data *out) {
+  if (!path || !out) return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "piola_vtu_read: NULL argument");
+  memset(out, 0, sizeof *out);
+  char *data = NULL;
+  size_t size = 0;
+  PIOLA_TRY(piola__read_file(path, &data, &size));
+  piola_status status = piola__vtu_read_mem(path, data, size, out);
+  free(data);
+  return status;
+}
+
+/* The tet mesh of a VTU file: its tets, a cell field "region" as tet_regions, oriented. */
+piola_status piola__read_vtu_mem(const char *name, const char *data, size_t size, piola_tet_mesh *out) {
+  memset(out, 0, sizeof *out);
+  piola_vtu_data vtu;
+  PIOLA_TRY(piola__vtu_read_mem(name, data, size, &vtu));
+  const piola_vtu_array *region = piola_vtu_find_field(vtu.cell_fields, vtu.cell_field_count, "region");
+  piola_status status = PIOLA_OK;
+  if (region) {
+    out->tet_regions = malloc((size_t)vtu.tet_count * sizeof(int32_t) + 1);
+    if (!out->tet_regions) status = PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "%s: out of memory", name);
+    for (int32_t t = 0; status == PIOLA_OK && t < vtu.tet_count; ++t) {
+      double reg = region->values[(size_t)region->components * (size_t)vtu.tet_cells[t]];
+      out->tet_regions[t] = fabs(reg) < 2e9 ? (int32_t)lround(reg) : 0;
+    }
+  }
+  out->vertex_count = vtu.point_count;
+  out->positions = vtu.positions;
+  out->tet_count = vtu.tet_count;
+  out->tets = vtu.tets;
+  vtu.positions = NULL;
+  vtu.tets = NULL;
+  piola_vtu_data_free(&vtu);
+  if (status == PIOLA_OK) status = piola__tet_mesh_finish(out, name, NULL);
   if (status != PIOLA_OK) piola_tet_mesh_free(out);
   return status;
 }

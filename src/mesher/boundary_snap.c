@@ -5,6 +5,7 @@
 #include <string.h>
 
 #include "common/status_internal.h"
+#include "common/threads.h"
 #include "mesher/tet_topology.h"
 
 typedef struct snap_context {
@@ -110,7 +111,7 @@ piola_status piola__boundary_snap(piola_tet_mesh *mesh, const piola__shape_union
   }
   const double remaining[] = {0.25, 1.0 / 3.0, 0.5, 1.0, 1.0, 1.0, 1.0, 1.0, 1.0};
   for (size_t stage = 0; stage < sizeof(remaining) / sizeof(remaining[0]); ++stage) {
-#pragma omp parallel for schedule(dynamic, 256)
+#pragma omp parallel for schedule(dynamic, 256) num_threads(piola__thread_count())
     for (int32_t i = 0; i < nb; ++i)
       target[i] = piola__shape_union_project(shapes, vec3_load(mesh->positions + 3 * (size_t)boundary[i]));
     for (int32_t i = 0; i < nb; ++i) {

@@ -6,6 +6,7 @@
 #include <string.h>
 
 #include "common/status_internal.h"
+#include "common/threads.h"
 #include "render/render_internal.h"
 #include "sim/obstacle_internal.h"
 
@@ -272,7 +273,7 @@ piola_status piola_renderer_render(piola_renderer *r, const piola_render_mesh *m
   r->def.width = w, r->def.height = h;
   if (st == PIOLA_OK) st = piola__image_resize(image, w, h);
   if (st == PIOLA_OK) {
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(static) num_threads(piola__thread_count())
     for (int32_t y = 0; y < h; ++y)
       for (int32_t x = 0; x < w; ++x) {
         uint32_t sum[3] = {0, 0, 0};

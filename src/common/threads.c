@@ -1,8 +1,8 @@
-/* The thread count piola's parallel loops use. Results never depend on it (see
- * elastic_body_internal.h); only speed does. */
-#include <omp.h>
+/* The thread count piola's parallel loops use (see common/threads.h). Results never depend
+ * on it; only speed does. */
+#include "common/threads.h"
 
-#include "force/elastic_body_internal.h"
+#include <omp.h>
 
 static int requested_threads = 0;
 

@@ -152,7 +152,7 @@ int cli_run(int argc, char **argv) {
   int frame = 0;
   for (frame = 1; rc == 0 && frame <= frames; ++frame) {
     double t0 = now_seconds();
-    piola_step_stats st = {0, 0, 0, 0};
+    piola_step_stats st = {0};
     if (piola_world_advance_to(world, frame / fps, &st) != PIOLA_OK) {
       char message[1024];
       snprintf(message, sizeof message, "%s", piola_last_error());

@@ -29,6 +29,7 @@ typedef struct world_solid {
   int32_t motion_count;
   piola_track stiffness_scale, shear_viscosity, bulk_viscosity;
   piola_elastic_stats elastic;  /* of the last update */
+  piola_self_collision_def self_collision;
   /* scratch for the step */
   double *x_old, *v_old, *force_old, *rhs, *work, *tmp;
   uint8_t *colliding;
@@ -42,6 +43,7 @@ struct piola_world {
   int32_t solid_count, solid_capacity;
   piola_obstacle **obstacles;
   int32_t obstacle_count, obstacle_capacity;
+  struct world_contact *contact; /* self-collision of boundary surfaces (world_contact.c) */
 };
 
 /* Marks constrained nodes of s from its constraint defs (rest positions rest, 3n). */
@@ -53,5 +55,12 @@ void piola__solid_constrained_state(const world_solid *s, int32_t i, double t, d
                                     double v[3]);
 /* Recomputes the elastic force of s at its positions x and time t (stiffness scale). */
 piola_status piola__solid_update_forces(world_solid *s, double t);
+
+/* Self-collision after a step of length dt (s) that every solid has taken from x_old to x:
+ * changes x and v of solids with self-collision enabled (and recomputes their forces at
+ * time t1) and adds to stats. Builds its collision surface on first use or when solids were
+ * added. */
+piola_status piola__world_self_collide(piola_world *w, double dt, double t1, piola_step_stats *stats);
+void piola__world_contact_free(piola_world *w);
 
 #endif

@@ -144,7 +144,7 @@ int cli_run(int argc, char **argv) {
   long long total_steps = 0, total_cg = 0;
   int max_inverted = 0;
   double sim_start = now_seconds();
-  piola_frame_info info = {0, 0, 0, 0};
+  piola_frame_info info = {0};
   if (piola_output_write_frame(out, world, &info) != PIOLA_OK) {
     fprintf(stderr, "piola run: %s\n", piola_last_error());
     rc = 1;
@@ -168,6 +168,9 @@ int cli_run(int argc, char **argv) {
     info.frame = frame;
     info.substeps = st.substeps;
     info.cg_iterations = st.cg_iterations;
+    info.contacts = st.contacts;
+    info.impacts = st.impacts;
+    info.impact_zones = st.impact_zones;
     info.wall_seconds = now_seconds() - t0;
     total_steps += st.substeps;
     total_cg += st.cg_iterations;

@@ -276,6 +276,93 @@ static void incline_sticks_or_slides_as_coulomb_says(void **state) {
   assert_close(a, 0, 0.02 * g);
 }
 
+/* Fixed nodes stay at their rest positions and driven nodes follow their motion exactly,
+ * while the free nodes between them stretch. */
+static void constraints_hold_and_drive_nodes_exactly(void **state) {
+  (void)state;
+  piola_world *w = make_world(-9.81, 1e-3);
+  piola_tet_mesh mesh = block(1, 1, 4, 0.1, 0.1, 0.4);
+  piola_constraint_def cons[2];
+  memset(cons, 0, sizeof cons);
+  cons[0].selector.type = PIOLA_SELECT_BOX;
+  cons[0].selector.box_min = (piola_vec3){-1, -1, -1e-9};
+  cons[0].selector.box_max = (piola_vec3){1, 1, 1e-9};
+  cons[0].motion = piola_default_rigid_motion_def();
+  cons[1].selector.type = PIOLA_SELECT_SPHERE;
+  cons[1].selector.center = (piola_vec3){0.05, 0.05, 0.4};
+  cons[1].selector.radius = 0.08; /* the four top corners */
+  cons[1].driven = true;
+  cons[1].motion = piola_default_rigid_motion_def();
+  cons[1].motion.velocity[2] = piola_track_constant(0.5);
+  piola_solid_def sd = piola_default_solid_def();
+  sd.mesh = &mesh;
+  sd.material.youngs_modulus = 1e5;
+  sd.shear_viscosity = piola_track_constant(10);
+  sd.constraints = cons;
+  sd.constraint_count = 2;
+  sd.scramble_radius = 0.005; /* free nodes only */
+  assert_int_equal(piola_world_add_solid(w, &sd, NULL), PIOLA_OK);
+  const uint8_t *flags = piola_world_solid_constraint_flags(w, 0);
+  int fixed = 0, driven = 0;
+  for (int32_t i = 0; i < mesh.vertex_count; ++i) fixed += flags[i] == 1, driven += flags[i] == 2;
+  assert_int_equal(fixed, 4);
+  assert_int_equal(driven, 4);
+  assert_int_equal(piola_world_advance_to(w, 0.2, NULL), PIOLA_OK);
+  const double *x = piola_world_solid_positions(w, 0), *v = piola_world_solid_velocities(w, 0);
+  const double *rest = piola_elastic_body_rest_positions(piola_world_solid_body(w, 0));
+  double mid_lift = 0;
+  for (int32_t i = 0; i < mesh.vertex_count; ++i) {
+    double lift = flags[i] == 2 ? 0.5 * 0.2 : 0;
+    if (flags[i] == 0) {
+      if (fabs(rest[3 * i + 2] - 0.2) < 1e-9) mid_lift += (x[3 * i + 2] - 0.2) / 4;
+      continue;
+    }
+    for (int k = 0; k < 3; ++k) assert_close(x[3 * i + k], rest[3 * i + k] + (k == 2 ? lift : 0), 1e-12);
+    assert_close(v[3 * i + 2], flags[i] == 2 ? 0.5 : 0, 1e-12);
+  }
+  /* the middle of the bar follows about half way */
+  assert_true(mid_lift > 0.02 && mid_lift < 0.08);
+  free_mesh(&mesh);
+  piola_world_destroy(w);
+}
+
+/* The initial deformation: a zero matrix collapses the free nodes to the rest centroid, and
+ * the scramble is a fixed function of the seed. */
+static void initial_state_is_deformed_as_asked(void **state) {
+  (void)state;
+  piola_world *w = make_world(0, 1e-3);
+  piola_tet_mesh mesh = block(2, 2, 2, 0.2, 0.2, 0.2);
+  piola_solid_def sd = piola_default_solid_def();
+  sd.mesh = &mesh;
+  sd.shear_viscosity = piola_track_constant(20);
+  sd.bulk_viscosity = piola_track_constant(20);
+  memset(&sd.initial_matrix, 0, sizeof sd.initial_matrix);
+  assert_int_equal(piola_world_add_solid(w, &sd, NULL), PIOLA_OK);
+  sd.initial_matrix = (piola_mat3){{{1, 0, 0}, {0, 1, 0}, {0, 0, 1}}};
+  sd.scramble_radius = 0.01;
+  sd.scramble_seed = 42;
+  assert_int_equal(piola_world_add_solid(w, &sd, NULL), PIOLA_OK);
+  assert_int_equal(piola_world_add_solid(w, &sd, NULL), PIOLA_OK);
+  const double *point = piola_world_solid_positions(w, 0);
+  for (int32_t i = 0; i < mesh.vertex_count; ++i)
+    for (int k = 0; k < 3; ++k) assert_close(point[3 * i + k], 0.1, 1e-15);
+  assert_true(piola_world_solid_stats(w, 0).min_det_f == 0);
+  const double *a = piola_world_solid_positions(w, 1), *b = piola_world_solid_positions(w, 2);
+  double largest = 0;
+  for (int32_t i = 0; i < 3 * mesh.vertex_count; ++i) {
+    assert_true(a[i] == b[i]);
+    largest = fmax(largest, fabs(a[i] - mesh.positions[i]));
+  }
+  assert_true(largest > 0.002 && largest <= 0.01);
+  /* collapsed to a point, it recovers */
+  assert_int_equal(piola_world_advance_to(w, 0.5, NULL), PIOLA_OK);
+  piola_solid_stats rec = piola_world_solid_stats(w, 0);
+  if (!(rec.inverted_count == 0 && rec.min_det_f > 0.8))
+    fail_msg("after collapse to a point: %d inverted, min det F %g", (int)rec.inverted_count, rec.min_det_f);
+  free_mesh(&mesh);
+  piola_world_destroy(w);
+}
+
 int main(void) {
   /* tiny meshes: one thread avoids OpenMP barrier overhead on a shared machine; forces are
    * identical whatever the thread count */
@@ -286,6 +373,8 @@ int main(void) {
       cmocka_unit_test(undamped_bounce_gains_no_energy),
       cmocka_unit_test(resting_body_stays_on_the_plane),
       cmocka_unit_test(incline_sticks_or_slides_as_coulomb_says),
+      cmocka_unit_test(constraints_hold_and_drive_nodes_exactly),
+      cmocka_unit_test(initial_state_is_deformed_as_asked),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
 }

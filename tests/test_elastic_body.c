@@ -262,7 +262,10 @@ static void collapsed_and_inverted_tets_are_pushed_back(void **state) {
 static void forces_do_not_depend_on_the_thread_count(void **state) {
   (void)state;
   test_rng rng = test_rng_seeded(15);
-  piola_tet_mesh mesh = fixture_grid(6, 0.1);
+  /* large enough that the loops do run in parallel (PIOLA_PARALLEL_MIN_BLOCKS, _VERTICES) */
+  piola_tet_mesh mesh = fixture_grid(17, 0.1);
+  assert_true(mesh.tet_count >= 8 * PIOLA_PARALLEL_MIN_BLOCKS);
+  assert_true(mesh.vertex_count >= PIOLA_PARALLEL_MIN_VERTICES);
   int n = 3 * mesh.vertex_count;
   double *x = malloc(sizeof(double) * (size_t)n);
   double *f[3];

@@ -11,6 +11,9 @@
 #include <omp.h>
 
 #include "geometry/analytic_shapes.h"
+#include "mesher/bcc_lattice.h"
+#include "mesher/lattice_phi.h"
+#include "mesher/red_green.h"
 #include "piola/mesher.h"
 
 /* The dihedral-angle bound the mesher documents (docs/mesher.md). */
@@ -49,6 +52,13 @@ static int compare_edge(const void *pa, const void *pb) {
   const edge_key *a = pa, *b = pb;
   if (a->a != b->a) return a->a < b->a ? -1 : 1;
   if (a->b != b->b) return a->b < b->b ? -1 : 1;
+  return 0;
+}
+
+static int compare_triple(const void *pa, const void *pb) {
+  const int32_t *a = pa, *b = pb;
+  for (int k = 0; k < 3; ++k)
+    if (a[k] != b[k]) return a[k] < b[k] ? -1 : 1;
   return 0;
 }
 
@@ -367,6 +377,55 @@ static void bad_arguments_are_refused(void **state) {
   assert_int_equal(piola_mesher_generate(&def, &mesh), PIOLA_ERROR_INVALID_ARGUMENT);
 }
 
+/* Red-green refinement alone (before any tet is dropped or node moved): every face is shared
+ * by exactly two tets except the lattice's own outer faces, which are unchanged; the volume
+ * is unchanged (no gaps, no overlaps); all tets are positive; the BCC lattice tets have 60
+ * degree, and green tets at least 25 degree, minimum dihedral angles. */
+static void red_green_alone_is_conforming(void **state) {
+  (void)state;
+  double h = 0.5;
+  piola__bcc_lattice lattice;
+  assert_int_equal(piola__bcc_lattice_build(vec3_make(-2, -2, -2), vec3_make(2, 2, 2), h, 1 << 24, &lattice), PIOLA_OK);
+  piola_tet_mesh before = {lattice.vertex_count, lattice.positions, lattice.tet_count, lattice.tets, NULL};
+  int32_t *hull = NULL;
+  mesh_report r0 = analyse(&before, &hull);
+  piola_mesher_def def = piola_default_mesher_def();
+  def.shapes[0] = base_shape(PIOLA_SHAPE_SPHERE);
+  def.shapes[0].radius = 0.7;
+  def.shape_count = 1;
+  piola__shape_union shapes;
+  assert_int_equal(piola__shape_union_create(&def, &shapes), PIOLA_OK);
+  piola__tet_soup soup = {lattice.vertex_count, lattice.vertex_count, lattice.positions, NULL,
+                          lattice.tet_count, lattice.tet_count, lattice.tets};
+  soup.phi = malloc((size_t)soup.vertex_count * sizeof(double));
+  assert_int_equal(piola__lattice_phi(&shapes, soup.positions, soup.vertex_count, soup.tets, soup.tet_count, 1.5 * h, soup.phi), PIOLA_OK);
+  assert_int_equal(piola__red_green_refine(&soup, &shapes, 2, h), PIOLA_OK);
+  piola_tet_mesh after = {soup.vertex_count, soup.positions, soup.tet_count, soup.tets, NULL};
+  int32_t *hull_after = NULL;
+  mesh_report r1 = analyse(&after, &hull_after);
+  printf("  red-green alone: %d -> %d tets, volume %.12g -> %.12g, dihedral min %.2f, outer faces %d -> %d\n",
+         (int)before.tet_count, (int)after.tet_count, r0.volume, r1.volume,
+         r1.min_dihedral, r0.boundary_faces, r1.boundary_faces);
+  assert_true(after.tet_count > before.tet_count);
+  assert_true(r1.min_volume > 0);
+  assert_int_equal(r1.faces_shared_by_more_than_two, 0);
+  assert_close(r1.volume, r0.volume, 1e-10 * r0.volume);
+  assert_true(r1.min_dihedral >= 25.0);
+  /* The faces used once are exactly the lattice's outer faces: no hanging node inside. */
+  assert_int_equal(r1.boundary_faces, r0.boundary_faces);
+  for (int f = 0; f < r0.boundary_faces; ++f) {
+    sort3(hull + 3 * f);
+    sort3(hull_after + 3 * f);
+  }
+  qsort(hull, (size_t)r0.boundary_faces, 3 * sizeof(int32_t), compare_triple);
+  qsort(hull_after, (size_t)r1.boundary_faces, 3 * sizeof(int32_t), compare_triple);
+  assert_memory_equal(hull, hull_after, (size_t)r0.boundary_faces * 3 * sizeof(int32_t));
+  free(hull);
+  free(hull_after);
+  piola__tet_soup_free(&soup);
+  piola__shape_union_destroy(&shapes);
+}
+
 /* The output does not depend on the number of threads (bit for bit). */
 static void output_is_independent_of_thread_count(void **state) {
   (void)state;
@@ -399,6 +458,7 @@ int main(void) {
       cmocka_unit_test(capsule_is_meshed),  cmocka_unit_test(refinement_is_conforming_and_graded),
       cmocka_unit_test(union_of_shapes_is_meshed), cmocka_unit_test(bad_arguments_are_refused),
       cmocka_unit_test(output_is_independent_of_thread_count),
+      cmocka_unit_test(red_green_alone_is_conforming),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -17,7 +17,9 @@
 #include "cli/commands.h"
 #include "piola/elastic_body.h"
 #include "piola/output.h"
+#include "piola/render.h"
 #include "piola/scene.h"
+#include "piola/world_shells.h"
 #include "piola/world.h"
 
 static void usage(FILE *out) {
@@ -28,6 +30,8 @@ static void usage(FILE *out) {
           "  --threads N        worker threads (default: all cores)\n"
           "  --frames N         write N frames instead of the scene's `frames`\n"
           "  --force            write into DIR even if it holds earlier results\n"
+          "  --render           also render every frame to DIR/render/frame_NNNN.png\n"
+          "                     (DIR/preview.png of the last frame is always written)\n"
           "                     (earlier frames, stats.csv and sim.pvd are removed)\n"
           "  -h, --help         this text\n");
 }
@@ -80,7 +84,7 @@ static void progress(bool tty, int frame, int frames, double t, double elapsed, 
 int cli_run(int argc, char **argv) {
   const char *scene_path = NULL, *out_dir = NULL;
   long threads = 0, frames_override = -1;
-  bool force = false;
+  bool force = false, render_frames = false;
   for (int i = 1; i < argc; ++i) {
     const char *a = argv[i];
     if (strcmp(a, "-h") == 0 || strcmp(a, "--help") == 0) {
@@ -97,6 +101,8 @@ int cli_run(int argc, char **argv) {
         return fprintf(stderr, "piola run: --frames needs an integer in [0, 1000000]\n"), 2;
     } else if (strcmp(a, "--force") == 0) {
       force = true;
+    } else if (strcmp(a, "--render") == 0) {
+      render_frames = true;
     } else if (a[0] == '-' && a[1]) {
       fprintf(stderr, "piola run: unknown option '%s'\n", a);
       usage(stderr);
@@ -137,9 +143,14 @@ int cli_run(int argc, char **argv) {
     return 1;
   }
   bool tty = isatty(STDERR_FILENO);
-  fprintf(stderr, "piola run: %s -> %s: %d frames at %g fps, %d solids, %d obstacles, first dt %.3g s\n",
+  fprintf(stderr, "piola run: %s -> %s: %d frames at %g fps, %d solids, %d shells, %d obstacles, first dt %.3g s\n",
           scene_path, out_dir, frames, fps, (int)piola_world_solid_count(world),
-          (int)piola_world_obstacle_count(world), piola_world_stable_dt(world));
+          (int)piola_world_shell_count(world), (int)piola_world_obstacle_count(world),
+          piola_world_stable_dt(world));
+  /* previews (src/render): DIR/scene.json, DIR/preview.png and, with --render, every frame */
+  piola_preview *preview = NULL;
+  if (piola_preview_open(out_dir, scene_path, render_frames, &preview) != PIOLA_OK)
+    fprintf(stderr, "piola run: no preview: %s\n", piola_last_error());
   int rc = 0;
   long long total_steps = 0, total_cg = 0;
   int max_inverted = 0;
@@ -148,6 +159,8 @@ int cli_run(int argc, char **argv) {
   if (piola_output_write_frame(out, world, &info) != PIOLA_OK) {
     fprintf(stderr, "piola run: %s\n", piola_last_error());
     rc = 1;
+  } else if (preview && piola_preview_frame_written(preview, 0, piola_world_time(world)) != PIOLA_OK) {
+    fprintf(stderr, "piola run: preview: %s\n", piola_last_error());
   }
   int frame = 0;
   for (frame = 1; rc == 0 && frame <= frames; ++frame) {
@@ -184,6 +197,8 @@ int cli_run(int argc, char **argv) {
       rc = 1;
       break;
     }
+    if (preview && piola_preview_frame_written(preview, frame, piola_world_time(world)) != PIOLA_OK)
+      fprintf(stderr, "piola run: preview: %s\n", piola_last_error());
     progress(tty, frame, frames, piola_world_time(world), now_seconds() - sim_start, st.substeps, inverted);
   }
   double wall = now_seconds() - t_start;
@@ -194,6 +209,10 @@ int cli_run(int argc, char **argv) {
           "%lld CG iterations, at most %d inverted tets in a frame. Open %s/sim.pvd in ParaView.\n",
           rc == 0 ? "done" : "stopped", written, written / fps, wall,
           sim_wall > 0 ? written / sim_wall : 0.0, total_steps, total_cg, max_inverted, out_dir);
+  if (preview && piola_preview_close(preview) != PIOLA_OK)
+    fprintf(stderr, "piola run: preview.png: %s\n", piola_last_error());
+  else if (preview)
+    fprintf(stderr, "piola run: preview of the last frame: %s/preview.png\n", out_dir);
   piola_output_close(out);
   piola_scene_destroy(scene);
   return rc;

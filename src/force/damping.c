@@ -145,7 +145,8 @@ void piola_elastic_body_damping_forces(const piola_elastic_body *body, const dou
   int32_t blocks = body->padded_tet_count / B;
   /* the per-tet buffer is scratch shared with the elastic update: concurrent calls on one
    * body are not allowed */
-#pragma omp parallel for schedule(static) num_threads(piola__thread_count())
+#pragma omp parallel for schedule(static) num_threads(piola__thread_count()) \
+    if (blocks >= PIOLA_PARALLEL_MIN_BLOCKS)
   for (int32_t b = 0; b < blocks; ++b)
     damping_block(body, v, shear_viscosity, bulk_viscosity, b);
   piola__elastic_body_gather_forces(body, forces);

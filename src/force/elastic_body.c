@@ -75,7 +75,8 @@ const double *piola_elastic_body_fhat(const piola_elastic_body *body) { return b
 void piola__elastic_body_gather_forces(const piola_elastic_body *body, double *forces) {
   const int32_t *start = body->incidence_start, *inc = body->incidence;
   const double *tf = body->tet_forces;
-#pragma omp parallel for schedule(static) num_threads(piola__thread_count())
+#pragma omp parallel for schedule(static) num_threads(piola__thread_count()) \
+    if (body->vertex_count >= PIOLA_PARALLEL_MIN_VERTICES)
   for (int32_t i = 0; i < body->vertex_count; ++i) {
     double fx = 0, fy = 0, fz = 0;
     for (int32_t e = start[i]; e < start[i + 1]; ++e) {
@@ -207,7 +208,8 @@ piola_status piola_elastic_body_update(piola_elastic_body *body, const double *x
                           (int)(i / 3));
   }
   int32_t blocks = body->padded_tet_count / B;
-#pragma omp parallel for schedule(static) num_threads(piola__thread_count())
+#pragma omp parallel for schedule(static) num_threads(piola__thread_count()) \
+    if (blocks >= PIOLA_PARALLEL_MIN_BLOCKS)
   for (int32_t b = 0; b < blocks; ++b) update_block(body, x, stiffness_scale, stats != NULL, b);
   piola__elastic_body_gather_forces(body, forces);
   body->has_state = 1;

@@ -33,6 +33,12 @@
 
 #define PIOLA_TET_BLOCK 8
 
+/* Below these sizes the loops run on one thread: a parallel region costs microseconds (much
+ * more when the machine is oversubscribed and a thread waits for its time slice), more than
+ * the work of a small body. Results do not depend on it (see Determinism above). */
+#define PIOLA_PARALLEL_MIN_BLOCKS 256
+#define PIOLA_PARALLEL_MIN_VERTICES 4096
+
 struct piola_elastic_body {
   /* sizes */
   int32_t vertex_count;

@@ -18,6 +18,8 @@
 #define MAX_REFINEMENT_LEVELS 6
 #define MAX_REPAIR_ROUNDS 64
 #define PRUNE_ROUNDS 3
+/* Pieces smaller than this many finest lattice cubes are dropped. */
+#define CRUMB_CELLS 4.0
 
 piola_mesher_def piola_default_mesher_def(void) {
   piola_mesher_def def;
@@ -228,6 +230,62 @@ static int64_t drop_boundary_only_tets(const piola__tet_soup *soup, const lattic
   return dropped;
 }
 
+static int32_t find_root(int32_t *parent, int32_t v) {
+  while (parent[v] != v) {
+    parent[v] = parent[parent[v]];
+    v = parent[v];
+  }
+  return v;
+}
+
+/* Drops face-connected pieces of the kept tets whose volume is below min_volume: crumbs cut off
+ * thin, unresolved parts (an ear tip thinner than the lattice), not shapes of their own.
+ * Pieces never touch (the repair made the boundary manifold), so this keeps it manifold.
+ * Returns the number of tets dropped, or -1 when out of memory. */
+static int64_t drop_crumbs(const piola__tet_soup *soup, const lattice_topology *topo, uint8_t *keep,
+                           double min_volume) {
+  int32_t nt = soup->tet_count;
+  int32_t *parent = malloc((size_t)nt * sizeof(int32_t) + 1);
+  double *volume = calloc((size_t)nt + 1, sizeof(double));
+  if (!parent || !volume) {
+    free(parent);
+    free(volume);
+    return -1;
+  }
+  for (int32_t t = 0; t < nt; ++t) parent[t] = t;
+  for (int32_t t = 0; t < nt; ++t) {
+    if (!keep[t]) continue;
+    for (int f = 0; f < 4; ++f) {
+      int32_t u = topo->neighbor[4 * (size_t)t + f];
+      if (u < 0 || !keep[u]) continue;
+      int32_t a = find_root(parent, t), b = find_root(parent, u);
+      if (a != b) parent[a < b ? b : a] = a < b ? a : b;
+    }
+  }
+  for (int32_t t = 0; t < nt; ++t) {
+    if (!keep[t]) continue;
+    const int32_t *tet = soup->tets + 4 * (size_t)t;
+    volume[find_root(parent, t)] += piola__tet_volume(
+        vec3_load(soup->positions + 3 * (size_t)tet[0]), vec3_load(soup->positions + 3 * (size_t)tet[1]),
+        vec3_load(soup->positions + 3 * (size_t)tet[2]), vec3_load(soup->positions + 3 * (size_t)tet[3]));
+  }
+  double largest = 0;
+  for (int32_t t = 0; t < nt; ++t) largest = fmax(largest, volume[t]);
+  int64_t dropped = 0;
+  for (int32_t t = 0; t < nt; ++t) {
+    if (!keep[t]) continue;
+    double v = volume[find_root(parent, t)];
+    /* Never drop the largest piece, so a small shape still gets a mesh. */
+    if (v < min_volume && v < largest) {
+      keep[t] = 0;
+      dropped++;
+    }
+  }
+  free(parent);
+  free(volume);
+  return dropped;
+}
+
 static piola_status extract(const piola__tet_soup *soup, const uint8_t *keep, piola_tet_mesh *out) {
   int32_t *map = malloc((size_t)soup->vertex_count * sizeof(int32_t));
   if (!map) return PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "mesher: output");
@@ -342,9 +400,14 @@ piola_status piola_mesher_generate(const piola_mesher_def *def, piola_tet_mesh *
     status = repair_manifold(&soup, &topo, keep);
   }
   if (status != PIOLA_OK) goto done;
+  double h_fine = h / (double)(1 << def->refinement_levels);
+  if (drop_crumbs(&soup, &topo, keep, CRUMB_CELLS * h_fine * h_fine * h_fine) < 0) {
+    status = PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "mesher: connected pieces");
+    goto done;
+  }
   status = extract(&soup, keep, out);
   if (status != PIOLA_OK) goto done;
-  status = piola__boundary_snap(out, &shapes, h / (double)(1 << def->refinement_levels));
+  status = piola__boundary_snap(out, &shapes, h_fine);
   if (status != PIOLA_OK) {
     free(out->positions);
     free(out->tets);

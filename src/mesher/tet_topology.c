@@ -69,38 +69,6 @@ void piola__face_neighbors(const int32_t *tets, int32_t tet_count, const uint8_t
   }
 }
 
-double piola__tet_dihedral_range(vec3 a, vec3 b, vec3 c, vec3 d, double *max_angle) {
-  vec3 x[4] = {a, b, c, d};
-  if (piola__tet_volume(a, b, c, d) <= 0) {
-    if (max_angle) *max_angle = M_PI;
-    return -1.0;
-  }
-  vec3 n[4];
-  for (int f = 0; f < 4; ++f) {
-    vec3 p = x[piola__tet_face[f][0]], q = x[piola__tet_face[f][1]], r = x[piola__tet_face[f][2]];
-    vec3 m = vec3_cross(vec3_sub(q, p), vec3_sub(r, p));
-    double len = vec3_norm(m);
-    if (!(len > 0)) {
-      if (max_angle) *max_angle = M_PI;
-      return -1.0;
-    }
-    n[f] = vec3_scale(m, 1.0 / len);
-  }
-  /* The dihedral angle at the edge shared by faces f and g is acos(-n_f . n_g): track the
-   * extreme cosines and take acos only twice. */
-  double cos_max = -1, cos_min = 1;
-  for (int f = 0; f < 4; ++f)
-    for (int g = f + 1; g < 4; ++g) {
-      double cosine = -vec3_dot(n[f], n[g]);
-      if (cosine > cos_max) cos_max = cosine;
-      if (cosine < cos_min) cos_min = cosine;
-    }
-  double lo = acos(fmin(1.0, cos_max));
-  double hi = max_angle ? acos(fmax(-1.0, cos_min)) : 0;
-  if (max_angle) *max_angle = hi;
-  return lo;
-}
-
 double piola__tet_min_dihedral_cosine(vec3 a, vec3 b, vec3 c, vec3 d) {
   vec3 x[4] = {a, b, c, d};
   if (piola__tet_volume(a, b, c, d) <= 0) return 2.0;

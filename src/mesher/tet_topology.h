@@ -43,12 +43,9 @@ static inline double piola__tet_volume(vec3 a, vec3 b, vec3 c, vec3 d) {
   return vec3_dot(vec3_sub(b, a), vec3_cross(vec3_sub(c, a), vec3_sub(d, a))) / 6.0;
 }
 
-/* Minimum and maximum dihedral angle (radians). Returns the minimum, or a negative number
- * when the tet is not positively oriented (then max is set to pi). */
-double piola__tet_dihedral_range(vec3 a, vec3 b, vec3 c, vec3 d, double *max_angle);
-
 /* Cosine of the smallest dihedral angle (larger = worse), or 2 when the tet is not
- * positively oriented: the same order as the angle without any acos, for inner loops. */
+ * positively oriented: ordered like the angle, without any acos, for the inner loops of the
+ * quality guard. */
 double piola__tet_min_dihedral_cosine(vec3 a, vec3 b, vec3 c, vec3 d);
 
 #endif

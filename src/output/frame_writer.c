@@ -5,7 +5,12 @@
  * index) so a viewer loads one file per frame. Topology and the boundary surface are built
  * once when the output opens; each frame only refreshes positions and fields. stats.csv and
  * sim.pvd are kept in memory and rewritten atomically after every frame, so the files on disk
- * always describe exactly the frames that exist. */
+ * always describe exactly the frames that exist.
+ *
+ * Shells (piola/world_shells.h) follow the solids: their vertices come after the solids'
+ * in the point list, their triangles are the VTU's triangle cells (cell fields: det_f is
+ * the signed area ratio fhat0 * fhat1, inverted flags triangles opposing their reference
+ * normal, energy_density is 0, solid is -1 - the shell's index) and join the OBJ surface. */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -15,6 +20,7 @@
 #include "io/atomic_file.h"
 #include "output/output_internal.h"
 #include "piola/mesh_io.h"
+#include "piola/world_shells.h"
 
 typedef struct pvd_entry {
   int32_t frame;
@@ -24,7 +30,11 @@ typedef struct pvd_entry {
 struct piola_output {
   char dir[4096];
   piola_tet_mesh tets;      /* concatenated; positions refreshed per frame */
-  piola_tri_mesh surface;   /* concatenated boundary, shares vertex numbering with tets */
+  piola_tri_mesh surface;   /* concatenated boundary, shares vertex numbering with tets, then
+                               the shells' triangles */
+  piola_tri_mesh shells;    /* concatenated shell triangles, numbered from the first shell
+                               vertex; positions borrowed per frame */
+  int32_t solid_vertices, solid_cells; /* where the shells start in points and cells */
   double *rest;             /* 3 * vertex_count */
   double *velocity, *displacement, *det_f, *inverted, *energy, *solid;
   char *csv;
@@ -52,6 +62,8 @@ void piola_output_close(piola_output *o) {
   if (!o) return;
   piola_tet_mesh_free(&o->tets);
   piola_tri_mesh_free(&o->surface);
+  o->shells.positions = NULL; /* borrowed */
+  piola_tri_mesh_free(&o->shells);
   free(o->rest), free(o->velocity), free(o->displacement), free(o->det_f), free(o->inverted);
   free(o->energy), free(o->solid), free(o->csv), free(o->pvd);
   free(o);
@@ -71,16 +83,28 @@ piola_status piola_output_open(const char *dir, bool force, const piola_world *w
     nv += piola_elastic_body_vertex_count(b);
     nt += piola_elastic_body_tet_count(b);
   }
-  size_t v3 = 3 * (size_t)(nv > 0 ? nv : 1) * sizeof(double);
-  size_t tc = (size_t)(nt > 0 ? nt : 1);
+  int32_t snv = 0, snt = 0;
+  for (int32_t s = 0; s < piola_world_shell_count(world); ++s) {
+    const piola_shell_body *b = piola_world_shell_body(world, s);
+    snv += piola_shell_body_vertex_count(b);
+    snt += piola_shell_body_triangle_count(b);
+  }
+  o->solid_vertices = nv;
+  o->solid_cells = nt;
+  /* point arrays hold the solids' vertices then the shells'; cell arrays tets then triangles */
+  size_t v3 = 3 * (size_t)(nv + snv > 0 ? nv + snv : 1) * sizeof(double);
+  size_t tc = (size_t)(nt + snt > 0 ? nt + snt : 1);
   o->tets.vertex_count = nv;
   o->tets.tet_count = nt;
+  o->shells.vertex_count = snv;
+  o->shells.triangle_count = snt;
+  o->shells.triangles = malloc(3 * (size_t)(snt > 0 ? snt : 1) * sizeof(int32_t));
   o->tets.positions = malloc(v3);
   o->tets.tets = malloc(4 * tc * sizeof(int32_t));
   o->rest = malloc(v3), o->velocity = malloc(v3), o->displacement = malloc(v3);
   o->det_f = malloc(tc * sizeof(double)), o->inverted = malloc(tc * sizeof(double));
   o->energy = malloc(tc * sizeof(double)), o->solid = malloc(tc * sizeof(double));
-  if (!o->tets.positions || !o->tets.tets || !o->rest || !o->velocity || !o->displacement ||
+  if (!o->tets.positions || !o->tets.tets || !o->shells.triangles || !o->rest || !o->velocity || !o->displacement ||
       !o->det_f || !o->inverted || !o->energy || !o->solid) {
     piola_output_close(o);
     return PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "output: out of memory");
@@ -96,8 +120,38 @@ piola_status piola_output_open(const char *dir, bool force, const piola_world *w
     voff += n;
     toff += t;
   }
-  memcpy(o->tets.positions, o->rest, 3 * (size_t)nv * sizeof(double));
-  piola_status st = piola_tet_mesh_boundary(&o->tets, &o->surface);
+  int32_t soff = 0, stoff = 0;
+  for (int32_t s = 0; s < piola_world_shell_count(world); ++s) {
+    const piola_shell_body *b = piola_world_shell_body(world, s);
+    int32_t n = piola_shell_body_vertex_count(b), t = piola_shell_body_triangle_count(b);
+    memcpy(o->rest + 3 * (size_t)(nv + soff), piola_shell_body_rest_positions(b),
+           3 * (size_t)n * sizeof(double));
+    const int32_t *tris = piola_shell_body_triangles(b);
+    for (int64_t k = 0; k < 3 * (int64_t)t; ++k) o->shells.triangles[3 * (int64_t)stoff + k] = tris[k] + soff;
+    for (int32_t k = 0; k < t; ++k) o->solid[nt + stoff + k] = -1 - s;
+    soff += n;
+    stoff += t;
+  }
+  memcpy(o->tets.positions, o->rest, 3 * (size_t)(nv + snv) * sizeof(double));
+  piola_status st = PIOLA_OK;
+  if (nt > 0) st = piola_tet_mesh_boundary(&o->tets, &o->surface);
+  if (st == PIOLA_OK) {
+    /* the surface shares the tets' numbering: each frame lends it the current positions */
+    free(o->surface.positions);
+    o->surface.positions = NULL;
+  }
+  if (st == PIOLA_OK && snt > 0) {
+    /* the OBJ surface: the solids' boundary, then the shells' triangles */
+    int32_t base = o->surface.triangle_count;
+    int32_t *grown = realloc(o->surface.triangles, 3 * (size_t)(base + snt) * sizeof(int32_t));
+    if (!grown) st = PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "output: out of memory");
+    else {
+      o->surface.triangles = grown;
+      for (int64_t k = 0; k < 3 * (int64_t)snt; ++k) grown[3 * (int64_t)base + k] = o->shells.triangles[k] + nv;
+      o->surface.triangle_count = base + snt;
+      o->surface.vertex_count = nv + snv;
+    }
+  }
   if (st == PIOLA_OK) st = piola__output_prepare_folder(dir, force);
   if (st == PIOLA_OK) st = csv_append(o, "frame,time,substeps,cg_iterations,kinetic_energy,elastic_energy,"
                                          "inverted,min_det_f,wall_seconds,contacts,impacts,impact_zones\n");
@@ -166,14 +220,42 @@ piola_status piola_output_write_frame(piola_output *o, const piola_world *world,
     voff += n;
     toff += t;
   }
+  int32_t nshell = piola_world_shell_count(world);
+  for (int32_t s = 0; s < nshell; ++s) {
+    const piola_shell_body *b = piola_world_shell_body(world, s);
+    int32_t n = piola_shell_body_vertex_count(b), t = piola_shell_body_triangle_count(b);
+    const double *x = piola_world_shell_positions(world, s);
+    const double *v = piola_world_shell_velocities(world, s);
+    for (int64_t k = 0; k < 3 * (int64_t)n; ++k) {
+      int64_t g = 3 * (int64_t)voff + k;
+      o->tets.positions[g] = x[k];
+      o->velocity[g] = v[k];
+      o->displacement[g] = x[k] - o->rest[g];
+    }
+    const double *fhat = piola_shell_body_fhat(b);
+    for (int32_t k = 0; k < t; ++k) {
+      o->det_f[toff + k] = fhat[2 * k] * fhat[2 * k + 1];
+      o->inverted[toff + k] = fhat[2 * k + 1] < 0 ? 1.0 : 0.0;
+      o->energy[toff + k] = 0.0;
+    }
+    piola_world_shell_stats st = piola_world_shell_get_stats(world, s);
+    ke += st.kinetic_energy;
+    ee += st.membrane_energy + st.bending_energy;
+    inverted += st.inverted_count;
+    voff += n;
+    toff += t;
+  }
+  o->shells.positions = o->tets.positions + 3 * (size_t)o->solid_vertices;
   char path[4200];
   piola_vtu_field points[2] = {{"velocity", 3, o->velocity}, {"displacement", 3, o->displacement}};
   piola_vtu_field cells[4] = {{"det_f", 1, o->det_f},
                               {"inverted", 1, o->inverted},
                               {"energy_density", 1, o->energy},
                               {"solid", 1, o->solid}};
-  piola_vtu_frame frame = {.tets = &o->tets, .triangles = NULL, .point_fields = points,
-                           .point_field_count = 2, .cell_fields = cells, .cell_field_count = 4};
+  piola_vtu_frame frame = {.tets = o->solid_cells > 0 ? &o->tets : NULL,
+                           .triangles = o->shells.triangle_count > 0 ? &o->shells : NULL,
+                           .point_fields = points, .point_field_count = 2, .cell_fields = cells,
+                           .cell_field_count = 4, .positions = o->tets.positions};
   snprintf(path, sizeof path, "%s/frames/frame_%04d.vtu", o->dir, (int)info->frame);
   PIOLA_TRY(piola_vtu_write(path, &frame));
   o->surface.positions = o->tets.positions; /* same numbering; borrowed for the write */

@@ -7,6 +7,7 @@
 #include "math/mat3.h"
 #include "piola/mesh_io.h"
 #include "piola/mesher.h"
+#include "piola/shell_body.h"
 #include "scene/scene_desc.h"
 
 /* R = Rz(c) Ry(b) Rx(a): rotate about x first, then y, then z (fixed axes). */
@@ -28,6 +29,48 @@ static void place(piola_tet_mesh *mesh, const scene_solid_desc *d) {
   }
 }
 
+/* Shells: read or generate the triangle mesh, place it, add the shell. */
+static piola_status build_shell(piola_world *world, const scene_shell_desc *d) {
+  piola_tri_mesh mesh;
+  memset(&mesh, 0, sizeof mesh);
+  piola_status st;
+  if (d->generator == 1)
+    st = piola_tri_mesh_rectangle(d->size[0], d->size[1], d->resolution[0], d->resolution[1], &mesh);
+  else if (d->generator == 2)
+    st = piola_tri_mesh_disk(d->radius, d->resolution[0], &mesh);
+  else if (d->generator == 3)
+    st = piola_tri_mesh_torus(d->radius, d->minor_radius, d->resolution[0], d->resolution[1],
+                              d->sweep_degrees, &mesh);
+  else
+    st = piola_tri_mesh_read(d->base.mesh_path, &mesh);
+  if (st == PIOLA_OK && mesh.triangle_count < 1)
+    st = PIOLA_FAIL(PIOLA_ERROR_PARSE, "the mesh has no triangles");
+  if (st != PIOLA_OK) {
+    piola_tri_mesh_free(&mesh);
+    return PIOLA_FAIL(st, "mesh: %s", piola_last_error());
+  }
+  mat3 r = euler_xyz_degrees(d->base.rotate_degrees);
+  for (int32_t i = 0; i < mesh.vertex_count; ++i) {
+    double *p = mesh.positions + 3 * i;
+    vec3 s = {p[0] * d->base.scale.x, p[1] * d->base.scale.y, p[2] * d->base.scale.z};
+    vec3_store(p, vec3_add(mat3_mul_vec(r, s), d->base.translate));
+  }
+  piola_shell_def def = d->def;
+  def.mesh = &mesh;
+  def.name = d->base.name;
+  def.material = d->base.def.material;
+  def.density = d->base.def.density;
+  def.stiffness_scale = d->base.def.stiffness_scale;
+  def.shear_viscosity = d->base.def.shear_viscosity;
+  def.bulk_viscosity = d->base.def.bulk_viscosity;
+  def.velocity = d->base.def.velocity;
+  def.constraints = d->base.constraints;
+  def.constraint_count = d->base.constraint_count;
+  st = piola_world_add_shell(world, &def, NULL);
+  piola_tri_mesh_free(&mesh);
+  return st;
+}
+
 piola_status piola__scene_build(const scene_desc *desc, const char *label, piola_world **out) {
   *out = NULL;
   if (!label) label = "scene";
@@ -46,6 +89,23 @@ piola_status piola__scene_build(const scene_desc *desc, const char *label, piola
       piola_world_destroy(world);
       return PIOLA_FAIL(st, "%s: solids[%d].mesh: %s", label, (int)i, piola_last_error());
     }
+    /* index selectors can only be checked against the mesh: name the scene key */
+    for (int32_t c = 0; c < d->constraint_count; ++c) {
+      const piola_selector *sel = &d->constraints[c].selector;
+      if (sel->type != PIOLA_SELECT_INDICES) continue;
+      for (int32_t k = 0; k < sel->index_count; ++k)
+        if (sel->indices[k] >= mesh.vertex_count) {
+          int fixed = c < d->fixed_count;
+          piola_status bad = PIOLA_FAIL(
+              PIOLA_ERROR_INVALID_ARGUMENT,
+              "%s: solids[%d].%s[%d].indices[%d]: vertex %d is out of range (the mesh has %d vertices)",
+              label, (int)i, fixed ? "fixed" : "driven", (int)(fixed ? c : c - d->fixed_count), (int)k,
+              (int)sel->indices[k], (int)mesh.vertex_count);
+          piola_tet_mesh_free(&mesh);
+          piola_world_destroy(world);
+          return bad;
+        }
+    }
     place(&mesh, d);
     piola_solid_def def = d->def;
     def.mesh = &mesh;
@@ -57,6 +117,13 @@ piola_status piola__scene_build(const scene_desc *desc, const char *label, piola
     if (st != PIOLA_OK) {
       piola_world_destroy(world);
       return PIOLA_FAIL(st, "%s: solids[%d]: %s", label, (int)i, piola_last_error());
+    }
+  }
+  for (int32_t i = 0; i < desc->shell_count; ++i) {
+    piola_status st = build_shell(world, &desc->shells[i]);
+    if (st != PIOLA_OK) {
+      piola_world_destroy(world);
+      return PIOLA_FAIL(st, "%s: shells[%d]: %s", label, (int)i, piola_last_error());
     }
   }
   for (int32_t i = 0; i < desc->obstacle_count; ++i) {

@@ -12,6 +12,7 @@
 #include "piola/mesher.h"
 #include "piola/obstacle.h"
 #include "piola/world.h"
+#include "piola/world_shells.h"
 
 #define SCENE_PATH_MAX 4096
 
@@ -26,8 +27,23 @@ typedef struct scene_solid_desc {
   piola_vec3 scale;               /* per axis */
   piola_constraint_def *constraints;
   int32_t constraint_count;
+  int32_t fixed_count;            /* constraints[0, fixed_count) come from `fixed`, the rest
+                                     from `driven` */
   int32_t **index_lists;          /* owned index arrays, one per constraint (or NULL) */
 } scene_solid_desc;
+
+/* A shell: the solid fields it shares (name, transform, density, material, damping,
+ * velocity, fixed, driven; base.def is not used for the mesh) plus its own. */
+typedef struct scene_shell_desc {
+  scene_solid_desc base;
+  piola_shell_def def;            /* thickness, bending, plasticity, reference normals */
+  int generator;                  /* 0 file (base.mesh_path), 1 rectangle, 2 disk, 3 torus */
+  double size[2];                 /* rectangle: m */
+  int32_t resolution[2];          /* rectangle: cells; disk: rings in [0]; torus: segments */
+  double radius;                  /* disk, torus: m */
+  double minor_radius;            /* torus: m */
+  double sweep_degrees;           /* torus */
+} scene_shell_desc;
 
 typedef struct scene_obstacle_desc {
   piola_obstacle_def def;
@@ -42,6 +58,8 @@ typedef struct scene_desc {
   int32_t solid_count;
   scene_obstacle_desc *obstacles;
   int32_t obstacle_count;
+  scene_shell_desc *shells;       /* the `shells` key (scene_parse.c, shells section) */
+  int32_t shell_count;
 } scene_desc;
 
 /* Parses and validates JSON text; label prefixes error messages. */

@@ -511,6 +511,41 @@ static piola_status parse_self_collision(parser *p, const cJSON *obj,
   return PIOLA_OK;
 }
 
+static piola_status parse_transform(parser *p, const cJSON *v, scene_solid_desc *d) {
+  size_t old = push_key(p, "transform");
+  static const char *const keys[] = {"translate", "rotate_degrees", "scale", NULL};
+  PIOLA_TRY(check_keys(p, v, keys));
+  PIOLA_TRY(opt_vec3(p, v, "translate", ANY, &d->translate));
+  PIOLA_TRY(opt_vec3(p, v, "rotate_degrees", ANY, &d->rotate_degrees));
+  const cJSON *sc = get(v, "scale");
+  if (sc) {
+    size_t o2 = push_key(p, "scale");
+    if (cJSON_IsNumber(sc)) {
+      double s;
+      PIOLA_TRY(number_value(p, sc, POSITIVE, &s));
+      d->scale = (piola_vec3){s, s, s};
+    } else {
+      PIOLA_TRY(vec3_value(p, sc, POSITIVE, &d->scale));
+    }
+    pop(p, o2);
+  }
+  pop(p, old);
+  return PIOLA_OK;
+}
+
+/* The name key of a solid or a shell. */
+static piola_status parse_name(parser *p, const cJSON *obj, scene_solid_desc *d) {
+  const cJSON *v = get(obj, "name");
+  if (!v) return PIOLA_OK;
+  size_t old = push_key(p, "name");
+  if (!cJSON_IsString(v) || !v->valuestring[0] || strlen(v->valuestring) >= sizeof d->name)
+    return fail(p, PIOLA_ERROR_PARSE, "must be a non-empty string of at most %d characters",
+                (int)sizeof d->name - 1);
+  snprintf(d->name, sizeof d->name, "%s", v->valuestring);
+  pop(p, old);
+  return PIOLA_OK;
+}
+
 static piola_status parse_solid(parser *p, const cJSON *obj, int index, scene_solid_desc *d) {
   static const char *const allowed[] = {"name",     "mesh",   "transform", "density",
                                         "material", "damping", "velocity", "fixed",
@@ -520,16 +555,8 @@ static piola_status parse_solid(parser *p, const cJSON *obj, int index, scene_so
   d->def = piola_default_solid_def();
   d->scale = (piola_vec3){1, 1, 1};
   snprintf(d->name, sizeof d->name, "solid%d", index);
-  const cJSON *v;
-  if ((v = get(obj, "name"))) {
-    size_t old = push_key(p, "name");
-    if (!cJSON_IsString(v) || !v->valuestring[0] || strlen(v->valuestring) >= sizeof d->name)
-      return fail(p, PIOLA_ERROR_PARSE, "must be a non-empty string of at most %d characters",
-                  (int)sizeof d->name - 1);
-    snprintf(d->name, sizeof d->name, "%s", v->valuestring);
-    pop(p, old);
-  }
-  v = get(obj, "mesh");
+  PIOLA_TRY(parse_name(p, obj, d));
+  const cJSON *v = get(obj, "mesh");
   size_t old = push_key(p, "mesh");
   if (cJSON_IsObject(v)) {
     d->mesh_generated = 1;
@@ -540,26 +567,7 @@ static piola_status parse_solid(parser *p, const cJSON *obj, int index, scene_so
     PIOLA_TRY(resolve_path(p, v, d->mesh_path));
   }
   pop(p, old);
-  if ((v = get(obj, "transform"))) {
-    old = push_key(p, "transform");
-    static const char *const keys[] = {"translate", "rotate_degrees", "scale", NULL};
-    PIOLA_TRY(check_keys(p, v, keys));
-    PIOLA_TRY(opt_vec3(p, v, "translate", ANY, &d->translate));
-    PIOLA_TRY(opt_vec3(p, v, "rotate_degrees", ANY, &d->rotate_degrees));
-    const cJSON *sc = get(v, "scale");
-    if (sc) {
-      size_t o2 = push_key(p, "scale");
-      if (cJSON_IsNumber(sc)) {
-        double s;
-        PIOLA_TRY(number_value(p, sc, POSITIVE, &s));
-        d->scale = (piola_vec3){s, s, s};
-      } else {
-        PIOLA_TRY(vec3_value(p, sc, POSITIVE, &d->scale));
-      }
-      pop(p, o2);
-    }
-    pop(p, old);
-  }
+  if ((v = get(obj, "transform"))) PIOLA_TRY(parse_transform(p, v, d));
   PIOLA_TRY(opt_number(p, obj, "density", POSITIVE, &d->def.density));
   if ((v = get(obj, "material"))) {
     old = push_key(p, "material");
@@ -577,6 +585,7 @@ static piola_status parse_solid(parser *p, const cJSON *obj, int index, scene_so
   PIOLA_TRY(opt_vec3(p, obj, "velocity", ANY, &d->def.velocity));
   PIOLA_TRY(parse_self_collision(p, obj, &d->def.self_collision));
   PIOLA_TRY(parse_constraints(p, obj, "fixed", 0, d));
+  d->fixed_count = d->constraint_count;
   PIOLA_TRY(parse_constraints(p, obj, "driven", 1, d));
   if ((v = get(obj, "initial"))) {
     old = push_key(p, "initial");
@@ -690,11 +699,202 @@ static piola_status parse_obstacle(parser *p, const cJSON *obj, scene_obstacle_d
   return PIOLA_OK;
 }
 
+/* ------------------------------------------------------------------ shells */
+
+/* A shell's mesh: a triangle surface file, or {"generate": "rectangle", "size": [w, h],
+ * "resolution": [nx, ny]} / {"generate": "disk", "radius": r, "rings": n} in the z = 0
+ * plane centred at the origin, or {"generate": "torus", "radius": R, "minor_radius": r,
+ * "segments": [around, tube], "sweep_degrees": s} around the z axis, before the transform. */
+static piola_status parse_shell_mesh(parser *p, const cJSON *v, scene_shell_desc *d) {
+  size_t old = push_key(p, "mesh");
+  if (cJSON_IsString(v)) {
+    PIOLA_TRY(resolve_path(p, v, d->base.mesh_path));
+    pop(p, old);
+    return PIOLA_OK;
+  }
+  if (!cJSON_IsObject(v))
+    return fail(p, PIOLA_ERROR_PARSE, "must be a triangle mesh file path or a generator object, got %s",
+                type_name(v));
+  const cJSON *g = get(v, "generate");
+  if (cJSON_IsString(g) && strcmp(g->valuestring, "rectangle") == 0) {
+    static const char *const keys[] = {"generate", "size", "resolution", NULL};
+    PIOLA_TRY(check_keys(p, v, keys));
+    PIOLA_TRY(required(p, v, "size"));
+    PIOLA_TRY(required(p, v, "resolution"));
+    d->generator = 1;
+    const cJSON *size = get(v, "size"), *res = get(v, "resolution");
+    size_t o2 = push_key(p, "size");
+    if (!cJSON_IsArray(size) || cJSON_GetArraySize(size) != 2)
+      return fail(p, PIOLA_ERROR_PARSE, "must be [width, height] in m");
+    PIOLA_TRY(number_value(p, size->child, POSITIVE, &d->size[0]));
+    PIOLA_TRY(number_value(p, size->child->next, POSITIVE, &d->size[1]));
+    pop(p, o2);
+    o2 = push_key(p, "resolution");
+    if (!cJSON_IsArray(res) || cJSON_GetArraySize(res) != 2)
+      return fail(p, PIOLA_ERROR_PARSE, "must be [cells along width, cells along height]");
+    int k = 0;
+    for (const cJSON *e = res->child; e; e = e->next, ++k) {
+      if (!cJSON_IsNumber(e) || e->valuedouble != floor(e->valuedouble) || e->valuedouble < 1 ||
+          e->valuedouble > 100000)
+        return fail(p, BAD_VALUE, "must be two integers in 1..100000");
+      d->resolution[k] = (int32_t)e->valuedouble;
+    }
+    pop(p, o2);
+  } else if (cJSON_IsString(g) && strcmp(g->valuestring, "disk") == 0) {
+    static const char *const keys[] = {"generate", "radius", "rings", NULL};
+    PIOLA_TRY(check_keys(p, v, keys));
+    PIOLA_TRY(required(p, v, "radius"));
+    PIOLA_TRY(required(p, v, "rings"));
+    d->generator = 2;
+    PIOLA_TRY(opt_number(p, v, "radius", POSITIVE, &d->radius));
+    int64_t rings = 1;
+    PIOLA_TRY(opt_int(p, v, "rings", 1, 20000, &rings));
+    d->resolution[0] = (int32_t)rings;
+  } else if (cJSON_IsString(g) && strcmp(g->valuestring, "torus") == 0) {
+    static const char *const keys[] = {"generate", "radius", "minor_radius", "segments",
+                                       "sweep_degrees", NULL};
+    PIOLA_TRY(check_keys(p, v, keys));
+    PIOLA_TRY(required(p, v, "radius"));
+    PIOLA_TRY(required(p, v, "minor_radius"));
+    PIOLA_TRY(required(p, v, "segments"));
+    d->generator = 3;
+    d->sweep_degrees = 360;
+    PIOLA_TRY(opt_number(p, v, "radius", POSITIVE, &d->radius));
+    PIOLA_TRY(opt_number(p, v, "minor_radius", POSITIVE, &d->minor_radius));
+    PIOLA_TRY(opt_number(p, v, "sweep_degrees", (range){0, 360, 1, 0}, &d->sweep_degrees));
+    if (!(d->minor_radius < d->radius)) {
+      push_key(p, "minor_radius");
+      return fail(p, BAD_VALUE, "must be smaller than radius (%g m), got %g", d->radius, d->minor_radius);
+    }
+    const cJSON *seg = get(v, "segments");
+    size_t o2 = push_key(p, "segments");
+    if (!cJSON_IsArray(seg) || cJSON_GetArraySize(seg) != 2)
+      return fail(p, PIOLA_ERROR_PARSE, "must be [segments around the ring, segments around the tube]");
+    int k = 0;
+    for (const cJSON *e = seg->child; e; e = e->next, ++k) {
+      if (!cJSON_IsNumber(e) || e->valuedouble != floor(e->valuedouble) || e->valuedouble < 3 ||
+          e->valuedouble > 100000)
+        return fail(p, BAD_VALUE, "must be two integers in 3..100000");
+      d->resolution[k] = (int32_t)e->valuedouble;
+    }
+    pop(p, o2);
+  } else {
+    push_key(p, "generate");
+    return fail(p, BAD_VALUE, "must be \"rectangle\", \"disk\" or \"torus\"");
+  }
+  pop(p, old);
+  return PIOLA_OK;
+}
+
+static piola_status parse_shell(parser *p, const cJSON *obj, int index, scene_shell_desc *d) {
+  static const char *const allowed[] = {"name", "mesh", "transform", "thickness", "density",
+                                        "material", "damping", "bending", "plasticity",
+                                        "reference_normals", "velocity", "fixed", "driven",
+                                        "collide_with_solids", "solid_friction", NULL};
+  PIOLA_TRY(check_keys(p, obj, allowed));
+  PIOLA_TRY(required(p, obj, "mesh"));
+  d->def = piola_default_shell_def();
+  d->base.def = piola_default_solid_def();
+  d->base.def.density = d->def.density;
+  d->base.scale = (piola_vec3){1, 1, 1};
+  snprintf(d->base.name, sizeof d->base.name, "shell%d", index);
+  PIOLA_TRY(parse_name(p, obj, &d->base));
+  PIOLA_TRY(parse_shell_mesh(p, get(obj, "mesh"), d));
+  const cJSON *v;
+  if ((v = get(obj, "transform"))) PIOLA_TRY(parse_transform(p, v, &d->base));
+  PIOLA_TRY(opt_number(p, obj, "thickness", POSITIVE, &d->def.thickness));
+  PIOLA_TRY(opt_number(p, obj, "density", POSITIVE, &d->base.def.density));
+  if ((v = get(obj, "material"))) {
+    size_t old = push_key(p, "material");
+    PIOLA_TRY(parse_material(p, v, &d->base));
+    pop(p, old);
+  }
+  if ((v = get(obj, "damping"))) {
+    size_t old = push_key(p, "damping");
+    static const char *const keys[] = {"shear", "bulk", NULL};
+    PIOLA_TRY(check_keys(p, v, keys));
+    PIOLA_TRY(opt_track(p, v, "shear", NONNEGATIVE, &d->base.def.shear_viscosity));
+    PIOLA_TRY(opt_track(p, v, "bulk", NONNEGATIVE, &d->base.def.bulk_viscosity));
+    pop(p, old);
+  }
+  if ((v = get(obj, "bending"))) {
+    size_t old = push_key(p, "bending");
+    static const char *const keys[] = {"stiffness", "damping", "plasticity", NULL};
+    PIOLA_TRY(check_keys(p, v, keys));
+    PIOLA_TRY(opt_number(p, v, "stiffness", NONNEGATIVE, &d->def.bending.stiffness));
+    PIOLA_TRY(opt_number(p, v, "damping", NONNEGATIVE, &d->def.bending.damping));
+    const cJSON *pl = get(v, "plasticity");
+    if (pl) {
+      size_t o2 = push_key(p, "plasticity");
+      static const char *const pkeys[] = {"yield_angle_degrees", "rate", NULL};
+      PIOLA_TRY(check_keys(p, pl, pkeys));
+      PIOLA_TRY(required(p, pl, "yield_angle_degrees"));
+      double degrees = 0;
+      PIOLA_TRY(opt_number(p, pl, "yield_angle_degrees", (range){0, 180, 0, 0}, &degrees));
+      d->def.bending.yield_angle = degrees * M_PI / 180.0;
+      PIOLA_TRY(opt_number(p, pl, "rate", POSITIVE, &d->def.bending.plastic_rate));
+      pop(p, o2);
+    }
+    pop(p, old);
+  }
+  if ((v = get(obj, "plasticity"))) {
+    size_t old = push_key(p, "plasticity");
+    static const char *const keys[] = {"yield_strain", "rate", "max_plastic_stretch", NULL};
+    PIOLA_TRY(check_keys(p, v, keys));
+    PIOLA_TRY(required(p, v, "yield_strain"));
+    PIOLA_TRY(opt_number(p, v, "yield_strain", NONNEGATIVE, &d->def.plasticity.yield_strain));
+    PIOLA_TRY(opt_number(p, v, "rate", POSITIVE, &d->def.plasticity.rate));
+    PIOLA_TRY(opt_number(p, v, "max_plastic_stretch", (range){1, INFINITY, 1, 0},
+                         &d->def.plasticity.max_plastic_stretch));
+    pop(p, old);
+  }
+  if ((v = get(obj, "reference_normals"))) {
+    size_t old = push_key(p, "reference_normals");
+    if (!cJSON_IsBool(v)) return fail(p, PIOLA_ERROR_PARSE, "must be true or false, got %s", type_name(v));
+    d->def.use_reference_normals = cJSON_IsTrue(v);
+    pop(p, old);
+  }
+  if ((v = get(obj, "collide_with_solids"))) {
+    size_t old = push_key(p, "collide_with_solids");
+    if (!cJSON_IsBool(v)) return fail(p, PIOLA_ERROR_PARSE, "must be true or false, got %s", type_name(v));
+    d->def.collide_with_solids = cJSON_IsTrue(v);
+    pop(p, old);
+  }
+  PIOLA_TRY(opt_number(p, obj, "solid_friction", NONNEGATIVE, &d->def.solid_friction));
+  PIOLA_TRY(opt_vec3(p, obj, "velocity", ANY, &d->base.def.velocity));
+  PIOLA_TRY(parse_constraints(p, obj, "fixed", 0, &d->base));
+  PIOLA_TRY(parse_constraints(p, obj, "driven", 1, &d->base));
+  return PIOLA_OK;
+}
+
+static piola_status parse_shells(parser *p, const cJSON *v, scene_desc *out) {
+  size_t old = push_key(p, "shells");
+  if (!cJSON_IsArray(v)) return fail(p, PIOLA_ERROR_PARSE, "must be an array of shells");
+  int count = cJSON_GetArraySize(v);
+  out->shells = calloc((size_t)(count > 0 ? count : 1), sizeof *out->shells);
+  if (!out->shells) return fail(p, PIOLA_ERROR_OUT_OF_MEMORY, "out of memory");
+  int i = 0;
+  for (const cJSON *e = v->child; e; e = e->next, ++i) {
+    size_t o2 = push_index(p, i);
+    out->shell_count = i + 1;
+    PIOLA_TRY(parse_shell(p, e, i, &out->shells[i]));
+    for (int j = 0; j < i; ++j)
+      if (strcmp(out->shells[j].base.name, out->shells[i].base.name) == 0) {
+        push_key(p, "name");
+        return fail(p, BAD_VALUE, "\"%s\" is already the name of shells[%d]",
+                    out->shells[i].base.name, j);
+      }
+    pop(p, o2);
+  }
+  pop(p, old);
+  return PIOLA_OK;
+}
+
 /* ------------------------------------------------------------------ top level */
 
 static piola_status parse_top(parser *p, const cJSON *root, scene_desc *out) {
   static const char *const allowed[] = {"description", "fps", "frames", "gravity", "integrator",
-                                        "solids", "obstacles", NULL};
+                                        "solids", "obstacles", "shells", NULL};
   PIOLA_TRY(check_keys(p, root, allowed));
   const cJSON *v;
   if ((v = get(root, "description")) && !cJSON_IsString(v)) {
@@ -718,16 +918,21 @@ static piola_status parse_top(parser *p, const cJSON *root, scene_desc *out) {
     out->world.cg_max_iterations = (int32_t)it;
     pop(p, old);
   }
-  PIOLA_TRY(required(p, root, "solids"));
+  /* a scene needs something to simulate: solids, or shells */
+  const cJSON *shells = get(root, "shells");
+  if (shells)
+    PIOLA_TRY(parse_shells(p, shells, out));
+  else
+    PIOLA_TRY(required(p, root, "solids"));
   v = get(root, "solids");
   size_t old = push_key(p, "solids");
-  if (!cJSON_IsArray(v) || cJSON_GetArraySize(v) < 1)
+  if (v && (!cJSON_IsArray(v) || cJSON_GetArraySize(v) < 1))
     return fail(p, PIOLA_ERROR_PARSE, "must be a non-empty array of solids");
-  int count = cJSON_GetArraySize(v);
-  out->solids = calloc((size_t)count, sizeof *out->solids);
+  int count = v ? cJSON_GetArraySize(v) : 0;
+  out->solids = calloc((size_t)(count > 0 ? count : 1), sizeof *out->solids);
   if (!out->solids) return fail(p, PIOLA_ERROR_OUT_OF_MEMORY, "out of memory");
   int i = 0;
-  for (const cJSON *e = v->child; e; e = e->next, ++i) {
+  for (const cJSON *e = v ? v->child : NULL; e; e = e->next, ++i) {
     size_t o2 = push_index(p, i);
     out->solid_count = i + 1;
     PIOLA_TRY(parse_solid(p, e, i, &out->solids[i]));
@@ -767,6 +972,13 @@ void piola__scene_desc_free(scene_desc *desc) {
   }
   free(desc->solids);
   free(desc->obstacles);
+  for (int32_t i = 0; i < desc->shell_count; ++i) {
+    scene_solid_desc *s = &desc->shells[i].base;
+    for (int32_t c = 0; c < s->constraint_count; ++c) free(s->index_lists[c]);
+    free(s->index_lists);
+    free(s->constraints);
+  }
+  free(desc->shells);
   memset(desc, 0, sizeof *desc);
 }
 

@@ -88,7 +88,9 @@ int32_t piola_obstacles_collide(piola_obstacle *const *obstacles, int32_t obstac
     if (obstacles[k]) piola__rigid_motion_state(&obstacles[k]->motion, t, &states[k]);
 
   int32_t count = 0;
-#pragma omp parallel for schedule(static) reduction(+ : count)
+  /* Below a few thousand nodes a parallel region costs more than it saves (and far more on a
+   * loaded machine, where a descheduled thread stalls the barrier). */
+#pragma omp parallel for schedule(static) reduction(+ : count) if (node_count >= 4096)
   for (int32_t i = 0; i < node_count; ++i) {
     vec3 xi = vec3_load(x + 3 * i), vi = vec3_load(v + 3 * i), ni = vec3_make(0, 0, 0);
     bool hit = false;

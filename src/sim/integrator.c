@@ -31,7 +31,7 @@ typedef struct damping_system {
 static void damping_apply(void *ctx, const double *p, double *out) {
   const damping_system *d = ctx;
   const world_solid *s = d->s;
-  piola_elastic_body_damping_forces(s->body, p, d->beta, d->alpha, d->scratch);
+  piola__solid_damping_forces(s, p, d->beta, d->alpha, d->scratch);
   for (int32_t i = 0; i < s->n; ++i)
     for (int k = 0; k < 3; ++k)
       out[3 * i + k] = s->mass[i] * p[3 * i + k] - d->h * d->scratch[3 * i + k];
@@ -58,7 +58,7 @@ static int32_t damping_solve(const piola_world *w, world_solid *s, double h, dou
   double beta = piola_track_eval(&s->shear_viscosity, t);
   double alpha = piola_track_eval(&s->bulk_viscosity, t);
   damping_system d = {s, h, beta, alpha, hold_normals, s->tmp};
-  if (beta == 0 && alpha == 0) {
+  if (piola__solid_undamped(s, beta, alpha)) {
     /* M is diagonal: the filtered solve is exact in one pass */
     for (int32_t i = 0; i < s->n; ++i) {
       if (s->flags[i] != SOLID_FREE) continue;
@@ -145,6 +145,10 @@ double piola_world_stable_dt(const piola_world *w) {
     double h = piola_elastic_body_min_rest_altitude(s->body);
     if (speed > 0 && h > 0) dt = fmin(dt, w->def.cfl * h / speed);
   }
+  for (int32_t i = 0; i < w->shell_count; ++i) {
+    const world_solid *s = &w->shells[i];
+    dt = fmin(dt, piola__shell_stable_dt(w, s, stiffness_bound(s, w->time, w->time + w->def.max_dt)));
+  }
   return dt;
 }
 
@@ -195,6 +199,7 @@ static piola_status step_solid(piola_world *w, world_solid *s, double t, double 
   if (w->obstacle_count > 0)
     colliding = piola_obstacles_collide(w->obstacles, w->obstacle_count, t1, dt, n, s->x, s->v,
                                         s->colliding, s->normals);
+  if (s->shell && s->collide_with_solids) colliding += piola__shell_collide_with_solids(w, s, t1, dt);
   for (int32_t i = 0; i < n; ++i) {
     if (s->flags[i] == SOLID_FREE) continue;
     if (s->colliding[i]) colliding--;
@@ -205,8 +210,8 @@ static piola_status step_solid(piola_world *w, world_solid *s, double t, double 
   /* damping at (x^n, v') while the body still holds the rotations of x^n */
   double beta0 = piola_track_eval(&s->shear_viscosity, t);
   double alpha0 = piola_track_eval(&s->bulk_viscosity, t);
-  if (beta0 != 0 || alpha0 != 0)
-    piola_elastic_body_damping_forces(s->body, s->v, beta0, alpha0, s->tmp);
+  if (!piola__solid_undamped(s, beta0, alpha0))
+    piola__solid_damping_forces(s, s->v, beta0, alpha0, s->tmp);
   else
     memset(s->tmp, 0, v3);
   for (int32_t i = 0; i < n; ++i)
@@ -220,6 +225,7 @@ static piola_status step_solid(piola_world *w, world_solid *s, double t, double 
     restore(s, t);
     return st;
   }
+  if (s->shell) piola_shell_body_plastic_flow(s->shell, dt);
 
   /* 4. trapezoidal velocity, damping at n+1 implicit, normal velocity of contacts held */
   for (int32_t i = 0; i < n; ++i)
@@ -231,7 +237,7 @@ static piola_status step_solid(piola_world *w, world_solid *s, double t, double 
     double beta1 = piola_track_eval(&s->shear_viscosity, t1);
     double alpha1 = piola_track_eval(&s->bulk_viscosity, t1);
     damping_system d = {s, h, beta1, alpha1, 1, s->tmp};
-    if (beta1 != 0 || alpha1 != 0) {
+    if (!piola__solid_undamped(s, beta1, alpha1)) {
       damping_apply(&d, s->v, s->rhs);
     } else {
       for (int32_t i = 0; i < n; ++i)
@@ -246,6 +252,16 @@ static piola_status step_solid(piola_world *w, world_solid *s, double t, double 
                         "solid '%s': velocity of vertex %lld became non-finite at t = %g s", s->name,
                         (long long)(j / 3), t1);
     }
+  /* a state whose energies overflow has blown up even if each coordinate is still finite */
+  double kinetic = 0;
+  for (int32_t i = 0; i < n; ++i)
+    for (int k = 0; k < 3; ++k) kinetic += s->mass[i] * s->v[3 * i + k] * s->v[3 * i + k];
+  if (!isfinite(kinetic) || !isfinite(s->elastic.elastic_energy)) {
+    restore(s, t);
+    return PIOLA_FAIL(PIOLA_ERROR_NOT_FINITE,
+                      "solid '%s': the %s energy became non-finite at t = %g s (the state blew up)",
+                      s->name, isfinite(kinetic) ? "elastic" : "kinetic", t1);
+  }
   return PIOLA_OK;
 }
 
@@ -254,10 +270,12 @@ piola_status piola_world_step(piola_world *w, double dt_limit, piola_step_stats 
   double dt = piola_world_stable_dt(w);
   if (dt_limit > 0 && dt_limit < dt) dt = dt_limit;
   if (!(dt > 0)) return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "step: dt must be > 0, got %g", dt);
-  for (int32_t i = 0; i < w->solid_count; ++i) {
-    piola_status st = step_solid(w, &w->solids[i], w->time, dt, &local);
+  for (int32_t i = 0; i < w->solid_count + w->shell_count; ++i) {
+    world_solid *s = i < w->solid_count ? &w->solids[i] : &w->shells[i - w->solid_count];
+    piola_status st = step_solid(w, s, w->time, dt, &local);
     if (st != PIOLA_OK) {
-      for (int32_t j = 0; j < i; ++j) restore(&w->solids[j], w->time);
+      for (int32_t j = 0; j < i; ++j)
+        restore(j < w->solid_count ? &w->solids[j] : &w->shells[j - w->solid_count], w->time);
       if (stats) *stats = local;
       return st;
     }

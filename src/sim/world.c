@@ -40,9 +40,12 @@ piola_status piola_world_create(const piola_world_def *def, piola_world **out) {
   return PIOLA_OK;
 }
 
-static void solid_free(world_solid *s) {
+void piola__solid_free(world_solid *s) {
   free(s->name);
   piola_elastic_body_destroy(s->body);
+  piola_shell_body_destroy(s->shell);
+  if (s->boundary) piola_tri_mesh_free(s->boundary);
+  free(s->boundary);
   free(s->x), free(s->v), free(s->mass), free(s->inverse_mass), free(s->force), free(s->start), free(s->flags);
   free(s->motion_of), free(s->motions);
   free(s->x_old), free(s->v_old), free(s->force_old), free(s->rhs), free(s->work), free(s->tmp);
@@ -52,7 +55,9 @@ static void solid_free(world_solid *s) {
 
 void piola_world_destroy(piola_world *world) {
   if (!world) return;
-  for (int32_t i = 0; i < world->solid_count; ++i) solid_free(&world->solids[i]);
+  for (int32_t i = 0; i < world->solid_count; ++i) piola__solid_free(&world->solids[i]);
+  for (int32_t i = 0; i < world->shell_count; ++i) piola__solid_free(&world->shells[i]);
+  free(world->shells);
   for (int32_t i = 0; i < world->obstacle_count; ++i) piola_obstacle_destroy(world->obstacles[i]);
   piola__world_contact_free(world);
   free(world->solids);
@@ -61,6 +66,7 @@ void piola_world_destroy(piola_world *world) {
 }
 
 piola_status piola__solid_update_forces(world_solid *s, double t) {
+  if (s->shell) return piola__shell_update_forces(s, t);
   double scale = piola_track_eval(&s->stiffness_scale, t);
   return piola_elastic_body_update(s->body, s->x, scale, s->force, &s->elastic);
 }
@@ -146,7 +152,7 @@ piola_status piola_world_add_solid(piola_world *world, const piola_solid_def *de
   if (!s->name || !s->x || !s->v || !s->force || !s->start || !s->mass || !s->inverse_mass || !s->flags ||
       !s->motion_of || !s->x_old || !s->v_old || !s->force_old || !s->rhs || !s->tmp || !s->work ||
       !s->normals || !s->colliding) {
-    solid_free(s);
+    piola__solid_free(s);
     return PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "solid %d: out of memory", (int)id);
   }
   strcpy(s->name, name);
@@ -160,7 +166,7 @@ piola_status piola_world_add_solid(piola_world *world, const piola_solid_def *de
   s->self_collision = def->self_collision;
   st = piola__solid_apply_constraints(s, rest, def->constraints, def->constraint_count);
   if (st != PIOLA_OK) {
-    solid_free(s);
+    piola__solid_free(s);
     return st;
   }
   for (int32_t i = 0; i < n; ++i) {
@@ -184,7 +190,7 @@ piola_status piola_world_add_solid(piola_world *world, const piola_solid_def *de
   }
   st = piola__solid_update_forces(s, world->time);
   if (st != PIOLA_OK) {
-    solid_free(s);
+    piola__solid_free(s);
     return st;
   }
   world->solid_count++;

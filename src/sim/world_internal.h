@@ -11,12 +11,19 @@
 #include <stdint.h>
 
 #include "piola/world.h"
+#include "piola/world_shells.h"
 
 enum { SOLID_FREE = 0, SOLID_FIXED = 1, SOLID_DRIVEN = 2 };
 
 typedef struct world_solid {
   char *name;
-  piola_elastic_body *body;
+  piola_elastic_body *body;  /* a tetrahedral solid, or NULL for a shell */
+  piola_shell_body *shell;   /* a shell (world_shells.c), or NULL */
+  piola_shell_stats shell_stats; /* of the last update, shells only */
+  int collide_with_solids;   /* shells: one-way coupling to the solids' surfaces */
+  double solid_friction;     /* shells: Coulomb mu against solids */
+  piola_tri_mesh *boundary;  /* solids: boundary surface, built when a shell first needs it */
+  double boundary_reach;     /* solids: longest boundary edge, m */
   int32_t n;                 /* vertex count */
   double *x, *v;             /* 3n current state */
   double *mass;              /* n lumped masses, kg */
@@ -41,6 +48,8 @@ struct piola_world {
   double time;
   world_solid *solids;
   int32_t solid_count, solid_capacity;
+  world_solid *shells;        /* shells step like solids, with a shell body (world_shells.c) */
+  int32_t shell_count, shell_capacity;
   piola_obstacle **obstacles;
   int32_t obstacle_count, obstacle_capacity;
   struct world_contact *contact; /* self-collision of boundary surfaces (world_contact.c) */
@@ -55,6 +64,23 @@ void piola__solid_constrained_state(const world_solid *s, int32_t i, double t, d
                                     double v[3]);
 /* Recomputes the elastic force of s at its positions x and time t (stiffness scale). */
 piola_status piola__solid_update_forces(world_solid *s, double t);
+/* Frees everything s owns (world.c). */
+void piola__solid_free(world_solid *s);
+
+/* Shells (world_shells.c): the body-kind dispatch the step loop needs. */
+/* Damping force at velocities v of a solid or a shell (out overwritten, N). */
+void piola__solid_damping_forces(const world_solid *s, const double *v, double beta,
+                                 double alpha, double *out);
+/* True when s has no damping at all (its damping solve is a diagonal one). */
+int piola__solid_undamped(const world_solid *s, double beta, double alpha);
+/* Elastic force update of a shell (called by piola__solid_update_forces). */
+piola_status piola__shell_update_forces(world_solid *s, double t);
+/* One-way coupling (world_shells.c): pushes the free nodes of shell s out of the solids'
+ * current boundary surfaces at t1 after a step of dt, as obstacle collisions do; flags and
+ * normals are set for the final solve. Returns the number of nodes it moved. */
+int32_t piola__shell_collide_with_solids(piola_world *w, world_solid *s, double t1, double dt);
+/* The step bound of a shell (in-plane CFL and bending time scale), s. */
+double piola__shell_stable_dt(const piola_world *w, const world_solid *s, double scale);
 
 /* Self-collision after a step of length dt (s) that every solid has taken from x_old to x:
  * changes x and v of solids with self-collision enabled (and recomputes their forces at

@@ -51,7 +51,7 @@ expect_bad obstacle '{"solids": [{"mesh": {"generate": "box", "half_extents": [0
   "obstacles[0].normal: must be a nonzero vector"
 expect_bad missing_mesh '{"solids": [{"mesh": "no_such_mesh.veg"}]}' "solids[0].mesh"
 expect_bad bad_index '{"solids": [{"mesh": {"generate": "box", "half_extents": [0.1, 0.1, 0.1], "cell_size": 0.1}, "fixed": [{"indices": [100000]}]}]}' \
-  "solids[0]"
+  "solids[0].fixed[0].indices[0]: vertex 100000 is out of range"
 expect_bad not_json '{"solids": [' "invalid JSON"
 
 # a folder that holds anything is refused without --force, and left alone

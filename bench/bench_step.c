@@ -1,0 +1,135 @@
+/* Benchmark of one full time step of the world: elastic forces and diagonalization once,
+ * two damping solves by conjugate gradient, collisions with a ground plane.
+ *
+ *   build/<dir>/bench_step [repeats] [mesh]
+ *
+ * Mesh: Vega's torus-easy.veg (97,878 tets) from ../shared/data unless another is given.
+ * The torus starts slightly scrambled (so elastic forces and damping are busy), falls under
+ * gravity onto a plane through its lowest point, with shear and bulk viscosities chosen so
+ * the two solves of a step take about 20 CG iterations together. Each timing is 10 steps of
+ * fixed dt = 1e-4 s; the table gives the median over `repeats` (default 5) for 1 and 2
+ * threads: wall and process CPU time per step (CPU time is less disturbed by a loaded
+ * machine; with 2 threads it counts both), CG iterations per step, and the two kernels a
+ * step is made of timed alone: one elastic update and one damping-force evaluation (a step
+ * costs one update plus about one damping evaluation per CG iteration). */
+#include <math.h>
+#include <omp.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+#include "piola/mesh_io.h"
+#include "piola/world.h"
+
+static double now_seconds(void) {
+  struct timespec ts;
+  clock_gettime(CLOCK_MONOTONIC, &ts);
+  return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+static int compare_doubles(const void *a, const void *b) {
+  double x = *(const double *)a, y = *(const double *)b;
+  return (x > y) - (x < y);
+}
+
+int main(int argc, char **argv) {
+  int repeats = argc > 1 ? atoi(argv[1]) : 5;
+  if (repeats < 1) repeats = 1;
+  const char *path = argc > 2 ? argv[2] : PIOLA_DATA_DIR "/vega/torus-easy.veg";
+  piola_tet_mesh mesh;
+  if (piola_tet_mesh_read(path, &mesh) != PIOLA_OK) {
+    fprintf(stderr, "bench_step: %s\n", piola_last_error());
+    return 1;
+  }
+  double zmin = INFINITY, xmin = INFINITY, xmax = -INFINITY;
+  for (int32_t i = 0; i < mesh.vertex_count; ++i) {
+    zmin = fmin(zmin, mesh.positions[3 * i + 2]);
+    xmin = fmin(xmin, mesh.positions[3 * i]);
+    xmax = fmax(xmax, mesh.positions[3 * i]);
+  }
+  double size = xmax - xmin;
+  printf("bench_step: %s, %d vertices, %d tets, size %.3g m\n", path, (int)mesh.vertex_count,
+         (int)mesh.tet_count, size);
+  printf("%8s %10s %14s %14s %12s %14s\n", "threads", "ms/step", "CPU ms/step", "CG iter/step",
+         "ms/update", "ms/damping");
+  for (int threads = 1; threads <= 2; ++threads) {
+    piola_set_thread_count(threads);
+    omp_set_num_threads(threads);
+    double *times = malloc((size_t)repeats * sizeof *times);
+    double *cpu = malloc((size_t)repeats * sizeof *cpu);
+    double *upd = malloc((size_t)repeats * sizeof *upd);
+    double *damp = malloc((size_t)repeats * sizeof *damp);
+    double cg_per_step = 0;
+    for (int r = 0; r < repeats; ++r) {
+      piola_world_def wd = piola_default_world_def();
+      wd.max_dt = 1e-4;
+      wd.cfl = 2; /* fixed dt: this measures the cost of a step, not the step size */
+      piola_world *world = NULL;
+      piola_solid_def sd = piola_default_solid_def();
+      sd.mesh = &mesh;
+      sd.material.model = PIOLA_MODEL_NEOHOOKEAN;
+      sd.material.youngs_modulus = 1e5;
+      sd.material.poisson_ratio = 0.4;
+      sd.shear_viscosity = piola_track_constant(2e-5 * 1000 * size * size / 1e-4);
+      sd.bulk_viscosity = piola_track_constant(2e-5 * 1000 * size * size / 1e-4);
+      sd.scramble_radius = 1e-3 * size;
+      sd.velocity = (piola_vec3){0, 0, -1};
+      piola_obstacle_def ground = piola_default_obstacle_def();
+      ground.type = PIOLA_OBSTACLE_PLANE;
+      ground.center = (piola_vec3){0, 0, zmin};
+      ground.axis = (piola_vec3){0, 0, 1};
+      ground.friction = 0.5;
+      if (piola_world_create(&wd, &world) != PIOLA_OK || piola_world_add_solid(world, &sd, NULL) != PIOLA_OK ||
+          piola_world_add_obstacle(world, &ground, NULL) != PIOLA_OK) {
+        fprintf(stderr, "bench_step: %s\n", piola_last_error());
+        return 1;
+      }
+      piola_step_stats st;
+      for (int s = 0; s < 3; ++s) piola_world_step(world, 1e-4, &st); /* warm up */
+      const int steps = 10;
+      int cg = 0;
+      double t0 = now_seconds();
+      clock_t c0 = clock();
+      for (int s = 0; s < steps; ++s) {
+        if (piola_world_step(world, 1e-4, &st) != PIOLA_OK) {
+          fprintf(stderr, "bench_step: %s\n", piola_last_error());
+          return 1;
+        }
+        cg += st.cg_iterations;
+      }
+      times[r] = (now_seconds() - t0) / steps;
+      cpu[r] = (double)(clock() - c0) / CLOCKS_PER_SEC / steps;
+      cg_per_step = (double)cg / steps;
+      /* the two kernels of a step alone, on this state: one elastic update, one damping apply */
+      const piola_elastic_body *body = piola_world_solid_body(world, 0);
+      int32_t n = piola_elastic_body_vertex_count(body);
+      double *f = malloc(3 * (size_t)n * sizeof *f);
+      double *x = malloc(3 * (size_t)n * sizeof *x);
+      memcpy(x, piola_world_solid_positions(world, 0), 3 * (size_t)n * sizeof *x);
+      piola_elastic_body *mut = (piola_elastic_body *)body; /* the world's own body, same state */
+      double u0 = now_seconds();
+      for (int k = 0; k < 3; ++k) piola_elastic_body_update(mut, x, 1.0, f, NULL);
+      upd[r] = (now_seconds() - u0) / 3;
+      double d0 = now_seconds();
+      for (int k = 0; k < 5; ++k)
+        piola_elastic_body_damping_forces(body, piola_world_solid_velocities(world, 0), 1, 1, f);
+      damp[r] = (now_seconds() - d0) / 5;
+      free(f);
+      free(x);
+      piola_world_destroy(world);
+    }
+    qsort(times, (size_t)repeats, sizeof *times, compare_doubles);
+    qsort(cpu, (size_t)repeats, sizeof *cpu, compare_doubles);
+    qsort(upd, (size_t)repeats, sizeof *upd, compare_doubles);
+    qsort(damp, (size_t)repeats, sizeof *damp, compare_doubles);
+    printf("%8d %10.2f %14.2f %14.1f %12.2f %14.2f\n", threads, 1e3 * times[repeats / 2],
+           1e3 * cpu[repeats / 2], cg_per_step, 1e3 * upd[repeats / 2], 1e3 * damp[repeats / 2]);
+    free(times);
+    free(cpu);
+    free(upd);
+    free(damp);
+  }
+  piola_tet_mesh_free(&mesh);
+  return 0;
+}

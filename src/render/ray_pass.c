@@ -1,0 +1,154 @@
+/* The ray pass: one camera ray per pixel finds the background, the ground and the
+ * obstacles, and leaves their depth for the triangle pass.
+ *
+ * Planes are intersected analytically. Other obstacles are sphere-traced through their
+ * signed distance, only inside their bounding sphere; a hit is accepted when the distance is
+ * below a fraction of the pixel's footprint, so edges are as sharp as the pixel grid. The
+ * pose of every obstacle is computed once per frame. */
+#include <math.h>
+#include <stdlib.h>
+
+#include "render/render_internal.h"
+#include "sim/obstacle_internal.h"
+
+typedef struct ground_plane {
+  vec3 normal, t1, t2, point; /* unit normal; in-plane axes; a point on it */
+  double camera_height;       /* signed distance of the camera above the plane, m */
+  float light;                /* diffuse light of the plane: one value, lights are directional */
+} ground_plane;
+
+typedef struct traced_obstacle {
+  const piola_obstacle *obstacle;
+  piola__rigid_state state;
+  vec3 center; /* world centre of the bounding sphere at this pose */
+  double radius;
+} traced_obstacle;
+
+static ground_plane make_plane(const render_camera *cam, vec3 point, vec3 n, vec3 camera) {
+  ground_plane g;
+  g.normal = n;
+  g.point = point;
+  vec3 a = fabs(n.z) < 0.9 ? (vec3){0, 0, 1} : (vec3){1, 0, 0};
+  g.t1 = vec3_cross(n, a);
+  g.t1 = vec3_scale(g.t1, 1.0 / vec3_norm(g.t1));
+  g.t2 = vec3_cross(n, g.t1);
+  g.camera_height = vec3_dot(vec3_sub(camera, point), n);
+  float spec;
+  g.light = render_light(cam, n, vec3_neg(cam->forward), &spec);
+  return g;
+}
+
+static void background(const render_camera *c, int y, float out[3]) {
+  float s = (float)y / (float)(c->height > 1 ? c->height - 1 : 1);
+  out[0] = 236 - 40 * s;
+  out[1] = 239 - 36 * s;
+  out[2] = 244 - 28 * s;
+}
+
+void piola__render_ray_pass(const piola_renderer *r, const render_camera *cam, double time,
+                            const render_shadow *shadow, float *depth, uint8_t *rgb) {
+  enum { MAX_PLANES = 16, MAX_TRACED = 64 };
+  ground_plane planes[MAX_PLANES];
+  traced_obstacle traced[MAX_TRACED];
+  int np = 0, nt = 0;
+  for (int32_t i = 0; i < r->obstacle_count; ++i) {
+    const piola_obstacle *o = r->obstacles[i];
+    piola__rigid_state st;
+    piola__rigid_motion_state(&o->motion, time, &st);
+    if (o->type == PIOLA_OBSTACLE_MESH) continue; /* rasterized with the triangles */
+    if (o->type == PIOLA_OBSTACLE_PLANE) {
+      if (np == MAX_PLANES) continue;
+      vec3 n;
+      double d = piola__obstacle_distance_posed(o, &st, cam->position, &n, NULL);
+      vec3 foot = vec3_sub(cam->position, vec3_scale(n, d));
+      planes[np++] = make_plane(cam, foot, n, cam->position);
+    } else if (nt < MAX_TRACED) {
+      traced_obstacle *t = &traced[nt++];
+      t->obstacle = o;
+      t->state = st;
+      t->center = vec3_add(mat3_mul_vec(st.rotation, o->bound_center), st.translation);
+      t->radius = o->bound_radius;
+    }
+  }
+  if (np == 0 && r->def.ground)
+    planes[np++] =
+        make_plane(cam, vec3_scale(r->def.up, r->ground_height), r->def.up, cam->position);
+
+  const double checker = r->checker_size, fog = 10 * (r->scene_size > 0 ? r->scene_size : 1);
+  const double inv_f = 1.0 / cam->focal_px;
+  const int W = cam->width, H = cam->height;
+#pragma omp parallel for schedule(dynamic, 4)
+  for (int y = 0; y < H; ++y) {
+    float bg[3];
+    background(cam, y, bg);
+    for (int x = 0; x < W; ++x) {
+      vec3 dir =
+          vec3_add(cam->forward, vec3_add(vec3_scale(cam->right, (x + 0.5 - 0.5 * W) * inv_f),
+                                          vec3_scale(cam->up, -(y + 0.5 - 0.5 * H) * inv_f)));
+      double dir_len = vec3_norm(dir);
+      vec3 dn = vec3_scale(dir, 1.0 / dir_len);
+      double best = INFINITY; /* view depth, m */
+      float col[3] = {bg[0], bg[1], bg[2]};
+      for (int k = 0; k < np; ++k) {
+        const ground_plane *g = &planes[k];
+        double denom = vec3_dot(g->normal, dir);
+        if (!(g->camera_height > 0) || !(denom < 0)) continue;
+        double s = -g->camera_height / denom;
+        if (!(s < best)) continue;
+        best = s;
+        vec3 p = vec3_add(cam->position, vec3_scale(dir, s));
+        vec3 rel = vec3_sub(p, g->point);
+        double u = vec3_dot(rel, g->t1) / checker, v = vec3_dot(rel, g->t2) / checker;
+        long parity = ((long)floor(u) + (long)floor(v)) & 1;
+        float base = parity ? 206.f : 160.f;
+        /* far away the squares are smaller than a pixel: blend to their mean, then fog */
+        double footprint = s * dir_len * inv_f / fabs(vec3_dot(dn, g->normal)) / checker;
+        float w = (float)fmin(1.0, footprint);
+        base = base * (1 - w) + 183.f * w;
+        double q = s * dir_len / fog;
+        float fade = q < 1e-3 ? 0.f : (float)(1 - exp(-q * q));
+        float lit = base * (0.55f + 0.45f * g->light);
+        if (shadow->size > 0) lit *= (float)(1 - 0.42 * piola__render_shadow_at(shadow, p));
+        col[0] = lit * (1 - fade) + bg[0] * fade;
+        col[1] = lit * (1 - fade) + bg[1] * fade;
+        col[2] = (lit + 4) * (1 - fade) + bg[2] * fade;
+      }
+      for (int k = 0; k < nt; ++k) {
+        const traced_obstacle *t = &traced[k];
+        vec3 oc = vec3_sub(cam->position, t->center);
+        double b = vec3_dot(oc, dn), cc = vec3_norm2(oc) - t->radius * t->radius;
+        double disc = b * b - cc;
+        if (!(disc >= 0)) continue;
+        double sq = sqrt(disc), t0 = -b - sq, t1 = -b + sq;
+        if (t1 <= 0 || t0 / dir_len >= best) continue;
+        double s = t0 > 0 ? t0 : 0, s_max = fmin(t1, best * dir_len);
+        vec3 n = {0, 0, 1};
+        bool hit = false;
+        for (int it = 0; it < 200 && s <= s_max; ++it) {
+          vec3 p = vec3_add(cam->position, vec3_scale(dn, s));
+          double d = piola__obstacle_distance_posed(t->obstacle, &t->state, p, &n, NULL);
+          if (it == 0 && d < 0 && s == 0) break; /* camera inside: draw nothing */
+          double eps = 0.25 * s * inv_f + 1e-9 * t->radius;
+          if (d < eps) {
+            hit = true;
+            break;
+          }
+          s += d;
+        }
+        if (!hit || !(s / dir_len < best)) continue;
+        best = s / dir_len;
+        float spec;
+        float light = render_light(cam, n, vec3_neg(dn), &spec);
+        col[0] = RENDER_OBSTACLE_R * light + 255 * spec;
+        col[1] = RENDER_OBSTACLE_G * light + 255 * spec;
+        col[2] = RENDER_OBSTACLE_B * light + 255 * spec;
+      }
+      size_t i = (size_t)y * (size_t)W + (size_t)x;
+      depth[i] = (float)best;
+      for (int c = 0; c < 3; ++c) {
+        float v = col[c] + 0.5f;
+        rgb[3 * i + (size_t)c] = (uint8_t)(v < 0 ? 0 : v > 255 ? 255 : v);
+      }
+    }
+  }
+}

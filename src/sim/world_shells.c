@@ -1,0 +1,332 @@
+/* Shells in the world: adding them, the body-kind dispatch of the step loop (forces,
+ * damping, step bound) and the shell accessors. A shell is a world_solid whose body is a
+ * piola_shell_body, so it is stepped by the very same code as a solid (integrator.c):
+ * constraints, collisions, the two damping solves and the trapezoidal velocity. */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "common/status_internal.h"
+#include "math/mat3.h"
+#include "sim/world_internal.h"
+
+piola_shell_def piola_default_shell_def(void) {
+  piola_shell_def def;
+  memset(&def, 0, sizeof def);
+  piola_shell_body_def body = piola_default_shell_body_def();
+  def.material = piola_default_material_def();
+  def.thickness = body.thickness;
+  def.density = body.density;
+  def.bending = body.bending;
+  def.plasticity = body.plasticity;
+  def.stiffness_scale.value = 1.0;
+  def.solid_friction = 0.3;
+  return def;
+}
+
+static int track_ok(const piola_track *t) {
+  if (t->key_count < 0 || t->key_count > PIOLA_MAX_KEYS) return 0;
+  if (t->key_count == 0) return isfinite(t->value) && t->value >= 0;
+  for (int32_t k = 0; k < t->key_count; ++k)
+    if (!isfinite(t->values[k]) || t->values[k] < 0) return 0;
+  return 1;
+}
+
+void piola__solid_damping_forces(const world_solid *s, const double *v, double beta,
+                                 double alpha, double *out) {
+  if (s->shell)
+    piola_shell_body_damping_forces(s->shell, v, beta, alpha, out);
+  else
+    piola_elastic_body_damping_forces(s->body, v, beta, alpha, out);
+}
+
+/* A shell with bending damping is damped even with zero in-plane viscosities. */
+int piola__solid_undamped(const world_solid *s, double beta, double alpha) {
+  if (beta != 0 || alpha != 0) return 0;
+  return !s->shell || piola_shell_body_bending_damping(s->shell) == 0;
+}
+
+piola_status piola__shell_update_forces(world_solid *s, double t) {
+  double scale = piola_track_eval(&s->stiffness_scale, t);
+  return piola_shell_body_update(s->shell, s->x, scale, s->force, &s->shell_stats);
+}
+
+double piola__shell_stable_dt(const piola_world *w, const world_solid *s, double scale) {
+  double dt = INFINITY;
+  double speed = piola_shell_body_max_wave_speed(s->shell) * sqrt(scale);
+  double h = piola_shell_body_min_rest_altitude(s->shell);
+  if (speed > 0 && h > 0) dt = w->def.cfl * h / speed;
+  /* bending: explicit, stable up to ~2 sqrt(m/k); cfl in (0, 2] scales it the same way */
+  double bending = piola_shell_body_bending_time_scale(s->shell);
+  if (scale > 0 && isfinite(bending)) dt = fmin(dt, w->def.cfl * bending / sqrt(scale));
+  return dt;
+}
+
+piola_status piola_world_add_shell(piola_world *world, const piola_shell_def *def, int32_t *index) {
+  if (!world || !def) return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "add_shell: NULL argument");
+  int32_t id = world->shell_count;
+  if (!def->mesh) return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "shell %d: mesh is required", (int)id);
+  if (!track_ok(&def->stiffness_scale))
+    return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "shell %d: stiffness_scale must be >= 0", (int)id);
+  if (!track_ok(&def->shear_viscosity) || !track_ok(&def->bulk_viscosity))
+    return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "shell %d: viscosities must be >= 0 Pa s", (int)id);
+  if (!isfinite(def->velocity.x) || !isfinite(def->velocity.y) || !isfinite(def->velocity.z))
+    return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "shell %d: velocity must be finite", (int)id);
+  if (!(def->solid_friction >= 0) || !isfinite(def->solid_friction))
+    return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "shell %d: solid_friction must be >= 0, got %g",
+                      (int)id, def->solid_friction);
+  piola_material material;
+  PIOLA_TRY(piola_material_init(&def->material, &material));
+  piola_shell_body_def bdef = piola_default_shell_body_def();
+  bdef.rest_mesh = def->mesh;
+  bdef.materials = &material;
+  bdef.material_count = 1;
+  bdef.thickness = def->thickness;
+  bdef.density = def->density;
+  bdef.bending = def->bending;
+  bdef.plasticity = def->plasticity;
+  bdef.use_reference_normals = def->use_reference_normals;
+
+  if (world->shell_count == world->shell_capacity) {
+    int32_t cap = world->shell_capacity ? 2 * world->shell_capacity : 4;
+    world_solid *grown = realloc(world->shells, (size_t)cap * sizeof *grown);
+    if (!grown) return PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "add_shell: out of memory");
+    world->shells = grown;
+    world->shell_capacity = cap;
+  }
+  world_solid *s = &world->shells[id];
+  memset(s, 0, sizeof *s);
+  piola_status st = piola_shell_body_create(&bdef, &s->shell);
+  if (st != PIOLA_OK) {
+    s->shell = NULL;
+    return st;
+  }
+  int32_t n = s->n = piola_shell_body_vertex_count(s->shell);
+  size_t v3 = 3 * (size_t)n * sizeof(double);
+  char fallback[32];
+  snprintf(fallback, sizeof fallback, "shell%d", (int)id);
+  const char *name = def->name ? def->name : fallback;
+  s->name = malloc(strlen(name) + 1);
+  s->x = malloc(v3), s->v = malloc(v3), s->force = malloc(v3), s->start = malloc(v3);
+  s->mass = malloc((size_t)n * sizeof(double));
+  s->inverse_mass = malloc((size_t)n * sizeof(double));
+  s->flags = calloc((size_t)n, 1);
+  s->motion_of = malloc((size_t)n * sizeof(int32_t));
+  s->x_old = malloc(v3), s->v_old = malloc(v3), s->force_old = malloc(v3), s->rhs = malloc(v3);
+  s->tmp = malloc(v3), s->work = malloc(4 * v3), s->normals = malloc(v3);
+  s->colliding = calloc((size_t)n, 1);
+  if (!s->name || !s->x || !s->v || !s->force || !s->start || !s->mass || !s->inverse_mass ||
+      !s->flags || !s->motion_of || !s->x_old || !s->v_old || !s->force_old || !s->rhs ||
+      !s->tmp || !s->work || !s->normals || !s->colliding) {
+    piola__solid_free(s);
+    return PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "shell %d: out of memory", (int)id);
+  }
+  strcpy(s->name, name);
+  const double *rest = piola_shell_body_rest_positions(s->shell);
+  memcpy(s->mass, piola_shell_body_masses(s->shell), (size_t)n * sizeof(double));
+  memcpy(s->start, rest, v3);
+  for (int32_t i = 0; i < n; ++i) s->motion_of[i] = -1;
+  s->stiffness_scale = def->stiffness_scale;
+  s->shear_viscosity = def->shear_viscosity;
+  s->bulk_viscosity = def->bulk_viscosity;
+  s->collide_with_solids = def->collide_with_solids;
+  s->solid_friction = def->solid_friction;
+  st = piola__solid_apply_constraints(s, rest, def->constraints, def->constraint_count);
+  if (st != PIOLA_OK) {
+    piola__solid_free(s);
+    return st;
+  }
+  for (int32_t i = 0; i < n; ++i) {
+    s->inverse_mass[i] = s->mass[i] > 0 ? 1.0 / s->mass[i] : 0.0;
+    if (!(s->mass[i] > 0)) s->flags[i] = SOLID_FIXED; /* a vertex in no triangle cannot move */
+  }
+  for (int32_t i = 0; i < n; ++i) {
+    if (s->flags[i] != SOLID_FREE) {
+      piola__solid_constrained_state(s, i, world->time, s->x + 3 * i, s->v + 3 * i);
+      continue;
+    }
+    memcpy(s->x + 3 * i, rest + 3 * i, 3 * sizeof(double));
+    s->v[3 * i] = def->velocity.x, s->v[3 * i + 1] = def->velocity.y, s->v[3 * i + 2] = def->velocity.z;
+  }
+  st = piola__solid_update_forces(s, world->time);
+  if (st != PIOLA_OK) {
+    piola__solid_free(s);
+    return st;
+  }
+  world->shell_count++;
+  if (index) *index = id;
+  return PIOLA_OK;
+}
+
+static const world_solid *shell_at(const piola_world *w, int32_t i) {
+  return (w && i >= 0 && i < w->shell_count) ? &w->shells[i] : NULL;
+}
+
+int32_t piola_world_shell_count(const piola_world *world) { return world ? world->shell_count : 0; }
+const char *piola_world_shell_name(const piola_world *world, int32_t shell) {
+  const world_solid *s = shell_at(world, shell);
+  return s ? s->name : NULL;
+}
+const piola_shell_body *piola_world_shell_body(const piola_world *world, int32_t shell) {
+  const world_solid *s = shell_at(world, shell);
+  return s ? s->shell : NULL;
+}
+const double *piola_world_shell_positions(const piola_world *world, int32_t shell) {
+  const world_solid *s = shell_at(world, shell);
+  return s ? s->x : NULL;
+}
+const double *piola_world_shell_velocities(const piola_world *world, int32_t shell) {
+  const world_solid *s = shell_at(world, shell);
+  return s ? s->v : NULL;
+}
+const uint8_t *piola_world_shell_constraint_flags(const piola_world *world, int32_t shell) {
+  const world_solid *s = shell_at(world, shell);
+  return s ? s->flags : NULL;
+}
+
+piola_world_shell_stats piola_world_shell_get_stats(const piola_world *world, int32_t shell) {
+  piola_world_shell_stats st;
+  memset(&st, 0, sizeof st);
+  const world_solid *s = shell_at(world, shell);
+  if (!s) return st;
+  for (int32_t i = 0; i < s->n; ++i) {
+    const double *v = s->v + 3 * i;
+    st.kinetic_energy += 0.5 * s->mass[i] * (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
+  }
+  st.membrane_energy = s->shell_stats.membrane_energy;
+  st.bending_energy = s->shell_stats.bending_energy;
+  st.inverted_count = s->shell_stats.inverted_count;
+  st.degenerate_count = s->shell_stats.degenerate_count;
+  return st;
+}
+
+/* ------------------------------------------------------------------ one-way coupling */
+
+/* The closest point to p on triangle (a, b, c), with its barycentric weights (Voronoi
+ * regions of the vertices, then the edges, then the face). */
+static vec3 closest_on_triangle(vec3 p, vec3 a, vec3 b, vec3 c, double w[3]) {
+  vec3 ab = vec3_sub(b, a), ac = vec3_sub(c, a), ap = vec3_sub(p, a);
+  double d1 = vec3_dot(ab, ap), d2 = vec3_dot(ac, ap);
+  if (d1 <= 0 && d2 <= 0) return w[0] = 1, w[1] = w[2] = 0, a;
+  vec3 bp = vec3_sub(p, b);
+  double d3 = vec3_dot(ab, bp), d4 = vec3_dot(ac, bp);
+  if (d3 >= 0 && d4 <= d3) return w[1] = 1, w[0] = w[2] = 0, b;
+  double vc = d1 * d4 - d3 * d2;
+  if (vc <= 0 && d1 >= 0 && d3 <= 0) {
+    double t = d1 / (d1 - d3);
+    w[0] = 1 - t, w[1] = t, w[2] = 0;
+    return vec3_add(a, vec3_scale(ab, t));
+  }
+  vec3 cp = vec3_sub(p, c);
+  double d5 = vec3_dot(ab, cp), d6 = vec3_dot(ac, cp);
+  if (d6 >= 0 && d5 <= d6) return w[2] = 1, w[0] = w[1] = 0, c;
+  double vb = d5 * d2 - d1 * d6;
+  if (vb <= 0 && d2 >= 0 && d6 <= 0) {
+    double t = d2 / (d2 - d6);
+    w[0] = 1 - t, w[1] = 0, w[2] = t;
+    return vec3_add(a, vec3_scale(ac, t));
+  }
+  double va = d3 * d6 - d5 * d4;
+  if (va <= 0 && (d4 - d3) >= 0 && (d5 - d6) >= 0) {
+    double t = (d4 - d3) / ((d4 - d3) + (d5 - d6));
+    w[0] = 0, w[1] = 1 - t, w[2] = t;
+    return vec3_add(b, vec3_scale(vec3_sub(c, b), t));
+  }
+  double denom = 1.0 / (va + vb + vc), v = vb * denom, u = vc * denom;
+  w[0] = 1 - v - u, w[1] = v, w[2] = u;
+  return vec3_add(a, vec3_add(vec3_scale(ab, v), vec3_scale(ac, u)));
+}
+
+/* The boundary surface of a solid, built once (rest topology; positions are read live). */
+static piola_status solid_boundary(world_solid *solid) {
+  if (solid->boundary) return PIOLA_OK;
+  const piola_elastic_body *b = solid->body;
+  piola_tet_mesh tets = {piola_elastic_body_vertex_count(b),
+                         (double *)piola_elastic_body_rest_positions(b),
+                         piola_elastic_body_tet_count(b), (int32_t *)piola_elastic_body_tets(b), NULL};
+  piola_tri_mesh *surface = calloc(1, sizeof *surface);
+  if (!surface) return PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "solid boundary: out of memory");
+  piola_status st = piola_tet_mesh_boundary(&tets, surface);
+  if (st != PIOLA_OK) {
+    free(surface);
+    return st;
+  }
+  double reach = 0;
+  for (int32_t t = 0; t < surface->triangle_count; ++t)
+    for (int k = 0; k < 3; ++k) {
+      vec3 p = vec3_load(tets.positions + 3 * surface->triangles[3 * t + k]);
+      vec3 q = vec3_load(tets.positions + 3 * surface->triangles[3 * t + (k + 1) % 3]);
+      reach = fmax(reach, vec3_norm(vec3_sub(p, q)));
+    }
+  solid->boundary = surface;
+  solid->boundary_reach = reach;
+  return PIOLA_OK;
+}
+
+int32_t piola__shell_collide_with_solids(piola_world *w, world_solid *s, double t1, double dt) {
+  (void)t1;
+  int32_t moved = 0;
+  for (int32_t k = 0; k < w->solid_count; ++k) {
+    world_solid *solid = &w->solids[k];
+    if (solid_boundary(solid) != PIOLA_OK) return moved;
+    const piola_tri_mesh *surface = solid->boundary;
+    const double *sx = solid->x, *sv = solid->v;
+    /* the solid's current bounding box, grown by the search reach */
+    double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+    for (int32_t i = 0; i < solid->n; ++i)
+      for (int a = 0; a < 3; ++a) lo[a] = fmin(lo[a], sx[3 * i + a]), hi[a] = fmax(hi[a], sx[3 * i + a]);
+    const double reach = solid->boundary_reach;
+    for (int32_t i = 0; i < s->n; ++i) {
+      if (s->flags[i] != SOLID_FREE) continue;
+      vec3 x = vec3_load(s->x + 3 * i);
+      if (x.x < lo[0] - reach || x.x > hi[0] + reach || x.y < lo[1] - reach || x.y > hi[1] + reach ||
+          x.z < lo[2] - reach || x.z > hi[2] + reach)
+        continue;
+      double best = reach * reach, weights[3] = {0, 0, 0};
+      int32_t best_t = -1;
+      vec3 best_p = x;
+      for (int32_t t = 0; t < surface->triangle_count; ++t) {
+        const int32_t *tri = surface->triangles + 3 * t;
+        vec3 a = vec3_load(sx + 3 * tri[0]), b = vec3_load(sx + 3 * tri[1]), c = vec3_load(sx + 3 * tri[2]);
+        /* cheap rejection: the triangle's box is farther than the best distance so far */
+        double r = sqrt(best);
+        if (fmin(a.x, fmin(b.x, c.x)) > x.x + r || fmax(a.x, fmax(b.x, c.x)) < x.x - r ||
+            fmin(a.y, fmin(b.y, c.y)) > x.y + r || fmax(a.y, fmax(b.y, c.y)) < x.y - r ||
+            fmin(a.z, fmin(b.z, c.z)) > x.z + r || fmax(a.z, fmax(b.z, c.z)) < x.z - r)
+          continue;
+        double wt[3];
+        vec3 p = closest_on_triangle(x, a, b, c, wt);
+        double d2 = vec3_norm2(vec3_sub(x, p));
+        if (d2 < best) best = d2, best_t = t, best_p = p, weights[0] = wt[0], weights[1] = wt[1], weights[2] = wt[2];
+      }
+      if (best_t < 0) continue;
+      const int32_t *tri = surface->triangles + 3 * best_t;
+      vec3 a = vec3_load(sx + 3 * tri[0]), b = vec3_load(sx + 3 * tri[1]), c = vec3_load(sx + 3 * tri[2]);
+      vec3 face = vec3_cross(vec3_sub(b, a), vec3_sub(c, a)); /* outward: boundary faces wind outward */
+      vec3 d = vec3_sub(x, best_p);
+      double side = vec3_dot(d, face);
+      if (side >= 0) continue; /* outside (or on) the surface */
+      /* the normal: along the node-to-surface direction, pointing outward */
+      double dn = vec3_norm(d);
+      vec3 normal = dn > 1e-14 * reach ? vec3_scale(d, -1.0 / dn) : vec3_scale(face, 1.0 / vec3_norm(face));
+      vec3 vs = vec3_add(vec3_add(vec3_scale(vec3_load(sv + 3 * tri[0]), weights[0]),
+                                  vec3_scale(vec3_load(sv + 3 * tri[1]), weights[1])),
+                         vec3_scale(vec3_load(sv + 3 * tri[2]), weights[2]));
+      vec3 v = vec3_load(s->v + 3 * i);
+      vec3 rel = vec3_sub(v, vs);
+      double rn = vec3_dot(rel, normal);
+      double dvn = rn < 0 ? -rn : 0; /* normal velocity change: take the surface's */
+      vec3 vt = vec3_sub(rel, vec3_scale(normal, rn));
+      double vtn = vec3_norm(vt), push = dvn + (dt > 0 ? dn / dt : 0);
+      double keep = vtn > 0 ? fmax(0.0, 1.0 - s->solid_friction * push / vtn) : 0.0;
+      vec3 rel_new = vec3_add(vec3_scale(normal, rn < 0 ? 0.0 : rn), vec3_scale(vt, keep));
+      vec3_store(s->v + 3 * i, vec3_add(vs, rel_new));
+      vec3_store(s->x + 3 * i, best_p);
+      vec3_store(s->normals + 3 * i, normal);
+      if (!s->colliding[i]) ++moved;
+      s->colliding[i] = 1;
+    }
+  }
+  return moved;
+}

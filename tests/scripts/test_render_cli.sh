@@ -1,0 +1,110 @@
+#!/usr/bin/env bash
+# `piola run` leaves a preview (DIR/preview.png, DIR/scene.json, and with --render one PNG per
+# frame); `piola render DIR` writes PNGs of the requested size, a contact sheet and an MP4
+# that ffprobe decodes to exactly one frame per PNG; --every thins both; obstacles from the
+# scene copy are drawn; stress colouring works with the scene; the inverted colouring shows red exactly for a frame with inverted
+# tets (pixels decoded by ffmpeg, an independent PNG reader); bad input exits 2.
+set -euo pipefail
+: "${PIOLA:?path of the piola program}"
+work=$(mktemp -d)
+trap 'rm -rf "$work"' EXIT
+fail() { echo "FAIL: $*"; exit 1; }
+
+cat >"$work/tiny.json" <<'JSON'
+{"fps": 20, "frames": 3, "gravity": [0, 0, -9.81],
+ "solids": [{"name": "cube", "mesh": {"generate": "box", "center": [0, 0, 0.15], "half_extents": [0.1, 0.1, 0.1], "cell_size": 0.1},
+             "material": {"youngs_modulus": 1e4, "poisson_ratio": 0.3}}],
+ "obstacles": [{"type": "plane", "point": [0, 0, 0], "normal": [0, 0, 1]},
+               {"type": "sphere", "center": [0.3, 0.2, 0.1], "radius": 0.1}]}
+JSON
+# the same cube mirrored at the start: every tet inverted in frame 0
+sed 's/"material"/"initial": {"matrix": [[-1, 0, 0], [0, 1, 0], [0, 0, 1]]}, "material"/' \
+  "$work/tiny.json" >"$work/mirrored.json"
+
+"$PIOLA" run "$work/tiny.json" -o "$work/out" --threads 2 --render >"$work/log" 2>&1 || { cat "$work/log"; fail "piola run"; }
+out="$work/out"
+[[ -s "$out/preview.png" ]] || fail "no preview.png"
+[[ -s "$out/scene.json" ]] || fail "no scene.json copy"
+for f in 0 1 2 3; do
+  [[ -s "$out/render/frame_000$f.png" ]] || fail "piola run --render: no render/frame_000$f.png"
+done
+
+# PNG size from the IHDR chunk
+png_size() { python3 -c "import struct,sys; d=open(sys.argv[1],'rb').read(24); assert d[:8]==b'\x89PNG\r\n\x1a\n'; print('%dx%d' % struct.unpack('>II', d[16:24]))" "$1"; }
+[[ $(png_size "$out/preview.png") == 1280x720 ]] || fail "preview.png is $(png_size "$out/preview.png")"
+
+"$PIOLA" render "$out" --width 320 --height 240 --contact-sheet --fps 10 >"$work/log" 2>&1 || { cat "$work/log"; fail "piola render"; }
+for f in 0 1 2 3; do
+  [[ $(png_size "$out/render/frame_000$f.png") == 320x240 ]] || fail "frame $f size"
+done
+[[ -s "$out/render/contact_sheet.png" ]] || fail "no contact sheet"
+frames_in() { ffprobe -v error -count_frames -select_streams v:0 -show_entries stream=nb_read_frames -of csv=p=0 "$1"; }
+if command -v ffmpeg >/dev/null && command -v ffprobe >/dev/null; then
+  [[ -s "$out/render/movie.mp4" ]] || { cat "$work/log"; fail "no movie.mp4"; }
+  n=$(frames_in "$out/render/movie.mp4")
+  [[ $n -eq 4 ]] || fail "movie has $n frames, expected 4"
+else
+  echo "ffmpeg/ffprobe not installed: movie checks skipped"
+fi
+
+# --every 2: frames 0 and 2 only; the earlier PNGs are gone
+"$PIOLA" render "$out" --width 160 --height 120 --every 2 >"$work/log" 2>&1 || { cat "$work/log"; fail "--every 2"; }
+pngs=$(cd "$out/render" && ls frame_*.png | tr '\n' ' ')
+[[ ! -e "$out/render/contact_sheet.png" ]] || fail "a stale contact sheet was kept"
+[[ $pngs == "frame_0000.png frame_0002.png " ]] || fail "--every 2 left: $pngs"
+if command -v ffprobe >/dev/null; then
+  n=$(frames_in "$out/render/movie.mp4")
+  [[ $n -eq 2 ]] || fail "--every 2 movie has $n frames"
+fi
+
+# pixels, decoded by ffmpeg: count strongly red ones (the inverted highlight)
+red_pixels() {
+  ffmpeg -v error -i "$1" -f rawvideo -pix_fmt rgb24 - | python3 -c "
+import sys
+d = sys.stdin.buffer.read()
+print(sum(1 for i in range(0, len(d), 3) if d[i] > 60 and 2 * d[i + 1] < d[i] and 2 * d[i + 2] < d[i]))"
+}
+if command -v ffmpeg >/dev/null; then
+  # obstacles from the scene copy change the picture; without the copy they are absent
+  "$PIOLA" render "$out" --width 160 --height 120 --no-movie --color inverted >/dev/null 2>&1
+  [[ $(red_pixels "$out/render/frame_0000.png") -eq 0 ]] || fail "red pixels without inverted tets"
+  cp "$out/render/frame_0000.png" "$work/with_scene.png"
+  mv "$out/scene.json" "$work/scene_copy.json"
+  "$PIOLA" render "$out" --width 160 --height 120 --no-movie --color inverted >/dev/null 2>&1
+  cmp -s "$out/render/frame_0000.png" "$work/with_scene.png" && fail "obstacles not drawn (same image without the scene)"
+  "$PIOLA" render "$out" --width 160 --height 120 --no-movie --color inverted --scene "$work/scene_copy.json" >/dev/null 2>&1
+  cmp -s "$out/render/frame_0000.png" "$work/with_scene.png" || fail "--scene differs from the scene copy"
+
+  "$PIOLA" run "$work/mirrored.json" -o "$work/mirror" --frames 0 >"$work/log" 2>&1 || { cat "$work/log"; fail "mirrored run"; }
+  "$PIOLA" render "$work/mirror" --width 160 --height 120 --no-movie --color inverted >/dev/null 2>&1
+  n=$(red_pixels "$work/mirror/render/frame_0000.png")
+  [[ $n -gt 50 ]] || fail "inverted frame shows only $n red pixels"
+  "$PIOLA" render "$work/mirror" --width 160 --height 120 --no-movie --color plain >/dev/null 2>&1
+  [[ $(red_pixels "$work/mirror/render/frame_0000.png") -eq 0 ]] || fail "plain colouring shows red"
+fi
+
+# energy colouring works; stress is computed from the displacements and the scene's
+# materials, so it needs the scene
+"$PIOLA" render "$out" --width 160 --height 120 --no-movie --color energy >/dev/null 2>&1 || fail "--color energy"
+"$PIOLA" render "$out" --width 160 --height 120 --no-movie --color stress --scene "$work/tiny.json" >"$work/log" 2>&1 ||
+  { cat "$work/log"; fail "--color stress --scene"; }
+rm -f "$out/scene.json"
+expect2() {
+  set +e
+  "$PIOLA" render "$@" >"$work/log" 2>&1
+  local rc=$?
+  set -e
+  [[ $rc -eq 2 ]] || { cat "$work/log"; fail "piola render $*: exit $rc, expected 2"; }
+  [[ -s "$work/log" ]] || fail "piola render $*: no message"
+}
+expect2 "$out" --color stress --no-movie
+expect2 "$out" --color purple
+expect2 "$out" --width 0
+expect2 "$out" --camera-position 1,2
+expect2 "$out" --bogus
+expect2 "$work/does-not-exist"
+mkdir "$work/empty"
+expect2 "$work/empty"
+expect2 "$out" --scene "$work/nope.json"
+expect2
+echo "piola render ok"

@@ -1,0 +1,158 @@
+/* The scene key `shells`: every key reaches the shell definition, defaults hold, bad input
+ * names its key path, and a loaded scene has the shell in its world with generated meshes
+ * placed by their transform. */
+#include "test_support.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <string.h>
+
+#include "piola/keyframes.h"
+#include "piola/scene.h"
+#include "piola/world_shells.h"
+#include "scene/scene_desc.h"
+
+static const char *FULL =
+    "{\"shells\": [{\"name\": \"cape\", \"mesh\": {\"generate\": \"rectangle\", \"size\": [2, 1], "
+    "\"resolution\": [4, 2]},\n"
+    "  \"transform\": {\"translate\": [0, 0, 1], \"rotate_degrees\": [90, 0, 0]}, \"thickness\": 0.002,\n"
+    "  \"density\": 300, \"material\": {\"model\": \"stvk\", \"youngs_modulus\": 3e5, \"poisson_ratio\": 0.2},\n"
+    "  \"damping\": {\"shear\": 0.5, \"bulk\": 0.25},\n"
+    "  \"bending\": {\"stiffness\": 1e-4, \"damping\": 2e-5, \"plasticity\": {\"yield_angle_degrees\": 10, \"rate\": 5}},\n"
+    "  \"plasticity\": {\"yield_strain\": 0.05, \"rate\": 7, \"max_plastic_stretch\": 3},\n"
+    "  \"reference_normals\": true, \"velocity\": [0, 1, 0], \"collide_with_solids\": true,\n"
+    "  \"solid_friction\": 0.1,\n"
+    "  \"fixed\": [{\"indices\": [0, 4]}]},\n"
+    " {\"mesh\": {\"generate\": \"disk\", \"radius\": 0.5, \"rings\": 3}},\n"
+    " {\"mesh\": {\"generate\": \"torus\", \"radius\": 0.5, \"minor_radius\": 0.1, \"segments\": [8, 6], "
+    "\"sweep_degrees\": 180}},\n"
+    " {\"mesh\": \"cloth.obj\"}]}";
+
+static void every_shell_key_reaches_its_definition(void **state) {
+  (void)state;
+  scene_desc d;
+  if (piola__scene_parse(FULL, "/base", "t", &d) != PIOLA_OK) fail_msg("%s", piola_last_error());
+  assert_int_equal(d.solid_count, 0);
+  assert_int_equal(d.shell_count, 4);
+  const scene_shell_desc *s = &d.shells[0];
+  assert_string_equal(s->base.name, "cape");
+  assert_int_equal(s->generator, 1);
+  assert_close(s->size[0], 2, 0);
+  assert_int_equal(s->resolution[1], 2);
+  assert_close(s->base.translate.z, 1, 0);
+  assert_close(s->base.rotate_degrees.x, 90, 0);
+  assert_close(s->def.thickness, 0.002, 0);
+  assert_close(s->base.def.density, 300, 0);
+  assert_int_equal(s->base.def.material.model, PIOLA_MODEL_STVK);
+  assert_close(s->base.def.material.youngs_modulus, 3e5, 0);
+  assert_close(piola_track_eval(&s->base.def.shear_viscosity, 0), 0.5, 0);
+  assert_close(piola_track_eval(&s->base.def.bulk_viscosity, 0), 0.25, 0);
+  assert_close(s->def.bending.stiffness, 1e-4, 0);
+  assert_close(s->def.bending.damping, 2e-5, 0);
+  assert_close(s->def.bending.yield_angle, 10 * M_PI / 180, 1e-15);
+  assert_close(s->def.bending.plastic_rate, 5, 0);
+  assert_close(s->def.plasticity.yield_strain, 0.05, 0);
+  assert_close(s->def.plasticity.rate, 7, 0);
+  assert_close(s->def.plasticity.max_plastic_stretch, 3, 0);
+  assert_true(s->def.use_reference_normals);
+  assert_true(s->def.collide_with_solids);
+  assert_close(s->def.solid_friction, 0.1, 0);
+  assert_close(s->base.def.velocity.y, 1, 0);
+  assert_int_equal(s->base.constraint_count, 1);
+  /* defaults */
+  s = &d.shells[1];
+  assert_string_equal(s->base.name, "shell1");
+  assert_int_equal(s->generator, 2);
+  assert_int_equal(s->resolution[0], 3);
+  assert_close(s->def.thickness, 1e-3, 0);
+  assert_close(s->def.bending.stiffness, 0, 0);
+  assert_true(isinf(s->def.bending.yield_angle));
+  assert_true(isinf(s->def.plasticity.yield_strain));
+  assert_false(s->def.use_reference_normals);
+  assert_false(s->def.collide_with_solids);
+  assert_close(s->def.solid_friction, 0.3, 0);
+  assert_int_equal(d.shells[2].generator, 3);
+  assert_close(d.shells[2].sweep_degrees, 180, 0);
+  assert_int_equal(d.shells[3].generator, 0);
+  assert_string_equal(d.shells[3].base.mesh_path, "/base/cloth.obj");
+  piola__scene_desc_free(&d);
+}
+
+static const struct {
+  const char *json;
+  const char *expected;
+} BAD[] = {
+    {"{\"shells\": {}}", "shells: must be an array"},
+    {"{\"shells\": [{}]}", "shells[0].mesh: is required"},
+    {"{\"shells\": [{\"mesh\": 3}]}", "shells[0].mesh: must be a triangle mesh file path"},
+    {"{\"shells\": [{\"mesh\": {\"generate\": \"cube\"}}]}", "shells[0].mesh.generate: must be"},
+    {"{\"shells\": [{\"mesh\": {\"generate\": \"rectangle\", \"size\": [1, 0], \"resolution\": [2, 2]}}]}",
+     "shells[0].mesh.size"},
+    {"{\"shells\": [{\"mesh\": {\"generate\": \"rectangle\", \"size\": [1, 1], \"resolution\": [2, 0.5]}}]}",
+     "shells[0].mesh.resolution: must be two integers"},
+    {"{\"shells\": [{\"mesh\": {\"generate\": \"disk\", \"radius\": 1}}]}", "shells[0].mesh.rings: is required"},
+    {"{\"shells\": [{\"mesh\": {\"generate\": \"torus\", \"radius\": 1, \"minor_radius\": 2, \"segments\": [8, 8]}}]}",
+     "shells[0].mesh.minor_radius: must be smaller"},
+    {"{\"shells\": [{\"mesh\": \"a.obj\", \"thickness\": 0}]}", "shells[0].thickness"},
+    {"{\"shells\": [{\"mesh\": \"a.obj\", \"bendng\": {}}]}", "shells[0].bendng: unknown key"},
+    {"{\"shells\": [{\"mesh\": \"a.obj\", \"bending\": {\"stiffness\": -1}}]}", "shells[0].bending.stiffness"},
+    {"{\"shells\": [{\"mesh\": \"a.obj\", \"bending\": {\"plasticity\": {\"rate\": 1}}}]}",
+     "shells[0].bending.plasticity.yield_angle_degrees: is required"},
+    {"{\"shells\": [{\"mesh\": \"a.obj\", \"plasticity\": {\"yield_strain\": 0.1, \"max_plastic_stretch\": 1}}]}",
+     "shells[0].plasticity.max_plastic_stretch"},
+    {"{\"shells\": [{\"mesh\": \"a.obj\", \"reference_normals\": 1}]}", "shells[0].reference_normals: must be true or false"},
+    {"{\"shells\": [{\"mesh\": \"a.obj\", \"name\": \"x\"}, {\"mesh\": \"b.obj\", \"name\": \"x\"}]}",
+     "shells[1].name: \"x\" is already the name of shells[0]"},
+    {"{\"obstacles\": []}", "solids: is required"},
+};
+
+static void bad_shell_input_names_its_key_path(void **state) {
+  (void)state;
+  for (size_t i = 0; i < sizeof BAD / sizeof BAD[0]; ++i) {
+    scene_desc d;
+    piola_clear_error();
+    piola_status st = piola__scene_parse(BAD[i].json, ".", "bad.json", &d);
+    if (st == PIOLA_OK) fail_msg("case %zu was accepted: %s", i, BAD[i].json);
+    if (!strstr(piola_last_error(), BAD[i].expected))
+      fail_msg("case %zu: message '%s' does not contain '%s'", i, piola_last_error(), BAD[i].expected);
+  }
+}
+
+/* A cloth-only scene loads, its generated sheet is placed by the transform, and the fixed
+ * selector holds the nodes it names. */
+static void cloth_scene_builds_its_world(void **state) {
+  (void)state;
+  const char *json =
+      "{\"shells\": [{\"name\": \"cloth\", \"mesh\": {\"generate\": \"rectangle\", \"size\": [1, 1], "
+      "\"resolution\": [4, 4]}, \"transform\": {\"translate\": [0, 0, 2]},\n"
+      "  \"bending\": {\"stiffness\": 1e-4}, \"fixed\": [{\"box\": [[-1, 0.49, 1], [1, 1, 3]]}]}],\n"
+      " \"obstacles\": [{\"type\": \"plane\", \"point\": [0, 0, 0], \"normal\": [0, 0, 1]}]}";
+  piola_scene *scene;
+  if (piola_scene_load_string(json, ".", "cloth", &scene) != PIOLA_OK) fail_msg("%s", piola_last_error());
+  piola_world *world = piola_scene_world(scene);
+  assert_int_equal(piola_world_solid_count(world), 0);
+  assert_int_equal(piola_world_shell_count(world), 1);
+  assert_string_equal(piola_world_shell_name(world, 0), "cloth");
+  const double *x = piola_world_shell_positions(world, 0);
+  const uint8_t *flags = piola_world_shell_constraint_flags(world, 0);
+  int fixed = 0;
+  for (int i = 0; i < 25; ++i) {
+    assert_close(x[3 * i + 2], 2.0, 1e-15);
+    fixed += flags[i] != 0;
+  }
+  assert_int_equal(fixed, 5); /* the row y = +0.5 */
+  assert_int_equal(piola_world_advance_to(world, 0.02, NULL), PIOLA_OK);
+  x = piola_world_shell_positions(world, 0);
+  assert_true(x[2] < 2.0);      /* a free corner falls */
+  assert_close(x[3 * 24 + 2], 2.0, 1e-12); /* a pinned one does not */
+  piola_scene_destroy(scene);
+}
+
+int main(void) {
+  const struct CMUnitTest tests[] = {
+      cmocka_unit_test(every_shell_key_reaches_its_definition),
+      cmocka_unit_test(bad_shell_input_names_its_key_path),
+      cmocka_unit_test(cloth_scene_builds_its_world),
+  };
+  return cmocka_run_group_tests(tests, NULL, NULL);
+}

@@ -282,7 +282,8 @@ piola_status piola_world_step(piola_world *w, double dt_limit, piola_step_stats 
   }
   piola_status contact = piola__world_self_collide(w, dt, w->time + dt, &local);
   if (contact != PIOLA_OK) {
-    for (int32_t j = 0; j < w->solid_count; ++j) restore(&w->solids[j], w->time);
+    for (int32_t j = 0; j < w->solid_count + w->shell_count; ++j)
+      restore(j < w->solid_count ? &w->solids[j] : &w->shells[j - w->solid_count], w->time);
     if (stats) *stats = local;
     return contact;
   }

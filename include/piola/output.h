@@ -43,6 +43,9 @@ typedef struct piola_frame_info {
   int32_t substeps;       /* steps taken since the previous frame */
   int32_t cg_iterations;  /* CG iterations since the previous frame */
   double wall_seconds;    /* wall time spent since the previous frame, s */
+  int64_t contacts;       /* self-collision repulsion contacts since the previous frame */
+  int64_t impacts;        /* self-collision impacts since the previous frame */
+  int32_t impact_zones;   /* self-collision rigid impact zones since the previous frame */
 } piola_frame_info;
 
 /* Writes the VTU and OBJ of the world's current state and appends a row to stats.csv and

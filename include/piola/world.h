@@ -76,6 +76,15 @@ typedef struct piola_constraint_def {
   piola_rigid_motion_def motion; /* used when driven */
 } piola_constraint_def;
 
+/* Self-collision of a solid's boundary surface, with itself and with every other solid that
+ * has it enabled (Bridson, Fedkiw and Anderson 2002; docs/contact.md), processed after every
+ * step, outside it (paper section 9). */
+typedef struct piola_self_collision_def {
+  bool enabled;     /* Default false */
+  double thickness; /* m, > 0: boundary pairs closer than this repel. Default 1e-3 */
+  double friction;  /* Coulomb coefficient, >= 0. Default 0.3 */
+} piola_self_collision_def;
+
 typedef struct piola_solid_def {
   const char *name;               /* copied; NULL gives "solid<i>" */
   const piola_tet_mesh *mesh;     /* rest shape in world space (m), copied. Required */
@@ -95,6 +104,7 @@ typedef struct piola_solid_def {
   uint64_t scramble_seed;         /* the random sequence is fixed by this seed. Default 1 */
   const piola_plasticity_def *plasticity; /* NULL (default): purely elastic. Read by
                                      add_solid only (goal positions included) */
+  piola_self_collision_def self_collision; /* default: off */
 } piola_solid_def;
 
 PIOLA_API piola_solid_def piola_default_solid_def(void);
@@ -114,6 +124,9 @@ typedef struct piola_step_stats {
   int32_t cg_iterations;  /* conjugate-gradient iterations, both solves of every step */
   int32_t colliding;      /* colliding nodes in the last step */
   double last_dt;         /* s */
+  int64_t contacts;       /* self-collision: repulsion contacts, summed over the steps */
+  int64_t impacts;        /* self-collision: collision impulses, summed over the steps */
+  int32_t impact_zones;   /* self-collision: rigid impact zones, summed over the steps */
 } piola_step_stats;
 
 /* The step size the next step would take with no target time: min(max_dt, CFL bound), s. */

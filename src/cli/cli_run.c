@@ -152,7 +152,7 @@ int cli_run(int argc, char **argv) {
   long long total_steps = 0, total_cg = 0;
   int max_inverted = 0;
   double sim_start = now_seconds();
-  piola_frame_info info = {0, 0, 0, 0};
+  piola_frame_info info = {0};
   if (piola_output_write_frame(out, world, &info) != PIOLA_OK) {
     fprintf(stderr, "piola run: %s\n", piola_last_error());
     rc = 1;
@@ -162,7 +162,7 @@ int cli_run(int argc, char **argv) {
   int frame = 0;
   for (frame = 1; rc == 0 && frame <= frames; ++frame) {
     double t0 = now_seconds();
-    piola_step_stats st = {0, 0, 0, 0};
+    piola_step_stats st = {0};
     if (piola_world_advance_to(world, frame / fps, &st) != PIOLA_OK) {
       char message[1024];
       snprintf(message, sizeof message, "%s", piola_last_error());
@@ -178,6 +178,9 @@ int cli_run(int argc, char **argv) {
     info.frame = frame;
     info.substeps = st.substeps;
     info.cg_iterations = st.cg_iterations;
+    info.contacts = st.contacts;
+    info.impacts = st.impacts;
+    info.impact_zones = st.impact_zones;
     info.wall_seconds = now_seconds() - t0;
     total_steps += st.substeps;
     total_cg += st.cg_iterations;

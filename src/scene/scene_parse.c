@@ -560,6 +560,29 @@ static piola_status parse_plasticity(parser *p, const cJSON *obj, scene_solid_de
   return PIOLA_OK;
 }
 
+/* "self_collision": {"enabled": true, "thickness": m, "friction": mu}; giving the object
+ * turns it on unless "enabled" is false (docs/contact.md). */
+static piola_status parse_self_collision(parser *p, const cJSON *obj,
+                                         piola_self_collision_def *out) {
+  const cJSON *v = get(obj, "self_collision");
+  if (!v) return PIOLA_OK;
+  size_t old = push_key(p, "self_collision");
+  static const char *const keys[] = {"enabled", "thickness", "friction", NULL};
+  PIOLA_TRY(check_keys(p, v, keys));
+  out->enabled = true;
+  const cJSON *e = get(v, "enabled");
+  if (e) {
+    size_t o2 = push_key(p, "enabled");
+    if (!cJSON_IsBool(e)) return fail(p, PIOLA_ERROR_PARSE, "must be true or false, got %s", type_name(e));
+    out->enabled = cJSON_IsTrue(e);
+    pop(p, o2);
+  }
+  PIOLA_TRY(opt_number(p, v, "thickness", POSITIVE, &out->thickness));
+  PIOLA_TRY(opt_number(p, v, "friction", NONNEGATIVE, &out->friction));
+  pop(p, old);
+  return PIOLA_OK;
+}
+
 static piola_status parse_transform(parser *p, const cJSON *v, scene_solid_desc *d) {
   size_t old = push_key(p, "transform");
   static const char *const keys[] = {"translate", "rotate_degrees", "scale", NULL};
@@ -600,7 +623,7 @@ static piola_status parse_name(parser *p, const cJSON *obj, scene_solid_desc *d)
 static piola_status parse_solid(parser *p, const cJSON *obj, int index, scene_solid_desc *d) {
   static const char *const allowed[] = {"name", "mesh", "transform", "density", "material",
                                         "damping", "velocity", "fixed", "driven", "initial",
-                                        "plasticity", NULL};
+                                        "plasticity", "self_collision", NULL};
   PIOLA_TRY(check_keys(p, obj, allowed));
   PIOLA_TRY(required(p, obj, "mesh"));
   d->def = piola_default_solid_def();
@@ -634,6 +657,7 @@ static piola_status parse_solid(parser *p, const cJSON *obj, int index, scene_so
     pop(p, old);
   }
   PIOLA_TRY(opt_vec3(p, obj, "velocity", ANY, &d->def.velocity));
+  PIOLA_TRY(parse_self_collision(p, obj, &d->def.self_collision));
   if ((v = get(obj, "plasticity"))) {
     old = push_key(p, "plasticity");
     PIOLA_TRY(parse_plasticity(p, v, d));

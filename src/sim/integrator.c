@@ -268,7 +268,7 @@ static piola_status step_solid(piola_world *w, world_solid *s, double t, double 
 }
 
 piola_status piola_world_step(piola_world *w, double dt_limit, piola_step_stats *stats) {
-  piola_step_stats local = {0, 0, 0, 0};
+  piola_step_stats local = {0};
   double dt = piola_world_stable_dt(w);
   if (dt_limit > 0 && dt_limit < dt) dt = dt_limit;
   if (!(dt > 0)) return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "step: dt must be > 0, got %g", dt);
@@ -281,6 +281,13 @@ piola_status piola_world_step(piola_world *w, double dt_limit, piola_step_stats 
       if (stats) *stats = local;
       return st;
     }
+  }
+  piola_status contact = piola__world_self_collide(w, dt, w->time + dt, &local);
+  if (contact != PIOLA_OK) {
+    for (int32_t j = 0; j < w->solid_count + w->shell_count; ++j)
+      restore(j < w->solid_count ? &w->solids[j] : &w->shells[j - w->solid_count], w->time);
+    if (stats) *stats = local;
+    return contact;
   }
   for (int32_t i = 0; i < w->solid_count; ++i) piola__solid_plastic_update(&w->solids[i], dt);
   w->time += dt;
@@ -305,6 +312,9 @@ piola_status piola_world_advance_to(piola_world *w, double t_end, piola_step_sta
       stats->substeps += one.substeps;
       stats->cg_iterations += one.cg_iterations;
       stats->colliding = one.colliding;
+      stats->contacts += one.contacts;
+      stats->impacts += one.impacts;
+      stats->impact_zones += one.impact_zones;
       if (one.substeps) stats->last_dt = one.last_dt;
     }
     if (st != PIOLA_OK) return st;

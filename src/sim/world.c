@@ -60,6 +60,7 @@ void piola_world_destroy(piola_world *world) {
   for (int32_t i = 0; i < world->shell_count; ++i) piola__solid_free(&world->shells[i]);
   free(world->shells);
   for (int32_t i = 0; i < world->obstacle_count; ++i) piola_obstacle_destroy(world->obstacles[i]);
+  piola__world_contact_free(world);
   free(world->solids);
   free(world->obstacles);
   free(world);
@@ -104,6 +105,12 @@ piola_status piola_world_add_solid(piola_world *world, const piola_solid_def *de
                       (int)id);
   if (!mat3_is_finite(def->initial_matrix))
     return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "solid %d: initial matrix must be finite", (int)id);
+  if (def->self_collision.enabled &&
+      (!(def->self_collision.thickness > 0) || !isfinite(def->self_collision.thickness) ||
+       !(def->self_collision.friction >= 0) || !isfinite(def->self_collision.friction)))
+    return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT,
+                      "solid %d: self_collision needs thickness > 0 m and friction >= 0, got %g, %g",
+                      (int)id, def->self_collision.thickness, def->self_collision.friction);
   if (!isfinite(def->velocity.x) || !isfinite(def->velocity.y) || !isfinite(def->velocity.z))
     return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "solid %d: velocity must be finite", (int)id);
 
@@ -157,6 +164,7 @@ piola_status piola_world_add_solid(piola_world *world, const piola_solid_def *de
   s->stiffness_scale = def->stiffness_scale;
   s->shear_viscosity = def->shear_viscosity;
   s->bulk_viscosity = def->bulk_viscosity;
+  s->self_collision = def->self_collision;
   st = piola__solid_apply_constraints(s, rest, def->constraints, def->constraint_count);
   if (st == PIOLA_OK) st = piola__solid_plastic_create(s, def);
   if (st != PIOLA_OK) {

@@ -28,5 +28,8 @@ piola_solid_def piola_default_solid_def(void) {
   def.bulk_viscosity = piola_track_constant(0);
   def.initial_matrix = mat3_identity();
   def.scramble_seed = 1;
+  def.self_collision.enabled = false;
+  def.self_collision.thickness = 1e-3;
+  def.self_collision.friction = 0.3;
   return def;
 }

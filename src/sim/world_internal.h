@@ -38,6 +38,7 @@ typedef struct world_solid {
   piola_elastic_stats elastic;  /* of the last update */
   piola_plastic_state *plastic; /* NULL for an elastic solid (world_plasticity.c) */
   piola_plastic_stats plastic_stats; /* of the last plastic update */
+  piola_self_collision_def self_collision;
   /* scratch for the step */
   double *x_old, *v_old, *force_old, *rhs, *work, *tmp;
   uint8_t *colliding;
@@ -53,6 +54,7 @@ struct piola_world {
   int32_t shell_count, shell_capacity;
   piola_obstacle **obstacles;
   int32_t obstacle_count, obstacle_capacity;
+  struct world_contact *contact; /* self-collision of boundary surfaces (world_contact.c) */
 };
 
 /* Marks constrained nodes of s from its constraint defs (rest positions rest, 3n). */
@@ -89,5 +91,11 @@ double piola__shell_stable_dt(const piola_world *w, const world_solid *s, double
 piola_status piola__solid_plastic_create(world_solid *s, const piola_solid_def *def);
 void piola__solid_plastic_update(world_solid *s, double dt);
 double piola__solid_plastic_stiffening(const world_solid *s);
+/* Self-collision after a step of length dt (s) that every solid has taken from x_old to x:
+ * changes x and v of solids with self-collision enabled (and recomputes their forces at
+ * time t1) and adds to stats. Builds its collision surface on first use or when solids were
+ * added. */
+piola_status piola__world_self_collide(piola_world *w, double dt, double t1, piola_step_stats *stats);
+void piola__world_contact_free(piola_world *w);
 
 #endif

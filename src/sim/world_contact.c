@@ -1,0 +1,144 @@
+/* Self-collision of the solids' boundary surfaces, run after every world step (paper section 9:
+ * "outside the step"), with the BFA02 collision module (piola/collision_surface.h).
+ *
+ * One collision surface holds the boundary triangles of every solid with self-collision
+ * enabled, over the solids' own vertex numbering shifted by an offset per solid (interior
+ * nodes sit in the arrays but belong to no triangle, so they take no part); each solid is one
+ * body with its thickness and friction. Boundaries of different solids are in the same
+ * surface, so solids collide with each other as well as with themselves.
+ *
+ * A step moved every solid from x_old to x. The average velocity of the step, (x - x_old)/dt,
+ * is what collision processing corrects: x = x_old + dt v_c'. The final velocity changes by
+ * the same amount, v += v_c' - v_c, as in BFA02, and the elastic forces of a solid whose
+ * positions changed are recomputed, since the next step starts from them. Constrained nodes
+ * count as pinned (infinite mass). */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "common/status_internal.h"
+#include "piola/collision_surface.h"
+#include "sim/world_internal.h"
+
+typedef struct world_contact {
+  piola_collision_surface *surface;
+  int32_t solid_count; /* solids in the world when built */
+  int32_t vertex_count;
+  int32_t *offset; /* per solid: first global vertex, or -1 when not enabled */
+  double *x0, *v, *v_before, *mass;
+} world_contact;
+
+void piola__world_contact_free(piola_world *w) {
+  world_contact *c = w->contact;
+  if (!c) return;
+  piola_collision_surface_destroy(c->surface);
+  free(c->offset), free(c->x0), free(c->v), free(c->v_before), free(c->mass);
+  free(c);
+  w->contact = NULL;
+}
+
+static piola_status build(piola_world *w) {
+  piola__world_contact_free(w);
+  world_contact *c = calloc(1, sizeof(*c));
+  if (!c) return PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "self-collision: out of memory");
+  w->contact = c;
+  c->solid_count = w->solid_count;
+  c->offset = malloc(sizeof(int32_t) * (size_t)(w->solid_count > 0 ? w->solid_count : 1));
+  if (!c->offset) return PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "self-collision: out of memory");
+  int32_t nv = 0, nt = 0, bodies = 0;
+  piola_tri_mesh *boundaries =
+      calloc((size_t)(w->solid_count > 0 ? w->solid_count : 1), sizeof(piola_tri_mesh));
+  if (!boundaries) return PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "self-collision: out of memory");
+  piola_status st = PIOLA_OK;
+  for (int32_t i = 0; i < w->solid_count && st == PIOLA_OK; ++i) {
+    world_solid *s = &w->solids[i];
+    c->offset[i] = -1;
+    if (!s->self_collision.enabled) continue;
+    piola_tet_mesh mesh = {.vertex_count = s->n,
+                           .positions = s->x,
+                           .tet_count = piola_elastic_body_tet_count(s->body),
+                           .tets = (int32_t *)piola_elastic_body_tets(s->body)};
+    st = piola_tet_mesh_boundary(&mesh, &boundaries[i]);
+    c->offset[i] = nv;
+    nv += s->n, nt += boundaries[i].triangle_count, ++bodies;
+  }
+  int32_t *tris = NULL, *vertex_body = NULL;
+  piola_collision_body_def *defs = NULL;
+  if (st == PIOLA_OK) {
+    tris = malloc(sizeof(int32_t) * 3 * (size_t)(nt > 0 ? nt : 1));
+    vertex_body = malloc(sizeof(int32_t) * (size_t)(nv > 0 ? nv : 1));
+    defs = malloc(sizeof(*defs) * (size_t)(bodies > 0 ? bodies : 1));
+    c->x0 = malloc(sizeof(double) * 3 * (size_t)(nv > 0 ? nv : 1));
+    c->v = malloc(sizeof(double) * 3 * (size_t)(nv > 0 ? nv : 1));
+    c->v_before = malloc(sizeof(double) * 3 * (size_t)(nv > 0 ? nv : 1));
+    c->mass = malloc(sizeof(double) * (size_t)(nv > 0 ? nv : 1));
+    if (!tris || !vertex_body || !defs || !c->x0 || !c->v || !c->v_before || !c->mass)
+      st = PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "self-collision: out of memory");
+  }
+  if (st == PIOLA_OK) {
+    int32_t t = 0, b = 0;
+    for (int32_t i = 0; i < w->solid_count; ++i) {
+      if (c->offset[i] < 0) continue;
+      const world_solid *s = &w->solids[i];
+      for (int32_t k = 0; k < 3 * boundaries[i].triangle_count; ++k)
+        tris[3 * t + k] = c->offset[i] + boundaries[i].triangles[k];
+      t += boundaries[i].triangle_count;
+      for (int32_t k = 0; k < s->n; ++k) vertex_body[c->offset[i] + k] = b;
+      defs[b] = piola_default_collision_body_def();
+      defs[b].thickness = s->self_collision.thickness;
+      defs[b].friction = s->self_collision.friction;
+      ++b;
+    }
+    piola_collision_surface_def def = piola_default_collision_surface_def();
+    def.vertex_count = nv, def.triangle_count = nt, def.triangles = tris;
+    def.body_count = bodies > 0 ? bodies : 1, def.bodies = defs, def.vertex_body = vertex_body;
+    if (bodies == 0) defs[0] = piola_default_collision_body_def();
+    st = piola_collision_surface_create(&def, &c->surface);
+  }
+  c->vertex_count = nv;
+  for (int32_t i = 0; i < w->solid_count; ++i) piola_tri_mesh_free(&boundaries[i]);
+  free(boundaries), free(tris), free(vertex_body), free(defs);
+  return st;
+}
+
+piola_status piola__world_self_collide(piola_world *w, double dt, double t1,
+                                       piola_step_stats *stats) {
+  int any = 0;
+  for (int32_t i = 0; i < w->solid_count; ++i) any |= w->solids[i].self_collision.enabled;
+  if (!any) return PIOLA_OK;
+  if (!w->contact || w->contact->solid_count != w->solid_count) PIOLA_TRY(build(w));
+  world_contact *c = w->contact;
+  for (int32_t i = 0; i < w->solid_count; ++i) {
+    if (c->offset[i] < 0) continue;
+    const world_solid *s = &w->solids[i];
+    for (int32_t k = 0; k < s->n; ++k) {
+      const int32_t g = c->offset[i] + k;
+      for (int d = 0; d < 3; ++d) {
+        c->x0[3 * g + d] = s->x_old[3 * k + d];
+        c->v[3 * g + d] = (s->x[3 * k + d] - s->x_old[3 * k + d]) / dt;
+      }
+      c->mass[g] = s->flags[k] != SOLID_FREE || s->inverse_mass[k] == 0.0 ? INFINITY : s->mass[k];
+    }
+  }
+  memcpy(c->v_before, c->v, sizeof(double) * 3 * (size_t)c->vertex_count);
+  piola_collision_stats cs;
+  PIOLA_TRY(piola_collision_surface_process(c->surface, c->x0, c->v, c->mass, dt, NULL, &cs));
+  stats->contacts += cs.contacts;
+  stats->impacts += cs.impacts;
+  stats->impact_zones += cs.impact_zones;
+  for (int32_t i = 0; i < w->solid_count; ++i) {
+    if (c->offset[i] < 0) continue;
+    world_solid *s = &w->solids[i];
+    int changed = 0;
+    for (int32_t k = 0; k < 3 * s->n; ++k) {
+      const int32_t g = 3 * c->offset[i] + k;
+      const double dv = c->v[g] - c->v_before[g];
+      if (dv == 0.0) continue;
+      changed = 1;
+      s->x[k] = c->x0[g] + dt * c->v[g];
+      s->v[k] += dv;
+    }
+    if (changed) PIOLA_TRY(piola__solid_update_forces(s, t1));
+  }
+  return PIOLA_OK;
+}

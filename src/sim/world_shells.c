@@ -306,7 +306,11 @@ int32_t piola__shell_collide_with_solids(piola_world *w, world_solid *s, double 
       vec3 face = vec3_cross(vec3_sub(b, a), vec3_sub(c, a)); /* outward: boundary faces wind outward */
       vec3 d = vec3_sub(x, best_p);
       double side = vec3_dot(d, face);
-      if (side >= 0) continue; /* outside (or on) the surface */
+      /* Inside only when the offset clearly points into the solid. Where the closest point is
+       * on an edge or a corner, the offset can be perpendicular to the chosen face's normal
+       * (a node right above a vertical side face); side is then a rounding residue of either
+       * sign, and reading it as "inside" would drag an outside node onto the edge. */
+      if (side >= -1e-9 * vec3_norm(d) * vec3_norm(face)) continue; /* outside (or on) */
       /* the normal: along the node-to-surface direction, pointing outward */
       double dn = vec3_norm(d);
       vec3 normal = dn > 1e-14 * reach ? vec3_scale(d, -1.0 / dn) : vec3_scale(face, 1.0 / vec3_norm(face));

@@ -89,6 +89,54 @@ static vec3 random_in_ball(uint64_t *state, double radius) {
   }
 }
 
+/* One more zeroed slot at the end of a world_solid array (solids or shells), growing it. */
+world_solid *piola__world_new_slot(world_solid **items, int32_t count, int32_t *capacity) {
+  if (count == *capacity) {
+    int32_t cap = *capacity ? 2 * *capacity : 4;
+    world_solid *grown = realloc(*items, (size_t)cap * sizeof *grown);
+    if (!grown) return NULL;
+    *items = grown;
+    *capacity = cap;
+  }
+  world_solid *s = &(*items)[count];
+  memset(s, 0, sizeof *s);
+  return s;
+}
+
+piola_status piola__solid_allocate(world_solid *s, int32_t n, const char *name, const char *kind,
+                                   int32_t id, const double *rest, const double *mass) {
+  s->n = n;
+  size_t v3 = 3 * (size_t)n * sizeof(double);
+  char fallback[32];
+  snprintf(fallback, sizeof fallback, "%s%d", kind, (int)id);
+  if (!name) name = fallback;
+  s->name = malloc(strlen(name) + 1);
+  s->x = malloc(v3), s->v = malloc(v3), s->force = malloc(v3), s->start = malloc(v3);
+  s->mass = malloc((size_t)n * sizeof(double));
+  s->inverse_mass = malloc((size_t)n * sizeof(double));
+  s->flags = calloc((size_t)n, 1);
+  s->motion_of = malloc((size_t)n * sizeof(int32_t));
+  s->x_old = malloc(v3), s->v_old = malloc(v3), s->force_old = malloc(v3), s->rhs = malloc(v3);
+  s->tmp = malloc(v3), s->work = malloc(4 * v3), s->normals = malloc(v3);
+  s->colliding = calloc((size_t)n, 1);
+  if (!s->name || !s->x || !s->v || !s->force || !s->start || !s->mass || !s->inverse_mass || !s->flags ||
+      !s->motion_of || !s->x_old || !s->v_old || !s->force_old || !s->rhs || !s->tmp || !s->work ||
+      !s->normals || !s->colliding)
+    return PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "%s %d: out of memory", kind, (int)id);
+  strcpy(s->name, name);
+  memcpy(s->mass, mass, (size_t)n * sizeof(double));
+  memcpy(s->start, rest, v3);
+  for (int32_t i = 0; i < n; ++i) s->motion_of[i] = -1;
+  return PIOLA_OK;
+}
+
+void piola__solid_finish_masses(world_solid *s) {
+  for (int32_t i = 0; i < s->n; ++i) {
+    s->inverse_mass[i] = s->mass[i] > 0 ? 1.0 / s->mass[i] : 0.0;
+    if (!(s->mass[i] > 0)) s->flags[i] = SOLID_FIXED; /* a vertex in no element cannot move */
+  }
+}
+
 piola_status piola_world_add_solid(piola_world *world, const piola_solid_def *def, int32_t *index) {
   if (!world || !def) return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "add_solid: NULL argument");
   int32_t id = world->solid_count;
@@ -122,45 +170,20 @@ piola_status piola_world_add_solid(piola_world *world, const piola_solid_def *de
   bdef.material_count = 1;
   bdef.density = def->density;
 
-  if (world->solid_count == world->solid_capacity) {
-    int32_t cap = world->solid_capacity ? 2 * world->solid_capacity : 4;
-    world_solid *grown = realloc(world->solids, (size_t)cap * sizeof *grown);
-    if (!grown) return PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "add_solid: out of memory");
-    world->solids = grown;
-    world->solid_capacity = cap;
-  }
-  world_solid *s = &world->solids[id];
-  memset(s, 0, sizeof *s);
+  world_solid *s = piola__world_new_slot(&world->solids, world->solid_count, &world->solid_capacity);
+  if (!s) return PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "add_solid: out of memory");
   piola_status st = piola_elastic_body_create(&bdef, &s->body);
   if (st != PIOLA_OK) {
     s->body = NULL;
     return st;
   }
-  int32_t n = s->n = piola_elastic_body_vertex_count(s->body);
-  size_t v3 = 3 * (size_t)n * sizeof(double);
-  char fallback[32];
-  snprintf(fallback, sizeof fallback, "solid%d", (int)id);
-  const char *name = def->name ? def->name : fallback;
-  s->name = malloc(strlen(name) + 1);
-  s->x = malloc(v3), s->v = malloc(v3), s->force = malloc(v3), s->start = malloc(v3);
-  s->mass = malloc((size_t)n * sizeof(double));
-  s->inverse_mass = malloc((size_t)n * sizeof(double));
-  s->flags = calloc((size_t)n, 1);
-  s->motion_of = malloc((size_t)n * sizeof(int32_t));
-  s->x_old = malloc(v3), s->v_old = malloc(v3), s->force_old = malloc(v3), s->rhs = malloc(v3);
-  s->tmp = malloc(v3), s->work = malloc(4 * v3), s->normals = malloc(v3);
-  s->colliding = calloc((size_t)n, 1);
-  if (!s->name || !s->x || !s->v || !s->force || !s->start || !s->mass || !s->inverse_mass || !s->flags ||
-      !s->motion_of || !s->x_old || !s->v_old || !s->force_old || !s->rhs || !s->tmp || !s->work ||
-      !s->normals || !s->colliding) {
-    piola__solid_free(s);
-    return PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "solid %d: out of memory", (int)id);
-  }
-  strcpy(s->name, name);
+  int32_t n = piola_elastic_body_vertex_count(s->body);
   const double *rest = piola_elastic_body_rest_positions(s->body);
-  memcpy(s->mass, piola_elastic_body_masses(s->body), (size_t)n * sizeof(double));
-  memcpy(s->start, rest, v3);
-  for (int32_t i = 0; i < n; ++i) s->motion_of[i] = -1;
+  st = piola__solid_allocate(s, n, def->name, "solid", id, rest, piola_elastic_body_masses(s->body));
+  if (st != PIOLA_OK) {
+    piola__solid_free(s);
+    return st;
+  }
   s->stiffness_scale = def->stiffness_scale;
   s->shear_viscosity = def->shear_viscosity;
   s->bulk_viscosity = def->bulk_viscosity;
@@ -171,10 +194,7 @@ piola_status piola_world_add_solid(piola_world *world, const piola_solid_def *de
     piola__solid_free(s);
     return st;
   }
-  for (int32_t i = 0; i < n; ++i) {
-    s->inverse_mass[i] = s->mass[i] > 0 ? 1.0 / s->mass[i] : 0.0;
-    if (!(s->mass[i] > 0)) s->flags[i] = SOLID_FIXED; /* a vertex in no tet cannot move */
-  }
+  piola__solid_finish_masses(s);
   /* initial state: free nodes deformed about the rest centroid, constrained ones at rest */
   vec3 c = {0, 0, 0};
   for (int32_t i = 0; i < n; ++i) c = vec3_add(c, vec3_load(rest + 3 * i));

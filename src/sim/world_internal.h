@@ -58,6 +58,16 @@ struct piola_world {
 };
 
 /* Marks constrained nodes of s from its constraint defs (rest positions rest, 3n). */
+/* Shared by add_solid and add_shell (world.c). new_slot appends a zeroed entry to a
+ * world_solid array (NULL when out of memory); allocate sizes the per-node state and
+ * scratch for n nodes, names the body (kind and id when name is NULL) and copies its rest
+ * positions and lumped masses; finish_masses sets inverse masses once constraints are in
+ * and fixes massless vertices. */
+world_solid *piola__world_new_slot(world_solid **items, int32_t count, int32_t *capacity);
+piola_status piola__solid_allocate(world_solid *s, int32_t n, const char *name, const char *kind,
+                                   int32_t id, const double *rest, const double *mass);
+void piola__solid_finish_masses(world_solid *s);
+
 piola_status piola__solid_apply_constraints(world_solid *s, const double *rest,
                                             const piola_constraint_def *constraints,
                                             int32_t count);

@@ -88,45 +88,20 @@ piola_status piola_world_add_shell(piola_world *world, const piola_shell_def *de
   bdef.plasticity = def->plasticity;
   bdef.use_reference_normals = def->use_reference_normals;
 
-  if (world->shell_count == world->shell_capacity) {
-    int32_t cap = world->shell_capacity ? 2 * world->shell_capacity : 4;
-    world_solid *grown = realloc(world->shells, (size_t)cap * sizeof *grown);
-    if (!grown) return PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "add_shell: out of memory");
-    world->shells = grown;
-    world->shell_capacity = cap;
-  }
-  world_solid *s = &world->shells[id];
-  memset(s, 0, sizeof *s);
+  world_solid *s = piola__world_new_slot(&world->shells, world->shell_count, &world->shell_capacity);
+  if (!s) return PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "add_shell: out of memory");
   piola_status st = piola_shell_body_create(&bdef, &s->shell);
   if (st != PIOLA_OK) {
     s->shell = NULL;
     return st;
   }
-  int32_t n = s->n = piola_shell_body_vertex_count(s->shell);
-  size_t v3 = 3 * (size_t)n * sizeof(double);
-  char fallback[32];
-  snprintf(fallback, sizeof fallback, "shell%d", (int)id);
-  const char *name = def->name ? def->name : fallback;
-  s->name = malloc(strlen(name) + 1);
-  s->x = malloc(v3), s->v = malloc(v3), s->force = malloc(v3), s->start = malloc(v3);
-  s->mass = malloc((size_t)n * sizeof(double));
-  s->inverse_mass = malloc((size_t)n * sizeof(double));
-  s->flags = calloc((size_t)n, 1);
-  s->motion_of = malloc((size_t)n * sizeof(int32_t));
-  s->x_old = malloc(v3), s->v_old = malloc(v3), s->force_old = malloc(v3), s->rhs = malloc(v3);
-  s->tmp = malloc(v3), s->work = malloc(4 * v3), s->normals = malloc(v3);
-  s->colliding = calloc((size_t)n, 1);
-  if (!s->name || !s->x || !s->v || !s->force || !s->start || !s->mass || !s->inverse_mass ||
-      !s->flags || !s->motion_of || !s->x_old || !s->v_old || !s->force_old || !s->rhs ||
-      !s->tmp || !s->work || !s->normals || !s->colliding) {
-    piola__solid_free(s);
-    return PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "shell %d: out of memory", (int)id);
-  }
-  strcpy(s->name, name);
+  int32_t n = piola_shell_body_vertex_count(s->shell);
   const double *rest = piola_shell_body_rest_positions(s->shell);
-  memcpy(s->mass, piola_shell_body_masses(s->shell), (size_t)n * sizeof(double));
-  memcpy(s->start, rest, v3);
-  for (int32_t i = 0; i < n; ++i) s->motion_of[i] = -1;
+  st = piola__solid_allocate(s, n, def->name, "shell", id, rest, piola_shell_body_masses(s->shell));
+  if (st != PIOLA_OK) {
+    piola__solid_free(s);
+    return st;
+  }
   s->stiffness_scale = def->stiffness_scale;
   s->shear_viscosity = def->shear_viscosity;
   s->bulk_viscosity = def->bulk_viscosity;
@@ -137,10 +112,7 @@ piola_status piola_world_add_shell(piola_world *world, const piola_shell_def *de
     piola__solid_free(s);
     return st;
   }
-  for (int32_t i = 0; i < n; ++i) {
-    s->inverse_mass[i] = s->mass[i] > 0 ? 1.0 / s->mass[i] : 0.0;
-    if (!(s->mass[i] > 0)) s->flags[i] = SOLID_FIXED; /* a vertex in no triangle cannot move */
-  }
+  piola__solid_finish_masses(s);
   for (int32_t i = 0; i < n; ++i) {
     if (s->flags[i] != SOLID_FREE) {
       piola__solid_constrained_state(s, i, world->time, s->x + 3 * i, s->v + 3 * i);

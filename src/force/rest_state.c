@@ -7,6 +7,7 @@
 
 #include "common/status_internal.h"
 #include "force/elastic_body_internal.h"
+#include "mesh/element_input.h"
 #include "math/mat3.h"
 
 /* A rest tet whose |V0| is below this fraction of (longest edge)^3 is degenerate. A regular
@@ -60,39 +61,9 @@ static piola_status validate_def(const piola_elastic_body_def *def) {
   if (!(def->density > 0) || !isfinite(def->density))
     return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "density must be > 0 kg/m^3, got %g",
                       def->density);
-  if (!def->materials || def->material_count <= 0)
-    return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT,
-                      "elastic body needs at least one material (material_count %d)",
-                      (int)def->material_count);
-  for (int32_t m = 0; m < def->material_count; ++m) {
-    const piola_material *mat = &def->materials[m];
-    if ((int)mat->model < 0 || mat->model >= PIOLA_MODEL_COUNT || !isfinite(mat->mu) ||
-        !isfinite(mat->lambda))
-      return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT,
-                        "material %d is not an initialized material (use piola_material_init)",
-                        (int)m);
-  }
-  for (int32_t i = 0; i < 3 * mesh->vertex_count; ++i)
-    if (!isfinite(mesh->positions[i]))
-      return PIOLA_FAIL(PIOLA_ERROR_NOT_FINITE, "rest position of vertex %d is not finite",
-                        (int)(i / 3));
-  for (int32_t t = 0; t < mesh->tet_count; ++t) {
-    for (int c = 0; c < 4; ++c) {
-      int32_t v = mesh->tets[4 * t + c];
-      if (v < 0 || v >= mesh->vertex_count)
-        return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT,
-                          "tet %d corner %d refers to vertex %d, outside 0..%d", (int)t, c,
-                          (int)v, (int)mesh->vertex_count - 1);
-    }
-    if (def->tet_materials) {
-      int32_t m = def->tet_materials[t];
-      if (m < 0 || m >= def->material_count)
-        return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT,
-                          "tet %d has material index %d, outside 0..%d", (int)t, (int)m,
-                          (int)def->material_count - 1);
-    }
-  }
-  return PIOLA_OK;
+  return piola__check_element_input("elastic body", "tet", 4, mesh->vertex_count, mesh->positions,
+                                    mesh->tet_count, mesh->tets, def->materials,
+                                    def->material_count, def->tet_materials);
 }
 
 static double triangle_area(vec3 a, vec3 b, vec3 c) {

@@ -8,6 +8,7 @@
 #include "common/status_internal.h"
 #include "material/membrane_kernels.h"
 #include "math/mat3.h"
+#include "mesh/element_input.h"
 #include "shell/shell_body_internal.h"
 
 /* A rest triangle whose area is below this fraction of (longest edge)^2 is degenerate:
@@ -81,43 +82,15 @@ static piola_status validate_def(const piola_shell_body_def *def) {
     return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT,
                       "plasticity.max_plastic_stretch must be finite and > 1, got %g",
                       p->max_plastic_stretch);
-  if (!def->materials || def->material_count <= 0)
-    return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT,
-                      "shell body needs at least one material (material_count %d)",
-                      (int)def->material_count);
-  for (int32_t m = 0; m < def->material_count; ++m) {
-    const piola_material *mat = &def->materials[m];
-    if ((int)mat->model < 0 || mat->model >= PIOLA_MODEL_COUNT || !isfinite(mat->mu) ||
-        !isfinite(mat->lambda) || !(mat->mu > 0))
-      return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT,
-                        "material %d is not an initialized material (use piola_material_init)",
-                        (int)m);
-  }
-  for (int32_t i = 0; i < 3 * mesh->vertex_count; ++i)
-    if (!isfinite(mesh->positions[i]))
-      return PIOLA_FAIL(PIOLA_ERROR_NOT_FINITE, "rest position of vertex %d is not finite",
-                        (int)(i / 3));
-  for (int32_t t = 0; t < mesh->triangle_count; ++t) {
-    for (int c = 0; c < 3; ++c) {
-      int32_t v = mesh->triangles[3 * t + c];
-      if (v < 0 || v >= mesh->vertex_count)
-        return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT,
-                          "triangle %d corner %d refers to vertex %d, outside 0..%d", (int)t, c,
-                          (int)v, (int)mesh->vertex_count - 1);
-    }
-    if (def->triangle_materials) {
-      int32_t m = def->triangle_materials[t];
-      if (m < 0 || m >= def->material_count)
-        return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT,
-                          "triangle %d has material index %d, outside 0..%d", (int)t, (int)m,
-                          (int)def->material_count - 1);
-    }
-    if (def->reference_normals)
-      for (int k = 0; k < 3; ++k)
-        if (!isfinite(def->reference_normals[3 * t + k]))
-          return PIOLA_FAIL(PIOLA_ERROR_NOT_FINITE, "reference normal of triangle %d is not finite",
-                            (int)t);
-  }
+  PIOLA_TRY(piola__check_element_input("shell body", "triangle", 3, mesh->vertex_count,
+                                       mesh->positions, mesh->triangle_count, mesh->triangles,
+                                       def->materials, def->material_count,
+                                       def->triangle_materials));
+  if (def->reference_normals)
+    for (int32_t i = 0; i < 3 * mesh->triangle_count; ++i)
+      if (!isfinite(def->reference_normals[i]))
+        return PIOLA_FAIL(PIOLA_ERROR_NOT_FINITE, "reference normal of triangle %d is not finite",
+                          (int)(i / 3));
   return PIOLA_OK;
 }
 

@@ -11,17 +11,7 @@
 
 #include "piola/mesh_io.h"
 #include "piola/obstacle.h"
-
-static double now_seconds(void) {
-  struct timespec t;
-  clock_gettime(CLOCK_MONOTONIC, &t);
-  return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
-}
-
-static int compare_doubles(const void *a, const void *b) {
-  const double x = *(const double *)a, y = *(const double *)b;
-  return (x > y) - (x < y);
-}
+#include "support/bench_support.h"
 
 int main(int argc, char **argv) {
   const int n = argc > 1 ? atoi(argv[1]) : 200000;
@@ -81,11 +71,11 @@ int main(int argc, char **argv) {
     int hits = 0;
     for (int r = 0; r < 7; ++r) {
       for (int i = 0; i < 3 * n; ++i) x[i] = x0[i], v[i] = 0.0;
-      double t0 = now_seconds();
+      double t0 = bench_wall_seconds();
       hits = piola_obstacles_collide(&o, 1, 0.5, 0.01, n, x, v, NULL, NULL);
-      runs[r] = now_seconds() - t0;
+      runs[r] = bench_wall_seconds() - t0;
     }
-    qsort(runs, 7, sizeof(double), compare_doubles);
+    qsort(runs, 7, sizeof(double), bench_compare_doubles);
     printf("| %s | %.1f | %.1f %% |\n", names[type], runs[3] / n * 1e9, 100.0 * hits / n);
     piola_obstacle_destroy(o);
   }

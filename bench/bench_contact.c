@@ -17,23 +17,7 @@
 #include <time.h>
 
 #include "piola/collision_surface.h"
-
-static double now_seconds(void) {
-  struct timespec t;
-  clock_gettime(CLOCK_MONOTONIC, &t);
-  return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
-}
-
-static double cpu_seconds(void) {
-  struct timespec t;
-  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
-  return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
-}
-
-static int compare_doubles(const void *a, const void *b) {
-  const double x = *(const double *)a, y = *(const double *)b;
-  return (x > y) - (x < y);
-}
+#include "support/bench_support.h"
 
 static unsigned long long rng_state = 88172645463325252ull;
 static double uniform(void) {
@@ -107,9 +91,9 @@ int main(int argc, char **argv) {
             u[c] = (next[c] - here[c]) / dt + 0.2 * spacing / dt * (uniform() - 0.5);
         }
       piola_collision_stats st;
-      double t0 = now_seconds(), c0 = cpu_seconds();
+      double t0 = bench_wall_seconds(), c0 = bench_cpu_seconds();
       if (piola_collision_surface_process(surface, x, v, m, dt, NULL, &st) != PIOLA_OK) return 1;
-      double elapsed = now_seconds() - t0, cpu_elapsed = cpu_seconds() - c0;
+      double elapsed = bench_wall_seconds() - t0, cpu_elapsed = bench_cpu_seconds() - c0;
       if (getenv("BENCH_TRACE"))
         fprintf(stderr, "step %d: %.1f ms contacts %lld impacts %lld passes %d zone passes %d\n",
                 step, 1e3 * elapsed, (long long)st.contacts, (long long)st.impacts,
@@ -121,8 +105,8 @@ int main(int argc, char **argv) {
         contacts += st.contacts, impacts += st.impacts, zone_vertices += st.zone_vertices;
       }
     }
-    qsort(times, 8, sizeof(double), compare_doubles);
-    qsort(cpu, 8, sizeof(double), compare_doubles);
+    qsort(times, 8, sizeof(double), bench_compare_doubles);
+    qsort(cpu, 8, sizeof(double), bench_compare_doubles);
     double median = 0.5 * (times[3] + times[4]), cpu_median = 0.5 * (cpu[3] + cpu[4]);
     printf("| %d | %d | %.1f | %.1f | %.0f | %lld | %lld | %lld |\n", nt, nv, 1e3 * median,
            1e3 * cpu_median, 1e9 * cpu_median / nt, contacts / 8, impacts / 8, zone_vertices / 8);

@@ -22,36 +22,7 @@
 
 #include "piola/elastic_body.h"
 #include "piola/mesh_io.h"
-
-static double now_seconds(void) {
-  struct timespec ts;
-  clock_gettime(CLOCK_MONOTONIC, &ts);
-  return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
-
-static double cpu_seconds(void) {
-  struct timespec ts;
-  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
-  return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
-
-static uint64_t rng_state = 0x9E3779B97F4A7C15ull;
-static double uniform(double lo, double hi) {
-  rng_state ^= rng_state << 13;
-  rng_state ^= rng_state >> 7;
-  rng_state ^= rng_state << 17;
-  return lo + (hi - lo) * (double)(rng_state >> 11) * 0x1.0p-53;
-}
-
-static int compare_doubles(const void *a, const void *b) {
-  double x = *(const double *)a, y = *(const double *)b;
-  return (x > y) - (x < y);
-}
-
-static double median(double *v, int n) {
-  qsort(v, (size_t)n, sizeof *v, compare_doubles);
-  return v[n / 2];
-}
+#include "support/bench_support.h"
 
 int main(int argc, char **argv) {
   int repeats = argc > 1 ? atoi(argv[1]) : 7;
@@ -89,8 +60,8 @@ int main(int argc, char **argv) {
   double *x = malloc(sizeof(double) * (size_t)n), *v = malloc(sizeof(double) * (size_t)n);
   double *f = malloc(sizeof(double) * (size_t)n);
   for (int32_t i = 0; i < n; ++i) {
-    x[i] = mesh.positions[i] + 0.02 * edge * uniform(-1, 1);
-    v[i] = uniform(-1, 1);
+    x[i] = mesh.positions[i] + 0.02 * edge * bench_uniform(-1, 1);
+    v[i] = bench_uniform(-1, 1);
   }
   printf("bench_damping: %s, %d vertices, %d tets\n", path, (int)nv, (int)mesh.tet_count);
   printf("%8s %14s %14s %14s %16s %16s\n", "threads", "ms/apply", "CPU ms/apply", "min CPU ms",
@@ -105,19 +76,19 @@ int main(int argc, char **argv) {
         fprintf(stderr, "bench_damping: %s\n", piola_last_error());
         return 1;
       }
-      double w0 = now_seconds(), c0 = cpu_seconds();
+      double w0 = bench_wall_seconds(), c0 = bench_cpu_seconds();
       piola_elastic_body_damping_forces(body, v, 1.0, 0.5, f);
-      wall1[r] = now_seconds() - w0;
-      cpu1[r] = cpu_seconds() - c0;
-      w0 = now_seconds();
-      c0 = cpu_seconds();
+      wall1[r] = bench_wall_seconds() - w0;
+      cpu1[r] = bench_cpu_seconds() - c0;
+      w0 = bench_wall_seconds();
+      c0 = bench_cpu_seconds();
       for (int k = 0; k < applies; ++k) piola_elastic_body_damping_forces(body, v, 1.0, 0.5, f);
-      wall[r] = (now_seconds() - w0) / applies;
-      cpu[r] = (cpu_seconds() - c0) / applies;
+      wall[r] = (bench_wall_seconds() - w0) / applies;
+      cpu[r] = (bench_cpu_seconds() - c0) / applies;
     }
-    double cpu_median = median(cpu, repeats); /* sorts cpu: cpu[0] is the least */
-    printf("%8d %14.3f %14.3f %14.3f %16.3f %16.3f\n", threads, 1e3 * median(wall, repeats),
-           1e3 * cpu_median, 1e3 * cpu[0], 1e3 * median(wall1, repeats), 1e3 * median(cpu1, repeats));
+    double cpu_median = bench_median(cpu, repeats); /* sorts cpu: cpu[0] is the least */
+    printf("%8d %14.3f %14.3f %14.3f %16.3f %16.3f\n", threads, 1e3 * bench_median(wall, repeats),
+           1e3 * cpu_median, 1e3 * cpu[0], 1e3 * bench_median(wall1, repeats), 1e3 * bench_median(cpu1, repeats));
   }
   piola_set_thread_count(0);
   free(wall);

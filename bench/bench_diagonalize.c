@@ -12,6 +12,7 @@
 #include <time.h>
 
 #include "piola/diagonalize.h"
+#include "support/bench_support.h"
 
 typedef struct rng {
   uint64_t s;
@@ -31,17 +32,6 @@ static double normal(rng *r) {
 
 /* CPU time of this thread, not wall time: on a shared machine the wall clock also counts the
  * time other processes hold the core. */
-static double now_seconds(void) {
-  struct timespec t;
-  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
-  return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
-}
-
-static int compare_doubles(const void *a, const void *b) {
-  double x = *(const double *)a, y = *(const double *)b;
-  return (x > y) - (x < y);
-}
-
 /* A deformed element: I + 0.3 G for most, a few percent inverted (one axis pushed through
  * zero), a few percent near flat (one direction squashed to 1e-6..1e-2). */
 static piola_mat3 simulation_like(rng *r) {
@@ -69,21 +59,21 @@ typedef struct timing {
 } timing;
 
 static timing time_runs(double *samples, int runs, long n) {
-  qsort(samples, (size_t)runs, sizeof *samples, compare_doubles);
+  qsort(samples, (size_t)runs, sizeof *samples, bench_compare_doubles);
   return (timing){samples[runs / 2] * 1e9 / (double)n, samples[0] * 1e9 / (double)n};
 }
 
 static timing bench3(const piola_mat3 *fs, long n, int runs, double *checksum) {
   double *t = malloc(sizeof *t * (size_t)runs);
   for (int run = 0; run < runs; ++run) {
-    double start = now_seconds(), sum = 0;
+    double start = bench_wall_seconds(), sum = 0;
     for (long k = 0; k < n; ++k) {
       piola_mat3 u, v;
       piola_vec3 d;
       piola_diagonalize3(&fs[k], &u, &d, &v);
       sum += d.z + u.m[2][2] + v.m[1][2];
     }
-    t[run] = now_seconds() - start;
+    t[run] = bench_wall_seconds() - start;
     *checksum += sum;
   }
   timing out = time_runs(t, runs, n);
@@ -94,7 +84,7 @@ static timing bench3(const piola_mat3 *fs, long n, int runs, double *checksum) {
 static timing bench3x2(const piola_mat3x2 *fs, long n, int runs, double *checksum) {
   double *t = malloc(sizeof *t * (size_t)runs);
   for (int run = 0; run < runs; ++run) {
-    double start = now_seconds(), sum = 0;
+    double start = bench_wall_seconds(), sum = 0;
     for (long k = 0; k < n; ++k) {
       piola_mat3x2 u;
       piola_mat2 v;
@@ -102,7 +92,7 @@ static timing bench3x2(const piola_mat3x2 *fs, long n, int runs, double *checksu
       piola_diagonalize3x2(&fs[k], &u, d, &v);
       sum += d[1] + u.m[2][1] + v.m[1][0];
     }
-    t[run] = now_seconds() - start;
+    t[run] = bench_wall_seconds() - start;
     *checksum += sum;
   }
   timing out = time_runs(t, runs, n);

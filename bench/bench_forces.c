@@ -6,7 +6,7 @@
  * when the mesh reader is available. Each is deformed by a small random perturbation plus
  * mirroring one corner of ~1% of the tets through the plane of the other three, so a few
  * percent of tets are inverted, as in a simulation recovering from collisions. Reports the
- * median of `repeats` (default 7) timings of piola_elastic_body_update (forces, no stats:
+ * bench_median of `repeats` (default 7) timings of piola_elastic_body_update (forces, no stats:
  * the energy is computed only on request) with 1 and 2 threads, as wall time and as process
  * CPU time divided by the thread count (the machine is shared; see docs/bench-notes). */
 #include <math.h>
@@ -20,39 +20,10 @@
 #include "force/svd_kernel.h"
 #include "piola/elastic_body.h"
 #include "piola/mesh_io.h"
-
-static double now_seconds(void) {
-  struct timespec ts;
-  clock_gettime(CLOCK_MONOTONIC, &ts);
-  return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
+#include "support/bench_support.h"
 
 /* CPU time of the whole process (all threads): on a loaded machine wall time mostly
  * measures the other processes; CPU time / threads estimates the time with the cores free. */
-static double cpu_seconds(void) {
-  struct timespec ts;
-  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
-  return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
-
-static uint64_t rng_state = 0x9E3779B97F4A7C15ull;
-static double uniform(double lo, double hi) {
-  rng_state ^= rng_state << 13;
-  rng_state ^= rng_state >> 7;
-  rng_state ^= rng_state << 17;
-  return lo + (hi - lo) * (double)(rng_state >> 11) * 0x1.0p-53;
-}
-
-static int compare_doubles(const void *a, const void *b) {
-  double x = *(const double *)a, y = *(const double *)b;
-  return (x > y) - (x < y);
-}
-
-static double median(double *v, int n) {
-  qsort(v, (size_t)n, sizeof *v, compare_doubles);
-  return v[n / 2];
-}
-
 /* n^3 cubes, 6 tets each, edge h. */
 static piola_tet_mesh grid_mesh(int n, double h) {
   piola_tet_mesh mesh;
@@ -100,9 +71,9 @@ static double *deformed_positions(const piola_elastic_body *body) {
   }
   edge /= nt;
   double *x = malloc(sizeof(double) * 3 * (size_t)nv);
-  for (int32_t i = 0; i < 3 * nv; ++i) x[i] = rest[i] + 0.01 * edge * uniform(-1, 1);
+  for (int32_t i = 0; i < 3 * nv; ++i) x[i] = rest[i] + 0.01 * edge * bench_uniform(-1, 1);
   for (int32_t t = 0; t < nt; ++t) {
-    if (uniform(0, 1) > 0.01) continue;
+    if (bench_uniform(0, 1) > 0.01) continue;
     const int32_t *c = tets + 4 * t;
     double *p = x + 3 * c[0], *a = x + 3 * c[1], *b = x + 3 * c[2], *d = x + 3 * c[3];
     double e1[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]}, e2[3] = {d[0] - a[0], d[1] - a[1], d[2] - a[2]};
@@ -143,12 +114,12 @@ static void bench_mesh(const char *name, const piola_tet_mesh *mesh, int repeats
       int n = repeats < 64 ? repeats : 64;
       piola_elastic_body_update(body, x, 1.0, f, NULL); /* warm up */
       for (int r = 0; r < n; ++r) {
-        double t0 = now_seconds(), c0 = cpu_seconds();
+        double t0 = bench_wall_seconds(), c0 = bench_cpu_seconds();
         piola_elastic_body_update(body, x, 1.0, f, NULL);
-        times[r] = now_seconds() - t0;
-        cpu[r] = (cpu_seconds() - c0) / threads;
+        times[r] = bench_wall_seconds() - t0;
+        cpu[r] = (bench_cpu_seconds() - c0) / threads;
       }
-      double t = median(times, n), c = median(cpu, n);
+      double t = bench_median(times, n), c = bench_median(cpu, n);
       printf("| %-14s | %-14s | %7d | %5.2f%% | %d | %8.3f | %7.2f | %7.2f |\n", name,
              piola_material_model_name(models[m]), (int)mesh->tet_count,
              100.0 * stats.inverted_count / mesh->tet_count, threads, 1e3 * t,
@@ -160,12 +131,12 @@ static void bench_mesh(const char *name, const piola_tet_mesh *mesh, int repeats
       double times[64], cpu[64];
       int n = repeats < 64 ? repeats : 64;
       for (int r = 0; r < n; ++r) {
-        double t0 = now_seconds(), c0 = cpu_seconds();
+        double t0 = bench_wall_seconds(), c0 = bench_cpu_seconds();
         piola__elastic_body_update_reference(body, x, 1.0, f, NULL);
-        times[r] = now_seconds() - t0;
-        cpu[r] = cpu_seconds() - c0;
+        times[r] = bench_wall_seconds() - t0;
+        cpu[r] = bench_cpu_seconds() - c0;
       }
-      double t = median(times, n), c = median(cpu, n);
+      double t = bench_median(times, n), c = bench_median(cpu, n);
       printf("| %-14s | %-14s | %7d |        | 1 | %8.3f | %7.2f | %7.2f | (scalar reference)\n",
              name, piola_material_model_name(models[m]), (int)mesh->tet_count, 1e3 * t,
              mesh->tet_count / t * 1e-6, mesh->tet_count / c * 1e-6);
@@ -174,13 +145,13 @@ static void bench_mesh(const char *name, const piola_tet_mesh *mesh, int repeats
     double times[64];
     int n = repeats < 64 ? repeats : 64;
     for (int r = 0; r < n; ++r) {
-      double t0 = now_seconds();
+      double t0 = bench_wall_seconds();
       piola_elastic_body_damping_forces(body, x, 1.0, 0.5, f);
-      times[r] = now_seconds() - t0;
+      times[r] = bench_wall_seconds() - t0;
     }
     if (m == 0)
       printf("| %-14s | damping        | %7d |        | 2 | %8.3f | %7.2f |         |\n", name,
-             (int)mesh->tet_count, 1e3 * median(times, n), mesh->tet_count / median(times, n) * 1e-6);
+             (int)mesh->tet_count, 1e3 * bench_median(times, n), mesh->tet_count / bench_median(times, n) * 1e-6);
     piola_set_thread_count(0);
     free(x);
     free(f);
@@ -192,18 +163,18 @@ static void bench_svd(int repeats) {
   int n = 1 << 16;
   double *f = malloc(sizeof(double) * 9 * (size_t)n), *u = malloc(sizeof(double) * 9 * (size_t)n);
   double *v = malloc(sizeof(double) * 9 * (size_t)n), *s = malloc(sizeof(double) * 3 * (size_t)n);
-  for (int i = 0; i < 9 * n; ++i) f[i] = (i % 4 == 0 ? 1.0 : 0.0) + uniform(-0.3, 0.3);
+  for (int i = 0; i < 9 * n; ++i) f[i] = (i % 4 == 0 ? 1.0 : 0.0) + bench_uniform(-0.3, 0.3);
   double times[64], cpu[64];
   int r_count = repeats < 64 ? repeats : 64;
   for (int r = 0; r < r_count; ++r) {
-    double t0 = now_seconds(), c0 = cpu_seconds();
+    double t0 = bench_wall_seconds(), c0 = bench_cpu_seconds();
     piola__svd3_kernel_batch(n, f, u, s, v);
-    times[r] = now_seconds() - t0;
-    cpu[r] = cpu_seconds() - c0;
+    times[r] = bench_wall_seconds() - t0;
+    cpu[r] = bench_cpu_seconds() - c0;
   }
   printf("\nvectorized SVD kernel (8 lanes, %d sweeps), 1 thread: %.1f ns/matrix wall, %.1f ns/matrix "
          "CPU time (medians of %d; includes the AoS<->SoA copies of the batch)\n",
-         PIOLA_SVD_JACOBI_SWEEPS, 1e9 * median(times, r_count) / n, 1e9 * median(cpu, r_count) / n,
+         PIOLA_SVD_JACOBI_SWEEPS, 1e9 * bench_median(times, r_count) / n, 1e9 * bench_median(cpu, r_count) / n,
          r_count);
   free(f);
   free(u);

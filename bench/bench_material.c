@@ -1,7 +1,7 @@
 /* Cost of the diagonal stress Phat(Fhat) per evaluation, for each model: through the public
  * function (one call per tet) and through the inline per-model kernel in a `#pragma omp simd`
  * loop over a block (how the force loop uses it). 10% of the samples lie below the inversion
- * threshold, some inverted. Prints the median of 9 runs in ns per evaluation.
+ * threshold, some inverted. Prints the bench_median of 9 runs in ns per evaluation.
  *
  *   build/NAME/bench_material [count]      (default 65536 tets per run) */
 #include <stdio.h>
@@ -10,17 +10,7 @@
 
 #include "material/material_kernels.h"
 #include "piola/material.h"
-
-static double now_seconds(void) {
-  struct timespec t;
-  clock_gettime(CLOCK_MONOTONIC, &t);
-  return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
-}
-
-static int compare_doubles(const void *a, const void *b) {
-  const double x = *(const double *)a, y = *(const double *)b;
-  return (x > y) - (x < y);
-}
+#include "support/bench_support.h"
 
 static void simd_block(const piola_material *m, long n, const double *restrict f0,
                        const double *restrict f1, const double *restrict f2, double *restrict p0,
@@ -75,11 +65,6 @@ static void simd_block_energy(const piola_material *m, long n, const double *res
   }
 }
 
-static double median(double *v, int n) {
-  qsort(v, (size_t)n, sizeof(double), compare_doubles);
-  return v[n / 2];
-}
-
 int main(int argc, char **argv) {
   const long n = argc > 1 ? atol(argv[1]) : 65536;
   if (n <= 0) return 1;
@@ -105,20 +90,20 @@ int main(int argc, char **argv) {
     if (piola_material_init(&def, &m) != PIOLA_OK) return 1;
     double t_pub[RUNS], t_simd[RUNS], t_pub_e[RUNS], t_simd_e[RUNS];
     for (int r = 0; r < RUNS; ++r) {
-      double t = now_seconds();
+      double t = bench_wall_seconds();
       for (long i = 0; i < n; ++i) {
         const double f[3] = {f0[i], f1[i], f2[i]};
         double p[3];
         piola_material_stress(&m, f, p);
         p0[i] = p[0], p1[i] = p[1], p2[i] = p[2];
       }
-      t_pub[r] = (now_seconds() - t) / (double)n * 1e9;
+      t_pub[r] = (bench_wall_seconds() - t) / (double)n * 1e9;
       sink += p0[n / 2];
-      t = now_seconds();
+      t = bench_wall_seconds();
       simd_block(&m, n, f0, f1, f2, p0, p1, p2);
-      t_simd[r] = (now_seconds() - t) / (double)n * 1e9;
+      t_simd[r] = (bench_wall_seconds() - t) / (double)n * 1e9;
       sink += p1[n / 3];
-      t = now_seconds();
+      t = bench_wall_seconds();
       for (long i = 0; i < n; ++i) {
         const double f[3] = {f0[i], f1[i], f2[i]};
         double p[3];
@@ -126,16 +111,16 @@ int main(int argc, char **argv) {
         psi[i] = piola_material_energy_density(&m, f);
         p0[i] = p[0], p1[i] = p[1], p2[i] = p[2];
       }
-      t_pub_e[r] = (now_seconds() - t) / (double)n * 1e9;
+      t_pub_e[r] = (bench_wall_seconds() - t) / (double)n * 1e9;
       sink += psi[n / 2];
-      t = now_seconds();
+      t = bench_wall_seconds();
       simd_block_energy(&m, n, f0, f1, f2, p0, p1, p2, psi);
-      t_simd_e[r] = (now_seconds() - t) / (double)n * 1e9;
+      t_simd_e[r] = (bench_wall_seconds() - t) / (double)n * 1e9;
       sink += psi[n / 3];
     }
     printf("| %s | %.1f | %.1f | %.1f | %.1f |\n", piola_material_model_name(m.model),
-           median(t_pub, RUNS), median(t_simd, RUNS), median(t_pub_e, RUNS),
-           median(t_simd_e, RUNS));
+           bench_median(t_pub, RUNS), bench_median(t_simd, RUNS), bench_median(t_pub_e, RUNS),
+           bench_median(t_simd_e, RUNS));
   }
   fprintf(stderr, "(checksum %g)\n", sink);
   free(buf);

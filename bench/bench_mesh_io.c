@@ -14,33 +14,12 @@
 
 #include "piola/mesh.h"
 #include "piola/mesh_io.h"
-
-static double now(void) {
-  struct timespec ts;
-  clock_gettime(CLOCK_MONOTONIC, &ts);
-  return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
+#include "support/bench_support.h"
 
 /* CPU time of this process: less disturbed than wall time on a shared machine. */
-static double cpu_now(void) {
-  struct timespec ts;
-  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
-  return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
-
 static double file_size(const char *path) {
   struct stat st;
   return stat(path, &st) == 0 ? (double)st.st_size : 0.0;
-}
-
-static int cmp_double(const void *a, const void *b) {
-  double x = *(const double *)a, y = *(const double *)b;
-  return (x > y) - (x < y);
-}
-
-static double median(double *v, int n) {
-  qsort(v, (size_t)n, sizeof(double), cmp_double);
-  return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
 }
 
 /* n^3 cubes, each split into 6 tets around its main diagonal (conforming across cubes). */
@@ -138,7 +117,7 @@ int main(int argc, char **argv) {
   if (!mkdtemp(dir)) return 1;
   piola_tet_mesh mesh = {0};
   make_grid(n, &mesh);
-  printf("mesh: %d vertices, %d tets (structured %d^3 grid, 6 tets per cube), %d runs, median\n",
+  printf("mesh: %d vertices, %d tets (structured %d^3 grid, 6 tets per cube), %d runs, bench_median\n",
          (int)mesh.vertex_count, (int)mesh.tet_count, n, runs);
   char msh[256], node[256], ele[256], bin[256], vtu[256];
   snprintf(msh, sizeof msh, "%s/grid.msh", dir);
@@ -161,16 +140,16 @@ int main(int argc, char **argv) {
     double wt = 0, wc = 0, rt = 0, rc = 0;
     if (rows[r].write_with_piola) {
       for (int i = 0; i < runs; ++i) {
-        double t0 = now(), c0 = cpu_now();
+        double t0 = bench_wall_seconds(), c0 = bench_cpu_seconds();
         if (piola_tet_mesh_write(rows[r].path, &mesh) != PIOLA_OK) {
           fprintf(stderr, "%s\n", piola_last_error());
           status = 1;
         }
-        times[i] = now() - t0;
-        cpu[i] = cpu_now() - c0;
+        times[i] = bench_wall_seconds() - t0;
+        cpu[i] = bench_cpu_seconds() - c0;
       }
-      wt = median(times, runs);
-      wc = median(cpu, runs);
+      wt = bench_median(times, runs);
+      wc = bench_median(cpu, runs);
     } else if (write_msh_binary(rows[r].path, &mesh) != 0) {
       status = 1;
     }
@@ -178,18 +157,18 @@ int main(int argc, char **argv) {
     if (rows[r].read_with_piola) {
       for (int i = 0; i < runs; ++i) {
         piola_tet_mesh back;
-        double t0 = now(), c0 = cpu_now();
+        double t0 = bench_wall_seconds(), c0 = bench_cpu_seconds();
         if (piola_tet_mesh_read(rows[r].path, &back) != PIOLA_OK) {
           fprintf(stderr, "%s\n", piola_last_error());
           status = 1;
         }
-        times[i] = now() - t0;
-        cpu[i] = cpu_now() - c0;
+        times[i] = bench_wall_seconds() - t0;
+        cpu[i] = bench_cpu_seconds() - c0;
         if (back.tet_count != mesh.tet_count) status = 1;
         piola_tet_mesh_free(&back);
       }
-      rt = median(times, runs);
-      rc = median(cpu, runs);
+      rt = bench_median(times, runs);
+      rc = bench_median(cpu, runs);
     }
     double mb = size / 1e6;
     printf("%-26s %8.1f ", rows[r].name, mb);

@@ -2,7 +2,7 @@
  *
  *   build/<dir>/bench_plasticity [repeats]
  *
- * Mesh: Vega's torus-easy.veg (97,878 tets), neo-Hookean. Scenarios, each timed as the median
+ * Mesh: Vega's torus-easy.veg (97,878 tets), neo-Hookean. Scenarios, each timed as the bench_median
  * of `repeats` (default 7) runs with 1 and 2 threads, as CPU time / threads (the machine is
  * shared; see docs/bench-notes/plasticity.md):
  *   quiet    small random motion (1% of an edge): almost no tet yields; the common step.
@@ -22,30 +22,7 @@
 #include "piola/elastic_body.h"
 #include "piola/mesh_io.h"
 #include "piola/plasticity.h"
-
-static double cpu_seconds(void) {
-  struct timespec ts;
-  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
-  return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
-
-static uint64_t rng_state = 0x9E3779B97F4A7C15ull;
-static double uniform(double lo, double hi) {
-  rng_state ^= rng_state << 13;
-  rng_state ^= rng_state >> 7;
-  rng_state ^= rng_state << 17;
-  return lo + (hi - lo) * (double)(rng_state >> 11) * 0x1.0p-53;
-}
-
-static int compare_doubles(const void *a, const void *b) {
-  double x = *(const double *)a, y = *(const double *)b;
-  return (x > y) - (x < y);
-}
-
-static double median(double *v, int n) {
-  qsort(v, (size_t)n, sizeof *v, compare_doubles);
-  return v[n / 2];
-}
+#include "support/bench_support.h"
 
 enum { QUIET, FLOWING, LIMITED, CONTROL, SCENARIO_COUNT };
 static const char *const names[] = {"quiet", "flowing", "limited", "control"};
@@ -55,9 +32,9 @@ static void positions(const piola_elastic_body *body, int scenario, double *x) {
   const double *rest = piola_elastic_body_rest_positions(body);
   double stretch = scenario == QUIET ? 1.0 : (scenario == LIMITED ? 4.0 : 1.3);
   for (int32_t i = 0; i < nv; ++i) {
-    x[3 * i] = stretch * rest[3 * i] + 0.002 * uniform(-1, 1);
-    x[3 * i + 1] = rest[3 * i + 1] + 0.002 * uniform(-1, 1);
-    x[3 * i + 2] = rest[3 * i + 2] + 0.002 * uniform(-1, 1);
+    x[3 * i] = stretch * rest[3 * i] + 0.002 * bench_uniform(-1, 1);
+    x[3 * i + 1] = rest[3 * i + 1] + 0.002 * bench_uniform(-1, 1);
+    x[3 * i + 2] = rest[3 * i + 2] + 0.002 * bench_uniform(-1, 1);
   }
 }
 
@@ -86,7 +63,7 @@ int main(int argc, char **argv) {
   int32_t nv = piola_elastic_body_vertex_count(body), nt = piola_elastic_body_tet_count(body);
   double *x = malloc(sizeof(double) * 3 * (size_t)nv), *f = malloc(sizeof(double) * 3 * (size_t)nv);
   double *force_t = malloc(sizeof(double) * (size_t)repeats), *plastic_t = malloc(sizeof(double) * (size_t)repeats);
-  printf("torus-easy.veg: %d tets; median of %d, CPU time / threads\n", (int)nt, repeats);
+  printf("torus-easy.veg: %d tets; bench_median of %d, CPU time / threads\n", (int)nt, repeats);
   printf("%-8s %7s %12s %12s %9s %8s %8s\n", "scenario", "threads", "force (ms)", "plastic (ms)", "ratio", "yielded", "limited");
   for (int threads = 1; threads <= 2; ++threads) {
     piola_set_thread_count(threads);
@@ -106,16 +83,16 @@ int main(int argc, char **argv) {
           fprintf(stderr, "bench_plasticity: %s\n", piola_last_error());
           return 1;
         }
-        double c0 = cpu_seconds();
+        double c0 = bench_cpu_seconds();
         piola_elastic_body_update(body, x, 1.0, f, NULL);
-        double c1 = cpu_seconds();
+        double c1 = bench_cpu_seconds();
         piola_plastic_state_update(p, 1e-3, &st);
-        double c2 = cpu_seconds();
+        double c2 = bench_cpu_seconds();
         force_t[r] = (c1 - c0) / threads;
         plastic_t[r] = (c2 - c1) / threads;
         piola_plastic_state_destroy(p);
       }
-      double fm = median(force_t, repeats), pm = median(plastic_t, repeats);
+      double fm = bench_median(force_t, repeats), pm = bench_median(plastic_t, repeats);
       printf("%-8s %7d %12.2f %12.2f %8.1f%% %8d %8d\n", names[sc], threads, 1e3 * fm, 1e3 * pm, 100 * pm / fm,
              (int)st.yielded_count, (int)st.limited_count);
     }

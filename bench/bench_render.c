@@ -12,17 +12,7 @@
 #include <unistd.h>
 
 #include "piola/render.h"
-
-static double now_seconds(void) {
-  struct timespec t;
-  clock_gettime(CLOCK_MONOTONIC, &t);
-  return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
-}
-
-static int compare_doubles(const void *a, const void *b) {
-  const double x = *(const double *)a, y = *(const double *)b;
-  return (x > y) - (x < y);
-}
+#include "support/bench_support.h"
 
 int main(int argc, char **argv) {
   long want = argc > 1 ? atol(argv[1]) : 100000;
@@ -84,15 +74,15 @@ int main(int argc, char **argv) {
     char png[64];
     snprintf(png, sizeof png, "/tmp/piola_bench_render_%d.png", (int)getpid());
     for (int run = 0; run < RUNS; ++run) {
-      double t0 = now_seconds();
+      double t0 = bench_wall_seconds();
       if (piola_renderer_render(rd, &mesh, &img) != PIOLA_OK) return 1;
-      double t1 = now_seconds();
+      double t1 = bench_wall_seconds();
       if (mode == 0 && piola_image_write_png(png, &img) != PIOLA_OK) return 1;
-      tpng[run] = now_seconds() - t1;
+      tpng[run] = bench_wall_seconds() - t1;
       t[run] = t1 - t0;
     }
-    qsort(t, RUNS, sizeof t[0], compare_doubles);
-    qsort(tpng, RUNS, sizeof tpng[0], compare_doubles);
+    qsort(t, RUNS, sizeof t[0], bench_compare_doubles);
+    qsort(tpng, RUNS, sizeof tpng[0], bench_compare_doubles);
     static const char *const names[] = {"plain, plane ground + sphere obstacle",
                                         "inverted colouring, same scene",
                                         "plain, fallback ground only", "plain, obstacles, no shadows"};

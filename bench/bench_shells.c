@@ -4,7 +4,7 @@
  *
  * Mesh: a generated 1 m square sheet of 224 x 224 cells (100,352 triangles, ~150K hinges),
  * crumpled by two waves plus noise, with ~1% of the triangles collapsed onto a line (as a
- * cloth has after contact). Reports the median of `repeats` (default 7) timings, with 1 and
+ * cloth has after contact). Reports the bench_median of `repeats` (default 7) timings, with 1 and
  * 2 threads, of
  *   - piola_shell_body_update without bending (in-plane only) and with bending,
  *   - piola_shell_body_damping_forces (in-plane and bending damping: the CG's operator),
@@ -23,39 +23,10 @@
 #include "piola/obstacle.h"
 #include "piola/shell_body.h"
 #include "piola/world_shells.h"
-
-static double now_seconds(void) {
-  struct timespec ts;
-  clock_gettime(CLOCK_MONOTONIC, &ts);
-  return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
+#include "support/bench_support.h"
 
 /* CPU time of the process (all threads): on a loaded machine the 1-thread rows' CPU time
  * is the cost of the work itself, while wall time includes waiting for a core. */
-static double cpu_seconds(void) {
-  struct timespec ts;
-  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
-  return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
-
-static uint64_t rng_state = 0x9E3779B97F4A7C15ull;
-static double uniform(double lo, double hi) {
-  rng_state ^= rng_state << 13;
-  rng_state ^= rng_state >> 7;
-  rng_state ^= rng_state << 17;
-  return lo + (hi - lo) * (double)(rng_state >> 11) * 0x1.0p-53;
-}
-
-static int compare_doubles(const void *a, const void *b) {
-  double x = *(const double *)a, y = *(const double *)b;
-  return (x > y) - (x < y);
-}
-
-static double median(double *v, int n) {
-  qsort(v, (size_t)n, sizeof *v, compare_doubles);
-  return v[n / 2];
-}
-
 static piola_shell_body *make_body(const piola_tri_mesh *mesh, const piola_material *material,
                                    double bending) {
   piola_shell_body_def def = piola_default_shell_body_def();
@@ -106,10 +77,10 @@ int main(int argc, char **argv) {
   const double h = 1.0 / cells;
   for (int32_t i = 0; i < n; ++i) {
     const double *p = mesh.positions + 3 * i;
-    x[3 * i] = p[0] + 0.1 * h * uniform(-1, 1);
-    x[3 * i + 1] = p[1] + 0.1 * h * uniform(-1, 1);
-    x[3 * i + 2] = 0.02 * sin(9 * p[0]) * cos(7 * p[1]) + 0.1 * h * uniform(-1, 1);
-    for (int k = 0; k < 3; ++k) v[3 * i + k] = uniform(-0.1, 0.1);
+    x[3 * i] = p[0] + 0.1 * h * bench_uniform(-1, 1);
+    x[3 * i + 1] = p[1] + 0.1 * h * bench_uniform(-1, 1);
+    x[3 * i + 2] = 0.02 * sin(9 * p[0]) * cos(7 * p[1]) + 0.1 * h * bench_uniform(-1, 1);
+    for (int k = 0; k < 3; ++k) v[3 * i + k] = bench_uniform(-0.1, 0.1);
   }
   /* collapse ~1% of the triangles: corner 2 onto the midpoint of corners 0 and 1 */
   for (int32_t t = 0; t < nt; t += 100) {
@@ -124,7 +95,7 @@ int main(int argc, char **argv) {
   piola_shell_body *membrane = make_body(&mesh, &material, 0.0);
   piola_shell_body *full = make_body(&mesh, &material, 1e-5);
   int32_t hinges = piola_shell_body_hinge_count(full);
-  printf("sheet: %d triangles, %d hinges, %d vertices; median of %d runs\n\n", (int)nt,
+  printf("sheet: %d triangles, %d hinges, %d vertices; bench_median of %d runs\n\n", (int)nt,
          (int)hinges, (int)n, repeats);
   printf("| measurement | threads | wall ms | triangles/s (wall) | CPU ms | triangles/s per CPU |\n"
          "|---|---|---|---|---|---|\n");
@@ -138,15 +109,15 @@ int main(int argc, char **argv) {
       piola_shell_body *body = which == 0 ? membrane : full;
       piola_shell_body_update(body, x, 1.0, f, NULL); /* warm up */
       for (int r = 0; r < repeats; ++r) {
-        double t0 = now_seconds(), c0 = cpu_seconds();
+        double t0 = bench_wall_seconds(), c0 = bench_cpu_seconds();
         if (which < 2)
           piola_shell_body_update(body, x, 1.0, f, NULL);
         else
           piola_shell_body_damping_forces(body, v, 0.1, 0.1, f);
-        times[r] = now_seconds() - t0;
-        cpu[r] = cpu_seconds() - c0;
+        times[r] = bench_wall_seconds() - t0;
+        cpu[r] = bench_cpu_seconds() - c0;
       }
-      double m = median(times, repeats), mc = median(cpu, repeats);
+      double m = bench_median(times, repeats), mc = bench_median(cpu, repeats);
       printf("| %s | %d | %.2f | %.3g | %.2f | %.3g |\n", names[which], threads, 1e3 * m, nt / m,
              1e3 * mc, nt / mc);
     }
@@ -182,12 +153,12 @@ int main(int argc, char **argv) {
   for (int threads = 1; threads <= 2; ++threads) {
     piola_set_thread_count(threads);
     for (int r = 0; r < repeats; ++r) {
-      double t0 = now_seconds(), c0 = cpu_seconds();
+      double t0 = bench_wall_seconds(), c0 = bench_cpu_seconds();
       for (int s = 0; s < 5; ++s, t += dt) cloth_step(&c, t, dt);
-      times[r] = (now_seconds() - t0) / 5;
-      cpu[r] = (cpu_seconds() - c0) / 5;
+      times[r] = (bench_wall_seconds() - t0) / 5;
+      cpu[r] = (bench_cpu_seconds() - c0) / 5;
     }
-    double m = median(times, repeats), mc = median(cpu, repeats);
+    double m = bench_median(times, repeats), mc = bench_median(cpu, repeats);
     printf("| explicit step | %d | %.2f | %.3g | %.2f |\n", threads, 1e3 * m, 1 / m, 1e3 * mc);
   }
   /* world steps: the same cloth, pinned at two corners, over the sphere */
@@ -225,16 +196,16 @@ int main(int argc, char **argv) {
       int cg = 0, steps = 0;
       double last_dt = 0;
       for (int r = 0; r < repeats; ++r) {
-        double t0 = now_seconds(), c0 = cpu_seconds();
+        double t0 = bench_wall_seconds(), c0 = bench_cpu_seconds();
         piola_step_stats st;
         piola_world_step(world, 0, &st);
-        times[r] = now_seconds() - t0;
-        cpu[r] = cpu_seconds() - c0;
+        times[r] = bench_wall_seconds() - t0;
+        cpu[r] = bench_cpu_seconds() - c0;
         cg += st.cg_iterations;
         steps++;
         last_dt = st.last_dt;
       }
-      double m = median(times, repeats), mc = median(cpu, repeats);
+      double m = bench_median(times, repeats), mc = bench_median(cpu, repeats);
       printf("| world step | %d | %.1f | %.3g | %.1f | %.2g | %.1f |\n", threads, 1e3 * m, 1 / m,
              1e3 * mc, last_dt, (double)cg / steps);
     }

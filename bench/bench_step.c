@@ -23,17 +23,7 @@
 #include "piola/mesh_io.h"
 #include "piola/threads.h"
 #include "piola/world.h"
-
-static double now_seconds(void) {
-  struct timespec ts;
-  clock_gettime(CLOCK_MONOTONIC, &ts);
-  return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
-
-static int compare_doubles(const void *a, const void *b) {
-  double x = *(const double *)a, y = *(const double *)b;
-  return (x > y) - (x < y);
-}
+#include "support/bench_support.h"
 
 int main(int argc, char **argv) {
   int repeats = argc > 1 ? atoi(argv[1]) : 5;
@@ -90,7 +80,7 @@ int main(int argc, char **argv) {
       for (int s = 0; s < 3; ++s) piola_world_step(world, 1e-4, &st); /* warm up */
       const int steps = 10;
       int cg = 0;
-      double t0 = now_seconds();
+      double t0 = bench_wall_seconds();
       clock_t c0 = clock();
       for (int s = 0; s < steps; ++s) {
         if (piola_world_step(world, 1e-4, &st) != PIOLA_OK) {
@@ -99,7 +89,7 @@ int main(int argc, char **argv) {
         }
         cg += st.cg_iterations;
       }
-      times[r] = (now_seconds() - t0) / steps;
+      times[r] = (bench_wall_seconds() - t0) / steps;
       cpu[r] = (double)(clock() - c0) / CLOCKS_PER_SEC / steps;
       cg_per_step = (double)cg / steps;
       /* the two kernels of a step alone, on this state: one elastic update, one damping apply */
@@ -109,24 +99,24 @@ int main(int argc, char **argv) {
       double *x = malloc(3 * (size_t)n * sizeof *x);
       memcpy(x, piola_world_solid_positions(world, 0), 3 * (size_t)n * sizeof *x);
       piola_elastic_body *mut = (piola_elastic_body *)body; /* the world's own body, same state */
-      double u0 = now_seconds();
+      double u0 = bench_wall_seconds();
       for (int k = 0; k < 3; ++k) piola_elastic_body_update(mut, x, 1.0, f, NULL);
-      upd[r] = (now_seconds() - u0) / 3;
+      upd[r] = (bench_wall_seconds() - u0) / 3;
       /* the first call after an update prepares the per-tet records (once per step): not
        * part of the per-apply time, which is what each CG iteration pays */
       piola_elastic_body_damping_forces(body, piola_world_solid_velocities(world, 0), 1, 1, f);
-      double d0 = now_seconds();
+      double d0 = bench_wall_seconds();
       for (int k = 0; k < 5; ++k)
         piola_elastic_body_damping_forces(body, piola_world_solid_velocities(world, 0), 1, 1, f);
-      damp[r] = (now_seconds() - d0) / 5;
+      damp[r] = (bench_wall_seconds() - d0) / 5;
       free(f);
       free(x);
       piola_world_destroy(world);
     }
-    qsort(times, (size_t)repeats, sizeof *times, compare_doubles);
-    qsort(cpu, (size_t)repeats, sizeof *cpu, compare_doubles);
-    qsort(upd, (size_t)repeats, sizeof *upd, compare_doubles);
-    qsort(damp, (size_t)repeats, sizeof *damp, compare_doubles);
+    qsort(times, (size_t)repeats, sizeof *times, bench_compare_doubles);
+    qsort(cpu, (size_t)repeats, sizeof *cpu, bench_compare_doubles);
+    qsort(upd, (size_t)repeats, sizeof *upd, bench_compare_doubles);
+    qsort(damp, (size_t)repeats, sizeof *damp, bench_compare_doubles);
     printf("%8d %10.2f %14.2f %14.1f %12.2f %14.2f\n", threads, 1e3 * times[repeats / 2],
            1e3 * cpu[repeats / 2], cg_per_step, 1e3 * upd[repeats / 2], 1e3 * damp[repeats / 2]);
     free(times);

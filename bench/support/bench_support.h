@@ -1,0 +1,21 @@
+/* Helpers every benchmark program shares: clocks, medians and a fixed random sequence.
+ * Linked into each benchmark program by CMakeLists.txt (every .c file in bench/support). */
+#ifndef PIOLA_BENCH_SUPPORT_H
+#define PIOLA_BENCH_SUPPORT_H
+
+/* Monotonic wall-clock time, s. */
+double bench_wall_seconds(void);
+
+/* CPU time of the whole process (all threads), s: steadier than wall time on a busy machine. */
+double bench_cpu_seconds(void);
+
+/* qsort comparator for doubles, ascending. */
+int bench_compare_doubles(const void *a, const void *b);
+
+/* Median of n values (sorts v in place; the mean of the middle two when n is even). */
+double bench_median(double *v, int n);
+
+/* Uniform in [lo, hi) from one xorshift sequence with a fixed seed, so runs are repeatable. */
+double bench_uniform(double lo, double hi);
+
+#endif

@@ -14,34 +14,7 @@
  * (a conforming triangulation). Orientation is left to the body. */
 static inline piola_tet_mesh fixture_grid(int n, double h) {
   piola_tet_mesh mesh;
-  memset(&mesh, 0, sizeof mesh);
-  int nv1 = n + 1;
-  mesh.vertex_count = nv1 * nv1 * nv1;
-  mesh.tet_count = 6 * n * n * n;
-  mesh.positions = malloc(sizeof(double) * 3 * (size_t)mesh.vertex_count);
-  mesh.tets = malloc(sizeof(int32_t) * 4 * (size_t)mesh.tet_count);
-  for (int k = 0; k < nv1; ++k)
-    for (int j = 0; j < nv1; ++j)
-      for (int i = 0; i < nv1; ++i) {
-        int v = (k * nv1 + j) * nv1 + i;
-        mesh.positions[3 * v] = i * h;
-        mesh.positions[3 * v + 1] = j * h;
-        mesh.positions[3 * v + 2] = k * h;
-      }
-  static const int perms[6][3] = {{0, 1, 2}, {0, 2, 1}, {1, 0, 2}, {1, 2, 0}, {2, 0, 1}, {2, 1, 0}};
-  int t = 0;
-  for (int k = 0; k < n; ++k)
-    for (int j = 0; j < n; ++j)
-      for (int i = 0; i < n; ++i)
-        for (int p = 0; p < 6; ++p) {
-          int c[3] = {i, j, k};
-          mesh.tets[4 * t] = (c[2] * nv1 + c[1]) * nv1 + c[0];
-          for (int s = 0; s < 3; ++s) {
-            c[perms[p][s]]++;
-            mesh.tets[4 * t + 1 + s] = (c[2] * nv1 + c[1]) * nv1 + c[0];
-          }
-          ++t;
-        }
+  assert_int_equal(piola_tet_mesh_box_grid(n, n, n, (piola_vec3){h, h, h}, &mesh), PIOLA_OK);
   return mesh;
 }
 

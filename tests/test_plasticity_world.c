@@ -9,39 +9,15 @@
 #include <string.h>
 
 #include "piola/plasticity.h"
+#include "piola/mesh.h"
 #include "piola/world.h"
 #include "test_elastic_body_fixtures.h"
 
-/* A box [0,a]x[0,b]x[0,c] of nx*ny*nz cubes, 6 tets each. */
+/* A box [0,a]x[0,b]x[0,c] of nx*ny*nz cubes, 6 tets each (piola_tet_mesh_box_grid). */
 static piola_tet_mesh block(int nx, int ny, int nz, double a, double b, double c) {
   piola_tet_mesh m;
-  memset(&m, 0, sizeof m);
-  m.vertex_count = (nx + 1) * (ny + 1) * (nz + 1);
-  m.tet_count = 6 * nx * ny * nz;
-  m.positions = malloc(3 * (size_t)m.vertex_count * sizeof(double));
-  m.tets = malloc(4 * (size_t)m.tet_count * sizeof(int32_t));
-#define VID(i, j, k) ((i) + (nx + 1) * ((j) + (ny + 1) * (k)))
-  for (int k = 0; k <= nz; ++k)
-    for (int j = 0; j <= ny; ++j)
-      for (int i = 0; i <= nx; ++i) {
-        double *p = m.positions + 3 * VID(i, j, k);
-        p[0] = a * i / nx, p[1] = b * j / ny, p[2] = c * k / nz;
-      }
-  static const int perms[6][3] = {{0, 1, 2}, {0, 2, 1}, {1, 0, 2}, {1, 2, 0}, {2, 0, 1}, {2, 1, 0}};
-  int t = 0;
-  for (int k = 0; k < nz; ++k)
-    for (int j = 0; j < ny; ++j)
-      for (int i = 0; i < nx; ++i)
-        for (int p = 0; p < 6; ++p) {
-          int c3[3] = {i, j, k};
-          int32_t *tet = m.tets + 4 * t++;
-          tet[0] = VID(c3[0], c3[1], c3[2]);
-          for (int s = 0; s < 3; ++s) {
-            c3[perms[p][s]]++;
-            tet[s + 1] = VID(c3[0], c3[1], c3[2]);
-          }
-        }
-#undef VID
+  assert_int_equal(piola_tet_mesh_box_grid(nx, ny, nz, (piola_vec3){a / nx, b / ny, c / nz}, &m),
+                   PIOLA_OK);
   return m;
 }
 

@@ -14,6 +14,8 @@ double bench_wall_seconds(void) { return seconds_of(CLOCK_MONOTONIC); }
 
 double bench_cpu_seconds(void) { return seconds_of(CLOCK_PROCESS_CPUTIME_ID); }
 
+double bench_thread_cpu_seconds(void) { return seconds_of(CLOCK_THREAD_CPUTIME_ID); }
+
 int bench_compare_doubles(const void *a, const void *b) {
   double x = *(const double *)a, y = *(const double *)b;
   return (x > y) - (x < y);

@@ -9,6 +9,9 @@ double bench_wall_seconds(void);
 /* CPU time of the whole process (all threads), s: steadier than wall time on a busy machine. */
 double bench_cpu_seconds(void);
 
+/* CPU time of the calling thread, s: excludes time other processes hold the core. */
+double bench_thread_cpu_seconds(void);
+
 /* qsort comparator for doubles, ascending. */
 int bench_compare_doubles(const void *a, const void *b);
 

@@ -10,6 +10,7 @@
 #include <stdint.h>
 
 #include "piola/export.h"
+#include "piola/math_types.h"
 #include "piola/status.h"
 
 #ifdef __cplusplus
@@ -50,6 +51,15 @@ PIOLA_API int32_t piola_tet_mesh_orient(piola_tet_mesh *mesh);
 /* The boundary surface: faces used by exactly one tet, wound outward. Faces of tets are
  * (0,2,1), (0,1,3), (0,3,2), (1,2,3). The result shares vertex numbering with the mesh. */
 PIOLA_API piola_status piola_tet_mesh_boundary(const piola_tet_mesh *mesh, piola_tri_mesh *out);
+
+/* A structured box mesh: nx * ny * nz cells of spacing (m) along x, y, z, with a corner at
+ * the origin, each cell split into 6 tets around its main diagonal (a conforming
+ * triangulation). Vertex (i, j, k) is number i + (nx + 1) (j + (ny + 1) k) at
+ * (i spacing.x, j spacing.y, k spacing.z). Half of the tets come out negatively oriented;
+ * piola_tet_mesh_orient or an elastic body fixes that. For tests, benchmarks and quick
+ * scenes; real shapes go through the mesher. */
+PIOLA_API piola_status piola_tet_mesh_box_grid(int32_t nx, int32_t ny, int32_t nz,
+                                               piola_vec3 spacing, piola_tet_mesh *out);
 
 #ifdef __cplusplus
 }

@@ -265,6 +265,15 @@ PIOLA_WIDE_VECTORS static void apply_block(const piola_elastic_body *body, const
   }
 }
 
+void piola__elastic_body_damping_prepare(piola_elastic_body *body) {
+  if (body->damping_ready) return;
+  const int32_t blocks = body->padded_tet_count / B;
+#pragma omp parallel for schedule(static) num_threads(piola__thread_count()) \
+    if (blocks >= PIOLA_PARALLEL_MIN_BLOCKS)
+  for (int32_t b = 0; b < blocks; ++b) prepare_block(body, b);
+  body->damping_ready = 1;
+}
+
 void piola_elastic_body_damping_forces(const piola_elastic_body *body, const double *v,
                                        double shear_viscosity, double bulk_viscosity,
                                        double *forces) {
@@ -273,13 +282,7 @@ void piola_elastic_body_damping_forces(const piola_elastic_body *body, const dou
   const int64_t n = 3 * (int64_t)body->vertex_count;
   /* the records and partial sums are prepared in place, like the lazy energy: concurrent
    * calls on one body are not allowed */
-  piola_elastic_body *mutable_body = (piola_elastic_body *)body;
-  if (!body->damping_ready) {
-#pragma omp parallel for schedule(static) num_threads(piola__thread_count()) \
-    if (blocks >= PIOLA_PARALLEL_MIN_BLOCKS)
-    for (int32_t b = 0; b < blocks; ++b) prepare_block(mutable_body, b);
-    mutable_body->damping_ready = 1;
-  }
+  piola__elastic_body_damping_prepare((piola_elastic_body *)body);
   if (blocks < PIOLA_PARALLEL_MIN_BLOCKS || !body->damping_chunk_forces) {
     for (int64_t i = 0; i < n; ++i) forces[i] = 0.0;
     for (int32_t b = 0; b < blocks; ++b) apply_block(body, v, shear_viscosity, bulk_viscosity, b, forces);

@@ -134,6 +134,11 @@ void piola__elastic_body_damping_reference(const piola_elastic_body *body, const
                                            double shear_viscosity, double bulk_viscosity,
                                            double *forces);
 
+/* Prepares the damping operator's per-tet records from the last update, if that has not
+ * been done yet (damping.c). piola_elastic_body_damping_forces calls it itself; the step
+ * loop calls it apart so its cost can be timed. */
+void piola__elastic_body_damping_prepare(piola_elastic_body *body);
+
 /* Sums the per-tet force buffer into per-vertex forces, in parallel, deterministically. */
 void piola__elastic_body_gather_forces(const piola_elastic_body *body, double *forces);
 

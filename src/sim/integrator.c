@@ -19,6 +19,7 @@
 
 #include "common/status_internal.h"
 #include "math/mat3.h"
+#include "force/elastic_body_internal.h"
 #include "sim/conjugate_gradient.h"
 #include "sim/world_internal.h"
 
@@ -28,12 +29,15 @@ typedef struct damping_system {
   double beta, alpha;    /* shear and bulk viscosity, Pa s */
   int hold_normals;      /* filter the normal components of colliding nodes too */
   double *scratch;       /* 3n */
+  step_profile *profile; /* the world's timers (the applies are counted apart) */
 } damping_system;
 
 static void damping_apply(void *ctx, const double *p, double *out) {
   const damping_system *d = ctx;
   const world_solid *s = d->s;
+  piola__step_profile_apply(d->profile, 1);
   piola__solid_damping_forces(s, p, d->beta, d->alpha, d->scratch);
+  piola__step_profile_apply(d->profile, 0);
   for (int32_t i = 0; i < s->n; ++i)
     for (int k = 0; k < 3; ++k)
       out[3 * i + k] = s->mass[i] * p[3 * i + k] - d->h * d->scratch[3 * i + k];
@@ -55,11 +59,11 @@ static void damping_filter(void *ctx, double *r) {
 }
 
 /* Solves (M - h D) v = rhs, keeping the filtered components of the guess in v. */
-static int32_t damping_solve(const piola_world *w, world_solid *s, double h, double t,
+static int32_t damping_solve(piola_world *w, world_solid *s, double h, double t,
                              int hold_normals, const double *rhs, double *v) {
   double beta = piola_track_eval(&s->shear_viscosity, t);
   double alpha = piola_track_eval(&s->bulk_viscosity, t);
-  damping_system d = {s, h, beta, alpha, hold_normals, s->tmp};
+  damping_system d = {s, h, beta, alpha, hold_normals, s->tmp, &w->profile};
   if (piola__solid_undamped(s, beta, alpha)) {
     /* M is diagonal: the filtered solve is exact in one pass */
     for (int32_t i = 0; i < s->n; ++i) {
@@ -190,7 +194,11 @@ static piola_status step_solid(piola_world *w, world_solid *s, double t, double 
     piola__solid_constrained_state(s, i, t1, xp, vp);
     for (int k = 0; k < 3; ++k) s->v[3 * i + k] = (xp[k] - s->x[3 * i + k]) / dt;
   }
+  piola__step_profile_mark(&w->profile, STEP_PHASE_SETUP);
+  if (s->body) piola__elastic_body_damping_prepare(s->body);
+  piola__step_profile_mark(&w->profile, STEP_PHASE_PREPARE);
   stats->cg_iterations += damping_solve(w, s, h, t, 0, s->rhs, s->v);
+  piola__step_profile_mark(&w->profile, STEP_PHASE_SOLVE1);
 
   /* 2. x~ */
   for (int64_t j = 0; j < m; ++j) s->x[j] += dt * s->v[j];
@@ -209,6 +217,7 @@ static piola_status step_solid(piola_world *w, world_solid *s, double t, double 
     piola__solid_constrained_state(s, i, t1, s->x + 3 * i, s->v + 3 * i);
   }
   stats->colliding += colliding;
+  piola__step_profile_mark(&w->profile, STEP_PHASE_COLLIDE);
   /* damping at (x^n, v') while the body still holds the rotations of x^n */
   double beta0 = piola_track_eval(&s->shear_viscosity, t);
   double alpha0 = piola_track_eval(&s->bulk_viscosity, t);
@@ -221,6 +230,7 @@ static piola_status step_solid(piola_world *w, world_solid *s, double t, double 
       s->rhs[3 * i + k] = s->mass[i] * s->v[3 * i + k] +
                           h * (s->force_old[3 * i + k] + s->tmp[3 * i + k] + s->mass[i] * g0[k]);
 
+  piola__step_profile_mark(&w->profile, STEP_PHASE_RHS2);
   /* F, diagonalization and elastic force at x^n+1, once per step */
   piola_status st = piola__solid_update_forces(s, t1);
   if (st != PIOLA_OK) {
@@ -228,17 +238,21 @@ static piola_status step_solid(piola_world *w, world_solid *s, double t, double 
     return st;
   }
   if (s->shell) piola_shell_body_plastic_flow(s->shell, dt);
+  piola__step_profile_mark(&w->profile, STEP_PHASE_UPDATE);
+  if (s->body) piola__elastic_body_damping_prepare(s->body);
+  piola__step_profile_mark(&w->profile, STEP_PHASE_PREPARE);
 
   /* 4. trapezoidal velocity, damping at n+1 implicit, normal velocity of contacts held */
   for (int32_t i = 0; i < n; ++i)
     for (int k = 0; k < 3; ++k)
       s->rhs[3 * i + k] += h * (s->force[3 * i + k] + s->mass[i] * g1[k]);
   stats->cg_iterations += damping_solve(w, s, h, t1, 1, s->rhs, s->v);
+  piola__step_profile_mark(&w->profile, STEP_PHASE_SOLVE2);
   if (colliding > 0) {
     /* A v^n+1 for the friction of the held normal impulse (tmp and rhs are free now) */
     double beta1 = piola_track_eval(&s->shear_viscosity, t1);
     double alpha1 = piola_track_eval(&s->bulk_viscosity, t1);
-    damping_system d = {s, h, beta1, alpha1, 1, s->tmp};
+    damping_system d = {s, h, beta1, alpha1, 1, s->tmp, &w->profile};
     if (!piola__solid_undamped(s, beta1, alpha1)) {
       damping_apply(&d, s->v, s->rhs);
     } else {
@@ -247,6 +261,7 @@ static piola_status step_solid(piola_world *w, world_solid *s, double t, double 
     }
     contact_friction(w, s, t1, h, g1, s->rhs);
   }
+  piola__step_profile_mark(&w->profile, STEP_PHASE_FRICTION);
   for (int64_t j = 0; j < m; ++j)
     if (!isfinite(s->v[j])) {
       restore(s, t);
@@ -264,14 +279,17 @@ static piola_status step_solid(piola_world *w, world_solid *s, double t, double 
                       "solid '%s': the %s energy became non-finite at t = %g s (the state blew up)",
                       s->name, isfinite(kinetic) ? "elastic" : "kinetic", t1);
   }
+  piola__step_profile_mark(&w->profile, STEP_PHASE_CHECK);
   return PIOLA_OK;
 }
 
 piola_status piola_world_step(piola_world *w, double dt_limit, piola_step_stats *stats) {
   piola_step_stats local = {0};
+  piola__step_profile_start(&w->profile);
   double dt = piola_world_stable_dt(w);
   if (dt_limit > 0 && dt_limit < dt) dt = dt_limit;
   if (!(dt > 0)) return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "step: dt must be > 0, got %g", dt);
+  piola__step_profile_mark(&w->profile, STEP_PHASE_WORLD);
   for (int32_t i = 0; i < w->solid_count + w->shell_count; ++i) {
     world_solid *s = i < w->solid_count ? &w->solids[i] : &w->shells[i - w->solid_count];
     piola_status st = step_solid(w, s, w->time, dt, &local);
@@ -290,6 +308,8 @@ piola_status piola_world_step(piola_world *w, double dt_limit, piola_step_stats 
     return contact;
   }
   for (int32_t i = 0; i < w->solid_count; ++i) piola__solid_plastic_update(&w->solids[i], dt);
+  piola__step_profile_mark(&w->profile, STEP_PHASE_WORLD);
+  if (w->profile.enabled) w->profile.steps++;
   w->time += dt;
   local.substeps = 1;
   local.last_dt = dt;

@@ -12,6 +12,7 @@
 
 #include "piola/world.h"
 #include "piola/world_shells.h"
+#include "sim/step_profile.h"
 
 enum { SOLID_FREE = 0, SOLID_FIXED = 1, SOLID_DRIVEN = 2 };
 
@@ -55,6 +56,7 @@ struct piola_world {
   piola_obstacle **obstacles;
   int32_t obstacle_count, obstacle_capacity;
   struct world_contact *contact; /* self-collision of boundary surfaces (world_contact.c) */
+  step_profile profile;       /* per-phase step timers, off unless a benchmark turns them on */
 };
 
 /* Marks constrained nodes of s from its constraint defs (rest positions rest, 3n). */

@@ -14,7 +14,8 @@ static void precondition(const cg_problem *pb, const double *r, double *z) {
     for (int k = 0; k < 3; ++k) z[3 * i + k] = r[3 * i + k] * pb->inverse_mass[i];
 }
 
-int32_t piola__cg_solve(const cg_problem *pb, const double *b, double *x, double *work) {
+int32_t piola__cg_solve(const cg_problem *pb, const double *b, double *x, double *work,
+                        double *ax) {
   const int64_t m = 3 * (int64_t)pb->n;
   double *r = work, *z = work + m, *p = work + 2 * m, *q = work + 3 * m;
   /* reference size: the filtered right-hand side */
@@ -23,6 +24,8 @@ int32_t piola__cg_solve(const cg_problem *pb, const double *b, double *x, double
   precondition(pb, r, z);
   double bnorm2 = dot(m, r, z);
   pb->apply(pb->ctx, x, q);
+  if (ax)
+    for (int64_t i = 0; i < m; ++i) ax[i] = q[i];
   for (int64_t i = 0; i < m; ++i) r[i] = b[i] - q[i];
   pb->filter(pb->ctx, r);
   precondition(pb, r, z);
@@ -34,10 +37,14 @@ int32_t piola__cg_solve(const cg_problem *pb, const double *b, double *x, double
   while (it < pb->max_iterations) {
     ++it;
     pb->apply(pb->ctx, p, q);
-    pb->filter(pb->ctx, q);
+    /* p is filtered (p = S p), so p . S q = p . q: taken before the filter, whose q A x
+     * needs */
     double pq = dot(m, p, q);
     if (!(pq > 0)) break; /* not positive definite along p (or zero): stop where we are */
     double alpha = rz / pq;
+    if (ax)
+      for (int64_t i = 0; i < m; ++i) ax[i] += alpha * q[i];
+    pb->filter(pb->ctx, q);
     for (int64_t i = 0; i < m; ++i) {
       x[i] += alpha * p[i];
       r[i] -= alpha * q[i];

@@ -58,9 +58,10 @@ static void damping_filter(void *ctx, double *r) {
   }
 }
 
-/* Solves (M - h D) v = rhs, keeping the filtered components of the guess in v. */
+/* Solves (M - h D) v = rhs, keeping the filtered components of the guess in v. av (3n, may
+ * be NULL) receives (M - h D) v at the solution, to rounding. */
 static int32_t damping_solve(piola_world *w, world_solid *s, double h, double t,
-                             int hold_normals, const double *rhs, double *v) {
+                             int hold_normals, const double *rhs, double *v, double *av) {
   double beta = piola_track_eval(&s->shear_viscosity, t);
   double alpha = piola_track_eval(&s->bulk_viscosity, t);
   damping_system d = {s, h, beta, alpha, hold_normals, s->tmp, &w->profile};
@@ -77,6 +78,9 @@ static int32_t damping_solve(piola_world *w, world_solid *s, double h, double t,
         for (int k = 0; k < 3; ++k) vi[k] -= dn * nrm[k];
       }
     }
+    if (av)
+      for (int32_t i = 0; i < s->n; ++i)
+        for (int k = 0; k < 3; ++k) av[3 * i + k] = s->mass[i] * v[3 * i + k];
     return 0;
   }
   cg_problem pb;
@@ -87,7 +91,7 @@ static int32_t damping_solve(piola_world *w, world_solid *s, double h, double t,
   pb.inverse_mass = s->inverse_mass;
   pb.tolerance = w->def.cg_tolerance;
   pb.max_iterations = w->def.cg_max_iterations;
-  return piola__cg_solve(&pb, rhs, v, s->work);
+  return piola__cg_solve(&pb, rhs, v, s->work, av);
 }
 
 /* Friction for the second half of the step's contact impulse.
@@ -197,7 +201,7 @@ static piola_status step_solid(piola_world *w, world_solid *s, double t, double 
   piola__step_profile_mark(&w->profile, STEP_PHASE_SETUP);
   if (s->body) piola__elastic_body_damping_prepare(s->body);
   piola__step_profile_mark(&w->profile, STEP_PHASE_PREPARE);
-  stats->cg_iterations += damping_solve(w, s, h, t, 0, s->rhs, s->v);
+  stats->cg_iterations += damping_solve(w, s, h, t, 0, s->rhs, s->v, NULL);
   piola__step_profile_mark(&w->profile, STEP_PHASE_SOLVE1);
 
   /* 2. x~ */
@@ -246,21 +250,12 @@ static piola_status step_solid(piola_world *w, world_solid *s, double t, double 
   for (int32_t i = 0; i < n; ++i)
     for (int k = 0; k < 3; ++k)
       s->rhs[3 * i + k] += h * (s->force[3 * i + k] + s->mass[i] * g1[k]);
-  stats->cg_iterations += damping_solve(w, s, h, t1, 1, s->rhs, s->v);
+  /* the solve also gives A v^n+1 (the fifth work vector; CG uses four), which the friction
+   * of the held normal impulse needs */
+  double *av = s->work + 4 * m;
+  stats->cg_iterations += damping_solve(w, s, h, t1, 1, s->rhs, s->v, colliding > 0 ? av : NULL);
   piola__step_profile_mark(&w->profile, STEP_PHASE_SOLVE2);
-  if (colliding > 0) {
-    /* A v^n+1 for the friction of the held normal impulse (tmp and rhs are free now) */
-    double beta1 = piola_track_eval(&s->shear_viscosity, t1);
-    double alpha1 = piola_track_eval(&s->bulk_viscosity, t1);
-    damping_system d = {s, h, beta1, alpha1, 1, s->tmp, &w->profile};
-    if (!piola__solid_undamped(s, beta1, alpha1)) {
-      damping_apply(&d, s->v, s->rhs);
-    } else {
-      for (int32_t i = 0; i < n; ++i)
-        for (int k = 0; k < 3; ++k) s->rhs[3 * i + k] = s->mass[i] * s->v[3 * i + k];
-    }
-    contact_friction(w, s, t1, h, g1, s->rhs);
-  }
+  if (colliding > 0) contact_friction(w, s, t1, h, g1, av);
   piola__step_profile_mark(&w->profile, STEP_PHASE_FRICTION);
   for (int64_t j = 0; j < m; ++j)
     if (!isfinite(s->v[j])) {

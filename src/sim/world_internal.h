@@ -36,7 +36,8 @@ typedef struct world_solid {
   piola_rigid_motion_def *motions;
   int32_t motion_count;
   piola_track stiffness_scale, shear_viscosity, bulk_viscosity;
-  piola_elastic_stats elastic;  /* of the last update */
+  piola_elastic_stats elastic;  /* of the last update, once refreshed (world.c) */
+  int elastic_stale;            /* elastic does not match the last update yet */
   piola_plastic_state *plastic; /* NULL for an elastic solid (world_plasticity.c) */
   piola_plastic_stats plastic_stats; /* of the last plastic update */
   piola_self_collision_def self_collision;

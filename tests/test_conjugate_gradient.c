@@ -31,9 +31,9 @@ static void dense_apply(void *ctx, const double *p, double *out) {
   }
 }
 
-static void dense_filter(void *ctx, double *r) {
+static void dense_filter(void *ctx, double *r, int32_t begin, int32_t end) {
   const dense_system *d = ctx;
-  for (int i = 0; i < NODES; ++i) {
+  for (int i = begin; i < end; ++i) {
     double *ri = r + 3 * i;
     const double *n = d->normal[i];
     if (d->held[i]) {
@@ -102,7 +102,7 @@ static void reference_solution(const dense_system *d, const double *b, const dou
     for (int k = 0; k < 3; ++k) {
       double e[DOF] = {0};
       e[3 * i + k] = 1;
-      dense_filter((void *)d, e);
+      dense_filter((void *)d, e, 0, NODES);
       /* Gram-Schmidt against the node's earlier columns */
       for (int c = 0; c < cols; ++c) {
         double s = 0;

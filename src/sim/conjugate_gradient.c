@@ -1,60 +1,110 @@
-/* Filtered, preconditioned conjugate gradient; see conjugate_gradient.h. */
+/* Filtered, preconditioned conjugate gradient; see conjugate_gradient.h.
+ *
+ * Speed. Per iteration the operator apply dominates, but the vector work around it was ~10%
+ * of a step on the 20,186-vertex torus: eight serial passes over 3n doubles (filter, dot,
+ * two axpys, the preconditioner into z, dot, the new direction). Here it is two fused
+ * passes after the apply (p . q; then A x, filter, x, r and r . M^-1 r together) and one
+ * for the new direction, with z never stored (M^-1 r is formed where it is used). The
+ * passes split the nodes into CG_CHUNKS fixed ranges, whatever the thread count; each
+ * range sums its part of a dot product in index order and the parts are added in range
+ * order, so results are bit-identical for any number of threads. */
 #include "sim/conjugate_gradient.h"
 
 #include <math.h>
 
-static double dot(int64_t m, const double *a, const double *b) {
+#include "common/threads.h"
+
+enum { CG_CHUNKS = 16 };
+/* below this many nodes the passes run on one thread (a parallel region costs more) */
+#define CG_PARALLEL_MIN_NODES 4096
+
+static int32_t chunk_begin(int32_t n, int c) { return (int32_t)((int64_t)n * c / CG_CHUNKS); }
+
+static double sum_parts(const double part[CG_CHUNKS]) {
   double s = 0;
-  for (int64_t i = 0; i < m; ++i) s += a[i] * b[i];
+  for (int c = 0; c < CG_CHUNKS; ++c) s += part[c];
   return s;
 }
 
-static void precondition(const cg_problem *pb, const double *r, double *z) {
-  for (int32_t i = 0; i < pb->n; ++i)
-    for (int k = 0; k < 3; ++k) z[3 * i + k] = r[3 * i + k] * pb->inverse_mass[i];
+/* sum over nodes of a . M^-1 b (a, b filtered) */
+static double dot_inverse_mass(const cg_problem *pb, const double *a, const double *b) {
+  double part[CG_CHUNKS];
+  const int32_t n = pb->n;
+#pragma omp parallel for schedule(static) num_threads(piola__thread_count()) if (n >= CG_PARALLEL_MIN_NODES)
+  for (int c = 0; c < CG_CHUNKS; ++c) {
+    double s = 0;
+    for (int32_t i = chunk_begin(n, c); i < chunk_begin(n, c + 1); ++i)
+      s += (a[3 * i] * b[3 * i] + a[3 * i + 1] * b[3 * i + 1] + a[3 * i + 2] * b[3 * i + 2]) * pb->inverse_mass[i];
+    part[c] = s;
+  }
+  return sum_parts(part);
+}
+
+static double dot(int32_t n, const double *a, const double *b) {
+  double part[CG_CHUNKS];
+#pragma omp parallel for schedule(static) num_threads(piola__thread_count()) if (n >= CG_PARALLEL_MIN_NODES)
+  for (int c = 0; c < CG_CHUNKS; ++c) {
+    double s = 0;
+    for (int64_t i = 3 * (int64_t)chunk_begin(n, c); i < 3 * (int64_t)chunk_begin(n, c + 1); ++i) s += a[i] * b[i];
+    part[c] = s;
+  }
+  return sum_parts(part);
 }
 
 int32_t piola__cg_solve(const cg_problem *pb, const double *b, double *x, double *work,
                         double *ax) {
-  const int64_t m = 3 * (int64_t)pb->n;
-  double *r = work, *z = work + m, *p = work + 2 * m, *q = work + 3 * m;
+  const int32_t n = pb->n;
+  const int64_t m = 3 * (int64_t)n;
+  const double *inverse_mass = pb->inverse_mass;
+  double *r = work, *p = work + 2 * m, *q = work + 3 * m;
   /* reference size: the filtered right-hand side */
   for (int64_t i = 0; i < m; ++i) r[i] = b[i];
-  pb->filter(pb->ctx, r);
-  precondition(pb, r, z);
-  double bnorm2 = dot(m, r, z);
+  pb->filter(pb->ctx, r, 0, n);
+  double bnorm2 = dot_inverse_mass(pb, r, r);
   pb->apply(pb->ctx, x, q);
   if (ax)
     for (int64_t i = 0; i < m; ++i) ax[i] = q[i];
   for (int64_t i = 0; i < m; ++i) r[i] = b[i] - q[i];
-  pb->filter(pb->ctx, r);
-  precondition(pb, r, z);
-  double rz = dot(m, r, z);
+  pb->filter(pb->ctx, r, 0, n);
+  double rz = dot_inverse_mass(pb, r, r);
   double tol2 = pb->tolerance * pb->tolerance * bnorm2;
   if (!(bnorm2 > 0) || rz <= tol2) return 0;
-  for (int64_t i = 0; i < m; ++i) p[i] = z[i];
+  for (int32_t i = 0; i < n; ++i)
+    for (int k = 0; k < 3; ++k) p[3 * i + k] = r[3 * i + k] * inverse_mass[i];
   int32_t it = 0;
   while (it < pb->max_iterations) {
     ++it;
     pb->apply(pb->ctx, p, q);
     /* p is filtered (p = S p), so p . S q = p . q: taken before the filter, whose q A x
      * needs */
-    double pq = dot(m, p, q);
+    double pq = dot(n, p, q);
     if (!(pq > 0)) break; /* not positive definite along p (or zero): stop where we are */
     double alpha = rz / pq;
-    if (ax)
-      for (int64_t i = 0; i < m; ++i) ax[i] += alpha * q[i];
-    pb->filter(pb->ctx, q);
-    for (int64_t i = 0; i < m; ++i) {
-      x[i] += alpha * p[i];
-      r[i] -= alpha * q[i];
+    double part[CG_CHUNKS];
+#pragma omp parallel for schedule(static) num_threads(piola__thread_count()) if (n >= CG_PARALLEL_MIN_NODES)
+    for (int c = 0; c < CG_CHUNKS; ++c) {
+      const int32_t i0 = chunk_begin(n, c), i1 = chunk_begin(n, c + 1);
+      if (ax)
+        for (int64_t j = 3 * (int64_t)i0; j < 3 * (int64_t)i1; ++j) ax[j] += alpha * q[j];
+      pb->filter(pb->ctx, q, i0, i1);
+      double s = 0;
+      for (int32_t i = i0; i < i1; ++i)
+        for (int k = 0; k < 3; ++k) {
+          int64_t j = 3 * (int64_t)i + k;
+          x[j] += alpha * p[j];
+          r[j] -= alpha * q[j];
+          s += r[j] * r[j] * inverse_mass[i];
+        }
+      part[c] = s;
     }
-    precondition(pb, r, z);
-    double rz_new = dot(m, r, z);
+    double rz_new = sum_parts(part);
     if (rz_new <= tol2 || !isfinite(rz_new)) break;
     double beta = rz_new / rz;
     rz = rz_new;
-    for (int64_t i = 0; i < m; ++i) p[i] = z[i] + beta * p[i];
+#pragma omp parallel for schedule(static) num_threads(piola__thread_count()) if (n >= CG_PARALLEL_MIN_NODES)
+    for (int c = 0; c < CG_CHUNKS; ++c)
+      for (int32_t i = chunk_begin(n, c); i < chunk_begin(n, c + 1); ++i)
+        for (int k = 0; k < 3; ++k) p[3 * i + k] = r[3 * i + k] * inverse_mass[i] + beta * p[3 * i + k];
   }
   return it;
 }

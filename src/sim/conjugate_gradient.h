@@ -21,7 +21,9 @@
 typedef struct cg_problem {
   int32_t n;                                  /* nodes; vectors are 3n */
   void (*apply)(void *ctx, const double *p, double *out); /* out = A p */
-  void (*filter)(void *ctx, double *r);       /* projects constrained components to zero */
+  /* projects the constrained components of nodes [begin, end) of r to zero; called on
+   * disjoint node ranges from several threads at once */
+  void (*filter)(void *ctx, double *r, int32_t begin, int32_t end);
   void *ctx;
   const double *inverse_mass;                 /* n, the preconditioner */
   double tolerance;                           /* relative, in the M^-1 norm */
@@ -29,7 +31,7 @@ typedef struct cg_problem {
 } cg_problem;
 
 /* Solves A x = b starting from x (whose filtered components are kept). work holds 4 * 3n
- * doubles. ax (3n, may be NULL) receives A x at the returned x, unfiltered, to rounding.
+ * doubles (the second 3n are unused now). ax (3n, may be NULL) receives A x at the returned x, unfiltered, to rounding.
  * Returns the iterations used. */
 int32_t piola__cg_solve(const cg_problem *problem, const double *b, double *x, double *work,
                         double *ax);

@@ -43,10 +43,10 @@ static void damping_apply(void *ctx, const double *p, double *out) {
       out[3 * i + k] = s->mass[i] * p[3 * i + k] - d->h * d->scratch[3 * i + k];
 }
 
-static void damping_filter(void *ctx, double *r) {
+static void damping_filter(void *ctx, double *r, int32_t begin, int32_t end) {
   const damping_system *d = ctx;
   const world_solid *s = d->s;
-  for (int32_t i = 0; i < s->n; ++i) {
+  for (int32_t i = begin; i < end; ++i) {
     double *ri = r + 3 * i;
     if (s->flags[i] != SOLID_FREE) {
       ri[0] = ri[1] = ri[2] = 0;

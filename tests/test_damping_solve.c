@@ -9,7 +9,8 @@
  *    1e-5 the solves stop before their first iteration (the tolerance is relative to the
  *    right-hand side, here dominated by the block's 3 m/s of momentum) and the error is 18
  *    times the step error: why the default was not loosened (docs/time-stepping.md);
- *  - results do not depend on the thread count. */
+ *  - results do not depend on the thread count, for small bodies and for bodies large
+ *    enough that the solver's passes run in parallel. */
 #include "test_support.h"
 
 #include <math.h>
@@ -140,11 +141,57 @@ static void solves_do_not_depend_on_the_thread_count(void **state) {
   assert_memory_equal(v1, v2, (size_t)n3 * sizeof(double));
 }
 
+/* A body large enough that the solver's passes and the damping apply run in parallel
+ * (>= 4096 nodes): a few steps on 1 and 2 threads give the same bits. */
+static void large_body_does_not_depend_on_the_thread_count(void **state) {
+  (void)state;
+  double *result[2] = {NULL, NULL};
+  int32_t n3 = 0;
+  for (int threads = 1; threads <= 2; ++threads) {
+    piola_set_thread_count(threads);
+    piola_world_def wd = piola_default_world_def();
+    wd.max_dt = 1e-3;
+    piola_world *w = NULL;
+    assert_int_equal(piola_world_create(&wd, &w), PIOLA_OK);
+    piola_tet_mesh mesh;
+    assert_int_equal(piola_tet_mesh_box_grid(16, 16, 16, (piola_vec3){0.02, 0.02, 0.02}, &mesh), PIOLA_OK);
+    piola_solid_def sd = piola_default_solid_def();
+    sd.mesh = &mesh;
+    sd.material.youngs_modulus = 1e5;
+    sd.shear_viscosity = piola_track_constant(50);
+    sd.bulk_viscosity = piola_track_constant(20);
+    sd.scramble_radius = 2e-3;
+    assert_int_equal(piola_world_add_solid(w, &sd, NULL), PIOLA_OK);
+    piola_obstacle_def ground = piola_default_obstacle_def();
+    ground.type = PIOLA_OBSTACLE_PLANE;
+    ground.center = (piola_vec3){0, 0, 0.001};
+    ground.axis = (piola_vec3){0, 0, 1};
+    ground.friction = 0.5;
+    assert_int_equal(piola_world_add_obstacle(w, &ground, NULL), PIOLA_OK);
+    n3 = 3 * piola_elastic_body_vertex_count(piola_world_solid_body(w, 0));
+    assert_true(n3 >= 3 * 4096);
+    piola_step_stats st = {0};
+    for (int k = 0; k < 3; ++k) assert_int_equal(piola_world_step(w, 1e-4, &st), PIOLA_OK);
+    assert_true(st.cg_iterations > 0 && st.colliding > 0);
+    result[threads - 1] = malloc(2 * (size_t)n3 * sizeof(double));
+    memcpy(result[threads - 1], piola_world_solid_positions(w, 0), (size_t)n3 * sizeof(double));
+    memcpy(result[threads - 1] + n3, piola_world_solid_velocities(w, 0), (size_t)n3 * sizeof(double));
+    piola_world_destroy(w);
+    free(mesh.positions);
+    free(mesh.tets);
+  }
+  piola_set_thread_count(0);
+  assert_memory_equal(result[0], result[1], 2 * (size_t)n3 * sizeof(double));
+  free(result[0]);
+  free(result[1]);
+}
+
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(free_fall_gains_exactly_gravity_momentum),
       cmocka_unit_test(default_tolerance_error_is_well_below_the_step_error),
       cmocka_unit_test(solves_do_not_depend_on_the_thread_count),
+      cmocka_unit_test(large_body_does_not_depend_on_the_thread_count),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -274,10 +274,10 @@ void piola__elastic_body_damping_prepare(piola_elastic_body *body) {
   body->damping_ready = 1;
 }
 
-void piola_elastic_body_damping_forces(const piola_elastic_body *body, const double *v,
-                                       double shear_viscosity, double bulk_viscosity,
-                                       double *forces) {
-  if (!body || !v || !forces) return;
+/* forces = D v, or with mass given, out = M v - h D v (the implicit step's operator: its
+ * last pass, which sums the chunks, forms it instead of a separate pass over the result). */
+static void damping_pass(const piola_elastic_body *body, const double *v, double shear_viscosity,
+                         double bulk_viscosity, const double *mass, double h, double *forces) {
   const int32_t blocks = body->padded_tet_count / B;
   const int64_t n = 3 * (int64_t)body->vertex_count;
   /* the records and partial sums are prepared in place, like the lazy energy: concurrent
@@ -286,6 +286,8 @@ void piola_elastic_body_damping_forces(const piola_elastic_body *body, const dou
   if (blocks < PIOLA_PARALLEL_MIN_BLOCKS || !body->damping_chunk_forces) {
     for (int64_t i = 0; i < n; ++i) forces[i] = 0.0;
     for (int32_t b = 0; b < blocks; ++b) apply_block(body, v, shear_viscosity, bulk_viscosity, b, forces);
+    if (mass)
+      for (int64_t i = 0; i < n; ++i) forces[i] = mass[i / 3] * v[i] - h * forces[i];
     return;
   }
   /* Determinism without a per-tet buffer: PIOLA_DAMPING_CHUNKS fixed ranges of blocks, each
@@ -306,9 +308,22 @@ void piola_elastic_body_damping_forces(const piola_elastic_body *body, const dou
     for (int64_t i = 0; i < n; ++i) {
       double sum = partial[i];
       for (int k = 1; k < PIOLA_DAMPING_CHUNKS; ++k) sum += partial[(size_t)k * (size_t)n + i];
-      forces[i] = sum;
+      forces[i] = mass ? mass[i / 3] * v[i] - h * sum : sum;
     }
   }
+}
+
+void piola_elastic_body_damping_forces(const piola_elastic_body *body, const double *v,
+                                       double shear_viscosity, double bulk_viscosity,
+                                       double *forces) {
+  if (!body || !v || !forces) return;
+  damping_pass(body, v, shear_viscosity, bulk_viscosity, NULL, 0.0, forces);
+}
+
+void piola__elastic_body_damping_operator(const piola_elastic_body *body, const double *v,
+                                          double shear_viscosity, double bulk_viscosity,
+                                          const double *mass, double h, double *out) {
+  damping_pass(body, v, shear_viscosity, bulk_viscosity, mass, h, out);
 }
 
 /* Removes from the 4 corner vectors y (12) their rigid-rotation part about the centroid

@@ -139,6 +139,13 @@ void piola__elastic_body_damping_reference(const piola_elastic_body *body, const
  * loop calls it apart so its cost can be timed. */
 void piola__elastic_body_damping_prepare(piola_elastic_body *body);
 
+/* The implicit step's operator out = M v - h D v (3 * vertex_count), D the damping of
+ * piola_elastic_body_damping_forces, mass the lumped masses (vertex_count, kg), h in s: the
+ * same numbers as forming it from the damping forces, without a separate pass (damping.c). */
+void piola__elastic_body_damping_operator(const piola_elastic_body *body, const double *v,
+                                          double shear_viscosity, double bulk_viscosity,
+                                          const double *mass, double h, double *out);
+
 /* Sums the per-tet force buffer into per-vertex forces, in parallel, deterministically. */
 void piola__elastic_body_gather_forces(const piola_elastic_body *body, double *forces);
 

@@ -36,11 +36,16 @@ static void damping_apply(void *ctx, const double *p, double *out) {
   const damping_system *d = ctx;
   const world_solid *s = d->s;
   piola__step_profile_apply(d->profile, 1);
-  piola__solid_damping_forces(s, p, d->beta, d->alpha, d->scratch);
+  if (s->body) {
+    /* one pass: the damping's own chunk sum forms M p - h D p */
+    piola__elastic_body_damping_operator(s->body, p, d->beta, d->alpha, s->mass, d->h, out);
+  } else {
+    piola__solid_damping_forces(s, p, d->beta, d->alpha, d->scratch);
+    for (int32_t i = 0; i < s->n; ++i)
+      for (int k = 0; k < 3; ++k)
+        out[3 * i + k] = s->mass[i] * p[3 * i + k] - d->h * d->scratch[3 * i + k];
+  }
   piola__step_profile_apply(d->profile, 0);
-  for (int32_t i = 0; i < s->n; ++i)
-    for (int k = 0; k < 3; ++k)
-      out[3 * i + k] = s->mass[i] * p[3 * i + k] - d->h * d->scratch[3 * i + k];
 }
 
 static void damping_filter(void *ctx, double *r, int32_t begin, int32_t end) {

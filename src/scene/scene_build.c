@@ -87,6 +87,24 @@ static piola_status build_shell(piola_world *world, const scene_shell_desc *d) {
   return st;
 }
 
+/* Bones: the obstacle part as for obstacles, then the attachments (solids are in). */
+static piola_status build_bone(piola_world *world, const scene_bone_desc *d) {
+  piola_bone_def def = piola_default_bone_def();
+  def.shape = d->obstacle.def;
+  def.attachments = d->attachments;
+  def.attachment_count = d->attachment_count;
+  piola_tri_mesh surface;
+  memset(&surface, 0, sizeof surface);
+  piola_status st = PIOLA_OK;
+  if (def.shape.type == PIOLA_OBSTACLE_MESH) {
+    st = piola_tri_mesh_read(d->obstacle.mesh_path, &surface);
+    def.shape.mesh = &surface;
+  }
+  if (st == PIOLA_OK) st = piola_world_add_bone(world, &def, NULL, NULL);
+  piola_tri_mesh_free(&surface);
+  return st;
+}
+
 piola_status piola__scene_build(const scene_desc *desc, const char *label, piola_world **out) {
   *out = NULL;
   if (!label) label = "scene";
@@ -177,6 +195,16 @@ piola_status piola__scene_build(const scene_desc *desc, const char *label, piola
     if (st != PIOLA_OK) {
       piola_world_destroy(world);
       return PIOLA_FAIL(st, "%s: obstacles[%d]: %s", label, (int)i, piola_last_error());
+    }
+  }
+  for (int32_t i = 0; i < desc->bone_count; ++i) {
+    piola_status st = build_bone(world, &desc->bones[i]);
+    if (st != PIOLA_OK) {
+      piola_world_destroy(world);
+      /* world messages start with "attachments[k]..." or describe the shape */
+      const char *msg = piola_last_error();
+      int attachment = strncmp(msg, "attachments[", 12) == 0;
+      return PIOLA_FAIL(st, "%s: bones[%d]%s%s", label, (int)i, attachment ? "." : ": ", msg);
     }
   }
   *out = world;

@@ -12,6 +12,7 @@
 #include "piola/mesher.h"
 #include "piola/obstacle.h"
 #include "piola/world.h"
+#include "piola/world_bones.h"
 #include "piola/world_shells.h"
 
 #define SCENE_PATH_MAX 4096
@@ -53,6 +54,16 @@ typedef struct scene_obstacle_desc {
   char mesh_path[SCENE_PATH_MAX]; /* mesh obstacles */
 } scene_obstacle_desc;
 
+/* A bone (docs/bones.md): an obstacle's shape, friction and motion plus attachments; the
+ * attachments' solid indices are resolved from their names while parsing. */
+typedef struct scene_bone_desc {
+  scene_obstacle_desc obstacle;
+  char name[128];
+  piola_attachment_def *attachments;
+  int32_t attachment_count;
+  int32_t **index_lists;          /* owned index arrays, one per attachment (or NULL) */
+} scene_bone_desc;
+
 typedef struct scene_desc {
   double fps;
   int32_t frames;
@@ -63,6 +74,8 @@ typedef struct scene_desc {
   int32_t obstacle_count;
   scene_shell_desc *shells;       /* the `shells` key (scene_parse.c, shells section) */
   int32_t shell_count;
+  scene_bone_desc *bones;         /* the `bones` key (scene_parse.c, bones section) */
+  int32_t bone_count;
 } scene_desc;
 
 /* Parses and validates JSON text; label prefixes error messages. */

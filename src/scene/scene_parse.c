@@ -698,7 +698,10 @@ static piola_status parse_solid(parser *p, const cJSON *obj, int index, scene_so
 
 /* ------------------------------------------------------------------ obstacles */
 
-static piola_status parse_obstacle(parser *p, const cJSON *obj, scene_obstacle_desc *d) {
+/* An obstacle, or the obstacle part of a bone: extra_keys (NULL-terminated, or NULL) are
+ * also allowed and left to the caller. */
+static piola_status parse_obstacle(parser *p, const cJSON *obj, const char *const *extra_keys,
+                                   scene_obstacle_desc *d) {
   static const char *const names[] = {"plane", "sphere", "box", "cylinder", "capsule", "torus",
                                       "gear", "mesh", NULL};
   static const char *const keysets[][10] = {
@@ -730,7 +733,12 @@ static piola_status parse_obstacle(parser *p, const cJSON *obj, scene_obstacle_d
                 "must be one of \"plane\", \"sphere\", \"box\", \"cylinder\", \"capsule\", \"torus\", "
                 "\"gear\", \"mesh\"");
   pop(p, old);
-  PIOLA_TRY(check_keys(p, obj, keysets[found]));
+  const char *allowed[16];
+  int nallowed = 0;
+  for (int i = 0; keysets[found][i]; ++i) allowed[nallowed++] = keysets[found][i];
+  for (int i = 0; extra_keys && extra_keys[i] && nallowed < 15; ++i) allowed[nallowed++] = extra_keys[i];
+  allowed[nallowed] = NULL;
+  PIOLA_TRY(check_keys(p, obj, allowed));
   for (int i = 0; required_keys[found][i]; ++i) PIOLA_TRY(required(p, obj, required_keys[found][i]));
   piola_obstacle_def *o = &d->def;
   *o = piola_default_obstacle_def();
@@ -969,11 +977,112 @@ static piola_status parse_shells(parser *p, const cJSON *v, scene_desc *out) {
   return PIOLA_OK;
 }
 
+/* ------------------------------------------------------------------ bones */
+
+/* {"solid": NAME, one of box | sphere | indices | within}: which nodes of a solid the bone
+ * carries (docs/bones.md). Solids are parsed before bones, so the name resolves here. */
+static piola_status parse_attachment(parser *p, const cJSON *obj, const scene_desc *scene,
+                                     piola_attachment_def *out, int32_t **indices_out) {
+  static const char *const keys[] = {"solid", "box", "sphere", "indices", "within", NULL};
+  PIOLA_TRY(check_keys(p, obj, keys));
+  PIOLA_TRY(required(p, obj, "solid"));
+  *out = piola_default_attachment_def();
+  const cJSON *v = get(obj, "solid");
+  size_t old = push_key(p, "solid");
+  if (!cJSON_IsString(v)) return fail(p, PIOLA_ERROR_PARSE, "must be the name of a solid, got %s", type_name(v));
+  out->solid = -1;
+  for (int32_t i = 0; i < scene->solid_count; ++i)
+    if (strcmp(scene->solids[i].name, v->valuestring) == 0) out->solid = i;
+  if (out->solid < 0) {
+    for (int32_t i = 0; i < scene->shell_count; ++i)
+      if (strcmp(scene->shells[i].base.name, v->valuestring) == 0)
+        return fail(p, BAD_VALUE, "\"%s\" is a shell: bones attach to solids only", v->valuestring);
+    char list[256] = "";
+    for (int32_t i = 0; i < scene->solid_count; ++i) {
+      if (i) strncat(list, ", ", sizeof list - strlen(list) - 1);
+      strncat(list, scene->solids[i].name, sizeof list - strlen(list) - 1);
+    }
+    return fail(p, BAD_VALUE, "no solid is named \"%s\" (solids: %s)", v->valuestring,
+                scene->solid_count ? list : "none");
+  }
+  pop(p, old);
+  int kinds = !!get(obj, "box") + !!get(obj, "sphere") + !!get(obj, "indices") + !!get(obj, "within");
+  if (kinds != 1) return fail(p, PIOLA_ERROR_PARSE, "needs exactly one of box, sphere, indices or within");
+  if (get(obj, "within")) {
+    out->near_surface = true;
+    return opt_number(p, obj, "within", NONNEGATIVE, &out->distance);
+  }
+  /* the selector keys are those of `fixed`: parse a copy without "solid" */
+  cJSON *copy = cJSON_Duplicate(obj, 1);
+  if (!copy) return fail(p, PIOLA_ERROR_OUT_OF_MEMORY, "out of memory");
+  cJSON_DeleteItemFromObjectCaseSensitive(copy, "solid");
+  piola_constraint_def con;
+  piola_status st = parse_selector(p, copy, 0, &con, indices_out);
+  cJSON_Delete(copy);
+  if (st == PIOLA_OK) out->selector = con.selector;
+  return st;
+}
+
+static piola_status parse_bone(parser *p, const cJSON *obj, int index, const scene_desc *scene,
+                               scene_bone_desc *d) {
+  static const char *const extra[] = {"name", "attachments", NULL};
+  snprintf(d->name, sizeof d->name, "bone%d", index);
+  PIOLA_TRY(parse_obstacle(p, obj, extra, &d->obstacle));
+  const cJSON *v = get(obj, "name");
+  if (v) {
+    size_t old = push_key(p, "name");
+    if (!cJSON_IsString(v) || !v->valuestring[0] || strlen(v->valuestring) >= sizeof d->name)
+      return fail(p, PIOLA_ERROR_PARSE, "must be a non-empty string of at most %d characters",
+                  (int)sizeof d->name - 1);
+    snprintf(d->name, sizeof d->name, "%s", v->valuestring);
+    pop(p, old);
+  }
+  const cJSON *list = get(obj, "attachments");
+  if (!list) return PIOLA_OK;
+  size_t old = push_key(p, "attachments");
+  if (!cJSON_IsArray(list)) return fail(p, PIOLA_ERROR_PARSE, "must be an array of attachments");
+  int count = cJSON_GetArraySize(list);
+  d->attachments = calloc((size_t)(count > 0 ? count : 1), sizeof *d->attachments);
+  d->index_lists = calloc((size_t)(count > 0 ? count : 1), sizeof *d->index_lists);
+  if (!d->attachments || !d->index_lists) return fail(p, PIOLA_ERROR_OUT_OF_MEMORY, "out of memory");
+  int i = 0;
+  for (const cJSON *e = list->child; e; e = e->next, ++i) {
+    size_t o2 = push_index(p, i);
+    d->attachment_count = i + 1;
+    PIOLA_TRY(parse_attachment(p, e, scene, &d->attachments[i], &d->index_lists[i]));
+    pop(p, o2);
+  }
+  pop(p, old);
+  return PIOLA_OK;
+}
+
+static piola_status parse_bones(parser *p, const cJSON *v, scene_desc *out) {
+  size_t old = push_key(p, "bones");
+  if (!cJSON_IsArray(v)) return fail(p, PIOLA_ERROR_PARSE, "must be an array of bones");
+  int count = cJSON_GetArraySize(v);
+  out->bones = calloc((size_t)(count > 0 ? count : 1), sizeof *out->bones);
+  if (!out->bones) return fail(p, PIOLA_ERROR_OUT_OF_MEMORY, "out of memory");
+  int i = 0;
+  for (const cJSON *e = v->child; e; e = e->next, ++i) {
+    size_t o2 = push_index(p, i);
+    out->bone_count = i + 1;
+    PIOLA_TRY(parse_bone(p, e, i, out, &out->bones[i]));
+    for (int j = 0; j < i; ++j)
+      if (strcmp(out->bones[j].name, out->bones[i].name) == 0) {
+        push_key(p, "name");
+        return fail(p, BAD_VALUE, "\"%s\" is already the name of bones[%d]", out->bones[i].name, j);
+      }
+    pop(p, o2);
+  }
+  pop(p, old);
+  return PIOLA_OK;
+}
+
 /* ------------------------------------------------------------------ top level */
 
 static piola_status parse_top(parser *p, const cJSON *root, scene_desc *out) {
   static const char *const allowed[] = {"description", "fps", "frames", "gravity", "integrator",
-                                        "solids", "obstacles", "shells", NULL};
+                                        "solids", "obstacles", "shells", "bones", NULL};
   PIOLA_TRY(check_keys(p, root, allowed));
   const cJSON *v;
   if ((v = get(root, "description")) && !cJSON_IsString(v)) {
@@ -1033,11 +1142,12 @@ static piola_status parse_top(parser *p, const cJSON *root, scene_desc *out) {
     for (const cJSON *e = v->child; e; e = e->next, ++i) {
       size_t o2 = push_index(p, i);
       out->obstacle_count = i + 1;
-      PIOLA_TRY(parse_obstacle(p, e, &out->obstacles[i]));
+      PIOLA_TRY(parse_obstacle(p, e, NULL, &out->obstacles[i]));
       pop(p, o2);
     }
     pop(p, old);
   }
+  if ((v = get(root, "bones"))) PIOLA_TRY(parse_bones(p, v, out));
   return PIOLA_OK;
 }
 
@@ -1058,6 +1168,13 @@ void piola__scene_desc_free(scene_desc *desc) {
     free(s->constraints);
   }
   free(desc->shells);
+  for (int32_t i = 0; i < desc->bone_count; ++i) {
+    scene_bone_desc *b = &desc->bones[i];
+    for (int32_t a = 0; a < b->attachment_count; ++a) free(b->index_lists[a]);
+    free(b->index_lists);
+    free(b->attachments);
+  }
+  free(desc->bones);
   memset(desc, 0, sizeof *desc);
 }
 

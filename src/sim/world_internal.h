@@ -68,6 +68,9 @@ piola_status piola__solid_allocate(world_solid *s, int32_t n, const char *name, 
                                    int32_t id, const double *rest, const double *mass);
 void piola__solid_finish_masses(world_solid *s);
 
+/* True when rest position p (3 doubles, m) lies in a box or sphere selector (index lists
+ * select by index, not by position: false). Shared by constraints and bone attachments. */
+int piola__selector_contains(const piola_selector *sel, const double *p);
 piola_status piola__solid_apply_constraints(world_solid *s, const double *rest,
                                             const piola_constraint_def *constraints,
                                             int32_t count);

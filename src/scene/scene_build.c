@@ -20,13 +20,12 @@ static mat3 euler_xyz_degrees(piola_vec3 deg) {
   return mat3_mul(rz, mat3_mul(ry, rx));
 }
 
+/* X' = translate + R (scale * X); fibres turn with the rest shape (piola_tet_mesh_transform).
+ * Scales are > 0 and R a rotation, so the map is always accepted. */
 static void place(piola_tet_mesh *mesh, const scene_solid_desc *d) {
   mat3 r = euler_xyz_degrees(d->rotate_degrees);
-  for (int32_t i = 0; i < mesh->vertex_count; ++i) {
-    double *p = mesh->positions + 3 * i;
-    vec3 s = {p[0] * d->scale.x, p[1] * d->scale.y, p[2] * d->scale.z};
-    vec3_store(p, vec3_add(mat3_mul_vec(r, s), d->translate));
-  }
+  mat3 scale = {{{d->scale.x, 0, 0}, {0, d->scale.y, 0}, {0, 0, d->scale.z}}};
+  (void)piola_tet_mesh_transform(mesh, mat3_mul(r, scale), d->translate);
 }
 
 piola_status piola__scene_read_goal_mesh(const scene_solid_desc *d, const piola_tet_mesh *rest,

@@ -216,7 +216,7 @@ static piola_status solid_boundary(world_solid *solid) {
   const piola_elastic_body *b = solid->body;
   piola_tet_mesh tets = {piola_elastic_body_vertex_count(b),
                          (double *)piola_elastic_body_rest_positions(b),
-                         piola_elastic_body_tet_count(b), (int32_t *)piola_elastic_body_tets(b), NULL};
+                         piola_elastic_body_tet_count(b), (int32_t *)piola_elastic_body_tets(b), NULL, NULL};
   piola_tri_mesh *surface = calloc(1, sizeof *surface);
   if (!surface) return PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "solid boundary: out of memory");
   piola_status st = piola_tet_mesh_boundary(&tets, surface);

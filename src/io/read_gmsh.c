@@ -503,10 +503,12 @@ static piola_status read_element_data(gmsh_reader *g) {
   PIOLA_TRY(get_int(g, &nints, "integer tag count"));
   if (nints < 0 || nints > 100) return piola__scan_error(&g->s, PIOLA_ERROR_PARSE, "bad integer tag count %d", nints);
   int32_t ints[4] = {0, 0, 0, 0};
+  long component_line = g->s.line;
   for (int32_t k = 0; k < nints; ++k) {
     int32_t v;
     PIOLA_TRY(get_int(g, &v, "integer tag"));
     if (k < 4) ints[k] = v;
+    if (k == 1) component_line = g->s.line;
   }
   int fiber = strcmp(name, "fiber") == 0 || strcmp(name, "fibers") == 0;
   if (!fiber) {
@@ -520,13 +522,13 @@ static piola_status read_element_data(gmsh_reader *g) {
     return piola__scan_error(&g->s, PIOLA_ERROR_PARSE,
                              "$ElementData \"%s\" needs the integer tags time step, component count and entry count", name);
   if (ints[1] != 3)
-    return piola__scan_error(&g->s, PIOLA_ERROR_PARSE,
-                             "$ElementData \"%s\" has %d components, expected 3 (a fibre direction per element)", name,
-                             (int)ints[1]);
+    return PIOLA_FAIL(PIOLA_ERROR_PARSE,
+                      "%s:%ld: $ElementData \"%s\" has %d components, expected 3 (a fibre direction per element)",
+                      g->s.name, component_line, name, (int)ints[1]);
   if (ints[2] < 0) return piola__scan_error(&g->s, PIOLA_ERROR_PARSE, "$ElementData \"%s\": negative entry count", name);
   g->binary = binary;
   size_t count = (size_t)ints[2];
-  PIOLA_TRY(check_count(g, count, 4 * 4, "$ElementData entry count"));
+  PIOLA_TRY(check_count(g, count, 8, "$ElementData entry count")); /* "1 0 0 0\n" */
   g->have_fibers = 1;
   g->fiber_line = line;
   snprintf(g->fiber_name, sizeof g->fiber_name, "%s", name);

@@ -6,9 +6,12 @@
 
 #include <math.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 
 #include "piola/mesh.h"
+#include "piola/render.h"
 #include "piola/scene.h"
 #include "piola/world.h"
 #include "piola/world_bones.h"
@@ -319,6 +322,28 @@ static void scene_bones_are_obstacles_with_attached_nodes(void **state) {
   piola_scene_destroy(scene);
 }
 
+/* The renderer draws what the scene's obstacles and bones are (piola render, previews). */
+static void renderer_draws_bones_with_the_obstacles(void **state) {
+  (void)state;
+  char path[] = "/tmp/piola_bones_scene_XXXXXX";
+  int fd = mkstemp(path);
+  assert_true(fd >= 0);
+  FILE *f = fdopen(fd, "w");
+  assert_non_null(f);
+  fputs(scene_with_bones("[{\"type\": \"capsule\", \"radius\": 0.01, \"half_length\": 0.05, "
+                         "\"attachments\": [{\"solid\": \"flesh\", \"within\": 0.1}]}, "
+                         "{\"type\": \"sphere\", \"center\": [1, 0, 0], \"radius\": 0.1}]"),
+        f);
+  fclose(f);
+  piola_render_def def = piola_default_render_def();
+  piola_renderer *r = NULL;
+  assert_int_equal(piola_renderer_create(&def, &r), PIOLA_OK);
+  if (piola_renderer_load_scene_obstacles(r, path) != PIOLA_OK) fail_msg("%s", piola_last_error());
+  assert_int_equal(piola_renderer_obstacle_count(r), 2);
+  piola_renderer_destroy(r);
+  remove(path);
+}
+
 /* ------------------------------------------------------------------ the flexing arm */
 
 /* examples/arm_flex.json made cheaper: a coarser flesh mesh and a faster flex (150 degrees
@@ -372,6 +397,7 @@ int main(void) {
       cmocka_unit_test(a_bad_attachment_leaves_the_world_unchanged),
       cmocka_unit_test(scene_errors_name_the_key),
       cmocka_unit_test(scene_bones_are_obstacles_with_attached_nodes),
+      cmocka_unit_test(renderer_draws_bones_with_the_obstacles),
       cmocka_unit_test(flexed_elbow_inverts_tets_that_recover),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);

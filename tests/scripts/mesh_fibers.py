@@ -1,4 +1,5 @@
 """Checks behind test_mesh_fibers.sh (see there)."""
+import json
 import os
 import shutil
 import subprocess
@@ -82,6 +83,8 @@ try:
         for ext in ["vtu", "msh"]:
             out = os.path.join(work, f"{name}.piola.{ext}")
             run(PIOLA, "mesh", "convert", path, out)
+            info = json.loads(run(PIOLA, "mesh", "info", "--json", out).stdout)
+            check(info["fibers"] is True, f"{name} -> piola .{ext}: `piola mesh info` reports fibres")
             m, tets, fibers = tets_and_fibers(out)
             same_tets = tets.shape == expected_tets.shape and np.array_equal(
                 np.sort(tets, axis=1), np.sort(expected_tets, axis=1))
@@ -95,6 +98,12 @@ try:
     run(PIOLA, "mesh", "convert", first, again)
     _, _, fibers = tets_and_fibers(again)
     check(fibers is not None and np.array_equal(fibers, expected), "piola .msh -> piola .vtu: fibres kept")
+
+    plain = os.path.join(work, "plain.vtu")
+    run(PIOLA, "mesh", "convert", base, plain)
+    check(json.loads(run(PIOLA, "mesh", "info", "--json", plain).stdout)["fibers"] is False,
+          "a mesh without fibres: `piola mesh info` reports none, and none are written")
+    check(tets_and_fibers(plain)[2] is None, "a mesh without fibres gets no fiber array")
 
     # ---- bad data is refused with the file and the array or line named
     two = meshio.Mesh(src.points, [c for c in src.cells if c.type == "tetra"],

@@ -264,13 +264,16 @@ static piola_status resolve_path(parser *p, const cJSON *v, char *out) {
 
 /* ------------------------------------------------------------------ motion */
 
+/* default_pivot and default_axis: where and about what the rotation turns unless the scene
+ * says otherwise (an obstacle's centre and, for shapes with an axis, that axis). */
 static piola_status parse_motion(parser *p, const cJSON *obj, piola_vec3 default_pivot,
-                                 piola_rigid_motion_def *out) {
+                                 piola_vec3 default_axis, piola_rigid_motion_def *out) {
   static const char *const allowed[] = {"velocity", "angular_speed", "translation", "angle",
                                         "axis", "pivot", NULL};
   PIOLA_TRY(check_keys(p, obj, allowed));
   *out = piola_default_rigid_motion_def();
   out->pivot = default_pivot;
+  out->axis = default_axis;
   int velocity_kind = get(obj, "velocity") || get(obj, "angular_speed");
   int pose_kind = get(obj, "translation") || get(obj, "angle");
   if (velocity_kind && pose_kind)
@@ -348,7 +351,8 @@ static piola_status parse_selector(parser *p, const cJSON *obj, int driven, piol
   if (driven) {
     PIOLA_TRY(required(p, obj, "motion"));
     size_t old = push_key(p, "motion");
-    PIOLA_TRY(parse_motion(p, get(obj, "motion"), (piola_vec3){0, 0, 0}, &out->motion));
+    PIOLA_TRY(parse_motion(p, get(obj, "motion"), (piola_vec3){0, 0, 0}, (piola_vec3){0, 0, 1},
+                           &out->motion));
     pop(p, old);
   }
   return PIOLA_OK;
@@ -777,7 +781,13 @@ static piola_status parse_obstacle(parser *p, const cJSON *obj, const char *cons
   const cJSON *mo = get(obj, "motion");
   if (mo) {
     old = push_key(p, "motion");
-    PIOLA_TRY(parse_motion(p, mo, o->center, &o->motion));
+    /* A cylinder, capsule, torus or gear spins about its own axis unless told otherwise: a
+     * gear with axis y turning about the global default z would swing through the scene
+     * like a revolving door (the gears example once did exactly that). */
+    int axial = o->type == PIOLA_OBSTACLE_CYLINDER || o->type == PIOLA_OBSTACLE_CAPSULE ||
+                o->type == PIOLA_OBSTACLE_TORUS || o->type == PIOLA_OBSTACLE_GEAR;
+    piola_vec3 default_axis = axial ? o->axis : (piola_vec3){0, 0, 1};
+    PIOLA_TRY(parse_motion(p, mo, o->center, default_axis, &o->motion));
     pop(p, old);
   } else {
     o->motion = piola_default_rigid_motion_def();

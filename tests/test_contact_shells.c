@@ -366,6 +366,53 @@ static void block_hits_free_cloth_conserving_momentum(void **state) {
   piola_world_destroy(w);
 }
 
+/* With self_collision on both sides, the one-way collide_with_solids stays out of the pair:
+ * turning it on changes nothing, to the bit. */
+static void one_way_coupling_defers_to_two_way_contact(void **state) {
+  (void)state;
+  double *runs[2] = {NULL, NULL};
+  int32_t nc = 0;
+  piola_step_stats totals[2] = {{0}, {0}};
+  for (int one_way = 0; one_way < 2; ++one_way) {
+    piola_world_def wd = piola_default_world_def();
+    wd.max_dt = 5e-4;
+    piola_world *w = NULL;
+    assert_int_equal(piola_world_create(&wd, &w), PIOLA_OK);
+    piola_tet_mesh block;
+    assert_int_equal(piola_tet_mesh_box_grid(3, 3, 2, (piola_vec3){0.02, 0.02, 0.02}, &block),
+                     PIOLA_OK);
+    for (int32_t i = 0; i < block.vertex_count; ++i)
+      block.positions[3 * i] -= 0.03, block.positions[3 * i + 1] -= 0.03;
+    piola_tet_mesh_orient(&block);
+    piola_solid_def sd = piola_default_solid_def();
+    sd.mesh = &block;
+    sd.material.youngs_modulus = 1e5;
+    sd.constraints = &(piola_constraint_def){.selector = {.type = PIOLA_SELECT_BOX,
+                                                          .box_min = {-1, -1, -1},
+                                                          .box_max = {1, 1, 1e-3}}};
+    sd.constraint_count = 1;
+    sd.self_collision.enabled = true;
+    sd.self_collision.thickness = 2e-3;
+    assert_int_equal(piola_world_add_solid(w, &sd, NULL), PIOLA_OK);
+    piola_tri_mesh cloth = sheet(0.12, 10, 0.05, 0.0);
+    piola_shell_def cd = cloth_def(&cloth, 1, 2e-3);
+    cd.collide_with_solids = one_way != 0;
+    cd.velocity = (piola_vec3){0, 0, -6.0}; /* 3 mm a step: x~ reaches into the block */
+    assert_int_equal(piola_world_add_shell(w, &cd, NULL), PIOLA_OK);
+    piola_tri_mesh_free(&cloth);
+    assert_int_equal(piola_world_advance_to(w, 0.03, &totals[one_way]), PIOLA_OK);
+    nc = piola_shell_body_vertex_count(piola_world_shell_body(w, 0));
+    runs[one_way] = malloc(sizeof(double) * 3 * (size_t)nc);
+    assert_non_null(runs[one_way]);
+    memcpy(runs[one_way], piola_world_shell_positions(w, 0), sizeof(double) * 3 * (size_t)nc);
+    piola_tet_mesh_free(&block);
+    piola_world_destroy(w);
+  }
+  assert_true(totals[0].contacts > 0); /* the cloth did reach the block */
+  assert_memory_equal(runs[0], runs[1], sizeof(double) * 3 * (size_t)nc);
+  free(runs[0]), free(runs[1]);
+}
+
 /* ------------------------------------------------------------------ keys and defs */
 
 static void shell_self_collision_key_and_def(void **state) {
@@ -407,6 +454,7 @@ int main(void) {
       cmocka_unit_test(shell_self_collision_key_and_def),
       cmocka_unit_test(block_hits_free_cloth_conserving_momentum),
       cmocka_unit_test(stacked_sheets_stay_apart),
+      cmocka_unit_test(one_way_coupling_defers_to_two_way_contact),
       cmocka_unit_test(cloth_folds_example_never_intersects),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);

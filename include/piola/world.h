@@ -76,12 +76,13 @@ typedef struct piola_constraint_def {
   piola_rigid_motion_def motion; /* used when driven */
 } piola_constraint_def;
 
-/* Self-collision of a solid's boundary surface, with itself and with every other solid that
- * has it enabled (Bridson, Fedkiw and Anderson 2002; docs/contact.md), processed after every
- * step, outside it (paper section 9). */
+/* Self-collision of a solid's boundary surface (or of a shell's triangles, piola_shell_def),
+ * with itself and with every other solid or shell that has it enabled (Bridson, Fedkiw and
+ * Anderson 2002; docs/contact.md), processed after every step, outside it (paper section 9).
+ * Contact between two bodies is two-way: impulses act on both. */
 typedef struct piola_self_collision_def {
   bool enabled;     /* Default false */
-  double thickness; /* m, > 0: boundary pairs closer than this repel. Default 1e-3 */
+  double thickness; /* m, > 0: surface pairs closer than this repel. Default 1e-3 */
   double friction;  /* Coulomb coefficient, >= 0. Default 0.3 */
 } piola_self_collision_def;
 

@@ -887,7 +887,8 @@ static piola_status parse_shell(parser *p, const cJSON *obj, int index, scene_sh
   static const char *const allowed[] = {"name", "mesh", "transform", "thickness", "density",
                                         "material", "damping", "bending", "plasticity",
                                         "reference_normals", "velocity", "fixed", "driven",
-                                        "collide_with_solids", "solid_friction", NULL};
+                                        "collide_with_solids", "solid_friction",
+                                        "self_collision", NULL};
   PIOLA_TRY(check_keys(p, obj, allowed));
   PIOLA_TRY(required(p, obj, "mesh"));
   d->def = piola_default_shell_def();
@@ -958,6 +959,7 @@ static piola_status parse_shell(parser *p, const cJSON *obj, int index, scene_sh
     pop(p, old);
   }
   PIOLA_TRY(opt_number(p, obj, "solid_friction", NONNEGATIVE, &d->def.solid_friction));
+  PIOLA_TRY(parse_self_collision(p, obj, &d->def.self_collision));
   PIOLA_TRY(opt_vec3(p, obj, "velocity", ANY, &d->base.def.velocity));
   PIOLA_TRY(parse_constraints(p, obj, "fixed", 0, &d->base));
   PIOLA_TRY(parse_constraints(p, obj, "driven", 1, &d->base));

@@ -103,6 +103,38 @@ PIOLA_WIDE_VECTORS static void update_block(piola_elastic_body *body, const doub
   const int32_t *i0 = body->tet_vertices[0] + base, *i1 = body->tet_vertices[1] + base;
   const int32_t *i2 = body->tet_vertices[2] + base, *i3 = body->tet_vertices[3] + base;
   double *const *dmi = body->dm_inv;
+#if defined(__AVX512F__)
+  {
+    /* 8-wide gathers by hand: GCC splits the gathers of the loop below into 4-wide ones
+     * (int32 indices), two per coordinate; one 8-wide vgatherdpd each halves them */
+    const __m256i three = _mm256_set1_epi32(3);
+    __m256i ia = _mm256_mullo_epi32(_mm256_loadu_si256((const __m256i *)i0), three);
+    __m256i ib = _mm256_mullo_epi32(_mm256_loadu_si256((const __m256i *)i1), three);
+    __m256i ic = _mm256_mullo_epi32(_mm256_loadu_si256((const __m256i *)i2), three);
+    __m256i id = _mm256_mullo_epi32(_mm256_loadu_si256((const __m256i *)i3), three);
+    piola_v8d ds[3][3];
+    PIOLA_UNROLL
+    for (int k = 0; k < 3; ++k) {
+      piola_v8d xa = (piola_v8d)_mm512_i32gather_pd(ia, x + k, 8);
+      ds[k][0] = (piola_v8d)_mm512_i32gather_pd(ib, x + k, 8) - xa;
+      ds[k][1] = (piola_v8d)_mm512_i32gather_pd(ic, x + k, 8) - xa;
+      ds[k][2] = (piola_v8d)_mm512_i32gather_pd(id, x + k, 8) - xa;
+    }
+    piola_v8d m[9];
+    PIOLA_UNROLL
+    for (int k = 0; k < 9; ++k) m[k] = piola__v8_load(dmi[k] + base);
+    piola_v8d fv[9];
+    PIOLA_UNROLL
+    for (int i = 0; i < 3; ++i)
+      PIOLA_UNROLL
+      for (int j = 0; j < 3; ++j) {
+        fv[3 * i + j] = ds[i][0] * m[j] + ds[i][1] * m[3 + j] + ds[i][2] * m[6 + j];
+        piola__v8_store(f[3 * i + j], fv[3 * i + j]);
+      }
+    piola__v8_store(detf, fv[0] * (fv[4] * fv[8] - fv[5] * fv[7]) - fv[1] * (fv[3] * fv[8] - fv[5] * fv[6]) +
+                              fv[2] * (fv[3] * fv[7] - fv[4] * fv[6]));
+  }
+#else
 #pragma omp simd
   for (int l = 0; l < B; ++l) {
     /* index arithmetic, not pointers, so GCC emits vector gathers */
@@ -124,6 +156,8 @@ PIOLA_WIDE_VECTORS static void update_block(piola_elastic_body *body, const doub
     detf[l] = f00 * (f11 * f22 - f12 * f21) - f01 * (f10 * f22 - f12 * f20) +
               f02 * (f10 * f21 - f11 * f20);
   }
+
+#endif
 
   /* U and V go straight into the body's SoA arrays (stride padded_tet_count) */
   double fhat[3][B];

@@ -95,11 +95,11 @@ void piola__elastic_body_gather_forces(const piola_elastic_body *body, double *f
   }
 }
 
-/* One block of B tets: F, SVD, stress, forces into the per-tet buffer, block statistics. */
-PIOLA_WIDE_VECTORS static void update_block(piola_elastic_body *body, const double *x, double stiffness_scale,
-                         int want_energy, int32_t block, double *out) {
+/* F = Ds Dm^-1 and det F of the B tets of one block (f[k][lane], entry k row-major). */
+PIOLA_WIDE_VECTORS PIOLA_KERNEL_INLINE void block_deformation_gradients(const piola_elastic_body *body,
+                                                                        const double *x, int32_t block,
+                                                                        double f[9][B], double detf[B]) {
   const int32_t base = block * B;
-  double f[9][B], detf[B];
   const int32_t *i0 = body->tet_vertices[0] + base, *i1 = body->tet_vertices[1] + base;
   const int32_t *i2 = body->tet_vertices[2] + base, *i3 = body->tet_vertices[3] + base;
   double *const *dmi = body->dm_inv;
@@ -158,13 +158,18 @@ PIOLA_WIDE_VECTORS static void update_block(piola_elastic_body *body, const doub
   }
 
 #endif
+}
 
-  /* U and V go straight into the body's SoA arrays (stride padded_tet_count) */
-  double fhat[3][B];
-  double *uo = body->u[0] + base, *vo = body->v[0] + base;
+/* The rest of one block once its F, U, V (in the body's arrays) and Fhat are known: stress,
+ * P, nodal forces added into out in tet order, per-tet state, block statistics. */
+PIOLA_WIDE_VECTORS PIOLA_KERNEL_INLINE void finish_block(piola_elastic_body *body, double stiffness_scale,
+                                                         int want_energy, int32_t block,
+                                                         double fhat[3][B], const double detf[B],
+                                                         double *out) {
+  const int32_t base = block * B;
+  double *const *dmi = body->dm_inv;
+  const double *uo = body->u[0] + base, *vo = body->v[0] + base;
   const long stride = body->padded_tet_count;
-  piola__svd3_kernel_v8(&f[0][0], B, uo, vo, stride, &fhat[0][0], B);
-
   double phat[3][B], psi[B];
   piola__material_stress_lanes(body, base, fhat, phat);
   if (want_energy)
@@ -241,6 +246,34 @@ PIOLA_WIDE_VECTORS static void update_block(piola_elastic_body *body, const doub
   body->block_min_det[block] = min_det;
 }
 
+/* count (1 or 2) consecutive blocks from first: F of each, their SVDs (two blocks have their
+ * Jacobi rotations interleaved, see piola_svd8 in svd_kernel.h; the results are the same as
+ * one at a time), then the rest block by block, in order. U and V go straight into the
+ * body's SoA arrays (stride padded_tet_count). */
+PIOLA_WIDE_VECTORS static void update_blocks(piola_elastic_body *body, const double *x, double stiffness_scale,
+                                             int want_energy, int32_t first, int count, double *out) {
+  double f[2][9][B], detf[2][B], fhat[2][3][B];
+  double *u = body->u[0], *v = body->v[0];
+  const long stride = body->padded_tet_count;
+  const int32_t base0 = first * B, base1 = (first + 1) * B;
+  block_deformation_gradients(body, x, first, f[0], detf[0]);
+  if (count == 2) {
+    block_deformation_gradients(body, x, first + 1, f[1], detf[1]);
+    piola__svd3_kernel_v8x2(&f[0][0][0], &f[1][0][0], B, u + base0, v + base0, u + base1, v + base1,
+                            stride, &fhat[0][0][0], &fhat[1][0][0], B);
+  } else {
+    piola__svd3_kernel_v8(&f[0][0][0], B, u + base0, v + base0, stride, &fhat[0][0][0], B);
+  }
+  for (int k = 0; k < count; ++k) finish_block(body, stiffness_scale, want_energy, first + k, fhat[k], detf[k], out);
+}
+
+/* Blocks [b0, b1) in pairs (the pairing depends only on b0 and b1, not on threads). */
+static void update_block_range(piola_elastic_body *body, const double *x, double stiffness_scale,
+                               int want_energy, int32_t b0, int32_t b1, double *out) {
+  for (int32_t b = b0; b < b1; b += 2)
+    update_blocks(body, x, stiffness_scale, want_energy, b, b1 - b >= 2 ? 2 : 1, out);
+}
+
 static int positions_are_finite(const double *x, int32_t n) {
   int finite = 1;
   for (int32_t i = 0; i < n; ++i) finite &= isfinite(x[i]);
@@ -265,7 +298,7 @@ piola_status piola_elastic_body_update(piola_elastic_body *body, const double *x
   const int64_t n = 3 * (int64_t)body->vertex_count;
   if (blocks < PIOLA_PARALLEL_MIN_BLOCKS || !body->damping_chunk_forces) {
     for (int64_t i = 0; i < n; ++i) forces[i] = 0.0;
-    for (int32_t b = 0; b < blocks; ++b) update_block(body, x, stiffness_scale, stats != NULL, b, forces);
+    update_block_range(body, x, stiffness_scale, stats != NULL, 0, blocks, forces);
   } else {
     /* Determinism without a per-tet buffer (as in damping.c): PIOLA_DAMPING_CHUNKS fixed
      * ranges of blocks, each summed in tet order into its own array, the arrays added in
@@ -279,7 +312,7 @@ piola_status piola_elastic_body_update(piola_elastic_body *body, const double *x
         for (int64_t i = 0; i < n; ++i) fk[i] = 0.0;
         int32_t b0 = (int32_t)((int64_t)blocks * k / PIOLA_DAMPING_CHUNKS);
         int32_t b1 = (int32_t)((int64_t)blocks * (k + 1) / PIOLA_DAMPING_CHUNKS);
-        for (int32_t b = b0; b < b1; ++b) update_block(body, x, stiffness_scale, stats != NULL, b, fk);
+        update_block_range(body, x, stiffness_scale, stats != NULL, b0, b1, fk);
       }
 #pragma omp for schedule(static)
       for (int64_t i = 0; i < n; ++i) {

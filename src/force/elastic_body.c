@@ -164,17 +164,17 @@ PIOLA_WIDE_VECTORS PIOLA_KERNEL_INLINE void block_deformation_gradients(const pi
  * P, nodal forces added into out in tet order, per-tet state, block statistics. */
 PIOLA_WIDE_VECTORS PIOLA_KERNEL_INLINE void finish_block(piola_elastic_body *body, double stiffness_scale,
                                                          int want_energy, int32_t block,
-                                                         double fhat[3][B], const double detf[B],
+                                                         const double *fhat, const double *phat,
+                                                         long lane_stride, const double detf[B],
                                                          double *out) {
   const int32_t base = block * B;
   double *const *dmi = body->dm_inv;
   const double *uo = body->u[0] + base, *vo = body->v[0] + base;
   const long stride = body->padded_tet_count;
-  double phat[3][B], psi[B];
-  piola__material_stress_lanes(body, base, fhat, phat);
+  double psi[B];
   if (want_energy)
     for (int l = 0; l < B; ++l) {
-      double fh[3] = {fhat[0][l], fhat[1][l], fhat[2][l]};
+      double fh[3] = {fhat[l], fhat[lane_stride + l], fhat[2 * lane_stride + l]};
       psi[l] = piola_material_energy_density(&body->materials[body->tet_material[base + l]], fh);
     }
 
@@ -182,8 +182,8 @@ PIOLA_WIDE_VECTORS PIOLA_KERNEL_INLINE void finish_block(piola_elastic_body *bod
   double tf[12 * B]; /* this block's 12 rows (3 corner + component) of B lanes */
 #pragma omp simd
   for (int l = 0; l < B; ++l) {
-    double p0 = phat[0][l] * stiffness_scale, p1 = phat[1][l] * stiffness_scale,
-           p2 = phat[2][l] * stiffness_scale;
+    double p0 = phat[l] * stiffness_scale, p1 = phat[lane_stride + l] * stiffness_scale,
+           p2 = phat[2 * lane_stride + l] * stiffness_scale;
     /* P = U diag(phat) V^T */
     double pm[3][3];
     PIOLA_UNROLL
@@ -224,9 +224,9 @@ PIOLA_WIDE_VECTORS PIOLA_KERNEL_INLINE void finish_block(piola_elastic_body *bod
   double *fhat_out = body->fhat + 3 * (size_t)base, *det_out = body->det_f + base;
 #pragma omp simd
   for (int l = 0; l < B; ++l) {
-    fhat_out[3 * l] = fhat[0][l];
-    fhat_out[3 * l + 1] = fhat[1][l];
-    fhat_out[3 * l + 2] = fhat[2][l];
+    fhat_out[3 * l] = fhat[l];
+    fhat_out[3 * l + 1] = fhat[lane_stride + l];
+    fhat_out[3 * l + 2] = fhat[2 * lane_stride + l];
     det_out[l] = detf[l];
   }
   if (!want_energy) return;
@@ -252,7 +252,9 @@ PIOLA_WIDE_VECTORS PIOLA_KERNEL_INLINE void finish_block(piola_elastic_body *bod
  * body's SoA arrays (stride padded_tet_count). */
 PIOLA_WIDE_VECTORS static void update_blocks(piola_elastic_body *body, const double *x, double stiffness_scale,
                                              int want_energy, int32_t first, int count, double *out) {
-  double f[2][9][B], detf[2][B], fhat[2][3][B];
+  /* Fhat and the stress of both blocks side by side, [entry][2 B lanes], so that the stress
+   * of the pair is one lane loop of 2 B independent lanes */
+  double f[2][9][B], detf[2][B], fhat[3][2 * B], phat[3][2 * B];
   double *u = body->u[0], *v = body->v[0];
   const long stride = body->padded_tet_count;
   const int32_t base0 = first * B, base1 = (first + 1) * B;
@@ -260,11 +262,20 @@ PIOLA_WIDE_VECTORS static void update_blocks(piola_elastic_body *body, const dou
   if (count == 2) {
     block_deformation_gradients(body, x, first + 1, f[1], detf[1]);
     piola__svd3_kernel_v8x2(&f[0][0][0], &f[1][0][0], B, u + base0, v + base0, u + base1, v + base1,
-                            stride, &fhat[0][0][0], &fhat[1][0][0], B);
+                            stride, &fhat[0][0], &fhat[0][B], 2 * B);
+    piola__material_stress_lanes2(body, base0, fhat, phat);
   } else {
-    piola__svd3_kernel_v8(&f[0][0][0], B, u + base0, v + base0, stride, &fhat[0][0][0], B);
+    piola__svd3_kernel_v8(&f[0][0][0], B, u + base0, v + base0, stride, &fhat[0][0], 2 * B);
+    double fh1[3][B], ph1[3][B];
+    for (int i = 0; i < 3; ++i)
+      for (int l = 0; l < B; ++l) fh1[i][l] = fhat[i][l];
+    piola__material_stress_lanes(body, base0, fh1, ph1);
+    for (int i = 0; i < 3; ++i)
+      for (int l = 0; l < B; ++l) phat[i][l] = ph1[i][l];
   }
-  for (int k = 0; k < count; ++k) finish_block(body, stiffness_scale, want_energy, first + k, fhat[k], detf[k], out);
+  for (int k = 0; k < count; ++k)
+    finish_block(body, stiffness_scale, want_energy, first + k, &fhat[0][k * B], &phat[0][k * B], 2 * B,
+                 detf[k], out);
 }
 
 /* Blocks [b0, b1) in pairs (the pairing depends only on b0 and b1, not on threads). */

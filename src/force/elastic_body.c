@@ -160,30 +160,34 @@ PIOLA_WIDE_VECTORS PIOLA_KERNEL_INLINE void block_deformation_gradients(const pi
 #endif
 }
 
-/* The rest of one block once its F, U, V (in the body's arrays) and Fhat are known: stress,
- * P, nodal forces added into out in tet order, per-tet state, block statistics. */
-PIOLA_WIDE_VECTORS PIOLA_KERNEL_INLINE void finish_block(piola_elastic_body *body, double stiffness_scale,
-                                                         int want_energy, int32_t block,
-                                                         const double *fhat, const double *phat,
-                                                         long lane_stride, const double detf[B],
-                                                         double *out) {
-  const int32_t base = block * B;
+/* The rest of count (1 or 2) consecutive blocks once their F, U, V (in the body's arrays),
+ * Fhat and stress are known: P, nodal forces added into out in tet order, per-tet state,
+ * block statistics. Consecutive blocks are consecutive in every per-tet array, so the two
+ * blocks of a pair are one lane loop of 2 B lanes, whose halves the compiler interleaves.
+ * fhat, phat and detf hold lane l of entry i at [i * 2 B + l]. */
+#define LANES (2 * B)
+PIOLA_WIDE_VECTORS PIOLA_KERNEL_INLINE void finish_blocks(piola_elastic_body *body, double stiffness_scale,
+                                                          int want_energy, int32_t first, int count,
+                                                          const double *fhat, const double *phat,
+                                                          const double *detf, double *out) {
+  const int32_t base = first * B;
+  const int lanes = count * B;
   double *const *dmi = body->dm_inv;
   const double *uo = body->u[0] + base, *vo = body->v[0] + base;
   const long stride = body->padded_tet_count;
-  double psi[B];
+  double psi[LANES];
   if (want_energy)
-    for (int l = 0; l < B; ++l) {
-      double fh[3] = {fhat[l], fhat[lane_stride + l], fhat[2 * lane_stride + l]};
+    for (int l = 0; l < lanes; ++l) {
+      double fh[3] = {fhat[l], fhat[LANES + l], fhat[2 * LANES + l]};
       psi[l] = piola_material_energy_density(&body->materials[body->tet_material[base + l]], fh);
     }
 
   const double *volume = body->rest_volume + base;
-  double tf[12 * B]; /* this block's 12 rows (3 corner + component) of B lanes */
+  double tf[12 * LANES]; /* 12 rows (3 corner + component) of LANES lanes */
 #pragma omp simd
-  for (int l = 0; l < B; ++l) {
-    double p0 = phat[l] * stiffness_scale, p1 = phat[lane_stride + l] * stiffness_scale,
-           p2 = phat[2 * lane_stride + l] * stiffness_scale;
+  for (int l = 0; l < lanes; ++l) {
+    double p0 = phat[l] * stiffness_scale, p1 = phat[LANES + l] * stiffness_scale,
+           p2 = phat[2 * LANES + l] * stiffness_scale;
     /* P = U diag(phat) V^T */
     double pm[3][3];
     PIOLA_UNROLL
@@ -202,48 +206,51 @@ PIOLA_WIDE_VECTORS PIOLA_KERNEL_INLINE void finish_block(piola_elastic_body *bod
       for (int j = 0; j < 3; ++j) {
         double g = w * (pm[i][0] * dmi[3 * j][base + l] + pm[i][1] * dmi[3 * j + 1][base + l] +
                         pm[i][2] * dmi[3 * j + 2][base + l]);
-        tf[(3 * (j + 1) + i) * B + l] = g;
+        tf[(3 * (j + 1) + i) * LANES + l] = g;
         g0 -= g;
       }
-      tf[i * B + l] = g0;
+      tf[i * LANES + l] = g0;
     }
   }
 
-  /* add the block's forces into out, tet by tet in order (padding tets are skipped) */
-  int32_t real_tets = body->tet_count - base < B ? body->tet_count - base : B;
+  /* add the forces into out, tet by tet in order (padding tets are skipped) */
+  int32_t real_tets = body->tet_count - base < lanes ? body->tet_count - base : lanes;
   for (int l = 0; l < real_tets; ++l)
     for (int c = 0; c < 4; ++c) {
       double *o = out + 3 * (size_t)body->tet_vertices[c][base + l];
-      o[0] += tf[(3 * c) * B + l];
-      o[1] += tf[(3 * c + 1) * B + l];
-      o[2] += tf[(3 * c + 2) * B + l];
+      o[0] += tf[(3 * c) * LANES + l];
+      o[1] += tf[(3 * c + 1) * LANES + l];
+      o[2] += tf[(3 * c + 2) * LANES + l];
     }
 
   /* per-tet state for the getters (fhat AoS as the public API has it), then statistics,
    * which only a caller asking for stats needs */
   double *fhat_out = body->fhat + 3 * (size_t)base, *det_out = body->det_f + base;
 #pragma omp simd
-  for (int l = 0; l < B; ++l) {
+  for (int l = 0; l < lanes; ++l) {
     fhat_out[3 * l] = fhat[l];
-    fhat_out[3 * l + 1] = fhat[lane_stride + l];
-    fhat_out[3 * l + 2] = fhat[2 * lane_stride + l];
+    fhat_out[3 * l + 1] = fhat[LANES + l];
+    fhat_out[3 * l + 2] = fhat[2 * LANES + l];
     det_out[l] = detf[l];
   }
   if (!want_energy) return;
-  int32_t real = body->tet_count - base < B ? body->tet_count - base : B;
-  double energy = 0, min_det = INFINITY;
-  int32_t inverted = 0;
-  for (int l = 0; l < B; ++l) {
-    body->energy_density[base + l] = psi[l] * stiffness_scale;
-    if (l < real) {
-      energy += volume[l] * psi[l] * stiffness_scale;
-      inverted += detf[l] < 0;
-      min_det = fmin(min_det, detf[l]);
+  for (int k = 0; k < count; ++k) {
+    const int32_t block = first + k, bbase = block * B;
+    int32_t real = body->tet_count - bbase < B ? body->tet_count - bbase : B;
+    double energy = 0, min_det = INFINITY;
+    int32_t inverted = 0;
+    for (int l = k * B; l < (k + 1) * B; ++l) {
+      body->energy_density[base + l] = psi[l] * stiffness_scale;
+      if (l - k * B < real) {
+        energy += volume[l] * psi[l] * stiffness_scale;
+        inverted += detf[l] < 0;
+        min_det = fmin(min_det, detf[l]);
+      }
     }
+    body->block_energy[block] = energy;
+    body->block_inverted[block] = inverted;
+    body->block_min_det[block] = min_det;
   }
-  body->block_energy[block] = energy;
-  body->block_inverted[block] = inverted;
-  body->block_min_det[block] = min_det;
 }
 
 /* count (1 or 2) consecutive blocks from first: F of each, their SVDs (two blocks have their
@@ -273,10 +280,13 @@ PIOLA_WIDE_VECTORS static void update_blocks(piola_elastic_body *body, const dou
     for (int i = 0; i < 3; ++i)
       for (int l = 0; l < B; ++l) phat[i][l] = ph1[i][l];
   }
-  for (int k = 0; k < count; ++k)
-    finish_block(body, stiffness_scale, want_energy, first + k, &fhat[0][k * B], &phat[0][k * B], 2 * B,
-                 detf[k], out);
+  if (count == 2)
+    finish_blocks(body, stiffness_scale, want_energy, first, 2, &fhat[0][0], &phat[0][0], &detf[0][0], out);
+  else
+    finish_blocks(body, stiffness_scale, want_energy, first, 1, &fhat[0][0], &phat[0][0], &detf[0][0], out);
 }
+
+#undef LANES
 
 /* Blocks [b0, b1) in pairs (the pairing depends only on b0 and b1, not on threads). */
 static void update_block_range(piola_elastic_body *body, const double *x, double stiffness_scale,

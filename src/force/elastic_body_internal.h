@@ -20,6 +20,9 @@
  * place, so forces are bit-for-bit identical for any thread count, without atomics. (The
  * per-tet buffer tet_forces and the incidence list below were the previous scheme.)
  * Statistics are summed per block and then serially over blocks for the same reason.
+ * Within a range, blocks go through the loop in pairs whose SVDs are interleaved (see
+ * piola_svd8 in svd_kernel.h); the pairing depends only on the range, and the paired SVD
+ * gives exactly the single one's bits, so it changes nothing either.
  *
  * The energy density is computed only when asked for (stats or the getter): stepping needs
  * forces, not energy, and the energy goes through the (scalar) public material function.

@@ -73,6 +73,7 @@ static const bad_case BAD[] = {
     {"{\"solids\": [{\"mesh\": \"a.veg\", \"material\": {\"model\": \"muscle\", \"muscle\": {\"max_active_stress\": -1}}}]}", "solids[0].material.muscle.max_active_stress: must be >= 0"},
     {"{\"solids\": [{\"mesh\": \"a.veg\", \"material\": {\"model\": \"muscle\", \"muscle\": {\"optimal_stretch\": 0}}}]}", "solids[0].material.muscle.optimal_stretch: must be > 0"},
     {"{\"solids\": [{\"mesh\": \"a.veg\", \"material\": {\"model\": \"muscle\", \"muscle\": {\"strength\": 1}}}]}", "solids[0].material.muscle.strength: unknown key"},
+    {"{\"shells\": [{\"mesh\": \"a.obj\", \"thickness\": 0.001, \"material\": {\"model\": \"muscle\"}}]}", "shells[0].material.model: \"muscle\" is for solids only"},
 };
 
 static void bad_muscle_keys_name_their_path(void **state) {

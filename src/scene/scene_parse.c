@@ -960,6 +960,10 @@ static piola_status parse_shell(parser *p, const cJSON *obj, int index, scene_sh
   if ((v = get(obj, "material"))) {
     size_t old = push_key(p, "material");
     PIOLA_TRY(parse_material(p, v, &d->base));
+    if (d->base.def.material.model == PIOLA_MODEL_MUSCLE) {
+      push_key(p, "model");
+      return fail(p, BAD_VALUE, "\"muscle\" is for solids only (shells have no fibres)");
+    }
     pop(p, old);
   }
   if ((v = get(obj, "damping"))) {

@@ -136,6 +136,72 @@ static void forces_are_minus_the_energy_gradient(void **state) {
   fixture_mesh_free(&mesh);
 }
 
+/* Rotating the rest mesh and its fibres by R (material) and the deformed positions by Q
+ * (world) rotates the forces by Q: the fibre rotates with the material. Rotating the mesh
+ * but not the fibres changes them (the fibres are anisotropic). */
+static void forces_rotate_with_world_and_material(void **state) {
+  (void)state;
+  test_rng rng = test_rng_seeded(94);
+  piola_tet_mesh mesh = fixture_grid(2, 0.1), turned = fixture_grid(2, 0.1);
+  const int n = 3 * mesh.vertex_count;
+  double *fibers = random_fibers(&rng, mesh.tet_count);
+  double *turned_fibers = malloc(sizeof(double) * 3 * (size_t)mesh.tet_count);
+  const double c = cos(0.7), s = sin(0.7), c2 = cos(-1.1), s2 = sin(-1.1);
+  const double r[3][3] = {{c, -s, 0}, {s, c, 0}, {0, 0, 1}};   /* material rotation */
+  const double q[3][3] = {{1, 0, 0}, {0, c2, -s2}, {0, s2, c2}}; /* world rotation */
+  for (int32_t v = 0; v < mesh.vertex_count; ++v)
+    for (int i = 0; i < 3; ++i)
+      turned.positions[3 * v + i] = r[i][0] * mesh.positions[3 * v] + r[i][1] * mesh.positions[3 * v + 1] +
+                                    r[i][2] * mesh.positions[3 * v + 2];
+  for (int32_t t = 0; t < mesh.tet_count; ++t)
+    for (int i = 0; i < 3; ++i)
+      turned_fibers[3 * t + i] = r[i][0] * fibers[3 * t] + r[i][1] * fibers[3 * t + 1] + r[i][2] * fibers[3 * t + 2];
+  const piola_material m = muscle(3e4);
+  piola_elastic_body *a = make_body(&mesh, &m, 1, NULL, fibers);
+  piola_elastic_body *b = make_body(&turned, &m, 1, NULL, turned_fibers);
+  piola_elastic_body *wrong = make_body(&turned, &m, 1, NULL, fibers);
+  double *x = malloc(sizeof(double) * (size_t)n), *y = malloc(sizeof(double) * (size_t)n);
+  double *fa = malloc(sizeof(double) * (size_t)n), *fb = malloc(sizeof(double) * (size_t)n);
+  for (int i = 0; i < n; ++i)
+    x[i] = mesh.positions[i] * (i % 3 == 1 ? 1.2 : 0.9) + 0.02 * test_rng_uniform(&rng, -1, 1);
+  for (int v = 0; v < 3; ++v) x[3 * v + 2] = 0.15; /* a few flattened and inverted tets */
+  for (int32_t v = 0; v < mesh.vertex_count; ++v)
+    for (int i = 0; i < 3; ++i)
+      y[3 * v + i] = q[i][0] * x[3 * v] + q[i][1] * x[3 * v + 1] + q[i][2] * x[3 * v + 2];
+  piola_elastic_body_set_activation(a, 0.8);
+  piola_elastic_body_set_activation(b, 0.8);
+  piola_elastic_body_set_activation(wrong, 0.8);
+  piola_elastic_stats sa, sb;
+  assert_int_equal(piola_elastic_body_update(a, x, 1.0, fa, &sa), PIOLA_OK);
+  assert_int_equal(piola_elastic_body_update(b, y, 1.0, fb, &sb), PIOLA_OK);
+  assert_true(sa.inverted_count > 0);
+  const double scale = fixture_max_abs(fa, n);
+  for (int32_t v = 0; v < mesh.vertex_count; ++v)
+    for (int i = 0; i < 3; ++i) {
+      const double expect = q[i][0] * fa[3 * v] + q[i][1] * fa[3 * v + 1] + q[i][2] * fa[3 * v + 2];
+      assert_close(fb[3 * v + i], expect, 1e-9 * scale);
+    }
+  assert_close(sb.elastic_energy, sa.elastic_energy, 1e-9 * fabs(sa.elastic_energy));
+  assert_int_equal(piola_elastic_body_update(wrong, y, 1.0, fb, NULL), PIOLA_OK);
+  double differ = 0;
+  for (int32_t v = 0; v < mesh.vertex_count; ++v)
+    for (int i = 0; i < 3; ++i)
+      differ = fmax(differ, fabs(fb[3 * v + i] - (q[i][0] * fa[3 * v] + q[i][1] * fa[3 * v + 1] +
+                                                   q[i][2] * fa[3 * v + 2])));
+  assert_true(differ > 1e-3 * scale);
+  piola_elastic_body_destroy(a);
+  piola_elastic_body_destroy(b);
+  piola_elastic_body_destroy(wrong);
+  free(fibers);
+  free(turned_fibers);
+  free(x);
+  free(y);
+  free(fa);
+  free(fb);
+  fixture_mesh_free(&mesh);
+  fixture_mesh_free(&turned);
+}
+
 /* A single tet with its apex pushed through the opposite face, fibres active in every
  * direction: the apex's force is finite and points back through the face. */
 static void inverted_tet_with_active_fibres_is_pushed_back(void **state) {
@@ -338,6 +404,7 @@ int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(fast_loop_matches_reference_with_fibres),
       cmocka_unit_test(forces_are_minus_the_energy_gradient),
+      cmocka_unit_test(forces_rotate_with_world_and_material),
       cmocka_unit_test(inverted_tet_with_active_fibres_is_pushed_back),
       cmocka_unit_test(fibres_are_checked_and_counted_in_the_wave_speed),
       cmocka_unit_test(activated_bar_shortens_along_its_fibres_and_bulges),

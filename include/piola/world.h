@@ -106,6 +106,13 @@ typedef struct piola_solid_def {
   const piola_plasticity_def *plasticity; /* NULL (default): purely elastic. Read by
                                      add_solid only (goal positions included) */
   piola_self_collision_def self_collision; /* default: off */
+  /* Muscle fibres (paper section 6.1; material.model PIOLA_MODEL_MUSCLE, see
+   * piola_muscle_def): the fibre direction of each tet in rest space, 3 per tet, copied and
+   * normalised (a zero one is an error naming the tet). NULL (default): no fibres. Not
+   * supported together with plasticity. */
+  const double *fiber_directions;
+  piola_track activation;         /* dimensionless, in [0, 1], keyframable: the fibres'
+                                     activation, set every step. Default 0 */
 } piola_solid_def;
 
 PIOLA_API piola_solid_def piola_default_solid_def(void);

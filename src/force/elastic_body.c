@@ -11,6 +11,7 @@
 
 #include "common/status_internal.h"
 #include "force/elastic_body_internal.h"
+#include "force/fiber_lanes.h"
 #include "force/material_lanes.h"
 #include "force/svd_kernel.h"
 #include "math/mat3.h"
@@ -69,7 +70,8 @@ const double *piola_elastic_body_energy_density(const piola_elastic_body *body) 
     for (int32_t t = 0; t < body->tet_count; ++t)
       mutable_body->energy_density[t] =
           body->last_stiffness_scale *
-          piola_material_energy_density(&body->materials[body->tet_material[t]], body->fhat + 3 * t);
+          (piola_material_energy_density(&body->materials[body->tet_material[t]], body->fhat + 3 * t) +
+           piola__fiber_energy_density(body, t));
     mutable_body->energy_valid = 1;
   }
   return body->energy_density;
@@ -212,6 +214,19 @@ PIOLA_WIDE_VECTORS PIOLA_KERNEL_INLINE void finish_blocks(piola_elastic_body *bo
       tf[i * LANES + l] = g0;
     }
   }
+
+  if (body->fiber[0]) /* muscle fibres (fiber_lanes.h), block by block */
+    for (int k = 0; k < count; ++k) {
+      double fh[3][B], tfk[12 * B] = {0}, psik[B] = {0};
+      for (int i = 0; i < 3; ++i)
+        for (int l = 0; l < B; ++l) fh[i][l] = fhat[i * LANES + k * B + l];
+      piola__fiber_forces_lanes(body, base + k * B, fh, stiffness_scale, tfk,
+                                want_energy ? psik : NULL);
+      for (int r = 0; r < 12; ++r)
+        for (int l = 0; l < B; ++l) tf[r * LANES + k * B + l] += tfk[r * B + l];
+      if (want_energy)
+        for (int l = 0; l < B; ++l) psi[k * B + l] += psik[l];
+    }
 
   /* add the forces into out, tet by tet in order (padding tets are skipped) */
   int32_t real_tets = body->tet_count - base < lanes ? body->tet_count - base : lanes;
@@ -390,6 +405,16 @@ piola_status piola__elastic_body_update_reference(const piola_elastic_body *body
     piola_material_stress(material, fh, ph);
     double psi = piola_material_energy_density(material, fh) * stiffness_scale;
     mat3 p = mat3_mul_diag_transpose(u, vec3_scale(vec3_make(ph[0], ph[1], ph[2]), stiffness_scale), v);
+    if (body->fiber[0]) { /* fibre part in the diagonal frame, ahat = V^T a (section 6.1) */
+      vec3 a = vec3_make(body->fiber[0][t], body->fiber[1][t], body->fiber[2][t]);
+      vec3 ah = mat3_mul_vec(mat3_transpose(v), a);
+      double ahat[3] = {ah.x, ah.y, ah.z}, pf[3][3];
+      piola_material_fiber_stress(material, fh, ahat, body->activation, pf);
+      mat3 pfm;
+      for (int k = 0; k < 9; ++k) pfm.m[k / 3][k % 3] = pf[k / 3][k % 3] * stiffness_scale;
+      p = mat3_add(p, mat3_mul(mat3_mul(u, pfm), mat3_transpose(v)));
+      psi += piola_material_fiber_energy_density(material, fh, ahat, body->activation) * stiffness_scale;
+    }
     mat3 g = mat3_scale(mat3_mul_transpose_b(p, dm_inv), -body->rest_volume[t]);
     vec3 g0 = vec3_make(0, 0, 0);
     for (int c = 1; c < 4; ++c) {

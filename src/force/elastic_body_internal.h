@@ -78,6 +78,12 @@ struct piola_elastic_body {
   int32_t *block_inverted;
   double *block_min_det;
 
+  /* muscle fibres (fiber_lanes.c): unit direction in rest space per padded tet (SoA, padding
+   * tets 0), or all NULL when the body has none; the AoS public copy; the activation */
+  double *fiber[3];
+  double *fiber_aos;
+  double activation;
+
   /* materials */
   piola_material *materials;
   int32_t material_count;

@@ -31,7 +31,8 @@
     switch (m->model) {                                                                    \
       case PIOLA_MODEL_COROTATED: PIOLA_MATERIAL_LANE_LOOP(corotated_stress, lanes); return; \
       case PIOLA_MODEL_STVK: PIOLA_MATERIAL_LANE_LOOP(stvk_stress, lanes); return;          \
-      case PIOLA_MODEL_NEOHOOKEAN: PIOLA_MATERIAL_LANE_LOOP(neohookean_stress, lanes); return; \
+      case PIOLA_MODEL_NEOHOOKEAN:                                                         \
+      case PIOLA_MODEL_MUSCLE: PIOLA_MATERIAL_LANE_LOOP(neohookean_stress, lanes); return;  \
       case PIOLA_MODEL_SPLINE: PIOLA_MATERIAL_LANE_LOOP(spline_stress, lanes); return;      \
       case PIOLA_MODEL_ROTATED_LINEAR:                                                     \
       default: PIOLA_MATERIAL_LANE_LOOP(rotated_linear_stress, lanes); return;             \

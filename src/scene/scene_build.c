@@ -1,6 +1,7 @@
 /* Scene building: read or generate each solid's mesh, place it by its transform, and add
  * solids and obstacles to a new world. Errors name the key path of the solid or obstacle. */
 #include <math.h>
+#include <stdlib.h>
 #include <string.h>
 
 #include "common/status_internal.h"
@@ -164,7 +165,17 @@ piola_status piola__scene_build(const scene_desc *desc, const char *label, piola
         plasticity.control.goal_vertex_count = goal.vertex_count;
       }
     }
+    double *fibers = NULL;
+    st = piola__scene_fiber_directions(&d->fibers, &mesh, &fibers);
+    if (st != PIOLA_OK) {
+      piola_tet_mesh_free(&mesh);
+      piola_tet_mesh_free(&goal);
+      piola_world_destroy(world);
+      return PIOLA_FAIL(st, "%s: solids[%d].%s", label, (int)i, piola_last_error());
+    }
+    def.fiber_directions = fibers;
     st = piola_world_add_solid(world, &def, NULL);
+    free(fibers);
     piola_tet_mesh_free(&mesh);
     piola_tet_mesh_free(&goal);
     if (st != PIOLA_OK) {

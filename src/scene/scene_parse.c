@@ -437,23 +437,25 @@ static piola_status parse_generator(parser *p, const cJSON *obj, piola_mesher_de
 
 static piola_status parse_material(parser *p, const cJSON *obj, scene_solid_desc *d) {
   static const char *const allowed[] = {"model", "youngs_modulus", "poisson_ratio", "stiffness_scale",
-                                        "inversion", "spline", NULL};
+                                        "inversion", "spline", "muscle", NULL};
   PIOLA_TRY(check_keys(p, obj, allowed));
   piola_material_def *m = &d->def.material;
   const cJSON *model = get(obj, "model");
   if (model) {
     size_t old = push_key(p, "model");
-    static const char *const names[] = {"rotated_linear", "corotated", "stvk", "neohookean", "spline", NULL};
+    static const char *const names[] = {"rotated_linear", "corotated", "stvk", "neohookean", "spline",
+                                        "muscle", NULL};
     static const piola_material_model models[] = {PIOLA_MODEL_ROTATED_LINEAR, PIOLA_MODEL_COROTATED,
                                                   PIOLA_MODEL_STVK, PIOLA_MODEL_NEOHOOKEAN,
-                                                  PIOLA_MODEL_SPLINE};
+                                                  PIOLA_MODEL_SPLINE, PIOLA_MODEL_MUSCLE};
     int found = -1;
     if (cJSON_IsString(model))
       for (int i = 0; names[i]; ++i)
         if (strcmp(model->valuestring, names[i]) == 0) found = i;
     if (found < 0)
       return fail(p, BAD_VALUE,
-                  "must be one of \"rotated_linear\", \"corotated\", \"stvk\", \"neohookean\", \"spline\"");
+                  "must be one of \"rotated_linear\", \"corotated\", \"stvk\", \"neohookean\", \"spline\", "
+                  "\"muscle\"");
     m->model = models[found];
     pop(p, old);
   }
@@ -489,6 +491,63 @@ static piola_status parse_material(parser *p, const cJSON *obj, scene_solid_desc
     PIOLA_TRY(opt_number(p, sp, "stiffening", (range){1, INFINITY, 0, 0}, &m->spline.stiffening));
     pop(p, old);
   }
+  const cJSON *mu = get(obj, "muscle");
+  if (mu) {
+    size_t old = push_key(p, "muscle");
+    if (m->model != PIOLA_MODEL_MUSCLE) return fail(p, BAD_VALUE, "needs \"model\": \"muscle\"");
+    static const char *const keys[] = {"passive_stiffness", "passive_toe_stretch", "max_active_stress",
+                                       "optimal_stretch", "active_width", NULL};
+    PIOLA_TRY(check_keys(p, mu, keys));
+    piola_muscle_def *md = &m->muscle;
+    PIOLA_TRY(opt_number(p, mu, "passive_stiffness", NONNEGATIVE, &md->passive_stiffness));
+    PIOLA_TRY(opt_number(p, mu, "passive_toe_stretch", (range){1, INFINITY, 1, 0}, &md->passive_toe_stretch));
+    PIOLA_TRY(opt_number(p, mu, "max_active_stress", NONNEGATIVE, &md->max_active_stress));
+    PIOLA_TRY(opt_number(p, mu, "optimal_stretch", POSITIVE, &md->optimal_stretch));
+    PIOLA_TRY(opt_number(p, mu, "active_width", (range){0, 1, 1, 1}, &md->active_width));
+    pop(p, old);
+  }
+  return PIOLA_OK;
+}
+
+/* ------------------------------------------------------------------ muscle fibres */
+
+/* "fibers": {"axis": [x, y, z]} | {"curve": [[x, y, z], ...]} | {"from_mesh": true}. */
+static piola_status parse_fibers(parser *p, const cJSON *obj, scene_fibers *f) {
+  static const char *const allowed[] = {"axis", "curve", "from_mesh", NULL};
+  PIOLA_TRY(check_keys(p, obj, allowed));
+  const cJSON *axis = get(obj, "axis"), *curve = get(obj, "curve"), *mesh = get(obj, "from_mesh");
+  if ((axis != NULL) + (curve != NULL) + (mesh != NULL) != 1)
+    return fail(p, PIOLA_ERROR_PARSE, "needs exactly one of \"axis\", \"curve\" and \"from_mesh\"");
+  if (axis) {
+    f->kind = SCENE_FIBERS_AXIS;
+    return opt_direction(p, obj, "axis", &f->axis);
+  }
+  if (mesh) {
+    size_t old = push_key(p, "from_mesh");
+    if (!cJSON_IsTrue(mesh)) return fail(p, BAD_VALUE, "must be true (leave the key out for no fibres)");
+    f->kind = SCENE_FIBERS_FROM_MESH;
+    pop(p, old);
+    return PIOLA_OK;
+  }
+  size_t old = push_key(p, "curve");
+  const int count = cJSON_IsArray(curve) ? cJSON_GetArraySize(curve) : 0;
+  if (count < 2) return fail(p, PIOLA_ERROR_PARSE, "must be an array of at least 2 points [x, y, z] (m)");
+  f->kind = SCENE_FIBERS_CURVE;
+  f->curve = malloc(sizeof(double) * 3 * (size_t)count);
+  if (!f->curve) return fail(p, PIOLA_ERROR_OUT_OF_MEMORY, "out of memory");
+  f->curve_points = count;
+  int i = 0;
+  for (const cJSON *e = curve->child; e; e = e->next, ++i) {
+    size_t o2 = push_index(p, i);
+    piola_vec3 q;
+    PIOLA_TRY(vec3_value(p, e, ANY, &q));
+    f->curve[3 * i] = q.x, f->curve[3 * i + 1] = q.y, f->curve[3 * i + 2] = q.z;
+    if (i > 0 && f->curve[3 * i] == f->curve[3 * i - 3] && f->curve[3 * i + 1] == f->curve[3 * i - 2] &&
+        f->curve[3 * i + 2] == f->curve[3 * i - 1])
+      return fail(p, BAD_VALUE, "repeats the point before it (a segment needs a direction)");
+    pop(p, o2);
+  }
+  pop(p, old);
   return PIOLA_OK;
 }
 
@@ -627,7 +686,7 @@ static piola_status parse_name(parser *p, const cJSON *obj, scene_solid_desc *d)
 static piola_status parse_solid(parser *p, const cJSON *obj, int index, scene_solid_desc *d) {
   static const char *const allowed[] = {"name", "mesh", "transform", "density", "material",
                                         "damping", "velocity", "fixed", "driven", "initial",
-                                        "plasticity", "self_collision", NULL};
+                                        "plasticity", "self_collision", "fibers", "activation", NULL};
   PIOLA_TRY(check_keys(p, obj, allowed));
   PIOLA_TRY(required(p, obj, "mesh"));
   d->def = piola_default_solid_def();
@@ -670,6 +729,21 @@ static piola_status parse_solid(parser *p, const cJSON *obj, int index, scene_so
   PIOLA_TRY(parse_constraints(p, obj, "fixed", 0, d));
   d->fixed_count = d->constraint_count;
   PIOLA_TRY(parse_constraints(p, obj, "driven", 1, d));
+  if ((v = get(obj, "fibers"))) {
+    old = push_key(p, "fibers");
+    if (d->def.material.model != PIOLA_MODEL_MUSCLE)
+      return fail(p, BAD_VALUE, "needs material.model \"muscle\"");
+    if (d->plastic) return fail(p, BAD_VALUE, "cannot be combined with plasticity (not supported)");
+    PIOLA_TRY(parse_fibers(p, v, &d->fibers));
+    pop(p, old);
+  }
+  if ((v = get(obj, "activation"))) {
+    old = push_key(p, "activation");
+    if (d->def.material.model != PIOLA_MODEL_MUSCLE)
+      return fail(p, BAD_VALUE, "needs material.model \"muscle\"");
+    PIOLA_TRY(track_value(p, v, (range){0, 1, 0, 0}, &d->def.activation));
+    pop(p, old);
+  }
   if ((v = get(obj, "initial"))) {
     old = push_key(p, "initial");
     static const char *const keys[] = {"matrix", "scramble", "seed", NULL};
@@ -905,6 +979,10 @@ static piola_status parse_shell(parser *p, const cJSON *obj, int index, scene_sh
   if ((v = get(obj, "material"))) {
     size_t old = push_key(p, "material");
     PIOLA_TRY(parse_material(p, v, &d->base));
+    if (d->base.def.material.model == PIOLA_MODEL_MUSCLE) {
+      push_key(p, "model");
+      return fail(p, BAD_VALUE, "\"muscle\" is for solids only (shells have no fibres)");
+    }
     pop(p, old);
   }
   if ((v = get(obj, "damping"))) {
@@ -1170,6 +1248,7 @@ void piola__scene_desc_free(scene_desc *desc) {
     for (int32_t c = 0; c < s->constraint_count; ++c) free(s->index_lists[c]);
     free(s->index_lists);
     free(s->constraints);
+    free(s->fibers.curve);
   }
   free(desc->solids);
   free(desc->obstacles);

@@ -35,6 +35,7 @@ typedef struct world_solid {
   piola_rigid_motion_def *motions;
   int32_t motion_count;
   piola_track stiffness_scale, shear_viscosity, bulk_viscosity;
+  piola_track activation;       /* muscle fibres' activation, set before every force update */
   piola_elastic_stats elastic;  /* of the last update */
   piola_plastic_state *plastic; /* NULL for an elastic solid (world_plasticity.c) */
   piola_plastic_stats plastic_stats; /* of the last plastic update */

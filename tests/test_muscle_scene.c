@@ -2,8 +2,12 @@
  * fibers (axis, curve, from_mesh) and activation, with errors that name the key, and the
  * direction fields as the built body sees them. */
 #include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 
+#include "piola/mesh_io.h"
 #include "piola/scene.h"
 #include "piola/world.h"
 #include "scene/scene_desc.h"
@@ -134,7 +138,7 @@ static void curve_fibres_follow_the_nearest_segment(void **state) {
   piola_scene_destroy(scene);
 }
 
-static void fibres_from_the_mesh_are_not_supported_yet(void **state) {
+static void fibres_from_the_mesh_need_mesh_data(void **state) {
   (void)state;
   const char *json =
       "{\"solids\": [{\"mesh\": {\"generate\": \"box\", \"half_extents\": [1, 1, 1], "
@@ -142,7 +146,46 @@ static void fibres_from_the_mesh_are_not_supported_yet(void **state) {
   piola_scene *scene = NULL;
   assert_int_not_equal(piola_scene_load_string(json, ".", "mesh.json", &scene), PIOLA_OK);
   assert_non_null(strstr(piola_last_error(), "solids[0].fibers.from_mesh"));
-  assert_non_null(strstr(piola_last_error(), "not supported yet"));
+  assert_non_null(strstr(piola_last_error(), "no per-tet fibre data"));
+}
+
+/* Fibres written into a .vtu cell array reach the body, turned with the solid's transform. */
+static void fibres_from_the_mesh_file_reach_the_body(void **state) {
+  (void)state;
+  piola_tet_mesh mesh;
+  assert_int_equal(piola_tet_mesh_box_grid(2, 2, 3, (piola_vec3){0.01, 0.01, 0.02}, &mesh), PIOLA_OK);
+  mesh.tet_fibers = malloc(sizeof(double) * 3 * (size_t)mesh.tet_count);
+  assert_non_null(mesh.tet_fibers);
+  for (int32_t t = 0; t < mesh.tet_count; ++t) { /* a different direction per tet */
+    mesh.tet_fibers[3 * t] = 1.0;
+    mesh.tet_fibers[3 * t + 1] = 0.1 * (t % 7);
+    mesh.tet_fibers[3 * t + 2] = 2.0 + 0.05 * (t % 5);
+  }
+  char dir[] = "/tmp/piola_fibres_XXXXXX";
+  assert_non_null(mkdtemp(dir));
+  char path[256];
+  snprintf(path, sizeof path, "%s/fibres.vtu", dir);
+  assert_int_equal(piola_tet_mesh_write(path, &mesh), PIOLA_OK);
+  /* a quarter turn about z maps (x, y, z) to (-y, x, z) */
+  const char *json =
+      "{\"solids\": [{\"mesh\": \"fibres.vtu\", \"transform\": {\"rotate_degrees\": [0, 0, 90]}, "
+      "\"material\": {\"model\": \"muscle\"}, \"fibers\": {\"from_mesh\": true}}]}";
+  piola_scene *scene = NULL;
+  assert_int_equal(piola_scene_load_string(json, dir, "fibres.json", &scene), PIOLA_OK);
+  const piola_elastic_body *body = piola_world_solid_body(piola_scene_world(scene), 0);
+  const double *a = piola_elastic_body_fiber_directions(body);
+  assert_int_equal(piola_elastic_body_tet_count(body), mesh.tet_count);
+  for (int32_t t = 0; t < mesh.tet_count; ++t) {
+    const double *g = mesh.tet_fibers + 3 * t;
+    const double n = sqrt(g[0] * g[0] + g[1] * g[1] + g[2] * g[2]);
+    assert_close(a[3 * t], -g[1] / n, 1e-12);
+    assert_close(a[3 * t + 1], g[0] / n, 1e-12);
+    assert_close(a[3 * t + 2], g[2] / n, 1e-12);
+  }
+  piola_scene_destroy(scene);
+  piola_tet_mesh_free(&mesh);
+  remove(path);
+  rmdir(dir);
 }
 
 int main(void) {
@@ -150,7 +193,8 @@ int main(void) {
       cmocka_unit_test(keys_reach_their_definitions),
       cmocka_unit_test(bad_muscle_keys_name_their_path),
       cmocka_unit_test(curve_fibres_follow_the_nearest_segment),
-      cmocka_unit_test(fibres_from_the_mesh_are_not_supported_yet),
+      cmocka_unit_test(fibres_from_the_mesh_need_mesh_data),
+      cmocka_unit_test(fibres_from_the_mesh_file_reach_the_body),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
 }

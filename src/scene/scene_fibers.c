@@ -1,9 +1,10 @@
 /* A solid's `fibers` key turned into one fibre direction per tet of the placed rest mesh:
- * a uniform axis, or the tangent of the polyline segment nearest each tet's rest centroid
+ * the per-tet data of the mesh file, a uniform axis, or the tangent of the polyline segment nearest each tet's rest centroid
  * (a muscle's fibres follow its line of action from one end to the other). Directions are
  * in scene coordinates, like the placed mesh. */
 #include <math.h>
 #include <stdlib.h>
+#include <string.h>
 
 #include "common/status_internal.h"
 #include "math/mat3.h"
@@ -21,12 +22,20 @@ piola_status piola__scene_fiber_directions(const scene_fibers *fibers, const pio
                                            double **out) {
   *out = NULL;
   if (fibers->kind == SCENE_FIBERS_NONE) return PIOLA_OK;
-  if (fibers->kind == SCENE_FIBERS_FROM_MESH)
+  if (fibers->kind == SCENE_FIBERS_FROM_MESH && !mesh->tet_fibers)
     return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT,
-                      "fibers.from_mesh: per-tet fibre data from mesh files is not supported yet; "
-                      "use \"axis\" or \"curve\"");
+                      "fibers.from_mesh: the mesh file has no per-tet fibre data (a 3-component "
+                      "cell array named \"fiber\" or \"fibers\" in .vtu, or $ElementData of that "
+                      "name in .msh; see docs/file-formats.md)");
   double *a = malloc(sizeof(double) * 3 * (size_t)mesh->tet_count);
   if (!a) return PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "fibers: out of memory");
+  if (fibers->kind == SCENE_FIBERS_FROM_MESH) {
+    /* already turned with the rest shape by the scene's transform; the body normalises them
+     * and names a zero one by its tet */
+    memcpy(a, mesh->tet_fibers, sizeof(double) * 3 * (size_t)mesh->tet_count);
+    *out = a;
+    return PIOLA_OK;
+  }
   for (int32_t t = 0; t < mesh->tet_count; ++t) {
     vec3 d = fibers->axis;
     if (fibers->kind == SCENE_FIBERS_CURVE) {

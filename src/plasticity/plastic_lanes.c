@@ -1,0 +1,168 @@
+/* The blocked plastic update: the return mapping of 8 tets at once on explicit 8-lane
+ * vectors (design in plastic_state.h; the scalar path it must agree with is update_tet in
+ * plastic_state.c, the per-tet math in return_mapping.h). */
+/* Fused multiply-adds, as in the force loop (see "Fused multiply-adds" in svd_kernel.h). */
+#if defined(__GNUC__) && !defined(__clang__)
+#pragma GCC optimize("fp-contract=fast")
+#endif
+#include <math.h>
+#include <string.h>
+
+#include "force/effective_dm_inv.h"
+#include "force/elastic_body_internal.h"
+#include "math/v8_logexp.h"
+#include "plasticity/plastic_state.h"
+
+#if defined(__AVX512F__)
+#include <immintrin.h>
+#endif
+
+#define L PIOLA_PLASTIC_LANES
+_Static_assert(PIOLA_PLASTIC_LANES == PIOLA_TET_BLOCK, "plastic lanes are the force loop's blocks");
+
+typedef piola_f64x8 v8;
+typedef piola_i64x8 m8;
+#define SEL PIOLA_F64X8_SELECT
+
+static inline __attribute__((always_inline)) v8 v8_sqrt(v8 x) {
+#if defined(__AVX512F__)
+  return (v8)_mm512_sqrt_pd((__m512d)x);
+#else
+  v8 r;
+  for (int l = 0; l < L; ++l) r[l] = sqrt(x[l]);
+  return r;
+#endif
+}
+
+static inline __attribute__((always_inline)) int any_lane(m8 m) {
+  int any = 0;
+  for (int l = 0; l < L; ++l) any |= m[l] != 0;
+  return any;
+}
+
+/* Fhat of the block's tets (AoS in the body, 3 per tet) as three lane vectors. */
+static inline __attribute__((always_inline)) void load_fhat(const double *fh, v8 f[3]) {
+  for (int i = 0; i < 3; ++i)
+    for (int l = 0; l < L; ++l) f[i][l] = fh[3 * l + i];
+}
+
+PIOLA_F64X8_WIDE int32_t piola__plastic_update_block(piola_plastic_state *s, int32_t block, int32_t *limited) {
+  const int32_t base = block * L;
+  const int32_t valid_count = s->tet_count - base < L ? s->tet_count - base : L;
+  const plastic_params *p = &s->params;
+  double *dm_inv[9];
+  const double *vk[9];
+  int32_t padded;
+  piola__elastic_body_plastic_lanes(s->body, dm_inv, vk, &padded);
+  (void)padded;
+
+  m8 valid;
+  for (int l = 0; l < L; ++l) valid[l] = l < valid_count ? -1 : 0;
+  v8 fh[3];
+  load_fhat(piola_elastic_body_fhat(s->body) + 3 * (size_t)base, fh);
+  v8 alpha = piola__f64x8_load(s->alpha + base);
+
+  /* quick test: every entry inside [exp(-gamma/sqrt3), exp(gamma/sqrt3)] cannot yield */
+  v8 gamma = p->yield + p->hardening * alpha;
+  v8 lo, hi;
+  if (p->hardening == 0) {
+    lo = piola__f64x8_splat(s->quick_lo0), hi = piola__f64x8_splat(s->quick_hi0);
+  } else {
+    v8 r = gamma * (1.0 / 1.7320508075688772);
+    lo = piola__f64x8_exp(-r), hi = piola__f64x8_exp(r);
+  }
+  m8 outside = (fh[0] < lo) | (fh[0] > hi) | (fh[1] < lo) | (fh[1] > hi) | (fh[2] < lo) | (fh[2] > hi);
+  /* NaN entries compare false both ways: they go to the full path like the scalar one */
+  outside |= (fh[0] != fh[0]) | (fh[1] != fh[1]) | (fh[2] != fh[2]);
+  if (!any_lane(outside & valid)) return 0;
+
+  /* radial return (return_mapping.h) */
+  const v8 floor = piola__f64x8_splat(PIOLA_PLASTIC_FLAT_FLOOR);
+  v8 e[3];
+  for (int i = 0; i < 3; ++i) e[i] = piola__f64x8_log(SEL((m8)(fh[i] > floor), fh[i], floor));
+  v8 mean = p->volume_preserving ? (e[0] + e[1] + e[2]) * (1.0 / 3.0) : piola__f64x8_splat(0.0);
+  v8 d[3] = {e[0] - mean, e[1] - mean, e[2] - mean};
+  v8 norm = v8_sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+  m8 yielded = (m8)(norm > gamma) & valid;
+  if (!any_lane(yielded)) return 0;
+  v8 dl = SEL(yielded, (norm - gamma) * (1.0 / (1.0 + p->hardening)), piola__f64x8_splat(0.0));
+  v8 scale = SEL(yielded, dl / SEL(yielded, norm, piola__f64x8_splat(1.0)), piola__f64x8_splat(0.0));
+
+  /* M = V exp(-delta) V^T = I + V diag(exp(-delta) - 1) V^T, so Fp^-1 <- Fp^-1 M; in the
+   * second form a lane with delta = 0 gets M = I exactly */
+  v8 g[3];
+  for (int i = 0; i < 3; ++i) g[i] = piola__f64x8_exp(-scale * d[i]) - 1.0;
+  v8 v[9], w[9];
+  for (int k = 0; k < 9; ++k) v[k] = piola__f64x8_load(vk[k] + base);
+  for (int k = 0; k < 9; ++k) w[k] = v[k] * g[k % 3];
+  v8 m00 = 1.0 + w[0] * v[0] + w[1] * v[1] + w[2] * v[2];
+  v8 m11 = 1.0 + w[3] * v[3] + w[4] * v[4] + w[5] * v[5];
+  v8 m22 = 1.0 + w[6] * v[6] + w[7] * v[7] + w[8] * v[8];
+  v8 m01 = w[0] * v[3] + w[1] * v[4] + w[2] * v[5];
+  v8 m02 = w[0] * v[6] + w[1] * v[7] + w[2] * v[8];
+  v8 m12 = w[3] * v[6] + w[4] * v[7] + w[5] * v[8];
+  v8 m[9] = {m00, m01, m02, m01, m11, m12, m02, m12, m22};
+
+  /* Fp^-1 of the block's tets, AoS -> lanes */
+  double *fp = s->fp_inv + 9 * (size_t)base;
+  v8 a[9];
+  for (int k = 0; k < 9; ++k)
+    for (int l = 0; l < L; ++l) a[k][l] = l < valid_count ? fp[9 * l + k] : (k % 4 == 0);
+  v8 an[9];
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j)
+      an[3 * i + j] = a[3 * i] * m[j] + a[3 * i + 1] * m[3 + j] + a[3 * i + 2] * m[6 + j];
+
+  /* cheap bounds on the singular values of the new Fp^-1 from B = A A^T (see
+   * singular_bounds in plastic_state.c, here compared squared) */
+  v8 b00 = an[0] * an[0] + an[1] * an[1] + an[2] * an[2];
+  v8 b11 = an[3] * an[3] + an[4] * an[4] + an[5] * an[5];
+  v8 b22 = an[6] * an[6] + an[7] * an[7] + an[8] * an[8];
+  v8 b01 = an[0] * an[3] + an[1] * an[4] + an[2] * an[5];
+  v8 b02 = an[0] * an[6] + an[1] * an[7] + an[2] * an[8];
+  v8 b12 = an[3] * an[6] + an[4] * an[7] + an[5] * an[8];
+  v8 mb = (b00 + b11 + b22) * (1.0 / 3.0);
+  v8 dev = v8_sqrt((b00 - mb) * (b00 - mb) + (b11 - mb) * (b11 - mb) + (b22 - mb) * (b22 - mb) +
+                   2.0 * (b01 * b01 + b02 * b02 + b12 * b12));
+  v8 bhi = mb + 0.816496580927726 * dev; /* sqrt(2/3) */
+  v8 det = an[0] * (an[4] * an[8] - an[5] * an[7]) - an[1] * (an[3] * an[8] - an[5] * an[6]) +
+           an[2] * (an[3] * an[7] - an[4] * an[6]);
+  v8 blo1 = mb - 0.816496580927726 * dev, blo2 = det * det / (bhi * bhi);
+  v8 blo = SEL((m8)(blo1 > blo2), blo1, blo2);
+  const double cap = s->limit_cap;
+  m8 inside = (m8)(bhi <= cap * cap) & (m8)(blo >= 1.0 / (cap * cap));
+  m8 exact = yielded & ~inside;
+  v8 upper = v8_sqrt(bhi);
+
+  /* the new effective Dm^-1 = Dm^-1,rest Fp^-1 into the body's lanes (others keep theirs) */
+  const double *rest = s->rest_lanes + (size_t)block * 9 * L;
+  v8 r[9];
+  for (int k = 0; k < 9; ++k) r[k] = piola__f64x8_load(rest + k * L);
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j) {
+      v8 eff = r[3 * i] * an[j] + r[3 * i + 1] * an[3 + j] + r[3 * i + 2] * an[6 + j];
+      double *out = dm_inv[3 * i + j] + base;
+      piola__f64x8_store(out, SEL(yielded, eff, piola__f64x8_load(out)));
+    }
+  piola__f64x8_store(s->alpha + base, alpha + dl);
+  v8 old_bound = piola__f64x8_load(s->stretch_bound + base);
+  piola__f64x8_store(s->stretch_bound + base, SEL(yielded, upper, old_bound));
+
+  /* lanes -> AoS for the tets that yielded; the exact limit where the bounds leave it */
+  int32_t count = 0;
+  for (int l = 0; l < valid_count; ++l) {
+    if (!yielded[l]) continue;
+    ++count;
+    double *fl = fp + 9 * l;
+    for (int k = 0; k < 9; ++k) fl[k] = an[k][l];
+    if (exact[l]) {
+      s->stretch_bound[base + l] = piola__plastic_exact_limit(fl, p);
+      piola__plastic_commit_tet(s, base + l);
+      *limited += 1;
+    }
+  }
+  double bmax = 1.0;
+  for (int l = 0; l < valid_count; ++l) bmax = fmax(bmax, s->stretch_bound[base + l]);
+  s->block_bound[block] = bmax;
+  return count;
+}

@@ -38,6 +38,14 @@
 #define PIOLA_V8_INLINE static inline
 #endif
 
+/* Functions holding 8-lane code ask GCC for full AVX-512 vectors where the build targets
+ * them (as svd_kernel.h does for the force loop). */
+#if defined(__GNUC__) && !defined(__clang__) && defined(__AVX512F__)
+#define PIOLA_F64X8_WIDE __attribute__((target("prefer-vector-width=512")))
+#else
+#define PIOLA_F64X8_WIDE
+#endif
+
 typedef double piola_f64x8 __attribute__((vector_size(64)));
 typedef int64_t piola_i64x8 __attribute__((vector_size(64)));
 

@@ -40,10 +40,53 @@ static inline __attribute__((always_inline)) int any_lane(m8 m) {
   return any;
 }
 
-/* Fhat of the block's tets (AoS in the body, 3 per tet) as three lane vectors. */
+#define SHUF __builtin_shufflevector
+
+/* Fhat of the block's tets (AoS in the body, 3 per tet: 24 doubles = 3 vectors) as three
+ * lane vectors, by two shuffles each. */
 static inline __attribute__((always_inline)) void load_fhat(const double *fh, v8 f[3]) {
-  for (int i = 0; i < 3; ++i)
-    for (int l = 0; l < L; ++l) f[i][l] = fh[3 * l + i];
+  v8 x0 = piola__f64x8_load(fh), x1 = piola__f64x8_load(fh + 8), x2 = piola__f64x8_load(fh + 16);
+  v8 s0 = SHUF(x0, x1, 0, 3, 6, 9, 12, 15, 0, 0);
+  v8 s1 = SHUF(x0, x1, 1, 4, 7, 10, 13, 0, 0, 0);
+  v8 s2 = SHUF(x0, x1, 2, 5, 8, 11, 14, 0, 0, 0);
+  f[0] = SHUF(s0, x2, 0, 1, 2, 3, 4, 5, 10, 13);
+  f[1] = SHUF(s1, x2, 0, 1, 2, 3, 4, 8, 11, 14);
+  f[2] = SHUF(s2, x2, 0, 1, 2, 3, 4, 9, 12, 15);
+}
+
+/* r[k][l] <- r[l][k]: three rounds of interleaving, 24 shuffles. */
+static inline __attribute__((always_inline)) void transpose8(v8 r[8]) {
+  v8 t[8], u[8];
+  for (int i = 0; i < 4; ++i) {
+    t[2 * i] = SHUF(r[2 * i], r[2 * i + 1], 0, 8, 2, 10, 4, 12, 6, 14);
+    t[2 * i + 1] = SHUF(r[2 * i], r[2 * i + 1], 1, 9, 3, 11, 5, 13, 7, 15);
+  }
+  for (int h = 0; h < 2; ++h)
+    for (int odd = 0; odd < 2; ++odd) {
+      v8 a = t[4 * h + odd], b = t[4 * h + 2 + odd];
+      u[4 * h + odd] = SHUF(a, b, 0, 1, 8, 9, 4, 5, 12, 13);
+      u[4 * h + 2 + odd] = SHUF(a, b, 2, 3, 10, 11, 6, 7, 14, 15);
+    }
+  for (int k = 0; k < 4; ++k) {
+    r[k] = SHUF(u[k], u[4 + k], 0, 1, 2, 3, 8, 9, 10, 11);
+    r[4 + k] = SHUF(u[k], u[4 + k], 4, 5, 6, 7, 12, 13, 14, 15);
+  }
+}
+
+/* The 9-entry matrices of 8 tets (AoS, 72 doubles) as 9 lane vectors: an 8 x 8 transpose
+ * of unaligned rows for entries 0..7, entry 8 lane by lane. */
+static inline __attribute__((always_inline)) void load_matrices(const double *m, v8 a[9]) {
+  for (int l = 0; l < L; ++l) a[l] = piola__f64x8_load(m + 9 * l);
+  transpose8(a);
+  for (int l = 0; l < L; ++l) a[8][l] = m[9 * l + 8];
+}
+
+static inline __attribute__((always_inline)) void store_matrices(double *m, const v8 a[9]) {
+  v8 r[8];
+  for (int k = 0; k < 8; ++k) r[k] = a[k];
+  transpose8(r);
+  for (int l = 0; l < L; ++l) piola__f64x8_store(m + 9 * l, r[l]);
+  for (int l = 0; l < L; ++l) m[9 * l + 8] = a[8][l];
 }
 
 PIOLA_F64X8_WIDE int32_t piola__plastic_update_block(piola_plastic_state *s, int32_t block, int32_t *limited) {
@@ -106,8 +149,7 @@ PIOLA_F64X8_WIDE int32_t piola__plastic_update_block(piola_plastic_state *s, int
   /* Fp^-1 of the block's tets, AoS -> lanes */
   double *fp = s->fp_inv + 9 * (size_t)base;
   v8 a[9];
-  for (int k = 0; k < 9; ++k)
-    for (int l = 0; l < L; ++l) a[k][l] = l < valid_count ? fp[9 * l + k] : (k % 4 == 0);
+  load_matrices(fp, a); /* fp_inv is padded to whole blocks (identity) */
   v8 an[9];
   for (int i = 0; i < 3; ++i)
     for (int j = 0; j < 3; ++j)
@@ -148,13 +190,15 @@ PIOLA_F64X8_WIDE int32_t piola__plastic_update_block(piola_plastic_state *s, int
   v8 old_bound = piola__f64x8_load(s->stretch_bound + base);
   piola__f64x8_store(s->stretch_bound + base, SEL(yielded, upper, old_bound));
 
-  /* lanes -> AoS for the tets that yielded; the exact limit where the bounds leave it */
+  /* lanes -> AoS (tets that did not yield keep their bits); the exact limit where the
+   * bounds leave it */
+  for (int k = 0; k < 9; ++k) an[k] = SEL(yielded, an[k], a[k]);
+  store_matrices(fp, an);
   int32_t count = 0;
   for (int l = 0; l < valid_count; ++l) {
     if (!yielded[l]) continue;
     ++count;
     double *fl = fp + 9 * l;
-    for (int k = 0; k < 9; ++k) fl[k] = an[k][l];
     if (exact[l]) {
       s->stretch_bound[base + l] = piola__plastic_exact_limit(fl, p);
       piola__plastic_commit_tet(s, base + l);

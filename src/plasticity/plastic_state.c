@@ -143,7 +143,7 @@ piola_status piola_plastic_state_create(piola_elastic_body *body, const piola_pl
   s->controlled = def->control.goal != PIOLA_PLASTIC_GOAL_NONE;
   s->strength = def->control.strength;
   s->rest_lanes = calloc(9 * np, sizeof(double));
-  s->fp_inv = malloc(9 * n * sizeof(double));
+  s->fp_inv = malloc(9 * np * sizeof(double)); /* padded: the blocked update reads whole blocks */
   s->alpha = calloc(np, sizeof(double));
   s->stretch_bound = malloc(np * sizeof(double));
   s->block_bound = malloc(np / PIOLA_PLASTIC_LANES * sizeof(double));
@@ -158,14 +158,14 @@ piola_status piola_plastic_state_create(piola_elastic_body *body, const piola_pl
   }
   for (size_t i = 0; i < np; ++i) s->stretch_bound[i] = 1.0;
   for (size_t b = 0; b < np / PIOLA_PLASTIC_LANES; ++b) s->block_bound[b] = 1.0;
+  for (size_t t = 0; t < np; ++t)
+    for (int k = 0; k < 9; ++k) s->fp_inv[9 * t + k] = (k % 4 == 0) ? 1.0 : 0.0;
   for (int32_t t = 0; t < nt; ++t) {
     double rest[9];
     piola__elastic_body_get_dm_inv(body, t, rest);
     for (int k = 0; k < 9; ++k)
       s->rest_lanes[(size_t)(t / PIOLA_PLASTIC_LANES) * 9 * PIOLA_PLASTIC_LANES + (size_t)k * PIOLA_PLASTIC_LANES +
                     (size_t)(t % PIOLA_PLASTIC_LANES)] = rest[k];
-    double *a = s->fp_inv + 9 * t;
-    for (int k = 0; k < 9; ++k) a[k] = (k % 4 == 0) ? 1.0 : 0.0;
   }
   if (s->controlled) {
     for (int32_t t = 0; t < nt; ++t) {

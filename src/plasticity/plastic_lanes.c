@@ -34,10 +34,38 @@ static inline __attribute__((always_inline)) v8 v8_sqrt(v8 x) {
 #endif
 }
 
-static inline __attribute__((always_inline)) int any_lane(m8 m) {
-  int any = 0;
-  for (int l = 0; l < L; ++l) any |= m[l] != 0;
-  return any;
+/* Bit l set where lane l of the mask is set. */
+static inline __attribute__((always_inline)) unsigned lane_bits(m8 m) {
+#if defined(__AVX512DQ__)
+  return (unsigned)_mm512_movepi64_mask((__m512i)m);
+#else
+  unsigned bits = 0;
+  for (int l = 0; l < L; ++l) bits |= (unsigned)(m[l] != 0) << l;
+  return bits;
+#endif
+}
+
+/* Stores x into the lanes of p whose bit is set in bits; the others keep their bits. */
+static inline __attribute__((always_inline)) void store_lanes(double *p, v8 x, m8 mask, unsigned bits) {
+#if defined(__AVX512F__)
+  (void)mask;
+  _mm512_mask_storeu_pd(p, (__mmask8)bits, (__m512d)x);
+#else
+  (void)bits;
+  piola__f64x8_store(p, SEL(mask, x, piola__f64x8_load(p)));
+#endif
+}
+
+/* 1 / x to about an ulp, and a / x to about an ulp (x normal, positive or negative). */
+static inline __attribute__((always_inline)) v8 v8_div(v8 a, v8 x) {
+#if defined(__AVX512F__)
+  v8 y = (v8)_mm512_rcp14_pd((__m512d)x); /* relative error below 2^-14 */
+  y = y * (2.0 - x * y);                  /* 2^-28 */
+  v8 q = a * y;
+  return q + y * (a - q * x);             /* one correction of the quotient: ~2^-56 + rounding */
+#else
+  return a / x;
+#endif
 }
 
 #define SHUF __builtin_shufflevector
@@ -117,7 +145,7 @@ PIOLA_F64X8_WIDE int32_t piola__plastic_update_block(piola_plastic_state *s, int
   m8 outside = (fh[0] < lo) | (fh[0] > hi) | (fh[1] < lo) | (fh[1] > hi) | (fh[2] < lo) | (fh[2] > hi);
   /* NaN entries compare false both ways: they go to the full path like the scalar one */
   outside |= (fh[0] != fh[0]) | (fh[1] != fh[1]) | (fh[2] != fh[2]);
-  if (!any_lane(outside & valid)) return 0;
+  if (!lane_bits(outside & valid)) return 0;
 
   /* radial return (return_mapping.h) */
   const v8 floor = piola__f64x8_splat(PIOLA_PLASTIC_FLAT_FLOOR);
@@ -127,9 +155,10 @@ PIOLA_F64X8_WIDE int32_t piola__plastic_update_block(piola_plastic_state *s, int
   v8 d[3] = {e[0] - mean, e[1] - mean, e[2] - mean};
   v8 norm = v8_sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
   m8 yielded = (m8)(norm > gamma) & valid;
-  if (!any_lane(yielded)) return 0;
+  const unsigned ybits = lane_bits(yielded);
+  if (!ybits) return 0;
   v8 dl = SEL(yielded, (norm - gamma) * (1.0 / (1.0 + p->hardening)), piola__f64x8_splat(0.0));
-  v8 scale = SEL(yielded, dl / SEL(yielded, norm, piola__f64x8_splat(1.0)), piola__f64x8_splat(0.0));
+  v8 scale = SEL(yielded, v8_div(dl, SEL(yielded, norm, piola__f64x8_splat(1.0))), piola__f64x8_splat(0.0));
 
   /* M = V exp(-delta) V^T = I + V diag(exp(-delta) - 1) V^T, so Fp^-1 <- Fp^-1 M; in the
    * second form a lane with delta = 0 gets M = I exactly */
@@ -169,10 +198,10 @@ PIOLA_F64X8_WIDE int32_t piola__plastic_update_block(piola_plastic_state *s, int
   v8 bhi = mb + 0.816496580927726 * dev; /* sqrt(2/3) */
   v8 det = an[0] * (an[4] * an[8] - an[5] * an[7]) - an[1] * (an[3] * an[8] - an[5] * an[6]) +
            an[2] * (an[3] * an[7] - an[4] * an[6]);
-  v8 blo1 = mb - 0.816496580927726 * dev, blo2 = det * det / (bhi * bhi);
-  v8 blo = SEL((m8)(blo1 > blo2), blo1, blo2);
-  const double cap = s->limit_cap;
-  m8 inside = (m8)(bhi <= cap * cap) & (m8)(blo >= 1.0 / (cap * cap));
+  /* lambda_min >= max(blo1, det^2 / bhi^2) >= 1 / cap^2, without the division */
+  v8 blo1 = mb - 0.816496580927726 * dev;
+  const double cap = s->limit_cap, inv_cap2 = 1.0 / (cap * cap);
+  m8 inside = (m8)(bhi <= cap * cap) & ((m8)(blo1 >= inv_cap2) | (m8)(det * det >= inv_cap2 * (bhi * bhi)));
   m8 exact = yielded & ~inside;
   v8 upper = v8_sqrt(bhi);
 
@@ -183,8 +212,7 @@ PIOLA_F64X8_WIDE int32_t piola__plastic_update_block(piola_plastic_state *s, int
   for (int i = 0; i < 3; ++i)
     for (int j = 0; j < 3; ++j) {
       v8 eff = r[3 * i] * an[j] + r[3 * i + 1] * an[3 + j] + r[3 * i + 2] * an[6 + j];
-      double *out = dm_inv[3 * i + j] + base;
-      piola__f64x8_store(out, SEL(yielded, eff, piola__f64x8_load(out)));
+      store_lanes(dm_inv[3 * i + j] + base, eff, yielded, ybits);
     }
   piola__f64x8_store(s->alpha + base, alpha + dl);
   v8 old_bound = piola__f64x8_load(s->stretch_bound + base);
@@ -194,12 +222,11 @@ PIOLA_F64X8_WIDE int32_t piola__plastic_update_block(piola_plastic_state *s, int
    * bounds leave it */
   for (int k = 0; k < 9; ++k) an[k] = SEL(yielded, an[k], a[k]);
   store_matrices(fp, an);
-  int32_t count = 0;
-  for (int l = 0; l < valid_count; ++l) {
-    if (!yielded[l]) continue;
-    ++count;
+  const int32_t count = __builtin_popcount(ybits);
+  for (unsigned ebits = lane_bits(exact); ebits; ebits &= ebits - 1) {
+    int l = __builtin_ctz(ebits);
     double *fl = fp + 9 * l;
-    if (exact[l]) {
+    {
       s->stretch_bound[base + l] = piola__plastic_exact_limit(fl, p);
       piola__plastic_commit_tet(s, base + l);
       *limited += 1;

@@ -117,22 +117,26 @@ static inline __attribute__((always_inline)) void store_matrices(double *m, cons
   for (int l = 0; l < L; ++l) m[9 * l + 8] = a[8][l];
 }
 
-PIOLA_F64X8_WIDE int32_t piola__plastic_update_block(piola_plastic_state *s, int32_t block, int32_t *limited) {
+/* What phase 1 hands phase 2 for one block: the yielding lanes, the exponents -delta of
+ * exp(-delta) and the plastic strain increments. */
+typedef struct block_flow {
+  v8 minus_delta[3];
+  v8 dl;
+  unsigned bits; /* bit l: lane l yields */
+} block_flow;
+
+/* Phase 1 of a block: quick test and radial return. */
+static inline __attribute__((always_inline)) void return_map_block(const piola_plastic_state *s, int32_t block,
+                                                                   const double *fhat_all, block_flow *out) {
   const int32_t base = block * L;
   const int32_t valid_count = s->tet_count - base < L ? s->tet_count - base : L;
   const plastic_params *p = &s->params;
-  double *dm_inv[9];
-  const double *vk[9];
-  int32_t padded;
-  piola__elastic_body_plastic_lanes(s->body, dm_inv, vk, &padded);
-  (void)padded;
-
+  out->bits = 0;
   m8 valid;
   for (int l = 0; l < L; ++l) valid[l] = l < valid_count ? -1 : 0;
   v8 fh[3];
-  load_fhat(piola_elastic_body_fhat(s->body) + 3 * (size_t)base, fh);
+  load_fhat(fhat_all + 3 * (size_t)base, fh);
   v8 alpha = piola__f64x8_load(s->alpha + base);
-
   /* quick test: every entry inside [exp(-gamma/sqrt3), exp(gamma/sqrt3)] cannot yield */
   v8 gamma = p->yield + p->hardening * alpha;
   v8 lo, hi;
@@ -145,7 +149,7 @@ PIOLA_F64X8_WIDE int32_t piola__plastic_update_block(piola_plastic_state *s, int
   m8 outside = (fh[0] < lo) | (fh[0] > hi) | (fh[1] < lo) | (fh[1] > hi) | (fh[2] < lo) | (fh[2] > hi);
   /* NaN entries compare false both ways: they go to the full path like the scalar one */
   outside |= (fh[0] != fh[0]) | (fh[1] != fh[1]) | (fh[2] != fh[2]);
-  if (!lane_bits(outside & valid)) return 0;
+  if (!lane_bits(outside & valid)) return;
 
   /* radial return (return_mapping.h) */
   const v8 floor = piola__f64x8_splat(PIOLA_PLASTIC_FLAT_FLOOR);
@@ -156,14 +160,29 @@ PIOLA_F64X8_WIDE int32_t piola__plastic_update_block(piola_plastic_state *s, int
   v8 norm = v8_sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
   m8 yielded = (m8)(norm > gamma) & valid;
   const unsigned ybits = lane_bits(yielded);
-  if (!ybits) return 0;
+  if (!ybits) return;
   v8 dl = SEL(yielded, (norm - gamma) * (1.0 / (1.0 + p->hardening)), piola__f64x8_splat(0.0));
   v8 scale = SEL(yielded, v8_div(dl, SEL(yielded, norm, piola__f64x8_splat(1.0))), piola__f64x8_splat(0.0));
 
+  for (int i = 0; i < 3; ++i) out->minus_delta[i] = -scale * d[i];
+  out->dl = dl;
+  out->bits = ybits;
+}
+
+/* Phase 2 of a block that has yielding lanes: new Fp^-1, bounds, effective Dm^-1. Returns
+ * the number of yielded tets and adds the limited ones to *limited. */
+static inline __attribute__((always_inline)) int32_t flow_block(piola_plastic_state *s, int32_t block,
+                                                                double *const dm_inv[9], const double *const vk[9],
+                                                                const block_flow *in, int32_t *limited) {
+  const int32_t base = block * L;
+  const plastic_params *p = &s->params;
+  const unsigned ybits = in->bits;
+  m8 yielded;
+  for (int l = 0; l < L; ++l) yielded[l] = (ybits >> l & 1) ? -1 : 0;
   /* M = V exp(-delta) V^T = I + V diag(exp(-delta) - 1) V^T, so Fp^-1 <- Fp^-1 M; in the
    * second form a lane with delta = 0 gets M = I exactly */
   v8 g[3];
-  for (int i = 0; i < 3; ++i) g[i] = piola__f64x8_exp(-scale * d[i]) - 1.0;
+  for (int i = 0; i < 3; ++i) g[i] = piola__f64x8_exp(in->minus_delta[i]) - 1.0;
   v8 v[9], w[9];
   for (int k = 0; k < 9; ++k) v[k] = piola__f64x8_load(vk[k] + base);
   for (int k = 0; k < 9; ++k) w[k] = v[k] * g[k % 3];
@@ -205,16 +224,28 @@ PIOLA_F64X8_WIDE int32_t piola__plastic_update_block(piola_plastic_state *s, int
   m8 exact = yielded & ~inside;
   v8 upper = v8_sqrt(bhi);
 
-  /* the new effective Dm^-1 = Dm^-1,rest Fp^-1 into the body's lanes (others keep theirs) */
-  const double *rest = s->rest_lanes + (size_t)block * 9 * L;
-  v8 r[9];
-  for (int k = 0; k < 9; ++k) r[k] = piola__f64x8_load(rest + k * L);
+  /* the new effective Dm^-1 = Dm^-1,rest Fp^-1 M = (old effective Dm^-1) M into the body's
+   * lanes (others keep theirs). From the old one rather than from the rest Dm^-1: the
+   * body's lanes are read and written anyway (a store pulls the cache line in), so the rest
+   * data is read for one block in PIOLA_PLASTIC_REFRESH only; the two products differ by
+   * rounding (the tests bound it) */
+  v8 e[9];
+  const v8 *right = m;
+  if ((block & (PIOLA_PLASTIC_REFRESH - 1)) == s->refresh_phase) {
+    /* this update's share of blocks is recomputed from the rest data: rounding cannot pile
+     * up over more than PIOLA_PLASTIC_REFRESH updates */
+    const double *rest = s->rest_lanes + (size_t)block * 9 * L;
+    for (int k = 0; k < 9; ++k) e[k] = piola__f64x8_load(rest + k * L);
+    right = an;
+  } else {
+    for (int k = 0; k < 9; ++k) e[k] = piola__f64x8_load(dm_inv[k] + base);
+  }
   for (int i = 0; i < 3; ++i)
     for (int j = 0; j < 3; ++j) {
-      v8 eff = r[3 * i] * an[j] + r[3 * i + 1] * an[3 + j] + r[3 * i + 2] * an[6 + j];
+      v8 eff = e[3 * i] * right[j] + e[3 * i + 1] * right[3 + j] + e[3 * i + 2] * right[6 + j];
       store_lanes(dm_inv[3 * i + j] + base, eff, yielded, ybits);
     }
-  piola__f64x8_store(s->alpha + base, alpha + dl);
+  piola__f64x8_store(s->alpha + base, piola__f64x8_load(s->alpha + base) + in->dl);
   v8 old_bound = piola__f64x8_load(s->stretch_bound + base);
   piola__f64x8_store(s->stretch_bound + base, SEL(yielded, upper, old_bound));
 
@@ -233,7 +264,34 @@ PIOLA_F64X8_WIDE int32_t piola__plastic_update_block(piola_plastic_state *s, int
     }
   }
   double bmax = 1.0;
-  for (int l = 0; l < valid_count; ++l) bmax = fmax(bmax, s->stretch_bound[base + l]);
+  for (int l = 0; l < L; ++l) bmax = fmax(bmax, s->stretch_bound[base + l]); /* padding lanes hold 1 */
   s->block_bound[block] = bmax;
   return count;
+}
+
+/* Two phases over a chunk of blocks rather than one pass per block: each phase's loop body
+ * is half as long, so the processor overlaps consecutive blocks (the work of one block is
+ * a long chain of dependent operations: log, norm, exp, products). */
+enum { CHUNK_BLOCKS = 16 };
+
+PIOLA_F64X8_WIDE int32_t piola__plastic_update_blocks(piola_plastic_state *s, int32_t first, int32_t end,
+                                                      int32_t *limited, double *bound) {
+  double *dm_inv[9];
+  const double *vk[9];
+  int32_t padded;
+  piola__elastic_body_plastic_lanes(s->body, dm_inv, vk, &padded);
+  (void)padded;
+  const double *fhat = piola_elastic_body_fhat(s->body);
+  block_flow flow[CHUNK_BLOCKS];
+  int32_t yielded = 0;
+  double bmax = 1.0;
+  for (int32_t b0 = first; b0 < end; b0 += CHUNK_BLOCKS) {
+    int32_t n = end - b0 < CHUNK_BLOCKS ? end - b0 : CHUNK_BLOCKS;
+    for (int32_t i = 0; i < n; ++i) return_map_block(s, b0 + i, fhat, &flow[i]);
+    for (int32_t i = 0; i < n; ++i)
+      if (flow[i].bits) yielded += flow_block(s, b0 + i, dm_inv, vk, &flow[i], limited);
+    for (int32_t i = 0; i < n; ++i) bmax = fmax(bmax, s->block_bound[b0 + i]);
+  }
+  *bound = bmax;
+  return yielded;
 }

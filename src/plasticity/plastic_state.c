@@ -299,13 +299,19 @@ piola_status piola_plastic_state_update(piola_plastic_state *s, double dt, piola
   }
   int32_t yielded = 0, limited = 0;
   double bound = 1.0;
-  const int32_t blocks = s->padded_count / PIOLA_PLASTIC_LANES;
+  /* ranges of 64 blocks: big enough for the blocked kernel's two phases, small enough to
+   * share out; the counts and the maximum do not depend on how they are shared */
+  const int32_t blocks = s->padded_count / PIOLA_PLASTIC_LANES, range = 64;
+  const int32_t ranges = (blocks + range - 1) / range;
 #pragma omp parallel for schedule(static) reduction(+ : yielded, limited) reduction(max : bound) \
     num_threads(piola__thread_count()) if (blocks >= PIOLA_PARALLEL_MIN_BLOCKS)
-  for (int32_t b = 0; b < blocks; ++b) {
-    yielded += piola__plastic_update_block(s, b, &limited);
-    bound = fmax(bound, s->block_bound[b]);
+  for (int32_t r = 0; r < ranges; ++r) {
+    int32_t end = (r + 1) * range < blocks ? (r + 1) * range : blocks;
+    double b = 1.0;
+    yielded += piola__plastic_update_blocks(s, r * range, end, &limited, &b);
+    bound = fmax(bound, b);
   }
+  s->refresh_phase = (s->refresh_phase + 1) & (PIOLA_PLASTIC_REFRESH - 1);
   if (stats) {
     stats->yielded_count = yielded;
     stats->limited_count = limited;

@@ -51,6 +51,8 @@ struct piola_plastic_state {
   double *alpha;          /* accumulated plastic strain, padded_count entries */
   double *stretch_bound;  /* upper bound on sigma_max(Fp^-1), padded_count entries */
   double *block_bound;    /* max of stretch_bound over each block */
+  int32_t refresh_phase;  /* blocks b with b % PIOLA_PLASTIC_REFRESH == this take their
+                             effective Dm^-1 from the rest data in this update */
   /* control */
   int controlled;
   double strength;        /* 1/s */
@@ -59,6 +61,10 @@ struct piola_plastic_state {
 };
 
 #define PIOLA_PLASTIC_LANES 8
+/* The blocked update carries a yielding tet's effective Dm^-1 forward (old one times the
+ * increment, so the rest data stays unread); every this many updates (a power of 2) each
+ * block is recomputed from the rest data instead, which bounds the rounding drift. */
+#define PIOLA_PLASTIC_REFRESH 64
 
 /* Entry k (row-major) of tet t's rest Dm^-1. */
 static inline double piola__plastic_rest_entry(const piola_plastic_state *s, int32_t t, int k) {
@@ -73,9 +79,11 @@ void piola__plastic_commit_tet(piola_plastic_state *s, int32_t t);
  * Returns the largest singular value of the result. */
 double piola__plastic_exact_limit(double a[9], const plastic_params *p);
 
-/* The blocked update of block `block` (not for controlled states): returns the number of
- * tets that yielded, adds the limited ones to *limited, refreshes block_bound[block]. */
-int32_t piola__plastic_update_block(piola_plastic_state *s, int32_t block, int32_t *limited);
+/* The blocked update of blocks [first, end) (not for controlled states): returns the number
+ * of tets that yielded, adds the limited ones to *limited, refreshes their block_bound and
+ * writes the largest of them (at least 1) to *bound. */
+int32_t piola__plastic_update_blocks(piola_plastic_state *s, int32_t first, int32_t end, int32_t *limited,
+                                     double *bound);
 
 /* The scalar per-tet update of every tet (the path of controlled states, and the tests'
  * reference for the blocked one); same contract as piola_plastic_state_update. */

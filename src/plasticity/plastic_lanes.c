@@ -230,19 +230,10 @@ static inline __attribute__((always_inline)) int32_t flow_block(piola_plastic_st
    * data is read for one block in PIOLA_PLASTIC_REFRESH only; the two products differ by
    * rounding (the tests bound it) */
   v8 e[9];
-  const v8 *right = m;
-  if ((block & (PIOLA_PLASTIC_REFRESH - 1)) == s->refresh_phase) {
-    /* this update's share of blocks is recomputed from the rest data: rounding cannot pile
-     * up over more than PIOLA_PLASTIC_REFRESH updates */
-    const double *rest = s->rest_lanes + (size_t)block * 9 * L;
-    for (int k = 0; k < 9; ++k) e[k] = piola__f64x8_load(rest + k * L);
-    right = an;
-  } else {
-    for (int k = 0; k < 9; ++k) e[k] = piola__f64x8_load(dm_inv[k] + base);
-  }
+  for (int k = 0; k < 9; ++k) e[k] = piola__f64x8_load(dm_inv[k] + base);
   for (int i = 0; i < 3; ++i)
     for (int j = 0; j < 3; ++j) {
-      v8 eff = e[3 * i] * right[j] + e[3 * i + 1] * right[3 + j] + e[3 * i + 2] * right[6 + j];
+      v8 eff = e[3 * i] * m[j] + e[3 * i + 1] * m[3 + j] + e[3 * i + 2] * m[6 + j];
       store_lanes(dm_inv[3 * i + j] + base, eff, yielded, ybits);
     }
   piola__f64x8_store(s->alpha + base, piola__f64x8_load(s->alpha + base) + in->dl);
@@ -289,7 +280,14 @@ PIOLA_F64X8_WIDE int32_t piola__plastic_update_blocks(piola_plastic_state *s, in
     int32_t n = end - b0 < CHUNK_BLOCKS ? end - b0 : CHUNK_BLOCKS;
     for (int32_t i = 0; i < n; ++i) return_map_block(s, b0 + i, fhat, &flow[i]);
     for (int32_t i = 0; i < n; ++i)
-      if (flow[i].bits) yielded += flow_block(s, b0 + i, dm_inv, vk, &flow[i], limited);
+      if (flow[i].bits) {
+        yielded += flow_block(s, b0 + i, dm_inv, vk, &flow[i], limited);
+        /* this update's share of blocks: effective Dm^-1 recomputed from the rest data, so
+         * rounding cannot pile up over more than PIOLA_PLASTIC_REFRESH updates */
+        if (((b0 + i) & (PIOLA_PLASTIC_REFRESH - 1)) == s->refresh_phase)
+          for (int32_t t = (b0 + i) * L; t < (b0 + i + 1) * L && t < s->tet_count; ++t)
+            piola__plastic_commit_tet(s, t);
+      }
     for (int32_t i = 0; i < n; ++i) bmax = fmax(bmax, s->block_bound[b0 + i]);
   }
   *bound = bmax;

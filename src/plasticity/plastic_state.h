@@ -64,7 +64,7 @@ struct piola_plastic_state {
 /* The blocked update carries a yielding tet's effective Dm^-1 forward (old one times the
  * increment, so the rest data stays unread); every this many updates (a power of 2) each
  * block is recomputed from the rest data instead, which bounds the rounding drift. */
-#define PIOLA_PLASTIC_REFRESH 64
+#define PIOLA_PLASTIC_REFRESH 256
 
 /* Entry k (row-major) of tet t's rest Dm^-1. */
 static inline double piola__plastic_rest_entry(const piola_plastic_state *s, int32_t t, int k) {

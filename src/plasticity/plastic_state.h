@@ -11,12 +11,17 @@
  * blocks of 8 tets (PIOLA_TET_BLOCK lanes, see force/elastic_body_internal.h), on explicit
  * 8-lane vectors: the radial return with the branch-free log/exp of math/v8_logexp.h, the
  * increment M = I + V diag(exp(-delta) - 1) V^T, Fp^-1 M, cheap bounds on the singular
- * values of the result and the new effective Dm^-1 = Dm^-1,rest Fp^-1, written into the
- * body's SoA lanes with a select, so tets that do not yield keep their bits. It reads only
- * what the force loop left (Fhat and V of Fe,trial) and per-tet data that never changes
- * (the rest Dm^-1, kept in the same blocked SoA layout: block b's entry k of lane l at
- * rest_lanes[72 b + 8 k + l]). A block none of whose tets leaves the quick interval is
- * skipped after one comparison per entry.
+ * values of the result and the new effective Dm^-1 = Dm^-1,rest Fp^-1 M = (old effective
+ * Dm^-1) M, written into the body's SoA lanes with masked stores, so tets that do not yield
+ * keep their bits. On big meshes the update is bound by memory traffic (about 400 bytes per
+ * yielding tet), so it reads only what the force loop left (Fhat and V of Fe,trial), Fp^-1,
+ * and the body's effective Dm^-1 that it rewrites anyway; the rest Dm^-1 (kept in the same
+ * blocked SoA layout: block b's entry k of lane l at rest_lanes[72 b + 8 k + l]) is read only
+ * to recompute one yielding block in PIOLA_PLASTIC_REFRESH per update, which keeps the
+ * rounding of the carried product from piling up. A block none of whose tets leaves the
+ * quick interval costs one comparison per entry. Blocks go in chunks, in two passes (return
+ * map of all, then the flow of those that yield): shorter loop bodies let the processor
+ * overlap blocks, whose work is a long chain of dependent operations.
  *
  * Per-tet exceptions stay scalar: a tet whose cheap bounds leave the limit gets an exact
  * SVD and clamp (the bounds on the eigenvalues of B = Fp^-1 Fp^-T: lambda_max <= tr/3 +

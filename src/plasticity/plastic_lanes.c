@@ -136,13 +136,14 @@ static inline __attribute__((always_inline)) void return_map_block(const piola_p
   for (int l = 0; l < L; ++l) valid[l] = l < valid_count ? -1 : 0;
   v8 fh[3];
   load_fhat(fhat_all + 3 * (size_t)base, fh);
-  v8 alpha = piola__f64x8_load(s->alpha + base);
-  /* quick test: every entry inside [exp(-gamma/sqrt3), exp(gamma/sqrt3)] cannot yield */
-  v8 gamma = p->yield + p->hardening * alpha;
-  v8 lo, hi;
+  /* quick test: every entry inside [exp(-gamma/sqrt3), exp(gamma/sqrt3)] cannot yield
+   * (without hardening gamma is the same for all: the strain is not even read) */
+  v8 gamma, lo, hi;
   if (p->hardening == 0) {
+    gamma = piola__f64x8_splat(p->yield);
     lo = piola__f64x8_splat(s->quick_lo0), hi = piola__f64x8_splat(s->quick_hi0);
   } else {
+    gamma = p->yield + p->hardening * piola__f64x8_load(s->alpha + base);
     v8 r = gamma * (1.0 / 1.7320508075688772);
     lo = piola__f64x8_exp(-r), hi = piola__f64x8_exp(r);
   }

@@ -10,10 +10,10 @@
  * must stay well below the cost of a force evaluation. So it runs on the force loop's
  * blocks of 8 tets (PIOLA_TET_BLOCK lanes, see force/elastic_body_internal.h), on explicit
  * 8-lane vectors: the radial return with the branch-free log/exp of math/v8_logexp.h, the
- * increment M = I + V diag(exp(-delta) - 1) V^T, Fp^-1 M, cheap bounds on the singular
+ * increment M = V exp(-delta) V^T (from two columns of V), Fp^-1 M, cheap bounds on the singular
  * values of the result and the new effective Dm^-1 = Dm^-1,rest Fp^-1 M = (old effective
  * Dm^-1) M, written into the body's SoA lanes with masked stores, so tets that do not yield
- * keep their bits. On big meshes the update is bound by memory traffic (about 400 bytes per
+ * keep their bits. On big meshes the update is bound by memory traffic (about 390 bytes per
  * yielding tet), so it reads only what the force loop left (Fhat and V of Fe,trial), Fp^-1,
  * and the body's effective Dm^-1 that it rewrites anyway; the rest Dm^-1 (kept in the same
  * blocked SoA layout: block b's entry k of lane l at rest_lanes[72 b + 8 k + l]) is read only

@@ -117,6 +117,71 @@ static inline __attribute__((always_inline)) void store_matrices(double *m, cons
   for (int l = 0; l < L; ++l) m[9 * l + 8] = a[8][l];
 }
 
+/* The exact limit of 8 Fp^-1 at once (lanes of a, rows as in the AoS matrices): the SVD
+ * a = W Sigma Q^T by one-sided Jacobi on the rows of a (they are rotated until orthogonal;
+ * the rotations accumulate into W, the row norms become Sigma), Sigma clamped to
+ * [1/cap, cap] (= log Sigma clamped to [-limit, limit]), and out = W Sigma' W^T, rotation
+ * dropped, as piola__plastic_exact_limit does one tet at a time. One-sided Jacobi keeps the
+ * small singular values relatively accurate (unlike an eigen-decomposition of a a^T, whose
+ * condition is squared). Fixed sweeps, no branches; returns the lanes whose rows ended
+ * orthogonal to 1e-14 (the others must take the scalar path) and the largest clamped
+ * singular value in *largest. Not inlined: it runs only while tets reach the limit. */
+enum { LIMIT_SWEEPS = 4 };
+__attribute__((noinline)) PIOLA_F64X8_WIDE static m8 limit_lanes(const v8 a[9], double cap, v8 out[9],
+                                                                  v8 *largest) {
+  v8 x[3][3], w[3][3];
+  for (int i = 0; i < 3; ++i)
+    for (int c = 0; c < 3; ++c) {
+      x[i][c] = a[3 * i + c];
+      w[i][c] = piola__f64x8_splat(i == c ? 1.0 : 0.0);
+    }
+  static const int pairs[3][2] = {{0, 1}, {0, 2}, {1, 2}};
+  for (int sweep = 0; sweep < LIMIT_SWEEPS; ++sweep)
+    for (int r = 0; r < 3; ++r) {
+      const int pi = pairs[r][0], qi = pairs[r][1];
+      v8 alpha = x[pi][0] * x[pi][0] + x[pi][1] * x[pi][1] + x[pi][2] * x[pi][2];
+      v8 beta = x[qi][0] * x[qi][0] + x[qi][1] * x[qi][1] + x[qi][2] * x[qi][2];
+      v8 gamma = x[pi][0] * x[qi][0] + x[pi][1] * x[qi][1] + x[pi][2] * x[qi][2];
+      /* rows p' = c p - s q, q' = s p + c q are orthogonal for t = s / c the smaller root of
+       * gamma t^2 + 2 tau t - gamma = 0, tau = (beta - alpha) / 2:
+       * t = sign(tau) gamma / (|tau| + sqrt(tau^2 + gamma^2)); gamma = 0 gives t = 0 */
+      v8 tau = 0.5 * (beta - alpha);
+      v8 abs_tau = (v8)((m8)tau & INT64_C(0x7fffffffffffffff));
+      v8 signed_gamma = (v8)((m8)gamma ^ ((m8)tau & INT64_MIN));
+      v8 t = signed_gamma / (abs_tau + v8_sqrt(tau * tau + gamma * gamma) + 1e-300);
+      v8 c = 1.0 / v8_sqrt(1.0 + t * t), sn = c * t;
+      for (int k = 0; k < 3; ++k) {
+        v8 xp = x[pi][k], xq = x[qi][k];
+        x[pi][k] = c * xp - sn * xq;
+        x[qi][k] = sn * xp + c * xq;
+        v8 wp = w[pi][k], wq = w[qi][k];
+        w[pi][k] = c * wp - sn * wq;
+        w[qi][k] = sn * wp + c * wq;
+      }
+    }
+  m8 ok = (m8)(piola__f64x8_splat(0.0) == piola__f64x8_splat(0.0));
+  v8 norm2[3];
+  for (int i = 0; i < 3; ++i) norm2[i] = x[i][0] * x[i][0] + x[i][1] * x[i][1] + x[i][2] * x[i][2];
+  for (int r = 0; r < 3; ++r) {
+    const int pi = pairs[r][0], qi = pairs[r][1];
+    v8 gamma = x[pi][0] * x[qi][0] + x[pi][1] * x[qi][1] + x[pi][2] * x[qi][2];
+    ok &= (m8)(gamma * gamma <= 1e-28 * (norm2[pi] * norm2[qi]));
+  }
+  v8 d[3], lo = piola__f64x8_splat(1.0 / cap), hi = piola__f64x8_splat(cap);
+  for (int k = 0; k < 3; ++k) {
+    v8 sigma = v8_sqrt(norm2[k]);
+    sigma = SEL((m8)(sigma < lo), lo, sigma);
+    d[k] = SEL((m8)(sigma > hi), hi, sigma);
+  }
+  /* w[k] is column k of W (the rotations act on it as on the rows of a) */
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j)
+      out[3 * i + j] = d[0] * w[0][i] * w[0][j] + d[1] * w[1][i] * w[1][j] + d[2] * w[2][i] * w[2][j];
+  v8 m = SEL((m8)(d[0] > d[1]), d[0], d[1]);
+  *largest = SEL((m8)(d[2] > m), d[2], m);
+  return ok;
+}
+
 /* What phase 1 hands phase 2 for one block: the yielding lanes, the exponents -delta of
  * exp(-delta) and the plastic strain increments. */
 typedef struct block_flow {
@@ -228,17 +293,32 @@ static inline __attribute__((always_inline)) int32_t flow_block(piola_plastic_st
   m8 inside = (m8)(bhi <= cap * cap) & ((m8)(blo1 >= inv_cap2) | (m8)(det * det >= inv_cap2 * (bhi * bhi)));
   m8 exact = yielded & ~inside;
   v8 upper = v8_sqrt(bhi);
+  const unsigned ebits = lane_bits(exact);
+  /* tets past the limit: the vector exact limit (not with volume preservation, whose clamp
+   * keeps the sum of the log-stretches by bisection: scalar) */
+  m8 vlim = {0, 0, 0, 0, 0, 0, 0, 0};
+  unsigned vbits = 0;
+  if (ebits && !p->volume_preserving) {
+    v8 alim[9], largest;
+    vlim = limit_lanes(an, s->limit_cap, alim, &largest) & exact;
+    vbits = lane_bits(vlim);
+    for (int k = 0; k < 9; ++k) an[k] = SEL(vlim, alim[k], an[k]);
+    upper = SEL(vlim, largest, upper);
+  }
 
   /* the new effective Dm^-1 = Dm^-1,rest Fp^-1 M = (old effective Dm^-1) M into the body's
    * lanes (others keep theirs). From the old one rather than from the rest Dm^-1: the
    * body's lanes are read and written anyway (a store pulls the cache line in), so the rest
    * data is read for one block in PIOLA_PLASTIC_REFRESH only; the two products differ by
    * rounding (the tests bound it) */
-  v8 e[9];
+  v8 e[9], r[9];
   for (int k = 0; k < 9; ++k) e[k] = piola__f64x8_load(dm_inv[k] + base);
+  if (vbits) /* limited lanes: Dm^-1,rest times their new Fp^-1 */
+    for (int k = 0; k < 9; ++k) r[k] = piola__f64x8_load(s->rest_lanes + (size_t)block * 9 * L + (size_t)k * L);
   for (int i = 0; i < 3; ++i)
     for (int j = 0; j < 3; ++j) {
       v8 eff = e[3 * i] * m[j] + e[3 * i + 1] * m[3 + j] + e[3 * i + 2] * m[6 + j];
+      if (vbits) eff = SEL(vlim, r[3 * i] * an[j] + r[3 * i + 1] * an[3 + j] + r[3 * i + 2] * an[6 + j], eff);
       store_lanes(dm_inv[3 * i + j] + base, eff, yielded, ybits);
     }
   piola__f64x8_store(s->alpha + base, piola__f64x8_load(s->alpha + base) + in->dl);
@@ -250,14 +330,11 @@ static inline __attribute__((always_inline)) int32_t flow_block(piola_plastic_st
   for (int k = 0; k < 9; ++k) an[k] = SEL(yielded, an[k], a[k]);
   store_matrices(fp, an);
   const int32_t count = __builtin_popcount(ybits);
-  for (unsigned ebits = lane_bits(exact); ebits; ebits &= ebits - 1) {
-    int l = __builtin_ctz(ebits);
-    double *fl = fp + 9 * l;
-    {
-      s->stretch_bound[base + l] = piola__plastic_exact_limit(fl, p);
-      piola__plastic_commit_tet(s, base + l);
-      *limited += 1;
-    }
+  *limited += __builtin_popcount(ebits);
+  for (unsigned sbits = ebits & ~vbits; sbits; sbits &= sbits - 1) {
+    int l = __builtin_ctz(sbits);
+    s->stretch_bound[base + l] = piola__plastic_exact_limit(fp + 9 * l, p);
+    piola__plastic_commit_tet(s, base + l);
   }
   double bmax = 1.0;
   for (int l = 0; l < L; ++l) bmax = fmax(bmax, s->stretch_bound[base + l]); /* padding lanes hold 1 */

@@ -14,7 +14,7 @@
 #include "test_elastic_body_fixtures.h"
 #include "test_support.h"
 
-enum { LARGE, CHAOS, FLAT, COLLAPSED, INVERTED, BARELY, MIXED, KIND_COUNT };
+enum { LARGE, CHAOS, FLAT, COLLAPSED, INVERTED, BARELY, MIXED, ISOTROPIC, EXTREME, KIND_COUNT };
 
 /* Positions of deformation `kind` around the rest positions. */
 static void random_positions(const piola_elastic_body *body, int kind, test_rng *rng, double *x) {
@@ -24,6 +24,20 @@ static void random_positions(const piola_elastic_body *body, int kind, test_rng 
   for (int i = 0; i < 9; ++i) a[i] = (i % 4 == 0 ? 1.0 : 0.0) + 0.5 * test_rng_normal(rng);
   if (kind == FLAT) a[6] = a[7] = a[8] = 0; /* every tet rank 2 */
   if (kind == INVERTED) a[0] = -fabs(a[0]) - 0.5, a[4] = fabs(a[4]) + 0.5, a[8] = fabs(a[8]) + 0.5;
+  if (kind == ISOTROPIC) { /* equal singular values: the exact limit's degenerate case */
+    double k = test_rng_uniform(rng, 0, 1) < 0.5 ? test_rng_uniform(rng, 2, 5) : test_rng_uniform(rng, 0.2, 0.5);
+    for (int i = 0; i < 9; ++i) a[i] = (i % 4 == 0) ? k : 0.0;
+  }
+  if (kind == EXTREME) { /* R1 diag(30, 1, 1/30) R2: far past the limit both ways */
+    double r1[9], r2[9], m[9];
+    fixture_random_rotation(rng, r1);
+    fixture_random_rotation(rng, r2);
+    const double d[3] = {30.0, 1.0, 1.0 / 30.0};
+    for (int i = 0; i < 3; ++i)
+      for (int j = 0; j < 3; ++j) m[3 * i + j] = r1[3 * i + j] * d[j];
+    for (int i = 0; i < 3; ++i)
+      for (int j = 0; j < 3; ++j) a[3 * i + j] = m[3 * i] * r2[j] + m[3 * i + 1] * r2[3 + j] + m[3 * i + 2] * r2[6 + j];
+  }
   for (int32_t v = 0; v < n; ++v) {
     const double *p = rest + 3 * v;
     for (int r = 0; r < 3; ++r) {
@@ -33,6 +47,7 @@ static void random_positions(const piola_elastic_body *body, int kind, test_rng 
         case COLLAPSED: y = 0.25; break;                           /* F = 0 */
         case BARELY: y = p[r] * (1 + 1e-3) + 1e-4 * test_rng_normal(rng); break;
         case MIXED: y = (v % 3 == 0) ? p[r] + 0.2 * test_rng_normal(rng) : p[r]; break;
+        case ISOTROPIC: case EXTREME: break;
         case FLAT: y += 1e-9 * (r == 2) * test_rng_normal(rng); break;
         default: y += 0.01 * test_rng_normal(rng); break;
       }

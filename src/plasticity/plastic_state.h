@@ -23,12 +23,13 @@
  * map of all, then the flow of those that yield): shorter loop bodies let the processor
  * overlap blocks, whose work is a long chain of dependent operations.
  *
- * Per-tet exceptions stay scalar: a tet whose cheap bounds leave the limit gets an exact
- * SVD and clamp (the bounds on the eigenvalues of B = Fp^-1 Fp^-T: lambda_max <= tr/3 +
- * sqrt(2/3) |dev B|, lambda_min >= max(tr/3 - sqrt(2/3) |dev B|, det B / lambda_max^2));
- * controlled solids take the scalar per-tet path throughout (their control step works on
- * matrix logarithms per tet). The scalar path is also the reference the tests compare the
- * blocked one with.
+ * A tet whose cheap bounds leave the limit (bounds on the eigenvalues of B = Fp^-1 Fp^-T:
+ * lambda_max <= tr/3 + sqrt(2/3) |dev B|, lambda_min >= max(tr/3 - sqrt(2/3) |dev B|,
+ * det B / lambda_max^2)) gets the exact SVD and clamp on the block's lanes too (one-sided
+ * Jacobi, verified per lane). Exceptions stay scalar: a lane whose Jacobi did not converge,
+ * the limit of volume-preserving solids (a bisection), and controlled solids throughout
+ * (their control step works on matrix logarithms per tet). The scalar path is also the
+ * reference the tests compare the blocked one with.
  *
  * Determinism. Blocks are independent and the reductions are integer counts and a maximum,
  * so results are bit-for-bit the same for any thread count.

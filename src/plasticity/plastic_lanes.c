@@ -248,7 +248,7 @@ static inline __attribute__((always_inline)) int32_t flow_block(piola_plastic_st
   /* M = V exp(-delta) V^T, so Fp^-1 <- Fp^-1 M. With columns v0, v1, v2 of the rotation V
    * (v0 v0^T + v1 v1^T + v2 v2^T = I) and G = exp(-delta):
    *   M = G2 I + (G0 - G2) v0 v0^T + (G1 - G2) v1 v1^T,
-   * so the third column of V is never read (a quarter less V traffic, fewer products), and
+   * so the third column of V is never read (a third less V traffic, fewer products), and
    * a lane with delta = 0 (G = 1) gets M = I exactly */
   v8 G[3];
   for (int i = 0; i < 3; ++i) G[i] = piola__f64x8_exp(in->minus_delta[i]);

@@ -386,7 +386,7 @@ static void red_green_alone_is_conforming(void **state) {
   double h = 0.5;
   piola__bcc_lattice lattice;
   assert_int_equal(piola__bcc_lattice_build(vec3_make(-2, -2, -2), vec3_make(2, 2, 2), h, 1 << 24, &lattice), PIOLA_OK);
-  piola_tet_mesh before = {lattice.vertex_count, lattice.positions, lattice.tet_count, lattice.tets, NULL};
+  piola_tet_mesh before = {lattice.vertex_count, lattice.positions, lattice.tet_count, lattice.tets, NULL, NULL};
   int32_t *hull = NULL;
   mesh_report r0 = analyse(&before, &hull);
   piola_mesher_def def = piola_default_mesher_def();
@@ -400,7 +400,7 @@ static void red_green_alone_is_conforming(void **state) {
   soup.phi = malloc((size_t)soup.vertex_count * sizeof(double));
   assert_int_equal(piola__lattice_phi(&shapes, soup.positions, soup.vertex_count, soup.tets, soup.tet_count, 1.5 * h, soup.phi), PIOLA_OK);
   assert_int_equal(piola__red_green_refine(&soup, &shapes, 2, h), PIOLA_OK);
-  piola_tet_mesh after = {soup.vertex_count, soup.positions, soup.tet_count, soup.tets, NULL};
+  piola_tet_mesh after = {soup.vertex_count, soup.positions, soup.tet_count, soup.tets, NULL, NULL};
   int32_t *hull_after = NULL;
   mesh_report r1 = analyse(&after, &hull_after);
   printf("  red-green alone: %d -> %d tets, volume %.12g -> %.12g, dihedral min %.2f, outer faces %d -> %d\n",

@@ -141,12 +141,18 @@ static void every_key_reaches_its_definition(void **state) {
   assert_close(piola_track_eval(&o->motion.translation[0], 0.25), 0.25, 1e-15);
   assert_close(piola_track_eval(&o->motion.angle, 0), 0.5, 0);
   assert_close(o->motion.pivot.x, 1, 0); /* defaults to the centre */
+  assert_close(o->motion.axis.z, 1, 0);   /* a sphere has no axis: z */
   o = &d.obstacles[2].def;
   assert_int_equal(o->type, PIOLA_OBSTACLE_GEAR);
   assert_int_equal(o->tooth_count, 12);
   assert_close(o->tooth_depth, 0.05, 0);
   assert_close(o->half_length, 0.1, 0);
   assert_close(piola_track_eval(&o->motion.angular_speed, 3), 1.5, 0);
+  /* A gear spins about its own axis (y here) unless the motion names another one. */
+  assert_close(o->motion.axis.x, 0, 0);
+  assert_close(o->motion.axis.y, 1, 0);
+  assert_close(o->motion.axis.z, 0, 0);
+  assert_close(o->motion.pivot.x, 0, 0);
   assert_int_equal(d.obstacles[3].def.type, PIOLA_OBSTACLE_MESH);
   assert_string_equal(d.obstacles[3].mesh_path, "dir/bowl.obj");
   piola__scene_desc_free(&d);

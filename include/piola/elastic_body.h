@@ -40,6 +40,11 @@ typedef struct piola_elastic_body_def {
   int32_t material_count;
   const int32_t *tet_materials;     /* tet_count indices into materials, or NULL: all use 0 */
   double density;                   /* kg/m^3, > 0. Default 1000 */
+  const double *fiber_directions;   /* 3 per tet: the fibre direction of each tet in rest
+                                       (material) space, normalised on copy; a zero or
+                                       non-finite one is an error naming the tet. NULL
+                                       (default): no fibres. Used by tets whose material is
+                                       PIOLA_MODEL_MUSCLE (paper section 6.1) */
 } piola_elastic_body_def;
 
 PIOLA_API piola_elastic_body_def piola_default_elastic_body_def(void);
@@ -58,8 +63,16 @@ PIOLA_API const double *piola_elastic_body_rest_positions(const piola_elastic_bo
 PIOLA_API const double *piola_elastic_body_masses(const piola_elastic_body *body);
 /* Smallest rest altitude over all tets, m: the length in the CFL condition. */
 PIOLA_API double piola_elastic_body_min_rest_altitude(const piola_elastic_body *body);
-/* Largest dilatational wave speed sqrt((lambda + 2 mu) / density) over the materials, m/s. */
+/* Largest dilatational wave speed sqrt((lambda + 2 mu + fibre modulus) / density) over the
+ * materials, m/s (the fibre modulus is piola_material.fiber_modulus, 0 without fibres). */
 PIOLA_API double piola_elastic_body_max_wave_speed(const piola_elastic_body *body);
+
+/* Activation of the muscle fibres (dimensionless, clamped to [0, 1]; NaN gives 0), used by
+ * the next updates. Default 0: fibres are passive. */
+PIOLA_API void piola_elastic_body_set_activation(piola_elastic_body *body, double activation);
+PIOLA_API double piola_elastic_body_activation(const piola_elastic_body *body);
+/* Fibre directions in rest space, 3 per tet (unit), or NULL when the body has none. */
+PIOLA_API const double *piola_elastic_body_fiber_directions(const piola_elastic_body *body);
 
 typedef struct piola_elastic_stats {
   double elastic_energy;   /* J */

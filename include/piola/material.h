@@ -46,6 +46,10 @@ typedef enum piola_material_model {
   PIOLA_MODEL_STVK,               /* St. Venant-Kirchhoff: Fhat (2 mu E + lambda tr(E) I) */
   PIOLA_MODEL_NEOHOOKEAN,         /* mu (Fhat - Fhat^-1) + lambda ln(J) Fhat^-1 */
   PIOLA_MODEL_SPLINE,             /* the paper's "biological" model: see piola_spline_def */
+  PIOLA_MODEL_MUSCLE,             /* transversely isotropic muscle (section 6.1): the isotropic
+                                     part (matrix + volume) is neo-Hookean with E, nu; the
+                                     fibre part is piola_material_fiber_stress. See
+                                     piola_muscle_def and docs/materials.md */
   PIOLA_MODEL_COUNT
 } piola_material_model;
 
@@ -62,6 +66,29 @@ typedef struct piola_spline_def {
                                  the slope at rest. Default 10 */
 } piola_spline_def;
 
+/* The fibre part of PIOLA_MODEL_MUSCLE. With lambda = |F a| the stretch along the unit fibre
+ * direction a (material space), the fibre carries a tension T(lambda) (Pa, force per rest
+ * area across the fibre) and never a compression:
+ *   passive  T_p = 0 for lambda <= 1; a quadratic toe whose slope rises from 0 to
+ *            passive_stiffness up to passive_toe_stretch; linear with that slope beyond.
+ *   active   T_a = activation * max_active_stress * L((lambda / optimal_stretch - 1) / active_width)
+ *            with the force-length bump L(s) = (1 - s^2)^2 for |s| < 1, else 0.
+ * Energy density psi_f = integral from 1 to lambda of T; stress P_f = (T / lambda) F a a^T,
+ * which in the diagonal frame is Fhat times the symmetric (T / lambda) ahat ahat^T with
+ * ahat = V^T a (paper section 6.1). */
+typedef struct piola_muscle_def {
+  double passive_stiffness;   /* Pa, >= 0: slope of the passive fibre tension past the toe.
+                                 Default 1e5 */
+  double passive_toe_stretch; /* dimensionless, > 1: where the passive slope is reached.
+                                 Default 1.2 */
+  double max_active_stress;   /* Pa, >= 0: isometric tension at full activation and optimal
+                                 stretch. Default 1e5 */
+  double optimal_stretch;     /* dimensionless, > 0: fibre stretch of peak active tension.
+                                 Default 1 (the rest length is optimal) */
+  double active_width;        /* dimensionless, in (0, 1): half width of the force-length
+                                 bump, relative to optimal_stretch. Default 0.5 */
+} piola_muscle_def;
+
 typedef struct piola_material_def {
   piola_material_model model;
   double youngs_modulus;      /* Pa, > 0. Default 1e5 */
@@ -69,6 +96,9 @@ typedef struct piola_material_def {
   double inversion_threshold; /* dimensionless, in (0, 1): compression threshold c. Default 0.3 */
   piola_inversion_mode inversion_mode; /* Default PIOLA_INVERSION_LINEAR */
   piola_spline_def spline;    /* used by PIOLA_MODEL_SPLINE only */
+  piola_muscle_def muscle;    /* used by PIOLA_MODEL_MUSCLE only; youngs_modulus and
+                                 poisson_ratio give its matrix and volume part (use nu close
+                                 to 0.5, e.g. 0.45, for a quasi-incompressible muscle) */
 } piola_material_def;
 
 /* The defaults above, written once. */
@@ -87,6 +117,10 @@ typedef struct piola_material {
   double threshold;           /* dimensionless compression threshold c */
   piola_inversion_mode inversion_mode;
   double spline_coefficients[16]; /* precomputed spline pieces, model-internal */
+  piola_muscle_def muscle;    /* PIOLA_MODEL_MUSCLE: the validated fibre parameters */
+  double fiber_modulus;       /* Pa: bound on the fibre's tangent stiffness at full activation
+                                 (0 for other models), added to lambda + 2 mu in the CFL
+                                 wave speed */
 } piola_material;
 
 /* Checks def (E > 0, nu in (-1, 0.5), threshold in (0, 1), spline shape) and fills out.
@@ -106,7 +140,40 @@ PIOLA_API double piola_material_energy_density(const piola_material *material, c
 PIOLA_API void piola_material_stress_derivative(const piola_material *material,
                                                 const double fhat[3], double dphat[3][3]);
 
-/* Name used in scene files: "rotated_linear", "corotated", "stvk", "neohookean", "spline". */
+/* ------------------------------------------------------------------ muscle fibres
+ * For a PIOLA_MODEL_MUSCLE material (all zero for other models). fiber is the fibre
+ * direction in the frame of the diagonalization, ahat = V^T a (any length; it is normalised,
+ * a zero vector means no fibre); activation (dimensionless) is clamped to [0, 1]. The
+ * functions above give the isotropic part; these give the fibre part and the sum. */
+
+/* Fibre tension T (Pa) at fibre stretch lambda >= 0. */
+PIOLA_API double piola_material_fiber_tension(const piola_material *material, double stretch,
+                                              double activation);
+
+/* Fibre part of the stress in the diagonal frame, Pa: phat[i][j] = (T / lambda) f_i ahat_i
+ * ahat_j = (Fhat S)_ij with S symmetric. Finite for every fhat (flat and inverted too). */
+PIOLA_API void piola_material_fiber_stress(const piola_material *material, const double fhat[3],
+                                           const double fiber[3], double activation,
+                                           double phat[3][3]);
+
+/* Fibre energy density, J/m^3: the integral of T from stretch 1 to lambda = |Fhat ahat|. */
+PIOLA_API double piola_material_fiber_energy_density(const piola_material *material,
+                                                     const double fhat[3], const double fiber[3],
+                                                     double activation);
+
+/* The whole muscle stress in the diagonal frame: diag(piola_material_stress) plus the fibre
+ * part. P = U phat V^T. */
+PIOLA_API void piola_material_muscle_stress(const piola_material *material, const double fhat[3],
+                                            const double fiber[3], double activation,
+                                            double phat[3][3]);
+
+/* Isotropic plus fibre energy density, J/m^3. */
+PIOLA_API double piola_material_muscle_energy_density(const piola_material *material,
+                                                      const double fhat[3], const double fiber[3],
+                                                      double activation);
+
+/* Name used in scene files: "rotated_linear", "corotated", "stvk", "neohookean", "spline",
+ * "muscle". */
 PIOLA_API const char *piola_material_model_name(piola_material_model model);
 
 /* Parses a scene-file name; false if unknown. */

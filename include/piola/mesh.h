@@ -23,6 +23,10 @@ typedef struct piola_tet_mesh {
   int32_t tet_count;
   int32_t *tets;          /* 4 * tet_count vertex indices */
   int32_t *tet_regions;   /* tet_count region ids (physical group, attribute, ref), or NULL */
+  double *tet_fibers;     /* 3 * tet_count fibre directions (muscle, wood...) in world space,
+                             dimensionless, as given (not normalized), or NULL when the file has
+                             none. Read from a .vtu cell array or a .msh $ElementData named
+                             "fiber" or "fibers" (docs/file-formats.md) */
 } piola_tet_mesh;
 
 typedef struct piola_tri_mesh {
@@ -38,7 +42,16 @@ PIOLA_API void piola_tri_mesh_free(piola_tri_mesh *mesh);
 /* Deep copy. */
 PIOLA_API piola_status piola_tet_mesh_copy(const piola_tet_mesh *source, piola_tet_mesh *out);
 
-/* Checks counts, index ranges and finite positions; names the first offending entry. */
+/* Maps the mesh by x' = linear x + translation (positions in m) and carries its fibres
+ * along as material directions: d' = linear d, rescaled to the length of d (unit fibres stay
+ * unit; a zero fibre stays zero). det(linear) must be > 0 so tets keep their orientation;
+ * a singular or mirroring map or non-finite entries are refused and leave the mesh as it
+ * was. With linear = R S (a rotation times a scale) this is the scene's `transform`. */
+PIOLA_API piola_status piola_tet_mesh_transform(piola_tet_mesh *mesh, piola_mat3 linear,
+                                                piola_vec3 translation);
+
+/* Checks counts, index ranges, finite positions and finite fibres; names the first
+ * offending entry. */
 PIOLA_API piola_status piola_tet_mesh_validate(const piola_tet_mesh *mesh);
 
 /* Signed volume of tet t, (x1-x0) . ((x2-x0) x (x3-x0)) / 6, in m^3. */

@@ -19,5 +19,6 @@
 #include "piola/status.h"
 #include "piola/threads.h"
 #include "piola/world.h"
+#include "piola/world_bones.h"
 
 #endif

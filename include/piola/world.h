@@ -76,12 +76,13 @@ typedef struct piola_constraint_def {
   piola_rigid_motion_def motion; /* used when driven */
 } piola_constraint_def;
 
-/* Self-collision of a solid's boundary surface, with itself and with every other solid that
- * has it enabled (Bridson, Fedkiw and Anderson 2002; docs/contact.md), processed after every
- * step, outside it (paper section 9). */
+/* Self-collision of a solid's boundary surface (or of a shell's triangles, piola_shell_def),
+ * with itself and with every other solid or shell that has it enabled (Bridson, Fedkiw and
+ * Anderson 2002; docs/contact.md), processed after every step, outside it (paper section 9).
+ * Contact between two bodies is two-way: impulses act on both. */
 typedef struct piola_self_collision_def {
   bool enabled;     /* Default false */
-  double thickness; /* m, > 0: boundary pairs closer than this repel. Default 1e-3 */
+  double thickness; /* m, > 0: surface pairs closer than this repel. Default 1e-3 */
   double friction;  /* Coulomb coefficient, >= 0. Default 0.3 */
 } piola_self_collision_def;
 
@@ -105,6 +106,13 @@ typedef struct piola_solid_def {
   const piola_plasticity_def *plasticity; /* NULL (default): purely elastic. Read by
                                      add_solid only (goal positions included) */
   piola_self_collision_def self_collision; /* default: off */
+  /* Muscle fibres (paper section 6.1; material.model PIOLA_MODEL_MUSCLE, see
+   * piola_muscle_def): the fibre direction of each tet in rest space, 3 per tet, copied and
+   * normalised (a zero one is an error naming the tet). NULL (default): no fibres. Not
+   * supported together with plasticity. */
+  const double *fiber_directions;
+  piola_track activation;         /* dimensionless, in [0, 1], keyframable: the fibres'
+                                     activation, set every step. Default 0 */
 } piola_solid_def;
 
 PIOLA_API piola_solid_def piola_default_solid_def(void);

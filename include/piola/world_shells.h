@@ -16,7 +16,12 @@
  * outward. Only the part of a node's path within the longest boundary edge of the surface
  * is searched, so a node that got deeper than that is not found. The solids do not feel the
  * shell.
-
+ *
+ * Two-way contact (self_collision): the shell's own triangles, edges and vertices join the
+ * world's collision surface (world_contact.c), with its thickness as the repulsion distance
+ * and its lumped masses, so it collides with itself, with other shells and with the solids
+ * that have self_collision too, and the impulses act on both sides. Against such a solid the
+ * one-way coupling above is skipped, so the two never act on the same pair.
  *
  *   piola_shell_def def = piola_default_shell_def();
  *   def.mesh = &cloth;                 // rest shape in world space, m
@@ -54,6 +59,11 @@ typedef struct piola_shell_def {
   int32_t constraint_count;
   bool collide_with_solids;       /* one-way coupling to the solids' surfaces. Default false */
   double solid_friction;          /* Coulomb mu against the solids, >= 0. Default 0.3 */
+  /* Two-way contact through the collision module (BFA02, docs/contact.md): the shell's
+   * triangles join the world's collision surface, so the shell collides with itself, with
+   * other shells and with solids that have self_collision enabled, and impulses act on both
+   * sides. Default: off */
+  piola_self_collision_def self_collision;
 } piola_shell_def;
 
 PIOLA_API piola_shell_def piola_default_shell_def(void);

@@ -134,6 +134,7 @@ static int info_tets(const char *path, int json) {
     cJSON_AddNumberToObject(o, "vertices", m.vertex_count);
     cJSON_AddNumberToObject(o, "tets", m.tet_count);
     cJSON_AddNumberToObject(o, "boundary_faces", boundary.triangle_count);
+    cJSON_AddBoolToObject(o, "fibers", m.tet_fibers != NULL);
     cJSON_AddNumberToObject(o, "volume", q.volume);
     cJSON_AddNumberToObject(o, "min_tet_volume", q.min_volume);
     cJSON_AddNumberToObject(o, "max_tet_volume", q.max_volume);
@@ -164,6 +165,7 @@ static int info_tets(const char *path, int json) {
     printf("vertices:         %d\n", (int)m.vertex_count);
     printf("tets:             %d\n", (int)m.tet_count);
     printf("boundary faces:   %d\n", (int)boundary.triangle_count);
+    printf("fibres:           %s\n", m.tet_fibers ? "one direction per tet" : "none");
     printf("volume:           %.9g m^3 (tets from %.3g to %.3g m^3)\n", q.volume, q.min_volume, q.max_volume);
     printf("regions:         ");
     for (int32_t i = 0; i < m.tet_count;) {

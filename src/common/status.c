@@ -4,6 +4,7 @@
 
 #include <stdarg.h>
 #include <stdio.h>
+#include <string.h>
 
 static _Thread_local char last_error_message[1024];
 
@@ -26,9 +27,13 @@ const char *piola_last_error(void) { return last_error_message; }
 void piola_clear_error(void) { last_error_message[0] = '\0'; }
 
 piola_status piola__fail(piola_status status, const char *format, ...) {
+  /* Callers often wrap the last message ("%s: solids[0]: %s", ..., piola_last_error()):
+   * format into a copy first, as the arguments may point into the buffer being written. */
+  char message[sizeof last_error_message];
   va_list args;
   va_start(args, format);
-  vsnprintf(last_error_message, sizeof last_error_message, format, args);
+  vsnprintf(message, sizeof message, format, args);
   va_end(args);
+  memcpy(last_error_message, message, sizeof message);
   return status;
 }

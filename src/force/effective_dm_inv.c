@@ -22,3 +22,12 @@ void piola__elastic_body_get_rotations(const piola_elastic_body *body, int32_t t
     if (v) v[k] = body->v[k][t];
   }
 }
+
+void piola__elastic_body_plastic_lanes(piola_elastic_body *body, double *dm_inv[9], const double *v[9],
+                                       int32_t *padded_tet_count) {
+  for (int k = 0; k < 9; ++k) {
+    dm_inv[k] = body->dm_inv[k];
+    v[k] = body->v[k];
+  }
+  *padded_tet_count = body->padded_tet_count;
+}

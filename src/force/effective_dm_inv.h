@@ -24,4 +24,10 @@ const double *piola__elastic_body_rest_volumes(const piola_elastic_body *body);
 void piola__elastic_body_get_rotations(const piola_elastic_body *body, int32_t t, double u[9],
                                        double v[9]);
 
+/* The SoA lanes the blocked plastic update works on: entry k (row-major) of tet t's
+ * effective Dm^-1 is dm_inv[k][t], of its V from the last update v[k][t], for t below
+ * *padded_tet_count (a multiple of 8; padding tets have Dm^-1 = 0). */
+void piola__elastic_body_plastic_lanes(piola_elastic_body *body, double *dm_inv[9], const double *v[9],
+                                       int32_t *padded_tet_count);
+
 #endif

@@ -11,6 +11,7 @@
 
 #include "common/status_internal.h"
 #include "force/elastic_body_internal.h"
+#include "force/fiber_lanes.h"
 #include "force/material_lanes.h"
 #include "force/svd_kernel.h"
 #include "math/mat3.h"
@@ -69,7 +70,8 @@ const double *piola_elastic_body_energy_density(const piola_elastic_body *body) 
     for (int32_t t = 0; t < body->tet_count; ++t)
       mutable_body->energy_density[t] =
           body->last_stiffness_scale *
-          piola_material_energy_density(&body->materials[body->tet_material[t]], body->fhat + 3 * t);
+          (piola_material_energy_density(&body->materials[body->tet_material[t]], body->fhat + 3 * t) +
+           piola__fiber_energy_density(body, t));
     mutable_body->energy_valid = 1;
   }
   return body->energy_density;
@@ -95,14 +97,46 @@ void piola__elastic_body_gather_forces(const piola_elastic_body *body, double *f
   }
 }
 
-/* One block of B tets: F, SVD, stress, forces into the per-tet buffer, block statistics. */
-PIOLA_WIDE_VECTORS static void update_block(piola_elastic_body *body, const double *x, double stiffness_scale,
-                         int want_energy, int32_t block, double *out) {
+/* F = Ds Dm^-1 and det F of the B tets of one block (f[k][lane], entry k row-major). */
+PIOLA_WIDE_VECTORS PIOLA_KERNEL_INLINE void block_deformation_gradients(const piola_elastic_body *body,
+                                                                        const double *x, int32_t block,
+                                                                        double f[9][B], double detf[B]) {
   const int32_t base = block * B;
-  double f[9][B], detf[B];
   const int32_t *i0 = body->tet_vertices[0] + base, *i1 = body->tet_vertices[1] + base;
   const int32_t *i2 = body->tet_vertices[2] + base, *i3 = body->tet_vertices[3] + base;
   double *const *dmi = body->dm_inv;
+#if defined(__AVX512F__)
+  {
+    /* 8-wide gathers by hand: GCC splits the gathers of the loop below into 4-wide ones
+     * (int32 indices), two per coordinate; one 8-wide vgatherdpd each halves them */
+    const __m256i three = _mm256_set1_epi32(3);
+    __m256i ia = _mm256_mullo_epi32(_mm256_loadu_si256((const __m256i *)i0), three);
+    __m256i ib = _mm256_mullo_epi32(_mm256_loadu_si256((const __m256i *)i1), three);
+    __m256i ic = _mm256_mullo_epi32(_mm256_loadu_si256((const __m256i *)i2), three);
+    __m256i id = _mm256_mullo_epi32(_mm256_loadu_si256((const __m256i *)i3), three);
+    piola_v8d ds[3][3];
+    PIOLA_UNROLL
+    for (int k = 0; k < 3; ++k) {
+      piola_v8d xa = (piola_v8d)_mm512_i32gather_pd(ia, x + k, 8);
+      ds[k][0] = (piola_v8d)_mm512_i32gather_pd(ib, x + k, 8) - xa;
+      ds[k][1] = (piola_v8d)_mm512_i32gather_pd(ic, x + k, 8) - xa;
+      ds[k][2] = (piola_v8d)_mm512_i32gather_pd(id, x + k, 8) - xa;
+    }
+    piola_v8d m[9];
+    PIOLA_UNROLL
+    for (int k = 0; k < 9; ++k) m[k] = piola__v8_load(dmi[k] + base);
+    piola_v8d fv[9];
+    PIOLA_UNROLL
+    for (int i = 0; i < 3; ++i)
+      PIOLA_UNROLL
+      for (int j = 0; j < 3; ++j) {
+        fv[3 * i + j] = ds[i][0] * m[j] + ds[i][1] * m[3 + j] + ds[i][2] * m[6 + j];
+        piola__v8_store(f[3 * i + j], fv[3 * i + j]);
+      }
+    piola__v8_store(detf, fv[0] * (fv[4] * fv[8] - fv[5] * fv[7]) - fv[1] * (fv[3] * fv[8] - fv[5] * fv[6]) +
+                              fv[2] * (fv[3] * fv[7] - fv[4] * fv[6]));
+  }
+#else
 #pragma omp simd
   for (int l = 0; l < B; ++l) {
     /* index arithmetic, not pointers, so GCC emits vector gathers */
@@ -125,26 +159,37 @@ PIOLA_WIDE_VECTORS static void update_block(piola_elastic_body *body, const doub
               f02 * (f10 * f21 - f11 * f20);
   }
 
-  /* U and V go straight into the body's SoA arrays (stride padded_tet_count) */
-  double fhat[3][B];
-  double *uo = body->u[0] + base, *vo = body->v[0] + base;
-  const long stride = body->padded_tet_count;
-  piola__svd3_kernel_v8(&f[0][0], B, uo, vo, stride, &fhat[0][0], B);
+#endif
+}
 
-  double phat[3][B], psi[B];
-  piola__material_stress_lanes(body, base, fhat, phat);
+/* The rest of count (1 or 2) consecutive blocks once their F, U, V (in the body's arrays),
+ * Fhat and stress are known: P, nodal forces added into out in tet order, per-tet state,
+ * block statistics. Consecutive blocks are consecutive in every per-tet array, so the two
+ * blocks of a pair are one lane loop of 2 B lanes, whose halves the compiler interleaves.
+ * fhat, phat and detf hold lane l of entry i at [i * 2 B + l]. */
+#define LANES (2 * B)
+PIOLA_WIDE_VECTORS PIOLA_KERNEL_INLINE void finish_blocks(piola_elastic_body *body, double stiffness_scale,
+                                                          int want_energy, int32_t first, int count,
+                                                          const double *fhat, const double *phat,
+                                                          const double *detf, double *out) {
+  const int32_t base = first * B;
+  const int lanes = count * B;
+  double *const *dmi = body->dm_inv;
+  const double *uo = body->u[0] + base, *vo = body->v[0] + base;
+  const long stride = body->padded_tet_count;
+  double psi[LANES];
   if (want_energy)
-    for (int l = 0; l < B; ++l) {
-      double fh[3] = {fhat[0][l], fhat[1][l], fhat[2][l]};
+    for (int l = 0; l < lanes; ++l) {
+      double fh[3] = {fhat[l], fhat[LANES + l], fhat[2 * LANES + l]};
       psi[l] = piola_material_energy_density(&body->materials[body->tet_material[base + l]], fh);
     }
 
   const double *volume = body->rest_volume + base;
-  double tf[12 * B]; /* this block's 12 rows (3 corner + component) of B lanes */
+  double tf[12 * LANES]; /* 12 rows (3 corner + component) of LANES lanes */
 #pragma omp simd
-  for (int l = 0; l < B; ++l) {
-    double p0 = phat[0][l] * stiffness_scale, p1 = phat[1][l] * stiffness_scale,
-           p2 = phat[2][l] * stiffness_scale;
+  for (int l = 0; l < lanes; ++l) {
+    double p0 = phat[l] * stiffness_scale, p1 = phat[LANES + l] * stiffness_scale,
+           p2 = phat[2 * LANES + l] * stiffness_scale;
     /* P = U diag(phat) V^T */
     double pm[3][3];
     PIOLA_UNROLL
@@ -163,48 +208,106 @@ PIOLA_WIDE_VECTORS static void update_block(piola_elastic_body *body, const doub
       for (int j = 0; j < 3; ++j) {
         double g = w * (pm[i][0] * dmi[3 * j][base + l] + pm[i][1] * dmi[3 * j + 1][base + l] +
                         pm[i][2] * dmi[3 * j + 2][base + l]);
-        tf[(3 * (j + 1) + i) * B + l] = g;
+        tf[(3 * (j + 1) + i) * LANES + l] = g;
         g0 -= g;
       }
-      tf[i * B + l] = g0;
+      tf[i * LANES + l] = g0;
     }
   }
 
-  /* add the block's forces into out, tet by tet in order (padding tets are skipped) */
-  int32_t real_tets = body->tet_count - base < B ? body->tet_count - base : B;
+  if (body->fiber[0]) /* muscle fibres (fiber_lanes.h), block by block */
+    for (int k = 0; k < count; ++k) {
+      double fh[3][B], tfk[12 * B] = {0}, psik[B] = {0};
+      for (int i = 0; i < 3; ++i)
+        for (int l = 0; l < B; ++l) fh[i][l] = fhat[i * LANES + k * B + l];
+      piola__fiber_forces_lanes(body, base + k * B, fh, stiffness_scale, tfk,
+                                want_energy ? psik : NULL);
+      for (int r = 0; r < 12; ++r)
+        for (int l = 0; l < B; ++l) tf[r * LANES + k * B + l] += tfk[r * B + l];
+      if (want_energy)
+        for (int l = 0; l < B; ++l) psi[k * B + l] += psik[l];
+    }
+
+  /* add the forces into out, tet by tet in order (padding tets are skipped) */
+  int32_t real_tets = body->tet_count - base < lanes ? body->tet_count - base : lanes;
   for (int l = 0; l < real_tets; ++l)
     for (int c = 0; c < 4; ++c) {
       double *o = out + 3 * (size_t)body->tet_vertices[c][base + l];
-      o[0] += tf[(3 * c) * B + l];
-      o[1] += tf[(3 * c + 1) * B + l];
-      o[2] += tf[(3 * c + 2) * B + l];
+      o[0] += tf[(3 * c) * LANES + l];
+      o[1] += tf[(3 * c + 1) * LANES + l];
+      o[2] += tf[(3 * c + 2) * LANES + l];
     }
 
   /* per-tet state for the getters (fhat AoS as the public API has it), then statistics,
    * which only a caller asking for stats needs */
   double *fhat_out = body->fhat + 3 * (size_t)base, *det_out = body->det_f + base;
 #pragma omp simd
-  for (int l = 0; l < B; ++l) {
-    fhat_out[3 * l] = fhat[0][l];
-    fhat_out[3 * l + 1] = fhat[1][l];
-    fhat_out[3 * l + 2] = fhat[2][l];
+  for (int l = 0; l < lanes; ++l) {
+    fhat_out[3 * l] = fhat[l];
+    fhat_out[3 * l + 1] = fhat[LANES + l];
+    fhat_out[3 * l + 2] = fhat[2 * LANES + l];
     det_out[l] = detf[l];
   }
   if (!want_energy) return;
-  int32_t real = body->tet_count - base < B ? body->tet_count - base : B;
-  double energy = 0, min_det = INFINITY;
-  int32_t inverted = 0;
-  for (int l = 0; l < B; ++l) {
-    body->energy_density[base + l] = psi[l] * stiffness_scale;
-    if (l < real) {
-      energy += volume[l] * psi[l] * stiffness_scale;
-      inverted += detf[l] < 0;
-      min_det = fmin(min_det, detf[l]);
+  for (int k = 0; k < count; ++k) {
+    const int32_t block = first + k, bbase = block * B;
+    int32_t real = body->tet_count - bbase < B ? body->tet_count - bbase : B;
+    double energy = 0, min_det = INFINITY;
+    int32_t inverted = 0;
+    for (int l = k * B; l < (k + 1) * B; ++l) {
+      body->energy_density[base + l] = psi[l] * stiffness_scale;
+      if (l - k * B < real) {
+        energy += volume[l] * psi[l] * stiffness_scale;
+        inverted += detf[l] < 0;
+        min_det = fmin(min_det, detf[l]);
+      }
     }
+    body->block_energy[block] = energy;
+    body->block_inverted[block] = inverted;
+    body->block_min_det[block] = min_det;
   }
-  body->block_energy[block] = energy;
-  body->block_inverted[block] = inverted;
-  body->block_min_det[block] = min_det;
+}
+
+/* count (1 or 2) consecutive blocks from first: F of each, their SVDs (two blocks have their
+ * Jacobi rotations interleaved, see piola_svd8 in svd_kernel.h; the results are the same as
+ * one at a time), then the rest block by block, in order. U and V go straight into the
+ * body's SoA arrays (stride padded_tet_count). */
+PIOLA_WIDE_VECTORS static void update_blocks(piola_elastic_body *body, const double *x, double stiffness_scale,
+                                             int want_energy, int32_t first, int count, double *out) {
+  /* Fhat and the stress of both blocks side by side, [entry][2 B lanes], so that the stress
+   * of the pair is one lane loop of 2 B independent lanes */
+  double f[2][9][B], detf[2][B], fhat[3][2 * B], phat[3][2 * B];
+  double *u = body->u[0], *v = body->v[0];
+  const long stride = body->padded_tet_count;
+  const int32_t base0 = first * B, base1 = (first + 1) * B;
+  block_deformation_gradients(body, x, first, f[0], detf[0]);
+  if (count == 2) {
+    block_deformation_gradients(body, x, first + 1, f[1], detf[1]);
+    piola__svd3_kernel_v8x2(&f[0][0][0], &f[1][0][0], B, u + base0, v + base0, u + base1, v + base1,
+                            stride, &fhat[0][0], &fhat[0][B], 2 * B);
+    piola__material_stress_lanes2(body, base0, fhat, phat);
+  } else {
+    piola__svd3_kernel_v8(&f[0][0][0], B, u + base0, v + base0, stride, &fhat[0][0], 2 * B);
+    double fh1[3][B], ph1[3][B];
+    for (int i = 0; i < 3; ++i)
+      for (int l = 0; l < B; ++l) fh1[i][l] = fhat[i][l];
+    piola__material_stress_lanes(body, base0, fh1, ph1);
+    for (int i = 0; i < 3; ++i)
+      for (int l = 0; l < B; ++l) phat[i][l] = ph1[i][l];
+  }
+  if (count == 2)
+    finish_blocks(body, stiffness_scale, want_energy, first, 2, &fhat[0][0], &phat[0][0], &detf[0][0], out);
+  else
+    finish_blocks(body, stiffness_scale, want_energy, first, 1, &fhat[0][0], &phat[0][0], &detf[0][0], out);
+}
+
+#undef LANES
+
+/* Blocks [b0, b1) in pairs (the pairing depends only on b0 and b1, not on threads). */
+static void update_block_range(piola_elastic_body *body, const double *x, double stiffness_scale,
+                               int want_energy, int32_t b0, int32_t b1, double *out) {
+  for (int32_t b = b0; b < b1; b += 2)
+    update_blocks(body, x, stiffness_scale, want_energy, b, b1 - b >= 2 ? 2 : 1, out);
 }
 
 static int positions_are_finite(const double *x, int32_t n) {
@@ -231,7 +334,7 @@ piola_status piola_elastic_body_update(piola_elastic_body *body, const double *x
   const int64_t n = 3 * (int64_t)body->vertex_count;
   if (blocks < PIOLA_PARALLEL_MIN_BLOCKS || !body->damping_chunk_forces) {
     for (int64_t i = 0; i < n; ++i) forces[i] = 0.0;
-    for (int32_t b = 0; b < blocks; ++b) update_block(body, x, stiffness_scale, stats != NULL, b, forces);
+    update_block_range(body, x, stiffness_scale, stats != NULL, 0, blocks, forces);
   } else {
     /* Determinism without a per-tet buffer (as in damping.c): PIOLA_DAMPING_CHUNKS fixed
      * ranges of blocks, each summed in tet order into its own array, the arrays added in
@@ -245,7 +348,7 @@ piola_status piola_elastic_body_update(piola_elastic_body *body, const double *x
         for (int64_t i = 0; i < n; ++i) fk[i] = 0.0;
         int32_t b0 = (int32_t)((int64_t)blocks * k / PIOLA_DAMPING_CHUNKS);
         int32_t b1 = (int32_t)((int64_t)blocks * (k + 1) / PIOLA_DAMPING_CHUNKS);
-        for (int32_t b = b0; b < b1; ++b) update_block(body, x, stiffness_scale, stats != NULL, b, fk);
+        update_block_range(body, x, stiffness_scale, stats != NULL, b0, b1, fk);
       }
 #pragma omp for schedule(static)
       for (int64_t i = 0; i < n; ++i) {
@@ -302,6 +405,16 @@ piola_status piola__elastic_body_update_reference(const piola_elastic_body *body
     piola_material_stress(material, fh, ph);
     double psi = piola_material_energy_density(material, fh) * stiffness_scale;
     mat3 p = mat3_mul_diag_transpose(u, vec3_scale(vec3_make(ph[0], ph[1], ph[2]), stiffness_scale), v);
+    if (body->fiber[0]) { /* fibre part in the diagonal frame, ahat = V^T a (section 6.1) */
+      vec3 a = vec3_make(body->fiber[0][t], body->fiber[1][t], body->fiber[2][t]);
+      vec3 ah = mat3_mul_vec(mat3_transpose(v), a);
+      double ahat[3] = {ah.x, ah.y, ah.z}, pf[3][3];
+      piola_material_fiber_stress(material, fh, ahat, body->activation, pf);
+      mat3 pfm;
+      for (int k = 0; k < 9; ++k) pfm.m[k / 3][k % 3] = pf[k / 3][k % 3] * stiffness_scale;
+      p = mat3_add(p, mat3_mul(mat3_mul(u, pfm), mat3_transpose(v)));
+      psi += piola_material_fiber_energy_density(material, fh, ahat, body->activation) * stiffness_scale;
+    }
     mat3 g = mat3_scale(mat3_mul_transpose_b(p, dm_inv), -body->rest_volume[t]);
     vec3 g0 = vec3_make(0, 0, 0);
     for (int c = 1; c < 4; ++c) {

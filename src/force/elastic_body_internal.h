@@ -20,6 +20,9 @@
  * place, so forces are bit-for-bit identical for any thread count, without atomics. (The
  * per-tet buffer tet_forces and the incidence list below were the previous scheme.)
  * Statistics are summed per block and then serially over blocks for the same reason.
+ * Within a range, blocks go through the loop in pairs whose SVDs are interleaved (see
+ * piola_svd8 in svd_kernel.h); the pairing depends only on the range, and the paired SVD
+ * gives exactly the single one's bits, so it changes nothing either.
  *
  * The energy density is computed only when asked for (stats or the getter): stepping needs
  * forces, not energy, and the energy goes through the (scalar) public material function.
@@ -74,6 +77,12 @@ struct piola_elastic_body {
   double *block_energy;
   int32_t *block_inverted;
   double *block_min_det;
+
+  /* muscle fibres (fiber_lanes.c): unit direction in rest space per padded tet (SoA, padding
+   * tets 0), or all NULL when the body has none; the AoS public copy; the activation */
+  double *fiber[3];
+  double *fiber_aos;
+  double activation;
 
   /* materials */
   piola_material *materials;

@@ -7,6 +7,7 @@
 
 #include "common/status_internal.h"
 #include "force/elastic_body_internal.h"
+#include "force/fiber_lanes.h"
 #include "mesh/element_input.h"
 #include "math/mat3.h"
 
@@ -44,6 +45,8 @@ void piola__elastic_body_free_arrays(piola_elastic_body *body) {
   free(body->positions);
   free(body->damping_data);
   free(body->damping_chunk_forces);
+  for (int k = 0; k < 3; ++k) free(body->fiber[k]);
+  free(body->fiber_aos);
   memset(body, 0, sizeof *body);
 }
 
@@ -166,6 +169,7 @@ piola_status piola__elastic_body_build_rest_state(piola_elastic_body *body,
   /* padding tets: zero Dm^-1 and volume, all corners at vertex 0, the first material */
   for (int32_t t = nt; t < np; ++t) body->tet_material[t] = body->uniform_material >= 0 ? body->uniform_material : 0;
   body->min_rest_altitude = min_altitude;
+  PIOLA_TRY(piola__fiber_copy(body, def));
 
   /* incidence: counting sort of (tet, corner) by vertex, so each list is in tet order */
   for (int32_t t = 0; t < nt; ++t)
@@ -183,7 +187,8 @@ piola_status piola__elastic_body_build_rest_state(piola_elastic_body *body,
   double speed = 0;
   for (int32_t m = 0; m < def->material_count; ++m) {
     const piola_material *mat = &def->materials[m];
-    speed = fmax(speed, sqrt(fmax(0.0, mat->lambda + 2.0 * mat->mu) / def->density));
+    speed = fmax(speed, sqrt(fmax(0.0, mat->lambda + 2.0 * mat->mu + mat->fiber_modulus) /
+                              def->density));
   }
   body->max_wave_speed = speed;
   for (int32_t t = 0; t < np; ++t) {

@@ -193,11 +193,21 @@ PIOLA_KERNEL_INLINE piola_v8d piola__v8_rsqrt(piola_v8d x) {
     t_ = v2i; v2i = PIOLA_V8_SELECT(swap_, v2j, v2i); v2j = PIOLA_V8_SELECT(swap_, -t_, v2j); \
   } while (0)
 
-/* piola__svd3_kernel on 8 matrices: entry k of F for lanes 0..7 is f[k * in_stride + 0..7],
- * and likewise for U, V (out_stride) and Fhat (fhat_stride). Same steps, same conventions. */
-PIOLA_KERNEL_INLINE void piola__svd3_kernel_v8(const double *f, long in_stride, double *u,
-                                               double *v, long out_stride, double *fhat,
-                                               long fhat_stride) {
+/* The state of 8 diagonalizations between their steps: the normalized F (a), its scale, the
+ * symmetric S = F^T F being diagonalized and the accumulated V. The kernel is split into a
+ * beginning, Jacobi rotations and an end so that two independent blocks can be interleaved
+ * rotation by rotation (piola__svd3_kernel_v8x2): each rotation waits for the previous one
+ * (the angle needs the updated S), so one block's rotations leave most of the core idle
+ * for their latency, and a second, independent chain fills it. Every lane's arithmetic is
+ * the same in both forms, so the results are identical bit for bit. */
+typedef struct piola_svd8 {
+  piola_v8d a00, a01, a02, a10, a11, a12, a20, a21, a22, scale;
+  piola_v8d s00, s11, s22, s01, s02, s12;
+  piola_v8d v00, v01, v02, v10, v11, v12, v20, v21, v22;
+} piola_svd8;
+
+/* Loads entry k of F for lanes 0..7 from f[k * in_stride + 0..7], normalizes it, forms S. */
+PIOLA_KERNEL_INLINE void piola__svd8_begin(piola_svd8 *st, const double *f, long in_stride) {
   const piola_v8d zero = piola__v8_splat(0.0), one = piola__v8_splat(1.0);
   piola_v8d a00 = piola__v8_load(f), a01 = piola__v8_load(f + in_stride),
             a02 = piola__v8_load(f + 2 * in_stride), a10 = piola__v8_load(f + 3 * in_stride),
@@ -226,19 +236,39 @@ PIOLA_KERNEL_INLINE void piola__svd3_kernel_v8(const double *f, long in_stride, 
   piola_v8d s12 = a01 * a02 + a11 * a12 + a21 * a22;
   piola_v8d v00 = one, v01 = zero, v02 = zero, v10 = zero, v11 = one, v12 = zero, v20 = zero,
             v21 = zero, v22 = one;
-  /* r = sqrt(d^2 + e^2) only tilts the angle: the first sweeps take it from the bare
-   * estimate (angle off by ~1e-4 of itself, which later sweeps correct), the third refines
-   * it once (6e-9), the last to an ulp (worst random-matrix reconstruction 1e-14 -> 2e-15) */
-#define PIOLA_V8_SWEEP(rsqrt_r)                                                                   \
-  PIOLA_V8_JACOBI(rsqrt_r, s00, s11, s22, s01, s02, s12, v00, v01, v02, v10, v11, v12, v20, v21, v22); \
-  PIOLA_V8_JACOBI(rsqrt_r, s00, s22, s11, s02, s01, s12, v00, v02, v01, v10, v12, v11, v20, v22, v21); \
-  PIOLA_V8_JACOBI(rsqrt_r, s11, s22, s00, s12, s01, s02, v01, v02, v00, v11, v12, v10, v21, v22, v20)
-  PIOLA_UNROLL
-  for (int sweep = 2; sweep < PIOLA_SVD_JACOBI_SWEEPS; ++sweep) { PIOLA_V8_SWEEP(piola__v8_rsqrt_estimate); }
-  PIOLA_V8_SWEEP(piola__v8_rsqrt_refined);
-  PIOLA_V8_SWEEP(piola__v8_rsqrt);
-#undef PIOLA_V8_SWEEP
+  st->a00 = a00; st->a01 = a01; st->a02 = a02; st->a10 = a10; st->a11 = a11; st->a12 = a12;
+  st->a20 = a20; st->a21 = a21; st->a22 = a22; st->scale = scale;
+  st->s00 = s00; st->s11 = s11; st->s22 = s22; st->s01 = s01; st->s02 = s02; st->s12 = s12;
+  st->v00 = v00; st->v01 = v01; st->v02 = v02; st->v10 = v10; st->v11 = v11; st->v12 = v12;
+  st->v20 = v20; st->v21 = v21; st->v22 = v22;
+}
 
+/* The three rotations of a cyclic sweep, as (p, q, k) = (0, 1, 2), (0, 2, 1), (1, 2, 0). */
+#define PIOLA_V8_ROTATION_01(st, rsqrt_r)                                                      \
+  PIOLA_V8_JACOBI(rsqrt_r, (st).s00, (st).s11, (st).s22, (st).s01, (st).s02, (st).s12, (st).v00, \
+                  (st).v01, (st).v02, (st).v10, (st).v11, (st).v12, (st).v20, (st).v21, (st).v22)
+#define PIOLA_V8_ROTATION_02(st, rsqrt_r)                                                      \
+  PIOLA_V8_JACOBI(rsqrt_r, (st).s00, (st).s22, (st).s11, (st).s02, (st).s01, (st).s12, (st).v00, \
+                  (st).v02, (st).v01, (st).v10, (st).v12, (st).v11, (st).v20, (st).v22, (st).v21)
+#define PIOLA_V8_ROTATION_12(st, rsqrt_r)                                                      \
+  PIOLA_V8_JACOBI(rsqrt_r, (st).s11, (st).s22, (st).s00, (st).s12, (st).s01, (st).s02, (st).v01, \
+                  (st).v02, (st).v00, (st).v11, (st).v12, (st).v10, (st).v21, (st).v22, (st).v20)
+
+/* r = sqrt(d^2 + e^2) only tilts the angle: the first sweeps take it from the bare estimate
+ * (angle off by ~1e-4 of itself, which later sweeps correct), the next to last refines it
+ * once (6e-9), the last to an ulp (worst random-matrix reconstruction 1e-14 -> 2e-15). */
+#define PIOLA_V8_SWEEP_RSQRT(sweep)                                                    \
+  ((sweep) == PIOLA_SVD_JACOBI_SWEEPS - 1 ? 2 : (sweep) == PIOLA_SVD_JACOBI_SWEEPS - 2 ? 1 : 0)
+
+/* V normalized, B = F V with its columns sorted, U by Gram-Schmidt, Fhat; stores U, V (entry
+ * k at k * out_stride) and Fhat (entry i at i * fhat_stride). */
+PIOLA_KERNEL_INLINE void piola__svd8_finish(const piola_svd8 *st, double *u, double *v,
+                                            long out_stride, double *fhat, long fhat_stride) {
+  const piola_v8d zero = piola__v8_splat(0.0), one = piola__v8_splat(1.0);
+  const piola_v8d a00 = st->a00, a01 = st->a01, a02 = st->a02, a10 = st->a10, a11 = st->a11,
+                  a12 = st->a12, a20 = st->a20, a21 = st->a21, a22 = st->a22, scale = st->scale;
+  piola_v8d v00 = st->v00, v01 = st->v01, v02 = st->v02, v10 = st->v10, v11 = st->v11,
+            v12 = st->v12, v20 = st->v20, v21 = st->v21, v22 = st->v22;
   piola_v8d kv = piola__v8_rsqrt(v00 * v00 + v10 * v10 + v20 * v20);
   v00 *= kv; v01 *= kv; v02 *= kv;
   v10 *= kv; v11 *= kv; v12 *= kv;
@@ -309,6 +339,70 @@ PIOLA_KERNEL_INLINE void piola__svd3_kernel_v8(const double *f, long in_stride, 
   piola__v8_store(v + 4 * out_stride, v11); piola__v8_store(v + 5 * out_stride, v12);
   piola__v8_store(v + 6 * out_stride, v20); piola__v8_store(v + 7 * out_stride, v21);
   piola__v8_store(v + 8 * out_stride, v22);
+}
+
+/* piola__svd3_kernel on 8 matrices: entry k of F for lanes 0..7 is f[k * in_stride + 0..7],
+ * and likewise for U, V (out_stride) and Fhat (fhat_stride). Same steps, same conventions. */
+PIOLA_KERNEL_INLINE void piola__svd3_kernel_v8(const double *f, long in_stride, double *u,
+                                               double *v, long out_stride, double *fhat,
+                                               long fhat_stride) {
+  piola_svd8 st;
+  piola__svd8_begin(&st, f, in_stride);
+  PIOLA_UNROLL
+  for (int sweep = 0; sweep < PIOLA_SVD_JACOBI_SWEEPS; ++sweep) {
+    switch (PIOLA_V8_SWEEP_RSQRT(sweep)) {
+      case 0:
+        PIOLA_V8_ROTATION_01(st, piola__v8_rsqrt_estimate);
+        PIOLA_V8_ROTATION_02(st, piola__v8_rsqrt_estimate);
+        PIOLA_V8_ROTATION_12(st, piola__v8_rsqrt_estimate);
+        break;
+      case 1:
+        PIOLA_V8_ROTATION_01(st, piola__v8_rsqrt_refined);
+        PIOLA_V8_ROTATION_02(st, piola__v8_rsqrt_refined);
+        PIOLA_V8_ROTATION_12(st, piola__v8_rsqrt_refined);
+        break;
+      default:
+        PIOLA_V8_ROTATION_01(st, piola__v8_rsqrt);
+        PIOLA_V8_ROTATION_02(st, piola__v8_rsqrt);
+        PIOLA_V8_ROTATION_12(st, piola__v8_rsqrt);
+        break;
+    }
+  }
+  piola__svd8_finish(&st, u, v, out_stride, fhat, fhat_stride);
+}
+
+/* Two independent blocks of 8 (F at fa and fb, same in_stride; outputs at ua, va, fhata and
+ * ub, vb, fhatb), their rotations interleaved: the same results as two calls of
+ * piola__svd3_kernel_v8, in less time (see piola_svd8). */
+PIOLA_KERNEL_INLINE void piola__svd3_kernel_v8x2(const double *fa, const double *fb, long in_stride,
+                                                 double *ua, double *va, double *ub, double *vb,
+                                                 long out_stride, double *fhata, double *fhatb,
+                                                 long fhat_stride) {
+  piola_svd8 sa, sb;
+  piola__svd8_begin(&sa, fa, in_stride);
+  piola__svd8_begin(&sb, fb, in_stride);
+  PIOLA_UNROLL
+  for (int sweep = 0; sweep < PIOLA_SVD_JACOBI_SWEEPS; ++sweep) {
+    switch (PIOLA_V8_SWEEP_RSQRT(sweep)) {
+      case 0:
+        PIOLA_V8_ROTATION_01(sa, piola__v8_rsqrt_estimate); PIOLA_V8_ROTATION_01(sb, piola__v8_rsqrt_estimate);
+        PIOLA_V8_ROTATION_02(sa, piola__v8_rsqrt_estimate); PIOLA_V8_ROTATION_02(sb, piola__v8_rsqrt_estimate);
+        PIOLA_V8_ROTATION_12(sa, piola__v8_rsqrt_estimate); PIOLA_V8_ROTATION_12(sb, piola__v8_rsqrt_estimate);
+        break;
+      case 1:
+        PIOLA_V8_ROTATION_01(sa, piola__v8_rsqrt_refined); PIOLA_V8_ROTATION_01(sb, piola__v8_rsqrt_refined);
+        PIOLA_V8_ROTATION_02(sa, piola__v8_rsqrt_refined); PIOLA_V8_ROTATION_02(sb, piola__v8_rsqrt_refined);
+        PIOLA_V8_ROTATION_12(sa, piola__v8_rsqrt_refined); PIOLA_V8_ROTATION_12(sb, piola__v8_rsqrt_refined);
+        break;
+      default:
+        PIOLA_V8_ROTATION_01(sa, piola__v8_rsqrt); PIOLA_V8_ROTATION_01(sb, piola__v8_rsqrt);
+        PIOLA_V8_ROTATION_02(sa, piola__v8_rsqrt); PIOLA_V8_ROTATION_02(sb, piola__v8_rsqrt);
+        PIOLA_V8_ROTATION_12(sa, piola__v8_rsqrt); PIOLA_V8_ROTATION_12(sb, piola__v8_rsqrt);
+        break;
+    }
+  }
+  piola__svd8_finish(&sa, ua, va, out_stride, fhata, fhat_stride);
+  piola__svd8_finish(&sb, ub, vb, out_stride, fhatb, fhat_stride);
 }
 
 /* For benchmarks and tests: n matrices, row-major AoS (9 each), through the kernel in

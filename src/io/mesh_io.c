@@ -190,16 +190,16 @@ piola_status piola_tet_mesh_write(const char *path, const piola_tet_mesh *mesh) 
   if (strcasecmp(ext, ".vtu") == 0) {
     piola_vtu_frame frame = {0};
     frame.tets = mesh;
-    piola_vtu_field region = {"region", 1, NULL};
+    piola_vtu_field fields[2];
     double *values = NULL;
     if (mesh->tet_regions) {
       values = malloc((size_t)mesh->tet_count * sizeof(double) + 1);
       if (!values) return PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "out of memory");
       for (int32_t t = 0; t < mesh->tet_count; ++t) values[t] = mesh->tet_regions[t];
-      region.values = values;
-      frame.cell_fields = &region;
-      frame.cell_field_count = 1;
+      fields[frame.cell_field_count++] = (piola_vtu_field){"region", 1, values};
     }
+    if (mesh->tet_fibers) fields[frame.cell_field_count++] = (piola_vtu_field){"fiber", 3, mesh->tet_fibers};
+    frame.cell_fields = fields;
     piola_status s = piola_vtu_write(path, &frame);
     free(values);
     return s;

@@ -38,7 +38,15 @@ typedef struct gmsh_reader {
   uint64_t *tet_nodes;
   int32_t *tet_regions;
   int32_t *tet_lines; /* ASCII files: line of each tet */
+  uint64_t *tet_tags; /* element tag of each tet, for $ElementData */
   size_t tet_count, tet_capacity;
+  /* fibres: the $ElementData named "fiber" or "fibers", by element tag until mapped */
+  int have_fibers;
+  char fiber_name[8];
+  long fiber_line;
+  uint64_t *fiber_tags;
+  double *fiber_values;
+  size_t fiber_count;
 } gmsh_reader;
 
 static piola_status binary_error(const gmsh_reader *g, const char *format, const char *what) {
@@ -127,12 +135,16 @@ static piola_status reserve_tets(gmsh_reader *g, size_t more) {
   int32_t *l = realloc(g->tet_lines, cap * sizeof(int32_t));
   if (!l) return PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "%s: out of memory", g->s.name);
   g->tet_lines = l;
+  uint64_t *tags = realloc(g->tet_tags, cap * sizeof(uint64_t));
+  if (!tags) return PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "%s: out of memory", g->s.name);
+  g->tet_tags = tags;
   return PIOLA_OK;
 }
 
-static piola_status add_tet(gmsh_reader *g, const uint64_t *nodes, int32_t region) {
+static piola_status add_tet(gmsh_reader *g, uint64_t tag, const uint64_t *nodes, int32_t region) {
   if (g->tet_count + 1 > g->tet_capacity) PIOLA_TRY(reserve_tets(g, g->tet_capacity + 1));
   g->tet_lines[g->tet_count] = (int32_t)g->s.line;
+  g->tet_tags[g->tet_count] = tag;
   memcpy(g->tet_nodes + 4 * g->tet_count, nodes, 4 * sizeof(uint64_t));
   g->tet_regions[g->tet_count++] = region;
   return PIOLA_OK;
@@ -350,7 +362,7 @@ static piola_status read_elements_v4(gmsh_reader *g) {
         PIOLA_TRY(get_size(g, &v, "element node"));
         if (k < 4) nodes[k] = v;
       }
-      if (keep) PIOLA_TRY(add_tet(g, nodes, region));
+      if (keep) PIOLA_TRY(add_tet(g, tag, nodes, region));
     }
     seen += n;
   }
@@ -383,7 +395,7 @@ static piola_status read_nodes_v2(gmsh_reader *g) {
   return expect_end(g, "Nodes");
 }
 
-static piola_status read_element_body_v2(gmsh_reader *g, int32_t type, int32_t ntags) {
+static piola_status read_element_body_v2(gmsh_reader *g, int32_t id, int32_t type, int32_t ntags) {
   int npe = nodes_of_type(type);
   if (npe == 0) {
     if (g->binary) return PIOLA_FAIL(PIOLA_ERROR_UNSUPPORTED, "%s: byte %lld: unknown element type %d", g->s.name,
@@ -404,7 +416,7 @@ static piola_status read_element_body_v2(gmsh_reader *g, int32_t type, int32_t n
     if (v < 0) return piola__scan_error(&g->s, PIOLA_ERROR_PARSE, "negative node tag %d", v);
     if (k < 4) nodes[k] = (uint64_t)v;
   }
-  if (is_tet_type(type)) PIOLA_TRY(add_tet(g, nodes, region));
+  if (is_tet_type(type)) PIOLA_TRY(add_tet(g, (uint64_t)(uint32_t)id, nodes, region));
   return PIOLA_OK;
 }
 
@@ -419,7 +431,7 @@ static piola_status read_elements_v2(gmsh_reader *g) {
       PIOLA_TRY(get_int(g, &id, "element id"));
       PIOLA_TRY(get_int(g, &type, "element type"));
       PIOLA_TRY(get_int(g, &ntags, "tag count"));
-      PIOLA_TRY(read_element_body_v2(g, type, ntags));
+      PIOLA_TRY(read_element_body_v2(g, id, type, ntags));
       if (piola__scan_more_on_line(&g->s))
         return piola__scan_error(&g->s, PIOLA_ERROR_PARSE, "element %d: more values than its type %d and %d tags need", id,
                                  type, ntags);
@@ -435,7 +447,7 @@ static piola_status read_elements_v2(gmsh_reader *g) {
       for (int32_t e = 0; e < count; ++e) {
         int32_t id;
         PIOLA_TRY(get_int(g, &id, "element id"));
-        PIOLA_TRY(read_element_body_v2(g, type, ntags));
+        PIOLA_TRY(read_element_body_v2(g, id, type, ntags));
       }
       seen += (uint64_t)count;
     }
@@ -443,11 +455,150 @@ static piola_status read_elements_v2(gmsh_reader *g) {
   return expect_end(g, "Elements");
 }
 
-/* Tag -> index: a dense table when tags are compact, else a sorted list. */
+/* Orders (tag, index) pairs by tag. */
 static int cmp_pair(const void *a, const void *b) {
   const uint64_t *x = a, *y = b;
   return x[0] < y[0] ? -1 : x[0] > y[0];
 }
+
+/* $ElementData: a text header (string tags: the name first; real tags: the time; integer
+ * tags: time step, component count, entry count[, partition]) and then, per entry, an
+ * element tag and the values (binary in binary files: a 4-byte int tag, also in 4.1). Only a view named "fiber" or
+ * "fibers" is kept, as the tets' fibre directions; any other view is skipped. */
+static piola_status read_element_data(gmsh_reader *g) {
+  long line = g->s.line;
+  int binary = g->binary;
+  g->binary = 0; /* the header is text in both encodings */
+  int32_t nstrings = 0, nreals = 0, nints = 0;
+  char name[64] = "";
+  PIOLA_TRY(get_int(g, &nstrings, "string tag count"));
+  if (nstrings < 0 || nstrings > 100) return piola__scan_error(&g->s, PIOLA_ERROR_PARSE, "bad string tag count %d", nstrings);
+  for (int32_t k = 0; k < nstrings; ++k) {
+    /* a quoted string; it may hold blanks, so take tokens up to the closing quote */
+    char text[64] = "";
+    size_t used = 0;
+    for (;;) {
+      const char *tok;
+      size_t len;
+      if (!piola__scan_skip(&g->s)) return piola__scan_error(&g->s, PIOLA_ERROR_PARSE, "unexpected end of $ElementData");
+      PIOLA_TRY(piola__scan_token(&g->s, &tok, &len, "a string tag"));
+      if (used > 0 && used + 1 < sizeof text) text[used++] = ' ';
+      for (size_t c = 0; c < len && used + 1 < sizeof text; ++c) text[used++] = tok[c];
+      text[used] = '\0';
+      if (text[0] != '"' || (used >= 2 && text[used - 1] == '"')) break;
+    }
+    if (k == 0) {
+      const char *b = text[0] == '"' ? text + 1 : text;
+      snprintf(name, sizeof name, "%s", b);
+      size_t n = strlen(name);
+      while (n > 0 && (name[n - 1] == '"' || name[n - 1] == ' ')) name[--n] = '\0';
+    }
+  }
+  PIOLA_TRY(get_int(g, &nreals, "real tag count"));
+  if (nreals < 0 || nreals > 100) return piola__scan_error(&g->s, PIOLA_ERROR_PARSE, "bad real tag count %d", nreals);
+  for (int32_t k = 0; k < nreals; ++k) {
+    double ignored;
+    PIOLA_TRY(get_double(g, &ignored, "real tag"));
+  }
+  PIOLA_TRY(get_int(g, &nints, "integer tag count"));
+  if (nints < 0 || nints > 100) return piola__scan_error(&g->s, PIOLA_ERROR_PARSE, "bad integer tag count %d", nints);
+  int32_t ints[4] = {0, 0, 0, 0};
+  long component_line = g->s.line;
+  for (int32_t k = 0; k < nints; ++k) {
+    int32_t v;
+    PIOLA_TRY(get_int(g, &v, "integer tag"));
+    if (k < 4) ints[k] = v;
+    if (k == 1) component_line = g->s.line;
+  }
+  int fiber = strcmp(name, "fiber") == 0 || strcmp(name, "fibers") == 0;
+  if (!fiber) {
+    g->binary = binary;
+    return skip_section(g, "ElementData");
+  }
+  if (g->have_fibers)
+    return piola__scan_error(&g->s, PIOLA_ERROR_PARSE, "a second $ElementData named \"%s\" (the first is \"%s\" at line %ld)",
+                             name, g->fiber_name, g->fiber_line);
+  if (nints < 3)
+    return piola__scan_error(&g->s, PIOLA_ERROR_PARSE,
+                             "$ElementData \"%s\" needs the integer tags time step, component count and entry count", name);
+  if (ints[1] != 3)
+    return PIOLA_FAIL(PIOLA_ERROR_PARSE,
+                      "%s:%ld: $ElementData \"%s\" has %d components, expected 3 (a fibre direction per element)",
+                      g->s.name, component_line, name, (int)ints[1]);
+  if (ints[2] < 0) return piola__scan_error(&g->s, PIOLA_ERROR_PARSE, "$ElementData \"%s\": negative entry count", name);
+  g->binary = binary;
+  size_t count = (size_t)ints[2];
+  PIOLA_TRY(check_count(g, count, 8, "$ElementData entry count")); /* "1 0 0 0\n" */
+  g->have_fibers = 1;
+  g->fiber_line = line;
+  snprintf(g->fiber_name, sizeof g->fiber_name, "%s", name);
+  g->fiber_tags = malloc((count + 1) * sizeof(uint64_t));
+  g->fiber_values = malloc((3 * count + 1) * sizeof(double));
+  if (!g->fiber_tags || !g->fiber_values) return PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "%s: out of memory", g->s.name);
+  to_binary_data(g);
+  for (size_t e = 0; e < count; ++e) {
+    /* post-processing views keep 4-byte element tags in binary, in 4.1 too */
+    int32_t tag32;
+    int64_t tag64;
+    if (g->binary) {
+      PIOLA_TRY(get_int(g, &tag32, "element tag"));
+      tag64 = tag32;
+    } else {
+      PIOLA_TRY(piola__scan_int64(&g->s, &tag64, "element tag"));
+    }
+    if (tag64 < 0) return piola__scan_error(&g->s, PIOLA_ERROR_PARSE, "negative element tag %lld", (long long)tag64);
+    g->fiber_tags[e] = (uint64_t)tag64;
+    for (int k = 0; k < 3; ++k) PIOLA_TRY(get_double(g, &g->fiber_values[3 * e + (size_t)k], "fibre component"));
+    g->fiber_count = e + 1;
+    if (!g->binary && piola__scan_more_on_line(&g->s))
+      return piola__scan_error(&g->s, PIOLA_ERROR_PARSE, "$ElementData \"%s\": more than 3 values for element %llu",
+                               name, (unsigned long long)g->fiber_tags[e]);
+  }
+  return expect_end(g, "ElementData");
+}
+
+/* Gives every tet its fibre from the $ElementData entries (matched by element tag); entries
+ * of other elements (triangles...) are ignored, and a tet without one is an error. */
+static piola_status map_fibers(gmsh_reader *g, piola_tet_mesh *out) {
+  size_t nt = g->tet_count;
+  uint64_t *pairs = malloc(2 * nt * sizeof(uint64_t) + 1);
+  uint8_t *given = calloc(nt + 1, 1);
+  out->tet_fibers = malloc(3 * nt * sizeof(double) + 1);
+  if (!pairs || !given || !out->tet_fibers) {
+    free(pairs);
+    free(given);
+    return PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "%s: out of memory", g->s.name);
+  }
+  for (size_t t = 0; t < nt; ++t) pairs[2 * t] = g->tet_tags[t], pairs[2 * t + 1] = t;
+  qsort(pairs, nt, 2 * sizeof(uint64_t), cmp_pair);
+  size_t missing = nt;
+  for (size_t e = 0; e < g->fiber_count; ++e) {
+    size_t lo = 0, hi = nt;
+    while (lo < hi) {
+      size_t mid = (lo + hi) / 2;
+      if (pairs[2 * mid] < g->fiber_tags[e]) lo = mid + 1;
+      else hi = mid;
+    }
+    if (lo >= nt || pairs[2 * lo] != g->fiber_tags[e]) continue; /* not a tet */
+    size_t t = pairs[2 * lo + 1];
+    memcpy(out->tet_fibers + 3 * t, g->fiber_values + 3 * e, 3 * sizeof(double));
+    if (!given[t]) --missing;
+    given[t] = 1;
+  }
+  size_t first = 0;
+  while (first < nt && given[first]) ++first;
+  free(pairs);
+  free(given);
+  if (missing)
+    return PIOLA_FAIL(PIOLA_ERROR_PARSE,
+                      "%s:%ld: $ElementData \"%s\" has %zu entries but %zu of the %zu tets have no fibre "
+                      "(the first is element %llu)",
+                      g->s.name, g->fiber_line, g->fiber_name, g->fiber_count, missing, nt,
+                      (unsigned long long)g->tet_tags[first]);
+  return PIOLA_OK;
+}
+
+/* Tag -> index: a dense table when tags are compact, else a sorted list. */
 
 static piola_status map_tags(gmsh_reader *g, piola_tet_mesh *out) {
   size_t n = g->node_count;
@@ -537,6 +688,8 @@ static piola_status parse(gmsh_reader *g, piola_tet_mesh *out) {
       if (have_elements) return piola__scan_error(&g->s, PIOLA_ERROR_UNSUPPORTED, "more than one $Elements section");
       PIOLA_TRY(g->version == 4 ? read_elements_v4(g) : read_elements_v2(g));
       have_elements = 1;
+    } else if (strcmp(name, "ElementData") == 0) {
+      PIOLA_TRY(read_element_data(g));
     } else if (strcmp(name, "Entities") == 0 && g->version == 4 && !g->have_entities) {
       PIOLA_TRY(read_entities(g));
     } else {
@@ -554,6 +707,7 @@ static piola_status parse(gmsh_reader *g, piola_tet_mesh *out) {
   g->positions = NULL;
   out->tet_regions = g->tet_regions;
   g->tet_regions = NULL;
+  if (g->have_fibers) PIOLA_TRY(map_fibers(g, out));
   if (!out->positions) {
     out->positions = malloc(1);
     if (!out->positions) return PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "%s: out of memory", g->s.name);
@@ -574,6 +728,9 @@ piola_status piola__read_gmsh_mem(const char *name, const char *data, size_t siz
   free(g.tet_nodes);
   free(g.tet_regions);
   free(g.tet_lines);
+  free(g.tet_tags);
+  free(g.fiber_tags);
+  free(g.fiber_values);
   if (status != PIOLA_OK) piola_tet_mesh_free(out);
   return status;
 }

@@ -6,7 +6,8 @@
  * the corners of quadratic tets, 24; triangles: 5 and the corners of 22) with every
  * numeric point and cell field; the renderer builds its frames from it. The tet mesh reader
  * (piola_tet_mesh_read) sits on top: it keeps the tets, turns a cell field named "region"
- * into tet_regions and orients the mesh. Every count and offset is checked against the
+ * into tet_regions and one named "fiber" or "fibers" (3 components) into tet_fibers, and
+ * orients the mesh. Every count and offset is checked against the
  * file size before anything is read or allocated, so a truncated frame of a running
  * simulation fails cleanly. The XML is scanned for the few tags needed, not parsed in full:
  * this is an exchange format reader, not a general XML parser. Refused: compressed data,
@@ -417,7 +418,8 @@ piola_status piola_vtu_read(const char *path, piola_vtu_data *out) {
   return status;
 }
 
-/* The tet mesh of a VTU file: its tets, a cell field "region" as tet_regions, oriented. */
+/* The tet mesh of a VTU file: its tets, a cell field "region" as tet_regions, a 3-component
+ * cell field "fiber" or "fibers" as tet_fibers, oriented. */
 piola_status piola__read_vtu_mem(const char *name, const char *data, size_t size, piola_tet_mesh *out) {
   memset(out, 0, sizeof *out);
   piola_vtu_data vtu;
@@ -431,6 +433,27 @@ piola_status piola__read_vtu_mem(const char *name, const char *data, size_t size
       double reg = region->values[(size_t)region->components * (size_t)vtu.tet_cells[t]];
       out->tet_regions[t] = fabs(reg) < 2e9 ? (int32_t)lround(reg) : 0;
     }
+  }
+  /* fibres: a 3-component cell array "fiber" (or "fibers"), one direction per tet */
+  const piola_vtu_array *fiber = piola_vtu_find_field(vtu.cell_fields, vtu.cell_field_count, "fiber");
+  if (!fiber) fiber = piola_vtu_find_field(vtu.cell_fields, vtu.cell_field_count, "fibers");
+  if (status == PIOLA_OK && fiber) {
+    if (fiber->components != 3)
+      status = PIOLA_FAIL(PIOLA_ERROR_PARSE,
+                          "%s: CellData array '%s' has %d components, expected 3 (a fibre direction per cell)",
+                          name, fiber->name, fiber->components);
+    else if (!(out->tet_fibers = malloc(3 * (size_t)vtu.tet_count * sizeof(double) + 1)))
+      status = PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "%s: out of memory", name);
+    for (int32_t t = 0; status == PIOLA_OK && t < vtu.tet_count; ++t)
+      for (int k = 0; k < 3; ++k) {
+        double v = fiber->values[3 * (size_t)vtu.tet_cells[t] + (size_t)k];
+        if (!isfinite(v)) {
+          status = PIOLA_FAIL(PIOLA_ERROR_PARSE, "%s: CellData array '%s': cell %d has a non-finite value",
+                              name, fiber->name, (int)vtu.tet_cells[t]);
+          break;
+        }
+        out->tet_fibers[3 * (size_t)t + (size_t)k] = v;
+      }
   }
   out->vertex_count = vtu.point_count;
   out->positions = vtu.positions;

@@ -3,7 +3,8 @@
  * One volume entity per distinct region id, carrying that id as its physical group (ids <= 0
  * cannot be physical tags in Gmsh: such entities get none). Nodes in one block with tags
  * 1..N. Elements in blocks of consecutive tets with the same region, so reading the file
- * back gives the tets in their original order. */
+ * back gives the tets in their original order. Fibres (tet_fibers) follow as an
+ * $ElementData view named "fiber" with 3 components, written to read back exactly. */
 #include <stdlib.h>
 #include <string.h>
 
@@ -97,6 +98,20 @@ piola_status piola__write_gmsh41(const char *path, const piola_tet_mesh *mesh) {
     t = e;
   }
   fprintf(o, "$EndElements\n");
+  if (mesh->tet_fibers) {
+    /* one view "fiber": time 0, step 0, 3 components, one entry per tet (tag t + 1) */
+    fprintf(o, "$ElementData\n1\n\"fiber\"\n1\n0\n3\n0\n3\n%zu\n", nt);
+    for (size_t t = 0; t < nt; ++t) {
+      piola__tw_int(w, (int64_t)t + 1);
+      for (int k = 0; k < 3; ++k) {
+        piola__tw_char(w, ' ');
+        piola__tw_double(w, mesh->tet_fibers[3 * t + (size_t)k]);
+      }
+      piola__tw_char(w, '\n');
+    }
+    piola__tw_flush(w);
+    fprintf(o, "$EndElementData\n");
+  }
   free(w);
   free(ids);
   return atomic_file_commit(&f);

@@ -8,6 +8,7 @@
 
 #include "common/status_internal.h"
 #include "material/material_kernels.h"
+#include "material/muscle.h"
 #include "piola/material.h"
 
 piola_material_def piola_default_material_def(void) {
@@ -21,6 +22,7 @@ piola_material_def piola_default_material_def(void) {
   def.spline.compression_stretch = 0.8;
   def.spline.elongation_stretch = 1.2;
   def.spline.stiffening = 10.0;
+  def.muscle = piola__default_muscle_def();
   return def;
 }
 
@@ -101,12 +103,13 @@ piola_status piola_material_init(const piola_material_def *def, piola_material *
     s[SPLINE_INV_WE] = 1.0 / s[SPLINE_WE];
     s[SPLINE_INV_WC] = 1.0 / s[SPLINE_WC];
   }
+  if (def->model == PIOLA_MODEL_MUSCLE) PIOLA_TRY(piola__muscle_init(def, &m));
   *out = m;
   return PIOLA_OK;
 }
 
 static const char *const model_names[PIOLA_MODEL_COUNT] = {"rotated_linear", "corotated", "stvk",
-                                                           "neohookean", "spline"};
+                                                           "neohookean", "spline", "muscle"};
 
 const char *piola_material_model_name(piola_material_model model) {
   if ((int)model < 0 || model >= PIOLA_MODEL_COUNT) return "unknown";
@@ -176,6 +179,7 @@ static double entry_third(const piola_material *m, double f) {
     case PIOLA_MODEL_STVK:
       return 6.0 * m->mu * f;
     case PIOLA_MODEL_NEOHOOKEAN:
+    case PIOLA_MODEL_MUSCLE:
       return -2.0 * m->mu / (f * f * f);
     case PIOLA_MODEL_SPLINE: {
       const double *s = m->spline_coefficients;
@@ -197,7 +201,8 @@ static void model_third_derivative(const piola_material *m, const double f[3], d
     for (int j = 0; j < 3; ++j)
       for (int k = 0; k < 3; ++k) {
         double tq = 0.0; /* third derivative of the invariant q */
-        if (m->model == PIOLA_MODEL_NEOHOOKEAN && i == j && j == k)
+        if ((m->model == PIOLA_MODEL_NEOHOOKEAN || m->model == PIOLA_MODEL_MUSCLE) && i == j &&
+            j == k)
           tq = 2.0 / (f[i] * f[i] * f[i]);
         else if ((m->model == PIOLA_MODEL_COROTATED || m->model == PIOLA_MODEL_SPLINE) && i != j &&
                  j != k && i != k)

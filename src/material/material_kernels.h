@@ -132,7 +132,8 @@ MATERIAL_KERNEL void entry_slope_curvature(piola_material_model model, const pio
       *a1 = mu * f * (f * f - 1.0);
       *a2 = mu * (3.0 * f * f - 1.0);
       return;
-    case PIOLA_MODEL_NEOHOOKEAN: { /* A = mu (f^2 - 1)/2 - mu ln f */
+    case PIOLA_MODEL_NEOHOOKEAN: /* muscle: its matrix and volume part is neo-Hookean */
+    case PIOLA_MODEL_MUSCLE: { /* A = mu (f^2 - 1)/2 - mu ln f */
       const double inv = 1.0 / f;
       *a1 = mu * (f - inv);
       *a2 = mu * (1.0 + inv * inv);
@@ -174,7 +175,8 @@ MATERIAL_KERNEL double invariant_terms(piola_material_model model, const piola_m
       g[0] = 2.0 * f0, g[1] = 2.0 * f1, g[2] = 2.0 * f2;
       h[0][0] = h[1][1] = h[2][2] = 2.0;
       return f0 * f0 + f1 * f1 + f2 * f2 - 3.0;
-    case PIOLA_MODEL_NEOHOOKEAN: { /* q = ln J, kappa = lambda */
+    case PIOLA_MODEL_NEOHOOKEAN:
+    case PIOLA_MODEL_MUSCLE: { /* q = ln J, kappa = lambda */
       *kappa = m->lambda;
       const double i0 = 1.0 / f0, i1 = 1.0 / f1, i2 = 1.0 / f2;
       g[0] = i0, g[1] = i1, g[2] = i2;
@@ -315,6 +317,7 @@ MATERIAL_KERNEL double entry_energy(piola_material_model model, const piola_mate
     case PIOLA_MODEL_STVK:
       return 0.25 * mu * (f * f - 1.0) * (f * f - 1.0);
     case PIOLA_MODEL_NEOHOOKEAN:
+    case PIOLA_MODEL_MUSCLE:
       return mu * (0.5 * (f * f - 1.0) - kernel_log(f));
     case PIOLA_MODEL_SPLINE: {
       /* Integral from 1 to f of the 1D stress curve. Each side (t = stretch or compression
@@ -415,6 +418,7 @@ MATERIAL_KERNEL void material_stress_kernel(const piola_material *m, double f0, 
       stvk_stress(m, f0, f1, f2, p0, p1, p2);
       return;
     case PIOLA_MODEL_NEOHOOKEAN:
+    case PIOLA_MODEL_MUSCLE:
       neohookean_stress(m, f0, f1, f2, p0, p1, p2);
       return;
     case PIOLA_MODEL_SPLINE:
@@ -463,6 +467,7 @@ MATERIAL_KERNEL void material_stress_energy_kernel(const piola_material *m, doub
       stvk_stress_energy(m, f0, f1, f2, p0, p1, p2, psi);
       return;
     case PIOLA_MODEL_NEOHOOKEAN:
+    case PIOLA_MODEL_MUSCLE:
       neohookean_stress_energy(m, f0, f1, f2, p0, p1, p2, psi);
       return;
     case PIOLA_MODEL_SPLINE:

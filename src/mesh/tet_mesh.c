@@ -16,6 +16,7 @@ void piola_tet_mesh_free(piola_tet_mesh *mesh) {
   free(mesh->positions);
   free(mesh->tets);
   free(mesh->tet_regions);
+  free(mesh->tet_fibers);
   memset(mesh, 0, sizeof *mesh);
 }
 
@@ -28,13 +29,16 @@ piola_status piola_tet_mesh_copy(const piola_tet_mesh *source, piola_tet_mesh *o
   out->positions = malloc(3 * nv * sizeof(double) + 1);
   out->tets = malloc(4 * nt * sizeof(int32_t) + 1);
   if (source->tet_regions) out->tet_regions = malloc(nt * sizeof(int32_t) + 1);
-  if (!out->positions || !out->tets || (source->tet_regions && !out->tet_regions)) {
+  if (source->tet_fibers) out->tet_fibers = malloc(3 * nt * sizeof(double) + 1);
+  if (!out->positions || !out->tets || (source->tet_regions && !out->tet_regions) ||
+      (source->tet_fibers && !out->tet_fibers)) {
     piola_tet_mesh_free(out);
     return PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "tet mesh copy: out of memory");
   }
   if (nv) memcpy(out->positions, source->positions, 3 * nv * sizeof(double));
   if (nt) memcpy(out->tets, source->tets, 4 * nt * sizeof(int32_t));
   if (source->tet_regions && nt) memcpy(out->tet_regions, source->tet_regions, nt * sizeof(int32_t));
+  if (source->tet_fibers && nt) memcpy(out->tet_fibers, source->tet_fibers, 3 * nt * sizeof(double));
   out->vertex_count = source->vertex_count;
   out->tet_count = source->tet_count;
   return PIOLA_OK;
@@ -60,6 +64,33 @@ piola_status piola_tet_mesh_validate(const piola_tet_mesh *mesh) {
         if (mesh->tets[4 * t + j] == v)
           return PIOLA_FAIL(PIOLA_ERROR_DEGENERATE_ELEMENT, "tet %d repeats vertex %d", (int)t, (int)v);
     }
+  for (int32_t t = 0; mesh->tet_fibers && t < mesh->tet_count; ++t)
+    for (int k = 0; k < 3; ++k)
+      if (!isfinite(mesh->tet_fibers[3 * (size_t)t + (size_t)k]))
+        return PIOLA_FAIL(PIOLA_ERROR_NOT_FINITE, "tet %d: fibre direction is not finite", (int)t);
+  return PIOLA_OK;
+}
+
+piola_status piola_tet_mesh_transform(piola_tet_mesh *mesh, piola_mat3 linear, piola_vec3 translation) {
+  if (!mesh) return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "tet mesh transform: NULL mesh");
+  double det = mat3_det(linear);
+  if (!mat3_is_finite(linear) || !isfinite(translation.x) || !isfinite(translation.y) ||
+      !isfinite(translation.z) || !(det > 0) || !isfinite(det))
+    return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT,
+                      "tet mesh transform: the map must be finite with a positive determinant, got "
+                      "det %g", det);
+  for (int32_t i = 0; i < mesh->vertex_count; ++i) {
+    double *p = mesh->positions + 3 * (size_t)i;
+    vec3_store(p, vec3_add(mat3_mul_vec(linear, vec3_load(p)), translation));
+  }
+  for (int32_t t = 0; mesh->tet_fibers && t < mesh->tet_count; ++t) {
+    double *d = mesh->tet_fibers + 3 * (size_t)t;
+    vec3 a = vec3_load(d), b = mat3_mul_vec(linear, a);
+    double la = vec3_norm(a), lb = vec3_norm(b);
+    /* a material direction is a tangent vector: it maps by the linear part; its length
+     * (often 1 by convention, or a weight) is kept */
+    vec3_store(d, lb > 0 ? vec3_scale(b, la / lb) : a);
+  }
   return PIOLA_OK;
 }
 

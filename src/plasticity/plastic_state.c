@@ -38,16 +38,24 @@ static double det33(const double a[9]) {
          a[2] * (a[3] * a[7] - a[4] * a[6]);
 }
 
-static void set_quick_bounds(piola_plastic_state *s, int32_t t) {
-  double gamma = s->params.yield + s->params.hardening * s->alpha[t];
-  double r = gamma / sqrt(3.0);
-  s->quick_lo[t] = exp(-r);
-  s->quick_hi[t] = exp(r);
+/* The interval of Fhat entries inside which tet t cannot yield (plastic_state.h). */
+static void quick_bounds(const piola_plastic_state *s, int32_t t, double *lo, double *hi) {
+  if (s->params.hardening == 0) {
+    *lo = s->quick_lo0, *hi = s->quick_hi0;
+    return;
+  }
+  double r = (s->params.yield + s->params.hardening * s->alpha[t]) / sqrt(3.0);
+  *lo = exp(-r), *hi = exp(r);
 }
 
-static void commit_tet(piola_plastic_state *s, int32_t t) {
-  double eff[9];
-  mul33(s->rest_dm_inv + 9 * t, s->fp_inv + 9 * t, eff);
+static void rest_dm_inv(const piola_plastic_state *s, int32_t t, double out[9]) {
+  for (int k = 0; k < 9; ++k) out[k] = piola__plastic_rest_entry(s, t, k);
+}
+
+void piola__plastic_commit_tet(piola_plastic_state *s, int32_t t) {
+  double eff[9], rest[9];
+  rest_dm_inv(s, t, rest);
+  mul33(rest, s->fp_inv + 9 * t, eff);
   piola__elastic_body_set_dm_inv(s->body, t, eff);
 }
 
@@ -89,7 +97,7 @@ static piola_status validate(const piola_elastic_body *body, const piola_plastic
 }
 
 /* Goal Fp of tet t: the goal map, or Dg Dm^-1 of the goal mesh. */
-static void goal_fp(const piola_elastic_body *body, const double *rest_dm_inv,
+static void goal_fp(const piola_elastic_body *body, const piola_plastic_state *s,
                     const piola_plasticity_control_def *c, int32_t t, double fp[9]) {
   if (c->goal == PIOLA_PLASTIC_GOAL_MAP) {
     for (int k = 0; k < 9; ++k) fp[k] = c->goal_map.m[k / 3][k % 3];
@@ -97,18 +105,22 @@ static void goal_fp(const piola_elastic_body *body, const double *rest_dm_inv,
   }
   const int32_t *idx = piola_elastic_body_tets(body) + 4 * t;
   const double *g = c->goal_positions;
-  double dg[9];
+  double dg[9], rest[9];
   for (int i = 0; i < 3; ++i)
     for (int j = 0; j < 3; ++j) dg[3 * i + j] = g[3 * idx[j + 1] + i] - g[3 * idx[0] + i];
-  mul33(dg, rest_dm_inv + 9 * t, fp);
+  rest_dm_inv(s, t, rest);
+  mul33(dg, rest, fp);
 }
 
 void piola_plastic_state_destroy(piola_plastic_state *s) {
   if (!s) return;
-  if (s->body && s->rest_dm_inv)
-    for (int32_t t = 0; t < s->tet_count; ++t)
-      piola__elastic_body_set_dm_inv(s->body, t, s->rest_dm_inv + 9 * t);
-  free(s->rest_dm_inv), free(s->fp_inv), free(s->alpha), free(s->quick_lo), free(s->quick_hi);
+  if (s->body && s->rest_lanes)
+    for (int32_t t = 0; t < s->tet_count; ++t) {
+      double rest[9];
+      rest_dm_inv(s, t, rest);
+      piola__elastic_body_set_dm_inv(s->body, t, rest);
+    }
+  free(s->rest_lanes), free(s->fp_inv), free(s->alpha), free(s->block_bound);
   free(s->stretch_bound), free(s->goal_log), free(s->log_fp);
   free(s);
 }
@@ -122,36 +134,43 @@ piola_status piola_plastic_state_create(piola_elastic_body *body, const piola_pl
   if (!s) return PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "plasticity: out of memory");
   int32_t nt = s->tet_count = piola_elastic_body_tet_count(body);
   size_t n = nt > 0 ? (size_t)nt : 1;
+  s->padded_count = (nt + PIOLA_PLASTIC_LANES - 1) / PIOLA_PLASTIC_LANES * PIOLA_PLASTIC_LANES;
+  size_t np = s->padded_count > 0 ? (size_t)s->padded_count : PIOLA_PLASTIC_LANES;
   s->params = (plastic_params){def->yield, def->hardening, def->limit, def->volume_preserving};
   s->limit_cap = exp(def->limit);
+  s->quick_lo0 = exp(-def->yield / sqrt(3.0));
+  s->quick_hi0 = exp(def->yield / sqrt(3.0));
   s->controlled = def->control.goal != PIOLA_PLASTIC_GOAL_NONE;
   s->strength = def->control.strength;
-  s->rest_dm_inv = malloc(9 * n * sizeof(double));
-  s->fp_inv = malloc(9 * n * sizeof(double));
-  s->alpha = calloc(n, sizeof(double));
-  s->quick_lo = malloc(n * sizeof(double));
-  s->quick_hi = malloc(n * sizeof(double));
-  s->stretch_bound = malloc(n * sizeof(double));
+  s->rest_lanes = calloc(9 * np, sizeof(double));
+  s->fp_inv = malloc(9 * np * sizeof(double)); /* padded: the blocked update reads whole blocks */
+  s->alpha = calloc(np, sizeof(double));
+  s->stretch_bound = malloc(np * sizeof(double));
+  s->block_bound = malloc(np / PIOLA_PLASTIC_LANES * sizeof(double));
   if (s->controlled) {
     s->goal_log = malloc(6 * n * sizeof(double));
     s->log_fp = calloc(6 * n, sizeof(double));
   }
-  if (!s->rest_dm_inv || !s->fp_inv || !s->alpha || !s->quick_lo || !s->quick_hi || !s->stretch_bound ||
+  if (!s->rest_lanes || !s->fp_inv || !s->alpha || !s->block_bound || !s->stretch_bound ||
       (s->controlled && (!s->goal_log || !s->log_fp))) {
     piola_plastic_state_destroy(s);
     return PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "plasticity for %d tets: out of memory", (int)nt);
   }
+  for (size_t i = 0; i < np; ++i) s->stretch_bound[i] = 1.0;
+  for (size_t b = 0; b < np / PIOLA_PLASTIC_LANES; ++b) s->block_bound[b] = 1.0;
+  for (size_t t = 0; t < np; ++t)
+    for (int k = 0; k < 9; ++k) s->fp_inv[9 * t + k] = (k % 4 == 0) ? 1.0 : 0.0;
   for (int32_t t = 0; t < nt; ++t) {
-    piola__elastic_body_get_dm_inv(body, t, s->rest_dm_inv + 9 * t);
-    double *a = s->fp_inv + 9 * t;
-    for (int k = 0; k < 9; ++k) a[k] = (k % 4 == 0) ? 1.0 : 0.0;
-    s->stretch_bound[t] = 1.0;
-    set_quick_bounds(s, t);
+    double rest[9];
+    piola__elastic_body_get_dm_inv(body, t, rest);
+    for (int k = 0; k < 9; ++k)
+      s->rest_lanes[(size_t)(t / PIOLA_PLASTIC_LANES) * 9 * PIOLA_PLASTIC_LANES + (size_t)k * PIOLA_PLASTIC_LANES +
+                    (size_t)(t % PIOLA_PLASTIC_LANES)] = rest[k];
   }
   if (s->controlled) {
     for (int32_t t = 0; t < nt; ++t) {
       double fp[9];
-      goal_fp(body, s->rest_dm_inv, &def->control, t, fp);
+      goal_fp(body, s, &def->control, t, fp);
       if (piola__plastic_goal_log(fp, def->limit, s->goal_log + 6 * t) != PIOLA_OK) {
         piola_plastic_state_destroy(s);
         return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT,
@@ -186,7 +205,7 @@ static double singular_bounds(const double a[9], double *lower) {
 
 /* Exact limit: SVD a = W Sigma Q^T, clamp log Sigma, a <- W Sigma' W^T (rotation dropped).
  * Returns the largest singular value after clamping. */
-static double exact_limit(double a[9], const plastic_params *p) {
+double piola__plastic_exact_limit(double a[9], const plastic_params *p) {
   piola_mat3 m, w, q;
   piola_vec3 s;
   for (int k = 0; k < 9; ++k) m.m[k / 3][k % 3] = a[k];
@@ -205,7 +224,8 @@ static int update_tet(piola_plastic_state *s, const double *fhat_all, int32_t t,
                       int *limited) {
   const double *fh = fhat_all + 3 * t;
   int drift = s->controlled && pull > 0;
-  double lo = s->quick_lo[t], hi = s->quick_hi[t];
+  double lo, hi;
+  quick_bounds(s, t, &lo, &hi);
   if (!drift && fh[0] >= lo && fh[0] <= hi && fh[1] >= lo && fh[1] <= hi && fh[2] >= lo && fh[2] <= hi)
     return 0;
   double delta[3], dl;
@@ -223,10 +243,9 @@ static int update_tet(piola_plastic_state *s, const double *fhat_all, int32_t t,
                        v[3 * i + 2] * d[2] * v[3 * j + 2];
     mul33(a, m, a);
     s->alpha[t] += dl;
-    if (s->params.hardening > 0) set_quick_bounds(s, t);
     double lower, upper = singular_bounds(a, &lower);
     if (!(upper <= s->limit_cap && lower >= 1.0 / s->limit_cap)) {
-      upper = exact_limit(a, &s->params);
+      upper = piola__plastic_exact_limit(a, &s->params);
       *limited += 1;
     }
     s->stretch_bound[t] = upper;
@@ -239,27 +258,60 @@ static int update_tet(piola_plastic_state *s, const double *fhat_all, int32_t t,
     double largest = piola__plastic_fp_inverse_from_log(lcur, s->params.limit, a);
     s->stretch_bound[t] = exp(largest);
   }
-  commit_tet(s, t);
+  piola__plastic_commit_tet(s, t);
   return yielded;
 }
 
-piola_status piola_plastic_state_update(piola_plastic_state *s, double dt, piola_plastic_stats *stats) {
-  if (!s) return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "plasticity update: NULL state");
-  if (!(dt >= 0) || !isfinite(dt))
-    return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "plasticity update: dt must be >= 0 s, got %g", dt);
+void piola__plastic_state_update_scalar(piola_plastic_state *s, double dt, piola_plastic_stats *stats) {
   const double *fhat = piola_elastic_body_fhat(s->body);
   double pull = s->controlled ? fmin(1.0, s->strength * dt) : 0.0;
   int32_t yielded = 0, limited = 0;
   double bound = 1.0;
   const int32_t nt = s->tet_count;
 #pragma omp parallel for schedule(static) reduction(+ : yielded, limited) reduction(max : bound) \
-    num_threads(piola__thread_count())
+    num_threads(piola__thread_count()) if (nt >= PIOLA_PARALLEL_MIN_BLOCKS * PIOLA_PLASTIC_LANES)
   for (int32_t t = 0; t < nt; ++t) {
     int lim = 0;
     yielded += update_tet(s, fhat, t, pull, &lim);
     limited += lim;
     bound = fmax(bound, s->stretch_bound[t]);
   }
+  /* keep the blocked path's per-block maxima right (the two paths share the state) */
+  for (int32_t b = 0; b < s->padded_count / PIOLA_PLASTIC_LANES; ++b) {
+    double m = 1.0;
+    for (int l = 0; l < PIOLA_PLASTIC_LANES; ++l) m = fmax(m, s->stretch_bound[PIOLA_PLASTIC_LANES * b + l]);
+    s->block_bound[b] = m;
+  }
+  if (stats) {
+    stats->yielded_count = yielded;
+    stats->limited_count = limited;
+    stats->max_fp_stretch = bound;
+  }
+}
+
+piola_status piola_plastic_state_update(piola_plastic_state *s, double dt, piola_plastic_stats *stats) {
+  if (!s) return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "plasticity update: NULL state");
+  if (!(dt >= 0) || !isfinite(dt))
+    return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "plasticity update: dt must be >= 0 s, got %g", dt);
+  if (s->controlled) {
+    piola__plastic_state_update_scalar(s, dt, stats);
+    return PIOLA_OK;
+  }
+  int32_t yielded = 0, limited = 0;
+  double bound = 1.0;
+  /* ranges of 64 blocks: big enough for the blocked kernel's two phases, small enough to
+   * share out; the counts and the maximum do not depend on how they are shared */
+  const int32_t blocks = s->padded_count / PIOLA_PLASTIC_LANES, range = 64;
+  const int32_t ranges = (blocks + range - 1) / range;
+#pragma omp parallel for schedule(static) reduction(+ : yielded, limited) reduction(max : bound) \
+    num_threads(piola__thread_count()) if (blocks >= PIOLA_PARALLEL_MIN_BLOCKS)
+  for (int32_t r = 0; r < ranges; ++r) {
+    int32_t end = (r + 1) * range < blocks ? (r + 1) * range : blocks;
+    double b = 1.0;
+    yielded += piola__plastic_update_blocks(s, r * range, end, &limited, &b);
+    bound = fmax(bound, b);
+  }
+  s->refresh_phase = (s->refresh_phase + 1) & (PIOLA_PLASTIC_REFRESH - 1);
   if (stats) {
     stats->yielded_count = yielded;
     stats->limited_count = limited;
@@ -296,10 +348,11 @@ double piola_plastic_state_goal_distance(const piola_plastic_state *s, const dou
   double sum = 0, total = 0;
   for (int32_t t = 0; t < s->tet_count; ++t) {
     const int32_t *idx = tets + 4 * t;
-    double ds[9], f[9];
+    double ds[9], f[9], rest[9];
     for (int i = 0; i < 3; ++i)
       for (int j = 0; j < 3; ++j) ds[3 * i + j] = x[3 * idx[j + 1] + i] - x[3 * idx[0] + i];
-    mul33(ds, s->rest_dm_inv + 9 * t, f);
+    rest_dm_inv(s, t, rest);
+    mul33(ds, rest, f);
     piola_mat3 m, u, v;
     piola_vec3 sv;
     for (int k = 0; k < 9; ++k) m.m[k / 3][k % 3] = f[k];

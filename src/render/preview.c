@@ -38,7 +38,7 @@ static void make_absolute(cJSON *item, const char *folder) {
   cJSON_SetValuestring(item, buf);
 }
 
-/* DIR/scene.json: the scene with the mesh paths of solids and obstacles made absolute. */
+/* DIR/scene.json: the scene with the mesh paths of solids, obstacles and bones made absolute. */
 static piola_status copy_scene(const char *scene_path, const char *dir) {
   char *text = NULL;
   FILE *f = fopen(scene_path, "rb");
@@ -72,6 +72,9 @@ static piola_status copy_scene(const char *scene_path, const char *dir) {
       make_absolute(cJSON_GetObjectItemCaseSensitive(it, "mesh"), folder);
   cJSON *obstacles = cJSON_GetObjectItemCaseSensitive(root, "obstacles");
   cJSON_ArrayForEach(it, obstacles)
+      make_absolute(cJSON_GetObjectItemCaseSensitive(it, "path"), folder);
+  cJSON *bones = cJSON_GetObjectItemCaseSensitive(root, "bones");
+  cJSON_ArrayForEach(it, bones)
       make_absolute(cJSON_GetObjectItemCaseSensitive(it, "path"), folder);
   char *out = cJSON_Print(root);
   cJSON_Delete(root);

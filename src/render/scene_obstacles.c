@@ -1,4 +1,4 @@
-/* The obstacles of a scene file, for drawing. Only the parser runs (src/scene): solids'
+/* The obstacles (and bones) of a scene file, for drawing. Only the parser runs (src/scene): solids'
  * meshes are neither read nor generated, so a large scene's preview costs nothing extra;
  * mesh obstacles read their surface file, resolved against the scene's folder. */
 #include <errno.h>
@@ -53,8 +53,10 @@ piola_status piola_renderer_load_scene_obstacles(piola_renderer *r, const char *
   piola_status st = piola__scene_parse(text, dir, path, &desc);
   free(text);
   PIOLA_TRY(st);
-  for (int32_t i = 0; st == PIOLA_OK && i < desc.obstacle_count; ++i) {
-    scene_obstacle_desc *d = &desc.obstacles[i];
+  /* bones are obstacles too (their attachments do not matter for drawing) */
+  for (int32_t i = 0; st == PIOLA_OK && i < desc.obstacle_count + desc.bone_count; ++i) {
+    scene_obstacle_desc *d = i < desc.obstacle_count ? &desc.obstacles[i]
+                                                     : &desc.bones[i - desc.obstacle_count].obstacle;
     piola_obstacle_def def = d->def;
     piola_tri_mesh surface = {0};
     if (def.type == PIOLA_OBSTACLE_MESH) {

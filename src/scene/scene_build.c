@@ -1,6 +1,7 @@
 /* Scene building: read or generate each solid's mesh, place it by its transform, and add
  * solids and obstacles to a new world. Errors name the key path of the solid or obstacle. */
 #include <math.h>
+#include <stdlib.h>
 #include <string.h>
 
 #include "common/status_internal.h"
@@ -20,13 +21,12 @@ static mat3 euler_xyz_degrees(piola_vec3 deg) {
   return mat3_mul(rz, mat3_mul(ry, rx));
 }
 
+/* X' = translate + R (scale * X); fibres turn with the rest shape (piola_tet_mesh_transform).
+ * Scales are > 0 and R a rotation, so the map is always accepted. */
 static void place(piola_tet_mesh *mesh, const scene_solid_desc *d) {
   mat3 r = euler_xyz_degrees(d->rotate_degrees);
-  for (int32_t i = 0; i < mesh->vertex_count; ++i) {
-    double *p = mesh->positions + 3 * i;
-    vec3 s = {p[0] * d->scale.x, p[1] * d->scale.y, p[2] * d->scale.z};
-    vec3_store(p, vec3_add(mat3_mul_vec(r, s), d->translate));
-  }
+  mat3 scale = {{{d->scale.x, 0, 0}, {0, d->scale.y, 0}, {0, 0, d->scale.z}}};
+  (void)piola_tet_mesh_transform(mesh, mat3_mul(r, scale), d->translate);
 }
 
 piola_status piola__scene_read_goal_mesh(const scene_solid_desc *d, const piola_tet_mesh *rest,
@@ -84,6 +84,24 @@ static piola_status build_shell(piola_world *world, const scene_shell_desc *d) {
   def.constraint_count = d->base.constraint_count;
   st = piola_world_add_shell(world, &def, NULL);
   piola_tri_mesh_free(&mesh);
+  return st;
+}
+
+/* Bones: the obstacle part as for obstacles, then the attachments (solids are in). */
+static piola_status build_bone(piola_world *world, const scene_bone_desc *d) {
+  piola_bone_def def = piola_default_bone_def();
+  def.shape = d->obstacle.def;
+  def.attachments = d->attachments;
+  def.attachment_count = d->attachment_count;
+  piola_tri_mesh surface;
+  memset(&surface, 0, sizeof surface);
+  piola_status st = PIOLA_OK;
+  if (def.shape.type == PIOLA_OBSTACLE_MESH) {
+    st = piola_tri_mesh_read(d->obstacle.mesh_path, &surface);
+    def.shape.mesh = &surface;
+  }
+  if (st == PIOLA_OK) st = piola_world_add_bone(world, &def, NULL, NULL);
+  piola_tri_mesh_free(&surface);
   return st;
 }
 
@@ -147,7 +165,17 @@ piola_status piola__scene_build(const scene_desc *desc, const char *label, piola
         plasticity.control.goal_vertex_count = goal.vertex_count;
       }
     }
+    double *fibers = NULL;
+    st = piola__scene_fiber_directions(&d->fibers, &mesh, &fibers);
+    if (st != PIOLA_OK) {
+      piola_tet_mesh_free(&mesh);
+      piola_tet_mesh_free(&goal);
+      piola_world_destroy(world);
+      return PIOLA_FAIL(st, "%s: solids[%d].%s", label, (int)i, piola_last_error());
+    }
+    def.fiber_directions = fibers;
     st = piola_world_add_solid(world, &def, NULL);
+    free(fibers);
     piola_tet_mesh_free(&mesh);
     piola_tet_mesh_free(&goal);
     if (st != PIOLA_OK) {
@@ -177,6 +205,16 @@ piola_status piola__scene_build(const scene_desc *desc, const char *label, piola
     if (st != PIOLA_OK) {
       piola_world_destroy(world);
       return PIOLA_FAIL(st, "%s: obstacles[%d]: %s", label, (int)i, piola_last_error());
+    }
+  }
+  for (int32_t i = 0; i < desc->bone_count; ++i) {
+    piola_status st = build_bone(world, &desc->bones[i]);
+    if (st != PIOLA_OK) {
+      piola_world_destroy(world);
+      /* world messages start with "attachments[k]..." or describe the shape */
+      const char *msg = piola_last_error();
+      int attachment = strncmp(msg, "attachments[", 12) == 0;
+      return PIOLA_FAIL(st, "%s: bones[%d]%s%s", label, (int)i, attachment ? "." : ": ", msg);
     }
   }
   *out = world;

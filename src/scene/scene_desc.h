@@ -12,9 +12,25 @@
 #include "piola/mesher.h"
 #include "piola/obstacle.h"
 #include "piola/world.h"
+#include "piola/world_bones.h"
 #include "piola/world_shells.h"
 
 #define SCENE_PATH_MAX 4096
+
+/* A solid's `fibers` key: a direction field in scene (world) coordinates. */
+typedef enum scene_fiber_kind {
+  SCENE_FIBERS_NONE = 0,
+  SCENE_FIBERS_AXIS,      /* one direction for every tet */
+  SCENE_FIBERS_CURVE,     /* polyline: the tangent of the segment nearest each tet's centroid */
+  SCENE_FIBERS_FROM_MESH, /* per-tet data read with the mesh */
+} scene_fiber_kind;
+
+typedef struct scene_fibers {
+  scene_fiber_kind kind;
+  piola_vec3 axis;        /* SCENE_FIBERS_AXIS: unit */
+  double *curve;          /* SCENE_FIBERS_CURVE: 3 per point, owned */
+  int32_t curve_points;   /* >= 2 */
+} scene_fibers;
 
 typedef struct scene_solid_desc {
   piola_solid_def def;            /* mesh, name and constraints are filled in by the builder */
@@ -33,6 +49,8 @@ typedef struct scene_solid_desc {
   int plastic;                    /* 1: "plasticity" given */
   piola_plasticity_def plasticity;
   char goal_mesh_path[SCENE_PATH_MAX]; /* plasticity.control.goal.mesh, resolved */
+  scene_fibers fibers;            /* `fibers` (muscle), turned into per-tet directions by the
+                                     builder (scene_fibers.c) */
 } scene_solid_desc;
 
 /* A shell: the solid fields it shares (name, transform, density, material, damping,
@@ -53,6 +71,16 @@ typedef struct scene_obstacle_desc {
   char mesh_path[SCENE_PATH_MAX]; /* mesh obstacles */
 } scene_obstacle_desc;
 
+/* A bone (docs/bones.md): an obstacle's shape, friction and motion plus attachments; the
+ * attachments' solid indices are resolved from their names while parsing. */
+typedef struct scene_bone_desc {
+  scene_obstacle_desc obstacle;
+  char name[128];
+  piola_attachment_def *attachments;
+  int32_t attachment_count;
+  int32_t **index_lists;          /* owned index arrays, one per attachment (or NULL) */
+} scene_bone_desc;
+
 typedef struct scene_desc {
   double fps;
   int32_t frames;
@@ -63,6 +91,8 @@ typedef struct scene_desc {
   int32_t obstacle_count;
   scene_shell_desc *shells;       /* the `shells` key (scene_parse.c, shells section) */
   int32_t shell_count;
+  scene_bone_desc *bones;         /* the `bones` key (scene_parse.c, bones section) */
+  int32_t bone_count;
 } scene_desc;
 
 /* Parses and validates JSON text; label prefixes error messages. */
@@ -74,6 +104,11 @@ void piola__scene_desc_free(scene_desc *desc);
  * have the rest mesh's vertices and tets (scene_build.c). */
 piola_status piola__scene_read_goal_mesh(const scene_solid_desc *d, const piola_tet_mesh *rest,
                                          piola_tet_mesh *goal);
+
+/* Per-tet fibre directions (3 per tet, malloc'd into *out; NULL when the solid has no
+ * `fibers`) for the placed rest mesh (scene_fibers.c). Errors name the key. */
+piola_status piola__scene_fiber_directions(const scene_fibers *fibers, const piola_tet_mesh *mesh,
+                                           double **out);
 
 /* Reads or generates the meshes, places them and builds the world. */
 piola_status piola__scene_build(const scene_desc *desc, const char *label, piola_world **out);

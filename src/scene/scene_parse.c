@@ -264,13 +264,16 @@ static piola_status resolve_path(parser *p, const cJSON *v, char *out) {
 
 /* ------------------------------------------------------------------ motion */
 
+/* default_pivot and default_axis: where and about what the rotation turns unless the scene
+ * says otherwise (an obstacle's centre and, for shapes with an axis, that axis). */
 static piola_status parse_motion(parser *p, const cJSON *obj, piola_vec3 default_pivot,
-                                 piola_rigid_motion_def *out) {
+                                 piola_vec3 default_axis, piola_rigid_motion_def *out) {
   static const char *const allowed[] = {"velocity", "angular_speed", "translation", "angle",
                                         "axis", "pivot", NULL};
   PIOLA_TRY(check_keys(p, obj, allowed));
   *out = piola_default_rigid_motion_def();
   out->pivot = default_pivot;
+  out->axis = default_axis;
   int velocity_kind = get(obj, "velocity") || get(obj, "angular_speed");
   int pose_kind = get(obj, "translation") || get(obj, "angle");
   if (velocity_kind && pose_kind)
@@ -348,7 +351,8 @@ static piola_status parse_selector(parser *p, const cJSON *obj, int driven, piol
   if (driven) {
     PIOLA_TRY(required(p, obj, "motion"));
     size_t old = push_key(p, "motion");
-    PIOLA_TRY(parse_motion(p, get(obj, "motion"), (piola_vec3){0, 0, 0}, &out->motion));
+    PIOLA_TRY(parse_motion(p, get(obj, "motion"), (piola_vec3){0, 0, 0}, (piola_vec3){0, 0, 1},
+                           &out->motion));
     pop(p, old);
   }
   return PIOLA_OK;
@@ -433,23 +437,25 @@ static piola_status parse_generator(parser *p, const cJSON *obj, piola_mesher_de
 
 static piola_status parse_material(parser *p, const cJSON *obj, scene_solid_desc *d) {
   static const char *const allowed[] = {"model", "youngs_modulus", "poisson_ratio", "stiffness_scale",
-                                        "inversion", "spline", NULL};
+                                        "inversion", "spline", "muscle", NULL};
   PIOLA_TRY(check_keys(p, obj, allowed));
   piola_material_def *m = &d->def.material;
   const cJSON *model = get(obj, "model");
   if (model) {
     size_t old = push_key(p, "model");
-    static const char *const names[] = {"rotated_linear", "corotated", "stvk", "neohookean", "spline", NULL};
+    static const char *const names[] = {"rotated_linear", "corotated", "stvk", "neohookean", "spline",
+                                        "muscle", NULL};
     static const piola_material_model models[] = {PIOLA_MODEL_ROTATED_LINEAR, PIOLA_MODEL_COROTATED,
                                                   PIOLA_MODEL_STVK, PIOLA_MODEL_NEOHOOKEAN,
-                                                  PIOLA_MODEL_SPLINE};
+                                                  PIOLA_MODEL_SPLINE, PIOLA_MODEL_MUSCLE};
     int found = -1;
     if (cJSON_IsString(model))
       for (int i = 0; names[i]; ++i)
         if (strcmp(model->valuestring, names[i]) == 0) found = i;
     if (found < 0)
       return fail(p, BAD_VALUE,
-                  "must be one of \"rotated_linear\", \"corotated\", \"stvk\", \"neohookean\", \"spline\"");
+                  "must be one of \"rotated_linear\", \"corotated\", \"stvk\", \"neohookean\", \"spline\", "
+                  "\"muscle\"");
     m->model = models[found];
     pop(p, old);
   }
@@ -485,6 +491,63 @@ static piola_status parse_material(parser *p, const cJSON *obj, scene_solid_desc
     PIOLA_TRY(opt_number(p, sp, "stiffening", (range){1, INFINITY, 0, 0}, &m->spline.stiffening));
     pop(p, old);
   }
+  const cJSON *mu = get(obj, "muscle");
+  if (mu) {
+    size_t old = push_key(p, "muscle");
+    if (m->model != PIOLA_MODEL_MUSCLE) return fail(p, BAD_VALUE, "needs \"model\": \"muscle\"");
+    static const char *const keys[] = {"passive_stiffness", "passive_toe_stretch", "max_active_stress",
+                                       "optimal_stretch", "active_width", NULL};
+    PIOLA_TRY(check_keys(p, mu, keys));
+    piola_muscle_def *md = &m->muscle;
+    PIOLA_TRY(opt_number(p, mu, "passive_stiffness", NONNEGATIVE, &md->passive_stiffness));
+    PIOLA_TRY(opt_number(p, mu, "passive_toe_stretch", (range){1, INFINITY, 1, 0}, &md->passive_toe_stretch));
+    PIOLA_TRY(opt_number(p, mu, "max_active_stress", NONNEGATIVE, &md->max_active_stress));
+    PIOLA_TRY(opt_number(p, mu, "optimal_stretch", POSITIVE, &md->optimal_stretch));
+    PIOLA_TRY(opt_number(p, mu, "active_width", (range){0, 1, 1, 1}, &md->active_width));
+    pop(p, old);
+  }
+  return PIOLA_OK;
+}
+
+/* ------------------------------------------------------------------ muscle fibres */
+
+/* "fibers": {"axis": [x, y, z]} | {"curve": [[x, y, z], ...]} | {"from_mesh": true}. */
+static piola_status parse_fibers(parser *p, const cJSON *obj, scene_fibers *f) {
+  static const char *const allowed[] = {"axis", "curve", "from_mesh", NULL};
+  PIOLA_TRY(check_keys(p, obj, allowed));
+  const cJSON *axis = get(obj, "axis"), *curve = get(obj, "curve"), *mesh = get(obj, "from_mesh");
+  if ((axis != NULL) + (curve != NULL) + (mesh != NULL) != 1)
+    return fail(p, PIOLA_ERROR_PARSE, "needs exactly one of \"axis\", \"curve\" and \"from_mesh\"");
+  if (axis) {
+    f->kind = SCENE_FIBERS_AXIS;
+    return opt_direction(p, obj, "axis", &f->axis);
+  }
+  if (mesh) {
+    size_t old = push_key(p, "from_mesh");
+    if (!cJSON_IsTrue(mesh)) return fail(p, BAD_VALUE, "must be true (leave the key out for no fibres)");
+    f->kind = SCENE_FIBERS_FROM_MESH;
+    pop(p, old);
+    return PIOLA_OK;
+  }
+  size_t old = push_key(p, "curve");
+  const int count = cJSON_IsArray(curve) ? cJSON_GetArraySize(curve) : 0;
+  if (count < 2) return fail(p, PIOLA_ERROR_PARSE, "must be an array of at least 2 points [x, y, z] (m)");
+  f->kind = SCENE_FIBERS_CURVE;
+  f->curve = malloc(sizeof(double) * 3 * (size_t)count);
+  if (!f->curve) return fail(p, PIOLA_ERROR_OUT_OF_MEMORY, "out of memory");
+  f->curve_points = count;
+  int i = 0;
+  for (const cJSON *e = curve->child; e; e = e->next, ++i) {
+    size_t o2 = push_index(p, i);
+    piola_vec3 q;
+    PIOLA_TRY(vec3_value(p, e, ANY, &q));
+    f->curve[3 * i] = q.x, f->curve[3 * i + 1] = q.y, f->curve[3 * i + 2] = q.z;
+    if (i > 0 && f->curve[3 * i] == f->curve[3 * i - 3] && f->curve[3 * i + 1] == f->curve[3 * i - 2] &&
+        f->curve[3 * i + 2] == f->curve[3 * i - 1])
+      return fail(p, BAD_VALUE, "repeats the point before it (a segment needs a direction)");
+    pop(p, o2);
+  }
+  pop(p, old);
   return PIOLA_OK;
 }
 
@@ -623,7 +686,7 @@ static piola_status parse_name(parser *p, const cJSON *obj, scene_solid_desc *d)
 static piola_status parse_solid(parser *p, const cJSON *obj, int index, scene_solid_desc *d) {
   static const char *const allowed[] = {"name", "mesh", "transform", "density", "material",
                                         "damping", "velocity", "fixed", "driven", "initial",
-                                        "plasticity", "self_collision", NULL};
+                                        "plasticity", "self_collision", "fibers", "activation", NULL};
   PIOLA_TRY(check_keys(p, obj, allowed));
   PIOLA_TRY(required(p, obj, "mesh"));
   d->def = piola_default_solid_def();
@@ -666,6 +729,21 @@ static piola_status parse_solid(parser *p, const cJSON *obj, int index, scene_so
   PIOLA_TRY(parse_constraints(p, obj, "fixed", 0, d));
   d->fixed_count = d->constraint_count;
   PIOLA_TRY(parse_constraints(p, obj, "driven", 1, d));
+  if ((v = get(obj, "fibers"))) {
+    old = push_key(p, "fibers");
+    if (d->def.material.model != PIOLA_MODEL_MUSCLE)
+      return fail(p, BAD_VALUE, "needs material.model \"muscle\"");
+    if (d->plastic) return fail(p, BAD_VALUE, "cannot be combined with plasticity (not supported)");
+    PIOLA_TRY(parse_fibers(p, v, &d->fibers));
+    pop(p, old);
+  }
+  if ((v = get(obj, "activation"))) {
+    old = push_key(p, "activation");
+    if (d->def.material.model != PIOLA_MODEL_MUSCLE)
+      return fail(p, BAD_VALUE, "needs material.model \"muscle\"");
+    PIOLA_TRY(track_value(p, v, (range){0, 1, 0, 0}, &d->def.activation));
+    pop(p, old);
+  }
   if ((v = get(obj, "initial"))) {
     old = push_key(p, "initial");
     static const char *const keys[] = {"matrix", "scramble", "seed", NULL};
@@ -698,7 +776,10 @@ static piola_status parse_solid(parser *p, const cJSON *obj, int index, scene_so
 
 /* ------------------------------------------------------------------ obstacles */
 
-static piola_status parse_obstacle(parser *p, const cJSON *obj, scene_obstacle_desc *d) {
+/* An obstacle, or the obstacle part of a bone: extra_keys (NULL-terminated, or NULL) are
+ * also allowed and left to the caller. */
+static piola_status parse_obstacle(parser *p, const cJSON *obj, const char *const *extra_keys,
+                                   scene_obstacle_desc *d) {
   static const char *const names[] = {"plane", "sphere", "box", "cylinder", "capsule", "torus",
                                       "gear", "mesh", NULL};
   static const char *const keysets[][10] = {
@@ -730,7 +811,12 @@ static piola_status parse_obstacle(parser *p, const cJSON *obj, scene_obstacle_d
                 "must be one of \"plane\", \"sphere\", \"box\", \"cylinder\", \"capsule\", \"torus\", "
                 "\"gear\", \"mesh\"");
   pop(p, old);
-  PIOLA_TRY(check_keys(p, obj, keysets[found]));
+  const char *allowed[16];
+  int nallowed = 0;
+  for (int i = 0; keysets[found][i]; ++i) allowed[nallowed++] = keysets[found][i];
+  for (int i = 0; extra_keys && extra_keys[i] && nallowed < 15; ++i) allowed[nallowed++] = extra_keys[i];
+  allowed[nallowed] = NULL;
+  PIOLA_TRY(check_keys(p, obj, allowed));
   for (int i = 0; required_keys[found][i]; ++i) PIOLA_TRY(required(p, obj, required_keys[found][i]));
   piola_obstacle_def *o = &d->def;
   *o = piola_default_obstacle_def();
@@ -769,7 +855,13 @@ static piola_status parse_obstacle(parser *p, const cJSON *obj, scene_obstacle_d
   const cJSON *mo = get(obj, "motion");
   if (mo) {
     old = push_key(p, "motion");
-    PIOLA_TRY(parse_motion(p, mo, o->center, &o->motion));
+    /* A cylinder, capsule, torus or gear spins about its own axis unless told otherwise: a
+     * gear with axis y turning about the global default z would swing through the scene
+     * like a revolving door (the gears example once did exactly that). */
+    int axial = o->type == PIOLA_OBSTACLE_CYLINDER || o->type == PIOLA_OBSTACLE_CAPSULE ||
+                o->type == PIOLA_OBSTACLE_TORUS || o->type == PIOLA_OBSTACLE_GEAR;
+    piola_vec3 default_axis = axial ? o->axis : (piola_vec3){0, 0, 1};
+    PIOLA_TRY(parse_motion(p, mo, o->center, default_axis, &o->motion));
     pop(p, old);
   } else {
     o->motion = piola_default_rigid_motion_def();
@@ -869,7 +961,8 @@ static piola_status parse_shell(parser *p, const cJSON *obj, int index, scene_sh
   static const char *const allowed[] = {"name", "mesh", "transform", "thickness", "density",
                                         "material", "damping", "bending", "plasticity",
                                         "reference_normals", "velocity", "fixed", "driven",
-                                        "collide_with_solids", "solid_friction", NULL};
+                                        "collide_with_solids", "solid_friction",
+                                        "self_collision", NULL};
   PIOLA_TRY(check_keys(p, obj, allowed));
   PIOLA_TRY(required(p, obj, "mesh"));
   d->def = piola_default_shell_def();
@@ -886,6 +979,10 @@ static piola_status parse_shell(parser *p, const cJSON *obj, int index, scene_sh
   if ((v = get(obj, "material"))) {
     size_t old = push_key(p, "material");
     PIOLA_TRY(parse_material(p, v, &d->base));
+    if (d->base.def.material.model == PIOLA_MODEL_MUSCLE) {
+      push_key(p, "model");
+      return fail(p, BAD_VALUE, "\"muscle\" is for solids only (shells have no fibres)");
+    }
     pop(p, old);
   }
   if ((v = get(obj, "damping"))) {
@@ -940,6 +1037,7 @@ static piola_status parse_shell(parser *p, const cJSON *obj, int index, scene_sh
     pop(p, old);
   }
   PIOLA_TRY(opt_number(p, obj, "solid_friction", NONNEGATIVE, &d->def.solid_friction));
+  PIOLA_TRY(parse_self_collision(p, obj, &d->def.self_collision));
   PIOLA_TRY(opt_vec3(p, obj, "velocity", ANY, &d->base.def.velocity));
   PIOLA_TRY(parse_constraints(p, obj, "fixed", 0, &d->base));
   PIOLA_TRY(parse_constraints(p, obj, "driven", 1, &d->base));
@@ -969,11 +1067,112 @@ static piola_status parse_shells(parser *p, const cJSON *v, scene_desc *out) {
   return PIOLA_OK;
 }
 
+/* ------------------------------------------------------------------ bones */
+
+/* {"solid": NAME, one of box | sphere | indices | within}: which nodes of a solid the bone
+ * carries (docs/bones.md). Solids are parsed before bones, so the name resolves here. */
+static piola_status parse_attachment(parser *p, const cJSON *obj, const scene_desc *scene,
+                                     piola_attachment_def *out, int32_t **indices_out) {
+  static const char *const keys[] = {"solid", "box", "sphere", "indices", "within", NULL};
+  PIOLA_TRY(check_keys(p, obj, keys));
+  PIOLA_TRY(required(p, obj, "solid"));
+  *out = piola_default_attachment_def();
+  const cJSON *v = get(obj, "solid");
+  size_t old = push_key(p, "solid");
+  if (!cJSON_IsString(v)) return fail(p, PIOLA_ERROR_PARSE, "must be the name of a solid, got %s", type_name(v));
+  out->solid = -1;
+  for (int32_t i = 0; i < scene->solid_count; ++i)
+    if (strcmp(scene->solids[i].name, v->valuestring) == 0) out->solid = i;
+  if (out->solid < 0) {
+    for (int32_t i = 0; i < scene->shell_count; ++i)
+      if (strcmp(scene->shells[i].base.name, v->valuestring) == 0)
+        return fail(p, BAD_VALUE, "\"%s\" is a shell: bones attach to solids only", v->valuestring);
+    char list[256] = "";
+    for (int32_t i = 0; i < scene->solid_count; ++i) {
+      if (i) strncat(list, ", ", sizeof list - strlen(list) - 1);
+      strncat(list, scene->solids[i].name, sizeof list - strlen(list) - 1);
+    }
+    return fail(p, BAD_VALUE, "no solid is named \"%s\" (solids: %s)", v->valuestring,
+                scene->solid_count ? list : "none");
+  }
+  pop(p, old);
+  int kinds = !!get(obj, "box") + !!get(obj, "sphere") + !!get(obj, "indices") + !!get(obj, "within");
+  if (kinds != 1) return fail(p, PIOLA_ERROR_PARSE, "needs exactly one of box, sphere, indices or within");
+  if (get(obj, "within")) {
+    out->near_surface = true;
+    return opt_number(p, obj, "within", NONNEGATIVE, &out->distance);
+  }
+  /* the selector keys are those of `fixed`: parse a copy without "solid" */
+  cJSON *copy = cJSON_Duplicate(obj, 1);
+  if (!copy) return fail(p, PIOLA_ERROR_OUT_OF_MEMORY, "out of memory");
+  cJSON_DeleteItemFromObjectCaseSensitive(copy, "solid");
+  piola_constraint_def con;
+  piola_status st = parse_selector(p, copy, 0, &con, indices_out);
+  cJSON_Delete(copy);
+  if (st == PIOLA_OK) out->selector = con.selector;
+  return st;
+}
+
+static piola_status parse_bone(parser *p, const cJSON *obj, int index, const scene_desc *scene,
+                               scene_bone_desc *d) {
+  static const char *const extra[] = {"name", "attachments", NULL};
+  snprintf(d->name, sizeof d->name, "bone%d", index);
+  PIOLA_TRY(parse_obstacle(p, obj, extra, &d->obstacle));
+  const cJSON *v = get(obj, "name");
+  if (v) {
+    size_t old = push_key(p, "name");
+    if (!cJSON_IsString(v) || !v->valuestring[0] || strlen(v->valuestring) >= sizeof d->name)
+      return fail(p, PIOLA_ERROR_PARSE, "must be a non-empty string of at most %d characters",
+                  (int)sizeof d->name - 1);
+    snprintf(d->name, sizeof d->name, "%s", v->valuestring);
+    pop(p, old);
+  }
+  const cJSON *list = get(obj, "attachments");
+  if (!list) return PIOLA_OK;
+  size_t old = push_key(p, "attachments");
+  if (!cJSON_IsArray(list)) return fail(p, PIOLA_ERROR_PARSE, "must be an array of attachments");
+  int count = cJSON_GetArraySize(list);
+  d->attachments = calloc((size_t)(count > 0 ? count : 1), sizeof *d->attachments);
+  d->index_lists = calloc((size_t)(count > 0 ? count : 1), sizeof *d->index_lists);
+  if (!d->attachments || !d->index_lists) return fail(p, PIOLA_ERROR_OUT_OF_MEMORY, "out of memory");
+  int i = 0;
+  for (const cJSON *e = list->child; e; e = e->next, ++i) {
+    size_t o2 = push_index(p, i);
+    d->attachment_count = i + 1;
+    PIOLA_TRY(parse_attachment(p, e, scene, &d->attachments[i], &d->index_lists[i]));
+    pop(p, o2);
+  }
+  pop(p, old);
+  return PIOLA_OK;
+}
+
+static piola_status parse_bones(parser *p, const cJSON *v, scene_desc *out) {
+  size_t old = push_key(p, "bones");
+  if (!cJSON_IsArray(v)) return fail(p, PIOLA_ERROR_PARSE, "must be an array of bones");
+  int count = cJSON_GetArraySize(v);
+  out->bones = calloc((size_t)(count > 0 ? count : 1), sizeof *out->bones);
+  if (!out->bones) return fail(p, PIOLA_ERROR_OUT_OF_MEMORY, "out of memory");
+  int i = 0;
+  for (const cJSON *e = v->child; e; e = e->next, ++i) {
+    size_t o2 = push_index(p, i);
+    out->bone_count = i + 1;
+    PIOLA_TRY(parse_bone(p, e, i, out, &out->bones[i]));
+    for (int j = 0; j < i; ++j)
+      if (strcmp(out->bones[j].name, out->bones[i].name) == 0) {
+        push_key(p, "name");
+        return fail(p, BAD_VALUE, "\"%s\" is already the name of bones[%d]", out->bones[i].name, j);
+      }
+    pop(p, o2);
+  }
+  pop(p, old);
+  return PIOLA_OK;
+}
+
 /* ------------------------------------------------------------------ top level */
 
 static piola_status parse_top(parser *p, const cJSON *root, scene_desc *out) {
   static const char *const allowed[] = {"description", "fps", "frames", "gravity", "integrator",
-                                        "solids", "obstacles", "shells", NULL};
+                                        "solids", "obstacles", "shells", "bones", NULL};
   PIOLA_TRY(check_keys(p, root, allowed));
   const cJSON *v;
   if ((v = get(root, "description")) && !cJSON_IsString(v)) {
@@ -1033,11 +1232,12 @@ static piola_status parse_top(parser *p, const cJSON *root, scene_desc *out) {
     for (const cJSON *e = v->child; e; e = e->next, ++i) {
       size_t o2 = push_index(p, i);
       out->obstacle_count = i + 1;
-      PIOLA_TRY(parse_obstacle(p, e, &out->obstacles[i]));
+      PIOLA_TRY(parse_obstacle(p, e, NULL, &out->obstacles[i]));
       pop(p, o2);
     }
     pop(p, old);
   }
+  if ((v = get(root, "bones"))) PIOLA_TRY(parse_bones(p, v, out));
   return PIOLA_OK;
 }
 
@@ -1048,6 +1248,7 @@ void piola__scene_desc_free(scene_desc *desc) {
     for (int32_t c = 0; c < s->constraint_count; ++c) free(s->index_lists[c]);
     free(s->index_lists);
     free(s->constraints);
+    free(s->fibers.curve);
   }
   free(desc->solids);
   free(desc->obstacles);
@@ -1058,6 +1259,13 @@ void piola__scene_desc_free(scene_desc *desc) {
     free(s->constraints);
   }
   free(desc->shells);
+  for (int32_t i = 0; i < desc->bone_count; ++i) {
+    scene_bone_desc *b = &desc->bones[i];
+    for (int32_t a = 0; a < b->attachment_count; ++a) free(b->index_lists[a]);
+    free(b->index_lists);
+    free(b->attachments);
+  }
+  free(desc->bones);
   memset(desc, 0, sizeof *desc);
 }
 

@@ -7,7 +7,7 @@
 #include "math/mat3.h"
 #include "sim/world_internal.h"
 
-static int selects(const piola_selector *sel, const double *p) {
+int piola__selector_contains(const piola_selector *sel, const double *p) {
   switch (sel->type) {
     case PIOLA_SELECT_BOX:
       return p[0] >= sel->box_min.x && p[0] <= sel->box_max.x && p[1] >= sel->box_min.y &&
@@ -57,7 +57,7 @@ piola_status piola__solid_apply_constraints(world_solid *s, const double *rest,
       }
     } else {
       for (int32_t i = 0; i < s->n; ++i)
-        if (selects(sel, rest + 3 * i)) {
+        if (piola__selector_contains(sel, rest + 3 * i)) {
           s->flags[i] = flag;
           s->motion_of[i] = motion;
         }

@@ -18,6 +18,14 @@ static int track_ok(const piola_track *t, double lo) {
   return 1;
 }
 
+/* Every value of a track (checked by track_ok) is at most hi. */
+static int track_at_most(const piola_track *t, double hi) {
+  if (t->key_count == 0) return t->value <= hi;
+  for (int32_t k = 0; k < t->key_count; ++k)
+    if (t->values[k] > hi) return 0;
+  return 1;
+}
+
 piola_status piola_world_create(const piola_world_def *def, piola_world **out) {
   if (!def || !out) return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "world: NULL argument");
   *out = NULL;
@@ -74,6 +82,7 @@ void piola_world_destroy(piola_world *world) {
 piola_status piola__solid_update_forces(world_solid *s, double t) {
   if (s->shell) return piola__shell_update_forces(s, t);
   double scale = piola_track_eval(&s->stiffness_scale, t);
+  piola_elastic_body_set_activation(s->body, piola_track_eval(&s->activation, t));
   s->elastic_stale = 1;
   return piola_elastic_body_update(s->body, s->x, scale, s->force, NULL);
 }
@@ -186,6 +195,12 @@ piola_status piola_world_add_solid(piola_world *world, const piola_solid_def *de
                       (int)id, def->self_collision.thickness, def->self_collision.friction);
   if (!isfinite(def->velocity.x) || !isfinite(def->velocity.y) || !isfinite(def->velocity.z))
     return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "solid %d: velocity must be finite", (int)id);
+  if (!track_ok(&def->activation, 0) || !track_at_most(&def->activation, 1))
+    return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "solid %d: activation must be in [0, 1]", (int)id);
+  if (def->fiber_directions && def->plasticity)
+    return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT,
+                      "solid %d: fiber directions cannot be combined with plasticity (not supported)",
+                      (int)id);
 
   piola_material material;
   PIOLA_TRY(piola_material_init(&def->material, &material));
@@ -194,6 +209,7 @@ piola_status piola_world_add_solid(piola_world *world, const piola_solid_def *de
   bdef.materials = &material;
   bdef.material_count = 1;
   bdef.density = def->density;
+  bdef.fiber_directions = def->fiber_directions;
 
   world_solid *s = piola__world_new_slot(&world->solids, world->solid_count, &world->solid_capacity);
   if (!s) return PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "add_solid: out of memory");
@@ -212,6 +228,7 @@ piola_status piola_world_add_solid(piola_world *world, const piola_solid_def *de
   s->stiffness_scale = def->stiffness_scale;
   s->shear_viscosity = def->shear_viscosity;
   s->bulk_viscosity = def->bulk_viscosity;
+  s->activation = def->activation;
   s->self_collision = def->self_collision;
   st = piola__solid_apply_constraints(s, rest, def->constraints, def->constraint_count);
   if (st == PIOLA_OK) st = piola__solid_plastic_create(s, def);

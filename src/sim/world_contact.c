@@ -1,15 +1,24 @@
-/* Self-collision of the solids' boundary surfaces, run after every world step (paper section 9:
- * "outside the step"), with the BFA02 collision module (piola/collision_surface.h).
+/* Contact between deformable surfaces, run after every world step (paper section 9: "outside
+ * the step"), with the BFA02 collision module (piola/collision_surface.h): self-collision of
+ * the solids' boundary surfaces and of shells (cloth), and two-way contact between them.
  *
- * One collision surface holds the boundary triangles of every solid with self-collision
- * enabled, over the solids' own vertex numbering shifted by an offset per solid (interior
- * nodes sit in the arrays but belong to no triangle, so they take no part); each solid is one
- * body with its thickness and friction. Boundaries of different solids are in the same
- * surface, so solids collide with each other as well as with themselves.
+ * One collision surface holds the boundary triangles of every solid and the triangles of
+ * every shell with self_collision enabled, over each body's own vertex numbering shifted by
+ * an offset per body (interior nodes of a solid sit in the arrays but belong to no triangle,
+ * so they take no part); each body has its thickness and friction. All bodies are in the same
+ * surface, so they collide with each other as well as with themselves, and since every
+ * impulse acts on both sides of a pair with the lumped masses, solid-shell contact is two-way
+ * and conserves momentum.
  *
- * A step moved every solid from x_old to x. The average velocity of the step, (x - x_old)/dt,
+ * A shell is an open sheet: it has no inside, and none is needed. The repulsion thickness
+ * keeps two sheets (or two layers of one) apart, and continuous collision detection stops
+ * any vertex from passing through a triangle and any edge through an edge, boundary edges of
+ * the sheet included (they are ordinary edges of the surface, with one triangle instead of
+ * two). A solid's boundary is closed, but the module does not use that either.
+ *
+ * A step moved every body from x_old to x. The average velocity of the step, (x - x_old)/dt,
  * is what collision processing corrects: x = x_old + dt v_c'. The final velocity changes by
- * the same amount, v += v_c' - v_c, as in BFA02, and the elastic forces of a solid whose
+ * the same amount, v += v_c' - v_c, as in BFA02, and the elastic forces of a body whose
  * positions changed are recomputed, since the next step starts from them. Constrained nodes
  * count as pinned (infinite mass). */
 #include <math.h>
@@ -22,9 +31,9 @@
 
 typedef struct world_contact {
   piola_collision_surface *surface;
-  int32_t solid_count; /* solids in the world when built */
+  int32_t solid_count, shell_count; /* bodies in the world when built */
   int32_t vertex_count;
-  int32_t *offset; /* per solid: first global vertex, or -1 when not enabled */
+  int32_t *offset; /* per body (solids, then shells): first global vertex, or -1 when off */
   double *x0, *v, *v_before, *mass;
 } world_contact;
 
@@ -37,28 +46,40 @@ void piola__world_contact_free(piola_world *w) {
   w->contact = NULL;
 }
 
+/* Body i of the surface: the solids first, then the shells. */
+static world_solid *body_at(piola_world *w, int32_t i) {
+  return i < w->solid_count ? &w->solids[i] : &w->shells[i - w->solid_count];
+}
+
 static piola_status build(piola_world *w) {
   piola__world_contact_free(w);
   world_contact *c = calloc(1, sizeof(*c));
   if (!c) return PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "self-collision: out of memory");
   w->contact = c;
   c->solid_count = w->solid_count;
-  c->offset = malloc(sizeof(int32_t) * (size_t)(w->solid_count > 0 ? w->solid_count : 1));
+  c->shell_count = w->shell_count;
+  const int32_t count = w->solid_count + w->shell_count;
+  c->offset = malloc(sizeof(int32_t) * (size_t)(count > 0 ? count : 1));
   if (!c->offset) return PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "self-collision: out of memory");
   int32_t nv = 0, nt = 0, bodies = 0;
-  piola_tri_mesh *boundaries =
-      calloc((size_t)(w->solid_count > 0 ? w->solid_count : 1), sizeof(piola_tri_mesh));
+  piola_tri_mesh *boundaries = calloc((size_t)(count > 0 ? count : 1), sizeof(piola_tri_mesh));
   if (!boundaries) return PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "self-collision: out of memory");
   piola_status st = PIOLA_OK;
-  for (int32_t i = 0; i < w->solid_count && st == PIOLA_OK; ++i) {
-    world_solid *s = &w->solids[i];
-    c->offset[i] = -1;
+  for (int32_t i = 0; i < count; ++i) c->offset[i] = -1;
+  for (int32_t i = 0; i < count && st == PIOLA_OK; ++i) {
+    world_solid *s = body_at(w, i);
     if (!s->self_collision.enabled) continue;
-    piola_tet_mesh mesh = {.vertex_count = s->n,
-                           .positions = s->x,
-                           .tet_count = piola_elastic_body_tet_count(s->body),
-                           .tets = (int32_t *)piola_elastic_body_tets(s->body)};
-    st = piola_tet_mesh_boundary(&mesh, &boundaries[i]);
+    if (s->shell) {
+      /* a shell's own triangles, borrowed (not freed below: vertex_count stays 0) */
+      boundaries[i].triangle_count = piola_shell_body_triangle_count(s->shell);
+      boundaries[i].triangles = (int32_t *)piola_shell_body_triangles(s->shell);
+    } else {
+      piola_tet_mesh mesh = {.vertex_count = s->n,
+                             .positions = s->x,
+                             .tet_count = piola_elastic_body_tet_count(s->body),
+                             .tets = (int32_t *)piola_elastic_body_tets(s->body)};
+      st = piola_tet_mesh_boundary(&mesh, &boundaries[i]);
+    }
     c->offset[i] = nv;
     nv += s->n, nt += boundaries[i].triangle_count, ++bodies;
   }
@@ -77,9 +98,9 @@ static piola_status build(piola_world *w) {
   }
   if (st == PIOLA_OK) {
     int32_t t = 0, b = 0;
-    for (int32_t i = 0; i < w->solid_count; ++i) {
+    for (int32_t i = 0; i < count; ++i) {
       if (c->offset[i] < 0) continue;
-      const world_solid *s = &w->solids[i];
+      const world_solid *s = body_at(w, i);
       for (int32_t k = 0; k < 3 * boundaries[i].triangle_count; ++k)
         tris[3 * t + k] = c->offset[i] + boundaries[i].triangles[k];
       t += boundaries[i].triangle_count;
@@ -96,21 +117,25 @@ static piola_status build(piola_world *w) {
     st = piola_collision_surface_create(&def, &c->surface);
   }
   c->vertex_count = nv;
-  for (int32_t i = 0; i < w->solid_count; ++i) piola_tri_mesh_free(&boundaries[i]);
+  for (int32_t i = 0; i < count; ++i)
+    if (i < w->solid_count) piola_tri_mesh_free(&boundaries[i]);
   free(boundaries), free(tris), free(vertex_body), free(defs);
   return st;
 }
 
 piola_status piola__world_self_collide(piola_world *w, double dt, double t1,
                                        piola_step_stats *stats) {
+  const int32_t count = w->solid_count + w->shell_count;
   int any = 0;
-  for (int32_t i = 0; i < w->solid_count; ++i) any |= w->solids[i].self_collision.enabled;
+  for (int32_t i = 0; i < count; ++i) any |= body_at(w, i)->self_collision.enabled;
   if (!any) return PIOLA_OK;
-  if (!w->contact || w->contact->solid_count != w->solid_count) PIOLA_TRY(build(w));
+  if (!w->contact || w->contact->solid_count != w->solid_count ||
+      w->contact->shell_count != w->shell_count)
+    PIOLA_TRY(build(w));
   world_contact *c = w->contact;
-  for (int32_t i = 0; i < w->solid_count; ++i) {
+  for (int32_t i = 0; i < count; ++i) {
     if (c->offset[i] < 0) continue;
-    const world_solid *s = &w->solids[i];
+    const world_solid *s = body_at(w, i);
     for (int32_t k = 0; k < s->n; ++k) {
       const int32_t g = c->offset[i] + k;
       for (int d = 0; d < 3; ++d) {
@@ -126,9 +151,9 @@ piola_status piola__world_self_collide(piola_world *w, double dt, double t1,
   stats->contacts += cs.contacts;
   stats->impacts += cs.impacts;
   stats->impact_zones += cs.impact_zones;
-  for (int32_t i = 0; i < w->solid_count; ++i) {
+  for (int32_t i = 0; i < count; ++i) {
     if (c->offset[i] < 0) continue;
-    world_solid *s = &w->solids[i];
+    world_solid *s = body_at(w, i);
     int changed = 0;
     for (int32_t k = 0; k < 3 * s->n; ++k) {
       const int32_t g = 3 * c->offset[i] + k;

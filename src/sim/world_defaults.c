@@ -31,5 +31,7 @@ piola_solid_def piola_default_solid_def(void) {
   def.self_collision.enabled = false;
   def.self_collision.thickness = 1e-3;
   def.self_collision.friction = 0.3;
+  def.fiber_directions = NULL;
+  def.activation = piola_track_constant(0);
   return def;
 }

@@ -36,6 +36,7 @@ typedef struct world_solid {
   piola_rigid_motion_def *motions;
   int32_t motion_count;
   piola_track stiffness_scale, shear_viscosity, bulk_viscosity;
+  piola_track activation;       /* muscle fibres' activation, set before every force update */
   piola_elastic_stats elastic;  /* of the last update, once refreshed (world.c) */
   int elastic_stale;            /* elastic does not match the last update yet */
   piola_plastic_state *plastic; /* NULL for an elastic solid (world_plasticity.c) */
@@ -71,6 +72,9 @@ piola_status piola__solid_allocate(world_solid *s, int32_t n, const char *name, 
                                    int32_t id, const double *rest, const double *mass);
 void piola__solid_finish_masses(world_solid *s);
 
+/* True when rest position p (3 doubles, m) lies in a box or sphere selector (index lists
+ * select by index, not by position: false). Shared by constraints and bone attachments. */
+int piola__selector_contains(const piola_selector *sel, const double *p);
 piola_status piola__solid_apply_constraints(world_solid *s, const double *rest,
                                             const piola_constraint_def *constraints,
                                             int32_t count);

@@ -22,6 +22,7 @@ piola_shell_def piola_default_shell_def(void) {
   def.plasticity = body.plasticity;
   def.stiffness_scale.value = 1.0;
   def.solid_friction = 0.3;
+  def.self_collision = piola_default_solid_def().self_collision;
   return def;
 }
 
@@ -76,6 +77,12 @@ piola_status piola_world_add_shell(piola_world *world, const piola_shell_def *de
   if (!(def->solid_friction >= 0) || !isfinite(def->solid_friction))
     return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "shell %d: solid_friction must be >= 0, got %g",
                       (int)id, def->solid_friction);
+  const piola_self_collision_def *sc = &def->self_collision;
+  if (sc->enabled && (!(sc->thickness > 0) || !isfinite(sc->thickness) || !(sc->friction >= 0) ||
+                      !isfinite(sc->friction)))
+    return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT,
+                      "shell %d: self_collision needs thickness > 0 m and friction >= 0, got %g, %g",
+                      (int)id, sc->thickness, sc->friction);
   piola_material material;
   PIOLA_TRY(piola_material_init(&def->material, &material));
   piola_shell_body_def bdef = piola_default_shell_body_def();
@@ -107,6 +114,7 @@ piola_status piola_world_add_shell(piola_world *world, const piola_shell_def *de
   s->bulk_viscosity = def->bulk_viscosity;
   s->collide_with_solids = def->collide_with_solids;
   s->solid_friction = def->solid_friction;
+  s->self_collision = def->self_collision;
   st = piola__solid_apply_constraints(s, rest, def->constraints, def->constraint_count);
   if (st != PIOLA_OK) {
     piola__solid_free(s);
@@ -216,7 +224,7 @@ static piola_status solid_boundary(world_solid *solid) {
   const piola_elastic_body *b = solid->body;
   piola_tet_mesh tets = {piola_elastic_body_vertex_count(b),
                          (double *)piola_elastic_body_rest_positions(b),
-                         piola_elastic_body_tet_count(b), (int32_t *)piola_elastic_body_tets(b), NULL};
+                         piola_elastic_body_tet_count(b), (int32_t *)piola_elastic_body_tets(b), NULL, NULL};
   piola_tri_mesh *surface = calloc(1, sizeof *surface);
   if (!surface) return PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "solid boundary: out of memory");
   piola_status st = piola_tet_mesh_boundary(&tets, surface);
@@ -241,6 +249,8 @@ int32_t piola__shell_collide_with_solids(piola_world *w, world_solid *s, double 
   int32_t moved = 0;
   for (int32_t k = 0; k < w->solid_count; ++k) {
     world_solid *solid = &w->solids[k];
+    /* both in the collision surface: the two-way contact after the step handles the pair */
+    if (s->self_collision.enabled && solid->self_collision.enabled) continue;
     if (solid_boundary(solid) != PIOLA_OK) return moved;
     const piola_tri_mesh *surface = solid->boundary;
     const double *sx = solid->x, *sv = solid->v;

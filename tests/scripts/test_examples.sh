@@ -1,6 +1,9 @@
 #!/usr/bin/env bash
 # Every scene in examples/ is runnable as it is: it loads (meshes found, keys valid) and
-# simulates its first frames without error, NaN or an inverted-beyond-repair state.
+# simulates its first frames without error, NaN or an inverted-beyond-repair state. Scenes
+# whose bodies touch within those frames must show it in stats.csv's `contacts` column
+# (self_collision counts shells and solids alike).
+expect_contacts=" cloth_on_jelly "
 set -euo pipefail
 : "${PIOLA:?path of the piola program}" "${PIOLA_SOURCE_DIR:?}"
 work=$(mktemp -d)
@@ -12,6 +15,10 @@ for scene in "$PIOLA_SOURCE_DIR"/examples/*.json; do
     rows=$(($(wc -l < "$work/$name/stats.csv") - 1))
     if [ "$rows" -ne 3 ]; then
       echo "FAIL $name: stats.csv has $rows frame rows, expected 3 (frames 0..2)"; failed=1
+    elif [[ "$expect_contacts" == *" $name "* ]] &&
+         ! awk -F, 'NR == 1 { for (i = 1; i <= NF; ++i) if ($i == "contacts") c = i }
+                    NR > 1 && c && $c > 0 { found = 1 } END { exit !found }' "$work/$name/stats.csv"; then
+      echo "FAIL $name: no contacts counted in stats.csv within 2 frames"; failed=1
     else
       echo "ok   $name"
     fi

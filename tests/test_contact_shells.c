@@ -1,0 +1,478 @@
+/* Shells in the world's collision surface (docs/contact.md, "Shells"): cloth self-collision
+ * and two-way contact between solids and shells.
+ *
+ * - The cloth_folds example (examples/cloth_folds.json, at a reduced resolution) falls onto
+ *   itself in folds; after every step no two cloth triangles without a shared vertex
+ *   intersect (exact referee, src/contact/triangle_intersection.c, with a box sweep in front
+ *   of it that only drops pairs whose closed boxes are disjoint). Without self_collision the
+ *   same run does intersect, so the check has teeth.
+ * - Two sheets stacked on the ground: the upper one stays above the lower one, at about the
+ *   collision thickness, and never intersects it; without self_collision it sinks onto it.
+ * - A block flies into a free cloth with no gravity and no obstacles: total linear momentum
+ *   of the pair is conserved through the collision, both bodies change momentum (two-way),
+ *   and no triangle of the block's boundary or of the cloth intersects another.
+ * - The scene key and the def are checked on shells. */
+#include "test_support.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "contact/triangle_intersection.h"
+#include "piola/scene.h"
+#include "piola/world.h"
+#include "piola/world_shells.h"
+#include "scene/scene_desc.h"
+
+/* ------------------------------------------------------------------ referee */
+
+/* One triangle set to judge: positions (live pointer), triangles over them, and a group id;
+ * pairs inside one group that share a vertex are exempt. */
+typedef struct judged {
+  const double *x;
+  const int32_t *tris;
+  int32_t count;
+} judged;
+
+typedef struct tri_box {
+  double lo[3], hi[3];
+  int32_t set, tri;
+} tri_box;
+
+static int by_lo_x(const void *a, const void *b) {
+  double u = ((const tri_box *)a)->lo[0], v = ((const tri_box *)b)->lo[0];
+  return (u > v) - (u < v);
+}
+
+/* Intersecting triangle pairs over all sets (within and across), except pairs of one set
+ * that share a vertex. Pairs whose closed boxes are disjoint cannot share a point. */
+static long count_intersections(const judged *sets, int set_count) {
+  int32_t n = 0;
+  for (int s = 0; s < set_count; ++s) n += sets[s].count;
+  tri_box *boxes = malloc(sizeof(tri_box) * (size_t)n);
+  assert_non_null(boxes);
+  int32_t k = 0;
+  for (int s = 0; s < set_count; ++s)
+    for (int32_t t = 0; t < sets[s].count; ++t, ++k) {
+      tri_box *b = &boxes[k];
+      b->set = s, b->tri = t;
+      for (int d = 0; d < 3; ++d) b->lo[d] = INFINITY, b->hi[d] = -INFINITY;
+      for (int c = 0; c < 3; ++c)
+        for (int d = 0; d < 3; ++d) {
+          double v = sets[s].x[3 * sets[s].tris[3 * t + c] + d];
+          b->lo[d] = fmin(b->lo[d], v), b->hi[d] = fmax(b->hi[d], v);
+        }
+    }
+  qsort(boxes, (size_t)n, sizeof(tri_box), by_lo_x);
+  long hits = 0;
+  for (int32_t i = 0; i < n; ++i)
+    for (int32_t j = i + 1; j < n && boxes[j].lo[0] <= boxes[i].hi[0]; ++j) {
+      const tri_box *a = &boxes[i], *b = &boxes[j];
+      if (a->lo[1] > b->hi[1] || b->lo[1] > a->hi[1] || a->lo[2] > b->hi[2] || b->lo[2] > a->hi[2])
+        continue;
+      const int32_t *ta = sets[a->set].tris + 3 * a->tri, *tb = sets[b->set].tris + 3 * b->tri;
+      if (a->set == b->set) {
+        int shared = 0;
+        for (int p = 0; p < 3; ++p)
+          for (int q = 0; q < 3; ++q) shared |= ta[p] == tb[q];
+        if (shared) continue;
+      }
+      const double *xa = sets[a->set].x, *xb = sets[b->set].x;
+      const double *p[3] = {xa + 3 * ta[0], xa + 3 * ta[1], xa + 3 * ta[2]};
+      const double *q[3] = {xb + 3 * tb[0], xb + 3 * tb[1], xb + 3 * tb[2]};
+      int r = piola__triangles_intersect(p, q);
+      assert_true(r >= 0);
+      hits += r;
+    }
+  free(boxes);
+  return hits;
+}
+
+static judged shell_set(const piola_world *w, int32_t shell) {
+  const piola_shell_body *b = piola_world_shell_body(w, shell);
+  return (judged){piola_world_shell_positions(w, shell), piola_shell_body_triangles(b),
+                  piola_shell_body_triangle_count(b)};
+}
+
+/* The referee checks all pairs; the box sweep must not lose any. A crossing pair of
+ * triangles (and a pair that only touches at a point) among far apart ones is found. */
+static void referee_finds_crossings_among_many(void **state) {
+  (void)state;
+  double x[3 * 9] = {0, 0, 0,    1, 0, 0,   0, 1, 0,       /* in z = 0 */
+                     0.2, 0.2, -1, 0.3, 0.2, 1, 0.2, 0.3, 1, /* pierces it */
+                     5, 5, 5,    6, 5, 5,   5, 6, 5};      /* far away */
+  int32_t tris[9] = {0, 1, 2, 3, 4, 5, 6, 7, 8};
+  judged one = {x, tris, 3};
+  assert_int_equal(count_intersections(&one, 1), 1);
+  x[9 + 2] = 0.0, x[12 + 2] = 1, x[15 + 2] = 1; /* now it touches z = 0 at one point */
+  assert_int_equal(count_intersections(&one, 1), 1);
+  x[9 + 2] = 1e-12;
+  assert_int_equal(count_intersections(&one, 1), 0);
+  /* the same triangles as two sets: no vertex is shared across sets */
+  judged two[2] = {{x, tris, 1}, {x, tris, 1}};
+  assert_int_equal(count_intersections(two, 2), 1);
+}
+
+/* ------------------------------------------------------------------ cloth folds */
+
+static char *read_text(const char *path) {
+  FILE *f = fopen(path, "rb");
+  if (!f) fail_msg("cannot open %s", path);
+  fseek(f, 0, SEEK_END);
+  long size = ftell(f);
+  fseek(f, 0, SEEK_SET);
+  char *text = malloc((size_t)size + 1);
+  assert_non_null(text);
+  assert_int_equal(fread(text, 1, (size_t)size, f), (size_t)size);
+  text[size] = 0;
+  fclose(f);
+  return text;
+}
+
+/* Replaces the first occurrence of from in text by to (same length or shorter). */
+static void replace(char *text, const char *from, const char *to) {
+  char *at = strstr(text, from);
+  if (!at) fail_msg("'%s' not found in the example", from);
+  size_t a = strlen(from), b = strlen(to);
+  assert_true(b <= a);
+  memcpy(at, to, b);
+  memmove(at + b, at + a, strlen(at + a) + 1);
+}
+
+/* Runs the example at resolution cells x cells until t_end, checking every step; returns the
+ * worst number of intersecting pairs seen and adds the contact statistics to total. */
+static long run_cloth_folds(int self_collision, const char *cells, double t_end,
+                            piola_step_stats *total, double *final_top) {
+  char path[1024];
+  snprintf(path, sizeof path, "%s/examples/cloth_folds.json", PIOLA_SOURCE_DIR);
+  char *text = read_text(path);
+  replace(text, "\"resolution\": [48, 48]", cells);
+  if (!self_collision) replace(text, "\"enabled\": true", "\"enabled\":false");
+  piola_scene *scene = NULL;
+  if (piola_scene_load_string(text, PIOLA_SOURCE_DIR, "cloth_folds", &scene) != PIOLA_OK)
+    fail_msg("%s", piola_last_error());
+  free(text);
+  piola_world *w = piola_scene_world(scene);
+  assert_int_equal(piola_world_shell_count(w), 1);
+  judged cloth = shell_set(w, 0);
+  assert_int_equal(count_intersections(&cloth, 1), 0);
+  memset(total, 0, sizeof(*total));
+  long worst = 0;
+  int steps = 0;
+  while (piola_world_time(w) < t_end) {
+    piola_step_stats one;
+    assert_int_equal(piola_world_step(w, 0, &one), PIOLA_OK);
+    total->contacts += one.contacts, total->impacts += one.impacts;
+    total->impact_zones += one.impact_zones;
+    long bad = count_intersections(&cloth, 1);
+    if (bad > worst) worst = bad;
+    if (self_collision && bad)
+      fail_msg("step %d, t = %g s: %ld intersecting cloth triangle pairs", steps,
+               piola_world_time(w), bad);
+    ++steps;
+  }
+  const double *x = piola_world_shell_positions(w, 0);
+  double top = -INFINITY;
+  for (int32_t i = 0; i < piola_shell_body_vertex_count(piola_world_shell_body(w, 0)); ++i)
+    top = fmax(top, x[3 * i + 2]);
+  *final_top = top;
+  piola_scene_destroy(scene);
+  return worst;
+}
+
+static void cloth_folds_example_never_intersects(void **state) {
+  (void)state;
+  /* the cloth starts upright, 0.33 m up; by t_end its top has come down onto the pile */
+  const double t_end = 0.1 + 0.5 * (double)test_samples(10, 2) / 10.0;
+  piola_step_stats with, without;
+  double top_with, top_without;
+  long worst = run_cloth_folds(1, "\"resolution\": [20, 20]", t_end, &with, &top_with);
+  assert_int_equal(worst, 0);
+  print_message("cloth folds to t = %.2f s: %lld contacts, %lld impacts, %lld zones, top at %.3f m\n",
+                t_end, (long long)with.contacts, (long long)with.impacts,
+                (long long)with.impact_zones, top_with);
+  assert_true(with.contacts + with.impacts > 0);
+  if (t_end >= 0.5) assert_true(top_with < 0.2); /* it fell over onto itself */
+  long worst_off = run_cloth_folds(0, "\"resolution\": [20, 20]", t_end, &without, &top_without);
+  assert_true(without.contacts + without.impacts + without.impact_zones == 0);
+  if (t_end >= 0.5) assert_true(worst_off > 0);
+}
+
+/* ------------------------------------------------------------------ stacked sheets */
+
+static piola_tri_mesh sheet(double size, int cells, double z, double shift) {
+  piola_tri_mesh m;
+  assert_int_equal(piola_tri_mesh_rectangle(size, size, cells, cells, &m), PIOLA_OK);
+  for (int32_t i = 0; i < m.vertex_count; ++i) {
+    m.positions[3 * i] += shift, m.positions[3 * i + 1] += 0.5 * shift;
+    m.positions[3 * i + 2] = z;
+  }
+  return m;
+}
+
+static piola_shell_def cloth_def(const piola_tri_mesh *mesh, int self_collision, double h) {
+  piola_shell_def d = piola_default_shell_def();
+  d.mesh = mesh;
+  d.thickness = 5e-4;
+  d.density = 400;
+  d.material.youngs_modulus = 5e4;
+  d.material.poisson_ratio = 0.3;
+  d.shear_viscosity = piola_track_constant(0.05);
+  d.bulk_viscosity = piola_track_constant(0.05);
+  d.bending.stiffness = 2e-6;
+  d.self_collision.enabled = self_collision != 0;
+  d.self_collision.thickness = h;
+  d.self_collision.friction = 0.3;
+  return d;
+}
+
+/* Lowest vertex of the upper sheet minus the highest of the lower one, m. */
+static double sheet_gap(const piola_world *w) {
+  int32_t n0 = piola_shell_body_vertex_count(piola_world_shell_body(w, 0));
+  int32_t n1 = piola_shell_body_vertex_count(piola_world_shell_body(w, 1));
+  const double *x0 = piola_world_shell_positions(w, 0), *x1 = piola_world_shell_positions(w, 1);
+  double top_of_lower = -INFINITY, bottom_of_upper = INFINITY;
+  for (int32_t i = 0; i < n0; ++i) top_of_lower = fmax(top_of_lower, x0[3 * i + 2]);
+  for (int32_t i = 0; i < n1; ++i) bottom_of_upper = fmin(bottom_of_upper, x1[3 * i + 2]);
+  return bottom_of_upper - top_of_lower;
+}
+
+static double stack_sheets(int self_collision, double h, long *worst) {
+  piola_world_def wd = piola_default_world_def();
+  wd.max_dt = 1e-3;
+  piola_world *w = NULL;
+  assert_int_equal(piola_world_create(&wd, &w), PIOLA_OK);
+  piola_obstacle_def ground = piola_default_obstacle_def();
+  ground.friction = 0.5;
+  assert_int_equal(piola_world_add_obstacle(w, &ground, NULL), PIOLA_OK);
+  /* the lower sheet lies on the ground; the upper one, offset so no vertex sits over a
+   * vertex, falls onto it from 2 cm with 1 m/s */
+  piola_tri_mesh lower = sheet(0.2, 12, 0.0, 0.0), upper = sheet(0.16, 10, 0.02, 0.0037);
+  piola_shell_def a = cloth_def(&lower, self_collision, h), b = cloth_def(&upper, self_collision, h);
+  b.velocity = (piola_vec3){0, 0, -1.0};
+  assert_int_equal(piola_world_add_shell(w, &a, NULL), PIOLA_OK);
+  assert_int_equal(piola_world_add_shell(w, &b, NULL), PIOLA_OK);
+  piola_tri_mesh_free(&lower), piola_tri_mesh_free(&upper);
+  judged sets[2] = {shell_set(w, 0), shell_set(w, 1)};
+  double smallest_gap = INFINITY;
+  *worst = 0;
+  const double t_end = 0.05 + 0.15 * (double)test_samples(10, 2) / 10.0;
+  while (piola_world_time(w) < t_end) {
+    assert_int_equal(piola_world_step(w, 0, NULL), PIOLA_OK);
+    long bad = count_intersections(sets, 2);
+    if (bad > *worst) *worst = bad;
+    smallest_gap = fmin(smallest_gap, sheet_gap(w));
+  }
+  piola_world_destroy(w);
+  return smallest_gap;
+}
+
+static void stacked_sheets_stay_apart(void **state) {
+  (void)state;
+  const double h = 3e-3;
+  long worst = 0;
+  double gap = stack_sheets(1, h, &worst);
+  print_message("stacked sheets: smallest gap %.3g m (thickness %g m)\n", gap, h);
+  assert_int_equal(worst, 0);
+  /* the repulsion holds the upper sheet near the thickness; CCD never lets it reach the
+   * lower one, the ground projection at most pushes the lower one up a little */
+  assert_true(gap > 0.3 * h);
+  long worst_off = 0;
+  double gap_off = stack_sheets(0, h, &worst_off);
+  assert_true(gap_off < 1e-6); /* without it the upper sheet lands on the ground too */
+  assert_true(worst_off > 0);
+}
+
+/* ------------------------------------------------------------------ two-way, momentum */
+
+static void momentum(const double *v, const double *m, int32_t n, double out[3]) {
+  for (int32_t i = 0; i < n; ++i)
+    for (int d = 0; d < 3; ++d) out[d] += m[i] * v[3 * i + d];
+}
+
+/* speed: m/s of the block, h: collision thickness, m. At 12 m/s the block moves about 1.4 mm
+ * a step (the block's CFL step is about 0.12 ms), more than a thickness of 0.5 mm, so
+ * continuous detection (impacts) has to act, not only the repulsion. */
+static void block_hits_free_cloth(double speed, double h) {
+  piola_world_def wd = piola_default_world_def();
+  for (int d = 0; d < 3; ++d) wd.gravity[d] = piola_track_constant(0.0);
+  wd.max_dt = 5e-4;
+  piola_world *w = NULL;
+  assert_int_equal(piola_world_create(&wd, &w), PIOLA_OK);
+  /* a 6 x 6 x 3 cm block of 4x4x2 cells at z in [0.01, 0.04] moving up at 2 m/s ... */
+  piola_tet_mesh block;
+  assert_int_equal(piola_tet_mesh_box_grid(4, 4, 2, (piola_vec3){0.015, 0.015, 0.015}, &block),
+                   PIOLA_OK);
+  for (int32_t i = 0; i < block.vertex_count; ++i) {
+    block.positions[3 * i] -= 0.03 + 1e-3, block.positions[3 * i + 1] -= 0.03 + 2e-3;
+    block.positions[3 * i + 2] += 0.01;
+  }
+  piola_tet_mesh_orient(&block);
+  piola_solid_def sd = piola_default_solid_def();
+  sd.mesh = &block;
+  sd.density = 300;
+  sd.material.youngs_modulus = 1e5;
+  sd.material.poisson_ratio = 0.3;
+  sd.velocity = (piola_vec3){0.1 * speed, 0, speed};
+  sd.self_collision.enabled = true;
+  sd.self_collision.thickness = h;
+  sd.self_collision.friction = 0.3;
+  assert_int_equal(piola_world_add_solid(w, &sd, NULL), PIOLA_OK);
+  /* ... into a free 12 x 12 cm cloth at rest at z = 0.05 */
+  piola_tri_mesh cloth = sheet(0.12, 12, 0.05, 0.0);
+  piola_shell_def cd = cloth_def(&cloth, 1, h);
+  cd.density = 2000; /* 1 kg/m^2: heavy enough to visibly slow the block */
+  assert_int_equal(piola_world_add_shell(w, &cd, NULL), PIOLA_OK);
+  piola_tri_mesh_free(&cloth);
+
+  piola_tri_mesh boundary;
+  assert_int_equal(piola_tet_mesh_boundary(&block, &boundary), PIOLA_OK);
+  const int32_t nb = piola_elastic_body_vertex_count(piola_world_solid_body(w, 0));
+  const int32_t nc = piola_shell_body_vertex_count(piola_world_shell_body(w, 0));
+  const double *mb = piola_elastic_body_masses(piola_world_solid_body(w, 0));
+  const double *mc = piola_shell_body_masses(piola_world_shell_body(w, 0));
+  double p_block0[3] = {0}, p_cloth0[3] = {0};
+  momentum(piola_world_solid_velocities(w, 0), mb, nb, p_block0);
+  momentum(piola_world_shell_velocities(w, 0), mc, nc, p_cloth0);
+  const double scale = fabs(p_block0[2]);
+  judged sets[2] = {{piola_world_solid_positions(w, 0), boundary.triangles, boundary.triangle_count},
+                    shell_set(w, 0)};
+  assert_int_equal(count_intersections(sets, 2), 0);
+  piola_step_stats total = {0};
+  while (piola_world_time(w) < 0.08 / speed) {
+    piola_step_stats one;
+    assert_int_equal(piola_world_step(w, 0, &one), PIOLA_OK);
+    total.contacts += one.contacts, total.impacts += one.impacts;
+    total.impact_zones += one.impact_zones;
+    long bad = count_intersections(sets, 2);
+    if (bad) fail_msg("t = %g s: %ld intersecting triangle pairs", piola_world_time(w), bad);
+    double pb[3] = {0}, pc[3] = {0};
+    momentum(piola_world_solid_velocities(w, 0), mb, nb, pb);
+    momentum(piola_world_shell_velocities(w, 0), mc, nc, pc);
+    for (int d = 0; d < 3; ++d) assert_close(pb[d] + pc[d], p_block0[d] + p_cloth0[d], 1e-10 * scale);
+  }
+  double pb[3] = {0}, pc[3] = {0};
+  momentum(piola_world_solid_velocities(w, 0), mb, nb, pb);
+  momentum(piola_world_shell_velocities(w, 0), mc, nc, pc);
+  print_message("block into cloth at %g m/s: %lld contacts, %lld impacts, %lld zones; block p_z %.4g -> %.4g,"
+                " cloth p_z %.4g -> %.4g kg m/s\n",
+                speed, (long long)total.contacts, (long long)total.impacts,
+                (long long)total.impact_zones, p_block0[2], pb[2], p_cloth0[2], pc[2]);
+  assert_true(total.contacts + total.impacts > 0);
+  if (speed >= 10) assert_true(total.impacts > 0);
+  /* two-way: the block lost a real part of its momentum to the cloth */
+  assert_true(pb[2] < 0.9 * p_block0[2]);
+  assert_true(pc[2] > 0.1 * p_block0[2]);
+  piola_tri_mesh_free(&boundary);
+  piola_tet_mesh_free(&block);
+  piola_world_destroy(w);
+}
+
+/* With self_collision on both sides, the one-way collide_with_solids stays out of the pair:
+ * turning it on changes nothing, to the bit. */
+static void one_way_coupling_defers_to_two_way_contact(void **state) {
+  (void)state;
+  double *runs[2] = {NULL, NULL};
+  int32_t nc = 0;
+  piola_step_stats totals[2] = {{0}, {0}};
+  for (int one_way = 0; one_way < 2; ++one_way) {
+    piola_world_def wd = piola_default_world_def();
+    wd.max_dt = 5e-4;
+    piola_world *w = NULL;
+    assert_int_equal(piola_world_create(&wd, &w), PIOLA_OK);
+    piola_tet_mesh block;
+    assert_int_equal(piola_tet_mesh_box_grid(3, 3, 2, (piola_vec3){0.02, 0.02, 0.02}, &block),
+                     PIOLA_OK);
+    for (int32_t i = 0; i < block.vertex_count; ++i)
+      block.positions[3 * i] -= 0.03, block.positions[3 * i + 1] -= 0.03;
+    piola_tet_mesh_orient(&block);
+    piola_solid_def sd = piola_default_solid_def();
+    sd.mesh = &block;
+    sd.material.youngs_modulus = 1e5;
+    sd.constraints = &(piola_constraint_def){.selector = {.type = PIOLA_SELECT_BOX,
+                                                          .box_min = {-1, -1, -1},
+                                                          .box_max = {1, 1, 1e-3}}};
+    sd.constraint_count = 1;
+    sd.self_collision.enabled = true;
+    sd.self_collision.thickness = 2e-3;
+    assert_int_equal(piola_world_add_solid(w, &sd, NULL), PIOLA_OK);
+    piola_tri_mesh cloth = sheet(0.12, 10, 0.05, 0.0);
+    piola_shell_def cd = cloth_def(&cloth, 1, 2e-3);
+    cd.collide_with_solids = one_way != 0;
+    cd.velocity = (piola_vec3){0, 0, -6.0}; /* 3 mm a step: x~ reaches into the block */
+    assert_int_equal(piola_world_add_shell(w, &cd, NULL), PIOLA_OK);
+    piola_tri_mesh_free(&cloth);
+    assert_int_equal(piola_world_advance_to(w, 0.03, &totals[one_way]), PIOLA_OK);
+    nc = piola_shell_body_vertex_count(piola_world_shell_body(w, 0));
+    runs[one_way] = malloc(sizeof(double) * 3 * (size_t)nc);
+    assert_non_null(runs[one_way]);
+    memcpy(runs[one_way], piola_world_shell_positions(w, 0), sizeof(double) * 3 * (size_t)nc);
+    piola_tet_mesh_free(&block);
+    piola_world_destroy(w);
+  }
+  print_message("cloth onto block at 6 m/s: %lld contacts, %lld impacts, %lld zones\n",
+                (long long)totals[0].contacts, (long long)totals[0].impacts,
+                (long long)totals[0].impact_zones);
+  assert_true(totals[0].contacts > 0); /* the cloth did reach the block */
+  assert_memory_equal(runs[0], runs[1], sizeof(double) * 3 * (size_t)nc);
+  free(runs[0]), free(runs[1]);
+}
+
+static void block_hits_free_cloth_conserving_momentum(void **state) {
+  (void)state;
+  block_hits_free_cloth(2.0, 2e-3);
+}
+
+static void fast_block_hits_free_cloth_conserving_momentum(void **state) {
+  (void)state;
+  block_hits_free_cloth(12.0, 5e-4);
+}
+
+/* ------------------------------------------------------------------ keys and defs */
+
+static void shell_self_collision_key_and_def(void **state) {
+  (void)state;
+  scene_desc d;
+  const char *json =
+      "{\"shells\": [{\"mesh\": {\"generate\": \"rectangle\", \"size\": [1, 1], \"resolution\": [2, 2]},"
+      " \"self_collision\": {\"thickness\": 0.004, \"friction\": 0.1}},"
+      " {\"mesh\": {\"generate\": \"rectangle\", \"size\": [1, 1], \"resolution\": [2, 2]}}]}";
+  if (piola__scene_parse(json, "/base", "t", &d) != PIOLA_OK) fail_msg("%s", piola_last_error());
+  assert_true(d.shells[0].def.self_collision.enabled);
+  assert_close(d.shells[0].def.self_collision.thickness, 0.004, 0);
+  assert_close(d.shells[0].def.self_collision.friction, 0.1, 0);
+  assert_false(d.shells[1].def.self_collision.enabled);
+  piola__scene_desc_free(&d);
+  const char *bad =
+      "{\"shells\": [{\"mesh\": {\"generate\": \"rectangle\", \"size\": [1, 1], \"resolution\": [2, 2]},"
+      " \"self_collision\": {\"thickness\": -1}}]}";
+  assert_int_not_equal(piola__scene_parse(bad, "/base", "t", &d), PIOLA_OK);
+  assert_non_null(strstr(piola_last_error(), "self_collision"));
+
+  piola_world_def wd = piola_default_world_def();
+  piola_world *w = NULL;
+  assert_int_equal(piola_world_create(&wd, &w), PIOLA_OK);
+  piola_tri_mesh m = sheet(0.1, 2, 0, 0);
+  piola_shell_def sd = cloth_def(&m, 1, 0.0);
+  assert_int_equal(piola_world_add_shell(w, &sd, NULL), PIOLA_ERROR_INVALID_ARGUMENT);
+  sd.self_collision.thickness = 1e-3, sd.self_collision.friction = -0.5;
+  assert_int_equal(piola_world_add_shell(w, &sd, NULL), PIOLA_ERROR_INVALID_ARGUMENT);
+  sd.self_collision.friction = 0.5;
+  assert_int_equal(piola_world_add_shell(w, &sd, NULL), PIOLA_OK);
+  piola_tri_mesh_free(&m);
+  piola_world_destroy(w);
+}
+
+int main(void) {
+  const struct CMUnitTest tests[] = {
+      cmocka_unit_test(referee_finds_crossings_among_many),
+      cmocka_unit_test(shell_self_collision_key_and_def),
+      cmocka_unit_test(block_hits_free_cloth_conserving_momentum),
+      cmocka_unit_test(fast_block_hits_free_cloth_conserving_momentum),
+      cmocka_unit_test(stacked_sheets_stay_apart),
+      cmocka_unit_test(one_way_coupling_defers_to_two_way_contact),
+      cmocka_unit_test(cloth_folds_example_never_intersects),
+  };
+  return cmocka_run_group_tests(tests, NULL, NULL);
+}

@@ -147,7 +147,7 @@ static void solves_the_filtered_system_and_returns_its_product(void **state) {
   for (int trial = 0; trial < 3 * (int)test_samples(10, 2); ++trial) {
     dense_system d;
     random_system(&rng, &d, stiffness[trial % 3]);
-    double b[DOF], x0[DOF], x[DOF], ref[DOF], ax[DOF], direct[DOF], work[4 * DOF];
+    double b[DOF], x0[DOF], x[DOF], ref[DOF], ax[DOF], direct[DOF], work[3 * DOF];
     for (int i = 0; i < DOF; ++i) b[i] = test_rng_uniform(&rng, -1, 1), x0[i] = test_rng_uniform(&rng, -1, 1);
     memcpy(x, x0, sizeof x);
     cg_problem pb = {NODES, dense_apply, dense_filter, &d, d.inverse_mass, 1e-12, 200};
@@ -175,7 +175,7 @@ static void a_converged_guess_costs_one_apply(void **state) {
   test_rng rng = test_rng_seeded(5);
   dense_system d;
   random_system(&rng, &d, 1);
-  double x[DOF], b[DOF], ax[DOF], work[4 * DOF];
+  double x[DOF], b[DOF], ax[DOF], work[3 * DOF];
   for (int i = 0; i < DOF; ++i) x[i] = test_rng_uniform(&rng, -1, 1);
   dense_apply(&d, x, b); /* x already solves it */
   d.applies = 0;

@@ -56,7 +56,7 @@ int32_t piola__cg_solve(const cg_problem *pb, const double *b, double *x, double
   const int32_t n = pb->n;
   const int64_t m = 3 * (int64_t)n;
   const double *inverse_mass = pb->inverse_mass;
-  double *r = work, *p = work + 2 * m, *q = work + 3 * m;
+  double *r = work, *p = work + m, *q = work + 2 * m;
   /* reference size: the filtered right-hand side */
   for (int64_t i = 0; i < m; ++i) r[i] = b[i];
   pb->filter(pb->ctx, r, 0, n);

@@ -7,7 +7,8 @@
  * the initial guess by a filter S that projects those components out of every residual and
  * search direction (Baraff and Witkin's modified conjugate gradient). The preconditioner is
  * the inverse lumped mass, which commutes with the per-node filter. Dot products are summed
- * serially in index order so results do not depend on the thread count.
+ * over fixed node ranges in index order and the ranges in order, so results do not depend on
+ * the thread count.
  *
  * The solver also returns A x (unfiltered) at the solution, kept up to date alongside x
  * (A x += alpha A p with the A p it has anyway), so a caller that needs it (the friction
@@ -30,8 +31,8 @@ typedef struct cg_problem {
   int32_t max_iterations;
 } cg_problem;
 
-/* Solves A x = b starting from x (whose filtered components are kept). work holds 4 * 3n
- * doubles (the second 3n are unused now). ax (3n, may be NULL) receives A x at the returned x, unfiltered, to rounding.
+/* Solves A x = b starting from x (whose filtered components are kept). work holds 3 * 3n
+ * doubles. ax (3n, may be NULL) receives A x at the returned x, unfiltered, to rounding.
  * Returns the iterations used. */
 int32_t piola__cg_solve(const cg_problem *problem, const double *b, double *x, double *work,
                         double *ax);

@@ -274,9 +274,9 @@ static piola_status step_solid(piola_world *w, world_solid *s, double t, double 
   for (int32_t i = 0; i < n; ++i)
     for (int k = 0; k < 3; ++k)
       s->rhs[3 * i + k] += h * (s->force[3 * i + k] + s->mass[i] * g1[k]);
-  /* the solve also gives A v^n+1 (the fifth work vector; CG uses four), which the friction
-   * of the held normal impulse needs */
-  double *av = s->work + 4 * m;
+  /* the solve also gives A v^n+1 (the fourth work vector; CG uses three), which the
+   * friction of the held normal impulse needs */
+  double *av = s->work + 3 * m;
   const double gravity2[3] = {h * (g0[0] + g1[0]), h * (g0[1] + g1[1]), h * (g0[2] + g1[2])};
   stats->cg_iterations +=
       damping_solve(w, s, h, t1, 1, s->rhs, s->v, gravity2, colliding > 0 ? av : NULL);

@@ -51,6 +51,7 @@ typedef struct piola__contact {
   double gap;       /* m: r . normal at the start of the step */
   double thickness; /* m: of the pair */
   double friction;  /* Coulomb coefficient of the pair */
+  int32_t edge_edge; /* 1: edge (v[0], v[1]) against edge (v[2], v[3]); 0: point-triangle */
 } piola__contact;
 
 typedef struct piola__contact_list {

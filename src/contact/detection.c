@@ -143,11 +143,6 @@ static int all_pinned(const piola_collision_surface *s, const int32_t v[4]) {
          s->inverse_mass[v[2]] == 0.0 && s->inverse_mass[v[3]] == 0.0;
 }
 
-/* Pairs none of whose vertices changed velocity since the last pass were tested then. */
-static int any_dirty(const uint8_t *dirty, const int32_t v[4]) {
-  return !dirty || dirty[v[0]] || dirty[v[1]] || dirty[v[2]] || dirty[v[3]];
-}
-
 static vec3 unit(vec3 a) {
   double len = vec3_norm(a);
   return len > 0.0 ? vec3_scale(a, 1.0 / len) : a;
@@ -227,6 +222,7 @@ static int ccd_contact(const piola_collision_surface *s, const vec3 x[4], const 
  * collides during the step (continuous detection). */
 static int narrow_phase(const piola_collision_surface *s, const double *x0, const double *v,
                         double dt, detect_mode mode, int edge_edge, piola__contact *c) {
+  c->edge_edge = edge_edge;
   vec3 x[4];
   load_pair(x0, c->v, x);
   double dist2 = pair_distance2(x, edge_edge, c->w);
@@ -334,7 +330,7 @@ static int classify_pair(const piola_collision_surface *s, const double *x0, con
   if (all_pinned(s, v)) return 0;
   vec3 x[4];
   load_pair(x0, v, x);
-  piola__contact c = {.v = {v[0], v[1], v[2], v[3]}};
+  piola__contact c = {.v = {v[0], v[1], v[2], v[3]}, .edge_edge = edge_edge};
   double dist2 = pair_distance2(x, edge_edge, c.w);
   if (proximity_contact(s, x, edge_edge, dist2, &c) && piola__contact_list_push(&out->near, &c))
     return -1;
@@ -498,7 +494,8 @@ static int scan_candidates(piola_collision_surface *s, const double *x0, const d
       const piola__pair *p = &s->candidates.items[i];
       if (dirty && !any_flag(dirty, p->v)) continue;
       if (escaped && any_flag(escaped, p->v)) continue;
-      piola__contact contact = {.v = {p->v[0], p->v[1], p->v[2], p->v[3]}};
+      piola__contact contact = {.v = {p->v[0], p->v[1], p->v[2], p->v[3]},
+                                .edge_edge = p->edge_edge};
       vec3 x[4];
       load_pair(x0, p->v, x);
       if (ccd_contact(s, x, v, dt, p->edge_edge, p->start2, &contact) &&
@@ -513,11 +510,13 @@ static int scan_candidates(piola_collision_surface *s, const double *x0, const d
   return failed ? -1 : 0;
 }
 
-/* Pairs of one query primitive with the candidates the tree returns for its box; appends
- * the contacts found to list. Returns 0, or -1 out of memory. */
+/* Pairs of one query primitive with the candidates the tree returns for its box, each pair
+ * with a vertex marked in `dirty` once, and (when filter is given) with a vertex marked in
+ * filter; appends the contacts found to list. Returns 0, or -1 out of memory. */
 static int query_pairs(const piola_collision_surface *s, const double *x0, const double *v,
-                       double dt, detect_mode mode, const uint8_t *dirty, query_kind kind,
-                       int32_t q, piola__index_list *candidates, piola__contact_list *list) {
+                       double dt, detect_mode mode, const uint8_t *dirty, const uint8_t *filter,
+                       query_kind kind, int32_t q, piola__index_list *candidates,
+                       piola__contact_list *list) {
   candidates->count = 0;
   if (kind == QUERY_VERTEX) {
     if (piola__bvh_query(&s->triangle_tree, s->triangle_boxes, &s->vertex_boxes[q], candidates))
@@ -526,7 +525,7 @@ static int query_pairs(const piola_collision_surface *s, const double *x0, const
       const int32_t *tri = s->triangles + 3 * candidates->items[j];
       if (tri[0] == q || tri[1] == q || tri[2] == q) continue;
       piola__contact c = {.v = {q, tri[0], tri[1], tri[2]}};
-      if (all_pinned(s, c.v) || !any_dirty(dirty, c.v)) continue;
+      if (all_pinned(s, c.v) || (filter && !any_flag(filter, c.v))) continue;
       if (narrow_phase(s, x0, v, dt, mode, 0, &c) && piola__contact_list_push(list, &c)) return -1;
     }
   } else if (kind == QUERY_TRIANGLE) {
@@ -538,7 +537,7 @@ static int query_pairs(const piola_collision_surface *s, const double *x0, const
       const int32_t p = candidates->items[j];
       if (dirty[p] || !s->on_surface[p] || tri[0] == p || tri[1] == p || tri[2] == p) continue;
       piola__contact c = {.v = {p, tri[0], tri[1], tri[2]}};
-      if (all_pinned(s, c.v)) continue;
+      if (all_pinned(s, c.v) || (filter && !any_flag(filter, c.v))) continue;
       if (narrow_phase(s, x0, v, dt, mode, 0, &c) && piola__contact_list_push(list, &c)) return -1;
     }
   } else {
@@ -553,18 +552,19 @@ static int query_pairs(const piola_collision_surface *s, const double *x0, const
       if (dirty && e < q && (dirty[b0] || dirty[b1])) continue;
       if (a0 == b0 || a0 == b1 || a1 == b0 || a1 == b1) continue;
       piola__contact c = {.v = {a0, a1, b0, b1}};
-      if (all_pinned(s, c.v)) continue;
+      if (all_pinned(s, c.v) || (filter && !any_flag(filter, c.v))) continue;
       if (narrow_phase(s, x0, v, dt, mode, 1, &c) && piola__contact_list_push(list, &c)) return -1;
     }
   }
   return 0;
 }
 
-/* Every pair with a vertex marked in mask, found by querying the trees (fit to the current
- * boxes) from the marked vertices and from the triangles and edges that touch one; appended
- * to s->found in block order. Returns 0, or -1 out of memory. */
+/* Every pair with a vertex marked in mask (and one marked in filter, when given), found by
+ * querying the trees (fit to the current boxes) from the marked vertices and from the
+ * triangles and edges that touch one; appended to s->found in block order. Returns 0, or -1
+ * out of memory. */
 static int query_marked(piola_collision_surface *s, const double *x0, const double *v, double dt,
-                        detect_mode mode, const uint8_t *mask) {
+                        detect_mode mode, const uint8_t *mask, const uint8_t *filter) {
   /* The queries: (kind, primitive) in three runs. */
   int32_t runs[3] = {0, 0, 0}, n = 0;
   for (int32_t i = 0; i < s->vertex_count; ++i)
@@ -601,7 +601,7 @@ static int query_marked(piola_collision_surface *s, const double *x0, const doub
       const int32_t end =
           first + PIOLA__QUERY_BLOCK < runs[r] ? first + PIOLA__QUERY_BLOCK : runs[r];
       for (int32_t i = first; i < end; ++i)
-        if (query_pairs(s, x0, v, dt, mode, mask, kind, s->queries[i], &candidates, list)) {
+        if (query_pairs(s, x0, v, dt, mode, mask, filter, kind, s->queries[i], &candidates, list)) {
           failed = 1;
           break;
         }
@@ -638,7 +638,7 @@ int piola__detect(piola_collision_surface *s, const double *x0, const double *v,
    * to the swept boxes, for them. */
   compute_primitive_boxes(s);
   if (fit_trees(s, tree_built)) return -1;
-  return query_marked(s, x0, v, dt, mode, s->escaped);
+  return query_marked(s, x0, v, dt, mode, s->escaped, dirty);
 }
 
 int piola__detect_all_pairs(const piola_collision_surface *s, const double *x0, const double *v,

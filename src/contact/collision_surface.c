@@ -3,6 +3,7 @@
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
+#include <time.h>
 
 #include "common/status_internal.h"
 #include "contact/contact_internal.h"
@@ -268,6 +269,19 @@ static int apply_impact(piola_collision_surface *s, const piola__contact *c, dou
 
 /* ------------------------------------------------------------------ processing */
 
+static double thread_seconds(void) {
+  struct timespec ts;
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+  return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+/* Seconds since *clock, which moves on to now. */
+static double lap(double *clock) {
+  double now = thread_seconds(), elapsed = now - *clock;
+  *clock = now;
+  return elapsed;
+}
+
 static int same_zone(piola_collision_surface *s, const piola__contact *c) {
   if (!s->in_zone[c->v[0]]) return 0;
   int32_t root = piola__zone_root(s->zone_parent, c->v[0]);
@@ -307,13 +321,18 @@ piola_status piola_collision_surface_process(piola_collision_surface *s, const d
   }
   piola_collision_stats st = {0};
   int tree_built = 0;
+  s->profile = (piola__contact_profile){0};
+  double clock = thread_seconds();
   if (piola__collect_candidates(s, x0, v, dt, &tree_built)) goto out_of_memory;
+  s->profile.candidates = s->candidates.count;
+  s->profile.collect = lap(&clock);
 
   /* Stage 1: repulsion of pairs closer than their thickness at x0. */
   if (set.repulsion) {
     if (piola__detect(s, x0, v, dt, PIOLA__DETECT_PROXIMITY, NULL, &tree_built)) goto out_of_memory;
     for (int64_t i = 0; i < s->found.count; ++i)
       st.contacts += apply_repulsion(s, &s->found.items[i], v, dt, set.repulsion_stiffness);
+    s->profile.repulsion = lap(&clock);
   }
 
   /* Stage 2: continuous detection and impacts, a few passes. After the first pass only pairs
@@ -323,6 +342,7 @@ piola_status piola_collision_surface_process(piola_collision_surface *s, const d
   for (int pass = 0; pass < set.collision_iterations; ++pass) {
     if (piola__detect(s, x0, v, dt, PIOLA__DETECT_CCD, first_pass ? NULL : s->dirty, &tree_built))
       goto out_of_memory;
+    s->profile.detection += lap(&clock);
     first_pass = 0;
     ++st.collision_passes;
     if (s->found.count == 0) {
@@ -337,6 +357,7 @@ piola_status piola_collision_surface_process(piola_collision_surface *s, const d
       else
         for (int k = 0; k < 4; ++k) s->dirty[c->v[k]] = 1;
     }
+    s->profile.impulses += lap(&clock);
   }
 
   /* Stage 3: rigid impact zones until no collision is left. */
@@ -346,6 +367,7 @@ piola_status piola_collision_surface_process(piola_collision_surface *s, const d
     for (int pass = 0; pass < set.max_zone_iterations; ++pass) {
       if (piola__detect(s, x0, v, dt, PIOLA__DETECT_CCD, first_pass ? NULL : s->dirty, &tree_built))
         goto out_of_memory;
+      s->profile.detection += lap(&clock);
       first_pass = 0;
       ++st.zone_passes;
       /* Collisions inside one zone cannot be fixed by making it rigid again (and the rigid
@@ -362,6 +384,7 @@ piola_status piola_collision_surface_process(piola_collision_surface *s, const d
       int32_t zones = piola__impact_zones_apply(s, &s->found, x0, v, &st.zone_vertices);
       if (zones < 0) goto out_of_memory;
       st.impact_zones = zones;
+      s->profile.zones += lap(&clock);
     }
   }
   st.resolved = clean && !s->zone_misfit;

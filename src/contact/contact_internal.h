@@ -45,12 +45,12 @@
 
 /* One pair and what is needed to push it apart. */
 typedef struct piola__contact {
-  int32_t v[4];     /* vertices: point then triangle, or edge then edge */
-  double w[4];      /* relative position r = sum w[k] x[k] */
-  vec3 normal;      /* unit; r has a non-negative component along it at the start */
-  double gap;       /* m: r . normal at the start of the step */
-  double thickness; /* m: of the pair */
-  double friction;  /* Coulomb coefficient of the pair */
+  int32_t v[4];      /* vertices: point then triangle, or edge then edge */
+  double w[4];       /* relative position r = sum w[k] x[k] */
+  vec3 normal;       /* unit; r has a non-negative component along it at the start */
+  double gap;        /* m: r . normal at the start of the step */
+  double thickness;  /* m: of the pair */
+  double friction;   /* Coulomb coefficient of the pair */
   int32_t edge_edge; /* 1: edge (v[0], v[1]) against edge (v[2], v[3]); 0: point-triangle */
 } piola__contact;
 
@@ -75,6 +75,19 @@ typedef struct piola__pair_list {
 } piola__pair_list;
 
 typedef enum piola__detect_mode { PIOLA__DETECT_PROXIMITY, PIOLA__DETECT_CCD } piola__detect_mode;
+
+/* Where the last call's time went, in CPU seconds of the calling thread (with one thread,
+ * all of it), and how much detection work it did: read by bench/bench_contact.c. */
+typedef struct piola__contact_profile {
+  double collect;      /* boxes, trees and the tree descent at the start of the call */
+  double repulsion;    /* stage 1 */
+  double detection;    /* stage 2 and 3 detection passes (with any collection they redo) */
+  double impulses;     /* stage 2 impacts */
+  double zones;        /* stage 3 zone velocities */
+  int64_t candidates;  /* pairs collected at the start of the call */
+  int32_t collections; /* tree descents (1 + collections redone) */
+  int32_t escaped;     /* vertex escapes summed over detection passes */
+} piola__contact_profile;
 
 struct piola_collision_surface {
   int32_t vertex_count, triangle_count, edge_count, body_count;
@@ -105,6 +118,7 @@ struct piola_collision_surface {
   piola__contact_list near;    /* contacts at x0 found with the candidates */
   int32_t chunk_count;         /* capacity of chunks */
   piola__contact_list *chunks; /* per chunk of candidates: what a pass found */
+  piola__contact_profile profile;
 };
 
 /* Collects the candidate pairs of a call (into surface->candidates): reach boxes from x0 and

@@ -430,6 +430,7 @@ static int append_contacts(piola__contact_list *dst, const piola__contact *src, 
 
 int piola__collect_candidates(piola_collision_surface *s, const double *x0, const double *v,
                               double dt, int *tree_built) {
+  ++s->profile.collections;
   compute_vertex_boxes(s, x0, v, dt, BOX_REACH);
   memcpy(s->reach_boxes, s->vertex_boxes, sizeof(piola__box) * (size_t)s->vertex_count);
   compute_primitive_boxes(s);
@@ -627,6 +628,7 @@ int piola__detect(piola_collision_surface *s, const double *x0, const double *v,
     return 0;
   }
   int32_t escaped = compute_vertex_boxes(s, x0, v, dt, BOX_SWEPT);
+  s->profile.escaped += escaped;
   if (escaped > 0 && (int64_t)escaped * ESCAPE_FRACTION > s->vertex_count) {
     /* Too many velocities changed too much: collect the candidates again. */
     if (piola__collect_candidates(s, x0, v, dt, tree_built)) return -1;

@@ -69,6 +69,9 @@ void piola_collision_surface_destroy(piola_collision_surface *s) {
   free(s->candidates.items);
   free(s->near.items);
   free(s->reach_radius);
+  free(s->vertex_slabs);
+  free(s->triangle_slabs);
+  free(s->edge_slabs);
   if (s->chunks)
     for (int32_t c = 0; c < s->chunk_count; ++c) free(s->chunks[c].items);
   free(s->chunks);
@@ -151,10 +154,14 @@ piola_status piola_collision_surface_create(const piola_collision_surface_def *d
   s->reach_boxes = malloc(sizeof(piola__box) * nv1);
   s->escaped = calloc(nv1, 1);
   s->reach_radius = malloc(sizeof(double) * nv1);
-  if (!s->reach_boxes || !s->escaped || !s->reach_radius || !s->triangles || !s->edges ||
-      !s->vertex_body || !s->bodies || !s->inverse_mass || !s->vertex_thickness ||
-      !s->vertex_boxes || !s->triangle_boxes || !s->edge_boxes || !s->zone_parent || !s->in_zone ||
-      !s->zone_order || !s->dirty || !s->on_surface) {
+  s->vertex_slabs = malloc(sizeof(double) * 12 * nv1);
+  s->triangle_slabs = malloc(sizeof(double) * 12 * nt1);
+  s->edge_slabs = malloc(sizeof(double) * 36 * nt1);
+  if (!s->reach_boxes || !s->escaped || !s->reach_radius || !s->vertex_slabs ||
+      !s->triangle_slabs || !s->edge_slabs || !s->triangles || !s->edges || !s->vertex_body ||
+      !s->bodies || !s->inverse_mass || !s->vertex_thickness || !s->vertex_boxes ||
+      !s->triangle_boxes || !s->edge_boxes || !s->zone_parent || !s->in_zone || !s->zone_order ||
+      !s->dirty || !s->on_surface) {
     piola_collision_surface_destroy(s);
     return PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "collision surface: out of memory");
   }

@@ -119,6 +119,7 @@ struct piola_collision_surface {
   int32_t chunk_count;         /* capacity of chunks */
   piola__contact_list *chunks; /* per chunk of candidates: what a pass found */
   piola__contact_profile profile;
+  double *vertex_slabs, *triangle_slabs, *edge_slabs; /* 12 per primitive (detection.c) */
 };
 
 /* Collects the candidate pairs of a call (into surface->candidates): reach boxes from x0 and

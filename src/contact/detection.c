@@ -103,6 +103,61 @@ static void compute_primitive_boxes(piola_collision_surface *s) {
   }
 }
 
+/* Diagonal slabs: the extents of a primitive along the six directions x +- y, x +- z and
+ * y +- z, taken from the corners of its vertices' boxes (so they hold everything the boxes
+ * hold, padding included, and a pair within its thickness overlaps in them too). With the
+ * box they make an 18-sided bounding volume (a k-DOP), which separates what boxes of
+ * diagonal primitives cannot: in a triangulated sheet, the box of a diagonal edge holds the
+ * corners of its quad, so without them every edge and vertex around those corners would be
+ * a candidate. Six intervals, lo then hi, per primitive. */
+enum { SLABS = 12 };
+
+static void vertex_slabs(const piola__box *b, double *out) {
+  static const int axes[3][2] = {{0, 1}, {0, 2}, {1, 2}};
+  for (int k = 0; k < 3; ++k) {
+    const int i = axes[k][0], j = axes[k][1];
+    out[4 * k + 0] = b->lo[i] + b->lo[j], out[4 * k + 1] = b->hi[i] + b->hi[j]; /* i + j */
+    out[4 * k + 2] = b->lo[i] - b->hi[j], out[4 * k + 3] = b->hi[i] - b->lo[j]; /* i - j */
+  }
+}
+
+static void slabs_union(double *out, const double *a) {
+  for (int k = 0; k < SLABS; k += 2) {
+    out[k] = dmin(out[k], a[k]);
+    out[k + 1] = dmax(out[k + 1], a[k + 1]);
+  }
+}
+
+static int slabs_overlap(const double *a, const double *b) {
+  for (int k = 0; k < SLABS; k += 2)
+    if (a[k + 1] < b[k] || b[k + 1] < a[k]) return 0;
+  return 1;
+}
+
+/* Slabs of every vertex, triangle and edge from the current vertex boxes. */
+static void compute_slabs(piola_collision_surface *s) {
+#pragma omp parallel num_threads(piola__thread_count()) if (s->edge_count >= 8192)
+  {
+#pragma omp for schedule(static)
+    for (int32_t i = 0; i < s->vertex_count; ++i)
+      vertex_slabs(&s->vertex_boxes[i], s->vertex_slabs + SLABS * (size_t)i);
+#pragma omp for schedule(static)
+    for (int32_t t = 0; t < s->triangle_count; ++t) {
+      const int32_t *tri = s->triangles + 3 * t;
+      double *out = s->triangle_slabs + SLABS * (size_t)t;
+      memcpy(out, s->vertex_slabs + SLABS * (size_t)tri[0], sizeof(double) * SLABS);
+      slabs_union(out, s->vertex_slabs + SLABS * (size_t)tri[1]);
+      slabs_union(out, s->vertex_slabs + SLABS * (size_t)tri[2]);
+    }
+#pragma omp for schedule(static)
+    for (int32_t e = 0; e < s->edge_count; ++e) {
+      double *out = s->edge_slabs + SLABS * (size_t)e;
+      memcpy(out, s->vertex_slabs + SLABS * (size_t)s->edges[2 * e], sizeof(double) * SLABS);
+      slabs_union(out, s->vertex_slabs + SLABS * (size_t)s->edges[2 * e + 1]);
+    }
+  }
+}
+
 /* Fits the three trees to the current primitive boxes: a tree built in an earlier call is
  * refit as long as it is young (its shape came from positions close to these); every
  * REBUILD_PERIOD calls, and on the first use, it is built from scratch. Returns 0, or -1 out
@@ -382,18 +437,19 @@ static int run_task(const piola_collision_surface *s, const double *x0, const pi
     }
     if (k > 0) return -1; /* cannot happen: depth is bounded by the two trees' depths */
     const piola__bvh_node *na = &ta->nodes[t.a], *nb = &tb->nodes[t.b];
+    const piola__box *boxes_a = ta->leaf_boxes + na->first, *boxes_b = tb->leaf_boxes + nb->first;
     for (int32_t i = 0; i < na->count; ++i) {
       const int32_t pa = ta->order[na->first + i];
       for (int32_t j = (same_tree && t.a == t.b) ? i + 1 : 0; j < nb->count; ++j) {
+        if (!piola__boxes_overlap(&boxes_a[i], &boxes_b[j])) continue;
         const int32_t pb = tb->order[nb->first + j];
-        int failed;
-        if (same_tree) {
-          if (!piola__boxes_overlap(&s->edge_boxes[pa], &s->edge_boxes[pb])) continue;
-          failed = emit_edge_edge(s, x0, pa < pb ? pa : pb, pa < pb ? pb : pa, out);
-        } else {
-          if (!piola__boxes_overlap(&s->vertex_boxes[pa], &s->triangle_boxes[pb])) continue;
-          failed = emit_vertex_triangle(s, x0, pa, pb, out);
-        }
+        const double *slabs_a =
+            same_tree ? s->edge_slabs + SLABS * (size_t)pa : s->vertex_slabs + SLABS * (size_t)pa;
+        const double *slabs_b =
+            same_tree ? s->edge_slabs + SLABS * (size_t)pb : s->triangle_slabs + SLABS * (size_t)pb;
+        if (!slabs_overlap(slabs_a, slabs_b)) continue;
+        int failed = same_tree ? emit_edge_edge(s, x0, pa < pb ? pa : pb, pa < pb ? pb : pa, out)
+                               : emit_vertex_triangle(s, x0, pa, pb, out);
         if (failed) return -1;
       }
     }
@@ -434,6 +490,7 @@ int piola__collect_candidates(piola_collision_surface *s, const double *x0, cons
   compute_vertex_boxes(s, x0, v, dt, BOX_REACH);
   memcpy(s->reach_boxes, s->vertex_boxes, sizeof(piola__box) * (size_t)s->vertex_count);
   compute_primitive_boxes(s);
+  compute_slabs(s);
   if (fit_trees(s, tree_built)) return -1;
   int32_t nvt, nee;
   node_pair *vt = make_tasks(&s->vertex_tree, &s->triangle_tree, 0, &nvt);
@@ -520,8 +577,7 @@ static int query_pairs(const piola_collision_surface *s, const double *x0, const
                        piola__contact_list *list) {
   candidates->count = 0;
   if (kind == QUERY_VERTEX) {
-    if (piola__bvh_query(&s->triangle_tree, s->triangle_boxes, &s->vertex_boxes[q], candidates))
-      return -1;
+    if (piola__bvh_query(&s->triangle_tree, &s->vertex_boxes[q], candidates)) return -1;
     for (int64_t j = 0; j < candidates->count; ++j) {
       const int32_t *tri = s->triangles + 3 * candidates->items[j];
       if (tri[0] == q || tri[1] == q || tri[2] == q) continue;
@@ -531,8 +587,7 @@ static int query_pairs(const piola_collision_surface *s, const double *x0, const
     }
   } else if (kind == QUERY_TRIANGLE) {
     /* Only with a dirty triangle, and only clean vertices: dirty ones query themselves. */
-    if (piola__bvh_query(&s->vertex_tree, s->vertex_boxes, &s->triangle_boxes[q], candidates))
-      return -1;
+    if (piola__bvh_query(&s->vertex_tree, &s->triangle_boxes[q], candidates)) return -1;
     const int32_t *tri = s->triangles + 3 * q;
     for (int64_t j = 0; j < candidates->count; ++j) {
       const int32_t p = candidates->items[j];
@@ -542,7 +597,7 @@ static int query_pairs(const piola_collision_surface *s, const double *x0, const
       if (narrow_phase(s, x0, v, dt, mode, 0, &c) && piola__contact_list_push(list, &c)) return -1;
     }
   } else {
-    if (piola__bvh_query(&s->edge_tree, s->edge_boxes, &s->edge_boxes[q], candidates)) return -1;
+    if (piola__bvh_query(&s->edge_tree, &s->edge_boxes[q], candidates)) return -1;
     const int32_t a0 = s->edges[2 * q], a1 = s->edges[2 * q + 1];
     for (int64_t j = 0; j < candidates->count; ++j) {
       const int32_t e = candidates->items[j];

@@ -66,15 +66,13 @@ void piola_collision_surface_destroy(piola_collision_surface *s) {
   free(s->zone_order);
   free(s->reach_boxes);
   free(s->escaped);
-  free(s->candidates.items);
-  free(s->near.items);
+  for (int32_t t = 0; t < s->task_capacity; ++t)
+    free(s->candidates[t].items), free(s->near[t].items), free(s->task_found[t].items);
+  free(s->candidates), free(s->near), free(s->task_found);
   free(s->reach_radius);
   free(s->vertex_slabs);
   free(s->triangle_slabs);
   free(s->edge_slabs);
-  if (s->chunks)
-    for (int32_t c = 0; c < s->chunk_count; ++c) free(s->chunks[c].items);
-  free(s->chunks);
   free(s);
 }
 
@@ -331,7 +329,7 @@ piola_status piola_collision_surface_process(piola_collision_surface *s, const d
   s->profile = (piola__contact_profile){0};
   double clock = thread_seconds();
   if (piola__collect_candidates(s, x0, v, dt, &tree_built)) goto out_of_memory;
-  s->profile.candidates = s->candidates.count;
+  s->profile.candidates = s->candidate_count;
   s->profile.collect = lap(&clock);
 
   /* Stage 1: repulsion of pairs closer than their thickness at x0. */

@@ -106,18 +106,21 @@ struct piola_collision_surface {
   piola__contact_list found;
   int32_t *zone_parent;
   uint8_t *in_zone;
-  uint8_t *dirty;              /* velocity changed since the last detection pass */
-  uint8_t *on_surface;         /* vertex of at least one triangle */
-  int32_t zone_misfit;         /* a zone could not follow its pinned vertices (this call) */
-  int32_t tree_age;            /* calls since the trees were last built (0: never built) */
-  int32_t *zone_order;         /* vertices grouped by zone */
-  piola__box *reach_boxes;     /* per vertex: the boxes the candidates were collected with */
-  uint8_t *escaped;            /* swept box outside its reach box (this detection pass) */
-  double *reach_radius;        /* per vertex: farthest point of its reach box from x0 */
-  piola__pair_list candidates; /* pairs that can collide while in their reach boxes */
-  piola__contact_list near;    /* contacts at x0 found with the candidates */
-  int32_t chunk_count;         /* capacity of chunks */
-  piola__contact_list *chunks; /* per chunk of candidates: what a pass found */
+  uint8_t *dirty;          /* velocity changed since the last detection pass */
+  uint8_t *on_surface;     /* vertex of at least one triangle */
+  int32_t zone_misfit;     /* a zone could not follow its pinned vertices (this call) */
+  int32_t tree_age;        /* calls since the trees were last built (0: never built) */
+  int32_t *zone_order;     /* vertices grouped by zone */
+  piola__box *reach_boxes; /* per vertex: the boxes the candidates were collected with */
+  uint8_t *escaped;        /* swept box outside its reach box (this detection pass) */
+  double *reach_radius;    /* per vertex: farthest point of its reach box from x0 */
+  /* Per tree task of the last collection (task_count lists each, in task order, kept with
+   * their memory from call to call; task_capacity lists allocated): */
+  int32_t task_count, task_capacity;
+  piola__pair_list *candidates;    /* pairs that can collide while in their reach boxes */
+  piola__contact_list *near;       /* contacts at x0 */
+  piola__contact_list *task_found; /* what a detection pass found among the candidates */
+  int64_t candidate_count;         /* sum over the tasks */
   piola__contact_profile profile;
   double *vertex_slabs, *triangle_slabs, *edge_slabs; /* 12 per primitive (detection.c) */
 };

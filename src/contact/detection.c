@@ -11,7 +11,7 @@
 #include "contact/proximity.h"
 
 enum {
-  SCAN_CHUNK = 4096,    /* candidate pairs per parallel chunk */
+  SCAN_CHUNK = 4096,    /* scans of fewer than 4 of these candidates run on one thread */
   REBUILD_PERIOD = 8,   /* calls between full tree builds (refits in between) */
   ESCAPE_FRACTION = 16, /* re-collect candidates when more than 1/16 of the vertices escaped */
   TARGET_TASKS = 512    /* independent node-pair tasks of a tree descent */
@@ -457,20 +457,6 @@ static int run_task(const piola_collision_surface *s, const double *x0, const pi
   return 0;
 }
 
-/* Appends n items of src to the end of dst. Returns 0, or -1 out of memory. */
-static int append_pairs(piola__pair_list *dst, const piola__pair *src, int64_t n) {
-  if (dst->count + n > dst->capacity) {
-    int64_t capacity = dst->capacity ? dst->capacity : 256;
-    while (capacity < dst->count + n) capacity *= 2;
-    piola__pair *items = realloc(dst->items, sizeof(*items) * (size_t)capacity);
-    if (!items) return -1;
-    dst->items = items, dst->capacity = capacity;
-  }
-  if (n > 0) memcpy(dst->items + dst->count, src, sizeof(*src) * (size_t)n);
-  dst->count += n;
-  return 0;
-}
-
 static int append_contacts(piola__contact_list *dst, const piola__contact *src, int64_t n) {
   if (dst->count + n > dst->capacity) {
     int64_t capacity = dst->capacity ? dst->capacity : 32;
@@ -484,9 +470,30 @@ static int append_contacts(piola__contact_list *dst, const piola__contact *src, 
   return 0;
 }
 
+/* Makes room for n tasks' lists (kept from call to call, so their memory is reused). */
+static int reserve_tasks(piola_collision_surface *s, int32_t n) {
+  if (n <= s->task_capacity) return 0;
+  piola__pair_list *pairs = realloc(s->candidates, sizeof(*pairs) * (size_t)n);
+  if (!pairs) return -1;
+  s->candidates = pairs;
+  piola__contact_list *near = realloc(s->near, sizeof(*near) * (size_t)n);
+  if (!near) return -1;
+  s->near = near;
+  piola__contact_list *found = realloc(s->task_found, sizeof(*found) * (size_t)n);
+  if (!found) return -1;
+  s->task_found = found;
+  const size_t added = (size_t)(n - s->task_capacity);
+  memset(s->candidates + s->task_capacity, 0, sizeof(*pairs) * added);
+  memset(s->near + s->task_capacity, 0, sizeof(*near) * added);
+  memset(s->task_found + s->task_capacity, 0, sizeof(*found) * added);
+  s->task_capacity = n;
+  return 0;
+}
+
 int piola__collect_candidates(piola_collision_surface *s, const double *x0, const double *v,
                               double dt, int *tree_built) {
   ++s->profile.collections;
+  s->task_count = 0, s->candidate_count = 0;
   compute_vertex_boxes(s, x0, v, dt, BOX_REACH);
   memcpy(s->reach_boxes, s->vertex_boxes, sizeof(piola__box) * (size_t)s->vertex_count);
   compute_primitive_boxes(s);
@@ -497,29 +504,28 @@ int piola__collect_candidates(piola_collision_surface *s, const double *x0, cons
   node_pair *ee = make_tasks(&s->edge_tree, &s->edge_tree, 1, &nee);
   int failed = !vt || !ee;
   const int32_t total = failed ? 0 : nvt + nee;
-  task_output *outs = failed ? NULL : calloc((size_t)total + 1, sizeof(*outs));
-  if (!failed && !outs) failed = 1;
+  if (!failed && reserve_tasks(s, total)) failed = 1;
   if (!failed) {
 #pragma omp parallel for schedule(dynamic, 1) num_threads(piola__thread_count()) \
     reduction(|                                                                  \
               : failed) if (total >= 64 && s->triangle_count >= 2048)
     for (int32_t i = 0; i < total; ++i) {
-      if (failed) continue;
-      if (i < nvt)
-        failed |= run_task(s, x0, &s->vertex_tree, &s->triangle_tree, 0, vt[i], &outs[i]) != 0;
-      else
-        failed |= run_task(s, x0, &s->edge_tree, &s->edge_tree, 1, ee[i - nvt], &outs[i]) != 0;
+      task_output out = {s->candidates[i], s->near[i]};
+      out.pairs.count = 0, out.near.count = 0;
+      if (!failed) {
+        if (i < nvt)
+          failed |= run_task(s, x0, &s->vertex_tree, &s->triangle_tree, 0, vt[i], &out) != 0;
+        else
+          failed |= run_task(s, x0, &s->edge_tree, &s->edge_tree, 1, ee[i - nvt], &out) != 0;
+      }
+      s->candidates[i] = out.pairs, s->near[i] = out.near;
     }
   }
-  s->candidates.count = 0, s->near.count = 0;
-  for (int32_t i = 0; i < total && !failed; ++i)
-    if (append_pairs(&s->candidates, outs[i].pairs.items, outs[i].pairs.count) ||
-        append_contacts(&s->near, outs[i].near.items, outs[i].near.count))
-      failed = 1;
-  if (outs)
-    for (int32_t i = 0; i < total; ++i) free(outs[i].pairs.items), free(outs[i].near.items);
-  free(outs), free(vt), free(ee);
-  return failed ? -1 : 0;
+  free(vt), free(ee);
+  if (failed) return -1;
+  s->task_count = total;
+  for (int32_t i = 0; i < total; ++i) s->candidate_count += s->candidates[i].count;
+  return 0;
 }
 
 static int any_flag(const uint8_t *flags, const int32_t v[4]) {
@@ -527,29 +533,23 @@ static int any_flag(const uint8_t *flags, const int32_t v[4]) {
 }
 
 /* Continuous detection of the candidates (with a dirty vertex when dirty is given; with no
- * escaped vertex when escaped is given), appended to s->found in candidate order. Fixed chunks run
- * in parallel, each into its own list. Returns 0, or -1 out of memory. */
+ * escaped vertex when escaped is given), appended to s->found in candidate order. The lists
+ * of the tree tasks run in parallel, each into its own list. Returns 0, or -1 out of memory. */
 static int scan_candidates(piola_collision_surface *s, const double *x0, const double *v, double dt,
                            const uint8_t *dirty, const uint8_t *escaped) {
-  const int64_t n = s->candidates.count;
-  const int32_t chunks = (int32_t)((n + SCAN_CHUNK - 1) / SCAN_CHUNK);
-  if (chunks > s->chunk_count) {
-    piola__contact_list *grown = realloc(s->chunks, sizeof(*grown) * (size_t)chunks);
-    if (!grown) return -1;
-    memset(grown + s->chunk_count, 0, sizeof(*grown) * (size_t)(chunks - s->chunk_count));
-    s->chunks = grown, s->chunk_count = chunks;
-  }
+  const int32_t tasks = s->task_count;
   int failed = 0;
 #pragma omp parallel for schedule(dynamic, 1) num_threads(piola__thread_count()) \
     reduction(|                                                                  \
-              : failed) if (chunks >= 4)
-  for (int32_t c = 0; c < chunks; ++c) {
-    piola__contact_list *list = &s->chunks[c];
+              : failed) if (s->candidate_count >= 4 * SCAN_CHUNK)
+  for (int32_t t = 0; t < tasks; ++t) {
+    piola__contact_list *list = &s->task_found[t];
     list->count = 0;
     if (failed) continue;
-    const int64_t end = (int64_t)(c + 1) * SCAN_CHUNK < n ? (int64_t)(c + 1) * SCAN_CHUNK : n;
-    for (int64_t i = (int64_t)c * SCAN_CHUNK; i < end; ++i) {
-      const piola__pair *p = &s->candidates.items[i];
+    const piola__pair *pairs = s->candidates[t].items;
+    const int64_t n = s->candidates[t].count;
+    for (int64_t i = 0; i < n; ++i) {
+      const piola__pair *p = &pairs[i];
       if (dirty && !any_flag(dirty, p->v)) continue;
       if (escaped && any_flag(escaped, p->v)) continue;
       piola__contact contact = {.v = {p->v[0], p->v[1], p->v[2], p->v[3]},
@@ -563,8 +563,8 @@ static int scan_candidates(piola_collision_surface *s, const double *x0, const d
       }
     }
   }
-  for (int32_t c = 0; c < chunks && !failed; ++c)
-    if (append_contacts(&s->found, s->chunks[c].items, s->chunks[c].count)) failed = 1;
+  for (int32_t t = 0; t < tasks && !failed; ++t)
+    if (append_contacts(&s->found, s->task_found[t].items, s->task_found[t].count)) failed = 1;
   return failed ? -1 : 0;
 }
 
@@ -675,11 +675,11 @@ int piola__detect(piola_collision_surface *s, const double *x0, const double *v,
   s->found.count = 0;
   if (mode == DETECT_PROXIMITY) {
     /* Reach boxes hold the proximity boxes, so every contact was found with the candidates. */
-    if (!dirty) return append_contacts(&s->found, s->near.items, s->near.count);
-    for (int64_t i = 0; i < s->near.count; ++i)
-      if (any_flag(dirty, s->near.items[i].v) &&
-          piola__contact_list_push(&s->found, &s->near.items[i]))
-        return -1;
+    for (int32_t t = 0; t < s->task_count; ++t)
+      for (int64_t i = 0; i < s->near[t].count; ++i)
+        if ((!dirty || any_flag(dirty, s->near[t].items[i].v)) &&
+            piola__contact_list_push(&s->found, &s->near[t].items[i]))
+          return -1;
     return 0;
   }
   int32_t escaped = compute_vertex_boxes(s, x0, v, dt, BOX_SWEPT);

@@ -51,6 +51,16 @@ static int box_contains(const piola__box *outer, const piola__box *inner) {
          inner->hi[1] <= outer->hi[1] && inner->hi[2] <= outer->hi[2];
 }
 
+/* How far a vertex at x0 can move over the step while its swept box stays in its reach box. */
+static double reach_radius(const piola__box *reach, const double *x0) {
+  double r2 = 0.0;
+  for (int k = 0; k < 3; ++k) {
+    double far = dmax(x0[k] - reach->lo[k], reach->hi[k] - x0[k]);
+    r2 += far * far;
+  }
+  return sqrt(r2);
+}
+
 /* Vertex boxes of one kind into s->vertex_boxes. For swept boxes, also marks in s->escaped
  * the vertices (of the surface) whose box left the reach box the candidates were collected
  * with, and returns how many; otherwise returns 0. Two primitives within their pair's
@@ -74,13 +84,7 @@ static int32_t compute_vertex_boxes(piola_collision_surface *s, const double *x0
       s->escaped[i] = s->on_surface[i] && !box_contains(&s->reach_boxes[i], box);
       escaped += s->escaped[i];
     } else if (kind == BOX_REACH) {
-      /* How far the vertex can move over the step while its swept box stays in this box. */
-      double r2 = 0.0;
-      for (int k = 0; k < 3; ++k) {
-        double far = dmax(x0[3 * i + k] - box->lo[k], box->hi[k] - x0[3 * i + k]);
-        r2 += far * far;
-      }
-      s->reach_radius[i] = sqrt(r2);
+      s->reach_radius[i] = reach_radius(box, x0 + 3 * i);
     }
   }
   return escaped;
@@ -381,13 +385,14 @@ typedef struct task_output {
  * stay in their reach boxes (closer than their reach radii and the tolerance allow). Returns
  * 0, or -1 out of memory. */
 static int classify_pair(const piola_collision_surface *s, const double *x0, const int32_t v[4],
-                         int edge_edge, task_output *out) {
+                         int edge_edge, int with_near, task_output *out) {
   if (all_pinned(s, v)) return 0;
   vec3 x[4];
   load_pair(x0, v, x);
   piola__contact c = {.v = {v[0], v[1], v[2], v[3]}, .edge_edge = edge_edge};
   double dist2 = pair_distance2(x, edge_edge, c.w);
-  if (proximity_contact(s, x, edge_edge, dist2, &c) && piola__contact_list_push(&out->near, &c))
+  if (with_near && proximity_contact(s, x, edge_edge, dist2, &c) &&
+      piola__contact_list_push(&out->near, &c))
     return -1;
   const double *r = s->reach_radius;
   const int first_b = edge_edge ? 2 : 1;
@@ -407,7 +412,7 @@ static int emit_vertex_triangle(const piola_collision_surface *s, const double *
   const int32_t *tri = s->triangles + 3 * t;
   if (!s->on_surface[p] || tri[0] == p || tri[1] == p || tri[2] == p) return 0;
   const int32_t v[4] = {p, tri[0], tri[1], tri[2]};
-  return classify_pair(s, x0, v, 0, out);
+  return classify_pair(s, x0, v, 0, 1, out);
 }
 
 static int emit_edge_edge(const piola_collision_surface *s, const double *x0, int32_t a, int32_t b,
@@ -416,7 +421,7 @@ static int emit_edge_edge(const piola_collision_surface *s, const double *x0, in
   const int32_t b0 = s->edges[2 * b], b1 = s->edges[2 * b + 1];
   if (a0 == b0 || a0 == b1 || a1 == b0 || a1 == b1) return 0;
   const int32_t v[4] = {a0, a1, b0, b1};
-  return classify_pair(s, x0, v, 1, out);
+  return classify_pair(s, x0, v, 1, 1, out);
 }
 
 /* Runs one task to the end with an explicit stack. Returns 0, or -1 out of memory. */
@@ -532,11 +537,11 @@ static int any_flag(const uint8_t *flags, const int32_t v[4]) {
   return flags[v[0]] || flags[v[1]] || flags[v[2]] || flags[v[3]];
 }
 
-/* Continuous detection of the candidates (with a dirty vertex when dirty is given; with no
- * escaped vertex when escaped is given), appended to s->found in candidate order. The lists
- * of the tree tasks run in parallel, each into its own list. Returns 0, or -1 out of memory. */
+/* Continuous detection of the candidates (with a dirty vertex when dirty is given), appended
+ * to s->found in candidate order. The lists of the tree tasks run in parallel, each into its
+ * own list. Returns 0, or -1 out of memory. */
 static int scan_candidates(piola_collision_surface *s, const double *x0, const double *v, double dt,
-                           const uint8_t *dirty, const uint8_t *escaped) {
+                           const uint8_t *dirty) {
   const int32_t tasks = s->task_count;
   int failed = 0;
 #pragma omp parallel for schedule(dynamic, 1) num_threads(piola__thread_count()) \
@@ -551,7 +556,6 @@ static int scan_candidates(piola_collision_surface *s, const double *x0, const d
     for (int64_t i = 0; i < n; ++i) {
       const piola__pair *p = &pairs[i];
       if (dirty && !any_flag(dirty, p->v)) continue;
-      if (escaped && any_flag(escaped, p->v)) continue;
       piola__contact contact = {.v = {p->v[0], p->v[1], p->v[2], p->v[3]},
                                 .edge_edge = p->edge_edge};
       vec3 x[4];
@@ -568,71 +572,89 @@ static int scan_candidates(piola_collision_surface *s, const double *x0, const d
   return failed ? -1 : 0;
 }
 
-/* Pairs of one query primitive with the candidates the tree returns for its box, each pair
- * with a vertex marked in `dirty` once, and (when filter is given) with a vertex marked in
- * filter; appends the contacts found to list. Returns 0, or -1 out of memory. */
-static int query_pairs(const piola_collision_surface *s, const double *x0, const double *v,
-                       double dt, detect_mode mode, const uint8_t *dirty, const uint8_t *filter,
-                       query_kind kind, int32_t q, piola__index_list *candidates,
-                       piola__contact_list *list) {
-  candidates->count = 0;
+/* Candidate pairs of one query primitive with what the tree returns for its box: each pair
+ * with an escaped vertex once (a vertex against all triangles; a triangle only against
+ * vertices that did not escape, which do not query; an edge against edges that did not
+ * escape, or that come later). Returns 0, or -1 out of memory. */
+static int query_candidates(const piola_collision_surface *s, const double *x0, query_kind kind,
+                            int32_t q, piola__index_list *hits, task_output *out) {
+  const uint8_t *escaped = s->escaped;
+  hits->count = 0;
   if (kind == QUERY_VERTEX) {
-    if (piola__bvh_query(&s->triangle_tree, &s->vertex_boxes[q], candidates)) return -1;
-    for (int64_t j = 0; j < candidates->count; ++j) {
-      const int32_t *tri = s->triangles + 3 * candidates->items[j];
+    if (piola__bvh_query(&s->triangle_tree, &s->vertex_boxes[q], hits)) return -1;
+    for (int64_t j = 0; j < hits->count; ++j) {
+      const int32_t *tri = s->triangles + 3 * hits->items[j];
       if (tri[0] == q || tri[1] == q || tri[2] == q) continue;
-      piola__contact c = {.v = {q, tri[0], tri[1], tri[2]}};
-      if (all_pinned(s, c.v) || (filter && !any_flag(filter, c.v))) continue;
-      if (narrow_phase(s, x0, v, dt, mode, 0, &c) && piola__contact_list_push(list, &c)) return -1;
+      const int32_t v[4] = {q, tri[0], tri[1], tri[2]};
+      if (classify_pair(s, x0, v, 0, 0, out)) return -1;
     }
   } else if (kind == QUERY_TRIANGLE) {
-    /* Only with a dirty triangle, and only clean vertices: dirty ones query themselves. */
-    if (piola__bvh_query(&s->vertex_tree, &s->triangle_boxes[q], candidates)) return -1;
+    if (piola__bvh_query(&s->vertex_tree, &s->triangle_boxes[q], hits)) return -1;
     const int32_t *tri = s->triangles + 3 * q;
-    for (int64_t j = 0; j < candidates->count; ++j) {
-      const int32_t p = candidates->items[j];
-      if (dirty[p] || !s->on_surface[p] || tri[0] == p || tri[1] == p || tri[2] == p) continue;
-      piola__contact c = {.v = {p, tri[0], tri[1], tri[2]}};
-      if (all_pinned(s, c.v) || (filter && !any_flag(filter, c.v))) continue;
-      if (narrow_phase(s, x0, v, dt, mode, 0, &c) && piola__contact_list_push(list, &c)) return -1;
+    for (int64_t j = 0; j < hits->count; ++j) {
+      const int32_t p = hits->items[j];
+      if (escaped[p] || !s->on_surface[p] || tri[0] == p || tri[1] == p || tri[2] == p) continue;
+      const int32_t v[4] = {p, tri[0], tri[1], tri[2]};
+      if (classify_pair(s, x0, v, 0, 0, out)) return -1;
     }
   } else {
-    if (piola__bvh_query(&s->edge_tree, &s->edge_boxes[q], candidates)) return -1;
+    if (piola__bvh_query(&s->edge_tree, &s->edge_boxes[q], hits)) return -1;
     const int32_t a0 = s->edges[2 * q], a1 = s->edges[2 * q + 1];
-    for (int64_t j = 0; j < candidates->count; ++j) {
-      const int32_t e = candidates->items[j];
+    for (int64_t j = 0; j < hits->count; ++j) {
+      const int32_t e = hits->items[j];
       const int32_t b0 = s->edges[2 * e], b1 = s->edges[2 * e + 1];
-      /* Each pair once: from the lower index, or from the dirty edge when only one is. */
-      if (e == q) continue;
-      if (!dirty && e < q) continue;
-      if (dirty && e < q && (dirty[b0] || dirty[b1])) continue;
+      if (e == q || (e < q && (escaped[b0] || escaped[b1]))) continue;
       if (a0 == b0 || a0 == b1 || a1 == b0 || a1 == b1) continue;
-      piola__contact c = {.v = {a0, a1, b0, b1}};
-      if (all_pinned(s, c.v) || (filter && !any_flag(filter, c.v))) continue;
-      if (narrow_phase(s, x0, v, dt, mode, 1, &c) && piola__contact_list_push(list, &c)) return -1;
+      const int32_t v[4] = {a0, a1, b0, b1};
+      if (classify_pair(s, x0, v, 1, 0, out)) return -1;
     }
   }
   return 0;
 }
 
-/* Every pair with a vertex marked in mask (and one marked in filter, when given), found by
- * querying the trees (fit to the current boxes) from the marked vertices and from the
- * triangles and edges that touch one; appended to s->found in block order. Returns 0, or -1
- * out of memory. */
-static int query_marked(piola_collision_surface *s, const double *x0, const double *v, double dt,
-                        detect_mode mode, const uint8_t *mask, const uint8_t *filter) {
+/* Escaped vertices get new reach boxes from the velocities v, their old candidate pairs are
+ * dropped, and their pairs are collected again by querying the trees (refit to the reach
+ * boxes) from them and from the triangles and edges that touch one, into new task lists
+ * (one per fixed block of queries). Afterwards no vertex has escaped. Returns 0, or -1 out of
+ * memory. */
+static int recollect_escaped(piola_collision_surface *s, const double *x0, const double *v,
+                             double dt, int *tree_built) {
+  const uint8_t *escaped = s->escaped;
+  for (int32_t i = 0; i < s->vertex_count; ++i) {
+    if (!escaped[i]) continue;
+    const double pad = 0.5 * s->vertex_thickness[i];
+    piola__box *box = &s->reach_boxes[i];
+    for (int k = 0; k < 3; ++k) {
+      double a = x0[3 * i + k], b = a + dt * v[3 * i + k];
+      box->lo[k] = dmin(a, b) - pad, box->hi[k] = dmax(a, b) + pad;
+    }
+    s->reach_radius[i] = reach_radius(box, x0 + 3 * i);
+  }
+  /* Drop the old pairs of escaped vertices. */
+#pragma omp parallel for schedule(dynamic, 16) \
+    num_threads(piola__thread_count()) if (s->candidate_count >= 4 * SCAN_CHUNK)
+  for (int32_t t = 0; t < s->task_count; ++t) {
+    piola__pair *pairs = s->candidates[t].items;
+    int64_t kept = 0;
+    for (int64_t i = 0; i < s->candidates[t].count; ++i)
+      if (!any_flag(escaped, pairs[i].v)) pairs[kept++] = pairs[i];
+    s->candidates[t].count = kept;
+  }
+  memcpy(s->vertex_boxes, s->reach_boxes, sizeof(piola__box) * (size_t)s->vertex_count);
+  compute_primitive_boxes(s);
+  if (fit_trees(s, tree_built)) return -1;
   /* The queries: (kind, primitive) in three runs. */
   int32_t runs[3] = {0, 0, 0}, n = 0;
   for (int32_t i = 0; i < s->vertex_count; ++i)
-    if (mask[i] && s->on_surface[i]) s->queries[n++] = i;
+    if (escaped[i] && s->on_surface[i]) s->queries[n++] = i;
   runs[0] = n;
   for (int32_t t = 0; t < s->triangle_count; ++t) {
     const int32_t *tri = s->triangles + 3 * t;
-    if (mask[tri[0]] || mask[tri[1]] || mask[tri[2]]) s->queries[n++] = t;
+    if (escaped[tri[0]] || escaped[tri[1]] || escaped[tri[2]]) s->queries[n++] = t;
   }
   runs[1] = n;
   for (int32_t e = 0; e < s->edge_count; ++e)
-    if (mask[s->edges[2 * e]] || mask[s->edges[2 * e + 1]]) s->queries[n++] = e;
+    if (escaped[s->edges[2 * e]] || escaped[s->edges[2 * e + 1]]) s->queries[n++] = e;
   runs[2] = n;
   /* Blocks never straddle two runs, so each block has one kind. */
   int32_t block_start[3], blocks = 0;
@@ -641,33 +663,34 @@ static int query_marked(piola_collision_surface *s, const double *x0, const doub
     int32_t len = runs[r] - (r ? runs[r - 1] : 0);
     blocks += (len + PIOLA__QUERY_BLOCK - 1) / PIOLA__QUERY_BLOCK;
   }
+  const int32_t first_task = s->task_count;
+  if (reserve_tasks(s, first_task + blocks)) return -1;
   int failed = 0;
 #pragma omp parallel num_threads(piola__thread_count()) reduction(| : failed) if (blocks >= 16)
   {
-    piola__index_list candidates = {0};
+    piola__index_list hits = {0};
 #pragma omp for schedule(dynamic, 1)
     for (int32_t b = 0; b < blocks; ++b) {
-      piola__contact_list *list = &s->blocks[b];
-      list->count = 0;
-      if (failed) continue;
-      int r = b >= block_start[2] ? 2 : (b >= block_start[1] ? 1 : 0);
+      const int32_t task = first_task + b;
+      task_output out = {s->candidates[task], s->near[task]};
+      out.pairs.count = 0, out.near.count = 0;
+      const int r = b >= block_start[2] ? 2 : (b >= block_start[1] ? 1 : 0);
       const query_kind kind = r == 0 ? QUERY_VERTEX : (r == 1 ? QUERY_TRIANGLE : QUERY_EDGE);
       const int32_t run_begin = r ? runs[r - 1] : 0;
       const int32_t first = run_begin + (b - block_start[r]) * PIOLA__QUERY_BLOCK;
       const int32_t end =
           first + PIOLA__QUERY_BLOCK < runs[r] ? first + PIOLA__QUERY_BLOCK : runs[r];
-      for (int32_t i = first; i < end; ++i)
-        if (query_pairs(s, x0, v, dt, mode, mask, filter, kind, s->queries[i], &candidates, list)) {
-          failed = 1;
-          break;
-        }
+      for (int32_t i = first; i < end && !failed; ++i)
+        if (query_candidates(s, x0, kind, s->queries[i], &hits, &out)) failed = 1;
+      s->candidates[task] = out.pairs, s->near[task] = out.near;
     }
-    free(candidates.items);
+    free(hits.items);
   }
-  /* Candidates of a query come out in tree order, which the deterministic build fixes. */
-  for (int32_t b = 0; b < blocks && !failed; ++b)
-    if (append_contacts(&s->found, s->blocks[b].items, s->blocks[b].count)) failed = 1;
-  return failed ? -1 : 0;
+  if (failed) return -1;
+  s->task_count = first_task + blocks;
+  s->candidate_count = 0;
+  for (int32_t t = 0; t < s->task_count; ++t) s->candidate_count += s->candidates[t].count;
+  return 0;
 }
 
 int piola__detect(piola_collision_surface *s, const double *x0, const double *v, double dt,
@@ -689,13 +712,9 @@ int piola__detect(piola_collision_surface *s, const double *x0, const double *v,
     if (piola__collect_candidates(s, x0, v, dt, tree_built)) return -1;
     escaped = compute_vertex_boxes(s, x0, v, dt, BOX_SWEPT);
   }
-  if (scan_candidates(s, x0, v, dt, dirty, escaped > 0 ? s->escaped : NULL)) return -1;
-  if (escaped == 0) return 0;
-  /* Pairs with an escaped vertex may be missing from the candidates: query the trees, fit
-   * to the swept boxes, for them. */
-  compute_primitive_boxes(s);
-  if (fit_trees(s, tree_built)) return -1;
-  return query_marked(s, x0, v, dt, mode, s->escaped, dirty);
+  /* Pairs with an escaped vertex may be missing from the candidates: collect them again. */
+  if (escaped > 0 && recollect_escaped(s, x0, v, dt, tree_built)) return -1;
+  return scan_candidates(s, x0, v, dt, dirty);
 }
 
 int piola__detect_all_pairs(const piola_collision_surface *s, const double *x0, const double *v,

@@ -66,7 +66,7 @@ int piola__contact_list_push(piola__contact_list *list, const piola__contact *c)
 typedef struct piola__pair {
   int32_t v[4];
   int32_t edge_edge; /* 1 for an edge-edge pair */
-  double start2;     /* m^2: squared distance at x0 */
+  double separation; /* m: distance at x0 less twice the detection tolerance */
 } piola__pair;
 
 typedef struct piola__pair_list {

@@ -245,17 +245,24 @@ static int proximity_contact(const piola_collision_surface *s, const vec3 x[4], 
   return 1;
 }
 
-/* Continuous detection of a pair at x (x0) whose squared distance at x0 is start2: returns 1
- * and fills c when it collides during the step. */
-static int ccd_contact(const piola_collision_surface *s, const vec3 x[4], const double *v,
-                       double dt, int edge_edge, double start2, piola__contact *c) {
+/* How much farther apart than the tolerance allows a pair starts (m; negative when closer),
+ * from its squared distance at x0: the separation bound of ccd_contact compares this with
+ * how far the pair's vertices move relative to each other. */
+static double ccd_separation(const piola_collision_surface *s, const int32_t v[4], int edge_edge,
+                             double start2) {
+  return sqrt(start2) - 2.0 * PIOLA__CCD_TOLERANCE * pair_thickness(s, v, edge_edge);
+}
+
+/* Continuous detection of a pair (c->v) with the given ccd_separation: returns 1 and fills c
+ * when it collides during the step. */
+static int ccd_contact(const piola_collision_surface *s, const double *x0, const double *v,
+                       double dt, int edge_edge, double separation, piola__contact *c) {
   vec3 d[4];
   for (int k = 0; k < 4; ++k) d[k] = vec3_scale(vec3_load(v + 3 * c->v[k]), dt);
-  c->thickness = pair_thickness(s, c->v, edge_edge);
-  double eps = PIOLA__CCD_TOLERANCE * c->thickness;
   /* Separation bound: any two points of the pair (fixed barycentric weights) move apart or
    * together by at most the largest relative displacement of a vertex of one side and a
-   * vertex of the other, so a pair farther apart than that at the start cannot touch. */
+   * vertex of the other, so a pair farther apart than that (and the tolerance) at the start
+   * cannot touch. Tested first: it needs neither positions nor thickness. */
   double move2 = 0.0;
   const int first_b = edge_edge ? 2 : 1;
   for (int i = 0; i < first_b; ++i)
@@ -263,7 +270,11 @@ static int ccd_contact(const piola_collision_surface *s, const vec3 x[4], const 
       double m = vec3_norm2(vec3_sub(d[i], d[k]));
       move2 = m > move2 ? m : move2;
     }
-  if (sqrt(start2) > sqrt(move2) + 2.0 * eps) return 0;
+  if (separation > 0.0 && separation * separation > move2) return 0;
+  vec3 x[4];
+  load_pair(x0, c->v, x);
+  c->thickness = pair_thickness(s, c->v, edge_edge);
+  double eps = PIOLA__CCD_TOLERANCE * c->thickness;
   piola__ccd_hit hit;
   int found = edge_edge ? piola__ccd_edge_edge(x, d, eps, &hit)
                         : piola__ccd_point_triangle(x, d, eps, &hit);
@@ -286,7 +297,7 @@ static int narrow_phase(const piola_collision_surface *s, const double *x0, cons
   load_pair(x0, c->v, x);
   double dist2 = pair_distance2(x, edge_edge, c->w);
   if (mode == DETECT_PROXIMITY) return proximity_contact(s, x, edge_edge, dist2, c);
-  return ccd_contact(s, x, v, dt, edge_edge, dist2, c);
+  return ccd_contact(s, x0, v, dt, edge_edge, ccd_separation(s, c->v, edge_edge, dist2), c);
 }
 
 /* ---------------------------------------------------------- candidates: tree against tree
@@ -403,7 +414,9 @@ static int classify_pair(const piola_collision_surface *s, const double *x0, con
    * within the reach radius; the factor covers rounding. */
   double reach = (ra + rb + 2.0 * PIOLA__CCD_TOLERANCE * pair_thickness(s, v, edge_edge)) * 1.0001;
   if (dist2 > reach * reach) return 0;
-  piola__pair p = {.v = {v[0], v[1], v[2], v[3]}, .edge_edge = edge_edge, .start2 = dist2};
+  piola__pair p = {.v = {v[0], v[1], v[2], v[3]},
+                   .edge_edge = edge_edge,
+                   .separation = ccd_separation(s, v, edge_edge, dist2)};
   return pair_list_push(&out->pairs, &p);
 }
 
@@ -558,9 +571,7 @@ static int scan_candidates(piola_collision_surface *s, const double *x0, const d
       if (dirty && !any_flag(dirty, p->v)) continue;
       piola__contact contact = {.v = {p->v[0], p->v[1], p->v[2], p->v[3]},
                                 .edge_edge = p->edge_edge};
-      vec3 x[4];
-      load_pair(x0, p->v, x);
-      if (ccd_contact(s, x, v, dt, p->edge_edge, p->start2, &contact) &&
+      if (ccd_contact(s, x0, v, dt, p->edge_edge, p->separation, &contact) &&
           piola__contact_list_push(list, &contact)) {
         failed = 1;
         break;
@@ -582,18 +593,22 @@ static int query_candidates(const piola_collision_surface *s, const double *x0, 
   hits->count = 0;
   if (kind == QUERY_VERTEX) {
     if (piola__bvh_query(&s->triangle_tree, &s->vertex_boxes[q], hits)) return -1;
+    const double *slabs = s->vertex_slabs + SLABS * (size_t)q;
     for (int64_t j = 0; j < hits->count; ++j) {
       const int32_t *tri = s->triangles + 3 * hits->items[j];
       if (tri[0] == q || tri[1] == q || tri[2] == q) continue;
+      if (!slabs_overlap(slabs, s->triangle_slabs + SLABS * (size_t)hits->items[j])) continue;
       const int32_t v[4] = {q, tri[0], tri[1], tri[2]};
       if (classify_pair(s, x0, v, 0, 0, out)) return -1;
     }
   } else if (kind == QUERY_TRIANGLE) {
     if (piola__bvh_query(&s->vertex_tree, &s->triangle_boxes[q], hits)) return -1;
     const int32_t *tri = s->triangles + 3 * q;
+    const double *slabs = s->triangle_slabs + SLABS * (size_t)q;
     for (int64_t j = 0; j < hits->count; ++j) {
       const int32_t p = hits->items[j];
       if (escaped[p] || !s->on_surface[p] || tri[0] == p || tri[1] == p || tri[2] == p) continue;
+      if (!slabs_overlap(slabs, s->vertex_slabs + SLABS * (size_t)p)) continue;
       const int32_t v[4] = {p, tri[0], tri[1], tri[2]};
       if (classify_pair(s, x0, v, 0, 0, out)) return -1;
     }
@@ -605,6 +620,8 @@ static int query_candidates(const piola_collision_surface *s, const double *x0, 
       const int32_t b0 = s->edges[2 * e], b1 = s->edges[2 * e + 1];
       if (e == q || (e < q && (escaped[b0] || escaped[b1]))) continue;
       if (a0 == b0 || a0 == b1 || a1 == b0 || a1 == b1) continue;
+      if (!slabs_overlap(s->edge_slabs + SLABS * (size_t)q, s->edge_slabs + SLABS * (size_t)e))
+        continue;
       const int32_t v[4] = {a0, a1, b0, b1};
       if (classify_pair(s, x0, v, 1, 0, out)) return -1;
     }
@@ -642,6 +659,7 @@ static int recollect_escaped(piola_collision_surface *s, const double *x0, const
   }
   memcpy(s->vertex_boxes, s->reach_boxes, sizeof(piola__box) * (size_t)s->vertex_count);
   compute_primitive_boxes(s);
+  compute_slabs(s);
   if (fit_trees(s, tree_built)) return -1;
   /* The queries: (kind, primitive) in three runs. */
   int32_t runs[3] = {0, 0, 0}, n = 0;

@@ -101,9 +101,12 @@ int main(int argc, char **argv) {
       if (piola_collision_surface_process(surface, x, v, m, dt, NULL, &st) != PIOLA_OK) return 1;
       double elapsed = bench_wall_seconds() - t0, cpu_elapsed = bench_cpu_seconds() - c0;
       if (getenv("BENCH_TRACE"))
-        fprintf(stderr, "step %d: %.1f ms contacts %lld impacts %lld passes %d zone passes %d\n",
+        fprintf(stderr,
+                "step %d: %.1f ms contacts %lld impacts %lld passes %d zone passes %d escaped %d "
+                "descents %d\n",
                 step, 1e3 * elapsed, (long long)st.contacts, (long long)st.impacts,
-                st.collision_passes, st.zone_passes);
+                st.collision_passes, st.zone_passes, surface->profile.escaped,
+                surface->profile.collections);
       for (int i = 0; i < 3 * nv; ++i) x[i] += dt * v[i];
       theta += dtheta;
       if (step >= 2) {

@@ -133,9 +133,10 @@ int piola__collect_candidates(piola_collision_surface *surface, const double *x0
 
 /* All contacts (proximity at x0) or collisions (continuous detection over the step with
  * velocities v) into surface->found, in an order that does not depend on the thread count.
- * With dirty given, only pairs with a vertex marked there are tested. Needs the candidates
- * of this call (piola__collect_candidates); continuous detection collects them again when
- * many velocities left their reach boxes. Returns 0, or -1 out of memory. */
+ * With dirty given, only pairs with a vertex marked there are tested (continuous detection
+ * then queries the trees from those vertices; without, it scans the candidates). Needs the
+ * candidates of this call (piola__collect_candidates), which it collects again, for some
+ * vertices or all, when velocities left their reach boxes. Returns 0, or -1 out of memory. */
 int piola__detect(piola_collision_surface *surface, const double *x0, const double *v, double dt,
                   piola__detect_mode mode, const uint8_t *dirty, int *tree_built);
 

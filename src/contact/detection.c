@@ -11,10 +11,10 @@
 #include "contact/proximity.h"
 
 enum {
-  SCAN_CHUNK = 4096,    /* scans of fewer than 4 of these candidates run on one thread */
-  REBUILD_PERIOD = 8,   /* calls between full tree builds (refits in between) */
-  ESCAPE_FRACTION = 16, /* re-collect candidates when more than 1/16 of the vertices escaped */
-  TARGET_TASKS = 512    /* independent node-pair tasks of a tree descent */
+  SCAN_CHUNK = 4096,   /* scans of fewer than 4 of these candidates run on one thread */
+  REBUILD_PERIOD = 8,  /* calls between full tree builds (refits in between) */
+  ESCAPE_FRACTION = 4, /* re-collect candidates when more than 1/4 of the vertices escaped */
+  TARGET_TASKS = 512   /* independent node-pair tasks of a tree descent */
 };
 
 typedef piola__detect_mode detect_mode;
@@ -711,6 +711,108 @@ static int recollect_escaped(piola_collision_surface *s, const double *x0, const
   return 0;
 }
 
+/* Pairs of one query primitive with the candidates the tree returns for its box, each pair
+ * with a vertex marked in `dirty` once, and (when filter is given) with a vertex marked in
+ * filter; appends the contacts found to list. Returns 0, or -1 out of memory. */
+static int query_pairs(const piola_collision_surface *s, const double *x0, const double *v,
+                       double dt, detect_mode mode, const uint8_t *dirty, const uint8_t *filter,
+                       query_kind kind, int32_t q, piola__index_list *candidates,
+                       piola__contact_list *list) {
+  candidates->count = 0;
+  if (kind == QUERY_VERTEX) {
+    if (piola__bvh_query(&s->triangle_tree, &s->vertex_boxes[q], candidates)) return -1;
+    for (int64_t j = 0; j < candidates->count; ++j) {
+      const int32_t *tri = s->triangles + 3 * candidates->items[j];
+      if (tri[0] == q || tri[1] == q || tri[2] == q) continue;
+      piola__contact c = {.v = {q, tri[0], tri[1], tri[2]}};
+      if (all_pinned(s, c.v) || (filter && !any_flag(filter, c.v))) continue;
+      if (narrow_phase(s, x0, v, dt, mode, 0, &c) && piola__contact_list_push(list, &c)) return -1;
+    }
+  } else if (kind == QUERY_TRIANGLE) {
+    /* Only with a dirty triangle, and only clean vertices: dirty ones query themselves. */
+    if (piola__bvh_query(&s->vertex_tree, &s->triangle_boxes[q], candidates)) return -1;
+    const int32_t *tri = s->triangles + 3 * q;
+    for (int64_t j = 0; j < candidates->count; ++j) {
+      const int32_t p = candidates->items[j];
+      if (dirty[p] || !s->on_surface[p] || tri[0] == p || tri[1] == p || tri[2] == p) continue;
+      piola__contact c = {.v = {p, tri[0], tri[1], tri[2]}};
+      if (all_pinned(s, c.v) || (filter && !any_flag(filter, c.v))) continue;
+      if (narrow_phase(s, x0, v, dt, mode, 0, &c) && piola__contact_list_push(list, &c)) return -1;
+    }
+  } else {
+    if (piola__bvh_query(&s->edge_tree, &s->edge_boxes[q], candidates)) return -1;
+    const int32_t a0 = s->edges[2 * q], a1 = s->edges[2 * q + 1];
+    for (int64_t j = 0; j < candidates->count; ++j) {
+      const int32_t e = candidates->items[j];
+      const int32_t b0 = s->edges[2 * e], b1 = s->edges[2 * e + 1];
+      /* Each pair once: from the lower index, or from the dirty edge when only one is. */
+      if (e == q) continue;
+      if (!dirty && e < q) continue;
+      if (dirty && e < q && (dirty[b0] || dirty[b1])) continue;
+      if (a0 == b0 || a0 == b1 || a1 == b0 || a1 == b1) continue;
+      piola__contact c = {.v = {a0, a1, b0, b1}};
+      if (all_pinned(s, c.v) || (filter && !any_flag(filter, c.v))) continue;
+      if (narrow_phase(s, x0, v, dt, mode, 1, &c) && piola__contact_list_push(list, &c)) return -1;
+    }
+  }
+  return 0;
+}
+
+/* Every pair with a vertex marked in mask (and one marked in filter, when given), found by
+ * querying the trees (fit to the current boxes) from the marked vertices and from the
+ * triangles and edges that touch one; appended to s->found in block order. Returns 0, or -1
+ * out of memory. */
+static int query_marked(piola_collision_surface *s, const double *x0, const double *v, double dt,
+                        detect_mode mode, const uint8_t *mask, const uint8_t *filter) {
+  /* The queries: (kind, primitive) in three runs. */
+  int32_t runs[3] = {0, 0, 0}, n = 0;
+  for (int32_t i = 0; i < s->vertex_count; ++i)
+    if (mask[i] && s->on_surface[i]) s->queries[n++] = i;
+  runs[0] = n;
+  for (int32_t t = 0; t < s->triangle_count; ++t) {
+    const int32_t *tri = s->triangles + 3 * t;
+    if (mask[tri[0]] || mask[tri[1]] || mask[tri[2]]) s->queries[n++] = t;
+  }
+  runs[1] = n;
+  for (int32_t e = 0; e < s->edge_count; ++e)
+    if (mask[s->edges[2 * e]] || mask[s->edges[2 * e + 1]]) s->queries[n++] = e;
+  runs[2] = n;
+  /* Blocks never straddle two runs, so each block has one kind. */
+  int32_t block_start[3], blocks = 0;
+  for (int r = 0; r < 3; ++r) {
+    block_start[r] = blocks;
+    int32_t len = runs[r] - (r ? runs[r - 1] : 0);
+    blocks += (len + PIOLA__QUERY_BLOCK - 1) / PIOLA__QUERY_BLOCK;
+  }
+  int failed = 0;
+#pragma omp parallel num_threads(piola__thread_count()) reduction(| : failed) if (blocks >= 16)
+  {
+    piola__index_list candidates = {0};
+#pragma omp for schedule(dynamic, 1)
+    for (int32_t b = 0; b < blocks; ++b) {
+      piola__contact_list *list = &s->blocks[b];
+      list->count = 0;
+      if (failed) continue;
+      int r = b >= block_start[2] ? 2 : (b >= block_start[1] ? 1 : 0);
+      const query_kind kind = r == 0 ? QUERY_VERTEX : (r == 1 ? QUERY_TRIANGLE : QUERY_EDGE);
+      const int32_t run_begin = r ? runs[r - 1] : 0;
+      const int32_t first = run_begin + (b - block_start[r]) * PIOLA__QUERY_BLOCK;
+      const int32_t end =
+          first + PIOLA__QUERY_BLOCK < runs[r] ? first + PIOLA__QUERY_BLOCK : runs[r];
+      for (int32_t i = first; i < end; ++i)
+        if (query_pairs(s, x0, v, dt, mode, mask, filter, kind, s->queries[i], &candidates, list)) {
+          failed = 1;
+          break;
+        }
+    }
+    free(candidates.items);
+  }
+  /* Candidates of a query come out in tree order, which the deterministic build fixes. */
+  for (int32_t b = 0; b < blocks && !failed; ++b)
+    if (append_contacts(&s->found, s->blocks[b].items, s->blocks[b].count)) failed = 1;
+  return failed ? -1 : 0;
+}
+
 int piola__detect(piola_collision_surface *s, const double *x0, const double *v, double dt,
                   piola__detect_mode mode, const uint8_t *dirty, int *tree_built) {
   s->found.count = 0;
@@ -722,6 +824,16 @@ int piola__detect(piola_collision_surface *s, const double *x0, const double *v,
             piola__contact_list_push(&s->found, &s->near[t].items[i]))
           return -1;
     return 0;
+  }
+  if (dirty) {
+    /* A later pass: only pairs with a dirty vertex, and velocities that may have changed
+     * much (impacts, rigid zones). Querying the trees, refit to the swept boxes, from the
+     * dirty vertices and the triangles and edges touching them is cheaper than scanning
+     * every candidate and following the escapes. */
+    compute_vertex_boxes(s, x0, v, dt, BOX_SWEPT);
+    compute_primitive_boxes(s);
+    if (fit_trees(s, tree_built)) return -1;
+    return query_marked(s, x0, v, dt, mode, dirty, NULL);
   }
   int32_t escaped = compute_vertex_boxes(s, x0, v, dt, BOX_SWEPT);
   s->profile.escaped += escaped;

@@ -121,6 +121,7 @@ struct piola_collision_surface {
   piola__contact_list *near;       /* contacts at x0 */
   piola__contact_list *task_found; /* what a detection pass found among the candidates */
   int64_t candidate_count;         /* sum over the tasks */
+  int32_t near_valid;              /* near holds the contacts at x0 (reach boxes were used) */
   piola__contact_profile profile;
   double *vertex_slabs, *triangle_slabs, *edge_slabs; /* 12 per primitive (detection.c) */
 };

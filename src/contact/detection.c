@@ -421,25 +421,26 @@ static int classify_pair(const piola_collision_surface *s, const double *x0, con
 }
 
 static int emit_vertex_triangle(const piola_collision_surface *s, const double *x0, int32_t p,
-                                int32_t t, task_output *out) {
+                                int32_t t, int with_near, task_output *out) {
   const int32_t *tri = s->triangles + 3 * t;
   if (!s->on_surface[p] || tri[0] == p || tri[1] == p || tri[2] == p) return 0;
   const int32_t v[4] = {p, tri[0], tri[1], tri[2]};
-  return classify_pair(s, x0, v, 0, 1, out);
+  return classify_pair(s, x0, v, 0, with_near, out);
 }
 
 static int emit_edge_edge(const piola_collision_surface *s, const double *x0, int32_t a, int32_t b,
-                          task_output *out) {
+                          int with_near, task_output *out) {
   const int32_t a0 = s->edges[2 * a], a1 = s->edges[2 * a + 1];
   const int32_t b0 = s->edges[2 * b], b1 = s->edges[2 * b + 1];
   if (a0 == b0 || a0 == b1 || a1 == b0 || a1 == b1) return 0;
   const int32_t v[4] = {a0, a1, b0, b1};
-  return classify_pair(s, x0, v, 1, 1, out);
+  return classify_pair(s, x0, v, 1, with_near, out);
 }
 
 /* Runs one task to the end with an explicit stack. Returns 0, or -1 out of memory. */
 static int run_task(const piola_collision_surface *s, const double *x0, const piola__bvh *ta,
-                    const piola__bvh *tb, int same_tree, node_pair task, task_output *out) {
+                    const piola__bvh *tb, int same_tree, int with_near, node_pair task,
+                    task_output *out) {
   node_pair stack[256];
   int top = 0;
   stack[top++] = task;
@@ -466,8 +467,9 @@ static int run_task(const piola_collision_surface *s, const double *x0, const pi
         const double *slabs_b =
             same_tree ? s->edge_slabs + SLABS * (size_t)pb : s->triangle_slabs + SLABS * (size_t)pb;
         if (!slabs_overlap(slabs_a, slabs_b)) continue;
-        int failed = same_tree ? emit_edge_edge(s, x0, pa < pb ? pa : pb, pa < pb ? pb : pa, out)
-                               : emit_vertex_triangle(s, x0, pa, pb, out);
+        int failed =
+            same_tree ? emit_edge_edge(s, x0, pa < pb ? pa : pb, pa < pb ? pb : pa, with_near, out)
+                      : emit_vertex_triangle(s, x0, pa, pb, with_near, out);
         if (failed) return -1;
       }
     }
@@ -508,11 +510,17 @@ static int reserve_tasks(piola_collision_surface *s, int32_t n) {
   return 0;
 }
 
-int piola__collect_candidates(piola_collision_surface *s, const double *x0, const double *v,
-                              double dt, int *tree_built) {
+/* The tree descent over reach boxes (with the contacts at x0), or, when tight, over the swept
+ * boxes of the current velocities (no contacts: only the detection pass at hand uses them). */
+static int collect(piola_collision_surface *s, const double *x0, const double *v, double dt,
+                   int *tree_built, int tight) {
   ++s->profile.collections;
   s->task_count = 0, s->candidate_count = 0;
-  compute_vertex_boxes(s, x0, v, dt, BOX_REACH);
+  s->near_valid = !tight;
+  compute_vertex_boxes(s, x0, v, dt, tight ? BOX_SWEPT : BOX_REACH);
+  if (tight)
+    for (int32_t i = 0; i < s->vertex_count; ++i)
+      s->reach_radius[i] = reach_radius(&s->vertex_boxes[i], x0 + 3 * i);
   memcpy(s->reach_boxes, s->vertex_boxes, sizeof(piola__box) * (size_t)s->vertex_count);
   compute_primitive_boxes(s);
   compute_slabs(s);
@@ -532,9 +540,9 @@ int piola__collect_candidates(piola_collision_surface *s, const double *x0, cons
       out.pairs.count = 0, out.near.count = 0;
       if (!failed) {
         if (i < nvt)
-          failed |= run_task(s, x0, &s->vertex_tree, &s->triangle_tree, 0, vt[i], &out) != 0;
+          failed |= run_task(s, x0, &s->vertex_tree, &s->triangle_tree, 0, !tight, vt[i], &out);
         else
-          failed |= run_task(s, x0, &s->edge_tree, &s->edge_tree, 1, ee[i - nvt], &out) != 0;
+          failed |= run_task(s, x0, &s->edge_tree, &s->edge_tree, 1, !tight, ee[i - nvt], &out);
       }
       s->candidates[i] = out.pairs, s->near[i] = out.near;
     }
@@ -544,6 +552,11 @@ int piola__collect_candidates(piola_collision_surface *s, const double *x0, cons
   s->task_count = total;
   for (int32_t i = 0; i < total; ++i) s->candidate_count += s->candidates[i].count;
   return 0;
+}
+
+int piola__collect_candidates(piola_collision_surface *s, const double *x0, const double *v,
+                              double dt, int *tree_built) {
+  return collect(s, x0, v, dt, tree_built, 0);
 }
 
 static int any_flag(const uint8_t *flags, const int32_t v[4]) {
@@ -817,7 +830,9 @@ int piola__detect(piola_collision_surface *s, const double *x0, const double *v,
                   piola__detect_mode mode, const uint8_t *dirty, int *tree_built) {
   s->found.count = 0;
   if (mode == DETECT_PROXIMITY) {
-    /* Reach boxes hold the proximity boxes, so every contact was found with the candidates. */
+    /* Reach boxes hold the proximity boxes, so every contact was found with the candidates
+     * (unless a tight collection replaced them). */
+    if (!s->near_valid && collect(s, x0, v, dt, tree_built, 0)) return -1;
     for (int32_t t = 0; t < s->task_count; ++t)
       for (int64_t i = 0; i < s->near[t].count; ++i)
         if ((!dirty || any_flag(dirty, s->near[t].items[i].v)) &&
@@ -838,8 +853,9 @@ int piola__detect(piola_collision_surface *s, const double *x0, const double *v,
   int32_t escaped = compute_vertex_boxes(s, x0, v, dt, BOX_SWEPT);
   s->profile.escaped += escaped;
   if (escaped > 0 && (int64_t)escaped * ESCAPE_FRACTION > s->vertex_count) {
-    /* Too many velocities changed too much: collect the candidates again. */
-    if (piola__collect_candidates(s, x0, v, dt, tree_built)) return -1;
+    /* Too many velocities changed too much: collect the candidates again, for this pass only
+     * (later passes query the trees), so with the swept boxes. */
+    if (collect(s, x0, v, dt, tree_built, 1)) return -1;
     escaped = compute_vertex_boxes(s, x0, v, dt, BOX_SWEPT);
   }
   /* Pairs with an escaped vertex may be missing from the candidates: collect them again. */

@@ -12,16 +12,18 @@
  *   expensive part, and the tree descent is the expensive part of that. So a call descends
  *   the trees once, at its start, with "reach" boxes per vertex: swept from x0 to the
  *   proposed x1 and padded by half the thickness. They hold the proximity boxes (x0 padded by
- *   half the thickness) and the swept boxes of every detection pass as long as the velocity
- *   changes stay small against the thickness, which repulsion and most impacts do. The pairs
- *   whose reach boxes overlap (the candidates, stored) are all that the repulsion stage and the
- *   detection passes then test, after a cheap box check with their current boxes. A vertex
- *   whose swept box escapes its reach box makes its pairs uncertain: they are found by tree
- *   queries from that vertex, or, when many vertices escaped, the candidates are collected
- *   again. Parallel work runs over fixed chunks (of candidates, tree tasks or queries), each
- *   into its own list, joined in chunk order, so the result does not depend on the thread
- *   count. Impulses are then applied one pair after the other (Gauss-Seidel), in that order,
- *   so later pairs see the velocities earlier pairs left.
+ *   half the thickness) and the swept boxes of the first detection pass as long as repulsion
+ *   changes the velocities little against the thickness. The descent measures the distance
+ *   of each pair it yields once: the contacts of the repulsion stage, and the candidates of
+ *   the first detection pass (pairs that can collide while their vertices stay in their reach
+ *   boxes), which that pass scans. A vertex whose swept box escapes its reach box makes its
+ *   pairs uncertain: they are found by tree queries from that vertex, or, when most vertices
+ *   escaped, the descent is redone with the swept boxes. Later passes test only pairs with a
+ *   vertex whose velocity changed, by tree queries from those. Parallel work runs over fixed
+ *   chunks (tree tasks or blocks of queries), each into its own list, joined in chunk order,
+ *   so the result does not depend on the thread count. Impulses are then applied one pair
+ *   after the other (Gauss-Seidel), in that order, so later pairs see the velocities earlier
+ *   pairs left.
  * - Rigid impact zones use the linearised rigid motion v = v_cm + w x (x0 - c). Over the step
  *   this moves the zone by the affine map x -> x + s dt (v_cm + w x (x - c)), whose matrix
  *   I + s dt [w]x has singular values 1 and sqrt(1 + (s dt |w|)^2): it never shrinks a

@@ -563,11 +563,11 @@ static int any_flag(const uint8_t *flags, const int32_t v[4]) {
   return flags[v[0]] || flags[v[1]] || flags[v[2]] || flags[v[3]];
 }
 
-/* Continuous detection of the candidates (with a dirty vertex when dirty is given), appended
- * to s->found in candidate order. The lists of the tree tasks run in parallel, each into its
- * own list. Returns 0, or -1 out of memory. */
+/* Continuous detection of the candidates (skipping those with a vertex marked in skip, when
+ * given), appended to s->found in candidate order. The lists of the tree tasks run in
+ * parallel, each into its own list. Returns 0, or -1 out of memory. */
 static int scan_candidates(piola_collision_surface *s, const double *x0, const double *v, double dt,
-                           const uint8_t *dirty) {
+                           const uint8_t *skip) {
   const int32_t tasks = s->task_count;
   int failed = 0;
 #pragma omp parallel for schedule(dynamic, 1) num_threads(piola__thread_count()) \
@@ -581,7 +581,7 @@ static int scan_candidates(piola_collision_surface *s, const double *x0, const d
     const int64_t n = s->candidates[t].count;
     for (int64_t i = 0; i < n; ++i) {
       const piola__pair *p = &pairs[i];
-      if (dirty && !any_flag(dirty, p->v)) continue;
+      if (skip && any_flag(skip, p->v)) continue;
       piola__contact contact = {.v = {p->v[0], p->v[1], p->v[2], p->v[3]},
                                 .edge_edge = p->edge_edge};
       if (ccd_contact(s, x0, v, dt, p->edge_edge, p->separation, &contact) &&
@@ -594,134 +594,6 @@ static int scan_candidates(piola_collision_surface *s, const double *x0, const d
   for (int32_t t = 0; t < tasks && !failed; ++t)
     if (append_contacts(&s->found, s->task_found[t].items, s->task_found[t].count)) failed = 1;
   return failed ? -1 : 0;
-}
-
-/* Candidate pairs of one query primitive with what the tree returns for its box: each pair
- * with an escaped vertex once (a vertex against all triangles; a triangle only against
- * vertices that did not escape, which do not query; an edge against edges that did not
- * escape, or that come later). Returns 0, or -1 out of memory. */
-static int query_candidates(const piola_collision_surface *s, const double *x0, query_kind kind,
-                            int32_t q, piola__index_list *hits, task_output *out) {
-  const uint8_t *escaped = s->escaped;
-  hits->count = 0;
-  if (kind == QUERY_VERTEX) {
-    if (piola__bvh_query(&s->triangle_tree, &s->vertex_boxes[q], hits)) return -1;
-    const double *slabs = s->vertex_slabs + SLABS * (size_t)q;
-    for (int64_t j = 0; j < hits->count; ++j) {
-      const int32_t *tri = s->triangles + 3 * hits->items[j];
-      if (tri[0] == q || tri[1] == q || tri[2] == q) continue;
-      if (!slabs_overlap(slabs, s->triangle_slabs + SLABS * (size_t)hits->items[j])) continue;
-      const int32_t v[4] = {q, tri[0], tri[1], tri[2]};
-      if (classify_pair(s, x0, v, 0, 0, out)) return -1;
-    }
-  } else if (kind == QUERY_TRIANGLE) {
-    if (piola__bvh_query(&s->vertex_tree, &s->triangle_boxes[q], hits)) return -1;
-    const int32_t *tri = s->triangles + 3 * q;
-    const double *slabs = s->triangle_slabs + SLABS * (size_t)q;
-    for (int64_t j = 0; j < hits->count; ++j) {
-      const int32_t p = hits->items[j];
-      if (escaped[p] || !s->on_surface[p] || tri[0] == p || tri[1] == p || tri[2] == p) continue;
-      if (!slabs_overlap(slabs, s->vertex_slabs + SLABS * (size_t)p)) continue;
-      const int32_t v[4] = {p, tri[0], tri[1], tri[2]};
-      if (classify_pair(s, x0, v, 0, 0, out)) return -1;
-    }
-  } else {
-    if (piola__bvh_query(&s->edge_tree, &s->edge_boxes[q], hits)) return -1;
-    const int32_t a0 = s->edges[2 * q], a1 = s->edges[2 * q + 1];
-    for (int64_t j = 0; j < hits->count; ++j) {
-      const int32_t e = hits->items[j];
-      const int32_t b0 = s->edges[2 * e], b1 = s->edges[2 * e + 1];
-      if (e == q || (e < q && (escaped[b0] || escaped[b1]))) continue;
-      if (a0 == b0 || a0 == b1 || a1 == b0 || a1 == b1) continue;
-      if (!slabs_overlap(s->edge_slabs + SLABS * (size_t)q, s->edge_slabs + SLABS * (size_t)e))
-        continue;
-      const int32_t v[4] = {a0, a1, b0, b1};
-      if (classify_pair(s, x0, v, 1, 0, out)) return -1;
-    }
-  }
-  return 0;
-}
-
-/* Escaped vertices get new reach boxes from the velocities v, their old candidate pairs are
- * dropped, and their pairs are collected again by querying the trees (refit to the reach
- * boxes) from them and from the triangles and edges that touch one, into new task lists
- * (one per fixed block of queries). Afterwards no vertex has escaped. Returns 0, or -1 out of
- * memory. */
-static int recollect_escaped(piola_collision_surface *s, const double *x0, const double *v,
-                             double dt, int *tree_built) {
-  const uint8_t *escaped = s->escaped;
-  for (int32_t i = 0; i < s->vertex_count; ++i) {
-    if (!escaped[i]) continue;
-    const double pad = 0.5 * s->vertex_thickness[i];
-    piola__box *box = &s->reach_boxes[i];
-    for (int k = 0; k < 3; ++k) {
-      double a = x0[3 * i + k], b = a + dt * v[3 * i + k];
-      box->lo[k] = dmin(a, b) - pad, box->hi[k] = dmax(a, b) + pad;
-    }
-    s->reach_radius[i] = reach_radius(box, x0 + 3 * i);
-  }
-  /* Drop the old pairs of escaped vertices. */
-#pragma omp parallel for schedule(dynamic, 16) \
-    num_threads(piola__thread_count()) if (s->candidate_count >= 4 * SCAN_CHUNK)
-  for (int32_t t = 0; t < s->task_count; ++t) {
-    piola__pair *pairs = s->candidates[t].items;
-    int64_t kept = 0;
-    for (int64_t i = 0; i < s->candidates[t].count; ++i)
-      if (!any_flag(escaped, pairs[i].v)) pairs[kept++] = pairs[i];
-    s->candidates[t].count = kept;
-  }
-  memcpy(s->vertex_boxes, s->reach_boxes, sizeof(piola__box) * (size_t)s->vertex_count);
-  compute_primitive_boxes(s);
-  compute_slabs(s);
-  if (fit_trees(s, tree_built)) return -1;
-  /* The queries: (kind, primitive) in three runs. */
-  int32_t runs[3] = {0, 0, 0}, n = 0;
-  for (int32_t i = 0; i < s->vertex_count; ++i)
-    if (escaped[i] && s->on_surface[i]) s->queries[n++] = i;
-  runs[0] = n;
-  for (int32_t t = 0; t < s->triangle_count; ++t) {
-    const int32_t *tri = s->triangles + 3 * t;
-    if (escaped[tri[0]] || escaped[tri[1]] || escaped[tri[2]]) s->queries[n++] = t;
-  }
-  runs[1] = n;
-  for (int32_t e = 0; e < s->edge_count; ++e)
-    if (escaped[s->edges[2 * e]] || escaped[s->edges[2 * e + 1]]) s->queries[n++] = e;
-  runs[2] = n;
-  /* Blocks never straddle two runs, so each block has one kind. */
-  int32_t block_start[3], blocks = 0;
-  for (int r = 0; r < 3; ++r) {
-    block_start[r] = blocks;
-    int32_t len = runs[r] - (r ? runs[r - 1] : 0);
-    blocks += (len + PIOLA__QUERY_BLOCK - 1) / PIOLA__QUERY_BLOCK;
-  }
-  const int32_t first_task = s->task_count;
-  if (reserve_tasks(s, first_task + blocks)) return -1;
-  int failed = 0;
-#pragma omp parallel num_threads(piola__thread_count()) reduction(| : failed) if (blocks >= 16)
-  {
-    piola__index_list hits = {0};
-#pragma omp for schedule(dynamic, 1)
-    for (int32_t b = 0; b < blocks; ++b) {
-      const int32_t task = first_task + b;
-      task_output out = {s->candidates[task], s->near[task]};
-      out.pairs.count = 0, out.near.count = 0;
-      const int r = b >= block_start[2] ? 2 : (b >= block_start[1] ? 1 : 0);
-      const query_kind kind = r == 0 ? QUERY_VERTEX : (r == 1 ? QUERY_TRIANGLE : QUERY_EDGE);
-      const int32_t run_begin = r ? runs[r - 1] : 0;
-      const int32_t first = run_begin + (b - block_start[r]) * PIOLA__QUERY_BLOCK;
-      const int32_t end =
-          first + PIOLA__QUERY_BLOCK < runs[r] ? first + PIOLA__QUERY_BLOCK : runs[r];
-      for (int32_t i = first; i < end && !failed; ++i)
-        if (query_candidates(s, x0, kind, s->queries[i], &hits, &out)) failed = 1;
-      s->candidates[task] = out.pairs, s->near[task] = out.near;
-    }
-    free(hits.items);
-  }
-  if (failed) return -1;
-  s->task_count = first_task + blocks;
-  s->candidate_count = 0;
-  for (int32_t t = 0; t < s->task_count; ++t) s->candidate_count += s->candidates[t].count;
-  return 0;
 }
 
 /* Pairs of one query primitive with the candidates the tree returns for its box, each pair
@@ -858,9 +730,13 @@ int piola__detect(piola_collision_surface *s, const double *x0, const double *v,
     if (collect(s, x0, v, dt, tree_built, 1)) return -1;
     escaped = compute_vertex_boxes(s, x0, v, dt, BOX_SWEPT);
   }
-  /* Pairs with an escaped vertex may be missing from the candidates: collect them again. */
-  if (escaped > 0 && recollect_escaped(s, x0, v, dt, tree_built)) return -1;
-  return scan_candidates(s, x0, v, dt, dirty);
+  if (scan_candidates(s, x0, v, dt, escaped > 0 ? s->escaped : NULL)) return -1;
+  if (escaped == 0) return 0;
+  /* Pairs with an escaped vertex may be missing from the candidates: query the trees, refit
+   * to the swept boxes, for them. */
+  compute_primitive_boxes(s);
+  if (fit_trees(s, tree_built)) return -1;
+  return query_marked(s, x0, v, dt, mode, s->escaped, NULL);
 }
 
 int piola__detect_all_pairs(const piola_collision_surface *s, const double *x0, const double *v,

@@ -4,7 +4,10 @@
  * that the layers come into contact along the fold and then over the whole overlap. Prints,
  * for each size, the median over the measured steps of the processing time (wall clock, and
  * CPU time of all threads, which is steadier on a shared machine), with contacts,
- * impacts and impact-zone vertices per step.
+ * impacts and impact-zone vertices per step. A second table splits the time into the phases
+ * of a call (CPU time of the calling thread, so all of it with OMP_NUM_THREADS=1): collecting
+ * candidate pairs (boxes, trees, the tree descent), repulsion, the detection passes, impulses
+ * and impact zones, with the number of candidate pairs and of tree descents per call.
  *
  *   build/NAME/bench_contact [max_triangles [closing]]   (OMP_NUM_THREADS sets the threads)
  *
@@ -16,6 +19,7 @@
 #include <stdlib.h>
 #include <time.h>
 
+#include "contact/contact_internal.h"
 #include "piola/collision_surface.h"
 #include "support/bench_support.h"
 
@@ -49,6 +53,8 @@ int main(int argc, char **argv) {
       "| triangles | vertices | wall ms/step | CPU ms/step | CPU ns/triangle | contacts | impacts "
       "| zone vertices |\n");
   printf("|---|---|---|---|---|---|---|---|\n");
+  double phase_ms[5][7];
+  int sizes[5], measured = 0;
   for (size_t t = 0; t < sizeof targets / sizeof targets[0]; ++t) {
     if (targets[t] > max_triangles) break;
     const int n = (int)lround(sqrt(targets[t] / 2.0)) + 1;
@@ -77,7 +83,7 @@ int main(int argc, char **argv) {
     for (int j = 0; j < n; ++j)
       for (int i = 0; i < n; ++i) folded(n, i, j, theta, x + 3 * (j * n + i));
     for (int i = 0; i < nv; ++i) m[i] = 1e-4;
-    double times[8], cpu[8];
+    double times[8], cpu[8], phase[5][8], candidates[8], collections[8];
     long long contacts = 0, impacts = 0, zone_vertices = 0;
     for (int step = 0; step < 10; ++step) {
       const double dtheta = closing * h / 0.5;
@@ -95,14 +101,22 @@ int main(int argc, char **argv) {
       if (piola_collision_surface_process(surface, x, v, m, dt, NULL, &st) != PIOLA_OK) return 1;
       double elapsed = bench_wall_seconds() - t0, cpu_elapsed = bench_cpu_seconds() - c0;
       if (getenv("BENCH_TRACE"))
-        fprintf(stderr, "step %d: %.1f ms contacts %lld impacts %lld passes %d zone passes %d\n",
+        fprintf(stderr,
+                "step %d: %.1f ms contacts %lld impacts %lld passes %d zone passes %d escaped %d "
+                "descents %d\n",
                 step, 1e3 * elapsed, (long long)st.contacts, (long long)st.impacts,
-                st.collision_passes, st.zone_passes);
+                st.collision_passes, st.zone_passes, surface->profile.escaped,
+                surface->profile.collections);
       for (int i = 0; i < 3 * nv; ++i) x[i] += dt * v[i];
       theta += dtheta;
       if (step >= 2) {
         times[step - 2] = elapsed, cpu[step - 2] = cpu_elapsed;
         contacts += st.contacts, impacts += st.impacts, zone_vertices += st.zone_vertices;
+        const piola__contact_profile *p = &surface->profile;
+        phase[0][step - 2] = p->collect, phase[1][step - 2] = p->repulsion;
+        phase[2][step - 2] = p->detection, phase[3][step - 2] = p->impulses;
+        phase[4][step - 2] = p->zones, candidates[step - 2] = (double)p->candidates;
+        collections[step - 2] = p->collections;
       }
     }
     qsort(times, 8, sizeof(double), bench_compare_doubles);
@@ -110,9 +124,20 @@ int main(int argc, char **argv) {
     double median = 0.5 * (times[3] + times[4]), cpu_median = 0.5 * (cpu[3] + cpu[4]);
     printf("| %d | %d | %.1f | %.1f | %.0f | %lld | %lld | %lld |\n", nt, nv, 1e3 * median,
            1e3 * cpu_median, 1e9 * cpu_median / nt, contacts / 8, impacts / 8, zone_vertices / 8);
+    for (int ph = 0; ph < 5; ++ph) phase_ms[t][ph] = 1e3 * bench_median(phase[ph], 8);
+    phase_ms[t][5] = bench_median(candidates, 8), phase_ms[t][6] = bench_median(collections, 8);
+    sizes[t] = nt, measured = (int)t + 1;
     fflush(stdout);
     piola_collision_surface_destroy(surface);
     free(tris), free(x), free(v), free(m);
   }
+  printf(
+      "\nphases, median CPU ms per step of the calling thread\n"
+      "| triangles | collect | repulsion | detection | impulses | zones | candidates | "
+      "descents |\n|---|---|---|---|---|---|---|---|\n");
+  for (int t = 0; t < measured; ++t)
+    printf("| %d | %.1f | %.1f | %.1f | %.1f | %.1f | %.0f | %.0f |\n", sizes[t], phase_ms[t][0],
+           phase_ms[t][1], phase_ms[t][2], phase_ms[t][3], phase_ms[t][4], phase_ms[t][5],
+           phase_ms[t][6]);
   return 0;
 }

@@ -95,12 +95,17 @@ int piola__bvh_build(piola__bvh *bvh, const piola__box *boxes, int32_t n) {
     int32_t *order = realloc(bvh->order, sizeof(*order) * (size_t)(n > 0 ? n : 1));
     if (!order) return -1;
     bvh->order = order;
+    piola__box *leaf_boxes =
+        realloc(bvh->leaf_boxes, sizeof(*leaf_boxes) * (size_t)(n > 0 ? n : 1));
+    if (!leaf_boxes) return -1;
+    bvh->leaf_boxes = leaf_boxes;
   }
   bvh->primitive_count = n;
   bvh->node_count = 0;
   if (n == 0) return 0;
   for (int32_t i = 0; i < n; ++i) bvh->order[i] = i;
   build_node(bvh, boxes, 0, n);
+  for (int32_t i = 0; i < n; ++i) bvh->leaf_boxes[i] = boxes[bvh->order[i]];
   return 0;
 }
 
@@ -110,9 +115,13 @@ void piola__bvh_refit(piola__bvh *bvh, const piola__box *boxes) {
 #pragma omp parallel for schedule(static) num_threads(piola__thread_count()) if (count >= 4096)
   for (int32_t i = 0; i < count; ++i) {
     if (nodes[i].count == 0) continue;
-    piola__box b = boxes[bvh->order[nodes[i].first]];
-    for (int32_t j = 1; j < nodes[i].count; ++j)
-      box_union(&b, &boxes[bvh->order[nodes[i].first + j]]);
+    piola__box *leaf = bvh->leaf_boxes + nodes[i].first;
+    leaf[0] = boxes[bvh->order[nodes[i].first]];
+    piola__box b = leaf[0];
+    for (int32_t j = 1; j < nodes[i].count; ++j) {
+      leaf[j] = boxes[bvh->order[nodes[i].first + j]];
+      box_union(&b, &leaf[j]);
+    }
     nodes[i].box = b;
   }
   for (int32_t i = count - 1; i >= 0; --i) {
@@ -134,8 +143,7 @@ int piola__index_list_push(piola__index_list *list, int32_t value) {
   return 0;
 }
 
-int piola__bvh_query(const piola__bvh *bvh, const piola__box *boxes, const piola__box *query,
-                     piola__index_list *out) {
+int piola__bvh_query(const piola__bvh *bvh, const piola__box *query, piola__index_list *out) {
   if (bvh->node_count == 0) return 0;
   int32_t stack[MAX_DEPTH];
   int top = 0;
@@ -146,7 +154,9 @@ int piola__bvh_query(const piola__bvh *bvh, const piola__box *boxes, const piola
     if (node->count > 0) {
       for (int32_t j = 0; j < node->count; ++j) {
         int32_t id = bvh->order[node->first + j];
-        if (piola__boxes_overlap(&boxes[id], query) && piola__index_list_push(out, id)) return -1;
+        if (piola__boxes_overlap(&bvh->leaf_boxes[node->first + j], query) &&
+            piola__index_list_push(out, id))
+          return -1;
       }
     } else {
       int32_t self = (int32_t)(node - bvh->nodes);
@@ -160,5 +170,6 @@ int piola__bvh_query(const piola__bvh *bvh, const piola__box *boxes, const piola
 void piola__bvh_free(piola__bvh *bvh) {
   free(bvh->nodes);
   free(bvh->order);
+  free(bvh->leaf_boxes);
   *bvh = (piola__bvh){0};
 }

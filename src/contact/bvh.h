@@ -26,7 +26,9 @@ typedef struct piola__bvh {
   int32_t primitive_count;
   int32_t node_count;
   piola__bvh_node *nodes;
-  int32_t *order; /* primitive indices, grouped by leaf */
+  int32_t *order;         /* primitive indices, grouped by leaf */
+  piola__box *leaf_boxes; /* boxes[order[k]]: the primitive boxes in leaf order, so the tests
+                             at the leaves read memory in sequence (set by build and refit) */
 } piola__bvh;
 
 /* A growable list of indices. */
@@ -39,12 +41,13 @@ typedef struct piola__index_list {
  * runs out. */
 int piola__bvh_build(piola__bvh *bvh, const piola__box *boxes, int32_t n);
 
-/* Recomputes every node box from the primitive boxes (same count and order as the build). */
+/* Recomputes every node box (and leaf_boxes) from the primitive boxes (same count and order
+ * as the build). */
 void piola__bvh_refit(piola__bvh *bvh, const piola__box *boxes);
 
-/* Appends to out the primitives whose boxes overlap query. Returns 0, or -1 out of memory. */
-int piola__bvh_query(const piola__bvh *bvh, const piola__box *boxes, const piola__box *query,
-                     piola__index_list *out);
+/* Appends to out the primitives whose boxes (as of the last build or refit) overlap query.
+ * Returns 0, or -1 out of memory. */
+int piola__bvh_query(const piola__bvh *bvh, const piola__box *query, piola__index_list *out);
 
 void piola__bvh_free(piola__bvh *bvh);
 

@@ -1,16 +1,12 @@
-/* Collision surfaces: construction, detection passes, repulsion and impact impulses, and the
+/* Collision surfaces: construction, repulsion and impact impulses, and the
  * three-stage processing of BFA02 (see piola/collision_surface.h and contact_internal.h). */
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
+#include <time.h>
 
 #include "common/status_internal.h"
-#include "common/threads.h"
-#include "contact/ccd.h"
 #include "contact/contact_internal.h"
-#include "contact/proximity.h"
-
-enum { QUERY_BLOCK = 256, REBUILD_PERIOD = 8 };
 
 piola_collision_body_def piola_default_collision_body_def(void) {
   return (piola_collision_body_def){.thickness = 1e-3, .friction = 0.3};
@@ -68,6 +64,15 @@ void piola_collision_surface_destroy(piola_collision_surface *s) {
   free(s->dirty);
   free(s->on_surface);
   free(s->zone_order);
+  free(s->reach_boxes);
+  free(s->escaped);
+  for (int32_t t = 0; t < s->task_capacity; ++t)
+    free(s->candidates[t].items), free(s->near[t].items), free(s->task_found[t].items);
+  free(s->candidates), free(s->near), free(s->task_found);
+  free(s->reach_radius);
+  free(s->vertex_slabs);
+  free(s->triangle_slabs);
+  free(s->edge_slabs);
   free(s);
 }
 
@@ -144,9 +149,17 @@ piola_status piola_collision_surface_create(const piola_collision_surface_def *d
   s->dirty = calloc(nv1, 1);
   s->on_surface = calloc(nv1, 1);
   s->zone_order = malloc(sizeof(int32_t) * nv1);
-  if (!s->triangles || !s->edges || !s->vertex_body || !s->bodies || !s->inverse_mass ||
-      !s->vertex_thickness || !s->vertex_boxes || !s->triangle_boxes || !s->edge_boxes ||
-      !s->zone_parent || !s->in_zone || !s->zone_order || !s->dirty || !s->on_surface) {
+  s->reach_boxes = malloc(sizeof(piola__box) * nv1);
+  s->escaped = calloc(nv1, 1);
+  s->reach_radius = malloc(sizeof(double) * nv1);
+  s->vertex_slabs = malloc(sizeof(double) * 12 * nv1);
+  s->triangle_slabs = malloc(sizeof(double) * 12 * nt1);
+  s->edge_slabs = malloc(sizeof(double) * 36 * nt1);
+  if (!s->reach_boxes || !s->escaped || !s->reach_radius || !s->vertex_slabs ||
+      !s->triangle_slabs || !s->edge_slabs || !s->triangles || !s->edges || !s->vertex_body ||
+      !s->bodies || !s->inverse_mass || !s->vertex_thickness || !s->vertex_boxes ||
+      !s->triangle_boxes || !s->edge_boxes || !s->zone_parent || !s->in_zone || !s->zone_order ||
+      !s->dirty || !s->on_surface) {
     piola_collision_surface_destroy(s);
     return PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "collision surface: out of memory");
   }
@@ -177,7 +190,7 @@ piola_status piola_collision_surface_create(const piola_collision_surface_def *d
     ++unique;
   }
   s->edge_count = unique;
-  s->block_count = (nv + nt + unique) / QUERY_BLOCK + 3;
+  s->block_count = (nv + nt + unique) / PIOLA__QUERY_BLOCK + 3;
   s->queries = malloc(sizeof(int32_t) * ((size_t)nv + (size_t)nt + (size_t)unique + 1));
   s->blocks = calloc((size_t)(s->block_count > 0 ? s->block_count : 1), sizeof(*s->blocks));
   if (!s->blocks || !s->queries) {
@@ -186,455 +199,6 @@ piola_status piola_collision_surface_create(const piola_collision_surface_def *d
   }
   *out = s;
   return PIOLA_OK;
-}
-
-/* ------------------------------------------------------------------ detection */
-
-typedef enum detect_mode { DETECT_PROXIMITY, DETECT_CCD } detect_mode;
-
-/* What a query primitive is tested against: a vertex against triangles, a triangle against
- * vertices, an edge against edges. */
-typedef enum query_kind { QUERY_VERTEX, QUERY_TRIANGLE, QUERY_EDGE } query_kind;
-
-static double max3(double a, double b, double c) { return fmax(a, fmax(b, c)); }
-
-static void box_of_vertex(piola__box *box, const double *x0, const double *v, double dt,
-                          double pad) {
-  for (int k = 0; k < 3; ++k) {
-    double a = x0[k], b = v ? x0[k] + dt * v[k] : a;
-    box->lo[k] = fmin(a, b) - pad;
-    box->hi[k] = fmax(a, b) + pad;
-  }
-}
-
-static void box_union_of(piola__box *out, const piola__box *a, const piola__box *b) {
-  for (int k = 0; k < 3; ++k) {
-    out->lo[k] = fmin(a->lo[k], b->lo[k]);
-    out->hi[k] = fmax(a->hi[k], b->hi[k]);
-  }
-}
-
-/* Vertex, triangle and edge boxes: at x0 padded by half the thickness (proximity), or swept
- * over the step padded by the detection tolerance (continuous detection); two primitives
- * within their pair's thickness (or tolerance) then always have overlapping boxes. */
-static void compute_boxes(piola_collision_surface *s, const double *x0, const double *v, double dt,
-                          detect_mode mode) {
-#pragma omp parallel num_threads(piola__thread_count()) if (s->vertex_count + s->edge_count >= 4096)
-  {
-#pragma omp for schedule(static)
-    for (int32_t i = 0; i < s->vertex_count; ++i) {
-      double h = s->vertex_thickness[i];
-      box_of_vertex(&s->vertex_boxes[i], x0 + 3 * i, mode == DETECT_CCD ? v + 3 * i : NULL, dt,
-                    mode == DETECT_CCD ? PIOLA__CCD_TOLERANCE * h : 0.5 * h);
-    }
-#pragma omp for schedule(static)
-    for (int32_t t = 0; t < s->triangle_count; ++t) {
-      const int32_t *tri = s->triangles + 3 * t;
-      box_union_of(&s->triangle_boxes[t], &s->vertex_boxes[tri[0]], &s->vertex_boxes[tri[1]]);
-      box_union_of(&s->triangle_boxes[t], &s->triangle_boxes[t], &s->vertex_boxes[tri[2]]);
-    }
-#pragma omp for schedule(static)
-    for (int32_t e = 0; e < s->edge_count; ++e)
-      box_union_of(&s->edge_boxes[e], &s->vertex_boxes[s->edges[2 * e]],
-                   &s->vertex_boxes[s->edges[2 * e + 1]]);
-  }
-}
-
-/* Each side of a pair keeps half its body's thickness: the pair keeps the sum, which within
- * one body is that body's thickness. */
-static double pair_thickness(const piola_collision_surface *s, const int32_t v[4], int edge_edge) {
-  const double *h = s->vertex_thickness;
-  double side_a = edge_edge ? fmax(h[v[0]], h[v[1]]) : h[v[0]];
-  double side_b = edge_edge ? fmax(h[v[2]], h[v[3]]) : max3(h[v[1]], h[v[2]], h[v[3]]);
-  return 0.5 * (side_a + side_b);
-}
-
-static double pair_friction(const piola_collision_surface *s, const int32_t v[4]) {
-  return 0.5 *
-         (s->bodies[s->vertex_body[v[0]]].friction + s->bodies[s->vertex_body[v[3]]].friction);
-}
-
-static int all_pinned(const piola_collision_surface *s, const int32_t v[4]) {
-  return s->inverse_mass[v[0]] == 0.0 && s->inverse_mass[v[1]] == 0.0 &&
-         s->inverse_mass[v[2]] == 0.0 && s->inverse_mass[v[3]] == 0.0;
-}
-
-/* Pairs none of whose vertices changed velocity since the last pass were tested then. */
-static int any_dirty(const uint8_t *dirty, const int32_t v[4]) {
-  return !dirty || dirty[v[0]] || dirty[v[1]] || dirty[v[2]] || dirty[v[3]];
-}
-
-static vec3 unit(vec3 a) {
-  double len = vec3_norm(a);
-  return len > 0.0 ? vec3_scale(a, 1.0 / len) : a;
-}
-
-/* Narrow phase of one pair. Returns 1 and fills c when the pair is in contact (proximity) or
- * collides during the step (continuous detection). */
-static int narrow_phase(const piola_collision_surface *s, const double *x0, const double *v,
-                        double dt, detect_mode mode, int edge_edge, piola__contact *c) {
-  vec3 x[4];
-  for (int k = 0; k < 4; ++k) x[k] = vec3_load(x0 + 3 * c->v[k]);
-  c->thickness = pair_thickness(s, c->v, edge_edge);
-  c->friction = pair_friction(s, c->v);
-  if (mode == DETECT_PROXIMITY) {
-    double dist2;
-    vec3 fallback;
-    if (!edge_edge) {
-      double b[3];
-      dist2 = piola__point_triangle_closest(x[0], x[1], x[2], x[3], b);
-      c->w[0] = 1.0, c->w[1] = -b[0], c->w[2] = -b[1], c->w[3] = -b[2];
-      fallback = vec3_cross(vec3_sub(x[2], x[1]), vec3_sub(x[3], x[1]));
-    } else {
-      double a, b;
-      dist2 = piola__segment_segment_closest(x[0], x[1], x[2], x[3], &a, &b);
-      c->w[0] = 1.0 - a, c->w[1] = a, c->w[2] = -(1.0 - b), c->w[3] = -b;
-      fallback = vec3_cross(vec3_sub(x[1], x[0]), vec3_sub(x[3], x[2]));
-    }
-    if (!(dist2 < c->thickness * c->thickness)) return 0;
-    vec3 r = {0, 0, 0};
-    for (int k = 0; k < 4; ++k) r = vec3_add(r, vec3_scale(x[k], c->w[k]));
-    vec3 n = unit(r);
-    if (vec3_norm2(n) == 0.0) n = unit(fallback);
-    if (vec3_norm2(n) == 0.0) return 0;
-    c->normal = n;
-    c->gap = vec3_dot(r, n);
-    return 1;
-  }
-  vec3 d[4];
-  for (int k = 0; k < 4; ++k) d[k] = vec3_scale(vec3_load(v + 3 * c->v[k]), dt);
-  piola__ccd_hit hit;
-  double eps = PIOLA__CCD_TOLERANCE * c->thickness;
-  /* Separation bound: any two points of the pair (fixed barycentric weights) move apart or
-   * together by at most the largest relative displacement of a vertex of one side and a
-   * vertex of the other, so a pair farther apart than that at the start cannot touch. */
-  double start2, move2 = 0.0;
-  if (!edge_edge) {
-    double b[3];
-    start2 = piola__point_triangle_closest(x[0], x[1], x[2], x[3], b);
-    for (int k = 1; k < 4; ++k) move2 = fmax(move2, vec3_norm2(vec3_sub(d[0], d[k])));
-  } else {
-    double a, b;
-    start2 = piola__segment_segment_closest(x[0], x[1], x[2], x[3], &a, &b);
-    for (int i = 0; i < 2; ++i)
-      for (int k = 2; k < 4; ++k) move2 = fmax(move2, vec3_norm2(vec3_sub(d[i], d[k])));
-  }
-  if (sqrt(start2) > sqrt(move2) + 2.0 * eps) return 0;
-  int found = edge_edge ? piola__ccd_edge_edge(x, d, eps, &hit)
-                        : piola__ccd_point_triangle(x, d, eps, &hit);
-  if (!found) return 0;
-  memcpy(c->w, hit.w, sizeof(c->w));
-  c->normal = hit.normal;
-  vec3 r = {0, 0, 0};
-  for (int k = 0; k < 4; ++k) r = vec3_add(r, vec3_scale(x[k], c->w[k]));
-  c->gap = vec3_dot(r, hit.normal);
-  return 1;
-}
-
-/* Narrow phase of vertex p against triangle t, and of edges a and b; push on a hit. Return 0,
- * or -1 out of memory. */
-static int emit_vertex_triangle(const piola_collision_surface *s, const double *x0, const double *v,
-                                double dt, detect_mode mode, int32_t p, int32_t t,
-                                piola__contact_list *list) {
-  const int32_t *tri = s->triangles + 3 * t;
-  if (!s->on_surface[p] || tri[0] == p || tri[1] == p || tri[2] == p) return 0;
-  piola__contact c = {.v = {p, tri[0], tri[1], tri[2]}};
-  if (all_pinned(s, c.v)) return 0;
-  if (narrow_phase(s, x0, v, dt, mode, 0, &c) && piola__contact_list_push(list, &c)) return -1;
-  return 0;
-}
-
-static int emit_edge_edge(const piola_collision_surface *s, const double *x0, const double *v,
-                          double dt, detect_mode mode, int32_t a, int32_t b,
-                          piola__contact_list *list) {
-  const int32_t a0 = s->edges[2 * a], a1 = s->edges[2 * a + 1];
-  const int32_t b0 = s->edges[2 * b], b1 = s->edges[2 * b + 1];
-  if (a0 == b0 || a0 == b1 || a1 == b0 || a1 == b1) return 0;
-  piola__contact c = {.v = {a0, a1, b0, b1}};
-  if (all_pinned(s, c.v)) return 0;
-  if (narrow_phase(s, x0, v, dt, mode, 1, &c) && piola__contact_list_push(list, &c)) return -1;
-  return 0;
-}
-
-/* ---------------------------------------------------------- tree against tree (full passes)
- * A full pass finds all pairs by descending two trees together (a vertex tree against the
- * triangle tree, the edge tree against itself), which visits each overlapping node pair once
- * instead of descending from the root for every primitive. The top of the descent is done
- * sequentially, into a fixed number of independent tasks (node pairs), which then run in
- * parallel, each into its own list; lists are joined in task order, so the result does not
- * depend on the thread count. */
-
-typedef struct node_pair {
-  int32_t a, b; /* node indices; a == b means the pairs within one subtree (same tree) */
-} node_pair;
-
-enum { TARGET_TASKS = 512 };
-
-/* Size of a node for deciding which side of a pair to descend: its box's half perimeter. */
-static double node_size(const piola__bvh *t, int32_t n) {
-  const piola__box *b = &t->nodes[n].box;
-  return (b->hi[0] - b->lo[0]) + (b->hi[1] - b->lo[1]) + (b->hi[2] - b->lo[2]);
-}
-
-/* Splits one task into its children tasks (appended to out); returns how many, or -1 when
- * the task is a leaf-leaf pair that cannot be split. */
-static int split_task(const piola__bvh *ta, const piola__bvh *tb, int same_tree, node_pair task,
-                      node_pair out[3]) {
-  const piola__bvh_node *na = &ta->nodes[task.a], *nb = &tb->nodes[task.b];
-  if (same_tree && task.a == task.b) {
-    if (na->count > 0) return -1;
-    int32_t l = task.a + 1, r = na->first;
-    out[0] = (node_pair){l, l}, out[1] = (node_pair){r, r}, out[2] = (node_pair){l, r};
-    return 3;
-  }
-  if (!piola__boxes_overlap(&na->box, &nb->box)) return 0;
-  if (na->count > 0 && nb->count > 0) return -1;
-  int split_a = nb->count > 0 || (na->count == 0 && node_size(ta, task.a) >= node_size(tb, task.b));
-  if (split_a) {
-    out[0] = (node_pair){task.a + 1, task.b}, out[1] = (node_pair){na->first, task.b};
-  } else {
-    out[0] = (node_pair){task.a, task.b + 1}, out[1] = (node_pair){task.a, nb->first};
-  }
-  return 2;
-}
-
-/* Breadth-first expansion of the root task into about TARGET_TASKS tasks. */
-static node_pair *make_tasks(const piola__bvh *ta, const piola__bvh *tb, int same_tree,
-                             int32_t *count) {
-  *count = 0;
-  if (ta->node_count == 0 || tb->node_count == 0) return malloc(sizeof(node_pair));
-  int32_t cap = 4 * TARGET_TASKS + 16, n = 1;
-  node_pair *tasks = malloc(sizeof(node_pair) * (size_t)cap);
-  node_pair *next = malloc(sizeof(node_pair) * (size_t)cap);
-  if (!tasks || !next) {
-    free(tasks), free(next);
-    return NULL;
-  }
-  tasks[0] = (node_pair){0, 0};
-  for (int round = 0; round < 64 && n < TARGET_TASKS; ++round) {
-    int32_t m = 0, split_any = 0;
-    for (int32_t i = 0; i < n; ++i) {
-      node_pair kids[3];
-      int k = m + 3 * (n - i) < cap ? split_task(ta, tb, same_tree, tasks[i], kids) : -1;
-      if (k < 0) {
-        next[m++] = tasks[i];
-        continue;
-      }
-      split_any = 1;
-      for (int j = 0; j < k; ++j) next[m++] = kids[j];
-    }
-    node_pair *t = tasks;
-    tasks = next, next = t, n = m;
-    if (!split_any) break;
-  }
-  free(next);
-  *count = n;
-  return tasks;
-}
-
-/* Runs one task to the end with an explicit stack. Returns 0, or -1 out of memory. */
-static int run_task(const piola_collision_surface *s, const double *x0, const double *v, double dt,
-                    detect_mode mode, const piola__bvh *ta, const piola__bvh *tb, int same_tree,
-                    node_pair task, piola__contact_list *list) {
-  node_pair stack[256];
-  int top = 0;
-  stack[top++] = task;
-  while (top > 0) {
-    node_pair t = stack[--top];
-    node_pair kids[3];
-    int k = split_task(ta, tb, same_tree, t, kids);
-    if (k == 0) continue;
-    if (k > 0 && top + k <= 256) {
-      /* Pushed in reverse so they are taken in order (the order is part of the result). */
-      for (int j = k - 1; j >= 0; --j) stack[top++] = kids[j];
-      continue;
-    }
-    if (k > 0) return -1; /* cannot happen: depth is bounded by the two trees' depths */
-    const piola__bvh_node *na = &ta->nodes[t.a], *nb = &tb->nodes[t.b];
-    for (int32_t i = 0; i < na->count; ++i) {
-      const int32_t pa = ta->order[na->first + i];
-      for (int32_t j = (same_tree && t.a == t.b) ? i + 1 : 0; j < nb->count; ++j) {
-        const int32_t pb = tb->order[nb->first + j];
-        int failed;
-        if (same_tree) {
-          if (!piola__boxes_overlap(&s->edge_boxes[pa], &s->edge_boxes[pb])) continue;
-          failed = emit_edge_edge(s, x0, v, dt, mode, pa < pb ? pa : pb, pa < pb ? pb : pa, list);
-        } else {
-          if (!piola__boxes_overlap(&s->vertex_boxes[pa], &s->triangle_boxes[pb])) continue;
-          failed = emit_vertex_triangle(s, x0, v, dt, mode, pa, pb, list);
-        }
-        if (failed) return -1;
-      }
-    }
-  }
-  return 0;
-}
-
-/* Full pass by tree descents into s->found. Returns 0, or -1 out of memory. */
-static int detect_all(piola_collision_surface *s, const double *x0, const double *v, double dt,
-                      detect_mode mode) {
-  int32_t nvt, nee;
-  node_pair *vt = make_tasks(&s->vertex_tree, &s->triangle_tree, 0, &nvt);
-  node_pair *ee = make_tasks(&s->edge_tree, &s->edge_tree, 1, &nee);
-  int failed = !vt || !ee;
-  const int32_t total = failed ? 0 : nvt + nee;
-  piola__contact_list *lists = failed ? NULL : calloc((size_t)total + 1, sizeof(*lists));
-  if (!failed && !lists) failed = 1;
-  if (!failed) {
-#pragma omp parallel for schedule(dynamic, 1) num_threads(piola__thread_count()) \
-    reduction(|                               \
-              : failed) if (total >= 64 && s->triangle_count >= 2048)
-    for (int32_t i = 0; i < total; ++i) {
-      if (failed) continue;
-      if (i < nvt)
-        failed |= run_task(s, x0, v, dt, mode, &s->vertex_tree, &s->triangle_tree, 0, vt[i],
-                           &lists[i]) != 0;
-      else
-        failed |= run_task(s, x0, v, dt, mode, &s->edge_tree, &s->edge_tree, 1, ee[i - nvt],
-                           &lists[i]) != 0;
-    }
-  }
-  s->found.count = 0;
-  for (int32_t i = 0; i < total && !failed; ++i)
-    for (int64_t j = 0; j < lists[i].count; ++j)
-      if (piola__contact_list_push(&s->found, &lists[i].items[j])) failed = 1;
-  if (lists)
-    for (int32_t i = 0; i < total; ++i) free(lists[i].items);
-  free(lists), free(vt), free(ee);
-  return failed ? -1 : 0;
-}
-
-/* Pairs of one query primitive with the candidates the tree returns for its box; appends
- * the contacts found to list. Returns 0, or -1 out of memory. */
-static int query_pairs(piola_collision_surface *s, const double *x0, const double *v, double dt,
-                       detect_mode mode, const uint8_t *dirty, query_kind kind, int32_t q,
-                       piola__index_list *candidates, piola__contact_list *list) {
-  candidates->count = 0;
-  if (kind == QUERY_VERTEX) {
-    if (piola__bvh_query(&s->triangle_tree, s->triangle_boxes, &s->vertex_boxes[q], candidates))
-      return -1;
-    for (int64_t j = 0; j < candidates->count; ++j) {
-      const int32_t *tri = s->triangles + 3 * candidates->items[j];
-      if (tri[0] == q || tri[1] == q || tri[2] == q) continue;
-      piola__contact c = {.v = {q, tri[0], tri[1], tri[2]}};
-      if (all_pinned(s, c.v) || !any_dirty(dirty, c.v)) continue;
-      if (narrow_phase(s, x0, v, dt, mode, 0, &c) && piola__contact_list_push(list, &c)) return -1;
-    }
-  } else if (kind == QUERY_TRIANGLE) {
-    /* Only with a dirty triangle, and only clean vertices: dirty ones query themselves. */
-    if (piola__bvh_query(&s->vertex_tree, s->vertex_boxes, &s->triangle_boxes[q], candidates))
-      return -1;
-    const int32_t *tri = s->triangles + 3 * q;
-    for (int64_t j = 0; j < candidates->count; ++j) {
-      const int32_t p = candidates->items[j];
-      if (dirty[p] || !s->on_surface[p] || tri[0] == p || tri[1] == p || tri[2] == p) continue;
-      piola__contact c = {.v = {p, tri[0], tri[1], tri[2]}};
-      if (all_pinned(s, c.v)) continue;
-      if (narrow_phase(s, x0, v, dt, mode, 0, &c) && piola__contact_list_push(list, &c)) return -1;
-    }
-  } else {
-    if (piola__bvh_query(&s->edge_tree, s->edge_boxes, &s->edge_boxes[q], candidates)) return -1;
-    const int32_t a0 = s->edges[2 * q], a1 = s->edges[2 * q + 1];
-    for (int64_t j = 0; j < candidates->count; ++j) {
-      const int32_t e = candidates->items[j];
-      const int32_t b0 = s->edges[2 * e], b1 = s->edges[2 * e + 1];
-      /* Each pair once: from the lower index, or from the dirty edge when only one is. */
-      if (e == q) continue;
-      if (!dirty && e < q) continue;
-      if (dirty && e < q && (dirty[b0] || dirty[b1])) continue;
-      if (a0 == b0 || a0 == b1 || a1 == b0 || a1 == b1) continue;
-      piola__contact c = {.v = {a0, a1, b0, b1}};
-      if (all_pinned(s, c.v)) continue;
-      if (narrow_phase(s, x0, v, dt, mode, 1, &c) && piola__contact_list_push(list, &c)) return -1;
-    }
-  }
-  return 0;
-}
-
-/* All contacts (proximity) or collisions (continuous detection) into s->found, in an order
- * that does not depend on the thread count. With dirty given, only pairs with a vertex whose
- * velocity changed are tested: they are found from the dirty vertices, from the triangles
- * and edges that touch one, against the trees of the other primitives. Returns 0, or -1 out
- * of memory. */
-static int detect(piola_collision_surface *s, const double *x0, const double *v, double dt,
-                  detect_mode mode, int *tree_built, const uint8_t *dirty) {
-  compute_boxes(s, x0, v, dt, mode);
-  /* A tree built in an earlier call is refit as long as it is young: its shape came from
-   * positions close to these; every REBUILD_PERIOD calls it is rebuilt from scratch. */
-  if (!*tree_built && s->tree_age > 0 && s->tree_age < REBUILD_PERIOD) *tree_built = 1;
-  if (!*tree_built) {
-    s->tree_age = 0;
-    if (piola__bvh_build(&s->triangle_tree, s->triangle_boxes, s->triangle_count) ||
-        piola__bvh_build(&s->edge_tree, s->edge_boxes, s->edge_count) ||
-        piola__bvh_build(&s->vertex_tree, s->vertex_boxes, s->vertex_count))
-      return -1;
-    *tree_built = 1;
-  } else {
-    piola__bvh_refit(&s->triangle_tree, s->triangle_boxes);
-    piola__bvh_refit(&s->edge_tree, s->edge_boxes);
-    piola__bvh_refit(&s->vertex_tree, s->vertex_boxes);
-  }
-  if (!dirty) return detect_all(s, x0, v, dt, mode);
-  /* The queries: (kind, primitive) in three runs. */
-  int32_t runs[3] = {0, 0, 0}, n = 0;
-  if (!dirty) {
-    for (int32_t i = 0; i < s->vertex_count; ++i)
-      if (s->on_surface[i]) s->queries[n++] = i;
-    runs[0] = n;
-    runs[1] = n;
-    for (int32_t e = 0; e < s->edge_count; ++e) s->queries[n++] = e;
-    runs[2] = n;
-  } else {
-    for (int32_t i = 0; i < s->vertex_count; ++i)
-      if (dirty[i] && s->on_surface[i]) s->queries[n++] = i;
-    runs[0] = n;
-    for (int32_t t = 0; t < s->triangle_count; ++t) {
-      const int32_t *tri = s->triangles + 3 * t;
-      if (dirty[tri[0]] || dirty[tri[1]] || dirty[tri[2]]) s->queries[n++] = t;
-    }
-    runs[1] = n;
-    for (int32_t e = 0; e < s->edge_count; ++e)
-      if (dirty[s->edges[2 * e]] || dirty[s->edges[2 * e + 1]]) s->queries[n++] = e;
-    runs[2] = n;
-  }
-  /* Blocks never straddle two runs, so each block has one kind. */
-  int32_t block_start[3], blocks = 0;
-  for (int r = 0; r < 3; ++r) {
-    block_start[r] = blocks;
-    int32_t len = runs[r] - (r ? runs[r - 1] : 0);
-    blocks += (len + QUERY_BLOCK - 1) / QUERY_BLOCK;
-  }
-  int failed = 0;
-#pragma omp parallel num_threads(piola__thread_count()) reduction(| : failed) if (blocks >= 16)
-  {
-    piola__index_list candidates = {0};
-#pragma omp for schedule(dynamic, 1)
-    for (int32_t b = 0; b < blocks; ++b) {
-      piola__contact_list *list = &s->blocks[b];
-      list->count = 0;
-      if (failed) continue;
-      int r = b >= block_start[2] ? 2 : (b >= block_start[1] ? 1 : 0);
-      const query_kind kind = r == 0 ? QUERY_VERTEX : (r == 1 ? QUERY_TRIANGLE : QUERY_EDGE);
-      const int32_t run_begin = r ? runs[r - 1] : 0;
-      const int32_t first = run_begin + (b - block_start[r]) * QUERY_BLOCK;
-      const int32_t end = first + QUERY_BLOCK < runs[r] ? first + QUERY_BLOCK : runs[r];
-      for (int32_t i = first; i < end; ++i)
-        if (query_pairs(s, x0, v, dt, mode, dirty, kind, s->queries[i], &candidates, list)) {
-          failed = 1;
-          break;
-        }
-    }
-    free(candidates.items);
-  }
-  if (failed) return -1;
-  s->found.count = 0;
-  for (int32_t b = 0; b < blocks; ++b) {
-    /* Candidates of a query come out in tree order; that order is fixed by the build, which
-     * is itself deterministic, so no sort is needed. */
-    for (int64_t i = 0; i < s->blocks[b].count; ++i)
-      if (piola__contact_list_push(&s->found, &s->blocks[b].items[i])) return -1;
-  }
-  return 0;
 }
 
 /* ------------------------------------------------------------------ impulses */
@@ -710,6 +274,19 @@ static int apply_impact(piola_collision_surface *s, const piola__contact *c, dou
 
 /* ------------------------------------------------------------------ processing */
 
+static double thread_seconds(void) {
+  struct timespec ts;
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+  return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+/* Seconds since *clock, which moves on to now. */
+static double lap(double *clock) {
+  double now = thread_seconds(), elapsed = now - *clock;
+  *clock = now;
+  return elapsed;
+}
+
 static int same_zone(piola_collision_surface *s, const piola__contact *c) {
   if (!s->in_zone[c->v[0]]) return 0;
   int32_t root = piola__zone_root(s->zone_parent, c->v[0]);
@@ -749,12 +326,18 @@ piola_status piola_collision_surface_process(piola_collision_surface *s, const d
   }
   piola_collision_stats st = {0};
   int tree_built = 0;
+  s->profile = (piola__contact_profile){0};
+  double clock = thread_seconds();
+  if (piola__collect_candidates(s, x0, v, dt, &tree_built)) goto out_of_memory;
+  s->profile.candidates = s->candidate_count;
+  s->profile.collect = lap(&clock);
 
   /* Stage 1: repulsion of pairs closer than their thickness at x0. */
   if (set.repulsion) {
-    if (detect(s, x0, v, dt, DETECT_PROXIMITY, &tree_built, NULL)) goto out_of_memory;
+    if (piola__detect(s, x0, v, dt, PIOLA__DETECT_PROXIMITY, NULL, &tree_built)) goto out_of_memory;
     for (int64_t i = 0; i < s->found.count; ++i)
       st.contacts += apply_repulsion(s, &s->found.items[i], v, dt, set.repulsion_stiffness);
+    s->profile.repulsion = lap(&clock);
   }
 
   /* Stage 2: continuous detection and impacts, a few passes. After the first pass only pairs
@@ -762,8 +345,9 @@ piola_status piola_collision_surface_process(piola_collision_surface *s, const d
    * changed their answer, so only those are tested again. */
   int clean = 0, first_pass = 1;
   for (int pass = 0; pass < set.collision_iterations; ++pass) {
-    if (detect(s, x0, v, dt, DETECT_CCD, &tree_built, first_pass ? NULL : s->dirty))
+    if (piola__detect(s, x0, v, dt, PIOLA__DETECT_CCD, first_pass ? NULL : s->dirty, &tree_built))
       goto out_of_memory;
+    s->profile.detection += lap(&clock);
     first_pass = 0;
     ++st.collision_passes;
     if (s->found.count == 0) {
@@ -778,6 +362,7 @@ piola_status piola_collision_surface_process(piola_collision_surface *s, const d
       else
         for (int k = 0; k < 4; ++k) s->dirty[c->v[k]] = 1;
     }
+    s->profile.impulses += lap(&clock);
   }
 
   /* Stage 3: rigid impact zones until no collision is left. */
@@ -785,8 +370,9 @@ piola_status piola_collision_surface_process(piola_collision_surface *s, const d
   if (!clean) {
     for (int32_t i = 0; i < s->vertex_count; ++i) s->zone_parent[i] = i, s->in_zone[i] = 0;
     for (int pass = 0; pass < set.max_zone_iterations; ++pass) {
-      if (detect(s, x0, v, dt, DETECT_CCD, &tree_built, first_pass ? NULL : s->dirty))
+      if (piola__detect(s, x0, v, dt, PIOLA__DETECT_CCD, first_pass ? NULL : s->dirty, &tree_built))
         goto out_of_memory;
+      s->profile.detection += lap(&clock);
       first_pass = 0;
       ++st.zone_passes;
       /* Collisions inside one zone cannot be fixed by making it rigid again (and the rigid
@@ -803,6 +389,7 @@ piola_status piola_collision_surface_process(piola_collision_surface *s, const d
       int32_t zones = piola__impact_zones_apply(s, &s->found, x0, v, &st.zone_vertices);
       if (zones < 0) goto out_of_memory;
       st.impact_zones = zones;
+      s->profile.zones += lap(&clock);
     }
   }
   st.resolved = clean && !s->zone_misfit;

@@ -8,11 +8,22 @@
  *   formula covers point-triangle and edge-edge pairs, unequal masses and pinned vertices
  *   (1 / m = 0). The change of relative velocity is J sum_k w_k^2 / m_k, so the impulse that
  *   produces a wanted change is a division by that sum.
- * - Detection (broad phase in a BVH, then the exact narrow test of each candidate pair) is
- *   the expensive part and runs in parallel over fixed blocks of query primitives; each block
- *   keeps its own list, and the lists are joined in block order, so the result does not
- *   depend on the thread count. Impulses are then applied one pair after the other
- *   (Gauss-Seidel), in that order, so later pairs see the velocities earlier pairs left.
+ * - Detection (broad phase in a BVH, then the exact narrow test of each pair) is the
+ *   expensive part, and the tree descent is the expensive part of that. So a call descends
+ *   the trees once, at its start, with "reach" boxes per vertex: swept from x0 to the
+ *   proposed x1 and padded by half the thickness. They hold the proximity boxes (x0 padded by
+ *   half the thickness) and the swept boxes of the first detection pass as long as repulsion
+ *   changes the velocities little against the thickness. The descent measures the distance
+ *   of each pair it yields once: the contacts of the repulsion stage, and the candidates of
+ *   the first detection pass (pairs that can collide while their vertices stay in their reach
+ *   boxes), which that pass scans. A vertex whose swept box escapes its reach box makes its
+ *   pairs uncertain: they are found by tree queries from that vertex, or, when most vertices
+ *   escaped, the descent is redone with the swept boxes. Later passes test only pairs with a
+ *   vertex whose velocity changed, by tree queries from those. Parallel work runs over fixed
+ *   chunks (tree tasks or blocks of queries), each into its own list, joined in chunk order,
+ *   so the result does not depend on the thread count. Impulses are then applied one pair
+ *   after the other (Gauss-Seidel), in that order, so later pairs see the velocities earlier
+ *   pairs left.
  * - Rigid impact zones use the linearised rigid motion v = v_cm + w x (x0 - c). Over the step
  *   this moves the zone by the affine map x -> x + s dt (v_cm + w x (x - c)), whose matrix
  *   I + s dt [w]x has singular values 1 and sqrt(1 + (s dt |w|)^2): it never shrinks a
@@ -31,14 +42,18 @@
 #define PIOLA__CCD_TOLERANCE 1e-3
 #define PIOLA__CCD_TARGET_GAP 1e-2
 
+/* Tree queries per parallel block of a detection pass (the size of surface->blocks). */
+#define PIOLA__QUERY_BLOCK 256
+
 /* One pair and what is needed to push it apart. */
 typedef struct piola__contact {
-  int32_t v[4];     /* vertices: point then triangle, or edge then edge */
-  double w[4];      /* relative position r = sum w[k] x[k] */
-  vec3 normal;      /* unit; r has a non-negative component along it at the start */
-  double gap;       /* m: r . normal at the start of the step */
-  double thickness; /* m: of the pair */
-  double friction;  /* Coulomb coefficient of the pair */
+  int32_t v[4];      /* vertices: point then triangle, or edge then edge */
+  double w[4];       /* relative position r = sum w[k] x[k] */
+  vec3 normal;       /* unit; r has a non-negative component along it at the start */
+  double gap;        /* m: r . normal at the start of the step */
+  double thickness;  /* m: of the pair */
+  double friction;   /* Coulomb coefficient of the pair */
+  int32_t edge_edge; /* 1: edge (v[0], v[1]) against edge (v[2], v[3]); 0: point-triangle */
 } piola__contact;
 
 typedef struct piola__contact_list {
@@ -47,6 +62,34 @@ typedef struct piola__contact_list {
 } piola__contact_list;
 
 int piola__contact_list_push(piola__contact_list *list, const piola__contact *c);
+
+/* A candidate pair: vertex v[0] against triangle (v[1], v[2], v[3]), or edge (v[0], v[1])
+ * against edge (v[2], v[3]). */
+typedef struct piola__pair {
+  int32_t v[4];
+  int32_t edge_edge; /* 1 for an edge-edge pair */
+  double separation; /* m: distance at x0 less twice the detection tolerance */
+} piola__pair;
+
+typedef struct piola__pair_list {
+  piola__pair *items;
+  int64_t count, capacity;
+} piola__pair_list;
+
+typedef enum piola__detect_mode { PIOLA__DETECT_PROXIMITY, PIOLA__DETECT_CCD } piola__detect_mode;
+
+/* Where the last call's time went, in CPU seconds of the calling thread (with one thread,
+ * all of it), and how much detection work it did: read by bench/bench_contact.c. */
+typedef struct piola__contact_profile {
+  double collect;      /* boxes, trees and the tree descent at the start of the call */
+  double repulsion;    /* stage 1 */
+  double detection;    /* stage 2 and 3 detection passes (with any collection they redo) */
+  double impulses;     /* stage 2 impacts */
+  double zones;        /* stage 3 zone velocities */
+  int64_t candidates;  /* pairs collected at the start of the call */
+  int32_t collections; /* tree descents (1 + collections redone) */
+  int32_t escaped;     /* vertex escapes summed over detection passes */
+} piola__contact_profile;
 
 struct piola_collision_surface {
   int32_t vertex_count, triangle_count, edge_count, body_count;
@@ -65,12 +108,47 @@ struct piola_collision_surface {
   piola__contact_list found;
   int32_t *zone_parent;
   uint8_t *in_zone;
-  uint8_t *dirty;      /* velocity changed since the last detection pass */
-  uint8_t *on_surface; /* vertex of at least one triangle */
-  int32_t zone_misfit; /* a zone could not follow its pinned vertices (this call) */
-  int32_t tree_age;    /* calls since the trees were last built (0: never built) */
-  int32_t *zone_order; /* vertices grouped by zone */
+  uint8_t *dirty;          /* velocity changed since the last detection pass */
+  uint8_t *on_surface;     /* vertex of at least one triangle */
+  int32_t zone_misfit;     /* a zone could not follow its pinned vertices (this call) */
+  int32_t tree_age;        /* calls since the trees were last built (0: never built) */
+  int32_t *zone_order;     /* vertices grouped by zone */
+  piola__box *reach_boxes; /* per vertex: the boxes the candidates were collected with */
+  uint8_t *escaped;        /* swept box outside its reach box (this detection pass) */
+  double *reach_radius;    /* per vertex: farthest point of its reach box from x0 */
+  /* Per tree task of the last collection (task_count lists each, in task order, kept with
+   * their memory from call to call; task_capacity lists allocated): */
+  int32_t task_count, task_capacity;
+  piola__pair_list *candidates;    /* pairs that can collide while in their reach boxes */
+  piola__contact_list *near;       /* contacts at x0 */
+  piola__contact_list *task_found; /* what a detection pass found among the candidates */
+  int64_t candidate_count;         /* sum over the tasks */
+  int32_t near_valid;              /* near holds the contacts at x0 (reach boxes were used) */
+  piola__contact_profile profile;
+  double *vertex_slabs, *triangle_slabs, *edge_slabs; /* 12 per primitive (detection.c) */
 };
+
+/* Collects the candidate pairs of a call (into surface->candidates): reach boxes from x0 and
+ * the velocities v, the trees fit to them (built when *tree_built is 0 and the trees are old
+ * or new; see detection.c), one descent of tree against tree. Returns 0, or -1 out of memory. */
+int piola__collect_candidates(piola_collision_surface *surface, const double *x0, const double *v,
+                              double dt, int *tree_built);
+
+/* All contacts (proximity at x0) or collisions (continuous detection over the step with
+ * velocities v) into surface->found, in an order that does not depend on the thread count.
+ * With dirty given, only pairs with a vertex marked there are tested (continuous detection
+ * then queries the trees from those vertices; without, it scans the candidates). Needs the
+ * candidates of this call (piola__collect_candidates), which it collects again, for some
+ * vertices or all, when velocities left their reach boxes. Returns 0, or -1 out of memory. */
+int piola__detect(piola_collision_surface *surface, const double *x0, const double *v, double dt,
+                  piola__detect_mode mode, const uint8_t *dirty, int *tree_built);
+
+/* The same by testing every pair (O(n^2)): the reference that tests compare with. Pairs come
+ * vertex-triangle first (by vertex, then triangle), then edge-edge (lower edge index first).
+ * Returns 0, or -1 out of memory. */
+int piola__detect_all_pairs(const piola_collision_surface *surface, const double *x0,
+                            const double *v, double dt, piola__detect_mode mode,
+                            piola__contact_list *out);
 
 /* Velocity field of rigid impact zones: merges the vertices of every contact in `hits` into
  * zones (union-find in surface->zone_parent), then gives every vertex of every zone the rigid

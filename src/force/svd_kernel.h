@@ -150,7 +150,12 @@ PIOLA_KERNEL_INLINE piola_v8d piola__v8_rsqrt(piola_v8d x) {
  * from its series to third order (error 5 delta^4 / 128 < 1e-17), and the third axis is
  * scaled by the same m: S <- G^T S G = m^2 R^T S R keeps its eigenvectors, V <- V G stays
  * a scaled rotation and is normalized once at the end. No branch, no divide, no mask:
- * d = e = 0 (a diagonal or zero S) gives c = 1, s = 0 through the 1e-300 floor. */
+ * d = e = 0 (a diagonal or zero S) gives c = 1, s = 0 through the 1e-300 floor.
+ * Written for a short chain from one rotation's S to the next (the chain, not the
+ * instruction count, bounds the kernel): the new S entries are k^2 (m k for the k row)
+ * times what the unscaled (c0, s0) give, and those products are formed while the estimate
+ * k is computed; m comes from delta = k^2 rho0^2 - 1 (rho0^2 = c0^2 + s0^2) by an Estrin
+ * form of its series, and skk is scaled by m^2 = k^2 rho0^2 with no series at all. */
 #define PIOLA_V8_JACOBI(rsqrt_r, spp, sqq, skk, spq, spk, sqk, v0p, v0q, v0k, v1p, v1q, v1k,  \
                         v2p, v2q, v2k)                                                      \
   do {                                                                                      \

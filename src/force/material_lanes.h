@@ -29,13 +29,13 @@
   if (body->uniform_material >= 0) {                                                       \
     const piola_material *m = &body->materials[body->uniform_material];                    \
     switch (m->model) {                                                                    \
-      case PIOLA_MODEL_COROTATED: PIOLA_MATERIAL_LANE_LOOP(corotated_stress, lanes); return; \
-      case PIOLA_MODEL_STVK: PIOLA_MATERIAL_LANE_LOOP(stvk_stress, lanes); return;          \
+      case PIOLA_MODEL_COROTATED: PIOLA_MATERIAL_LANE_LOOP(corotated_stress_lanes, lanes); return; \
+      case PIOLA_MODEL_STVK: PIOLA_MATERIAL_LANE_LOOP(stvk_stress_lanes, lanes); return;          \
       case PIOLA_MODEL_NEOHOOKEAN:                                                         \
-      case PIOLA_MODEL_MUSCLE: PIOLA_MATERIAL_LANE_LOOP(neohookean_stress, lanes); return;  \
-      case PIOLA_MODEL_SPLINE: PIOLA_MATERIAL_LANE_LOOP(spline_stress, lanes); return;      \
+      case PIOLA_MODEL_MUSCLE: PIOLA_MATERIAL_LANE_LOOP(neohookean_stress_lanes, lanes); return;  \
+      case PIOLA_MODEL_SPLINE: PIOLA_MATERIAL_LANE_LOOP(spline_stress_lanes, lanes); return;      \
       case PIOLA_MODEL_ROTATED_LINEAR:                                                     \
-      default: PIOLA_MATERIAL_LANE_LOOP(rotated_linear_stress, lanes); return;             \
+      default: PIOLA_MATERIAL_LANE_LOOP(rotated_linear_stress_lanes, lanes); return;             \
     }                                                                                      \
   }                                                                                        \
   for (int l = 0; l < (lanes); ++l) {                                                      \

@@ -150,30 +150,43 @@ PIOLA_KERNEL_INLINE piola_v8d piola__v8_rsqrt(piola_v8d x) {
  * from its series to third order (error 5 delta^4 / 128 < 1e-17), and the third axis is
  * scaled by the same m: S <- G^T S G = m^2 R^T S R keeps its eigenvectors, V <- V G stays
  * a scaled rotation and is normalized once at the end. No branch, no divide, no mask:
- * d = e = 0 (a diagonal or zero S) gives c = 1, s = 0 through the 1e-300 floor. */
+ * d = e = 0 (a diagonal or zero S) gives c = 1, s = 0 through the 1e-300 floor.
+ * Written for a short chain from one rotation's S to the next (the chain, not the
+ * instruction count, bounds the kernel): the new S entries are k^2 (m k for the k row)
+ * times what the unscaled (c0, s0) give, and those products are formed while the estimate
+ * k is computed; m comes from delta = k^2 rho0^2 - 1 (rho0^2 = c0^2 + s0^2) by an Estrin
+ * form of its series, and skk is scaled by m^2 = k^2 rho0^2 with no series at all. */
 #define PIOLA_V8_JACOBI(rsqrt_r, spp, sqq, skk, spq, spk, sqk, v0p, v0q, v0k, v1p, v1q, v1k,  \
                         v2p, v2q, v2k)                                                      \
   do {                                                                                      \
     piola_v8d d_ = spp - sqq, e_ = 2.0 * spq;                                               \
     /* + 1e-300: d = e = 0 gives r, c ~ 1e-150 and so c = 1, s = 0 after normalization */   \
-    piola_v8d r2_ = d_ * d_ + e_ * e_ + 1e-300;                                             \
-    piola_v8d r_ = r2_ * rsqrt_r(r2_);                                                      \
-    piola_v8d c_ = piola__v8_abs(d_) + r_;                                                  \
+    piola_v8d r2_ = d_ * d_ + (e_ * e_ + 1e-300);                                           \
+    piola_v8d c0_ = piola__v8_abs(d_) + r2_ * rsqrt_r(r2_);                                 \
     piola_v8l dsign_ = (piola_v8l)d_ & INT64_MIN; /* s = d >= 0 ? e : -e */                 \
-    piola_v8d s_ = (piola_v8d)((piola_v8l)e_ ^ dsign_);                                     \
-    piola_v8d k_ = piola__v8_rsqrt_estimate(c_ * c_ + s_ * s_);                             \
-    c_ *= k_;                                                                               \
-    s_ *= k_;                                                                               \
-    piola_v8d delta_ = c_ * c_ + s_ * s_ - 1.0;                                             \
-    piola_v8d m_ = 1.0 + delta_ * (0.5 + delta_ * (-0.125 + delta_ * 0.0625));              \
-    piola_v8d cc_ = c_ * c_, ss_ = s_ * s_, cs_ = c_ * s_;                                  \
-    piola_v8d spp_ = spp, sqq_ = sqq, spq_ = spq, spk_ = spk, sqk_ = sqk;                  \
-    spp = cc_ * spp_ + 2.0 * cs_ * spq_ + ss_ * sqq_;                                       \
-    sqq = ss_ * spp_ - 2.0 * cs_ * spq_ + cc_ * sqq_;                                       \
-    spq = (cc_ - ss_) * spq_ - cs_ * (spp_ - sqq_);                                         \
-    spk = m_ * (c_ * spk_ + s_ * sqk_);                                                     \
-    sqk = m_ * (c_ * sqk_ - s_ * spk_);                                                     \
-    skk = m_ * m_ * skk;                                                                    \
+    piola_v8d s0_ = (piola_v8d)((piola_v8l)e_ ^ dsign_);                                    \
+    piola_v8d rho2_ = c0_ * c0_ + s0_ * s0_;                                                \
+    /* the new S entries as k^2 (or m k) times what c0, s0 give, formed while the estimate \
+     * k is computed: the chain from one rotation's S to the next is shorter */            \
+    piola_v8d cc0_ = c0_ * c0_, ss0_ = s0_ * s0_, cs0_ = c0_ * s0_;                         \
+    piola_v8d spp0_ = cc0_ * spp + cs0_ * e_ + ss0_ * sqq;                                  \
+    piola_v8d sqq0_ = ss0_ * spp - cs0_ * e_ + cc0_ * sqq;                                  \
+    piola_v8d spq0_ = (cc0_ - ss0_) * spq - cs0_ * d_;                                      \
+    piola_v8d spk0_ = c0_ * spk + s0_ * sqk, sqk0_ = c0_ * sqk - s0_ * spk;                 \
+    piola_v8d k_ = piola__v8_rsqrt_estimate(rho2_);                                         \
+    piola_v8d k2_ = k_ * k_;                                                                \
+    piola_v8d m2_ = k2_ * rho2_; /* c^2 + s^2 of the scaled (c, s) = 1 + delta */           \
+    piola_v8d delta_ = k2_ * rho2_ - 1.0;                                                   \
+    piola_v8d delta2_ = delta_ * delta_;                                                    \
+    piola_v8d mser_ = 0.5 * delta_ + delta2_ * (-0.125 + delta_ * 0.0625); /* m - 1 */     \
+    piola_v8d m_ = 1.0 + mser_, mk_ = k_ + k_ * mser_;                                      \
+    piola_v8d c_ = c0_ * k_, s_ = s0_ * k_;                                                 \
+    spp = k2_ * spp0_;                                                                      \
+    sqq = k2_ * sqq0_;                                                                      \
+    spq = k2_ * spq0_;                                                                      \
+    spk = mk_ * spk0_;                                                                      \
+    sqk = mk_ * sqk0_;                                                                      \
+    skk = m2_ * skk;                                                                        \
     piola_v8d t_;                                                                           \
     t_ = v0p; v0p = c_ * t_ + s_ * v0q; v0q = c_ * v0q - s_ * t_; v0k *= m_;                \
     t_ = v1p; v1p = c_ * t_ + s_ * v1q; v1q = c_ * v1q - s_ * t_; v1k *= m_;                \

@@ -169,7 +169,7 @@ static extension_point extension_point_at(const piola_material *m, const double 
     e.d[i] = f[i] - e.fc[i];
     e.clamped[i] = e.d[i] < 0.0;
   }
-  material_model_parts(m->model, m, e.fc[0], e.fc[1], e.fc[2], &e.parts);
+  material_model_parts(m->model, m, KERNEL_EXACT_DIVIDE, e.fc[0], e.fc[1], e.fc[2], &e.parts);
   return e;
 }
 
@@ -196,7 +196,7 @@ static double entry_third(const piola_material *m, double f) {
 /* T_ijk = d3 psi / df_i df_j df_k of the unextended model at f (all entries > 0). */
 static void model_third_derivative(const piola_material *m, const double f[3], double t[3][3][3]) {
   double g[3], h[3][3], kappa;
-  const double qm = invariant_terms(m->model, m, f[0], f[1], f[2], g, h, &kappa);
+  const double qm = invariant_terms(m->model, m, KERNEL_EXACT_DIVIDE, f[0], f[1], f[2], g, h, &kappa);
   for (int i = 0; i < 3; ++i)
     for (int j = 0; j < 3; ++j)
       for (int k = 0; k < 3; ++k) {
@@ -231,15 +231,15 @@ void piola_material_stress_derivative(const piola_material *material, const doub
   const double w = 0.25 * c, cap = fmax(2.0 * m->mu + m->lambda, floor_slope);
   double q[3], dq[3]; /* saturated offsets and their derivatives, 1 / (1 - d / w)^2 */
   for (int k = 0; k < 3; ++k) {
-    q[k] = extension_saturation(m, e.d[k]);
+    q[k] = extension_saturation(m, KERNEL_EXACT_DIVIDE, e.d[k]);
     const double r = w / (w - e.d[k]);
     dq[k] = r * r;
   }
 
   for (int i = 0; i < 3; ++i) {
     const double kii = pa->k[i][i], p = pa->p[i];
-    const double s = extension_diagonal_slope(m, p, kii);
-    const double s_far = extension_far_slope(m, p, kii);
+    const double s = extension_diagonal_slope(m, KERNEL_EXACT_DIVIDE, p, kii);
+    const double s_far = extension_far_slope(m, KERNEL_EXACT_DIVIDE, p, kii);
     const double raised = floor_slope + fmax(p, 0.0) / c;
     for (int j = 0; j < 3; ++j) {
       double v;

@@ -77,6 +77,45 @@ enum {
 MATERIAL_KERNEL double kernel_max(double a, double b) { return a > b ? a : b; }
 MATERIAL_KERNEL double kernel_min(double a, double b) { return a < b ? a : b; }
 
+/* How a kernel divides. The public functions (material.c) divide exactly (correctly rounded
+ * IEEE division). The force loop's lane kernels take KERNEL_FAST_RECIPROCAL: a divide is a
+ * long-latency, low-throughput instruction on 512-bit vectors (~16 cycles per vdivpd, one
+ * unit), and neo-Hookean with the inversion extension has 15 of them per lane (1/f_i, one in
+ * each logarithm, p/c twice per entry, the saturation), which bound the stress loop.
+ * kernel_recip_fast is multiplies and adds only (they pipeline, two units), within ~2 ulp of
+ * 1/x. The argument is a compile-time constant in every caller, so the choice folds away. */
+typedef enum kernel_division { KERNEL_EXACT_DIVIDE = 0, KERNEL_FAST_RECIPROCAL = 1 } kernel_division;
+
+/* 1/x for a positive normal x whose reciprocal is normal (piola calls it on clamped entries
+ * >= threshold, on 1 + m in [1.7, 2.5] in the logarithm and on the saturation's w - d >= w),
+ * within ~2 ulp. First guess from the bits: subtracting x's bit pattern from a constant
+ * negates the exponent and mirrors the mantissa, a piecewise-linear fit of 1/x whose
+ * relative error e = 1 - x y is at most 0.0505 with this constant. Then two steps
+ * y <- y (1 + e)(1 + e^2), each taking e to e^4: 0.0505 -> 6.5e-6 -> 1.8e-21, below the
+ * rounding of the last operations. No fused multiply-add is assumed (C17 without
+ * contraction); the rounding of x y in the last e costs at most ~1 ulp. */
+MATERIAL_KERNEL double kernel_recip_fast(double x) {
+  uint64_t bits;
+  memcpy(&bits, &x, sizeof bits);
+  bits = 0x7fde623822fc16e6ull - bits;
+  double y;
+  memcpy(&y, &bits, sizeof y);
+  double e = 1.0 - x * y;
+  y = y + y * e;
+  y = y + y * (e * e);
+  e = 1.0 - x * y;
+  y = y + y * e;
+  return y + y * (e * e);
+}
+
+MATERIAL_KERNEL double kernel_recip(double x, kernel_division dv) {
+  return dv == KERNEL_FAST_RECIPROCAL ? kernel_recip_fast(x) : 1.0 / x;
+}
+
+MATERIAL_KERNEL double kernel_div(double a, double b, kernel_division dv) {
+  return dv == KERNEL_FAST_RECIPROCAL ? a * kernel_recip_fast(b) : a / b;
+}
+
 /* Natural logarithm of x > 0 (normal or subnormal; piola calls it on clamped entries only,
  * which are >= threshold > 0), accurate to a few ulp, written so that GCC can vectorize it:
  * libm's log is a call the vectorizer cannot widen (glibc declares its vector variants only
@@ -84,7 +123,7 @@ MATERIAL_KERNEL double kernel_min(double a, double b) { return a < b ? a : b; }
  * ln m = 2 atanh(s) with s = (m - 1)/(m + 1), |s| < 0.172, from its odd series to s^23.
  * The exponent is turned into a double with the 2^52 trick (integer shifts and ors only,
  * no 64-bit integer-to-double conversion, which AVX2 lacks). */
-MATERIAL_KERNEL double kernel_log(double x) {
+MATERIAL_KERNEL double kernel_log_div(double x, kernel_division dv) {
   const int tiny = x < 2.2250738585072014e-308;         /* subnormal: scale into the normal range */
   const double xs = tiny ? x * 18014398509481984.0 : x; /* 2^54 */
   uint64_t bits;
@@ -98,7 +137,7 @@ MATERIAL_KERNEL double kernel_log(double x) {
   const int big = m > 1.4142135623730951;
   m = big ? 0.5 * m : m;
   e = big ? e + 1.0 : e;
-  const double s = (m - 1.0) / (m + 1.0), s2 = s * s;
+  const double s = kernel_div(m - 1.0, m + 1.0, dv), s2 = s * s;
   double poly = 1.0 / 23.0;
   poly = poly * s2 + 1.0 / 21.0;
   poly = poly * s2 + 1.0 / 19.0;
@@ -115,6 +154,8 @@ MATERIAL_KERNEL double kernel_log(double x) {
   return e * ln2_hi + (2.0 * s + (2.0 * s * s2 * poly + e * ln2_lo));
 }
 
+MATERIAL_KERNEL double kernel_log(double x) { return kernel_log_div(x, KERNEL_EXACT_DIVIDE); }
+
 /* Value and derivative of the model at a point with all entries >= threshold > 0. */
 typedef struct material_parts {
   double p[3];    /* Pa: Phat */
@@ -125,7 +166,8 @@ typedef struct material_parts {
 
 /* A'(f) and A''(f) of the separable energy of each model. */
 MATERIAL_KERNEL void entry_slope_curvature(piola_material_model model, const piola_material *m,
-                                           double f, double *a1, double *a2) {
+                                           kernel_division dv, double f, double *a1,
+                                           double *a2) {
   const double mu = m->mu;
   switch (model) {
     case PIOLA_MODEL_STVK: /* A = mu/4 (f^2 - 1)^2 */
@@ -134,7 +176,7 @@ MATERIAL_KERNEL void entry_slope_curvature(piola_material_model model, const pio
       return;
     case PIOLA_MODEL_NEOHOOKEAN: /* muscle: its matrix and volume part is neo-Hookean */
     case PIOLA_MODEL_MUSCLE: { /* A = mu (f^2 - 1)/2 - mu ln f */
-      const double inv = 1.0 / f;
+      const double inv = kernel_recip(f, dv);
       *a1 = mu * (f - inv);
       *a2 = mu * (1.0 + inv * inv);
       return;
@@ -162,7 +204,7 @@ MATERIAL_KERNEL void entry_slope_curvature(piola_material_model model, const pio
 
 /* kappa, q - q0, g = dq/df and H = d2q/df2 at f (all entries > 0). */
 MATERIAL_KERNEL double invariant_terms(piola_material_model model, const piola_material *m,
-                                       double f0, double f1, double f2, double g[3], double h[3][3],
+                                       kernel_division dv, double f0, double f1, double f2, double g[3], double h[3][3],
                                        double *kappa) {
   h[0][0] = h[0][1] = h[0][2] = h[1][0] = h[1][1] = h[1][2] = h[2][0] = h[2][1] = h[2][2] = 0.0;
   switch (model) {
@@ -178,11 +220,11 @@ MATERIAL_KERNEL double invariant_terms(piola_material_model model, const piola_m
     case PIOLA_MODEL_NEOHOOKEAN:
     case PIOLA_MODEL_MUSCLE: { /* q = ln J, kappa = lambda */
       *kappa = m->lambda;
-      const double i0 = 1.0 / f0, i1 = 1.0 / f1, i2 = 1.0 / f2;
+      const double i0 = kernel_recip(f0, dv), i1 = kernel_recip(f1, dv), i2 = kernel_recip(f2, dv);
       g[0] = i0, g[1] = i1, g[2] = i2;
       h[0][0] = -i0 * i0, h[1][1] = -i1 * i1, h[2][2] = -i2 * i2;
       /* Three logs, not log(J): J can underflow or overflow where each entry does not. */
-      return kernel_log(f0) + kernel_log(f1) + kernel_log(f2);
+      return kernel_log_div(f0, dv) + kernel_log_div(f1, dv) + kernel_log_div(f2, dv);
     }
     case PIOLA_MODEL_COROTATED:
     case PIOLA_MODEL_SPLINE:
@@ -198,15 +240,15 @@ MATERIAL_KERNEL double invariant_terms(piola_material_model model, const piola_m
 
 /* Phat and dPhat/dFhat of the unextended model at f (all entries > 0). */
 MATERIAL_KERNEL void material_model_parts(piola_material_model model, const piola_material *m,
-                                          double f0, double f1, double f2, material_parts *out) {
+                                          kernel_division dv, double f0, double f1, double f2, material_parts *out) {
   double g[3], h[3][3], kappa;
-  const double qm = invariant_terms(model, m, f0, f1, f2, g, h, &kappa);
+  const double qm = invariant_terms(model, m, dv, f0, f1, f2, g, h, &kappa);
   /* Written out, not looped: clang does not always unroll a loop around the spline's entry
    * function, and a loop over small local arrays left in a simd loop blocks vectorization. */
   double a1[3], a2[3];
-  entry_slope_curvature(model, m, f0, &a1[0], &a2[0]);
-  entry_slope_curvature(model, m, f1, &a1[1], &a2[1]);
-  entry_slope_curvature(model, m, f2, &a1[2], &a2[2]);
+  entry_slope_curvature(model, m, dv, f0, &a1[0], &a2[0]);
+  entry_slope_curvature(model, m, dv, f1, &a1[1], &a2[1]);
+  entry_slope_curvature(model, m, dv, f2, &a1[2], &a2[2]);
   const double kq = kappa * qm;
   out->p[0] = a1[0] + kq * g[0];
   out->p[1] = a1[1] + kq * g[1];
@@ -226,13 +268,14 @@ MATERIAL_KERNEL void material_model_parts(piola_material_model model, const piol
  * stress is at most -mu c at f_i = 0 (restoring) and at least mu (never softening past the
  * threshold). CLAMP: zero (constant stress), unless the clamped stress is not already
  * compressive enough, in which case the ramp that reaches -mu c at zero. */
-MATERIAL_KERNEL double extension_diagonal_slope(const piola_material *m, double p, double kii) {
+MATERIAL_KERNEL double extension_diagonal_slope(const piola_material *m, kernel_division dv,
+                                                double p, double kii) {
   const double c = m->threshold, floor_slope = m->mu;
   /* Both variants are computed and blended by a 0/1 factor: a select on a loop-invariant
    * integer between doubles is one of the statements GCC's vectorizer rejects. */
   const double linear = (double)(m->inversion_mode != PIOLA_INVERSION_CLAMP);
-  const double taylor = kernel_max(kii, floor_slope + kernel_max(p, 0.0) / c);
-  const double ramp = kernel_max(0.0, p / c + floor_slope);
+  const double taylor = kernel_max(kii, floor_slope + kernel_div(kernel_max(p, 0.0), c, dv));
+  const double ramp = kernel_max(0.0, kernel_div(p, c, dv) + floor_slope);
   return linear * taylor + (1.0 - linear) * ramp;
 }
 
@@ -242,21 +285,22 @@ MATERIAL_KERNEL double extension_diagonal_slope(const piola_material *m, double 
  * models whose slope there is already moderate; neo-Hookean's is ~14x its rest stiffness, and
  * continued linearly that steep slope makes tangled meshes stable (docs/materials.md). CLAMP:
  * the ramp itself. */
-MATERIAL_KERNEL double extension_far_slope(const piola_material *m, double p, double kii) {
+MATERIAL_KERNEL double extension_far_slope(const piola_material *m, kernel_division dv, double p,
+                                           double kii) {
   const double c = m->threshold, floor_slope = m->mu;
   const double linear = (double)(m->inversion_mode != PIOLA_INVERSION_CLAMP);
   const double cap = kernel_max(2.0 * m->mu + m->lambda, floor_slope);
-  const double far = kernel_max(kernel_min(kii, cap), floor_slope + kernel_max(p, 0.0) / c);
-  const double ramp = kernel_max(0.0, p / c + floor_slope);
+  const double far = kernel_max(kernel_min(kii, cap), floor_slope + kernel_div(kernel_max(p, 0.0), c, dv));
+  const double ramp = kernel_max(0.0, kernel_div(p, c, dv) + floor_slope);
   return linear * far + (1.0 - linear) * ramp;
 }
 
 /* The saturating offset q(d) = d / (1 - d / w), w = c / 4, for d = f - fc <= 0: q(0) = 0,
  * q'(0) = 1 (so the extension keeps the Taylor value and slope at the threshold: C1), and
  * -w < q <= 0 (so what is multiplied by q stays bounded however deep the inversion). */
-MATERIAL_KERNEL double extension_saturation(const piola_material *m, double d) {
+MATERIAL_KERNEL double extension_saturation(const piola_material *m, kernel_division dv, double d) {
   const double w = 0.25 * m->threshold;
-  return d * w / (w - d);
+  return kernel_div(d * w, w - d, dv);
 }
 
 /* One entry of the extended stress: entry i with value p and slopes kii, kij, kik at the
@@ -270,11 +314,11 @@ MATERIAL_KERNEL double extension_saturation(const piola_material *m, double d) {
  * stress turns compressive past f_k < c/2 and grows with the lateral stretch, a feedback
  * that expands a body without bound). Clamped rows never take a negative coupling to other
  * clamped entries (it could pull an inverted entry further). CLAMP: p + ramp di. */
-MATERIAL_KERNEL double extended_entry(const piola_material *m, double p, double kii, double kij,
+MATERIAL_KERNEL double extended_entry(const piola_material *m, kernel_division dv, double p, double kii, double kij,
                                       double kik, double di, double dj, double dk, double qi,
                                       double qj, double qk) {
-  const double s = extension_diagonal_slope(m, p, kii);
-  const double s_far = extension_far_slope(m, p, kii);
+  const double s = extension_diagonal_slope(m, dv, p, kii);
+  const double s_far = extension_far_slope(m, dv, p, kii);
   const double clamped_row = kernel_max(kij, 0.0) * dj + kernel_max(kik, 0.0) * dk;
   const double free_row = kij * qj + kik * qk;
   const double coupling = di < 0.0 ? clamped_row : free_row;
@@ -283,13 +327,14 @@ MATERIAL_KERNEL double extended_entry(const piola_material *m, double p, double 
 }
 
 /* Extended stress from the parts at the clamped point and the offsets d = f - fc. */
-MATERIAL_KERNEL void material_extend(const piola_material *m, const material_parts *pa, double d0,
+MATERIAL_KERNEL void material_extend(const piola_material *m, kernel_division dv,
+                                     const material_parts *pa, double d0,
                                      double d1, double d2, double *p0, double *p1, double *p2) {
-  const double q0 = extension_saturation(m, d0), q1 = extension_saturation(m, d1),
-               q2 = extension_saturation(m, d2);
-  *p0 = extended_entry(m, pa->p[0], pa->k[0][0], pa->k[0][1], pa->k[0][2], d0, d1, d2, q0, q1, q2);
-  *p1 = extended_entry(m, pa->p[1], pa->k[1][1], pa->k[1][0], pa->k[1][2], d1, d0, d2, q1, q0, q2);
-  *p2 = extended_entry(m, pa->p[2], pa->k[2][2], pa->k[2][0], pa->k[2][1], d2, d0, d1, q2, q0, q1);
+  const double q0 = extension_saturation(m, dv, d0), q1 = extension_saturation(m, dv, d1),
+               q2 = extension_saturation(m, dv, d2);
+  *p0 = extended_entry(m, dv, pa->p[0], pa->k[0][0], pa->k[0][1], pa->k[0][2], d0, d1, d2, q0, q1, q2);
+  *p1 = extended_entry(m, dv, pa->p[1], pa->k[1][1], pa->k[1][0], pa->k[1][2], d1, d0, d2, q1, q0, q2);
+  *p2 = extended_entry(m, dv, pa->p[2], pa->k[2][2], pa->k[2][0], pa->k[2][1], d2, d0, d1, q2, q0, q1);
 }
 
 /* Integral from 0 to d of the saturating offset: -w d - w^2 ln(1 - d / w) (d <= 0, so the
@@ -301,13 +346,13 @@ MATERIAL_KERNEL double extension_saturation_integral(const piola_material *m, do
 
 /* The hot entry point for one model known at compile time. */
 MATERIAL_KERNEL void material_extended_stress(piola_material_model model, const piola_material *m,
-                                              double f0, double f1, double f2, double *p0,
+                                              kernel_division dv, double f0, double f1, double f2, double *p0,
                                               double *p1, double *p2) {
   const double c = m->threshold;
   const double fc0 = kernel_max(f0, c), fc1 = kernel_max(f1, c), fc2 = kernel_max(f2, c);
   material_parts parts;
-  material_model_parts(model, m, fc0, fc1, fc2, &parts);
-  material_extend(m, &parts, f0 - fc0, f1 - fc1, f2 - fc2, p0, p1, p2);
+  material_model_parts(model, m, dv, fc0, fc1, fc2, &parts);
+  material_extend(m, dv, &parts, f0 - fc0, f1 - fc1, f2 - fc2, p0, p1, p2);
 }
 
 /* A(f): the separable energy of each model (see entry_slope_curvature). */
@@ -345,7 +390,7 @@ MATERIAL_KERNEL double entry_energy(piola_material_model model, const piola_mate
 MATERIAL_KERNEL double material_model_energy(piola_material_model model, const piola_material *m,
                                              double f0, double f1, double f2) {
   double g[3], h[3][3], kappa;
-  const double qm = invariant_terms(model, m, f0, f1, f2, g, h, &kappa);
+  const double qm = invariant_terms(model, m, KERNEL_EXACT_DIVIDE, f0, f1, f2, g, h, &kappa);
   return entry_energy(model, m, f0) + entry_energy(model, m, f1) + entry_energy(model, m, f2) +
          0.5 * kappa * qm * qm;
 }
@@ -364,15 +409,15 @@ MATERIAL_KERNEL void material_extended_stress_energy(piola_material_model model,
   const double fc0 = kernel_max(f0, c), fc1 = kernel_max(f1, c), fc2 = kernel_max(f2, c);
   const double d0 = f0 - fc0, d1 = f1 - fc1, d2 = f2 - fc2;
   material_parts pa;
-  material_model_parts(model, m, fc0, fc1, fc2, &pa);
-  material_extend(m, &pa, d0, d1, d2, p0, p1, p2);
+  material_model_parts(model, m, KERNEL_EXACT_DIVIDE, fc0, fc1, fc2, &pa);
+  material_extend(m, KERNEL_EXACT_DIVIDE, &pa, d0, d1, d2, p0, p1, p2);
   const double linear = (double)(m->inversion_mode != PIOLA_INVERSION_CLAMP);
-  const double s0 = extension_diagonal_slope(m, pa.p[0], pa.k[0][0]);
-  const double s1 = extension_diagonal_slope(m, pa.p[1], pa.k[1][1]);
-  const double s2 = extension_diagonal_slope(m, pa.p[2], pa.k[2][2]);
-  const double r0 = extension_far_slope(m, pa.p[0], pa.k[0][0]);
-  const double r1 = extension_far_slope(m, pa.p[1], pa.k[1][1]);
-  const double r2 = extension_far_slope(m, pa.p[2], pa.k[2][2]);
+  const double s0 = extension_diagonal_slope(m, KERNEL_EXACT_DIVIDE, pa.p[0], pa.k[0][0]);
+  const double s1 = extension_diagonal_slope(m, KERNEL_EXACT_DIVIDE, pa.p[1], pa.k[1][1]);
+  const double s2 = extension_diagonal_slope(m, KERNEL_EXACT_DIVIDE, pa.p[2], pa.k[2][2]);
+  const double r0 = extension_far_slope(m, KERNEL_EXACT_DIVIDE, pa.p[0], pa.k[0][0]);
+  const double r1 = extension_far_slope(m, KERNEL_EXACT_DIVIDE, pa.p[1], pa.k[1][1]);
+  const double r2 = extension_far_slope(m, KERNEL_EXACT_DIVIDE, pa.p[2], pa.k[2][2]);
   const double first = pa.p[0] * d0 + pa.p[1] * d1 + pa.p[2] * d2;
   const double second =
       0.5 * (r0 * d0 * d0 + r1 * d1 * d1 + r2 * d2 * d2) +
@@ -387,23 +432,46 @@ MATERIAL_KERNEL void material_extended_stress_energy(piola_material_model model,
 /* Per-model kernels: the model is a constant, so each compiles to straight-line code. */
 MATERIAL_KERNEL void rotated_linear_stress(const piola_material *m, double f0, double f1, double f2,
                                            double *p0, double *p1, double *p2) {
-  material_extended_stress(PIOLA_MODEL_ROTATED_LINEAR, m, f0, f1, f2, p0, p1, p2);
+  material_extended_stress(PIOLA_MODEL_ROTATED_LINEAR, m, KERNEL_EXACT_DIVIDE, f0, f1, f2, p0, p1, p2);
 }
 MATERIAL_KERNEL void corotated_stress(const piola_material *m, double f0, double f1, double f2,
                                       double *p0, double *p1, double *p2) {
-  material_extended_stress(PIOLA_MODEL_COROTATED, m, f0, f1, f2, p0, p1, p2);
+  material_extended_stress(PIOLA_MODEL_COROTATED, m, KERNEL_EXACT_DIVIDE, f0, f1, f2, p0, p1, p2);
 }
 MATERIAL_KERNEL void stvk_stress(const piola_material *m, double f0, double f1, double f2,
                                  double *p0, double *p1, double *p2) {
-  material_extended_stress(PIOLA_MODEL_STVK, m, f0, f1, f2, p0, p1, p2);
+  material_extended_stress(PIOLA_MODEL_STVK, m, KERNEL_EXACT_DIVIDE, f0, f1, f2, p0, p1, p2);
 }
 MATERIAL_KERNEL void neohookean_stress(const piola_material *m, double f0, double f1, double f2,
                                        double *p0, double *p1, double *p2) {
-  material_extended_stress(PIOLA_MODEL_NEOHOOKEAN, m, f0, f1, f2, p0, p1, p2);
+  material_extended_stress(PIOLA_MODEL_NEOHOOKEAN, m, KERNEL_EXACT_DIVIDE, f0, f1, f2, p0, p1, p2);
 }
 MATERIAL_KERNEL void spline_stress(const piola_material *m, double f0, double f1, double f2,
                                    double *p0, double *p1, double *p2) {
-  material_extended_stress(PIOLA_MODEL_SPLINE, m, f0, f1, f2, p0, p1, p2);
+  material_extended_stress(PIOLA_MODEL_SPLINE, m, KERNEL_EXACT_DIVIDE, f0, f1, f2, p0, p1, p2);
+}
+
+/* The same kernels with the fast reciprocal, for the force loop's lanes (material_lanes.h):
+ * not bit-identical to the public piola_material_stress (within a few ulp). */
+MATERIAL_KERNEL void rotated_linear_stress_lanes(const piola_material *m, double f0, double f1, double f2,
+                                      double *p0, double *p1, double *p2) {
+  material_extended_stress(PIOLA_MODEL_ROTATED_LINEAR, m, KERNEL_FAST_RECIPROCAL, f0, f1, f2, p0, p1, p2);
+}
+MATERIAL_KERNEL void corotated_stress_lanes(const piola_material *m, double f0, double f1, double f2,
+                                      double *p0, double *p1, double *p2) {
+  material_extended_stress(PIOLA_MODEL_COROTATED, m, KERNEL_FAST_RECIPROCAL, f0, f1, f2, p0, p1, p2);
+}
+MATERIAL_KERNEL void stvk_stress_lanes(const piola_material *m, double f0, double f1, double f2,
+                                      double *p0, double *p1, double *p2) {
+  material_extended_stress(PIOLA_MODEL_STVK, m, KERNEL_FAST_RECIPROCAL, f0, f1, f2, p0, p1, p2);
+}
+MATERIAL_KERNEL void neohookean_stress_lanes(const piola_material *m, double f0, double f1, double f2,
+                                      double *p0, double *p1, double *p2) {
+  material_extended_stress(PIOLA_MODEL_NEOHOOKEAN, m, KERNEL_FAST_RECIPROCAL, f0, f1, f2, p0, p1, p2);
+}
+MATERIAL_KERNEL void spline_stress_lanes(const piola_material *m, double f0, double f1, double f2,
+                                      double *p0, double *p1, double *p2) {
+  material_extended_stress(PIOLA_MODEL_SPLINE, m, KERNEL_FAST_RECIPROCAL, f0, f1, f2, p0, p1, p2);
 }
 
 /* Run-time dispatch, for scalar callers. In a loop, switch on m->model outside the loop and

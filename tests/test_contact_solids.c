@@ -151,7 +151,7 @@ static void squeezed_solid_folds_onto_itself(void **state) {
   test_rng rng = test_rng_seeded(13);
   const double dt = 0.01;
   int64_t events = 0;
-  const int steps = (int)test_samples(20, 6);
+  const int steps = (int)test_samples(20, 9); /* the first impacts come in the 7th step */
   for (int step = 0; step < steps; ++step) {
     for (int32_t i = 0; i < s.nv; ++i) {
       const double *x = s.x + 3 * i;

@@ -352,6 +352,26 @@ void piola__elastic_body_damping_operator(const piola_elastic_body *body, const 
   damping_pass(body, v, shear_viscosity, bulk_viscosity, mass, h, out);
 }
 
+static int vertex_moves(const double *v, int32_t i) {
+  return v[3 * i] != 0 || v[3 * i + 1] != 0 || v[3 * i + 2] != 0;
+}
+
+void piola__elastic_body_damping_forces_add_sparse(const piola_elastic_body *body, const double *v,
+                                                   double shear_viscosity, double bulk_viscosity,
+                                                   double *forces) {
+  piola__elastic_body_damping_prepare((piola_elastic_body *)body);
+  const int32_t blocks = body->padded_tet_count / B;
+  for (int32_t b = 0; b < blocks; ++b) {
+    const int32_t base = b * B;
+    const int32_t lanes = body->tet_count - base < B ? body->tet_count - base : B;
+    int touched = 0;
+    for (int l = 0; l < lanes && !touched; ++l)
+      for (int c = 0; c < 4; ++c) touched |= vertex_moves(v, body->tet_vertices[c][base + l]);
+    /* a tet whose corners are all at rest gets exactly zero force: skipping it is exact */
+    if (touched) apply_block(body, v, shear_viscosity, bulk_viscosity, b, forces);
+  }
+}
+
 /* Removes from the 4 corner vectors y (12) their rigid-rotation part about the centroid
  * of positions p (12). */
 static void reference_remove_rotation(const double p[12], double y[12]) {

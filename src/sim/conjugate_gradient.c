@@ -60,6 +60,8 @@ int32_t piola__cg_solve(const cg_problem *pb, const double *b, double *x, double
   pb->apply(pb->ctx, x, q);
   if (ax)
     for (int64_t i = 0; i < m; ++i) ax[i] = q[i];
+  if (pb->initial_ax)
+    for (int64_t i = 0; i < m; ++i) pb->initial_ax[i] = q[i];
   for (int64_t i = 0; i < m; ++i) r[i] = b[i] - q[i];
   pb->filter(pb->ctx, r, 0, n);
   /* reference size: the residual of the guess, i.e. the correction still to be made (not

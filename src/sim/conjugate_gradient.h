@@ -39,6 +39,7 @@ typedef struct cg_problem {
   const double *inverse_mass;                 /* n, the preconditioner */
   double tolerance;                           /* residual / initial residual, M^-1 norm */
   int32_t max_iterations;
+  double *initial_ax; /* 3n or NULL: receives A x at the guess, unfiltered */
 } cg_problem;
 
 /* Solves A x = b starting from x (whose filtered components are kept). work holds 3 * 3n

@@ -150,7 +150,7 @@ static void solves_the_filtered_system_and_returns_its_product(void **state) {
     double b[DOF], x0[DOF], x[DOF], ref[DOF], ax[DOF], direct[DOF], work[3 * DOF];
     for (int i = 0; i < DOF; ++i) b[i] = test_rng_uniform(&rng, -1, 1), x0[i] = test_rng_uniform(&rng, -1, 1);
     memcpy(x, x0, sizeof x);
-    cg_problem pb = {NODES, dense_apply, dense_filter, &d, d.inverse_mass, 1e-12, 200};
+    cg_problem pb = {NODES, dense_apply, dense_filter, &d, d.inverse_mass, 1e-12, 200, NULL};
     int32_t it = piola__cg_solve(&pb, b, x, work, ax);
     assert_true(it > 0 && it < 200);
     reference_solution(&d, b, x0, ref);
@@ -179,16 +179,62 @@ static void a_converged_guess_costs_one_apply(void **state) {
   for (int i = 0; i < DOF; ++i) x[i] = test_rng_uniform(&rng, -1, 1);
   dense_apply(&d, x, b); /* x already solves it */
   d.applies = 0;
-  cg_problem pb = {NODES, dense_apply, dense_filter, &d, d.inverse_mass, 1e-8, 200};
+  cg_problem pb = {NODES, dense_apply, dense_filter, &d, d.inverse_mass, 1e-8, 200, NULL};
   assert_int_equal(piola__cg_solve(&pb, b, x, work, ax), 0);
   assert_int_equal(d.applies, 1);
   for (int i = 0; i < DOF; ++i) assert_close(ax[i], b[i], 0);
+}
+
+/* M^-1-norm of the filtered residual b - A x. */
+static double residual_norm(dense_system *d, const double *b, const double *x) {
+  double ax[DOF], r[DOF];
+  dense_apply(d, x, ax);
+  for (int i = 0; i < DOF; ++i) r[i] = b[i] - ax[i];
+  dense_filter(d, r, 0, NODES);
+  double s = 0;
+  for (int i = 0; i < DOF; ++i) s += r[i] * r[i] * d->inverse_mass[i / 3];
+  return sqrt(s);
+}
+
+/* The stopping test is relative to the residual of the guess, not to b: it stops once the
+ * residual is below tol times the initial one, and moving guess and right-hand side together
+ * by a large y (x0 + y, b + A y: the same correction to make, as for a fast body whose old
+ * velocity is the guess) leaves the iterations as they were. */
+static void stops_relative_to_the_initial_residual(void **state) {
+  (void)state;
+  test_rng rng = test_rng_seeded(9);
+  for (int trial = 0; trial < (int)test_samples(10, 2); ++trial) {
+    dense_system d;
+    random_system(&rng, &d, 30);
+    double b[DOF], x0[DOF], y[DOF], ay[DOF], b2[DOF], x2[DOF], x[DOF], work[3 * DOF];
+    for (int i = 0; i < DOF; ++i) {
+      b[i] = test_rng_uniform(&rng, -1, 1), x0[i] = test_rng_uniform(&rng, -1, 1);
+      y[i] = 1e4 * test_rng_uniform(&rng, -1, 1);
+    }
+    dense_apply(&d, y, ay);
+    for (int i = 0; i < DOF; ++i) b2[i] = b[i] + ay[i], x2[i] = x0[i] + y[i];
+    const double tol = 1e-3;
+    cg_problem pb = {NODES, dense_apply, dense_filter, &d, d.inverse_mass, tol, 200, NULL};
+    memcpy(x, x0, sizeof x);
+    int32_t it = piola__cg_solve(&pb, b, x, work, NULL);
+    int32_t it2 = piola__cg_solve(&pb, b2, x2, work, NULL);
+    assert_true(it > 0);
+    assert_int_equal(it, it2);
+    double r0 = residual_norm(&d, b, x0), r = residual_norm(&d, b, x);
+    assert_true(r <= tol * r0 * (1 + 1e-9));
+    /* and it stopped there, short of what a tight tolerance takes */
+    cg_problem tight = pb;
+    tight.tolerance = 1e-12;
+    memcpy(x, x0, sizeof x);
+    assert_true(piola__cg_solve(&tight, b, x, work, NULL) > it);
+  }
 }
 
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(solves_the_filtered_system_and_returns_its_product),
       cmocka_unit_test(a_converged_guess_costs_one_apply),
+      cmocka_unit_test(stops_relative_to_the_initial_residual),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -46,7 +46,7 @@ typedef struct piola_world_def {
   double max_dt;             /* s, > 0: the user's cap on the step size. Default 1e-3 */
   double cfl;                /* dimensionless, in (0, 2]: dt <= cfl * min altitude / wave
                                 speed. Default 0.5 */
-  double cg_tolerance;       /* relative residual of the damping solves, > 0. Default 1e-8 */
+  double cg_tolerance;       /* damping solves stop at this fraction of the initial residual (the step's velocity change), > 0. Default 1e-4 */
   int32_t cg_max_iterations; /* >= 1. Default 200 */
 } piola_world_def;
 

@@ -42,6 +42,7 @@
  * with g_0 = -sum g_j, R^T g = sum_j (r_j - r_0) x g_j. A scalar reference of the original
  * per-tet formulation (piola__elastic_body_damping_reference) is kept for the tests. */
 #include <math.h>
+#include <stdlib.h>
 
 #include "force/elastic_body_internal.h"
 #include "force/svd_kernel.h"
@@ -350,6 +351,34 @@ void piola__elastic_body_damping_operator(const piola_elastic_body *body, const 
                                           double shear_viscosity, double bulk_viscosity,
                                           const double *mass, double h, double *out) {
   damping_pass(body, v, shear_viscosity, bulk_viscosity, mass, h, out);
+}
+
+static int vertex_moves(const double *v, int32_t i) {
+  return v[3 * i] != 0 || v[3 * i + 1] != 0 || v[3 * i + 2] != 0;
+}
+
+void piola__elastic_body_damping_forces_add_sparse(const piola_elastic_body *body, const double *v,
+                                                   double shear_viscosity, double bulk_viscosity,
+                                                   double *forces) {
+  piola__elastic_body_damping_prepare((piola_elastic_body *)body);
+  const int32_t blocks = body->padded_tet_count / B;
+  /* a byte per vertex (in cache, unlike v) for the scan over the tets */
+  uint8_t *moves = malloc((size_t)body->vertex_count + 1);
+  if (moves)
+    for (int32_t i = 0; i < body->vertex_count; ++i) moves[i] = (uint8_t)vertex_moves(v, i);
+  for (int32_t b = 0; b < blocks; ++b) {
+    const int32_t base = b * B;
+    const int32_t lanes = body->tet_count - base < B ? body->tet_count - base : B;
+    int touched = 0;
+    for (int l = 0; l < lanes; ++l)
+      for (int c = 0; c < 4; ++c) {
+        int32_t i = body->tet_vertices[c][base + l];
+        touched |= moves ? moves[i] : vertex_moves(v, i);
+      }
+    /* a tet whose corners are all at rest gets exactly zero force: skipping it is exact */
+    if (touched) apply_block(body, v, shear_viscosity, bulk_viscosity, b, forces);
+  }
+  free(moves);
 }
 
 /* Removes from the 4 corner vectors y (12) their rigid-rotation part about the centroid

@@ -155,6 +155,13 @@ void piola__elastic_body_damping_operator(const piola_elastic_body *body, const 
                                           double shear_viscosity, double bulk_viscosity,
                                           const double *mass, double h, double *out);
 
+/* forces += D v for a v that is zero on all but a few vertices: only the blocks of tets
+ * touching a vertex with nonzero v are evaluated, serially, in tet order (damping.c). For
+ * correcting a product already taken at a nearby v (the step's second right-hand side). */
+void piola__elastic_body_damping_forces_add_sparse(const piola_elastic_body *body, const double *v,
+                                                   double shear_viscosity, double bulk_viscosity,
+                                                   double *forces);
+
 /* Sums the per-tet force buffer into per-vertex forces, in parallel, deterministically. */
 void piola__elastic_body_gather_forces(const piola_elastic_body *body, double *forces);
 

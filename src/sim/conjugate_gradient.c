@@ -57,18 +57,18 @@ int32_t piola__cg_solve(const cg_problem *pb, const double *b, double *x, double
   const int64_t m = 3 * (int64_t)n;
   const double *inverse_mass = pb->inverse_mass;
   double *r = work, *p = work + m, *q = work + 2 * m;
-  /* reference size: the filtered right-hand side */
-  for (int64_t i = 0; i < m; ++i) r[i] = b[i];
-  pb->filter(pb->ctx, r, 0, n);
-  double bnorm2 = dot_inverse_mass(pb, r, r);
   pb->apply(pb->ctx, x, q);
   if (ax)
     for (int64_t i = 0; i < m; ++i) ax[i] = q[i];
+  if (pb->initial_ax)
+    for (int64_t i = 0; i < m; ++i) pb->initial_ax[i] = q[i];
   for (int64_t i = 0; i < m; ++i) r[i] = b[i] - q[i];
   pb->filter(pb->ctx, r, 0, n);
+  /* reference size: the residual of the guess, i.e. the correction still to be made (not
+   * b, which a moving body's momentum dominates; see the header) */
   double rz = dot_inverse_mass(pb, r, r);
-  double tol2 = pb->tolerance * pb->tolerance * bnorm2;
-  if (!(bnorm2 > 0) || rz <= tol2) return 0;
+  double tol2 = pb->tolerance * pb->tolerance * rz;
+  if (!(rz > 0) || !isfinite(rz)) return 0;
   for (int32_t i = 0; i < n; ++i)
     for (int k = 0; k < 3; ++k) p[3 * i + k] = r[3 * i + k] * inverse_mass[i];
   int32_t it = 0;

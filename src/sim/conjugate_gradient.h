@@ -10,6 +10,16 @@
  * over fixed node ranges in index order and the ranges in order, so results do not depend on
  * the thread count.
  *
+ * The stopping test is relative to the residual of the initial guess, ||r|| <= tol ||b - A x0||
+ * (filtered, M^-1 norm), not to ||b||. The callers' b is M v plus a step's worth of forces, so
+ * ||b|| is a body's momentum, and a test relative to it lets a body moving at 3 m/s stop
+ * with an error in its velocity change far larger, relative to that change, than the same
+ * body at rest; at loose tolerances the guess (the old velocity) passed it before any
+ * iteration. The
+ * residual of a guess that carries the old velocity (A x0 = M x0 - h D x0, and D ignores
+ * rigid motion) measures only the step's velocity change still to be made, so tol is the
+ * fraction of that change left unresolved, whatever the body's speed.
+ *
  * The solver also returns A x (unfiltered) at the solution, kept up to date alongside x
  * (A x += alpha A p with the A p it has anyway), so a caller that needs it (the friction
  * pass after the final solve) does not pay one more operator apply: the operator is the
@@ -27,8 +37,9 @@ typedef struct cg_problem {
   void (*filter)(void *ctx, double *r, int32_t begin, int32_t end);
   void *ctx;
   const double *inverse_mass;                 /* n, the preconditioner */
-  double tolerance;                           /* relative, in the M^-1 norm */
+  double tolerance;                           /* residual / initial residual, M^-1 norm */
   int32_t max_iterations;
+  double *initial_ax; /* 3n or NULL: receives A x at the guess, unfiltered */
 } cg_problem;
 
 /* Solves A x = b starting from x (whose filtered components are kept). work holds 3 * 3n

@@ -23,6 +23,8 @@
 #include "sim/conjugate_gradient.h"
 #include "sim/world_internal.h"
 
+int piola__step_reuse_first_product = 1;
+
 typedef struct damping_system {
   const world_solid *s;
   double h;              /* dt / 2 */
@@ -74,7 +76,7 @@ static void damping_filter(void *ctx, double *r, int32_t begin, int32_t end) {
  * off by the net force left in the final residual. */
 static int32_t damping_solve(piola_world *w, world_solid *s, double h, double t,
                              int hold_normals, const double *rhs, double *v, const double uniform[3],
-                             double *av) {
+                             double *av, double *guess_copy, double *initial_av) {
   double beta = piola_track_eval(&s->shear_viscosity, t);
   double alpha = piola_track_eval(&s->bulk_viscosity, t);
   damping_system d = {s, h, beta, alpha, hold_normals, s->tmp, &w->profile};
@@ -106,6 +108,7 @@ static int32_t damping_solve(piola_world *w, world_solid *s, double h, double t,
     }
     for (int k = 0; k < 3; ++k) v[3 * i + k] += du[k];
   }
+  if (guess_copy) memcpy(guess_copy, v, 3 * (size_t)s->n * sizeof(double));
   cg_problem pb;
   pb.n = s->n;
   pb.apply = damping_apply;
@@ -114,6 +117,7 @@ static int32_t damping_solve(piola_world *w, world_solid *s, double h, double t,
   pb.inverse_mass = s->inverse_mass;
   pb.tolerance = w->def.cg_tolerance;
   pb.max_iterations = w->def.cg_max_iterations;
+  pb.initial_ax = initial_av;
   return piola__cg_solve(&pb, rhs, v, s->work, av);
 }
 
@@ -225,7 +229,16 @@ static piola_status step_solid(piola_world *w, world_solid *s, double t, double 
   if (s->body) piola__elastic_body_damping_prepare(s->body);
   piola__step_profile_mark(&w->profile, STEP_PHASE_PREPARE);
   const double gravity1[3] = {h * g0[0], h * g0[1], h * g0[2]};
-  stats->cg_iterations += damping_solve(w, s, h, t, 0, s->rhs, s->v, gravity1, NULL);
+  /* for a damped body, keep the guess x0 (in tmp) and A x0 (in the slot of A v, free until
+   * the final solve): the second right-hand side's D_n v' is h D_n x0 = M x0 - A x0 plus a
+   * correction on the few nodes where v' differs from the guess (see there) */
+  double *initial_av = s->work + 3 * m;
+  double beta0 = piola_track_eval(&s->shear_viscosity, t);
+  double alpha0 = piola_track_eval(&s->bulk_viscosity, t);
+  const int damped = !piola__solid_undamped(s, beta0, alpha0);
+  const int reuse = damped && s->body && piola__step_reuse_first_product;
+  stats->cg_iterations += damping_solve(w, s, h, t, 0, s->rhs, s->v, gravity1, NULL,
+                                        reuse ? s->tmp : NULL, reuse ? initial_av : NULL);
   piola__step_profile_mark(&w->profile, STEP_PHASE_SOLVE1);
 
   /* 2. x~ */
@@ -247,16 +260,38 @@ static piola_status step_solid(piola_world *w, world_solid *s, double t, double 
   stats->colliding += colliding;
   piola__step_profile_mark(&w->profile, STEP_PHASE_COLLIDE);
   /* damping at (x^n, v') while the body still holds the rotations of x^n */
-  double beta0 = piola_track_eval(&s->shear_viscosity, t);
-  double alpha0 = piola_track_eval(&s->bulk_viscosity, t);
-  if (!piola__solid_undamped(s, beta0, alpha0))
-    piola__solid_damping_forces(s, s->v, beta0, alpha0, s->tmp);
-  else
-    memset(s->tmp, 0, v3);
-  for (int32_t i = 0; i < n; ++i)
-    for (int k = 0; k < 3; ++k)
-      s->rhs[3 * i + k] = s->mass[i] * s->v[3 * i + k] +
-                          h * (s->force_old[3 * i + k] + s->tmp[3 * i + k] + s->mass[i] * g0[k]);
+  if (reuse) {
+    /* h D_n v' without a full pass: v' = x0 - h g0 - e, where the uniform h g0 is invisible
+     * to D and e is zero except on nodes the collisions or constraints moved (v' != v^n) or
+     * that are constrained (x0 was their secant velocity). So h D_n v' = (M x0 - A x0) -
+     * h D_n e, with D_n e evaluated only on the tets touching those nodes. M x0 - A x0 holds
+     * h D_n x0 to the rounding of M x0, the size of the rounding of M v' in the sum. */
+    double *hd = initial_av, *de = s->work;
+    memset(de, 0, v3);
+    for (int32_t i = 0; i < n; ++i) {
+      double *x0 = s->tmp + 3 * i;
+      const double *vi = s->v + 3 * i, *vo = s->v_old + 3 * i;
+      int moved = s->flags[i] != SOLID_FREE || vi[0] != vo[0] || vi[1] != vo[1] || vi[2] != vo[2];
+      for (int k = 0; k < 3; ++k) {
+        hd[3 * i + k] = s->mass[i] * x0[k] - hd[3 * i + k];
+        x0[k] = moved ? x0[k] - vi[k] - gravity1[k] : 0.0;
+      }
+    }
+    piola__elastic_body_damping_forces_add_sparse(s->body, s->tmp, beta0, alpha0, de);
+    for (int32_t i = 0; i < n; ++i)
+      for (int k = 0; k < 3; ++k)
+        s->rhs[3 * i + k] = s->mass[i] * s->v[3 * i + k] + hd[3 * i + k] - h * de[3 * i + k] +
+                            h * (s->force_old[3 * i + k] + s->mass[i] * g0[k]);
+  } else {
+    if (damped)
+      piola__solid_damping_forces(s, s->v, beta0, alpha0, s->tmp);
+    else
+      memset(s->tmp, 0, v3);
+    for (int32_t i = 0; i < n; ++i)
+      for (int k = 0; k < 3; ++k)
+        s->rhs[3 * i + k] = s->mass[i] * s->v[3 * i + k] +
+                            h * (s->force_old[3 * i + k] + s->tmp[3 * i + k] + s->mass[i] * g0[k]);
+  }
 
   piola__step_profile_mark(&w->profile, STEP_PHASE_RHS2);
   /* F, diagonalization and elastic force at x^n+1, once per step */
@@ -279,7 +314,7 @@ static piola_status step_solid(piola_world *w, world_solid *s, double t, double 
   double *av = s->work + 3 * m;
   const double gravity2[3] = {h * (g0[0] + g1[0]), h * (g0[1] + g1[1]), h * (g0[2] + g1[2])};
   stats->cg_iterations +=
-      damping_solve(w, s, h, t1, 1, s->rhs, s->v, gravity2, colliding > 0 ? av : NULL);
+      damping_solve(w, s, h, t1, 1, s->rhs, s->v, gravity2, colliding > 0 ? av : NULL, NULL, NULL);
   piola__step_profile_mark(&w->profile, STEP_PHASE_SOLVE2);
   if (colliding > 0) contact_friction(w, s, t1, h, g1, av);
   piola__step_profile_mark(&w->profile, STEP_PHASE_FRICTION);

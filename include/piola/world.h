@@ -48,6 +48,13 @@ typedef struct piola_world_def {
                                 speed. Default 0.5 */
   double cg_tolerance;       /* relative residual of the damping solves, > 0. Default 1e-8 */
   int32_t cg_max_iterations; /* >= 1. Default 200 */
+  /* s, >= 0: the collision step of Bridson, Fedkiw and Anderson 2002 (docs/contact.md).
+   * Self-collision processing (piola_self_collision_def) runs once per interval of this
+   * length, from the positions at its start to those after the steps inside it, instead of
+   * after every step; steps end exactly on interval ends, and piola_world_advance_to's
+   * target always closes an interval, so the state it returns is collision-processed.
+   * 0 (default): after every step. Obstacles are handled inside every step either way. */
+  double collision_interval;
 } piola_world_def;
 
 PIOLA_API piola_world_def piola_default_world_def(void);
@@ -78,8 +85,9 @@ typedef struct piola_constraint_def {
 
 /* Self-collision of a solid's boundary surface (or of a shell's triangles, piola_shell_def),
  * with itself and with every other solid or shell that has it enabled (Bridson, Fedkiw and
- * Anderson 2002; docs/contact.md), processed after every step, outside it (paper section 9).
- * Contact between two bodies is two-way: impulses act on both. */
+ * Anderson 2002; docs/contact.md), processed after every step, outside it (paper section 9),
+ * or once per piola_world_def.collision_interval. Contact between two bodies is two-way:
+ * impulses act on both. */
 typedef struct piola_self_collision_def {
   bool enabled;     /* Default false */
   double thickness; /* m, > 0: surface pairs closer than this repel. Default 1e-3 */

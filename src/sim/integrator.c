@@ -315,6 +315,12 @@ piola_status piola_world_step(piola_world *w, double dt_limit, piola_step_stats 
   double dt = piola_world_stable_dt(w);
   if (dt_limit > 0 && dt_limit < dt) dt = dt_limit;
   if (!(dt > 0)) return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "step: dt must be > 0, got %g", dt);
+  /* a collision interval (world_contact.c) ends exactly on a step, without a sliver step */
+  double left;
+  PIOLA_TRY(piola__world_collision_open(w, &left));
+  if (dt >= left) dt = left;
+  else if (dt > 0.5 * left) dt = 0.5 * left;
+  const int closes = dt == left || dt == w->collision_deadline - w->time;
   piola__step_profile_mark(&w->profile, STEP_PHASE_WORLD);
   for (int32_t i = 0; i < w->solid_count + w->shell_count; ++i) {
     world_solid *s = i < w->solid_count ? &w->solids[i] : &w->shells[i - w->solid_count];
@@ -326,7 +332,7 @@ piola_status piola_world_step(piola_world *w, double dt_limit, piola_step_stats 
       return st;
     }
   }
-  piola_status contact = piola__world_self_collide(w, dt, w->time + dt, &local);
+  piola_status contact = piola__world_self_collide(w, dt, w->time + dt, closes, &local);
   if (contact != PIOLA_OK) {
     for (int32_t j = 0; j < w->solid_count + w->shell_count; ++j)
       restore(j < w->solid_count ? &w->solids[j] : &w->shells[j - w->solid_count], w->time);
@@ -353,7 +359,9 @@ piola_status piola_world_advance_to(piola_world *w, double t_end, piola_step_sta
     double limit = left;
     if (left > dt && left < 2 * dt) limit = 0.5 * left;
     piola_step_stats one;
+    w->collision_deadline = t_end;
     piola_status st = piola_world_step(w, limit, &one);
+    w->collision_deadline = NAN;
     if (stats) {
       stats->substeps += one.substeps;
       stats->cg_iterations += one.cg_iterations;

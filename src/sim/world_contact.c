@@ -169,6 +169,12 @@ piola_status piola__world_collision_open(piola_world *w, double *left) {
     c->open = 1;
   }
   *left = c->t_start + w->def.collision_interval - w->time;
+  /* advance_to's target ends the interval when it comes first, or only a rounding error
+   * after the interval's end (an interval that divides the frame time), instead of leaving
+   * a sliver of an interval to it. The step then must land exactly on the target (advance_to
+   * asks for that step), not halve its way towards it. */
+  const double to_deadline = w->collision_deadline - w->time; /* NAN outside advance_to */
+  if (to_deadline <= *left + 1e-6 * w->def.collision_interval) *left = to_deadline;
   return PIOLA_OK;
 }
 

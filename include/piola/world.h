@@ -51,8 +51,9 @@ typedef struct piola_world_def {
   /* s, >= 0: the collision step of Bridson, Fedkiw and Anderson 2002 (docs/contact.md).
    * Self-collision processing (piola_self_collision_def) runs once per interval of this
    * length, from the positions at its start to those after the steps inside it, instead of
-   * after every step; steps end exactly on interval ends, and piola_world_advance_to's
-   * target always closes an interval, so the state it returns is collision-processed.
+   * after every step; an interval ends with the first step that reaches its end, and
+   * piola_world_advance_to's target always ends one, so the state it returns is
+   * collision-processed.
    * 0 (default): after every step. Obstacles are handled inside every step either way. */
   double collision_interval;
 } piola_world_def;
@@ -143,6 +144,8 @@ typedef struct piola_step_stats {
   int64_t contacts;       /* self-collision: repulsion contacts, summed over the steps */
   int64_t impacts;        /* self-collision: collision impulses, summed over the steps */
   int32_t impact_zones;   /* self-collision: rigid impact zones, summed over the steps */
+  int32_t collision_steps; /* self-collision: processing runs (every step, or one per
+                              collision interval; 0 without self-collision) */
 } piola_step_stats;
 
 /* The step size the next step would take with no target time: min(max_dt, CFL bound), s. */

@@ -315,12 +315,11 @@ piola_status piola_world_step(piola_world *w, double dt_limit, piola_step_stats 
   double dt = piola_world_stable_dt(w);
   if (dt_limit > 0 && dt_limit < dt) dt = dt_limit;
   if (!(dt > 0)) return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "step: dt must be > 0, got %g", dt);
-  /* a collision interval (world_contact.c) ends exactly on a step, without a sliver step */
+  /* a collision interval (world_contact.c) ends with the first step that reaches its end
+   * (steps are not shortened for it), or on advance_to's target */
   double left;
   PIOLA_TRY(piola__world_collision_open(w, &left));
-  if (dt >= left) dt = left;
-  else if (dt > 0.5 * left) dt = 0.5 * left;
-  const int closes = dt == left || dt == w->collision_deadline - w->time;
+  const int closes = dt >= left || dt == w->collision_deadline - w->time;
   piola__step_profile_mark(&w->profile, STEP_PHASE_WORLD);
   for (int32_t i = 0; i < w->solid_count + w->shell_count; ++i) {
     world_solid *s = i < w->solid_count ? &w->solids[i] : &w->shells[i - w->solid_count];
@@ -369,6 +368,7 @@ piola_status piola_world_advance_to(piola_world *w, double t_end, piola_step_sta
       stats->contacts += one.contacts;
       stats->impacts += one.impacts;
       stats->impact_zones += one.impact_zones;
+      stats->collision_steps += one.collision_steps;
       if (one.substeps) stats->last_dt = one.last_dt;
     }
     if (st != PIOLA_OK) return st;

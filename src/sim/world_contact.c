@@ -24,9 +24,11 @@
  *
  * With a collision interval dt_c > 0 (piola_world_def.collision_interval) this is BFA02's
  * collision step: the internal dynamics takes as many steps as its stability needs, and
- * collision processing runs once, at the end of the interval, from the positions x_c kept
- * when it opened to the positions after its last step, with the average velocity
- * (x - x_c)/dt_c, dt_c the time since it opened. x_c was collision-free (the previous
+ * collision processing runs once, after the first step that reaches the interval's end (or
+ * on advance_to's target), from the positions x_c kept when it opened to the positions after
+ * that step, with the average velocity (x - x_c)/dt_c, dt_c the time since it opened (at
+ * least the interval, less than the interval plus one step). Steps are not shortened to end
+ * on intervals: that would add a step per interval whenever the steps do not divide it. x_c was collision-free (the previous
  * interval's result), and the linear trajectories from it are what CCD checks, so the end of
  * every interval is collision-free whatever the steps inside it did; the detection passes,
  * which dominate the cost of a cloth, run once per interval instead of once per step. */
@@ -170,9 +172,9 @@ piola_status piola__world_collision_open(piola_world *w, double *left) {
   }
   *left = c->t_start + w->def.collision_interval - w->time;
   /* advance_to's target ends the interval when it comes first, or only a rounding error
-   * after the interval's end (an interval that divides the frame time), instead of leaving
-   * a sliver of an interval to it. The step then must land exactly on the target (advance_to
-   * asks for that step), not halve its way towards it. */
+   * after the interval's end (an interval that divides the frame time): then the interval
+   * ends on the target, not on a step a rounding error before it, which would leave a sliver
+   * of an interval to the target */
   const double to_deadline = w->collision_deadline - w->time; /* NAN outside advance_to */
   if (to_deadline <= *left + 1e-6 * w->def.collision_interval) *left = to_deadline;
   return PIOLA_OK;
@@ -204,6 +206,7 @@ piola_status piola__world_self_collide(piola_world *w, double dt, double t1, int
   stats->contacts += cs.contacts;
   stats->impacts += cs.impacts;
   stats->impact_zones += cs.impact_zones;
+  stats->collision_steps += 1;
   for (int32_t i = 0; i < count; ++i) {
     if (c->offset[i] < 0) continue;
     world_solid *s = body_at(w, i);

@@ -115,7 +115,8 @@ double piola__solid_plastic_stiffening(const world_solid *s);
  * collision_open runs before a step: it builds the collision surface on first use or when
  * bodies were added, opens an interval when none is open (keeping the positions at its
  * start) and gives the time left to the interval's end (s; INFINITY when collisions run
- * after every step or no body has self-collision), which the step must not pass.
+ * after every step or no body has self-collision); the step that reaches it ends the
+ * interval.
  * self_collide runs after a step of length dt (s) that every body has taken from x_old to x
  * and that ends at t1: when collisions run every step, or when closes != 0 (the step ends
  * the interval), it changes x and v of bodies with self-collision enabled from the average

@@ -89,7 +89,7 @@ static long run_cloth_folds(int self_collision, const char *cells, double t_end,
   replace(text, "\"resolution\": [48, 48]", cells);
   /* collisions after every step, so that every step is judged (test_collision_step.c judges
    * the example's own collision steps) */
-  replace(text, "\"collision_interval\": 0.004166666666666667", "\"collision_interval\": 0");
+  replace(text, "\"collision_interval\": 0.0016666666666666668", "\"collision_interval\": 0");
   if (!self_collision) replace(text, "\"enabled\": true", "\"enabled\":false");
   piola_scene *scene = NULL;
   if (piola_scene_load_string(text, PIOLA_SOURCE_DIR, "cloth_folds", &scene) != PIOLA_OK)

@@ -1,7 +1,8 @@
 /* Shells in the world's collision surface (docs/contact.md, "Shells"): cloth self-collision
  * and two-way contact between solids and shells.
  *
- * - The cloth_folds example (examples/cloth_folds.json, at a reduced resolution) falls onto
+ * - The cloth_folds example (examples/cloth_folds.json, at a reduced resolution, with
+ *   collisions after every step instead of its collision_interval) falls onto
  *   itself in folds; after every step no two cloth triangles without a shared vertex
  *   intersect (exact referee, src/contact/triangle_intersection.c, with a box sweep in front
  *   of it that only drops pairs whose closed boxes are disjoint). Without self_collision the
@@ -19,75 +20,13 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "contact/triangle_intersection.h"
 #include "piola/scene.h"
 #include "piola/world.h"
 #include "piola/world_shells.h"
 #include "scene/scene_desc.h"
+#include "triangle_referee.h"
 
 /* ------------------------------------------------------------------ referee */
-
-/* One triangle set to judge: positions (live pointer), triangles over them, and a group id;
- * pairs inside one group that share a vertex are exempt. */
-typedef struct judged {
-  const double *x;
-  const int32_t *tris;
-  int32_t count;
-} judged;
-
-typedef struct tri_box {
-  double lo[3], hi[3];
-  int32_t set, tri;
-} tri_box;
-
-static int by_lo_x(const void *a, const void *b) {
-  double u = ((const tri_box *)a)->lo[0], v = ((const tri_box *)b)->lo[0];
-  return (u > v) - (u < v);
-}
-
-/* Intersecting triangle pairs over all sets (within and across), except pairs of one set
- * that share a vertex. Pairs whose closed boxes are disjoint cannot share a point. */
-static long count_intersections(const judged *sets, int set_count) {
-  int32_t n = 0;
-  for (int s = 0; s < set_count; ++s) n += sets[s].count;
-  tri_box *boxes = malloc(sizeof(tri_box) * (size_t)n);
-  assert_non_null(boxes);
-  int32_t k = 0;
-  for (int s = 0; s < set_count; ++s)
-    for (int32_t t = 0; t < sets[s].count; ++t, ++k) {
-      tri_box *b = &boxes[k];
-      b->set = s, b->tri = t;
-      for (int d = 0; d < 3; ++d) b->lo[d] = INFINITY, b->hi[d] = -INFINITY;
-      for (int c = 0; c < 3; ++c)
-        for (int d = 0; d < 3; ++d) {
-          double v = sets[s].x[3 * sets[s].tris[3 * t + c] + d];
-          b->lo[d] = fmin(b->lo[d], v), b->hi[d] = fmax(b->hi[d], v);
-        }
-    }
-  qsort(boxes, (size_t)n, sizeof(tri_box), by_lo_x);
-  long hits = 0;
-  for (int32_t i = 0; i < n; ++i)
-    for (int32_t j = i + 1; j < n && boxes[j].lo[0] <= boxes[i].hi[0]; ++j) {
-      const tri_box *a = &boxes[i], *b = &boxes[j];
-      if (a->lo[1] > b->hi[1] || b->lo[1] > a->hi[1] || a->lo[2] > b->hi[2] || b->lo[2] > a->hi[2])
-        continue;
-      const int32_t *ta = sets[a->set].tris + 3 * a->tri, *tb = sets[b->set].tris + 3 * b->tri;
-      if (a->set == b->set) {
-        int shared = 0;
-        for (int p = 0; p < 3; ++p)
-          for (int q = 0; q < 3; ++q) shared |= ta[p] == tb[q];
-        if (shared) continue;
-      }
-      const double *xa = sets[a->set].x, *xb = sets[b->set].x;
-      const double *p[3] = {xa + 3 * ta[0], xa + 3 * ta[1], xa + 3 * ta[2]};
-      const double *q[3] = {xb + 3 * tb[0], xb + 3 * tb[1], xb + 3 * tb[2]};
-      int r = piola__triangles_intersect(p, q);
-      assert_true(r >= 0);
-      hits += r;
-    }
-  free(boxes);
-  return hits;
-}
 
 static judged shell_set(const piola_world *w, int32_t shell) {
   const piola_shell_body *b = piola_world_shell_body(w, shell);
@@ -104,14 +43,14 @@ static void referee_finds_crossings_among_many(void **state) {
                      5, 5, 5,    6, 5, 5,   5, 6, 5};      /* far away */
   int32_t tris[9] = {0, 1, 2, 3, 4, 5, 6, 7, 8};
   judged one = {x, tris, 3};
-  assert_int_equal(count_intersections(&one, 1), 1);
+  assert_int_equal(referee_count_intersections(&one, 1), 1);
   x[9 + 2] = 0.0, x[12 + 2] = 1, x[15 + 2] = 1; /* now it touches z = 0 at one point */
-  assert_int_equal(count_intersections(&one, 1), 1);
+  assert_int_equal(referee_count_intersections(&one, 1), 1);
   x[9 + 2] = 1e-12;
-  assert_int_equal(count_intersections(&one, 1), 0);
+  assert_int_equal(referee_count_intersections(&one, 1), 0);
   /* the same triangles as two sets: no vertex is shared across sets */
   judged two[2] = {{x, tris, 1}, {x, tris, 1}};
-  assert_int_equal(count_intersections(two, 2), 1);
+  assert_int_equal(referee_count_intersections(two, 2), 1);
 }
 
 /* ------------------------------------------------------------------ cloth folds */
@@ -148,6 +87,9 @@ static long run_cloth_folds(int self_collision, const char *cells, double t_end,
   snprintf(path, sizeof path, "%s/examples/cloth_folds.json", PIOLA_SOURCE_DIR);
   char *text = read_text(path);
   replace(text, "\"resolution\": [48, 48]", cells);
+  /* collisions after every step, so that every step is judged (test_collision_step.c judges
+   * the example's own collision steps) */
+  replace(text, "\"collision_interval\": 0.0016666666666666668", "\"collision_interval\": 0");
   if (!self_collision) replace(text, "\"enabled\": true", "\"enabled\":false");
   piola_scene *scene = NULL;
   if (piola_scene_load_string(text, PIOLA_SOURCE_DIR, "cloth_folds", &scene) != PIOLA_OK)
@@ -156,7 +98,7 @@ static long run_cloth_folds(int self_collision, const char *cells, double t_end,
   piola_world *w = piola_scene_world(scene);
   assert_int_equal(piola_world_shell_count(w), 1);
   judged cloth = shell_set(w, 0);
-  assert_int_equal(count_intersections(&cloth, 1), 0);
+  assert_int_equal(referee_count_intersections(&cloth, 1), 0);
   memset(total, 0, sizeof(*total));
   long worst = 0;
   int steps = 0;
@@ -165,7 +107,7 @@ static long run_cloth_folds(int self_collision, const char *cells, double t_end,
     assert_int_equal(piola_world_step(w, 0, &one), PIOLA_OK);
     total->contacts += one.contacts, total->impacts += one.impacts;
     total->impact_zones += one.impact_zones;
-    long bad = count_intersections(&cloth, 1);
+    long bad = referee_count_intersections(&cloth, 1);
     if (bad > worst) worst = bad;
     if (self_collision && bad)
       fail_msg("step %d, t = %g s: %ld intersecting cloth triangle pairs", steps,
@@ -260,7 +202,7 @@ static double stack_sheets(int self_collision, double h, long *worst) {
   const double t_end = 0.05 + 0.15 * (double)test_samples(10, 2) / 10.0;
   while (piola_world_time(w) < t_end) {
     assert_int_equal(piola_world_step(w, 0, NULL), PIOLA_OK);
-    long bad = count_intersections(sets, 2);
+    long bad = referee_count_intersections(sets, 2);
     if (bad > *worst) *worst = bad;
     smallest_gap = fmin(smallest_gap, sheet_gap(w));
   }
@@ -338,14 +280,14 @@ static void block_hits_free_cloth(double speed, double h) {
   const double scale = fabs(p_block0[2]);
   judged sets[2] = {{piola_world_solid_positions(w, 0), boundary.triangles, boundary.triangle_count},
                     shell_set(w, 0)};
-  assert_int_equal(count_intersections(sets, 2), 0);
+  assert_int_equal(referee_count_intersections(sets, 2), 0);
   piola_step_stats total = {0};
   while (piola_world_time(w) < 0.08 / speed) {
     piola_step_stats one;
     assert_int_equal(piola_world_step(w, 0, &one), PIOLA_OK);
     total.contacts += one.contacts, total.impacts += one.impacts;
     total.impact_zones += one.impact_zones;
-    long bad = count_intersections(sets, 2);
+    long bad = referee_count_intersections(sets, 2);
     if (bad) fail_msg("t = %g s: %ld intersecting triangle pairs", piola_world_time(w), bad);
     double pb[3] = {0}, pc[3] = {0};
     momentum(piola_world_solid_velocities(w, 0), mb, nb, pb);

@@ -48,6 +48,14 @@ typedef struct piola_world_def {
                                 speed. Default 0.5 */
   double cg_tolerance;       /* damping solves stop at this fraction of the initial residual (the step's velocity change), > 0. Default 1e-4 */
   int32_t cg_max_iterations; /* >= 1. Default 200 */
+  /* s, >= 0: the collision step of Bridson, Fedkiw and Anderson 2002 (docs/contact.md).
+   * Self-collision processing (piola_self_collision_def) runs once per interval of this
+   * length, from the positions at its start to those after the steps inside it, instead of
+   * after every step; an interval ends with the first step that reaches its end, and
+   * piola_world_advance_to's target always ends one, so the state it returns is
+   * collision-processed.
+   * 0 (default): after every step. Obstacles are handled inside every step either way. */
+  double collision_interval;
 } piola_world_def;
 
 PIOLA_API piola_world_def piola_default_world_def(void);
@@ -78,8 +86,9 @@ typedef struct piola_constraint_def {
 
 /* Self-collision of a solid's boundary surface (or of a shell's triangles, piola_shell_def),
  * with itself and with every other solid or shell that has it enabled (Bridson, Fedkiw and
- * Anderson 2002; docs/contact.md), processed after every step, outside it (paper section 9).
- * Contact between two bodies is two-way: impulses act on both. */
+ * Anderson 2002; docs/contact.md), processed after every step, outside it (paper section 9),
+ * or once per piola_world_def.collision_interval. Contact between two bodies is two-way:
+ * impulses act on both. */
 typedef struct piola_self_collision_def {
   bool enabled;     /* Default false */
   double thickness; /* m, > 0: surface pairs closer than this repel. Default 1e-3 */
@@ -135,6 +144,8 @@ typedef struct piola_step_stats {
   int64_t contacts;       /* self-collision: repulsion contacts, summed over the steps */
   int64_t impacts;        /* self-collision: collision impulses, summed over the steps */
   int32_t impact_zones;   /* self-collision: rigid impact zones, summed over the steps */
+  int32_t collision_steps; /* self-collision: processing runs (every step, or one per
+                              collision interval; 0 without self-collision) */
 } piola_step_stats;
 
 /* The step size the next step would take with no target time: min(max_dt, CFL bound), s. */

@@ -1186,7 +1186,8 @@ static piola_status parse_top(parser *p, const cJSON *root, scene_desc *out) {
   PIOLA_TRY(opt_vec3_tracks(p, root, "gravity", out->world.gravity));
   if ((v = get(root, "integrator"))) {
     size_t old = push_key(p, "integrator");
-    static const char *const keys[] = {"max_dt", "cfl", "cg_tolerance", "cg_max_iterations", NULL};
+    static const char *const keys[] = {"max_dt", "cfl", "cg_tolerance", "cg_max_iterations",
+                                       "collision_interval", NULL};
     PIOLA_TRY(check_keys(p, v, keys));
     PIOLA_TRY(opt_number(p, v, "max_dt", (range){0, 1, 1, 0}, &out->world.max_dt));
     PIOLA_TRY(opt_number(p, v, "cfl", (range){0, 2, 1, 0}, &out->world.cfl));
@@ -1194,6 +1195,8 @@ static piola_status parse_top(parser *p, const cJSON *root, scene_desc *out) {
     int64_t it = out->world.cg_max_iterations;
     PIOLA_TRY(opt_int(p, v, "cg_max_iterations", 1, 1000000, &it));
     out->world.cg_max_iterations = (int32_t)it;
+    PIOLA_TRY(opt_number(p, v, "collision_interval", (range){0, 1, 0, 0},
+                         &out->world.collision_interval));
     pop(p, old);
   }
   /* a scene needs something to simulate: solids, or shells */

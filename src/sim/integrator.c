@@ -350,6 +350,11 @@ piola_status piola_world_step(piola_world *w, double dt_limit, piola_step_stats 
   double dt = piola_world_stable_dt(w);
   if (dt_limit > 0 && dt_limit < dt) dt = dt_limit;
   if (!(dt > 0)) return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "step: dt must be > 0, got %g", dt);
+  /* a collision interval (world_contact.c) ends with the first step that reaches its end
+   * (steps are not shortened for it), or on advance_to's target */
+  double left;
+  PIOLA_TRY(piola__world_collision_open(w, &left));
+  const int closes = dt >= left || dt == w->collision_deadline - w->time;
   piola__step_profile_mark(&w->profile, STEP_PHASE_WORLD);
   for (int32_t i = 0; i < w->solid_count + w->shell_count; ++i) {
     world_solid *s = i < w->solid_count ? &w->solids[i] : &w->shells[i - w->solid_count];
@@ -361,7 +366,7 @@ piola_status piola_world_step(piola_world *w, double dt_limit, piola_step_stats 
       return st;
     }
   }
-  piola_status contact = piola__world_self_collide(w, dt, w->time + dt, &local);
+  piola_status contact = piola__world_self_collide(w, dt, w->time + dt, closes, &local);
   if (contact != PIOLA_OK) {
     for (int32_t j = 0; j < w->solid_count + w->shell_count; ++j)
       restore(j < w->solid_count ? &w->solids[j] : &w->shells[j - w->solid_count], w->time);
@@ -388,7 +393,9 @@ piola_status piola_world_advance_to(piola_world *w, double t_end, piola_step_sta
     double limit = left;
     if (left > dt && left < 2 * dt) limit = 0.5 * left;
     piola_step_stats one;
+    w->collision_deadline = t_end;
     piola_status st = piola_world_step(w, limit, &one);
+    w->collision_deadline = NAN;
     if (stats) {
       stats->substeps += one.substeps;
       stats->cg_iterations += one.cg_iterations;
@@ -396,6 +403,7 @@ piola_status piola_world_advance_to(piola_world *w, double t_end, piola_step_sta
       stats->contacts += one.contacts;
       stats->impacts += one.impacts;
       stats->impact_zones += one.impact_zones;
+      stats->collision_steps += one.collision_steps;
       if (one.substeps) stats->last_dt = one.last_dt;
     }
     if (st != PIOLA_OK) return st;

@@ -42,9 +42,13 @@ piola_status piola_world_create(const piola_world_def *def, piola_world **out) {
   if (def->cg_max_iterations < 1)
     return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "cg_max_iterations must be >= 1, got %d",
                       (int)def->cg_max_iterations);
+  if (!(def->collision_interval >= 0) || !isfinite(def->collision_interval))
+    return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "collision_interval must be >= 0 s, got %g",
+                      def->collision_interval);
   piola_world *w = calloc(1, sizeof *w);
   if (!w) return PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "world: out of memory");
   w->def = *def;
+  w->collision_deadline = NAN;
   *out = w;
   return PIOLA_OK;
 }
@@ -323,6 +327,7 @@ piola_status piola_world_solid_set_state(piola_world *world, int32_t solid, cons
     memcpy(s->x, positions, v3);
   }
   if (velocities) memcpy(s->v, velocities, v3);
+  piola__world_collision_reset(world); /* the open interval's start no longer leads here */
   return piola__solid_update_forces(s, world->time);
 }
 

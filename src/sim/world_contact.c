@@ -20,7 +20,18 @@
  * is what collision processing corrects: x = x_old + dt v_c'. The final velocity changes by
  * the same amount, v += v_c' - v_c, as in BFA02, and the elastic forces of a body whose
  * positions changed are recomputed, since the next step starts from them. Constrained nodes
- * count as pinned (infinite mass). */
+ * count as pinned (infinite mass).
+ *
+ * With a collision interval dt_c > 0 (piola_world_def.collision_interval) this is BFA02's
+ * collision step: the internal dynamics takes as many steps as its stability needs, and
+ * collision processing runs once, after the first step that reaches the interval's end (or
+ * on advance_to's target), from the positions x_c kept when it opened to the positions after
+ * that step, with the average velocity (x - x_c)/dt_c, dt_c the time since it opened (at
+ * least the interval, less than the interval plus one step). Steps are not shortened to end
+ * on intervals: that would add a step per interval whenever the steps do not divide it. x_c was collision-free (the previous
+ * interval's result), and the linear trajectories from it are what CCD checks, so the end of
+ * every interval is collision-free whatever the steps inside it did; the detection passes,
+ * which dominate the cost of a cloth, run once per interval instead of once per step. */
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -35,6 +46,10 @@ typedef struct world_contact {
   int32_t vertex_count;
   int32_t *offset; /* per body (solids, then shells): first global vertex, or -1 when off */
   double *x0, *v, *v_before, *mass;
+  /* collision_interval > 0: x0 holds the positions at t_start, the start of the open
+   * interval */
+  int open;
+  double t_start;
 } world_contact;
 
 void piola__world_contact_free(piola_world *w) {
@@ -123,25 +138,65 @@ static piola_status build(piola_world *w) {
   return st;
 }
 
-piola_status piola__world_self_collide(piola_world *w, double dt, double t1,
-                                       piola_step_stats *stats) {
-  const int32_t count = w->solid_count + w->shell_count;
+static int any_self_collision(piola_world *w) {
   int any = 0;
-  for (int32_t i = 0; i < count; ++i) any |= body_at(w, i)->self_collision.enabled;
-  if (!any) return PIOLA_OK;
+  for (int32_t i = 0; i < w->solid_count + w->shell_count; ++i)
+    any |= body_at(w, i)->self_collision.enabled;
+  return any;
+}
+
+static piola_status ensure_built(piola_world *w) {
   if (!w->contact || w->contact->solid_count != w->solid_count ||
       w->contact->shell_count != w->shell_count)
     PIOLA_TRY(build(w));
+  return PIOLA_OK;
+}
+
+void piola__world_collision_reset(piola_world *w) {
+  if (w->contact) w->contact->open = 0;
+}
+
+piola_status piola__world_collision_open(piola_world *w, double *left) {
+  *left = INFINITY;
+  if (!(w->def.collision_interval > 0) || !any_self_collision(w)) return PIOLA_OK;
+  PIOLA_TRY(ensure_built(w));
   world_contact *c = w->contact;
+  if (!c->open) {
+    for (int32_t i = 0; i < w->solid_count + w->shell_count; ++i) {
+      if (c->offset[i] < 0) continue;
+      const world_solid *s = body_at(w, i);
+      memcpy(c->x0 + 3 * (size_t)c->offset[i], s->x, sizeof(double) * 3 * (size_t)s->n);
+    }
+    c->t_start = w->time;
+    c->open = 1;
+  }
+  *left = c->t_start + w->def.collision_interval - w->time;
+  /* advance_to's target ends the interval when it comes first, or only a rounding error
+   * after the interval's end (an interval that divides the frame time): then the interval
+   * ends on the target, not on a step a rounding error before it, which would leave a sliver
+   * of an interval to the target */
+  const double to_deadline = w->collision_deadline - w->time; /* NAN outside advance_to */
+  if (to_deadline <= *left + 1e-6 * w->def.collision_interval) *left = to_deadline;
+  return PIOLA_OK;
+}
+
+piola_status piola__world_self_collide(piola_world *w, double dt, double t1, int closes,
+                                       piola_step_stats *stats) {
+  const int32_t count = w->solid_count + w->shell_count;
+  if (!any_self_collision(w)) return PIOLA_OK;
+  const int per_step = !(w->def.collision_interval > 0);
+  if (!per_step && (!closes || !w->contact || !w->contact->open)) return PIOLA_OK;
+  PIOLA_TRY(ensure_built(w));
+  world_contact *c = w->contact;
+  if (!per_step) dt = t1 - c->t_start; /* the collision step: the whole interval */
   for (int32_t i = 0; i < count; ++i) {
     if (c->offset[i] < 0) continue;
     const world_solid *s = body_at(w, i);
     for (int32_t k = 0; k < s->n; ++k) {
       const int32_t g = c->offset[i] + k;
-      for (int d = 0; d < 3; ++d) {
-        c->x0[3 * g + d] = s->x_old[3 * k + d];
-        c->v[3 * g + d] = (s->x[3 * k + d] - s->x_old[3 * k + d]) / dt;
-      }
+      if (per_step)
+        for (int d = 0; d < 3; ++d) c->x0[3 * g + d] = s->x_old[3 * k + d];
+      for (int d = 0; d < 3; ++d) c->v[3 * g + d] = (s->x[3 * k + d] - c->x0[3 * g + d]) / dt;
       c->mass[g] = s->flags[k] != SOLID_FREE || s->inverse_mass[k] == 0.0 ? INFINITY : s->mass[k];
     }
   }
@@ -151,6 +206,7 @@ piola_status piola__world_self_collide(piola_world *w, double dt, double t1,
   stats->contacts += cs.contacts;
   stats->impacts += cs.impacts;
   stats->impact_zones += cs.impact_zones;
+  stats->collision_steps += 1;
   for (int32_t i = 0; i < count; ++i) {
     if (c->offset[i] < 0) continue;
     world_solid *s = body_at(w, i);
@@ -165,5 +221,6 @@ piola_status piola__world_self_collide(piola_world *w, double dt, double t1,
     }
     if (changed) PIOLA_TRY(piola__solid_update_forces(s, t1));
   }
+  c->open = 0;
   return PIOLA_OK;
 }

@@ -58,6 +58,8 @@ struct piola_world {
   piola_obstacle **obstacles;
   int32_t obstacle_count, obstacle_capacity;
   struct world_contact *contact; /* self-collision of boundary surfaces (world_contact.c) */
+  double collision_deadline;  /* advance_to's target, which closes a collision interval too;
+                                 NAN outside advance_to */
   step_profile profile;       /* per-phase step timers, off unless a benchmark turns them on */
 };
 
@@ -108,11 +110,23 @@ double piola__shell_stable_dt(const piola_world *w, const world_solid *s, double
 piola_status piola__solid_plastic_create(world_solid *s, const piola_solid_def *def);
 void piola__solid_plastic_update(world_solid *s, double dt);
 double piola__solid_plastic_stiffening(const world_solid *s);
-/* Self-collision after a step of length dt (s) that every solid has taken from x_old to x:
- * changes x and v of solids with self-collision enabled (and recomputes their forces at
- * time t1) and adds to stats. Builds its collision surface on first use or when solids were
- * added. */
-piola_status piola__world_self_collide(piola_world *w, double dt, double t1, piola_step_stats *stats);
+/* Self-collision (world_contact.c), once per collision interval (piola_world_def.
+ * collision_interval; 0: every step).
+ * collision_open runs before a step: it builds the collision surface on first use or when
+ * bodies were added, opens an interval when none is open (keeping the positions at its
+ * start) and gives the time left to the interval's end (s; INFINITY when collisions run
+ * after every step or no body has self-collision); the step that reaches it ends the
+ * interval.
+ * self_collide runs after a step of length dt (s) that every body has taken from x_old to x
+ * and that ends at t1: when collisions run every step, or when closes != 0 (the step ends
+ * the interval), it changes x and v of bodies with self-collision enabled from the average
+ * velocity over the step or interval (and recomputes their forces at time t1) and adds to
+ * stats; otherwise it does nothing. collision_reset drops the open interval (the state was
+ * set from outside). */
+piola_status piola__world_collision_open(piola_world *w, double *left);
+piola_status piola__world_self_collide(piola_world *w, double dt, double t1, int closes,
+                                       piola_step_stats *stats);
+void piola__world_collision_reset(piola_world *w);
 void piola__world_contact_free(piola_world *w);
 
 /* 1 (default): the step's second right-hand side takes D_n v' from the first solve's

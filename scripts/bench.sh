@@ -8,7 +8,7 @@ cmake -S . -B build/release -DCMAKE_BUILD_TYPE=Release -DPIOLA_BUILD_TESTS=OFF >
 cmake --build build/release -j "$(nproc)" >/dev/null
 mkdir -p out/bench
 names=("$@")
-[ ${#names[@]} -gt 0 ] || names=(diagonalize material forces step collisions mesh_io mesher render shells contact plasticity)
+[ ${#names[@]} -gt 0 ] || names=(diagonalize material forces step step_phases damping collisions mesh_io mesher render shells contact collision_step plasticity muscle)
 for name in "${names[@]}"; do
   exe=build/release/bench_$name
   [ -x "$exe" ] || { echo "bench: no $exe, skipped"; continue; }

@@ -24,42 +24,14 @@
 #include "piola/world_shells.h"
 #include "triangle_referee.h"
 
-static judged shell_set(const piola_world *w, int32_t shell) {
-  const piola_shell_body *b = piola_world_shell_body(w, shell);
-  return (judged){piola_world_shell_positions(w, shell), piola_shell_body_triangles(b),
-                  piola_shell_body_triangle_count(b)};
-}
 
-static char *read_text(const char *path) {
-  FILE *f = fopen(path, "rb");
-  if (!f) fail_msg("cannot open %s", path);
-  fseek(f, 0, SEEK_END);
-  long size = ftell(f);
-  fseek(f, 0, SEEK_SET);
-  char *text = malloc((size_t)size + 1);
-  assert_non_null(text);
-  assert_int_equal(fread(text, 1, (size_t)size, f), (size_t)size);
-  text[size] = 0;
-  fclose(f);
-  return text;
-}
-
-/* Replaces the first occurrence of from in text by to (same length or shorter). */
-static void replace(char *text, const char *from, const char *to) {
-  char *at = strstr(text, from);
-  if (!at) fail_msg("'%s' not found in the example", from);
-  size_t a = strlen(from), b = strlen(to);
-  assert_true(b <= a);
-  memcpy(at, to, b);
-  memmove(at + b, at + a, strlen(at + a) + 1);
-}
 
 /* The cloth_folds example at 20 x 20 cells; *interval receives its collision_interval. */
 static piola_scene *cloth_folds(double *interval) {
   char path[1024];
   snprintf(path, sizeof path, "%s/examples/cloth_folds.json", PIOLA_SOURCE_DIR);
-  char *text = read_text(path);
-  replace(text, "\"resolution\": [48, 48]", "\"resolution\": [20, 20]");
+  char *text = test_read_text(path);
+  test_replace_first(text, "\"resolution\": [48, 48]", "\"resolution\": [20, 20]");
   const char *key = strstr(text, "\"collision_interval\":");
   if (!key) fail_msg("the example has no integrator.collision_interval");
   *interval = strtod(key + strlen("\"collision_interval\":"), NULL);
@@ -88,7 +60,7 @@ static void cloth_folds_interval_ends_are_collision_free(void **state) {
   double dtc;
   piola_scene *scene = cloth_folds(&dtc);
   piola_world *w = piola_scene_world(scene);
-  judged cloth = shell_set(w, 0);
+  judged cloth = referee_shell_set(w, 0);
   assert_int_equal(referee_count_intersections(&cloth, 1), 0);
   double next_end = dtc;
   long intervals = 0, steps = 0, inside_bad = 0;
@@ -134,7 +106,7 @@ static void cloth_folds_frames_are_collision_free(void **state) {
   double dtc;
   piola_scene *scene = cloth_folds(&dtc);
   piola_world *w = piola_scene_world(scene);
-  judged cloth = shell_set(w, 0);
+  judged cloth = referee_shell_set(w, 0);
   piola_step_stats total = {0};
   const double frame = 1.0 / piola_scene_fps(scene);
   for (int f = 1; f <= frames; ++f) {
@@ -232,7 +204,7 @@ static void block_hits_free_cloth(double speed, double h, double dtc) {
   momentum(piola_world_shell_velocities(w, 0), mc, nc, p_cloth0);
   const double scale = fabs(p_block0[2]);
   judged sets[2] = {{piola_world_solid_positions(w, 0), boundary.triangles, boundary.triangle_count},
-                    shell_set(w, 0)};
+                    referee_shell_set(w, 0)};
   piola_step_stats total = {0};
   for (int k = 1; k * dtc <= 0.08 / speed + dtc; ++k) {
     assert_int_equal(piola_world_advance_to(w, k * dtc, &total), PIOLA_OK);
@@ -301,7 +273,7 @@ static void driven_cloth_on_ground(void **state) {
   int32_t driven = 0;
   for (int32_t i = 0; i < n; ++i) driven += flags[i] != 0;
   assert_int_equal(driven, 13);
-  judged set = shell_set(w, 0);
+  judged set = referee_shell_set(w, 0);
   piola_step_stats total = {0};
   const int intervals = (int)(12 + 36 * test_samples(10, 1) / 10);
   double lowest = INFINITY;

@@ -28,11 +28,6 @@
 
 /* ------------------------------------------------------------------ referee */
 
-static judged shell_set(const piola_world *w, int32_t shell) {
-  const piola_shell_body *b = piola_world_shell_body(w, shell);
-  return (judged){piola_world_shell_positions(w, shell), piola_shell_body_triangles(b),
-                  piola_shell_body_triangle_count(b)};
-}
 
 /* The referee checks all pairs; the box sweep must not lose any. A crossing pair of
  * triangles (and a pair that only touches at a point) among far apart ones is found. */
@@ -55,29 +50,6 @@ static void referee_finds_crossings_among_many(void **state) {
 
 /* ------------------------------------------------------------------ cloth folds */
 
-static char *read_text(const char *path) {
-  FILE *f = fopen(path, "rb");
-  if (!f) fail_msg("cannot open %s", path);
-  fseek(f, 0, SEEK_END);
-  long size = ftell(f);
-  fseek(f, 0, SEEK_SET);
-  char *text = malloc((size_t)size + 1);
-  assert_non_null(text);
-  assert_int_equal(fread(text, 1, (size_t)size, f), (size_t)size);
-  text[size] = 0;
-  fclose(f);
-  return text;
-}
-
-/* Replaces the first occurrence of from in text by to (same length or shorter). */
-static void replace(char *text, const char *from, const char *to) {
-  char *at = strstr(text, from);
-  if (!at) fail_msg("'%s' not found in the example", from);
-  size_t a = strlen(from), b = strlen(to);
-  assert_true(b <= a);
-  memcpy(at, to, b);
-  memmove(at + b, at + a, strlen(at + a) + 1);
-}
 
 /* Runs the example at resolution cells x cells until t_end, checking every step; returns the
  * worst number of intersecting pairs seen and adds the contact statistics to total. */
@@ -85,19 +57,19 @@ static long run_cloth_folds(int self_collision, const char *cells, double t_end,
                             piola_step_stats *total, double *final_top) {
   char path[1024];
   snprintf(path, sizeof path, "%s/examples/cloth_folds.json", PIOLA_SOURCE_DIR);
-  char *text = read_text(path);
-  replace(text, "\"resolution\": [48, 48]", cells);
+  char *text = test_read_text(path);
+  test_replace_first(text, "\"resolution\": [48, 48]", cells);
   /* collisions after every step, so that every step is judged (test_collision_step.c judges
    * the example's own collision steps) */
-  replace(text, "\"collision_interval\": 0.0016666666666666668", "\"collision_interval\": 0");
-  if (!self_collision) replace(text, "\"enabled\": true", "\"enabled\":false");
+  test_replace_first(text, "\"collision_interval\": 0.0016666666666666668", "\"collision_interval\": 0");
+  if (!self_collision) test_replace_first(text, "\"enabled\": true", "\"enabled\":false");
   piola_scene *scene = NULL;
   if (piola_scene_load_string(text, PIOLA_SOURCE_DIR, "cloth_folds", &scene) != PIOLA_OK)
     fail_msg("%s", piola_last_error());
   free(text);
   piola_world *w = piola_scene_world(scene);
   assert_int_equal(piola_world_shell_count(w), 1);
-  judged cloth = shell_set(w, 0);
+  judged cloth = referee_shell_set(w, 0);
   assert_int_equal(referee_count_intersections(&cloth, 1), 0);
   memset(total, 0, sizeof(*total));
   long worst = 0;
@@ -196,7 +168,7 @@ static double stack_sheets(int self_collision, double h, long *worst) {
   assert_int_equal(piola_world_add_shell(w, &a, NULL), PIOLA_OK);
   assert_int_equal(piola_world_add_shell(w, &b, NULL), PIOLA_OK);
   piola_tri_mesh_free(&lower), piola_tri_mesh_free(&upper);
-  judged sets[2] = {shell_set(w, 0), shell_set(w, 1)};
+  judged sets[2] = {referee_shell_set(w, 0), referee_shell_set(w, 1)};
   double smallest_gap = INFINITY;
   *worst = 0;
   const double t_end = 0.05 + 0.15 * (double)test_samples(10, 2) / 10.0;
@@ -279,7 +251,7 @@ static void block_hits_free_cloth(double speed, double h) {
   momentum(piola_world_shell_velocities(w, 0), mc, nc, p_cloth0);
   const double scale = fabs(p_block0[2]);
   judged sets[2] = {{piola_world_solid_positions(w, 0), boundary.triangles, boundary.triangle_count},
-                    shell_set(w, 0)};
+                    referee_shell_set(w, 0)};
   assert_int_equal(referee_count_intersections(sets, 2), 0);
   piola_step_stats total = {0};
   while (piola_world_time(w) < 0.08 / speed) {

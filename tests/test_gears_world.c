@@ -74,22 +74,6 @@ static double nip_half_height(void) {
   return sqrt(GEAR_TIP_RADIUS * GEAR_TIP_RADIUS - GEAR_CENTER_X * GEAR_CENTER_X);
 }
 
-static char *read_text(const char *path) {
-  FILE *f = fopen(path, "rb");
-  if (!f) return NULL;
-  fseek(f, 0, SEEK_END);
-  long n = ftell(f);
-  fseek(f, 0, SEEK_SET);
-  char *s = malloc((size_t)n + 1);
-  if (s && fread(s, 1, (size_t)n, f) != (size_t)n) {
-    free(s);
-    s = NULL;
-  }
-  if (s) s[n] = '\0';
-  fclose(f);
-  return s;
-}
-
 /* Replaces the one occurrence of `from` in *text by `to` (fails the test if absent). */
 static void replace_once(char **text, const char *from, const char *to) {
   char *at = strstr(*text, from);
@@ -137,8 +121,7 @@ static piola_scene *load_example(const char *replace_a, const char *by_a, const 
                                  const char *by_b) {
   char path[1024];
   snprintf(path, sizeof path, "%s/examples/gears.json", PIOLA_SOURCE_DIR);
-  char *text = read_text(path);
-  if (!text) fail_msg("cannot read %s", path);
+  char *text = test_read_text(path);
   if (replace_a) replace_once(&text, replace_a, by_a);
   if (replace_b) replace_once(&text, replace_b, by_b);
   piola_scene *scene = NULL;

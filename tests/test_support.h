@@ -37,4 +37,11 @@ double test_rng_normal(test_rng *rng);                         /* standard norma
 /* Path of a file in ../shared/data (static buffer, valid until the next call). */
 const char *test_data_path(const char *relative);
 
+/* The whole text file at path, NUL-terminated (free it); fails the test if it cannot be read. */
+char *test_read_text(const char *path);
+
+/* Replaces the first occurrence of from in text by to (no longer than from), in place: tests
+ * edit an example scene's text before loading it. Fails the test if from is absent. */
+void test_replace_first(char *text, const char *from, const char *to);
+
 #endif

@@ -19,4 +19,8 @@ typedef struct judged {
  * that share a vertex. Fails the test if the exact test reports an error. */
 long referee_count_intersections(const judged *sets, int set_count);
 
+struct piola_world;
+/* The triangles of shell `shell` of world w at its current positions. */
+judged referee_shell_set(const struct piola_world *w, int32_t shell);
+
 #endif

@@ -3,6 +3,7 @@
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
+#include <string.h>
 
 double test_scale(void) {
   const char *s = getenv("PIOLA_TEST_SCALE");
@@ -45,4 +46,27 @@ const char *test_data_path(const char *relative) {
   static char path[4096];
   snprintf(path, sizeof path, "%s/%s", PIOLA_DATA_DIR, relative);
   return path;
+}
+
+char *test_read_text(const char *path) {
+  FILE *f = fopen(path, "rb");
+  if (!f) fail_msg("cannot open %s", path);
+  fseek(f, 0, SEEK_END);
+  long size = ftell(f);
+  fseek(f, 0, SEEK_SET);
+  char *text = malloc((size_t)size + 1);
+  assert_non_null(text);
+  assert_int_equal(fread(text, 1, (size_t)size, f), (size_t)size);
+  text[size] = 0;
+  fclose(f);
+  return text;
+}
+
+void test_replace_first(char *text, const char *from, const char *to) {
+  char *at = strstr(text, from);
+  if (!at) fail_msg("'%s' not found in the text", from);
+  size_t a = strlen(from), b = strlen(to);
+  assert_true(b <= a);
+  memcpy(at, to, b);
+  memmove(at + b, at + a, strlen(at + a) + 1);
 }

@@ -5,6 +5,9 @@
 #include <stdlib.h>
 
 #include "contact/triangle_intersection.h"
+#include "piola/shell_body.h"
+#include "piola/world.h"
+#include "piola/world_shells.h"
 #include "triangle_referee.h"
 
 typedef struct tri_box {
@@ -61,3 +64,9 @@ long referee_count_intersections(const judged *sets, int set_count) {
   return hits;
 }
 
+
+judged referee_shell_set(const piola_world *w, int32_t shell) {
+  const piola_shell_body *b = piola_world_shell_body(w, shell);
+  return (judged){piola_world_shell_positions(w, shell), piola_shell_body_triangles(b),
+                  piola_shell_body_triangle_count(b)};
+}

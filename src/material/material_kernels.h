@@ -469,6 +469,30 @@ MATERIAL_KERNEL void neohookean_stress_lanes(const piola_material *m, double f0,
                                       double *p0, double *p1, double *p2) {
   material_extended_stress(PIOLA_MODEL_NEOHOOKEAN, m, KERNEL_FAST_RECIPROCAL, f0, f1, f2, p0, p1, p2);
 }
+/* Neo-Hookean for lanes whose entries all lie at or above the threshold (the force loop takes
+ * it for a block only when every lane qualifies, see material_lanes.h): there the extension
+ * adds exactly zero (d = q = 0), so this is the plain formula p_i = mu (f_i - 1/f_i) +
+ * lambda ln J / f_i, without the extension's saturations, slopes and selects. One logarithm
+ * of J = f0 f1 f2 instead of three: the caller guarantees J within [1e-300, 1e300]. Differs
+ * from neohookean_stress_lanes by a few ulp of lambda (ln J rounds once, not thrice). */
+MATERIAL_KERNEL void neohookean_stress_lanes_unclamped(const piola_material *m, double f0,
+                                                       double f1, double f2, double *p0,
+                                                       double *p1, double *p2) {
+  const double mu = m->mu;
+  const double i0 = kernel_recip_fast(f0), i1 = kernel_recip_fast(f1), i2 = kernel_recip_fast(f2);
+  const double lq = m->lambda * kernel_log_div(f0 * f1 * f2, KERNEL_FAST_RECIPROCAL);
+  *p0 = mu * (f0 - i0) + lq * i0;
+  *p1 = mu * (f1 - i1) + lq * i1;
+  *p2 = mu * (f2 - i2) + lq * i2;
+}
+
+/* 1 when neohookean_stress_lanes_unclamped applies to this lane: every entry >= threshold
+ * (false for NaN) and J in the range its single logarithm takes. */
+MATERIAL_KERNEL int neohookean_lane_unclamped(const piola_material *m, double f0, double f1,
+                                              double f2) {
+  const double c = m->threshold, j = f0 * f1 * f2;
+  return (f0 >= c) & (f1 >= c) & (f2 >= c) & (j >= 1e-300) & (j <= 1e300);
+}
 MATERIAL_KERNEL void spline_stress_lanes(const piola_material *m, double f0, double f1, double f2,
                                       double *p0, double *p1, double *p2) {
   material_extended_stress(PIOLA_MODEL_SPLINE, m, KERNEL_FAST_RECIPROCAL, f0, f1, f2, p0, p1, p2);

@@ -23,6 +23,7 @@
 #include "piola/mesh_io.h"
 #include "piola/threads.h"
 #include "piola/world.h"
+#include "support/bench_scenes.h"
 #include "support/bench_support.h"
 
 int main(int argc, char **argv) {
@@ -53,29 +54,9 @@ int main(int argc, char **argv) {
     double *damp = malloc((size_t)repeats * sizeof *damp);
     double cg_per_step = 0;
     for (int r = 0; r < repeats; ++r) {
-      piola_world_def wd = piola_default_world_def();
-      wd.max_dt = 1e-4;
-      wd.cfl = 2; /* fixed dt: this measures the cost of a step, not the step size */
-      piola_world *world = NULL;
-      piola_solid_def sd = piola_default_solid_def();
-      sd.mesh = &mesh;
-      sd.material.model = PIOLA_MODEL_NEOHOOKEAN;
-      sd.material.youngs_modulus = 1e5;
-      sd.material.poisson_ratio = 0.4;
-      sd.shear_viscosity = piola_track_constant(2e-5 * 1000 * size * size / 1e-4);
-      sd.bulk_viscosity = piola_track_constant(2e-5 * 1000 * size * size / 1e-4);
-      sd.scramble_radius = 1e-3 * size;
-      sd.velocity = (piola_vec3){0, 0, -1};
-      piola_obstacle_def ground = piola_default_obstacle_def();
-      ground.type = PIOLA_OBSTACLE_PLANE;
-      ground.center = (piola_vec3){0, 0, zmin};
-      ground.axis = (piola_vec3){0, 0, 1};
-      ground.friction = 0.5;
-      if (piola_world_create(&wd, &world) != PIOLA_OK || piola_world_add_solid(world, &sd, NULL) != PIOLA_OK ||
-          piola_world_add_obstacle(world, &ground, NULL) != PIOLA_OK) {
-        fprintf(stderr, "bench_step: %s\n", piola_last_error());
-        return 1;
-      }
+      /* the shared issue-3 scene (bench/support/bench_scenes.h): fixed dt 1e-4 s */
+      piola_world *world = bench_torus_step_world(&mesh, 0);
+      if (!world) return 1;
       piola_step_stats st;
       for (int s = 0; s < 3; ++s) piola_world_step(world, 1e-4, &st); /* warm up */
       const int steps = 10;

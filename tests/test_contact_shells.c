@@ -24,6 +24,7 @@
 #include "piola/world.h"
 #include "piola/world_shells.h"
 #include "scene/scene_desc.h"
+#include "cloth_scenes.h"
 #include "triangle_referee.h"
 
 /* ------------------------------------------------------------------ referee */
@@ -115,32 +116,6 @@ static void cloth_folds_example_never_intersects(void **state) {
 
 /* ------------------------------------------------------------------ stacked sheets */
 
-static piola_tri_mesh sheet(double size, int cells, double z, double shift) {
-  piola_tri_mesh m;
-  assert_int_equal(piola_tri_mesh_rectangle(size, size, cells, cells, &m), PIOLA_OK);
-  for (int32_t i = 0; i < m.vertex_count; ++i) {
-    m.positions[3 * i] += shift, m.positions[3 * i + 1] += 0.5 * shift;
-    m.positions[3 * i + 2] = z;
-  }
-  return m;
-}
-
-static piola_shell_def cloth_def(const piola_tri_mesh *mesh, int self_collision, double h) {
-  piola_shell_def d = piola_default_shell_def();
-  d.mesh = mesh;
-  d.thickness = 5e-4;
-  d.density = 400;
-  d.material.youngs_modulus = 5e4;
-  d.material.poisson_ratio = 0.3;
-  d.shear_viscosity = piola_track_constant(0.05);
-  d.bulk_viscosity = piola_track_constant(0.05);
-  d.bending.stiffness = 2e-6;
-  d.self_collision.enabled = self_collision != 0;
-  d.self_collision.thickness = h;
-  d.self_collision.friction = 0.3;
-  return d;
-}
-
 /* Lowest vertex of the upper sheet minus the highest of the lower one, m. */
 static double sheet_gap(const piola_world *w) {
   int32_t n0 = piola_shell_body_vertex_count(piola_world_shell_body(w, 0));
@@ -162,8 +137,8 @@ static double stack_sheets(int self_collision, double h, long *worst) {
   assert_int_equal(piola_world_add_obstacle(w, &ground, NULL), PIOLA_OK);
   /* the lower sheet lies on the ground; the upper one, offset so no vertex sits over a
    * vertex, falls onto it from 2 cm with 1 m/s */
-  piola_tri_mesh lower = sheet(0.2, 12, 0.0, 0.0), upper = sheet(0.16, 10, 0.02, 0.0037);
-  piola_shell_def a = cloth_def(&lower, self_collision, h), b = cloth_def(&upper, self_collision, h);
+  piola_tri_mesh lower = cloth_sheet(0.2, 12, 0.0, 0.0), upper = cloth_sheet(0.16, 10, 0.02, 0.0037);
+  piola_shell_def a = cloth_shell_def(&lower, self_collision, h), b = cloth_shell_def(&upper, self_collision, h);
   b.velocity = (piola_vec3){0, 0, -1.0};
   assert_int_equal(piola_world_add_shell(w, &a, NULL), PIOLA_OK);
   assert_int_equal(piola_world_add_shell(w, &b, NULL), PIOLA_OK);
@@ -200,89 +175,6 @@ static void stacked_sheets_stay_apart(void **state) {
 
 /* ------------------------------------------------------------------ two-way, momentum */
 
-static void momentum(const double *v, const double *m, int32_t n, double out[3]) {
-  for (int32_t i = 0; i < n; ++i)
-    for (int d = 0; d < 3; ++d) out[d] += m[i] * v[3 * i + d];
-}
-
-/* speed: m/s of the block, h: collision thickness, m. At 12 m/s the block moves about 1.4 mm
- * a step (the block's CFL step is about 0.12 ms), more than a thickness of 0.5 mm, so
- * continuous detection (impacts) has to act, not only the repulsion. */
-static void block_hits_free_cloth(double speed, double h) {
-  piola_world_def wd = piola_default_world_def();
-  for (int d = 0; d < 3; ++d) wd.gravity[d] = piola_track_constant(0.0);
-  wd.max_dt = 5e-4;
-  piola_world *w = NULL;
-  assert_int_equal(piola_world_create(&wd, &w), PIOLA_OK);
-  /* a 6 x 6 x 3 cm block of 4x4x2 cells at z in [0.01, 0.04] moving up at 2 m/s ... */
-  piola_tet_mesh block;
-  assert_int_equal(piola_tet_mesh_box_grid(4, 4, 2, (piola_vec3){0.015, 0.015, 0.015}, &block),
-                   PIOLA_OK);
-  for (int32_t i = 0; i < block.vertex_count; ++i) {
-    block.positions[3 * i] -= 0.03 + 1e-3, block.positions[3 * i + 1] -= 0.03 + 2e-3;
-    block.positions[3 * i + 2] += 0.01;
-  }
-  piola_tet_mesh_orient(&block);
-  piola_solid_def sd = piola_default_solid_def();
-  sd.mesh = &block;
-  sd.density = 300;
-  sd.material.youngs_modulus = 1e5;
-  sd.material.poisson_ratio = 0.3;
-  sd.velocity = (piola_vec3){0.1 * speed, 0, speed};
-  sd.self_collision.enabled = true;
-  sd.self_collision.thickness = h;
-  sd.self_collision.friction = 0.3;
-  assert_int_equal(piola_world_add_solid(w, &sd, NULL), PIOLA_OK);
-  /* ... into a free 12 x 12 cm cloth at rest at z = 0.05 */
-  piola_tri_mesh cloth = sheet(0.12, 12, 0.05, 0.0);
-  piola_shell_def cd = cloth_def(&cloth, 1, h);
-  cd.density = 2000; /* 1 kg/m^2: heavy enough to visibly slow the block */
-  assert_int_equal(piola_world_add_shell(w, &cd, NULL), PIOLA_OK);
-  piola_tri_mesh_free(&cloth);
-
-  piola_tri_mesh boundary;
-  assert_int_equal(piola_tet_mesh_boundary(&block, &boundary), PIOLA_OK);
-  const int32_t nb = piola_elastic_body_vertex_count(piola_world_solid_body(w, 0));
-  const int32_t nc = piola_shell_body_vertex_count(piola_world_shell_body(w, 0));
-  const double *mb = piola_elastic_body_masses(piola_world_solid_body(w, 0));
-  const double *mc = piola_shell_body_masses(piola_world_shell_body(w, 0));
-  double p_block0[3] = {0}, p_cloth0[3] = {0};
-  momentum(piola_world_solid_velocities(w, 0), mb, nb, p_block0);
-  momentum(piola_world_shell_velocities(w, 0), mc, nc, p_cloth0);
-  const double scale = fabs(p_block0[2]);
-  judged sets[2] = {{piola_world_solid_positions(w, 0), boundary.triangles, boundary.triangle_count},
-                    referee_shell_set(w, 0)};
-  assert_int_equal(referee_count_intersections(sets, 2), 0);
-  piola_step_stats total = {0};
-  while (piola_world_time(w) < 0.08 / speed) {
-    piola_step_stats one;
-    assert_int_equal(piola_world_step(w, 0, &one), PIOLA_OK);
-    total.contacts += one.contacts, total.impacts += one.impacts;
-    total.impact_zones += one.impact_zones;
-    long bad = referee_count_intersections(sets, 2);
-    if (bad) fail_msg("t = %g s: %ld intersecting triangle pairs", piola_world_time(w), bad);
-    double pb[3] = {0}, pc[3] = {0};
-    momentum(piola_world_solid_velocities(w, 0), mb, nb, pb);
-    momentum(piola_world_shell_velocities(w, 0), mc, nc, pc);
-    for (int d = 0; d < 3; ++d) assert_close(pb[d] + pc[d], p_block0[d] + p_cloth0[d], 1e-10 * scale);
-  }
-  double pb[3] = {0}, pc[3] = {0};
-  momentum(piola_world_solid_velocities(w, 0), mb, nb, pb);
-  momentum(piola_world_shell_velocities(w, 0), mc, nc, pc);
-  print_message("block into cloth at %g m/s: %lld contacts, %lld impacts, %lld zones; block p_z %.4g -> %.4g,"
-                " cloth p_z %.4g -> %.4g kg m/s\n",
-                speed, (long long)total.contacts, (long long)total.impacts,
-                (long long)total.impact_zones, p_block0[2], pb[2], p_cloth0[2], pc[2]);
-  assert_true(total.contacts + total.impacts > 0);
-  if (speed >= 10) assert_true(total.impacts > 0);
-  /* two-way: the block lost a real part of its momentum to the cloth */
-  assert_true(pb[2] < 0.9 * p_block0[2]);
-  assert_true(pc[2] > 0.1 * p_block0[2]);
-  piola_tri_mesh_free(&boundary);
-  piola_tet_mesh_free(&block);
-  piola_world_destroy(w);
-}
-
 /* With self_collision on both sides, the one-way collide_with_solids stays out of the pair:
  * turning it on changes nothing, to the bit. */
 static void one_way_coupling_defers_to_two_way_contact(void **state) {
@@ -311,8 +203,8 @@ static void one_way_coupling_defers_to_two_way_contact(void **state) {
     sd.self_collision.enabled = true;
     sd.self_collision.thickness = 2e-3;
     assert_int_equal(piola_world_add_solid(w, &sd, NULL), PIOLA_OK);
-    piola_tri_mesh cloth = sheet(0.12, 10, 0.05, 0.0);
-    piola_shell_def cd = cloth_def(&cloth, 1, 2e-3);
+    piola_tri_mesh cloth = cloth_sheet(0.12, 10, 0.05, 0.0);
+    piola_shell_def cd = cloth_shell_def(&cloth, 1, 2e-3);
     cd.collide_with_solids = one_way != 0;
     cd.velocity = (piola_vec3){0, 0, -6.0}; /* 3 mm a step: x~ reaches into the block */
     assert_int_equal(piola_world_add_shell(w, &cd, NULL), PIOLA_OK);
@@ -333,14 +225,19 @@ static void one_way_coupling_defers_to_two_way_contact(void **state) {
   free(runs[0]), free(runs[1]);
 }
 
+/* speed: m/s of the block, h: collision thickness, m (cloth_scenes.h). At 12 m/s the block
+ * moves about 1.4 mm a step (the block's CFL step is about 0.12 ms), more than a thickness of
+ * 0.5 mm, so continuous detection (impacts) has to act, not only the repulsion. Collisions are
+ * processed and judged after every step (collision_interval 0). */
+
 static void block_hits_free_cloth_conserving_momentum(void **state) {
   (void)state;
-  block_hits_free_cloth(2.0, 2e-3);
+  block_hits_free_cloth(2.0, 2e-3, 0);
 }
 
 static void fast_block_hits_free_cloth_conserving_momentum(void **state) {
   (void)state;
-  block_hits_free_cloth(12.0, 5e-4);
+  block_hits_free_cloth(12.0, 5e-4, 0);
 }
 
 /* ------------------------------------------------------------------ keys and defs */
@@ -367,8 +264,8 @@ static void shell_self_collision_key_and_def(void **state) {
   piola_world_def wd = piola_default_world_def();
   piola_world *w = NULL;
   assert_int_equal(piola_world_create(&wd, &w), PIOLA_OK);
-  piola_tri_mesh m = sheet(0.1, 2, 0, 0);
-  piola_shell_def sd = cloth_def(&m, 1, 0.0);
+  piola_tri_mesh m = cloth_sheet(0.1, 2, 0, 0);
+  piola_shell_def sd = cloth_shell_def(&m, 1, 0.0);
   assert_int_equal(piola_world_add_shell(w, &sd, NULL), PIOLA_ERROR_INVALID_ARGUMENT);
   sd.self_collision.thickness = 1e-3, sd.self_collision.friction = -0.5;
   assert_int_equal(piola_world_add_shell(w, &sd, NULL), PIOLA_ERROR_INVALID_ARGUMENT);

@@ -8,7 +8,7 @@
 /* The default fibre parameters (piola_default_material_def fills them in). */
 piola_muscle_def piola__default_muscle_def(void);
 
-/* Validates def->muscle (errors name the key, "muscle.xxx") and stores it and the fibre
+/* Validates def->muscle (errors name the key, e.g. "muscle.active_width") and stores it and the fibre
  * modulus in out. Called for PIOLA_MODEL_MUSCLE only. */
 piola_status piola__muscle_init(const piola_material_def *def, piola_material *out);
 

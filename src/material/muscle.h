@@ -8,8 +8,8 @@
 /* The default fibre parameters (piola_default_material_def fills them in). */
 piola_muscle_def piola__default_muscle_def(void);
 
-/* Validates def->muscle (errors name the key, e.g. "muscle.active_width") and stores it and the fibre
- * modulus in out. Called for PIOLA_MODEL_MUSCLE only. */
+/* Validates def->muscle (errors name the key, e.g. "muscle.active_width") and stores it and
+ * the fibre modulus in out. Called for PIOLA_MODEL_MUSCLE only. */
 piola_status piola__muscle_init(const piola_material_def *def, piola_material *out);
 
 #endif

@@ -332,34 +332,34 @@ piola_status piola_elastic_body_update(piola_elastic_body *body, const double *x
   }
   int32_t blocks = body->padded_tet_count / B;
   const int64_t n = 3 * (int64_t)body->vertex_count;
-  if (blocks < PIOLA_PARALLEL_MIN_BLOCKS || !body->damping_chunk_forces) {
+  if (blocks < PIOLA_PARALLEL_MIN_BLOCKS || !body->chunk_forces) {
     for (int64_t i = 0; i < n; ++i) forces[i] = 0.0;
     update_block_range(body, x, stiffness_scale, stats != NULL, 0, blocks, forces);
   } else {
-    /* Determinism without a per-tet buffer (as in damping.c): PIOLA_DAMPING_CHUNKS fixed
+    /* Determinism without a per-tet buffer: PIOLA_FORCE_CHUNKS fixed
      * ranges of blocks, each summed in tet order into its own array, the arrays added in
      * chunk order; which thread runs a chunk changes nothing. */
-    double *partial = body->damping_chunk_forces;
+    double *partial = body->chunk_forces;
 #pragma omp parallel num_threads(piola__thread_count())
     {
 #pragma omp for schedule(static)
-      for (int k = 0; k < PIOLA_DAMPING_CHUNKS; ++k) {
+      for (int k = 0; k < PIOLA_FORCE_CHUNKS; ++k) {
         double *fk = partial + (size_t)k * (size_t)n;
         for (int64_t i = 0; i < n; ++i) fk[i] = 0.0;
-        int32_t b0 = (int32_t)((int64_t)blocks * k / PIOLA_DAMPING_CHUNKS);
-        int32_t b1 = (int32_t)((int64_t)blocks * (k + 1) / PIOLA_DAMPING_CHUNKS);
+        int32_t b0 = (int32_t)((int64_t)blocks * k / PIOLA_FORCE_CHUNKS);
+        int32_t b1 = (int32_t)((int64_t)blocks * (k + 1) / PIOLA_FORCE_CHUNKS);
         update_block_range(body, x, stiffness_scale, stats != NULL, b0, b1, fk);
       }
 #pragma omp for schedule(static)
       for (int64_t i = 0; i < n; ++i) {
         double sum = partial[i];
-        for (int k = 1; k < PIOLA_DAMPING_CHUNKS; ++k) sum += partial[(size_t)k * (size_t)n + i];
+        for (int k = 1; k < PIOLA_FORCE_CHUNKS; ++k) sum += partial[(size_t)k * (size_t)n + i];
         forces[i] = sum;
       }
     }
   }
   body->has_state = 1;
-  body->damping_ready = 0;
+  body->damping.ready = 0;
   memcpy(body->positions, x, sizeof(double) * 3 * (size_t)body->vertex_count);
   body->energy_valid = stats != NULL;
   body->last_stiffness_scale = stiffness_scale;

@@ -13,9 +13,9 @@
  * 9 multiplies it costs. Cold data (rest positions, masses, the public AoS copy of the tets)
  * lives apart and the loop never touches it.
  *
- * Determinism. The force loop splits the tets into PIOLA_DAMPING_CHUNKS fixed ranges of
+ * Determinism. The force loop splits the tets into PIOLA_FORCE_CHUNKS fixed ranges of
  * blocks (whatever the thread count); each range adds its tets' forces in tet order into its
- * own per-vertex array (damping_chunk_forces, shared scratch with damping), and the arrays
+ * own per-vertex array (chunk_forces), and the arrays
  * are added in range order. Each sum has a fixed order and no two threads write the same
  * place, so forces are bit-for-bit identical for any thread count, without atomics. (The
  * per-tet buffer tet_forces and the incidence list below were the previous scheme.)
@@ -35,6 +35,7 @@
 #include <stdint.h>
 
 #include "common/threads.h"
+#include "force/damping_matrix.h"
 #include "piola/elastic_body.h"
 
 #define PIOLA_TET_BLOCK 8
@@ -102,18 +103,16 @@ struct piola_elastic_body {
                                when stats are requested, or lazily by the getter) */
   double last_stiffness_scale;
 
-  /* damping (damping.c): per-tet operator data, prepared from the last update by the first
-   * damping call after it; per block of PIOLA_TET_BLOCK tets at most PIOLA_DAMPING_FIELDS
-   * rows of PIOLA_TET_BLOCK doubles (layout in damping.c) */
-  double *damping_data;
-  double *damping_chunk_forces;  /* PIOLA_DAMPING_CHUNKS * 3 * vertex_count partial sums */
-  int damping_ready;             /* damping_data matches the last update (cleared by it) */
+  double *chunk_forces; /* PIOLA_FORCE_CHUNKS * 3 * vertex_count partial sums of the force loop */
+
+  /* damping (damping.c): the operator as a sparse matrix, assembled from the last update by
+   * the first damping call after it (the update clears damping.ready) */
+  piola__damping_matrix damping;
 };
 
-/* Bodies of at least PIOLA_PARALLEL_MIN_BLOCKS blocks sum their damping forces in this many
+/* Bodies of at least PIOLA_PARALLEL_MIN_BLOCKS blocks sum their elastic forces in this many
  * fixed tet ranges (each its own partial sum), whatever the thread count. */
-#define PIOLA_DAMPING_CHUNKS 4
-#define PIOLA_DAMPING_FIELDS 27
+#define PIOLA_FORCE_CHUNKS 4
 
 /* Where tet t's corner c force starts in tet_forces: blocks of PIOLA_TET_BLOCK tets hold
  * 12 rows (3 c + i) of PIOLA_TET_BLOCK lanes, so the force loop stores whole vectors. */
@@ -143,10 +142,11 @@ void piola__elastic_body_damping_reference(const piola_elastic_body *body, const
                                            double shear_viscosity, double bulk_viscosity,
                                            double *forces);
 
-/* Prepares the damping operator's per-tet records from the last update, if that has not
- * been done yet (damping.c). piola_elastic_body_damping_forces calls it itself; the step
- * loop calls it apart so its cost can be timed. */
-void piola__elastic_body_damping_prepare(piola_elastic_body *body);
+/* Assembles the damping matrix from the last update with these viscosities (Pa s), unless
+ * that has been done already (damping.c). The damping calls do it themselves; the step loop
+ * calls it apart so its cost can be timed. */
+void piola__elastic_body_damping_prepare(piola_elastic_body *body, double shear_viscosity,
+                                         double bulk_viscosity);
 
 /* The implicit step's operator out = M v - h D v (3 * vertex_count), D the damping of
  * piola_elastic_body_damping_forces, mass the lumped masses (vertex_count, kg), h in s: the
@@ -155,8 +155,8 @@ void piola__elastic_body_damping_operator(const piola_elastic_body *body, const 
                                           double shear_viscosity, double bulk_viscosity,
                                           const double *mass, double h, double *out);
 
-/* forces += D v for a v that is zero on all but a few vertices: only the blocks of tets
- * touching a vertex with nonzero v are evaluated, serially, in tet order (damping.c). For
+/* forces += D v for a v that is zero on all but a few vertices: only the edges touching a
+ * vertex with nonzero v are visited, serially, in vertex order (damping.c). For
  * correcting a product already taken at a nearby v (the step's second right-hand side). */
 void piola__elastic_body_damping_forces_add_sparse(const piola_elastic_body *body, const double *v,
                                                    double shear_viscosity, double bulk_viscosity,

@@ -43,8 +43,8 @@ void piola__elastic_body_free_arrays(piola_elastic_body *body) {
   free(body->rest_positions);
   free(body->masses);
   free(body->positions);
-  free(body->damping_data);
-  free(body->damping_chunk_forces);
+  free(body->chunk_forces);
+  piola__damping_matrix_free(&body->damping);
   for (int k = 0; k < 3; ++k) free(body->fiber[k]);
   free(body->fiber_aos);
   memset(body, 0, sizeof *body);
@@ -114,9 +114,8 @@ piola_status piola__elastic_body_build_rest_state(piola_elastic_body *body,
   ok &= (body->rest_positions = alloc_array(3 * (size_t)nv, sizeof(double))) != NULL;
   ok &= (body->masses = alloc_array((size_t)nv, sizeof(double))) != NULL;
   ok &= (body->positions = alloc_array(3 * (size_t)nv, sizeof(double))) != NULL;
-  ok &= (body->damping_data = alloc_array(PIOLA_DAMPING_FIELDS * (size_t)np, sizeof(double))) != NULL;
   if (nb >= PIOLA_PARALLEL_MIN_BLOCKS)
-    ok &= (body->damping_chunk_forces = alloc_array(PIOLA_DAMPING_CHUNKS * 3 * (size_t)nv, sizeof(double))) != NULL;
+    ok &= (body->chunk_forces = alloc_array(PIOLA_FORCE_CHUNKS * 3 * (size_t)nv, sizeof(double))) != NULL;
   if (!ok) return PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "elastic body with %d tets: out of memory", (int)nt);
 
   memcpy(body->materials, def->materials, sizeof(piola_material) * (size_t)def->material_count);
@@ -199,5 +198,5 @@ piola_status piola__elastic_body_build_rest_state(piola_elastic_body *body,
   }
   body->energy_valid = 1; /* zero at rest */
   body->last_stiffness_scale = 1.0;
-  return PIOLA_OK;
+  return piola__damping_matrix_init(&body->damping, body);
 }

@@ -226,16 +226,16 @@ static piola_status step_solid(piola_world *w, world_solid *s, double t, double 
     for (int k = 0; k < 3; ++k) s->v[3 * i + k] = (xp[k] - s->x[3 * i + k]) / dt;
   }
   piola__step_profile_mark(&w->profile, STEP_PHASE_SETUP);
-  if (s->body) piola__elastic_body_damping_prepare(s->body);
+  double beta0 = piola_track_eval(&s->shear_viscosity, t);
+  double alpha0 = piola_track_eval(&s->bulk_viscosity, t);
+  const int damped = !piola__solid_undamped(s, beta0, alpha0);
+  if (s->body && damped) piola__elastic_body_damping_prepare(s->body, beta0, alpha0);
   piola__step_profile_mark(&w->profile, STEP_PHASE_PREPARE);
   const double gravity1[3] = {h * g0[0], h * g0[1], h * g0[2]};
   /* for a damped body, keep the guess x0 (in tmp) and A x0 (in the slot of A v, free until
    * the final solve): the second right-hand side's D_n v' is h D_n x0 = M x0 - A x0 plus a
    * correction on the few nodes where v' differs from the guess (see there) */
   double *initial_av = s->work + 3 * m;
-  double beta0 = piola_track_eval(&s->shear_viscosity, t);
-  double alpha0 = piola_track_eval(&s->bulk_viscosity, t);
-  const int damped = !piola__solid_undamped(s, beta0, alpha0);
   const int reuse = damped && s->body && piola__step_reuse_first_product;
   stats->cg_iterations += damping_solve(w, s, h, t, 0, s->rhs, s->v, gravity1, NULL,
                                         reuse ? s->tmp : NULL, reuse ? initial_av : NULL);
@@ -302,7 +302,11 @@ static piola_status step_solid(piola_world *w, world_solid *s, double t, double 
   }
   if (s->shell) piola_shell_body_plastic_flow(s->shell, dt);
   piola__step_profile_mark(&w->profile, STEP_PHASE_UPDATE);
-  if (s->body) piola__elastic_body_damping_prepare(s->body);
+  if (s->body) {
+    double beta1 = piola_track_eval(&s->shear_viscosity, t1);
+    double alpha1 = piola_track_eval(&s->bulk_viscosity, t1);
+    if (!piola__solid_undamped(s, beta1, alpha1)) piola__elastic_body_damping_prepare(s->body, beta1, alpha1);
+  }
   piola__step_profile_mark(&w->profile, STEP_PHASE_PREPARE);
 
   /* 4. trapezoidal velocity, damping at n+1 implicit, normal velocity of contacts held */

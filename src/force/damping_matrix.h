@@ -1,0 +1,63 @@
+/* The damping operator as an assembled sparse matrix (see damping.c for the physics).
+ *
+ * The damping force is linear in the velocities, f = D v, and D changes only when the body is
+ * updated, while the implicit step applies it in every conjugate-gradient iteration. So D is
+ * assembled once per update and each apply is a sparse product. D is symmetric and its rows
+ * sum to zero (a uniform velocity is not damped), so only the off-diagonal 3x3 blocks are
+ * stored, one per mesh edge (i, j), i < j, holding D_ij (D_ji is its transpose), and the
+ * product is written in edge differences:
+ *   f_i = sum over edges (i, j) of D_ij (v_j - v_i).
+ * That keeps a rigid translation undamped exactly and needs no diagonal blocks.
+ *
+ * Layout. Edges are numbered row by row: the edges of row i are (i, col[k]) for k in
+ * [row_start[i], row_start[i + 1]), col increasing, and block k is blocks[9 k .. 9 k + 8]
+ * (row-major). Row i's other edges, (j, i) with j < i, are listed in lower_edge/lower_col
+ * [lower_start[i], lower_start[i + 1]). The product gathers both lists per row, so every row
+ * is summed by one thread in a fixed order: bit-identical results for any thread count.
+ *
+ * Assembly. Each tet adds its 6 corner-pair blocks to the blocks of its 6 edges
+ * (tet_edges[6 t + p], pair p in the order 01 02 03 12 13 23; bit p of tet_flags[t] says the
+ * tet's corner pair is stored transposed, bit 6 + p that this tet is the first to write that
+ * block, so the blocks need no clearing pass). Tets are processed in chunks of whole SIMD
+ * blocks; chunks of one color share no edge, so a color's chunks run in parallel, the colors
+ * one after another. Every block is then summed in the same order (color, then tet) for any
+ * thread count. */
+#ifndef PIOLA_FORCE_DAMPING_MATRIX_H
+#define PIOLA_FORCE_DAMPING_MATRIX_H
+
+#include <stdint.h>
+
+#include "piola/elastic_body.h"
+
+typedef struct piola__damping_matrix {
+  int32_t vertex_count;
+  int32_t edge_count;
+  int32_t *row_start;   /* vertex_count + 1 */
+  int32_t *col;         /* edge_count */
+  int32_t *lower_start; /* vertex_count + 1 */
+  int32_t *lower_edge;  /* edge_count */
+  int32_t *lower_col;   /* edge_count */
+  int32_t *tet_edges;   /* 6 per tet (tet_count) */
+  uint16_t *tet_flags;  /* per tet: transposed pairs (bits 0-5), first writers (bits 6-11) */
+  int32_t chunk_blocks; /* SIMD blocks per assembly chunk */
+  int32_t chunk_count;
+  int32_t color_count;
+  int serial;           /* the coloring gave up (over 64 colors): one color, one thread */
+  int32_t *color_start; /* color_count + 1, into color_chunks */
+  int32_t *color_chunks;/* chunk indices grouped by color, increasing within a color */
+  double *blocks;       /* 9 per edge: D_ij, N s/m (force per velocity) */
+  double shear_viscosity, bulk_viscosity; /* what blocks were assembled with, Pa s */
+  int ready;            /* blocks match the body's last update and these viscosities */
+} piola__damping_matrix;
+
+/* Builds the sparsity pattern, tet edge slots and the assembly coloring of body's mesh
+ * (damping_pattern.c); allocates the blocks. Needs the body's tets and vertex count. */
+piola_status piola__damping_matrix_init(piola__damping_matrix *matrix, const piola_elastic_body *body);
+
+void piola__damping_matrix_free(piola__damping_matrix *matrix);
+
+/* Assembles the blocks from the body's last update (damping_assembly.c). */
+void piola__damping_matrix_assemble(piola__damping_matrix *matrix, const piola_elastic_body *body,
+                                    double shear_viscosity, double bulk_viscosity);
+
+#endif

@@ -13,9 +13,10 @@
  * stored orientation is the other way round. The diagonal blocks are never formed: rows of D
  * sum to zero, and the product works in edge differences.
  *
- * Cost: about 900 flops per tet, vectorized across a SIMD block of tets, then 54 scalar
- * additions into the edge blocks. Chunks of one color share no edge, so they run in
- * parallel; each block is summed in a fixed order for any thread count. */
+ * Cost: about 1100 flops per tet, vectorized across a SIMD block of tets, then 54 scalar
+ * additions into the edge blocks. Fixed tet ranges run in parallel, edges they share
+ * through private slots (damping_matrix.h), so each block is summed in a fixed order for
+ * any thread count. */
 #include <math.h>
 
 #include "force/damping_matrix.h"
@@ -23,6 +24,7 @@
 #include "force/svd_kernel.h"
 
 #define B PIOLA_TET_BLOCK
+#define PREFETCH_BLOCKS 4
 
 /* Corner pairs, as in damping_pattern.c. */
 static const int PAIR_A[6] = {0, 0, 0, 1, 1, 2}, PAIR_B[6] = {1, 2, 3, 2, 3, 3};
@@ -35,6 +37,18 @@ PIOLA_WIDE_VECTORS static void tet_blocks(const piola_elastic_body *body, int32_
   const int32_t *i0 = body->tet_vertices[0] + base, *i1 = body->tet_vertices[1] + base;
   const int32_t *i2 = body->tet_vertices[2] + base, *i3 = body->tet_vertices[3] + base;
   const double *x = body->positions, *volume = body->rest_volume + base;
+  /* the tet state comes in 32 streams (U, V, Dm^-1 entry by entry, V0, the corners), more
+   * than the hardware prefetcher follows: ask for a later block's lines now */
+  const int32_t ahead = base + PREFETCH_BLOCKS * B;
+  if (ahead < body->padded_tet_count) {
+    for (int k = 0; k < 9; ++k) {
+      __builtin_prefetch(body->u[k] + ahead);
+      __builtin_prefetch(body->v[k] + ahead);
+      __builtin_prefetch(body->dm_inv[k] + ahead);
+    }
+    __builtin_prefetch(body->rest_volume + ahead);
+    for (int c = 0; c < 4; ++c) __builtin_prefetch(body->tet_vertices[c] + ahead);
+  }
   double q9[9][B], m9[9][B];
   /* Q = U V^T and sqrt(V0) Dm^-1, in loops of their own so the one below stays in registers
    * as far as it can */
@@ -164,17 +178,17 @@ PIOLA_WIDE_VECTORS static void tet_blocks(const piola_elastic_body *body, int32_
   }
 }
 
-/* Adds (or, for a block's first writer, stores) a SIMD block's tet blocks into the edges,
+/* Adds (or, for a slot's first writer, stores) a SIMD block's tet blocks into their slots,
  * transposed where the edge is stored the other way round (D_ij = D_ba^T). */
 static void scatter_tets(piola__damping_matrix *m, int32_t block, int32_t tet_count, const double *out) {
   static const int TRANSPOSE[2][9] = {{0, 1, 2, 3, 4, 5, 6, 7, 8}, {0, 3, 6, 1, 4, 7, 2, 5, 8}};
   const int32_t base = block * B;
   const int32_t lanes = tet_count - base < B ? tet_count - base : B;
   for (int l = 0; l < lanes; ++l) {
-    const int32_t *edges = m->tet_edges + 6 * (size_t)(base + l);
+    const int32_t *slots = m->tet_slot + 6 * (size_t)(base + l);
     const unsigned flags = m->tet_flags[base + l];
     for (int p = 0; p < 6; ++p) {
-      double *dst = m->blocks + 9 * (size_t)edges[p];
+      double *dst = m->store + 9 * (size_t)slots[p];
       const double *src = out + 9 * p * B + l;
       const int *order = TRANSPOSE[(flags >> p) & 1];
       if ((flags >> (6 + p)) & 1)
@@ -185,26 +199,37 @@ static void scatter_tets(piola__damping_matrix *m, int32_t block, int32_t tet_co
   }
 }
 
-static void assemble_chunk(piola__damping_matrix *m, const piola_elastic_body *body, int32_t chunk,
-                           double beta, double alpha) {
+/* Range k of the tets: its SIMD blocks in order. */
+static void assemble_part(piola__damping_matrix *m, const piola_elastic_body *body, int k, double beta,
+                          double alpha) {
   const int32_t blocks = body->padded_tet_count / B;
-  int32_t b0 = chunk * m->chunk_blocks, b1 = b0 + m->chunk_blocks < blocks ? b0 + m->chunk_blocks : blocks;
   double out[54 * B];
-  for (int32_t b = b0; b < b1; ++b) {
+  for (int32_t b = piola__damping_part_start(blocks, k); b < piola__damping_part_start(blocks, k + 1); ++b) {
     tet_blocks(body, b, beta, alpha, out);
     scatter_tets(m, b, body->tet_count, out);
+  }
+}
+
+/* Edge shared_edge[k] = the sum of its private slots, in range order. */
+static void reduce_shared(piola__damping_matrix *m, int32_t k) {
+  double *dst = m->blocks + 9 * (size_t)m->shared_edge[k];
+  int32_t s0 = m->shared_slot_start[k], s1 = m->shared_slot_start[k + 1];
+  for (int i = 0; i < 9; ++i) {
+    double sum = m->store[9 * (size_t)s0 + i];
+    for (int32_t s = s0 + 1; s < s1; ++s) sum += m->store[9 * (size_t)s + i];
+    dst[i] = sum;
   }
 }
 
 void piola__damping_matrix_assemble(piola__damping_matrix *m, const piola_elastic_body *body,
                                     double shear_viscosity, double bulk_viscosity) {
   const int32_t blocks = body->padded_tet_count / B;
-  const int threads = m->serial ? 1 : piola__thread_count();
-#pragma omp parallel num_threads(threads) if (blocks >= PIOLA_PARALLEL_MIN_BLOCKS)
-  for (int k = 0; k < m->color_count; ++k) {
-#pragma omp for schedule(dynamic, 1)
-    for (int32_t s = m->color_start[k]; s < m->color_start[k + 1]; ++s)
-      assemble_chunk(m, body, m->color_chunks[s], shear_viscosity, bulk_viscosity);
+#pragma omp parallel num_threads(piola__thread_count()) if (blocks >= PIOLA_PARALLEL_MIN_BLOCKS)
+  {
+#pragma omp for schedule(static)
+    for (int k = 0; k < PIOLA_DAMPING_PARTS; ++k) assemble_part(m, body, k, shear_viscosity, bulk_viscosity);
+#pragma omp for schedule(static)
+    for (int32_t k = 0; k < m->shared_count; ++k) reduce_shared(m, k);
   }
   m->shear_viscosity = shear_viscosity;
   m->bulk_viscosity = bulk_viscosity;

@@ -15,13 +15,15 @@
  * [lower_start[i], lower_start[i + 1]). The product gathers both lists per row, so every row
  * is summed by one thread in a fixed order: bit-identical results for any thread count.
  *
- * Assembly. Each tet adds its 6 corner-pair blocks to the blocks of its 6 edges
- * (tet_edges[6 t + p], pair p in the order 01 02 03 12 13 23; bit p of tet_flags[t] says the
- * tet's corner pair is stored transposed, bit 6 + p that this tet is the first to write that
- * block, so the blocks need no clearing pass). Tets are processed in chunks of whole SIMD
- * blocks; chunks of one color share no edge, so a color's chunks run in parallel, the colors
- * one after another. Every block is then summed in the same order (color, then tet) for any
- * thread count. */
+ * Assembly. Each tet adds its 6 corner-pair blocks to its 6 edges (pair p in the order
+ * 01 02 03 12 13 23; bit p of tet_flags[t] says the pair is stored transposed). The tets are
+ * split into PIOLA_DAMPING_PARTS fixed ranges assembled in parallel. An edge only one range
+ * touches is written in place; an edge several ranges touch (the ranges' borders, or most
+ * edges of a mesh whose tet order has no locality) gets a private slot per range, after the
+ * blocks in `store`, and a last pass adds those slots up in range order. tet_slot[6 t + p]
+ * is where tet t writes pair p, and bit 6 + p of tet_flags[t] says it writes there first,
+ * so nothing needs clearing. Every block is summed in the same order for any thread
+ * count. */
 #ifndef PIOLA_FORCE_DAMPING_MATRIX_H
 #define PIOLA_FORCE_DAMPING_MATRIX_H
 
@@ -37,20 +39,26 @@ typedef struct piola__damping_matrix {
   int32_t *lower_start; /* vertex_count + 1 */
   int32_t *lower_edge;  /* edge_count */
   int32_t *lower_col;   /* edge_count */
-  int32_t *tet_edges;   /* 6 per tet (tet_count) */
+  int32_t *tet_slot;    /* 6 per tet (tet_count): where each pair goes in store */
   uint16_t *tet_flags;  /* per tet: transposed pairs (bits 0-5), first writers (bits 6-11) */
-  int32_t chunk_blocks; /* SIMD blocks per assembly chunk */
-  int32_t chunk_count;
-  int32_t color_count;
-  int serial;           /* the coloring gave up (over 64 colors): one color, one thread */
-  int32_t *color_start; /* color_count + 1, into color_chunks */
-  int32_t *color_chunks;/* chunk indices grouped by color, increasing within a color */
-  double *blocks;       /* 9 per edge: D_ij, N s/m (force per velocity) */
+  int32_t shared_count; /* edges touched by more than one tet range */
+  int32_t *shared_edge; /* shared_count edges, increasing */
+  int32_t *shared_slot_start; /* shared_count + 1: the private slots of shared_edge[k] */
+  double *store;        /* 9 doubles per slot: the edge_count blocks, then private slots */
+  double *blocks;       /* = store: 9 per edge, D_ij, N s/m (force per velocity) */
   double shear_viscosity, bulk_viscosity; /* what blocks were assembled with, Pa s */
   int ready;            /* blocks match the body's last update and these viscosities */
 } piola__damping_matrix;
 
-/* Builds the sparsity pattern, tet edge slots and the assembly coloring of body's mesh
+/* Tet ranges assembled in parallel; fixed, so results do not depend on the thread count. */
+#define PIOLA_DAMPING_PARTS 8
+
+/* The first SIMD block of range k (k = PIOLA_DAMPING_PARTS: the end) of blocks blocks. */
+static inline int32_t piola__damping_part_start(int32_t blocks, int k) {
+  return (int32_t)((int64_t)blocks * k / PIOLA_DAMPING_PARTS);
+}
+
+/* Builds the sparsity pattern, the tets' slots and the private slots of body's mesh
  * (damping_pattern.c); allocates the blocks. Needs the body's tets and vertex count. */
 piola_status piola__damping_matrix_init(piola__damping_matrix *matrix, const piola_elastic_body *body);
 

@@ -1,17 +1,12 @@
-/* The damping matrix's structure (layout in damping_matrix.h): one block per mesh edge,
- * each tet's 6 edge slots, and the coloring that lets tets be assembled in parallel
- * without two threads adding to one block. Built once per body. */
+/* The damping matrix's structure (layout in damping_matrix.h): one block per mesh edge, and
+ * where each tet writes its 6 pairs so that tet ranges can be assembled in parallel without
+ * two threads adding to one block. Built once per body. */
 #include <stdlib.h>
 #include <string.h>
 
 #include "common/status_internal.h"
 #include "force/damping_matrix.h"
 #include "force/elastic_body_internal.h"
-
-/* Tets per assembly chunk, in SIMD blocks: big enough that a color's chunks are worth
- * handing out to threads, small enough that chunks of a well-ordered mesh rarely share an
- * edge, so a few colors suffice. */
-#define CHUNK_BLOCKS 32
 
 /* Corner pairs of a tet, in the order of tet_edges and of the assembly's blocks. */
 static const int PAIRS[6][2] = {{0, 1}, {0, 2}, {0, 3}, {1, 2}, {1, 3}, {2, 3}};
@@ -96,75 +91,86 @@ static piola_status build_lower(piola__damping_matrix *m) {
   return PIOLA_OK;
 }
 
-/* Greedy coloring of the chunks (no two chunks of a color touch one edge), then which tet
- * writes each block first in the order colors, chunks, tets. More than 64 colors (a mesh
- * whose tet order has no locality at all) falls back to one color run on one thread. */
-static piola_status build_coloring(piola__damping_matrix *m, int32_t tet_count, int32_t padded_tet_count) {
-  int32_t blocks = padded_tet_count / PIOLA_TET_BLOCK;
-  m->chunk_blocks = CHUNK_BLOCKS;
-  m->chunk_count = (blocks + CHUNK_BLOCKS - 1) / CHUNK_BLOCKS;
-  int32_t nc = m->chunk_count, chunk_tets = CHUNK_BLOCKS * PIOLA_TET_BLOCK;
-  uint64_t *used = calloc((size_t)m->edge_count + 1, sizeof(uint64_t));
-  int32_t *color = malloc(sizeof(int32_t) * ((size_t)nc + 1));
-  uint8_t *seen = calloc((size_t)m->edge_count + 1, 1);
-  m->color_chunks = malloc(sizeof(int32_t) * ((size_t)nc + 1));
-  m->color_start = calloc(66, sizeof(int32_t));
-  if (!used || !color || !seen || !m->color_chunks || !m->color_start) {
-    free(used);
-    free(color);
-    free(seen);
+/* The range (of PIOLA_DAMPING_PARTS) that tet t belongs to. */
+static int tet_part(int32_t t, int32_t blocks) {
+  int32_t b = t / PIOLA_TET_BLOCK;
+  int k = (int)((int64_t)b * PIOLA_DAMPING_PARTS / (blocks > 0 ? blocks : 1));
+  while (k > 0 && b < piola__damping_part_start(blocks, k)) --k;
+  while (k + 1 < PIOLA_DAMPING_PARTS && b >= piola__damping_part_start(blocks, k + 1)) ++k;
+  return k;
+}
+
+/* Where each tet writes each pair: the edge's block, or for an edge that more than one range
+ * touches, that range's private slot; and which tet writes each slot first. */
+static piola_status build_slots(piola__damping_matrix *m, int32_t tet_count, int32_t blocks,
+                                const int32_t *tet_edge) {
+  const int32_t ne = m->edge_count;
+  int8_t *last = malloc((size_t)ne + 1);
+  int32_t *parts = calloc((size_t)ne + 1, sizeof(int32_t));
+  if (!last || !parts) {
+    free(last);
+    free(parts);
     return PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "damping matrix: out of memory");
   }
-  int serial = 0;
-  for (int32_t c = 0; c < nc && !serial; ++c) {
-    int32_t t0 = c * chunk_tets, t1 = t0 + chunk_tets < tet_count ? t0 + chunk_tets : tet_count;
-    uint64_t taken = 0;
-    for (int32_t t = t0; t < t1; ++t)
-      for (int p = 0; p < 6; ++p) taken |= used[m->tet_edges[6 * t + p]];
-    if (taken == ~(uint64_t)0) {
-      serial = 1;
-      break;
+  /* ranges touching each edge (tets come in range order, so a change of range is new) */
+  memset(last, -1, (size_t)ne + 1);
+  for (int32_t t = 0; t < tet_count; ++t) {
+    int k = tet_part(t, blocks);
+    for (int p = 0; p < 6; ++p) {
+      int32_t e = tet_edge[6 * t + p];
+      if (last[e] != k) last[e] = (int8_t)k, parts[e]++;
     }
-    int k = __builtin_ctzll(~taken);
-    color[c] = k;
-    for (int32_t t = t0; t < t1; ++t)
-      for (int p = 0; p < 6; ++p) used[m->tet_edges[6 * t + p]] |= (uint64_t)1 << k;
   }
-  if (serial) {
-    m->color_count = 1;
-    m->color_start[0] = 0;
-    m->color_start[1] = nc;
-    for (int32_t c = 0; c < nc; ++c) m->color_chunks[c] = c;
-  } else {
-    int32_t colors = 0;
-    for (int32_t c = 0; c < nc; ++c) {
-      if (color[c] + 1 > colors) colors = color[c] + 1;
-      m->color_start[color[c] + 1]++;
+  int32_t shared = 0, slots = ne;
+  for (int32_t e = 0; e < ne; ++e) shared += parts[e] > 1;
+  m->shared_count = shared;
+  m->shared_edge = malloc(sizeof(int32_t) * ((size_t)shared + 1));
+  m->shared_slot_start = malloc(sizeof(int32_t) * ((size_t)shared + 1));
+  /* reuse parts: for a shared edge, the next private slot to hand out */
+  if (m->shared_edge && m->shared_slot_start) {
+    int32_t k = 0;
+    for (int32_t e = 0; e < ne; ++e) {
+      if (parts[e] < 2) {
+        parts[e] = -1;
+        continue;
+      }
+      m->shared_edge[k] = e;
+      m->shared_slot_start[k++] = slots;
+      int32_t count = parts[e];
+      parts[e] = slots;
+      slots += count;
     }
-    for (int k = 0; k < colors; ++k) m->color_start[k + 1] += m->color_start[k];
-    int32_t fill[64];
-    memcpy(fill, m->color_start, sizeof fill);
-    for (int32_t c = 0; c < nc; ++c) m->color_chunks[fill[color[c]]++] = c;
-    m->color_count = colors;
+    m->shared_slot_start[shared] = slots;
   }
-  m->serial = serial;
-  /* first writers, in the order the assembly runs */
-  for (int k = 0; k < m->color_count; ++k)
-    for (int32_t s = m->color_start[k]; s < m->color_start[k + 1]; ++s) {
-      int32_t c = m->color_chunks[s];
-      int32_t t0 = c * chunk_tets, t1 = t0 + chunk_tets < tet_count ? t0 + chunk_tets : tet_count;
-      for (int32_t t = t0; t < t1; ++t)
-        for (int p = 0; p < 6; ++p) {
-          int32_t e = m->tet_edges[6 * t + p];
-          if (!seen[e]) {
-            seen[e] = 1;
-            m->tet_flags[t] |= (uint16_t)(1u << (6 + p));
-          }
-        }
+  m->store = malloc(sizeof(double) * 9 * (size_t)slots);
+  uint8_t *written = calloc((size_t)slots, 1);
+  if (!m->shared_edge || !m->shared_slot_start || !m->store || !written) {
+    free(last);
+    free(parts);
+    free(written);
+    return PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "damping matrix: out of memory");
+  }
+  m->blocks = m->store;
+  memset(last, -1, (size_t)ne + 1);
+  for (int32_t t = 0; t < tet_count; ++t) {
+    int k = tet_part(t, blocks);
+    for (int p = 0; p < 6; ++p) {
+      int32_t e = tet_edge[6 * t + p], slot = e;
+      if (parts[e] >= 0) { /* shared: this range's private slot, the next one on a new range */
+        if (last[e] != k && last[e] >= 0) parts[e]++;
+        last[e] = (int8_t)k;
+        slot = parts[e];
+      }
+      m->tet_slot[6 * t + p] = slot;
+      if (!written[slot]) {
+        written[slot] = 1;
+        m->tet_flags[t] |= (uint16_t)(1u << (6 + p));
+      }
     }
-  free(used);
-  free(color);
-  free(seen);
+  }
+  free(last);
+  free(parts);
+  free(written);
   return PIOLA_OK;
 }
 
@@ -174,9 +180,9 @@ piola_status piola__damping_matrix_init(piola__damping_matrix *m, const piola_el
   m->vertex_count = nv;
   m->row_start = calloc((size_t)nv + 1, sizeof(int32_t));
   m->lower_start = calloc((size_t)nv + 1, sizeof(int32_t));
-  m->tet_edges = malloc(sizeof(int32_t) * 6 * (size_t)nt);
+  m->tet_slot = malloc(sizeof(int32_t) * 6 * (size_t)nt);
   m->tet_flags = calloc((size_t)nt, sizeof(uint16_t));
-  if (!m->row_start || !m->lower_start || !m->tet_edges || !m->tet_flags) {
+  if (!m->row_start || !m->lower_start || !m->tet_slot || !m->tet_flags) {
     piola__damping_matrix_free(m);
     return PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "damping matrix: out of memory");
   }
@@ -188,23 +194,21 @@ piola_status piola__damping_matrix_init(piola__damping_matrix *m, const piola_el
   size_t ne = (size_t)(m->edge_count > 0 ? m->edge_count : 1);
   m->lower_edge = malloc(sizeof(int32_t) * ne);
   m->lower_col = malloc(sizeof(int32_t) * ne);
-  m->blocks = malloc(sizeof(double) * 9 * ne);
-  if (!m->lower_edge || !m->lower_col || !m->blocks) {
+  int32_t *tet_edge = malloc(sizeof(int32_t) * 6 * (size_t)(nt > 0 ? nt : 1));
+  if (!m->lower_edge || !m->lower_col || !tet_edge) {
+    free(tet_edge);
     piola__damping_matrix_free(m);
     return PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "damping matrix: out of memory");
   }
   st = build_lower(m);
-  if (st != PIOLA_OK) {
-    piola__damping_matrix_free(m);
-    return st;
-  }
-  for (int32_t t = 0; t < nt; ++t)
+  for (int32_t t = 0; t < nt && st == PIOLA_OK; ++t)
     for (int p = 0; p < 6; ++p) {
       int32_t a = body->tets[4 * t + PAIRS[p][0]], b = body->tets[4 * t + PAIRS[p][1]];
-      m->tet_edges[6 * t + p] = a < b ? find_edge(m, a, b) : find_edge(m, b, a);
+      tet_edge[6 * t + p] = a < b ? find_edge(m, a, b) : find_edge(m, b, a);
       if (a > b) m->tet_flags[t] |= (uint16_t)(1u << p);
     }
-  st = build_coloring(m, nt, body->padded_tet_count);
+  if (st == PIOLA_OK) st = build_slots(m, nt, body->padded_tet_count / PIOLA_TET_BLOCK, tet_edge);
+  free(tet_edge);
   if (st != PIOLA_OK) piola__damping_matrix_free(m);
   return st;
 }
@@ -215,10 +219,10 @@ void piola__damping_matrix_free(piola__damping_matrix *m) {
   free(m->lower_start);
   free(m->lower_edge);
   free(m->lower_col);
-  free(m->tet_edges);
+  free(m->tet_slot);
   free(m->tet_flags);
-  free(m->color_start);
-  free(m->color_chunks);
-  free(m->blocks);
+  free(m->shared_edge);
+  free(m->shared_slot_start);
+  free(m->store);
   memset(m, 0, sizeof *m);
 }

@@ -150,7 +150,7 @@ static void solves_the_filtered_system_and_returns_its_product(void **state) {
     double b[DOF], x0[DOF], x[DOF], ref[DOF], ax[DOF], direct[DOF], work[3 * DOF];
     for (int i = 0; i < DOF; ++i) b[i] = test_rng_uniform(&rng, -1, 1), x0[i] = test_rng_uniform(&rng, -1, 1);
     memcpy(x, x0, sizeof x);
-    cg_problem pb = {NODES, dense_apply, dense_filter, &d, d.inverse_mass, 1e-12, 200, NULL};
+    cg_problem pb = {NODES, dense_apply, dense_filter, &d, d.inverse_mass, 1e-12, 200, NULL, NULL};
     int32_t it = piola__cg_solve(&pb, b, x, work, ax);
     assert_true(it > 0 && it < 200);
     reference_solution(&d, b, x0, ref);
@@ -179,7 +179,7 @@ static void a_converged_guess_costs_one_apply(void **state) {
   for (int i = 0; i < DOF; ++i) x[i] = test_rng_uniform(&rng, -1, 1);
   dense_apply(&d, x, b); /* x already solves it */
   d.applies = 0;
-  cg_problem pb = {NODES, dense_apply, dense_filter, &d, d.inverse_mass, 1e-8, 200, NULL};
+  cg_problem pb = {NODES, dense_apply, dense_filter, &d, d.inverse_mass, 1e-8, 200, NULL, NULL};
   assert_int_equal(piola__cg_solve(&pb, b, x, work, ax), 0);
   assert_int_equal(d.applies, 1);
   for (int i = 0; i < DOF; ++i) assert_close(ax[i], b[i], 0);
@@ -214,7 +214,7 @@ static void stops_relative_to_the_initial_residual(void **state) {
     dense_apply(&d, y, ay);
     for (int i = 0; i < DOF; ++i) b2[i] = b[i] + ay[i], x2[i] = x0[i] + y[i];
     const double tol = 1e-3;
-    cg_problem pb = {NODES, dense_apply, dense_filter, &d, d.inverse_mass, tol, 200, NULL};
+    cg_problem pb = {NODES, dense_apply, dense_filter, &d, d.inverse_mass, tol, 200, NULL, NULL};
     memcpy(x, x0, sizeof x);
     int32_t it = piola__cg_solve(&pb, b, x, work, NULL);
     int32_t it2 = piola__cg_solve(&pb, b2, x2, work, NULL);

@@ -114,7 +114,7 @@ static int vertex_moves(const double *v, int32_t i) {
 
 void piola__elastic_body_damping_forces_add_sparse(const piola_elastic_body *body, const double *v,
                                                    double shear_viscosity, double bulk_viscosity,
-                                                   double *forces) {
+                                                   double scale, double *forces) {
   piola__elastic_body_damping_prepare((piola_elastic_body *)body, shear_viscosity, bulk_viscosity);
   const piola__damping_matrix *m = &body->damping;
   /* every edge with a moving end, once: from its smaller end if that one moves, else from
@@ -124,7 +124,8 @@ void piola__elastic_body_damping_forces_add_sparse(const piola_elastic_body *bod
     for (int32_t k = m->row_start[j]; k < m->row_start[j + 1]; ++k) {
       int32_t i = m->col[k];
       const double *a = m->blocks + 9 * (size_t)k;
-      double d[3] = {v[3 * i] - v[3 * j], v[3 * i + 1] - v[3 * j + 1], v[3 * i + 2] - v[3 * j + 2]};
+      double d[3] = {scale * (v[3 * i] - v[3 * j]), scale * (v[3 * i + 1] - v[3 * j + 1]),
+                     scale * (v[3 * i + 2] - v[3 * j + 2])};
       for (int c = 0; c < 3; ++c) {
         forces[3 * j + c] += a[3 * c] * d[0] + a[3 * c + 1] * d[1] + a[3 * c + 2] * d[2];
         forces[3 * i + c] -= a[c] * d[0] + a[3 + c] * d[1] + a[6 + c] * d[2];
@@ -134,7 +135,8 @@ void piola__elastic_body_damping_forces_add_sparse(const piola_elastic_body *bod
       int32_t i = m->lower_col[k];
       if (vertex_moves(v, i)) continue; /* done from i */
       const double *a = m->blocks + 9 * (size_t)m->lower_edge[k];
-      double d[3] = {v[3 * j] - v[3 * i], v[3 * j + 1] - v[3 * i + 1], v[3 * j + 2] - v[3 * i + 2]};
+      double d[3] = {scale * (v[3 * j] - v[3 * i]), scale * (v[3 * j + 1] - v[3 * i + 1]),
+                     scale * (v[3 * j + 2] - v[3 * i + 2])};
       for (int c = 0; c < 3; ++c) {
         forces[3 * i + c] += a[3 * c] * d[0] + a[3 * c + 1] * d[1] + a[3 * c + 2] * d[2];
         forces[3 * j + c] -= a[c] * d[0] + a[3 + c] * d[1] + a[6 + c] * d[2];

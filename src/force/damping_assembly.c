@@ -234,4 +234,5 @@ void piola__damping_matrix_assemble(piola__damping_matrix *m, const piola_elasti
   m->shear_viscosity = shear_viscosity;
   m->bulk_viscosity = bulk_viscosity;
   m->ready = 1;
+  m->generation++;
 }

@@ -48,6 +48,7 @@ typedef struct piola__damping_matrix {
   double *blocks;       /* = store: 9 per edge, D_ij, N s/m (force per velocity) */
   double shear_viscosity, bulk_viscosity; /* what blocks were assembled with, Pa s */
   int ready;            /* blocks match the body's last update and these viscosities */
+  uint64_t generation;  /* counts assemblies: a product taken at another one is stale */
 } piola__damping_matrix;
 
 /* Tet ranges assembled in parallel; fixed, so results do not depend on the thread count. */

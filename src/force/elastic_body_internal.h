@@ -155,12 +155,12 @@ void piola__elastic_body_damping_operator(const piola_elastic_body *body, const 
                                           double shear_viscosity, double bulk_viscosity,
                                           const double *mass, double h, double *out);
 
-/* forces += D v for a v that is zero on all but a few vertices: only the edges touching a
- * vertex with nonzero v are visited, serially, in vertex order (damping.c). For
+/* forces += scale D v for a v that is zero on all but a few vertices: only the edges
+ * touching a vertex with nonzero v are visited, serially, in vertex order (damping.c). For
  * correcting a product already taken at a nearby v (the step's second right-hand side). */
 void piola__elastic_body_damping_forces_add_sparse(const piola_elastic_body *body, const double *v,
                                                    double shear_viscosity, double bulk_viscosity,
-                                                   double *forces);
+                                                   double scale, double *forces);
 
 /* Sums the per-tet force buffer into per-vertex forces, in parallel, deterministically. */
 void piola__elastic_body_gather_forces(const piola_elastic_body *body, double *forces);

@@ -57,10 +57,13 @@ int32_t piola__cg_solve(const cg_problem *pb, const double *b, double *x, double
   const int64_t m = 3 * (int64_t)n;
   const double *inverse_mass = pb->inverse_mass;
   double *r = work, *p = work + m, *q = work + 2 * m;
-  pb->apply(pb->ctx, x, q);
+  if (pb->given_ax)
+    for (int64_t i = 0; i < m; ++i) q[i] = pb->given_ax[i];
+  else
+    pb->apply(pb->ctx, x, q);
   if (ax)
     for (int64_t i = 0; i < m; ++i) ax[i] = q[i];
-  if (pb->initial_ax)
+  if (pb->initial_ax && pb->initial_ax != pb->given_ax)
     for (int64_t i = 0; i < m; ++i) pb->initial_ax[i] = q[i];
   for (int64_t i = 0; i < m; ++i) r[i] = b[i] - q[i];
   pb->filter(pb->ctx, r, 0, n);

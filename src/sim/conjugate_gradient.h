@@ -40,6 +40,7 @@ typedef struct cg_problem {
   double tolerance;                           /* residual / initial residual, M^-1 norm */
   int32_t max_iterations;
   double *initial_ax; /* 3n or NULL: receives A x at the guess, unfiltered */
+  const double *given_ax; /* 3n or NULL: A x at the guess, known already (no apply for it) */
 } cg_problem;
 
 /* Solves A x = b starting from x (whose filtered components are kept). work holds 3 * 3n

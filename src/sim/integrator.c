@@ -76,7 +76,7 @@ static void damping_filter(void *ctx, double *r, int32_t begin, int32_t end) {
  * off by the net force left in the final residual. */
 static int32_t damping_solve(piola_world *w, world_solid *s, double h, double t,
                              int hold_normals, const double *rhs, double *v, const double uniform[3],
-                             double *av, double *guess_copy, double *initial_av) {
+                             double *av, double *guess_copy, double *initial_av, int from_product) {
   double beta = piola_track_eval(&s->shear_viscosity, t);
   double alpha = piola_track_eval(&s->bulk_viscosity, t);
   damping_system d = {s, h, beta, alpha, hold_normals, s->tmp, &w->profile};
@@ -98,17 +98,41 @@ static int32_t damping_solve(piola_world *w, world_solid *s, double h, double t,
         for (int k = 0; k < 3; ++k) av[3 * i + k] = s->mass[i] * v[3 * i + k];
     return 0;
   }
-  for (int32_t i = 0; i < s->n; ++i) {
-    if (s->flags[i] != SOLID_FREE) continue;
-    double du[3] = {uniform[0], uniform[1], uniform[2]};
-    if (hold_normals && s->colliding[i]) {
-      const double *nrm = s->normals + 3 * i;
-      double dn = du[0] * nrm[0] + du[1] * nrm[1] + du[2] * nrm[2];
-      for (int k = 0; k < 3; ++k) du[k] -= dn * nrm[k];
+  if (from_product) {
+    /* A x0 from the last final solve (first solve only, so no held normals): x0 = v + u on
+     * free nodes (u = uniform) and D ignores uniform fields, so D x0 = D v_p + D e with
+     * e = v - v_p, less u on constrained nodes (which get no shift). e is zero but where
+     * collisions, friction, contact or constraints changed the velocity since, and
+     * h_p D v_p = M v_p - A_p v_p. One pass forms e, the shifted guess and all of A x0 but
+     * h D e, which a sparse pass over the changed nodes' edges adds. */
+    const double ratio = h / s->product_h;
+    double *e = s->work;
+#pragma omp parallel for schedule(static) num_threads(piola__thread_count()) \
+    if (s->n >= PIOLA_PARALLEL_MIN_VERTICES)
+    for (int32_t i = 0; i < s->n; ++i) {
+      const int free_node = s->flags[i] == SOLID_FREE;
+      for (int k = 0; k < 3; ++k) {
+        const int64_t j = 3 * (int64_t)i + k;
+        e[j] = v[j] - s->v_product[j] - (free_node ? 0.0 : uniform[k]);
+        if (free_node) v[j] += uniform[k];
+        if (guess_copy) guess_copy[j] = v[j];
+        initial_av[j] = s->mass[i] * v[j] - ratio * (s->mass[i] * s->v_product[j] - s->av_product[j]);
+      }
     }
-    for (int k = 0; k < 3; ++k) v[3 * i + k] += du[k];
+    piola__elastic_body_damping_forces_add_sparse(s->body, e, beta, alpha, -h, initial_av);
+  } else {
+    for (int32_t i = 0; i < s->n; ++i) {
+      if (s->flags[i] != SOLID_FREE) continue;
+      double du[3] = {uniform[0], uniform[1], uniform[2]};
+      if (hold_normals && s->colliding[i]) {
+        const double *nrm = s->normals + 3 * i;
+        double dn = du[0] * nrm[0] + du[1] * nrm[1] + du[2] * nrm[2];
+        for (int k = 0; k < 3; ++k) du[k] -= dn * nrm[k];
+      }
+      for (int k = 0; k < 3; ++k) v[3 * i + k] += du[k];
+    }
+    if (guess_copy) memcpy(guess_copy, v, 3 * (size_t)s->n * sizeof(double));
   }
-  if (guess_copy) memcpy(guess_copy, v, 3 * (size_t)s->n * sizeof(double));
   cg_problem pb;
   pb.n = s->n;
   pb.apply = damping_apply;
@@ -118,6 +142,7 @@ static int32_t damping_solve(piola_world *w, world_solid *s, double h, double t,
   pb.tolerance = w->def.cg_tolerance;
   pb.max_iterations = w->def.cg_max_iterations;
   pb.initial_ax = initial_av;
+  pb.given_ax = from_product ? initial_av : NULL;
   return piola__cg_solve(&pb, rhs, v, s->work, av);
 }
 
@@ -195,6 +220,7 @@ static void gravity_at(const piola_world *w, double t, double g[3]) {
 
 static void restore(world_solid *s, double t) {
   size_t v3 = 3 * (size_t)s->n * sizeof(double);
+  s->product_valid = 0;
   memcpy(s->x, s->x_old, v3);
   memcpy(s->v, s->v_old, v3);
   memcpy(s->force, s->force_old, v3);
@@ -237,8 +263,12 @@ static piola_status step_solid(piola_world *w, world_solid *s, double t, double 
    * correction on the few nodes where v' differs from the guess (see there) */
   double *initial_av = s->work + 3 * m;
   const int reuse = damped && s->body && piola__step_reuse_first_product;
+  /* the last final solve ran with the same operator (same assembly) unless the body or the
+   * viscosities changed since: start from its product instead of a fresh apply */
+  const int from_product = reuse && s->product_valid && s->product_generation == s->body->damping.generation;
   stats->cg_iterations += damping_solve(w, s, h, t, 0, s->rhs, s->v, gravity1, NULL,
-                                        reuse ? s->tmp : NULL, reuse ? initial_av : NULL);
+                                        reuse ? s->tmp : NULL, reuse ? initial_av : NULL, from_product);
+  s->product_valid = 0;
   piola__step_profile_mark(&w->profile, STEP_PHASE_SOLVE1);
 
   /* 2. x~ */
@@ -266,8 +296,9 @@ static piola_status step_solid(piola_world *w, world_solid *s, double t, double 
      * that are constrained (x0 was their secant velocity). So h D_n v' = (M x0 - A x0) -
      * h D_n e, with D_n e evaluated only on the tets touching those nodes. M x0 - A x0 holds
      * h D_n x0 to the rounding of M x0, the size of the rounding of M v' in the sum. */
-    double *hd = initial_av, *de = s->work;
-    memset(de, 0, v3);
+    double *hd = initial_av;
+#pragma omp parallel for schedule(static) num_threads(piola__thread_count()) \
+    if (n >= PIOLA_PARALLEL_MIN_VERTICES)
     for (int32_t i = 0; i < n; ++i) {
       double *x0 = s->tmp + 3 * i;
       const double *vi = s->v + 3 * i, *vo = s->v_old + 3 * i;
@@ -277,10 +308,12 @@ static piola_status step_solid(piola_world *w, world_solid *s, double t, double 
         x0[k] = moved ? x0[k] - vi[k] - gravity1[k] : 0.0;
       }
     }
-    piola__elastic_body_damping_forces_add_sparse(s->body, s->tmp, beta0, alpha0, de);
+    piola__elastic_body_damping_forces_add_sparse(s->body, s->tmp, beta0, alpha0, -h, hd);
+#pragma omp parallel for schedule(static) num_threads(piola__thread_count()) \
+    if (n >= PIOLA_PARALLEL_MIN_VERTICES)
     for (int32_t i = 0; i < n; ++i)
       for (int k = 0; k < 3; ++k)
-        s->rhs[3 * i + k] = s->mass[i] * s->v[3 * i + k] + hd[3 * i + k] - h * de[3 * i + k] +
+        s->rhs[3 * i + k] = s->mass[i] * s->v[3 * i + k] + hd[3 * i + k] +
                             h * (s->force_old[3 * i + k] + s->mass[i] * g0[k]);
   } else {
     if (damped)
@@ -302,10 +335,12 @@ static piola_status step_solid(piola_world *w, world_solid *s, double t, double 
   }
   if (s->shell) piola_shell_body_plastic_flow(s->shell, dt);
   piola__step_profile_mark(&w->profile, STEP_PHASE_UPDATE);
+  int damped1 = 0;
   if (s->body) {
     double beta1 = piola_track_eval(&s->shear_viscosity, t1);
     double alpha1 = piola_track_eval(&s->bulk_viscosity, t1);
-    if (!piola__solid_undamped(s, beta1, alpha1)) piola__elastic_body_damping_prepare(s->body, beta1, alpha1);
+    damped1 = !piola__solid_undamped(s, beta1, alpha1);
+    if (damped1) piola__elastic_body_damping_prepare(s->body, beta1, alpha1);
   }
   piola__step_profile_mark(&w->profile, STEP_PHASE_PREPARE);
 
@@ -313,12 +348,19 @@ static piola_status step_solid(piola_world *w, world_solid *s, double t, double 
   for (int32_t i = 0; i < n; ++i)
     for (int k = 0; k < 3; ++k)
       s->rhs[3 * i + k] += h * (s->force[3 * i + k] + s->mass[i] * g1[k]);
-  /* the solve also gives A v^n+1 (the fourth work vector; CG uses three), which the
-   * friction of the held normal impulse needs */
-  double *av = s->work + 3 * m;
+  /* the solve also gives A v^n+1, which the friction of the held normal impulse needs and
+   * the next step's first solve starts from */
+  double *av = s->av_product;
+  const int keep_product = damped1 && piola__step_reuse_first_product;
   const double gravity2[3] = {h * (g0[0] + g1[0]), h * (g0[1] + g1[1]), h * (g0[2] + g1[2])};
-  stats->cg_iterations +=
-      damping_solve(w, s, h, t1, 1, s->rhs, s->v, gravity2, colliding > 0 ? av : NULL, NULL, NULL);
+  stats->cg_iterations += damping_solve(w, s, h, t1, 1, s->rhs, s->v, gravity2,
+                                        colliding > 0 || keep_product ? av : NULL, NULL, NULL, 0);
+  if (keep_product) {
+    memcpy(s->v_product, s->v, v3);
+    s->product_h = h;
+    s->product_generation = s->body->damping.generation;
+    s->product_valid = 1;
+  }
   piola__step_profile_mark(&w->profile, STEP_PHASE_SOLVE2);
   if (colliding > 0) contact_friction(w, s, t1, h, g1, av);
   piola__step_profile_mark(&w->profile, STEP_PHASE_FRICTION);

@@ -63,6 +63,7 @@ void piola__solid_free(world_solid *s) {
   free(s->x), free(s->v), free(s->mass), free(s->inverse_mass), free(s->force), free(s->start), free(s->flags);
   free(s->motion_of), free(s->motions);
   free(s->x_old), free(s->v_old), free(s->force_old), free(s->rhs), free(s->work), free(s->tmp);
+  free(s->av_product), free(s->v_product);
   free(s->colliding), free(s->normals);
   memset(s, 0, sizeof *s);
 }
@@ -156,8 +157,9 @@ piola_status piola__solid_allocate(world_solid *s, int32_t n, const char *name, 
   s->motion_of = malloc((size_t)n * sizeof(int32_t));
   s->x_old = malloc(v3), s->v_old = malloc(v3), s->force_old = malloc(v3), s->rhs = malloc(v3);
   s->tmp = malloc(v3), s->work = malloc(4 * v3) /* CG's 3 vectors + A v */, s->normals = malloc(v3);
+  s->av_product = malloc(v3), s->v_product = malloc(v3);
   s->colliding = calloc((size_t)n, 1);
-  if (!s->name || !s->x || !s->v || !s->force || !s->start || !s->mass || !s->inverse_mass || !s->flags ||
+  if (!s->av_product || !s->v_product || !s->name || !s->x || !s->v || !s->force || !s->start || !s->mass || !s->inverse_mass || !s->flags ||
       !s->motion_of || !s->x_old || !s->v_old || !s->force_old || !s->rhs || !s->tmp || !s->work ||
       !s->normals || !s->colliding)
     return PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "%s %d: out of memory", kind, (int)id);

@@ -44,6 +44,12 @@ typedef struct world_solid {
   piola_self_collision_def self_collision;
   /* scratch for the step */
   double *x_old, *v_old, *force_old, *rhs, *work, *tmp;
+  /* the final solve's A v (3n) and the v it was taken at (3n), with its h and the damping
+   * assembly it used: the next step's first solve starts from it (integrator.c) */
+  double *av_product, *v_product;
+  double product_h;
+  uint64_t product_generation;
+  int product_valid;
   uint8_t *colliding;
   double *normals;
 } world_solid;

@@ -41,27 +41,31 @@
 void piola__elastic_body_damping_prepare(piola_elastic_body *body, double shear_viscosity,
                                          double bulk_viscosity) {
   piola__damping_matrix *m = &body->damping;
-  if (m->ready && m->shear_viscosity == shear_viscosity && m->bulk_viscosity == bulk_viscosity) return;
+  if (m->ready && m->shear_viscosity == shear_viscosity && m->bulk_viscosity == bulk_viscosity)
+    return;
   piola__damping_matrix_assemble(m, body, shear_viscosity, bulk_viscosity);
 }
 
 /* Rows r0 .. r1 - 1 of f = D v, or with mass given of out = M v - h D v. Each row gathers
- * its edges to larger vertices (blocks D_ij) and to smaller ones (D_ji^T), in a fixed order. */
-static void product_rows(const piola__damping_matrix *m, const double *v, const double *mass, double h,
-                         int32_t r0, int32_t r1, double *out) {
+ * its edges to vertices ranked after it (blocks D_ij) and before it (D_ji^T), in a fixed
+ * order. */
+static void product_rows(const piola__damping_matrix *m, const double *v, const double *mass,
+                         double h, int32_t r0, int32_t r1, double *out) {
   const double *blocks = m->blocks;
-  for (int32_t i = r0; i < r1; ++i) {
+  for (int32_t r = r0; r < r1; ++r) {
+    const int32_t i = m->order[r];
     const double v0 = v[3 * i], v1 = v[3 * i + 1], v2 = v[3 * i + 2];
     double f0 = 0, f1 = 0, f2 = 0;
-    for (int32_t k = m->row_start[i]; k < m->row_start[i + 1]; ++k) {
+    for (int32_t k = m->row_start[r]; k < m->row_start[r + 1]; ++k) {
       const double *a = blocks + 9 * (size_t)k, *vj = v + 3 * (size_t)m->col[k];
       double d0 = vj[0] - v0, d1 = vj[1] - v1, d2 = vj[2] - v2;
       f0 += a[0] * d0 + a[1] * d1 + a[2] * d2;
       f1 += a[3] * d0 + a[4] * d1 + a[5] * d2;
       f2 += a[6] * d0 + a[7] * d1 + a[8] * d2;
     }
-    for (int32_t k = m->lower_start[i]; k < m->lower_start[i + 1]; ++k) {
-      const double *a = blocks + 9 * (size_t)m->lower_edge[k], *vj = v + 3 * (size_t)m->lower_col[k];
+    for (int32_t k = m->lower_start[r]; k < m->lower_start[r + 1]; ++k) {
+      const double *a = blocks + 9 * (size_t)m->lower_edge[k];
+      const double *vj = v + 3 * (size_t)m->lower_col[k];
       double d0 = vj[0] - v0, d1 = vj[1] - v1, d2 = vj[2] - v2;
       f0 += a[0] * d0 + a[3] * d1 + a[6] * d2;
       f1 += a[1] * d0 + a[4] * d1 + a[7] * d2;
@@ -92,7 +96,8 @@ static void damping_pass(const piola_elastic_body *body, const double *v, double
 #pragma omp parallel for schedule(static) num_threads(piola__thread_count()) \
     if (nv >= PIOLA_PARALLEL_MIN_VERTICES)
   for (int r = 0; r < RANGES; ++r)
-    product_rows(m, v, mass, h, (int32_t)((int64_t)nv * r / RANGES), (int32_t)((int64_t)nv * (r + 1) / RANGES), out);
+    product_rows(m, v, mass, h, (int32_t)((int64_t)nv * r / RANGES),
+                 (int32_t)((int64_t)nv * (r + 1) / RANGES), out);
 }
 
 void piola_elastic_body_damping_forces(const piola_elastic_body *body, const double *v,
@@ -117,11 +122,12 @@ void piola__elastic_body_damping_forces_add_sparse(const piola_elastic_body *bod
                                                    double scale, double *forces) {
   piola__elastic_body_damping_prepare((piola_elastic_body *)body, shear_viscosity, bulk_viscosity);
   const piola__damping_matrix *m = &body->damping;
-  /* every edge with a moving end, once: from its smaller end if that one moves, else from
-   * its larger end. An edge whose ends are both at rest adds exactly zero. */
+  /* every edge with a moving end, once: from its first-ranked end if that one moves, else
+   * from the other. An edge whose ends are both at rest adds exactly zero. */
   for (int32_t j = 0; j < body->vertex_count; ++j) {
     if (!vertex_moves(v, j)) continue;
-    for (int32_t k = m->row_start[j]; k < m->row_start[j + 1]; ++k) {
+    const int32_t r = m->rank[j];
+    for (int32_t k = m->row_start[r]; k < m->row_start[r + 1]; ++k) {
       int32_t i = m->col[k];
       const double *a = m->blocks + 9 * (size_t)k;
       double d[3] = {scale * (v[3 * i] - v[3 * j]), scale * (v[3 * i + 1] - v[3 * j + 1]),
@@ -131,7 +137,7 @@ void piola__elastic_body_damping_forces_add_sparse(const piola_elastic_body *bod
         forces[3 * i + c] -= a[c] * d[0] + a[3 + c] * d[1] + a[6 + c] * d[2];
       }
     }
-    for (int32_t k = m->lower_start[j]; k < m->lower_start[j + 1]; ++k) {
+    for (int32_t k = m->lower_start[r]; k < m->lower_start[r + 1]; ++k) {
       int32_t i = m->lower_col[k];
       if (vertex_moves(v, i)) continue; /* done from i */
       const double *a = m->blocks + 9 * (size_t)m->lower_edge[k];

@@ -31,8 +31,8 @@ static const int PAIR_A[6] = {0, 0, 0, 1, 1, 2}, PAIR_B[6] = {1, 2, 3, 2, 3, 3};
 
 /* The 6 corner-pair blocks D_ab of each tet of a SIMD block: out[(9 p + 3 c + d) B + l] is
  * entry (c, d) of pair p of lane l. */
-PIOLA_WIDE_VECTORS static void tet_blocks(const piola_elastic_body *body, int32_t block, double beta,
-                                          double alpha, double *out) {
+PIOLA_WIDE_VECTORS static void tet_blocks(const piola_elastic_body *body, int32_t block,
+                                          double beta, double alpha, double *out) {
   const int32_t base = block * B;
   const int32_t *i0 = body->tet_vertices[0] + base, *i1 = body->tet_vertices[1] + base;
   const int32_t *i2 = body->tet_vertices[2] + base, *i3 = body->tet_vertices[3] + base;
@@ -59,7 +59,8 @@ PIOLA_WIDE_VECTORS static void tet_blocks(const piola_elastic_body *body, int32_
     for (int i = 0; i < 3; ++i)
       PIOLA_UNROLL
       for (int j = 0; j < 3; ++j)
-        q9[3 * i + j][l] = body->u[3 * i][t] * body->v[3 * j][t] + body->u[3 * i + 1][t] * body->v[3 * j + 1][t] +
+        q9[3 * i + j][l] = body->u[3 * i][t] * body->v[3 * j][t] +
+                           body->u[3 * i + 1][t] * body->v[3 * j + 1][t] +
                            body->u[3 * i + 2][t] * body->v[3 * j + 2][t];
     double sv = sqrt(volume[l]);
     PIOLA_UNROLL
@@ -180,7 +181,8 @@ PIOLA_WIDE_VECTORS static void tet_blocks(const piola_elastic_body *body, int32_
 
 /* Adds (or, for a slot's first writer, stores) a SIMD block's tet blocks into their slots,
  * transposed where the edge is stored the other way round (D_ij = D_ba^T). */
-static void scatter_tets(piola__damping_matrix *m, int32_t block, int32_t tet_count, const double *out) {
+static void scatter_tets(piola__damping_matrix *m, int32_t block, int32_t tet_count,
+                         const double *out) {
   static const int TRANSPOSE[2][9] = {{0, 1, 2, 3, 4, 5, 6, 7, 8}, {0, 3, 6, 1, 4, 7, 2, 5, 8}};
   const int32_t base = block * B;
   const int32_t lanes = tet_count - base < B ? tet_count - base : B;
@@ -200,11 +202,12 @@ static void scatter_tets(piola__damping_matrix *m, int32_t block, int32_t tet_co
 }
 
 /* Range k of the tets: its SIMD blocks in order. */
-static void assemble_part(piola__damping_matrix *m, const piola_elastic_body *body, int k, double beta,
-                          double alpha) {
+static void assemble_part(piola__damping_matrix *m, const piola_elastic_body *body, int k,
+                          double beta, double alpha) {
   const int32_t blocks = body->padded_tet_count / B;
+  const int32_t b0 = piola__damping_part_start(blocks, k), b1 = piola__damping_part_start(blocks, k + 1);
   double out[54 * B];
-  for (int32_t b = piola__damping_part_start(blocks, k); b < piola__damping_part_start(blocks, k + 1); ++b) {
+  for (int32_t b = b0; b < b1; ++b) {
     tet_blocks(body, b, beta, alpha, out);
     scatter_tets(m, b, body->tet_count, out);
   }
@@ -227,7 +230,8 @@ void piola__damping_matrix_assemble(piola__damping_matrix *m, const piola_elasti
 #pragma omp parallel num_threads(piola__thread_count()) if (blocks >= PIOLA_PARALLEL_MIN_BLOCKS)
   {
 #pragma omp for schedule(static)
-    for (int k = 0; k < PIOLA_DAMPING_PARTS; ++k) assemble_part(m, body, k, shear_viscosity, bulk_viscosity);
+    for (int k = 0; k < PIOLA_DAMPING_PARTS; ++k)
+      assemble_part(m, body, k, shear_viscosity, bulk_viscosity);
 #pragma omp for schedule(static)
     for (int32_t k = 0; k < m->shared_count; ++k) reduce_shared(m, k);
   }

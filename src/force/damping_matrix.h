@@ -4,16 +4,21 @@
  * updated, while the implicit step applies it in every conjugate-gradient iteration. So D is
  * assembled once per update and each apply is a sparse product. D is symmetric and its rows
  * sum to zero (a uniform velocity is not damped), so only the off-diagonal 3x3 blocks are
- * stored, one per mesh edge (i, j), i < j, holding D_ij (D_ji is its transpose), and the
- * product is written in edge differences:
+ * stored, one per mesh edge (i, j), holding D_ij with i ranked first (D_ji is its
+ * transpose), and the product is written in edge differences:
  *   f_i = sum over edges (i, j) of D_ij (v_j - v_i).
  * That keeps a rigid translation undamped exactly and needs no diagonal blocks.
  *
- * Layout. Edges are numbered row by row: the edges of row i are (i, col[k]) for k in
- * [row_start[i], row_start[i + 1]), col increasing, and block k is blocks[9 k .. 9 k + 8]
- * (row-major). Row i's other edges, (j, i) with j < i, are listed in lower_edge/lower_col
- * [lower_start[i], lower_start[i + 1]). The product gathers both lists per row, so every row
- * is summed by one thread in a fixed order: bit-identical results for any thread count.
+ * Layout. Rows are the vertices in reverse Cuthill-McKee order (order[r] is the vertex of
+ * row r, rank[i] the row of vertex i), so a vertex's edges sit near those of the vertices
+ * around it whatever the mesh file's numbering. Edges are numbered row by row: row r holds
+ * the edges from vertex i = order[r] to the vertices ranked after it, col[k] for k in
+ * [row_start[r], row_start[r + 1]) (vertex indices, increasing), and block k,
+ * blocks[9 k .. 9 k + 8] (row-major), is D_{i, col[k]}. Row r's other edges, those to
+ * vertices ranked before it, are listed in lower_edge/lower_col [lower_start[r],
+ * lower_start[r + 1]); their blocks are used transposed. The product gathers both lists per
+ * row, so every row is summed by one thread in a fixed order: bit-identical results for any
+ * thread count, and the blocks of a row's earlier edges come from cache.
  *
  * Assembly. Each tet adds its 6 corner-pair blocks to its 6 edges (pair p in the order
  * 01 02 03 12 13 23; bit p of tet_flags[t] says the pair is stored transposed). The tets are
@@ -34,6 +39,8 @@
 typedef struct piola__damping_matrix {
   int32_t vertex_count;
   int32_t edge_count;
+  int32_t *order;       /* vertex_count: the vertex of each row */
+  int32_t *rank;        /* vertex_count: the row of each vertex */
   int32_t *row_start;   /* vertex_count + 1 */
   int32_t *col;         /* edge_count */
   int32_t *lower_start; /* vertex_count + 1 */
@@ -61,7 +68,8 @@ static inline int32_t piola__damping_part_start(int32_t blocks, int k) {
 
 /* Builds the sparsity pattern, the tets' slots and the private slots of body's mesh
  * (damping_pattern.c); allocates the blocks. Needs the body's tets and vertex count. */
-piola_status piola__damping_matrix_init(piola__damping_matrix *matrix, const piola_elastic_body *body);
+piola_status piola__damping_matrix_init(piola__damping_matrix *matrix,
+                                        const piola_elastic_body *body);
 
 void piola__damping_matrix_free(piola__damping_matrix *matrix);
 

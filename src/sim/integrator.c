@@ -116,7 +116,8 @@ static int32_t damping_solve(piola_world *w, world_solid *s, double h, double t,
         e[j] = v[j] - s->v_product[j] - (free_node ? 0.0 : uniform[k]);
         if (free_node) v[j] += uniform[k];
         if (guess_copy) guess_copy[j] = v[j];
-        initial_av[j] = s->mass[i] * v[j] - ratio * (s->mass[i] * s->v_product[j] - s->av_product[j]);
+        initial_av[j] =
+            s->mass[i] * v[j] - ratio * (s->mass[i] * s->v_product[j] - s->av_product[j]);
       }
     }
     piola__elastic_body_damping_forces_add_sparse(s->body, e, beta, alpha, -h, initial_av);
@@ -265,7 +266,8 @@ static piola_status step_solid(piola_world *w, world_solid *s, double t, double 
   const int reuse = damped && s->body && piola__step_reuse_first_product;
   /* the last final solve ran with the same operator (same assembly) unless the body or the
    * viscosities changed since: start from its product instead of a fresh apply */
-  const int from_product = reuse && s->product_valid && s->product_generation == s->body->damping.generation;
+  const int from_product =
+      reuse && s->product_valid && s->product_generation == s->body->damping.generation;
   stats->cg_iterations += damping_solve(w, s, h, t, 0, s->rhs, s->v, gravity1, NULL,
                                         reuse ? s->tmp : NULL, reuse ? initial_av : NULL, from_product);
   s->product_valid = 0;

@@ -1,12 +1,12 @@
 /* Benchmark of the damping operator, the kernel that each conjugate-gradient iteration of the
- * implicit step applies (about 20 times per elastic update).
+ * implicit step applies (a dozen or more times per elastic update), and of its assembly.
  *
  *   build/<dir>/bench_damping [repeats] [mesh]
  *
  * Mesh: Vega's torus-easy.veg (97,878 tets) unless another is given. The body is updated at
  * its rest positions plus a random perturbation of 2% of the mean edge length (a busy,
  * rotated-frame state), then, for 1 and 2 threads, each repeat updates once more and times
- * the first damping call after it (which prepares the per-tet records: "first") and then 20
+ * the first damping call after it (which assembles the damping matrix: "first") and then 20
  * applies ("apply", per call). Reports medians over `repeats` (default 7) of wall time and
  * of process CPU time (all threads together), and the least CPU time per apply seen: on a
  * loaded machine wall time mostly measures the other processes, and even CPU time grows

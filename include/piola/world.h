@@ -3,7 +3,7 @@
  * A world holds independent solids (tetrahedral elastic bodies with a material, damping,
  * gravity, initial state and constraints) and obstacles they collide with. It advances by
  * the Newmark scheme of paper section 9 (see docs/time-stepping.md): explicit elastic
- * forces, implicit damping solved by a matrix-free conjugate gradient, collisions between
+ * forces, implicit damping solved by a conjugate gradient, collisions between
  * the position and the final velocity update, and a trapezoidal final velocity. The step
  * size is variable: the smallest of a user cap, a CFL bound and the time left to a target.
  *

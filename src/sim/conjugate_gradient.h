@@ -1,8 +1,9 @@
-/* A matrix-free, filtered, diagonally preconditioned conjugate gradient.
+/* A filtered, diagonally preconditioned conjugate gradient.
  *
  * The damping solves of the step loop are (M - h D) v = b with M the lumped mass and D the
  * linear damping operator: symmetric, and positive definite because damping only removes
- * energy. The operator is applied through a callback so the matrix is never assembled.
+ * energy. The operator is applied through a callback (for a solid, a product with the
+ * damping matrix the body assembles once per update), so the solver needs no matrix.
  * Constrained nodes and the normal velocity of colliding nodes are held at the values of
  * the initial guess by a filter S that projects those components out of every residual and
  * search direction (Baraff and Witkin's modified conjugate gradient). The preconditioner is

@@ -26,20 +26,6 @@ static double sum_parts(const double part[CG_CHUNKS]) {
   return s;
 }
 
-/* sum over nodes of a . M^-1 b (a, b filtered) */
-static double dot_inverse_mass(const cg_problem *pb, const double *a, const double *b) {
-  double part[CG_CHUNKS];
-  const int32_t n = pb->n;
-#pragma omp parallel for schedule(static) num_threads(piola__thread_count()) if (n >= CG_PARALLEL_MIN_NODES)
-  for (int c = 0; c < CG_CHUNKS; ++c) {
-    double s = 0;
-    for (int32_t i = chunk_begin(n, c); i < chunk_begin(n, c + 1); ++i)
-      s += (a[3 * i] * b[3 * i] + a[3 * i + 1] * b[3 * i + 1] + a[3 * i + 2] * b[3 * i + 2]) * pb->inverse_mass[i];
-    part[c] = s;
-  }
-  return sum_parts(part);
-}
-
 static double dot(int32_t n, const double *a, const double *b) {
   double part[CG_CHUNKS];
 #pragma omp parallel for schedule(static) num_threads(piola__thread_count()) if (n >= CG_PARALLEL_MIN_NODES)
@@ -57,23 +43,35 @@ int32_t piola__cg_solve(const cg_problem *pb, const double *b, double *x, double
   const int64_t m = 3 * (int64_t)n;
   const double *inverse_mass = pb->inverse_mass;
   double *r = work, *p = work + m, *q = work + 2 * m;
-  if (pb->given_ax)
-    for (int64_t i = 0; i < m; ++i) q[i] = pb->given_ax[i];
-  else
+  const double *q0 = pb->given_ax;
+  if (!q0) {
     pb->apply(pb->ctx, x, q);
-  if (ax)
-    for (int64_t i = 0; i < m; ++i) ax[i] = q[i];
-  if (pb->initial_ax && pb->initial_ax != pb->given_ax)
-    for (int64_t i = 0; i < m; ++i) pb->initial_ax[i] = q[i];
-  for (int64_t i = 0; i < m; ++i) r[i] = b[i] - q[i];
-  pb->filter(pb->ctx, r, 0, n);
+    q0 = q;
+  }
+  /* one pass: the copies of A x0, r = S (b - A x0), its size and the first direction */
+  double part0[CG_CHUNKS];
+#pragma omp parallel for schedule(static) num_threads(piola__thread_count()) if (n >= CG_PARALLEL_MIN_NODES)
+  for (int c = 0; c < CG_CHUNKS; ++c) {
+    const int32_t i0 = chunk_begin(n, c), i1 = chunk_begin(n, c + 1);
+    for (int64_t j = 3 * (int64_t)i0; j < 3 * (int64_t)i1; ++j) {
+      if (ax) ax[j] = q0[j];
+      if (pb->initial_ax && pb->initial_ax != q0) pb->initial_ax[j] = q0[j];
+      r[j] = b[j] - q0[j];
+    }
+    pb->filter(pb->ctx, r, i0, i1);
+    double sum = 0;
+    for (int32_t i = i0; i < i1; ++i) {
+      const double *ri = r + 3 * i;
+      sum += (ri[0] * ri[0] + ri[1] * ri[1] + ri[2] * ri[2]) * inverse_mass[i];
+      for (int k = 0; k < 3; ++k) p[3 * i + k] = ri[k] * inverse_mass[i];
+    }
+    part0[c] = sum;
+  }
   /* reference size: the residual of the guess, i.e. the correction still to be made (not
    * b, which a moving body's momentum dominates; see the header) */
-  double rz = dot_inverse_mass(pb, r, r);
+  double rz = sum_parts(part0);
   double tol2 = pb->tolerance * pb->tolerance * rz;
   if (!(rz > 0) || !isfinite(rz)) return 0;
-  for (int32_t i = 0; i < n; ++i)
-    for (int k = 0; k < 3; ++k) p[3 * i + k] = r[3 * i + k] * inverse_mass[i];
   int32_t it = 0;
   while (it < pb->max_iterations) {
     ++it;

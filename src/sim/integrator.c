@@ -122,6 +122,8 @@ static int32_t damping_solve(piola_world *w, world_solid *s, double h, double t,
     }
     piola__elastic_body_damping_forces_add_sparse(s->body, e, beta, alpha, -h, initial_av);
   } else {
+#pragma omp parallel for schedule(static) num_threads(piola__thread_count()) \
+    if (s->n >= PIOLA_PARALLEL_MIN_VERTICES)
     for (int32_t i = 0; i < s->n; ++i) {
       if (s->flags[i] != SOLID_FREE) continue;
       double du[3] = {uniform[0], uniform[1], uniform[2]};
@@ -237,14 +239,17 @@ static piola_status step_solid(piola_world *w, world_solid *s, double t, double 
   double g0[3], g1[3];
   gravity_at(w, t, g0);
   gravity_at(w, t1, g1);
-  memcpy(s->x_old, s->x, v3);
-  memcpy(s->v_old, s->v, v3);
-  memcpy(s->force_old, s->force, v3);
-
-  /* 1. v~ */
+  /* 1. v~ (with the copies of the old state, in the same pass) */
+#pragma omp parallel for schedule(static) num_threads(piola__thread_count()) \
+    if (n >= PIOLA_PARALLEL_MIN_VERTICES)
   for (int32_t i = 0; i < n; ++i)
-    for (int k = 0; k < 3; ++k)
-      s->rhs[3 * i + k] = s->mass[i] * s->v[3 * i + k] + h * (s->force[3 * i + k] + s->mass[i] * g0[k]);
+    for (int k = 0; k < 3; ++k) {
+      const int64_t j = 3 * (int64_t)i + k;
+      s->x_old[j] = s->x[j];
+      s->v_old[j] = s->v[j];
+      s->force_old[j] = s->force[j];
+      s->rhs[j] = s->mass[i] * s->v[j] + h * (s->force[j] + s->mass[i] * g0[k]);
+    }
   if (n > 0) memset(s->colliding, 0, (size_t)n);
   for (int32_t i = 0; i < n; ++i) {
     if (s->flags[i] == SOLID_FREE) continue;
@@ -273,11 +278,17 @@ static piola_status step_solid(piola_world *w, world_solid *s, double t, double 
   s->product_valid = 0;
   piola__step_profile_mark(&w->profile, STEP_PHASE_SOLVE1);
 
-  /* 2. x~ */
-  for (int64_t j = 0; j < m; ++j) s->x[j] += dt * s->v[j];
+  /* 2. x~, and v back to v^n for 3. */
+#pragma omp parallel for schedule(static) num_threads(piola__thread_count()) \
+    if (n >= PIOLA_PARALLEL_MIN_VERTICES)
+  for (int32_t i = 0; i < n; ++i)
+    for (int k = 0; k < 3; ++k) {
+      const int64_t j = 3 * (int64_t)i + k;
+      s->x[j] += dt * s->v[j];
+      s->v[j] = s->v_old[j];
+    }
 
   /* 3. collisions with x~ and v^n */
-  memcpy(s->v, s->v_old, v3);
   int32_t colliding = 0;
   if (w->obstacle_count > 0)
     colliding = piola_obstacles_collide(w->obstacles, w->obstacle_count, t1, dt, n, s->x, s->v,
@@ -347,6 +358,8 @@ static piola_status step_solid(piola_world *w, world_solid *s, double t, double 
   piola__step_profile_mark(&w->profile, STEP_PHASE_PREPARE);
 
   /* 4. trapezoidal velocity, damping at n+1 implicit, normal velocity of contacts held */
+#pragma omp parallel for schedule(static) num_threads(piola__thread_count()) \
+    if (n >= PIOLA_PARALLEL_MIN_VERTICES)
   for (int32_t i = 0; i < n; ++i)
     for (int k = 0; k < 3; ++k)
       s->rhs[3 * i + k] += h * (s->force[3 * i + k] + s->mass[i] * g1[k]);
@@ -358,7 +371,9 @@ static piola_status step_solid(piola_world *w, world_solid *s, double t, double 
   stats->cg_iterations += damping_solve(w, s, h, t1, 1, s->rhs, s->v, gravity2,
                                         colliding > 0 || keep_product ? av : NULL, NULL, NULL, 0);
   if (keep_product) {
-    memcpy(s->v_product, s->v, v3);
+#pragma omp parallel for schedule(static) num_threads(piola__thread_count()) \
+    if (n >= PIOLA_PARALLEL_MIN_VERTICES)
+    for (int64_t j = 0; j < m; ++j) s->v_product[j] = s->v[j];
     s->product_h = h;
     s->product_generation = s->body->damping.generation;
     s->product_valid = 1;
@@ -366,22 +381,36 @@ static piola_status step_solid(piola_world *w, world_solid *s, double t, double 
   piola__step_profile_mark(&w->profile, STEP_PHASE_SOLVE2);
   if (colliding > 0) contact_friction(w, s, t1, h, g1, av);
   piola__step_profile_mark(&w->profile, STEP_PHASE_FRICTION);
-  for (int64_t j = 0; j < m; ++j)
-    if (!isfinite(s->v[j])) {
+  /* a state whose energies overflow has blown up even if each coordinate is still finite.
+   * The elastic energy is not computed per step (world.c); the squared norm of the elastic
+   * force overflows with it (both grow as |F|^2), and costs one pass over 3n numbers.
+   * Summed by fixed node ranges (only their finiteness is used). */
+  enum { CHECK_RANGES = 16 };
+  double kinetic_part[CHECK_RANGES], force2_part[CHECK_RANGES];
+  int64_t bad_part[CHECK_RANGES];
+#pragma omp parallel for schedule(static) num_threads(piola__thread_count()) \
+    if (n >= PIOLA_PARALLEL_MIN_VERTICES)
+  for (int r = 0; r < CHECK_RANGES; ++r) {
+    double ke = 0, f2 = 0;
+    int64_t bad = -1;
+    for (int64_t j = 3 * (m / 3 * r / CHECK_RANGES); j < 3 * (m / 3 * (r + 1) / CHECK_RANGES); ++j) {
+      if (bad < 0 && !isfinite(s->v[j])) bad = j;
+      ke += s->mass[j / 3] * s->v[j] * s->v[j];
+      f2 += s->force[j] * s->force[j];
+    }
+    kinetic_part[r] = ke, force2_part[r] = f2, bad_part[r] = bad;
+  }
+  double kinetic = 0, force2 = 0;
+  for (int r = 0; r < CHECK_RANGES; ++r) {
+    if (bad_part[r] >= 0) {
       restore(s, t);
       return PIOLA_FAIL(PIOLA_ERROR_NOT_FINITE,
                         "solid '%s': velocity of vertex %lld became non-finite at t = %g s", s->name,
-                        (long long)(j / 3), t1);
+                        (long long)(bad_part[r] / 3), t1);
     }
-  /* a state whose energies overflow has blown up even if each coordinate is still finite.
-   * The elastic energy is not computed per step (world.c); the squared norm of the elastic
-   * force overflows with it (both grow as |F|^2), and costs one pass over 3n numbers. */
-  double kinetic = 0, force2 = 0;
-  for (int32_t i = 0; i < n; ++i)
-    for (int k = 0; k < 3; ++k) {
-      kinetic += s->mass[i] * s->v[3 * i + k] * s->v[3 * i + k];
-      force2 += s->force[3 * i + k] * s->force[3 * i + k];
-    }
+    kinetic += kinetic_part[r];
+    force2 += force2_part[r];
+  }
   if (!isfinite(kinetic) || !isfinite(force2)) {
     restore(s, t);
     return PIOLA_FAIL(PIOLA_ERROR_NOT_FINITE,

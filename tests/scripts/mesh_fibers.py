@@ -3,26 +3,12 @@ import json
 import os
 import shutil
 import subprocess
-import sys
 import tempfile
 
 import meshio
 import numpy as np
 
-PIOLA = os.environ["PIOLA"]
-SOURCE = os.environ["PIOLA_SOURCE_DIR"]
-DATA = os.path.join(SOURCE, "tests", "data")
-failures = []
-
-
-def check(condition, message):
-    print(("ok   " if condition else "FAIL ") + message)
-    if not condition:
-        failures.append(message)
-
-
-def run(*args):
-    return subprocess.run(args, check=True, capture_output=True, text=True)
+from script_checks import DATA, PIOLA, check, finish, run
 
 
 def tets_and_fibers(path):
@@ -132,7 +118,4 @@ try:
 finally:
     shutil.rmtree(work, ignore_errors=True)
 
-if failures:
-    print(f"{len(failures)} check(s) failed")
-    sys.exit(1)
-print("all checks passed")
+finish()

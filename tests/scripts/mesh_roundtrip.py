@@ -3,28 +3,13 @@ import json
 import math
 import os
 import shutil
-import subprocess
-import sys
 import tempfile
 
 import meshio
 import numpy as np
 import vtk
 
-PIOLA = os.environ["PIOLA"]
-SOURCE = os.environ["PIOLA_SOURCE_DIR"]
-DATA = os.path.join(SOURCE, "tests", "data")
-failures = []
-
-
-def check(condition, message):
-    print(("ok   " if condition else "FAIL ") + message)
-    if not condition:
-        failures.append(message)
-
-
-def run(*args):
-    return subprocess.run(args, check=True, capture_output=True, text=True)
+from script_checks import DATA, PIOLA, check, finish, run
 
 
 def info(path):
@@ -154,5 +139,4 @@ try:
 finally:
     shutil.rmtree(work, ignore_errors=True)
 
-print(f"{len(failures)} failures")
-sys.exit(1 if failures else 0)
+finish()

@@ -25,7 +25,7 @@
  * split into PIOLA_DAMPING_PARTS fixed ranges assembled in parallel. An edge only one range
  * touches is written in place; an edge several ranges touch (the ranges' borders, or most
  * edges of a mesh whose tet order has no locality) gets a private slot per range, after the
- * blocks in `store`, and a last pass adds those slots up in range order. tet_slot[6 t + p]
+ * blocks in `blocks`, and a last pass adds those slots up in range order. tet_slot[6 t + p]
  * is where tet t writes pair p, and bit 6 + p of tet_flags[t] says it writes there first,
  * so nothing needs clearing. Every block is summed in the same order for any thread
  * count. */
@@ -46,13 +46,13 @@ typedef struct piola__damping_matrix {
   int32_t *lower_start; /* vertex_count + 1 */
   int32_t *lower_edge;  /* edge_count */
   int32_t *lower_col;   /* edge_count */
-  int32_t *tet_slot;    /* 6 per tet (tet_count): where each pair goes in store */
+  int32_t *tet_slot;    /* 6 per tet (tet_count): where each pair goes in blocks */
   uint16_t *tet_flags;  /* per tet: transposed pairs (bits 0-5), first writers (bits 6-11) */
   int32_t shared_count; /* edges touched by more than one tet range */
   int32_t *shared_edge; /* shared_count edges, increasing */
   int32_t *shared_slot_start; /* shared_count + 1: the private slots of shared_edge[k] */
-  double *store;        /* 9 doubles per slot: the edge_count blocks, then private slots */
-  double *blocks;       /* = store: 9 per edge, D_ij, N s/m (force per velocity) */
+  double *blocks;       /* 9 per slot: D_ij of each edge (N s/m, force per velocity), then
+                           the private slots of shared edges */
   double shear_viscosity, bulk_viscosity; /* what blocks were assembled with, Pa s */
   int ready;            /* blocks match the body's last update and these viscosities */
   uint64_t generation;  /* counts assemblies: a product taken at another one is stale */

@@ -230,15 +230,14 @@ static piola_status build_slots(piola__damping_matrix *m, int32_t tet_count, int
     }
     m->shared_slot_start[shared] = slots;
   }
-  m->store = malloc(sizeof(double) * 9 * (size_t)slots);
+  m->blocks = malloc(sizeof(double) * 9 * (size_t)slots);
   uint8_t *written = calloc((size_t)slots, 1);
-  if (!m->shared_edge || !m->shared_slot_start || !m->store || !written) {
+  if (!m->shared_edge || !m->shared_slot_start || !m->blocks || !written) {
     free(last);
     free(parts);
     free(written);
     return PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "damping matrix: out of memory");
   }
-  m->blocks = m->store;
   memset(last, -1, (size_t)ne + 1);
   for (int32_t t = 0; t < tet_count; ++t) {
     int k = tet_part(t, blocks);
@@ -318,6 +317,6 @@ void piola__damping_matrix_free(piola__damping_matrix *m) {
   free(m->tet_flags);
   free(m->shared_edge);
   free(m->shared_slot_start);
-  free(m->store);
+  free(m->blocks);
   memset(m, 0, sizeof *m);
 }

@@ -264,8 +264,8 @@ static piola_status step_solid(piola_world *w, world_solid *s, double t, double 
   if (s->body && damped) piola__elastic_body_damping_prepare(s->body, beta0, alpha0);
   piola__step_profile_mark(&w->profile, STEP_PHASE_PREPARE);
   const double gravity1[3] = {h * g0[0], h * g0[1], h * g0[2]};
-  /* for a damped body, keep the guess x0 (in tmp) and A x0 (in the slot of A v, free until
-   * the final solve): the second right-hand side's D_n v' is h D_n x0 = M x0 - A x0 plus a
+  /* for a damped body, keep the guess x0 (in tmp) and A x0 (in the fourth work vector, which
+   * CG does not use): the second right-hand side's D_n v' is h D_n x0 = M x0 - A x0 plus a
    * correction on the few nodes where v' differs from the guess (see there) */
   double *initial_av = s->work + 3 * m;
   const int reuse = damped && s->body && piola__step_reuse_first_product;

@@ -156,7 +156,7 @@ piola_status piola__solid_allocate(world_solid *s, int32_t n, const char *name, 
   s->flags = calloc((size_t)n, 1);
   s->motion_of = malloc((size_t)n * sizeof(int32_t));
   s->x_old = malloc(v3), s->v_old = malloc(v3), s->force_old = malloc(v3), s->rhs = malloc(v3);
-  s->tmp = malloc(v3), s->work = malloc(4 * v3) /* CG's 3 vectors + A v */, s->normals = malloc(v3);
+  s->tmp = malloc(v3), s->work = malloc(4 * v3) /* CG's 3 vectors + the first solve's A x0 */, s->normals = malloc(v3);
   s->av_product = malloc(v3), s->v_product = malloc(v3);
   s->colliding = calloc((size_t)n, 1);
   if (!s->av_product || !s->v_product || !s->name || !s->x || !s->v || !s->force || !s->start || !s->mass || !s->inverse_mass || !s->flags ||

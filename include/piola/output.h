@@ -46,6 +46,7 @@ typedef struct piola_frame_info {
   int64_t contacts;       /* self-collision repulsion contacts since the previous frame */
   int64_t impacts;        /* self-collision impacts since the previous frame */
   int32_t impact_zones;   /* self-collision rigid impact zones since the previous frame */
+  int32_t step_retries;   /* steps redone at a smaller size since the previous frame */
 } piola_frame_info;
 
 /* Writes the VTU and OBJ of the world's current state and appends a row to stats.csv and
@@ -58,6 +59,10 @@ PIOLA_API piola_status piola_output_write_frame(piola_output *output, const piol
 PIOLA_API piola_status piola_output_write_failure_report(piola_output *output,
                                                          const piola_world *world,
                                                          const char *message);
+
+/* Writes DIR/warnings.txt: the world's warnings raised so far (piola_world_warning), one
+ * per line; nothing when none has been raised. */
+PIOLA_API piola_status piola_output_write_warnings(piola_output *output, const piola_world *world);
 
 #ifdef __cplusplus
 }

@@ -146,14 +146,18 @@ typedef struct piola_step_stats {
   int32_t impact_zones;   /* self-collision: rigid impact zones, summed over the steps */
   int32_t collision_steps; /* self-collision: processing runs (every step, or one per
                               collision interval; 0 without self-collision) */
+  int32_t step_retries;   /* steps redone at a quarter of their size because the state blew
+                             up (docs/time-stepping.md, "Step retries") */
 } piola_step_stats;
 
 /* The step size the next step would take with no target time: min(max_dt, CFL bound), s. */
 PIOLA_API double piola_world_stable_dt(const piola_world *world);
 
-/* One step of min(stable dt, dt_limit) seconds. stats (may be NULL) is overwritten. If the
- * state becomes NaN or Inf, returns PIOLA_ERROR_NOT_FINITE and restores the state before
- * the step. */
+/* One step of min(stable dt, dt_limit) seconds. stats (may be NULL) is overwritten. A step
+ * whose state blows up (NaN, Inf, overflowing energy) is redone from the state before it at
+ * a quarter of its size, up to PIOLA_STEP_MAX_RETRIES times; if the last try blows up too,
+ * returns PIOLA_ERROR_NOT_FINITE and restores the state before the step. */
+#define PIOLA_STEP_MAX_RETRIES 4
 PIOLA_API piola_status piola_world_step(piola_world *world, double dt_limit,
                                         piola_step_stats *stats);
 
@@ -162,6 +166,21 @@ PIOLA_API piola_status piola_world_advance_to(piola_world *world, double t_end,
                                               piola_step_stats *stats);
 
 PIOLA_API double piola_world_time(const piola_world *world); /* s */
+
+/* Warnings: conditions a run survives but a user should know about. Each kind is raised at
+ * most once per world; its message (the first occurrence, naming the body, the element or
+ * the numbers) stays until the world is destroyed. docs/cli.md lists them. */
+typedef enum piola_warning_kind {
+  PIOLA_WARNING_CG_MAX_ITERATIONS = 0, /* a damping solve stopped at cg_max_iterations */
+  PIOLA_WARNING_SMALL_STEP,            /* the state-aware step fell below a tenth of the CFL
+                                          estimate of the rest state */
+  PIOLA_WARNING_SLIVER,                /* a tet's rest altitude forces a step far below the
+                                          others (found when the solid is added) */
+  PIOLA_WARNING_KIND_COUNT
+} piola_warning_kind;
+
+/* The message of warning kind, or NULL while it has not been raised. */
+PIOLA_API const char *piola_world_warning(const piola_world *world, piola_warning_kind kind);
 PIOLA_API int32_t piola_world_solid_count(const piola_world *world);
 PIOLA_API int32_t piola_world_obstacle_count(const piola_world *world);
 

@@ -60,6 +60,22 @@ static void format_duration(double s, char *buf, size_t n) {
   else snprintf(buf, n, "%02ld:%02ld", t / 60, t % 60);
 }
 
+/* Prints each warning the world raised since the last call once on stderr and rewrites
+ * DIR/warnings.txt with all of them (docs/cli.md). */
+static void report_warnings(piola_output *out, const piola_world *world, bool warned[],
+                            bool tty) {
+  bool fresh = false;
+  for (int k = 0; k < PIOLA_WARNING_KIND_COUNT; ++k) {
+    const char *w = piola_world_warning(world, (piola_warning_kind)k);
+    if (!w || warned[k]) continue;
+    if (tty && !fresh) fputc('\n', stderr);
+    fprintf(stderr, "piola run: warning: %s\n", w);
+    warned[k] = fresh = true;
+  }
+  if (fresh && piola_output_write_warnings(out, world) != PIOLA_OK)
+    fprintf(stderr, "piola run: warnings.txt: %s\n", piola_last_error());
+}
+
 static void progress(bool tty, int frame, int frames, double t, double elapsed, int substeps,
                      int inverted) {
   double eta = frame > 0 ? elapsed / frame * (frames - frame) : NAN;
@@ -140,6 +156,8 @@ int cli_run(int argc, char **argv) {
     return 1;
   }
   bool tty = isatty(STDERR_FILENO);
+  bool warned[PIOLA_WARNING_KIND_COUNT] = {false};
+  report_warnings(out, world, warned, false);
   fprintf(stderr, "piola run: %s -> %s: %d frames at %g fps, %d solids, %d shells, %d obstacles, first dt %.3g s\n",
           scene_path, out_dir, frames, fps, (int)piola_world_solid_count(world),
           (int)piola_world_shell_count(world), (int)piola_world_obstacle_count(world),
@@ -167,6 +185,7 @@ int cli_run(int argc, char **argv) {
       char message[1024];
       snprintf(message, sizeof message, "%s", piola_last_error());
       if (tty) fputc('\n', stderr);
+      report_warnings(out, world, warned, false);
       fprintf(stderr, "piola run: stopped at frame %d: %s\n", frame, message);
       if (piola_output_write_failure_report(out, world, message) == PIOLA_OK)
         fprintf(stderr, "piola run: frames 0..%d are kept; see %s/failure_report.txt\n", frame - 1, out_dir);
@@ -181,6 +200,7 @@ int cli_run(int argc, char **argv) {
     info.contacts = st.contacts;
     info.impacts = st.impacts;
     info.impact_zones = st.impact_zones;
+    info.step_retries = st.step_retries;
     info.wall_seconds = now_seconds() - t0;
     total_steps += st.substeps;
     total_cg += st.cg_iterations;
@@ -196,6 +216,7 @@ int cli_run(int argc, char **argv) {
     }
     if (preview && piola_preview_frame_written(preview, frame, piola_world_time(world)) != PIOLA_OK)
       fprintf(stderr, "piola run: preview: %s\n", piola_last_error());
+    report_warnings(out, world, warned, tty);
     progress(tty, frame, frames, piola_world_time(world), now_seconds() - sim_start, st.substeps, inverted);
   }
   double wall = now_seconds() - t_start;

@@ -103,6 +103,9 @@ struct piola_elastic_body {
                                when stats are requested, or lazily by the getter) */
   double last_stiffness_scale;
 
+  double *step_weight;      /* per tet 1 / (rho h_e^2), m/kg: the step bound's geometric factor
+                               (stable_step.c), built on first use */
+
   double *chunk_forces; /* PIOLA_FORCE_CHUNKS * 3 * vertex_count partial sums of the force loop */
 
   /* damping (damping.c): the operator as a sparse matrix, assembled from the last update by

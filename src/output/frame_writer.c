@@ -155,7 +155,7 @@ piola_status piola_output_open(const char *dir, bool force, const piola_world *w
   if (st == PIOLA_OK) st = piola__output_prepare_folder(dir, force);
   if (st == PIOLA_OK) st = csv_append(o, "frame,time,substeps,cg_iterations,kinetic_energy,elastic_energy,"
                                          "inverted,min_det_f,wall_seconds,plastic_yielded,max_fp_log_stretch,"
-                                         "contacts,impacts,impact_zones\n");
+                                         "contacts,impacts,impact_zones,step_retries\n");
   if (st != PIOLA_OK) {
     piola_output_close(o);
     return st;
@@ -274,10 +274,11 @@ piola_status piola_output_write_frame(piola_output *o, const piola_world *world,
   PIOLA_TRY(st);
 
   char line[512];
-  snprintf(line, sizeof line, "%d,%.17g,%d,%d,%.17g,%.17g,%lld,%.17g,%.6f,%lld,%.17g,%lld,%lld,%d\n",
+  snprintf(line, sizeof line, "%d,%.17g,%d,%d,%.17g,%.17g,%lld,%.17g,%.6f,%lld,%.17g,%lld,%lld,%d,%d\n",
            (int)info->frame, piola_world_time(world), (int)info->substeps, (int)info->cg_iterations,
            ke, ee, inverted, ns > 0 ? min_det : 1.0, info->wall_seconds, yielded, max_fp_log,
-           (long long)info->contacts, (long long)info->impacts, (int)info->impact_zones);
+           (long long)info->contacts, (long long)info->impacts, (int)info->impact_zones,
+           (int)info->step_retries);
   PIOLA_TRY(csv_append(o, line));
   snprintf(path, sizeof path, "%s/stats.csv", o->dir);
   PIOLA_TRY(write_text(path, o->csv, o->csv_len));
@@ -348,4 +349,19 @@ piola_status piola_output_write_failure_report(piola_output *o, const piola_worl
     free(r);
   }
   return atomic_file_commit(&f);
+}
+
+piola_status piola_output_write_warnings(piola_output *output, const piola_world *world) {
+  char text[4 * 1100];
+  size_t len = 0;
+  text[0] = 0;
+  for (int k = 0; k < PIOLA_WARNING_KIND_COUNT; ++k) {
+    const char *w = piola_world_warning(world, (piola_warning_kind)k);
+    if (w && len < sizeof text) len += (size_t)snprintf(text + len, sizeof text - len, "%s\n", w);
+  }
+  if (len == 0) return PIOLA_OK;
+  if (len >= sizeof text) len = sizeof text - 1;
+  char path[4200];
+  snprintf(path, sizeof path, "%s/warnings.txt", output->dir);
+  return write_text(path, text, len);
 }

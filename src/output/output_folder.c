@@ -90,8 +90,8 @@ piola_status piola__output_prepare_folder(const char *dir, bool force) {
   PIOLA_TRY(make_folder(path));
   if (force) {
     remove_matching(path, "frame_", ".obj");
-    static const char *const files[] = {"stats.csv", "sim.pvd", "failure_report.txt"};
-    for (int i = 0; i < 3; ++i) {
+    static const char *const files[] = {"stats.csv", "sim.pvd", "failure_report.txt", "warnings.txt"};
+    for (int i = 0; i < 4; ++i) {
       snprintf(path, sizeof path, "%s/%s", dir, files[i]);
       unlink(path);
     }

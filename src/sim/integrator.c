@@ -20,6 +20,7 @@
 #include "common/status_internal.h"
 #include "math/mat3.h"
 #include "force/elastic_body_internal.h"
+#include "force/stable_step.h"
 #include "sim/conjugate_gradient.h"
 #include "sim/world_internal.h"
 
@@ -146,7 +147,15 @@ static int32_t damping_solve(piola_world *w, world_solid *s, double h, double t,
   pb.max_iterations = w->def.cg_max_iterations;
   pb.initial_ax = initial_av;
   pb.given_ax = from_product ? initial_av : NULL;
-  return piola__cg_solve(&pb, rhs, v, s->work, av);
+  const int32_t iterations = piola__cg_solve(&pb, rhs, v, s->work, av);
+  if (iterations >= pb.max_iterations)
+    piola__world_warn(w, PIOLA_WARNING_CG_MAX_ITERATIONS,
+                      "%s '%s': a damping solve stopped at cg_max_iterations = %d at t = %g s "
+                      "before reaching cg_tolerance = %g: raise integrator.cg_max_iterations or "
+                      "lower max_dt (docs/time-stepping.md)",
+                      s->shell ? "shell" : "solid", s->name, (int)pb.max_iterations, t,
+                      pb.tolerance);
+  return iterations;
 }
 
 /* Friction for the second half of the step's contact impulse.
@@ -201,14 +210,36 @@ static double stiffness_bound(const world_solid *s, double t0, double t1) {
   return m;
 }
 
+/* The state-aware bound of solid s (stable_step.h), computed once per update. */
+static double solid_state_rate2(const world_solid *s) {
+  world_solid *cache = (world_solid *)s; /* a cache of a function of the const state */
+  if (!cache->state_rate_valid) {
+    cache->state_rate2 = piola__elastic_body_state_rate2(s->body, &cache->state_worst_tet);
+    cache->state_rate_valid = 1;
+  }
+  return s->state_rate2;
+}
+
+/* The step of solid s: its rest bound cfl h_min / c, or the state-aware bound cfl /
+ * sqrt(max_e s k_e / (rho h_e^2)) where that is smaller (docs/time-stepping.md, "Step size").
+ * At rest the two agree up to rounding, so the state bound takes over only when it is
+ * smaller by more than rounding: a state at rest keeps the rest step's bits. */
+static double solid_stable_dt(const piola_world *w, const world_solid *s, double scale) {
+  const double stiffening = piola__solid_plastic_stiffening(s);
+  double speed = piola_elastic_body_max_wave_speed(s->body) * sqrt(scale);
+  double h = piola_elastic_body_min_rest_altitude(s->body) / stiffening;
+  if (!(speed > 0 && h > 0)) return INFINITY;
+  double rest = w->def.cfl * h / speed;
+  double rate2 = solid_state_rate2(s) * scale * stiffening * stiffening;
+  double state = rate2 > 0 ? w->def.cfl / sqrt(rate2) : INFINITY;
+  return state < rest * (1.0 - 1e-9) ? state : rest;
+}
+
 double piola_world_stable_dt(const piola_world *w) {
   double dt = w->def.max_dt;
   for (int32_t i = 0; i < w->solid_count; ++i) {
     const world_solid *s = &w->solids[i];
-    double scale = stiffness_bound(s, w->time, w->time + w->def.max_dt);
-    double speed = piola_elastic_body_max_wave_speed(s->body) * sqrt(scale);
-    double h = piola_elastic_body_min_rest_altitude(s->body) / piola__solid_plastic_stiffening(s);
-    if (speed > 0 && h > 0) dt = fmin(dt, w->def.cfl * h / speed);
+    dt = fmin(dt, solid_stable_dt(w, s, stiffness_bound(s, w->time, w->time + w->def.max_dt)));
   }
   for (int32_t i = 0; i < w->shell_count; ++i) {
     const world_solid *s = &w->shells[i];
@@ -421,12 +452,37 @@ static piola_status step_solid(piola_world *w, world_solid *s, double t, double 
   return PIOLA_OK;
 }
 
-piola_status piola_world_step(piola_world *w, double dt_limit, piola_step_stats *stats) {
-  piola_step_stats local = {0};
-  piola__step_profile_start(&w->profile);
-  double dt = piola_world_stable_dt(w);
-  if (dt_limit > 0 && dt_limit < dt) dt = dt_limit;
-  if (!(dt > 0)) return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "step: dt must be > 0, got %g", dt);
+/* Raises PIOLA_WARNING_SMALL_STEP when a solid's state-aware step (of the last
+ * piola_world_stable_dt) is below a tenth of its rest CFL step, naming the tet that sets it. */
+static void note_small_step(piola_world *w) {
+  if (w->warnings[PIOLA_WARNING_SMALL_STEP]) return;
+  for (int32_t i = 0; i < w->solid_count; ++i) {
+    const world_solid *s = &w->solids[i];
+    if (!s->state_rate_valid || !(s->state_rate2 > 0) || s->state_worst_tet < 0) continue;
+    const double speed = piola_elastic_body_max_wave_speed(s->body);
+    const double h = piola_elastic_body_min_rest_altitude(s->body);
+    const double rest = w->def.cfl * h / speed, state = w->def.cfl / sqrt(s->state_rate2);
+    if (!(speed > 0 && h > 0) || !(state < 0.1 * rest)) continue;
+    const double *f = piola_elastic_body_fhat(s->body) + 3 * s->state_worst_tet;
+    piola__world_warn(w, PIOLA_WARNING_SMALL_STEP,
+                      "solid '%s': at t = %g s the stable step is %.3g s, %.0f times below the "
+                      "CFL estimate of the rest state (%.3g s): tet %d is deformed to Fhat = "
+                      "(%.3g, %.3g, %.3g), where the material is that much stiffer "
+                      "(docs/time-stepping.md, \"Step size\")",
+                      s->name, w->time, state, rest / state, rest, (int)s->state_worst_tet, f[0],
+                      f[1], f[2]);
+    return;
+  }
+}
+
+static void restore_all(piola_world *w, int32_t count) {
+  for (int32_t j = 0; j < count; ++j)
+    restore(j < w->solid_count ? &w->solids[j] : &w->shells[j - w->solid_count], w->time);
+}
+
+/* One try at a step of dt from the current state; on failure every body is back at the
+ * state before it. */
+static piola_status try_step(piola_world *w, double dt, piola_step_stats *local) {
   /* a collision interval (world_contact.c) ends with the first step that reaches its end
    * (steps are not shortened for it), or on advance_to's target */
   double left;
@@ -435,20 +491,37 @@ piola_status piola_world_step(piola_world *w, double dt_limit, piola_step_stats 
   piola__step_profile_mark(&w->profile, STEP_PHASE_WORLD);
   for (int32_t i = 0; i < w->solid_count + w->shell_count; ++i) {
     world_solid *s = i < w->solid_count ? &w->solids[i] : &w->shells[i - w->solid_count];
-    piola_status st = step_solid(w, s, w->time, dt, &local);
+    piola_status st = step_solid(w, s, w->time, dt, local);
     if (st != PIOLA_OK) {
-      for (int32_t j = 0; j < i; ++j)
-        restore(j < w->solid_count ? &w->solids[j] : &w->shells[j - w->solid_count], w->time);
-      if (stats) *stats = local;
+      restore_all(w, i);
       return st;
     }
   }
-  piola_status contact = piola__world_self_collide(w, dt, w->time + dt, closes, &local);
-  if (contact != PIOLA_OK) {
-    for (int32_t j = 0; j < w->solid_count + w->shell_count; ++j)
-      restore(j < w->solid_count ? &w->solids[j] : &w->shells[j - w->solid_count], w->time);
+  piola_status contact = piola__world_self_collide(w, dt, w->time + dt, closes, local);
+  if (contact != PIOLA_OK) restore_all(w, w->solid_count + w->shell_count);
+  return contact;
+}
+
+piola_status piola_world_step(piola_world *w, double dt_limit, piola_step_stats *stats) {
+  piola_step_stats local = {0};
+  piola__step_profile_start(&w->profile);
+  double dt = piola_world_stable_dt(w);
+  if (dt_limit > 0 && dt_limit < dt) dt = dt_limit;
+  if (!(dt > 0)) return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "step: dt must be > 0, got %g", dt);
+  note_small_step(w);
+  /* a step that blows up is redone from the restored state at a quarter of its size: the
+   * bound is a bound on the fastest wave, not a proof, and the paper's promise is that the
+   * run goes on. Only after the last retry does the failure reach the caller. */
+  piola_status st = try_step(w, dt, &local);
+  while (st == PIOLA_ERROR_NOT_FINITE &&
+         local.step_retries < PIOLA_STEP_MAX_RETRIES) {
+    local.step_retries++;
+    dt *= 0.25;
+    st = try_step(w, dt, &local);
+  }
+  if (st != PIOLA_OK) {
     if (stats) *stats = local;
-    return contact;
+    return st;
   }
   for (int32_t i = 0; i < w->solid_count; ++i) piola__solid_plastic_update(&w->solids[i], dt);
   piola__step_profile_mark(&w->profile, STEP_PHASE_WORLD);
@@ -481,6 +554,7 @@ piola_status piola_world_advance_to(piola_world *w, double t_end, piola_step_sta
       stats->impacts += one.impacts;
       stats->impact_zones += one.impact_zones;
       stats->collision_steps += one.collision_steps;
+      stats->step_retries += one.step_retries;
       if (one.substeps) stats->last_dt = one.last_dt;
     }
     if (st != PIOLA_OK) return st;

@@ -75,6 +75,7 @@ void piola_world_destroy(piola_world *world) {
   free(world->shells);
   for (int32_t i = 0; i < world->obstacle_count; ++i) piola_obstacle_destroy(world->obstacles[i]);
   piola__world_contact_free(world);
+  piola__world_warnings_free(world);
   free(world->solids);
   free(world->obstacles);
   free(world);
@@ -89,6 +90,7 @@ piola_status piola__solid_update_forces(world_solid *s, double t) {
   double scale = piola_track_eval(&s->stiffness_scale, t);
   piola_elastic_body_set_activation(s->body, piola_track_eval(&s->activation, t));
   s->elastic_stale = 1;
+  s->state_rate_valid = 0;
   return piola_elastic_body_update(s->body, s->x, scale, s->force, NULL);
 }
 
@@ -263,6 +265,7 @@ piola_status piola_world_add_solid(piola_world *world, const piola_solid_def *de
     piola__solid_free(s);
     return st;
   }
+  piola__world_check_slivers(world, s);
   world->solid_count++;
   if (index) *index = id;
   return PIOLA_OK;

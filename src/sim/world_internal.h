@@ -52,6 +52,11 @@ typedef struct world_solid {
   int product_valid;
   uint8_t *colliding;
   double *normals;
+  /* the state-aware step bound of the last update (solids; stable_step.h): max over tets of
+   * k_e / (rho h_e^2), 1/s^2, and the tet that attains it; valid until the next update */
+  double state_rate2;
+  int32_t state_worst_tet;
+  int state_rate_valid;
 } world_solid;
 
 struct piola_world {
@@ -67,7 +72,19 @@ struct piola_world {
   double collision_deadline;  /* advance_to's target, which closes a collision interval too;
                                  NAN outside advance_to */
   step_profile profile;       /* per-phase step timers, off unless a benchmark turns them on */
+  char *warnings[PIOLA_WARNING_KIND_COUNT]; /* first message of each kind, or NULL */
 };
+
+/* Warnings (world_warnings.c). warn records the message of kind unless one is recorded
+ * already (printf format). check_slivers raises PIOLA_WARNING_SLIVER for solid s when its
+ * worst tets force a rest step far below the typical tet's. warnings_free frees them. */
+void piola__world_warn(piola_world *w, piola_warning_kind kind, const char *format, ...)
+#if defined(__GNUC__)
+    __attribute__((format(printf, 3, 4)))
+#endif
+    ;
+void piola__world_check_slivers(piola_world *w, const world_solid *s);
+void piola__world_warnings_free(piola_world *w);
 
 /* Marks constrained nodes of s from its constraint defs (rest positions rest, 3n). */
 /* Shared by add_solid and add_shell (world.c). new_slot appends a zeroed entry to a

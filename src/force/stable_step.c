@@ -1,0 +1,168 @@
+/* The state-aware explicit step bound (see stable_step.h and docs/time-stepping.md).
+ *
+ * Why a separate pass and not the force loop: the bound needs only Fhat, which the update
+ * stores per tet, so one streaming pass over 3 doubles per tet (plus one cached per-tet
+ * geometric factor) gives it without touching the force kernels. The model switch is
+ * hoisted out of an `omp simd` loop as in the force loop, and the per-lane work is the
+ * model's value and slope at the clamped point (material_model_parts), its extension
+ * (material_extend) and three 2x2 blocks: a few percent of an update.
+ *
+ * The modulus. In the frame of the diagonalization dP/dF splits into the 3x3 block
+ * K = dPhat/dFhat on the diagonal entries and one 2x2 block per pair (i, j) on (F_ij, F_ji),
+ * [[a, b], [b, a]] with a + b = (P_i - P_j)/(f_i - f_j) and a - b = (P_i + P_j)/(f_i + f_j).
+ * For a rank-one unit dF = a n^T (a plane wave) with d_i = dF_ii, x = dF_ij, y = dF_ji one has
+ * d_i d_j = x y, so
+ *     dF : C : dF = sum_i K_ii d_i^2 + sum_{i<j} [x y] (B_ij + K_ij [[0,1],[1,0]]) [x y]^T
+ * and the weights d_i^2, x^2 + y^2 sum to |a|^2 |n|^2 = 1. Hence
+ *     k = max(max_i K_ii, max_{i<j} a_ij + |b_ij + K_ij|)
+ * bounds the squared plane-wave speed times density; at rest both terms are lambda + 2 mu.
+ * Past the inversion threshold the slopes are those of the extension at the threshold (the
+ * diagonal raised as the extension raises it); the denominator f_i + f_j is kept away from 0
+ * by the threshold c (the rotational block is singular there for any invertible model). */
+#include <math.h>
+#include <stdlib.h>
+
+#include "common/status_internal.h"
+#include "force/elastic_body_internal.h"
+#include "force/stable_step.h"
+#include "material/material_kernels.h"
+
+#define STABLE_STEP_KERNEL static inline __attribute__((always_inline))
+
+/* Largest eigenvalue of the pair block plus the K_ij coupling (see above). Selects, no
+ * branches, so that the lane loop vectorizes. */
+STABLE_STEP_KERNEL double pair_modulus(double c, double pi, double pj, double fi, double fj,
+                                       double kii, double kjj, double kij) {
+  const double df = fi - fj, sum = fi + fj;
+  const int close = fabs(df) <= 1e-6 * (fabs(fi) + fabs(fj));
+  const double minus = close ? 0.5 * (kii + kjj) - kij : (pi - pj) / (close ? 1.0 : df);
+  const double den = sum >= 0.0 ? kernel_max(sum, c) : kernel_min(sum, -c);
+  const double plus = (pi + pj) / den;
+  const double a = 0.5 * (minus + plus), b = 0.5 * (minus - plus);
+  return a + fabs(b + kij);
+}
+
+/* k of one tet of model MODEL (a compile-time constant in the lane loops). */
+STABLE_STEP_KERNEL double model_modulus(piola_material_model model, const piola_material *m,
+                                        double f0, double f1, double f2) {
+  const double c = m->threshold;
+  const double fc0 = kernel_max(f0, c), fc1 = kernel_max(f1, c), fc2 = kernel_max(f2, c);
+  const double d0 = f0 - fc0, d1 = f1 - fc1, d2 = f2 - fc2;
+  material_parts pa;
+  material_model_parts(model, m, KERNEL_FAST_RECIPROCAL, fc0, fc1, fc2, &pa);
+  double p0, p1, p2;
+  material_extend(m, KERNEL_FAST_RECIPROCAL, &pa, d0, d1, d2, &p0, &p1, &p2);
+  /* a clamped entry's diagonal slope is at most the extension's threshold slope */
+  const double floor_slope = m->mu;
+  const double k0 = d0 < 0.0 ? kernel_max(pa.k[0][0], floor_slope + kernel_max(pa.p[0], 0.0) / c) : pa.k[0][0];
+  const double k1 = d1 < 0.0 ? kernel_max(pa.k[1][1], floor_slope + kernel_max(pa.p[1], 0.0) / c) : pa.k[1][1];
+  const double k2 = d2 < 0.0 ? kernel_max(pa.k[2][2], floor_slope + kernel_max(pa.p[2], 0.0) / c) : pa.k[2][2];
+  double k = kernel_max(k0, kernel_max(k1, k2));
+  k = kernel_max(k, pair_modulus(c, p0, p1, f0, f1, k0, k1, pa.k[0][1]));
+  k = kernel_max(k, pair_modulus(c, p0, p2, f0, f2, k0, k2, pa.k[0][2]));
+  k = kernel_max(k, pair_modulus(c, p1, p2, f1, f2, k1, k2, pa.k[1][2]));
+  /* muscle fibres: their tangent stiffness bound, as in the rest bound */
+  return k + m->fiber_modulus;
+}
+
+static double material_modulus(const piola_material *m, double f0, double f1, double f2) {
+  switch (m->model) {
+    case PIOLA_MODEL_COROTATED: return model_modulus(PIOLA_MODEL_COROTATED, m, f0, f1, f2);
+    case PIOLA_MODEL_STVK: return model_modulus(PIOLA_MODEL_STVK, m, f0, f1, f2);
+    case PIOLA_MODEL_NEOHOOKEAN: return model_modulus(PIOLA_MODEL_NEOHOOKEAN, m, f0, f1, f2);
+    case PIOLA_MODEL_MUSCLE: return model_modulus(PIOLA_MODEL_MUSCLE, m, f0, f1, f2);
+    case PIOLA_MODEL_SPLINE: return model_modulus(PIOLA_MODEL_SPLINE, m, f0, f1, f2);
+    case PIOLA_MODEL_ROTATED_LINEAR:
+    default: return model_modulus(PIOLA_MODEL_ROTATED_LINEAR, m, f0, f1, f2);
+  }
+}
+
+double piola__elastic_body_tet_rest_altitude(const piola_elastic_body *body, int32_t t) {
+  /* grad N_c of corners 1..3 are the rows of Dm^-1, corner 0's is minus their sum */
+  double g0[3] = {0, 0, 0}, worst = 0;
+  for (int r = 0; r < 3; ++r) {
+    double n2 = 0;
+    for (int k = 0; k < 3; ++k) {
+      const double g = body->dm_inv[3 * r + k][t];
+      g0[k] -= g;
+      n2 += g * g;
+    }
+    worst = fmax(worst, n2);
+  }
+  worst = fmax(worst, g0[0] * g0[0] + g0[1] * g0[1] + g0[2] * g0[2]);
+  return worst > 0 ? 1.0 / sqrt(worst) : INFINITY;
+}
+
+double piola__elastic_body_tet_modulus(const piola_elastic_body *body, int32_t tet,
+                                       const double fhat[3]) {
+  return material_modulus(&body->materials[body->tet_material[tet]], fhat[0], fhat[1], fhat[2]);
+}
+
+/* 1 / (rho h_e^2) per tet, from the rest Dm^-1 (before plasticity changes it): built once. */
+static const double *rate_weights(piola_elastic_body *body) {
+  if (!body->step_weight) {
+    double *w = malloc((size_t)(body->tet_count > 0 ? body->tet_count : 1) * sizeof *w);
+    if (!w) return NULL;
+    for (int32_t t = 0; t < body->tet_count; ++t) {
+      const double h = piola__elastic_body_tet_rest_altitude(body, t);
+      w[t] = 1.0 / (body->density * h * h);
+    }
+    body->step_weight = w;
+  }
+  return body->step_weight;
+}
+
+#define MODEL_LANE_LOOP(model)                                                             \
+  _Pragma("omp simd reduction(max:best)") for (int32_t t = begin; t < end; ++t) {          \
+    const double r = w[t] * model_modulus(model, m, f[3 * t], f[3 * t + 1], f[3 * t + 2]);  \
+    best = r > best ? r : best;                                                            \
+  }                                                                                        \
+  break;
+
+/* max over tets [begin, end) of w_e k_e */
+static double range_rate2(const piola_elastic_body *body, const double *w, int32_t begin,
+                          int32_t end) {
+  const double *f = body->fhat;
+  double best = 0;
+  if (body->uniform_material >= 0) {
+    const piola_material *m = &body->materials[body->uniform_material];
+    switch (m->model) {
+      case PIOLA_MODEL_COROTATED: MODEL_LANE_LOOP(PIOLA_MODEL_COROTATED)
+      case PIOLA_MODEL_STVK: MODEL_LANE_LOOP(PIOLA_MODEL_STVK)
+      case PIOLA_MODEL_NEOHOOKEAN: MODEL_LANE_LOOP(PIOLA_MODEL_NEOHOOKEAN)
+      case PIOLA_MODEL_MUSCLE: MODEL_LANE_LOOP(PIOLA_MODEL_MUSCLE)
+      case PIOLA_MODEL_SPLINE: MODEL_LANE_LOOP(PIOLA_MODEL_SPLINE)
+      case PIOLA_MODEL_ROTATED_LINEAR:
+      default: MODEL_LANE_LOOP(PIOLA_MODEL_ROTATED_LINEAR)
+    }
+  } else {
+    for (int32_t t = begin; t < end; ++t) {
+      const double r = w[t] * piola__elastic_body_tet_modulus(body, t, f + 3 * t);
+      best = r > best ? r : best;
+    }
+  }
+  return best;
+}
+
+double piola__elastic_body_state_rate2(piola_elastic_body *body, int32_t *worst_tet) {
+  const double *w = rate_weights(body);
+  const int32_t nt = body->tet_count;
+  if (worst_tet) *worst_tet = -1;
+  if (!w || nt <= 0) return 0;
+  enum { RANGES = 16 };
+  double part[RANGES];
+  const int parallel = nt >= PIOLA_PARALLEL_MIN_BLOCKS * PIOLA_TET_BLOCK;
+#pragma omp parallel for schedule(static) num_threads(piola__thread_count()) if (parallel)
+  for (int r = 0; r < RANGES; ++r)
+    part[r] = range_rate2(body, w, (int32_t)((int64_t)nt * r / RANGES),
+                          (int32_t)((int64_t)nt * (r + 1) / RANGES));
+  double best = 0;
+  for (int r = 0; r < RANGES; ++r) best = part[r] > best ? part[r] : best;
+  if (worst_tet && best > 0)
+    for (int32_t t = 0; t < nt; ++t)
+      if (w[t] * piola__elastic_body_tet_modulus(body, t, body->fhat + 3 * t) >= best * (1 - 1e-12)) {
+        *worst_tet = t;
+        break;
+      }
+  return best;
+}

@@ -1,0 +1,100 @@
+/* The warning channel: conditions a run survives but a user should hear about once
+ * (piola_world_warning; `piola run` prints each on stderr and appends it to
+ * DIR/warnings.txt, docs/cli.md). */
+#include <math.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "force/elastic_body_internal.h"
+#include "force/stable_step.h"
+#include "piola/mesh_quality.h"
+#include "sim/world_internal.h"
+
+/* A tet whose rest step is this many times below the median tet's is a sliver that sets
+ * the step of the whole solid. */
+#define SLIVER_STEP_RATIO 10.0
+#define SLIVER_NAMED 3
+
+void piola__world_warn(piola_world *w, piola_warning_kind kind, const char *format, ...) {
+  if (kind < 0 || kind >= PIOLA_WARNING_KIND_COUNT || w->warnings[kind]) return;
+  char text[1024];
+  va_list ap;
+  va_start(ap, format);
+  vsnprintf(text, sizeof text, format, ap);
+  va_end(ap);
+  size_t n = strlen(text) + 1;
+  char *copy = malloc(n);
+  if (!copy) return; /* a warning is advisory: out of memory drops it, never the run */
+  memcpy(copy, text, n);
+  w->warnings[kind] = copy;
+}
+
+const char *piola_world_warning(const piola_world *world, piola_warning_kind kind) {
+  if (!world || kind < 0 || kind >= PIOLA_WARNING_KIND_COUNT) return NULL;
+  return world->warnings[kind];
+}
+
+void piola__world_warnings_free(piola_world *w) {
+  for (int k = 0; k < PIOLA_WARNING_KIND_COUNT; ++k) free(w->warnings[k]), w->warnings[k] = NULL;
+}
+
+static int compare_doubles(const void *a, const void *b) {
+  double x = *(const double *)a, y = *(const double *)b;
+  return (x > y) - (x < y);
+}
+
+void piola__world_check_slivers(piola_world *w, const world_solid *s) {
+  const piola_elastic_body *b = s->body;
+  const int32_t nt = b ? b->tet_count : 0;
+  if (nt < 2 || w->warnings[PIOLA_WARNING_SLIVER]) return;
+  double *step = malloc(2 * (size_t)nt * sizeof *step);
+  if (!step) return;
+  const double one[3] = {1, 1, 1};
+  /* the rest step each tet alone would allow: cfl h_e / c_e */
+  for (int32_t t = 0; t < nt; ++t) {
+    const double h = piola__elastic_body_tet_rest_altitude(b, t);
+    const double k = piola__elastic_body_tet_modulus(b, t, one);
+    step[t] = k > 0 ? w->def.cfl * h / sqrt(k / b->density) : INFINITY;
+  }
+  memcpy(step + nt, step, (size_t)nt * sizeof *step);
+  qsort(step + nt, (size_t)nt, sizeof *step, compare_doubles);
+  const double median = step[nt + nt / 2];
+  if (!(step[nt] * SLIVER_STEP_RATIO < median)) {
+    free(step);
+    return;
+  }
+  /* the worst few, each with its dihedral angles */
+  int32_t worst[SLIVER_NAMED];
+  int named = 0;
+  for (int r = 0; r < SLIVER_NAMED; ++r) {
+    int32_t best = -1;
+    for (int32_t t = 0; t < nt; ++t) {
+      int taken = 0;
+      for (int q = 0; q < named; ++q) taken |= worst[q] == t;
+      if (!taken && (best < 0 || step[t] < step[best])) best = t;
+    }
+    if (best < 0 || !(step[best] * SLIVER_STEP_RATIO < median)) break;
+    worst[named++] = best;
+  }
+  char list[768];
+  size_t len = 0;
+  list[0] = 0;
+  for (int q = 0; q < named && len < sizeof list; ++q) {
+    const int32_t *v = b->tets + 4 * worst[q];
+    const double *x = b->rest_positions;
+    double angles[6], lo = INFINITY, hi = -INFINITY;
+    piola_tet_dihedral_angles(x + 3 * v[0], x + 3 * v[1], x + 3 * v[2], x + 3 * v[3], angles);
+    for (int a = 0; a < 6; ++a) lo = fmin(lo, angles[a]), hi = fmax(hi, angles[a]);
+    len += (size_t)snprintf(list + len, sizeof list - len,
+                            "%stet %d (dihedral angles %.2f to %.2f degrees) forces %.3g s",
+                            q ? "; " : "", (int)worst[q], lo, hi, step[worst[q]]);
+  }
+  piola__world_warn(w, PIOLA_WARNING_SLIVER,
+                    "solid '%s': sliver elements set the step: %s, %.0f times below the median "
+                    "tet's %.3g s (tets numbered from 0 in file order); remesh with `piola mesh "
+                    "generate` for a step near the median",
+                    s->name, list, median / step[worst[0]], median);
+  free(step);
+}

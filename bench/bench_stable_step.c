@@ -1,0 +1,81 @@
+/* Cost of the state-aware step bound (src/force/stable_step.c) against the force loop it
+ * must stay under 5% of (issue 21).
+ *
+ *   build/<dir>/bench_stable_step [repeats]
+ *
+ * Vega's torus-easy.veg (97,878 tets) when the data folder is there, else a generated
+ * 105,456-tet grid, deformed by a random stretch of up to 30% plus noise of 5% of an edge,
+ * for neo-Hookean and corotated. Per model and thread count (1, 2) the update
+ * (piola_elastic_body_update, forces only) and the bound pass are timed interleaved, one of
+ * each per repeat; the medians (default 15 repeats) and their ratio are printed. The bound
+ * reads the Fhat the update stored, so each pass follows an update as in a step. */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+
+#include "force/elastic_body_internal.h"
+#include "force/stable_step.h"
+#include "piola/elastic_body.h"
+#include "piola/mesh_io.h"
+#include "support/bench_support.h"
+
+static void bench_model(const char *name, const piola_tet_mesh *mesh, piola_material_model model,
+                        int repeats) {
+  piola_material_def md = piola_default_material_def();
+  md.model = model;
+  piola_material material;
+  piola_elastic_body *body = NULL;
+  piola_elastic_body_def def = piola_default_elastic_body_def();
+  def.rest_mesh = mesh;
+  def.materials = &material;
+  def.material_count = 1;
+  if (piola_material_init(&md, &material) != PIOLA_OK || piola_elastic_body_create(&def, &body) != PIOLA_OK) {
+    fprintf(stderr, "bench_stable_step: %s\n", piola_last_error());
+    exit(1);
+  }
+  const int32_t nv = mesh->vertex_count;
+  double *x = malloc(sizeof(double) * 3 * (size_t)nv), *f = malloc(sizeof(double) * 3 * (size_t)nv);
+  double a[3] = {1 + bench_uniform(-0.3, 0.3), 1 + bench_uniform(-0.3, 0.3), 1 + bench_uniform(-0.3, 0.3)};
+  const double noise = 0.05 * piola_elastic_body_min_rest_altitude(body) * 3;
+  for (int32_t i = 0; i < nv; ++i)
+    for (int k = 0; k < 3; ++k) x[3 * i + k] = a[k] * mesh->positions[3 * i + k] + noise * bench_uniform(-1, 1);
+  double *tu = malloc(sizeof(double) * (size_t)repeats), *tb = malloc(sizeof(double) * (size_t)repeats);
+  for (int threads = 1; threads <= 2; ++threads) {
+    piola_set_thread_count(threads);
+    double sink = 0;
+    for (int r = -1; r < repeats; ++r) { /* r = -1 warms up (and builds the weights) */
+      double t0 = bench_wall_seconds();
+      piola_elastic_body_update(body, x, 1.0, f, NULL);
+      double t1 = bench_wall_seconds();
+      sink += piola__elastic_body_state_rate2(body, NULL);
+      double t2 = bench_wall_seconds();
+      if (r >= 0) tu[r] = t1 - t0, tb[r] = t2 - t1;
+    }
+    double mu = bench_median(tu, repeats), mb = bench_median(tb, repeats);
+    printf("| %-16s | %-10s | %7d | %d | %8.3f | %8.3f | %5.1f%% | (%g)\n", name,
+           piola_material_model_name(model), (int)mesh->tet_count, threads, 1e3 * mu, 1e3 * mb,
+           100 * mb / mu, sink > 0 ? 1.0 : 0.0);
+  }
+  piola_set_thread_count(0);
+  free(tu), free(tb), free(x), free(f);
+  piola_elastic_body_destroy(body);
+}
+
+int main(int argc, char **argv) {
+  int repeats = argc > 1 ? atoi(argv[1]) : 15;
+  if (repeats < 1) repeats = 1;
+  piola_tet_mesh mesh;
+  const char *name = "torus-easy.veg";
+  if (piola_tet_mesh_read(PIOLA_DATA_DIR "/vega/torus-easy.veg", &mesh) != PIOLA_OK) {
+    name = "grid 26^3x6";
+    if (piola_tet_mesh_box_grid(26, 26, 26, (piola_vec3){0.01, 0.01, 0.01}, &mesh) != PIOLA_OK) {
+      fprintf(stderr, "bench_stable_step: %s\n", piola_last_error());
+      return 1;
+    }
+  }
+  printf("| mesh             | model      |    tets | threads | update ms | bound ms | bound/update |\n");
+  bench_model(name, &mesh, PIOLA_MODEL_NEOHOOKEAN, repeats);
+  bench_model(name, &mesh, PIOLA_MODEL_COROTATED, repeats);
+  piola_tet_mesh_free(&mesh);
+  return 0;
+}

@@ -22,7 +22,7 @@
 #include <math.h>
 #include <stdlib.h>
 
-#include "common/status_internal.h"
+#include "common/status_report.h"
 #include "force/elastic_body_internal.h"
 #include "force/stable_step.h"
 #include "material/material_kernels.h"
@@ -209,7 +209,7 @@ double piola__elastic_body_state_rate2(piola_elastic_body *body, int32_t *worst_
   enum { RANGES = 16 };
   double part[RANGES];
   const int parallel = nt >= PIOLA_PARALLEL_MIN_BLOCKS * PIOLA_TET_BLOCK;
-#pragma omp parallel for schedule(static) num_threads(piola__thread_count()) if (parallel)
+#pragma omp parallel for schedule(static) num_threads(piola_thread_count()) if (parallel)
   for (int r = 0; r < RANGES; ++r)
     part[r] = range_rate2(body, w, (int32_t)((int64_t)nt * r / RANGES),
                           (int32_t)((int64_t)nt * (r + 1) / RANGES));

@@ -4,9 +4,10 @@
  *  - scrambles (every free node moved by a random point of a ball of the given radius) on
  *    unit_ball.mesh, octahedron.node and octopus-low.mesh (min dihedral angle 0.84 degrees,
  *    14% of tets with mean ratio < 0.1) run 2 s of simulated time with every step succeeding
- *    and a finite state: half a diagonal for every model, 1 and 2 diagonals for neo-Hookean
- *    and rotated linear (the others are not affordable there with an explicit step, see
- *    docs/time-stepping.md "Recovery");
+ *    and a finite state: 0.5, 1 and 2 diagonals for neo-Hookean and rotated linear on all
+ *    three; corotated, StVK and the spline only half a diagonal on the unit ball (elsewhere
+ *    their explicit runs are not affordable in a test, see docs/time-stepping.md
+ *    "Recovery");
  *  - point, line and plane collapses of every model on unit_ball and octahedron reach a shape
  *    error (largest distance to the rest shape after the best rigid motion) below 1% of the
  *    diagonal within the settling time docs/time-stepping.md "Recovery" predicts from E,
@@ -88,10 +89,11 @@ static void scrambles_run_to_the_end(void **state) {
     piola_tet_mesh mesh = read_scaled(meshes[mi]);
     for (int k = 0; k < 5; ++k)
       for (int r = 0; r < 3; ++r) {
-        /* 1 and 2 diagonals only for the models whose stiffness stays bounded under stretch
-         * (docs/time-stepping.md "Recovery": corotated, StVK and the spline stiffen without
-         * limit, and their stable step there is 1e4-1e5 times the rest one) */
-        if (r > 0 && models[k] != PIOLA_MODEL_NEOHOOKEAN && models[k] != PIOLA_MODEL_ROTATED_LINEAR) continue;
+        /* corotated, StVK and the spline stiffen without limit under stretch: their stable
+         * step in these starts is 1e-2 to 1e-5 of the rest one (docs/time-stepping.md
+         * "Recovery"), affordable here only for half a diagonal on the unit ball */
+        const int bounded = models[k] == PIOLA_MODEL_NEOHOOKEAN || models[k] == PIOLA_MODEL_ROTATED_LINEAR;
+        if (!bounded && (r > 0 || mi > 0)) continue;
         const double radius = (r == 0 ? 0.5 : r == 1 ? 1.0 : 2.0) * DIAGONAL;
         piola_world *w = make_world(&mesh, models[k], identity, radius);
         piola_step_stats st = {0};
@@ -162,7 +164,7 @@ static void collapses_settle_in_the_predicted_time(void **state) {
   static const char *const start_names[3] = {"point", "line", "plane"};
   const double eps = 0.01 * DIAGONAL;
   /* at reduced scale only every few cases, rotating through all of them */
-  const int stride = test_scale() < 0.5 ? 5 : 1;
+  const int stride = test_scale() < 0.5 ? 4 : 1;
   int index = 0;
   for (int mi = 0; mi < 2; ++mi) {
     piola_tet_mesh mesh = read_scaled(meshes[mi]);

@@ -88,14 +88,17 @@ def test_shared_meshes_agree_with_meshio():
     assert len(veg.tets) > 0
 
 
-def test_regions_and_fibers_survive_vtu(tmp_path, ball):
+@pytest.mark.parametrize("ext", [".msh", ".vtu", ".mesh", ".node"])
+def test_regions_and_fibers_survive(tmp_path, ball, ext):
     m = len(ball.tets)
-    regions = (np.arange(m) % 3).astype(np.int32)
-    fibers = np.tile([0.0, 0.0, 1.0], (m, 1))
-    path = str(tmp_path / "f.msh")
+    regions = (np.arange(m) % 3 + 1).astype(np.int32)
+    fibers = np.tile([0.0, 0.6, 0.8], (m, 1))
+    path = str(tmp_path / f"f{ext}")
     piola.write_mesh(path, ball.points, ball.tets, regions=regions, fibers=fibers)
     back = piola.read_mesh(path)
-    assert back.fibers is not None and np.allclose(back.fibers, fibers)
+    assert np.array_equal(back.regions, regions)
+    if ext in (".msh", ".vtu"):
+        assert np.allclose(back.fibers, fibers)
 
 
 def test_bad_files_and_arguments(tmp_path, ball):

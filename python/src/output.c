@@ -63,10 +63,8 @@ static PyObject *output_write_frame(PyObject *self_obj, PyObject *args) {
   if (!w) return NULL;
   info.frame = frame, info.substeps = substeps, info.cg_iterations = cg, info.impact_zones = zones;
   info.contacts = contacts, info.impacts = impacts;
-  piola_status st;
-  Py_BEGIN_ALLOW_THREADS
-  st = piola_output_write_frame(self->output, w, &info);
-  Py_END_ALLOW_THREADS
+  /* with the GIL held: no other thread can step the world while its frame is written */
+  piola_status st = piola_output_write_frame(self->output, w, &info);
   if (st != PIOLA_OK) return pypiola_raise(pypiola_error, st);
   Py_RETURN_NONE;
 }

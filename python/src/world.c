@@ -18,6 +18,9 @@
 #include <stdlib.h>
 #include <string.h>
 
+/* apply_view_writes' own refusal, told apart from the library's statuses */
+#define VIEW_BAD_VELOCITY ((piola_status)-100)
+
 typedef struct {
   double *x, *v; /* snapshots, 3n each */
   int32_t n;
@@ -85,6 +88,12 @@ static int take_snapshots(world_object *self) {
   return 0;
 }
 
+static int all_finite(const double *values, size_t count) {
+  for (size_t i = 0; i < count; ++i)
+    if (!isfinite(values[i])) return 0;
+  return 1;
+}
+
 /* Hands solids changed through their views to set_state. A refused state (NaN) is undone. */
 static int apply_view_writes(world_object *self) {
   for (int32_t i = 0; i < self->shadow_count; ++i) {
@@ -99,14 +108,18 @@ static int apply_view_writes(world_object *self) {
     memcpy(copy, x, bytes);
     memcpy(copy + 3 * (size_t)s->n, v, bytes);
     /* set_state copies into the same buffers: give it a separate copy */
-    piola_status st = piola_world_solid_set_state(self->world, i, dx ? copy : NULL,
-                                                  dv ? copy + 3 * (size_t)s->n : NULL);
+    /* set_state checks positions; velocities are checked here */
+    piola_status st = all_finite(v, 3 * (size_t)s->n)
+                          ? piola_world_solid_set_state(self->world, i, dx ? copy : NULL,
+                                                        dv ? copy + 3 * (size_t)s->n : NULL)
+                          : VIEW_BAD_VELOCITY;
     free(copy);
     if (st != PIOLA_OK) {
       memcpy(x, s->x, bytes);
       memcpy(v, s->v, bytes);
-      PyErr_Format(PyExc_ValueError, "solid %d: the positions written through its view were refused "
-                   "and undone: %s", (int)i, piola_last_error());
+      PyErr_Format(PyExc_ValueError, "solid %d: the state written through its views was refused "
+                   "and undone: %s", (int)i,
+                   st == VIEW_BAD_VELOCITY ? "a velocity is not finite" : piola_last_error());
       return -1;
     }
     memcpy(s->x, x, bytes);
@@ -349,7 +362,7 @@ static PyObject *world_set_solid_state(PyObject *self_obj, PyObject *args) {
   PyObject *pobj, *vobj;
   if (!PyArg_ParseTuple(args, "iOO", &index, &pobj, &vobj)) return NULL;
   if (!body_world(self_obj, 0, index) || !synced(self)) return NULL;
-  npy_intp dims[2] = {self->shadows[index].n, 3};
+  npy_intp dims[2] = {piola_elastic_body_vertex_count(piola_world_solid_body(self->world, index)), 3};
   const double *p = NULL, *v = NULL;
   if (pobj != Py_None) {
     PyArrayObject *a = pypiola_check_array(pobj, "positions", NPY_DOUBLE, 2, dims, 0);
@@ -360,6 +373,10 @@ static PyObject *world_set_solid_state(PyObject *self_obj, PyObject *args) {
     PyArrayObject *a = pypiola_check_array(vobj, "velocities", NPY_DOUBLE, 2, dims, 0);
     if (!a) return NULL;
     v = PyArray_DATA(a);
+    if (!all_finite(v, 3 * (size_t)dims[0])) {
+      PyErr_SetString(PyExc_ValueError, "set_state: a velocity is not finite");
+      return NULL;
+    }
   }
   /* the arrays may be the world's own views: copy before handing them over */
   size_t bytes = 3 * (size_t)dims[0] * sizeof(double);

@@ -8,8 +8,6 @@ SOURCE_DIR = os.environ.get("PIOLA_SOURCE_DIR",
                             os.path.abspath(os.path.join(os.path.dirname(__file__), "..", "..")))
 DATA_DIR = os.environ.get("PIOLA_DATA_DIR", os.path.join(SOURCE_DIR, "..", "shared", "data"))
 CLI = os.environ.get("PIOLA")
-# Heavy checks shrink with PIOLA_TEST_SCALE (1: full size), as the C tests do.
-SCALE = float(os.environ.get("PIOLA_TEST_SCALE", "1"))
 
 
 def data(*parts):

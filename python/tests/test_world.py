@@ -91,6 +91,12 @@ def test_writes_through_views_reach_the_solver():
     with pytest.raises(ValueError, match="refused"):
         w.advance_to(0.2)
     assert np.all(np.isfinite(b.positions))
+    b.velocities[3, 1] = np.inf
+    with pytest.raises(ValueError, match="velocity is not finite"):
+        b.stats()
+    assert np.all(np.isfinite(b.velocities))
+    with pytest.raises(ValueError, match="not finite"):
+        b.set_state(velocities=np.full((len(b.masses), 3), np.nan))
     w.advance_to(0.2)
     b.velocities = np.zeros((len(b.masses), 3), dtype=np.float32)  # setter copies
     assert b.stats()["kinetic_energy"] == 0

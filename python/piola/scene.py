@@ -28,6 +28,7 @@ class Scene:
             raise SceneError(f"{label}: not representable as JSON: {e}") from None
         base = os.fspath(base_dir) if base_dir is not None else os.getcwd()
         self._init(_piola.Scene("", text, base, label), None)
+        self._source, self._folder = json.loads(text), os.path.abspath(base)
 
     @classmethod
     def from_file(cls, path):
@@ -35,6 +36,9 @@ class Scene:
         self = cls.__new__(cls)
         path = os.fspath(path)
         self._init(_piola.Scene(path, None, None, None), path)
+        with open(path, encoding="utf-8") as f:
+            self._source = json.load(f)
+        self._folder = os.path.dirname(os.path.abspath(path))
         return self
 
     def _init(self, core, path):
@@ -56,7 +60,8 @@ class Scene:
 
     def run(self, out_dir, frames=None, force=False, progress=None):
         """Runs the scene from t = 0 and writes what `piola run` writes (docs/cli.md):
-        out_dir/frames/frame_NNNN.vtu, surface/frame_NNNN.obj, stats.csv, sim.pvd.
+        out_dir/frames/frame_NNNN.vtu, surface/frame_NNNN.obj, stats.csv, sim.pvd, and
+        scene.json (the scene with absolute mesh paths, for `piola render out_dir`).
 
         frames: frames after frame 0 (default: the scene's). force: reuse a non-empty folder,
         removing piola's earlier results there. progress(frame, frames, time_s, stats) is
@@ -78,6 +83,7 @@ class Scene:
         out = _piola.Output(os.fspath(out_dir), bool(force), world._core)
         steps = cg = written = 0
         try:
+            self._write_copy(os.path.join(os.fspath(out_dir), "scene.json"))
             out.write_frame(0, 0, 0, 0.0, 0, 0, 0)
             for frame in range(1, n + 1):
                 t0 = _time.perf_counter()
@@ -98,6 +104,21 @@ class Scene:
             out.close()
         return {"frames": written, "steps": steps, "cg_iterations": cg,
                 "wall_seconds": _time.perf_counter() - start}
+
+    def _write_copy(self, path):
+        """The scene with the mesh paths of solids, shells, obstacles and bones made absolute,
+        written whole or not at all."""
+        scene = json.loads(json.dumps(self._source))
+        for section, key in (("solids", "mesh"), ("shells", "mesh"), ("obstacles", "path"),
+                             ("bones", "path")):
+            for item in scene.get(section, []):
+                if isinstance(item.get(key), str):
+                    item[key] = os.path.join(self._folder, item[key])
+        tmp = path + ".tmp"
+        with open(tmp, "w", encoding="utf-8") as f:
+            json.dump(scene, f, indent=2)
+            f.write("\n")
+        os.replace(tmp, path)
 
     def close(self):
         """Ends the scene and its world: later calls raise ClosedError."""

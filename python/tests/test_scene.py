@@ -1,5 +1,6 @@
 """Scenes through Python: the same results and errors as `piola run`."""
 import csv
+import json
 import os
 import subprocess
 
@@ -37,6 +38,12 @@ def test_run_writes_what_the_cli_writes(tmp_path):
     with open(tmp_path / "py" / "stats.csv") as f:
         rows = list(csv.DictReader(f))
     assert [int(r["frame"]) for r in rows] == [0, 1, 2]
+    # piola render finds the scene (obstacles, materials) in the folder, as after piola run
+    copy = piola.Scene.from_file(tmp_path / "py" / "scene.json")
+    assert copy.frames == 90 and copy.world.obstacle_count == 1
+    subprocess.run([CLI, "render", str(tmp_path / "py"), "--no-movie"], check=True,
+                   capture_output=True)
+    assert os.path.exists(tmp_path / "py" / "render" / "frame_0002.png")
 
 
 def test_dict_scene_and_progress_stop(tmp_path):
@@ -66,6 +73,17 @@ def test_progress_exception_propagates_and_keeps_frames(tmp_path):
         piola.Scene(SMALL).run(tmp_path / "out", progress=boom)
     assert os.path.exists(tmp_path / "out" / "frames" / "frame_0001.vtu")
     assert os.path.exists(tmp_path / "out" / "sim.pvd")
+
+
+def test_scene_copy_has_absolute_mesh_paths(tmp_path):
+    piola.write_mesh(tmp_path / "ball.msh", piola.generate_mesh("sphere", radius=0.1, cell_size=0.05))
+    scene = piola.Scene(dict(SMALL, solids=[dict(SMALL["solids"][0], mesh="ball.msh")]),
+                        base_dir=tmp_path)
+    scene.run(tmp_path / "out", frames=1)
+    with open(tmp_path / "out" / "scene.json") as f:
+        copy = json.load(f)
+    assert copy["solids"][0]["mesh"] == str(tmp_path / "ball.msh")
+    assert piola.Scene(copy).world.solids[0].cells.shape == scene.world.solids[0].cells.shape
 
 
 def test_scene_errors_name_the_key_path(tmp_path):

@@ -24,8 +24,7 @@ static PyObject *material_check(PyObject *self, PyObject *args) {
 }
 
 /* out = U diag-or-full(phat) V^T */
-static void rotate_back(const piola_mat3 *u, double phat[3][3], const piola_mat3 *v,
-                        double *out) {
+static void rotate_back(const piola_mat3 *u, double phat[3][3], const piola_mat3 *v, double *out) {
   double t[3][3];
   for (int i = 0; i < 3; ++i)
     for (int j = 0; j < 3; ++j) {
@@ -50,24 +49,25 @@ static PyObject *diagonalize(PyObject *self, PyObject *args) {
   if (!f) return NULL;
   npy_intp n = PyArray_DIM(f, 0);
   npy_intp d33[3] = {n, 3, 3}, d3[2] = {n, 3};
-  PyArrayObject *u = pypiola_new_array(NPY_DOUBLE, 3, d33), *v = pypiola_new_array(NPY_DOUBLE, 3, d33),
+  PyArrayObject *u = pypiola_new_array(NPY_DOUBLE, 3, d33),
+                *v = pypiola_new_array(NPY_DOUBLE, 3, d33),
                 *fhat = pypiola_new_array(NPY_DOUBLE, 2, d3);
   if (!u || !v || !fhat) goto fail;
   const double *fp = PyArray_DATA(f);
   double *up = PyArray_DATA(u), *vp = PyArray_DATA(v), *hp = PyArray_DATA(fhat);
   npy_intp bad = -1;
-  Py_BEGIN_ALLOW_THREADS
-  for (npy_intp i = 0; i < n; ++i) {
+  Py_BEGIN_ALLOW_THREADS for (npy_intp i = 0; i < n; ++i) {
     piola_mat3 fm, um, vm;
     piola_vec3 h;
     for (int k = 0; k < 9; ++k) fm.m[k / 3][k % 3] = fp[9 * i + k];
     if (piola_diagonalize3(&fm, &um, &h, &vm) != PIOLA_OK && bad < 0) bad = i;
-    for (int k = 0; k < 9; ++k) up[9 * i + k] = um.m[k / 3][k % 3], vp[9 * i + k] = vm.m[k / 3][k % 3];
+    for (int k = 0; k < 9; ++k)
+      up[9 * i + k] = um.m[k / 3][k % 3], vp[9 * i + k] = vm.m[k / 3][k % 3];
     hp[3 * i] = h.x, hp[3 * i + 1] = h.y, hp[3 * i + 2] = h.z;
   }
-  Py_END_ALLOW_THREADS
-  if (bad >= 0) {
-    PyErr_Format(PyExc_ValueError, "F[%zd] is not finite (or too large to diagonalize)", (Py_ssize_t)bad);
+  Py_END_ALLOW_THREADS if (bad >= 0) {
+    PyErr_Format(PyExc_ValueError, "F[%zd] is not finite (or too large to diagonalize)",
+                 (Py_ssize_t)bad);
     goto fail;
   }
   return Py_BuildValue("NNN", u, fhat, v);
@@ -84,7 +84,8 @@ static PyObject *material_eval(PyObject *self, PyObject *args) {
   piola_material_def def;
   PyObject *fobj, *fibobj;
   double activation;
-  if (!PyArg_ParseTuple(args, "O&OOd", pypiola_material_converter, &def, &fobj, &fibobj, &activation))
+  if (!PyArg_ParseTuple(args, "O&OOd", pypiola_material_converter, &def, &fobj, &fibobj,
+                        &activation))
     return NULL;
   piola_material mat;
   if (init_material(&def, &mat) < 0) return NULL;
@@ -104,7 +105,8 @@ static PyObject *material_eval(PyObject *self, PyObject *args) {
     fib = PyArray_DATA(fa);
   }
   npy_intp d33[3] = {n, 3, 3}, d1[1] = {n};
-  PyArrayObject *p = pypiola_new_array(NPY_DOUBLE, 3, d33), *psi = pypiola_new_array(NPY_DOUBLE, 1, d1);
+  PyArrayObject *p = pypiola_new_array(NPY_DOUBLE, 3, d33),
+                *psi = pypiola_new_array(NPY_DOUBLE, 1, d1);
   if (!p || !psi) {
     Py_XDECREF(p);
     Py_XDECREF(psi);
@@ -113,8 +115,7 @@ static PyObject *material_eval(PyObject *self, PyObject *args) {
   const double *fp = PyArray_DATA(f);
   double *pp = PyArray_DATA(p), *ep = PyArray_DATA(psi);
   npy_intp bad = -1;
-  Py_BEGIN_ALLOW_THREADS
-  for (npy_intp i = 0; i < n; ++i) {
+  Py_BEGIN_ALLOW_THREADS for (npy_intp i = 0; i < n; ++i) {
     piola_mat3 fm, um, vm;
     piola_vec3 h;
     for (int k = 0; k < 9; ++k) fm.m[k / 3][k % 3] = fp[9 * i + k];
@@ -126,7 +127,8 @@ static PyObject *material_eval(PyObject *self, PyObject *args) {
     if (fib) {
       const double *a = fib + 3 * i;
       double ahat[3];
-      for (int r = 0; r < 3; ++r) ahat[r] = vm.m[0][r] * a[0] + vm.m[1][r] * a[1] + vm.m[2][r] * a[2];
+      for (int r = 0; r < 3; ++r)
+        ahat[r] = vm.m[0][r] * a[0] + vm.m[1][r] * a[1] + vm.m[2][r] * a[2];
       piola_material_muscle_stress(&mat, fhat, ahat, activation, phat);
       ep[i] = piola_material_muscle_energy_density(&mat, fhat, ahat, activation);
     } else {
@@ -137,11 +139,11 @@ static PyObject *material_eval(PyObject *self, PyObject *args) {
     }
     rotate_back(&um, phat, &vm, pp + 9 * i);
   }
-  Py_END_ALLOW_THREADS
-  if (bad >= 0) {
+  Py_END_ALLOW_THREADS if (bad >= 0) {
     Py_DECREF(p);
     Py_DECREF(psi);
-    PyErr_Format(PyExc_ValueError, "F[%zd] is not finite (or too large to diagonalize)", (Py_ssize_t)bad);
+    PyErr_Format(PyExc_ValueError, "F[%zd] is not finite (or too large to diagonalize)",
+                 (Py_ssize_t)bad);
     return NULL;
   }
   return Py_BuildValue("NN", p, psi);
@@ -160,7 +162,8 @@ static PyObject *material_eval_hat(PyObject *self, PyObject *args) {
   if (!h) return NULL;
   npy_intp n = PyArray_DIM(h, 0);
   npy_intp d3[2] = {n, 3}, d1[1] = {n}, d33[3] = {n, 3, 3};
-  PyArrayObject *p = pypiola_new_array(NPY_DOUBLE, 2, d3), *psi = pypiola_new_array(NPY_DOUBLE, 1, d1),
+  PyArrayObject *p = pypiola_new_array(NPY_DOUBLE, 2, d3),
+                *psi = pypiola_new_array(NPY_DOUBLE, 1, d1),
                 *dp = pypiola_new_array(NPY_DOUBLE, 3, d33);
   if (!p || !psi || !dp) {
     Py_XDECREF(p);
@@ -171,8 +174,7 @@ static PyObject *material_eval_hat(PyObject *self, PyObject *args) {
   const double *hp = PyArray_DATA(h);
   double *pp = PyArray_DATA(p), *ep = PyArray_DATA(psi), *dpp = PyArray_DATA(dp);
   npy_intp bad = -1;
-  Py_BEGIN_ALLOW_THREADS
-  for (npy_intp i = 0; i < n; ++i) {
+  Py_BEGIN_ALLOW_THREADS for (npy_intp i = 0; i < n; ++i) {
     const double *fh = hp + 3 * i;
     if (!isfinite(fh[0]) || !isfinite(fh[1]) || !isfinite(fh[2])) {
       if (bad < 0) bad = i;
@@ -184,8 +186,7 @@ static PyObject *material_eval_hat(PyObject *self, PyObject *args) {
     piola_material_stress_derivative(&mat, fh, d);
     for (int k = 0; k < 9; ++k) dpp[9 * i + k] = d[k / 3][k % 3];
   }
-  Py_END_ALLOW_THREADS
-  if (bad >= 0) {
+  Py_END_ALLOW_THREADS if (bad >= 0) {
     Py_DECREF(p);
     Py_DECREF(psi);
     Py_DECREF(dp);
@@ -197,8 +198,10 @@ static PyObject *material_eval_hat(PyObject *self, PyObject *args) {
 
 PyMethodDef pypiola_material_methods[] = {
     {"material_check", material_check, METH_VARARGS, "material_check(def) -> dict"},
-    {"material_eval", material_eval, METH_VARARGS, "material_eval(def, F, fibers, activation) -> (P, psi)"},
-    {"material_eval_hat", material_eval_hat, METH_VARARGS, "material_eval_hat(def, fhat) -> (phat, psi, dphat)"},
+    {"material_eval", material_eval, METH_VARARGS,
+     "material_eval(def, F, fibers, activation) -> (P, psi)"},
+    {"material_eval_hat", material_eval_hat, METH_VARARGS,
+     "material_eval_hat(def, fhat) -> (phat, psi, dphat)"},
     {"diagonalize", diagonalize, METH_VARARGS, "diagonalize(F) -> (U, fhat, V)"},
     {NULL, NULL, 0, NULL},
 };

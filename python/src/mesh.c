@@ -10,7 +10,8 @@ static PyArrayObject *copy_out(int type_num, const void *data, npy_intp count, n
                                size_t item) {
   npy_intp dims[2] = {count, width};
   PyArrayObject *a = pypiola_new_array(type_num, width > 0 ? 2 : 1, dims);
-  if (a && count > 0) memcpy(PyArray_DATA(a), data, (size_t)count * (size_t)(width > 0 ? width : 1) * item);
+  if (a && count > 0)
+    memcpy(PyArray_DATA(a), data, (size_t)count * (size_t)(width > 0 ? width : 1) * item);
   return a;
 }
 
@@ -21,19 +22,18 @@ static PyObject *read_tet_mesh(PyObject *self, PyObject *args) {
   piola_tet_mesh mesh = {0};
   piola_status st;
   const char *path = PyBytes_AS_STRING(path_obj);
-  Py_BEGIN_ALLOW_THREADS
-  st = piola_tet_mesh_read(path, &mesh);
-  Py_END_ALLOW_THREADS
-  Py_DECREF(path_obj);
+  Py_BEGIN_ALLOW_THREADS st = piola_tet_mesh_read(path, &mesh);
+  Py_END_ALLOW_THREADS Py_DECREF(path_obj);
   if (st != PIOLA_OK) return pypiola_raise(pypiola_mesh_error, st);
-  PyArrayObject *points = copy_out(NPY_DOUBLE, mesh.positions, mesh.vertex_count, 3, sizeof(double));
+  PyArrayObject *points =
+      copy_out(NPY_DOUBLE, mesh.positions, mesh.vertex_count, 3, sizeof(double));
   PyArrayObject *tets = copy_out(NPY_INT32, mesh.tets, mesh.tet_count, 4, sizeof(int32_t));
-  PyObject *regions = mesh.tet_regions
-                          ? (PyObject *)copy_out(NPY_INT32, mesh.tet_regions, mesh.tet_count, 0, sizeof(int32_t))
-                          : Py_NewRef(Py_None);
-  PyObject *fibers = mesh.tet_fibers
-                         ? (PyObject *)copy_out(NPY_DOUBLE, mesh.tet_fibers, mesh.tet_count, 3, sizeof(double))
-                         : Py_NewRef(Py_None);
+  PyObject *regions = mesh.tet_regions ? (PyObject *)copy_out(NPY_INT32, mesh.tet_regions,
+                                                              mesh.tet_count, 0, sizeof(int32_t))
+                                       : Py_NewRef(Py_None);
+  PyObject *fibers = mesh.tet_fibers ? (PyObject *)copy_out(NPY_DOUBLE, mesh.tet_fibers,
+                                                            mesh.tet_count, 3, sizeof(double))
+                                     : Py_NewRef(Py_None);
   piola_tet_mesh_free(&mesh);
   if (!points || !tets || !regions || !fibers) {
     Py_XDECREF(points);
@@ -52,13 +52,13 @@ static PyObject *read_tri_mesh(PyObject *self, PyObject *args) {
   piola_tri_mesh mesh = {0};
   piola_status st;
   const char *path = PyBytes_AS_STRING(path_obj);
-  Py_BEGIN_ALLOW_THREADS
-  st = piola_tri_mesh_read(path, &mesh);
-  Py_END_ALLOW_THREADS
-  Py_DECREF(path_obj);
+  Py_BEGIN_ALLOW_THREADS st = piola_tri_mesh_read(path, &mesh);
+  Py_END_ALLOW_THREADS Py_DECREF(path_obj);
   if (st != PIOLA_OK) return pypiola_raise(pypiola_mesh_error, st);
-  PyArrayObject *points = copy_out(NPY_DOUBLE, mesh.positions, mesh.vertex_count, 3, sizeof(double));
-  PyArrayObject *tris = copy_out(NPY_INT32, mesh.triangles, mesh.triangle_count, 3, sizeof(int32_t));
+  PyArrayObject *points =
+      copy_out(NPY_DOUBLE, mesh.positions, mesh.vertex_count, 3, sizeof(double));
+  PyArrayObject *tris =
+      copy_out(NPY_INT32, mesh.triangles, mesh.triangle_count, 3, sizeof(int32_t));
   piola_tri_mesh_free(&mesh);
   if (!points || !tris) {
     Py_XDECREF(points);
@@ -94,7 +94,8 @@ static int check_cells(PyObject *pobj, PyObject *cobj, int width, const char *ce
 static PyObject *write_tet_mesh(PyObject *self, PyObject *args) {
   (void)self;
   PyObject *path_obj, *pobj, *tobj, *robj, *fobj;
-  if (!PyArg_ParseTuple(args, "O&OOOO", PyUnicode_FSConverter, &path_obj, &pobj, &tobj, &robj, &fobj))
+  if (!PyArg_ParseTuple(args, "O&OOOO", PyUnicode_FSConverter, &path_obj, &pobj, &tobj, &robj,
+                        &fobj))
     return NULL;
   PyArrayObject *points, *tets;
   piola_tet_mesh mesh = {0};
@@ -155,7 +156,8 @@ static PyObject *generate_mesh(PyObject *self, PyObject *args) {
     return NULL;
   Py_ssize_t count = PyList_GET_SIZE(list);
   if (count < 1 || count > PIOLA_MESHER_MAX_SHAPES) {
-    PyErr_Format(PyExc_ValueError, "the mesher takes 1 to %d shapes, got %zd", PIOLA_MESHER_MAX_SHAPES, count);
+    PyErr_Format(PyExc_ValueError, "the mesher takes 1 to %d shapes, got %zd",
+                 PIOLA_MESHER_MAX_SHAPES, count);
     return NULL;
   }
   piola_tri_mesh surfaces[PIOLA_MESHER_MAX_SHAPES];
@@ -195,14 +197,13 @@ static PyObject *generate_mesh(PyObject *self, PyObject *args) {
   def.shape_count = (int)count;
   piola_tet_mesh mesh = {0};
   piola_status status;
-  Py_BEGIN_ALLOW_THREADS
-  status = piola_mesher_generate(&def, &mesh);
-  Py_END_ALLOW_THREADS
-  if (status != PIOLA_OK) {
+  Py_BEGIN_ALLOW_THREADS status = piola_mesher_generate(&def, &mesh);
+  Py_END_ALLOW_THREADS if (status != PIOLA_OK) {
     pypiola_raise(pypiola_mesh_error, status);
     goto done;
   }
-  PyArrayObject *points = copy_out(NPY_DOUBLE, mesh.positions, mesh.vertex_count, 3, sizeof(double));
+  PyArrayObject *points =
+      copy_out(NPY_DOUBLE, mesh.positions, mesh.vertex_count, 3, sizeof(double));
   PyArrayObject *tets = copy_out(NPY_INT32, mesh.tets, mesh.tet_count, 4, sizeof(int32_t));
   piola_tet_mesh_free(&mesh);
   if (points && tets) {
@@ -223,22 +224,31 @@ static PyObject *tet_mesh_boundary(PyObject *self, PyObject *args) {
   if (!PyArg_ParseTuple(args, "OO", &pobj, &tobj)) return NULL;
   PyArrayObject *points, *tets;
   if (check_cells(pobj, tobj, 4, "tets", &points, &tets) < 0) return NULL;
-  piola_tet_mesh mesh = {(int32_t)PyArray_DIM(points, 0), PyArray_DATA(points),
-                         (int32_t)PyArray_DIM(tets, 0), PyArray_DATA(tets), NULL, NULL};
+  piola_tet_mesh mesh = {(int32_t)PyArray_DIM(points, 0),
+                         PyArray_DATA(points),
+                         (int32_t)PyArray_DIM(tets, 0),
+                         PyArray_DATA(tets),
+                         NULL,
+                         NULL};
   piola_tri_mesh out = {0};
   piola_status st = piola_tet_mesh_boundary(&mesh, &out);
   if (st != PIOLA_OK) return pypiola_raise(pypiola_mesh_error, st);
-  PyObject *tris = (PyObject *)copy_out(NPY_INT32, out.triangles, out.triangle_count, 3, sizeof(int32_t));
+  PyObject *tris =
+      (PyObject *)copy_out(NPY_INT32, out.triangles, out.triangle_count, 3, sizeof(int32_t));
   piola_tri_mesh_free(&out);
   return tris;
 }
 
 PyMethodDef pypiola_mesh_methods[] = {
-    {"read_tet_mesh", read_tet_mesh, METH_VARARGS, "read_tet_mesh(path) -> (points, tets, regions, fibers)"},
+    {"read_tet_mesh", read_tet_mesh, METH_VARARGS,
+     "read_tet_mesh(path) -> (points, tets, regions, fibers)"},
     {"read_tri_mesh", read_tri_mesh, METH_VARARGS, "read_tri_mesh(path) -> (points, triangles)"},
-    {"write_tet_mesh", write_tet_mesh, METH_VARARGS, "write_tet_mesh(path, points, tets, regions, fibers)"},
+    {"write_tet_mesh", write_tet_mesh, METH_VARARGS,
+     "write_tet_mesh(path, points, tets, regions, fibers)"},
     {"write_tri_mesh", write_tri_mesh, METH_VARARGS, "write_tri_mesh(path, points, triangles)"},
-    {"generate_mesh", generate_mesh, METH_VARARGS, "generate_mesh(shapes, cell_size, levels) -> (points, tets)"},
-    {"tet_mesh_boundary", tet_mesh_boundary, METH_VARARGS, "tet_mesh_boundary(points, tets) -> triangles"},
+    {"generate_mesh", generate_mesh, METH_VARARGS,
+     "generate_mesh(shapes, cell_size, levels) -> (points, tets)"},
+    {"tet_mesh_boundary", tet_mesh_boundary, METH_VARARGS,
+     "tet_mesh_boundary(points, tets) -> triangles"},
     {NULL, NULL, 0, NULL},
 };

@@ -139,14 +139,13 @@ int pypiola_motion_converter(PyObject *obj, void *out) {
   piola_rigid_motion_def *m = out;
   *m = piola_default_rigid_motion_def();
   int kind = 0;
-  if (!PyArg_ParseTuple(obj, "iO&O&(O&O&O&)O&(O&O&O&)O&;bad motion tuple", &kind,
-                        pypiola_vec3_converter, &m->pivot, pypiola_vec3_converter, &m->axis,
-                        pypiola_track_converter, &m->velocity[0], pypiola_track_converter,
-                        &m->velocity[1], pypiola_track_converter, &m->velocity[2],
-                        pypiola_track_converter, &m->angular_speed, pypiola_track_converter,
-                        &m->translation[0], pypiola_track_converter, &m->translation[1],
-                        pypiola_track_converter, &m->translation[2], pypiola_track_converter,
-                        &m->angle))
+  if (!PyArg_ParseTuple(
+          obj, "iO&O&(O&O&O&)O&(O&O&O&)O&;bad motion tuple", &kind, pypiola_vec3_converter,
+          &m->pivot, pypiola_vec3_converter, &m->axis, pypiola_track_converter, &m->velocity[0],
+          pypiola_track_converter, &m->velocity[1], pypiola_track_converter, &m->velocity[2],
+          pypiola_track_converter, &m->angular_speed, pypiola_track_converter, &m->translation[0],
+          pypiola_track_converter, &m->translation[1], pypiola_track_converter, &m->translation[2],
+          pypiola_track_converter, &m->angle))
     return 0;
   if (kind != PIOLA_MOTION_VELOCITY && kind != PIOLA_MOTION_POSE) {
     PyErr_SetString(PyExc_ValueError, "motion kind must be 0 (velocity) or 1 (pose)");
@@ -176,19 +175,20 @@ static PyObject *defaults(PyObject *self, PyObject *unused) {
   piola_solid_def s = piola_default_solid_def();
   piola_mesher_def g = piola_default_mesher_def();
   return Py_BuildValue(
-      "{s:(sddds(ddd)(ddddd)),s:{s:(ddd),s:d,s:d,s:d,s:i,s:d},s:{s:d,s:d,s:d,s:d,s:K,s:(idd)},s:{s:i}}",
+      "{s:(sddds(ddd)(ddddd)),s:{s:(ddd),s:d,s:d,s:d,s:i,s:d},s:{s:d,s:d,s:d,s:d,s:K,s:(idd)},s:{s:"
+      "i}}",
       "material", piola_material_model_name(m.model), m.youngs_modulus, m.poisson_ratio,
-      m.inversion_threshold, piola_inversion_mode_name(m.inversion_mode), m.spline.compression_stretch,
-      m.spline.elongation_stretch, m.spline.stiffening, m.muscle.passive_stiffness,
-      m.muscle.passive_toe_stretch, m.muscle.max_active_stress, m.muscle.optimal_stretch,
-      m.muscle.active_width, "world", "gravity", w.gravity[0].value, w.gravity[1].value,
-      w.gravity[2].value, "max_dt", w.max_dt, "cfl", w.cfl, "cg_tolerance", w.cg_tolerance,
-      "cg_max_iterations", (int)w.cg_max_iterations, "collision_interval", w.collision_interval,
-      "solid", "density", s.density, "stiffness_scale", s.stiffness_scale.value, "scramble_radius",
-      s.scramble_radius, "activation", s.activation.value, "scramble_seed",
-      (unsigned long long)s.scramble_seed, "self_collision", (int)s.self_collision.enabled,
-      s.self_collision.thickness, s.self_collision.friction, "mesher", "refinement_levels",
-      g.refinement_levels);
+      m.inversion_threshold, piola_inversion_mode_name(m.inversion_mode),
+      m.spline.compression_stretch, m.spline.elongation_stretch, m.spline.stiffening,
+      m.muscle.passive_stiffness, m.muscle.passive_toe_stretch, m.muscle.max_active_stress,
+      m.muscle.optimal_stretch, m.muscle.active_width, "world", "gravity", w.gravity[0].value,
+      w.gravity[1].value, w.gravity[2].value, "max_dt", w.max_dt, "cfl", w.cfl, "cg_tolerance",
+      w.cg_tolerance, "cg_max_iterations", (int)w.cg_max_iterations, "collision_interval",
+      w.collision_interval, "solid", "density", s.density, "stiffness_scale",
+      s.stiffness_scale.value, "scramble_radius", s.scramble_radius, "activation",
+      s.activation.value, "scramble_seed", (unsigned long long)s.scramble_seed, "self_collision",
+      (int)s.self_collision.enabled, s.self_collision.thickness, s.self_collision.friction,
+      "mesher", "refinement_levels", g.refinement_levels);
 }
 
 static PyMethodDef module_methods[] = {
@@ -199,8 +199,15 @@ static PyMethodDef module_methods[] = {
 };
 
 static struct PyModuleDef module_def = {
-    PyModuleDef_HEAD_INIT, "_piola", "piola's C extension; use the piola package instead.", -1,
-    module_methods, NULL, NULL, NULL, NULL,
+    PyModuleDef_HEAD_INIT,
+    "_piola",
+    "piola's C extension; use the piola package instead.",
+    -1,
+    module_methods,
+    NULL,
+    NULL,
+    NULL,
+    NULL,
 };
 
 static int add_methods(PyObject *module, PyMethodDef *methods) {
@@ -290,17 +297,16 @@ PyMODINIT_FUNC PyInit__piola(void) {
       add_type(m, &pypiola_obstacle_type, "Obstacle") < 0 ||
       add_type(m, &pypiola_output_type, "Output") < 0)
     goto fail;
-  static const char *const obstacle_names[] = {"plane", "sphere", "box", "cylinder",
-                                               "capsule", "torus", "gear", "mesh"};
-  static const int obstacle_values[] = {PIOLA_OBSTACLE_PLANE, PIOLA_OBSTACLE_SPHERE,
-                                        PIOLA_OBSTACLE_BOX, PIOLA_OBSTACLE_CYLINDER,
-                                        PIOLA_OBSTACLE_CAPSULE, PIOLA_OBSTACLE_TORUS,
-                                        PIOLA_OBSTACLE_GEAR, PIOLA_OBSTACLE_MESH};
-  static const char *const shape_names[] = {"sphere", "box", "torus", "cylinder", "capsule",
-                                            "surface"};
-  static const int shape_values[] = {PIOLA_SHAPE_SPHERE, PIOLA_SHAPE_BOX, PIOLA_SHAPE_TORUS,
-                                     PIOLA_SHAPE_CYLINDER, PIOLA_SHAPE_CAPSULE,
-                                     PIOLA_SHAPE_SURFACE};
+  static const char *const obstacle_names[] = {"plane",   "sphere", "box",  "cylinder",
+                                               "capsule", "torus",  "gear", "mesh"};
+  static const int obstacle_values[] = {
+      PIOLA_OBSTACLE_PLANE,   PIOLA_OBSTACLE_SPHERE, PIOLA_OBSTACLE_BOX,  PIOLA_OBSTACLE_CYLINDER,
+      PIOLA_OBSTACLE_CAPSULE, PIOLA_OBSTACLE_TORUS,  PIOLA_OBSTACLE_GEAR, PIOLA_OBSTACLE_MESH};
+  static const char *const shape_names[] = {"sphere",   "box",     "torus",
+                                            "cylinder", "capsule", "surface"};
+  static const int shape_values[] = {PIOLA_SHAPE_SPHERE,  PIOLA_SHAPE_BOX,
+                                     PIOLA_SHAPE_TORUS,   PIOLA_SHAPE_CYLINDER,
+                                     PIOLA_SHAPE_CAPSULE, PIOLA_SHAPE_SURFACE};
   if (add_int_dict(m, "OBSTACLE_TYPES", obstacle_names, obstacle_values, 8) < 0 ||
       add_int_dict(m, "SHAPE_TYPES", shape_names, shape_values, 6) < 0)
     goto fail;

@@ -6,9 +6,8 @@
 #include <string.h>
 
 typedef struct {
-  PyObject_HEAD
-  piola_obstacle_def def; /* def.mesh points at surface */
-  piola_tri_mesh surface; /* own copy for a mesh obstacle */
+  PyObject_HEAD piola_obstacle_def def; /* def.mesh points at surface */
+  piola_tri_mesh surface;               /* own copy for a mesh obstacle */
   piola_obstacle *obstacle;
 } obstacle_object;
 
@@ -98,7 +97,8 @@ static PyObject *obstacle_signed_distance(PyObject *self_obj, PyObject *args) {
   PyArrayObject *p = pypiola_check_array(pobj, "points", NPY_DOUBLE, 2, pd, 0);
   if (!p) return NULL;
   npy_intp n = PyArray_DIM(p, 0), d1[1] = {n}, d3[2] = {n, 3};
-  PyArrayObject *d = pypiola_new_array(NPY_DOUBLE, 1, d1), *nr = pypiola_new_array(NPY_DOUBLE, 2, d3),
+  PyArrayObject *d = pypiola_new_array(NPY_DOUBLE, 1, d1),
+                *nr = pypiola_new_array(NPY_DOUBLE, 2, d3),
                 *v = pypiola_new_array(NPY_DOUBLE, 2, d3);
   if (!d || !nr || !v) {
     Py_XDECREF(d);
@@ -126,7 +126,8 @@ static PyObject *obstacle_pose(PyObject *self_obj, PyObject *args) {
   piola_vec3 c;
   piola_rigid_motion_pose(&self->def.motion, t, &r, &c);
   npy_intp d33[2] = {3, 3}, d3[1] = {3};
-  PyArrayObject *ra = pypiola_new_array(NPY_DOUBLE, 2, d33), *ca = pypiola_new_array(NPY_DOUBLE, 1, d3);
+  PyArrayObject *ra = pypiola_new_array(NPY_DOUBLE, 2, d33),
+                *ca = pypiola_new_array(NPY_DOUBLE, 1, d3);
   if (!ra || !ca) {
     Py_XDECREF(ra);
     Py_XDECREF(ca);

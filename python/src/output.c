@@ -2,8 +2,7 @@
 #include "pypiola.h"
 
 typedef struct {
-  PyObject_HEAD
-  piola_output *output;
+  PyObject_HEAD piola_output *output;
   PyObject *world; /* strong: the world whose frames are written */
 } output_object;
 
@@ -16,12 +15,14 @@ static int output_init(PyObject *self_obj, PyObject *args, PyObject *kwds) {
   }
   PyObject *dir_obj, *world_obj;
   int force = 0;
-  if (!PyArg_ParseTuple(args, "O&pO", PyUnicode_FSConverter, &dir_obj, &force, &world_obj)) return -1;
+  if (!PyArg_ParseTuple(args, "O&pO", PyUnicode_FSConverter, &dir_obj, &force, &world_obj))
+    return -1;
   piola_world *w = pypiola_world_get(world_obj);
   piola_status st = PIOLA_OK;
   if (w) {
     st = piola_output_check_folder(PyBytes_AS_STRING(dir_obj), force != 0);
-    if (st == PIOLA_OK) st = piola_output_open(PyBytes_AS_STRING(dir_obj), force != 0, w, &self->output);
+    if (st == PIOLA_OK)
+      st = piola_output_open(PyBytes_AS_STRING(dir_obj), force != 0, w, &self->output);
   }
   Py_DECREF(dir_obj);
   if (!w) return -1;
@@ -89,8 +90,10 @@ static PyObject *output_close(PyObject *self_obj, PyObject *unused) {
 }
 
 static PyMethodDef output_methods[] = {
-    {"write_frame", output_write_frame, METH_VARARGS, "write_frame(frame, substeps, cg, wall, contacts, impacts, zones)"},
-    {"write_failure_report", output_write_failure_report, METH_VARARGS, "write_failure_report(message)"},
+    {"write_frame", output_write_frame, METH_VARARGS,
+     "write_frame(frame, substeps, cg, wall, contacts, impacts, zones)"},
+    {"write_failure_report", output_write_failure_report, METH_VARARGS,
+     "write_failure_report(message)"},
     {"close", output_close, METH_NOARGS, "close()"},
     {NULL, NULL, 0, NULL},
 };

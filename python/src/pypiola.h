@@ -44,10 +44,10 @@ PyArrayObject *pypiola_new_array(int type_num, int ndim, const npy_intp *dims);
 /* Converters for PyArg_ParseTuple ("O&"): a sequence of 3 floats, a keyframe track
  * (a float, or a pair (times, values) of equal-length float sequences), a material
  * definition tuple, a rigid motion tuple. */
-int pypiola_vec3_converter(PyObject *obj, void *out);    /* piola_vec3 */
-int pypiola_track_converter(PyObject *obj, void *out);   /* piola_track */
+int pypiola_vec3_converter(PyObject *obj, void *out);     /* piola_vec3 */
+int pypiola_track_converter(PyObject *obj, void *out);    /* piola_track */
 int pypiola_material_converter(PyObject *obj, void *out); /* piola_material_def */
-int pypiola_motion_converter(PyObject *obj, void *out);  /* piola_rigid_motion_def */
+int pypiola_motion_converter(PyObject *obj, void *out);   /* piola_rigid_motion_def */
 
 /* Module functions by file. */
 extern PyMethodDef pypiola_material_methods[];

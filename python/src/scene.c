@@ -4,8 +4,7 @@
 #include "pypiola.h"
 
 typedef struct {
-  PyObject_HEAD
-  piola_scene *scene;
+  PyObject_HEAD piola_scene *scene;
   PyObject *world; /* borrowed: the world object, or NULL */
   int closed;
 } scene_object;
@@ -36,10 +35,9 @@ static int scene_init(PyObject *self_obj, PyObject *args, PyObject *kwds) {
   const char *path = PyBytes_AS_STRING(path_obj);
   piola_status st;
   piola_scene *scene = NULL;
-  Py_BEGIN_ALLOW_THREADS
-  st = json ? piola_scene_load_string(json, base, label, &scene) : piola_scene_load(path, &scene);
-  Py_END_ALLOW_THREADS
-  Py_DECREF(path_obj);
+  Py_BEGIN_ALLOW_THREADS st =
+      json ? piola_scene_load_string(json, base, label, &scene) : piola_scene_load(path, &scene);
+  Py_END_ALLOW_THREADS Py_DECREF(path_obj);
   if (st != PIOLA_OK) {
     pypiola_raise(pypiola_scene_error, st);
     return -1;

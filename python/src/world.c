@@ -27,11 +27,10 @@ typedef struct {
 } solid_shadow;
 
 typedef struct {
-  PyObject_HEAD
-  piola_world *world;
-  PyObject *scene;   /* the owning scene object (strong), or NULL for a world of our own */
+  PyObject_HEAD piola_world *world;
+  PyObject *scene; /* the owning scene object (strong), or NULL for a world of our own */
   int closed;
-  int busy;          /* a step is running with the GIL released */
+  int busy; /* a step is running with the GIL released */
   solid_shadow *shadows;
   int32_t shadow_count;
 } world_object;
@@ -54,7 +53,8 @@ piola_world *pypiola_world_get(PyObject *obj) {
 }
 
 static void free_shadows(world_object *self) {
-  for (int32_t i = 0; i < self->shadow_count; ++i) free(self->shadows[i].x), free(self->shadows[i].v);
+  for (int32_t i = 0; i < self->shadow_count; ++i)
+    free(self->shadows[i].x), free(self->shadows[i].v);
   free(self->shadows);
   self->shadows = NULL;
   self->shadow_count = 0;
@@ -117,8 +117,10 @@ static int apply_view_writes(world_object *self) {
     if (st != PIOLA_OK) {
       memcpy(x, s->x, bytes);
       memcpy(v, s->v, bytes);
-      PyErr_Format(PyExc_ValueError, "solid %d: the state written through its views was refused "
-                   "and undone: %s", (int)i,
+      PyErr_Format(PyExc_ValueError,
+                   "solid %d: the state written through its views was refused "
+                   "and undone: %s",
+                   (int)i,
                    st == VIEW_BAD_VELOCITY ? "a velocity is not finite" : piola_last_error());
       return -1;
     }
@@ -227,13 +229,13 @@ static PyObject *run_steps(world_object *self, int advance, double value) {
   piola_step_stats st = {0};
   piola_status status;
   self->busy = 1;
-  Py_BEGIN_ALLOW_THREADS
-  status = advance ? piola_world_advance_to(w, value, &st) : piola_world_step(w, value, &st);
-  Py_END_ALLOW_THREADS
-  self->busy = 0;
+  Py_BEGIN_ALLOW_THREADS status =
+      advance ? piola_world_advance_to(w, value, &st) : piola_world_step(w, value, &st);
+  Py_END_ALLOW_THREADS self->busy = 0;
   if (take_snapshots(self) < 0) return NULL;
   if (status != PIOLA_OK)
-    return pypiola_raise(status == PIOLA_ERROR_NOT_FINITE ? pypiola_simulation_error : pypiola_error, status);
+    return pypiola_raise(
+        status == PIOLA_ERROR_NOT_FINITE ? pypiola_simulation_error : pypiola_error, status);
   return stats_dict(&st);
 }
 
@@ -285,12 +287,13 @@ static PyObject *world_body_name(PyObject *self, PyObject *args) {
   if (!PyArg_ParseTuple(args, "ii", &kind, &index)) return NULL;
   piola_world *w = body_world(self, kind, index);
   if (!w) return NULL;
-  return PyUnicode_FromString(kind == 0 ? piola_world_solid_name(w, index) : piola_world_shell_name(w, index));
+  return PyUnicode_FromString(kind == 0 ? piola_world_solid_name(w, index)
+                                        : piola_world_shell_name(w, index));
 }
 
 /* A view of `data` (rows x width of type_num) owned by the world object. */
-static PyObject *make_view(PyObject *self, const void *data, npy_intp rows, npy_intp width, int type_num,
-                           int writable) {
+static PyObject *make_view(PyObject *self, const void *data, npy_intp rows, npy_intp width,
+                           int type_num, int writable) {
   npy_intp dims[2] = {rows, width};
   PyObject *a = PyArray_SimpleNewFromData(width > 0 ? 2 : 1, dims, type_num, (void *)data);
   if (!a) return NULL;
@@ -315,24 +318,29 @@ static PyObject *world_body_array(PyObject *self, PyObject *args) {
   const piola_shell_body *sb = kind == 1 ? piola_world_shell_body(w, index) : NULL;
   npy_intp n = eb ? piola_elastic_body_vertex_count(eb) : piola_shell_body_vertex_count(sb);
   if (strcmp(name, "positions") == 0)
-    return make_view(self, eb ? piola_world_solid_positions(w, index) : piola_world_shell_positions(w, index),
-                     n, 3, NPY_DOUBLE, eb != NULL);
+    return make_view(
+        self, eb ? piola_world_solid_positions(w, index) : piola_world_shell_positions(w, index), n,
+        3, NPY_DOUBLE, eb != NULL);
   if (strcmp(name, "velocities") == 0)
-    return make_view(self, eb ? piola_world_solid_velocities(w, index) : piola_world_shell_velocities(w, index),
-                     n, 3, NPY_DOUBLE, eb != NULL);
+    return make_view(
+        self, eb ? piola_world_solid_velocities(w, index) : piola_world_shell_velocities(w, index),
+        n, 3, NPY_DOUBLE, eb != NULL);
   if (strcmp(name, "rest_positions") == 0)
-    return make_view(self, eb ? piola_elastic_body_rest_positions(eb) : piola_shell_body_rest_positions(sb),
-                     n, 3, NPY_DOUBLE, 0);
+    return make_view(
+        self, eb ? piola_elastic_body_rest_positions(eb) : piola_shell_body_rest_positions(sb), n,
+        3, NPY_DOUBLE, 0);
   if (strcmp(name, "masses") == 0)
     return make_view(self, eb ? piola_elastic_body_masses(eb) : piola_shell_body_masses(sb), n, 0,
                      NPY_DOUBLE, 0);
   if (strcmp(name, "cells") == 0)
-    return eb ? make_view(self, piola_elastic_body_tets(eb), piola_elastic_body_tet_count(eb), 4, NPY_INT32, 0)
-              : make_view(self, piola_shell_body_triangles(sb), piola_shell_body_triangle_count(sb), 3,
-                          NPY_INT32, 0);
+    return eb ? make_view(self, piola_elastic_body_tets(eb), piola_elastic_body_tet_count(eb), 4,
+                          NPY_INT32, 0)
+              : make_view(self, piola_shell_body_triangles(sb), piola_shell_body_triangle_count(sb),
+                          3, NPY_INT32, 0);
   if (strcmp(name, "flags") == 0)
-    return make_view(self, eb ? piola_world_solid_constraint_flags(w, index)
-                              : piola_world_shell_constraint_flags(w, index),
+    return make_view(self,
+                     eb ? piola_world_solid_constraint_flags(w, index)
+                        : piola_world_shell_constraint_flags(w, index),
                      n, 0, NPY_UINT8, 0);
   PyErr_Format(PyExc_ValueError, "no body array '%s'", name);
   return NULL;
@@ -347,12 +355,14 @@ static PyObject *world_body_stats(PyObject *self, PyObject *args) {
   if (kind == 0) {
     piola_solid_stats s = piola_world_solid_stats(w, index);
     return Py_BuildValue("{s:d,s:d,s:i,s:d}", "kinetic_energy", s.kinetic_energy, "elastic_energy",
-                         s.elastic_energy, "inverted_count", (int)s.inverted_count, "min_det_f", s.min_det_f);
+                         s.elastic_energy, "inverted_count", (int)s.inverted_count, "min_det_f",
+                         s.min_det_f);
   }
   piola_world_shell_stats s = piola_world_shell_get_stats(w, index);
-  return Py_BuildValue("{s:d,s:d,s:d,s:i,s:i}", "kinetic_energy", s.kinetic_energy, "membrane_energy",
-                       s.membrane_energy, "bending_energy", s.bending_energy, "inverted_count",
-                       (int)s.inverted_count, "degenerate_count", (int)s.degenerate_count);
+  return Py_BuildValue("{s:d,s:d,s:d,s:i,s:i}", "kinetic_energy", s.kinetic_energy,
+                       "membrane_energy", s.membrane_energy, "bending_energy", s.bending_energy,
+                       "inverted_count", (int)s.inverted_count, "degenerate_count",
+                       (int)s.degenerate_count);
 }
 
 /* set_solid_state(index, positions or None, velocities or None): copies. */
@@ -362,7 +372,8 @@ static PyObject *world_set_solid_state(PyObject *self_obj, PyObject *args) {
   PyObject *pobj, *vobj;
   if (!PyArg_ParseTuple(args, "iOO", &index, &pobj, &vobj)) return NULL;
   if (!body_world(self_obj, 0, index) || !synced(self)) return NULL;
-  npy_intp dims[2] = {piola_elastic_body_vertex_count(piola_world_solid_body(self->world, index)), 3};
+  npy_intp dims[2] = {piola_elastic_body_vertex_count(piola_world_solid_body(self->world, index)),
+                      3};
   const double *p = NULL, *v = NULL;
   if (pobj != Py_None) {
     PyArrayObject *a = pypiola_check_array(pobj, "positions", NPY_DOUBLE, 2, dims, 0);
@@ -395,8 +406,8 @@ static PyObject *world_set_solid_state(PyObject *self_obj, PyObject *args) {
 static int matrix9_converter(PyObject *obj, void *out) {
   piola_mat3 *m = out;
   double *d = &m->m[0][0];
-  return PyArg_ParseTuple(obj, "ddddddddd;expected 9 floats (row-major 3x3)", d, d + 1, d + 2, d + 3,
-                          d + 4, d + 5, d + 6, d + 7, d + 8) != 0;
+  return PyArg_ParseTuple(obj, "ddddddddd;expected 9 floats (row-major 3x3)", d, d + 1, d + 2,
+                          d + 3, d + 4, d + 5, d + 6, d + 7, d + 8) != 0;
 }
 
 /* One (selector, driven, motion or None) constraint; selector (kind, box_min, box_max, center,
@@ -442,10 +453,10 @@ static PyObject *world_add_solid(PyObject *self_obj, PyObject *args) {
                         pypiola_material_converter, &def.material, pypiola_track_converter,
                         &def.stiffness_scale, &def.density, pypiola_track_converter,
                         &def.shear_viscosity, pypiola_track_converter, &def.bulk_viscosity,
-                        pypiola_vec3_converter, &def.velocity, &PyList_Type, &cons, matrix9_converter,
-                        &def.initial_matrix, &def.scramble_radius, &seed, &collide,
-                        &def.self_collision.thickness, &def.self_collision.friction, &fobj,
-                        pypiola_track_converter, &def.activation))
+                        pypiola_vec3_converter, &def.velocity, &PyList_Type, &cons,
+                        matrix9_converter, &def.initial_matrix, &def.scramble_radius, &seed,
+                        &collide, &def.self_collision.thickness, &def.self_collision.friction,
+                        &fobj, pypiola_track_converter, &def.activation))
     return NULL;
   def.scramble_seed = seed;
   def.self_collision.enabled = collide != 0;
@@ -457,8 +468,12 @@ static PyObject *world_add_solid(PyObject *self_obj, PyObject *args) {
     PyErr_SetString(PyExc_ValueError, "mesh too large for 32-bit indices");
     return NULL;
   }
-  piola_tet_mesh mesh = {(int32_t)PyArray_DIM(points, 0), PyArray_DATA(points),
-                         (int32_t)PyArray_DIM(tets, 0), PyArray_DATA(tets), NULL, NULL};
+  piola_tet_mesh mesh = {(int32_t)PyArray_DIM(points, 0),
+                         PyArray_DATA(points),
+                         (int32_t)PyArray_DIM(tets, 0),
+                         PyArray_DATA(tets),
+                         NULL,
+                         NULL};
   if (fobj != Py_None) {
     npy_intp fd[2] = {mesh.tet_count, 3};
     PyArrayObject *f = pypiola_check_array(fobj, "fibers", NPY_DOUBLE, 2, fd, 0);

@@ -7,11 +7,11 @@ from .material import Material, diagonalize
 from .mesh import Mesh, read_mesh, write_mesh, generate_mesh, boundary_surface
 from .world import World, Body, Obstacle
 from .scene import Scene
-from ._piola import set_thread_count
+from ._piola import set_thread_count, __version__
 
 __all__ = [
     "Error", "SceneError", "MeshError", "SimulationError", "ClosedError",
     "Material", "diagonalize",
     "Mesh", "read_mesh", "write_mesh", "generate_mesh", "boundary_surface",
-    "World", "Body", "Obstacle", "Scene", "set_thread_count",
+    "World", "Body", "Obstacle", "Scene", "set_thread_count", "__version__",
 ]

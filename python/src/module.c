@@ -307,6 +307,7 @@ PyMODINIT_FUNC PyInit__piola(void) {
   static const int shape_values[] = {PIOLA_SHAPE_SPHERE,  PIOLA_SHAPE_BOX,
                                      PIOLA_SHAPE_TORUS,   PIOLA_SHAPE_CYLINDER,
                                      PIOLA_SHAPE_CAPSULE, PIOLA_SHAPE_SURFACE};
+  if (PyModule_AddStringConstant(m, "__version__", PIOLA_VERSION_STRING) < 0) goto fail;
   if (add_int_dict(m, "OBSTACLE_TYPES", obstacle_names, obstacle_values, 8) < 0 ||
       add_int_dict(m, "SHAPE_TYPES", shape_names, shape_values, 6) < 0)
     goto fail;

@@ -50,7 +50,7 @@ class Obstacle:
     (point, normal), sphere (center, radius), box (center, half_extents), cylinder and
     capsule (center, axis, radius, half_length), torus (center, axis, radius, minor_radius),
     gear (center, axis, radius, half_length, teeth, tooth_depth), mesh (surface: a Mesh,
-    (points, triangles) or a path); friction (Coulomb mu); motion (velocity, angular_speed or
+    (points, triangles) or a path; or path: a surface file); friction (Coulomb mu); motion (velocity, angular_speed or
     translation, angle, each keyframable; axis; pivot). Lengths in m, times in s, angles in
     rad. Invalid values raise ValueError."""
 
@@ -65,14 +65,20 @@ class Obstacle:
             "capsule": ("center", "axis", "radius", "half_length"),
             "torus": ("center", "axis", "radius", "minor_radius"),
             "gear": ("center", "axis", "radius", "half_length", "teeth", "tooth_depth"),
-            "mesh": ("surface",),
+            "mesh": ("surface", "path"),
         }[type]
         check_keys(shape, allowed, f"{type} obstacle")
+        if type == "mesh":
+            if ("surface" in shape) == ("path" in shape):
+                raise ValueError("mesh obstacle: give surface (a Mesh or (points, triangles)) "
+                                 "or path (a surface file), not both")
+            if "path" in shape:
+                shape = {"surface": read_mesh(shape["path"])}
         required = {"plane": ("point", "normal"), "sphere": ("radius",), "box": ("half_extents",),
                     "cylinder": ("radius", "half_length"), "capsule": ("radius", "half_length"),
                     "torus": ("radius", "minor_radius"),
                     "gear": ("center", "axis", "radius", "half_length", "teeth"),
-                    "mesh": ("surface",)}[type]
+                    "mesh": ()}[type]
         for k in required:
             if k not in shape:
                 raise ValueError(f"{type} obstacle: {k!r} is required")

@@ -126,6 +126,20 @@ def test_keyframed_obstacle_motion():
     assert b.positions[:, 2].min() >= lift - 2e-3
 
 
+def test_mesh_obstacle_matches_the_sphere_it_samples(tmp_path):
+    ball = piola.generate_mesh("sphere", radius=0.2, cell_size=0.02)
+    surface = piola.Mesh(ball.points, triangles=piola.boundary_surface(ball.points, ball.tets))
+    piola.write_mesh(tmp_path / "ball.obj", surface)
+    p = np.array([[0, 0, 0.5], [0.3, 0.1, 0.0], [0.0, 0.0, 0.05]])
+    exact = np.linalg.norm(p, axis=1) - 0.2
+    for obs in (piola.Obstacle("mesh", surface=surface), piola.Obstacle("mesh", path=tmp_path / "ball.obj")):
+        d, n, _ = obs.signed_distance(p)
+        assert np.allclose(d, exact, atol=0.01)
+        assert np.allclose(n[0], [0, 0, 1], atol=0.05)
+    with pytest.raises(ValueError, match="not both"):
+        piola.Obstacle("mesh")
+
+
 def test_driven_and_fixed_nodes():
     mesh = piola.generate_mesh("box", half_extents=[0.1, 0.02, 0.02], cell_size=0.02)
     w = piola.World(gravity=(0, 0, -9.81))

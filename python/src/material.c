@@ -56,7 +56,8 @@ static PyObject *diagonalize(PyObject *self, PyObject *args) {
   const double *fp = PyArray_DATA(f);
   double *up = PyArray_DATA(u), *vp = PyArray_DATA(v), *hp = PyArray_DATA(fhat);
   npy_intp bad = -1;
-  Py_BEGIN_ALLOW_THREADS for (npy_intp i = 0; i < n; ++i) {
+  PyThreadState *released = PyEval_SaveThread(); /* the GIL */
+  for (npy_intp i = 0; i < n; ++i) {
     piola_mat3 fm, um, vm;
     piola_vec3 h;
     for (int k = 0; k < 9; ++k) fm.m[k / 3][k % 3] = fp[9 * i + k];
@@ -65,7 +66,8 @@ static PyObject *diagonalize(PyObject *self, PyObject *args) {
       up[9 * i + k] = um.m[k / 3][k % 3], vp[9 * i + k] = vm.m[k / 3][k % 3];
     hp[3 * i] = h.x, hp[3 * i + 1] = h.y, hp[3 * i + 2] = h.z;
   }
-  Py_END_ALLOW_THREADS if (bad >= 0) {
+  PyEval_RestoreThread(released);
+  if (bad >= 0) {
     PyErr_Format(PyExc_ValueError, "F[%zd] is not finite (or too large to diagonalize)",
                  (Py_ssize_t)bad);
     goto fail;
@@ -115,7 +117,8 @@ static PyObject *material_eval(PyObject *self, PyObject *args) {
   const double *fp = PyArray_DATA(f);
   double *pp = PyArray_DATA(p), *ep = PyArray_DATA(psi);
   npy_intp bad = -1;
-  Py_BEGIN_ALLOW_THREADS for (npy_intp i = 0; i < n; ++i) {
+  PyThreadState *released = PyEval_SaveThread(); /* the GIL */
+  for (npy_intp i = 0; i < n; ++i) {
     piola_mat3 fm, um, vm;
     piola_vec3 h;
     for (int k = 0; k < 9; ++k) fm.m[k / 3][k % 3] = fp[9 * i + k];
@@ -139,7 +142,8 @@ static PyObject *material_eval(PyObject *self, PyObject *args) {
     }
     rotate_back(&um, phat, &vm, pp + 9 * i);
   }
-  Py_END_ALLOW_THREADS if (bad >= 0) {
+  PyEval_RestoreThread(released);
+  if (bad >= 0) {
     Py_DECREF(p);
     Py_DECREF(psi);
     PyErr_Format(PyExc_ValueError, "F[%zd] is not finite (or too large to diagonalize)",
@@ -174,7 +178,8 @@ static PyObject *material_eval_hat(PyObject *self, PyObject *args) {
   const double *hp = PyArray_DATA(h);
   double *pp = PyArray_DATA(p), *ep = PyArray_DATA(psi), *dpp = PyArray_DATA(dp);
   npy_intp bad = -1;
-  Py_BEGIN_ALLOW_THREADS for (npy_intp i = 0; i < n; ++i) {
+  PyThreadState *released = PyEval_SaveThread(); /* the GIL */
+  for (npy_intp i = 0; i < n; ++i) {
     const double *fh = hp + 3 * i;
     if (!isfinite(fh[0]) || !isfinite(fh[1]) || !isfinite(fh[2])) {
       if (bad < 0) bad = i;
@@ -186,7 +191,8 @@ static PyObject *material_eval_hat(PyObject *self, PyObject *args) {
     piola_material_stress_derivative(&mat, fh, d);
     for (int k = 0; k < 9; ++k) dpp[9 * i + k] = d[k / 3][k % 3];
   }
-  Py_END_ALLOW_THREADS if (bad >= 0) {
+  PyEval_RestoreThread(released);
+  if (bad >= 0) {
     Py_DECREF(p);
     Py_DECREF(psi);
     Py_DECREF(dp);

@@ -22,8 +22,10 @@ static PyObject *read_tet_mesh(PyObject *self, PyObject *args) {
   piola_tet_mesh mesh = {0};
   piola_status st;
   const char *path = PyBytes_AS_STRING(path_obj);
-  Py_BEGIN_ALLOW_THREADS st = piola_tet_mesh_read(path, &mesh);
-  Py_END_ALLOW_THREADS Py_DECREF(path_obj);
+  PyThreadState *released = PyEval_SaveThread(); /* the GIL */
+  st = piola_tet_mesh_read(path, &mesh);
+  PyEval_RestoreThread(released);
+  Py_DECREF(path_obj);
   if (st != PIOLA_OK) return pypiola_raise(pypiola_mesh_error, st);
   PyArrayObject *points =
       copy_out(NPY_DOUBLE, mesh.positions, mesh.vertex_count, 3, sizeof(double));
@@ -52,8 +54,10 @@ static PyObject *read_tri_mesh(PyObject *self, PyObject *args) {
   piola_tri_mesh mesh = {0};
   piola_status st;
   const char *path = PyBytes_AS_STRING(path_obj);
-  Py_BEGIN_ALLOW_THREADS st = piola_tri_mesh_read(path, &mesh);
-  Py_END_ALLOW_THREADS Py_DECREF(path_obj);
+  PyThreadState *released = PyEval_SaveThread(); /* the GIL */
+  st = piola_tri_mesh_read(path, &mesh);
+  PyEval_RestoreThread(released);
+  Py_DECREF(path_obj);
   if (st != PIOLA_OK) return pypiola_raise(pypiola_mesh_error, st);
   PyArrayObject *points =
       copy_out(NPY_DOUBLE, mesh.positions, mesh.vertex_count, 3, sizeof(double));
@@ -197,8 +201,10 @@ static PyObject *generate_mesh(PyObject *self, PyObject *args) {
   def.shape_count = (int)count;
   piola_tet_mesh mesh = {0};
   piola_status status;
-  Py_BEGIN_ALLOW_THREADS status = piola_mesher_generate(&def, &mesh);
-  Py_END_ALLOW_THREADS if (status != PIOLA_OK) {
+  PyThreadState *released = PyEval_SaveThread(); /* the GIL */
+  status = piola_mesher_generate(&def, &mesh);
+  PyEval_RestoreThread(released);
+  if (status != PIOLA_OK) {
     pypiola_raise(pypiola_mesh_error, status);
     goto done;
   }

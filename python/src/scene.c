@@ -35,9 +35,10 @@ static int scene_init(PyObject *self_obj, PyObject *args, PyObject *kwds) {
   const char *path = PyBytes_AS_STRING(path_obj);
   piola_status st;
   piola_scene *scene = NULL;
-  Py_BEGIN_ALLOW_THREADS st =
-      json ? piola_scene_load_string(json, base, label, &scene) : piola_scene_load(path, &scene);
-  Py_END_ALLOW_THREADS Py_DECREF(path_obj);
+  PyThreadState *released = PyEval_SaveThread(); /* the GIL */
+  st = json ? piola_scene_load_string(json, base, label, &scene) : piola_scene_load(path, &scene);
+  PyEval_RestoreThread(released);
+  Py_DECREF(path_obj);
   if (st != PIOLA_OK) {
     pypiola_raise(pypiola_scene_error, st);
     return -1;

@@ -229,9 +229,10 @@ static PyObject *run_steps(world_object *self, int advance, double value) {
   piola_step_stats st = {0};
   piola_status status;
   self->busy = 1;
-  Py_BEGIN_ALLOW_THREADS status =
-      advance ? piola_world_advance_to(w, value, &st) : piola_world_step(w, value, &st);
-  Py_END_ALLOW_THREADS self->busy = 0;
+  PyThreadState *released = PyEval_SaveThread(); /* the GIL */
+  status = advance ? piola_world_advance_to(w, value, &st) : piola_world_step(w, value, &st);
+  PyEval_RestoreThread(released);
+  self->busy = 0;
   if (take_snapshots(self) < 0) return NULL;
   if (status != PIOLA_OK)
     return pypiola_raise(

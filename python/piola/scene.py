@@ -36,9 +36,7 @@ class Scene:
         self = cls.__new__(cls)
         path = os.fspath(path)
         self._init(_piola.Scene(path, None, None, None), path)
-        with open(path, encoding="utf-8") as f:
-            self._source = json.load(f)
-        self._folder = os.path.dirname(os.path.abspath(path))
+        self._source = self._folder = None  # the C library copies files itself
         return self
 
     def _init(self, core, path):
@@ -106,14 +104,25 @@ class Scene:
                 "wall_seconds": _time.perf_counter() - start}
 
     def _write_copy(self, path):
-        """The scene with the mesh paths of solids, shells, obstacles and bones made absolute,
-        written whole or not at all."""
+        """The scene with the mesh paths of solids, shells, obstacles, bones and plastic goals
+        made absolute (as piola_scene_copy_resolved does for a file), written whole or not at
+        all."""
+        if self.path is not None:
+            _piola.Scene.copy_resolved(self.path, path)
+            return
         scene = json.loads(json.dumps(self._source))
+
+        def resolve(item, key):
+            if isinstance(item, dict) and isinstance(item.get(key), str) and item[key]:
+                item[key] = os.path.join(self._folder, item[key])
+
         for section, key in (("solids", "mesh"), ("shells", "mesh"), ("obstacles", "path"),
                              ("bones", "path")):
             for item in scene.get(section, []):
-                if isinstance(item.get(key), str):
-                    item[key] = os.path.join(self._folder, item[key])
+                resolve(item, key)
+        for solid in scene.get("solids", []):
+            control = solid.get("plasticity", {}).get("control", {}) if isinstance(solid, dict) else {}
+            resolve(control.get("goal") if isinstance(control, dict) else None, "mesh")
         tmp = path + ".tmp"
         with open(tmp, "w", encoding="utf-8") as f:
             json.dump(scene, f, indent=2)

@@ -92,7 +92,22 @@ static PyObject *scene_get_closed(PyObject *self_obj, void *unused) {
   return PyBool_FromLong(pypiola_scene_closed(self_obj));
 }
 
+/* copy_resolved(scene_path, out_path): piola_scene_copy_resolved (a static method). */
+static PyObject *scene_copy_resolved(PyObject *unused, PyObject *args) {
+  (void)unused;
+  PyObject *src, *dst;
+  if (!PyArg_ParseTuple(args, "O&O&", PyUnicode_FSConverter, &src, PyUnicode_FSConverter, &dst))
+    return NULL;
+  piola_status st = piola_scene_copy_resolved(PyBytes_AS_STRING(src), PyBytes_AS_STRING(dst));
+  Py_DECREF(src);
+  Py_DECREF(dst);
+  if (st != PIOLA_OK) return pypiola_raise(pypiola_error, st);
+  Py_RETURN_NONE;
+}
+
 static PyMethodDef scene_methods[] = {
+    {"copy_resolved", scene_copy_resolved, METH_VARARGS | METH_STATIC,
+     "copy_resolved(scene_path, out_path): the scene file with absolute mesh paths"},
     {"info", scene_info, METH_NOARGS, "info() -> {fps, frames}"},
     {"world", scene_world, METH_NOARGS, "world() -> the scene's _piola.World"},
     {"close", scene_close, METH_NOARGS, "close(): later calls raise ClosedError"},

@@ -1,9 +1,9 @@
 """Worlds of elastic solids and rigid obstacles, stepped from Python (docs/python.md).
 
 A body's positions and velocities are NumPy views of the world's own memory, without a copy.
-Views of a solid's positions and velocities are writable: a write between steps is picked up
-by the next step (the solid's forces are recomputed from it). Rest positions, masses, cells,
-constraint flags and every array of a shell are read-only views. A view keeps the world's
+Views of a body's positions and velocities are writable: a write between steps is picked up
+by the next step (the body's forces are recomputed from it). Rest positions, masses, cells and
+constraint flags are read-only views. A view keeps the world's
 memory alive: after World.close() every call raises ClosedError, and existing views keep
 the last state until they are dropped."""
 import numbers
@@ -156,7 +156,7 @@ def _selector(sel, what, driven):
 class Body:
     """A solid or a shell of a world. kind is "solid" or "shell"; index counts within its kind.
 
-    positions, velocities: (n, 3) views in m and m/s (writable for solids);
+    positions, velocities: (n, 3) writable views in m and m/s;
     rest_positions (n, 3) m, masses (n,) kg, cells (tets (m, 4) or triangles (k, 3)),
     constraint_flags (n,) uint8 (0 free, 1 fixed, 2 driven): read-only views."""
 
@@ -186,13 +186,11 @@ class Body:
         self.set_state(velocities=value)
 
     def set_state(self, positions=None, velocities=None):
-        """Replaces positions (n, 3) m and/or velocities (n, 3) m/s (copied) of a solid."""
-        if self.kind != "solid":
-            raise TypeError("only a solid's state can be set")
+        """Replaces positions (n, 3) m and/or velocities (n, 3) m/s (copied)."""
         n = len(self.masses)
         p = None if positions is None else float_array(positions, "positions", (n, 3))
         v = None if velocities is None else float_array(velocities, "velocities", (n, 3))
-        self._world._core.set_solid_state(self.index, p, v)
+        self._world._core.set_body_state(self._k, self.index, p, v)
 
     def stats(self):
         """Solids: kinetic_energy (J), elastic_energy (J), inverted_count, min_det_f.

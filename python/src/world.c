@@ -1,17 +1,17 @@
 /* _piola.World: a world (piola/world.h), its bodies' state as NumPy views, and stepping with
  * the GIL released.
  *
- * Views: positions and velocities of solids are writable arrays over the world's own
- * buffers (no copy); every other array (rest positions, masses, tets, shells' state) is a
- * read-only view. A view holds a reference to the world object, so the memory under it lives
- * as long as the view: close() only ends the world for calls (ClosedError), and the world is
- * freed when the last view and the world object are gone.
+ * Views: positions and velocities of every body (solid or shell) are writable arrays over
+ * the world's own buffers (no copy); every other array (rest positions, masses, cells,
+ * constraint flags) is a read-only view. A view holds a reference to the world object, so the
+ * memory under it lives as long as the view: close() only ends the world for calls (ClosedError),
+ * and the world is freed when the last view and the world object are gone.
  *
  * Writes through a view reach the solver through a snapshot: after every call that changes
- * the state the world object copies each solid's positions and velocities; before the next
- * step (and before stats) it compares, and hands a changed solid to
- * piola_world_solid_set_state, which recomputes its forces. Untouched solids are not
- * touched, so stepping from Python gives the same numbers as stepping from C. */
+ * the state the world object copies each body's positions and velocities; before the next
+ * step (and before stats) it compares, and hands a changed body to piola_world_body_set_state,
+ * which recomputes its forces. Untouched bodies are not touched, so stepping from Python gives
+ * the same numbers as stepping from C. */
 #include "pypiola.h"
 
 #include <math.h>
@@ -22,16 +22,17 @@
 #define VIEW_BAD_VELOCITY ((piola_status)-100)
 
 typedef struct {
+  piola_body_id id;
   double *x, *v; /* snapshots, 3n each */
   int32_t n;
-} solid_shadow;
+} body_shadow;
 
 typedef struct {
   PyObject_HEAD piola_world *world;
   PyObject *scene; /* the owning scene object (strong), or NULL for a world of our own */
   int closed;
-  int busy; /* a step is running with the GIL released */
-  solid_shadow *shadows;
+  int busy;             /* a step is running with the GIL released */
+  body_shadow *shadows; /* one per body, in the world's body order */
   int32_t shadow_count;
 } world_object;
 
@@ -60,30 +61,32 @@ static void free_shadows(world_object *self) {
   self->shadow_count = 0;
 }
 
-/* Takes the snapshot of every solid (growing the list for new solids). */
+/* Takes the snapshot of every body; a new body (the count changed) rebuilds the list, since
+ * adding a solid moves the shells one place on. */
 static int take_snapshots(world_object *self) {
-  int32_t count = piola_world_solid_count(self->world);
-  if (count > self->shadow_count) {
-    solid_shadow *grown = realloc(self->shadows, (size_t)count * sizeof *grown);
-    if (!grown) return PyErr_NoMemory(), -1;
-    self->shadows = grown;
-    for (int32_t i = self->shadow_count; i < count; ++i) {
-      int32_t n = piola_elastic_body_vertex_count(piola_world_solid_body(self->world, i));
-      grown[i].n = n;
-      grown[i].x = malloc(3 * (size_t)n * sizeof(double) + 1);
-      grown[i].v = malloc(3 * (size_t)n * sizeof(double) + 1);
-      if (!grown[i].x || !grown[i].v) {
-        free(grown[i].x), free(grown[i].v);
-        self->shadow_count = i;
+  int32_t count = piola_world_body_count(self->world);
+  if (count != self->shadow_count) {
+    free_shadows(self);
+    body_shadow *list = calloc((size_t)count + 1, sizeof *list);
+    if (!list) return PyErr_NoMemory(), -1;
+    self->shadows = list;
+    self->shadow_count = count;
+    for (int32_t i = 0; i < count; ++i) {
+      list[i].id = piola_world_body_at(self->world, i);
+      list[i].n = piola_world_body_node_count(self->world, list[i].id);
+      list[i].x = malloc(3 * (size_t)list[i].n * sizeof(double) + 1);
+      list[i].v = malloc(3 * (size_t)list[i].n * sizeof(double) + 1);
+      if (!list[i].x || !list[i].v) {
+        free_shadows(self);
         return PyErr_NoMemory(), -1;
       }
     }
-    self->shadow_count = count;
   }
   for (int32_t i = 0; i < count; ++i) {
-    size_t bytes = 3 * (size_t)self->shadows[i].n * sizeof(double);
-    memcpy(self->shadows[i].x, piola_world_solid_positions(self->world, i), bytes);
-    memcpy(self->shadows[i].v, piola_world_solid_velocities(self->world, i), bytes);
+    body_shadow *s = &self->shadows[i];
+    size_t bytes = 3 * (size_t)s->n * sizeof(double);
+    memcpy(s->x, piola_world_body_positions(self->world, s->id), bytes);
+    memcpy(s->v, piola_world_body_velocities(self->world, s->id), bytes);
   }
   return 0;
 }
@@ -94,33 +97,32 @@ static int all_finite(const double *values, size_t count) {
   return 1;
 }
 
-/* Hands solids changed through their views to set_state. A refused state (NaN) is undone. */
+/* Hands bodies changed through their views to set_state. A refused state (NaN) is undone. */
 static int apply_view_writes(world_object *self) {
   for (int32_t i = 0; i < self->shadow_count; ++i) {
-    solid_shadow *s = &self->shadows[i];
+    body_shadow *s = &self->shadows[i];
     size_t bytes = 3 * (size_t)s->n * sizeof(double);
-    double *x = (double *)piola_world_solid_positions(self->world, i);
-    double *v = (double *)piola_world_solid_velocities(self->world, i);
+    double *x = (double *)piola_world_body_positions(self->world, s->id);
+    double *v = (double *)piola_world_body_velocities(self->world, s->id);
     int dx = memcmp(x, s->x, bytes) != 0, dv = memcmp(v, s->v, bytes) != 0;
     if (!dx && !dv) continue;
     double *copy = malloc(2 * bytes + 1);
     if (!copy) return PyErr_NoMemory(), -1;
     memcpy(copy, x, bytes);
     memcpy(copy + 3 * (size_t)s->n, v, bytes);
-    /* set_state copies into the same buffers: give it a separate copy */
-    /* set_state checks positions; velocities are checked here */
+    /* set_state copies into the same buffers: give it a separate copy. It checks positions;
+     * velocities are checked here. */
     piola_status st = all_finite(v, 3 * (size_t)s->n)
-                          ? piola_world_solid_set_state(self->world, i, dx ? copy : NULL,
-                                                        dv ? copy + 3 * (size_t)s->n : NULL)
+                          ? piola_world_body_set_state(self->world, s->id, dx ? copy : NULL,
+                                                       dv ? copy + 3 * (size_t)s->n : NULL)
                           : VIEW_BAD_VELOCITY;
     free(copy);
     if (st != PIOLA_OK) {
       memcpy(x, s->x, bytes);
       memcpy(v, s->v, bytes);
       PyErr_Format(PyExc_ValueError,
-                   "solid %d: the state written through its views was refused "
-                   "and undone: %s",
-                   (int)i,
+                   "body '%s': the state written through its views was refused and undone: %s",
+                   piola_world_body_name(self->world, s->id),
                    st == VIEW_BAD_VELOCITY ? "a velocity is not finite" : piola_last_error());
       return -1;
     }
@@ -321,11 +323,11 @@ static PyObject *world_body_array(PyObject *self, PyObject *args) {
   if (strcmp(name, "positions") == 0)
     return make_view(
         self, eb ? piola_world_solid_positions(w, index) : piola_world_shell_positions(w, index), n,
-        3, NPY_DOUBLE, eb != NULL);
+        3, NPY_DOUBLE, 1);
   if (strcmp(name, "velocities") == 0)
     return make_view(
         self, eb ? piola_world_solid_velocities(w, index) : piola_world_shell_velocities(w, index),
-        n, 3, NPY_DOUBLE, eb != NULL);
+        n, 3, NPY_DOUBLE, 1);
   if (strcmp(name, "rest_positions") == 0)
     return make_view(
         self, eb ? piola_elastic_body_rest_positions(eb) : piola_shell_body_rest_positions(sb), n,
@@ -366,15 +368,15 @@ static PyObject *world_body_stats(PyObject *self, PyObject *args) {
                        (int)s.degenerate_count);
 }
 
-/* set_solid_state(index, positions or None, velocities or None): copies. */
-static PyObject *world_set_solid_state(PyObject *self_obj, PyObject *args) {
+/* set_body_state(kind, index, positions or None, velocities or None): copies. */
+static PyObject *world_set_body_state(PyObject *self_obj, PyObject *args) {
   world_object *self = (world_object *)self_obj;
-  int index;
+  int kind, index;
   PyObject *pobj, *vobj;
-  if (!PyArg_ParseTuple(args, "iOO", &index, &pobj, &vobj)) return NULL;
-  if (!body_world(self_obj, 0, index) || !synced(self)) return NULL;
-  npy_intp dims[2] = {piola_elastic_body_vertex_count(piola_world_solid_body(self->world, index)),
-                      3};
+  if (!PyArg_ParseTuple(args, "iiOO", &kind, &index, &pobj, &vobj)) return NULL;
+  if (!body_world(self_obj, kind, index) || !synced(self)) return NULL;
+  piola_body_id id = piola_world_body_of(self->world, (piola_body_kind)kind, index);
+  npy_intp dims[2] = {piola_world_body_node_count(self->world, id), 3};
   const double *p = NULL, *v = NULL;
   if (pobj != Py_None) {
     PyArrayObject *a = pypiola_check_array(pobj, "positions", NPY_DOUBLE, 2, dims, 0);
@@ -396,8 +398,8 @@ static PyObject *world_set_solid_state(PyObject *self_obj, PyObject *args) {
   if (!copy) return PyErr_NoMemory();
   if (p) memcpy(copy, p, bytes);
   if (v) memcpy(copy + 3 * (size_t)dims[0], v, bytes);
-  piola_status st = piola_world_solid_set_state(self->world, index, p ? copy : NULL,
-                                                v ? copy + 3 * (size_t)dims[0] : NULL);
+  piola_status st = piola_world_body_set_state(self->world, id, p ? copy : NULL,
+                                               v ? copy + 3 * (size_t)dims[0] : NULL);
   free(copy);
   if (take_snapshots(self) < 0) return NULL;
   if (st != PIOLA_OK) return pypiola_raise(PyExc_ValueError, st);
@@ -521,7 +523,7 @@ static PyMethodDef world_methods[] = {
     {"body_name", world_body_name, METH_VARARGS, "body_name(kind, index)"},
     {"body_array", world_body_array, METH_VARARGS, "body_array(kind, index, name) -> view"},
     {"body_stats", world_body_stats, METH_VARARGS, "body_stats(kind, index) -> dict"},
-    {"set_solid_state", world_set_solid_state, METH_VARARGS, "set_solid_state(index, x, v)"},
+    {"set_body_state", world_set_body_state, METH_VARARGS, "set_body_state(kind, index, x, v)"},
     {"add_solid", world_add_solid, METH_VARARGS, "add_solid(definition tuple) -> index"},
     {"add_obstacle", world_add_obstacle, METH_O, "add_obstacle(_piola.Obstacle) -> index"},
     {NULL, NULL, 0, NULL},

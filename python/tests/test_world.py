@@ -168,10 +168,25 @@ def test_scene_world_and_bodies(tmp_path):
     assert [b.name for b in w.bodies] == ["ball", "sheet"]
     ball_body, sheet = w.body("ball"), w.body("sheet")
     assert sheet.kind == "shell" and sheet.cells.shape[1] == 3
-    assert not sheet.positions.flags.writeable
+    # a shell's views are writable too: a uniform velocity is pure kinetic energy
+    sheet.velocities[:] = [1.0, 0, 0]
+    assert sheet.stats()["kinetic_energy"] == pytest.approx(0.5 * sheet.masses.sum(), rel=1e-12)
+    sheet.positions[:, 2] += 0.5
+    assert sheet.stats()["membrane_energy"] == pytest.approx(0, abs=1e-12)
+    x0 = sheet.center_of_mass()
+    sheet.set_state(velocities=np.zeros((len(sheet.masses), 3)))
     assert ball_body.center_of_mass()[2] == pytest.approx(0.3, abs=1e-3)
     w.advance_to(0.05)
     assert set(sheet.stats()) >= {"kinetic_energy", "membrane_energy", "bending_energy"}
+    # free fall from rest under gravity for 0.05 s
+    assert sheet.center_of_mass()[2] == pytest.approx(x0[2] - 0.5 * 9.81 * 0.05**2, rel=1e-3)
+    # a solid added after the shell: views and writes still reach the right bodies
+    extra = w.add_solid(piola.generate_mesh("sphere", radius=0.05, cell_size=0.05, center=[1, 0, 0.5]))
+    assert [b.name for b in w.bodies] == ["ball", "solid1", "sheet"] and extra.index == 1
+    sheet.velocities[:] = [0, 2.0, 0]
+    extra.velocities[:] = [0, 0, 3.0]
+    assert sheet.stats()["kinetic_energy"] == pytest.approx(0.5 * sheet.masses.sum() * 4, rel=1e-12)
+    assert extra.stats()["kinetic_energy"] == pytest.approx(0.5 * extra.masses.sum() * 9, rel=1e-12)
 
 
 def test_stepping_releases_the_gil():
@@ -252,11 +267,11 @@ def test_misuse_raises():
     # the extension checks dtype, shape and order itself
     n = len(b.masses)
     with pytest.raises(TypeError, match="dtype"):
-        w._core.set_solid_state(0, np.zeros((n, 3), np.float32), None)
+        w._core.set_body_state(0, 0, np.zeros((n, 3), np.float32), None)
     with pytest.raises(ValueError, match="dimension"):
-        w._core.set_solid_state(0, np.zeros((n + 1, 3)), None)
+        w._core.set_body_state(0, 0, np.zeros((n + 1, 3)), None)
     with pytest.raises(ValueError, match="C-contiguous"):
-        w._core.set_solid_state(0, np.zeros((3, n)).T, None)
+        w._core.set_body_state(0, 0, np.zeros((3, n)).T, None)
     with pytest.raises(TypeError):
         w._core.add_solid(("x",))
     with pytest.raises(piola.ClosedError):

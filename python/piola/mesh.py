@@ -105,6 +105,18 @@ def write_mesh(path, points, cells=None, regions=None, fibers=None):
                      f"surfaces: {', '.join(SURFACE_WRITE)})")
 
 
+def read_vtu(path):
+    """Reads a VTK UnstructuredGrid file with its fields, e.g. a frame that Scene.run or
+    `piola run` wrote (frames/frame_NNNN.vtu; its fields are listed in docs/cli.md). Returns a
+    dict: points (n, 3) m, tets (m, 4), triangles (k, 3), point_data and cell_data
+    ({name: (count,) or (count, components) float64}), and tet_cells, triangle_cells: each
+    element's index among all cells, which cell_data is indexed by. Raises MeshError."""
+    points, tets, triangles, point_data, cell_data, tet_cells, triangle_cells = \
+        _piola.read_vtu(os.fspath(path))
+    return {"points": points, "tets": tets, "triangles": triangles, "point_data": point_data,
+            "cell_data": cell_data, "tet_cells": tet_cells, "triangle_cells": triangle_cells}
+
+
 def boundary_surface(points, tets):
     """The boundary triangles (k, 3) of a tet mesh, wound outward, same point numbering."""
     points = float_array(points, "points", (-1, 3))

@@ -245,7 +245,50 @@ static PyObject *tet_mesh_boundary(PyObject *self, PyObject *args) {
   return tris;
 }
 
+/* {name: (count, components) array} of VTU fields. */
+static PyObject *fields_dict(const piola_vtu_array *fields, int32_t count, int32_t rows) {
+  PyObject *d = PyDict_New();
+  for (int32_t i = 0; d && i < count; ++i) {
+    const piola_vtu_array *f = &fields[i];
+    PyArrayObject *a = f->components == 1
+                           ? copy_out(NPY_DOUBLE, f->values, rows, 0, sizeof(double))
+                           : copy_out(NPY_DOUBLE, f->values, rows, f->components, sizeof(double));
+    if (!a || PyDict_SetItemString(d, f->name, (PyObject *)a) < 0) Py_CLEAR(d);
+    Py_XDECREF(a);
+  }
+  return d;
+}
+
+/* read_vtu(path) -> (points, tets, triangles, point_fields, cell_fields, tet_cells,
+ * triangle_cells) */
+static PyObject *read_vtu(PyObject *self, PyObject *args) {
+  (void)self;
+  PyObject *path_obj;
+  if (!PyArg_ParseTuple(args, "O&", PyUnicode_FSConverter, &path_obj)) return NULL;
+  piola_vtu_data data = {0};
+  piola_status st;
+  const char *path = PyBytes_AS_STRING(path_obj);
+  PyThreadState *released = PyEval_SaveThread(); /* the GIL */
+  st = piola_vtu_read(path, &data);
+  PyEval_RestoreThread(released);
+  Py_DECREF(path_obj);
+  if (st != PIOLA_OK) return pypiola_raise(pypiola_mesh_error, st);
+  PyObject *result = Py_BuildValue(
+      "NNNNNNN", copy_out(NPY_DOUBLE, data.positions, data.point_count, 3, sizeof(double)),
+      copy_out(NPY_INT32, data.tets, data.tet_count, 4, sizeof(int32_t)),
+      copy_out(NPY_INT32, data.triangles, data.triangle_count, 3, sizeof(int32_t)),
+      fields_dict(data.point_fields, data.point_field_count, data.point_count),
+      fields_dict(data.cell_fields, data.cell_field_count, data.cell_count),
+      copy_out(NPY_INT32, data.tet_cells, data.tet_count, 0, sizeof(int32_t)),
+      copy_out(NPY_INT32, data.triangle_cells, data.triangle_count, 0, sizeof(int32_t)));
+  piola_vtu_data_free(&data);
+  return result;
+}
+
 PyMethodDef pypiola_mesh_methods[] = {
+    {"read_vtu", read_vtu, METH_VARARGS,
+     "read_vtu(path) -> (points, tets, triangles, point_fields, cell_fields, tet_cells, "
+     "triangle_cells)"},
     {"read_tet_mesh", read_tet_mesh, METH_VARARGS,
      "read_tet_mesh(path) -> (points, tets, regions, fibers)"},
     {"read_tri_mesh", read_tri_mesh, METH_VARARGS, "read_tri_mesh(path) -> (points, triangles)"},

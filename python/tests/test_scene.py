@@ -4,6 +4,7 @@ import json
 import os
 import subprocess
 
+import numpy as np
 import pytest
 
 import piola
@@ -63,6 +64,16 @@ def test_dict_scene_and_progress_stop(tmp_path):
     # the ball fell and rests above the floor
     ball = scene.world.body("ball")
     assert ball.positions[:, 2].min() > -1e-3
+    # the last frame holds the world's state: positions, velocities, energy
+    frame = piola.read_vtu(tmp_path / "out" / "frames" / "frame_0002.vtu")
+    assert np.array_equal(frame["points"], ball.positions)
+    assert np.array_equal(frame["point_data"]["velocity"], ball.velocities)
+    assert np.array_equal(frame["tets"], ball.cells)
+    X, t = ball.rest_positions, ball.cells
+    vol = np.einsum("ij,ij->i", X[t[:, 1]] - X[t[:, 0]],
+                    np.cross(X[t[:, 2]] - X[t[:, 0]], X[t[:, 3]] - X[t[:, 0]])) / 6
+    energy = frame["cell_data"]["energy_density"][frame["tet_cells"]] @ vol
+    assert energy == pytest.approx(ball.stats()["elastic_energy"], rel=1e-9)
 
 
 def test_progress_exception_propagates_and_keeps_frames(tmp_path):

@@ -15,7 +15,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "common/status_internal.h"
+#include "common/status_report.h"
 #include "sim/world_internal.h"
 
 static piola_body_id make_id(uint32_t slot, uint32_t generation) {

@@ -5,7 +5,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "common/status_internal.h"
+#include "common/status_report.h"
 #include "sim/world_internal.h"
 
 int piola__track_ok(const piola_track *t, double lo) {

@@ -52,6 +52,8 @@ typedef struct world_solid {
   int product_valid;
   uint8_t *colliding;
   double *normals;
+  struct implicit_state *implicit; /* the implicit integrators' matrix and vectors, made on
+                                      their first step (implicit_step.c) */
 } world_solid;
 
 struct piola_world {
@@ -134,6 +136,12 @@ piola_status piola__world_self_collide(piola_world *w, double dt, double t1, int
                                        piola_step_stats *stats);
 void piola__world_collision_reset(piola_world *w);
 void piola__world_contact_free(piola_world *w);
+
+/* The implicit integrators (implicit_step.c): piola_world_step and the step size for
+ * PIOLA_INTEGRATOR_BACKWARD_EULER and PIOLA_INTEGRATOR_QUASISTATIC; implicit_state_free
+ * frees a solid's implicit state (NULL is fine). */
+piola_status piola__implicit_world_step(piola_world *w, double dt_limit, piola_step_stats *stats);
+void piola__implicit_state_free(struct implicit_state *state);
 
 /* 1 (default): the step's second right-hand side takes D_n v' from the first solve's
  * initial product plus a correction on the nodes collisions and constraints moved

@@ -89,7 +89,12 @@ void piola__diagonal_stiffness_eval(const piola_material *material, const double
       twist = 0.5 * (d[p][p] + d[p][q] + d[q][p] + d[q][q]);
     if (project) {
       shear = fmax(shear, 0.0);
-      twist = fmax(twist, 0.0);
+      /* near f_p = -f_q (an inverted element close to a reflection) the stress is not
+       * continuous unless P_p + P_q vanishes there, and the quotient grows without bound;
+       * such a stiff rotation mode only stalls Newton, so it is capped at the element's
+       * other stiffnesses */
+      const double cap = fmax(shear, fmax(fabs(d[p][p]), fabs(d[q][q])));
+      twist = fmin(fmax(twist, 0.0), cap);
     }
     out->pair_a[k] = 0.5 * (shear + twist);
     out->pair_b[k] = 0.5 * (shear - twist);

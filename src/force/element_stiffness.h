@@ -15,7 +15,10 @@
  * its limit, the matching combination of dPhat/dFhat, so the result stays finite on flat,
  * collapsed and inverted elements. The definiteness fix clamps the 2x2 eigenvalues at zero
  * and projects the symmetrized 3x3 block onto its non-negative eigenvalues; the sum is then
- * positive semi-definite for every F.
+ * positive semi-definite for every F. The projection also caps the rotation eigenvalue
+ * (P_p + P_q) / (f_p + f_q) at the element's largest other stiffness (the shear quotient and
+ * the diagonal of dPhat/dFhat): it grows without bound near a reflection (f_p = -f_q), where
+ * the extended stress of most models jumps, and a Newton iteration seeing it would stall.
  *
  * The muscle's fibre term P_f = (T(lambda) / lambda) F a a^T (lambda = |F a|) is not
  * diagonal in that frame, but its derivative has a closed form in any frame:

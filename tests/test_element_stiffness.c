@@ -359,6 +359,54 @@ static void check_body_matrix(piola_material_model model, double squash) {
   fixture_mesh_free(&mesh);
 }
 
+/* At a state where no element needs the definiteness fix (a smooth, moderate deformation
+ * of a neo-Hookean grid, rotated), the assembled stiffness is the derivative of the body's
+ * own elastic forces: central differences of piola_elastic_body_update along random
+ * directions. */
+static void test_matrix_is_force_derivative(void **state) {
+  (void)state;
+  piola_tet_mesh mesh = fixture_grid(3, 0.3);
+  piola_material mat = fixture_material(PIOLA_MODEL_NEOHOOKEAN);
+  piola_elastic_body *body = fixture_body(&mesh, &mat);
+  const int32_t n = body->vertex_count, dim = 3 * n;
+  double *x = malloc(sizeof(double) * dim), *xp = malloc(sizeof(double) * dim);
+  double *f0 = malloc(sizeof(double) * dim), *fp = malloc(sizeof(double) * dim);
+  double *fm = malloc(sizeof(double) * dim), *p = malloc(sizeof(double) * dim);
+  double *kp = malloc(sizeof(double) * dim);
+  test_rng rng = test_rng_seeded(7);
+  double r[9];
+  fixture_random_rotation(&rng, r);
+  for (int32_t i = 0; i < n; ++i) {
+    const double *q = body->rest_positions + 3 * i;
+    /* a bend and a stretch, then a rotation */
+    double y[3] = {q[0] * 1.1 + 0.2 * q[1] * q[1], q[1] * 0.95, q[2] * 1.05 + 0.1 * q[0] * q[1]};
+    for (int k = 0; k < 3; ++k) x[3 * i + k] = r[3 * k] * y[0] + r[3 * k + 1] * y[1] + r[3 * k + 2] * y[2];
+  }
+  for (int32_t j = 0; j < dim; ++j) p[j] = test_rng_normal(&rng);
+  const double eps = 1e-6;
+  for (int32_t j = 0; j < dim; ++j) xp[j] = x[j] + eps * p[j];
+  assert_int_equal(piola_elastic_body_update(body, xp, 1.0, fp, NULL), PIOLA_OK);
+  for (int32_t j = 0; j < dim; ++j) xp[j] = x[j] - eps * p[j];
+  assert_int_equal(piola_elastic_body_update(body, xp, 1.0, fm, NULL), PIOLA_OK);
+  assert_int_equal(piola_elastic_body_update(body, x, 1.0, f0, NULL), PIOLA_OK);
+  piola__stiffness_matrix mx;
+  assert_int_equal(piola__stiffness_matrix_init(&mx, body), PIOLA_OK);
+  /* A = 0 M - 1 (df/dx): A p = -(df/dx) p */
+  piola__stiffness_matrix_assemble(&mx, body, 1.0, 0.0, body->masses, 0.0);
+  piola__stiffness_matrix_apply(&mx, body, body->masses, 0.0, p, kp);
+  double err = 0, size = 0;
+  for (int32_t j = 0; j < dim; ++j) {
+    double fd = -(fp[j] - fm[j]) / (2 * eps);
+    err = fmax(err, fabs(fd - kp[j]));
+    size = fmax(size, fabs(fd));
+  }
+  if (!(err <= 1e-5 * size)) fail_msg("K p differs from -df/dx p by %g (scale %g)", err, size);
+  piola__stiffness_matrix_free(&mx);
+  free(x), free(xp), free(f0), free(fp), free(fm), free(p), free(kp);
+  piola_elastic_body_destroy(body);
+  fixture_mesh_free(&mesh);
+}
+
 static void test_assembled_matrix(void **state) {
   (void)state;
   for (int model = 0; model < PIOLA_MODEL_COUNT; ++model) {
@@ -373,6 +421,7 @@ int main(void) {
       cmocka_unit_test(test_dpdf_every_model),
       cmocka_unit_test(test_projection_keeps_definite),
       cmocka_unit_test(test_assembled_matrix),
+      cmocka_unit_test(test_matrix_is_force_derivative),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
 }

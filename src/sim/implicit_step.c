@@ -400,7 +400,7 @@ static piola_status newton_solid(piola_world *w, world_solid *s, double t, doubl
           const double *b = st->matrix.diagonal + 9 * (size_t)i;
           trace += b[0] + b[4] + b[8];
         }
-        st->mu = 1e-4 * trace / (3.0 * pb.total_mass);
+        st->mu = 1e-6 * trace / (3.0 * pb.total_mass);
         if (!(st->mu > 0)) st->mu = 1.0;
       }
       piola__stiffness_matrix_assemble(&st->matrix, s->body, pb.force_weight, 0.0, s->mass, st->mu);
@@ -433,7 +433,10 @@ static piola_status newton_solid(piola_world *w, world_solid *s, double t, doubl
       phi = residual(&pb);
     }
     if (pb.quasistatic) {
-      st->mu = alpha == 1.0 ? fmax(st->mu / 3.0, 1e-300) : st->mu * 3.0;
+      if (alpha == 1.0)
+        st->mu = fmax(st->mu / 10.0, 1e-300);
+      else if (alpha < 0.25)
+        st->mu *= 10.0;
     } else {
       /* backward Euler: an iteration that had to backtrack far adds a multiple of M to the
        * matrix (Levenberg-Marquardt: shorter, more gradient-like steps), full steps take it

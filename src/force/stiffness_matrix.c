@@ -4,7 +4,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "common/status_internal.h"
+#include "common/status_report.h"
 #include "force/elastic_body_internal.h"
 #include "force/element_stiffness.h"
 #include "force/stiffness_matrix.h"
@@ -185,7 +185,7 @@ void piola__stiffness_matrix_assemble(piola__stiffness_matrix *m, const piola_el
   const int32_t blocks = body->padded_tet_count / PIOLA_TET_BLOCK;
   const int32_t nv = body->vertex_count;
   enum { RANGES = 16 };
-#pragma omp parallel num_threads(piola__thread_count()) if (blocks >= PIOLA_PARALLEL_MIN_BLOCKS)
+#pragma omp parallel num_threads(piola_thread_count()) if (blocks >= PIOLA_PARALLEL_MIN_BLOCKS)
   {
 #pragma omp for schedule(static)
     for (int k = 0; k < PIOLA_DAMPING_PARTS; ++k) assemble_part(m, body, k, stiffness_weight);
@@ -241,7 +241,7 @@ void piola__stiffness_matrix_apply(const piola__stiffness_matrix *m, const piola
   const piola__damping_matrix *d = &body->damping;
   const int32_t nv = body->vertex_count;
   enum { RANGES = 16 };
-#pragma omp parallel for schedule(static) num_threads(piola__thread_count()) \
+#pragma omp parallel for schedule(static) num_threads(piola_thread_count()) \
     if (nv >= PIOLA_PARALLEL_MIN_VERTICES)
   for (int r = 0; r < RANGES; ++r)
     product_rows(m, d, mass, mass_weight, p, (int32_t)((int64_t)nv * r / RANGES),

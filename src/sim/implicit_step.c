@@ -43,7 +43,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "common/status_internal.h"
+#include "common/status_report.h"
 #include "force/elastic_body_internal.h"
 #include "force/stiffness_matrix.h"
 #include "sim/world_internal.h"
@@ -100,7 +100,7 @@ static double dot_ranges(const world_solid *s, const double *a, const double *b,
                          const double *inverse_mass) {
   double part[RANGES];
   const int32_t n = s->n;
-#pragma omp parallel for schedule(static) num_threads(piola__thread_count()) \
+#pragma omp parallel for schedule(static) num_threads(piola_thread_count()) \
     if (n >= PIOLA_PARALLEL_MIN_VERTICES)
   for (int r = 0; r < RANGES; ++r) {
     double sum = 0;
@@ -166,7 +166,7 @@ static double residual(newton_problem *pb) {
     piola_elastic_body_damping_forces(s->body, v, pb->beta, pb->alpha, st->damping);
   }
   double part[RANGES];
-#pragma omp parallel for schedule(static) num_threads(piola__thread_count()) \
+#pragma omp parallel for schedule(static) num_threads(piola_thread_count()) \
     if (n >= PIOLA_PARALLEL_MIN_VERTICES)
   for (int r = 0; r < RANGES; ++r) {
     double sum = 0;

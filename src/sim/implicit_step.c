@@ -131,9 +131,11 @@ static inline void filter_node(const world_solid *s, int32_t i, double *r) {
   filter_vector(s, i, r + 3 * i);
 }
 
+/* True when a node with mass is held (constrained or in contact): then external forces act.
+ * Massless vertices (in no tet) are held fixed but carry no momentum. */
 static int has_filtered_nodes(const world_solid *s) {
   for (int32_t i = 0; i < s->n; ++i)
-    if (s->flags[i] != SOLID_FREE || s->colliding[i] || s->inverse_mass[i] == 0) return 1;
+    if (s->mass[i] > 0 && (s->flags[i] != SOLID_FREE || s->colliding[i])) return 1;
   return 0;
 }
 
@@ -237,7 +239,8 @@ static int32_t solve_newton_system(newton_problem *pb) {
     for (int32_t i = 0; i < n; ++i)
       for (int k = 0; k < 3; ++k) net[k] += st->residual[3 * i + k] + s->mass[i] * d[3 * i + k];
     for (int32_t i = 0; i < n; ++i)
-      for (int k = 0; k < 3; ++k) d[3 * i + k] -= net[k] / pb->total_mass;
+      if (s->mass[i] > 0)
+        for (int k = 0; k < 3; ++k) d[3 * i + k] -= net[k] / pb->total_mass;
   }
   return it;
 }

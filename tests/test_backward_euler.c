@@ -16,6 +16,7 @@
 #include <string.h>
 
 #include "piola/mesh.h"
+#include "piola/scene.h"
 #include "piola/world.h"
 
 static piola_tet_mesh block(int nx, int ny, int nz, double a, double b, double c) {
@@ -225,9 +226,41 @@ static void newmark_default(void **state) {
   assert_int_equal(piola_world_create(&wd, &w), PIOLA_ERROR_INVALID_ARGUMENT);
 }
 
+/* The scene keys: integrator.type picks the integrator, integrator.dt defaults to the frame
+ * time, and a bad value is refused with its key path. */
+static void scene_keys(void **state) {
+  (void)state;
+  const char *good = "{\"fps\": 24, \"frames\": 1, \"integrator\": {\"type\": \"backward_euler\"},"
+                     " \"solids\": [{\"mesh\": {\"generate\": \"box\", \"half_extents\": [0.1, 0.1, 0.1], \"cell_size\": 0.1}}]}";
+  piola_scene *scene = NULL;
+  if (piola_scene_load_string(good, NULL, NULL, &scene) != PIOLA_OK) fail_msg("%s", piola_last_error());
+  assert_close(piola_world_stable_dt(piola_scene_world(scene)), 1.0 / 24, 1e-15);
+  piola_step_stats st;
+  memset(&st, 0, sizeof st);
+  assert_int_equal(piola_world_advance_to(piola_scene_world(scene), 1.0 / 24, &st), PIOLA_OK);
+  assert_int_equal(st.substeps, 1);
+  /* free fall in one backward Euler step: every node moved by -g dt^2 (the first guess is
+   * exact, so Newton needs no iteration) */
+  const piola_world *w = piola_scene_world(scene);
+  const double *x = piola_world_solid_positions(w, 0);
+  const double *x0 = piola_elastic_body_rest_positions(piola_world_solid_body(w, 0));
+  for (int32_t i = 0; i < piola_elastic_body_vertex_count(piola_world_solid_body(w, 0)); ++i)
+    assert_close(x[3 * i + 2] - x0[3 * i + 2], -9.81 / (24.0 * 24.0), 1e-12);
+  piola_scene_destroy(scene);
+  const char *with_dt = "{\"fps\": 24, \"frames\": 1, \"integrator\": {\"type\": \"quasistatic\", \"dt\": 0.01},"
+                        " \"solids\": [{\"mesh\": {\"generate\": \"box\", \"half_extents\": [0.1, 0.1, 0.1], \"cell_size\": 0.1}}]}";
+  if (piola_scene_load_string(with_dt, NULL, NULL, &scene) != PIOLA_OK) fail_msg("%s", piola_last_error());
+  assert_close(piola_world_stable_dt(piola_scene_world(scene)), 0.01, 1e-15);
+  piola_scene_destroy(scene);
+  const char *bad = "{\"integrator\": {\"type\": \"implicit\"}, \"solids\": []}";
+  assert_int_equal(piola_scene_load_string(bad, NULL, NULL, &scene), PIOLA_ERROR_INVALID_ARGUMENT);
+  assert_non_null(strstr(piola_last_error(), "integrator.type"));
+}
+
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(newmark_default),
+      cmocka_unit_test(scene_keys),
       cmocka_unit_test(free_flight_momentum),
       cmocka_unit_test(drop_on_ground),
       cmocka_unit_test(incline_friction),

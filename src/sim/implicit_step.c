@@ -39,7 +39,6 @@
  * full steps and growing when the line search has to backtrack. Velocities are reported as
  * (x^n+1 - x^n) / dt; damping and contact friction do not act. */
 #include <math.h>
-#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -389,8 +388,6 @@ static piola_status newton_solid(piola_world *w, world_solid *s, double t, doubl
         break;
       }
     }
-    if (getenv("PIOLA_NEWTON_TRACE"))
-      fprintf(stderr, "newton %d: |g| %g target %g colliding %d\n", (int)iter, sqrt(phi), sqrt(target2), (int)0);
     stats->newton_iterations++;
     if (pb.damped) piola__elastic_body_damping_prepare(s->body, pb.beta, pb.alpha);
     piola__stiffness_matrix_assemble(&st->matrix, s->body, pb.force_weight,

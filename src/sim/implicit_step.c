@@ -72,7 +72,7 @@ void piola__implicit_state_free(struct implicit_state *st) {
   free(st);
 }
 
-static piola_status implicit_state_make(world_solid *s) {
+static piola_status implicit_state_make(world_body *s) {
   if (s->implicit) return PIOLA_OK;
   struct implicit_state *st = calloc(1, sizeof *st);
   if (!st) return PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "implicit step: out of memory");
@@ -83,7 +83,7 @@ static piola_status implicit_state_make(world_solid *s) {
   st->hit = malloc((size_t)(s->n > 0 ? s->n : 1));
   int ok = st->prediction && st->residual && st->step && st->base && st->damping &&
            st->scratch_v && st->hit && st->cg[0] && st->cg[1] && st->cg[2] && st->cg[3];
-  if (ok && piola__stiffness_matrix_init(&st->matrix, s->body) != PIOLA_OK) ok = 0;
+  if (ok && piola__stiffness_matrix_init(&st->matrix, s->solid) != PIOLA_OK) ok = 0;
   if (!ok) {
     piola__implicit_state_free(st);
     return PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "implicit step: out of memory");
@@ -95,7 +95,7 @@ static piola_status implicit_state_make(world_solid *s) {
 /* ------------------------------------------------------------------ vector helpers
  * Sums over 16 fixed node ranges, added in order: results do not depend on the thread count. */
 
-static double dot_ranges(const world_solid *s, const double *a, const double *b,
+static double dot_ranges(const world_body *s, const double *a, const double *b,
                          const double *inverse_mass) {
   double part[RANGES];
   const int32_t n = s->n;
@@ -116,8 +116,8 @@ static double dot_ranges(const world_solid *s, const double *a, const double *b,
 
 /* Zeroes the constrained components of node i of r: all of a fixed/driven node, the normal
  * of a node held by an obstacle. */
-static inline void filter_vector(const world_solid *s, int32_t i, double ri[3]) {
-  if (s->flags[i] != SOLID_FREE || s->inverse_mass[i] == 0) {
+static inline void filter_vector(const world_body *s, int32_t i, double ri[3]) {
+  if (s->flags[i] != NODE_FREE || s->inverse_mass[i] == 0) {
     ri[0] = ri[1] = ri[2] = 0;
   } else if (s->colliding[i]) {
     const double *nrm = s->normals + 3 * i;
@@ -126,15 +126,15 @@ static inline void filter_vector(const world_solid *s, int32_t i, double ri[3]) 
   }
 }
 
-static inline void filter_node(const world_solid *s, int32_t i, double *r) {
+static inline void filter_node(const world_body *s, int32_t i, double *r) {
   filter_vector(s, i, r + 3 * i);
 }
 
 /* True when a node with mass is held (constrained or in contact): then external forces act.
  * Massless vertices (in no tet) are held fixed but carry no momentum. */
-static int has_filtered_nodes(const world_solid *s) {
+static int has_filtered_nodes(const world_body *s) {
   for (int32_t i = 0; i < s->n; ++i)
-    if (s->mass[i] > 0 && (s->flags[i] != SOLID_FREE || s->colliding[i])) return 1;
+    if (s->mass[i] > 0 && (s->flags[i] != NODE_FREE || s->colliding[i])) return 1;
   return 0;
 }
 
@@ -142,7 +142,7 @@ static int has_filtered_nodes(const world_solid *s) {
 
 typedef struct newton_problem {
   piola_world *w;
-  world_solid *s;
+  world_body *s;
   struct implicit_state *st;
   double t1, dt;
   int quasistatic;
@@ -157,14 +157,14 @@ typedef struct newton_problem {
 /* The residual g at the body's current state (its last update is at s->x) into
  * st->residual; returns the squared filtered norm |S g|^2_{M^-1}. */
 static double residual(newton_problem *pb) {
-  world_solid *s = pb->s;
+  world_body *s = pb->s;
   struct implicit_state *st = pb->st;
   const int32_t n = s->n;
   const double w = pb->force_weight, inv_dt = 1.0 / pb->dt;
   if (pb->damped) {
     double *v = st->scratch_v;
     for (int64_t j = 0; j < 3 * (int64_t)n; ++j) v[j] = (s->x[j] - s->x_old[j]) * inv_dt;
-    piola_elastic_body_damping_forces(s->body, v, pb->beta, pb->alpha, st->damping);
+    piola_elastic_body_damping_forces(s->solid, v, pb->beta, pb->alpha, st->damping);
   }
   double part[RANGES];
 #pragma omp parallel for schedule(static) num_threads(piola_thread_count()) \
@@ -191,7 +191,7 @@ static double residual(newton_problem *pb) {
 
 /* Solves A d = -S g by the filtered block-Jacobi CG from d = 0; returns the iterations. */
 static int32_t solve_newton_system(newton_problem *pb) {
-  world_solid *s = pb->s;
+  world_body *s = pb->s;
   struct implicit_state *st = pb->st;
   const int32_t n = s->n;
   const int64_t m = 3 * (int64_t)n;
@@ -216,7 +216,7 @@ static int32_t solve_newton_system(newton_problem *pb) {
   const double stop = pb->w->def.linear_tolerance * pb->w->def.linear_tolerance * rz;
   int32_t it = 0;
   while (rz > stop && rz > 0 && it < pb->w->def.linear_max_iterations) {
-    piola__stiffness_matrix_apply(mx, s->body, s->mass, mass_weight, p, q);
+    piola__stiffness_matrix_apply(mx, s->solid, s->mass, mass_weight, p, q);
     for (int32_t i = 0; i < n; ++i) filter_node(s, i, q);
     double pq = dot_ranges(s, p, q, NULL);
     if (!(pq > 0)) break;
@@ -245,14 +245,14 @@ static int32_t solve_newton_system(newton_problem *pb) {
 }
 
 static piola_status update(newton_problem *pb) {
-  return piola__solid_update_forces(pb->s, pb->t1);
+  return piola__body_update_forces(pb->s, pb->t1);
 }
 
 /* Projects free nodes that are inside an obstacle onto its surface and holds their normal
  * from then on. Returns the number of nodes newly held (-1 on error). */
 static int32_t contacts(newton_problem *pb) {
   piola_world *w = pb->w;
-  world_solid *s = pb->s;
+  world_body *s = pb->s;
   struct implicit_state *st = pb->st;
   if (w->obstacle_count == 0 || pb->s->n == 0) return 0;
   memset(st->scratch_v, 0, sizeof(double) * 3 * (size_t)s->n);
@@ -263,10 +263,10 @@ static int32_t contacts(newton_problem *pb) {
   int32_t added = 0;
   for (int32_t i = 0; i < s->n; ++i) {
     if (!st->hit[i]) continue;
-    if (s->flags[i] != SOLID_FREE) {
+    if (s->flags[i] != NODE_FREE) {
       /* prescribed nodes are never projected: put them back */
       double xp[3], vp[3];
-      piola__solid_constrained_state(s, i, pb->t1, xp, vp);
+      piola__body_constrained_state(s, i, pb->t1, xp, vp);
       for (int k = 0; k < 3; ++k) s->x[3 * i + k] = xp[k];
       continue;
     }
@@ -280,10 +280,10 @@ static int32_t contacts(newton_problem *pb) {
 /* Releases held nodes whose contact force would pull them into the obstacle (g . n < 0 means
  * the constraint force g / dt^2 points along -n). Returns how many. */
 static int32_t release_contacts(newton_problem *pb) {
-  world_solid *s = pb->s;
+  world_body *s = pb->s;
   int32_t released = 0;
   for (int32_t i = 0; i < s->n; ++i) {
-    if (!s->colliding[i] || s->flags[i] != SOLID_FREE) continue;
+    if (!s->colliding[i] || s->flags[i] != NODE_FREE) continue;
     const double *g = pb->st->residual + 3 * i, *nrm = s->normals + 3 * i;
     if (g[0] * nrm[0] + g[1] * nrm[1] + g[2] * nrm[2] < 0) {
       s->colliding[i] = 0;
@@ -298,10 +298,10 @@ static int32_t release_contacts(newton_problem *pb) {
  * x and v of sliding nodes; returns how many. */
 static int32_t contact_friction(newton_problem *pb) {
   piola_world *w = pb->w;
-  world_solid *s = pb->s;
+  world_body *s = pb->s;
   int32_t changed = 0;
   for (int32_t i = 0; i < s->n; ++i) {
-    if (!s->colliding[i] || s->flags[i] != SOLID_FREE) continue;
+    if (!s->colliding[i] || s->flags[i] != NODE_FREE) continue;
     const double *g = pb->st->residual + 3 * i, *nrm = s->normals + 3 * i;
     double dvn = (g[0] * nrm[0] + g[1] * nrm[1] + g[2] * nrm[2]) / (pb->dt * s->mass[i]);
     if (!(dvn > 0)) continue;
@@ -332,7 +332,7 @@ static int32_t contact_friction(newton_problem *pb) {
 
 /* Newton's method for one solid over [t, t + dt]. Returns PIOLA_OK when converged,
  * PIOLA_ERROR_NOT_CONVERGED when not (the caller undoes and halves), or another error. */
-static piola_status newton_solid(piola_world *w, world_solid *s, double t, double dt,
+static piola_status newton_solid(piola_world *w, world_body *s, double t, double dt,
                                  int accept_unconverged, piola_step_stats *stats) {
   PIOLA_TRY(implicit_state_make(s));
   struct implicit_state *st = s->implicit;
@@ -345,7 +345,7 @@ static piola_status newton_solid(piola_world *w, world_solid *s, double t, doubl
   for (int k = 0; k < 3; ++k) pb.g1[k] = piola_track_eval(&w->def.gravity[k], pb.t1);
   pb.beta = piola_track_eval(&s->shear_viscosity, pb.t1);
   pb.alpha = piola_track_eval(&s->bulk_viscosity, pb.t1);
-  pb.damped = !pb.quasistatic && !piola__solid_undamped(s, pb.beta, pb.alpha);
+  pb.damped = !pb.quasistatic && !piola__body_undamped(s, pb.beta, pb.alpha);
   pb.force_weight = pb.quasistatic ? 1.0 : dt * dt;
   pb.mass_weight = pb.quasistatic ? 0.0 : 1.0;
   for (int32_t i = 0; i < n; ++i) pb.total_mass += s->mass[i];
@@ -364,9 +364,9 @@ static piola_status newton_solid(piola_world *w, world_solid *s, double t, doubl
     }
   if (n > 0) memset(s->colliding, 0, (size_t)n);
   for (int32_t i = 0; i < n; ++i) {
-    if (s->flags[i] == SOLID_FREE) continue;
+    if (s->flags[i] == NODE_FREE) continue;
     double vp[3];
-    piola__solid_constrained_state(s, i, pb.t1, s->x + 3 * i, vp);
+    piola__body_constrained_state(s, i, pb.t1, s->x + 3 * i, vp);
   }
   if (contacts(&pb) < 0) return PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "implicit step: out of memory");
   PIOLA_TRY(update(&pb));
@@ -389,8 +389,8 @@ static piola_status newton_solid(piola_world *w, world_solid *s, double t, doubl
       }
     }
     stats->newton_iterations++;
-    if (pb.damped) piola__elastic_body_damping_prepare(s->body, pb.beta, pb.alpha);
-    piola__stiffness_matrix_assemble(&st->matrix, s->body, pb.force_weight,
+    if (pb.damped) piola__elastic_body_damping_prepare(s->solid, pb.beta, pb.alpha);
+    piola__stiffness_matrix_assemble(&st->matrix, s->solid, pb.force_weight,
                                      pb.damped ? dt : 0.0, s->mass, pb.mass_weight);
     if (pb.quasistatic) {
       if (!(st->mu > 0)) {
@@ -403,9 +403,9 @@ static piola_status newton_solid(piola_world *w, world_solid *s, double t, doubl
         st->mu = 1e-6 * trace / (3.0 * pb.total_mass);
         if (!(st->mu > 0)) st->mu = 1.0;
       }
-      piola__stiffness_matrix_assemble(&st->matrix, s->body, pb.force_weight, 0.0, s->mass, st->mu);
+      piola__stiffness_matrix_assemble(&st->matrix, s->solid, pb.force_weight, 0.0, s->mass, st->mu);
     } else if (st->mu > 0) {
-      piola__stiffness_matrix_assemble(&st->matrix, s->body, pb.force_weight,
+      piola__stiffness_matrix_assemble(&st->matrix, s->solid, pb.force_weight,
                                        pb.damped ? dt : 0.0, s->mass, pb.mass_weight + st->mu);
     }
     stats->linear_iterations += solve_newton_system(&pb);
@@ -463,9 +463,9 @@ static piola_status newton_solid(piola_world *w, world_solid *s, double t, doubl
   if (!pb.quasistatic && w->obstacle_count > 0 && contact_friction(&pb) > 0) PIOLA_TRY(update(&pb));
   int32_t colliding = 0;
   for (int32_t i = 0; i < n; ++i) {
-    colliding += s->colliding[i] && s->flags[i] == SOLID_FREE;
-    if (s->flags[i] == SOLID_FREE) continue;
-    piola__solid_constrained_state(s, i, pb.t1, s->x + 3 * i, s->v + 3 * i);
+    colliding += s->colliding[i] && s->flags[i] == NODE_FREE;
+    if (s->flags[i] == NODE_FREE) continue;
+    piola__body_constrained_state(s, i, pb.t1, s->x + 3 * i, s->v + 3 * i);
   }
   stats->colliding += colliding;
   for (int64_t j = 0; j < m; ++j)
@@ -476,13 +476,13 @@ static piola_status newton_solid(piola_world *w, world_solid *s, double t, doubl
   return PIOLA_OK;
 }
 
-static void restore(world_solid *s, double t) {
+static void restore(world_body *s, double t) {
   size_t v3 = 3 * (size_t)s->n * sizeof(double);
   s->product_valid = 0;
   memcpy(s->x, s->x_old, v3);
   memcpy(s->v, s->v_old, v3);
   memcpy(s->force, s->force_old, v3);
-  (void)piola__solid_update_forces(s, t);
+  (void)piola__body_update_forces(s, t);
 }
 
 /* A step whose Newton does not converge is undone and retried at half the size up to this
@@ -497,7 +497,9 @@ piola_status piola__implicit_world_step(piola_world *w, double dt_limit, piola_s
   /* a limit a rounding error above the step is the caller's target: land on it */
   if (dt_limit > 0 && dt_limit <= dt * (1 + 1e-9)) dt = dt_limit;
   if (!(dt > 0)) return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "step: dt must be > 0, got %g", dt);
-  if (w->shell_count > 0)
+  int shells = 0;
+  for (int32_t i = 0; i < w->body_count; ++i) shells += w->bodies[i].kind != PIOLA_BODY_SOLID;
+  if (shells > 0)
     return PIOLA_FAIL(PIOLA_ERROR_UNSUPPORTED,
                       "integrator '%s' does not step shells yet: use \"newmark\" for scenes with "
                       "shells", piola_integrator_type_name(w->def.integrator));
@@ -506,10 +508,10 @@ piola_status piola__implicit_world_step(piola_world *w, double dt_limit, piola_s
   for (int halvings = 0;; ++halvings) {
     piola_status st = PIOLA_OK;
     int32_t done = 0;
-    for (; done < w->solid_count && st == PIOLA_OK; ++done)
-      st = newton_solid(w, &w->solids[done], w->time, dt, halvings == MAX_HALVINGS, &local);
+    for (; done < w->body_count && st == PIOLA_OK; ++done)
+      st = newton_solid(w, &w->bodies[done], w->time, dt, halvings == MAX_HALVINGS, &local);
     if (st == PIOLA_OK) break;
-    for (int32_t j = 0; j < done; ++j) restore(&w->solids[j], w->time);
+    for (int32_t j = 0; j < done; ++j) restore(&w->bodies[j], w->time);
     if (st != PIOLA_ERROR_NOT_CONVERGED) {
       if (stats) *stats = local;
       return st;
@@ -520,11 +522,11 @@ piola_status piola__implicit_world_step(piola_world *w, double dt_limit, piola_s
   const int closes = dt >= left || dt == w->collision_deadline - w->time;
   piola_status contact = piola__world_self_collide(w, dt, w->time + dt, closes, &local);
   if (contact != PIOLA_OK) {
-    for (int32_t j = 0; j < w->solid_count; ++j) restore(&w->solids[j], w->time);
+    for (int32_t j = 0; j < w->body_count; ++j) restore(&w->bodies[j], w->time);
     if (stats) *stats = local;
     return contact;
   }
-  for (int32_t i = 0; i < w->solid_count; ++i) piola__solid_plastic_update(&w->solids[i], dt);
+  for (int32_t i = 0; i < w->body_count; ++i) piola__body_plastic_after_step(&w->bodies[i], dt);
   w->time += dt;
   local.substeps = 1;
   local.last_dt = dt;

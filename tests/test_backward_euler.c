@@ -1,14 +1,14 @@
 /* The implicit integrators (src/sim/implicit_step.c) through the public world API:
- *  - backward Euler, free flight: a stretched, spinning block keeps its linear momentum
- *    exactly (damped or not) at one step per 1/30 s frame, and its angular momentum is not
- *    gained (backward Euler only dissipates);
- *  - backward Euler dissipates: the total energy of an undamped free block never grows;
- *  - a block dropped on the ground at one step per frame comes to rest on it, no node below
- *    it, and stays put on an incline steeper than... not: with mu > tan(theta) it does not
- *    slide, with mu < tan(theta) it slides at about g (sin - mu cos);
- *  - the Newmark path is untouched by the new fields (same positions bit for bit as a world
- *    created without them: the default integrator is Newmark);
- *  - a fixed end: a cantilever stays finite and hangs down. */
+ *  - the defaults (Newmark stays the default), the names, and invalid parameters refused;
+ *  - the scene keys: integrator.type, integrator.dt defaulting to the frame time, a bad type
+ *    refused by its key path, free fall in one step;
+ *  - backward Euler, free flight: a stretched, spinning block keeps its linear momentum to
+ *    1e-10 (damped or not, every isotropic model) at one step per 1/30 s frame, and its total
+ *    energy never grows (backward Euler only dissipates);
+ *  - a block dropped on the ground at one step per frame comes to rest on it with no node
+ *    below it;
+ *  - on a 0.5 rad incline a block with mu = 0.2 slides at g (sin - mu cos) within 10%, and one
+ *    with mu = 0.8 > tan(0.5) stays put. */
 #include "test_support.h"
 
 #include <math.h>

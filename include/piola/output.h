@@ -46,6 +46,11 @@ typedef struct piola_frame_info {
   int64_t contacts;       /* self-collision repulsion contacts since the previous frame */
   int64_t impacts;        /* self-collision impacts since the previous frame */
   int32_t impact_zones;   /* self-collision rigid impact zones since the previous frame */
+  int32_t newton_iterations; /* implicit integrators: Newton iterations since the previous
+                                frame (0 with Newmark) */
+  int32_t linear_iterations; /* implicit integrators: CG iterations of the Newton systems */
+  int32_t newton_failures;   /* implicit integrators: steps retried at half the size because
+                                Newton did not converge */
 } piola_frame_info;
 
 /* Writes the VTU and OBJ of the world's current state and appends a row to stats.csv and

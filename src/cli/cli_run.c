@@ -142,7 +142,7 @@ int cli_run(int argc, char **argv) {
   if (piola_preview_open(out_dir, scene_path, render_frames, &preview) != PIOLA_OK)
     fprintf(stderr, "piola run: no preview: %s\n", piola_last_error());
   int rc = 0;
-  long long total_steps = 0, total_cg = 0;
+  long long total_steps = 0, total_cg = 0, total_newton = 0, total_linear = 0, total_failures = 0;
   int max_inverted = 0;
   double sim_start = now_seconds();
   piola_frame_info info = {0};
@@ -174,6 +174,12 @@ int cli_run(int argc, char **argv) {
     info.contacts = st.contacts;
     info.impacts = st.impacts;
     info.impact_zones = st.impact_zones;
+    info.newton_iterations = st.newton_iterations;
+    info.linear_iterations = st.linear_iterations;
+    info.newton_failures = st.newton_failures;
+    total_newton += st.newton_iterations;
+    total_linear += st.linear_iterations;
+    total_failures += st.newton_failures;
     info.wall_seconds = now_seconds() - t0;
     total_steps += st.substeps;
     total_cg += st.cg_iterations;
@@ -196,9 +202,11 @@ int cli_run(int argc, char **argv) {
   int written = rc == 0 ? frames : frame - 1;
   fprintf(stderr,
           "piola run: %s. %d frames (%.3f s simulated) in %.2f s wall (%.2f frames/s), %lld steps, "
-          "%lld CG iterations, at most %d inverted tets in a frame. Open %s/sim.pvd in ParaView.\n",
+          "%lld CG iterations, %lld Newton iterations, %lld linear iterations, %lld failed "
+          "Newton steps, at most %d inverted tets in a frame. Open %s/sim.pvd in ParaView.\n",
           rc == 0 ? "done" : "stopped", written, written / fps, wall,
-          sim_wall > 0 ? written / sim_wall : 0.0, total_steps, total_cg, max_inverted, out_dir);
+          sim_wall > 0 ? written / sim_wall : 0.0, total_steps, total_cg, total_newton,
+          total_linear, total_failures, max_inverted, out_dir);
   if (preview && piola_preview_close(preview) != PIOLA_OK)
     fprintf(stderr, "piola run: preview.png: %s\n", piola_last_error());
   else if (preview)

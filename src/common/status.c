@@ -18,6 +18,7 @@ const char *piola_status_name(piola_status status) {
     case PIOLA_ERROR_IO: return "input/output error";
     case PIOLA_ERROR_PARSE: return "parse error";
     case PIOLA_ERROR_UNSUPPORTED: return "unsupported";
+    case PIOLA_ERROR_NOT_CONVERGED: return "not converged";
   }
   return "unknown status";
 }

@@ -156,7 +156,8 @@ piola_status piola_output_open(const char *dir, bool force, const piola_world *w
   if (st == PIOLA_OK) st = piola__output_prepare_folder(dir, force);
   if (st == PIOLA_OK) st = csv_append(o, "frame,time,substeps,cg_iterations,kinetic_energy,elastic_energy,"
                                          "inverted,min_det_f,wall_seconds,plastic_yielded,max_fp_log_stretch,"
-                                         "contacts,impacts,impact_zones\n");
+                                         "contacts,impacts,impact_zones,newton_iterations,"
+                                         "linear_iterations,newton_failures\n");
   if (st != PIOLA_OK) {
     piola_output_close(o);
     return st;
@@ -270,10 +271,11 @@ piola_status piola_output_write_frame(piola_output *o, const piola_world *world,
   PIOLA_TRY(st);
 
   char line[512];
-  snprintf(line, sizeof line, "%d,%.17g,%d,%d,%.17g,%.17g,%lld,%.17g,%.6f,%lld,%.17g,%lld,%lld,%d\n",
+  snprintf(line, sizeof line, "%d,%.17g,%d,%d,%.17g,%.17g,%lld,%.17g,%.6f,%lld,%.17g,%lld,%lld,%d,%d,%d,%d\n",
            (int)info->frame, piola_world_time(world), (int)info->substeps, (int)info->cg_iterations,
            ke, ee, inverted, ns > 0 ? min_det : 1.0, info->wall_seconds, yielded, max_fp_log,
-           (long long)info->contacts, (long long)info->impacts, (int)info->impact_zones);
+           (long long)info->contacts, (long long)info->impacts, (int)info->impact_zones,
+           (int)info->newton_iterations, (int)info->linear_iterations, (int)info->newton_failures);
   PIOLA_TRY(csv_append(o, line));
   snprintf(path, sizeof path, "%s/stats.csv", o->dir);
   PIOLA_TRY(write_text(path, o->csv, o->csv_len));

@@ -77,6 +77,8 @@ typedef struct world_body {
   int product_valid;
   uint8_t *colliding;
   double *normals;
+  struct implicit_state *implicit; /* the implicit integrators' matrix and vectors, made on
+                                      their first step of a solid (implicit_step.c) */
 } world_body;
 
 /* ---- the kind-dependent operations (body.c) */

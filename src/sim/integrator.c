@@ -193,6 +193,7 @@ static double stiffness_bound(const world_body *s, double t0, double t1) {
 }
 
 double piola_world_stable_dt(const piola_world *w) {
+  if (w->def.integrator != PIOLA_INTEGRATOR_NEWMARK) return w->def.implicit_dt;
   double dt = w->def.max_dt;
   for (int32_t i = 0; i < w->body_count; ++i) {
     const world_body *b = &w->bodies[i];
@@ -408,6 +409,8 @@ static piola_status step_body(piola_world *w, world_body *s, double t, double dt
 }
 
 piola_status piola_world_step(piola_world *w, double dt_limit, piola_step_stats *stats) {
+  if (w->def.integrator != PIOLA_INTEGRATOR_NEWMARK)
+    return piola__implicit_world_step(w, dt_limit, stats);
   piola_step_stats local = {0};
   piola__step_profile_start(&w->profile);
   double dt = piola_world_stable_dt(w);
@@ -452,6 +455,9 @@ piola_status piola_world_advance_to(piola_world *w, double t_end, piola_step_sta
     double dt = piola_world_stable_dt(w);
     double limit = left;
     if (left > dt && left < 2 * dt) limit = 0.5 * left;
+    /* the implicit step is the user's, usually a frame: a target a rounding error past it
+     * is reached in one step */
+    if (w->def.integrator != PIOLA_INTEGRATOR_NEWMARK && left <= dt * (1 + 1e-9)) limit = left;
     piola_step_stats one;
     w->collision_deadline = t_end;
     piola_status st = piola_world_step(w, limit, &one);
@@ -464,6 +470,9 @@ piola_status piola_world_advance_to(piola_world *w, double t_end, piola_step_sta
       stats->impacts += one.impacts;
       stats->impact_zones += one.impact_zones;
       stats->collision_steps += one.collision_steps;
+      stats->newton_iterations += one.newton_iterations;
+      stats->linear_iterations += one.linear_iterations;
+      stats->newton_failures += one.newton_failures;
       if (one.substeps) stats->last_dt = one.last_dt;
     }
     if (st != PIOLA_OK) return st;

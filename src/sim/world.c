@@ -35,6 +35,23 @@ piola_status piola_world_create(const piola_world_def *def, piola_world **out) {
   if (!(def->collision_interval >= 0) || !isfinite(def->collision_interval))
     return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "collision_interval must be >= 0 s, got %g",
                       def->collision_interval);
+  if ((int)def->integrator < 0 || def->integrator >= PIOLA_INTEGRATOR_COUNT)
+    return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "integrator: unknown type %d", (int)def->integrator);
+  if (!(def->implicit_dt > 0) || !isfinite(def->implicit_dt))
+    return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "integrator dt must be > 0 s, got %g",
+                      def->implicit_dt);
+  if (!(def->newton_tolerance > 0) || !isfinite(def->newton_tolerance))
+    return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "newton_tolerance must be > 0, got %g",
+                      def->newton_tolerance);
+  if (def->newton_max_iterations < 1)
+    return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "newton_max_iterations must be >= 1, got %d",
+                      (int)def->newton_max_iterations);
+  if (!(def->linear_tolerance > 0 && def->linear_tolerance < 1))
+    return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "linear_tolerance must be in (0, 1), got %g",
+                      def->linear_tolerance);
+  if (def->linear_max_iterations < 1)
+    return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "linear_max_iterations must be >= 1, got %d",
+                      (int)def->linear_max_iterations);
   piola_world *w = calloc(1, sizeof *w);
   if (!w) return PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "world: out of memory");
   w->def = *def;

@@ -105,4 +105,10 @@ void piola__world_contact_free(piola_world *w);
  * (integrator.c); 0: a full damping pass. For tests comparing the two. */
 extern int piola__step_reuse_first_product;
 
+/* The implicit integrators (implicit_step.c): piola_world_step for
+ * PIOLA_INTEGRATOR_BACKWARD_EULER and PIOLA_INTEGRATOR_QUASISTATIC; implicit_state_free frees
+ * a body's implicit state (NULL is fine). */
+piola_status piola__implicit_world_step(piola_world *w, double dt_limit, piola_step_stats *stats);
+void piola__implicit_state_free(struct implicit_state *state);
+
 #endif

@@ -38,6 +38,13 @@ PIOLA_API piola_status piola_output_open(const char *dir, bool force, const piol
                                          piola_output **out);
 PIOLA_API void piola_output_close(piola_output *output);
 
+/* Reopens the folder of an earlier run to continue after frame `frame` (a resume from a
+ * checkpoint, piola/checkpoint.h): frames 0..frame must be in place and listed in
+ * stats.csv; later frames, their index rows and stray temporaries are removed, and both
+ * indexes are rewritten to list exactly frames 0..frame. */
+PIOLA_API piola_status piola_output_open_resume(const char *dir, int32_t frame,
+                                                const piola_world *world, piola_output **out);
+
 typedef struct piola_frame_info {
   int32_t frame;          /* frame number, 0 is the initial state */
   int32_t substeps;       /* steps taken since the previous frame */

@@ -6,6 +6,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include "common/fault_injection.h"
 #include "common/status_internal.h"
 
 piola_status atomic_file_open(atomic_file *file, const char *path) {
@@ -32,9 +33,10 @@ piola_status atomic_file_open(atomic_file *file, const char *path) {
   return PIOLA_OK;
 }
 
-piola_status atomic_file_commit(atomic_file *file) {
+piola_status atomic_file_finish(atomic_file *file) {
   int failed = ferror(file->stream) || fflush(file->stream) != 0;
   int err = errno;
+  if (!failed && piola__fault_write_fails()) failed = 1, err = ENOSPC;
   if (fclose(file->stream) != 0 && !failed) {
     failed = 1;
     err = errno;
@@ -44,8 +46,13 @@ piola_status atomic_file_commit(atomic_file *file) {
     unlink(file->temporary);
     return PIOLA_FAIL(PIOLA_ERROR_IO, "%s: write failed: %s", file->target, strerror(err));
   }
+  return PIOLA_OK;
+}
+
+piola_status atomic_file_commit(atomic_file *file) {
+  PIOLA_TRY(atomic_file_finish(file));
   if (rename(file->temporary, file->target) != 0) {
-    err = errno;
+    int err = errno;
     unlink(file->temporary);
     return PIOLA_FAIL(PIOLA_ERROR_IO, "%s: cannot move into place: %s", file->target, strerror(err));
   }

@@ -24,6 +24,10 @@ typedef struct atomic_file {
 piola_status atomic_file_open(atomic_file *file, const char *path);
 /* Flushes, checks for write errors, and renames into place. Closes the stream either way. */
 piola_status atomic_file_commit(atomic_file *file);
+/* The first half of commit: flushes, checks for write errors and closes, leaving the
+ * complete temporary file for the caller to rename (output/frame_commit.c renames a whole
+ * frame's files in a fixed order); on failure the temporary is removed. */
+piola_status atomic_file_finish(atomic_file *file);
 /* Closes and deletes the temporary file. */
 void atomic_file_abort(atomic_file *file);
 

@@ -90,6 +90,8 @@ piola_status piola__output_prepare_folder(const char *dir, bool force) {
   PIOLA_TRY(make_folder(path));
   if (force) {
     remove_matching(path, "frame_", ".obj");
+    remove_matching(dir, "checkpoint_", ".bin");
+    piola__output_remove_strays(dir, -1);
     static const char *const files[] = {"stats.csv", "sim.pvd", "failure_report.txt"};
     for (int i = 0; i < 3; ++i) {
       snprintf(path, sizeof path, "%s/%s", dir, files[i]);

@@ -51,6 +51,7 @@ piola_status atomic_file_finish(atomic_file *file) {
 
 piola_status atomic_file_commit(atomic_file *file) {
   PIOLA_TRY(atomic_file_finish(file));
+  piola__fault_before_rename();
   if (rename(file->temporary, file->target) != 0) {
     int err = errno;
     unlink(file->temporary);

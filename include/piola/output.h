@@ -27,9 +27,11 @@ extern "C" {
 
 typedef struct piola_output piola_output;
 
-/* Whether results may be written to dir without touching anything: OK when dir does not
- * exist or is an empty folder, or when force is set and dir is a folder. Otherwise
- * PIOLA_ERROR_INVALID_ARGUMENT with a message saying why. */
+/* Whether results may be written to dir, leaving it as it was: OK when dir does not exist
+ * and can be created (its nearest existing ancestor is a writable folder), or is an empty
+ * writable folder, or when force is set and dir is a writable folder (writability is tested
+ * by creating and removing a probe file). Otherwise PIOLA_ERROR_INVALID_ARGUMENT with a
+ * message saying why. */
 PIOLA_API piola_status piola_output_check_folder(const char *dir, bool force);
 
 /* Creates dir, dir/frames and dir/surface (after piola_output_check_folder), removing the

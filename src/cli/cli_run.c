@@ -167,14 +167,20 @@ int cli_run(int argc, char **argv) {
   int32_t resume_frame = -1;
   if (resume) {
     int found = run_checkpoint_resume(out_dir, world, scene_key, &resume_frame);
-    if (found == 2 || (found == 1 && piola_output_check_folder(out_dir, false) != PIOLA_OK)) {
+    int listed = found == 1 ? run_listed_frames(out_dir) : 0;
+    if (found == 2 || listed > 1) {
       if (found == 1)
-        fprintf(stderr, "piola run: cannot resume: %s holds no checkpoint (checkpoint_NNNN.bin); "
-                        "use --force to start over\n", out_dir);
+        fprintf(stderr, "piola run: cannot resume: %s holds frames 0..%d but no checkpoint "
+                        "(checkpoint_NNNN.bin); use --force to start over\n", out_dir, listed - 1);
       piola_scene_destroy(scene);
       return 2;
     }
-    /* found == 1: an empty or missing folder, a fresh run */
+    if (found == 1) {
+      /* no checkpoint and at most frame 0: a missing or empty folder, or a run killed
+       * before its first checkpoint; starting over loses nothing */
+      fprintf(stderr, "piola run: no checkpoint in %s, starting from frame 0\n", out_dir);
+      force = true;
+    }
   }
   piola_output *out = NULL;
   piola_status opened = resume_frame >= 0 ? piola_output_open_resume(out_dir, resume_frame, world, &out)

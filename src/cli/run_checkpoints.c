@@ -111,3 +111,15 @@ int run_checkpoint_save(const char *dir, const piola_world *world, uint64_t key,
   free(frames);
   return 1;
 }
+
+int run_listed_frames(const char *dir) {
+  char path[4200], line[1024];
+  snprintf(path, sizeof path, "%s/stats.csv", dir);
+  FILE *f = fopen(path, "rb");
+  if (!f) return 0;
+  int rows = 0;
+  while (fgets(line, sizeof line, f))
+    if (line[0] >= '0' && line[0] <= '9') rows++;
+  fclose(f);
+  return rows;
+}

@@ -17,6 +17,9 @@ int run_scene_key(const char *scene_path, const piola_world *world, uint64_t *ke
  * another format version, or none intact. Damaged newer ones are skipped with a warning. */
 int run_checkpoint_resume(const char *dir, piola_world *world, uint64_t key, int32_t *frame);
 
+/* The number of frame rows in dir/stats.csv (0 when it is missing). */
+int run_listed_frames(const char *dir);
+
 /* Writes dir/checkpoint_<frame>.bin and removes older checkpoints but the previous one. */
 int run_checkpoint_save(const char *dir, const piola_world *world, uint64_t key, int32_t frame);
 

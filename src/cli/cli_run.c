@@ -35,6 +35,7 @@ static void usage(FILE *out) {
           "  --force            write into DIR even if it holds earlier results\n"
           "                     (earlier frames, stats.csv, sim.pvd and checkpoints are removed)\n"
           "  --resume           continue the run in DIR from its newest checkpoint\n"
+          "  --max-steps N      refuse a run estimated to take more than N steps (1e7)\n"
           "  --checkpoint-every N  a checkpoint every N frames (0: none; default: every 10\n"
           "                     frames or 5 minutes of wall time, whichever comes first)\n"
           "  --render           also render every frame to DIR/render/frame_NNNN.png\n"
@@ -87,9 +88,27 @@ static void progress(bool tty, int frame, int frames, double t, double elapsed, 
   fflush(stderr);
 }
 
+/* The time-budget guard: a scene whose simulated time (frames / fps) would take more than
+ * max_steps steps of the first stable step is refused before anything is written, as a
+ * mistyped fps (1e-300) or frame count would otherwise run for ever. The estimate uses the
+ * step at t = 0; steps shrink under stiffening and contact, so it is a lower bound. */
+static bool budget_ok(const char *scene_path, const piola_world *world, int frames, double fps,
+                      double max_steps) {
+  double simulated = frames / fps, dt = piola_world_stable_dt(world);
+  double steps = simulated / dt;
+  if (isfinite(steps) && steps <= max_steps) return true;
+  fprintf(stderr,
+          "piola run: %s: %d frames at %g fps are %.3g s of simulated time, about %.3g steps of "
+          "%.3g s: more than the limit of %.3g steps. Check fps and frames, or raise the limit "
+          "with --max-steps N\n",
+          scene_path, frames, fps, simulated, steps, dt, max_steps);
+  return false;
+}
+
 int cli_run(int argc, char **argv) {
   const char *scene_path = NULL, *out_dir = NULL;
   long threads = 0, frames_override = -1, checkpoint_every = -1; /* -1: the default */
+  double max_steps = 1e7; /* the time-budget guard (see budget_ok) */
   bool force = false, render_frames = false, resume = false;
   for (int i = 1; i < argc; ++i) {
     const char *a = argv[i];
@@ -107,6 +126,11 @@ int cli_run(int argc, char **argv) {
         return fprintf(stderr, "piola run: --frames needs an integer in [0, 1000000]\n"), 2;
     } else if (strcmp(a, "--force") == 0) {
       force = true;
+    } else if (strcmp(a, "--max-steps") == 0) {
+      char *end = NULL;
+      if (++i < argc) max_steps = strtod(argv[i], &end);
+      if (i >= argc || end == argv[i] || *end || !(max_steps >= 1) || max_steps > 1e18)
+        return fprintf(stderr, "piola run: --max-steps needs a number in [1, 1e18]\n"), 2;
     } else if (strcmp(a, "--resume") == 0) {
       resume = true;
     } else if (strcmp(a, "--checkpoint-every") == 0) {
@@ -148,6 +172,10 @@ int cli_run(int argc, char **argv) {
   piola_world *world = piola_scene_world(scene);
   int frames = frames_override >= 0 ? (int)frames_override : (int)piola_scene_frames(scene);
   double fps = piola_scene_fps(scene);
+  if (!budget_ok(scene_path, world, frames, fps, max_steps)) {
+    piola_scene_destroy(scene);
+    return 2;
+  }
   /* checkpoints: on by default where they cover the whole state */
   const char *why = NULL;
   uint64_t scene_key = 0;

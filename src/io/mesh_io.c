@@ -7,6 +7,7 @@
 #include <sys/mman.h>
 #include <sys/stat.h>
 
+#include "common/input_path.h"
 #include "common/status_internal.h"
 #include "io/mesh_io_internal.h"
 #include "io/mesh_writers.h"
@@ -30,8 +31,8 @@ int piola__grow(void **array, size_t *capacity, size_t need, size_t item) {
 piola_status piola__read_file(const char *path, char **data, size_t *size) {
   *data = NULL;
   *size = 0;
-  FILE *f = fopen(path, "rb");
-  if (!f) return PIOLA_FAIL(PIOLA_ERROR_IO, "%s: cannot open: %s", path, strerror(errno));
+  FILE *f;
+  PIOLA_TRY(piola__open_input(path, &f));
   struct stat st;
   if (fstat(fileno(f), &st) != 0 || !S_ISREG(st.st_mode)) {
     fclose(f);
@@ -66,8 +67,8 @@ typedef struct loaded_file {
 
 static piola_status load_file(const char *path, loaded_file *f) {
   memset(f, 0, sizeof *f);
-  FILE *stream = fopen(path, "rb");
-  if (!stream) return PIOLA_FAIL(PIOLA_ERROR_IO, "%s: cannot open: %s", path, strerror(errno));
+  FILE *stream;
+  PIOLA_TRY(piola__open_input(path, &stream));
   struct stat st;
   if (fstat(fileno(stream), &st) == 0 && S_ISREG(st.st_mode) && st.st_size > 0) {
     void *p = mmap(NULL, (size_t)st.st_size, PROT_READ, MAP_PRIVATE, fileno(stream), 0);

@@ -14,6 +14,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include "common/input_path.h"
 #include "common/status_internal.h"
 #include "io/atomic_file.h"
 #include "render/render_internal.h"
@@ -41,8 +42,8 @@ static void make_absolute(cJSON *item, const char *folder) {
 /* DIR/scene.json: the scene with the mesh paths of solids, obstacles and bones made absolute. */
 static piola_status copy_scene(const char *scene_path, const char *dir) {
   char *text = NULL;
-  FILE *f = fopen(scene_path, "rb");
-  if (!f) return PIOLA_FAIL(PIOLA_ERROR_IO, "%s: cannot open: %s", scene_path, strerror(errno));
+  FILE *f;
+  PIOLA_TRY(piola__open_input(scene_path, &f));
   long n = -1;
   if (fseek(f, 0, SEEK_END) == 0) n = ftell(f);
   if (n >= 0 && n < (64L << 20) && fseek(f, 0, SEEK_SET) == 0) text = malloc((size_t)n + 1);

@@ -6,6 +6,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "common/input_path.h"
 #include "common/status_internal.h"
 #include "piola/mesh_io.h"
 #include "render/render_internal.h"
@@ -13,8 +14,8 @@
 
 static piola_status read_all(const char *path, char **out) {
   *out = NULL;
-  FILE *f = fopen(path, "rb");
-  if (!f) return PIOLA_FAIL(PIOLA_ERROR_IO, "%s: cannot open: %s", path, strerror(errno));
+  FILE *f;
+  PIOLA_TRY(piola__open_input(path, &f));
   long n = -1;
   if (fseek(f, 0, SEEK_END) == 0) n = ftell(f);
   if (n < 0 || n > (64L << 20) || fseek(f, 0, SEEK_SET) != 0) {

@@ -6,6 +6,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "common/input_path.h"
 #include "common/status_internal.h"
 #include "scene/scene_desc.h"
 
@@ -22,6 +23,7 @@ piola_status piola_scene_load_string(const char *json, const char *base_dir, con
   if (!label) label = "scene";
   if (!base_dir) base_dir = ".";
   scene_desc desc;
+  if (json) PIOLA_TRY(piola__scene_check_text(json, label));
   PIOLA_TRY(piola__scene_parse(json, base_dir, label, &desc));
   piola_scene *scene = calloc(1, sizeof *scene);
   if (!scene) {
@@ -43,8 +45,8 @@ piola_status piola_scene_load_string(const char *json, const char *base_dir, con
 piola_status piola_scene_load(const char *path, piola_scene **out) {
   if (!out || !path) return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "scene: NULL argument");
   *out = NULL;
-  FILE *f = fopen(path, "rb");
-  if (!f) return PIOLA_FAIL(PIOLA_ERROR_IO, "%s: cannot open: %s", path, strerror(errno));
+  FILE *f;
+  PIOLA_TRY(piola__open_input(path, &f));
   char *text = NULL;
   size_t len = 0, cap = 0;
   for (;;) {

@@ -6,7 +6,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
-#include "common/status_internal.h"
+#include "common/status_report.h"
 
 static const char *kind(mode_t mode) {
   if (S_ISDIR(mode)) return "a folder";

@@ -1,4 +1,4 @@
-#include "io/atomic_file.h"
+#include "piola/files.h"
 
 #include <errno.h>
 #include <stdlib.h>
@@ -7,9 +7,10 @@
 #include <unistd.h>
 
 #include "common/fault_injection.h"
-#include "common/status_internal.h"
+#include "common/status_report.h"
+#include "io/atomic_file_internal.h"
 
-piola_status atomic_file_open(atomic_file *file, const char *path) {
+piola_status piola_atomic_file_open(piola_atomic_file *file, const char *path) {
   memset(file, 0, sizeof *file);
   size_t n = strlen(path);
   if (n == 0 || n + 16 >= sizeof file->target)
@@ -33,7 +34,7 @@ piola_status atomic_file_open(atomic_file *file, const char *path) {
   return PIOLA_OK;
 }
 
-piola_status atomic_file_finish(atomic_file *file) {
+piola_status piola__atomic_file_finish(piola_atomic_file *file) {
   int failed = ferror(file->stream) || fflush(file->stream) != 0;
   int err = errno;
   if (!failed && piola__fault_write_fails()) failed = 1, err = ENOSPC;
@@ -49,8 +50,8 @@ piola_status atomic_file_finish(atomic_file *file) {
   return PIOLA_OK;
 }
 
-piola_status atomic_file_commit(atomic_file *file) {
-  PIOLA_TRY(atomic_file_finish(file));
+piola_status piola_atomic_file_commit(piola_atomic_file *file) {
+  PIOLA_TRY(piola__atomic_file_finish(file));
   piola__fault_before_rename();
   if (rename(file->temporary, file->target) != 0) {
     int err = errno;
@@ -60,7 +61,7 @@ piola_status atomic_file_commit(atomic_file *file) {
   return PIOLA_OK;
 }
 
-void atomic_file_abort(atomic_file *file) {
+void piola_atomic_file_abort(piola_atomic_file *file) {
   if (file->stream) fclose(file->stream);
   file->stream = NULL;
   if (file->temporary[0]) unlink(file->temporary);

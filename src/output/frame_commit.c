@@ -6,7 +6,7 @@
 #include <unistd.h>
 
 #include "common/fault_injection.h"
-#include "common/status_internal.h"
+#include "common/status_report.h"
 
 int piola__frame_pending_name(const char *final_path, char *out, size_t size) {
   const char *dot = strrchr(final_path, '.');

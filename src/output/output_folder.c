@@ -10,7 +10,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
-#include "common/status_internal.h"
+#include "common/status_report.h"
 
 /* Whether files can be created in folder: creates and removes a probe (permission bits
  * alone do not say, e.g. for root or on a read-only or special file system). */

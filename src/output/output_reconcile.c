@@ -13,7 +13,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
-#include "common/status_internal.h"
+#include "common/status_report.h"
 #include "output/output_internal.h"
 
 static const char *const piola_names[] = {"frame_", "stats.csv", "sim.pvd", "failure_report.txt",

@@ -5,7 +5,7 @@
  * of which may hold NUL, so the scene is refused with the place of the escape. */
 #include <stdint.h>
 
-#include "common/status_internal.h"
+#include "common/status_report.h"
 #include "scene/scene_desc.h"
 
 piola_status piola__scene_check_text(const char *json, const char *label) {

@@ -16,9 +16,9 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "common/status_internal.h"
+#include "common/status_report.h"
 #include "force/elastic_body_internal.h"
-#include "io/atomic_file.h"
+#include "piola/files.h"
 #include "piola/checkpoint.h"
 #include "plasticity/plastic_state.h"
 #include "shell/shell_body_internal.h"
@@ -314,14 +314,14 @@ piola_status piola_world_checkpoint_write(const piola_world *world, const char *
     free(s.data);
     return PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "%s: out of memory", path);
   }
-  atomic_file f;
-  piola_status st = atomic_file_open(&f, path);
+  piola_atomic_file f;
+  piola_status st = piola_atomic_file_open(&f, path);
   if (st == PIOLA_OK) {
     if (fwrite(s.data, 1, s.length, f.stream) != s.length) {
-      atomic_file_abort(&f);
+      piola_atomic_file_abort(&f);
       st = PIOLA_FAIL(PIOLA_ERROR_IO, "%s: write failed", path);
     } else {
-      st = atomic_file_commit(&f);
+      st = piola_atomic_file_commit(&f);
     }
   }
   free(s.data);

@@ -5,7 +5,7 @@
 #include "test_support.h"
 
 #include "common/printable.h"
-#include "common/status_internal.h"
+#include "common/status_report.h"
 
 static void escapes(const char *in, const char *expected) {
   char out[256];

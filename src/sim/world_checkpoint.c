@@ -3,7 +3,9 @@
  * Layout (docs/file-formats.md): a 48-byte header (magic, format version, byte-order mark,
  * scene key, frame, payload length, body counts), the payload, and an FNV-1a 64 checksum
  * of everything before it. The payload is a sequence of arrays, each a u64 element count
- * then the elements, in a fixed order per body (solids, then shells). Reading runs the
+ * then the elements, in a fixed order per body of the world's body table (its order: by
+ * kind, then as added), each by its kind's own function (a switch on the kind, so a new kind
+ * without checkpoint code does not compile, -Wswitch). Reading runs the
  * payload twice: a dry pass that checks every count against the world, then the pass that
  * stores, so a mismatched file changes nothing.
  *
@@ -42,9 +44,8 @@ int piola_world_checkpoint_supported(const piola_world *w, const char **why) {
   static const char *const contact =
       "checkpoints do not cover self-collision (contact between deformable surfaces)";
   *why = NULL;
-  for (int32_t i = 0; i < w->solid_count + w->shell_count; ++i) {
-    const world_solid *s = i < w->solid_count ? &w->solids[i] : &w->shells[i - w->solid_count];
-    if (s->self_collision.enabled) {
+  for (int32_t i = 0; i < w->body_count; ++i) {
+    if (w->bodies[i].self_collision.enabled) {
       *why = contact;
       return 0;
     }
@@ -55,19 +56,30 @@ int piola_world_checkpoint_supported(const piola_world *w, const char **why) {
 uint64_t piola_world_scene_key(const piola_world *w, const void *scene, size_t length) {
   uint64_t h = FNV_OFFSET;
   if (scene) h = fnv1a(h, scene, length);
-  for (int32_t i = 0; i < w->solid_count; ++i) {
-    const piola_elastic_body *b = w->solids[i].body;
-    h = fnv1a(h, b->rest_positions, 3 * (size_t)b->vertex_count * sizeof(double));
-    h = fnv1a(h, b->tets, 4 * (size_t)b->tet_count * sizeof(int32_t));
-    h = fnv1a(h, b->masses, (size_t)b->vertex_count * sizeof(double));
+  for (int32_t i = 0; i < w->body_count; ++i) {
+    const world_body *b = &w->bodies[i];
+    int32_t kind = (int32_t)b->kind;
+    h = fnv1a(h, &kind, sizeof kind);
+    switch (b->kind) {
+      case PIOLA_BODY_SOLID: {
+        const piola_elastic_body *e = b->solid;
+        h = fnv1a(h, e->rest_positions, 3 * (size_t)e->vertex_count * sizeof(double));
+        h = fnv1a(h, e->tets, 4 * (size_t)e->tet_count * sizeof(int32_t));
+        h = fnv1a(h, e->masses, (size_t)e->vertex_count * sizeof(double));
+        break;
+      }
+      case PIOLA_BODY_SHELL: {
+        const piola_shell_body *sh = b->shell;
+        h = fnv1a(h, sh->rest_positions, 3 * (size_t)sh->vertex_count * sizeof(double));
+        h = fnv1a(h, sh->triangle_indices, 3 * (size_t)sh->triangle_count * sizeof(int32_t));
+        h = fnv1a(h, sh->masses, (size_t)sh->vertex_count * sizeof(double));
+        break;
+      }
+      case PIOLA_BODY_NONE:
+        break;
+    }
   }
-  for (int32_t i = 0; i < w->shell_count; ++i) {
-    const piola_shell_body *b = w->shells[i].shell;
-    h = fnv1a(h, b->rest_positions, 3 * (size_t)b->vertex_count * sizeof(double));
-    h = fnv1a(h, b->triangle_indices, 3 * (size_t)b->triangle_count * sizeof(int32_t));
-    h = fnv1a(h, b->masses, (size_t)b->vertex_count * sizeof(double));
-  }
-  int32_t counts[3] = {w->solid_count, w->shell_count, w->obstacle_count};
+  int32_t counts[2] = {w->body_count, w->obstacle_count};
   return fnv1a(h, counts, sizeof counts);
 }
 
@@ -155,8 +167,8 @@ static void local_int(stream *s, int32_t *p, const char *what) {
 
 /* ------------------------------------------------------------------ per body */
 
-static void elastic_state(stream *s, world_solid *b) {
-  piola_elastic_body *e = b->body;
+static void elastic_state(stream *s, world_body *b) {
+  piola_elastic_body *e = b->solid;
   const uint64_t np = (uint64_t)e->padded_tet_count, n3 = 3 * (uint64_t)b->n;
   doubles(s, b->force, n3, "elastic force");
   doubles(s, e->u[0], 9 * np, "U");
@@ -205,7 +217,7 @@ static void elastic_state(stream *s, world_solid *b) {
   free(saved);
 }
 
-static void plastic_state(stream *s, world_solid *b) {
+static void plastic_state(stream *s, world_body *b) {
   piola_plastic_state *p = b->plastic;
   int32_t present = p != NULL;
   local_int(s, &present, "plasticity");
@@ -226,7 +238,7 @@ static void plastic_state(stream *s, world_solid *b) {
   field(s, &b->plastic_stats, 1, sizeof b->plastic_stats, "plastic stats");
 }
 
-static void shell_state(stream *s, world_solid *b) {
+static void shell_state(stream *s, world_body *b) {
   piola_shell_body *sh = b->shell;
   const uint64_t nt = (uint64_t)sh->triangle_count, nh = (uint64_t)sh->hinge_count;
   doubles(s, b->force, 3 * (uint64_t)b->n, "shell force");
@@ -256,15 +268,27 @@ static void shell_state(stream *s, world_solid *b) {
 
 static void world_state(stream *s, piola_world *w) {
   one_double(s, &w->time, "time");
-  for (int32_t i = 0; i < w->solid_count + w->shell_count && !s->failed; ++i) {
-    world_solid *b = i < w->solid_count ? &w->solids[i] : &w->shells[i - w->solid_count];
+  for (int32_t i = 0; i < w->body_count && !s->failed; ++i) {
+    world_body *b = &w->bodies[i];
+    int32_t kind = (int32_t)b->kind;
+    local_int(s, &kind, "body kind");
+    if (!s->failed && kind != (int32_t)b->kind) {
+      s->failed = 1;
+      snprintf(s->what, sizeof s->what, "body %d is a %s in this scene", (int)i, piola__body_kind_name(b->kind));
+      return;
+    }
     doubles(s, b->x, 3 * (uint64_t)b->n, "positions");
     doubles(s, b->v, 3 * (uint64_t)b->n, "velocities");
-    if (b->body) {
-      elastic_state(s, b);
-      plastic_state(s, b);
-    } else {
-      shell_state(s, b);
+    switch (b->kind) {
+      case PIOLA_BODY_SOLID:
+        elastic_state(s, b);
+        plastic_state(s, b);
+        break;
+      case PIOLA_BODY_SHELL:
+        shell_state(s, b);
+        break;
+      case PIOLA_BODY_NONE:
+        break;
     }
   }
 }
@@ -304,9 +328,9 @@ piola_status piola_world_checkpoint_write(const piola_world *world, const char *
   put_u32(h + 12, byte_order_mark);
   put_u64(h + 16, scene_key);
   put_u32(h + 24, (uint32_t)frame);
-  put_u32(h + 28, (uint32_t)(world->solid_count));
+  put_u32(h + 28, (uint32_t)(world->body_count));
   put_u64(h + 32, (uint64_t)(s.length - HEADER_BYTES));
-  put_u32(h + 40, (uint32_t)(world->shell_count));
+  put_u32(h + 40, (uint32_t)(world->obstacle_count));
   put_u32(h + 44, 0);
   uint64_t sum = fnv1a(FNV_OFFSET, s.data, s.length);
   put(&s, &sum, sizeof sum);
@@ -369,8 +393,8 @@ piola_status piola_world_checkpoint_read(piola_world *world, const char *path, u
                     "%s was written for another scene (its scene file or meshes differ: key "
                     "%016llx, this scene's %016llx)", path, (unsigned long long)get_u64(h + 16),
                     (unsigned long long)scene_key);
-  else if ((int32_t)get_u32(h + 28) != world->solid_count || (int32_t)get_u32(h + 40) != world->shell_count)
-    st = PIOLA_FAIL(PIOLA_ERROR_UNSUPPORTED, "%s: body counts differ from this scene", path);
+  else if ((int32_t)get_u32(h + 28) != world->body_count || (int32_t)get_u32(h + 40) != world->obstacle_count)
+    st = PIOLA_FAIL(PIOLA_ERROR_UNSUPPORTED, "%s: body or obstacle counts differ from this scene", path);
   if (st == PIOLA_OK) {
     s.length -= 8; /* the checksum */
     s.reading = 1;

@@ -36,7 +36,9 @@ static int fails_now(void) {
   return 1;
 }
 void *__wrap_malloc(size_t size) { return fails_now() ? NULL : __real_malloc(size); }
-void *__wrap_calloc(size_t count, size_t size) { return fails_now() ? NULL : __real_calloc(count, size); }
+void *__wrap_calloc(size_t count, size_t size) {
+  return fails_now() ? NULL : __real_calloc(count, size);
+}
 void *__wrap_realloc(void *p, size_t size) { return fails_now() ? NULL : __real_realloc(p, size); }
 static void *json_malloc(size_t size) { return __wrap_malloc(size); }
 
@@ -67,11 +69,14 @@ static void fail_each_allocation(operation op, const void *arg, const char *name
     runs++;
     if (st != PIOLA_OK) {
       errors++;
-      if (piola_last_error()[0] == '\0') fail_msg("%s: allocation %ld of %ld failed: status %d without a message", name, k, total, st);
+      if (piola_last_error()[0] == '\0')
+        fail_msg("%s: allocation %ld of %ld failed: status %d without a message", name, k, total,
+                 st);
     }
   }
-  printf("%s: %ld allocations, %ld failed in turn: %ld gave an error with a message, %ld recovered\n",
-         name, total, runs, errors, runs - errors);
+  printf(
+      "%s: %ld allocations, %ld failed in turn: %ld gave an error with a message, %ld recovered\n",
+      name, total, runs, errors, runs - errors);
   /* nearly every allocation is essential: most failures must be reported */
   assert_true(errors >= runs / 2);
 }
@@ -105,28 +110,37 @@ static void scene_loading_and_world_creation(void **state) {
       "{\"fps\": 30, \"frames\": 2, \"gravity\": [0, 0, -9.81],"
       " \"solids\": ["
       "  {\"name\": \"oct\", \"mesh\": \"octahedron.node\", \"transform\": {\"scale\": 0.1}},"
-      "  {\"name\": \"bar\", \"mesh\": {\"generate\": \"box\", \"center\": [1, 0, 0], \"half_extents\": [0.2, 0.05, 0.05], \"cell_size\": 0.05},"
-      "   \"material\": {\"model\": \"neohookean\", \"youngs_modulus\": 1e5, \"poisson_ratio\": 0.3},"
-      "   \"damping\": {\"shear\": 1, \"bulk\": 1}, \"fixed\": [{\"box\": [[0.7, -1, -1], [0.85, 1, 1]]}],"
+      "  {\"name\": \"bar\", \"mesh\": {\"generate\": \"box\", \"center\": [1, 0, 0], "
+      "\"half_extents\": [0.2, 0.05, 0.05], \"cell_size\": 0.05},"
+      "   \"material\": {\"model\": \"neohookean\", \"youngs_modulus\": 1e5, \"poisson_ratio\": "
+      "0.3},"
+      "   \"damping\": {\"shear\": 1, \"bulk\": 1}, \"fixed\": [{\"box\": [[0.7, -1, -1], [0.85, "
+      "1, 1]]}],"
       "   \"plasticity\": {\"yield\": 0.01, \"limit\": 1.0, \"hardening\": 0.5}}],"
-      " \"shells\": [{\"name\": \"sheet\", \"mesh\": {\"generate\": \"torus\", \"radius\": 0.2, \"minor_radius\": 0.05,"
-      "   \"segments\": [8, 6], \"sweep_degrees\": 180}, \"transform\": {\"translate\": [0, 1, 0]}, \"thickness\": 0.004,"
+      " \"shells\": [{\"name\": \"sheet\", \"mesh\": {\"generate\": \"torus\", \"radius\": 0.2, "
+      "\"minor_radius\": 0.05,"
+      "   \"segments\": [8, 6], \"sweep_degrees\": 180}, \"transform\": {\"translate\": [0, 1, "
+      "0]}, \"thickness\": 0.004,"
       "   \"bending\": {\"stiffness\": 1e-3}}],"
       " \"obstacles\": [{\"type\": \"plane\", \"point\": [0, 0, -1], \"normal\": [0, 0, 1]},"
       "   {\"type\": \"sphere\", \"center\": [0, 0, 1], \"radius\": 0.1,"
       "    \"motion\": {\"translation\": [0, 0, {\"keys\": [[0, 0], [1, -0.5]]}]}}],"
-      " \"bones\": [{\"name\": \"grip\", \"type\": \"box\", \"center\": [1.2, 0, 0], \"half_extents\": [0.02, 0.1, 0.1],"
+      " \"bones\": [{\"name\": \"grip\", \"type\": \"box\", \"center\": [1.2, 0, 0], "
+      "\"half_extents\": [0.02, 0.1, 0.1],"
       "   \"attachments\": [{\"solid\": \"bar\", \"within\": 0.01}]}]}";
   fail_each_allocation(load_scene, scene, "scene");
 }
 
 static void mesh_reading(void **state) {
   (void)state;
-  static const char *const tets[] = {
-      PIOLA_DATA_DIR "/tetgen/octahedron.node", PIOLA_DATA_DIR "/gmsh/tet.msh",
-      PIOLA_DATA_DIR "/gmsh/msh_tetra.msh",     PIOLA_DATA_DIR "/medit/unit_ball.mesh",
-      PIOLA_DATA_DIR "/vega/beam3_tet.veg",     PIOLA_SOURCE_DIR "/tests/data/five_tets_base64.vtu"};
-  for (size_t i = 0; i < sizeof tets / sizeof *tets; ++i) fail_each_allocation(read_tets, tets[i], tets[i]);
+  static const char *const tets[] = {PIOLA_DATA_DIR "/tetgen/octahedron.node",
+                                     PIOLA_DATA_DIR "/gmsh/tet.msh",
+                                     PIOLA_DATA_DIR "/gmsh/msh_tetra.msh",
+                                     PIOLA_DATA_DIR "/medit/unit_ball.mesh",
+                                     PIOLA_DATA_DIR "/vega/beam3_tet.veg",
+                                     PIOLA_SOURCE_DIR "/tests/data/five_tets_base64.vtu"};
+  for (size_t i = 0; i < sizeof tets / sizeof *tets; ++i)
+    fail_each_allocation(read_tets, tets[i], tets[i]);
   fail_each_allocation(read_surface, PIOLA_DATA_DIR "/surface/sphere.obj", "sphere.obj");
   /* OFF and STL: written from the sphere first */
   piola_tri_mesh sphere = {0};

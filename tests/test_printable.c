@@ -23,11 +23,17 @@ static void control_bytes_are_escaped(void **state) {
 static void utf8_is_kept_and_broken_utf8_escaped(void **state) {
   (void)state;
   escapes("caf\xc3\xa9 \xe2\x88\x87 \xf0\x9f\x98\x80", "caf\xc3\xa9 \xe2\x88\x87 \xf0\x9f\x98\x80");
-  escapes("\xc2\x9b" "31m", "\\xc2\\x9b31m");     /* C1 CSI as UTF-8 */
-  escapes("\x9b" "31m", "\\x9b31m");             /* raw C1 byte */
-  escapes("\xc0\xaf", "\\xc0\\xaf");             /* overlong '/' */
-  escapes("\xed\xa0\x80", "\\xed\\xa0\\x80");     /* a surrogate */
-  escapes("\xe2\x88", "\\xe2\\x88");             /* cut short */
+  escapes(
+      "\xc2\x9b"
+      "31m",
+      "\\xc2\\x9b31m"); /* C1 CSI as UTF-8 */
+  escapes(
+      "\x9b"
+      "31m",
+      "\\x9b31m");                            /* raw C1 byte */
+  escapes("\xc0\xaf", "\\xc0\\xaf");          /* overlong '/' */
+  escapes("\xed\xa0\x80", "\\xed\\xa0\\x80"); /* a surrogate */
+  escapes("\xe2\x88", "\\xe2\\x88");          /* cut short */
   escapes("\xff\xfe", "\\xff\\xfe");
 }
 

@@ -16,7 +16,8 @@ int run_scene_key(const char *scene_path, const piola_world *world, uint64_t *ke
   struct stat st;
   if (fd < 0 || fstat(fd, &st) != 0 || !S_ISREG(st.st_mode) || st.st_size > (1 << 28)) {
     if (fd >= 0) close(fd);
-    fprintf(stderr, "piola run: %s: cannot read the scene again for its checkpoint key\n", scene_path);
+    fprintf(stderr, "piola run: %s: cannot read the scene again for its checkpoint key\n",
+            scene_path);
     return 0;
   }
   size_t n = (size_t)st.st_size, got = 0;
@@ -29,7 +30,8 @@ int run_scene_key(const char *scene_path, const piola_world *world, uint64_t *ke
   close(fd);
   if (!bytes || got != n) {
     free(bytes);
-    fprintf(stderr, "piola run: %s: cannot read the scene again for its checkpoint key\n", scene_path);
+    fprintf(stderr, "piola run: %s: cannot read the scene again for its checkpoint key\n",
+            scene_path);
     return 0;
   }
   *key = piola_world_scene_key(world, bytes, n);
@@ -84,12 +86,15 @@ int run_checkpoint_resume(const char *dir, piola_world *world, uint64_t key, int
       break;
     }
     if (st == PIOLA_ERROR_UNSUPPORTED) { /* another scene or version: never silently older */
-      fprintf(stderr, "piola run: cannot resume: %s; use --force to start over\n", piola_last_error());
+      fprintf(stderr, "piola run: cannot resume: %s; use --force to start over\n",
+              piola_last_error());
       break;
     }
     fprintf(stderr, "piola run: skipping a damaged checkpoint: %s\n", piola_last_error());
     if (i == count - 1)
-      fprintf(stderr, "piola run: cannot resume: no intact checkpoint in %s; use --force to start over\n", dir);
+      fprintf(stderr,
+              "piola run: cannot resume: no intact checkpoint in %s; use --force to start over\n",
+              dir);
   }
   free(frames);
   return rc;

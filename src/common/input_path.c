@@ -21,7 +21,8 @@ piola_status piola__open_input(const char *path, FILE **out) {
   *out = NULL;
   if (!path || !path[0]) return PIOLA_FAIL(PIOLA_ERROR_IO, "empty file path");
   struct stat st;
-  if (stat(path, &st) != 0) return PIOLA_FAIL(PIOLA_ERROR_IO, "%s: cannot open: %s", path, strerror(errno));
+  if (stat(path, &st) != 0)
+    return PIOLA_FAIL(PIOLA_ERROR_IO, "%s: cannot open: %s", path, strerror(errno));
   if (!S_ISREG(st.st_mode))
     return PIOLA_FAIL(PIOLA_ERROR_IO, "%s: not a regular file (%s)", path, kind(st.st_mode));
   int fd = open(path, O_RDONLY | O_NONBLOCK | O_CLOEXEC);

@@ -16,8 +16,9 @@
 #include "common/status_report.h"
 #include "output/output_internal.h"
 
-static const char *const piola_names[] = {"frame_", "stats.csv", "sim.pvd", "failure_report.txt",
-                                          "checkpoint_", "scene.json", "preview.png"};
+static const char *const piola_names[] = {
+    "frame_",      "stats.csv",  "sim.pvd",    "failure_report.txt",
+    "checkpoint_", "scene.json", "preview.png"};
 
 /* A temporary of a file piola writes: NAME.tmpXXXXXX (mkstemp's six characters), or a
  * frame's pending data file frame_NNNN.pending.EXT. */
@@ -64,7 +65,8 @@ void piola__output_remove_strays(const char *dir, long drop_after) {
   clean_folder(path, drop_after, ".obj");
 }
 
-piola_status piola__output_reconcile(const char *dir, int32_t last_frame, char **rows, size_t *length) {
+piola_status piola__output_reconcile(const char *dir, int32_t last_frame, char **rows,
+                                     size_t *length) {
   *rows = NULL;
   *length = 0;
   char path[4200];
@@ -76,13 +78,14 @@ piola_status piola__output_reconcile(const char *dir, int32_t last_frame, char *
     if (!vtu || stat(path, &st) != 0 || !S_ISREG(st.st_mode))
       return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT,
                         "%s: frame %d of the checkpoint's run is missing (frames/ or surface/); "
-                        "cannot resume, use --force to start over", dir, (int)k);
+                        "cannot resume, use --force to start over",
+                        dir, (int)k);
   }
   snprintf(path, sizeof path, "%s/stats.csv", dir);
   FILE *f = fopen(path, "rb");
   if (!f)
-    return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "%s: %s; cannot resume, use --force to start over",
-                      path, strerror(errno));
+    return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT,
+                      "%s: %s; cannot resume, use --force to start over", path, strerror(errno));
   size_t cap = 4096, len = 0;
   char *kept = malloc(cap), line[1024];
   if (!kept) {
@@ -118,7 +121,8 @@ piola_status piola__output_reconcile(const char *dir, int32_t last_frame, char *
     free(kept);
     return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT,
                       "%s lists frames 0..%d, the checkpoint is at frame %d; cannot resume, use "
-                      "--force to start over", path, (int)expect - 1, (int)last_frame);
+                      "--force to start over",
+                      path, (int)expect - 1, (int)last_frame);
   }
   piola__output_remove_strays(dir, last_frame);
   *rows = kept;

@@ -27,7 +27,8 @@ piola_status piola__scene_check_text(const char *json, const char *label) {
       if (c[1] == 'u' && c[2] == '0' && c[3] == '0' && c[4] == '0' && c[5] == '0')
         return PIOLA_FAIL(PIOLA_ERROR_PARSE,
                           "%s:%d:%d: a string holds \\u0000 (NUL), which no path, name or "
-                          "keyword may contain", label, (int)line, (int)(c - line_start) + 1);
+                          "keyword may contain",
+                          label, (int)line, (int)(c - line_start) + 1);
       if (c[1]) ++c; /* the escaped character, so \" and \\ do not end or start anything */
     }
   }

@@ -146,9 +146,15 @@ static void field(stream *s, void *p, uint64_t count, size_t size, const char *w
   if (count) take(s, p, (size_t)count * size, what);
 }
 
-static void doubles(stream *s, double *p, uint64_t n, const char *what) { field(s, p, n, sizeof(double), what); }
-static void one_double(stream *s, double *p, const char *what) { field(s, p, 1, sizeof(double), what); }
-static void one_int(stream *s, int32_t *p, const char *what) { field(s, p, 1, sizeof(int32_t), what); }
+static void doubles(stream *s, double *p, uint64_t n, const char *what) {
+  field(s, p, n, sizeof(double), what);
+}
+static void one_double(stream *s, double *p, const char *what) {
+  field(s, p, 1, sizeof(double), what);
+}
+static void one_int(stream *s, int32_t *p, const char *what) {
+  field(s, p, 1, sizeof(int32_t), what);
+}
 
 /* Values the reader needs on both passes (flags that decide later counts): stored into the
  * caller's locals even on the dry pass. */
@@ -274,7 +280,8 @@ static void world_state(stream *s, piola_world *w) {
     local_int(s, &kind, "body kind");
     if (!s->failed && kind != (int32_t)b->kind) {
       s->failed = 1;
-      snprintf(s->what, sizeof s->what, "body %d is a %s in this scene", (int)i, piola__body_kind_name(b->kind));
+      snprintf(s->what, sizeof s->what, "body %d is a %s in this scene", (int)i,
+               piola__body_kind_name(b->kind));
       return;
     }
     doubles(s, b->x, 3 * (uint64_t)b->n, "positions");
@@ -367,7 +374,8 @@ static piola_status read_file(const char *path, stream *s) {
 
 piola_status piola_world_checkpoint_read(piola_world *world, const char *path, uint64_t scene_key,
                                          int32_t *frame) {
-  if (!world || !path || !frame) return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "checkpoint: NULL argument");
+  if (!world || !path || !frame)
+    return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "checkpoint: NULL argument");
   stream s = {0};
   piola_status st = read_file(path, &s);
   if (st != PIOLA_OK) {
@@ -382,19 +390,22 @@ piola_status piola_world_checkpoint_read(piola_world *world, const char *path, u
                     "%s: checkpoint format version %u, this piola reads version %d only", path,
                     (unsigned)get_u32(h + 8), PIOLA_CHECKPOINT_VERSION);
   else if (get_u32(h + 12) != byte_order_mark)
-    st = PIOLA_FAIL(PIOLA_ERROR_UNSUPPORTED, "%s: written on a machine of another byte order", path);
+    st =
+        PIOLA_FAIL(PIOLA_ERROR_UNSUPPORTED, "%s: written on a machine of another byte order", path);
   else if (get_u64(h + 32) != s.length - HEADER_BYTES - 8)
-    st = PIOLA_FAIL(PIOLA_ERROR_PARSE, "%s: %zu bytes, the header says %llu (a truncated file)", path,
-                    s.length, (unsigned long long)get_u64(h + 32) + HEADER_BYTES + 8);
+    st = PIOLA_FAIL(PIOLA_ERROR_PARSE, "%s: %zu bytes, the header says %llu (a truncated file)",
+                    path, s.length, (unsigned long long)get_u64(h + 32) + HEADER_BYTES + 8);
   else if (fnv1a(FNV_OFFSET, s.data, s.length - 8) != get_u64(s.data + s.length - 8))
     st = PIOLA_FAIL(PIOLA_ERROR_PARSE, "%s: checksum mismatch (a damaged file)", path);
   else if (get_u64(h + 16) != scene_key)
     st = PIOLA_FAIL(PIOLA_ERROR_UNSUPPORTED,
                     "%s was written for another scene (its scene file or meshes differ: key "
-                    "%016llx, this scene's %016llx)", path, (unsigned long long)get_u64(h + 16),
-                    (unsigned long long)scene_key);
-  else if ((int32_t)get_u32(h + 28) != world->body_count || (int32_t)get_u32(h + 40) != world->obstacle_count)
-    st = PIOLA_FAIL(PIOLA_ERROR_UNSUPPORTED, "%s: body or obstacle counts differ from this scene", path);
+                    "%016llx, this scene's %016llx)",
+                    path, (unsigned long long)get_u64(h + 16), (unsigned long long)scene_key);
+  else if ((int32_t)get_u32(h + 28) != world->body_count ||
+           (int32_t)get_u32(h + 40) != world->obstacle_count)
+    st = PIOLA_FAIL(PIOLA_ERROR_UNSUPPORTED, "%s: body or obstacle counts differ from this scene",
+                    path);
   if (st == PIOLA_OK) {
     s.length -= 8; /* the checksum */
     s.reading = 1;
@@ -407,8 +418,10 @@ piola_status piola_world_checkpoint_read(piola_world *world, const char *path, u
         snprintf(s.what, sizeof s.what, "%zu bytes left over", s.length - s.pos);
       }
     }
-    if (s.failed) st = PIOLA_FAIL(PIOLA_ERROR_PARSE, "%s: does not fit this scene: %s", path, s.what);
-    else *frame = (int32_t)get_u32(h + 24);
+    if (s.failed)
+      st = PIOLA_FAIL(PIOLA_ERROR_PARSE, "%s: does not fit this scene: %s", path, s.what);
+    else
+      *frame = (int32_t)get_u32(h + 24);
   }
   if (st == PIOLA_OK) piola__world_collision_reset(world);
   free(s.data);

@@ -120,14 +120,13 @@ int cli_run(int argc, char **argv) {
     } else if (strcmp(a, "--force") == 0) {
       force = true;
     } else if (strcmp(a, "--max-steps") == 0) {
-      char *end = NULL;
-      if (++i < argc) max_steps = strtod(argv[i], &end);
-      if (i >= argc || end == argv[i] || *end || !(max_steps >= 1) || max_steps > 1e18)
+      if (++i >= argc || !cli_parse_double(argv[i], &max_steps) || !(max_steps >= 1) ||
+          max_steps > 1e18)
         return fprintf(stderr, "piola run: --max-steps needs a number in [1, 1e18]\n"), 2;
     } else if (strcmp(a, "--resume") == 0) {
       resume = true;
     } else if (strcmp(a, "--checkpoint-every") == 0) {
-      if (++i >= argc || !parse_count(argv[i], 0, 1000000, &checkpoint_every))
+      if (++i >= argc || !cli_parse_long(argv[i], 0, 1000000, &checkpoint_every))
         return fprintf(stderr, "piola run: --checkpoint-every needs an integer in [0, 1000000]\n"), 2;
     } else if (strcmp(a, "--render") == 0) {
       render_frames = true;

@@ -9,6 +9,7 @@
 #define PIOLA_PIOLA_H
 
 /* core: libpiola */
+#include "piola/checkpoint.h"
 #include "piola/collision_surface.h"
 #include "piola/diagonalize.h"
 #include "piola/elastic_body.h"

@@ -8,6 +8,7 @@
 #include <sys/stat.h>
 
 #include "common/grow.h"
+#include "common/input_path.h"
 #include "common/status_report.h"
 #include "io/mesh_io_internal.h"
 #include "io/mesh_writers.h"
@@ -25,8 +26,8 @@ typedef struct loaded_file {
 
 static piola_status load_file(const char *path, loaded_file *f) {
   memset(f, 0, sizeof *f);
-  FILE *stream = fopen(path, "rb");
-  if (!stream) return PIOLA_FAIL(PIOLA_ERROR_IO, "%s: cannot open: %s", path, strerror(errno));
+  FILE *stream;
+  PIOLA_TRY(piola__open_input(path, &stream));
   struct stat st;
   if (fstat(fileno(stream), &st) == 0 && S_ISREG(st.st_mode) && st.st_size > 0) {
     void *p = mmap(NULL, (size_t)st.st_size, PROT_READ, MAP_PRIVATE, fileno(stream), 0);

@@ -17,6 +17,8 @@
 #include <string.h>
 
 #include "common/status_report.h"
+#include "io/atomic_file_internal.h"
+#include "output/frame_commit.h"
 #include "output/output_internal.h"
 #include "piola/files.h"
 #include "piola/mesh_io.h"
@@ -70,8 +72,12 @@ void piola_output_close(piola_output *o) {
   free(o);
 }
 
-piola_status piola_output_open(const char *dir, bool force, const piola_world *world,
-                               piola_output **out) {
+static piola_status resume_indexes(piola_output *o, int32_t frame);
+static piola_status pvd_append(piola_output *o, int32_t frame, double time);
+
+/* resume_frame < 0: a new run (force as in piola_output_open); else a resume after it. */
+static piola_status open_output(const char *dir, bool force, int32_t resume_frame,
+                                const piola_world *world, piola_output **out) {
   if (!dir || !world || !out) return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "output: NULL argument");
   *out = NULL;
   if (strlen(dir) > 3500) return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "output: path too long");
@@ -153,11 +159,12 @@ piola_status piola_output_open(const char *dir, bool force, const piola_world *w
       o->surface.vertex_count = nv + snv;
     }
   }
-  if (st == PIOLA_OK) st = piola__output_prepare_folder(dir, force);
+  if (st == PIOLA_OK && resume_frame < 0) st = piola__output_prepare_folder(dir, force);
   if (st == PIOLA_OK) st = csv_append(o, "frame,time,substeps,cg_iterations,kinetic_energy,elastic_energy,"
                                          "inverted,min_det_f,wall_seconds,plastic_yielded,max_fp_log_stretch,"
                                          "contacts,impacts,impact_zones,newton_iterations,"
                                          "linear_iterations,newton_failures\n");
+  if (st == PIOLA_OK && resume_frame >= 0) st = resume_indexes(o, resume_frame);
   if (st != PIOLA_OK) {
     piola_output_close(o);
     return st;
@@ -166,17 +173,20 @@ piola_status piola_output_open(const char *dir, bool force, const piola_world *w
   return PIOLA_OK;
 }
 
-static piola_status write_text(const char *path, const char *text, size_t len) {
+/* Writes text to a temporary file next to path and queues its rename to path. */
+static piola_status stage_text(frame_commit *c, const char *path, const char *text, size_t len) {
   piola_atomic_file f;
   PIOLA_TRY(piola_atomic_file_open(&f, path));
   if (len && fwrite(text, 1, len, f.stream) != len) {
     piola_atomic_file_abort(&f);
     return PIOLA_FAIL(PIOLA_ERROR_IO, "%s: write failed", path);
   }
-  return piola_atomic_file_commit(&f);
+  PIOLA_TRY(piola__atomic_file_finish(&f));
+  piola__frame_commit_add(c, f.temporary, f.target, 1);
+  return PIOLA_OK;
 }
 
-static piola_status write_pvd(piola_output *o) {
+static piola_status stage_pvd(piola_output *o, frame_commit *c) {
   char path[4200];
   snprintf(path, sizeof path, "%s/sim.pvd", o->dir);
   piola_atomic_file f;
@@ -187,7 +197,56 @@ static piola_status write_pvd(piola_output *o) {
     fprintf(f.stream, "    <DataSet timestep=\"%.17g\" group=\"\" part=\"0\" file=\"frames/frame_%04d.vtu\"/>\n",
             o->pvd[i].time, (int)o->pvd[i].frame);
   fprintf(f.stream, "  </Collection>\n</VTKFile>\n");
-  return piola_atomic_file_commit(&f);
+  PIOLA_TRY(piola__atomic_file_finish(&f));
+  piola__frame_commit_add(c, f.temporary, f.target, 1);
+  return PIOLA_OK;
+}
+
+static piola_status pvd_append(piola_output *o, int32_t frame, double time) {
+  if (o->pvd_count == o->pvd_cap) {
+    int32_t cap = o->pvd_cap ? 2 * o->pvd_cap : 64;
+    pvd_entry *grown = realloc(o->pvd, (size_t)cap * sizeof *grown);
+    if (!grown) return PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "sim.pvd: out of memory");
+    o->pvd = grown;
+    o->pvd_cap = cap;
+  }
+  o->pvd[o->pvd_count++] = (pvd_entry){frame, time};
+  return PIOLA_OK;
+}
+
+/* Writes the frame's files under temporary names and publishes them at one commit point
+ * (output/frame_commit.h); on any failure nothing of the frame is listed and the indexes in
+ * memory are as before. */
+static piola_status commit_frame(piola_output *o, const piola_vtu_frame *frame, int32_t number,
+                                 const char *row, double time) {
+  frame_commit commit = {0};
+  char path[4200], pending[4200];
+  snprintf(path, sizeof path, "%s/frames/frame_%04d.vtu", o->dir, (int)number);
+  if (!piola__frame_pending_name(path, pending, sizeof pending))
+    return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "output: path too long");
+  PIOLA_TRY(piola_vtu_write(pending, frame));
+  piola__frame_commit_add(&commit, pending, path, 0);
+  snprintf(path, sizeof path, "%s/surface/frame_%04d.obj", o->dir, (int)number);
+  piola__frame_pending_name(path, pending, sizeof pending);
+  o->surface.positions = o->tets.positions; /* same numbering; borrowed for the write */
+  piola_status st = piola_tri_mesh_write(pending, &o->surface);
+  o->surface.positions = NULL;
+  if (st == PIOLA_OK) piola__frame_commit_add(&commit, pending, path, 0);
+  size_t csv_len = o->csv_len;
+  int32_t pvd_count = o->pvd_count;
+  if (st == PIOLA_OK) st = csv_append(o, row);
+  if (st == PIOLA_OK) st = pvd_append(o, number, time);
+  snprintf(path, sizeof path, "%s/stats.csv", o->dir);
+  if (st == PIOLA_OK) st = stage_text(&commit, path, o->csv, o->csv_len);
+  if (st == PIOLA_OK) st = stage_pvd(o, &commit);
+  if (st == PIOLA_OK) st = piola__frame_commit_publish(&commit);
+  if (st != PIOLA_OK) {
+    piola__frame_commit_discard(&commit);
+    o->csv_len = csv_len;
+    if (o->csv) o->csv[csv_len] = '\0';
+    o->pvd_count = pvd_count;
+  }
+  return st;
 }
 
 piola_status piola_output_write_frame(piola_output *o, const piola_world *world,
@@ -252,7 +311,6 @@ piola_status piola_output_write_frame(piola_output *o, const piola_world *world,
     toff += t;
   }
   o->shells.positions = o->tets.positions + 3 * (size_t)o->solid_vertices;
-  char path[4200];
   piola_vtu_field points[2] = {{"velocity", 3, o->velocity}, {"displacement", 3, o->displacement}};
   piola_vtu_field cells[4] = {{"det_f", 1, o->det_f},
                               {"inverted", 1, o->inverted},
@@ -262,32 +320,50 @@ piola_status piola_output_write_frame(piola_output *o, const piola_world *world,
                            .triangles = o->shells.triangle_count > 0 ? &o->shells : NULL,
                            .point_fields = points, .point_field_count = 2, .cell_fields = cells,
                            .cell_field_count = 4, .positions = o->tets.positions};
-  snprintf(path, sizeof path, "%s/frames/frame_%04d.vtu", o->dir, (int)info->frame);
-  PIOLA_TRY(piola_vtu_write(path, &frame));
-  o->surface.positions = o->tets.positions; /* same numbering; borrowed for the write */
-  snprintf(path, sizeof path, "%s/surface/frame_%04d.obj", o->dir, (int)info->frame);
-  piola_status st = piola_tri_mesh_write(path, &o->surface);
-  o->surface.positions = NULL;
-  PIOLA_TRY(st);
-
   char line[512];
   snprintf(line, sizeof line, "%d,%.17g,%d,%d,%.17g,%.17g,%lld,%.17g,%.6f,%lld,%.17g,%lld,%lld,%d,%d,%d,%d\n",
            (int)info->frame, piola_world_time(world), (int)info->substeps, (int)info->cg_iterations,
            ke, ee, inverted, ns > 0 ? min_det : 1.0, info->wall_seconds, yielded, max_fp_log,
            (long long)info->contacts, (long long)info->impacts, (int)info->impact_zones,
            (int)info->newton_iterations, (int)info->linear_iterations, (int)info->newton_failures);
-  PIOLA_TRY(csv_append(o, line));
-  snprintf(path, sizeof path, "%s/stats.csv", o->dir);
-  PIOLA_TRY(write_text(path, o->csv, o->csv_len));
-  if (o->pvd_count == o->pvd_cap) {
-    int32_t cap = o->pvd_cap ? 2 * o->pvd_cap : 64;
-    pvd_entry *grown = realloc(o->pvd, (size_t)cap * sizeof *grown);
-    if (!grown) return PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "sim.pvd: out of memory");
-    o->pvd = grown;
-    o->pvd_cap = cap;
+  return commit_frame(o, &frame, info->frame, line, piola_world_time(world));
+}
+
+piola_status piola_output_open(const char *dir, bool force, const piola_world *world,
+                               piola_output **out) {
+  return open_output(dir, force, -1, world, out);
+}
+
+piola_status piola_output_open_resume(const char *dir, int32_t frame, const piola_world *world,
+                                      piola_output **out) {
+  if (frame < 0) return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "output: resume frame must be >= 0");
+  return open_output(dir, false, frame, world, out);
+}
+
+/* Takes over frames 0..frame of the folder (output_reconcile.c) and rewrites both indexes
+ * to list exactly those. */
+static piola_status resume_indexes(piola_output *o, int32_t frame) {
+  char *rows;
+  size_t length;
+  PIOLA_TRY(piola__output_reconcile(o->dir, frame, &rows, &length));
+  piola_status st = csv_append(o, rows);
+  for (const char *line = rows; st == PIOLA_OK && *line;) {
+    char *end;
+    long k = strtol(line, &end, 10);
+    double time = strtod(end + 1, NULL);
+    st = pvd_append(o, (int32_t)k, time);
+    const char *next = strchr(line, '\n');
+    line = next ? next + 1 : line + strlen(line);
   }
-  o->pvd[o->pvd_count++] = (pvd_entry){info->frame, piola_world_time(world)};
-  return write_pvd(o);
+  free(rows);
+  frame_commit commit = {0};
+  char path[4200];
+  snprintf(path, sizeof path, "%s/stats.csv", o->dir);
+  if (st == PIOLA_OK) st = stage_text(&commit, path, o->csv, o->csv_len);
+  if (st == PIOLA_OK) st = stage_pvd(o, &commit);
+  if (st == PIOLA_OK) st = piola__frame_commit_publish(&commit);
+  if (st != PIOLA_OK) piola__frame_commit_discard(&commit);
+  return st;
 }
 
 typedef struct ranked {

@@ -30,6 +30,7 @@ piola_status piola_scene_parse_string(const char *json, const char *base_dir, co
   *out = NULL;
   if (!label) label = "scene";
   if (!base_dir) base_dir = ".";
+  if (json) PIOLA_TRY(piola__scene_check_text(json, label));
   piola_scene_desc *d = calloc(1, sizeof *d);
   if (!d) return PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "%s: out of memory", label);
   snprintf(d->label, sizeof d->label, "%s", label);

@@ -116,4 +116,8 @@ piola_status piola__scene_fiber_directions(const scene_fibers *fibers, const pio
 /* Reads or generates the meshes, places them and builds the world. */
 piola_status piola__scene_build(const scene_desc *desc, const char *label, piola_world **out);
 
+/* Refuses a scene text whose strings hold the escape \u0000 (scene_text_check.c): it would
+ * cut a path short. */
+piola_status piola__scene_check_text(const char *json, const char *label);
+
 #endif

@@ -18,6 +18,7 @@
 #include <time.h>
 #include <unistd.h>
 
+#include "cli/cli_numbers.h"
 #include "cli/commands.h"
 #include "piola/mesh_io.h"
 #include "piola/render.h"
@@ -46,38 +47,6 @@ static void usage(FILE *out) {
           "  --fps F                 movie frame rate (default: real time, from the frame times\n"
           "                          in DIR/sim.pvd and --every; 30 without them)\n"
           "  -h, --help              this text\n");
-}
-
-static bool parse_int(const char *s, long lo, long hi, long *out) {
-  char *end;
-  errno = 0;
-  long v = strtol(s, &end, 10);
-  if (!*s || *end || errno || v < lo || v > hi) return false;
-  *out = v;
-  return true;
-}
-
-static bool parse_double(const char *s, double *out) {
-  char *end;
-  double v = strtod(s, &end);
-  if (!*s || *end || !isfinite(v)) return false;
-  *out = v;
-  return true;
-}
-
-static bool parse_vec3(const char *s, piola_vec3 *out) {
-  char *end;
-  double v[3];
-  const char *p = s;
-  for (int k = 0; k < 3; ++k) {
-    v[k] = strtod(p, &end);
-    if (end == p || !isfinite(v[k])) return false;
-    if (k < 2 && *end != ',') return false;
-    p = end + (k < 2);
-  }
-  if (*end) return false;
-  *out = (piola_vec3){v[0], v[1], v[2]};
-  return true;
 }
 
 static bool is_dir(const char *path) {
@@ -375,29 +344,29 @@ int cli_render(int argc, char **argv) {
       if (comma) {
         char lo[64];
         snprintf(lo, sizeof lo, "%.*s", (int)(comma - v), v);
-        ok = parse_double(lo, &range[0]) && parse_double(comma + 1, &range[1]) &&
+        ok = cli_parse_double(lo, &range[0]) && cli_parse_double(comma + 1, &range[1]) &&
              range[1] > range[0];
       }
       NEEDS(ok, "MIN,MAX with MIN < MAX");
       have_range = true;
     } else if (strcmp(a, "--width") == 0) {
-      NEEDS(parse_int(v, 16, 16384, &w), "an integer in [16, 16384]");
+      NEEDS(cli_parse_long(v, 16, 16384, &w), "an integer in [16, 16384]");
     } else if (strcmp(a, "--height") == 0) {
-      NEEDS(parse_int(v, 16, 16384, &h), "an integer in [16, 16384]");
+      NEEDS(cli_parse_long(v, 16, 16384, &h), "an integer in [16, 16384]");
     } else if (strcmp(a, "--camera-position") == 0) {
-      NEEDS(parse_vec3(v, &pos), "X,Y,Z in metres");
+      NEEDS(cli_parse_vec3(v, &pos), "X,Y,Z in metres");
       have_pos = true;
     } else if (strcmp(a, "--camera-target") == 0) {
-      NEEDS(parse_vec3(v, &target), "X,Y,Z in metres");
+      NEEDS(cli_parse_vec3(v, &target), "X,Y,Z in metres");
       have_target = true;
     } else if (strcmp(a, "--fov") == 0) {
-      NEEDS(parse_double(v, &def.fov_degrees) && def.fov_degrees > 1 && def.fov_degrees < 170,
+      NEEDS(cli_parse_double(v, &def.fov_degrees) && def.fov_degrees > 1 && def.fov_degrees < 170,
             "degrees in (1, 170)");
     } else if (strcmp(a, "--up") == 0) {
-      NEEDS(parse_vec3(v, &def.up) && (def.up.x != 0 || def.up.y != 0 || def.up.z != 0),
+      NEEDS(cli_parse_vec3(v, &def.up) && (def.up.x != 0 || def.up.y != 0 || def.up.z != 0),
             "a nonzero X,Y,Z");
     } else if (strcmp(a, "--every") == 0) {
-      NEEDS(parse_int(v, 1, 1000000, &every), "an integer >= 1");
+      NEEDS(cli_parse_long(v, 1, 1000000, &every), "an integer >= 1");
     } else if (strcmp(a, "--scene") == 0) {
       NEEDS(v[0], "a scene file");
       scene = v;
@@ -410,14 +379,14 @@ int cli_render(int argc, char **argv) {
     } else if (strcmp(a, "--contact-sheet") == 0) {
       sheet = true;
     } else if (strcmp(a, "--sheet-frames") == 0) {
-      NEEDS(parse_int(v, 1, 100, &sheet_frames), "an integer in [1, 100]");
+      NEEDS(cli_parse_long(v, 1, 100, &sheet_frames), "an integer in [1, 100]");
       sheet = true;
     } else if (strcmp(a, "--movie") == 0) {
       movie = 1;
     } else if (strcmp(a, "--no-movie") == 0) {
       movie = 0;
     } else if (strcmp(a, "--fps") == 0) {
-      NEEDS(parse_double(v, &fps) && fps > 0 && fps <= 1000, "frames per second in (0, 1000]");
+      NEEDS(cli_parse_double(v, &fps) && fps > 0 && fps <= 1000, "frames per second in (0, 1000]");
     } else if (a[0] == '-' && a[1]) {
       fprintf(stderr, "piola render: unknown option '%s'\n", a);
       usage(stderr);

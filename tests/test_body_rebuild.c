@@ -2,8 +2,9 @@
  * refinement will: after a solid is replaced by a refined copy its energy, plastic state and
  * forces are those of the same deformation (forces against finite differences of the
  * energy); after it is split in two its momentum is kept, the pieces collide with each
- * other through the rebuilt collision surface and the world goes on stepping; constraints
- * follow the parent nodes; a bad change leaves the body as it was. */
+ * other through the rebuilt collision surface and the world goes on stepping; a cloth
+ * coupled to it reads its new surface; constraints follow the parent nodes; a bad change
+ * leaves the body as it was. */
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -351,11 +352,70 @@ static void constraints_follow_parents_and_bad_changes_are_refused(void **state)
   free_tets(&bar), free_tets(&fine);
 }
 
+/* A cloth coupled one-way to a block (collide_with_solids) lands on it; the block is then
+ * replaced by its refinement in the same place. The coupling reads the new block's boundary
+ * (the old one, in the old numbering, would name nodes near the bottom of the new mesh): the
+ * cloth keeps resting on top instead of falling into the block. */
+static void cloth_rests_on_a_refined_block(void **state) {
+  (void)state;
+  const double size = 0.2;
+  piola_tet_mesh coarse = grid(2, 2, 2, size / 2), fine = grid(4, 4, 4, size / 4);
+  piola_world_def wdef = piola_default_world_def();
+  wdef.max_dt = 1e-3;
+  piola_world *w;
+  assert_int_equal(piola_world_create(&wdef, &w), PIOLA_OK);
+  piola_obstacle_def ground = piola_default_obstacle_def();
+  assert_int_equal(piola_world_add_obstacle(w, &ground, NULL), PIOLA_OK);
+  piola_solid_def def = piola_default_solid_def();
+  def.mesh = &coarse;
+  def.material.youngs_modulus = 1e6;
+  def.shear_viscosity.value = 20;
+  assert_int_equal(piola_world_add_solid(w, &def, NULL), PIOLA_OK);
+  piola_tri_mesh sheet;
+  assert_int_equal(piola_tri_mesh_rectangle(0.16, 0.16, 8, 8, &sheet), PIOLA_OK);
+  for (int32_t i = 0; i < sheet.vertex_count; ++i)
+    sheet.positions[3 * i] += 0.5 * size, sheet.positions[3 * i + 1] += 0.5 * size,
+        sheet.positions[3 * i + 2] = size + 0.002;
+  piola_shell_def sd = piola_default_shell_def();
+  sd.mesh = &sheet;
+  sd.material.youngs_modulus = 1e5;
+  sd.density = 200;
+  sd.shear_viscosity.value = 0.5;
+  sd.collide_with_solids = true;
+  assert_int_equal(piola_world_add_shell(w, &sd, NULL), PIOLA_OK);
+  const piola_body_id block = piola_world_body_of(w, PIOLA_BODY_SOLID, 0);
+  const piola_body_id cloth = piola_world_body_of(w, PIOLA_BODY_SHELL, 0);
+  while (piola_world_time(w) < 0.04) assert_int_equal(piola_world_step(w, 0, NULL), PIOLA_OK);
+  world_body *b = piola__world_body(w, block);
+  const int32_t n = fine.vertex_count;
+  double *x = malloc(3 * sizeof(double) * (size_t)n), *v = malloc(3 * sizeof(double) * (size_t)n);
+  for (int32_t i = 0; i < n; ++i) {
+    interpolate(b->solid, b->x, fine.positions + 3 * i, x + 3 * i);
+    interpolate(b->solid, b->v, fine.positions + 3 * i, v + 3 * i);
+  }
+  body_change change = {.solid_rest = &fine, .x = x, .v = v};
+  assert_int_equal(piola__body_rebuild(w, b, &change), PIOLA_OK);
+  while (piola_world_time(w) < 0.12) assert_int_equal(piola_world_step(w, 0, NULL), PIOLA_OK);
+  /* the block's top, and the cloth over it */
+  const double *xb = piola_world_body_positions(w, block), *xc = piola_world_body_positions(w, cloth);
+  double top = INFINITY;
+  for (int32_t i = 0; i < n; ++i)
+    if (fine.positions[3 * i + 2] > size - 1e-9) top = fmin(top, xb[3 * i + 2]);
+  assert_true(top > 0.9 * size);
+  for (int32_t i = 0; i < sheet.vertex_count; ++i)
+    assert_true(xc[3 * i + 2] > top - 0.01 * size);
+  free(x), free(v);
+  piola_tri_mesh_free(&sheet);
+  piola_world_destroy(w);
+  free_tets(&coarse), free_tets(&fine);
+}
+
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(refined_solid_keeps_energy_and_forces),
       cmocka_unit_test(split_solid_keeps_momentum_and_collides),
       cmocka_unit_test(constraints_follow_parents_and_bad_changes_are_refused),
+      cmocka_unit_test(cloth_rests_on_a_refined_block),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
 }

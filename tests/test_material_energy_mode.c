@@ -98,11 +98,16 @@ static void stress_is_the_energy_gradient_everywhere(void **state) {
         piola_material_stress(&m, f, p);
         const double h = 1e-6, scale = stress_scale(&m, f);
         for (int i = 0; i < 3; ++i) {
-          double a[3] = {f[0], f[1], f[2]}, b[3] = {f[0], f[1], f[2]};
+          double a[3] = {f[0], f[1], f[2]}, b[3] = {f[0], f[1], f[2]}, ka[3][3], kb[3][3];
           a[i] += h, b[i] -= h;
           const double fd =
               (piola_material_energy_density(&m, a) - piola_material_energy_density(&m, b)) / (2 * h);
-          if (!(fabs(fd - p[i]) <= 2e-6 * scale))
+          /* A central difference across the threshold, where the curvature jumps, is off by up
+           * to h times the jump. */
+          piola_material_stress_derivative(&m, a, ka);
+          piola_material_stress_derivative(&m, b, kb);
+          const double kink = fabs(f[i] - m.threshold) < h ? h * fabs(ka[i][i] - kb[i][i]) : 0.0;
+          if (!(fabs(fd - p[i]) <= 2e-6 * scale + kink))
             fail_msg("%s nu %g f (%.17g %.17g %.17g) entry %d: stress %.12g, energy slope %.12g",
                      piola_material_model_name(m.model), nus[n], f[0], f[1], f[2], i, p[i], fd);
         }

@@ -255,9 +255,10 @@ static double mixed_third_slope(const piola_material *m, const double f[3], int 
 }
 
 /* dPhat/dFhat of PIOLA_INVERSION_ENERGY: the Hessian of psi_E (material_kernels.h), symmetric.
- * With m the third index of a pair i != j: off the diagonal K_ij + T_012 d_m in every case; on
- * it k for a clamped entry, K_ii + sum_{a clamped} T_iia d_a + dT_012/df_i d_a d_b for an
- * unclamped one (a, b the other two). Not smooth
+ * With m the third index of a pair i != j: off the diagonal K_ij + T_012 d_m + phi'(fc_i) d_j +
+ * phi'(fc_j) d_i in every case; on it k(fc) for a clamped entry, K_ii + sum_{a clamped} T_iia
+ * d_a + dT_012/df_i d_a d_b + phi''(fc_i) |d|^2 / 2 for an unclamped one (a, b the other two).
+ * Not smooth
  * at the threshold (the diagonal jumps from K_ii to k). */
 static void energy_mode_derivative(const piola_material *m, const extension_point *e,
                                    double dphat[3][3]) {
@@ -265,15 +266,18 @@ static void energy_mode_derivative(const piola_material *m, const extension_poin
   const int any_clamped = e->clamped[0] || e->clamped[1] || e->clamped[2];
   double t[3][3][3] = {{{0}}};
   if (any_clamped) model_third_derivative(m, e->fc, t);
+  double g[3], h[3], k = m->model_constants[ENERGY_SLOPE];
+  for (int i = 0; i < 3; ++i) k += energy_growth(m, e->fc[i], &g[i], &h[i]);
+  const double half_d2 = 0.5 * (e->d[0] * e->d[0] + e->d[1] * e->d[1] + e->d[2] * e->d[2]);
   for (int i = 0; i < 3; ++i)
     for (int j = 0; j < 3; ++j) {
       double v;
-      if (i != j)
-        v = pa->k[i][j] + t[0][1][2] * e->d[3 - i - j];
+      if (i != j) /* phi' vanishes at a clamped entry, d at an unclamped one */
+        v = pa->k[i][j] + t[0][1][2] * e->d[3 - i - j] + g[i] * e->d[j] + g[j] * e->d[i];
       else if (e->clamped[i])
-        v = m->model_constants[ENERGY_SLOPE];
+        v = k;
       else {
-        v = pa->k[i][i];
+        v = pa->k[i][i] + h[i] * half_d2;
         for (int a = 0; a < 3; ++a) v += t[i][i][a] * e->d[a];
         /* T_012 d_a d_b of Phat_i moves with f_i: the fourth derivative d T_012 / d f_i. */
         v += mixed_third_slope(m, e->fc, i) * e->d[(i + 1) % 3] * e->d[(i + 2) % 3];

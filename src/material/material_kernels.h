@@ -77,7 +77,9 @@ enum {
   SNH_LAMBDA = 1, /* Pa: lambda' = lambda + 5/6 mu (> 0 for every nu in (-1, 0.5)) */
   SNH_ALPHA = 2,  /* dimensionless: alpha = 1 + 3 mu' / (4 lambda') = 1 + mu / lambda' */
   SNH_REST = 3,   /* J/m^3: lambda'/2 (1 - alpha)^2, the J term's value at rest */
-  ENERGY_SLOPE = 4 /* Pa: k, the energy extension's diagonal slope (every model) */
+  ENERGY_SLOPE = 4, /* Pa: k0, the energy extension's diagonal slope at rest (every model) */
+  ENERGY_GROWTH_2 = 5, /* Pa: a2, its growth with the clamped point's stretch (see energy_slope) */
+  ENERGY_GROWTH_4 = 6  /* Pa: a4 */
 };
 
 
@@ -397,19 +399,20 @@ MATERIAL_KERNEL void material_extended_stress(piola_material_model model, const 
  * p = Phat(fc), K = dPhat/dFhat(fc) and T = d3 psi / df0 df1 df2 (fc) of the model at the
  * clamped point and d = f - fc <= 0 (zero for unclamped entries):
  *
- *     psi_E(f) = psi(fc) + p.d + k/2 |d|^2 + sum_{i<j} K_ij d_i d_j + T d0 d1 d2
- *     Phat_i   = p_i + k d_i + sum_{j != i} K_ij d_j + T d_j d_l      (j, l the other two)
+ *     psi_E(f) = psi(fc) + p.d + k(fc)/2 |d|^2 + sum_{i<j} K_ij d_i d_j + T d0 d1 d2
+ *     Phat_i   = p_i + k d_i + sum_{j != i} K_ij d_j + T d_j d_l + phi'(fc_i) |d|^2 / 2
  *
+ * (j, l the other two; k(fc) = k0 + sum_j phi(fc_j), see energy_growth)
  * the same formula for clamped and unclamped entries (for an unclamped i, d_i = 0 and the
  * derivatives of the coefficients with f_i multiply d_i, so they drop out). This is the
  * Taylor expansion of the energy around the clamped point with its diagonal curvature
- * replaced by the constant k = ENERGY_SLOPE: Stomakhin et al.'s psi(fc) + grad psi . d +
- * k/2 |d|^2, plus the mixed terms that keep the energy C1 where the clamped set changes (the
- * edges and corners of the box f >= c, which their smooth threshold surface does not have).
- * k is one constant per material: a k that depended on the unclamped entries would put
- * dk/df_j |d|^2 / 2 into their stress, and that term does not vanish where a second entry
- * crosses the threshold, so the stress would jump there. The energy is C1 everywhere; the
- * stress is continuous and its derivative jumps at the threshold. */
+ * replaced by k: Stomakhin et al.'s psi(fc) + grad psi . d + k/2 |d|^2, plus the mixed terms
+ * that keep the energy C1 where the clamped set changes (the edges and corners of the box
+ * f >= c, which their smooth threshold surface does not have). k must grow with the clamped
+ * point's stretch (the volume term's tension p_i there grows like lambda c s^4 for the J
+ * models: with a constant k the energy would be unbounded below), but may depend on an entry
+ * only through a function flat at the threshold (energy_growth). The energy is C1
+ * everywhere; the stress is continuous and its derivative jumps at the threshold. */
 
 /* Mixed third derivative d3 psi / df0 df1 df2 of the model at f (all entries > 0): zero for
  * the separable-plus-(trace, |f|^2 or ln J) models, kappa (4 J - q0) for the J penalty,
@@ -459,16 +462,46 @@ MATERIAL_KERNEL void material_derive_constants(piola_material *m) {
   m->model_constants[ENERGY_SLOPE] = 2.0 * m->mu + m->lambda + 2.0 * fabs(pa.k[0][1]) +
                                      fabs(t) * c + kernel_max(pa.p[0], 0.0) / c +
                                      kernel_max(stretched.p[0], 0.0) / c;
+  /* The volume terms make p_i(c, s, s) grow like lambda s^2 (trace, |f|^2, ln J) or
+   * lambda c s^4 (J): the growth terms keep k above 2 p_i / c (restoring, and psi_E bounded
+   * below: its minimum along d_i, psi(fc) - p_i^2 / 2k, stays above psi(fc) / 2). */
+  const int quartic = model == PIOLA_MODEL_COROTATED || model == PIOLA_MODEL_SPLINE ||
+                      model == PIOLA_MODEL_STABLE_NEOHOOKEAN;
+  const double volume = model == PIOLA_MODEL_STABLE_NEOHOOKEAN ? m->model_constants[SNH_LAMBDA] : m->lambda;
+  m->model_constants[ENERGY_GROWTH_2] = 2.0 * (2.0 * m->mu + fabs(volume)) / c;
+  m->model_constants[ENERGY_GROWTH_4] = quartic ? 2.0 * fabs(volume) / c : 0.0;
 }
 
-/* The gradient of psi_E from the parts at the clamped point and the offsets d = f - fc. */
+/* phi(x) = a2 u^2 + a4 u^4, u = max(x - 1, 0), and its first two derivatives: the growth of
+ * the slope k(fc) = k0 + phi(fc0) + phi(fc1) + phi(fc2) with a clamped point's stretch beyond
+ * 1 (k0 covers the stretches up to 2). phi is flat at the threshold (phi = phi' = 0 there),
+ * so k does not move with an entry at the threshold: that is what keeps the energy C1 where
+ * an entry crosses it while another is clamped (k's slope there multiplies |d|^2 / 2 in the
+ * crossing entry's stress). */
+MATERIAL_KERNEL double energy_growth(const piola_material *m, double x, double *slope,
+                                     double *curvature) {
+  const double u = kernel_max(x - 1.0, 0.0), u2 = u * u;
+  const double stretched = (double)(x > 1.0);
+  const double a2 = m->model_constants[ENERGY_GROWTH_2], a4 = m->model_constants[ENERGY_GROWTH_4];
+  *slope = 2.0 * a2 * u + 4.0 * a4 * u2 * u;
+  *curvature = stretched * (2.0 * a2 + 12.0 * a4 * u2);
+  return a2 * u2 + a4 * u2 * u2;
+}
+
+/* The gradient of psi_E from the parts at the clamped point fc and the offsets d = f - fc:
+ * Phat_i = p_i + k d_i + sum_{j != i} K_ij d_j + T d_j d_l + phi'(fc_i) |d|^2 / 2. */
 MATERIAL_KERNEL void material_energy_extend(const piola_material *m, const material_parts *pa,
-                                            double t, double d0, double d1, double d2, double *p0,
-                                            double *p1, double *p2) {
-  const double k = m->model_constants[ENERGY_SLOPE];
-  *p0 = pa->p[0] + k * d0 + pa->k[0][1] * d1 + pa->k[0][2] * d2 + t * d1 * d2;
-  *p1 = pa->p[1] + k * d1 + pa->k[1][0] * d0 + pa->k[1][2] * d2 + t * d0 * d2;
-  *p2 = pa->p[2] + k * d2 + pa->k[2][0] * d0 + pa->k[2][1] * d1 + t * d0 * d1;
+                                            double t, double fc0, double fc1, double fc2,
+                                            double d0, double d1, double d2, double *p0,
+                                            double *p1, double *p2, double *slope_k) {
+  double g0, g1, g2, h;
+  const double k = m->model_constants[ENERGY_SLOPE] + energy_growth(m, fc0, &g0, &h) +
+                   energy_growth(m, fc1, &g1, &h) + energy_growth(m, fc2, &g2, &h);
+  const double half_d2 = 0.5 * (d0 * d0 + d1 * d1 + d2 * d2);
+  *p0 = pa->p[0] + k * d0 + pa->k[0][1] * d1 + pa->k[0][2] * d2 + t * d1 * d2 + g0 * half_d2;
+  *p1 = pa->p[1] + k * d1 + pa->k[1][0] * d0 + pa->k[1][2] * d2 + t * d0 * d2 + g1 * half_d2;
+  *p2 = pa->p[2] + k * d2 + pa->k[2][0] * d0 + pa->k[2][1] * d1 + t * d0 * d1 + g2 * half_d2;
+  *slope_k = k;
 }
 
 /* The hot entry point of the energy extension for one model known at compile time. */
@@ -481,7 +514,8 @@ MATERIAL_KERNEL void material_energy_extended_stress(piola_material_model model,
   material_parts parts;
   material_model_parts(model, m, dv, fc0, fc1, fc2, &parts);
   const double t = material_mixed_third(model, m, dv, fc0, fc1, fc2);
-  material_energy_extend(m, &parts, t, f0 - fc0, f1 - fc1, f2 - fc2, p0, p1, p2);
+  double k;
+  material_energy_extend(m, &parts, t, fc0, fc1, fc2, f0 - fc0, f1 - fc1, f2 - fc2, p0, p1, p2, &k);
 }
 
 /* A(f): the separable energy of each model (see entry_slope_curvature). */
@@ -575,8 +609,8 @@ MATERIAL_KERNEL void material_energy_extended_stress_energy(piola_material_model
   material_parts pa;
   material_model_parts(model, m, KERNEL_EXACT_DIVIDE, fc0, fc1, fc2, &pa);
   const double t = material_mixed_third(model, m, KERNEL_EXACT_DIVIDE, fc0, fc1, fc2);
-  material_energy_extend(m, &pa, t, d0, d1, d2, p0, p1, p2);
-  const double k = m->model_constants[ENERGY_SLOPE];
+  double k;
+  material_energy_extend(m, &pa, t, fc0, fc1, fc2, d0, d1, d2, p0, p1, p2, &k);
   *psi = material_model_energy(model, m, fc0, fc1, fc2) +
          (pa.p[0] * d0 + pa.p[1] * d1 + pa.p[2] * d2 +
           0.5 * k * (d0 * d0 + d1 * d1 + d2 * d2) +

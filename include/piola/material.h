@@ -53,6 +53,10 @@ typedef enum piola_material_model {
   PIOLA_MODEL_STABLE_NEOHOOKEAN,  /* Smith, de Goes, Kim 2018: mu'/2 (I_C - 3) + lambda'/2 (J - alpha)^2
                                      - mu'/2 ln(I_C + 1), with mu' = 4/3 mu, lambda' = lambda + 5/6 mu,
                                      alpha = 1 + mu / lambda' (docs/materials.md) */
+  PIOLA_MODEL_MOONEY_RIVLIN,      /* C10 sum (f_i^2 - 1) + C01 sum (f_i^-2 - 1) - 2 (C10 - C01) ln J
+                                     + lambda/2 (ln J)^2: see piola_mooney_rivlin_def */
+  PIOLA_MODEL_OGDEN,              /* sum_p mu_p / alpha_p sum_i (f_i^alpha_p - 1) - (sum_p mu_p) ln J
+                                     + lambda/2 (ln J)^2: see piola_ogden_def */
   PIOLA_MODEL_COUNT
 } piola_material_model;
 
@@ -94,6 +98,29 @@ typedef struct piola_muscle_def {
                                  bump, relative to optimal_stretch. Default 0.5 */
 } piola_muscle_def;
 
+/* Ogden (1972) in principal stretches, N terms, compressible through a ln J volume term:
+ *   psi = sum_p mu_p / alpha_p sum_i (f_i^alpha_p - 1) - (sum_p mu_p) ln J + lambda/2 (ln J)^2
+ * Its shear modulus is mu = 1/2 sum_p mu_p alpha_p (must be > 0); lambda comes from
+ * poisson_ratio with that mu (youngs_modulus is not used). For incompressible deformations
+ * (J = 1) this is Ogden's energy; Mooney-Rivlin and neo-Hookean are its two- and one-term
+ * cases (alpha = 2, -2). */
+#define PIOLA_OGDEN_MAX_TERMS 6
+typedef struct piola_ogden_def {
+  int term_count;                     /* 1..PIOLA_OGDEN_MAX_TERMS. Default 3 */
+  double mu[PIOLA_OGDEN_MAX_TERMS];    /* Pa, each nonzero. Default Ogden's 1972 fit to
+                                          Treloar's rubber: 6.18e5, 1.18e3, -9.81e3 */
+  double alpha[PIOLA_OGDEN_MAX_TERMS]; /* dimensionless, each nonzero. Default 1.3, 5, -2 */
+} piola_ogden_def;
+
+/* Mooney-Rivlin in principal stretches, compressible through the same ln J volume term:
+ *   psi = C10 sum_i (f_i^2 - 1) + C01 sum_i (f_i^-2 - 1) - 2 (C10 - C01) ln J + lambda/2 (ln J)^2
+ * which for J = 1 is the classical C10 (I1 - 3) + C01 (I2 - 3). Shear modulus
+ * mu = 2 (C10 + C01) (must be > 0); lambda from poisson_ratio (youngs_modulus is not used). */
+typedef struct piola_mooney_rivlin_def {
+  double c10; /* Pa. Default 1.5e4 */
+  double c01; /* Pa. Default 5e3 */
+} piola_mooney_rivlin_def;
+
 typedef struct piola_material_def {
   piola_material_model model;
   double youngs_modulus;      /* Pa, > 0. Default 1e5 */
@@ -101,6 +128,8 @@ typedef struct piola_material_def {
   double inversion_threshold; /* dimensionless, in (0, 1): compression threshold c. Default 0.3 */
   piola_inversion_mode inversion_mode; /* Default PIOLA_INVERSION_LINEAR */
   piola_spline_def spline;    /* used by PIOLA_MODEL_SPLINE only */
+  piola_ogden_def ogden;      /* used by PIOLA_MODEL_OGDEN only */
+  piola_mooney_rivlin_def mooney_rivlin; /* used by PIOLA_MODEL_MOONEY_RIVLIN only */
   piola_muscle_def muscle;    /* used by PIOLA_MODEL_MUSCLE only; youngs_modulus and
                                  poisson_ratio give its matrix and volume part (use nu close
                                  to 0.5, e.g. 0.45, for a quasi-incompressible muscle) */
@@ -122,8 +151,9 @@ typedef struct piola_material {
   double threshold;           /* dimensionless compression threshold c */
   piola_inversion_mode inversion_mode;
   double spline_coefficients[16]; /* precomputed spline pieces, model-internal */
-  double model_constants[8];  /* precomputed constants, model-internal (Stable Neo-Hookean's
-                                 mu', lambda', alpha; the energy extension's slope) */
+  double model_constants[24]; /* precomputed constants, model-internal (Stable Neo-Hookean's
+                                 mu', lambda', alpha; the energy extension's slope; the
+                                 Ogden / Mooney-Rivlin terms) */
   piola_muscle_def muscle;    /* PIOLA_MODEL_MUSCLE: the validated fibre parameters */
   double fiber_modulus;       /* Pa: bound on the fibre's tangent stiffness at full activation
                                  (0 for other models), added to lambda + 2 mu in the CFL
@@ -202,7 +232,7 @@ PIOLA_API double piola_material_muscle_energy_density(const piola_material *mate
                                                       double activation);
 
 /* Name used in scene files: "rotated_linear", "corotated", "stvk", "neohookean", "spline",
- * "muscle", "stable_neohookean". */
+ * "muscle", "stable_neohookean", "mooney_rivlin", "ogden". */
 PIOLA_API const char *piola_material_model_name(piola_material_model model);
 
 /* Parses a scene-file name; false if unknown. */

@@ -80,6 +80,8 @@
                                stable_neohookean_stress_energy_mode_lanes, lanes);         \
           return;                                                                          \
         case PIOLA_MODEL_SPLINE: PIOLA_MATERIAL_LANE_LOOP(spline_stress_energy_mode_lanes, lanes); return; \
+        case PIOLA_MODEL_MOONEY_RIVLIN:                                                    \
+        case PIOLA_MODEL_OGDEN: PIOLA_MATERIAL_LANE_LOOP(ogden_stress_energy_mode_lanes, lanes); return; \
         case PIOLA_MODEL_ROTATED_LINEAR:                                                   \
         default: PIOLA_MATERIAL_LANE_LOOP(rotated_linear_stress_energy_mode_lanes, lanes); return; \
       }                                                                                    \
@@ -97,6 +99,8 @@
                              stable_neohookean_stress_lanes, lanes);                       \
         return;                                                                            \
       case PIOLA_MODEL_SPLINE: PIOLA_MATERIAL_LANE_LOOP(spline_stress_lanes, lanes); return;      \
+      case PIOLA_MODEL_MOONEY_RIVLIN:                                                      \
+      case PIOLA_MODEL_OGDEN: PIOLA_MATERIAL_LANE_LOOP(ogden_stress_lanes, lanes); return;         \
       case PIOLA_MODEL_ROTATED_LINEAR:                                                     \
       default: PIOLA_MATERIAL_LANE_LOOP(rotated_linear_stress_lanes, lanes); return;             \
     }                                                                                      \

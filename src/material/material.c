@@ -23,6 +23,14 @@ piola_material_def piola_default_material_def(void) {
   def.spline.elongation_stretch = 1.2;
   def.spline.stiffening = 10.0;
   def.muscle = piola__default_muscle_def();
+  /* Ogden 1972, Table 1 fit to Treloar's 1944 data: 6.3, 0.012, -0.1 kg/cm^2 (1 kg/cm^2 =
+   * 98066.5 Pa), alpha 1.3, 5.0, -2.0. */
+  def.ogden.term_count = 3;
+  def.ogden.mu[0] = 6.3 * 98066.5, def.ogden.alpha[0] = 1.3;
+  def.ogden.mu[1] = 0.012 * 98066.5, def.ogden.alpha[1] = 5.0;
+  def.ogden.mu[2] = -0.1 * 98066.5, def.ogden.alpha[2] = -2.0;
+  def.mooney_rivlin.c10 = 1.5e4;
+  def.mooney_rivlin.c01 = 5e3;
   return def;
 }
 
@@ -51,6 +59,52 @@ static piola_status check_finite(const char *key, double value) {
   return PIOLA_OK;
 }
 
+/* Ogden terms (Mooney-Rivlin as the terms (2 C10, 2), (-2 C01, -2)) into model_constants; mu
+ * = 1/2 sum mu_p alpha_p, lambda from nu with that mu. */
+static piola_status ogden_init(const piola_material_def *def, double nu, piola_material *m) {
+  double mus[PIOLA_OGDEN_MAX_TERMS], alphas[PIOLA_OGDEN_MAX_TERMS];
+  int n;
+  if (def->model == PIOLA_MODEL_MOONEY_RIVLIN) {
+    PIOLA_TRY(check_finite("mooney_rivlin.c10", def->mooney_rivlin.c10));
+    PIOLA_TRY(check_finite("mooney_rivlin.c01", def->mooney_rivlin.c01));
+    n = 2;
+    mus[0] = 2.0 * def->mooney_rivlin.c10, alphas[0] = 2.0;
+    mus[1] = -2.0 * def->mooney_rivlin.c01, alphas[1] = -2.0;
+    if (!(def->mooney_rivlin.c10 + def->mooney_rivlin.c01 > 0.0))
+      return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT,
+                        "mooney_rivlin: c10 + c01 must be > 0 Pa (shear modulus 2 (c10 + c01)), got %g",
+                        def->mooney_rivlin.c10 + def->mooney_rivlin.c01);
+  } else {
+    n = def->ogden.term_count;
+    if (n < 1 || n > PIOLA_OGDEN_MAX_TERMS)
+      return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "ogden: needs 1 to %d terms, got %d",
+                        PIOLA_OGDEN_MAX_TERMS, n);
+    for (int p = 0; p < n; ++p) {
+      mus[p] = def->ogden.mu[p], alphas[p] = def->ogden.alpha[p];
+      if (!isfinite(mus[p]) || mus[p] == 0.0)
+        return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "ogden.mu[%d] must be finite and nonzero, got %g",
+                          p, mus[p]);
+      if (!isfinite(alphas[p]) || alphas[p] == 0.0)
+        return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT,
+                          "ogden.alpha[%d] must be finite and nonzero, got %g", p, alphas[p]);
+    }
+  }
+  double shear = 0.0, msum = 0.0;
+  for (int p = 0; p < n; ++p) shear += 0.5 * mus[p] * alphas[p], msum += mus[p];
+  if (!(shear > 0.0))
+    return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT,
+                      "ogden: the shear modulus 1/2 sum mu_p alpha_p must be > 0 Pa, got %g", shear);
+  m->mu = shear;
+  m->lambda = 2.0 * shear * nu / (1.0 - 2.0 * nu);
+  m->model_constants[OGDEN_COUNT] = n;
+  m->model_constants[OGDEN_MU_SUM] = msum;
+  for (int p = 0; p < n; ++p) {
+    m->model_constants[OGDEN_TERMS + 2 * p] = mus[p];
+    m->model_constants[OGDEN_TERMS + 2 * p + 1] = alphas[p];
+  }
+  return PIOLA_OK;
+}
+
 piola_status piola_material_init(const piola_material_def *def, piola_material *out) {
   if (!def || !out) return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "material_init: NULL argument");
   if ((int)def->model < 0 || def->model >= PIOLA_MODEL_COUNT)
@@ -61,10 +115,12 @@ piola_status piola_material_init(const piola_material_def *def, piola_material *
     return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "inversion.mode: unknown mode %d",
                       (int)def->inversion_mode);
   const double e = def->youngs_modulus, nu = def->poisson_ratio, c = def->inversion_threshold;
-  PIOLA_TRY(check_finite("youngs_modulus", e));
+  if (def->model != PIOLA_MODEL_OGDEN && def->model != PIOLA_MODEL_MOONEY_RIVLIN)
+    PIOLA_TRY(check_finite("youngs_modulus", e));
   PIOLA_TRY(check_finite("poisson_ratio", nu));
   PIOLA_TRY(check_finite("inversion.threshold", c));
-  if (!(e > 0.0))
+  const int ogden = def->model == PIOLA_MODEL_OGDEN || def->model == PIOLA_MODEL_MOONEY_RIVLIN;
+  if (!(e > 0.0) && !ogden) /* the Ogden models take their shear modulus from their terms */
     return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "youngs_modulus must be > 0 Pa, got %g", e);
   if (!(nu > -1.0 && nu < 0.5))
     return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "poisson_ratio must be in (-1, 0.5), got %g",
@@ -105,13 +161,16 @@ piola_status piola_material_init(const piola_material_def *def, piola_material *
     s[SPLINE_INV_WC] = 1.0 / s[SPLINE_WC];
   }
   if (def->model == PIOLA_MODEL_MUSCLE) PIOLA_TRY(piola__muscle_init(def, &m));
+  if (def->model == PIOLA_MODEL_OGDEN || def->model == PIOLA_MODEL_MOONEY_RIVLIN)
+    PIOLA_TRY(ogden_init(def, nu, &m));
   material_derive_constants(&m);
   *out = m;
   return PIOLA_OK;
 }
 
 static const char *const model_names[PIOLA_MODEL_COUNT] = {
-    "rotated_linear", "corotated", "stvk", "neohookean", "spline", "muscle", "stable_neohookean"};
+    "rotated_linear", "corotated", "stvk", "neohookean", "spline", "muscle", "stable_neohookean",
+    "mooney_rivlin", "ogden"};
 
 const char *piola_material_model_name(piola_material_model model) {
   if ((int)model < 0 || model >= PIOLA_MODEL_COUNT) return "unknown";
@@ -187,6 +246,16 @@ static double entry_third(const piola_material *m, double f) {
     case PIOLA_MODEL_NEOHOOKEAN:
     case PIOLA_MODEL_MUSCLE:
       return -2.0 * m->mu / (f * f * f);
+    case PIOLA_MODEL_MOONEY_RIVLIN:
+    case PIOLA_MODEL_OGDEN: {
+      const double *o = m->model_constants;
+      double t = -2.0 * o[OGDEN_MU_SUM] / (f * f * f);
+      for (int p = 0; p < (int)o[OGDEN_COUNT]; ++p) {
+        const double alpha = o[OGDEN_TERMS + 2 * p + 1];
+        t += o[OGDEN_TERMS + 2 * p] * (alpha - 1.0) * (alpha - 2.0) * pow(f, alpha - 3.0);
+      }
+      return t;
+    }
     case PIOLA_MODEL_SPLINE: {
       const double *s = m->spline_coefficients;
       const double u = f - 1.0;
@@ -207,8 +276,9 @@ static void model_third_derivative(const piola_material *m, const double f[3], d
     for (int j = 0; j < 3; ++j)
       for (int k = 0; k < 3; ++k) {
         double tq = 0.0; /* third derivative of the invariant q */
-        if ((m->model == PIOLA_MODEL_NEOHOOKEAN || m->model == PIOLA_MODEL_MUSCLE) && i == j &&
-            j == k)
+        if ((m->model == PIOLA_MODEL_NEOHOOKEAN || m->model == PIOLA_MODEL_MUSCLE ||
+             MATERIAL_IS_OGDEN(m->model)) &&
+            i == j && j == k)
           tq = 2.0 / (f[i] * f[i] * f[i]);
         else if ((m->model == PIOLA_MODEL_COROTATED || m->model == PIOLA_MODEL_SPLINE ||
                   m->model == PIOLA_MODEL_STABLE_NEOHOOKEAN) &&

@@ -79,8 +79,19 @@ enum {
   SNH_REST = 3,   /* J/m^3: lambda'/2 (1 - alpha)^2, the J term's value at rest */
   ENERGY_SLOPE = 4, /* Pa: k0, the energy extension's diagonal slope at rest (every model) */
   ENERGY_GROWTH_2 = 5, /* Pa: a2, its growth with the clamped point's stretch (see energy_slope) */
-  ENERGY_GROWTH_4 = 6  /* Pa: a4 */
+  ENERGY_GROWTH_4 = 6, /* Pa: a4 */
+  OGDEN_COUNT = 7,     /* Ogden and Mooney-Rivlin (as two Ogden terms): the number of terms */
+  OGDEN_MU_SUM = 8,    /* Pa: sum_p mu_p, the coefficient of -ln J */
+  OGDEN_TERMS = 9      /* mu_p (Pa) at OGDEN_TERMS + 2 p, alpha_p at OGDEN_TERMS + 2 p + 1 */
 };
+
+/* Ogden and Mooney-Rivlin share one code path (Mooney-Rivlin is stored as the Ogden terms
+ * (2 C10, 2), (-2 C01, -2)). */
+#define MATERIAL_IS_OGDEN(model) ((model) == PIOLA_MODEL_OGDEN || (model) == PIOLA_MODEL_MOONEY_RIVLIN)
+
+/* f^a for f > 0 (clamped entries): libm's pow. Not vectorizable; the Ogden models have no
+ * speed target. */
+MATERIAL_KERNEL double kernel_pow(double f, double a) { return pow(f, a); }
 
 
 /* max and min as selects. C's fmax/fmin must return the non-NaN operand, which x86 vector
@@ -208,6 +219,21 @@ MATERIAL_KERNEL void entry_slope_curvature(piola_material_model model, const pio
       *a1 = m->model_constants[SNH_MU] * f;
       *a2 = m->model_constants[SNH_MU];
       return;
+    case PIOLA_MODEL_MOONEY_RIVLIN:
+    case PIOLA_MODEL_OGDEN: { /* A = sum_p mu_p / alpha_p (f^alpha_p - 1) - M ln f */
+      const double *o = m->model_constants;
+      const double inv = kernel_recip(f, dv), msum = o[OGDEN_MU_SUM];
+      double s1 = 0.0, s2 = 0.0;
+      for (int p = 0; p < (int)o[OGDEN_COUNT]; ++p) {
+        const double mu_p = o[OGDEN_TERMS + 2 * p], alpha = o[OGDEN_TERMS + 2 * p + 1];
+        const double fa = kernel_pow(f, alpha - 1.0); /* f^(alpha - 1) */
+        s1 += mu_p * fa;
+        s2 += mu_p * (alpha - 1.0) * fa * inv;
+      }
+      *a1 = s1 - msum * inv;
+      *a2 = s2 + msum * inv * inv;
+      return;
+    }
     case PIOLA_MODEL_ROTATED_LINEAR:
     case PIOLA_MODEL_COROTATED:
     default: /* A = mu (f - 1)^2 */
@@ -235,7 +261,9 @@ MATERIAL_KERNEL double invariant_terms(piola_material_model model, const piola_m
       h[0][0] = h[1][1] = h[2][2] = 2.0;
       return f0 * f0 + f1 * f1 + f2 * f2 - 3.0;
     case PIOLA_MODEL_NEOHOOKEAN:
-    case PIOLA_MODEL_MUSCLE: { /* q = ln J, kappa = lambda */
+    case PIOLA_MODEL_MUSCLE:
+    case PIOLA_MODEL_MOONEY_RIVLIN:
+    case PIOLA_MODEL_OGDEN: { /* q = ln J, kappa = lambda */
       *kappa = m->lambda;
       const double i0 = kernel_recip(f0, dv), i1 = kernel_recip(f1, dv), i2 = kernel_recip(f2, dv);
       g[0] = i0, g[1] = i1, g[2] = i2;
@@ -452,7 +480,9 @@ MATERIAL_KERNEL void material_derive_constants(piola_material *m) {
     m->model_constants[SNH_ALPHA] = alpha;
     m->model_constants[SNH_REST] = 0.5 * lambda_s * (1.0 - alpha) * (1.0 - alpha);
   }
-  const piola_material_model model = m->model == PIOLA_MODEL_MUSCLE ? PIOLA_MODEL_NEOHOOKEAN : m->model;
+  const piola_material_model model = m->model == PIOLA_MODEL_MUSCLE        ? PIOLA_MODEL_NEOHOOKEAN
+                                     : m->model == PIOLA_MODEL_MOONEY_RIVLIN ? PIOLA_MODEL_OGDEN
+                                                                             : m->model;
   const double c = m->threshold;
   material_parts pa;
   material_model_parts(model, m, KERNEL_EXACT_DIVIDE, c, c, c, &pa);
@@ -544,6 +574,16 @@ MATERIAL_KERNEL double entry_energy(piola_material_model model, const piola_mate
     }
     case PIOLA_MODEL_STABLE_NEOHOOKEAN:
       return 0.5 * m->model_constants[SNH_MU] * (f * f - 1.0);
+    case PIOLA_MODEL_MOONEY_RIVLIN:
+    case PIOLA_MODEL_OGDEN: {
+      const double *o = m->model_constants;
+      double a = -o[OGDEN_MU_SUM] * kernel_log(f);
+      for (int p = 0; p < (int)o[OGDEN_COUNT]; ++p) {
+        const double alpha = o[OGDEN_TERMS + 2 * p + 1];
+        a += o[OGDEN_TERMS + 2 * p] / alpha * (kernel_pow(f, alpha) - 1.0);
+      }
+      return a;
+    }
     case PIOLA_MODEL_ROTATED_LINEAR:
     case PIOLA_MODEL_COROTATED:
     default:
@@ -638,6 +678,10 @@ MATERIAL_KERNEL void spline_stress(const piola_material *m, double f0, double f1
                                    double *p0, double *p1, double *p2) {
   material_extended_stress(PIOLA_MODEL_SPLINE, m, KERNEL_EXACT_DIVIDE, f0, f1, f2, p0, p1, p2);
 }
+MATERIAL_KERNEL void ogden_stress(const piola_material *m, double f0, double f1, double f2,
+                                  double *p0, double *p1, double *p2) {
+  material_extended_stress(PIOLA_MODEL_OGDEN, m, KERNEL_EXACT_DIVIDE, f0, f1, f2, p0, p1, p2);
+}
 MATERIAL_KERNEL void stable_neohookean_stress(const piola_material *m, double f0, double f1,
                                               double f2, double *p0, double *p1, double *p2) {
   material_extended_stress(PIOLA_MODEL_STABLE_NEOHOOKEAN, m, KERNEL_EXACT_DIVIDE, f0, f1, f2, p0,
@@ -690,6 +734,10 @@ MATERIAL_KERNEL void spline_stress_lanes(const piola_material *m, double f0, dou
                                       double *p0, double *p1, double *p2) {
   material_extended_stress(PIOLA_MODEL_SPLINE, m, KERNEL_FAST_RECIPROCAL, f0, f1, f2, p0, p1, p2);
 }
+MATERIAL_KERNEL void ogden_stress_lanes(const piola_material *m, double f0, double f1, double f2,
+                                        double *p0, double *p1, double *p2) {
+  material_extended_stress(PIOLA_MODEL_OGDEN, m, KERNEL_FAST_RECIPROCAL, f0, f1, f2, p0, p1, p2);
+}
 MATERIAL_KERNEL void stable_neohookean_stress_lanes(const piola_material *m, double f0, double f1,
                                                     double f2, double *p0, double *p1, double *p2) {
   material_extended_stress(PIOLA_MODEL_STABLE_NEOHOOKEAN, m, KERNEL_FAST_RECIPROCAL, f0, f1, f2, p0,
@@ -737,6 +785,7 @@ MATERIAL_ENERGY_MODE_KERNELS(stvk, PIOLA_MODEL_STVK)
 MATERIAL_ENERGY_MODE_KERNELS(neohookean, PIOLA_MODEL_NEOHOOKEAN)
 MATERIAL_ENERGY_MODE_KERNELS(spline, PIOLA_MODEL_SPLINE)
 MATERIAL_ENERGY_MODE_KERNELS(stable_neohookean, PIOLA_MODEL_STABLE_NEOHOOKEAN)
+MATERIAL_ENERGY_MODE_KERNELS(ogden, PIOLA_MODEL_OGDEN)
 #undef MATERIAL_ENERGY_MODE_KERNELS
 
 /* Run-time dispatch, for scalar callers. In a loop, switch on m->model outside the loop and
@@ -761,6 +810,10 @@ MATERIAL_KERNEL void material_stress_kernel(const piola_material *m, double f0, 
       case PIOLA_MODEL_STABLE_NEOHOOKEAN:
         stable_neohookean_stress_energy_mode(m, f0, f1, f2, p0, p1, p2);
         return;
+      case PIOLA_MODEL_MOONEY_RIVLIN:
+      case PIOLA_MODEL_OGDEN:
+        ogden_stress_energy_mode(m, f0, f1, f2, p0, p1, p2);
+        return;
       case PIOLA_MODEL_ROTATED_LINEAR:
       default:
         rotated_linear_stress_energy_mode(m, f0, f1, f2, p0, p1, p2);
@@ -783,6 +836,10 @@ MATERIAL_KERNEL void material_stress_kernel(const piola_material *m, double f0, 
       return;
     case PIOLA_MODEL_STABLE_NEOHOOKEAN:
       stable_neohookean_stress(m, f0, f1, f2, p0, p1, p2);
+      return;
+    case PIOLA_MODEL_MOONEY_RIVLIN:
+    case PIOLA_MODEL_OGDEN:
+      ogden_stress(m, f0, f1, f2, p0, p1, p2);
       return;
     case PIOLA_MODEL_ROTATED_LINEAR:
     default:
@@ -813,6 +870,10 @@ MATERIAL_KERNEL void neohookean_stress_energy(const piola_material *m, double f0
 MATERIAL_KERNEL void spline_stress_energy(const piola_material *m, double f0, double f1, double f2,
                                           double *p0, double *p1, double *p2, double *psi) {
   material_extended_stress_energy(PIOLA_MODEL_SPLINE, m, f0, f1, f2, p0, p1, p2, psi);
+}
+MATERIAL_KERNEL void ogden_stress_energy(const piola_material *m, double f0, double f1, double f2,
+                                         double *p0, double *p1, double *p2, double *psi) {
+  material_extended_stress_energy(PIOLA_MODEL_OGDEN, m, f0, f1, f2, p0, p1, p2, psi);
 }
 MATERIAL_KERNEL void stable_neohookean_stress_energy(const piola_material *m, double f0,
                                                      double f1, double f2, double *p0, double *p1,
@@ -845,6 +906,10 @@ MATERIAL_KERNEL void material_stress_energy_kernel(const piola_material *m, doub
         material_energy_extended_stress_energy(PIOLA_MODEL_STABLE_NEOHOOKEAN, m, f0, f1, f2, p0, p1,
                                                p2, psi);
         return;
+      case PIOLA_MODEL_MOONEY_RIVLIN:
+      case PIOLA_MODEL_OGDEN:
+        material_energy_extended_stress_energy(PIOLA_MODEL_OGDEN, m, f0, f1, f2, p0, p1, p2, psi);
+        return;
       default:
         material_energy_extended_stress_energy(PIOLA_MODEL_ROTATED_LINEAR, m, f0, f1, f2, p0, p1, p2,
                                                psi);
@@ -867,6 +932,10 @@ MATERIAL_KERNEL void material_stress_energy_kernel(const piola_material *m, doub
       return;
     case PIOLA_MODEL_STABLE_NEOHOOKEAN:
       stable_neohookean_stress_energy(m, f0, f1, f2, p0, p1, p2, psi);
+      return;
+    case PIOLA_MODEL_MOONEY_RIVLIN:
+    case PIOLA_MODEL_OGDEN:
+      ogden_stress_energy(m, f0, f1, f2, p0, p1, p2, psi);
       return;
     case PIOLA_MODEL_ROTATED_LINEAR:
     default:

@@ -468,7 +468,7 @@ MATERIAL_KERNEL double material_mixed_third(piola_material_model model, const pi
  * user's E and nu, like every other model.
  * The energy extension's slope k (PIOLA_INVERSION_ENERGY, every model): the rest stiffness
  * 2 mu + lambda plus what the model's couplings at the point collapse (c, c, c) could take
- * away from it (2 |K_01| + |T| c) and the tension of an entry at the threshold at (c, c, c)
+ * away from it (2 max(-K_01, 0) + max(T, 0) c) and the tension of an entry at the threshold at (c, c, c)
  * and with the other two stretched to 2 (max(p_0, 0) / c each), so that a collapsed, flat or
  * inverted entry is pushed back up to that lateral stretch (docs/materials.md). */
 MATERIAL_KERNEL void material_derive_constants(piola_material *m) {
@@ -489,8 +489,8 @@ MATERIAL_KERNEL void material_derive_constants(piola_material *m) {
   const double t = material_mixed_third(model, m, KERNEL_EXACT_DIVIDE, c, c, c);
   material_parts stretched; /* one entry at c, the others stretched to 2 */
   material_model_parts(model, m, KERNEL_EXACT_DIVIDE, c, 2.0, 2.0, &stretched);
-  m->model_constants[ENERGY_SLOPE] = 2.0 * m->mu + m->lambda + 2.0 * fabs(pa.k[0][1]) +
-                                     fabs(t) * c + kernel_max(pa.p[0], 0.0) / c +
+  m->model_constants[ENERGY_SLOPE] = 2.0 * m->mu + m->lambda + 2.0 * kernel_max(-pa.k[0][1], 0.0) +
+                                     kernel_max(t, 0.0) * c + kernel_max(pa.p[0], 0.0) / c +
                                      kernel_max(stretched.p[0], 0.0) / c;
   /* The volume terms make p_i(c, s, s) grow like lambda s^2 (trace, |f|^2, ln J) or
    * lambda c s^4 (J): the growth terms keep k above 2 p_i / c (restoring, and psi_E bounded

@@ -18,7 +18,9 @@
  * result is finite for every Fhat with entries up to 1e30 in magnitude (flat, collapsed and
  * inverted included; only the models' own growth, e.g. corotated's energy ~ f^6, overflows
  * far beyond that), and every entry f_i <= 0 gets Phat_i < 0: an inverted element is always
- * pushed back. See docs/materials.md.
+ * pushed back. PIOLA_INVERSION_ENERGY extends the energy instead (Stomakhin et al. 2012): the
+ * stress is then the exact gradient of the reported energy everywhere and the derivative is
+ * a symmetric Hessian. See docs/materials.md.
  *
  * Usage:
  *   piola_material_def def = piola_default_material_def();

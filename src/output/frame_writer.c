@@ -16,9 +16,9 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "common/status_internal.h"
-#include "io/atomic_file.h"
+#include "common/status_report.h"
 #include "output/output_internal.h"
+#include "piola/files.h"
 #include "piola/mesh_io.h"
 #include "piola/world_shells.h"
 
@@ -165,27 +165,27 @@ piola_status piola_output_open(const char *dir, bool force, const piola_world *w
 }
 
 static piola_status write_text(const char *path, const char *text, size_t len) {
-  atomic_file f;
-  PIOLA_TRY(atomic_file_open(&f, path));
+  piola_atomic_file f;
+  PIOLA_TRY(piola_atomic_file_open(&f, path));
   if (len && fwrite(text, 1, len, f.stream) != len) {
-    atomic_file_abort(&f);
+    piola_atomic_file_abort(&f);
     return PIOLA_FAIL(PIOLA_ERROR_IO, "%s: write failed", path);
   }
-  return atomic_file_commit(&f);
+  return piola_atomic_file_commit(&f);
 }
 
 static piola_status write_pvd(piola_output *o) {
   char path[4200];
   snprintf(path, sizeof path, "%s/sim.pvd", o->dir);
-  atomic_file f;
-  PIOLA_TRY(atomic_file_open(&f, path));
+  piola_atomic_file f;
+  PIOLA_TRY(piola_atomic_file_open(&f, path));
   fprintf(f.stream, "<?xml version=\"1.0\"?>\n<VTKFile type=\"Collection\" version=\"0.1\" "
                     "byte_order=\"LittleEndian\">\n  <Collection>\n");
   for (int32_t i = 0; i < o->pvd_count; ++i)
     fprintf(f.stream, "    <DataSet timestep=\"%.17g\" group=\"\" part=\"0\" file=\"frames/frame_%04d.vtu\"/>\n",
             o->pvd[i].time, (int)o->pvd[i].frame);
   fprintf(f.stream, "  </Collection>\n</VTKFile>\n");
-  return atomic_file_commit(&f);
+  return piola_atomic_file_commit(&f);
 }
 
 piola_status piola_output_write_frame(piola_output *o, const piola_world *world,
@@ -306,8 +306,8 @@ piola_status piola_output_write_failure_report(piola_output *o, const piola_worl
                                                const char *message) {
   char path[4200];
   snprintf(path, sizeof path, "%s/failure_report.txt", o->dir);
-  atomic_file f;
-  PIOLA_TRY(atomic_file_open(&f, path));
+  piola_atomic_file f;
+  PIOLA_TRY(piola_atomic_file_open(&f, path));
   fprintf(f.stream, "piola run stopped: %s\n", message ? message : "(no message)");
   fprintf(f.stream, "last good state: t = %.9g s (frames written up to that point are complete)\n\n",
           piola_world_time(world));
@@ -325,7 +325,7 @@ piola_status piola_output_write_failure_report(piola_output *o, const piola_worl
             st.kinetic_energy, st.elastic_energy);
     ranked *r = malloc((size_t)(t > 0 ? t : 1) * sizeof *r);
     if (!r) {
-      atomic_file_abort(&f);
+      piola_atomic_file_abort(&f);
       return PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "failure report: out of memory");
     }
     for (int pass = 0; pass < 2; ++pass) {
@@ -347,5 +347,5 @@ piola_status piola_output_write_failure_report(piola_output *o, const piola_worl
     }
     free(r);
   }
-  return atomic_file_commit(&f);
+  return piola_atomic_file_commit(&f);
 }

@@ -3,7 +3,7 @@
  * ones on nodes they both select. */
 #include <stdlib.h>
 
-#include "common/status_internal.h"
+#include "common/status_report.h"
 #include "math/mat3.h"
 #include "sim/world_internal.h"
 

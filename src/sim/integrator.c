@@ -17,9 +17,9 @@
 #include <math.h>
 #include <string.h>
 
-#include "common/status_internal.h"
-#include "math/mat3.h"
+#include "common/status_report.h"
 #include "force/elastic_body_internal.h"
+#include "math/mat3.h"
 #include "sim/conjugate_gradient.h"
 #include "sim/world_internal.h"
 
@@ -107,7 +107,7 @@ static int32_t damping_solve(piola_world *w, world_solid *s, double h, double t,
      * h D e, which a sparse pass over the changed nodes' edges adds. */
     const double ratio = h / s->product_h;
     double *e = s->work;
-#pragma omp parallel for schedule(static) num_threads(piola__thread_count()) \
+#pragma omp parallel for schedule(static) num_threads(piola_thread_count()) \
     if (s->n >= PIOLA_PARALLEL_MIN_VERTICES)
     for (int32_t i = 0; i < s->n; ++i) {
       const int free_node = s->flags[i] == SOLID_FREE;
@@ -122,7 +122,7 @@ static int32_t damping_solve(piola_world *w, world_solid *s, double h, double t,
     }
     piola__elastic_body_damping_forces_add_sparse(s->body, e, beta, alpha, -h, initial_av);
   } else {
-#pragma omp parallel for schedule(static) num_threads(piola__thread_count()) \
+#pragma omp parallel for schedule(static) num_threads(piola_thread_count()) \
     if (s->n >= PIOLA_PARALLEL_MIN_VERTICES)
     for (int32_t i = 0; i < s->n; ++i) {
       if (s->flags[i] != SOLID_FREE) continue;
@@ -240,7 +240,7 @@ static piola_status step_solid(piola_world *w, world_solid *s, double t, double 
   gravity_at(w, t, g0);
   gravity_at(w, t1, g1);
   /* 1. v~ (with the copies of the old state, in the same pass) */
-#pragma omp parallel for schedule(static) num_threads(piola__thread_count()) \
+#pragma omp parallel for schedule(static) num_threads(piola_thread_count()) \
     if (n >= PIOLA_PARALLEL_MIN_VERTICES)
   for (int32_t i = 0; i < n; ++i)
     for (int k = 0; k < 3; ++k) {
@@ -279,7 +279,7 @@ static piola_status step_solid(piola_world *w, world_solid *s, double t, double 
   piola__step_profile_mark(&w->profile, STEP_PHASE_SOLVE1);
 
   /* 2. x~, and v back to v^n for 3. */
-#pragma omp parallel for schedule(static) num_threads(piola__thread_count()) \
+#pragma omp parallel for schedule(static) num_threads(piola_thread_count()) \
     if (n >= PIOLA_PARALLEL_MIN_VERTICES)
   for (int32_t i = 0; i < n; ++i)
     for (int k = 0; k < 3; ++k) {
@@ -310,7 +310,7 @@ static piola_status step_solid(piola_world *w, world_solid *s, double t, double 
      * h D_n e, with D_n e evaluated only on the tets touching those nodes. M x0 - A x0 holds
      * h D_n x0 to the rounding of M x0, the size of the rounding of M v' in the sum. */
     double *hd = initial_av;
-#pragma omp parallel for schedule(static) num_threads(piola__thread_count()) \
+#pragma omp parallel for schedule(static) num_threads(piola_thread_count()) \
     if (n >= PIOLA_PARALLEL_MIN_VERTICES)
     for (int32_t i = 0; i < n; ++i) {
       double *x0 = s->tmp + 3 * i;
@@ -322,7 +322,7 @@ static piola_status step_solid(piola_world *w, world_solid *s, double t, double 
       }
     }
     piola__elastic_body_damping_forces_add_sparse(s->body, s->tmp, beta0, alpha0, -h, hd);
-#pragma omp parallel for schedule(static) num_threads(piola__thread_count()) \
+#pragma omp parallel for schedule(static) num_threads(piola_thread_count()) \
     if (n >= PIOLA_PARALLEL_MIN_VERTICES)
     for (int32_t i = 0; i < n; ++i)
       for (int k = 0; k < 3; ++k)
@@ -358,7 +358,7 @@ static piola_status step_solid(piola_world *w, world_solid *s, double t, double 
   piola__step_profile_mark(&w->profile, STEP_PHASE_PREPARE);
 
   /* 4. trapezoidal velocity, damping at n+1 implicit, normal velocity of contacts held */
-#pragma omp parallel for schedule(static) num_threads(piola__thread_count()) \
+#pragma omp parallel for schedule(static) num_threads(piola_thread_count()) \
     if (n >= PIOLA_PARALLEL_MIN_VERTICES)
   for (int32_t i = 0; i < n; ++i)
     for (int k = 0; k < 3; ++k)
@@ -371,7 +371,7 @@ static piola_status step_solid(piola_world *w, world_solid *s, double t, double 
   stats->cg_iterations += damping_solve(w, s, h, t1, 1, s->rhs, s->v, gravity2,
                                         colliding > 0 || keep_product ? av : NULL, NULL, NULL, 0);
   if (keep_product) {
-#pragma omp parallel for schedule(static) num_threads(piola__thread_count()) \
+#pragma omp parallel for schedule(static) num_threads(piola_thread_count()) \
     if (n >= PIOLA_PARALLEL_MIN_VERTICES)
     for (int64_t j = 0; j < m; ++j) s->v_product[j] = s->v[j];
     s->product_h = h;
@@ -388,7 +388,7 @@ static piola_status step_solid(piola_world *w, world_solid *s, double t, double 
   enum { CHECK_RANGES = 16 };
   double kinetic_part[CHECK_RANGES], force2_part[CHECK_RANGES];
   int64_t bad_part[CHECK_RANGES];
-#pragma omp parallel for schedule(static) num_threads(piola__thread_count()) \
+#pragma omp parallel for schedule(static) num_threads(piola_thread_count()) \
     if (n >= PIOLA_PARALLEL_MIN_VERTICES)
   for (int r = 0; r < CHECK_RANGES; ++r) {
     double ke = 0, f2 = 0;

@@ -36,7 +36,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "common/status_internal.h"
+#include "common/status_report.h"
 #include "piola/collision_surface.h"
 #include "sim/world_internal.h"
 

@@ -12,7 +12,7 @@
  * CFL altitude is divided by the bound the plastic update reports (at most e^limit). */
 #include <math.h>
 
-#include "common/status_internal.h"
+#include "common/status_report.h"
 #include "sim/world_internal.h"
 
 piola_status piola__solid_plastic_create(world_solid *s, const piola_solid_def *def) {

@@ -29,6 +29,7 @@
 #include "piola/status.h"
 #include "piola/threads.h"
 #include "piola/world.h"
+#include "piola/world_bodies.h"
 #include "piola/world_bones.h"
 #include "piola/world_shells.h"
 

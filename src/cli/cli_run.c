@@ -24,16 +24,19 @@
 
 static void usage(FILE *out) {
   fprintf(out,
-          "usage: piola run SCENE.json -o DIR [--threads N] [--frames N] [--force]\n"
+          "usage: piola run SCENE.json -o DIR [--threads N] [--frames N] [--force] [--render]\n"
           "\n"
           "  -o, --output DIR   folder for frames/, surface/, stats.csv and sim.pvd\n"
-          "  --threads N        worker threads (default: all cores)\n"
-          "  --frames N         write N frames instead of the scene's `frames`\n"
+          "  --threads N        worker threads, 1 to 1024 (default: all cores)\n"
+          "  --frames N         write N frames after frame 0 instead of the scene's `frames`\n"
           "  --force            write into DIR even if it holds earlier results\n"
+          "                     (the earlier run's frames, surfaces, stats.csv, sim.pvd and\n"
+          "                     failure_report.txt are removed first, nothing else)\n"
           "  --render           also render every frame to DIR/render/frame_NNNN.png\n"
           "                     (DIR/preview.png of the last frame is always written)\n"
-          "                     (earlier frames, stats.csv and sim.pvd are removed)\n"
-          "  -h, --help         this text\n");
+          "  -h, --help         this text\n"
+          "\n"
+          "`piola check SCENE.json` validates a scene and estimates its run without writing.\n");
 }
 
 static double now_seconds(void) {

@@ -426,7 +426,7 @@ static piola_status parse_generator(parser *p, const cJSON *obj, piola_mesher_de
   PIOLA_TRY(opt_vec3(p, obj, "half_extents", POSITIVE, &s->half_extents));
   PIOLA_TRY(opt_number(p, obj, "cell_size", POSITIVE, &m->cell_size));
   int64_t levels = m->refinement_levels;
-  PIOLA_TRY(opt_int(p, obj, "refinement_levels", 0, 8, &levels));
+  PIOLA_TRY(opt_int(p, obj, "refinement_levels", 0, 6, &levels));
   m->refinement_levels = (int)levels;
   if (s->type == PIOLA_SHAPE_TORUS && !(s->minor_radius < s->radius)) {
     push_key(p, "minor_radius");

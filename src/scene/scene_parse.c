@@ -1235,7 +1235,23 @@ static piola_status parse_top(parser *p, const cJSON *root, scene_desc *out) {
     for (const cJSON *e = v->child; e; e = e->next, ++i) {
       size_t o2 = push_index(p, i);
       out->obstacle_count = i + 1;
-      PIOLA_TRY(parse_obstacle(p, e, NULL, &out->obstacles[i]));
+      static const char *const extra[] = {"name", NULL};
+      scene_obstacle_desc *d = &out->obstacles[i];
+      PIOLA_TRY(parse_obstacle(p, e, extra, d));
+      snprintf(d->name, sizeof d->name, "obstacle%d", i);
+      const cJSON *name = get(e, "name");
+      if (name) {
+        size_t o3 = push_key(p, "name");
+        if (!cJSON_IsString(name) || !name->valuestring[0] ||
+            strlen(name->valuestring) >= sizeof d->name)
+          return fail(p, PIOLA_ERROR_PARSE, "must be a non-empty string of at most %d characters",
+                      (int)sizeof d->name - 1);
+        snprintf(d->name, sizeof d->name, "%s", name->valuestring);
+        for (int j = 0; j < i; ++j)
+          if (strcmp(out->obstacles[j].name, d->name) == 0)
+            return fail(p, BAD_VALUE, "\"%s\" is already the name of obstacles[%d]", d->name, j);
+        pop(p, o3);
+      }
       pop(p, o2);
     }
     pop(p, old);

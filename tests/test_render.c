@@ -587,6 +587,60 @@ static void test_deterministic_for_any_thread_count(void **state) {
   test_sphere_free(&s);
 }
 
+/* Once the camera is fitted, planes are a finite floor: a wall (a plane facing sideways)
+ * is not drawn at all, and the floor covers fewer pixels than the same plane unbounded
+ * (drawn by a renderer with the same camera set and never fitted), yet still the pixels
+ * under the framed box. */
+static int count_differing(const piola_image *a, const piola_image *b) {
+  int n = 0;
+  for (int y = 0; y < a->height; ++y)
+    for (int x = 0; x < a->width; ++x) n += !same_rgb(a, b, x, y);
+  return n;
+}
+
+static void test_fitted_planes_are_a_finite_floor(void **state) {
+  (void)state;
+  piola_render_def def = piola_default_render_def();
+  def.width = 320, def.height = 240;
+  def.ground = false;
+  def.shadows = false;
+  piola_obstacle_def floor_def = piola_default_obstacle_def(), wall = piola_default_obstacle_def();
+  floor_def.type = wall.type = PIOLA_OBSTACLE_PLANE;
+  floor_def.center = (piola_vec3){0, 0, -0.5};
+  floor_def.axis = (piola_vec3){0, 0, 1};
+  wall.center = (piola_vec3){0, 2, 0}; /* behind the box, facing the camera */
+  wall.axis = (piola_vec3){0, -1, 0};
+  piola_vec3 lo = {-0.5, -0.5, -0.5}, hi = {0.5, 0.5, 0.5};
+  piola_image sky = {0}, with_wall = {0}, fitted = {0}, unbounded = {0};
+  piola_renderer *r;
+  assert_int_equal(piola_renderer_create(&def, &r), PIOLA_OK);
+  piola_renderer_fit_camera(r, lo, hi);
+  piola_vec3 pos, target;
+  piola_renderer_camera(r, &pos, &target);
+  assert_int_equal(piola_renderer_render(r, NULL, &sky), PIOLA_OK);
+  assert_int_equal(piola_renderer_add_obstacle(r, &wall), PIOLA_OK);
+  assert_int_equal(piola_renderer_render(r, NULL, &with_wall), PIOLA_OK);
+  assert_int_equal(count_differing(&sky, &with_wall), 0);
+  assert_int_equal(piola_renderer_add_obstacle(r, &floor_def), PIOLA_OK);
+  assert_int_equal(piola_renderer_render(r, NULL, &fitted), PIOLA_OK);
+  piola_renderer_destroy(r);
+  def.camera_set = true;
+  def.camera_position = pos, def.camera_target = target;
+  assert_int_equal(piola_renderer_create(&def, &r), PIOLA_OK);
+  assert_int_equal(piola_renderer_add_obstacle(r, &floor_def), PIOLA_OK);
+  assert_int_equal(piola_renderer_render(r, NULL, &unbounded), PIOLA_OK);
+  piola_renderer_destroy(r);
+  int finite = count_differing(&sky, &fitted), whole = count_differing(&sky, &unbounded);
+  assert_true(finite > 0);
+  assert_true(finite < whole);
+  /* the image centre looks at the box centre, above the floor's middle: floor there */
+  assert_false(same_rgb(&sky, &fitted, def.width / 2, def.height - 1));
+  piola_image_free(&sky);
+  piola_image_free(&with_wall);
+  piola_image_free(&fitted);
+  piola_image_free(&unbounded);
+}
+
 static void test_bad_arguments_are_refused(void **state) {
   (void)state;
   piola_renderer *r = NULL;
@@ -631,6 +685,7 @@ int main(void) {
       cmocka_unit_test(test_shadow_of_a_sphere_on_the_ground),
       cmocka_unit_test(test_supersampling_averages_a_larger_render),
       cmocka_unit_test(test_deterministic_for_any_thread_count),
+      cmocka_unit_test(test_fitted_planes_are_a_finite_floor),
       cmocka_unit_test(test_bad_arguments_are_refused),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);

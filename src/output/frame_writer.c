@@ -41,6 +41,7 @@ struct piola_output {
   size_t csv_len, csv_cap;
   pvd_entry *pvd;
   int32_t pvd_count, pvd_cap;
+  obj_layout obj;           /* the OBJ surface: one object per body (obj_frame.c) */
 };
 
 static piola_status csv_append(piola_output *o, const char *line) {
@@ -66,6 +67,7 @@ void piola_output_close(piola_output *o) {
   piola_tri_mesh_free(&o->shells);
   free(o->rest), free(o->velocity), free(o->displacement), free(o->det_f), free(o->inverted);
   free(o->energy), free(o->solid), free(o->csv), free(o->pvd);
+  piola__obj_layout_free(&o->obj);
   free(o);
 }
 
@@ -151,6 +153,30 @@ piola_status piola_output_open(const char *dir, bool force, const piola_world *w
       o->surface.triangle_count = base + snt;
       o->surface.vertex_count = nv + snv;
     }
+  }
+  if (st == PIOLA_OK) {
+    /* bodies in point order: the solids, then the shells */
+    int32_t nb = ns + piola_world_shell_count(world);
+    int32_t *first = malloc((size_t)(nb + 1) * sizeof *first);
+    const char **names = malloc((size_t)(nb > 0 ? nb : 1) * sizeof *names);
+    if (!first || !names) st = PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "output: out of memory");
+    else {
+      int32_t v = 0;
+      for (int32_t b = 0; b < nb; ++b) {
+        first[b] = v;
+        if (b < ns) {
+          v += piola_elastic_body_vertex_count(piola_world_solid_body(world, b));
+          names[b] = piola_world_solid_name(world, b);
+        } else {
+          v += piola_shell_body_vertex_count(piola_world_shell_body(world, b - ns));
+          names[b] = piola_world_shell_name(world, b - ns);
+        }
+      }
+      first[nb] = v;
+      st = piola__obj_layout_build(&o->surface, first, nb, names, nv + snv, &o->obj);
+    }
+    free(first);
+    free(names);
   }
   if (st == PIOLA_OK) st = piola__output_prepare_folder(dir, force);
   if (st == PIOLA_OK) st = csv_append(o, "frame,time,substeps,cg_iterations,kinetic_energy,elastic_energy,"
@@ -267,11 +293,8 @@ piola_status piola_output_write_frame(piola_output *o, const piola_world *world,
                            .cell_field_count = 4, .positions = o->tets.positions};
   snprintf(path, sizeof path, "%s/frames/frame_%04d.vtu", o->dir, (int)info->frame);
   PIOLA_TRY(piola_vtu_write(path, &frame));
-  o->surface.positions = o->tets.positions; /* same numbering; borrowed for the write */
   snprintf(path, sizeof path, "%s/surface/frame_%04d.obj", o->dir, (int)info->frame);
-  piola_status st = piola_tri_mesh_write(path, &o->surface);
-  o->surface.positions = NULL;
-  PIOLA_TRY(st);
+  PIOLA_TRY(piola__obj_layout_write(&o->obj, path, o->tets.positions));
 
   char line[512];
   snprintf(line, sizeof line, "%d,%.17g,%d,%d,%.17g,%.17g,%lld,%.17g,%.6f,%lld,%.17g,%lld,%lld,%d\n",

@@ -1,7 +1,7 @@
 /* A parsed scene, before any mesh is read: the definition structs of the world, its solids
  * and obstacles, plus where each mesh comes from and how it is placed.
  *
- * Parsing (scene_parse.c) and building (scene_build.c) are split so that every syntactic
+ * Parsing (scene_parse*.c) and building (scene_build.c) are split so that every syntactic
  * and range error is found, with its key path, before any file is opened, and so the
  * parser can be tested alone. */
 #ifndef PIOLA_SCENE_SCENE_DESC_H
@@ -91,9 +91,9 @@ typedef struct scene_desc {
   int32_t solid_count;
   scene_obstacle_desc *obstacles;
   int32_t obstacle_count;
-  scene_shell_desc *shells;       /* the `shells` key (scene_parse.c, shells section) */
+  scene_shell_desc *shells;       /* the `shells` key (scene_parse_shell.c) */
   int32_t shell_count;
-  scene_bone_desc *bones;         /* the `bones` key (scene_parse.c, bones section) */
+  scene_bone_desc *bones;         /* the `bones` key (scene_parse_bone.c) */
   int32_t bone_count;
 } scene_desc;
 

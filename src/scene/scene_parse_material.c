@@ -1,0 +1,85 @@
+/* A solid's or shell's `material` key: model, elastic constants, inversion, spline and
+ * muscle parameters. */
+#include <stdio.h>
+#include <string.h>
+
+#include "piola/material.h"
+#include "scene/scene_parse_sections.h"
+
+piola_status piola__scene_parse_material(scene_parser *p, const cJSON *obj, scene_solid_desc *d) {
+  static const char *const allowed[] = {"model", "youngs_modulus", "poisson_ratio",
+                                        "stiffness_scale", "inversion", "spline", "muscle", NULL};
+  PIOLA_TRY(piola__json_check_keys(p, obj, allowed));
+  piola_material_def *m = &d->def.material;
+  const cJSON *model = piola__json_get(obj, "model");
+  if (model) {
+    size_t old = piola__json_push_key(p, "model");
+    if (!cJSON_IsString(model) || !piola_material_model_from_name(model->valuestring, &m->model)) {
+      char list[256] = "";
+      for (int i = 0; i < PIOLA_MODEL_COUNT; ++i) {
+        size_t len = strlen(list);
+        snprintf(list + len, sizeof list - len, "%s\"%s\"", i ? ", " : "",
+                 piola_material_model_name((piola_material_model)i));
+      }
+      return piola__json_fail(p, BAD_VALUE, "must be one of %s", list);
+    }
+    piola__json_pop(p, old);
+  }
+  PIOLA_TRY(piola__json_opt_number(p, obj, "youngs_modulus", POSITIVE, &m->youngs_modulus));
+  PIOLA_TRY(piola__json_opt_number(p, obj, "poisson_ratio", (json_range){-1, 0.5, 1, 1},
+                                   &m->poisson_ratio));
+  PIOLA_TRY(piola__json_opt_track(p, obj, "stiffness_scale", NONNEGATIVE, &d->def.stiffness_scale));
+  const cJSON *inv = piola__json_get(obj, "inversion");
+  if (inv) {
+    size_t old = piola__json_push_key(p, "inversion");
+    static const char *const keys[] = {"threshold", "mode", NULL};
+    PIOLA_TRY(piola__json_check_keys(p, inv, keys));
+    PIOLA_TRY(piola__json_opt_number(p, inv, "threshold", (json_range){0, 1, 1, 1},
+                                     &m->inversion_threshold));
+    const cJSON *mode = piola__json_get(inv, "mode");
+    if (mode) {
+      size_t o2 = piola__json_push_key(p, "mode");
+      if (!cJSON_IsString(mode) ||
+          !piola_inversion_mode_from_name(mode->valuestring, &m->inversion_mode))
+        return piola__json_fail(p, BAD_VALUE, "must be \"linear\" or \"clamp\"");
+      piola__json_pop(p, o2);
+    }
+    piola__json_pop(p, old);
+  }
+  const cJSON *sp = piola__json_get(obj, "spline");
+  if (sp) {
+    size_t old = piola__json_push_key(p, "spline");
+    static const char *const keys[] = {"compression_stretch", "elongation_stretch", "stiffening",
+                                       NULL};
+    PIOLA_TRY(piola__json_check_keys(p, sp, keys));
+    PIOLA_TRY(piola__json_opt_number(p, sp, "compression_stretch", (json_range){0, 1, 1, 1},
+                                     &m->spline.compression_stretch));
+    PIOLA_TRY(piola__json_opt_number(p, sp, "elongation_stretch", (json_range){1, INFINITY, 1, 0},
+                                     &m->spline.elongation_stretch));
+    PIOLA_TRY(piola__json_opt_number(p, sp, "stiffening", (json_range){1, INFINITY, 0, 0},
+                                     &m->spline.stiffening));
+    piola__json_pop(p, old);
+  }
+  const cJSON *mu = piola__json_get(obj, "muscle");
+  if (mu) {
+    size_t old = piola__json_push_key(p, "muscle");
+    if (m->model != PIOLA_MODEL_MUSCLE)
+      return piola__json_fail(p, BAD_VALUE, "needs \"model\": \"muscle\"");
+    static const char *const keys[] = {"passive_stiffness", "passive_toe_stretch",
+                                       "max_active_stress", "optimal_stretch", "active_width",
+                                       NULL};
+    PIOLA_TRY(piola__json_check_keys(p, mu, keys));
+    piola_muscle_def *md = &m->muscle;
+    PIOLA_TRY(
+        piola__json_opt_number(p, mu, "passive_stiffness", NONNEGATIVE, &md->passive_stiffness));
+    PIOLA_TRY(piola__json_opt_number(p, mu, "passive_toe_stretch", (json_range){1, INFINITY, 1, 0},
+                                     &md->passive_toe_stretch));
+    PIOLA_TRY(
+        piola__json_opt_number(p, mu, "max_active_stress", NONNEGATIVE, &md->max_active_stress));
+    PIOLA_TRY(piola__json_opt_number(p, mu, "optimal_stretch", POSITIVE, &md->optimal_stretch));
+    PIOLA_TRY(
+        piola__json_opt_number(p, mu, "active_width", (json_range){0, 1, 1, 1}, &md->active_width));
+    piola__json_pop(p, old);
+  }
+  return PIOLA_OK;
+}

@@ -1,0 +1,29 @@
+/* The world's keys: fps, frames, gravity and integrator settings. */
+
+#include "scene/scene_parse_sections.h"
+
+piola_status piola__scene_parse_world(scene_parser *p, const cJSON *obj, scene_desc *out) {
+  const cJSON *v;
+  PIOLA_TRY(piola__json_opt_number(p, obj, "fps", (json_range){0, 10000, 1, 0}, &out->fps));
+  int64_t frames = out->frames;
+  PIOLA_TRY(piola__json_opt_int(p, obj, "frames", 0, 1000000, &frames));
+  out->frames = (int32_t)frames;
+  PIOLA_TRY(piola__json_opt_vec3_tracks(p, obj, "gravity", out->world.gravity));
+  if ((v = piola__json_get(obj, "integrator"))) {
+    size_t old = piola__json_push_key(p, "integrator");
+    static const char *const keys[] = {"max_dt", "cfl", "cg_tolerance", "cg_max_iterations",
+                                       "collision_interval", NULL};
+    PIOLA_TRY(piola__json_check_keys(p, v, keys));
+    PIOLA_TRY(piola__json_opt_number(p, v, "max_dt", (json_range){0, 1, 1, 0}, &out->world.max_dt));
+    PIOLA_TRY(piola__json_opt_number(p, v, "cfl", (json_range){0, 2, 1, 0}, &out->world.cfl));
+    PIOLA_TRY(piola__json_opt_number(p, v, "cg_tolerance", (json_range){0, 1, 1, 1},
+                                     &out->world.cg_tolerance));
+    int64_t it = out->world.cg_max_iterations;
+    PIOLA_TRY(piola__json_opt_int(p, v, "cg_max_iterations", 1, 1000000, &it));
+    out->world.cg_max_iterations = (int32_t)it;
+    PIOLA_TRY(piola__json_opt_number(p, v, "collision_interval", (json_range){0, 1, 0, 0},
+                                     &out->world.collision_interval));
+    piola__json_pop(p, old);
+  }
+  return PIOLA_OK;
+}

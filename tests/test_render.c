@@ -587,6 +587,34 @@ static void test_deterministic_for_any_thread_count(void **state) {
   test_sphere_free(&s);
 }
 
+/* A coarse triangulated sphere lying exactly on an obstacle sphere (every vertex on its
+ * surface, as draped cloth is): the flat triangles cut into the obstacle by their sagitta,
+ * yet the mesh covers the obstacle everywhere around the image centre, with no patches of
+ * the obstacle showing through. */
+static void test_mesh_lying_on_an_obstacle_is_not_pierced(void **state) {
+  (void)state;
+  piola_render_def def = axis_camera(4, 40);
+  piola_obstacle_def ob = piola_default_obstacle_def();
+  ob.type = PIOLA_OBSTACLE_SPHERE;
+  ob.radius = 0.5;
+  test_sphere s = test_uv_sphere(24, 12, 0.5, 0, 0, 0);
+  piola_render_mesh m = sphere_mesh(&s);
+  piola_image only_obstacle = {0}, both = {0};
+  piola_renderer *r;
+  assert_int_equal(piola_renderer_create(&def, &r), PIOLA_OK);
+  assert_int_equal(piola_renderer_add_obstacle(r, &ob), PIOLA_OK);
+  assert_int_equal(piola_renderer_render(r, NULL, &only_obstacle), PIOLA_OK);
+  assert_int_equal(piola_renderer_render(r, &m, &both), PIOLA_OK);
+  piola_renderer_destroy(r);
+  /* the sphere's disk has a radius of about 0.5 * 494 / 4 = 62 pixels: check +-30 */
+  for (int y = def.height / 2 - 30; y <= def.height / 2 + 30; ++y)
+    for (int x = def.width / 2 - 30; x <= def.width / 2 + 30; ++x)
+      assert_false(same_rgb(&only_obstacle, &both, x, y));
+  piola_image_free(&only_obstacle);
+  piola_image_free(&both);
+  test_sphere_free(&s);
+}
+
 /* Once the camera is fitted, planes are a finite floor: a wall (a plane facing sideways)
  * is not drawn at all, and the floor covers fewer pixels than the same plane unbounded
  * (drawn by a renderer with the same camera set and never fitted), yet still the pixels
@@ -685,6 +713,7 @@ int main(void) {
       cmocka_unit_test(test_shadow_of_a_sphere_on_the_ground),
       cmocka_unit_test(test_supersampling_averages_a_larger_render),
       cmocka_unit_test(test_deterministic_for_any_thread_count),
+      cmocka_unit_test(test_mesh_lying_on_an_obstacle_is_not_pierced),
       cmocka_unit_test(test_fitted_planes_are_a_finite_floor),
       cmocka_unit_test(test_bad_arguments_are_refused),
   };

@@ -9,7 +9,10 @@
  * The ground is stored a little deeper than it is (GROUND_DEPTH_BIAS, relative): a solid
  * resting exactly on a plane obstacle (a puddle whose nodes were projected onto it) has the
  * same depth as the plane up to rounding, and a tie must go to the solid, never to the
- * ground it lies on. */
+ * ground it lies on. Traced obstacles are likewise stored OBSTACLE_DEPTH_BIAS_PX pixel
+ * footprints deeper: cloth draped over a sphere rests on it, and its flat triangles cut
+ * into the curved surface by their sagitta (e^2 / 8R, a fraction of a millimetre), so the
+ * obstacle would show through the cloth in patches. Two pixels are invisible as depth. */
 #include <math.h>
 #include <stdlib.h>
 
@@ -20,6 +23,7 @@
 /* Relative depth offset of the ground: 1e-4 of the view depth (0.5 mm at 5 m) is far above
  * float rounding (6e-8) and far below anything a viewer could see through. */
 #define GROUND_DEPTH_BIAS 1e-4
+#define OBSTACLE_DEPTH_BIAS_PX 2.0
 
 /* A plane drawn as a floor fades out over this outer fraction of its half side. */
 #define FLOOR_FADE 0.2
@@ -114,7 +118,7 @@ void piola__render_ray_pass(const piola_renderer *r, const render_camera *cam, d
       double dir_len = vec3_norm(dir);
       vec3 dn = vec3_scale(dir, 1.0 / dir_len);
       double best = INFINITY; /* view depth, m */
-      bool ground_nearest = false;
+      bool ground_nearest = false, obstacle_nearest = false;
       float col[3] = {bg[0], bg[1], bg[2]};
       for (int k = 0; k < np; ++k) {
         const ground_plane *g = &planes[k];
@@ -132,6 +136,7 @@ void piola__render_ray_pass(const piola_renderer *r, const render_camera *cam, d
         }
         best = s;
         ground_nearest = true;
+        obstacle_nearest = false;
         vec3 rel = vec3_sub(p, g->point);
         double u = vec3_dot(rel, g->t1) / checker, v = vec3_dot(rel, g->t2) / checker;
         long parity = ((long)floor(u) + (long)floor(v)) & 1;
@@ -174,6 +179,7 @@ void piola__render_ray_pass(const piola_renderer *r, const render_camera *cam, d
         if (!hit || !(s / dir_len < best)) continue;
         best = s / dir_len;
         ground_nearest = false;
+        obstacle_nearest = true;
         float spec;
         float light = render_light(cam, n, vec3_neg(dn), &spec);
         col[0] = RENDER_OBSTACLE_R * light + 255 * spec;
@@ -181,7 +187,9 @@ void piola__render_ray_pass(const piola_renderer *r, const render_camera *cam, d
         col[2] = RENDER_OBSTACLE_B * light + 255 * spec;
       }
       size_t i = (size_t)y * (size_t)W + (size_t)x;
-      depth[i] = (float)(ground_nearest ? best * (1 + GROUND_DEPTH_BIAS) : best);
+      depth[i] = (float)(ground_nearest     ? best * (1 + GROUND_DEPTH_BIAS)
+                         : obstacle_nearest ? best * (1 + OBSTACLE_DEPTH_BIAS_PX * inv_f)
+                                            : best);
       for (int c = 0; c < 3; ++c) {
         float v = col[c] + 0.5f;
         rgb[3 * i + (size_t)c] = (uint8_t)(v < 0 ? 0 : v > 255 ? 255 : v);

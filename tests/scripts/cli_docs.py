@@ -38,6 +38,14 @@ def main():
     for c in COMMANDS:
         check(re.search(r"^\s+%s\b" % c, top, re.M) is not None, f"piola --help lists `{c}`")
 
+    mesher = open(os.path.join(SOURCE, "docs", "mesher.md")).read()
+    helped = flags(subprocess.run([PIOLA, "mesh", "generate", "--help"], capture_output=True,
+                                  text=True).stdout) - {"--help"}
+    documented = flags(cli_section(mesher, "## Command line"))
+    check(helped == documented, f"piola mesh generate: --help and mesher.md's command line give "
+          f"the same flags (only in --help: {sorted(helped - documented)}, only in the doc: "
+          f"{sorted(documented - helped)})")
+
     doc = open(os.path.join(SOURCE, "docs", "cli.md")).read()
     for args, title in [(["run"], "## piola run"), (["check"], "## piola check"),
                         (["render"], "## piola render"),
@@ -49,6 +57,20 @@ def main():
               f"docs/cli.md (missing: {sorted(helped - documented)})")
         check(documented <= helped, f"piola {' '.join(args)}: every flag docs/cli.md gives is "
               f"in --help (missing: {sorted(documented - helped)})")
+
+    # --refine and a scene's refinement_levels have one range, 0..6 (mesher.md)
+    with tempfile.TemporaryDirectory() as work:
+        p = subprocess.run([PIOLA, "mesh", "generate", "sphere", "--refine", "7", "-o",
+                            os.path.join(work, "x.msh")], capture_output=True, text=True)
+        check(p.returncode == 2, f"mesh generate --refine 7 is refused (rc {p.returncode})")
+        scene = os.path.join(work, "refine.json")
+        with open(scene, "w") as f:
+            json.dump({"solids": [{"mesh": {"generate": "sphere", "radius": 0.1, "cell_size": 0.05,
+                                            "refinement_levels": 7}}]}, f)
+        p = subprocess.run([PIOLA, "check", scene, "--timing-seconds", "0"], capture_output=True,
+                           text=True)
+        check(p.returncode == 2 and "solids[0].mesh.refinement_levels" in p.stderr and "6" in p.stderr,
+              f"a scene's refinement_levels 7 is refused naming the key and the range: {p.stderr.strip()}")
 
     # every ```json block of the docs is a whole scene that piola accepts
     sources = [os.path.join(SOURCE, "README.md")] + sorted(glob.glob(os.path.join(SOURCE, "docs", "*.md")))

@@ -162,11 +162,11 @@ typedef double (*distance_fn)(vec3 p, const piola_shape *s);
 
 static double shape_distance(vec3 p, const piola_shape *s) {
   switch (s->type) {
-    case PIOLA_SHAPE_SPHERE: return shape_sphere_distance(p, s->center, s->radius, NULL);
-    case PIOLA_SHAPE_BOX: return shape_box_distance(p, s->center, s->half_extents, NULL);
-    case PIOLA_SHAPE_TORUS: return shape_torus_distance(p, s->center, s->axis, s->radius, s->minor_radius, NULL);
-    case PIOLA_SHAPE_CYLINDER: return shape_cylinder_distance(p, s->center, s->axis, s->radius, s->half_length, NULL);
-    case PIOLA_SHAPE_CAPSULE: return shape_capsule_distance(p, s->center, s->axis, s->radius, s->half_length, NULL);
+    case PIOLA_SHAPE_SPHERE: return piola__shape_sphere_distance(p, s->center, s->radius, NULL);
+    case PIOLA_SHAPE_BOX: return piola__shape_box_distance(p, s->center, s->half_extents, NULL);
+    case PIOLA_SHAPE_TORUS: return piola__shape_torus_distance(p, s->center, s->axis, s->radius, s->minor_radius, NULL);
+    case PIOLA_SHAPE_CYLINDER: return piola__shape_cylinder_distance(p, s->center, s->axis, s->radius, s->half_length, NULL);
+    case PIOLA_SHAPE_CAPSULE: return piola__shape_capsule_distance(p, s->center, s->axis, s->radius, s->half_length, NULL);
     default: return NAN;
   }
 }

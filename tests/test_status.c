@@ -1,7 +1,7 @@
 /* Status codes and the per-thread error message. */
 #include "test_support.h"
 
-#include "common/status_internal.h"
+#include "common/status_report.h"
 
 static void failure_message_is_kept_until_cleared(void **state) {
   (void)state;

@@ -185,6 +185,18 @@ PIOLA_API const char *piola_inversion_mode_name(piola_inversion_mode mode);
 /* Parses "linear" or "clamp"; false if unknown. */
 PIOLA_API bool piola_inversion_mode_from_name(const char *name, piola_inversion_mode *mode);
 
+/* ------------------------------------------------------------------ membrane models (shells) */
+
+/* In-plane stress Phat (Pa) of a shell at the 2-entry diagonal deformation fhat: the
+ * material's model evaluated at (fhat[0], fhat[1], 1) with the plane-stress Lame parameter
+ * lambda* = 2 mu lambda / (lambda + 2 mu), inversion extension included. */
+PIOLA_API void piola_membrane_stress(const piola_material *material, const double fhat[2],
+                                     double phat[2]);
+
+/* Its energy density (J/m^3); piola_membrane_stress is its derivative. Zero at rest. */
+PIOLA_API double piola_membrane_energy_density(const piola_material *material,
+                                               const double fhat[2]);
+
 #ifdef __cplusplus
 }
 #endif

@@ -67,6 +67,29 @@ PIOLA_API double piola_obstacle_signed_distance(const piola_obstacle *obstacle, 
                                                 piola_vec3 *velocity);
 
 PIOLA_API double piola_obstacle_friction(const piola_obstacle *obstacle);
+PIOLA_API piola_obstacle_type piola_obstacle_shape_type(const piola_obstacle *obstacle);
+
+/* Where an obstacle is at one time: the point x0 of its shape at t = 0 is at
+ * rotation x0 + translation. */
+typedef struct piola_obstacle_pose {
+  piola_mat3 rotation;
+  piola_vec3 translation; /* m */
+} piola_obstacle_pose;
+
+/* The pose at time t (s). Many queries at one time (a renderer tracing rays) compute it once
+ * and pass it to piola_obstacle_posed_distance. */
+PIOLA_API piola_obstacle_pose piola_obstacle_pose_at(const piola_obstacle *obstacle, double t);
+
+/* piola_obstacle_signed_distance (m, negative inside) for the obstacle at pose: the same
+ * value and outward unit normal (written when not NULL) as at the pose's time. */
+PIOLA_API double piola_obstacle_posed_distance(const piola_obstacle *obstacle,
+                                               const piola_obstacle_pose *pose, piola_vec3 p,
+                                               piola_vec3 *normal);
+
+/* A sphere holding the shape at t = 0: centre (m) and radius (m; INFINITY for a plane).
+ * Points outside it at the matching pose are outside the obstacle. */
+PIOLA_API void piola_obstacle_bounding_sphere(const piola_obstacle *obstacle, piola_vec3 *center,
+                                              double *radius);
 
 PIOLA_API void piola_obstacle_destroy(piola_obstacle *obstacle);
 

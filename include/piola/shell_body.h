@@ -46,17 +46,7 @@
 extern "C" {
 #endif
 
-/* ------------------------------------------------------------------ membrane models */
-
-/* In-plane stress Phat (Pa) of a shell at the 2-entry diagonal deformation fhat: the
- * material's model evaluated at (fhat[0], fhat[1], 1) with the plane-stress Lame parameter
- * lambda* = 2 mu lambda / (lambda + 2 mu), inversion extension included. */
-PIOLA_API void piola_membrane_stress(const piola_material *material, const double fhat[2],
-                                     double phat[2]);
-
-/* Its energy density (J/m^3); piola_membrane_stress is its derivative. Zero at rest. */
-PIOLA_API double piola_membrane_energy_density(const piola_material *material,
-                                               const double fhat[2]);
+/* The membrane models (piola_membrane_stress) are in piola/material.h. */
 
 /* ------------------------------------------------------------------ sheet meshes */
 

@@ -33,6 +33,18 @@ PIOLA_API const char *piola_last_error(void);
 /* Clears the calling thread's last error message. */
 PIOLA_API void piola_clear_error(void);
 
+#if defined(__GNUC__) || defined(__clang__)
+#define PIOLA_PRINTF_LIKE(fmt, args) __attribute__((format(printf, fmt, args)))
+#else
+#define PIOLA_PRINTF_LIKE(fmt, args)
+#endif
+
+/* Sets the calling thread's last error message (printf-style format) and returns status
+ * unchanged: how the layers built on the core (scene files, the renderer) and code that
+ * calls back into piola report a failure the way piola's own functions do. */
+PIOLA_API piola_status piola_fail(piola_status status, const char *format, ...)
+    PIOLA_PRINTF_LIKE(2, 3);
+
 #ifdef __cplusplus
 }
 #endif

@@ -16,6 +16,13 @@ extern "C" {
  * omp_get_max_threads()). Process-wide; set it before starting work, not during. */
 PIOLA_API void piola_set_thread_count(int threads);
 
+/* The number of threads a parallel loop uses: the piola_set_thread_count value, or
+ * omp_get_max_threads() when none was set. Every `#pragma omp parallel` in piola (and in
+ * its scene and render layers) says num_threads(piola_thread_count()), so one setting
+ * governs them all without touching the OpenMP default the host program may rely on; loops
+ * keep their own size thresholds, below which they run on one thread. */
+PIOLA_API int piola_thread_count(void);
+
 #ifdef __cplusplus
 }
 #endif

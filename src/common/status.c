@@ -1,6 +1,6 @@
 /* Per-thread last-error message. A thread-local buffer keeps error reporting free of
  * allocation (it must work when allocation itself failed) and safe under OpenMP. */
-#include "common/status_internal.h"
+#include "common/status_report.h"
 
 #include <stdarg.h>
 #include <stdio.h>
@@ -26,7 +26,7 @@ const char *piola_last_error(void) { return last_error_message; }
 
 void piola_clear_error(void) { last_error_message[0] = '\0'; }
 
-piola_status piola__fail(piola_status status, const char *format, ...) {
+piola_status piola_fail(piola_status status, const char *format, ...) {
   /* Callers often wrap the last message ("%s: solids[0]: %s", ..., piola_last_error()):
    * format into a copy first, as the arguments may point into the buffer being written. */
   char message[sizeof last_error_message];

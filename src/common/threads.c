@@ -1,6 +1,6 @@
-/* The thread count piola's parallel loops use (see common/threads.h). Results never depend
+/* The thread count piola's parallel loops use (piola/threads.h). Results never depend
  * on it; only speed does. */
-#include "common/threads.h"
+#include "piola/threads.h"
 
 #include <omp.h>
 
@@ -8,6 +8,6 @@ static int requested_threads = 0;
 
 void piola_set_thread_count(int threads) { requested_threads = threads > 0 ? threads : 0; }
 
-int piola__thread_count(void) {
+int piola_thread_count(void) {
   return requested_threads > 0 ? requested_threads : omp_get_max_threads();
 }

@@ -3,7 +3,7 @@
 
 #include <stdlib.h>
 
-#include "common/threads.h"
+#include "piola/threads.h"
 
 enum { LEAF_SIZE = 4, MAX_DEPTH = 128 };
 
@@ -112,7 +112,7 @@ int piola__bvh_build(piola__bvh *bvh, const piola__box *boxes, int32_t n) {
 void piola__bvh_refit(piola__bvh *bvh, const piola__box *boxes) {
   const int32_t count = bvh->node_count;
   piola__bvh_node *nodes = bvh->nodes;
-#pragma omp parallel for schedule(static) num_threads(piola__thread_count()) if (count >= 4096)
+#pragma omp parallel for schedule(static) num_threads(piola_thread_count()) if (count >= 4096)
   for (int32_t i = 0; i < count; ++i) {
     if (nodes[i].count == 0) continue;
     piola__box *leaf = bvh->leaf_boxes + nodes[i].first;

@@ -5,7 +5,7 @@
 #include <string.h>
 #include <time.h>
 
-#include "common/status_internal.h"
+#include "common/status_report.h"
 #include "contact/contact_internal.h"
 
 piola_collision_body_def piola_default_collision_body_def(void) {

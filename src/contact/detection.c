@@ -5,10 +5,10 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "common/threads.h"
 #include "contact/ccd.h"
 #include "contact/contact_internal.h"
 #include "contact/proximity.h"
+#include "piola/threads.h"
 
 enum {
   SCAN_CHUNK = 4096,   /* scans of fewer than 4 of these candidates run on one thread */
@@ -69,7 +69,7 @@ static int32_t compute_vertex_boxes(piola_collision_surface *s, const double *x0
                                     double dt, box_kind kind) {
   int32_t escaped = 0;
   const int32_t n = s->vertex_count;
-#pragma omp parallel for schedule(static) num_threads(piola__thread_count()) \
+#pragma omp parallel for schedule(static) num_threads(piola_thread_count()) \
     reduction(+ : escaped) if (n >= 8192)
   for (int32_t i = 0; i < n; ++i) {
     const double h = s->vertex_thickness[i];
@@ -92,7 +92,7 @@ static int32_t compute_vertex_boxes(piola_collision_surface *s, const double *x0
 
 /* Triangle and edge boxes: unions of their vertices' boxes. */
 static void compute_primitive_boxes(piola_collision_surface *s) {
-#pragma omp parallel num_threads(piola__thread_count()) if (s->edge_count >= 8192)
+#pragma omp parallel num_threads(piola_thread_count()) if (s->edge_count >= 8192)
   {
 #pragma omp for schedule(static)
     for (int32_t t = 0; t < s->triangle_count; ++t) {
@@ -140,7 +140,7 @@ static int slabs_overlap(const double *a, const double *b) {
 
 /* Slabs of every vertex, triangle and edge from the current vertex boxes. */
 static void compute_slabs(piola_collision_surface *s) {
-#pragma omp parallel num_threads(piola__thread_count()) if (s->edge_count >= 8192)
+#pragma omp parallel num_threads(piola_thread_count()) if (s->edge_count >= 8192)
   {
 #pragma omp for schedule(static)
     for (int32_t i = 0; i < s->vertex_count; ++i)
@@ -532,7 +532,7 @@ static int collect(piola_collision_surface *s, const double *x0, const double *v
   const int32_t total = failed ? 0 : nvt + nee;
   if (!failed && reserve_tasks(s, total)) failed = 1;
   if (!failed) {
-#pragma omp parallel for schedule(dynamic, 1) num_threads(piola__thread_count()) \
+#pragma omp parallel for schedule(dynamic, 1) num_threads(piola_thread_count()) \
     reduction(|                                                                  \
               : failed) if (total >= 64 && s->triangle_count >= 2048)
     for (int32_t i = 0; i < total; ++i) {
@@ -570,7 +570,7 @@ static int scan_candidates(piola_collision_surface *s, const double *x0, const d
                            const uint8_t *skip) {
   const int32_t tasks = s->task_count;
   int failed = 0;
-#pragma omp parallel for schedule(dynamic, 1) num_threads(piola__thread_count()) \
+#pragma omp parallel for schedule(dynamic, 1) num_threads(piola_thread_count()) \
     reduction(|                                                                  \
               : failed) if (s->candidate_count >= 4 * SCAN_CHUNK)
   for (int32_t t = 0; t < tasks; ++t) {
@@ -670,7 +670,7 @@ static int query_marked(piola_collision_surface *s, const double *x0, const doub
     blocks += (len + PIOLA__QUERY_BLOCK - 1) / PIOLA__QUERY_BLOCK;
   }
   int failed = 0;
-#pragma omp parallel num_threads(piola__thread_count()) reduction(| : failed) if (blocks >= 16)
+#pragma omp parallel num_threads(piola_thread_count()) reduction(| : failed) if (blocks >= 16)
   {
     piola__index_list candidates = {0};
 #pragma omp for schedule(dynamic, 1)

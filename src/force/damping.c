@@ -93,7 +93,7 @@ static void damping_pass(const piola_elastic_body *body, const double *v, double
   const int32_t nv = body->vertex_count;
   /* fixed row ranges; each row is summed alone, so the split does not change any bit */
   enum { RANGES = 16 };
-#pragma omp parallel for schedule(static) num_threads(piola__thread_count()) \
+#pragma omp parallel for schedule(static) num_threads(piola_thread_count()) \
     if (nv >= PIOLA_PARALLEL_MIN_VERTICES)
   for (int r = 0; r < RANGES; ++r)
     product_rows(m, v, mass, h, (int32_t)((int64_t)nv * r / RANGES),

@@ -228,7 +228,7 @@ static void reduce_shared(piola__damping_matrix *m, int32_t k) {
 void piola__damping_matrix_assemble(piola__damping_matrix *m, const piola_elastic_body *body,
                                     double shear_viscosity, double bulk_viscosity) {
   const int32_t blocks = body->padded_tet_count / B;
-#pragma omp parallel num_threads(piola__thread_count()) if (blocks >= PIOLA_PARALLEL_MIN_BLOCKS)
+#pragma omp parallel num_threads(piola_thread_count()) if (blocks >= PIOLA_PARALLEL_MIN_BLOCKS)
   {
 #pragma omp for schedule(static)
     for (int k = 0; k < PIOLA_DAMPING_PARTS; ++k)

@@ -4,7 +4,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "common/status_internal.h"
+#include "common/status_report.h"
 #include "force/damping_matrix.h"
 #include "force/elastic_body_internal.h"
 

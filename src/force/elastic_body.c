@@ -9,7 +9,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "common/status_internal.h"
+#include "common/status_report.h"
 #include "force/elastic_body_internal.h"
 #include "force/fiber_lanes.h"
 #include "force/material_lanes.h"
@@ -81,7 +81,7 @@ const double *piola_elastic_body_fhat(const piola_elastic_body *body) { return b
 void piola__elastic_body_gather_forces(const piola_elastic_body *body, double *forces) {
   const int32_t *start = body->incidence_start, *inc = body->incidence;
   const double *tf = body->tet_forces;
-#pragma omp parallel for schedule(static) num_threads(piola__thread_count()) \
+#pragma omp parallel for schedule(static) num_threads(piola_thread_count()) \
     if (body->vertex_count >= PIOLA_PARALLEL_MIN_VERTICES)
   for (int32_t i = 0; i < body->vertex_count; ++i) {
     double fx = 0, fy = 0, fz = 0;
@@ -340,7 +340,7 @@ piola_status piola_elastic_body_update(piola_elastic_body *body, const double *x
      * ranges of blocks, each summed in tet order into its own array, the arrays added in
      * chunk order; which thread runs a chunk changes nothing. */
     double *partial = body->chunk_forces;
-#pragma omp parallel num_threads(piola__thread_count())
+#pragma omp parallel num_threads(piola_thread_count())
     {
 #pragma omp for schedule(static)
       for (int k = 0; k < PIOLA_FORCE_CHUNKS; ++k) {

@@ -34,9 +34,9 @@
 
 #include <stdint.h>
 
-#include "common/threads.h"
 #include "force/damping_matrix.h"
 #include "piola/elastic_body.h"
+#include "piola/threads.h"
 
 #define PIOLA_TET_BLOCK 8
 
@@ -165,7 +165,7 @@ void piola__elastic_body_damping_forces_add_sparse(const piola_elastic_body *bod
 /* Sums the per-tet force buffer into per-vertex forces, in parallel, deterministically. */
 void piola__elastic_body_gather_forces(const piola_elastic_body *body, double *forces);
 
-/* piola__thread_count, the number of threads a parallel loop should use, is in
+/* piola_thread_count, the number of threads a parallel loop should use, is in
  * common/threads.h (included above). */
 
 #endif

@@ -6,7 +6,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "common/status_internal.h"
+#include "common/status_report.h"
 #include "force/fiber_lanes.h"
 #include "force/svd_kernel.h"
 #include "material/muscle_kernels.h"

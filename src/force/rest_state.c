@@ -5,11 +5,11 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "common/status_internal.h"
+#include "common/status_report.h"
 #include "force/elastic_body_internal.h"
 #include "force/fiber_lanes.h"
-#include "mesh/element_input.h"
 #include "math/mat3.h"
+#include "mesh/element_input.h"
 
 /* A rest tet whose |V0| is below this fraction of (longest edge)^3 is degenerate. A regular
  * tet has V0 = 0.118 L^3; 1e-12 rejects only elements that are flat to round-off, whose Dm^-1

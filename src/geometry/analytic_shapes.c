@@ -9,7 +9,7 @@ static vec3 unit_or(vec3 v, vec3 fallback) {
   return n > 1e-300 ? vec3_scale(v, 1.0 / n) : fallback;
 }
 
-void shape_frame(vec3 axis, vec3 *e1, vec3 *e2) {
+void piola__shape_frame(vec3 axis, vec3 *e1, vec3 *e2) {
   /* Pick the world axis least aligned with `axis` to start Gram-Schmidt. */
   vec3 seed = fabs(axis.x) < 0.57 ? vec3_make(1, 0, 0)
               : (fabs(axis.y) < 0.57 ? vec3_make(0, 1, 0) : vec3_make(0, 0, 1));
@@ -18,18 +18,18 @@ void shape_frame(vec3 axis, vec3 *e1, vec3 *e2) {
   *e2 = vec3_cross(axis, *e1);
 }
 
-double shape_sphere_distance(vec3 p, vec3 center, double radius, vec3 *normal) {
+double piola__shape_sphere_distance(vec3 p, vec3 center, double radius, vec3 *normal) {
   vec3 d = vec3_sub(p, center);
   if (normal) *normal = unit_or(d, vec3_make(0, 0, 1));
   return vec3_norm(d) - radius;
 }
 
-double shape_plane_distance(vec3 p, vec3 point, vec3 unit_normal, vec3 *normal) {
+double piola__shape_plane_distance(vec3 p, vec3 point, vec3 unit_normal, vec3 *normal) {
   if (normal) *normal = unit_normal;
   return vec3_dot(vec3_sub(p, point), unit_normal);
 }
 
-double shape_box_distance(vec3 p, vec3 center, vec3 half_extents, vec3 *normal) {
+double piola__shape_box_distance(vec3 p, vec3 center, vec3 half_extents, vec3 *normal) {
   vec3 d = vec3_sub(p, center);
   double q[3] = {fabs(d.x) - half_extents.x, fabs(d.y) - half_extents.y, fabs(d.z) - half_extents.z};
   double s[3] = {d.x < 0 ? -1 : 1, d.y < 0 ? -1 : 1, d.z < 0 ? -1 : 1};
@@ -50,14 +50,14 @@ double shape_box_distance(vec3 p, vec3 center, vec3 half_extents, vec3 *normal) 
 }
 
 /* Distance to a capped cylinder in its 2D (radial, axial) half-plane. */
-double shape_cylinder_distance(vec3 p, vec3 center, vec3 axis, double radius, double half_length,
+double piola__shape_cylinder_distance(vec3 p, vec3 center, vec3 axis, double radius, double half_length,
                                vec3 *normal) {
   vec3 d = vec3_sub(p, center);
   double h = vec3_dot(d, axis);
   vec3 radial = vec3_sub(d, vec3_scale(axis, h));
   double r = vec3_norm(radial);
   vec3 e1, e2;
-  shape_frame(axis, &e1, &e2);
+  piola__shape_frame(axis, &e1, &e2);
   vec3 radial_dir = unit_or(radial, e1);
   vec3 axial_dir = h < 0 ? vec3_neg(axis) : axis;
   double qr = r - radius, qh = fabs(h) - half_length;
@@ -80,24 +80,24 @@ double shape_cylinder_distance(vec3 p, vec3 center, vec3 axis, double radius, do
   return dist;
 }
 
-double shape_capsule_distance(vec3 p, vec3 center, vec3 axis, double radius, double half_length,
+double piola__shape_capsule_distance(vec3 p, vec3 center, vec3 axis, double radius, double half_length,
                               vec3 *normal) {
   vec3 d = vec3_sub(p, center);
   double h = fmax(-half_length, fmin(half_length, vec3_dot(d, axis)));
   vec3 to_segment = vec3_sub(d, vec3_scale(axis, h));
   vec3 e1, e2;
-  shape_frame(axis, &e1, &e2);
+  piola__shape_frame(axis, &e1, &e2);
   if (normal) *normal = unit_or(to_segment, e1);
   return vec3_norm(to_segment) - radius;
 }
 
-double shape_torus_distance(vec3 p, vec3 center, vec3 axis, double major_radius,
+double piola__shape_torus_distance(vec3 p, vec3 center, vec3 axis, double major_radius,
                             double minor_radius, vec3 *normal) {
   vec3 d = vec3_sub(p, center);
   double h = vec3_dot(d, axis);
   vec3 radial = vec3_sub(d, vec3_scale(axis, h));
   vec3 e1, e2;
-  shape_frame(axis, &e1, &e2);
+  piola__shape_frame(axis, &e1, &e2);
   vec3 radial_dir = unit_or(radial, e1);
   vec3 ring_point = vec3_scale(radial_dir, major_radius); /* nearest point of the core circle */
   vec3 to_tube = vec3_sub(d, ring_point);

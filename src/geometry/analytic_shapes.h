@@ -11,20 +11,20 @@
 #include "math/mat3.h"
 
 /* An orthonormal frame (e1, e2, axis) around a unit axis. */
-void shape_frame(vec3 axis, vec3 *e1, vec3 *e2);
+void piola__shape_frame(vec3 axis, vec3 *e1, vec3 *e2);
 
-double shape_sphere_distance(vec3 p, vec3 center, double radius, vec3 *normal);
-double shape_plane_distance(vec3 p, vec3 point, vec3 unit_normal, vec3 *normal);
+double piola__shape_sphere_distance(vec3 p, vec3 center, double radius, vec3 *normal);
+double piola__shape_plane_distance(vec3 p, vec3 point, vec3 unit_normal, vec3 *normal);
 /* Box aligned with the world axes (rotate p into the box frame first for a rotated box). */
-double shape_box_distance(vec3 p, vec3 center, vec3 half_extents, vec3 *normal);
+double piola__shape_box_distance(vec3 p, vec3 center, vec3 half_extents, vec3 *normal);
 /* Capped cylinder: radius around the axis, |height| <= half_length along it. */
-double shape_cylinder_distance(vec3 p, vec3 center, vec3 axis, double radius, double half_length,
+double piola__shape_cylinder_distance(vec3 p, vec3 center, vec3 axis, double radius, double half_length,
                                vec3 *normal);
 /* Capsule: points within radius of the segment center +- half_length axis. */
-double shape_capsule_distance(vec3 p, vec3 center, vec3 axis, double radius, double half_length,
+double piola__shape_capsule_distance(vec3 p, vec3 center, vec3 axis, double radius, double half_length,
                               vec3 *normal);
 /* Torus: tube of minor_radius around the circle of major_radius in the plane normal to axis. */
-double shape_torus_distance(vec3 p, vec3 center, vec3 axis, double major_radius,
+double piola__shape_torus_distance(vec3 p, vec3 center, vec3 axis, double major_radius,
                             double minor_radius, vec3 *normal);
 
 #endif

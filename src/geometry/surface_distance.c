@@ -4,7 +4,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "common/status_internal.h"
+#include "common/status_report.h"
 
 #define LEAF_SIZE 4
 #define FAR_FIELD_RATIO 2.0

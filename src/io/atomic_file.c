@@ -1,4 +1,4 @@
-#include "io/atomic_file.h"
+#include "piola/files.h"
 
 #include <errno.h>
 #include <stdlib.h>
@@ -6,9 +6,9 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
-#include "common/status_internal.h"
+#include "common/status_report.h"
 
-piola_status atomic_file_open(atomic_file *file, const char *path) {
+piola_status piola_atomic_file_open(piola_atomic_file *file, const char *path) {
   memset(file, 0, sizeof *file);
   size_t n = strlen(path);
   if (n == 0 || n + 16 >= sizeof file->target)
@@ -32,7 +32,7 @@ piola_status atomic_file_open(atomic_file *file, const char *path) {
   return PIOLA_OK;
 }
 
-piola_status atomic_file_commit(atomic_file *file) {
+piola_status piola_atomic_file_commit(piola_atomic_file *file) {
   int failed = ferror(file->stream) || fflush(file->stream) != 0;
   int err = errno;
   if (fclose(file->stream) != 0 && !failed) {
@@ -52,7 +52,7 @@ piola_status atomic_file_commit(atomic_file *file) {
   return PIOLA_OK;
 }
 
-void atomic_file_abort(atomic_file *file) {
+void piola_atomic_file_abort(piola_atomic_file *file) {
   if (file->stream) fclose(file->stream);
   file->stream = NULL;
   if (file->temporary[0]) unlink(file->temporary);

@@ -7,10 +7,11 @@
 #include <sys/mman.h>
 #include <sys/stat.h>
 
-#include "common/status_internal.h"
+#include "common/status_report.h"
 #include "io/mesh_io_internal.h"
 #include "io/mesh_writers.h"
 #include "mesh/mesh_internal.h"
+#include "piola/files.h"
 #include "piola/mesh_io.h"
 
 int piola__grow(void **array, size_t *capacity, size_t need, size_t item) {
@@ -25,35 +26,6 @@ int piola__grow(void **array, size_t *capacity, size_t need, size_t item) {
   *array = p;
   *capacity = c;
   return 0;
-}
-
-piola_status piola__read_file(const char *path, char **data, size_t *size) {
-  *data = NULL;
-  *size = 0;
-  FILE *f = fopen(path, "rb");
-  if (!f) return PIOLA_FAIL(PIOLA_ERROR_IO, "%s: cannot open: %s", path, strerror(errno));
-  struct stat st;
-  if (fstat(fileno(f), &st) != 0 || !S_ISREG(st.st_mode)) {
-    fclose(f);
-    return PIOLA_FAIL(PIOLA_ERROR_IO, "%s: not a regular file", path);
-  }
-  size_t n = (size_t)st.st_size;
-  char *buf = malloc(n + 1);
-  if (!buf) {
-    fclose(f);
-    return PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "%s: cannot allocate %zu bytes", path, n);
-  }
-  size_t got = n ? fread(buf, 1, n, f) : 0;
-  int err = ferror(f);
-  fclose(f);
-  if (got != n || err) {
-    free(buf);
-    return PIOLA_FAIL(PIOLA_ERROR_IO, "%s: read error", path);
-  }
-  buf[n] = '\0';
-  *data = buf;
-  *size = n;
-  return PIOLA_OK;
 }
 
 /* A whole input file, memory-mapped when possible: mapping skips the copy into a fresh
@@ -80,7 +52,7 @@ static piola_status load_file(const char *path, loaded_file *f) {
     }
   }
   fclose(stream);
-  return piola__read_file(path, &f->data, &f->size);
+  return piola_read_file(path, 0, &f->data, &f->size);
 }
 
 static void unload_file(loaded_file *f) {

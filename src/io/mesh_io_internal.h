@@ -27,9 +27,6 @@ piola_status piola__read_obj_mem(const char *name, const char *data, size_t size
 piola_status piola__read_off_mem(const char *name, const char *data, size_t size, piola_tri_mesh *out);
 piola_status piola__read_stl_mem(const char *name, const char *data, size_t size, piola_tri_mesh *out);
 
-/* Reads a whole file into a malloc'ed buffer (with a NUL appended, not counted in size). */
-piola_status piola__read_file(const char *path, char **data, size_t *size);
-
 /* Merges vertices with bit-identical coordinates (-0 equals 0); remaps triangles. */
 piola_status piola__weld_vertices(piola_tri_mesh *mesh, const char *source);
 

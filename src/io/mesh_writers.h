@@ -1,4 +1,4 @@
-/* Internal writers, one file per format; all write through atomic_file. */
+/* Internal writers, one file per format; all write through piola_atomic_file. */
 #ifndef PIOLA_IO_MESH_WRITERS_H
 #define PIOLA_IO_MESH_WRITERS_H
 

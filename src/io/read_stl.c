@@ -9,7 +9,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "common/status_internal.h"
+#include "common/status_report.h"
 #include "io/mesh_io_internal.h"
 #include "io/text_scanner.h"
 

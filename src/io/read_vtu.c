@@ -17,10 +17,11 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "common/status_internal.h"
+#include "common/status_report.h"
 #include "io/mesh_io_internal.h"
 #include "io/text_scanner.h"
 #include "mesh/mesh_internal.h"
+#include "piola/files.h"
 
 typedef struct vtu_reader {
   const char *name, *data, *end;
@@ -412,7 +413,7 @@ piola_status piola_vtu_read(const char *path, piola_vtu_data *out) {
   memset(out, 0, sizeof *out);
   char *data = NULL;
   size_t size = 0;
-  PIOLA_TRY(piola__read_file(path, &data, &size));
+  PIOLA_TRY(piola_read_file(path, 0, &data, &size));
   piola_status status = piola__vtu_read_mem(path, data, size, out);
   free(data);
   return status;

@@ -6,7 +6,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "common/status_internal.h"
+#include "common/status_report.h"
 
 void piola__scanner_init(text_scanner *s, const char *name, const char *data, size_t size, char comment) {
   memset(s, 0, sizeof *s);

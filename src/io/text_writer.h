@@ -2,7 +2,7 @@
  *
  * Mesh files are millions of small integers; printf parses its format string for each one,
  * which made writing several times slower than reading. This writer formats integers by hand
- * into a 64 KiB buffer and hands full buffers to the (atomic_file) stream. Doubles go through
+ * into a 64 KiB buffer and hands full buffers to the (piola_atomic_file) stream. Doubles go through
  * piola__format_double, which guarantees an exact round trip. */
 #ifndef PIOLA_IO_TEXT_WRITER_H
 #define PIOLA_IO_TEXT_WRITER_H

@@ -8,10 +8,10 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "common/status_internal.h"
-#include "io/atomic_file.h"
+#include "common/status_report.h"
 #include "io/mesh_writers.h"
 #include "io/text_writer.h"
+#include "piola/files.h"
 
 static int cmp_int32(const void *a, const void *b) {
   int32_t x = *(const int32_t *)a, y = *(const int32_t *)b;
@@ -34,8 +34,8 @@ piola_status piola__write_gmsh41(const char *path, const piola_tet_mesh *mesh) {
       if (v == 0 || x < lo[k]) lo[k] = x;
       if (v == 0 || x > hi[k]) hi[k] = x;
     }
-  atomic_file f;
-  piola_status s = atomic_file_open(&f, path);
+  piola_atomic_file f;
+  piola_status s = piola_atomic_file_open(&f, path);
   if (s != PIOLA_OK) {
     free(ids);
     return s;
@@ -58,7 +58,7 @@ piola_status piola__write_gmsh41(const char *path, const piola_tet_mesh *mesh) {
   text_writer *w = malloc(sizeof *w);
   if (!w) {
     free(ids);
-    atomic_file_abort(&f);
+    piola_atomic_file_abort(&f);
     return PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "%s: out of memory", path);
   }
   piola__tw_init(w, o);
@@ -114,5 +114,5 @@ piola_status piola__write_gmsh41(const char *path, const piola_tet_mesh *mesh) {
   }
   free(w);
   free(ids);
-  return atomic_file_commit(&f);
+  return piola_atomic_file_commit(&f);
 }

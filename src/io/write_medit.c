@@ -1,16 +1,16 @@
 /* Medit .mesh writer (ASCII, version 2; tet ref = region, 0 without regions). */
 #include <stdlib.h>
 
-#include "common/status_internal.h"
-#include "io/atomic_file.h"
+#include "common/status_report.h"
 #include "io/mesh_writers.h"
 #include "io/text_writer.h"
+#include "piola/files.h"
 
 piola_status piola__write_medit(const char *path, const piola_tet_mesh *mesh) {
   text_writer *w = malloc(sizeof *w);
   if (!w) return PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "%s: out of memory", path);
-  atomic_file f;
-  piola_status s = atomic_file_open(&f, path);
+  piola_atomic_file f;
+  piola_status s = piola_atomic_file_open(&f, path);
   if (s != PIOLA_OK) {
     free(w);
     return s;
@@ -41,5 +41,5 @@ piola_status piola__write_medit(const char *path, const piola_tet_mesh *mesh) {
   piola__tw_str(w, "End\n");
   piola__tw_flush(w);
   free(w);
-  return atomic_file_commit(&f);
+  return piola_atomic_file_commit(&f);
 }

@@ -3,9 +3,9 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "common/status_internal.h"
-#include "io/atomic_file.h"
+#include "common/status_report.h"
 #include "io/mesh_writers.h"
+#include "piola/files.h"
 
 piola_status piola__tri_mesh_compact(piola_tri_mesh *mesh) {
   size_t n = (size_t)mesh->vertex_count;
@@ -26,8 +26,8 @@ piola_status piola__tri_mesh_compact(piola_tri_mesh *mesh) {
 }
 
 piola_status piola__write_obj(const char *path, const piola_tri_mesh *mesh) {
-  atomic_file f;
-  PIOLA_TRY(atomic_file_open(&f, path));
+  piola_atomic_file f;
+  PIOLA_TRY(piola_atomic_file_open(&f, path));
   char a[32], b[32], c[32];
   fprintf(f.stream, "# written by piola: %d vertices, %d triangles\n", (int)mesh->vertex_count,
           (int)mesh->triangle_count);
@@ -41,12 +41,12 @@ piola_status piola__write_obj(const char *path, const piola_tri_mesh *mesh) {
     const int32_t *q = mesh->triangles + 3 * (size_t)t;
     fprintf(f.stream, "f %d %d %d\n", q[0] + 1, q[1] + 1, q[2] + 1);
   }
-  return atomic_file_commit(&f);
+  return piola_atomic_file_commit(&f);
 }
 
 piola_status piola__write_off(const char *path, const piola_tri_mesh *mesh) {
-  atomic_file f;
-  PIOLA_TRY(atomic_file_open(&f, path));
+  piola_atomic_file f;
+  PIOLA_TRY(piola_atomic_file_open(&f, path));
   char a[32], b[32], c[32];
   fprintf(f.stream, "OFF\n%d %d 0\n", (int)mesh->vertex_count, (int)mesh->triangle_count);
   for (int32_t v = 0; v < mesh->vertex_count; ++v) {
@@ -59,13 +59,13 @@ piola_status piola__write_off(const char *path, const piola_tri_mesh *mesh) {
     const int32_t *q = mesh->triangles + 3 * (size_t)t;
     fprintf(f.stream, "3 %d %d %d\n", q[0], q[1], q[2]);
   }
-  return atomic_file_commit(&f);
+  return piola_atomic_file_commit(&f);
 }
 
 /* Binary STL stores float32: coordinates are rounded to single precision. */
 piola_status piola__write_stl(const char *path, const piola_tri_mesh *mesh) {
-  atomic_file f;
-  PIOLA_TRY(atomic_file_open(&f, path));
+  piola_atomic_file f;
+  PIOLA_TRY(piola_atomic_file_open(&f, path));
   unsigned char header[84];
   memset(header, 0, sizeof header);
   memcpy(header, "binary STL written by piola", 27);
@@ -98,5 +98,5 @@ piola_status piola__write_stl(const char *path, const piola_tri_mesh *mesh) {
     rec[48] = rec[49] = 0;
     fwrite(rec, 1, 50, f.stream);
   }
-  return atomic_file_commit(&f);
+  return piola_atomic_file_commit(&f);
 }

@@ -2,10 +2,10 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "common/status_internal.h"
-#include "io/atomic_file.h"
+#include "common/status_report.h"
 #include "io/mesh_writers.h"
 #include "io/text_writer.h"
+#include "piola/files.h"
 
 piola_status piola__write_tetgen(const char *path, const piola_tet_mesh *mesh) {
   size_t n = strlen(path);
@@ -22,8 +22,8 @@ piola_status piola__write_tetgen(const char *path, const piola_tet_mesh *mesh) {
   strcpy(node_path + stem, ".node");
   strcpy(ele_path + stem, ".ele");
   text_writer *w = malloc(sizeof *w);
-  atomic_file f;
-  piola_status s = w ? atomic_file_open(&f, node_path) : PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "%s: out of memory", path);
+  piola_atomic_file f;
+  piola_status s = w ? piola_atomic_file_open(&f, node_path) : PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "%s: out of memory", path);
   if (s == PIOLA_OK) {
     fprintf(f.stream, "%d 3 0 0\n", (int)mesh->vertex_count);
     piola__tw_init(w, f.stream);
@@ -37,9 +37,9 @@ piola_status piola__write_tetgen(const char *path, const piola_tet_mesh *mesh) {
     }
     piola__tw_str(w, "# written by piola\n");
     piola__tw_flush(w);
-    s = atomic_file_commit(&f);
+    s = piola_atomic_file_commit(&f);
   }
-  if (s == PIOLA_OK) s = atomic_file_open(&f, ele_path);
+  if (s == PIOLA_OK) s = piola_atomic_file_open(&f, ele_path);
   if (s == PIOLA_OK) {
     int attr = mesh->tet_regions != NULL;
     fprintf(f.stream, "%d 4 %d\n", (int)mesh->tet_count, attr);
@@ -59,7 +59,7 @@ piola_status piola__write_tetgen(const char *path, const piola_tet_mesh *mesh) {
     }
     piola__tw_str(w, "# written by piola\n");
     piola__tw_flush(w);
-    s = atomic_file_commit(&f);
+    s = piola_atomic_file_commit(&f);
   }
   free(w);
   free(node_path);

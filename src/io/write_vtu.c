@@ -6,8 +6,8 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "common/status_internal.h"
-#include "io/atomic_file.h"
+#include "common/status_report.h"
+#include "piola/files.h"
 #include "piola/mesh_io.h"
 
 static piola_status check_field(const char *path, const piola_vtu_field *f, const char *where) {
@@ -79,8 +79,8 @@ piola_status piola_vtu_write(const char *path, const piola_vtu_frame *frame) {
     types[nt + t] = 5;
   }
 
-  atomic_file f;
-  piola_status s = atomic_file_open(&f, path);
+  piola_atomic_file f;
+  piola_status s = piola_atomic_file_open(&f, path);
   if (s == PIOLA_OK) {
     FILE *o = f.stream;
     uint64_t offset = 0;
@@ -119,7 +119,7 @@ piola_status piola_vtu_write(const char *path, const piola_vtu_frame *frame) {
     write_block(o, offsets, nc * 8);
     write_block(o, types, nc);
     fprintf(o, "\n  </AppendedData>\n</VTKFile>\n");
-    s = atomic_file_commit(&f);
+    s = piola_atomic_file_commit(&f);
   }
   free(points);
   free(connectivity);

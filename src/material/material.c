@@ -6,7 +6,7 @@
 #include <stddef.h>
 #include <string.h>
 
-#include "common/status_internal.h"
+#include "common/status_report.h"
 #include "material/material_kernels.h"
 #include "material/muscle.h"
 #include "piola/material.h"

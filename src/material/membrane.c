@@ -2,7 +2,7 @@
  * (the solid model at unit thickness stretch with the plane-stress lambda) and why it was
  * chosen are in membrane_kernels.h and docs/shells.md. */
 #include "material/membrane_kernels.h"
-#include "piola/shell_body.h"
+#include "piola/material.h"
 
 void piola_membrane_stress(const piola_material *material, const double fhat[2], double phat[2]) {
   const piola_material membrane = membrane_material_from(material);

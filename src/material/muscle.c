@@ -4,7 +4,7 @@
 #include <math.h>
 #include <string.h>
 
-#include "common/status_internal.h"
+#include "common/status_report.h"
 #include "material/muscle.h"
 #include "material/muscle_kernels.h"
 

@@ -36,7 +36,7 @@
 #include <stdint.h>
 #include <string.h>
 
-#include "common/status_internal.h"
+#include "common/status_report.h"
 #include "math/mat3.h"
 
 enum { MAX_SWEEPS = 20 };

@@ -2,7 +2,7 @@
 
 #include <math.h>
 
-#include "common/status_internal.h"
+#include "common/status_report.h"
 
 piola_status piola__check_element_input(const char *body_name, const char *element_name,
                                         int corners, int32_t vertex_count,

@@ -3,7 +3,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "common/status_internal.h"
+#include "common/status_report.h"
 #include "piola/mesh.h"
 
 piola_status piola_tet_mesh_box_grid(int32_t nx, int32_t ny, int32_t nz, piola_vec3 spacing,

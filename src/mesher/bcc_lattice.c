@@ -3,7 +3,7 @@
 #include <math.h>
 #include <stdlib.h>
 
-#include "common/status_internal.h"
+#include "common/status_report.h"
 #include "mesher/tet_topology.h"
 
 void piola__bcc_lattice_free(piola__bcc_lattice *lattice) {

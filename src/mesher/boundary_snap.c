@@ -4,9 +4,9 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "common/status_internal.h"
-#include "common/threads.h"
+#include "common/status_report.h"
 #include "mesher/tet_topology.h"
+#include "piola/threads.h"
 
 typedef struct snap_context {
   piola_tet_mesh *mesh;
@@ -111,7 +111,7 @@ piola_status piola__boundary_snap(piola_tet_mesh *mesh, const piola__shape_union
   }
   const double remaining[] = {0.25, 1.0 / 3.0, 0.5, 1.0, 1.0, 1.0, 1.0, 1.0, 1.0};
   for (size_t stage = 0; stage < sizeof(remaining) / sizeof(remaining[0]); ++stage) {
-#pragma omp parallel for schedule(dynamic, 256) num_threads(piola__thread_count())
+#pragma omp parallel for schedule(dynamic, 256) num_threads(piola_thread_count())
     for (int32_t i = 0; i < nb; ++i)
       target[i] = piola__shape_union_project(shapes, vec3_load(mesh->positions + 3 * (size_t)boundary[i]));
     for (int32_t i = 0; i < nb; ++i) {

@@ -3,8 +3,8 @@
 #include <math.h>
 #include <stdlib.h>
 
-#include "common/status_internal.h"
-#include "common/threads.h"
+#include "common/status_report.h"
+#include "piola/threads.h"
 
 static int32_t find_root(int32_t *parent, int32_t v) {
   while (parent[v] != v) {
@@ -17,7 +17,7 @@ static int32_t find_root(int32_t *parent, int32_t v) {
 piola_status piola__lattice_phi(const piola__shape_union *shapes, const double *positions,
                                 int32_t vertex_count, const int32_t *tets, int32_t tet_count,
                                 double band, double *phi) {
-#pragma omp parallel for schedule(static) num_threads(piola__thread_count())
+#pragma omp parallel for schedule(static) num_threads(piola_thread_count())
   for (int32_t v = 0; v < vertex_count; ++v)
     phi[v] = piola__shape_union_phi_analytic(shapes, vec3_load(positions + 3 * (size_t)v));
   int32_t *parent = NULL;
@@ -35,7 +35,7 @@ piola_status piola__lattice_phi(const piola__shape_union *shapes, const double *
       }
     }
     /* value = signed distance in the band, NAN beyond it (sign to be found). */
-#pragma omp parallel for schedule(dynamic, 1024) num_threads(piola__thread_count())
+#pragma omp parallel for schedule(dynamic, 1024) num_threads(piola_thread_count())
     for (int32_t v = 0; v < vertex_count; ++v) {
       vec3 p = vec3_load(positions + 3 * (size_t)v);
       double d = piola__surface_closest_point_within(s, p, band, NULL, NULL);
@@ -55,7 +55,7 @@ piola_status piola__lattice_phi(const piola__shape_union *shapes, const double *
         }
     }
     /* One winding number per far component, at its root. */
-#pragma omp parallel for schedule(dynamic, 64) num_threads(piola__thread_count())
+#pragma omp parallel for schedule(dynamic, 64) num_threads(piola_thread_count())
     for (int32_t v = 0; v < vertex_count; ++v)
       if (isnan(value[v]) && parent[v] == v)
         value[v] = piola__surface_winding_number(s, vec3_load(positions + 3 * (size_t)v)) > 0.5 ? -band : band;

@@ -6,14 +6,14 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "common/status_internal.h"
-#include "common/threads.h"
+#include "common/status_report.h"
 #include "mesher/bcc_lattice.h"
 #include "mesher/boundary_snap.h"
 #include "mesher/lattice_phi.h"
 #include "mesher/red_green.h"
 #include "mesher/shape_union.h"
 #include "mesher/tet_topology.h"
+#include "piola/threads.h"
 
 #define MAX_LATTICE_TETS 120000000LL
 #define MAX_REFINEMENT_LEVELS 6
@@ -131,7 +131,7 @@ static int64_t mark_nonmanifold(const piola__tet_soup *soup, const lattice_topol
   for (int64_t f = 0; f < nf; ++f)
     for (int k = 0; k < 3; ++k) items[fill[tri[3 * f + k]]++] = (int32_t)f;
   free(fill);
-#pragma omp parallel for schedule(dynamic, 256) num_threads(piola__thread_count())
+#pragma omp parallel for schedule(dynamic, 256) num_threads(piola_thread_count())
   for (int32_t v = 0; v < nv; ++v) {
     int32_t begin = count[v], n = count[v + 1] - begin;
     if (n == 0 || bad[v]) continue;

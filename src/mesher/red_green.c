@@ -4,9 +4,9 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "common/status_internal.h"
-#include "common/threads.h"
+#include "common/status_report.h"
 #include "mesher/tet_topology.h"
+#include "piola/threads.h"
 
 /* Edge -> midpoint vertex, open addressing on the packed sorted pair. */
 typedef struct edge_map {
@@ -214,7 +214,7 @@ static int green_pattern(int mask) {
 }
 
 static void evaluate_new_phi(piola__tet_soup *s, const piola__shape_union *shapes) {
-#pragma omp parallel for schedule(dynamic, 256) num_threads(piola__thread_count())
+#pragma omp parallel for schedule(dynamic, 256) num_threads(piola_thread_count())
   for (int32_t v = 0; v < s->vertex_count; ++v)
     if (isnan(s->phi[v])) s->phi[v] = piola__shape_union_phi(shapes, vec3_load(s->positions + 3 * (size_t)v), NULL);
 }

@@ -3,7 +3,7 @@
 #include <math.h>
 #include <string.h>
 
-#include "common/status_internal.h"
+#include "common/status_report.h"
 #include "geometry/analytic_shapes.h"
 
 static const char *shape_name(piola_shape_type t) {
@@ -116,14 +116,14 @@ void piola__shape_union_bounds(const piola__shape_union *u, vec3 *lo, vec3 *hi) 
 static double shape_phi(const piola__shape_union *u, int i, vec3 p, vec3 *n) {
   const piola_shape *s = &u->shapes[i];
   switch (s->type) {
-    case PIOLA_SHAPE_SPHERE: return shape_sphere_distance(p, s->center, s->radius, n);
-    case PIOLA_SHAPE_BOX: return shape_box_distance(p, s->center, s->half_extents, n);
+    case PIOLA_SHAPE_SPHERE: return piola__shape_sphere_distance(p, s->center, s->radius, n);
+    case PIOLA_SHAPE_BOX: return piola__shape_box_distance(p, s->center, s->half_extents, n);
     case PIOLA_SHAPE_TORUS:
-      return shape_torus_distance(p, s->center, s->axis, s->radius, s->minor_radius, n);
+      return piola__shape_torus_distance(p, s->center, s->axis, s->radius, s->minor_radius, n);
     case PIOLA_SHAPE_CYLINDER:
-      return shape_cylinder_distance(p, s->center, s->axis, s->radius, s->half_length, n);
+      return piola__shape_cylinder_distance(p, s->center, s->axis, s->radius, s->half_length, n);
     case PIOLA_SHAPE_CAPSULE:
-      return shape_capsule_distance(p, s->center, s->axis, s->radius, s->half_length, n);
+      return piola__shape_capsule_distance(p, s->center, s->axis, s->radius, s->half_length, n);
     case PIOLA_SHAPE_SURFACE: return piola__surface_signed_distance(u->surfaces[i], p, n, NULL);
   }
   return INFINITY;

@@ -3,8 +3,8 @@
 #include <math.h>
 #include <stdlib.h>
 
-#include "common/status_internal.h"
-#include "common/threads.h"
+#include "common/status_report.h"
+#include "piola/threads.h"
 
 const int piola__tet_face[4][3] = {{0, 2, 1}, {0, 1, 3}, {0, 3, 2}, {1, 2, 3}};
 
@@ -48,7 +48,7 @@ static int tet_has(const int32_t *tet, int32_t v) {
 
 void piola__face_neighbors(const int32_t *tets, int32_t tet_count, const uint8_t *keep,
                            const piola__csr *vertex_tets, int32_t *neighbor) {
-#pragma omp parallel for schedule(static) num_threads(piola__thread_count())
+#pragma omp parallel for schedule(static) num_threads(piola_thread_count())
   for (int32_t t = 0; t < tet_count; ++t) {
     for (int f = 0; f < 4; ++f) {
       neighbor[4 * t + f] = -1;

@@ -16,10 +16,11 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "common/status_internal.h"
-#include "io/atomic_file.h"
+#include "common/status_report.h"
 #include "output/output_internal.h"
+#include "piola/files.h"
 #include "piola/mesh_io.h"
+#include "piola/world_bodies.h"
 #include "piola/world_shells.h"
 
 typedef struct pvd_entry {
@@ -191,27 +192,27 @@ piola_status piola_output_open(const char *dir, bool force, const piola_world *w
 }
 
 static piola_status write_text(const char *path, const char *text, size_t len) {
-  atomic_file f;
-  PIOLA_TRY(atomic_file_open(&f, path));
+  piola_atomic_file f;
+  PIOLA_TRY(piola_atomic_file_open(&f, path));
   if (len && fwrite(text, 1, len, f.stream) != len) {
-    atomic_file_abort(&f);
+    piola_atomic_file_abort(&f);
     return PIOLA_FAIL(PIOLA_ERROR_IO, "%s: write failed", path);
   }
-  return atomic_file_commit(&f);
+  return piola_atomic_file_commit(&f);
 }
 
 static piola_status write_pvd(piola_output *o) {
   char path[4200];
   snprintf(path, sizeof path, "%s/sim.pvd", o->dir);
-  atomic_file f;
-  PIOLA_TRY(atomic_file_open(&f, path));
+  piola_atomic_file f;
+  PIOLA_TRY(piola_atomic_file_open(&f, path));
   fprintf(f.stream, "<?xml version=\"1.0\"?>\n<VTKFile type=\"Collection\" version=\"0.1\" "
                     "byte_order=\"LittleEndian\">\n  <Collection>\n");
   for (int32_t i = 0; i < o->pvd_count; ++i)
     fprintf(f.stream, "    <DataSet timestep=\"%.17g\" group=\"\" part=\"0\" file=\"frames/frame_%04d.vtu\"/>\n",
             o->pvd[i].time, (int)o->pvd[i].frame);
   fprintf(f.stream, "  </Collection>\n</VTKFile>\n");
-  return atomic_file_commit(&f);
+  return piola_atomic_file_commit(&f);
 }
 
 piola_status piola_output_write_frame(piola_output *o, const piola_world *world,
@@ -222,61 +223,56 @@ piola_status piola_output_write_frame(piola_output *o, const piola_world *world,
   double ke = 0, ee = 0, min_det = INFINITY;
   long long inverted = 0, yielded = 0;
   double max_fp_log = 0; /* plastic solids: yielded tets in the last step, largest |log stretch| of Fp */
-  for (int32_t s = 0; s < ns; ++s) {
-    const piola_elastic_body *b = piola_world_solid_body(world, s);
-    int32_t n = piola_elastic_body_vertex_count(b), t = piola_elastic_body_tet_count(b);
-    const double *x = piola_world_solid_positions(world, s);
-    const double *v = piola_world_solid_velocities(world, s);
+  /* the bodies in step order: the solids, then the shells, as the points and cells are laid out */
+  for (int32_t p = 0; p < piola_world_body_count(world); ++p) {
+    const piola_body_id id = piola_world_body_at(world, p);
+    const int32_t index = piola_world_body_index(world, id);
+    const int32_t n = piola_world_body_node_count(world, id);
+    const int32_t t = piola_world_body_element_count(world, id);
+    const double *x = piola_world_body_positions(world, id);
+    const double *v = piola_world_body_velocities(world, id);
     for (int64_t k = 0; k < 3 * (int64_t)n; ++k) {
       int64_t g = 3 * (int64_t)voff + k;
       o->tets.positions[g] = x[k];
       o->velocity[g] = v[k];
       o->displacement[g] = x[k] - o->rest[g];
     }
-    const double *det = piola_elastic_body_det_f(b);
-    const double *psi = piola_elastic_body_energy_density(b);
-    for (int32_t k = 0; k < t; ++k) {
-      o->det_f[toff + k] = det[k];
-      o->inverted[toff + k] = det[k] < 0 ? 1.0 : 0.0;
-      o->energy[toff + k] = psi[k];
-    }
-    piola_solid_stats st = piola_world_solid_stats(world, s);
+    const piola_body_stats st = piola_world_body_stats(world, id);
     ke += st.kinetic_energy;
     ee += st.elastic_energy;
     inverted += st.inverted_count;
-    if (st.min_det_f < min_det) min_det = st.min_det_f;
-    const piola_plastic_state *plastic = piola_world_solid_plastic_state(world, s);
-    if (plastic) {
-      double largest;
-      piola_plastic_state_measure(plastic, &largest, NULL);
-      if (largest > max_fp_log) max_fp_log = largest;
-      yielded += piola_world_solid_plastic_stats(world, s).yielded_count;
+    switch (piola_world_body_kind(world, id)) {
+      case PIOLA_BODY_SOLID: {
+        const piola_elastic_body *b = piola_world_solid_body(world, index);
+        const double *det = piola_elastic_body_det_f(b);
+        const double *psi = piola_elastic_body_energy_density(b);
+        for (int32_t k = 0; k < t; ++k) {
+          o->det_f[toff + k] = det[k];
+          o->inverted[toff + k] = det[k] < 0 ? 1.0 : 0.0;
+          o->energy[toff + k] = psi[k];
+        }
+        double solid_min_det = piola_world_solid_stats(world, index).min_det_f;
+        if (solid_min_det < min_det) min_det = solid_min_det;
+        const piola_plastic_state *plastic = piola_world_solid_plastic_state(world, index);
+        if (plastic) {
+          double largest;
+          piola_plastic_state_measure(plastic, &largest, NULL);
+          if (largest > max_fp_log) max_fp_log = largest;
+          yielded += piola_world_solid_plastic_stats(world, index).yielded_count;
+        }
+        break;
+      }
+      case PIOLA_BODY_SHELL: {
+        const double *fhat = piola_shell_body_fhat(piola_world_shell_body(world, index));
+        for (int32_t k = 0; k < t; ++k) {
+          o->det_f[toff + k] = fhat[2 * k] * fhat[2 * k + 1];
+          o->inverted[toff + k] = fhat[2 * k + 1] < 0 ? 1.0 : 0.0;
+          o->energy[toff + k] = 0.0;
+        }
+        break;
+      }
+      case PIOLA_BODY_NONE: break;
     }
-    voff += n;
-    toff += t;
-  }
-  int32_t nshell = piola_world_shell_count(world);
-  for (int32_t s = 0; s < nshell; ++s) {
-    const piola_shell_body *b = piola_world_shell_body(world, s);
-    int32_t n = piola_shell_body_vertex_count(b), t = piola_shell_body_triangle_count(b);
-    const double *x = piola_world_shell_positions(world, s);
-    const double *v = piola_world_shell_velocities(world, s);
-    for (int64_t k = 0; k < 3 * (int64_t)n; ++k) {
-      int64_t g = 3 * (int64_t)voff + k;
-      o->tets.positions[g] = x[k];
-      o->velocity[g] = v[k];
-      o->displacement[g] = x[k] - o->rest[g];
-    }
-    const double *fhat = piola_shell_body_fhat(b);
-    for (int32_t k = 0; k < t; ++k) {
-      o->det_f[toff + k] = fhat[2 * k] * fhat[2 * k + 1];
-      o->inverted[toff + k] = fhat[2 * k + 1] < 0 ? 1.0 : 0.0;
-      o->energy[toff + k] = 0.0;
-    }
-    piola_world_shell_stats st = piola_world_shell_get_stats(world, s);
-    ke += st.kinetic_energy;
-    ee += st.membrane_energy + st.bending_energy;
-    inverted += st.inverted_count;
     voff += n;
     toff += t;
   }
@@ -329,8 +325,8 @@ piola_status piola_output_write_failure_report(piola_output *o, const piola_worl
                                                const char *message) {
   char path[4200];
   snprintf(path, sizeof path, "%s/failure_report.txt", o->dir);
-  atomic_file f;
-  PIOLA_TRY(atomic_file_open(&f, path));
+  piola_atomic_file f;
+  PIOLA_TRY(piola_atomic_file_open(&f, path));
   fprintf(f.stream, "piola run stopped: %s\n", message ? message : "(no message)");
   fprintf(f.stream, "last good state: t = %.9g s (frames written up to that point are complete)\n\n",
           piola_world_time(world));
@@ -348,7 +344,7 @@ piola_status piola_output_write_failure_report(piola_output *o, const piola_worl
             st.kinetic_energy, st.elastic_energy);
     ranked *r = malloc((size_t)(t > 0 ? t : 1) * sizeof *r);
     if (!r) {
-      atomic_file_abort(&f);
+      piola_atomic_file_abort(&f);
       return PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "failure report: out of memory");
     }
     for (int pass = 0; pass < 2; ++pass) {
@@ -370,5 +366,5 @@ piola_status piola_output_write_failure_report(piola_output *o, const piola_worl
     }
     free(r);
   }
-  return atomic_file_commit(&f);
+  return piola_atomic_file_commit(&f);
 }

@@ -9,7 +9,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
-#include "common/status_internal.h"
+#include "common/status_report.h"
 
 piola_status piola_output_check_folder(const char *dir, bool force) {
   if (!dir || !dir[0]) return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "output folder: empty path");

@@ -6,7 +6,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "common/status_internal.h"
+#include "common/status_report.h"
 #include "force/effective_dm_inv.h"
 #include "force/elastic_body_internal.h"
 #include "piola/diagonalize.h"
@@ -269,7 +269,7 @@ void piola__plastic_state_update_scalar(piola_plastic_state *s, double dt, piola
   double bound = 1.0;
   const int32_t nt = s->tet_count;
 #pragma omp parallel for schedule(static) reduction(+ : yielded, limited) reduction(max : bound) \
-    num_threads(piola__thread_count()) if (nt >= PIOLA_PARALLEL_MIN_BLOCKS * PIOLA_PLASTIC_LANES)
+    num_threads(piola_thread_count()) if (nt >= PIOLA_PARALLEL_MIN_BLOCKS * PIOLA_PLASTIC_LANES)
   for (int32_t t = 0; t < nt; ++t) {
     int lim = 0;
     yielded += update_tet(s, fhat, t, pull, &lim);
@@ -304,7 +304,7 @@ piola_status piola_plastic_state_update(piola_plastic_state *s, double dt, piola
   const int32_t blocks = s->padded_count / PIOLA_PLASTIC_LANES, range = 64;
   const int32_t ranges = (blocks + range - 1) / range;
 #pragma omp parallel for schedule(static) reduction(+ : yielded, limited) reduction(max : bound) \
-    num_threads(piola__thread_count()) if (blocks >= PIOLA_PARALLEL_MIN_BLOCKS)
+    num_threads(piola_thread_count()) if (blocks >= PIOLA_PARALLEL_MIN_BLOCKS)
   for (int32_t r = 0; r < ranges; ++r) {
     int32_t end = (r + 1) * range < blocks ? (r + 1) * range : blocks;
     double b = 1.0;

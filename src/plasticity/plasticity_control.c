@@ -4,7 +4,7 @@
 
 #include <math.h>
 
-#include "common/status_internal.h"
+#include "common/status_report.h"
 #include "piola/diagonalize.h"
 
 static piola_mat3 load(const double a[9]) {

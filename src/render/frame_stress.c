@@ -11,10 +11,10 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "common/status_internal.h"
+#include "common/status_report.h"
 #include "piola/diagonalize.h"
+#include "piola/scene.h"
 #include "render/render_internal.h"
-#include "scene/scene_desc.h"
 
 static mat3 edge_matrix(const double *x, const int32_t *t) {
   vec3 a = vec3_load(x + 3 * (size_t)t[0]);
@@ -97,34 +97,11 @@ piola_status piola_render_scene_materials(const char *path, piola_material_def *
   if (!path || !count || capacity < 0 || (capacity > 0 && !materials))
     return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "scene materials: NULL argument");
   *count = 0;
-  FILE *fp = fopen(path, "rb");
-  if (!fp) return PIOLA_FAIL(PIOLA_ERROR_IO, "%s: cannot open", path);
-  char *text = NULL;
-  long n = -1;
-  if (fseek(fp, 0, SEEK_END) == 0) n = ftell(fp);
-  if (n >= 0 && n < (64L << 20) && fseek(fp, 0, SEEK_SET) == 0) text = malloc((size_t)n + 1);
-  if (!text || fread(text, 1, (size_t)n, fp) != (size_t)n) {
-    fclose(fp);
-    free(text);
-    return PIOLA_FAIL(PIOLA_ERROR_IO, "%s: cannot read", path);
-  }
-  fclose(fp);
-  text[n] = '\0';
-  char dir[SCENE_PATH_MAX];
-  snprintf(dir, sizeof dir, "%s", path);
-  char *slash = strrchr(dir, '/');
-  if (slash)
-    *slash = '\0';
-  else
-    snprintf(dir, sizeof dir, ".");
-  if (!dir[0]) snprintf(dir, sizeof dir, "/");
-  scene_desc desc;
-  piola_status st = piola__scene_parse(text, dir, path, &desc);
-  free(text);
-  PIOLA_TRY(st);
-  for (int32_t i = 0; i < desc.solid_count && i < capacity; ++i)
-    materials[i] = desc.solids[i].def.material;
-  *count = desc.solid_count;
-  piola__scene_desc_free(&desc);
+  piola_scene_desc *desc;
+  PIOLA_TRY(piola_scene_parse_file(path, &desc));
+  *count = piola_scene_desc_solid_count(desc);
+  for (int32_t i = 0; i < *count && i < capacity; ++i)
+    materials[i] = piola_scene_desc_solid_material(desc, i);
+  piola_scene_desc_destroy(desc);
   return PIOLA_OK;
 }

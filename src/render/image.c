@@ -5,8 +5,8 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "common/status_internal.h"
-#include "io/atomic_file.h"
+#include "common/status_report.h"
+#include "piola/files.h"
 #include "render/render_internal.h"
 
 void piola_image_free(piola_image *image) {
@@ -80,13 +80,13 @@ static int png_write_stream(FILE *stream, const piola_image *image) {
 piola_status piola_image_write_png(const char *path, const piola_image *image) {
   if (!path || !image || !image->rgb || image->width <= 0 || image->height <= 0)
     return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "png write: NULL or empty image");
-  atomic_file f;
-  PIOLA_TRY(atomic_file_open(&f, path));
+  piola_atomic_file f;
+  PIOLA_TRY(piola_atomic_file_open(&f, path));
   if (png_write_stream(f.stream, image) != 0) {
-    atomic_file_abort(&f);
+    piola_atomic_file_abort(&f);
     return PIOLA_FAIL(PIOLA_ERROR_IO, "%s: PNG encoding failed", path);
   }
-  return atomic_file_commit(&f);
+  return piola_atomic_file_commit(&f);
 }
 
 static int png_read_stream(FILE *stream, piola_image *image) {

@@ -3,7 +3,6 @@
  * The preview reads back the VTU the frame writer just wrote instead of looking into the
  * world: the picture then shows exactly what was saved, and the renderer stays downstream
  * of the output stage (data flows one way). */
-#include <cjson/cJSON.h>
 #include <dirent.h>
 #include <errno.h>
 #include <limits.h>
@@ -14,8 +13,9 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
-#include "common/status_internal.h"
-#include "io/atomic_file.h"
+#include "common/status_report.h"
+#include "piola/files.h"
+#include "piola/scene.h"
 #include "render/render_internal.h"
 
 struct piola_preview {
@@ -27,70 +27,6 @@ struct piola_preview {
   int32_t last_frame;
   double last_time;
 };
-
-/* Makes a relative path string absolute against folder. */
-static void make_absolute(cJSON *item, const char *folder) {
-  if (!cJSON_IsString(item) || !item->valuestring || item->valuestring[0] == '/' ||
-      !item->valuestring[0])
-    return;
-  char buf[PATH_MAX + 512];
-  snprintf(buf, sizeof buf, "%s/%s", folder, item->valuestring);
-  cJSON_SetValuestring(item, buf);
-}
-
-/* DIR/scene.json: the scene with the mesh paths of solids, obstacles and bones made absolute. */
-static piola_status copy_scene(const char *scene_path, const char *dir) {
-  char *text = NULL;
-  FILE *f = fopen(scene_path, "rb");
-  if (!f) return PIOLA_FAIL(PIOLA_ERROR_IO, "%s: cannot open: %s", scene_path, strerror(errno));
-  long n = -1;
-  if (fseek(f, 0, SEEK_END) == 0) n = ftell(f);
-  if (n >= 0 && n < (64L << 20) && fseek(f, 0, SEEK_SET) == 0) text = malloc((size_t)n + 1);
-  if (!text || fread(text, 1, (size_t)n, f) != (size_t)n) {
-    fclose(f);
-    free(text);
-    return PIOLA_FAIL(PIOLA_ERROR_IO, "%s: cannot read", scene_path);
-  }
-  fclose(f);
-  text[n] = '\0';
-  cJSON *root = cJSON_Parse(text);
-  free(text);
-  if (!root) return PIOLA_FAIL(PIOLA_ERROR_PARSE, "%s: not valid JSON", scene_path);
-  char folder[PATH_MAX];
-  char tmp[PATH_MAX];
-  snprintf(tmp, sizeof tmp, "%s", scene_path);
-  char *slash = strrchr(tmp, '/');
-  if (slash)
-    *slash = '\0';
-  else
-    snprintf(tmp, sizeof tmp, ".");
-  if (!tmp[0]) snprintf(tmp, sizeof tmp, "/");
-  if (!realpath(tmp, folder)) snprintf(folder, sizeof folder, "%s", tmp);
-  cJSON *solids = cJSON_GetObjectItemCaseSensitive(root, "solids");
-  cJSON *it;
-  cJSON_ArrayForEach(it, solids)
-      make_absolute(cJSON_GetObjectItemCaseSensitive(it, "mesh"), folder);
-  cJSON *obstacles = cJSON_GetObjectItemCaseSensitive(root, "obstacles");
-  cJSON_ArrayForEach(it, obstacles)
-      make_absolute(cJSON_GetObjectItemCaseSensitive(it, "path"), folder);
-  cJSON *bones = cJSON_GetObjectItemCaseSensitive(root, "bones");
-  cJSON_ArrayForEach(it, bones)
-      make_absolute(cJSON_GetObjectItemCaseSensitive(it, "path"), folder);
-  char *out = cJSON_Print(root);
-  cJSON_Delete(root);
-  if (!out) return PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "scene copy: out of memory");
-  char path[4096];
-  snprintf(path, sizeof path, "%s/scene.json", dir);
-  atomic_file af;
-  piola_status st = atomic_file_open(&af, path);
-  if (st == PIOLA_OK) {
-    fputs(out, af.stream);
-    fputc('\n', af.stream);
-    st = atomic_file_commit(&af);
-  }
-  free(out);
-  return st;
-}
 
 piola_status piola_preview_open(const char *dir, const char *scene_path, bool every_frame,
                                 piola_preview **out) {
@@ -108,7 +44,9 @@ piola_status piola_preview_open(const char *dir, const char *scene_path, bool ev
   piola_status st = PIOLA_OK;
   if (scene_path) {
     if (!realpath(scene_path, p->scene)) p->scene[0] = '\0';
-    st = copy_scene(scene_path, dir);
+    char copy[4096];
+    snprintf(copy, sizeof copy, "%s/scene.json", dir);
+    st = piola_scene_copy_resolved(scene_path, copy);
   }
   if (st == PIOLA_OK && every_frame) {
     char path[4096];

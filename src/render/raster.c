@@ -9,8 +9,8 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "common/status_internal.h"
-#include "common/threads.h"
+#include "common/status_report.h"
+#include "piola/threads.h"
 #include "render/render_internal.h"
 
 enum { BAND_ROWS = 16 };
@@ -36,7 +36,7 @@ piola_status piola__render_triangles(const render_camera *cam, const piola_rende
   const double *x = mesh->positions;
   const int32_t *tri = mesh->triangles;
 
-#pragma omp parallel for schedule(static) num_threads(piola__thread_count())
+#pragma omp parallel for schedule(static) num_threads(piola_thread_count())
   for (int32_t v = 0; v < nv; ++v) {
     vec3 d = vec3_sub(vec3_load(x + 3 * (size_t)v), cam->position);
     double z = vec3_dot(d, cam->forward);
@@ -58,7 +58,7 @@ piola_status piola__render_triangles(const render_camera *cam, const piola_rende
   }
 
   const double near_z = 1e-6;
-#pragma omp parallel for schedule(static) num_threads(piola__thread_count())
+#pragma omp parallel for schedule(static) num_threads(piola_thread_count())
   for (int32_t t = 0; t < nt; ++t) {
     tri_setup *s = &setup[t];
     s->y0 = 1, s->y1 = 0;
@@ -125,7 +125,7 @@ piola_status piola__render_triangles(const render_camera *cam, const piola_rende
       for (int32_t b = setup[t].y0 / BAND_ROWS; b <= setup[t].y1 / BAND_ROWS; ++b)
         binned[fill[b]++] = t;
 
-#pragma omp parallel for schedule(dynamic, 1) num_threads(piola__thread_count())
+#pragma omp parallel for schedule(dynamic, 1) num_threads(piola_thread_count())
   for (int32_t b = 0; b < band_count; ++b) {
     int32_t row0 = b * BAND_ROWS, row1 = row0 + BAND_ROWS - 1;
     if (row1 > H - 1) row1 = H - 1;

@@ -16,9 +16,8 @@
 #include <math.h>
 #include <stdlib.h>
 
-#include "common/threads.h"
+#include "piola/threads.h"
 #include "render/render_internal.h"
-#include "sim/obstacle_internal.h"
 
 /* Relative depth offset of the ground: 1e-4 of the view depth (0.5 mm at 5 m) is far above
  * float rounding (6e-8) and far below anything a viewer could see through. */
@@ -41,7 +40,7 @@ typedef struct ground_plane {
 
 typedef struct traced_obstacle {
   const piola_obstacle *obstacle;
-  piola__rigid_state state;
+  piola_obstacle_pose pose;
   vec3 center; /* world centre of the bounding sphere at this pose */
   double radius;
 } traced_obstacle;
@@ -75,22 +74,23 @@ void piola__render_ray_pass(const piola_renderer *r, const render_camera *cam, d
   int np = 0, nt = 0;
   for (int32_t i = 0; i < r->obstacle_count; ++i) {
     const piola_obstacle *o = r->obstacles[i];
-    piola__rigid_state st;
-    piola__rigid_motion_state(&o->motion, time, &st);
-    if (o->type == PIOLA_OBSTACLE_MESH) continue; /* rasterized with the triangles */
-    if (o->type == PIOLA_OBSTACLE_PLANE) {
+    piola_obstacle_pose pose = piola_obstacle_pose_at(o, time);
+    piola_obstacle_type type = piola_obstacle_shape_type(o);
+    if (type == PIOLA_OBSTACLE_MESH) continue; /* rasterized with the triangles */
+    if (type == PIOLA_OBSTACLE_PLANE) {
       if (np == MAX_PLANES) continue;
       vec3 n;
-      double d = piola__obstacle_distance_posed(o, &st, cam->position, &n, NULL);
+      double d = piola_obstacle_posed_distance(o, &pose, cam->position, &n);
       if (isfinite(r->floor_half_size) && vec3_dot(n, r->def.up) < FLOOR_MIN_UP) continue;
       vec3 foot = vec3_sub(cam->position, vec3_scale(n, d));
       planes[np++] = make_plane(cam, foot, n, cam->position);
     } else if (nt < MAX_TRACED) {
       traced_obstacle *t = &traced[nt++];
       t->obstacle = o;
-      t->state = st;
-      t->center = vec3_add(mat3_mul_vec(st.rotation, o->bound_center), st.translation);
-      t->radius = o->bound_radius;
+      t->pose = pose;
+      vec3 center;
+      piola_obstacle_bounding_sphere(o, &center, &t->radius);
+      t->center = vec3_add(mat3_mul_vec(pose.rotation, center), pose.translation);
     }
   }
   if (np == 0 && r->def.ground)
@@ -107,7 +107,7 @@ void piola__render_ray_pass(const piola_renderer *r, const render_camera *cam, d
   const double checker = r->checker_size, fog = 10 * (r->scene_size > 0 ? r->scene_size : 1);
   const double inv_f = 1.0 / cam->focal_px;
   const int W = cam->width, H = cam->height;
-#pragma omp parallel for schedule(dynamic, 4) num_threads(piola__thread_count())
+#pragma omp parallel for schedule(dynamic, 4) num_threads(piola_thread_count())
   for (int y = 0; y < H; ++y) {
     float bg[3];
     background(cam, y, bg);
@@ -167,7 +167,7 @@ void piola__render_ray_pass(const piola_renderer *r, const render_camera *cam, d
         bool hit = false;
         for (int it = 0; it < 200 && s <= s_max; ++it) {
           vec3 p = vec3_add(cam->position, vec3_scale(dn, s));
-          double d = piola__obstacle_distance_posed(t->obstacle, &t->state, p, &n, NULL);
+          double d = piola_obstacle_posed_distance(t->obstacle, &t->pose, p, &n);
           if (it == 0 && d < 0 && s == 0) break; /* camera inside: draw nothing */
           double eps = 0.25 * s * inv_f + 1e-9 * t->radius;
           if (d < eps) {

@@ -5,10 +5,9 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "common/status_internal.h"
-#include "common/threads.h"
+#include "common/status_report.h"
+#include "piola/threads.h"
 #include "render/render_internal.h"
-#include "sim/obstacle_internal.h"
 
 piola_render_def piola_default_render_def(void) {
   piola_render_def d;
@@ -151,13 +150,13 @@ void piola_renderer_fit_camera(piola_renderer *r, piola_vec3 lo, piola_vec3 hi) 
    * floor slab, a distant wall) would shrink the solids to a speck and are left out. */
   vec3 glo = lo, ghi = hi;
   for (int32_t i = 0; i < r->obstacle_count; ++i) {
-    const piola_obstacle *o = r->obstacles[i];
-    if (!(o->bound_radius < 2 * radius)) continue;
-    piola__rigid_state st;
-    piola__rigid_motion_state(&o->motion, 0, &st);
-    vec3 c = vec3_add(mat3_mul_vec(st.rotation, o->bound_center), st.translation);
+    vec3 c0;
+    double b;
+    piola_obstacle_bounding_sphere(r->obstacles[i], &c0, &b);
+    if (!(b < 2 * radius)) continue;
+    piola_obstacle_pose pose = piola_obstacle_pose_at(r->obstacles[i], 0);
+    vec3 c = vec3_add(mat3_mul_vec(pose.rotation, c0), pose.translation);
     if (!(vec3_norm(vec3_sub(c, center)) < 3 * radius)) continue;
-    double b = o->bound_radius;
     glo = (vec3){fmin(glo.x, c.x - b), fmin(glo.y, c.y - b), fmin(glo.z, c.z - b)};
     ghi = (vec3){fmax(ghi.x, c.x + b), fmax(ghi.y, c.y + b), fmax(ghi.z, c.z + b)};
   }
@@ -276,7 +275,7 @@ piola_status piola_renderer_render(piola_renderer *r, const piola_render_mesh *m
   r->def.width = w, r->def.height = h;
   if (st == PIOLA_OK) st = piola__image_resize(image, w, h);
   if (st == PIOLA_OK) {
-#pragma omp parallel for schedule(static) num_threads(piola__thread_count())
+#pragma omp parallel for schedule(static) num_threads(piola_thread_count())
     for (int32_t y = 0; y < h; ++y)
       for (int32_t x = 0; x < w; ++x) {
         uint32_t sum[3] = {0, 0, 0};
@@ -327,8 +326,7 @@ static piola_status render_once(piola_renderer *r, const piola_render_mesh *mesh
   for (int32_t i = 0; i < r->obstacle_count; ++i) {
     const piola_tri_mesh *om = &r->obstacle_meshes[i];
     if (om->triangle_count == 0) continue;
-    piola__rigid_state st;
-    piola__rigid_motion_state(&r->obstacles[i]->motion, time, &st);
+    piola_obstacle_pose st = piola_obstacle_pose_at(r->obstacles[i], time);
     double *x = malloc(3 * (size_t)om->vertex_count * sizeof *x);
     float *face_rgb = malloc(3 * (size_t)om->triangle_count * sizeof *face_rgb);
     if (!x || !face_rgb) {

@@ -1,13 +1,18 @@
-/* The public scene handle: parse, build, and keep the output settings next to the world. */
+/* The public scene API: parse (scene_parse*.c) into a description, build (scene_build.c) it
+ * into a world, and keep the output settings next to the world. */
 #include "piola/scene.h"
 
-#include <errno.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
-#include "common/status_internal.h"
+#include "common/status_report.h"
+#include "piola/files.h"
+#include "piola/keyframes.h"
 #include "scene/scene_desc.h"
+
+/* Scene files are small; a bigger file is a mistake (a mesh passed as the scene). */
+#define SCENE_FILE_MAX_BYTES ((size_t)64 << 20)
 
 struct piola_scene {
   double fps;
@@ -15,23 +20,77 @@ struct piola_scene {
   piola_world *world;
 };
 
-piola_status piola_scene_load_string(const char *json, const char *base_dir, const char *label,
-                                     piola_scene **out) {
+struct piola_scene_desc {
+  scene_desc desc;
+  char label[SCENE_PATH_MAX]; /* starts every message of the build */
+};
+
+piola_status piola_scene_parse_string(const char *json, const char *base_dir, const char *label,
+                                      piola_scene_desc **out) {
   if (!out) return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "scene: out is NULL");
   *out = NULL;
   if (!label) label = "scene";
   if (!base_dir) base_dir = ".";
-  scene_desc desc;
-  PIOLA_TRY(piola__scene_parse(json, base_dir, label, &desc));
-  piola_scene *scene = calloc(1, sizeof *scene);
-  if (!scene) {
-    piola__scene_desc_free(&desc);
-    return PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "%s: out of memory", label);
+  piola_scene_desc *d = calloc(1, sizeof *d);
+  if (!d) return PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "%s: out of memory", label);
+  snprintf(d->label, sizeof d->label, "%s", label);
+  piola_status st = piola__scene_parse(json, base_dir, label, &d->desc);
+  if (st != PIOLA_OK) {
+    free(d);
+    return st;
   }
-  scene->fps = desc.fps;
-  scene->frames = desc.frames;
-  piola_status st = piola__scene_build(&desc, label, &scene->world);
-  piola__scene_desc_free(&desc);
+  *out = d;
+  return PIOLA_OK;
+}
+
+void piola__scene_folder(const char *path, char dir[SCENE_PATH_MAX]) {
+  snprintf(dir, SCENE_PATH_MAX, "%s", path);
+  char *slash = strrchr(dir, '/');
+  if (slash)
+    *slash = '\0';
+  else
+    snprintf(dir, SCENE_PATH_MAX, ".");
+  if (dir[0] == '\0') snprintf(dir, SCENE_PATH_MAX, "/");
+}
+
+/* The text of a scene file: a NUL byte inside would cut the JSON short without a word. */
+static piola_status read_scene_text(const char *path, char **text) {
+  size_t len;
+  PIOLA_TRY(piola_read_file(path, SCENE_FILE_MAX_BYTES, text, &len));
+  if (strlen(*text) != len) {
+    free(*text);
+    *text = NULL;
+    return PIOLA_FAIL(PIOLA_ERROR_PARSE, "%s: contains a NUL byte", path);
+  }
+  return PIOLA_OK;
+}
+
+piola_status piola_scene_parse_file(const char *path, piola_scene_desc **out) {
+  if (!out || !path) return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "scene: NULL argument");
+  *out = NULL;
+  char *text;
+  PIOLA_TRY(read_scene_text(path, &text));
+  char dir[SCENE_PATH_MAX];
+  piola__scene_folder(path, dir);
+  piola_status st = piola_scene_parse_string(text, dir, path, out);
+  free(text);
+  return st;
+}
+
+void piola_scene_desc_destroy(piola_scene_desc *desc) {
+  if (!desc) return;
+  piola__scene_desc_free(&desc->desc);
+  free(desc);
+}
+
+piola_status piola_scene_build(const piola_scene_desc *desc, piola_scene **out) {
+  if (!desc || !out) return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "scene: NULL argument");
+  *out = NULL;
+  piola_scene *scene = calloc(1, sizeof *scene);
+  if (!scene) return PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "%s: out of memory", desc->label);
+  scene->fps = desc->desc.fps;
+  scene->frames = desc->desc.frames;
+  piola_status st = piola__scene_build(&desc->desc, desc->label, &scene->world);
   if (st != PIOLA_OK) {
     free(scene);
     return st;
@@ -40,53 +99,28 @@ piola_status piola_scene_load_string(const char *json, const char *base_dir, con
   return PIOLA_OK;
 }
 
+/* Builds a parsed description and frees it. */
+static piola_status build_and_free(piola_scene_desc *desc, piola_scene **out) {
+  piola_status st = piola_scene_build(desc, out);
+  piola_scene_desc_destroy(desc);
+  return st;
+}
+
+piola_status piola_scene_load_string(const char *json, const char *base_dir, const char *label,
+                                     piola_scene **out) {
+  if (!out) return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "scene: out is NULL");
+  *out = NULL;
+  piola_scene_desc *desc;
+  PIOLA_TRY(piola_scene_parse_string(json, base_dir, label, &desc));
+  return build_and_free(desc, out);
+}
+
 piola_status piola_scene_load(const char *path, piola_scene **out) {
   if (!out || !path) return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "scene: NULL argument");
   *out = NULL;
-  FILE *f = fopen(path, "rb");
-  if (!f) return PIOLA_FAIL(PIOLA_ERROR_IO, "%s: cannot open: %s", path, strerror(errno));
-  char *text = NULL;
-  size_t len = 0, cap = 0;
-  for (;;) {
-    if (len + 4096 + 1 > cap) {
-      cap = cap ? 2 * cap : 65536;
-      if (cap > ((size_t)64 << 20)) {
-        free(text);
-        fclose(f);
-        return PIOLA_FAIL(PIOLA_ERROR_PARSE, "%s: scene file is larger than 64 MiB", path);
-      }
-      char *grown = realloc(text, cap);
-      if (!grown) {
-        free(text);
-        fclose(f);
-        return PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "%s: out of memory", path);
-      }
-      text = grown;
-    }
-    size_t got = fread(text + len, 1, 4096, f);
-    len += got;
-    if (got < 4096) break;
-  }
-  int bad = ferror(f);
-  fclose(f);
-  if (bad) {
-    free(text);
-    return PIOLA_FAIL(PIOLA_ERROR_IO, "%s: read error", path);
-  }
-  text[len] = '\0';
-  if (strlen(text) != len) {
-    free(text);
-    return PIOLA_FAIL(PIOLA_ERROR_PARSE, "%s: contains a NUL byte", path);
-  }
-  char dir[4096];
-  snprintf(dir, sizeof dir, "%s", path);
-  char *slash = strrchr(dir, '/');
-  if (slash) *slash = '\0';
-  else snprintf(dir, sizeof dir, ".");
-  if (dir[0] == '\0') snprintf(dir, sizeof dir, "/");
-  piola_status st = piola_scene_load_string(text, dir, path, out);
-  free(text);
-  return st;
+  piola_scene_desc *desc;
+  PIOLA_TRY(piola_scene_parse_file(path, &desc));
+  return build_and_free(desc, out);
 }
 
 void piola_scene_destroy(piola_scene *scene) {
@@ -98,3 +132,43 @@ void piola_scene_destroy(piola_scene *scene) {
 double piola_scene_fps(const piola_scene *scene) { return scene->fps; }
 int32_t piola_scene_frames(const piola_scene *scene) { return scene->frames; }
 piola_world *piola_scene_world(piola_scene *scene) { return scene->world; }
+
+double piola_scene_desc_fps(const piola_scene_desc *d) { return d->desc.fps; }
+int32_t piola_scene_desc_frames(const piola_scene_desc *d) { return d->desc.frames; }
+int32_t piola_scene_desc_solid_count(const piola_scene_desc *d) { return d->desc.solid_count; }
+
+const char *piola_scene_desc_solid_name(const piola_scene_desc *d, int32_t i) {
+  return d->desc.solids[i].name;
+}
+
+piola_material_def piola_scene_desc_solid_material(const piola_scene_desc *d, int32_t i) {
+  return d->desc.solids[i].def.material;
+}
+
+int32_t piola_scene_desc_obstacle_count(const piola_scene_desc *d) {
+  return d->desc.obstacle_count + d->desc.bone_count;
+}
+
+piola_obstacle_def piola_scene_desc_obstacle(const piola_scene_desc *d, int32_t i,
+                                             const char **mesh_path) {
+  const scene_desc *s = &d->desc;
+  const scene_obstacle_desc *o =
+      i < s->obstacle_count ? &s->obstacles[i] : &s->bones[i - s->obstacle_count].obstacle;
+  if (mesh_path) *mesh_path = o->mesh_path;
+  return o->def;
+}
+
+const char *piola_scene_desc_obstacle_name(const piola_scene_desc *d, int32_t i) {
+  const scene_desc *s = &d->desc;
+  return i < s->obstacle_count ? s->obstacles[i].name : s->bones[i - s->obstacle_count].name;
+}
+
+bool piola_scene_desc_obstacle_is_bone(const piola_scene_desc *d, int32_t i) {
+  return i >= d->desc.obstacle_count;
+}
+
+piola_vec3 piola_scene_desc_gravity(const piola_scene_desc *d, double t) {
+  const piola_track *g = d->desc.world.gravity;
+  return (piola_vec3){piola_track_eval(&g[0], t), piola_track_eval(&g[1], t),
+                      piola_track_eval(&g[2], t)};
+}

@@ -4,7 +4,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "common/status_internal.h"
+#include "common/status_report.h"
 #include "math/mat3.h"
 #include "piola/mesh_io.h"
 #include "piola/mesher.h"

@@ -97,6 +97,9 @@ typedef struct scene_desc {
   int32_t bone_count;
 } scene_desc;
 
+/* The folder of a file path: "." for a bare name, "/" for a file in the root (scene.c). */
+void piola__scene_folder(const char *path, char dir[SCENE_PATH_MAX]);
+
 /* Parses and validates JSON text; label prefixes error messages. */
 piola_status piola__scene_parse(const char *json, const char *base_dir, const char *label,
                                 scene_desc *out);

@@ -6,7 +6,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "common/status_internal.h"
+#include "common/status_report.h"
 #include "math/mat3.h"
 #include "scene/scene_desc.h"
 

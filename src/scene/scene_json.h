@@ -19,7 +19,7 @@
 #include <stddef.h>
 #include <stdint.h>
 
-#include "common/status_internal.h"
+#include "common/status_report.h"
 #include "piola/keyframes.h"
 #include "piola/math_types.h"
 

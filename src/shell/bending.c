@@ -20,8 +20,8 @@
 #include <math.h>
 #include <string.h>
 
-#include "force/elastic_body_internal.h" /* piola__thread_count */
 #include "math/mat3.h"
+#include "piola/threads.h"
 #include "shell/shell_body_internal.h"
 
 /* A hinge whose triangle height or edge is below this fraction of its size has no

@@ -18,7 +18,7 @@
 #include <math.h>
 #include <string.h>
 
-#include "force/elastic_body_internal.h" /* piola__thread_count */
+#include "piola/threads.h"
 #include "shell/shell_body_internal.h"
 
 static double flow_fraction(double rate, double dt) {
@@ -97,13 +97,13 @@ int32_t piola_shell_body_plastic_flow(piola_shell_body *body, double dt) {
   if (isfinite(body->plasticity.yield_strain)) {
     const double fraction = flow_fraction(body->plasticity.rate, dt);
 #pragma omp parallel for schedule(static) reduction(+ : flowed) \
-    num_threads(piola__thread_count()) if (body->triangle_count > 4096)
+    num_threads(piola_thread_count()) if (body->triangle_count > 4096)
     for (int32_t t = 0; t < body->triangle_count; ++t) flowed += flow_triangle(body, t, fraction);
   }
   if (isfinite(body->bending.yield_angle)) {
     const double fraction = flow_fraction(body->bending.plastic_rate, dt);
 #pragma omp parallel for schedule(static) reduction(+ : flowed) \
-    num_threads(piola__thread_count()) if (body->hinge_count > 4096)
+    num_threads(piola_thread_count()) if (body->hinge_count > 4096)
     for (int32_t h = 0; h < body->hinge_count; ++h) flowed += flow_hinge(body, h, fraction);
   }
   return flowed;

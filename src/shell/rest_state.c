@@ -5,7 +5,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "common/status_internal.h"
+#include "common/status_report.h"
 #include "material/membrane_kernels.h"
 #include "math/mat3.h"
 #include "mesh/element_input.h"

@@ -4,7 +4,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "common/status_internal.h"
+#include "common/status_report.h"
 #include "piola/shell_body.h"
 
 static piola_status allocate(int64_t vertices, int64_t triangles, piola_tri_mesh *out) {

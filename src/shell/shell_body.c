@@ -5,11 +5,11 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "common/status_internal.h"
-#include "force/elastic_body_internal.h" /* piola__thread_count */
+#include "common/status_report.h"
 #include "material/membrane_kernels.h"
 #include "math/mat3.h"
 #include "piola/diagonalize.h"
+#include "piola/threads.h"
 #include "shell/shell_body_internal.h"
 #include "shell/svd3x2.h"
 
@@ -115,7 +115,7 @@ void piola__shell_body_gather(const piola_shell_body *body, double *forces) {
   const int32_t *ts = body->tri_start, *ti = body->tri_incidence;
   const int32_t *hs = body->hinge_start, *hi = body->hinge_incidence;
   const double *tf = body->triangle_forces, *hf = body->hinge_forces;
-#pragma omp parallel for schedule(static) num_threads(piola__thread_count()) \
+#pragma omp parallel for schedule(static) num_threads(piola_thread_count()) \
     if (body->vertex_count > SHELL_PARALLEL_MIN_ELEMENTS)
   for (int32_t i = 0; i < body->vertex_count; ++i) {
     double fx = 0, fy = 0, fz = 0;
@@ -230,7 +230,7 @@ piola_status piola_shell_body_update(piola_shell_body *body, const double *x,
     if (!isfinite(x[i]))
       return PIOLA_FAIL(PIOLA_ERROR_NOT_FINITE, "position of shell vertex %d is not finite",
                         (int)(i / 3));
-  const int threads = piola__thread_count();
+  const int threads = piola_thread_count();
 #pragma omp parallel num_threads(threads) if (body->triangle_count > SHELL_PARALLEL_MIN_ELEMENTS)
   {
 #pragma omp for schedule(static) nowait
@@ -322,7 +322,7 @@ void piola_shell_body_damping_forces(const piola_shell_body *body, const double 
   /* the per-element buffers are scratch shared with the update: one call at a time per body */
   piola_shell_body *b = (piola_shell_body *)body;
   const double eta = body->bending.damping;
-#pragma omp parallel num_threads(piola__thread_count()) \
+#pragma omp parallel num_threads(piola_thread_count()) \
     if (body->triangle_count > SHELL_PARALLEL_MIN_ELEMENTS)
   {
 #pragma omp for schedule(static) nowait

@@ -19,8 +19,8 @@
 #include <math.h>
 #include <stdlib.h>
 
-#include "common/status_internal.h"
-#include "common/threads.h"
+#include "common/status_report.h"
+#include "piola/threads.h"
 #include "sim/obstacle_internal.h"
 
 #define COLLISION_SWEEPS 4
@@ -91,7 +91,7 @@ int32_t piola_obstacles_collide(piola_obstacle *const *obstacles, int32_t obstac
   int32_t count = 0;
   /* Below a few thousand nodes a parallel region costs more than it saves (and far more on a
    * loaded machine, where a descheduled thread stalls the barrier). */
-#pragma omp parallel for schedule(static) num_threads(piola__thread_count()) reduction(+ : count) \
+#pragma omp parallel for schedule(static) num_threads(piola_thread_count()) reduction(+ : count) \
     if (node_count >= 4096)
   for (int32_t i = 0; i < node_count; ++i) {
     vec3 xi = vec3_load(x + 3 * i), vi = vec3_load(v + 3 * i), ni = vec3_make(0, 0, 0);

@@ -12,7 +12,7 @@
 
 #include <math.h>
 
-#include "common/threads.h"
+#include "piola/threads.h"
 
 enum { CG_CHUNKS = 16 };
 /* below this many nodes the passes run on one thread (a parallel region costs more) */
@@ -28,7 +28,7 @@ static double sum_parts(const double part[CG_CHUNKS]) {
 
 static double dot(int32_t n, const double *a, const double *b) {
   double part[CG_CHUNKS];
-#pragma omp parallel for schedule(static) num_threads(piola__thread_count()) if (n >= CG_PARALLEL_MIN_NODES)
+#pragma omp parallel for schedule(static) num_threads(piola_thread_count()) if (n >= CG_PARALLEL_MIN_NODES)
   for (int c = 0; c < CG_CHUNKS; ++c) {
     double s = 0;
     for (int64_t i = 3 * (int64_t)chunk_begin(n, c); i < 3 * (int64_t)chunk_begin(n, c + 1); ++i) s += a[i] * b[i];
@@ -50,7 +50,7 @@ int32_t piola__cg_solve(const cg_problem *pb, const double *b, double *x, double
   }
   /* one pass: the copies of A x0, r = S (b - A x0), its size and the first direction */
   double part0[CG_CHUNKS];
-#pragma omp parallel for schedule(static) num_threads(piola__thread_count()) if (n >= CG_PARALLEL_MIN_NODES)
+#pragma omp parallel for schedule(static) num_threads(piola_thread_count()) if (n >= CG_PARALLEL_MIN_NODES)
   for (int c = 0; c < CG_CHUNKS; ++c) {
     const int32_t i0 = chunk_begin(n, c), i1 = chunk_begin(n, c + 1);
     for (int64_t j = 3 * (int64_t)i0; j < 3 * (int64_t)i1; ++j) {
@@ -82,7 +82,7 @@ int32_t piola__cg_solve(const cg_problem *pb, const double *b, double *x, double
     if (!(pq > 0)) break; /* not positive definite along p (or zero): stop where we are */
     double alpha = rz / pq;
     double part[CG_CHUNKS];
-#pragma omp parallel for schedule(static) num_threads(piola__thread_count()) if (n >= CG_PARALLEL_MIN_NODES)
+#pragma omp parallel for schedule(static) num_threads(piola_thread_count()) if (n >= CG_PARALLEL_MIN_NODES)
     for (int c = 0; c < CG_CHUNKS; ++c) {
       const int32_t i0 = chunk_begin(n, c), i1 = chunk_begin(n, c + 1);
       if (ax)
@@ -102,7 +102,7 @@ int32_t piola__cg_solve(const cg_problem *pb, const double *b, double *x, double
     if (rz_new <= tol2 || !isfinite(rz_new)) break;
     double beta = rz_new / rz;
     rz = rz_new;
-#pragma omp parallel for schedule(static) num_threads(piola__thread_count()) if (n >= CG_PARALLEL_MIN_NODES)
+#pragma omp parallel for schedule(static) num_threads(piola_thread_count()) if (n >= CG_PARALLEL_MIN_NODES)
     for (int c = 0; c < CG_CHUNKS; ++c)
       for (int32_t i = chunk_begin(n, c); i < chunk_begin(n, c + 1); ++i)
         for (int k = 0; k < 3; ++k) p[3 * i + k] = r[3 * i + k] * inverse_mass[i] + beta * p[3 * i + k];

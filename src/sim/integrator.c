@@ -17,16 +17,16 @@
 #include <math.h>
 #include <string.h>
 
-#include "common/status_internal.h"
-#include "math/mat3.h"
+#include "common/status_report.h"
 #include "force/elastic_body_internal.h"
+#include "math/mat3.h"
 #include "sim/conjugate_gradient.h"
 #include "sim/world_internal.h"
 
 int piola__step_reuse_first_product = 1;
 
 typedef struct damping_system {
-  const world_solid *s;
+  const world_body *s;
   double h;              /* dt / 2 */
   double beta, alpha;    /* shear and bulk viscosity, Pa s */
   int hold_normals;      /* filter the normal components of colliding nodes too */
@@ -36,26 +36,17 @@ typedef struct damping_system {
 
 static void damping_apply(void *ctx, const double *p, double *out) {
   const damping_system *d = ctx;
-  const world_solid *s = d->s;
   piola__step_profile_apply(d->profile, 1);
-  if (s->body) {
-    /* one pass: the damping's own chunk sum forms M p - h D p */
-    piola__elastic_body_damping_operator(s->body, p, d->beta, d->alpha, s->mass, d->h, out);
-  } else {
-    piola__solid_damping_forces(s, p, d->beta, d->alpha, d->scratch);
-    for (int32_t i = 0; i < s->n; ++i)
-      for (int k = 0; k < 3; ++k)
-        out[3 * i + k] = s->mass[i] * p[3 * i + k] - d->h * d->scratch[3 * i + k];
-  }
+  piola__body_damping_apply(d->s, p, d->beta, d->alpha, d->h, d->scratch, out);
   piola__step_profile_apply(d->profile, 0);
 }
 
 static void damping_filter(void *ctx, double *r, int32_t begin, int32_t end) {
   const damping_system *d = ctx;
-  const world_solid *s = d->s;
+  const world_body *s = d->s;
   for (int32_t i = begin; i < end; ++i) {
     double *ri = r + 3 * i;
-    if (s->flags[i] != SOLID_FREE) {
+    if (s->flags[i] != NODE_FREE) {
       ri[0] = ri[1] = ri[2] = 0;
     } else if (d->hold_normals && s->colliding[i]) {
       const double *nrm = s->normals + 3 * i;
@@ -74,16 +65,16 @@ static void damping_filter(void *ctx, double *r, int32_t begin, int32_t end) {
  * has no net force. CG's updates keep it so (1^T A p = 1^T M p = 1^T r for its directions),
  * so a free body's linear momentum comes out exact whatever the tolerance, instead of being
  * off by the net force left in the final residual. */
-static int32_t damping_solve(piola_world *w, world_solid *s, double h, double t,
+static int32_t damping_solve(piola_world *w, world_body *s, double h, double t,
                              int hold_normals, const double *rhs, double *v, const double uniform[3],
                              double *av, double *guess_copy, double *initial_av, int from_product) {
   double beta = piola_track_eval(&s->shear_viscosity, t);
   double alpha = piola_track_eval(&s->bulk_viscosity, t);
   damping_system d = {s, h, beta, alpha, hold_normals, s->tmp, &w->profile};
-  if (piola__solid_undamped(s, beta, alpha)) {
+  if (piola__body_undamped(s, beta, alpha)) {
     /* M is diagonal: the filtered solve is exact in one pass */
     for (int32_t i = 0; i < s->n; ++i) {
-      if (s->flags[i] != SOLID_FREE) continue;
+      if (s->flags[i] != NODE_FREE) continue;
       double *vi = v + 3 * i;
       double old[3] = {vi[0], vi[1], vi[2]};
       for (int k = 0; k < 3; ++k) vi[k] = rhs[3 * i + k] / s->mass[i];
@@ -107,10 +98,10 @@ static int32_t damping_solve(piola_world *w, world_solid *s, double h, double t,
      * h D e, which a sparse pass over the changed nodes' edges adds. */
     const double ratio = h / s->product_h;
     double *e = s->work;
-#pragma omp parallel for schedule(static) num_threads(piola__thread_count()) \
+#pragma omp parallel for schedule(static) num_threads(piola_thread_count()) \
     if (s->n >= PIOLA_PARALLEL_MIN_VERTICES)
     for (int32_t i = 0; i < s->n; ++i) {
-      const int free_node = s->flags[i] == SOLID_FREE;
+      const int free_node = s->flags[i] == NODE_FREE;
       for (int k = 0; k < 3; ++k) {
         const int64_t j = 3 * (int64_t)i + k;
         e[j] = v[j] - s->v_product[j] - (free_node ? 0.0 : uniform[k]);
@@ -120,12 +111,12 @@ static int32_t damping_solve(piola_world *w, world_solid *s, double h, double t,
             s->mass[i] * v[j] - ratio * (s->mass[i] * s->v_product[j] - s->av_product[j]);
       }
     }
-    piola__elastic_body_damping_forces_add_sparse(s->body, e, beta, alpha, -h, initial_av);
+    piola__body_damping_add_sparse(s, e, beta, alpha, -h, initial_av);
   } else {
-#pragma omp parallel for schedule(static) num_threads(piola__thread_count()) \
+#pragma omp parallel for schedule(static) num_threads(piola_thread_count()) \
     if (s->n >= PIOLA_PARALLEL_MIN_VERTICES)
     for (int32_t i = 0; i < s->n; ++i) {
-      if (s->flags[i] != SOLID_FREE) continue;
+      if (s->flags[i] != NODE_FREE) continue;
       double du[3] = {uniform[0], uniform[1], uniform[2]};
       if (hold_normals && s->colliding[i]) {
         const double *nrm = s->normals + 3 * i;
@@ -158,10 +149,10 @@ static int32_t damping_solve(piola_world *w, world_solid *s, double h, double t,
  * friction for it a block on an incline would feel half its Coulomb friction. Here that
  * impulse, dt/2 (f^n+1 + f_ext + D v^n+1) . n / m when it presses into the obstacle, limits
  * the relative tangential velocity the same way: vT <- max(0, 1 - mu dvN / |vT|) vT. */
-static void contact_friction(const piola_world *w, world_solid *s, double t1, double h,
+static void contact_friction(const piola_world *w, world_body *s, double t1, double h,
                              const double *g1, const double *av) {
   for (int32_t i = 0; i < s->n; ++i) {
-    if (!s->colliding[i] || s->flags[i] != SOLID_FREE) continue;
+    if (!s->colliding[i] || s->flags[i] != NODE_FREE) continue;
     const double *nrm = s->normals + 3 * i;
     double *vi = s->v + 3 * i;
     /* normal impulse per unit mass of the n+1 half: h (f + m g).n + (h D v).n, where
@@ -191,7 +182,7 @@ static void contact_friction(const piola_world *w, world_solid *s, double t1, do
   }
 }
 
-static double stiffness_bound(const world_solid *s, double t0, double t1) {
+static double stiffness_bound(const world_body *s, double t0, double t1) {
   /* the largest stiffness scale over [t0, t1]: the tracks are piecewise linear, so the
    * maximum is at an end or at a key inside */
   double m = fmax(piola_track_eval(&s->stiffness_scale, t0), piola_track_eval(&s->stiffness_scale, t1));
@@ -203,16 +194,9 @@ static double stiffness_bound(const world_solid *s, double t0, double t1) {
 
 double piola_world_stable_dt(const piola_world *w) {
   double dt = w->def.max_dt;
-  for (int32_t i = 0; i < w->solid_count; ++i) {
-    const world_solid *s = &w->solids[i];
-    double scale = stiffness_bound(s, w->time, w->time + w->def.max_dt);
-    double speed = piola_elastic_body_max_wave_speed(s->body) * sqrt(scale);
-    double h = piola_elastic_body_min_rest_altitude(s->body) / piola__solid_plastic_stiffening(s);
-    if (speed > 0 && h > 0) dt = fmin(dt, w->def.cfl * h / speed);
-  }
-  for (int32_t i = 0; i < w->shell_count; ++i) {
-    const world_solid *s = &w->shells[i];
-    dt = fmin(dt, piola__shell_stable_dt(w, s, stiffness_bound(s, w->time, w->time + w->def.max_dt)));
+  for (int32_t i = 0; i < w->body_count; ++i) {
+    const world_body *b = &w->bodies[i];
+    dt = fmin(dt, piola__body_stable_dt(w, b, stiffness_bound(b, w->time, w->time + w->def.max_dt)));
   }
   return dt;
 }
@@ -221,16 +205,16 @@ static void gravity_at(const piola_world *w, double t, double g[3]) {
   for (int k = 0; k < 3; ++k) g[k] = piola_track_eval(&w->def.gravity[k], t);
 }
 
-static void restore(world_solid *s, double t) {
+static void restore(world_body *s, double t) {
   size_t v3 = 3 * (size_t)s->n * sizeof(double);
   s->product_valid = 0;
   memcpy(s->x, s->x_old, v3);
   memcpy(s->v, s->v_old, v3);
   memcpy(s->force, s->force_old, v3);
-  (void)piola__solid_update_forces(s, t);
+  (void)piola__body_update_forces(s, t);
 }
 
-static piola_status step_solid(piola_world *w, world_solid *s, double t, double dt,
+static piola_status step_body(piola_world *w, world_body *s, double t, double dt,
                                piola_step_stats *stats) {
   const int32_t n = s->n > 0 ? s->n : 0;
   const int64_t m = 3 * (int64_t)n;
@@ -240,7 +224,7 @@ static piola_status step_solid(piola_world *w, world_solid *s, double t, double 
   gravity_at(w, t, g0);
   gravity_at(w, t1, g1);
   /* 1. v~ (with the copies of the old state, in the same pass) */
-#pragma omp parallel for schedule(static) num_threads(piola__thread_count()) \
+#pragma omp parallel for schedule(static) num_threads(piola_thread_count()) \
     if (n >= PIOLA_PARALLEL_MIN_VERTICES)
   for (int32_t i = 0; i < n; ++i)
     for (int k = 0; k < 3; ++k) {
@@ -252,34 +236,35 @@ static piola_status step_solid(piola_world *w, world_solid *s, double t, double 
     }
   if (n > 0) memset(s->colliding, 0, (size_t)n);
   for (int32_t i = 0; i < n; ++i) {
-    if (s->flags[i] == SOLID_FREE) continue;
+    if (s->flags[i] == NODE_FREE) continue;
     double xp[3], vp[3];
-    piola__solid_constrained_state(s, i, t1, xp, vp);
+    piola__body_constrained_state(s, i, t1, xp, vp);
     for (int k = 0; k < 3; ++k) s->v[3 * i + k] = (xp[k] - s->x[3 * i + k]) / dt;
   }
   piola__step_profile_mark(&w->profile, STEP_PHASE_SETUP);
   double beta0 = piola_track_eval(&s->shear_viscosity, t);
   double alpha0 = piola_track_eval(&s->bulk_viscosity, t);
-  const int damped = !piola__solid_undamped(s, beta0, alpha0);
-  if (s->body && damped) piola__elastic_body_damping_prepare(s->body, beta0, alpha0);
+  const int damped = !piola__body_undamped(s, beta0, alpha0);
+  const int reusable = piola__body_damping_reusable(s);
+  if (reusable && damped) piola__body_damping_prepare(s, beta0, alpha0);
   piola__step_profile_mark(&w->profile, STEP_PHASE_PREPARE);
   const double gravity1[3] = {h * g0[0], h * g0[1], h * g0[2]};
   /* for a damped body, keep the guess x0 (in tmp) and A x0 (in the fourth work vector, which
    * CG does not use): the second right-hand side's D_n v' is h D_n x0 = M x0 - A x0 plus a
    * correction on the few nodes where v' differs from the guess (see there) */
   double *initial_av = s->work + 3 * m;
-  const int reuse = damped && s->body && piola__step_reuse_first_product;
+  const int reuse = damped && reusable && piola__step_reuse_first_product;
   /* the last final solve ran with the same operator (same assembly) unless the body or the
    * viscosities changed since: start from its product instead of a fresh apply */
   const int from_product =
-      reuse && s->product_valid && s->product_generation == s->body->damping.generation;
+      reuse && s->product_valid && s->product_generation == piola__body_damping_generation(s);
   stats->cg_iterations += damping_solve(w, s, h, t, 0, s->rhs, s->v, gravity1, NULL,
                                         reuse ? s->tmp : NULL, reuse ? initial_av : NULL, from_product);
   s->product_valid = 0;
   piola__step_profile_mark(&w->profile, STEP_PHASE_SOLVE1);
 
   /* 2. x~, and v back to v^n for 3. */
-#pragma omp parallel for schedule(static) num_threads(piola__thread_count()) \
+#pragma omp parallel for schedule(static) num_threads(piola_thread_count()) \
     if (n >= PIOLA_PARALLEL_MIN_VERTICES)
   for (int32_t i = 0; i < n; ++i)
     for (int k = 0; k < 3; ++k) {
@@ -293,12 +278,12 @@ static piola_status step_solid(piola_world *w, world_solid *s, double t, double 
   if (w->obstacle_count > 0)
     colliding = piola_obstacles_collide(w->obstacles, w->obstacle_count, t1, dt, n, s->x, s->v,
                                         s->colliding, s->normals);
-  if (s->shell && s->collide_with_solids) colliding += piola__shell_collide_with_solids(w, s, t1, dt);
+  colliding += piola__body_collide_in_step(w, s, t1, dt);
   for (int32_t i = 0; i < n; ++i) {
-    if (s->flags[i] == SOLID_FREE) continue;
+    if (s->flags[i] == NODE_FREE) continue;
     if (s->colliding[i]) colliding--;
     s->colliding[i] = 0;
-    piola__solid_constrained_state(s, i, t1, s->x + 3 * i, s->v + 3 * i);
+    piola__body_constrained_state(s, i, t1, s->x + 3 * i, s->v + 3 * i);
   }
   stats->colliding += colliding;
   piola__step_profile_mark(&w->profile, STEP_PHASE_COLLIDE);
@@ -310,19 +295,19 @@ static piola_status step_solid(piola_world *w, world_solid *s, double t, double 
      * h D_n e, with D_n e evaluated only on the tets touching those nodes. M x0 - A x0 holds
      * h D_n x0 to the rounding of M x0, the size of the rounding of M v' in the sum. */
     double *hd = initial_av;
-#pragma omp parallel for schedule(static) num_threads(piola__thread_count()) \
+#pragma omp parallel for schedule(static) num_threads(piola_thread_count()) \
     if (n >= PIOLA_PARALLEL_MIN_VERTICES)
     for (int32_t i = 0; i < n; ++i) {
       double *x0 = s->tmp + 3 * i;
       const double *vi = s->v + 3 * i, *vo = s->v_old + 3 * i;
-      int moved = s->flags[i] != SOLID_FREE || vi[0] != vo[0] || vi[1] != vo[1] || vi[2] != vo[2];
+      int moved = s->flags[i] != NODE_FREE || vi[0] != vo[0] || vi[1] != vo[1] || vi[2] != vo[2];
       for (int k = 0; k < 3; ++k) {
         hd[3 * i + k] = s->mass[i] * x0[k] - hd[3 * i + k];
         x0[k] = moved ? x0[k] - vi[k] - gravity1[k] : 0.0;
       }
     }
-    piola__elastic_body_damping_forces_add_sparse(s->body, s->tmp, beta0, alpha0, -h, hd);
-#pragma omp parallel for schedule(static) num_threads(piola__thread_count()) \
+    piola__body_damping_add_sparse(s, s->tmp, beta0, alpha0, -h, hd);
+#pragma omp parallel for schedule(static) num_threads(piola_thread_count()) \
     if (n >= PIOLA_PARALLEL_MIN_VERTICES)
     for (int32_t i = 0; i < n; ++i)
       for (int k = 0; k < 3; ++k)
@@ -330,7 +315,7 @@ static piola_status step_solid(piola_world *w, world_solid *s, double t, double 
                             h * (s->force_old[3 * i + k] + s->mass[i] * g0[k]);
   } else {
     if (damped)
-      piola__solid_damping_forces(s, s->v, beta0, alpha0, s->tmp);
+      piola__body_damping_forces(s, s->v, beta0, alpha0, s->tmp);
     else
       memset(s->tmp, 0, v3);
     for (int32_t i = 0; i < n; ++i)
@@ -341,24 +326,24 @@ static piola_status step_solid(piola_world *w, world_solid *s, double t, double 
 
   piola__step_profile_mark(&w->profile, STEP_PHASE_RHS2);
   /* F, diagonalization and elastic force at x^n+1, once per step */
-  piola_status st = piola__solid_update_forces(s, t1);
+  piola_status st = piola__body_update_forces(s, t1);
   if (st != PIOLA_OK) {
     restore(s, t);
     return st;
   }
-  if (s->shell) piola_shell_body_plastic_flow(s->shell, dt);
+  piola__body_plastic_in_step(s, dt);
   piola__step_profile_mark(&w->profile, STEP_PHASE_UPDATE);
   int damped1 = 0;
-  if (s->body) {
+  if (reusable) {
     double beta1 = piola_track_eval(&s->shear_viscosity, t1);
     double alpha1 = piola_track_eval(&s->bulk_viscosity, t1);
-    damped1 = !piola__solid_undamped(s, beta1, alpha1);
-    if (damped1) piola__elastic_body_damping_prepare(s->body, beta1, alpha1);
+    damped1 = !piola__body_undamped(s, beta1, alpha1);
+    if (damped1) piola__body_damping_prepare(s, beta1, alpha1);
   }
   piola__step_profile_mark(&w->profile, STEP_PHASE_PREPARE);
 
   /* 4. trapezoidal velocity, damping at n+1 implicit, normal velocity of contacts held */
-#pragma omp parallel for schedule(static) num_threads(piola__thread_count()) \
+#pragma omp parallel for schedule(static) num_threads(piola_thread_count()) \
     if (n >= PIOLA_PARALLEL_MIN_VERTICES)
   for (int32_t i = 0; i < n; ++i)
     for (int k = 0; k < 3; ++k)
@@ -371,11 +356,11 @@ static piola_status step_solid(piola_world *w, world_solid *s, double t, double 
   stats->cg_iterations += damping_solve(w, s, h, t1, 1, s->rhs, s->v, gravity2,
                                         colliding > 0 || keep_product ? av : NULL, NULL, NULL, 0);
   if (keep_product) {
-#pragma omp parallel for schedule(static) num_threads(piola__thread_count()) \
+#pragma omp parallel for schedule(static) num_threads(piola_thread_count()) \
     if (n >= PIOLA_PARALLEL_MIN_VERTICES)
     for (int64_t j = 0; j < m; ++j) s->v_product[j] = s->v[j];
     s->product_h = h;
-    s->product_generation = s->body->damping.generation;
+    s->product_generation = piola__body_damping_generation(s);
     s->product_valid = 1;
   }
   piola__step_profile_mark(&w->profile, STEP_PHASE_SOLVE2);
@@ -388,7 +373,7 @@ static piola_status step_solid(piola_world *w, world_solid *s, double t, double 
   enum { CHECK_RANGES = 16 };
   double kinetic_part[CHECK_RANGES], force2_part[CHECK_RANGES];
   int64_t bad_part[CHECK_RANGES];
-#pragma omp parallel for schedule(static) num_threads(piola__thread_count()) \
+#pragma omp parallel for schedule(static) num_threads(piola_thread_count()) \
     if (n >= PIOLA_PARALLEL_MIN_VERTICES)
   for (int r = 0; r < CHECK_RANGES; ++r) {
     double ke = 0, f2 = 0;
@@ -405,7 +390,8 @@ static piola_status step_solid(piola_world *w, world_solid *s, double t, double 
     if (bad_part[r] >= 0) {
       restore(s, t);
       return PIOLA_FAIL(PIOLA_ERROR_NOT_FINITE,
-                        "solid '%s': velocity of vertex %lld became non-finite at t = %g s", s->name,
+                        "%s '%s': velocity of vertex %lld became non-finite at t = %g s",
+                        piola__body_kind_name(s->kind), s->name,
                         (long long)(bad_part[r] / 3), t1);
     }
     kinetic += kinetic_part[r];
@@ -414,8 +400,8 @@ static piola_status step_solid(piola_world *w, world_solid *s, double t, double 
   if (!isfinite(kinetic) || !isfinite(force2)) {
     restore(s, t);
     return PIOLA_FAIL(PIOLA_ERROR_NOT_FINITE,
-                      "solid '%s': the %s became non-finite at t = %g s (the state blew up)",
-                      s->name, isfinite(kinetic) ? "elastic force's squared norm" : "kinetic energy", t1);
+                      "%s '%s': the %s became non-finite at t = %g s (the state blew up)",
+                      piola__body_kind_name(s->kind), s->name, isfinite(kinetic) ? "elastic force's squared norm" : "kinetic energy", t1);
   }
   piola__step_profile_mark(&w->profile, STEP_PHASE_CHECK);
   return PIOLA_OK;
@@ -433,24 +419,21 @@ piola_status piola_world_step(piola_world *w, double dt_limit, piola_step_stats 
   PIOLA_TRY(piola__world_collision_open(w, &left));
   const int closes = dt >= left || dt == w->collision_deadline - w->time;
   piola__step_profile_mark(&w->profile, STEP_PHASE_WORLD);
-  for (int32_t i = 0; i < w->solid_count + w->shell_count; ++i) {
-    world_solid *s = i < w->solid_count ? &w->solids[i] : &w->shells[i - w->solid_count];
-    piola_status st = step_solid(w, s, w->time, dt, &local);
+  for (int32_t i = 0; i < w->body_count; ++i) {
+    piola_status st = step_body(w, &w->bodies[i], w->time, dt, &local);
     if (st != PIOLA_OK) {
-      for (int32_t j = 0; j < i; ++j)
-        restore(j < w->solid_count ? &w->solids[j] : &w->shells[j - w->solid_count], w->time);
+      for (int32_t j = 0; j < i; ++j) restore(&w->bodies[j], w->time);
       if (stats) *stats = local;
       return st;
     }
   }
   piola_status contact = piola__world_self_collide(w, dt, w->time + dt, closes, &local);
   if (contact != PIOLA_OK) {
-    for (int32_t j = 0; j < w->solid_count + w->shell_count; ++j)
-      restore(j < w->solid_count ? &w->solids[j] : &w->shells[j - w->solid_count], w->time);
+    for (int32_t j = 0; j < w->body_count; ++j) restore(&w->bodies[j], w->time);
     if (stats) *stats = local;
     return contact;
   }
-  for (int32_t i = 0; i < w->solid_count; ++i) piola__solid_plastic_update(&w->solids[i], dt);
+  for (int32_t i = 0; i < w->body_count; ++i) piola__body_plastic_after_step(&w->bodies[i], dt);
   piola__step_profile_mark(&w->profile, STEP_PHASE_WORLD);
   if (w->profile.enabled) w->profile.steps++;
   w->time += dt;

@@ -3,7 +3,7 @@
 
 #include <math.h>
 
-#include "common/status_internal.h"
+#include "common/status_report.h"
 
 piola_track piola_track_constant(double value) {
   piola_track track = {0};

@@ -5,7 +5,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 
-#include "common/status_internal.h"
+#include "common/status_report.h"
 
 piola_obstacle_def piola_default_obstacle_def(void) {
   piola_obstacle_def def;
@@ -193,6 +193,22 @@ double piola_obstacle_friction(const piola_obstacle *obstacle) {
   return obstacle ? obstacle->friction : 0.0;
 }
 
+piola_obstacle_type piola_obstacle_shape_type(const piola_obstacle *obstacle) {
+  return obstacle->type;
+}
+
+piola_obstacle_pose piola_obstacle_pose_at(const piola_obstacle *obstacle, double t) {
+  piola__rigid_state state;
+  piola__rigid_motion_state(&obstacle->motion, t, &state);
+  return (piola_obstacle_pose){state.rotation, state.translation};
+}
+
+void piola_obstacle_bounding_sphere(const piola_obstacle *obstacle, piola_vec3 *center,
+                                    double *radius) {
+  if (center) *center = obstacle->bound_center;
+  if (radius) *radius = obstacle->bound_radius;
+}
+
 /* The shape's distance in its t = 0 frame. */
 static double shape_distance(const piola_obstacle *o, vec3 p, vec3 *normal) {
   switch (o->type) {
@@ -229,6 +245,13 @@ double piola__obstacle_distance_posed(const piola_obstacle *obstacle,
   if (normal) *normal = mat3_mul_vec(state->rotation, n0);
   if (velocity) *velocity = piola__rigid_state_velocity(state, p);
   return d;
+}
+
+double piola_obstacle_posed_distance(const piola_obstacle *obstacle,
+                                     const piola_obstacle_pose *pose, piola_vec3 p,
+                                     piola_vec3 *normal) {
+  piola__rigid_state state = {.rotation = pose->rotation, .translation = pose->translation};
+  return piola__obstacle_distance_posed(obstacle, &state, p, normal, NULL);
 }
 
 double piola_obstacle_signed_distance(const piola_obstacle *obstacle, double t, piola_vec3 p,

@@ -1,7 +1,7 @@
 /* Solid box obstacle, aligned with the world axes at t = 0 (the motion may rotate it). */
 #include "sim/obstacles/obstacle_shapes.h"
 
-#include "common/status_internal.h"
+#include "common/status_report.h"
 #include "geometry/analytic_shapes.h"
 
 piola_status piola__box_init(const piola_obstacle_def *def, piola__box_shape *shape) {
@@ -13,5 +13,5 @@ piola_status piola__box_init(const piola_obstacle_def *def, piola__box_shape *sh
 }
 
 double piola__box_distance(const piola__box_shape *shape, vec3 p, vec3 *normal) {
-  return shape_box_distance(p, shape->center, shape->half_extents, normal);
+  return piola__shape_box_distance(p, shape->center, shape->half_extents, normal);
 }

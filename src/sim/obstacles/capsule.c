@@ -3,7 +3,7 @@
 
 #include <math.h>
 
-#include "common/status_internal.h"
+#include "common/status_report.h"
 #include "geometry/analytic_shapes.h"
 
 piola_status piola__capsule_init(const piola_obstacle_def *def, piola__axial_shape *shape) {
@@ -19,6 +19,6 @@ piola_status piola__capsule_init(const piola_obstacle_def *def, piola__axial_sha
 }
 
 double piola__capsule_distance(const piola__axial_shape *shape, vec3 p, vec3 *normal) {
-  return shape_capsule_distance(p, shape->center, shape->axis, shape->radius, shape->half_length,
+  return piola__shape_capsule_distance(p, shape->center, shape->axis, shape->radius, shape->half_length,
                                 normal);
 }

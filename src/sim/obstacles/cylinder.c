@@ -1,7 +1,7 @@
 /* Solid capped cylinder obstacle: radius around the axis, |height| <= half_length. */
 #include "sim/obstacles/obstacle_shapes.h"
 
-#include "common/status_internal.h"
+#include "common/status_report.h"
 #include "geometry/analytic_shapes.h"
 
 piola_status piola__cylinder_init(const piola_obstacle_def *def, piola__axial_shape *shape) {
@@ -14,6 +14,6 @@ piola_status piola__cylinder_init(const piola_obstacle_def *def, piola__axial_sh
 }
 
 double piola__cylinder_distance(const piola__axial_shape *shape, vec3 p, vec3 *normal) {
-  return shape_cylinder_distance(p, shape->center, shape->axis, shape->radius, shape->half_length,
+  return piola__shape_cylinder_distance(p, shape->center, shape->axis, shape->radius, shape->half_length,
                                  normal);
 }

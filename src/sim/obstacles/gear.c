@@ -19,7 +19,7 @@
  * few teeth for points near the gear. Inside the inscribed disk a thin gear's distance is
  * the axial one whenever that is provably nearer than the outline, with no edge search.
  *
- * Tooth 0 is centred on the direction e1 of shape_frame(axis) (for axis z that is +x), and
+ * Tooth 0 is centred on the direction e1 of piola__shape_frame(axis) (for axis z that is +x), and
  * teeth follow counter-clockwise about the axis. The top land (2 TIP_HALF of a period) is
  * narrower than the root land (1 - 2 ROOT_FROM) so that a tooth fits into the gap of an
  * equal gear placed at centre distance 2 radius - tooth_depth with a gap facing it; see
@@ -27,7 +27,7 @@
 #include <math.h>
 #include <stdlib.h>
 
-#include "common/status_internal.h"
+#include "common/status_report.h"
 #include "geometry/analytic_shapes.h"
 #include "sim/obstacles/obstacle_shapes.h"
 
@@ -93,7 +93,7 @@ piola_status piola__gear_init(const piola_obstacle_def *def, piola__gear_shape *
   shape->tip_radius = def->radius;
   shape->root_radius = def->radius - def->tooth_depth;
   shape->tooth_count = def->tooth_count;
-  shape_frame(shape->axis, &shape->e1, &shape->e2);
+  piola__shape_frame(shape->axis, &shape->e1, &shape->e2);
 
   int32_t v = PIOLA_GEAR_VERTICES_PER_TOOTH;
   shape->vertex_count = v * def->tooth_count;

@@ -16,7 +16,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "common/status_internal.h"
+#include "common/status_report.h"
 #include "geometry/surface_distance.h"
 #include "sim/obstacles/obstacle_shapes.h"
 

@@ -1,7 +1,7 @@
 /* Half-space obstacle: the solid side is below the plane (opposite to its normal). */
 #include "sim/obstacles/obstacle_shapes.h"
 
-#include "common/status_internal.h"
+#include "common/status_report.h"
 #include "geometry/analytic_shapes.h"
 
 piola_status piola__plane_init(const piola_obstacle_def *def, piola__plane_shape *shape) {
@@ -10,5 +10,5 @@ piola_status piola__plane_init(const piola_obstacle_def *def, piola__plane_shape
 }
 
 double piola__plane_distance(const piola__plane_shape *shape, vec3 p, vec3 *normal) {
-  return shape_plane_distance(p, shape->point, shape->normal, normal);
+  return piola__shape_plane_distance(p, shape->point, shape->normal, normal);
 }

@@ -2,7 +2,7 @@
  * def's `radius`) in the plane normal to the axis. */
 #include "sim/obstacles/obstacle_shapes.h"
 
-#include "common/status_internal.h"
+#include "common/status_report.h"
 #include "geometry/analytic_shapes.h"
 
 piola_status piola__torus_init(const piola_obstacle_def *def, piola__torus_shape *shape) {
@@ -20,6 +20,6 @@ piola_status piola__torus_init(const piola_obstacle_def *def, piola__torus_shape
 }
 
 double piola__torus_distance(const piola__torus_shape *shape, vec3 p, vec3 *normal) {
-  return shape_torus_distance(p, shape->center, shape->axis, shape->major_radius,
+  return piola__shape_torus_distance(p, shape->center, shape->axis, shape->major_radius,
                               shape->minor_radius, normal);
 }

@@ -10,8 +10,8 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "common/status_internal.h"
-#include "io/atomic_file.h"
+#include "common/status_report.h"
+#include "piola/files.h"
 #include "output/output_internal.h"
 
 void piola__obj_layout_free(obj_layout *l) {
@@ -70,8 +70,8 @@ piola_status piola__obj_layout_build(const piola_tri_mesh *surface, const int32_
 }
 
 piola_status piola__obj_layout_write(const obj_layout *l, const char *path, const double *positions) {
-  atomic_file f;
-  PIOLA_TRY(atomic_file_open(&f, path));
+  piola_atomic_file f;
+  PIOLA_TRY(piola_atomic_file_open(&f, path));
   fprintf(f.stream, "# piola frame: one object per body, its surface only\n");
   for (int32_t b = 0; b < l->body_count; ++b) {
     fprintf(f.stream, "o %s\n", l->names[b]);
@@ -85,8 +85,8 @@ piola_status piola__obj_layout_write(const obj_layout *l, const char *path, cons
     }
   }
   if (ferror(f.stream)) {
-    atomic_file_abort(&f);
+    piola_atomic_file_abort(&f);
     return PIOLA_FAIL(PIOLA_ERROR_IO, "%s: write failed", path);
   }
-  return atomic_file_commit(&f);
+  return piola_atomic_file_commit(&f);
 }

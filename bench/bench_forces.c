@@ -17,6 +17,7 @@
 #include <time.h>
 
 #include "force/elastic_body_internal.h"
+#include "support/elastic_referees.h"
 #include "force/svd_kernel.h"
 #include "piola/elastic_body.h"
 #include "piola/mesh_io.h"

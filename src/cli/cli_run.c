@@ -13,6 +13,7 @@
 #include <time.h>
 #include <unistd.h>
 
+#include "cli/cli_numbers.h"
 #include "cli/commands.h"
 #include "piola/elastic_body.h"
 #include "piola/output.h"
@@ -43,14 +44,6 @@ static double now_seconds(void) {
   struct timespec ts;
   clock_gettime(CLOCK_MONOTONIC, &ts);
   return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
-
-static bool parse_count(const char *s, long lo, long hi, long *out) {
-  char *end;
-  long v = strtol(s, &end, 10);
-  if (!*s || *end || v < lo || v > hi) return false;
-  *out = v;
-  return true;
 }
 
 static void format_duration(double s, char *buf, size_t n) {
@@ -97,10 +90,10 @@ int cli_run(int argc, char **argv) {
       if (++i >= argc) return fprintf(stderr, "piola run: %s needs a folder\n", a), 2;
       out_dir = argv[i];
     } else if (strcmp(a, "--threads") == 0) {
-      if (++i >= argc || !parse_count(argv[i], 1, 1024, &threads))
+      if (++i >= argc || !cli_parse_long(argv[i], 1, 1024, &threads))
         return fprintf(stderr, "piola run: --threads needs an integer in [1, 1024]\n"), 2;
     } else if (strcmp(a, "--frames") == 0) {
-      if (++i >= argc || !parse_count(argv[i], 0, 1000000, &frames_override))
+      if (++i >= argc || !cli_parse_long(argv[i], 0, 1000000, &frames_override))
         return fprintf(stderr, "piola run: --frames needs an integer in [0, 1000000]\n"), 2;
     } else if (strcmp(a, "--force") == 0) {
       force = true;

@@ -1,6 +1,8 @@
 /* The `piola` command-line program: dispatches to subcommands. Uses only the public API. */
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 
 #include "cli/commands.h"
 
@@ -18,7 +20,21 @@ static void print_usage(FILE *out) {
           "Run `piola <command> --help` for the options of a command.\n");
 }
 
+/* OpenMP threads wait passively (sleep) between parallel regions unless the user chose
+ * otherwise. With the runtime's default, a thread that finishes its share spins for a while
+ * before sleeping; on a machine busy with other work those spinning threads take the cores
+ * the working ones need, and `--threads` at all cores ran 4.6-5.7x slower than one thread
+ * (docs/cli.md). The runtime reads OMP_WAIT_POLICY once, when it is loaded, before main:
+ * so the program sets it and starts itself again, once. */
+static void wait_passively(char **argv) {
+  if (getenv("OMP_WAIT_POLICY")) return;
+  if (setenv("OMP_WAIT_POLICY", "passive", 1) != 0) return;
+  execv("/proc/self/exe", argv);
+  /* no /proc: run on with the runtime's default */
+}
+
 int main(int argc, char **argv) {
+  wait_passively(argv);
   if (argc < 2) {
     print_usage(stderr);
     return 2;

@@ -7,26 +7,13 @@
 #include <sys/mman.h>
 #include <sys/stat.h>
 
+#include "common/grow.h"
 #include "common/status_report.h"
 #include "io/mesh_io_internal.h"
 #include "io/mesh_writers.h"
 #include "mesh/mesh_internal.h"
 #include "piola/files.h"
 #include "piola/mesh_io.h"
-
-int piola__grow(void **array, size_t *capacity, size_t need, size_t item) {
-  if (need <= *capacity) return 0;
-  size_t c = *capacity ? *capacity : 64;
-  while (c < need) {
-    if (c > SIZE_MAX / 2 / item) return -1;
-    c *= 2;
-  }
-  void *p = realloc(*array, c * item);
-  if (!p) return -1;
-  *array = p;
-  *capacity = c;
-  return 0;
-}
 
 /* A whole input file, memory-mapped when possible: mapping skips the copy into a fresh
  * buffer and the zeroing of its pages, which cost as much as parsing for big files. */

@@ -77,7 +77,7 @@ static piola_status parse_solid(scene_parser *p, const cJSON *obj, int index, sc
   d->def = piola_default_solid_def();
   d->scale = (piola_vec3){1, 1, 1};
   snprintf(d->name, sizeof d->name, "solid%d", index);
-  PIOLA_TRY(piola__scene_parse_name(p, obj, d));
+  PIOLA_TRY(piola__scene_parse_name(p, obj, d->name, sizeof d->name));
   const cJSON *v = piola__json_get(obj, "mesh");
   size_t old = piola__json_push_key(p, "mesh");
   if (cJSON_IsObject(v)) {

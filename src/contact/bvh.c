@@ -134,7 +134,8 @@ void piola__bvh_refit(piola__bvh *bvh, const piola__box *boxes) {
 }
 
 int piola__index_list_push(piola__index_list *list, int32_t value) {
-  if (piola__grow((void **)&list->items, &list->capacity, (size_t)list->count + 1,
+  if ((size_t)list->count == list->capacity &&
+      piola__grow((void **)&list->items, &list->capacity, (size_t)list->count + 1,
                   sizeof *list->items))
     return -1;
   list->items[list->count++] = value;

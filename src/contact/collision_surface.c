@@ -25,7 +25,8 @@ piola_collision_settings piola_default_collision_settings(void) {
 }
 
 int piola__contact_list_push(piola__contact_list *list, const piola__contact *c) {
-  if (piola__grow((void **)&list->items, &list->capacity, (size_t)list->count + 1,
+  if ((size_t)list->count == list->capacity &&
+      piola__grow((void **)&list->items, &list->capacity, (size_t)list->count + 1,
                   sizeof *list->items))
     return -1;
   list->items[list->count++] = *c;

@@ -376,7 +376,8 @@ static node_pair *make_tasks(const piola__bvh *ta, const piola__bvh *tb, int sam
 }
 
 static int pair_list_push(piola__pair_list *list, const piola__pair *p) {
-  if (piola__grow((void **)&list->items, &list->capacity, (size_t)list->count + 1,
+  if ((size_t)list->count == list->capacity &&
+      piola__grow((void **)&list->items, &list->capacity, (size_t)list->count + 1,
                   sizeof *list->items))
     return -1;
   list->items[list->count++] = *p;

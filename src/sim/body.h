@@ -135,6 +135,28 @@ void piola__body_finish_masses(world_body *b);
 /* Frees everything b owns and zeroes it. */
 void piola__body_free(world_body *b);
 
+/* ---- bodies that change (body_rebuild.c) */
+
+/* A new mesh for a body, between steps (fracture, refinement). The parents say where each
+ * new node and element comes from in the old mesh. */
+typedef struct body_change {
+  const piola_tet_mesh *solid_rest; /* a solid's new rest mesh (m), copied */
+  const double *x, *v;          /* 3 per new node: positions (m) and velocities (m/s); a
+                                   constrained node's are replaced by its prescribed ones */
+  const int32_t *node_parent;   /* per new node: the old node whose constraint (fixed, or
+                                   driven by which motion) it takes, -1: free. NULL: all free */
+  const int32_t *element_parent; /* per new element: the old element whose material, fibre
+                                   direction and plastic state it takes, -1: material 0,
+                                   Fp = I. NULL: all -1 */
+} body_change;
+
+/* Gives body b of world w the mesh and state of change and rebuilds every structure sized
+ * or derived from its mesh: the kind's object (padded layout, damping pattern), plastic
+ * state, per-node state and scratch, constraint flags, the collision surfaces, the elastic
+ * force. b keeps its id, name and parameters. On error b and w are unchanged. Solids only
+ * for now (a shell answers PIOLA_ERROR_UNSUPPORTED). */
+piola_status piola__body_rebuild(piola_world *w, world_body *b, const body_change *change);
+
 /* ---- the kinds' own code */
 
 /* world_solids.c */

@@ -28,20 +28,23 @@
 static void usage(FILE *out) {
   fprintf(out,
           "usage: piola run SCENE.json -o DIR [--threads N] [--frames N] [--force | --resume]\n"
-          "                 [--checkpoint-every N]\n"
+          "                 [--checkpoint-every N] [--max-steps N] [--render]\n"
           "\n"
           "  -o, --output DIR   folder for frames/, surface/, stats.csv and sim.pvd\n"
-          "  --threads N        worker threads (default: all cores)\n"
-          "  --frames N         write N frames instead of the scene's `frames`\n"
+          "  --threads N        worker threads, 1 to 1024 (default: all cores)\n"
+          "  --frames N         write N frames after frame 0 instead of the scene's `frames`\n"
           "  --force            write into DIR even if it holds earlier results\n"
-          "                     (earlier frames, stats.csv, sim.pvd and checkpoints are removed)\n"
+          "                     (the earlier run's frames, surfaces, stats.csv, sim.pvd,\n"
+          "                     failure_report.txt and checkpoints are removed first, nothing else)\n"
           "  --resume           continue the run in DIR from its newest checkpoint\n"
           "  --max-steps N      refuse a run estimated to take more than N steps (1e7)\n"
           "  --checkpoint-every N  a checkpoint every N frames (0: none; default: every 10\n"
           "                     frames or 5 minutes of wall time, whichever comes first)\n"
           "  --render           also render every frame to DIR/render/frame_NNNN.png\n"
           "                     (DIR/preview.png of the last frame is always written)\n"
-          "  -h, --help         this text\n");
+          "  -h, --help         this text\n"
+          "\n"
+          "`piola check SCENE.json` validates a scene and estimates its run without writing.\n");
 }
 
 static double now_seconds(void) {

@@ -11,9 +11,11 @@ static void print_usage(FILE *out) {
           "usage: piola <command> [options]\n"
           "\n"
           "commands:\n"
-          "  run SCENE.json -o DIR     simulate a scene and write frames\n"
-          "  mesh info|convert|generate  inspect, convert or generate meshes\n"
-          "  version                   print the version\n"
+          "  run SCENE.json -o DIR        simulate a scene and write frames\n"
+          "  check SCENE.json             validate and build a scene, estimate its run; writes nothing\n"
+          "  render DIR                   PNG frames, a contact sheet and a movie of a run's frames\n"
+          "  mesh info|convert|generate   inspect, convert or generate meshes\n"
+          "  version                      print the version\n"
           "\n"
           "Run `piola <command> --help` for the options of a command.\n");
 }

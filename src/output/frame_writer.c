@@ -44,6 +44,7 @@ struct piola_output {
   size_t csv_len, csv_cap;
   pvd_entry *pvd;
   int32_t pvd_count, pvd_cap;
+  obj_layout obj;           /* the OBJ surface: one object per body (obj_frame.c) */
 };
 
 static piola_status csv_append(piola_output *o, const char *line) {
@@ -69,6 +70,7 @@ void piola_output_close(piola_output *o) {
   piola_tri_mesh_free(&o->shells);
   free(o->rest), free(o->velocity), free(o->displacement), free(o->det_f), free(o->inverted);
   free(o->energy), free(o->solid), free(o->csv), free(o->pvd);
+  piola__obj_layout_free(&o->obj);
   free(o);
 }
 
@@ -159,6 +161,30 @@ static piola_status open_output(const char *dir, bool force, int32_t resume_fram
       o->surface.vertex_count = nv + snv;
     }
   }
+  if (st == PIOLA_OK) {
+    /* bodies in point order: the solids, then the shells */
+    int32_t nb = ns + piola_world_shell_count(world);
+    int32_t *first = malloc((size_t)(nb + 1) * sizeof *first);
+    const char **names = malloc((size_t)(nb > 0 ? nb : 1) * sizeof *names);
+    if (!first || !names) st = PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "output: out of memory");
+    else {
+      int32_t v = 0;
+      for (int32_t b = 0; b < nb; ++b) {
+        first[b] = v;
+        if (b < ns) {
+          v += piola_elastic_body_vertex_count(piola_world_solid_body(world, b));
+          names[b] = piola_world_solid_name(world, b);
+        } else {
+          v += piola_shell_body_vertex_count(piola_world_shell_body(world, b - ns));
+          names[b] = piola_world_shell_name(world, b - ns);
+        }
+      }
+      first[nb] = v;
+      st = piola__obj_layout_build(&o->surface, first, nb, names, nv + snv, &o->obj);
+    }
+    free(first);
+    free(names);
+  }
   if (st == PIOLA_OK && resume_frame < 0) st = piola__output_prepare_folder(dir, force);
   if (st == PIOLA_OK) st = csv_append(o, "frame,time,substeps,cg_iterations,kinetic_energy,elastic_energy,"
                                          "inverted,min_det_f,wall_seconds,plastic_yielded,max_fp_log_stretch,"
@@ -228,9 +254,7 @@ static piola_status commit_frame(piola_output *o, const piola_vtu_frame *frame, 
   piola__frame_commit_add(&commit, pending, path, 0);
   snprintf(path, sizeof path, "%s/surface/frame_%04d.obj", o->dir, (int)number);
   piola__frame_pending_name(path, pending, sizeof pending);
-  o->surface.positions = o->tets.positions; /* same numbering; borrowed for the write */
-  piola_status st = piola_tri_mesh_write(pending, &o->surface);
-  o->surface.positions = NULL;
+  piola_status st = piola__obj_layout_write(&o->obj, pending, o->tets.positions);
   if (st == PIOLA_OK) piola__frame_commit_add(&commit, pending, path, 0);
   size_t csv_len = o->csv_len;
   int32_t pvd_count = o->pvd_count;

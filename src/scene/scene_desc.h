@@ -68,6 +68,8 @@ typedef struct scene_shell_desc {
 
 typedef struct scene_obstacle_desc {
   piola_obstacle_def def;
+  char name[128];                 /* `name` of an obstacle (default obstacle<i>); bones keep
+                                     theirs in scene_bone_desc */
   char mesh_path[SCENE_PATH_MAX]; /* mesh obstacles */
 } scene_obstacle_desc;
 

@@ -17,9 +17,11 @@
 #include <time.h>
 
 #include "force/elastic_body_internal.h"
+#include "support/elastic_referees.h"
 #include "force/svd_kernel.h"
 #include "piola/elastic_body.h"
 #include "piola/mesh_io.h"
+#include "support/bench_deform.h"
 #include "support/bench_support.h"
 
 /* n^3 cubes, 6 tets each, edge h. */
@@ -30,34 +32,6 @@ static piola_tet_mesh grid_mesh(int n, double h) {
     exit(1);
   }
   return mesh;
-}
-
-/* Deformed positions: rest + noise (1% of the mean edge), then ~1% of tets get corner 0
- * mirrored through the plane of corners 1..3. */
-static double *deformed_positions(const piola_elastic_body *body) {
-  int32_t nv = piola_elastic_body_vertex_count(body), nt = piola_elastic_body_tet_count(body);
-  const double *rest = piola_elastic_body_rest_positions(body);
-  const int32_t *tets = piola_elastic_body_tets(body);
-  double edge = 0;
-  for (int32_t t = 0; t < nt; ++t) {
-    const double *a = rest + 3 * tets[4 * t], *b = rest + 3 * tets[4 * t + 1];
-    edge += sqrt((a[0] - b[0]) * (a[0] - b[0]) + (a[1] - b[1]) * (a[1] - b[1]) + (a[2] - b[2]) * (a[2] - b[2]));
-  }
-  edge /= nt;
-  double *x = malloc(sizeof(double) * 3 * (size_t)nv);
-  for (int32_t i = 0; i < 3 * nv; ++i) x[i] = rest[i] + 0.01 * edge * bench_uniform(-1, 1);
-  for (int32_t t = 0; t < nt; ++t) {
-    if (bench_uniform(0, 1) > 0.01) continue;
-    const int32_t *c = tets + 4 * t;
-    double *p = x + 3 * c[0], *a = x + 3 * c[1], *b = x + 3 * c[2], *d = x + 3 * c[3];
-    double e1[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]}, e2[3] = {d[0] - a[0], d[1] - a[1], d[2] - a[2]};
-    double nrm[3] = {e1[1] * e2[2] - e1[2] * e2[1], e1[2] * e2[0] - e1[0] * e2[2], e1[0] * e2[1] - e1[1] * e2[0]};
-    double nn = nrm[0] * nrm[0] + nrm[1] * nrm[1] + nrm[2] * nrm[2];
-    if (nn == 0) continue;
-    double dist = ((p[0] - a[0]) * nrm[0] + (p[1] - a[1]) * nrm[1] + (p[2] - a[2]) * nrm[2]) / nn;
-    for (int i = 0; i < 3; ++i) p[i] -= 2 * dist * nrm[i];
-  }
-  return x;
 }
 
 static void bench_mesh(const char *name, const piola_tet_mesh *mesh, int repeats) {
@@ -78,7 +52,7 @@ static void bench_mesh(const char *name, const piola_tet_mesh *mesh, int repeats
       printf("%s: %s\n", name, piola_last_error());
       return;
     }
-    double *x = deformed_positions(body);
+    double *x = bench_deformed_positions(body);
     double *f = malloc(sizeof(double) * 3 * (size_t)mesh->vertex_count);
     piola_elastic_stats stats;
     piola_elastic_body_update(body, x, 1.0, f, &stats);

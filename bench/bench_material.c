@@ -32,6 +32,8 @@ static void simd_block(const piola_material *m, long n, const double *restrict f
       PIOLA_BENCH_LOOP(neohookean_stress)
     case PIOLA_MODEL_SPLINE:
       PIOLA_BENCH_LOOP(spline_stress)
+    case PIOLA_MODEL_STABLE_NEOHOOKEAN:
+      PIOLA_BENCH_LOOP(stable_neohookean_stress)
     default:
       break;
 #undef PIOLA_BENCH_LOOP
@@ -59,6 +61,8 @@ static void simd_block_energy(const piola_material *m, long n, const double *res
       PIOLA_BENCH_LOOP(neohookean_stress_energy)
     case PIOLA_MODEL_SPLINE:
       PIOLA_BENCH_LOOP(spline_stress_energy)
+    case PIOLA_MODEL_STABLE_NEOHOOKEAN:
+      PIOLA_BENCH_LOOP(stable_neohookean_stress_energy)
     default:
       break;
 #undef PIOLA_BENCH_LOOP

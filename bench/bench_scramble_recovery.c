@@ -12,10 +12,12 @@
  *               constitutive model itself, which no inversion extension can change;
  *   stuck-ext   stuck with some entry below the threshold: the extension takes part.
  *
- * usage: bench_scramble_recovery [seeds]   (default 40; seeds 1..N) */
+ * usage: bench_scramble_recovery [seeds] [name]   (default 40; seeds 1..N; name keeps the rows
+ *        of that model or inversion mode) */
 #include <math.h>
 #include <stdint.h>
 #include <stdio.h>
+#include <string.h>
 #include <stdlib.h>
 
 #include "support/bench_support.h"
@@ -129,12 +131,26 @@ int main(int argc, char **argv) {
       {PIOLA_MODEL_STVK, PIOLA_INVERSION_CLAMP, 0.3},
       {PIOLA_MODEL_SPLINE, PIOLA_INVERSION_LINEAR, 0.3},
       {PIOLA_MODEL_SPLINE, PIOLA_INVERSION_CLAMP, 0.3},
+      {PIOLA_MODEL_NEOHOOKEAN, PIOLA_INVERSION_ENERGY, 0.3},
+      {PIOLA_MODEL_NEOHOOKEAN, PIOLA_INVERSION_ENERGY, 0.5},
+      {PIOLA_MODEL_STABLE_NEOHOOKEAN, PIOLA_INVERSION_LINEAR, 0.3},
+      {PIOLA_MODEL_STABLE_NEOHOOKEAN, PIOLA_INVERSION_CLAMP, 0.3},
+      {PIOLA_MODEL_STABLE_NEOHOOKEAN, PIOLA_INVERSION_ENERGY, 0.3},
+      {PIOLA_MODEL_ROTATED_LINEAR, PIOLA_INVERSION_ENERGY, 0.3},
+      {PIOLA_MODEL_COROTATED, PIOLA_INVERSION_ENERGY, 0.3},
+      {PIOLA_MODEL_STVK, PIOLA_INVERSION_ENERGY, 0.3},
+      {PIOLA_MODEL_SPLINE, PIOLA_INVERSION_ENERGY, 0.3},
   };
+  /* An optional second argument keeps the rows whose model or inversion mode has that name. */
+  const char *only = argc > 2 ? argv[2] : NULL;
   printf("scrambled 3x3x3 grid (%d tets), seeds 1..%d, 12 s each\n", (int)mesh.tet_count, seeds);
   printf("| model | extension | threshold | recovered | slow | stuck (model) | stuck (extension) | wall s |\n");
   printf("|---|---|---|---|---|---|---|---|\n");
   for (size_t k = 0; k < sizeof configs / sizeof configs[0]; ++k) {
     const config *c = &configs[k];
+    if (only && strcmp(only, piola_material_model_name(c->model)) != 0 &&
+        strcmp(only, piola_inversion_mode_name(c->mode)) != 0)
+      continue;
     double t0 = bench_wall_seconds();
     outcome o = run_config(&mesh, c->model, c->mode, c->threshold, seeds);
     printf("| %s | %s | %.1f | %d | %d | %d | %d | %.1f |\n", piola_material_model_name(c->model),

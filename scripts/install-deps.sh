@@ -13,6 +13,8 @@ packages=(
   libcmocka-dev
   # external tools the round-trip tests talk to
   gmsh tetgen python3 python3-meshio python3-vtk9 python3-numpy
+  # the Python package (python/): the C extension's headers, its tests and the plotting example
+  python3-dev python3-pytest python3-matplotlib
   # movies from `piola render`
   ffmpeg
 )

@@ -6,6 +6,7 @@
 #include <string.h>
 
 #include "force/elastic_body_internal.h"
+#include "support/elastic_referees.h"
 #include "test_elastic_body_fixtures.h"
 
 static double dot(const double *a, const double *b, int n) {

@@ -5,6 +5,7 @@
 #include <stdlib.h>
 
 #include "force/elastic_body_internal.h"
+#include "support/elastic_referees.h"
 #include "piola/mesh_io.h"
 #include "test_elastic_body_fixtures.h"
 

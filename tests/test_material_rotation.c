@@ -37,10 +37,10 @@ static void stress_rotates_with_the_deformation(void **state) {
   test_rng rng = test_rng_seeded(31);
   const long samples = test_samples(300, 20);
   for (int model = 0; model < PIOLA_MODEL_COUNT; ++model)
-    for (int mode = 0; mode < 2; ++mode) {
+    for (int mode = 0; mode < 3; ++mode) {
       piola_material_def def = piola_default_material_def();
       def.model = (piola_material_model)model;
-      def.inversion_mode = mode ? PIOLA_INVERSION_CLAMP : PIOLA_INVERSION_LINEAR;
+      def.inversion_mode = (piola_inversion_mode[]){PIOLA_INVERSION_LINEAR, PIOLA_INVERSION_CLAMP, PIOLA_INVERSION_ENERGY}[mode];
       piola_material m;
       assert_int_equal(piola_material_init(&def, &m), PIOLA_OK);
       for (long s = 0; s < samples; ++s) {

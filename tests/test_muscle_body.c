@@ -9,6 +9,7 @@
 #include <string.h>
 
 #include "force/elastic_body_internal.h"
+#include "support/elastic_referees.h"
 #include "piola/world.h"
 #include "test_elastic_body_fixtures.h"
 

@@ -3,7 +3,8 @@
  * nu = 0.3, 1000 kg/m^3, shear and bulk viscosity 1000 Pa s, zero gravity:
  *  - scrambles (every free node moved by a random point of a ball of the given radius) on
  *    unit_ball.mesh, octahedron.node and octopus-low.mesh (min dihedral angle 0.84 degrees,
- *    14% of tets with mean ratio < 0.1) run 2 s of simulated time with every step succeeding
+ *    14% of tets with mean ratio < 0.1) run 2 s of simulated time (octopus-low 0.05 s: its
+ *    slivers make 2 s too many steps for a test) with every step succeeding
  *    and a finite state: 0.5, 1 and 2 diagonals for neo-Hookean and rotated linear on all
  *    three; corotated, StVK and the spline only half a diagonal on the unit ball (elsewhere
  *    their explicit runs are not affordable in a test, see docs/time-stepping.md
@@ -97,9 +98,16 @@ static void scrambles_run_to_the_end(void **state) {
         const double radius = (r == 0 ? 0.5 : r == 1 ? 1.0 : 2.0) * DIAGONAL;
         piola_world *w = make_world(&mesh, models[k], identity, radius);
         piola_step_stats st = {0};
-        if (piola_world_advance_to(w, seconds, &st) != PIOLA_OK || !state_finite(w))
+        /* octopus-low's slivers hold the step near 8e-6 s: 2 s there are 250,000 steps a
+         * case (over a minute each on the test machine), so it runs the first 0.05 s, the
+         * violent part of a scramble where the rest-state step blew up */
+        const double run = mi == 2 ? fmin(seconds, 0.05) : seconds;
+        if (piola_world_advance_to(w, run, &st) != PIOLA_OK || !state_finite(w))
           fail_msg("%s, %s, scramble %g m: %s", meshes[mi], piola_material_model_name(models[k]),
                    radius, piola_last_error());
+        if (getenv("PIOLA_TEST_VERBOSE"))
+          print_message("%s %s scramble %g m: %d steps\n", meshes[mi],
+                        piola_material_model_name(models[k]), radius, (int)st.substeps);
         piola_world_destroy(w);
       }
     piola_tet_mesh_free(&mesh);

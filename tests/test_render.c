@@ -587,6 +587,88 @@ static void test_deterministic_for_any_thread_count(void **state) {
   test_sphere_free(&s);
 }
 
+/* A coarse triangulated sphere lying exactly on an obstacle sphere (every vertex on its
+ * surface, as draped cloth is): the flat triangles cut into the obstacle by their sagitta,
+ * yet the mesh covers the obstacle everywhere around the image centre, with no patches of
+ * the obstacle showing through. */
+static void test_mesh_lying_on_an_obstacle_is_not_pierced(void **state) {
+  (void)state;
+  piola_render_def def = axis_camera(4, 40);
+  piola_obstacle_def ob = piola_default_obstacle_def();
+  ob.type = PIOLA_OBSTACLE_SPHERE;
+  ob.radius = 0.5;
+  test_sphere s = test_uv_sphere(24, 12, 0.5, 0, 0, 0);
+  piola_render_mesh m = sphere_mesh(&s);
+  piola_image only_obstacle = {0}, both = {0};
+  piola_renderer *r;
+  assert_int_equal(piola_renderer_create(&def, &r), PIOLA_OK);
+  assert_int_equal(piola_renderer_add_obstacle(r, &ob), PIOLA_OK);
+  assert_int_equal(piola_renderer_render(r, NULL, &only_obstacle), PIOLA_OK);
+  assert_int_equal(piola_renderer_render(r, &m, &both), PIOLA_OK);
+  piola_renderer_destroy(r);
+  /* the sphere's disk has a radius of about 0.5 * 494 / 4 = 62 pixels: check +-30 */
+  for (int y = def.height / 2 - 30; y <= def.height / 2 + 30; ++y)
+    for (int x = def.width / 2 - 30; x <= def.width / 2 + 30; ++x)
+      assert_false(same_rgb(&only_obstacle, &both, x, y));
+  piola_image_free(&only_obstacle);
+  piola_image_free(&both);
+  test_sphere_free(&s);
+}
+
+/* Once the camera is fitted, planes are a finite floor: a wall (a plane facing sideways)
+ * is not drawn at all, and the floor covers fewer pixels than the same plane unbounded
+ * (drawn by a renderer with the same camera set and never fitted), yet still the pixels
+ * under the framed box. */
+static int count_differing(const piola_image *a, const piola_image *b) {
+  int n = 0;
+  for (int y = 0; y < a->height; ++y)
+    for (int x = 0; x < a->width; ++x) n += !same_rgb(a, b, x, y);
+  return n;
+}
+
+static void test_fitted_planes_are_a_finite_floor(void **state) {
+  (void)state;
+  piola_render_def def = piola_default_render_def();
+  def.width = 320, def.height = 240;
+  def.ground = false;
+  def.shadows = false;
+  piola_obstacle_def floor_def = piola_default_obstacle_def(), wall = piola_default_obstacle_def();
+  floor_def.type = wall.type = PIOLA_OBSTACLE_PLANE;
+  floor_def.center = (piola_vec3){0, 0, -0.5};
+  floor_def.axis = (piola_vec3){0, 0, 1};
+  wall.center = (piola_vec3){0, 2, 0}; /* behind the box, facing the camera */
+  wall.axis = (piola_vec3){0, -1, 0};
+  piola_vec3 lo = {-0.5, -0.5, -0.5}, hi = {0.5, 0.5, 0.5};
+  piola_image sky = {0}, with_wall = {0}, fitted = {0}, unbounded = {0};
+  piola_renderer *r;
+  assert_int_equal(piola_renderer_create(&def, &r), PIOLA_OK);
+  piola_renderer_fit_camera(r, lo, hi);
+  piola_vec3 pos, target;
+  piola_renderer_camera(r, &pos, &target);
+  assert_int_equal(piola_renderer_render(r, NULL, &sky), PIOLA_OK);
+  assert_int_equal(piola_renderer_add_obstacle(r, &wall), PIOLA_OK);
+  assert_int_equal(piola_renderer_render(r, NULL, &with_wall), PIOLA_OK);
+  assert_int_equal(count_differing(&sky, &with_wall), 0);
+  assert_int_equal(piola_renderer_add_obstacle(r, &floor_def), PIOLA_OK);
+  assert_int_equal(piola_renderer_render(r, NULL, &fitted), PIOLA_OK);
+  piola_renderer_destroy(r);
+  def.camera_set = true;
+  def.camera_position = pos, def.camera_target = target;
+  assert_int_equal(piola_renderer_create(&def, &r), PIOLA_OK);
+  assert_int_equal(piola_renderer_add_obstacle(r, &floor_def), PIOLA_OK);
+  assert_int_equal(piola_renderer_render(r, NULL, &unbounded), PIOLA_OK);
+  piola_renderer_destroy(r);
+  int finite = count_differing(&sky, &fitted), whole = count_differing(&sky, &unbounded);
+  assert_true(finite > 0);
+  assert_true(finite < whole);
+  /* the image centre looks at the box centre, above the floor's middle: floor there */
+  assert_false(same_rgb(&sky, &fitted, def.width / 2, def.height - 1));
+  piola_image_free(&sky);
+  piola_image_free(&with_wall);
+  piola_image_free(&fitted);
+  piola_image_free(&unbounded);
+}
+
 static void test_bad_arguments_are_refused(void **state) {
   (void)state;
   piola_renderer *r = NULL;
@@ -631,6 +713,8 @@ int main(void) {
       cmocka_unit_test(test_shadow_of_a_sphere_on_the_ground),
       cmocka_unit_test(test_supersampling_averages_a_larger_render),
       cmocka_unit_test(test_deterministic_for_any_thread_count),
+      cmocka_unit_test(test_mesh_lying_on_an_obstacle_is_not_pierced),
+      cmocka_unit_test(test_fitted_planes_are_a_finite_floor),
       cmocka_unit_test(test_bad_arguments_are_refused),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);

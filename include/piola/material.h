@@ -18,7 +18,9 @@
  * result is finite for every Fhat with entries up to 1e30 in magnitude (flat, collapsed and
  * inverted included; only the models' own growth, e.g. corotated's energy ~ f^6, overflows
  * far beyond that), and every entry f_i <= 0 gets Phat_i < 0: an inverted element is always
- * pushed back. See docs/materials.md.
+ * pushed back. PIOLA_INVERSION_ENERGY extends the energy instead (Stomakhin et al. 2012): the
+ * stress is then the exact gradient of the reported energy everywhere and the derivative is
+ * a symmetric Hessian. See docs/materials.md.
  *
  * Usage:
  *   piola_material_def def = piola_default_material_def();
@@ -50,12 +52,21 @@ typedef enum piola_material_model {
                                      part (matrix + volume) is neo-Hookean with E, nu; the
                                      fibre part is piola_material_fiber_stress. See
                                      piola_muscle_def and docs/materials.md */
+  PIOLA_MODEL_STABLE_NEOHOOKEAN,  /* Smith, de Goes, Kim 2018: mu'/2 (I_C - 3) + lambda'/2 (J - alpha)^2
+                                     - mu'/2 ln(I_C + 1), with mu' = 4/3 mu, lambda' = lambda + 5/6 mu,
+                                     alpha = 1 + mu / lambda' (docs/materials.md) */
+  PIOLA_MODEL_MOONEY_RIVLIN,      /* C10 sum (f_i^2 - 1) + C01 sum (f_i^-2 - 1) - 2 (C10 - C01) ln J
+                                     + lambda/2 (ln J)^2: see piola_mooney_rivlin_def */
+  PIOLA_MODEL_OGDEN,              /* sum_p mu_p / alpha_p sum_i (f_i^alpha_p - 1) - (sum_p mu_p) ln J
+                                     + lambda/2 (ln J)^2: see piola_ogden_def */
   PIOLA_MODEL_COUNT
 } piola_material_model;
 
 typedef enum piola_inversion_mode {
   PIOLA_INVERSION_LINEAR = 0, /* C1: first-order Taylor expansion at the threshold (default) */
   PIOLA_INVERSION_CLAMP,      /* C0: the stress at the clamped point */
+  PIOLA_INVERSION_ENERGY,     /* the energy extended past the threshold (Stomakhin, Howes,
+                                 Schroeder, Teran 2012): the stress is its exact gradient */
 } piola_inversion_mode;
 
 /* Shape of the spline ("biological") model: soft near rest, stiffer past the thresholds. */
@@ -89,6 +100,29 @@ typedef struct piola_muscle_def {
                                  bump, relative to optimal_stretch. Default 0.5 */
 } piola_muscle_def;
 
+/* Ogden (1972) in principal stretches, N terms, compressible through a ln J volume term:
+ *   psi = sum_p mu_p / alpha_p sum_i (f_i^alpha_p - 1) - (sum_p mu_p) ln J + lambda/2 (ln J)^2
+ * Its shear modulus is mu = 1/2 sum_p mu_p alpha_p (must be > 0); lambda comes from
+ * poisson_ratio with that mu (youngs_modulus is not used). For incompressible deformations
+ * (J = 1) this is Ogden's energy; Mooney-Rivlin and neo-Hookean are its two- and one-term
+ * cases (alpha = 2, -2). */
+#define PIOLA_OGDEN_MAX_TERMS 6
+typedef struct piola_ogden_def {
+  int term_count;                     /* 1..PIOLA_OGDEN_MAX_TERMS. Default 3 */
+  double mu[PIOLA_OGDEN_MAX_TERMS];    /* Pa, each nonzero. Default Ogden's 1972 fit to
+                                          Treloar's rubber: 6.18e5, 1.18e3, -9.81e3 */
+  double alpha[PIOLA_OGDEN_MAX_TERMS]; /* dimensionless, each nonzero. Default 1.3, 5, -2 */
+} piola_ogden_def;
+
+/* Mooney-Rivlin in principal stretches, compressible through the same ln J volume term:
+ *   psi = C10 sum_i (f_i^2 - 1) + C01 sum_i (f_i^-2 - 1) - 2 (C10 - C01) ln J + lambda/2 (ln J)^2
+ * which for J = 1 is the classical C10 (I1 - 3) + C01 (I2 - 3). Shear modulus
+ * mu = 2 (C10 + C01) (must be > 0); lambda from poisson_ratio (youngs_modulus is not used). */
+typedef struct piola_mooney_rivlin_def {
+  double c10; /* Pa. Default 1.5e4 */
+  double c01; /* Pa. Default 5e3 */
+} piola_mooney_rivlin_def;
+
 typedef struct piola_material_def {
   piola_material_model model;
   double youngs_modulus;      /* Pa, > 0. Default 1e5 */
@@ -96,6 +130,8 @@ typedef struct piola_material_def {
   double inversion_threshold; /* dimensionless, in (0, 1): compression threshold c. Default 0.3 */
   piola_inversion_mode inversion_mode; /* Default PIOLA_INVERSION_LINEAR */
   piola_spline_def spline;    /* used by PIOLA_MODEL_SPLINE only */
+  piola_ogden_def ogden;      /* used by PIOLA_MODEL_OGDEN only */
+  piola_mooney_rivlin_def mooney_rivlin; /* used by PIOLA_MODEL_MOONEY_RIVLIN only */
   piola_muscle_def muscle;    /* used by PIOLA_MODEL_MUSCLE only; youngs_modulus and
                                  poisson_ratio give its matrix and volume part (use nu close
                                  to 0.5, e.g. 0.45, for a quasi-incompressible muscle) */
@@ -117,6 +153,9 @@ typedef struct piola_material {
   double threshold;           /* dimensionless compression threshold c */
   piola_inversion_mode inversion_mode;
   double spline_coefficients[16]; /* precomputed spline pieces, model-internal */
+  double model_constants[24]; /* precomputed constants, model-internal (Stable Neo-Hookean's
+                                 mu', lambda', alpha; the energy extension's slope; the
+                                 Ogden / Mooney-Rivlin terms) */
   piola_muscle_def muscle;    /* PIOLA_MODEL_MUSCLE: the validated fibre parameters */
   double fiber_modulus;       /* Pa: bound on the fibre's tangent stiffness at full activation
                                  (0 for other models), added to lambda + 2 mu in the CFL
@@ -136,9 +175,31 @@ PIOLA_API void piola_material_stress(const piola_material *material, const doubl
 PIOLA_API double piola_material_energy_density(const piola_material *material, const double fhat[3]);
 
 /* dPhat_i / dFhat_j (Pa): the exact derivative of the extended stress. Symmetric where the
- * stress has a potential (no entry below the threshold, or all three below it). */
+ * stress has a potential (no entry below the threshold, or all three below it; everywhere
+ * with PIOLA_INVERSION_ENERGY, whose stress is the gradient of the extended energy). */
 PIOLA_API void piola_material_stress_derivative(const piola_material *material,
                                                 const double fhat[3], double dphat[3][3]);
+
+/* The eigensystem of the Hessian d2psi/dF2 (9x9, Pa) of an isotropic energy at F = U Fhat V^T,
+ * in the diagonal frame, with negative eigenvalues clamped to zero: the projected Hessian
+ * that makes an implicit solver's element stiffness positive semi-definite (Teran et al.
+ * 2005; Smith, de Goes, Kim 2018, section 4). The Hessian is
+ *   sum_k eigenvalues[k] vec(U Q_k V^T) vec(U Q_k V^T)^T,   Q_k = eigenvectors[k]
+ * with Q_k orthonormal under the Frobenius product. Q_0..Q_2 are diagonal (the scaling
+ * modes: the eigenvectors of dPhat/dFhat); Q_3..Q_8 are (e_i e_j^T -+ e_j e_i^T) / sqrt 2 for
+ * (i, j) = (0, 1), (0, 2), (1, 2): Q_3..Q_5 twist (antisymmetric), Q_6..Q_8 flip (symmetric), with the
+ * eigenvalues (Phat_i + Phat_j) / (f_i + f_j) and (Phat_i - Phat_j) / (f_i - f_j).
+ * For PIOLA_MODEL_STABLE_NEOHOOKEAN with no entry below the inversion threshold the twist and
+ * flip eigenvalues are the closed forms mu' r +- lambda' (J - alpha) f_k (r = I_C / (I_C + 1),
+ * k the third index) and need no division. Available for every model in
+ * PIOLA_INVERSION_ENERGY mode or with no entry below the threshold (where the stress is the
+ * gradient of an energy); elsewhere (LINEAR or CLAMP with a clamped entry, or a muscle, whose
+ * fibres are not isotropic) returns PIOLA_ERROR_INVALID_ARGUMENT. Where f_i = +-f_j the
+ * quotients are replaced by their limits (dPhat_i/dFhat_i +- dPhat_i/dFhat_j). */
+PIOLA_API piola_status piola_material_projected_hessian_eigensystem(const piola_material *material,
+                                                                   const double fhat[3],
+                                                                   double eigenvalues[9],
+                                                                   double eigenvectors[9][3][3]);
 
 /* ------------------------------------------------------------------ muscle fibres
  * For a PIOLA_MODEL_MUSCLE material (all zero for other models). fiber is the fibre
@@ -173,16 +234,16 @@ PIOLA_API double piola_material_muscle_energy_density(const piola_material *mate
                                                       double activation);
 
 /* Name used in scene files: "rotated_linear", "corotated", "stvk", "neohookean", "spline",
- * "muscle". */
+ * "muscle", "stable_neohookean", "mooney_rivlin", "ogden". */
 PIOLA_API const char *piola_material_model_name(piola_material_model model);
 
 /* Parses a scene-file name; false if unknown. */
 PIOLA_API bool piola_material_model_from_name(const char *name, piola_material_model *model);
 
-/* Name used in scene files for the inversion mode: "linear" (C1) or "clamp" (C0). */
+/* Name used in scene files for the inversion mode: "linear" (C1), "clamp" (C0) or "energy". */
 PIOLA_API const char *piola_inversion_mode_name(piola_inversion_mode mode);
 
-/* Parses "linear" or "clamp"; false if unknown. */
+/* Parses "linear", "clamp" or "energy"; false if unknown. */
 PIOLA_API bool piola_inversion_mode_from_name(const char *name, piola_inversion_mode *mode);
 
 /* ------------------------------------------------------------------ membrane models (shells) */

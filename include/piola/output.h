@@ -27,9 +27,11 @@ extern "C" {
 
 typedef struct piola_output piola_output;
 
-/* Whether results may be written to dir without touching anything: OK when dir does not
- * exist or is an empty folder, or when force is set and dir is a folder. Otherwise
- * PIOLA_ERROR_INVALID_ARGUMENT with a message saying why. */
+/* Whether results may be written to dir, leaving it as it was: OK when dir does not exist
+ * and can be created (its nearest existing ancestor is a writable folder), or is an empty
+ * writable folder, or when force is set and dir is a writable folder (writability is tested
+ * by creating and removing a probe file). Otherwise PIOLA_ERROR_INVALID_ARGUMENT with a
+ * message saying why. */
 PIOLA_API piola_status piola_output_check_folder(const char *dir, bool force);
 
 /* Creates dir, dir/frames and dir/surface (after piola_output_check_folder), removing the
@@ -37,6 +39,13 @@ PIOLA_API piola_status piola_output_check_folder(const char *dir, bool force);
 PIOLA_API piola_status piola_output_open(const char *dir, bool force, const piola_world *world,
                                          piola_output **out);
 PIOLA_API void piola_output_close(piola_output *output);
+
+/* Reopens the folder of an earlier run to continue after frame `frame` (a resume from a
+ * checkpoint, piola/checkpoint.h): frames 0..frame must be in place and listed in
+ * stats.csv; later frames, their index rows and stray temporaries are removed, and both
+ * indexes are rewritten to list exactly frames 0..frame. */
+PIOLA_API piola_status piola_output_open_resume(const char *dir, int32_t frame,
+                                                const piola_world *world, piola_output **out);
 
 typedef struct piola_frame_info {
   int32_t frame;          /* frame number, 0 is the initial state */
@@ -46,6 +55,11 @@ typedef struct piola_frame_info {
   int64_t contacts;       /* self-collision repulsion contacts since the previous frame */
   int64_t impacts;        /* self-collision impacts since the previous frame */
   int32_t impact_zones;   /* self-collision rigid impact zones since the previous frame */
+  int32_t newton_iterations; /* implicit integrators: Newton iterations since the previous
+                                frame (0 with Newmark) */
+  int32_t linear_iterations; /* implicit integrators: CG iterations of the Newton systems */
+  int32_t newton_failures;   /* implicit integrators: steps retried at half the size because
+                                Newton did not converge */
   int32_t step_retries;   /* steps redone at a smaller size since the previous frame */
 } piola_frame_info;
 

@@ -9,6 +9,7 @@
 #define PIOLA_PIOLA_H
 
 /* core: libpiola */
+#include "piola/checkpoint.h"
 #include "piola/collision_surface.h"
 #include "piola/diagonalize.h"
 #include "piola/elastic_body.h"
@@ -29,6 +30,7 @@
 #include "piola/status.h"
 #include "piola/threads.h"
 #include "piola/world.h"
+#include "piola/world_bodies.h"
 #include "piola/world_bones.h"
 #include "piola/world_shells.h"
 

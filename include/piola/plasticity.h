@@ -84,6 +84,18 @@ PIOLA_API piola_status piola_plastic_state_create(piola_elastic_body *body,
                                                   piola_plastic_state **out);
 PIOLA_API void piola_plastic_state_destroy(piola_plastic_state *state);
 
+/* Creates a plastic state for body whose tets inherit the state of tets of another body's
+ * state `parent` (same parameters and control): tet t takes Fp, the accumulated plastic
+ * strain and the control goal of parent's tet tet_parent[t] (one per tet of body), or starts
+ * fresh (Fp = I, no strain) where tet_parent[t] is -1, which a controlled parent does not
+ * allow. For a body whose mesh changed (refined, split): body's rest Dm^-1 times the
+ * inherited Fp^-1 becomes its effective Dm^-1. body must outlive the state; parent is only
+ * read. */
+PIOLA_API piola_status piola_plastic_state_create_from(piola_elastic_body *body,
+                                                       const piola_plastic_state *parent,
+                                                       const int32_t *tet_parent,
+                                                       piola_plastic_state **out);
+
 typedef struct piola_plastic_stats {
   int32_t yielded_count;  /* tets whose yield criterion was exceeded in this update */
   int32_t limited_count;  /* tets whose Fp was projected onto the limit */

@@ -118,13 +118,29 @@ PIOLA_API piola_status piola_renderer_add_obstacle(piola_renderer *renderer,
 /* Adds every obstacle of a scene file (piola/scene.h format); solids are not read. */
 PIOLA_API piola_status piola_renderer_load_scene_obstacles(piola_renderer *renderer,
                                                            const char *scene_path);
+/* Like piola_renderer_load_scene_obstacles, leaving out every obstacle and bone that one of
+ * hide[0 .. hide_count) names: "all", a type ("plane", "sphere", ..., "mesh"), the `name` of
+ * an obstacle or a bone, or "obstacles[i]" / "bones[i]" (0-based). A name that matches
+ * nothing is an error (PIOLA_ERROR_INVALID_ARGUMENT, listing the names the scene has), and
+ * nothing is added then. */
+PIOLA_API piola_status piola_renderer_load_scene_obstacles_hiding(piola_renderer *renderer,
+                                                                  const char *scene_path,
+                                                                  const char *const *hide,
+                                                                  int32_t hide_count);
+/* The up direction of a scene file: minus its gravity at t = 0, normalized, or (0, 0, 1)
+ * when that gravity is zero (piola's convention). Only the parser runs. */
+PIOLA_API piola_status piola_render_scene_up(const char *scene_path, piola_vec3 *up);
 PIOLA_API int32_t piola_renderer_obstacle_count(const piola_renderer *renderer);
 
 /* Chooses the camera so the box [lo, hi] (m) fills the view, looking from the front right
  * and above, unless the def set a camera; also places the fallback ground at the box's
  * lowest point along `up`. The box is grown by the bounding spheres (at t = 0) of the
- * obstacles added so far that are no larger than the box and near it, so add obstacles
- * first. */
+ * obstacles added so far that are no larger than the box and near it: add obstacles first
+ * to frame them too, or after to frame the box alone (obstacles may then be cut by the
+ * image border). Once fitted, planes (plane obstacles and the fallback ground) are drawn as
+ * a finite floor: a square 8 times the framed box's radius across, centred under it and
+ * fading out at its edge, and only planes that face up (normal within 60 degrees of `up`);
+ * walls and ceilings are not drawn. */
 PIOLA_API void piola_renderer_fit_camera(piola_renderer *renderer, piola_vec3 lo, piola_vec3 hi);
 
 /* The camera in use (after fit_camera or from the def). */

@@ -22,6 +22,7 @@
 #ifndef PIOLA_SCENE_H
 #define PIOLA_SCENE_H
 
+#include <stdbool.h>
 #include <stdint.h>
 
 #include "piola/export.h"
@@ -79,6 +80,14 @@ PIOLA_API int32_t piola_scene_desc_obstacle_count(const piola_scene_desc *desc);
  * NULL) receives its resolved surface file, else "". */
 PIOLA_API piola_obstacle_def piola_scene_desc_obstacle(const piola_scene_desc *desc, int32_t i,
                                                        const char **mesh_path);
+
+/* Obstacle i's `name` (default "obstacle<i>"), or for a bone (i >= the number of
+ * obstacles) the bone's name. Valid while desc lives. */
+PIOLA_API const char *piola_scene_desc_obstacle_name(const piola_scene_desc *desc, int32_t i);
+/* Whether entry i of the obstacle list is a bone's shape. */
+PIOLA_API bool piola_scene_desc_obstacle_is_bone(const piola_scene_desc *desc, int32_t i);
+/* The scene's gravity (m/s^2) at time t (s). */
+PIOLA_API piola_vec3 piola_scene_desc_gravity(const piola_scene_desc *desc, double t);
 
 /* Writes the scene file at scene_path to out_path (whole or not at all) with every mesh path
  * of solids, shells, obstacles, bones and plastic goals made absolute, so the copy reads the

@@ -22,6 +22,8 @@ typedef enum piola_status {
   PIOLA_ERROR_IO = -5,                  /* a file could not be opened, read or written */
   PIOLA_ERROR_PARSE = -6,               /* a file or scene is malformed */
   PIOLA_ERROR_UNSUPPORTED = -7,         /* well-formed input that piola does not handle */
+  PIOLA_ERROR_NOT_CONVERGED = -8,       /* an iterative solve (the implicit integrators'
+                                           Newton) did not reach its tolerance */
 } piola_status;
 
 /* Short constant name of a status, e.g. "invalid argument". Never NULL. */

@@ -2,7 +2,12 @@
  *
  * One setting for every parallel loop of the library (forces, damping, collisions, the
  * mesher, the renderer). Results never depend on it, only speed does: every parallel loop
- * writes disjoint outputs and sums in a fixed order. */
+ * writes disjoint outputs and sums in a fixed order.
+ *
+ * On a machine busy with other work, OpenMP's default of spinning idle threads makes many
+ * threads slower than one: a host program should run with OMP_WAIT_POLICY=passive in its
+ * environment (the runtime reads it at start-up only; the `piola` program sets it itself,
+ * docs/cli.md). */
 #ifndef PIOLA_THREADS_H
 #define PIOLA_THREADS_H
 

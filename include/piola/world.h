@@ -41,6 +41,21 @@ extern "C" {
 
 typedef struct piola_world piola_world;
 
+/* How the world advances (docs/time-stepping.md). */
+typedef enum piola_integrator_type {
+  PIOLA_INTEGRATOR_NEWMARK = 0,   /* paper section 9: elastic forces explicit, damping
+                                     implicit, CFL-bounded steps (default) */
+  PIOLA_INTEGRATOR_BACKWARD_EULER, /* fully implicit: each step minimizes the incremental
+                                     potential by Newton's method; steps of implicit_dt */
+  PIOLA_INTEGRATOR_QUASISTATIC,   /* each step is the static equilibrium under the loads,
+                                     constraints and obstacles of its end time */
+  PIOLA_INTEGRATOR_COUNT
+} piola_integrator_type;
+
+/* Scene names "newmark", "backward_euler", "quasistatic". */
+PIOLA_API const char *piola_integrator_type_name(piola_integrator_type type);
+PIOLA_API bool piola_integrator_type_from_name(const char *name, piola_integrator_type *type);
+
 typedef struct piola_world_def {
   piola_track gravity[3];    /* m/s^2, keyframable. Default (0, 0, -9.81): z is up */
   double max_dt;             /* s, > 0: the user's cap on the step size. Default 1e-3 */
@@ -56,6 +71,20 @@ typedef struct piola_world_def {
    * collision-processed.
    * 0 (default): after every step. Obstacles are handled inside every step either way. */
   double collision_interval;
+  /* The integrator (default PIOLA_INTEGRATOR_NEWMARK). The fields below are used by the
+   * implicit ones only (max_dt, cfl and the cg_ fields by Newmark only). */
+  piola_integrator_type integrator;
+  double implicit_dt;          /* s, > 0: the step of the implicit integrators; halved only
+                                  when Newton fails to converge. Default 1/30 */
+  double newton_tolerance;     /* dimensionless, > 0: Newton stops when the mass-weighted RMS
+                                  of the unbalanced force per mass is below this times
+                                  9.81 m/s^2. Default 1e-5 */
+  int32_t newton_max_iterations; /* >= 1: past this the step counts as failed and is
+                                  retried at half its size. Default 30 */
+  double linear_tolerance;     /* dimensionless, in (0, 1): each Newton system is solved by
+                                  preconditioned CG to this fraction of its initial residual.
+                                  Default 1e-3 */
+  int32_t linear_max_iterations; /* >= 1: CG iterations per Newton system. Default 1000 */
 } piola_world_def;
 
 PIOLA_API piola_world_def piola_default_world_def(void);
@@ -146,6 +175,11 @@ typedef struct piola_step_stats {
   int32_t impact_zones;   /* self-collision: rigid impact zones, summed over the steps */
   int32_t collision_steps; /* self-collision: processing runs (every step, or one per
                               collision interval; 0 without self-collision) */
+  int32_t newton_iterations; /* implicit integrators: Newton iterations, summed over the
+                                steps and bodies (0 with Newmark) */
+  int32_t linear_iterations; /* implicit integrators: CG iterations of the Newton systems */
+  int32_t newton_failures;   /* implicit integrators: steps whose Newton did not converge,
+                                undone and retried at half the step */
   int32_t step_retries;   /* steps redone at a quarter of their size because the state blew
                              up (docs/time-stepping.md, "Step retries") */
 } piola_step_stats;

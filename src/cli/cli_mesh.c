@@ -1,6 +1,7 @@
 /* `piola mesh info|convert|generate`: inspect, convert and generate meshes. */
 #include <cjson/cJSON.h>
 #include <math.h>
+#include <stdbool.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -13,10 +14,95 @@
 
 static void usage(FILE *out) {
   fprintf(out,
-          "usage: piola mesh info FILE [--json]   counts, volume, regions, quality, boundary checks\n"
+          "usage: piola mesh info FILE [--json] [--material E,NU,RHO]\n"
+          "                                        counts, bounding box, volume, regions, quality,\n"
+          "                                        smallest altitude, boundary checks; with\n"
+          "                                        --material (Pa, -, kg/m^3) the explicit time step\n"
           "       piola mesh convert IN OUT        convert by extension (.node/.ele .msh .mesh .veg\n"
           "                                        .vtu .obj .off .stl)\n"
           "       piola mesh generate ...          see `piola mesh generate --help`\n");
+}
+
+/* --material E,NU,RHO: Young's modulus (Pa), Poisson ratio, density (kg/m^3). */
+typedef struct info_material {
+  bool given;
+  double youngs_modulus, poisson_ratio, density;
+} info_material;
+
+static bool parse_material(const char *s, info_material *m) {
+  double v[3];
+  const char *p = s;
+  char *end = NULL;
+  for (int k = 0; k < 3; ++k) {
+    v[k] = strtod(p, &end);
+    if (end == p || !isfinite(v[k]) || (k < 2 && *end != ',')) return false;
+    p = end + (k < 2);
+  }
+  if (*end || !(v[0] > 0) || !(v[1] > -1 && v[1] < 0.5) || !(v[2] > 0)) return false;
+  *m = (info_material){true, v[0], v[1], v[2]};
+  return true;
+}
+
+/* The dilatational wave speed sqrt((lambda + 2 mu) / rho), m/s: the speed that bounds the
+ * explicit step (docs/time-stepping.md). */
+static double wave_speed(const info_material *m) {
+  double e = m->youngs_modulus, nu = m->poisson_ratio;
+  double lambda = e * nu / ((1 + nu) * (1 - 2 * nu)), mu = e / (2 * (1 + nu));
+  return sqrt((lambda + 2 * mu) / m->density);
+}
+
+/* The scene's default `integrator.cfl` (docs/scene-format.md). */
+#define INFO_DEFAULT_CFL 0.5
+
+static void bounds(const double *x, int32_t n, double lo[3], double hi[3]) {
+  for (int k = 0; k < 3; ++k) lo[k] = n > 0 ? INFINITY : 0, hi[k] = n > 0 ? -INFINITY : 0;
+  for (int32_t i = 0; i < n; ++i)
+    for (int k = 0; k < 3; ++k) {
+      lo[k] = fmin(lo[k], x[3 * (size_t)i + (size_t)k]);
+      hi[k] = fmax(hi[k], x[3 * (size_t)i + (size_t)k]);
+    }
+}
+
+/* Smallest altitude (m) over the tets: 3 |volume| / largest face area of each, the length
+ * the CFL bound uses. */
+static double min_altitude(const piola_tet_mesh *m) {
+  double best = INFINITY;
+  for (int32_t t = 0; t < m->tet_count; ++t) {
+    const double *p[4];
+    for (int c = 0; c < 4; ++c) p[c] = m->positions + 3 * (size_t)m->tets[4 * (size_t)t + (size_t)c];
+    double e[3][3];
+    for (int c = 0; c < 3; ++c)
+      for (int k = 0; k < 3; ++k) e[c][k] = p[c + 1][k] - p[0][k];
+    double volume6 = fabs(e[0][0] * (e[1][1] * e[2][2] - e[1][2] * e[2][1]) -
+                          e[0][1] * (e[1][0] * e[2][2] - e[1][2] * e[2][0]) +
+                          e[0][2] * (e[1][0] * e[2][1] - e[1][1] * e[2][0]));
+    static const int faces[4][3] = {{1, 2, 3}, {0, 2, 3}, {0, 1, 3}, {0, 1, 2}};
+    double max_area2 = 0; /* twice the area */
+    for (int f = 0; f < 4; ++f) {
+      const double *a = p[faces[f][0]], *b = p[faces[f][1]], *c = p[faces[f][2]];
+      double u[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]};
+      double v[3] = {c[0] - a[0], c[1] - a[1], c[2] - a[2]};
+      double n[3] = {u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2], u[0] * v[1] - u[1] * v[0]};
+      max_area2 = fmax(max_area2, sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]));
+    }
+    /* altitude = 3 V / A = (6 V) / (2 A) */
+    double h = max_area2 > 0 ? volume6 / max_area2 : 0;
+    if (h < best) best = h;
+  }
+  return m->tet_count > 0 ? best : 0;
+}
+
+static void add_bounds_json(cJSON *o, const double lo[3], const double hi[3]) {
+  cJSON_AddItemToObject(o, "bounding_box_min", cJSON_CreateDoubleArray(lo, 3));
+  cJSON_AddItemToObject(o, "bounding_box_max", cJSON_CreateDoubleArray(hi, 3));
+  double size[3] = {hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]};
+  cJSON_AddItemToObject(o, "size", cJSON_CreateDoubleArray(size, 3));
+}
+
+static void print_bounds(const double lo[3], const double hi[3]) {
+  printf("bounding box:     [%.6g, %.6g, %.6g] to [%.6g, %.6g, %.6g] m\n", lo[0], lo[1], lo[2], hi[0],
+         hi[1], hi[2]);
+  printf("size:             %.6g x %.6g x %.6g m\n", hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]);
 }
 
 /* 2 for bad input (malformed, unsupported, degenerate), 1 for other failures (I/O, memory). */
@@ -65,7 +151,13 @@ static int print_json(cJSON *o) {
   return 0;
 }
 
-static int info_surface(const char *path, int json) {
+static int info_surface(const char *path, int json, const info_material *material) {
+  if (material->given) {
+    fprintf(stderr, "piola mesh info: --material: %s is a surface, it has no tets and so no time "
+                    "step; mesh it first (piola mesh generate %s -o OUT.msh)\n",
+            path, path);
+    return 2;
+  }
   piola_tri_mesh m;
   piola_status s = piola_tri_mesh_read(path, &m);
   if (s != PIOLA_OK) return fail(s);
@@ -76,6 +168,8 @@ static int info_surface(const char *path, int json) {
     return fail(s);
   }
   double volume = piola_tri_mesh_enclosed_volume(&m);
+  double lo[3], hi[3];
+  bounds(m.positions, m.vertex_count, lo, hi);
   int rc = 0;
   if (json) {
     cJSON *o = cJSON_CreateObject();
@@ -84,6 +178,7 @@ static int info_surface(const char *path, int json) {
     cJSON_AddNumberToObject(o, "vertices", m.vertex_count);
     cJSON_AddNumberToObject(o, "triangles", m.triangle_count);
     cJSON_AddNumberToObject(o, "boundary_faces", m.triangle_count);
+    add_bounds_json(o, lo, hi);
     cJSON_AddNumberToObject(o, "volume", volume);
     add_topology(o, &topo);
     rc = print_json(o);
@@ -91,6 +186,7 @@ static int info_surface(const char *path, int json) {
     printf("file:             %s (triangle surface)\n", path);
     printf("vertices:         %d\n", (int)m.vertex_count);
     printf("triangles:        %d\n", (int)m.triangle_count);
+    print_bounds(lo, hi);
     printf("enclosed volume:  %.9g m^3\n", volume);
     print_topology(&topo);
   }
@@ -98,7 +194,7 @@ static int info_surface(const char *path, int json) {
   return rc;
 }
 
-static int info_tets(const char *path, int json) {
+static int info_tets(const char *path, int json, const info_material *material) {
   piola_tet_mesh m;
   piola_status s = piola_tet_mesh_read(path, &m);
   if (s != PIOLA_OK) return fail(s);
@@ -126,6 +222,10 @@ static int info_tets(const char *path, int json) {
   }
   for (int32_t t = 0; t < m.tet_count; ++t) ids[t] = m.tet_regions ? m.tet_regions[t] : 0;
   qsort(ids, (size_t)m.tet_count, sizeof(int32_t), cmp_int32);
+  double lo[3], hi[3];
+  bounds(m.positions, m.vertex_count, lo, hi);
+  double h_min = min_altitude(&m);
+  double speed = material->given ? wave_speed(material) : 0;
   int rc = 0;
   if (json) {
     cJSON *o = cJSON_CreateObject();
@@ -135,12 +235,23 @@ static int info_tets(const char *path, int json) {
     cJSON_AddNumberToObject(o, "tets", m.tet_count);
     cJSON_AddNumberToObject(o, "boundary_faces", boundary.triangle_count);
     cJSON_AddBoolToObject(o, "fibers", m.tet_fibers != NULL);
+    add_bounds_json(o, lo, hi);
     cJSON_AddNumberToObject(o, "volume", q.volume);
     cJSON_AddNumberToObject(o, "min_tet_volume", q.min_volume);
     cJSON_AddNumberToObject(o, "max_tet_volume", q.max_volume);
     cJSON_AddNumberToObject(o, "min_dihedral_degrees", q.min_dihedral_degrees);
     cJSON_AddNumberToObject(o, "max_dihedral_degrees", q.max_dihedral_degrees);
     cJSON_AddNumberToObject(o, "min_mean_ratio", q.min_mean_ratio);
+    cJSON_AddNumberToObject(o, "min_altitude", h_min);
+    if (material->given) {
+      cJSON *mat = cJSON_AddObjectToObject(o, "material");
+      cJSON_AddNumberToObject(mat, "youngs_modulus", material->youngs_modulus);
+      cJSON_AddNumberToObject(mat, "poisson_ratio", material->poisson_ratio);
+      cJSON_AddNumberToObject(mat, "density", material->density);
+      cJSON_AddNumberToObject(mat, "wave_speed", speed);
+      cJSON_AddNumberToObject(mat, "explicit_dt", h_min / speed);
+      cJSON_AddNumberToObject(mat, "explicit_dt_default_cfl", INFO_DEFAULT_CFL * h_min / speed);
+    }
     cJSON *worst = cJSON_AddArrayToObject(o, "worst_aspect_ratios");
     for (int i = 0; i < q.worst_count; ++i) {
       cJSON *w = cJSON_CreateObject();
@@ -166,6 +277,7 @@ static int info_tets(const char *path, int json) {
     printf("tets:             %d\n", (int)m.tet_count);
     printf("boundary faces:   %d\n", (int)boundary.triangle_count);
     printf("fibres:           %s\n", m.tet_fibers ? "one direction per tet" : "none");
+    print_bounds(lo, hi);
     printf("volume:           %.9g m^3 (tets from %.3g to %.3g m^3)\n", q.volume, q.min_volume, q.max_volume);
     printf("regions:         ");
     for (int32_t i = 0; i < m.tet_count;) {
@@ -177,11 +289,17 @@ static int info_tets(const char *path, int json) {
     printf("\n");
     printf("dihedral angles:  min %.2f, max %.2f degrees\n", q.min_dihedral_degrees, q.max_dihedral_degrees);
     printf("mean ratio:       min %.4f (1 = regular tet)\n", q.min_mean_ratio);
+    printf("min altitude:     %.4g m (of any tet: the length of the CFL bound)\n", h_min);
     printf("worst aspect:    ");
     for (int i = 0; i < q.worst_count; ++i)
       printf(" tet %d: %.3g%s", (int)q.worst_tets[i], q.worst_aspect[i], i + 1 < q.worst_count ? "," : "");
     printf(" (1 = regular tet)\n");
     print_topology(&topo);
+    if (material->given)
+      printf("explicit step:    %.4g s = h / c (c = %.4g m/s for E %g Pa, nu %g, rho %g kg/m^3); "
+             "%.4g s at the scenes' default cfl %g\n",
+             h_min / speed, speed, material->youngs_modulus, material->poisson_ratio,
+             material->density, INFO_DEFAULT_CFL * h_min / speed, INFO_DEFAULT_CFL);
   }
   free(ids);
   piola_tri_mesh_free(&boundary);
@@ -222,8 +340,16 @@ int cli_mesh(int argc, char **argv) {
   if (strcmp(sub, "info") == 0) {
     const char *path = NULL;
     int json = 0;
+    info_material material = {0};
     for (int i = 2; i < argc; ++i) {
       if (strcmp(argv[i], "--json") == 0) json = 1;
+      else if (strcmp(argv[i], "--material") == 0) {
+        if (++i >= argc || !parse_material(argv[i], &material)) {
+          fprintf(stderr, "piola mesh info: --material needs E,NU,RHO: Young's modulus > 0 (Pa), "
+                          "Poisson ratio in (-1, 0.5), density > 0 (kg/m^3)\n");
+          return 2;
+        }
+      }
       else if (strcmp(argv[i], "--help") == 0 || strcmp(argv[i], "-h") == 0) {
         usage(stdout);
         return 0;
@@ -240,9 +366,15 @@ int cli_mesh(int argc, char **argv) {
       usage(stderr);
       return 2;
     }
-    return is_surface_path(path) ? info_surface(path, json) : info_tets(path, json);
+    return is_surface_path(path) ? info_surface(path, json, &material)
+                                 : info_tets(path, json, &material);
   }
   if (strcmp(sub, "convert") == 0) {
+    for (int i = 2; i < argc; ++i)
+      if (strcmp(argv[i], "--help") == 0 || strcmp(argv[i], "-h") == 0) {
+        usage(stdout);
+        return 0;
+      }
     if (argc != 4) {
       usage(stderr);
       return 2;

@@ -5,6 +5,7 @@
 #include <string.h>
 #include <strings.h>
 
+#include "cli/cli_numbers.h"
 #include "cli/commands.h"
 #include "piola/mesh.h"
 #include "piola/mesh_io.h"
@@ -27,32 +28,6 @@ static void usage(FILE *out) {
           "  --half-length h        cylinder half height, capsule half segment (default 1)\n"
           "  --center x,y,z         shape centre (default 0,0,0)\n"
           "  --axis x,y,z           torus, cylinder, capsule axis (default 0,0,1)\n");
-}
-
-static int parse_vec3(const char *text, piola_vec3 *out) {
-  char *end;
-  double v[3];
-  const char *s = text;
-  for (int k = 0; k < 3; ++k) {
-    v[k] = strtod(s, &end);
-    if (end == s || !isfinite(v[k])) return 0;
-    s = end;
-    if (k < 2) {
-      if (*s != ',') return 0;
-      ++s;
-    }
-  }
-  if (*s != '\0') return 0;
-  *out = (piola_vec3){v[0], v[1], v[2]};
-  return 1;
-}
-
-static int parse_double(const char *text, double *out) {
-  char *end;
-  double v = strtod(text, &end);
-  if (end == text || *end != '\0' || !isfinite(v)) return 0;
-  *out = v;
-  return 1;
 }
 
 static double shape_size(const piola_shape *s) {
@@ -96,23 +71,23 @@ int cli_mesh_generate(int argc, char **argv) {
       ok = has_value;
       out_path = value;
     } else if (strcmp(a, "--cell-size") == 0) {
-      ok = has_value && parse_double(value, &cell_size) && cell_size > 0;
+      ok = has_value && cli_parse_double(value, &cell_size) && cell_size > 0;
     } else if (strcmp(a, "--refine") == 0) {
       double levels = -1;
-      ok = has_value && parse_double(value, &levels) && levels >= 0 && levels <= 6 && levels == floor(levels);
+      ok = has_value && cli_parse_double(value, &levels) && levels >= 0 && levels <= 6 && levels == floor(levels);
       def.refinement_levels = (int)levels;
     } else if (strcmp(a, "--radius") == 0) {
-      ok = has_value && parse_double(value, &s->radius);
+      ok = has_value && cli_parse_double(value, &s->radius);
     } else if (strcmp(a, "--minor-radius") == 0) {
-      ok = has_value && parse_double(value, &s->minor_radius);
+      ok = has_value && cli_parse_double(value, &s->minor_radius);
     } else if (strcmp(a, "--half-length") == 0) {
-      ok = has_value && parse_double(value, &s->half_length);
+      ok = has_value && cli_parse_double(value, &s->half_length);
     } else if (strcmp(a, "--half-extents") == 0) {
-      ok = has_value && parse_vec3(value, &s->half_extents);
+      ok = has_value && cli_parse_vec3(value, &s->half_extents);
     } else if (strcmp(a, "--center") == 0) {
-      ok = has_value && parse_vec3(value, &s->center);
+      ok = has_value && cli_parse_vec3(value, &s->center);
     } else if (strcmp(a, "--axis") == 0) {
-      ok = has_value && parse_vec3(value, &s->axis);
+      ok = has_value && cli_parse_vec3(value, &s->axis);
     } else if (a[0] == '-' && a[1] != '\0') {
       fprintf(stderr, "piola mesh generate: unknown option '%s'\n", a);
       usage(stderr);

@@ -1,5 +1,5 @@
-/* `piola run SCENE.json -o DIR [--threads N] [--frames N] [--force]`: simulate a scene and
- * write its frames. Uses only the public API.
+/* `piola run SCENE.json -o DIR [--threads N] [--frames N] [--force | --resume]
+ * [--checkpoint-every N]`: simulate a scene and write its frames. Uses only the public API.
  *
  * Everything that can be wrong with the input (arguments, the scene, its meshes, the output
  * folder) is checked before anything is written, so a bad run exits 2 and leaves the output
@@ -13,7 +13,10 @@
 #include <time.h>
 #include <unistd.h>
 
+#include "cli/cli_numbers.h"
 #include "cli/commands.h"
+#include "cli/run_checkpoints.h"
+#include "piola/checkpoint.h"
 #include "piola/elastic_body.h"
 #include "piola/output.h"
 #include "piola/render.h"
@@ -24,30 +27,31 @@
 
 static void usage(FILE *out) {
   fprintf(out,
-          "usage: piola run SCENE.json -o DIR [--threads N] [--frames N] [--force]\n"
+          "usage: piola run SCENE.json -o DIR [--threads N] [--frames N] [--force | --resume]\n"
+          "                 [--checkpoint-every N] [--max-steps N] [--render]\n"
           "\n"
           "  -o, --output DIR   folder for frames/, surface/, stats.csv and sim.pvd\n"
-          "  --threads N        worker threads (default: all cores)\n"
-          "  --frames N         write N frames instead of the scene's `frames`\n"
+          "  --threads N        worker threads, 1 to 1024 (default: all cores)\n"
+          "  --frames N         write N frames after frame 0 instead of the scene's `frames`\n"
           "  --force            write into DIR even if it holds earlier results\n"
+          "                     (the earlier run's frames, surfaces, stats.csv, sim.pvd,\n"
+          "                     failure_report.txt, warnings.txt and checkpoints are removed\n"
+          "                     first, nothing else)\n"
+          "  --resume           continue the run in DIR from its newest checkpoint\n"
+          "  --max-steps N      refuse a run estimated to take more than N steps (1e7)\n"
+          "  --checkpoint-every N  a checkpoint every N frames (0: none; default: every 10\n"
+          "                     frames or 5 minutes of wall time, whichever comes first)\n"
           "  --render           also render every frame to DIR/render/frame_NNNN.png\n"
           "                     (DIR/preview.png of the last frame is always written)\n"
-          "                     (earlier frames, stats.csv and sim.pvd are removed)\n"
-          "  -h, --help         this text\n");
+          "  -h, --help         this text\n"
+          "\n"
+          "`piola check SCENE.json` validates a scene and estimates its run without writing.\n");
 }
 
 static double now_seconds(void) {
   struct timespec ts;
   clock_gettime(CLOCK_MONOTONIC, &ts);
   return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
-
-static bool parse_count(const char *s, long lo, long hi, long *out) {
-  char *end;
-  long v = strtol(s, &end, 10);
-  if (!*s || *end || v < lo || v > hi) return false;
-  *out = v;
-  return true;
 }
 
 static void format_duration(double s, char *buf, size_t n) {
@@ -97,10 +101,28 @@ static void progress(bool tty, int frame, int frames, double t, double elapsed, 
   fflush(stderr);
 }
 
+/* The time-budget guard: a scene whose simulated time (frames / fps) would take more than
+ * max_steps steps of the first stable step is refused before anything is written, as a
+ * mistyped fps (1e-300) or frame count would otherwise run for ever. The estimate uses the
+ * step at t = 0; steps shrink under stiffening and contact, so it is a lower bound. */
+static bool budget_ok(const char *scene_path, const piola_world *world, int frames, double fps,
+                      double max_steps) {
+  double simulated = frames / fps, dt = piola_world_stable_dt(world);
+  double steps = simulated / dt;
+  if (isfinite(steps) && steps <= max_steps) return true;
+  fprintf(stderr,
+          "piola run: %s: %d frames at %g fps are %.3g s of simulated time, about %.3g steps of "
+          "%.3g s: more than the limit of %.3g steps. Check fps and frames, or raise the limit "
+          "with --max-steps N\n",
+          scene_path, frames, fps, simulated, steps, dt, max_steps);
+  return false;
+}
+
 int cli_run(int argc, char **argv) {
   const char *scene_path = NULL, *out_dir = NULL;
-  long threads = 0, frames_override = -1;
-  bool force = false, render_frames = false;
+  long threads = 0, frames_override = -1, checkpoint_every = -1; /* -1: the default */
+  double max_steps = 1e7; /* the time-budget guard (see budget_ok) */
+  bool force = false, render_frames = false, resume = false;
   for (int i = 1; i < argc; ++i) {
     const char *a = argv[i];
     if (strcmp(a, "-h") == 0 || strcmp(a, "--help") == 0) {
@@ -110,13 +132,22 @@ int cli_run(int argc, char **argv) {
       if (++i >= argc) return fprintf(stderr, "piola run: %s needs a folder\n", a), 2;
       out_dir = argv[i];
     } else if (strcmp(a, "--threads") == 0) {
-      if (++i >= argc || !parse_count(argv[i], 1, 1024, &threads))
+      if (++i >= argc || !cli_parse_long(argv[i], 1, 1024, &threads))
         return fprintf(stderr, "piola run: --threads needs an integer in [1, 1024]\n"), 2;
     } else if (strcmp(a, "--frames") == 0) {
-      if (++i >= argc || !parse_count(argv[i], 0, 1000000, &frames_override))
+      if (++i >= argc || !cli_parse_long(argv[i], 0, 1000000, &frames_override))
         return fprintf(stderr, "piola run: --frames needs an integer in [0, 1000000]\n"), 2;
     } else if (strcmp(a, "--force") == 0) {
       force = true;
+    } else if (strcmp(a, "--max-steps") == 0) {
+      if (++i >= argc || !cli_parse_double(argv[i], &max_steps) || !(max_steps >= 1) ||
+          max_steps > 1e18)
+        return fprintf(stderr, "piola run: --max-steps needs a number in [1, 1e18]\n"), 2;
+    } else if (strcmp(a, "--resume") == 0) {
+      resume = true;
+    } else if (strcmp(a, "--checkpoint-every") == 0) {
+      if (++i >= argc || !cli_parse_long(argv[i], 0, 1000000, &checkpoint_every))
+        return fprintf(stderr, "piola run: --checkpoint-every needs an integer in [0, 1000000]\n"), 2;
     } else if (strcmp(a, "--render") == 0) {
       render_frames = true;
     } else if (a[0] == '-' && a[1]) {
@@ -135,7 +166,11 @@ int cli_run(int argc, char **argv) {
     usage(stderr);
     return 2;
   }
-  if (piola_output_check_folder(out_dir, force) != PIOLA_OK) {
+  if (force && resume) {
+    fprintf(stderr, "piola run: --force and --resume exclude each other (start over, or continue)\n");
+    return 2;
+  }
+  if (piola_output_check_folder(out_dir, force || resume) != PIOLA_OK) {
     fprintf(stderr, "piola run: %s\n", piola_last_error());
     return 2;
   }
@@ -149,12 +184,58 @@ int cli_run(int argc, char **argv) {
   piola_world *world = piola_scene_world(scene);
   int frames = frames_override >= 0 ? (int)frames_override : (int)piola_scene_frames(scene);
   double fps = piola_scene_fps(scene);
+  if (!budget_ok(scene_path, world, frames, fps, max_steps)) {
+    piola_scene_destroy(scene);
+    return 2;
+  }
+  /* checkpoints: on by default where they cover the whole state */
+  const char *why = NULL;
+  uint64_t scene_key = 0;
+  if (!piola_world_checkpoint_supported(world, &why)) {
+    if (resume || checkpoint_every > 0) {
+      fprintf(stderr, "piola run: %s: %s\n", resume ? "--resume" : "--checkpoint-every", why);
+      piola_scene_destroy(scene);
+      return 2;
+    }
+    if (checkpoint_every < 0) fprintf(stderr, "piola run: no checkpoints: %s\n", why);
+    checkpoint_every = 0;
+  }
+  if ((checkpoint_every != 0 || resume) && !run_scene_key(scene_path, world, &scene_key)) {
+    piola_scene_destroy(scene);
+    return 2;
+  }
+  int32_t resume_frame = -1;
+  if (resume) {
+    int found = run_checkpoint_resume(out_dir, world, scene_key, &resume_frame);
+    int listed = found == 1 ? run_listed_frames(out_dir) : 0;
+    if (found == 2 || listed > 1) {
+      if (found == 1)
+        fprintf(stderr, "piola run: cannot resume: %s holds frames 0..%d but no checkpoint "
+                        "(checkpoint_NNNN.bin); use --force to start over\n", out_dir, listed - 1);
+      piola_scene_destroy(scene);
+      return 2;
+    }
+    if (found == 1) {
+      /* no checkpoint and at most frame 0: a missing or empty folder, or a run killed
+       * before its first checkpoint; starting over loses nothing */
+      fprintf(stderr, "piola run: no checkpoint in %s, starting from frame 0\n", out_dir);
+      force = true;
+    }
+  }
   piola_output *out = NULL;
-  if (piola_output_open(out_dir, force, world, &out) != PIOLA_OK) {
+  piola_status opened = resume_frame >= 0 ? piola_output_open_resume(out_dir, resume_frame, world, &out)
+                                          : piola_output_open(out_dir, force, world, &out);
+  if (opened != PIOLA_OK) {
     fprintf(stderr, "piola run: %s\n", piola_last_error());
     piola_scene_destroy(scene);
-    return 1;
+    return opened == PIOLA_ERROR_INVALID_ARGUMENT ? 2 : 1;
   }
+  if (resume_frame >= 0)
+    fprintf(stderr, "piola run: resuming after frame %d (t = %.9g s) from %s/checkpoint_%04d.bin\n",
+            (int)resume_frame, piola_world_time(world), out_dir, (int)resume_frame);
+  const double checkpoint_wall = 300; /* s: the default's time bound */
+  int32_t last_checkpoint = resume_frame >= 0 ? resume_frame : 0;
+  double last_checkpoint_time = now_seconds();
   bool tty = isatty(STDERR_FILENO);
   bool warned[PIOLA_WARNING_KIND_COUNT] = {false};
   report_warnings(out, world, warned, false);
@@ -167,18 +248,23 @@ int cli_run(int argc, char **argv) {
   if (piola_preview_open(out_dir, scene_path, render_frames, &preview) != PIOLA_OK)
     fprintf(stderr, "piola run: no preview: %s\n", piola_last_error());
   int rc = 0;
-  long long total_steps = 0, total_cg = 0;
+  long long total_steps = 0, total_cg = 0, total_newton = 0, total_linear = 0, total_failures = 0;
   int max_inverted = 0;
   double sim_start = now_seconds();
   piola_frame_info info = {0};
-  if (piola_output_write_frame(out, world, &info) != PIOLA_OK) {
+  if (resume_frame >= 0) {
+    /* frames up to resume_frame are on disk already */
+  } else if (piola_output_write_frame(out, world, &info) != PIOLA_OK) {
     fprintf(stderr, "piola run: %s\n", piola_last_error());
     rc = 1;
-  } else if (preview && piola_preview_frame_written(preview, 0, piola_world_time(world)) != PIOLA_OK) {
-    fprintf(stderr, "piola run: preview: %s\n", piola_last_error());
+  } else {
+    if (preview && piola_preview_frame_written(preview, 0, piola_world_time(world)) != PIOLA_OK)
+      fprintf(stderr, "piola run: preview: %s\n", piola_last_error());
+    if (checkpoint_every != 0 && !run_checkpoint_save(out_dir, world, scene_key, 0)) rc = 1;
   }
-  int frame = 0;
-  for (frame = 1; rc == 0 && frame <= frames; ++frame) {
+  int frame = 0, frames_written = 0;
+  int first = resume_frame >= 0 ? resume_frame + 1 : 1;
+  for (frame = first; rc == 0 && frame <= frames; ++frame) {
     double t0 = now_seconds();
     piola_step_stats st = {0};
     if (piola_world_advance_to(world, frame / fps, &st) != PIOLA_OK) {
@@ -201,6 +287,12 @@ int cli_run(int argc, char **argv) {
     info.impacts = st.impacts;
     info.impact_zones = st.impact_zones;
     info.step_retries = st.step_retries;
+    info.newton_iterations = st.newton_iterations;
+    info.linear_iterations = st.linear_iterations;
+    info.newton_failures = st.newton_failures;
+    total_newton += st.newton_iterations;
+    total_linear += st.linear_iterations;
+    total_failures += st.newton_failures;
     info.wall_seconds = now_seconds() - t0;
     total_steps += st.substeps;
     total_cg += st.cg_iterations;
@@ -214,19 +306,34 @@ int cli_run(int argc, char **argv) {
       rc = 1;
       break;
     }
+    frames_written++;
     if (preview && piola_preview_frame_written(preview, frame, piola_world_time(world)) != PIOLA_OK)
       fprintf(stderr, "piola run: preview: %s\n", piola_last_error());
+    /* after the frame's commit, so a checkpoint's frames are all on disk */
+    bool due = checkpoint_every > 0 ? frame - last_checkpoint >= checkpoint_every
+                                    : frame - last_checkpoint >= 10 ||
+                                          now_seconds() - last_checkpoint_time >= checkpoint_wall;
+    if (checkpoint_every != 0 && (due || frame == frames)) {
+      if (!run_checkpoint_save(out_dir, world, scene_key, frame)) {
+        rc = 1;
+        break;
+      }
+      last_checkpoint = frame;
+      last_checkpoint_time = now_seconds();
+    }
     report_warnings(out, world, warned, tty);
     progress(tty, frame, frames, piola_world_time(world), now_seconds() - sim_start, st.substeps, inverted);
   }
   double wall = now_seconds() - t_start;
   double sim_wall = now_seconds() - sim_start;
-  int written = rc == 0 ? frames : frame - 1;
+  int written = frames_written;
   fprintf(stderr,
           "piola run: %s. %d frames (%.3f s simulated) in %.2f s wall (%.2f frames/s), %lld steps, "
-          "%lld CG iterations, at most %d inverted tets in a frame. Open %s/sim.pvd in ParaView.\n",
+          "%lld CG iterations, %lld Newton iterations, %lld linear iterations, %lld failed "
+          "Newton steps, at most %d inverted tets in a frame. Open %s/sim.pvd in ParaView.\n",
           rc == 0 ? "done" : "stopped", written, written / fps, wall,
-          sim_wall > 0 ? written / sim_wall : 0.0, total_steps, total_cg, max_inverted, out_dir);
+          sim_wall > 0 ? written / sim_wall : 0.0, total_steps, total_cg, total_newton,
+          total_linear, total_failures, max_inverted, out_dir);
   if (preview && piola_preview_close(preview) != PIOLA_OK)
     fprintf(stderr, "piola run: preview.png: %s\n", piola_last_error());
   else if (preview)

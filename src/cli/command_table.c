@@ -10,5 +10,6 @@ const cli_command cli_commands[] = {
     {"run", cli_run},
     {"mesh", cli_mesh},
     {"render", cli_render},
+    {"check", cli_check},
     {NULL, NULL},
 };

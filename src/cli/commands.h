@@ -15,6 +15,9 @@ extern const cli_command cli_commands[];
 /* `piola run SCENE.json -o DIR ...` (src/cli/cli_run.c). */
 int cli_run(int argc, char **argv);
 
+/* `piola check SCENE.json ...`: validate, build and estimate a scene (src/cli/cli_check.c). */
+int cli_check(int argc, char **argv);
+
 /* `piola mesh generate ...` (argv[0] is "generate"), called by the `mesh` command. */
 int cli_mesh_generate(int argc, char **argv);
 

@@ -1,6 +1,7 @@
 /* Per-thread last-error message. A thread-local buffer keeps error reporting free of
  * allocation (it must work when allocation itself failed) and safe under OpenMP. */
 #include "common/status_report.h"
+#include "common/printable.h"
 
 #include <stdarg.h>
 #include <stdio.h>
@@ -18,6 +19,7 @@ const char *piola_status_name(piola_status status) {
     case PIOLA_ERROR_IO: return "input/output error";
     case PIOLA_ERROR_PARSE: return "parse error";
     case PIOLA_ERROR_UNSUPPORTED: return "unsupported";
+    case PIOLA_ERROR_NOT_CONVERGED: return "not converged";
   }
   return "unknown status";
 }
@@ -34,6 +36,7 @@ piola_status piola_fail(piola_status status, const char *format, ...) {
   va_start(args, format);
   vsnprintf(message, sizeof message, format, args);
   va_end(args);
-  memcpy(last_error_message, message, sizeof message);
+  /* messages quote file content: no control bytes reach the terminal */
+  piola__printable(last_error_message, sizeof last_error_message, message);
   return status;
 }

@@ -3,6 +3,7 @@
 
 #include <stdlib.h>
 
+#include "common/grow.h"
 #include "piola/threads.h"
 
 enum { LEAF_SIZE = 4, MAX_DEPTH = 128 };
@@ -133,12 +134,10 @@ void piola__bvh_refit(piola__bvh *bvh, const piola__box *boxes) {
 }
 
 int piola__index_list_push(piola__index_list *list, int32_t value) {
-  if (list->count == list->capacity) {
-    int64_t capacity = list->capacity ? 2 * list->capacity : 64;
-    int32_t *items = realloc(list->items, sizeof(*items) * (size_t)capacity);
-    if (!items) return -1;
-    list->items = items, list->capacity = capacity;
-  }
+  if ((size_t)list->count == list->capacity &&
+      piola__grow((void **)&list->items, &list->capacity, (size_t)list->count + 1,
+                  sizeof *list->items))
+    return -1;
   list->items[list->count++] = value;
   return 0;
 }

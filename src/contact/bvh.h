@@ -10,6 +10,7 @@
 #ifndef PIOLA_CONTACT_BVH_H
 #define PIOLA_CONTACT_BVH_H
 
+#include <stddef.h>
 #include <stdint.h>
 
 typedef struct piola__box {
@@ -34,7 +35,8 @@ typedef struct piola__bvh {
 /* A growable list of indices. */
 typedef struct piola__index_list {
   int32_t *items;
-  int64_t count, capacity;
+  int64_t count;
+  size_t capacity; /* items (common/grow.h) */
 } piola__index_list;
 
 /* Builds (or rebuilds, reusing memory) the tree over n boxes. Returns 0, or -1 when memory

@@ -5,6 +5,7 @@
 #include <string.h>
 #include <time.h>
 
+#include "common/grow.h"
 #include "common/status_report.h"
 #include "contact/contact_internal.h"
 
@@ -24,12 +25,10 @@ piola_collision_settings piola_default_collision_settings(void) {
 }
 
 int piola__contact_list_push(piola__contact_list *list, const piola__contact *c) {
-  if (list->count == list->capacity) {
-    int64_t capacity = list->capacity ? 2 * list->capacity : 32;
-    piola__contact *items = realloc(list->items, sizeof(*items) * (size_t)capacity);
-    if (!items) return -1;
-    list->items = items, list->capacity = capacity;
-  }
+  if ((size_t)list->count == list->capacity &&
+      piola__grow((void **)&list->items, &list->capacity, (size_t)list->count + 1,
+                  sizeof *list->items))
+    return -1;
   list->items[list->count++] = *c;
   return 0;
 }

@@ -58,7 +58,8 @@ typedef struct piola__contact {
 
 typedef struct piola__contact_list {
   piola__contact *items;
-  int64_t count, capacity;
+  int64_t count;
+  size_t capacity; /* items (common/grow.h) */
 } piola__contact_list;
 
 int piola__contact_list_push(piola__contact_list *list, const piola__contact *c);
@@ -73,7 +74,8 @@ typedef struct piola__pair {
 
 typedef struct piola__pair_list {
   piola__pair *items;
-  int64_t count, capacity;
+  int64_t count;
+  size_t capacity; /* items (common/grow.h) */
 } piola__pair_list;
 
 typedef enum piola__detect_mode { PIOLA__DETECT_PROXIMITY, PIOLA__DETECT_CCD } piola__detect_mode;

@@ -5,6 +5,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "common/grow.h"
 #include "contact/ccd.h"
 #include "contact/contact_internal.h"
 #include "contact/proximity.h"
@@ -375,12 +376,10 @@ static node_pair *make_tasks(const piola__bvh *ta, const piola__bvh *tb, int sam
 }
 
 static int pair_list_push(piola__pair_list *list, const piola__pair *p) {
-  if (list->count == list->capacity) {
-    int64_t capacity = list->capacity ? 2 * list->capacity : 256;
-    piola__pair *items = realloc(list->items, sizeof(*items) * (size_t)capacity);
-    if (!items) return -1;
-    list->items = items, list->capacity = capacity;
-  }
+  if ((size_t)list->count == list->capacity &&
+      piola__grow((void **)&list->items, &list->capacity, (size_t)list->count + 1,
+                  sizeof *list->items))
+    return -1;
   list->items[list->count++] = *p;
   return 0;
 }
@@ -478,13 +477,9 @@ static int run_task(const piola_collision_surface *s, const double *x0, const pi
 }
 
 static int append_contacts(piola__contact_list *dst, const piola__contact *src, int64_t n) {
-  if (dst->count + n > dst->capacity) {
-    int64_t capacity = dst->capacity ? dst->capacity : 32;
-    while (capacity < dst->count + n) capacity *= 2;
-    piola__contact *items = realloc(dst->items, sizeof(*items) * (size_t)capacity);
-    if (!items) return -1;
-    dst->items = items, dst->capacity = capacity;
-  }
+  if (piola__grow((void **)&dst->items, &dst->capacity, (size_t)(dst->count + n),
+                  sizeof *dst->items))
+    return -1;
   if (n > 0) memcpy(dst->items + dst->count, src, sizeof(*src) * (size_t)n);
   dst->count += n;
   return 0;

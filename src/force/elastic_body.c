@@ -78,25 +78,6 @@ const double *piola_elastic_body_energy_density(const piola_elastic_body *body) 
 }
 const double *piola_elastic_body_fhat(const piola_elastic_body *body) { return body->fhat; }
 
-void piola__elastic_body_gather_forces(const piola_elastic_body *body, double *forces) {
-  const int32_t *start = body->incidence_start, *inc = body->incidence;
-  const double *tf = body->tet_forces;
-#pragma omp parallel for schedule(static) num_threads(piola_thread_count()) \
-    if (body->vertex_count >= PIOLA_PARALLEL_MIN_VERTICES)
-  for (int32_t i = 0; i < body->vertex_count; ++i) {
-    double fx = 0, fy = 0, fz = 0;
-    for (int32_t e = start[i]; e < start[i + 1]; ++e) {
-      const double *g = tf + inc[e];
-      fx += g[0];
-      fy += g[B];
-      fz += g[2 * B];
-    }
-    forces[3 * i] = fx;
-    forces[3 * i + 1] = fy;
-    forces[3 * i + 2] = fz;
-  }
-}
-
 /* F = Ds Dm^-1 and det F of the B tets of one block (f[k][lane], entry k row-major). */
 PIOLA_WIDE_VECTORS PIOLA_KERNEL_INLINE void block_deformation_gradients(const piola_elastic_body *body,
                                                                         const double *x, int32_t block,
@@ -371,64 +352,6 @@ piola_status piola_elastic_body_update(piola_elastic_body *body, const double *x
       inverted += body->block_inverted[b];
       min_det = fmin(min_det, body->block_min_det[b]);
     }
-    stats->elastic_energy = energy;
-    stats->inverted_count = inverted;
-    stats->min_det_f = min_det;
-  }
-  return PIOLA_OK;
-}
-
-piola_status piola__elastic_body_update_reference(const piola_elastic_body *body,
-                                                  const double *x, double stiffness_scale,
-                                                  double *forces, piola_elastic_stats *stats) {
-  for (int32_t i = 0; i < 3 * body->vertex_count; ++i) {
-    if (!isfinite(x[i]))
-      return PIOLA_FAIL(PIOLA_ERROR_NOT_FINITE, "position of vertex %d is not finite", (int)(i / 3));
-    forces[i] = 0;
-  }
-  double energy = 0, min_det = INFINITY;
-  int32_t inverted = 0;
-  for (int32_t t = 0; t < body->tet_count; ++t) {
-    const int32_t *idx = body->tets + 4 * t;
-    vec3 x0 = vec3_load(x + 3 * idx[0]);
-    mat3 ds = mat3_from_columns(vec3_sub(vec3_load(x + 3 * idx[1]), x0),
-                                vec3_sub(vec3_load(x + 3 * idx[2]), x0),
-                                vec3_sub(vec3_load(x + 3 * idx[3]), x0));
-    mat3 dm_inv;
-    for (int k = 0; k < 9; ++k) dm_inv.m[k / 3][k % 3] = body->dm_inv[k][t];
-    mat3 f = mat3_mul(ds, dm_inv);
-    mat3 u, v;
-    vec3 fhat;
-    PIOLA_TRY(piola_diagonalize3(&f, &u, &fhat, &v));
-    const piola_material *material = &body->materials[body->tet_material[t]];
-    double fh[3] = {fhat.x, fhat.y, fhat.z}, ph[3];
-    piola_material_stress(material, fh, ph);
-    double psi = piola_material_energy_density(material, fh) * stiffness_scale;
-    mat3 p = mat3_mul_diag_transpose(u, vec3_scale(vec3_make(ph[0], ph[1], ph[2]), stiffness_scale), v);
-    if (body->fiber[0]) { /* fibre part in the diagonal frame, ahat = V^T a (section 6.1) */
-      vec3 a = vec3_make(body->fiber[0][t], body->fiber[1][t], body->fiber[2][t]);
-      vec3 ah = mat3_mul_vec(mat3_transpose(v), a);
-      double ahat[3] = {ah.x, ah.y, ah.z}, pf[3][3];
-      piola_material_fiber_stress(material, fh, ahat, body->activation, pf);
-      mat3 pfm;
-      for (int k = 0; k < 9; ++k) pfm.m[k / 3][k % 3] = pf[k / 3][k % 3] * stiffness_scale;
-      p = mat3_add(p, mat3_mul(mat3_mul(u, pfm), mat3_transpose(v)));
-      psi += piola_material_fiber_energy_density(material, fh, ahat, body->activation) * stiffness_scale;
-    }
-    mat3 g = mat3_scale(mat3_mul_transpose_b(p, dm_inv), -body->rest_volume[t]);
-    vec3 g0 = vec3_make(0, 0, 0);
-    for (int c = 1; c < 4; ++c) {
-      vec3 gc = mat3_column(g, c - 1);
-      g0 = vec3_sub(g0, gc);
-      for (int i = 0; i < 3; ++i) forces[3 * idx[c] + i] += vec3_get(gc, i);
-    }
-    for (int i = 0; i < 3; ++i) forces[3 * idx[0] + i] += vec3_get(g0, i);
-    double det = mat3_det(f);
-    energy += body->rest_volume[t] * psi;
-    inverted += det < 0;
-    min_det = fmin(min_det, det);
-  }
-  if (stats) {
     stats->elastic_energy = energy;
     stats->inverted_count = inverted;
     stats->min_det_f = min_det;

@@ -17,8 +17,7 @@
  * blocks (whatever the thread count); each range adds its tets' forces in tet order into its
  * own per-vertex array (chunk_forces), and the arrays
  * are added in range order. Each sum has a fixed order and no two threads write the same
- * place, so forces are bit-for-bit identical for any thread count, without atomics. (The
- * per-tet buffer tet_forces and the incidence list below were the previous scheme.)
+ * place, so forces are bit-for-bit identical for any thread count, without atomics.
  * Statistics are summed per block and then serially over blocks for the same reason.
  * Within a range, blocks go through the loop in pairs whose SVDs are interleaved (see
  * piola_svd8 in svd_kernel.h); the pairing depends only on the range, and the paired SVD
@@ -65,14 +64,6 @@ struct piola_elastic_body {
   double *fhat;             /* 3 per tet, AoS (public) */
   double *det_f;
   double *energy_density;
-  double *tet_forces;       /* 12 per tet, blocked like the SIMD lanes: component i of
-                               corner c of tet t is at piola__tet_force_offset(t, c) + 8 i */
-
-  /* incidence: vertex i's (tet, corner) pairs are incidence[incidence_start[i] ..
-   * incidence_start[i + 1]), in increasing tet order, each stored as its offset in
-   * tet_forces (piola__tet_force_offset) */
-  int32_t *incidence_start;
-  int32_t *incidence;
 
   /* per block statistics scratch */
   double *block_energy;
@@ -117,12 +108,6 @@ struct piola_elastic_body {
  * fixed tet ranges (each its own partial sum), whatever the thread count. */
 #define PIOLA_FORCE_CHUNKS 4
 
-/* Where tet t's corner c force starts in tet_forces: blocks of PIOLA_TET_BLOCK tets hold
- * 12 rows (3 c + i) of PIOLA_TET_BLOCK lanes, so the force loop stores whole vectors. */
-static inline int32_t piola__tet_force_offset(int32_t t, int c) {
-  return (t / PIOLA_TET_BLOCK) * 12 * PIOLA_TET_BLOCK + 3 * c * PIOLA_TET_BLOCK + t % PIOLA_TET_BLOCK;
-}
-
 /* Builds the rest state of body from def (rest_state.c): validates def, reorients, fills
  * the SoA arrays, masses, incidence, altitude and wave speed. body must be zeroed. */
 piola_status piola__elastic_body_build_rest_state(piola_elastic_body *body,
@@ -130,20 +115,6 @@ piola_status piola__elastic_body_build_rest_state(piola_elastic_body *body,
 
 /* Frees everything body owns (not body itself). */
 void piola__elastic_body_free_arrays(piola_elastic_body *body);
-
-/* Scalar reference force loop for the tests: per tet F = Ds Dm^-1, the public
- * piola_diagonalize3, piola_material_stress and piola_material_energy_density, forces summed
- * serially. Writes forces and stats only; does not touch the stored per-tet state. */
-piola_status piola__elastic_body_update_reference(const piola_elastic_body *body,
-                                                  const double *x, double stiffness_scale,
-                                                  double *forces, piola_elastic_stats *stats);
-
-/* Scalar reference of the damping forces for the tests (damping.c): the original per-tet
- * formulation (U, V and the projections recomputed per tet), summed serially. Reads the
- * state of the last update like piola_elastic_body_damping_forces. */
-void piola__elastic_body_damping_reference(const piola_elastic_body *body, const double *v,
-                                           double shear_viscosity, double bulk_viscosity,
-                                           double *forces);
 
 /* Assembles the damping matrix from the last update with these viscosities (Pa s), unless
  * that has been done already (damping.c). The damping calls do it themselves; the step loop
@@ -165,10 +136,7 @@ void piola__elastic_body_damping_forces_add_sparse(const piola_elastic_body *bod
                                                    double shear_viscosity, double bulk_viscosity,
                                                    double scale, double *forces);
 
-/* Sums the per-tet force buffer into per-vertex forces, in parallel, deterministically. */
-void piola__elastic_body_gather_forces(const piola_elastic_body *body, double *forces);
-
 /* piola_thread_count, the number of threads a parallel loop should use, is in
- * common/threads.h (included above). */
+ * piola/threads.h (included above). */
 
 #endif

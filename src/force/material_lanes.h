@@ -17,7 +17,7 @@
 #include "material/material_kernels.h"
 #include "piola/material.h"
 
-/* One neo-Hookean lane loop over the constant COUNT lanes from lane FIRST, with KERNEL. */
+/* One lane loop over the constant COUNT lanes from lane FIRST, with KERNEL. */
 #define PIOLA_NEOHOOKEAN_RUN(kernel, first, count)                                         \
   do {                                                                                     \
     _Pragma("omp simd") for (int l = 0; l < (count); ++l)                                  \
@@ -25,15 +25,34 @@
                &phat[0][(first) + l], &phat[1][(first) + l], &phat[2][(first) + l]);       \
   } while (0)
 
-/* 1 when no lane of the PIOLA_TET_BLOCK lanes from lane FIRST has an entry below the
- * threshold: the block then takes the plain formula (the extension adds exactly zero there). */
-#define PIOLA_NEOHOOKEAN_BLOCK_UNCLAMPED(first, flag)                                      \
+/* 1 when every lane of the PIOLA_TET_BLOCK lanes from lane FIRST passes PREDICATE (no entry
+ * below the threshold): the block then takes the plain formula (every extension adds exactly
+ * zero there). */
+#define PIOLA_BLOCK_UNCLAMPED(predicate, first, flag)                                      \
   do {                                                                                     \
     int all_ = 1;                                                                          \
     _Pragma("omp simd reduction(&:all_)") for (int l = 0; l < PIOLA_TET_BLOCK; ++l)        \
-        all_ &= neohookean_lane_unclamped(m, fhat[0][(first) + l], fhat[1][(first) + l],   \
-                                          fhat[2][(first) + l]);                           \
+        all_ &= predicate(m, fhat[0][(first) + l], fhat[1][(first) + l],                   \
+                          fhat[2][(first) + l]);                                           \
     (flag) = all_;                                                                         \
+  } while (0)
+
+/* Blocks whose lanes are all unclamped take PLAIN, the others EXTENDED; per block of
+ * PIOLA_TET_BLOCK, and a pair that agrees stays one interleaved loop. */
+#define PIOLA_SPLIT_BY_BLOCK(predicate, plain, extended, lanes)                            \
+  do {                                                                                     \
+    int u0, u1 = 1;                                                                        \
+    PIOLA_BLOCK_UNCLAMPED(predicate, 0, u0);                                               \
+    if ((lanes) > PIOLA_TET_BLOCK) PIOLA_BLOCK_UNCLAMPED(predicate, PIOLA_TET_BLOCK, u1);  \
+    if ((lanes) == PIOLA_TET_BLOCK || u0 == u1) {                                          \
+      if (u0) PIOLA_NEOHOOKEAN_RUN(plain, 0, (lanes));                                     \
+      else PIOLA_NEOHOOKEAN_RUN(extended, 0, (lanes));                                     \
+    } else {                                                                               \
+      if (u0) PIOLA_NEOHOOKEAN_RUN(plain, 0, PIOLA_TET_BLOCK);                             \
+      else PIOLA_NEOHOOKEAN_RUN(extended, 0, PIOLA_TET_BLOCK);                             \
+      if (u1) PIOLA_NEOHOOKEAN_RUN(plain, PIOLA_TET_BLOCK, PIOLA_TET_BLOCK);               \
+      else PIOLA_NEOHOOKEAN_RUN(extended, PIOLA_TET_BLOCK, PIOLA_TET_BLOCK);               \
+    }                                                                                      \
   } while (0)
 
 #define PIOLA_MATERIAL_LANE_LOOP(kernel, lanes)                                            \
@@ -47,28 +66,41 @@
 #define PIOLA_MATERIAL_STRESS_LANES_BODY(lanes)                                            \
   if (body->uniform_material >= 0) {                                                       \
     const piola_material *m = &body->materials[body->uniform_material];                    \
+    if (m->inversion_mode == PIOLA_INVERSION_ENERGY) {                                     \
+      switch (m->model) {                                                                  \
+        case PIOLA_MODEL_COROTATED: PIOLA_MATERIAL_LANE_LOOP(corotated_stress_energy_mode_lanes, lanes); return; \
+        case PIOLA_MODEL_STVK: PIOLA_MATERIAL_LANE_LOOP(stvk_stress_energy_mode_lanes, lanes); return; \
+        case PIOLA_MODEL_NEOHOOKEAN:                                                       \
+        case PIOLA_MODEL_MUSCLE:                                                           \
+          PIOLA_SPLIT_BY_BLOCK(neohookean_lane_unclamped, neohookean_stress_lanes_unclamped, \
+                               neohookean_stress_energy_mode_lanes, lanes);                \
+          return;                                                                          \
+        case PIOLA_MODEL_STABLE_NEOHOOKEAN:                                                \
+          PIOLA_SPLIT_BY_BLOCK(lane_unclamped, stable_neohookean_stress_lanes_unclamped,   \
+                               stable_neohookean_stress_energy_mode_lanes, lanes);         \
+          return;                                                                          \
+        case PIOLA_MODEL_SPLINE: PIOLA_MATERIAL_LANE_LOOP(spline_stress_energy_mode_lanes, lanes); return; \
+        case PIOLA_MODEL_MOONEY_RIVLIN:                                                    \
+        case PIOLA_MODEL_OGDEN: PIOLA_MATERIAL_LANE_LOOP(ogden_stress_energy_mode_lanes, lanes); return; \
+        case PIOLA_MODEL_ROTATED_LINEAR:                                                   \
+        default: PIOLA_MATERIAL_LANE_LOOP(rotated_linear_stress_energy_mode_lanes, lanes); return; \
+      }                                                                                    \
+    }                                                                                      \
     switch (m->model) {                                                                    \
       case PIOLA_MODEL_COROTATED: PIOLA_MATERIAL_LANE_LOOP(corotated_stress_lanes, lanes); return; \
       case PIOLA_MODEL_STVK: PIOLA_MATERIAL_LANE_LOOP(stvk_stress_lanes, lanes); return;          \
       case PIOLA_MODEL_NEOHOOKEAN:                                                         \
-      case PIOLA_MODEL_MUSCLE: {                                                           \
-        /* block-uniform branch per block of PIOLA_TET_BLOCK; a pair that agrees stays one \
-         * interleaved loop */                                                             \
-        int u0, u1 = 1;                                                                    \
-        PIOLA_NEOHOOKEAN_BLOCK_UNCLAMPED(0, u0);                                           \
-        if ((lanes) > PIOLA_TET_BLOCK) PIOLA_NEOHOOKEAN_BLOCK_UNCLAMPED(PIOLA_TET_BLOCK, u1); \
-        if ((lanes) == PIOLA_TET_BLOCK || u0 == u1) {                                      \
-          if (u0) PIOLA_NEOHOOKEAN_RUN(neohookean_stress_lanes_unclamped, 0, (lanes));      \
-          else PIOLA_NEOHOOKEAN_RUN(neohookean_stress_lanes, 0, (lanes));                  \
-        } else {                                                                           \
-          if (u0) PIOLA_NEOHOOKEAN_RUN(neohookean_stress_lanes_unclamped, 0, PIOLA_TET_BLOCK); \
-          else PIOLA_NEOHOOKEAN_RUN(neohookean_stress_lanes, 0, PIOLA_TET_BLOCK);          \
-          if (u1) PIOLA_NEOHOOKEAN_RUN(neohookean_stress_lanes_unclamped, PIOLA_TET_BLOCK, PIOLA_TET_BLOCK); \
-          else PIOLA_NEOHOOKEAN_RUN(neohookean_stress_lanes, PIOLA_TET_BLOCK, PIOLA_TET_BLOCK); \
-        }                                                                                  \
+      case PIOLA_MODEL_MUSCLE:                                                             \
+        PIOLA_SPLIT_BY_BLOCK(neohookean_lane_unclamped, neohookean_stress_lanes_unclamped, \
+                             neohookean_stress_lanes, lanes);                              \
         return;                                                                            \
-      }                                                                                    \
+      case PIOLA_MODEL_STABLE_NEOHOOKEAN:                                                  \
+        PIOLA_SPLIT_BY_BLOCK(lane_unclamped, stable_neohookean_stress_lanes_unclamped,     \
+                             stable_neohookean_stress_lanes, lanes);                       \
+        return;                                                                            \
       case PIOLA_MODEL_SPLINE: PIOLA_MATERIAL_LANE_LOOP(spline_stress_lanes, lanes); return;      \
+      case PIOLA_MODEL_MOONEY_RIVLIN:                                                      \
+      case PIOLA_MODEL_OGDEN: PIOLA_MATERIAL_LANE_LOOP(ogden_stress_lanes, lanes); return;         \
       case PIOLA_MODEL_ROTATED_LINEAR:                                                     \
       default: PIOLA_MATERIAL_LANE_LOOP(rotated_linear_stress_lanes, lanes); return;             \
     }                                                                                      \
@@ -96,6 +128,7 @@ PIOLA_KERNEL_INLINE void piola__material_stress_lanes2(const piola_elastic_body 
 #undef PIOLA_MATERIAL_STRESS_LANES_BODY
 #undef PIOLA_MATERIAL_LANE_LOOP
 #undef PIOLA_NEOHOOKEAN_RUN
-#undef PIOLA_NEOHOOKEAN_BLOCK_UNCLAMPED
+#undef PIOLA_BLOCK_UNCLAMPED
+#undef PIOLA_SPLIT_BY_BLOCK
 
 #endif

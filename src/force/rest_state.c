@@ -32,9 +32,6 @@ void piola__elastic_body_free_arrays(piola_elastic_body *body) {
   free(body->fhat);
   free(body->det_f);
   free(body->energy_density);
-  free(body->tet_forces);
-  free(body->incidence_start);
-  free(body->incidence);
   free(body->block_energy);
   free(body->block_inverted);
   free(body->block_min_det);
@@ -104,9 +101,6 @@ piola_status piola__elastic_body_build_rest_state(piola_elastic_body *body,
   ok &= (body->fhat = alloc_array(3 * (size_t)np, sizeof(double))) != NULL;
   ok &= (body->det_f = alloc_array((size_t)np, sizeof(double))) != NULL;
   ok &= (body->energy_density = alloc_array((size_t)np, sizeof(double))) != NULL;
-  ok &= (body->tet_forces = alloc_array(12 * (size_t)np, sizeof(double))) != NULL;
-  ok &= (body->incidence_start = alloc_array((size_t)nv + 1, sizeof(int32_t))) != NULL;
-  ok &= (body->incidence = alloc_array(4 * (size_t)nt, sizeof(int32_t))) != NULL;
   ok &= (body->block_energy = alloc_array(nb, sizeof(double))) != NULL;
   ok &= (body->block_inverted = alloc_array(nb, sizeof(int32_t))) != NULL;
   ok &= (body->block_min_det = alloc_array(nb, sizeof(double))) != NULL;
@@ -170,19 +164,6 @@ piola_status piola__elastic_body_build_rest_state(piola_elastic_body *body,
   for (int32_t t = nt; t < np; ++t) body->tet_material[t] = body->uniform_material >= 0 ? body->uniform_material : 0;
   body->min_rest_altitude = min_altitude;
   PIOLA_TRY(piola__fiber_copy(body, def));
-
-  /* incidence: counting sort of (tet, corner) by vertex, so each list is in tet order */
-  for (int32_t t = 0; t < nt; ++t)
-    for (int c = 0; c < 4; ++c) body->incidence_start[body->tets[4 * t + c] + 1]++;
-  for (int32_t i = 0; i < nv; ++i) body->incidence_start[i + 1] += body->incidence_start[i];
-  int32_t *fill = alloc_array((size_t)nv, sizeof(int32_t));
-  if (!fill) return PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "elastic body incidence: out of memory");
-  for (int32_t t = 0; t < nt; ++t)
-    for (int c = 0; c < 4; ++c) {
-      int32_t v = body->tets[4 * t + c];
-      body->incidence[body->incidence_start[v] + fill[v]++] = piola__tet_force_offset(t, c);
-    }
-  free(fill);
 
   double speed = 0;
   for (int32_t m = 0; m < def->material_count; ++m) {

@@ -47,6 +47,8 @@
 #include <immintrin.h>
 #endif
 
+#include "math/v8.h"
+
 #ifndef PIOLA_SVD_JACOBI_SWEEPS
 #define PIOLA_SVD_JACOBI_SWEEPS 4
 #endif
@@ -56,20 +58,6 @@
  * while changing F by less than 1e-100 of its size. */
 #define PIOLA_SVD_FLUSH 1e-100
 
-/* The kernels must be inlined into the caller's `omp simd` loop, or that loop cannot be
- * vectorized. */
-#if defined(__GNUC__) || defined(__clang__)
-#define PIOLA_KERNEL_INLINE static inline __attribute__((always_inline))
-#else
-#define PIOLA_KERNEL_INLINE static inline
-#endif
-/* Functions holding a lane loop ask for full AVX-512 vectors where the build targets them
- * (GCC otherwise prefers 256-bit vectors on these CPUs; the kernel is ~30% faster at 512). */
-#if defined(__GNUC__) && !defined(__clang__) && defined(__AVX512F__)
-#define PIOLA_WIDE_VECTORS __attribute__((target("prefer-vector-width=512")))
-#else
-#define PIOLA_WIDE_VECTORS
-#endif
 /* Fixed-count inner loops must be unrolled before the lane loop is vectorized (GCC does not
  * vectorize a loop around two consecutive inner loops). */
 #if defined(__GNUC__) && !defined(__clang__)
@@ -88,32 +76,6 @@
  * of every Jacobi rotation (the kernel is latency-bound: each rotation waits for the last).
  * Elsewhere the estimate is the bit-level guess refined by two Newton steps (error 5e-6),
  * so both paths meet the same bound. Selections are bit masks (C has no vector ?:). */
-/* The kernel is always inlined, so the ABI of passing these vectors by value (which GCC
- * and clang warn about where the target has no 512-bit registers) never applies. GCC reports it at
- * the end of the translation unit, so the note stays off for the rest of the includer
- * (which passes no vectors by value itself). */
-#if defined(__GNUC__)
-#pragma GCC diagnostic ignored "-Wpsabi"
-#endif
-typedef double piola_v8d __attribute__((vector_size(64)));
-typedef int64_t piola_v8l __attribute__((vector_size(64)));
-typedef uint64_t piola_v8u __attribute__((vector_size(64)));
-
-#define PIOLA_V8_SELECT(mask, a, b) \
-  ((piola_v8d)(((mask) & (piola_v8l)(a)) | (~(mask) & (piola_v8l)(b))))
-PIOLA_KERNEL_INLINE piola_v8d piola__v8_abs(piola_v8d x) {
-  return (piola_v8d)((piola_v8l)x & INT64_C(0x7fffffffffffffff));
-}
-PIOLA_KERNEL_INLINE piola_v8d piola__v8_splat(double x) {
-  piola_v8d r = {x, x, x, x, x, x, x, x};
-  return r;
-}
-PIOLA_KERNEL_INLINE piola_v8d piola__v8_load(const double *p) {
-  piola_v8d r;
-  memcpy(&r, p, sizeof r);
-  return r;
-}
-PIOLA_KERNEL_INLINE void piola__v8_store(double *p, piola_v8d x) { memcpy(p, &x, sizeof x); }
 PIOLA_KERNEL_INLINE piola_v8d piola__v8_rsqrt_newton(piola_v8d x, piola_v8d y) {
   return y * (1.5 - 0.5 * x * y * y);
 }

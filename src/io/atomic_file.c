@@ -6,7 +6,9 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include "common/fault_injection.h"
 #include "common/status_report.h"
+#include "io/atomic_file_internal.h"
 
 piola_status piola_atomic_file_open(piola_atomic_file *file, const char *path) {
   memset(file, 0, sizeof *file);
@@ -32,9 +34,10 @@ piola_status piola_atomic_file_open(piola_atomic_file *file, const char *path) {
   return PIOLA_OK;
 }
 
-piola_status piola_atomic_file_commit(piola_atomic_file *file) {
+piola_status piola__atomic_file_finish(piola_atomic_file *file) {
   int failed = ferror(file->stream) || fflush(file->stream) != 0;
   int err = errno;
+  if (!failed && piola__fault_write_fails()) failed = 1, err = ENOSPC;
   if (fclose(file->stream) != 0 && !failed) {
     failed = 1;
     err = errno;
@@ -44,8 +47,14 @@ piola_status piola_atomic_file_commit(piola_atomic_file *file) {
     unlink(file->temporary);
     return PIOLA_FAIL(PIOLA_ERROR_IO, "%s: write failed: %s", file->target, strerror(err));
   }
+  return PIOLA_OK;
+}
+
+piola_status piola_atomic_file_commit(piola_atomic_file *file) {
+  PIOLA_TRY(piola__atomic_file_finish(file));
+  piola__fault_before_rename();
   if (rename(file->temporary, file->target) != 0) {
-    err = errno;
+    int err = errno;
     unlink(file->temporary);
     return PIOLA_FAIL(PIOLA_ERROR_IO, "%s: cannot move into place: %s", file->target, strerror(err));
   }

@@ -7,26 +7,14 @@
 #include <sys/mman.h>
 #include <sys/stat.h>
 
+#include "common/grow.h"
+#include "common/input_path.h"
 #include "common/status_report.h"
 #include "io/mesh_io_internal.h"
 #include "io/mesh_writers.h"
 #include "mesh/mesh_internal.h"
 #include "piola/files.h"
 #include "piola/mesh_io.h"
-
-int piola__grow(void **array, size_t *capacity, size_t need, size_t item) {
-  if (need <= *capacity) return 0;
-  size_t c = *capacity ? *capacity : 64;
-  while (c < need) {
-    if (c > SIZE_MAX / 2 / item) return -1;
-    c *= 2;
-  }
-  void *p = realloc(*array, c * item);
-  if (!p) return -1;
-  *array = p;
-  *capacity = c;
-  return 0;
-}
 
 /* A whole input file, memory-mapped when possible: mapping skips the copy into a fresh
  * buffer and the zeroing of its pages, which cost as much as parsing for big files. */
@@ -38,8 +26,8 @@ typedef struct loaded_file {
 
 static piola_status load_file(const char *path, loaded_file *f) {
   memset(f, 0, sizeof *f);
-  FILE *stream = fopen(path, "rb");
-  if (!stream) return PIOLA_FAIL(PIOLA_ERROR_IO, "%s: cannot open: %s", path, strerror(errno));
+  FILE *stream;
+  PIOLA_TRY(piola__open_input(path, &stream));
   struct stat st;
   if (fstat(fileno(stream), &st) == 0 && S_ISREG(st.st_mode) && st.st_size > 0) {
     void *p = mmap(NULL, (size_t)st.st_size, PROT_READ, MAP_PRIVATE, fileno(stream), 0);

@@ -10,6 +10,7 @@
 
 #include <stddef.h>
 
+#include "common/grow.h"
 #include "piola/mesh.h"
 #include "piola/mesh_io.h"
 
@@ -33,7 +34,5 @@ piola_status piola__weld_vertices(piola_tri_mesh *mesh, const char *source);
 /* Checks a loaded surface: at least one triangle, finite positions, indices in range. */
 piola_status piola__tri_mesh_finish(piola_tri_mesh *mesh, const char *source);
 
-/* Grows a malloc'ed array to hold at least `need` items of `item` bytes. 0 ok, -1 OOM. */
-int piola__grow(void **array, size_t *capacity, size_t need, size_t item);
 
 #endif

@@ -5,18 +5,19 @@
 #include <string.h>
 #include <sys/stat.h>
 
+#include "common/input_path.h"
 #include "common/status_report.h"
 #include "piola/files.h"
 
 piola_status piola_read_file(const char *path, size_t max_size, char **data, size_t *size) {
   *data = NULL;
   *size = 0;
-  FILE *f = fopen(path, "rb");
-  if (!f) return PIOLA_FAIL(PIOLA_ERROR_IO, "%s: cannot open: %s", path, strerror(errno));
+  FILE *f;
+  PIOLA_TRY(piola__open_input(path, &f)); /* a regular file, or refused before opening */
   struct stat st;
-  if (fstat(fileno(f), &st) != 0 || !S_ISREG(st.st_mode)) {
+  if (fstat(fileno(f), &st) != 0) {
     fclose(f);
-    return PIOLA_FAIL(PIOLA_ERROR_IO, "%s: not a regular file", path);
+    return PIOLA_FAIL(PIOLA_ERROR_IO, "%s: cannot read: %s", path, strerror(errno));
   }
   size_t n = (size_t)st.st_size;
   if (max_size > 0 && n > max_size) {

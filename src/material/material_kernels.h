@@ -70,6 +70,30 @@ enum {
   SPLINE_INV_WC = 5  /* 1 / SPLINE_WC */
 };
 
+/* Slots of piola_material.model_constants for PIOLA_MODEL_STABLE_NEOHOOKEAN (filled by
+ * material_derive_constants). */
+enum {
+  SNH_MU = 0,     /* Pa: mu' = 4/3 mu */
+  SNH_LAMBDA = 1, /* Pa: lambda' = lambda + 5/6 mu (> 0 for every nu in (-1, 0.5)) */
+  SNH_ALPHA = 2,  /* dimensionless: alpha = 1 + 3 mu' / (4 lambda') = 1 + mu / lambda' */
+  SNH_REST = 3,   /* J/m^3: lambda'/2 (1 - alpha)^2, the J term's value at rest */
+  ENERGY_SLOPE = 4, /* Pa: k0, the energy extension's diagonal slope at rest (every model) */
+  ENERGY_GROWTH_2 = 5, /* Pa: a2, its growth with the clamped point's stretch (see energy_slope) */
+  ENERGY_GROWTH_4 = 6, /* Pa: a4 */
+  OGDEN_COUNT = 7,     /* Ogden and Mooney-Rivlin (as two Ogden terms): the number of terms */
+  OGDEN_MU_SUM = 8,    /* Pa: sum_p mu_p, the coefficient of -ln J */
+  OGDEN_TERMS = 9      /* mu_p (Pa) at OGDEN_TERMS + 2 p, alpha_p at OGDEN_TERMS + 2 p + 1 */
+};
+
+/* Ogden and Mooney-Rivlin share one code path (Mooney-Rivlin is stored as the Ogden terms
+ * (2 C10, 2), (-2 C01, -2)). */
+#define MATERIAL_IS_OGDEN(model) ((model) == PIOLA_MODEL_OGDEN || (model) == PIOLA_MODEL_MOONEY_RIVLIN)
+
+/* f^a for f > 0 (clamped entries): libm's pow. Not vectorizable; the Ogden models have no
+ * speed target. */
+MATERIAL_KERNEL double kernel_pow(double f, double a) { return pow(f, a); }
+
+
 /* max and min as selects. C's fmax/fmin must return the non-NaN operand, which x86 vector
  * max/min instructions do not do, so GCC refuses to vectorize them without
  * -ffinite-math-only; a compare-and-select maps onto those instructions directly. With a NaN
@@ -191,6 +215,25 @@ MATERIAL_KERNEL void entry_slope_curvature(piola_material_model model, const pio
       *a2 = s[SPLINE_K0] + s[SPLINE_DK] * (tc * s[SPLINE_INV_WE] + cc * s[SPLINE_INV_WC]);
       return;
     }
+    case PIOLA_MODEL_STABLE_NEOHOOKEAN: /* A = mu'/2 (f^2 - 1) */
+      *a1 = m->model_constants[SNH_MU] * f;
+      *a2 = m->model_constants[SNH_MU];
+      return;
+    case PIOLA_MODEL_MOONEY_RIVLIN:
+    case PIOLA_MODEL_OGDEN: { /* A = sum_p mu_p / alpha_p (f^alpha_p - 1) - M ln f */
+      const double *o = m->model_constants;
+      const double inv = kernel_recip(f, dv), msum = o[OGDEN_MU_SUM];
+      double s1 = 0.0, s2 = 0.0;
+      for (int p = 0; p < (int)o[OGDEN_COUNT]; ++p) {
+        const double mu_p = o[OGDEN_TERMS + 2 * p], alpha = o[OGDEN_TERMS + 2 * p + 1];
+        const double fa = kernel_pow(f, alpha - 1.0); /* f^(alpha - 1) */
+        s1 += mu_p * fa;
+        s2 += mu_p * (alpha - 1.0) * fa * inv;
+      }
+      *a1 = s1 - msum * inv;
+      *a2 = s2 + msum * inv * inv;
+      return;
+    }
     case PIOLA_MODEL_ROTATED_LINEAR:
     case PIOLA_MODEL_COROTATED:
     default: /* A = mu (f - 1)^2 */
@@ -218,7 +261,9 @@ MATERIAL_KERNEL double invariant_terms(piola_material_model model, const piola_m
       h[0][0] = h[1][1] = h[2][2] = 2.0;
       return f0 * f0 + f1 * f1 + f2 * f2 - 3.0;
     case PIOLA_MODEL_NEOHOOKEAN:
-    case PIOLA_MODEL_MUSCLE: { /* q = ln J, kappa = lambda */
+    case PIOLA_MODEL_MUSCLE:
+    case PIOLA_MODEL_MOONEY_RIVLIN:
+    case PIOLA_MODEL_OGDEN: { /* q = ln J, kappa = lambda */
       *kappa = m->lambda;
       const double i0 = kernel_recip(f0, dv), i1 = kernel_recip(f1, dv), i2 = kernel_recip(f2, dv);
       g[0] = i0, g[1] = i1, g[2] = i2;
@@ -228,13 +273,17 @@ MATERIAL_KERNEL double invariant_terms(piola_material_model model, const piola_m
     }
     case PIOLA_MODEL_COROTATED:
     case PIOLA_MODEL_SPLINE:
-    default: /* q = J, kappa = lambda: the linear pressure lambda (J - 1) dJ/dFhat */
-      *kappa = m->lambda;
+    case PIOLA_MODEL_STABLE_NEOHOOKEAN:
+    default: { /* q = J, kappa = lambda: the linear pressure lambda (J - 1) dJ/dFhat; Stable
+                  Neo-Hookean: q0 = alpha, kappa = lambda' */
+      const int snh = model == PIOLA_MODEL_STABLE_NEOHOOKEAN;
+      *kappa = snh ? m->model_constants[SNH_LAMBDA] : m->lambda;
       g[0] = f1 * f2, g[1] = f0 * f2, g[2] = f0 * f1;
       h[0][1] = h[1][0] = f2;
       h[0][2] = h[2][0] = f1;
       h[1][2] = h[2][1] = f0;
-      return f0 * f1 * f2 - 1.0;
+      return f0 * f1 * f2 - (snh ? m->model_constants[SNH_ALPHA] : 1.0);
+    }
   }
 }
 
@@ -259,6 +308,22 @@ MATERIAL_KERNEL void material_model_parts(piola_material_model model, const piol
   out->k[0][1] = out->k[1][0] = kappa * g[0] * g[1] + kq * h[0][1];
   out->k[0][2] = out->k[2][0] = kappa * g[0] * g[2] + kq * h[0][2];
   out->k[1][2] = out->k[2][1] = kappa * g[1] * g[2] + kq * h[1][2];
+  if (model == PIOLA_MODEL_STABLE_NEOHOOKEAN) {
+    /* The term -mu'/2 ln(I_C + 1), I_C = |f|^2: gradient -mu' f / u, Hessian
+     * -mu' I / u + 2 mu' f f^T / u^2 with u = I_C + 1 >= 1. */
+    const double mu_s = m->model_constants[SNH_MU];
+    const double iu = kernel_recip(f0 * f0 + f1 * f1 + f2 * f2 + 1.0, dv);
+    const double a = mu_s * iu, b = 2.0 * mu_s * iu * iu;
+    out->p[0] -= a * f0;
+    out->p[1] -= a * f1;
+    out->p[2] -= a * f2;
+    out->k[0][0] += b * f0 * f0 - a;
+    out->k[1][1] += b * f1 * f1 - a;
+    out->k[2][2] += b * f2 * f2 - a;
+    out->k[0][1] = out->k[1][0] = out->k[0][1] + b * f0 * f1;
+    out->k[0][2] = out->k[2][0] = out->k[0][2] + b * f0 * f2;
+    out->k[1][2] = out->k[2][1] = out->k[1][2] + b * f1 * f2;
+  }
 }
 
 /* --------------------------------------------------------------- the extension */
@@ -355,6 +420,134 @@ MATERIAL_KERNEL void material_extended_stress(piola_material_model model, const 
   material_extend(m, dv, &parts, f0 - fc0, f1 - fc1, f2 - fc2, p0, p1, p2);
 }
 
+/* --------------------------------------------------------------- the energy extension
+ *
+ * PIOLA_INVERSION_ENERGY (after Stomakhin, Howes, Schroeder, Teran 2012): the energy, not the
+ * stress, is extended past the threshold, and the stress is its exact gradient. With
+ * p = Phat(fc), K = dPhat/dFhat(fc) and T = d3 psi / df0 df1 df2 (fc) of the model at the
+ * clamped point and d = f - fc <= 0 (zero for unclamped entries):
+ *
+ *     psi_E(f) = psi(fc) + p.d + k(fc)/2 |d|^2 + sum_{i<j} K_ij d_i d_j + T d0 d1 d2
+ *     Phat_i   = p_i + k d_i + sum_{j != i} K_ij d_j + T d_j d_l + phi'(fc_i) |d|^2 / 2
+ *
+ * (j, l the other two; k(fc) = k0 + sum_j phi(fc_j), see energy_growth)
+ * the same formula for clamped and unclamped entries (for an unclamped i, d_i = 0 and the
+ * derivatives of the coefficients with f_i multiply d_i, so they drop out). This is the
+ * Taylor expansion of the energy around the clamped point with its diagonal curvature
+ * replaced by k: Stomakhin et al.'s psi(fc) + grad psi . d + k/2 |d|^2, plus the mixed terms
+ * that keep the energy C1 where the clamped set changes (the edges and corners of the box
+ * f >= c, which their smooth threshold surface does not have). k must grow with the clamped
+ * point's stretch (the volume term's tension p_i there grows like lambda c s^4 for the J
+ * models: with a constant k the energy would be unbounded below), but may depend on an entry
+ * only through a function flat at the threshold (energy_growth). The energy is C1
+ * everywhere; the stress is continuous and its derivative jumps at the threshold. */
+
+/* Mixed third derivative d3 psi / df0 df1 df2 of the model at f (all entries > 0): zero for
+ * the separable-plus-(trace, |f|^2 or ln J) models, kappa (4 J - q0) for the J penalty,
+ * plus the Stable Neo-Hookean log term's -8 mu' f0 f1 f2 / (|f|^2 + 1)^3. */
+MATERIAL_KERNEL double material_mixed_third(piola_material_model model, const piola_material *m,
+                                            kernel_division dv, double f0, double f1, double f2) {
+  switch (model) {
+    case PIOLA_MODEL_COROTATED:
+    case PIOLA_MODEL_SPLINE:
+      return m->lambda * (4.0 * f0 * f1 * f2 - 1.0);
+    case PIOLA_MODEL_STABLE_NEOHOOKEAN: {
+      const double j = f0 * f1 * f2, iu = kernel_recip(f0 * f0 + f1 * f1 + f2 * f2 + 1.0, dv);
+      return m->model_constants[SNH_LAMBDA] * (4.0 * j - m->model_constants[SNH_ALPHA]) -
+             8.0 * m->model_constants[SNH_MU] * j * iu * iu * iu;
+    }
+    default:
+      return 0.0;
+  }
+}
+
+/* The model constants that follow from mu and lambda. Called by piola_material_init and
+ * again wherever lambda is replaced (the shells' plane-stress material).
+ * Stable Neo-Hookean (Smith, de Goes, Kim 2018, section 3.4): its own Lame parameters are
+ * chosen so that its rest tangent is linear elasticity's 2 mu I + lambda 1 1^T with the
+ * user's E and nu, like every other model.
+ * The energy extension's slope k (PIOLA_INVERSION_ENERGY, every model): the rest stiffness
+ * 2 mu + lambda plus what the model's couplings at the point collapse (c, c, c) could take
+ * away from it (2 max(-K_01, 0) + max(T, 0) c) and the tension of an entry at the threshold at (c, c, c)
+ * and with the other two stretched to 2 (max(p_0, 0) / c each), so that a collapsed, flat or
+ * inverted entry is pushed back up to that lateral stretch (docs/materials.md). */
+MATERIAL_KERNEL void material_derive_constants(piola_material *m) {
+  if (m->model == PIOLA_MODEL_STABLE_NEOHOOKEAN) {
+    const double mu_s = 4.0 / 3.0 * m->mu, lambda_s = m->lambda + 5.0 / 6.0 * m->mu;
+    const double alpha = 1.0 + m->mu / lambda_s;
+    m->model_constants[SNH_MU] = mu_s;
+    m->model_constants[SNH_LAMBDA] = lambda_s;
+    m->model_constants[SNH_ALPHA] = alpha;
+    m->model_constants[SNH_REST] = 0.5 * lambda_s * (1.0 - alpha) * (1.0 - alpha);
+  }
+  const piola_material_model model = m->model == PIOLA_MODEL_MUSCLE        ? PIOLA_MODEL_NEOHOOKEAN
+                                     : m->model == PIOLA_MODEL_MOONEY_RIVLIN ? PIOLA_MODEL_OGDEN
+                                                                             : m->model;
+  const double c = m->threshold;
+  material_parts pa;
+  material_model_parts(model, m, KERNEL_EXACT_DIVIDE, c, c, c, &pa);
+  const double t = material_mixed_third(model, m, KERNEL_EXACT_DIVIDE, c, c, c);
+  material_parts stretched; /* one entry at c, the others stretched to 2 */
+  material_model_parts(model, m, KERNEL_EXACT_DIVIDE, c, 2.0, 2.0, &stretched);
+  m->model_constants[ENERGY_SLOPE] = 2.0 * m->mu + m->lambda + 2.0 * kernel_max(-pa.k[0][1], 0.0) +
+                                     kernel_max(t, 0.0) * c + kernel_max(pa.p[0], 0.0) / c +
+                                     kernel_max(stretched.p[0], 0.0) / c;
+  /* The volume terms make p_i(c, s, s) grow like lambda s^2 (trace, |f|^2, ln J) or
+   * lambda c s^4 (J): the growth terms keep k above 2 p_i / c (restoring, and psi_E bounded
+   * below: its minimum along d_i, psi(fc) - p_i^2 / 2k, stays above psi(fc) / 2). */
+  const int quartic = model == PIOLA_MODEL_COROTATED || model == PIOLA_MODEL_SPLINE ||
+                      model == PIOLA_MODEL_STABLE_NEOHOOKEAN;
+  const double volume = model == PIOLA_MODEL_STABLE_NEOHOOKEAN ? m->model_constants[SNH_LAMBDA] : m->lambda;
+  m->model_constants[ENERGY_GROWTH_2] = 2.0 * (2.0 * m->mu + fabs(volume)) / c;
+  m->model_constants[ENERGY_GROWTH_4] = quartic ? 2.0 * fabs(volume) / c : 0.0;
+}
+
+/* phi(x) = a2 u^2 + a4 u^4, u = max(x - 1, 0), and its first two derivatives: the growth of
+ * the slope k(fc) = k0 + phi(fc0) + phi(fc1) + phi(fc2) with a clamped point's stretch beyond
+ * 1 (k0 covers the stretches up to 2). phi is flat at the threshold (phi = phi' = 0 there),
+ * so k does not move with an entry at the threshold: that is what keeps the energy C1 where
+ * an entry crosses it while another is clamped (k's slope there multiplies |d|^2 / 2 in the
+ * crossing entry's stress). */
+MATERIAL_KERNEL double energy_growth(const piola_material *m, double x, double *slope,
+                                     double *curvature) {
+  const double u = kernel_max(x - 1.0, 0.0), u2 = u * u;
+  const double stretched = (double)(x > 1.0);
+  const double a2 = m->model_constants[ENERGY_GROWTH_2], a4 = m->model_constants[ENERGY_GROWTH_4];
+  *slope = 2.0 * a2 * u + 4.0 * a4 * u2 * u;
+  *curvature = stretched * (2.0 * a2 + 12.0 * a4 * u2);
+  return a2 * u2 + a4 * u2 * u2;
+}
+
+/* The gradient of psi_E from the parts at the clamped point fc and the offsets d = f - fc:
+ * Phat_i = p_i + k d_i + sum_{j != i} K_ij d_j + T d_j d_l + phi'(fc_i) |d|^2 / 2. */
+MATERIAL_KERNEL void material_energy_extend(const piola_material *m, const material_parts *pa,
+                                            double t, double fc0, double fc1, double fc2,
+                                            double d0, double d1, double d2, double *p0,
+                                            double *p1, double *p2, double *slope_k) {
+  double g0, g1, g2, h;
+  const double k = m->model_constants[ENERGY_SLOPE] + energy_growth(m, fc0, &g0, &h) +
+                   energy_growth(m, fc1, &g1, &h) + energy_growth(m, fc2, &g2, &h);
+  const double half_d2 = 0.5 * (d0 * d0 + d1 * d1 + d2 * d2);
+  *p0 = pa->p[0] + k * d0 + pa->k[0][1] * d1 + pa->k[0][2] * d2 + t * d1 * d2 + g0 * half_d2;
+  *p1 = pa->p[1] + k * d1 + pa->k[1][0] * d0 + pa->k[1][2] * d2 + t * d0 * d2 + g1 * half_d2;
+  *p2 = pa->p[2] + k * d2 + pa->k[2][0] * d0 + pa->k[2][1] * d1 + t * d0 * d1 + g2 * half_d2;
+  *slope_k = k;
+}
+
+/* The hot entry point of the energy extension for one model known at compile time. */
+MATERIAL_KERNEL void material_energy_extended_stress(piola_material_model model,
+                                                     const piola_material *m, kernel_division dv,
+                                                     double f0, double f1, double f2, double *p0,
+                                                     double *p1, double *p2) {
+  const double c = m->threshold;
+  const double fc0 = kernel_max(f0, c), fc1 = kernel_max(f1, c), fc2 = kernel_max(f2, c);
+  material_parts parts;
+  material_model_parts(model, m, dv, fc0, fc1, fc2, &parts);
+  const double t = material_mixed_third(model, m, dv, fc0, fc1, fc2);
+  double k;
+  material_energy_extend(m, &parts, t, fc0, fc1, fc2, f0 - fc0, f1 - fc1, f2 - fc2, p0, p1, p2, &k);
+}
+
 /* A(f): the separable energy of each model (see entry_slope_curvature). */
 MATERIAL_KERNEL double entry_energy(piola_material_model model, const piola_material *m, double f) {
   const double mu = m->mu;
@@ -379,6 +572,18 @@ MATERIAL_KERNEL double entry_energy(piola_material_model model, const piola_mate
           cc * cc * cc * s[SPLINE_INV_WC] / 6.0 + ce * (0.5 * s[SPLINE_WC] + 0.5 * ce);
       return 0.5 * s[SPLINE_K0] * u * u + s[SPLINE_DK] * (tension + compression);
     }
+    case PIOLA_MODEL_STABLE_NEOHOOKEAN:
+      return 0.5 * m->model_constants[SNH_MU] * (f * f - 1.0);
+    case PIOLA_MODEL_MOONEY_RIVLIN:
+    case PIOLA_MODEL_OGDEN: {
+      const double *o = m->model_constants;
+      double a = -o[OGDEN_MU_SUM] * kernel_log(f);
+      for (int p = 0; p < (int)o[OGDEN_COUNT]; ++p) {
+        const double alpha = o[OGDEN_TERMS + 2 * p + 1];
+        a += o[OGDEN_TERMS + 2 * p] / alpha * (kernel_pow(f, alpha) - 1.0);
+      }
+      return a;
+    }
     case PIOLA_MODEL_ROTATED_LINEAR:
     case PIOLA_MODEL_COROTATED:
     default:
@@ -391,8 +596,12 @@ MATERIAL_KERNEL double material_model_energy(piola_material_model model, const p
                                              double f0, double f1, double f2) {
   double g[3], h[3][3], kappa;
   const double qm = invariant_terms(model, m, KERNEL_EXACT_DIVIDE, f0, f1, f2, g, h, &kappa);
-  return entry_energy(model, m, f0) + entry_energy(model, m, f1) + entry_energy(model, m, f2) +
-         0.5 * kappa * qm * qm;
+  const double separable =
+      entry_energy(model, m, f0) + entry_energy(model, m, f1) + entry_energy(model, m, f2);
+  if (model == PIOLA_MODEL_STABLE_NEOHOOKEAN) /* minus the rest values: zero at rest */
+    return separable + (0.5 * kappa * qm * qm - m->model_constants[SNH_REST]) -
+           0.5 * m->model_constants[SNH_MU] * kernel_log(0.25 * (f0 * f0 + f1 * f1 + f2 * f2 + 1.0));
+  return separable + 0.5 * kappa * qm * qm;
 }
 
 /* Extended stress and energy density in one pass (the force loop wants both; the clamped
@@ -429,6 +638,25 @@ MATERIAL_KERNEL void material_extended_stress_energy(piola_material_model model,
   *psi = material_model_energy(model, m, fc0, fc1, fc2) + first + second;
 }
 
+/* psi_E and its gradient in one pass (PIOLA_INVERSION_ENERGY). */
+MATERIAL_KERNEL void material_energy_extended_stress_energy(piola_material_model model,
+                                                            const piola_material *m, double f0,
+                                                            double f1, double f2, double *p0,
+                                                            double *p1, double *p2, double *psi) {
+  const double c = m->threshold;
+  const double fc0 = kernel_max(f0, c), fc1 = kernel_max(f1, c), fc2 = kernel_max(f2, c);
+  const double d0 = f0 - fc0, d1 = f1 - fc1, d2 = f2 - fc2;
+  material_parts pa;
+  material_model_parts(model, m, KERNEL_EXACT_DIVIDE, fc0, fc1, fc2, &pa);
+  const double t = material_mixed_third(model, m, KERNEL_EXACT_DIVIDE, fc0, fc1, fc2);
+  double k;
+  material_energy_extend(m, &pa, t, fc0, fc1, fc2, d0, d1, d2, p0, p1, p2, &k);
+  *psi = material_model_energy(model, m, fc0, fc1, fc2) +
+         (pa.p[0] * d0 + pa.p[1] * d1 + pa.p[2] * d2 +
+          0.5 * k * (d0 * d0 + d1 * d1 + d2 * d2) +
+          (pa.k[0][1] * d0 * d1 + pa.k[0][2] * d0 * d2 + pa.k[1][2] * d1 * d2) + t * d0 * d1 * d2);
+}
+
 /* Per-model kernels: the model is a constant, so each compiles to straight-line code. */
 MATERIAL_KERNEL void rotated_linear_stress(const piola_material *m, double f0, double f1, double f2,
                                            double *p0, double *p1, double *p2) {
@@ -449,6 +677,15 @@ MATERIAL_KERNEL void neohookean_stress(const piola_material *m, double f0, doubl
 MATERIAL_KERNEL void spline_stress(const piola_material *m, double f0, double f1, double f2,
                                    double *p0, double *p1, double *p2) {
   material_extended_stress(PIOLA_MODEL_SPLINE, m, KERNEL_EXACT_DIVIDE, f0, f1, f2, p0, p1, p2);
+}
+MATERIAL_KERNEL void ogden_stress(const piola_material *m, double f0, double f1, double f2,
+                                  double *p0, double *p1, double *p2) {
+  material_extended_stress(PIOLA_MODEL_OGDEN, m, KERNEL_EXACT_DIVIDE, f0, f1, f2, p0, p1, p2);
+}
+MATERIAL_KERNEL void stable_neohookean_stress(const piola_material *m, double f0, double f1,
+                                              double f2, double *p0, double *p1, double *p2) {
+  material_extended_stress(PIOLA_MODEL_STABLE_NEOHOOKEAN, m, KERNEL_EXACT_DIVIDE, f0, f1, f2, p0,
+                           p1, p2);
 }
 
 /* The same kernels with the fast reciprocal, for the force loop's lanes (material_lanes.h):
@@ -497,11 +734,92 @@ MATERIAL_KERNEL void spline_stress_lanes(const piola_material *m, double f0, dou
                                       double *p0, double *p1, double *p2) {
   material_extended_stress(PIOLA_MODEL_SPLINE, m, KERNEL_FAST_RECIPROCAL, f0, f1, f2, p0, p1, p2);
 }
+MATERIAL_KERNEL void ogden_stress_lanes(const piola_material *m, double f0, double f1, double f2,
+                                        double *p0, double *p1, double *p2) {
+  material_extended_stress(PIOLA_MODEL_OGDEN, m, KERNEL_FAST_RECIPROCAL, f0, f1, f2, p0, p1, p2);
+}
+MATERIAL_KERNEL void stable_neohookean_stress_lanes(const piola_material *m, double f0, double f1,
+                                                    double f2, double *p0, double *p1, double *p2) {
+  material_extended_stress(PIOLA_MODEL_STABLE_NEOHOOKEAN, m, KERNEL_FAST_RECIPROCAL, f0, f1, f2, p0,
+                           p1, p2);
+}
+
+/* Stable Neo-Hookean for lanes whose entries all lie at or above the threshold (the caller
+ * checks a whole block with any_lane_clamped): the plain formula
+ * p_i = mu' (1 - 1/(I_C + 1)) f_i + lambda' (J - alpha) J / f_i, no logarithm and one
+ * reciprocal. Within a few ulp of stable_neohookean_stress_lanes. */
+MATERIAL_KERNEL void stable_neohookean_stress_lanes_unclamped(const piola_material *m, double f0,
+                                                              double f1, double f2, double *p0,
+                                                              double *p1, double *p2) {
+  const double mu_s = m->model_constants[SNH_MU], lambda_s = m->model_constants[SNH_LAMBDA];
+  const double ic = f0 * f0 + f1 * f1 + f2 * f2;
+  const double a = mu_s * ic * kernel_recip_fast(ic + 1.0);
+  const double v = lambda_s * (f0 * f1 * f2 - m->model_constants[SNH_ALPHA]);
+  *p0 = a * f0 + v * (f1 * f2);
+  *p1 = a * f1 + v * (f0 * f2);
+  *p2 = a * f2 + v * (f0 * f1);
+}
+
+/* 1 when this lane has no entry below the threshold (false for NaN). */
+MATERIAL_KERNEL int lane_unclamped(const piola_material *m, double f0, double f1, double f2) {
+  const double c = m->threshold;
+  return (f0 >= c) & (f1 >= c) & (f2 >= c);
+}
+
+/* PIOLA_INVERSION_ENERGY kernels, one per model: NAME_stress_energy_mode (exact division, for
+ * the public functions) and NAME_stress_energy_mode_lanes (the force loop's). */
+#define MATERIAL_ENERGY_MODE_KERNELS(name, model)                                               \
+  MATERIAL_KERNEL void name##_stress_energy_mode(const piola_material *m, double f0, double f1, \
+                                                 double f2, double *p0, double *p1,             \
+                                                 double *p2) {                                  \
+    material_energy_extended_stress(model, m, KERNEL_EXACT_DIVIDE, f0, f1, f2, p0, p1, p2);     \
+  }                                                                                             \
+  MATERIAL_KERNEL void name##_stress_energy_mode_lanes(const piola_material *m, double f0,      \
+                                                       double f1, double f2, double *p0,        \
+                                                       double *p1, double *p2) {                \
+    material_energy_extended_stress(model, m, KERNEL_FAST_RECIPROCAL, f0, f1, f2, p0, p1, p2);  \
+  }
+MATERIAL_ENERGY_MODE_KERNELS(rotated_linear, PIOLA_MODEL_ROTATED_LINEAR)
+MATERIAL_ENERGY_MODE_KERNELS(corotated, PIOLA_MODEL_COROTATED)
+MATERIAL_ENERGY_MODE_KERNELS(stvk, PIOLA_MODEL_STVK)
+MATERIAL_ENERGY_MODE_KERNELS(neohookean, PIOLA_MODEL_NEOHOOKEAN)
+MATERIAL_ENERGY_MODE_KERNELS(spline, PIOLA_MODEL_SPLINE)
+MATERIAL_ENERGY_MODE_KERNELS(stable_neohookean, PIOLA_MODEL_STABLE_NEOHOOKEAN)
+MATERIAL_ENERGY_MODE_KERNELS(ogden, PIOLA_MODEL_OGDEN)
+#undef MATERIAL_ENERGY_MODE_KERNELS
 
 /* Run-time dispatch, for scalar callers. In a loop, switch on m->model outside the loop and
  * call the per-model kernel inside. */
 MATERIAL_KERNEL void material_stress_kernel(const piola_material *m, double f0, double f1,
                                             double f2, double *p0, double *p1, double *p2) {
+  if (m->inversion_mode == PIOLA_INVERSION_ENERGY) {
+    switch (m->model) {
+      case PIOLA_MODEL_COROTATED:
+        corotated_stress_energy_mode(m, f0, f1, f2, p0, p1, p2);
+        return;
+      case PIOLA_MODEL_STVK:
+        stvk_stress_energy_mode(m, f0, f1, f2, p0, p1, p2);
+        return;
+      case PIOLA_MODEL_NEOHOOKEAN:
+      case PIOLA_MODEL_MUSCLE:
+        neohookean_stress_energy_mode(m, f0, f1, f2, p0, p1, p2);
+        return;
+      case PIOLA_MODEL_SPLINE:
+        spline_stress_energy_mode(m, f0, f1, f2, p0, p1, p2);
+        return;
+      case PIOLA_MODEL_STABLE_NEOHOOKEAN:
+        stable_neohookean_stress_energy_mode(m, f0, f1, f2, p0, p1, p2);
+        return;
+      case PIOLA_MODEL_MOONEY_RIVLIN:
+      case PIOLA_MODEL_OGDEN:
+        ogden_stress_energy_mode(m, f0, f1, f2, p0, p1, p2);
+        return;
+      case PIOLA_MODEL_ROTATED_LINEAR:
+      default:
+        rotated_linear_stress_energy_mode(m, f0, f1, f2, p0, p1, p2);
+        return;
+    }
+  }
   switch (m->model) {
     case PIOLA_MODEL_COROTATED:
       corotated_stress(m, f0, f1, f2, p0, p1, p2);
@@ -515,6 +833,13 @@ MATERIAL_KERNEL void material_stress_kernel(const piola_material *m, double f0, 
       return;
     case PIOLA_MODEL_SPLINE:
       spline_stress(m, f0, f1, f2, p0, p1, p2);
+      return;
+    case PIOLA_MODEL_STABLE_NEOHOOKEAN:
+      stable_neohookean_stress(m, f0, f1, f2, p0, p1, p2);
+      return;
+    case PIOLA_MODEL_MOONEY_RIVLIN:
+    case PIOLA_MODEL_OGDEN:
+      ogden_stress(m, f0, f1, f2, p0, p1, p2);
       return;
     case PIOLA_MODEL_ROTATED_LINEAR:
     default:
@@ -546,11 +871,51 @@ MATERIAL_KERNEL void spline_stress_energy(const piola_material *m, double f0, do
                                           double *p0, double *p1, double *p2, double *psi) {
   material_extended_stress_energy(PIOLA_MODEL_SPLINE, m, f0, f1, f2, p0, p1, p2, psi);
 }
+MATERIAL_KERNEL void ogden_stress_energy(const piola_material *m, double f0, double f1, double f2,
+                                         double *p0, double *p1, double *p2, double *psi) {
+  material_extended_stress_energy(PIOLA_MODEL_OGDEN, m, f0, f1, f2, p0, p1, p2, psi);
+}
+MATERIAL_KERNEL void stable_neohookean_stress_energy(const piola_material *m, double f0,
+                                                     double f1, double f2, double *p0, double *p1,
+                                                     double *p2, double *psi) {
+  material_extended_stress_energy(PIOLA_MODEL_STABLE_NEOHOOKEAN, m, f0, f1, f2, p0, p1, p2, psi);
+}
 
 /* Run-time dispatch of the stress-and-energy kernels (same use as material_stress_kernel). */
 MATERIAL_KERNEL void material_stress_energy_kernel(const piola_material *m, double f0, double f1,
                                                    double f2, double *p0, double *p1, double *p2,
                                                    double *psi) {
+  if (m->inversion_mode == PIOLA_INVERSION_ENERGY) {
+    /* Off the hot path: the model is a run-time value here. */
+    const piola_material_model model =
+        m->model == PIOLA_MODEL_MUSCLE ? PIOLA_MODEL_NEOHOOKEAN : m->model;
+    switch (model) {
+      case PIOLA_MODEL_COROTATED:
+        material_energy_extended_stress_energy(PIOLA_MODEL_COROTATED, m, f0, f1, f2, p0, p1, p2, psi);
+        return;
+      case PIOLA_MODEL_STVK:
+        material_energy_extended_stress_energy(PIOLA_MODEL_STVK, m, f0, f1, f2, p0, p1, p2, psi);
+        return;
+      case PIOLA_MODEL_NEOHOOKEAN:
+        material_energy_extended_stress_energy(PIOLA_MODEL_NEOHOOKEAN, m, f0, f1, f2, p0, p1, p2, psi);
+        return;
+      case PIOLA_MODEL_SPLINE:
+        material_energy_extended_stress_energy(PIOLA_MODEL_SPLINE, m, f0, f1, f2, p0, p1, p2, psi);
+        return;
+      case PIOLA_MODEL_STABLE_NEOHOOKEAN:
+        material_energy_extended_stress_energy(PIOLA_MODEL_STABLE_NEOHOOKEAN, m, f0, f1, f2, p0, p1,
+                                               p2, psi);
+        return;
+      case PIOLA_MODEL_MOONEY_RIVLIN:
+      case PIOLA_MODEL_OGDEN:
+        material_energy_extended_stress_energy(PIOLA_MODEL_OGDEN, m, f0, f1, f2, p0, p1, p2, psi);
+        return;
+      default:
+        material_energy_extended_stress_energy(PIOLA_MODEL_ROTATED_LINEAR, m, f0, f1, f2, p0, p1, p2,
+                                               psi);
+        return;
+    }
+  }
   switch (m->model) {
     case PIOLA_MODEL_COROTATED:
       corotated_stress_energy(m, f0, f1, f2, p0, p1, p2, psi);
@@ -564,6 +929,13 @@ MATERIAL_KERNEL void material_stress_energy_kernel(const piola_material *m, doub
       return;
     case PIOLA_MODEL_SPLINE:
       spline_stress_energy(m, f0, f1, f2, p0, p1, p2, psi);
+      return;
+    case PIOLA_MODEL_STABLE_NEOHOOKEAN:
+      stable_neohookean_stress_energy(m, f0, f1, f2, p0, p1, p2, psi);
+      return;
+    case PIOLA_MODEL_MOONEY_RIVLIN:
+    case PIOLA_MODEL_OGDEN:
+      ogden_stress_energy(m, f0, f1, f2, p0, p1, p2, psi);
       return;
     case PIOLA_MODEL_ROTATED_LINEAR:
     default:

@@ -30,11 +30,13 @@
 
 #include "material/material_kernels.h"
 
-/* The plane-stress material: a copy of m with lambda replaced by 2 mu lambda / (lambda + 2 mu). */
+/* The plane-stress material: a copy of m with lambda replaced by 2 mu lambda / (lambda + 2 mu)
+ * (and the model constants derived from it, e.g. Stable Neo-Hookean's lambda'). */
 MATERIAL_KERNEL piola_material membrane_material_from(const piola_material *m) {
   piola_material r = *m;
   const double denominator = m->lambda + 2.0 * m->mu;
   r.lambda = denominator > 0.0 ? 2.0 * m->mu * m->lambda / denominator : 0.0;
+  material_derive_constants(&r); /* the constants that follow from lambda */
   return r;
 }
 

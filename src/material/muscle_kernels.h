@@ -63,6 +63,21 @@ MATERIAL_KERNEL void muscle_fiber_tension_energy(const piola_muscle_def *m, doub
   *energy = ep + ea;
 }
 
+/* dT / dlambda (Pa) at stretch lambda, activation clamped to [0, 1]: the slope of
+ * muscle_fiber_tension_energy's tension, piece by piece (the implicit integrator's fibre
+ * stiffness). */
+MATERIAL_KERNEL double muscle_fiber_tension_slope(const piola_muscle_def *m, double lambda,
+                                                  double activation) {
+  const double k = m->passive_stiffness, wt = m->passive_toe_stretch - 1.0;
+  const double u = kernel_max(lambda - 1.0, 0.0);
+  const double passive = u > 0.0 ? k * kernel_min(u / wt, 1.0) : 0.0;
+  const double sigma = activation * m->max_active_stress;
+  const double lo = m->optimal_stretch, w = m->active_width;
+  const double s = (lambda / lo - 1.0) / w;
+  const double active = s > -1.0 && s < 1.0 ? -4.0 * sigma * s * (1.0 - s * s) / (lo * w) : 0.0;
+  return passive + active;
+}
+
 /* Fibre stretch lambda = |Fhat ahat| and the factor T / lambda (Pa) for a unit ahat. */
 MATERIAL_KERNEL double muscle_fiber_factor(const piola_muscle_def *m, double f0, double f1,
                                            double f2, double a0, double a1, double a2,

@@ -17,9 +17,12 @@
 #include <string.h>
 
 #include "common/status_report.h"
+#include "io/atomic_file_internal.h"
+#include "output/frame_commit.h"
 #include "output/output_internal.h"
 #include "piola/files.h"
 #include "piola/mesh_io.h"
+#include "piola/world_bodies.h"
 #include "piola/world_shells.h"
 
 typedef struct pvd_entry {
@@ -41,6 +44,7 @@ struct piola_output {
   size_t csv_len, csv_cap;
   pvd_entry *pvd;
   int32_t pvd_count, pvd_cap;
+  obj_layout obj;           /* the OBJ surface: one object per body (obj_frame.c) */
 };
 
 static piola_status csv_append(piola_output *o, const char *line) {
@@ -66,11 +70,16 @@ void piola_output_close(piola_output *o) {
   piola_tri_mesh_free(&o->shells);
   free(o->rest), free(o->velocity), free(o->displacement), free(o->det_f), free(o->inverted);
   free(o->energy), free(o->solid), free(o->csv), free(o->pvd);
+  piola__obj_layout_free(&o->obj);
   free(o);
 }
 
-piola_status piola_output_open(const char *dir, bool force, const piola_world *world,
-                               piola_output **out) {
+static piola_status resume_indexes(piola_output *o, int32_t frame);
+static piola_status pvd_append(piola_output *o, int32_t frame, double time);
+
+/* resume_frame < 0: a new run (force as in piola_output_open); else a resume after it. */
+static piola_status open_output(const char *dir, bool force, int32_t resume_frame,
+                                const piola_world *world, piola_output **out) {
   if (!dir || !world || !out) return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "output: NULL argument");
   *out = NULL;
   if (strlen(dir) > 3500) return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "output: path too long");
@@ -152,10 +161,36 @@ piola_status piola_output_open(const char *dir, bool force, const piola_world *w
       o->surface.vertex_count = nv + snv;
     }
   }
-  if (st == PIOLA_OK) st = piola__output_prepare_folder(dir, force);
+  if (st == PIOLA_OK) {
+    /* bodies in point order: the solids, then the shells */
+    int32_t nb = ns + piola_world_shell_count(world);
+    int32_t *first = malloc((size_t)(nb + 1) * sizeof *first);
+    const char **names = malloc((size_t)(nb > 0 ? nb : 1) * sizeof *names);
+    if (!first || !names) st = PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "output: out of memory");
+    else {
+      int32_t v = 0;
+      for (int32_t b = 0; b < nb; ++b) {
+        first[b] = v;
+        if (b < ns) {
+          v += piola_elastic_body_vertex_count(piola_world_solid_body(world, b));
+          names[b] = piola_world_solid_name(world, b);
+        } else {
+          v += piola_shell_body_vertex_count(piola_world_shell_body(world, b - ns));
+          names[b] = piola_world_shell_name(world, b - ns);
+        }
+      }
+      first[nb] = v;
+      st = piola__obj_layout_build(&o->surface, first, nb, names, nv + snv, &o->obj);
+    }
+    free(first);
+    free(names);
+  }
+  if (st == PIOLA_OK && resume_frame < 0) st = piola__output_prepare_folder(dir, force);
   if (st == PIOLA_OK) st = csv_append(o, "frame,time,substeps,cg_iterations,kinetic_energy,elastic_energy,"
                                          "inverted,min_det_f,wall_seconds,plastic_yielded,max_fp_log_stretch,"
-                                         "contacts,impacts,impact_zones,step_retries\n");
+                                         "contacts,impacts,impact_zones,newton_iterations,"
+                                         "linear_iterations,newton_failures,step_retries\n");
+  if (st == PIOLA_OK && resume_frame >= 0) st = resume_indexes(o, resume_frame);
   if (st != PIOLA_OK) {
     piola_output_close(o);
     return st;
@@ -164,17 +199,20 @@ piola_status piola_output_open(const char *dir, bool force, const piola_world *w
   return PIOLA_OK;
 }
 
-static piola_status write_text(const char *path, const char *text, size_t len) {
+/* Writes text to a temporary file next to path and queues its rename to path. */
+static piola_status stage_text(frame_commit *c, const char *path, const char *text, size_t len) {
   piola_atomic_file f;
   PIOLA_TRY(piola_atomic_file_open(&f, path));
   if (len && fwrite(text, 1, len, f.stream) != len) {
     piola_atomic_file_abort(&f);
     return PIOLA_FAIL(PIOLA_ERROR_IO, "%s: write failed", path);
   }
-  return piola_atomic_file_commit(&f);
+  PIOLA_TRY(piola__atomic_file_finish(&f));
+  piola__frame_commit_add(c, f.temporary, f.target, 1);
+  return PIOLA_OK;
 }
 
-static piola_status write_pvd(piola_output *o) {
+static piola_status stage_pvd(piola_output *o, frame_commit *c) {
   char path[4200];
   snprintf(path, sizeof path, "%s/sim.pvd", o->dir);
   piola_atomic_file f;
@@ -185,7 +223,54 @@ static piola_status write_pvd(piola_output *o) {
     fprintf(f.stream, "    <DataSet timestep=\"%.17g\" group=\"\" part=\"0\" file=\"frames/frame_%04d.vtu\"/>\n",
             o->pvd[i].time, (int)o->pvd[i].frame);
   fprintf(f.stream, "  </Collection>\n</VTKFile>\n");
-  return piola_atomic_file_commit(&f);
+  PIOLA_TRY(piola__atomic_file_finish(&f));
+  piola__frame_commit_add(c, f.temporary, f.target, 1);
+  return PIOLA_OK;
+}
+
+static piola_status pvd_append(piola_output *o, int32_t frame, double time) {
+  if (o->pvd_count == o->pvd_cap) {
+    int32_t cap = o->pvd_cap ? 2 * o->pvd_cap : 64;
+    pvd_entry *grown = realloc(o->pvd, (size_t)cap * sizeof *grown);
+    if (!grown) return PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "sim.pvd: out of memory");
+    o->pvd = grown;
+    o->pvd_cap = cap;
+  }
+  o->pvd[o->pvd_count++] = (pvd_entry){frame, time};
+  return PIOLA_OK;
+}
+
+/* Writes the frame's files under temporary names and publishes them at one commit point
+ * (output/frame_commit.h); on any failure nothing of the frame is listed and the indexes in
+ * memory are as before. */
+static piola_status commit_frame(piola_output *o, const piola_vtu_frame *frame, int32_t number,
+                                 const char *row, double time) {
+  frame_commit commit = {0};
+  char path[4200], pending[4200];
+  snprintf(path, sizeof path, "%s/frames/frame_%04d.vtu", o->dir, (int)number);
+  if (!piola__frame_pending_name(path, pending, sizeof pending))
+    return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "output: path too long");
+  PIOLA_TRY(piola_vtu_write(pending, frame));
+  piola__frame_commit_add(&commit, pending, path, 0);
+  snprintf(path, sizeof path, "%s/surface/frame_%04d.obj", o->dir, (int)number);
+  piola__frame_pending_name(path, pending, sizeof pending);
+  piola_status st = piola__obj_layout_write(&o->obj, pending, o->tets.positions);
+  if (st == PIOLA_OK) piola__frame_commit_add(&commit, pending, path, 0);
+  size_t csv_len = o->csv_len;
+  int32_t pvd_count = o->pvd_count;
+  if (st == PIOLA_OK) st = csv_append(o, row);
+  if (st == PIOLA_OK) st = pvd_append(o, number, time);
+  snprintf(path, sizeof path, "%s/stats.csv", o->dir);
+  if (st == PIOLA_OK) st = stage_text(&commit, path, o->csv, o->csv_len);
+  if (st == PIOLA_OK) st = stage_pvd(o, &commit);
+  if (st == PIOLA_OK) st = piola__frame_commit_publish(&commit);
+  if (st != PIOLA_OK) {
+    piola__frame_commit_discard(&commit);
+    o->csv_len = csv_len;
+    if (o->csv) o->csv[csv_len] = '\0';
+    o->pvd_count = pvd_count;
+  }
+  return st;
 }
 
 piola_status piola_output_write_frame(piola_output *o, const piola_world *world,
@@ -196,66 +281,60 @@ piola_status piola_output_write_frame(piola_output *o, const piola_world *world,
   double ke = 0, ee = 0, min_det = INFINITY;
   long long inverted = 0, yielded = 0;
   double max_fp_log = 0; /* plastic solids: yielded tets in the last step, largest |log stretch| of Fp */
-  for (int32_t s = 0; s < ns; ++s) {
-    const piola_elastic_body *b = piola_world_solid_body(world, s);
-    int32_t n = piola_elastic_body_vertex_count(b), t = piola_elastic_body_tet_count(b);
-    const double *x = piola_world_solid_positions(world, s);
-    const double *v = piola_world_solid_velocities(world, s);
+  /* the bodies in step order: the solids, then the shells, as the points and cells are laid out */
+  for (int32_t p = 0; p < piola_world_body_count(world); ++p) {
+    const piola_body_id id = piola_world_body_at(world, p);
+    const int32_t index = piola_world_body_index(world, id);
+    const int32_t n = piola_world_body_node_count(world, id);
+    const int32_t t = piola_world_body_element_count(world, id);
+    const double *x = piola_world_body_positions(world, id);
+    const double *v = piola_world_body_velocities(world, id);
     for (int64_t k = 0; k < 3 * (int64_t)n; ++k) {
       int64_t g = 3 * (int64_t)voff + k;
       o->tets.positions[g] = x[k];
       o->velocity[g] = v[k];
       o->displacement[g] = x[k] - o->rest[g];
     }
-    const double *det = piola_elastic_body_det_f(b);
-    const double *psi = piola_elastic_body_energy_density(b);
-    for (int32_t k = 0; k < t; ++k) {
-      o->det_f[toff + k] = det[k];
-      o->inverted[toff + k] = det[k] < 0 ? 1.0 : 0.0;
-      o->energy[toff + k] = psi[k];
-    }
-    piola_solid_stats st = piola_world_solid_stats(world, s);
+    const piola_body_stats st = piola_world_body_stats(world, id);
     ke += st.kinetic_energy;
     ee += st.elastic_energy;
     inverted += st.inverted_count;
-    if (st.min_det_f < min_det) min_det = st.min_det_f;
-    const piola_plastic_state *plastic = piola_world_solid_plastic_state(world, s);
-    if (plastic) {
-      double largest;
-      piola_plastic_state_measure(plastic, &largest, NULL);
-      if (largest > max_fp_log) max_fp_log = largest;
-      yielded += piola_world_solid_plastic_stats(world, s).yielded_count;
+    switch (piola_world_body_kind(world, id)) {
+      case PIOLA_BODY_SOLID: {
+        const piola_elastic_body *b = piola_world_solid_body(world, index);
+        const double *det = piola_elastic_body_det_f(b);
+        const double *psi = piola_elastic_body_energy_density(b);
+        for (int32_t k = 0; k < t; ++k) {
+          o->det_f[toff + k] = det[k];
+          o->inverted[toff + k] = det[k] < 0 ? 1.0 : 0.0;
+          o->energy[toff + k] = psi[k];
+        }
+        double solid_min_det = piola_world_solid_stats(world, index).min_det_f;
+        if (solid_min_det < min_det) min_det = solid_min_det;
+        const piola_plastic_state *plastic = piola_world_solid_plastic_state(world, index);
+        if (plastic) {
+          double largest;
+          piola_plastic_state_measure(plastic, &largest, NULL);
+          if (largest > max_fp_log) max_fp_log = largest;
+          yielded += piola_world_solid_plastic_stats(world, index).yielded_count;
+        }
+        break;
+      }
+      case PIOLA_BODY_SHELL: {
+        const double *fhat = piola_shell_body_fhat(piola_world_shell_body(world, index));
+        for (int32_t k = 0; k < t; ++k) {
+          o->det_f[toff + k] = fhat[2 * k] * fhat[2 * k + 1];
+          o->inverted[toff + k] = fhat[2 * k + 1] < 0 ? 1.0 : 0.0;
+          o->energy[toff + k] = 0.0;
+        }
+        break;
+      }
+      case PIOLA_BODY_NONE: break;
     }
-    voff += n;
-    toff += t;
-  }
-  int32_t nshell = piola_world_shell_count(world);
-  for (int32_t s = 0; s < nshell; ++s) {
-    const piola_shell_body *b = piola_world_shell_body(world, s);
-    int32_t n = piola_shell_body_vertex_count(b), t = piola_shell_body_triangle_count(b);
-    const double *x = piola_world_shell_positions(world, s);
-    const double *v = piola_world_shell_velocities(world, s);
-    for (int64_t k = 0; k < 3 * (int64_t)n; ++k) {
-      int64_t g = 3 * (int64_t)voff + k;
-      o->tets.positions[g] = x[k];
-      o->velocity[g] = v[k];
-      o->displacement[g] = x[k] - o->rest[g];
-    }
-    const double *fhat = piola_shell_body_fhat(b);
-    for (int32_t k = 0; k < t; ++k) {
-      o->det_f[toff + k] = fhat[2 * k] * fhat[2 * k + 1];
-      o->inverted[toff + k] = fhat[2 * k + 1] < 0 ? 1.0 : 0.0;
-      o->energy[toff + k] = 0.0;
-    }
-    piola_world_shell_stats st = piola_world_shell_get_stats(world, s);
-    ke += st.kinetic_energy;
-    ee += st.membrane_energy + st.bending_energy;
-    inverted += st.inverted_count;
     voff += n;
     toff += t;
   }
   o->shells.positions = o->tets.positions + 3 * (size_t)o->solid_vertices;
-  char path[4200];
   piola_vtu_field points[2] = {{"velocity", 3, o->velocity}, {"displacement", 3, o->displacement}};
   piola_vtu_field cells[4] = {{"det_f", 1, o->det_f},
                               {"inverted", 1, o->inverted},
@@ -265,32 +344,51 @@ piola_status piola_output_write_frame(piola_output *o, const piola_world *world,
                            .triangles = o->shells.triangle_count > 0 ? &o->shells : NULL,
                            .point_fields = points, .point_field_count = 2, .cell_fields = cells,
                            .cell_field_count = 4, .positions = o->tets.positions};
-  snprintf(path, sizeof path, "%s/frames/frame_%04d.vtu", o->dir, (int)info->frame);
-  PIOLA_TRY(piola_vtu_write(path, &frame));
-  o->surface.positions = o->tets.positions; /* same numbering; borrowed for the write */
-  snprintf(path, sizeof path, "%s/surface/frame_%04d.obj", o->dir, (int)info->frame);
-  piola_status st = piola_tri_mesh_write(path, &o->surface);
-  o->surface.positions = NULL;
-  PIOLA_TRY(st);
-
   char line[512];
-  snprintf(line, sizeof line, "%d,%.17g,%d,%d,%.17g,%.17g,%lld,%.17g,%.6f,%lld,%.17g,%lld,%lld,%d,%d\n",
+  snprintf(line, sizeof line, "%d,%.17g,%d,%d,%.17g,%.17g,%lld,%.17g,%.6f,%lld,%.17g,%lld,%lld,%d,%d,%d,%d,%d\n",
            (int)info->frame, piola_world_time(world), (int)info->substeps, (int)info->cg_iterations,
            ke, ee, inverted, ns > 0 ? min_det : 1.0, info->wall_seconds, yielded, max_fp_log,
            (long long)info->contacts, (long long)info->impacts, (int)info->impact_zones,
+           (int)info->newton_iterations, (int)info->linear_iterations, (int)info->newton_failures,
            (int)info->step_retries);
-  PIOLA_TRY(csv_append(o, line));
-  snprintf(path, sizeof path, "%s/stats.csv", o->dir);
-  PIOLA_TRY(write_text(path, o->csv, o->csv_len));
-  if (o->pvd_count == o->pvd_cap) {
-    int32_t cap = o->pvd_cap ? 2 * o->pvd_cap : 64;
-    pvd_entry *grown = realloc(o->pvd, (size_t)cap * sizeof *grown);
-    if (!grown) return PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "sim.pvd: out of memory");
-    o->pvd = grown;
-    o->pvd_cap = cap;
+  return commit_frame(o, &frame, info->frame, line, piola_world_time(world));
+}
+
+piola_status piola_output_open(const char *dir, bool force, const piola_world *world,
+                               piola_output **out) {
+  return open_output(dir, force, -1, world, out);
+}
+
+piola_status piola_output_open_resume(const char *dir, int32_t frame, const piola_world *world,
+                                      piola_output **out) {
+  if (frame < 0) return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "output: resume frame must be >= 0");
+  return open_output(dir, false, frame, world, out);
+}
+
+/* Takes over frames 0..frame of the folder (output_reconcile.c) and rewrites both indexes
+ * to list exactly those. */
+static piola_status resume_indexes(piola_output *o, int32_t frame) {
+  char *rows;
+  size_t length;
+  PIOLA_TRY(piola__output_reconcile(o->dir, frame, &rows, &length));
+  piola_status st = csv_append(o, rows);
+  for (const char *line = rows; st == PIOLA_OK && *line;) {
+    char *end;
+    long k = strtol(line, &end, 10);
+    double time = strtod(end + 1, NULL);
+    st = pvd_append(o, (int32_t)k, time);
+    const char *next = strchr(line, '\n');
+    line = next ? next + 1 : line + strlen(line);
   }
-  o->pvd[o->pvd_count++] = (pvd_entry){info->frame, piola_world_time(world)};
-  return write_pvd(o);
+  free(rows);
+  frame_commit commit = {0};
+  char path[4200];
+  snprintf(path, sizeof path, "%s/stats.csv", o->dir);
+  if (st == PIOLA_OK) st = stage_text(&commit, path, o->csv, o->csv_len);
+  if (st == PIOLA_OK) st = stage_pvd(o, &commit);
+  if (st == PIOLA_OK) st = piola__frame_commit_publish(&commit);
+  if (st != PIOLA_OK) piola__frame_commit_discard(&commit);
+  return st;
 }
 
 typedef struct ranked {
@@ -351,17 +449,65 @@ piola_status piola_output_write_failure_report(piola_output *o, const piola_worl
   return piola_atomic_file_commit(&f);
 }
 
-piola_status piola_output_write_warnings(piola_output *output, const piola_world *world) {
-  char text[4 * 1100];
-  size_t len = 0;
-  text[0] = 0;
-  for (int k = 0; k < PIOLA_WARNING_KIND_COUNT; ++k) {
-    const char *w = piola_world_warning(world, (piola_warning_kind)k);
-    if (w && len < sizeof text) len += (size_t)snprintf(text + len, sizeof text - len, "%s\n", w);
+/* The lines of an earlier warnings.txt in dir (a resumed run's), or NULL; malloc'ed. */
+static char *earlier_warnings(const char *path) {
+  FILE *in = fopen(path, "rb");
+  if (!in) return NULL;
+  char *text = NULL;
+  size_t len = 0, cap = 0;
+  for (int c; (c = fgetc(in)) != EOF;) {
+    if (len + 2 > cap) {
+      cap = cap ? 2 * cap : 4096;
+      char *grown = realloc(text, cap);
+      if (!grown) break;
+      text = grown;
+    }
+    text[len++] = (char)c;
   }
-  if (len == 0) return PIOLA_OK;
-  if (len >= sizeof text) len = sizeof text - 1;
+  fclose(in);
+  if (text) text[len] = 0;
+  return text;
+}
+
+/* True when text holds line (without its newline) as a whole line. */
+static bool has_line(const char *text, const char *line) {
+  size_t n = strlen(line);
+  for (const char *p = text; p && *p;) {
+    const char *end = strchr(p, '\n');
+    size_t k = end ? (size_t)(end - p) : strlen(p);
+    if (k == n && memcmp(p, line, n) == 0) return true;
+    p = end ? end + 1 : NULL;
+  }
+  return false;
+}
+
+piola_status piola_output_write_warnings(piola_output *output, const piola_world *world) {
   char path[4200];
   snprintf(path, sizeof path, "%s/warnings.txt", output->dir);
-  return write_text(path, text, len);
+  /* the file's lines are kept: they are this run's own, or, after --resume, those of the run
+   * it continues (--force removes an earlier run's file when the output opens) */
+  char *kept = earlier_warnings(path);
+  bool fresh = false;
+  for (int k = 0; k < PIOLA_WARNING_KIND_COUNT; ++k) {
+    const char *w = piola_world_warning(world, (piola_warning_kind)k);
+    if (w && !has_line(kept, w)) fresh = true;
+  }
+  if (!fresh) {
+    free(kept);
+    return PIOLA_OK;
+  }
+  piola_atomic_file f;
+  piola_status st = piola_atomic_file_open(&f, path);
+  if (st != PIOLA_OK) {
+    free(kept);
+    return st;
+  }
+  if (kept) fputs(kept, f.stream);
+  if (kept && *kept && kept[strlen(kept) - 1] != '\n') fputc('\n', f.stream);
+  for (int k = 0; k < PIOLA_WARNING_KIND_COUNT; ++k) {
+    const char *w = piola_world_warning(world, (piola_warning_kind)k);
+    if (w && !has_line(kept, w)) fprintf(f.stream, "%s\n", w);
+  }
+  free(kept);
+  return piola_atomic_file_commit(&f);
 }

@@ -3,6 +3,7 @@
 #include "output/output_internal.h"
 
 #include <dirent.h>
+#include <stdlib.h>
 #include <errno.h>
 #include <stdio.h>
 #include <string.h>
@@ -11,15 +12,58 @@
 
 #include "common/status_report.h"
 
+/* Whether files can be created in folder: creates and removes a probe (permission bits
+ * alone do not say, e.g. for root or on a read-only or special file system). */
+static piola_status probe_writable(const char *folder, const char *dir) {
+  char probe[4200];
+  snprintf(probe, sizeof probe, "%s/.piola-probe-XXXXXX", folder);
+  int fd = mkstemp(probe);
+  if (fd < 0)
+    return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "output folder %s: cannot write in %s: %s", dir,
+                      folder, strerror(errno));
+  close(fd);
+  unlink(probe);
+  return PIOLA_OK;
+}
+
+/* A missing dir must be creatable: its nearest existing ancestor is a writable folder. */
+static piola_status check_creatable(const char *dir) {
+  char parent[4096];
+  int n = snprintf(parent, sizeof parent, "%s", dir);
+  if (n < 0 || n >= (int)sizeof parent)
+    return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "output folder: path too long");
+  for (;;) {
+    char *slash = strrchr(parent, '/');
+    while (slash && slash > parent && slash[1] == '\0') { /* trailing slashes */
+      *slash = '\0';
+      slash = strrchr(parent, '/');
+    }
+    if (!slash) snprintf(parent, sizeof parent, ".");
+    else if (slash == parent) parent[1] = '\0';
+    else *slash = '\0';
+    struct stat st;
+    if (stat(parent, &st) == 0) {
+      if (!S_ISDIR(st.st_mode))
+        return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "output folder %s: %s is not a folder", dir, parent);
+      return probe_writable(parent, dir);
+    }
+    if (errno != ENOENT)
+      return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "output folder %s: %s: %s", dir, parent, strerror(errno));
+    if (strcmp(parent, ".") == 0 || strcmp(parent, "/") == 0)
+      return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "output folder %s: no existing parent", dir);
+  }
+}
+
 piola_status piola_output_check_folder(const char *dir, bool force) {
   if (!dir || !dir[0]) return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "output folder: empty path");
   struct stat st;
   if (stat(dir, &st) != 0) {
-    if (errno == ENOENT) return PIOLA_OK;
-    return PIOLA_FAIL(PIOLA_ERROR_IO, "%s: %s", dir, strerror(errno));
+    if (errno == ENOENT) return check_creatable(dir);
+    return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "%s: %s", dir, strerror(errno));
   }
   if (!S_ISDIR(st.st_mode))
     return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "%s exists and is not a folder", dir);
+  PIOLA_TRY(probe_writable(dir, dir));
   if (force) return PIOLA_OK;
   DIR *d = opendir(dir);
   if (!d) return PIOLA_FAIL(PIOLA_ERROR_IO, "%s: %s", dir, strerror(errno));
@@ -90,6 +134,8 @@ piola_status piola__output_prepare_folder(const char *dir, bool force) {
   PIOLA_TRY(make_folder(path));
   if (force) {
     remove_matching(path, "frame_", ".obj");
+    remove_matching(dir, "checkpoint_", ".bin");
+    piola__output_remove_strays(dir, -1);
     static const char *const files[] = {"stats.csv", "sim.pvd", "failure_report.txt", "warnings.txt"};
     for (int i = 0; i < 4; ++i) {
       snprintf(path, sizeof path, "%s/%s", dir, files[i]);

@@ -3,11 +3,43 @@
 #define PIOLA_OUTPUT_OUTPUT_INTERNAL_H
 
 #include <stdbool.h>
+#include <stddef.h>
+#include <stdint.h>
 
+#include "piola/mesh.h"
 #include "piola/output.h"
 
 /* Checks the folder policy, creates DIR, DIR/frames and DIR/surface, and when forced
  * removes an earlier run's results. */
 piola_status piola__output_prepare_folder(const char *dir, bool force);
+
+/* output_reconcile.c: removes stray temporaries from dir, dir/frames and dir/surface and,
+ * with drop_after >= 0, the frames numbered above it. */
+void piola__output_remove_strays(const char *dir, long drop_after);
+/* For a resume from frame last_frame: checks that frames 0..last_frame are in place and
+ * stats.csv lists them, removes strays and later frames, and returns stats.csv's rows for
+ * frames 0..last_frame (no header; malloc'ed, *rows owned by the caller). */
+piola_status piola__output_reconcile(const char *dir, int32_t last_frame, char **rows, size_t *length);
+
+/* The per-body layout of the OBJ surface frames (obj_frame.c): the OBJ's vertices (indices
+ * into the frame's points), grouped by body, and its faces (1-based OBJ indices). */
+typedef struct obj_layout {
+  int32_t body_count;
+  int32_t *vertices;          /* point index of each OBJ vertex */
+  int32_t *faces;             /* 3 per face */
+  int32_t *body_vertex_start; /* body_count + 1 */
+  int32_t *body_face_start;   /* body_count + 1 */
+  char (*names)[128];         /* per body: the object name (blanks made '_') */
+} obj_layout;
+
+/* Bodies own the points [body_first_vertex[b], body_first_vertex[b + 1]) (body_count + 1
+ * entries); a surface triangle belongs to the body of its first vertex. */
+piola_status piola__obj_layout_build(const piola_tri_mesh *surface, const int32_t *body_first_vertex,
+                                     int32_t body_count, const char *const *names,
+                                     int32_t vertex_count, obj_layout *layout);
+/* Writes one frame (positions: 3 per point), whole or not at all. */
+piola_status piola__obj_layout_write(const obj_layout *layout, const char *path,
+                                     const double *positions);
+void piola__obj_layout_free(obj_layout *layout);
 
 #endif

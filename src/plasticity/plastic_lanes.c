@@ -20,9 +20,9 @@
 #define L PIOLA_PLASTIC_LANES
 _Static_assert(PIOLA_PLASTIC_LANES == PIOLA_TET_BLOCK, "plastic lanes are the force loop's blocks");
 
-typedef piola_f64x8 v8;
-typedef piola_i64x8 m8;
-#define SEL PIOLA_F64X8_SELECT
+typedef piola_v8d v8;
+typedef piola_v8l m8;
+#define SEL PIOLA_V8_SELECT
 
 static inline __attribute__((always_inline)) v8 v8_sqrt(v8 x) {
 #if defined(__AVX512F__)
@@ -52,7 +52,7 @@ static inline __attribute__((always_inline)) void store_lanes(double *p, v8 x, m
   _mm512_mask_storeu_pd(p, (__mmask8)bits, (__m512d)x);
 #else
   (void)bits;
-  piola__f64x8_store(p, SEL(mask, x, piola__f64x8_load(p)));
+  piola__v8_store(p, SEL(mask, x, piola__v8_load(p)));
 #endif
 }
 
@@ -96,7 +96,7 @@ static inline __attribute__((always_inline)) v8 v8_div(v8 a, v8 x) {
 /* Fhat of the block's tets (AoS in the body, 3 per tet: 24 doubles = 3 vectors) as three
  * lane vectors, by two shuffles each. */
 static inline __attribute__((always_inline)) void load_fhat(const double *fh, v8 f[3]) {
-  v8 x0 = piola__f64x8_load(fh), x1 = piola__f64x8_load(fh + 8), x2 = piola__f64x8_load(fh + 16);
+  v8 x0 = piola__v8_load(fh), x1 = piola__v8_load(fh + 8), x2 = piola__v8_load(fh + 16);
   v8 s0 = SHUF(x0, x1, 0, 3, 6, 9, 12, 15, 0, 0);
   v8 s1 = SHUF(x0, x1, 1, 4, 7, 10, 13, 0, 0, 0);
   v8 s2 = SHUF(x0, x1, 2, 5, 8, 11, 14, 0, 0, 0);
@@ -127,7 +127,7 @@ static inline __attribute__((always_inline)) void transpose8(v8 r[8]) {
 /* The 9-entry matrices of 8 tets (AoS, 72 doubles) as 9 lane vectors: an 8 x 8 transpose
  * of unaligned rows for entries 0..7, entry 8 lane by lane. */
 static inline __attribute__((always_inline)) void load_matrices(const double *m, v8 a[9]) {
-  for (int l = 0; l < L; ++l) a[l] = piola__f64x8_load(m + 9 * l);
+  for (int l = 0; l < L; ++l) a[l] = piola__v8_load(m + 9 * l);
   transpose8(a);
   for (int l = 0; l < L; ++l) a[8][l] = m[9 * l + 8];
 }
@@ -136,7 +136,7 @@ static inline __attribute__((always_inline)) void store_matrices(double *m, cons
   v8 r[8];
   for (int k = 0; k < 8; ++k) r[k] = a[k];
   transpose8(r);
-  for (int l = 0; l < L; ++l) piola__f64x8_store(m + 9 * l, r[l]);
+  for (int l = 0; l < L; ++l) piola__v8_store(m + 9 * l, r[l]);
   for (int l = 0; l < L; ++l) m[9 * l + 8] = a[8][l];
 }
 
@@ -150,13 +150,13 @@ static inline __attribute__((always_inline)) void store_matrices(double *m, cons
  * orthogonal to 1e-14 (the others must take the scalar path) and the largest clamped
  * singular value in *largest. Not inlined: it runs only while tets reach the limit. */
 enum { LIMIT_SWEEPS = 4 };
-__attribute__((noinline)) PIOLA_F64X8_WIDE static m8 limit_lanes(const v8 a[9], double cap, v8 out[9],
+__attribute__((noinline)) PIOLA_WIDE_VECTORS static m8 limit_lanes(const v8 a[9], double cap, v8 out[9],
                                                                   v8 *largest) {
   v8 x[3][3], w[3][3];
   for (int i = 0; i < 3; ++i)
     for (int c = 0; c < 3; ++c) {
       x[i][c] = a[3 * i + c];
-      w[i][c] = piola__f64x8_splat(i == c ? 1.0 : 0.0);
+      w[i][c] = piola__v8_splat(i == c ? 1.0 : 0.0);
     }
   static const int pairs[3][2] = {{0, 1}, {0, 2}, {1, 2}};
   for (int sweep = 0; sweep < LIMIT_SWEEPS; ++sweep)
@@ -186,7 +186,7 @@ __attribute__((noinline)) PIOLA_F64X8_WIDE static m8 limit_lanes(const v8 a[9], 
         w[qi][k] = sn * wp + c * wq;
       }
     }
-  m8 ok = (m8)(piola__f64x8_splat(0.0) == piola__f64x8_splat(0.0));
+  m8 ok = (m8)(piola__v8_splat(0.0) == piola__v8_splat(0.0));
   v8 norm2[3];
   for (int i = 0; i < 3; ++i) norm2[i] = x[i][0] * x[i][0] + x[i][1] * x[i][1] + x[i][2] * x[i][2];
   for (int r = 0; r < 3; ++r) {
@@ -194,7 +194,7 @@ __attribute__((noinline)) PIOLA_F64X8_WIDE static m8 limit_lanes(const v8 a[9], 
     v8 gamma = x[pi][0] * x[qi][0] + x[pi][1] * x[qi][1] + x[pi][2] * x[qi][2];
     ok &= (m8)(gamma * gamma <= 1e-28 * (norm2[pi] * norm2[qi]));
   }
-  v8 d[3], lo = piola__f64x8_splat(1.0 / cap), hi = piola__f64x8_splat(cap);
+  v8 d[3], lo = piola__v8_splat(1.0 / cap), hi = piola__v8_splat(cap);
   for (int k = 0; k < 3; ++k) {
     v8 sigma = v8_sqrt(norm2[k]);
     sigma = SEL((m8)(sigma < lo), lo, sigma);
@@ -232,12 +232,12 @@ static inline __attribute__((always_inline)) void return_map_block(const piola_p
    * (without hardening gamma is the same for all: the strain is not even read) */
   v8 gamma, lo, hi;
   if (p->hardening == 0) {
-    gamma = piola__f64x8_splat(p->yield);
-    lo = piola__f64x8_splat(s->quick_lo0), hi = piola__f64x8_splat(s->quick_hi0);
+    gamma = piola__v8_splat(p->yield);
+    lo = piola__v8_splat(s->quick_lo0), hi = piola__v8_splat(s->quick_hi0);
   } else {
-    gamma = p->yield + p->hardening * piola__f64x8_load(s->alpha + base);
+    gamma = p->yield + p->hardening * piola__v8_load(s->alpha + base);
     v8 r = gamma * (1.0 / 1.7320508075688772);
-    lo = piola__f64x8_exp(-r), hi = piola__f64x8_exp(r);
+    lo = piola__v8_exp(-r), hi = piola__v8_exp(r);
   }
   m8 outside = (fh[0] < lo) | (fh[0] > hi) | (fh[1] < lo) | (fh[1] > hi) | (fh[2] < lo) | (fh[2] > hi);
   /* NaN entries compare false both ways: they go to the full path like the scalar one */
@@ -245,17 +245,17 @@ static inline __attribute__((always_inline)) void return_map_block(const piola_p
   if (!lane_bits(outside & valid)) return;
 
   /* radial return (return_mapping.h) */
-  const v8 floor = piola__f64x8_splat(PIOLA_PLASTIC_FLAT_FLOOR);
+  const v8 floor = piola__v8_splat(PIOLA_PLASTIC_FLAT_FLOOR);
   v8 e[3];
-  for (int i = 0; i < 3; ++i) e[i] = piola__f64x8_log(SEL((m8)(fh[i] > floor), fh[i], floor));
-  v8 mean = p->volume_preserving ? (e[0] + e[1] + e[2]) * (1.0 / 3.0) : piola__f64x8_splat(0.0);
+  for (int i = 0; i < 3; ++i) e[i] = piola__v8_log(SEL((m8)(fh[i] > floor), fh[i], floor));
+  v8 mean = p->volume_preserving ? (e[0] + e[1] + e[2]) * (1.0 / 3.0) : piola__v8_splat(0.0);
   v8 d[3] = {e[0] - mean, e[1] - mean, e[2] - mean};
   v8 norm = v8_sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
   m8 yielded = (m8)(norm > gamma) & valid;
   const unsigned ybits = lane_bits(yielded);
   if (!ybits) return;
-  v8 dl = SEL(yielded, (norm - gamma) * (1.0 / (1.0 + p->hardening)), piola__f64x8_splat(0.0));
-  v8 scale = SEL(yielded, v8_div(dl, SEL(yielded, norm, piola__f64x8_splat(1.0))), piola__f64x8_splat(0.0));
+  v8 dl = SEL(yielded, (norm - gamma) * (1.0 / (1.0 + p->hardening)), piola__v8_splat(0.0));
+  v8 scale = SEL(yielded, v8_div(dl, SEL(yielded, norm, piola__v8_splat(1.0))), piola__v8_splat(0.0));
 
   for (int i = 0; i < 3; ++i) out->minus_delta[i] = -scale * d[i];
   out->dl = dl;
@@ -278,10 +278,10 @@ static inline __attribute__((always_inline)) int32_t flow_block(piola_plastic_st
    * so the third column of V is never read (a third less V traffic, fewer products), and
    * a lane with delta = 0 (G = 1) gets M = I exactly */
   v8 G[3];
-  for (int i = 0; i < 3; ++i) G[i] = piola__f64x8_exp(in->minus_delta[i]);
+  for (int i = 0; i < 3; ++i) G[i] = piola__v8_exp(in->minus_delta[i]);
   v8 c0 = G[0] - G[2], c1 = G[1] - G[2];
-  v8 a0 = piola__f64x8_load(vk[0] + base), a1 = piola__f64x8_load(vk[3] + base), a2 = piola__f64x8_load(vk[6] + base);
-  v8 b0 = piola__f64x8_load(vk[1] + base), b1 = piola__f64x8_load(vk[4] + base), b2 = piola__f64x8_load(vk[7] + base);
+  v8 a0 = piola__v8_load(vk[0] + base), a1 = piola__v8_load(vk[3] + base), a2 = piola__v8_load(vk[6] + base);
+  v8 b0 = piola__v8_load(vk[1] + base), b1 = piola__v8_load(vk[4] + base), b2 = piola__v8_load(vk[7] + base);
   v8 ca0 = c0 * a0, ca1 = c0 * a1, ca2 = c0 * a2, cb0 = c1 * b0, cb1 = c1 * b1, cb2 = c1 * b2;
   v8 m00 = G[2] + ca0 * a0 + cb0 * b0;
   v8 m11 = G[2] + ca1 * a1 + cb1 * b1;
@@ -339,18 +339,18 @@ static inline __attribute__((always_inline)) int32_t flow_block(piola_plastic_st
    * data is read for one block in PIOLA_PLASTIC_REFRESH only; the two products differ by
    * rounding (the tests bound it) */
   v8 e[9], r[9];
-  for (int k = 0; k < 9; ++k) e[k] = piola__f64x8_load(dm_inv[k] + base);
+  for (int k = 0; k < 9; ++k) e[k] = piola__v8_load(dm_inv[k] + base);
   if (vbits) /* limited lanes: Dm^-1,rest times their new Fp^-1 */
-    for (int k = 0; k < 9; ++k) r[k] = piola__f64x8_load(s->rest_lanes + (size_t)block * 9 * L + (size_t)k * L);
+    for (int k = 0; k < 9; ++k) r[k] = piola__v8_load(s->rest_lanes + (size_t)block * 9 * L + (size_t)k * L);
   for (int i = 0; i < 3; ++i)
     for (int j = 0; j < 3; ++j) {
       v8 eff = e[3 * i] * m[j] + e[3 * i + 1] * m[3 + j] + e[3 * i + 2] * m[6 + j];
       if (vbits) eff = SEL(vlim, r[3 * i] * an[j] + r[3 * i + 1] * an[3 + j] + r[3 * i + 2] * an[6 + j], eff);
       store_lanes(dm_inv[3 * i + j] + base, eff, yielded, ybits);
     }
-  piola__f64x8_store(s->alpha + base, piola__f64x8_load(s->alpha + base) + in->dl);
-  v8 old_bound = piola__f64x8_load(s->stretch_bound + base);
-  piola__f64x8_store(s->stretch_bound + base, SEL(yielded, upper, old_bound));
+  piola__v8_store(s->alpha + base, piola__v8_load(s->alpha + base) + in->dl);
+  v8 old_bound = piola__v8_load(s->stretch_bound + base);
+  piola__v8_store(s->stretch_bound + base, SEL(yielded, upper, old_bound));
 
   /* lanes -> AoS (tets that did not yield keep their bits); the exact limit where the
    * bounds leave it */
@@ -374,7 +374,7 @@ static inline __attribute__((always_inline)) int32_t flow_block(piola_plastic_st
  * a long chain of dependent operations: log, norm, exp, products). */
 enum { CHUNK_BLOCKS = 16 };
 
-PIOLA_F64X8_WIDE int32_t piola__plastic_update_blocks(piola_plastic_state *s, int32_t first, int32_t end,
+PIOLA_WIDE_VECTORS int32_t piola__plastic_update_blocks(piola_plastic_state *s, int32_t first, int32_t end,
                                                       int32_t *limited, double *bound) {
   double *dm_inv[9];
   const double *vk[9];

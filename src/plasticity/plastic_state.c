@@ -125,23 +125,13 @@ void piola_plastic_state_destroy(piola_plastic_state *s) {
   free(s);
 }
 
-piola_status piola_plastic_state_create(piola_elastic_body *body, const piola_plasticity_def *def,
-                                        piola_plastic_state **out) {
-  if (!out) return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "plasticity: out is NULL");
-  *out = NULL;
-  PIOLA_TRY(validate(body, def));
-  piola_plastic_state *s = calloc(1, sizeof *s);
-  if (!s) return PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "plasticity: out of memory");
+/* Sizes the per-tet arrays of s (params and controlled set) for the tets of body: Fp = I,
+ * no plastic strain, bounds 1, the body's current Dm^-1 as the rest one. */
+static piola_status allocate_tets(piola_plastic_state *s, const piola_elastic_body *body) {
   int32_t nt = s->tet_count = piola_elastic_body_tet_count(body);
   size_t n = nt > 0 ? (size_t)nt : 1;
   s->padded_count = (nt + PIOLA_PLASTIC_LANES - 1) / PIOLA_PLASTIC_LANES * PIOLA_PLASTIC_LANES;
   size_t np = s->padded_count > 0 ? (size_t)s->padded_count : PIOLA_PLASTIC_LANES;
-  s->params = (plastic_params){def->yield, def->hardening, def->limit, def->volume_preserving};
-  s->limit_cap = exp(def->limit);
-  s->quick_lo0 = exp(-def->yield / sqrt(3.0));
-  s->quick_hi0 = exp(def->yield / sqrt(3.0));
-  s->controlled = def->control.goal != PIOLA_PLASTIC_GOAL_NONE;
-  s->strength = def->control.strength;
   s->rest_lanes = calloc(9 * np, sizeof(double));
   s->fp_inv = malloc(9 * np * sizeof(double)); /* padded: the blocked update reads whole blocks */
   s->alpha = calloc(np, sizeof(double));
@@ -152,10 +142,8 @@ piola_status piola_plastic_state_create(piola_elastic_body *body, const piola_pl
     s->log_fp = calloc(6 * n, sizeof(double));
   }
   if (!s->rest_lanes || !s->fp_inv || !s->alpha || !s->block_bound || !s->stretch_bound ||
-      (s->controlled && (!s->goal_log || !s->log_fp))) {
-    piola_plastic_state_destroy(s);
+      (s->controlled && (!s->goal_log || !s->log_fp)))
     return PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "plasticity for %d tets: out of memory", (int)nt);
-  }
   for (size_t i = 0; i < np; ++i) s->stretch_bound[i] = 1.0;
   for (size_t b = 0; b < np / PIOLA_PLASTIC_LANES; ++b) s->block_bound[b] = 1.0;
   for (size_t t = 0; t < np; ++t)
@@ -167,6 +155,28 @@ piola_status piola_plastic_state_create(piola_elastic_body *body, const piola_pl
       s->rest_lanes[(size_t)(t / PIOLA_PLASTIC_LANES) * 9 * PIOLA_PLASTIC_LANES + (size_t)k * PIOLA_PLASTIC_LANES +
                     (size_t)(t % PIOLA_PLASTIC_LANES)] = rest[k];
   }
+  return PIOLA_OK;
+}
+
+piola_status piola_plastic_state_create(piola_elastic_body *body, const piola_plasticity_def *def,
+                                        piola_plastic_state **out) {
+  if (!out) return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "plasticity: out is NULL");
+  *out = NULL;
+  PIOLA_TRY(validate(body, def));
+  piola_plastic_state *s = calloc(1, sizeof *s);
+  if (!s) return PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "plasticity: out of memory");
+  s->params = (plastic_params){def->yield, def->hardening, def->limit, def->volume_preserving};
+  s->limit_cap = exp(def->limit);
+  s->quick_lo0 = exp(-def->yield / sqrt(3.0));
+  s->quick_hi0 = exp(def->yield / sqrt(3.0));
+  s->controlled = def->control.goal != PIOLA_PLASTIC_GOAL_NONE;
+  s->strength = def->control.strength;
+  piola_status st = allocate_tets(s, body);
+  if (st != PIOLA_OK) {
+    piola_plastic_state_destroy(s);
+    return st;
+  }
+  const int32_t nt = s->tet_count;
   if (s->controlled) {
     for (int32_t t = 0; t < nt; ++t) {
       double fp[9];
@@ -180,6 +190,54 @@ piola_status piola_plastic_state_create(piola_elastic_body *body, const piola_pl
     }
   }
   s->body = body; /* bound only now: destroy on the errors above must not touch the body */
+  *out = s;
+  return PIOLA_OK;
+}
+
+piola_status piola_plastic_state_create_from(piola_elastic_body *body,
+                                             const piola_plastic_state *parent,
+                                             const int32_t *tet_parent,
+                                             piola_plastic_state **out) {
+  if (!out) return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "plasticity: out is NULL");
+  *out = NULL;
+  if (!body || !parent || !tet_parent)
+    return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "plasticity create_from: NULL argument");
+  const int32_t nt = piola_elastic_body_tet_count(body);
+  for (int32_t t = 0; t < nt; ++t)
+    if (tet_parent[t] < -1 || tet_parent[t] >= parent->tet_count || (parent->controlled && tet_parent[t] < 0))
+      return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT,
+                        "plasticity create_from: tet %d has parent %d, outside [%d, %d)", (int)t,
+                        (int)tet_parent[t], parent->controlled ? 0 : -1, (int)parent->tet_count);
+  piola_plastic_state *s = calloc(1, sizeof *s);
+  if (!s) return PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "plasticity: out of memory");
+  s->params = parent->params;
+  s->limit_cap = parent->limit_cap;
+  s->quick_lo0 = parent->quick_lo0, s->quick_hi0 = parent->quick_hi0;
+  s->controlled = parent->controlled;
+  s->strength = parent->strength;
+  piola_status st = allocate_tets(s, body);
+  if (st != PIOLA_OK) {
+    piola_plastic_state_destroy(s);
+    return st;
+  }
+  for (int32_t t = 0; t < nt; ++t) {
+    const int32_t p = tet_parent[t];
+    if (p < 0) continue; /* Fp = I, no strain */
+    memcpy(s->fp_inv + 9 * t, parent->fp_inv + 9 * (size_t)p, 9 * sizeof(double));
+    s->alpha[t] = parent->alpha[p];
+    s->stretch_bound[t] = parent->stretch_bound[p];
+    if (s->controlled) {
+      memcpy(s->goal_log + 6 * t, parent->goal_log + 6 * (size_t)p, 6 * sizeof(double));
+      memcpy(s->log_fp + 6 * t, parent->log_fp + 6 * (size_t)p, 6 * sizeof(double));
+    }
+  }
+  for (int32_t b = 0; b < s->padded_count / PIOLA_PLASTIC_LANES; ++b) {
+    double m = 1.0;
+    for (int l = 0; l < PIOLA_PLASTIC_LANES; ++l) m = fmax(m, s->stretch_bound[PIOLA_PLASTIC_LANES * b + l]);
+    s->block_bound[b] = m;
+  }
+  s->body = body;
+  for (int32_t t = 0; t < nt; ++t) piola__plastic_commit_tet(s, t); /* Dm^-1 Fp^-1 */
   *out = s;
   return PIOLA_OK;
 }

@@ -9,7 +9,10 @@
  * The ground is stored a little deeper than it is (GROUND_DEPTH_BIAS, relative): a solid
  * resting exactly on a plane obstacle (a puddle whose nodes were projected onto it) has the
  * same depth as the plane up to rounding, and a tie must go to the solid, never to the
- * ground it lies on. */
+ * ground it lies on. Traced obstacles are likewise stored OBSTACLE_DEPTH_BIAS_PX pixel
+ * footprints deeper: cloth draped over a sphere rests on it, and its flat triangles cut
+ * into the curved surface by their sagitta (e^2 / 8R, a fraction of a millimetre), so the
+ * obstacle would show through the cloth in patches. Two pixels are invisible as depth. */
 #include <math.h>
 #include <stdlib.h>
 
@@ -19,9 +22,18 @@
 /* Relative depth offset of the ground: 1e-4 of the view depth (0.5 mm at 5 m) is far above
  * float rounding (6e-8) and far below anything a viewer could see through. */
 #define GROUND_DEPTH_BIAS 1e-4
+#define OBSTACLE_DEPTH_BIAS_PX 2.0
+
+/* A plane drawn as a floor fades out over this outer fraction of its half side. */
+#define FLOOR_FADE 0.2
+
+/* Planes facing further than this from `up` (cos 60 degrees) are walls or ceilings: not
+ * drawn once the floor is finite. */
+#define FLOOR_MIN_UP 0.5
 
 typedef struct ground_plane {
   vec3 normal, t1, t2, point; /* unit normal; in-plane axes; a point on it */
+  vec3 floor_origin;          /* the floor's centre on the plane */
   double camera_height;       /* signed distance of the camera above the plane, m */
   float light;                /* diffuse light of the plane: one value, lights are directional */
 } ground_plane;
@@ -69,6 +81,7 @@ void piola__render_ray_pass(const piola_renderer *r, const render_camera *cam, d
       if (np == MAX_PLANES) continue;
       vec3 n;
       double d = piola_obstacle_posed_distance(o, &pose, cam->position, &n);
+      if (isfinite(r->floor_half_size) && vec3_dot(n, r->def.up) < FLOOR_MIN_UP) continue;
       vec3 foot = vec3_sub(cam->position, vec3_scale(n, d));
       planes[np++] = make_plane(cam, foot, n, cam->position);
     } else if (nt < MAX_TRACED) {
@@ -83,6 +96,13 @@ void piola__render_ray_pass(const piola_renderer *r, const render_camera *cam, d
   if (np == 0 && r->def.ground)
     planes[np++] =
         make_plane(cam, vec3_scale(r->def.up, r->ground_height), r->def.up, cam->position);
+  const double floor_half = r->floor_half_size;
+  for (int k = 0; k < np; ++k) {
+    ground_plane *g = &planes[k];
+    g->floor_origin =
+        vec3_sub(r->floor_center, vec3_scale(g->normal, vec3_dot(vec3_sub(r->floor_center, g->point),
+                                                                 g->normal)));
+  }
 
   const double checker = r->checker_size, fog = 10 * (r->scene_size > 0 ? r->scene_size : 1);
   const double inv_f = 1.0 / cam->focal_px;
@@ -98,7 +118,7 @@ void piola__render_ray_pass(const piola_renderer *r, const render_camera *cam, d
       double dir_len = vec3_norm(dir);
       vec3 dn = vec3_scale(dir, 1.0 / dir_len);
       double best = INFINITY; /* view depth, m */
-      bool ground_nearest = false;
+      bool ground_nearest = false, obstacle_nearest = false;
       float col[3] = {bg[0], bg[1], bg[2]};
       for (int k = 0; k < np; ++k) {
         const ground_plane *g = &planes[k];
@@ -106,9 +126,17 @@ void piola__render_ray_pass(const piola_renderer *r, const render_camera *cam, d
         if (!(g->camera_height > 0) || !(denom < 0)) continue;
         double s = -g->camera_height / denom;
         if (!(s < best)) continue;
+        vec3 p = vec3_add(cam->position, vec3_scale(dir, s));
+        double edge = 0; /* 0 inside the floor, 1 at its border */
+        if (isfinite(floor_half)) {
+          vec3 from = vec3_sub(p, g->floor_origin);
+          double m = fmax(fabs(vec3_dot(from, g->t1)), fabs(vec3_dot(from, g->t2))) / floor_half;
+          if (m >= 1) continue;
+          edge = m > 1 - FLOOR_FADE ? (m - (1 - FLOOR_FADE)) / FLOOR_FADE : 0;
+        }
         best = s;
         ground_nearest = true;
-        vec3 p = vec3_add(cam->position, vec3_scale(dir, s));
+        obstacle_nearest = false;
         vec3 rel = vec3_sub(p, g->point);
         double u = vec3_dot(rel, g->t1) / checker, v = vec3_dot(rel, g->t2) / checker;
         long parity = ((long)floor(u) + (long)floor(v)) & 1;
@@ -119,6 +147,7 @@ void piola__render_ray_pass(const piola_renderer *r, const render_camera *cam, d
         base = base * (1 - w) + 183.f * w;
         double q = s * dir_len / fog;
         float fade = q < 1e-3 ? 0.f : (float)(1 - exp(-q * q));
+        fade = fade + (1 - fade) * (float)(edge * edge);
         float lit = base * (0.55f + 0.45f * g->light);
         if (shadow->size > 0) lit *= (float)(1 - 0.42 * piola__render_shadow_at(shadow, p));
         col[0] = lit * (1 - fade) + bg[0] * fade;
@@ -150,6 +179,7 @@ void piola__render_ray_pass(const piola_renderer *r, const render_camera *cam, d
         if (!hit || !(s / dir_len < best)) continue;
         best = s / dir_len;
         ground_nearest = false;
+        obstacle_nearest = true;
         float spec;
         float light = render_light(cam, n, vec3_neg(dn), &spec);
         col[0] = RENDER_OBSTACLE_R * light + 255 * spec;
@@ -157,7 +187,9 @@ void piola__render_ray_pass(const piola_renderer *r, const render_camera *cam, d
         col[2] = RENDER_OBSTACLE_B * light + 255 * spec;
       }
       size_t i = (size_t)y * (size_t)W + (size_t)x;
-      depth[i] = (float)(ground_nearest ? best * (1 + GROUND_DEPTH_BIAS) : best);
+      depth[i] = (float)(ground_nearest     ? best * (1 + GROUND_DEPTH_BIAS)
+                         : obstacle_nearest ? best * (1 + OBSTACLE_DEPTH_BIAS_PX * inv_f)
+                                            : best);
       for (int c = 0; c < 3; ++c) {
         float v = col[c] + 0.5f;
         rgb[3 * i + (size_t)c] = (uint8_t)(v < 0 ? 0 : v > 255 ? 255 : v);

@@ -58,6 +58,11 @@ struct piola_renderer {
   double ground_height; /* m along up, for the fallback ground */
   double checker_size;  /* m */
   double scene_size;    /* m, for fog and tracing tolerances */
+  /* Planes as a finite floor (set by fit_camera): a square of half side floor_half_size
+   * centred under floor_center, fading out at its edge; walls are not drawn. INFINITY:
+   * every plane is drawn whole (a camera set without fitting). */
+  vec3 floor_center;
+  double floor_half_size; /* m */
   /* per-frame buffers, reused */
   float *depth;
   size_t depth_capacity;

@@ -86,6 +86,7 @@ piola_status piola_renderer_create(const piola_render_def *def, piola_renderer *
   r->scene_size =
       def->camera_set ? vec3_norm(vec3_sub(def->camera_target, def->camera_position)) : 1.0;
   r->checker_size = nice_length(r->scene_size / 6);
+  r->floor_half_size = INFINITY;
   *out = r;
   return PIOLA_OK;
 }
@@ -171,6 +172,8 @@ void piola_renderer_fit_camera(piola_renderer *r, piola_vec3 lo, piola_vec3 hi) 
   }
   r->ground_height = low;
   r->scene_size = 2 * radius;
+  r->floor_center = center;
+  r->floor_half_size = 4 * radius;
   r->checker_size = nice_length(radius / 3);
   if (r->def.camera_set) return;
   /* A 3/4 view: from the front right (world -y, +x for z up) and 30 degrees above. Build

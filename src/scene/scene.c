@@ -8,6 +8,7 @@
 
 #include "common/status_report.h"
 #include "piola/files.h"
+#include "piola/keyframes.h"
 #include "scene/scene_desc.h"
 
 /* Scene files are small; a bigger file is a mistake (a mesh passed as the scene). */
@@ -30,6 +31,7 @@ piola_status piola_scene_parse_string(const char *json, const char *base_dir, co
   *out = NULL;
   if (!label) label = "scene";
   if (!base_dir) base_dir = ".";
+  if (json) PIOLA_TRY(piola__scene_check_text(json, label));
   piola_scene_desc *d = calloc(1, sizeof *d);
   if (!d) return PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "%s: out of memory", label);
   snprintf(d->label, sizeof d->label, "%s", label);
@@ -155,4 +157,19 @@ piola_obstacle_def piola_scene_desc_obstacle(const piola_scene_desc *d, int32_t 
       i < s->obstacle_count ? &s->obstacles[i] : &s->bones[i - s->obstacle_count].obstacle;
   if (mesh_path) *mesh_path = o->mesh_path;
   return o->def;
+}
+
+const char *piola_scene_desc_obstacle_name(const piola_scene_desc *d, int32_t i) {
+  const scene_desc *s = &d->desc;
+  return i < s->obstacle_count ? s->obstacles[i].name : s->bones[i - s->obstacle_count].name;
+}
+
+bool piola_scene_desc_obstacle_is_bone(const piola_scene_desc *d, int32_t i) {
+  return i >= d->desc.obstacle_count;
+}
+
+piola_vec3 piola_scene_desc_gravity(const piola_scene_desc *d, double t) {
+  const piola_track *g = d->desc.world.gravity;
+  return (piola_vec3){piola_track_eval(&g[0], t), piola_track_eval(&g[1], t),
+                      piola_track_eval(&g[2], t)};
 }

@@ -68,6 +68,8 @@ typedef struct scene_shell_desc {
 
 typedef struct scene_obstacle_desc {
   piola_obstacle_def def;
+  char name[128];                 /* `name` of an obstacle (default obstacle<i>); bones keep
+                                     theirs in scene_bone_desc */
   char mesh_path[SCENE_PATH_MAX]; /* mesh obstacles */
 } scene_obstacle_desc;
 
@@ -115,5 +117,9 @@ piola_status piola__scene_fiber_directions(const scene_fibers *fibers, const pio
 
 /* Reads or generates the meshes, places them and builds the world. */
 piola_status piola__scene_build(const scene_desc *desc, const char *label, piola_world **out);
+
+/* Refuses a scene text whose strings hold the escape \u0000 (scene_text_check.c): it would
+ * cut a path short. */
+piola_status piola__scene_check_text(const char *json, const char *label);
 
 #endif

@@ -4,15 +4,16 @@
 
 #include "scene/scene_parse_sections.h"
 
-piola_status piola__scene_parse_name(scene_parser *p, const cJSON *obj, scene_solid_desc *d) {
+piola_status piola__scene_parse_name(scene_parser *p, const cJSON *obj, char *name,
+                                     size_t capacity) {
   const cJSON *v = piola__json_get(obj, "name");
   if (!v) return PIOLA_OK;
   size_t old = piola__json_push_key(p, "name");
-  if (!cJSON_IsString(v) || !v->valuestring[0] || strlen(v->valuestring) >= sizeof d->name)
+  if (!cJSON_IsString(v) || !v->valuestring[0] || strlen(v->valuestring) >= capacity)
     return piola__json_fail(p, PIOLA_ERROR_PARSE,
                             "must be a non-empty string of at most %d characters",
-                            (int)sizeof d->name - 1);
-  snprintf(d->name, sizeof d->name, "%s", v->valuestring);
+                            (int)capacity - 1);
+  snprintf(name, capacity, "%s", v->valuestring);
   piola__json_pop(p, old);
   return PIOLA_OK;
 }

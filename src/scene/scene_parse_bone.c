@@ -61,16 +61,7 @@ static piola_status parse_bone(scene_parser *p, const cJSON *obj, int index,
   static const char *const extra[] = {"name", "attachments", NULL};
   snprintf(d->name, sizeof d->name, "bone%d", index);
   PIOLA_TRY(piola__scene_parse_obstacle(p, obj, extra, &d->obstacle));
-  const cJSON *v = piola__json_get(obj, "name");
-  if (v) {
-    size_t old = piola__json_push_key(p, "name");
-    if (!cJSON_IsString(v) || !v->valuestring[0] || strlen(v->valuestring) >= sizeof d->name)
-      return piola__json_fail(p, PIOLA_ERROR_PARSE,
-                              "must be a non-empty string of at most %d characters",
-                              (int)sizeof d->name - 1);
-    snprintf(d->name, sizeof d->name, "%s", v->valuestring);
-    piola__json_pop(p, old);
-  }
+  PIOLA_TRY(piola__scene_parse_name(p, obj, d->name, sizeof d->name));
   const cJSON *list = piola__json_get(obj, "attachments");
   if (!list) return PIOLA_OK;
   size_t old = piola__json_push_key(p, "attachments");

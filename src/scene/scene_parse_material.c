@@ -6,9 +6,52 @@
 #include "piola/material.h"
 #include "scene/scene_parse_sections.h"
 
+/* `ogden`: {"mu": [Pa, ...], "alpha": [...]}, two arrays of the same length 1..6, nonzero
+ * entries, with a positive shear modulus 1/2 sum mu_p alpha_p. */
+static piola_status parse_ogden(scene_parser *p, const cJSON *obj, piola_material_def *m) {
+  const cJSON *og = piola__json_get(obj, "ogden");
+  if (!og) return PIOLA_OK;
+  size_t old = piola__json_push_key(p, "ogden");
+  if (m->model != PIOLA_MODEL_OGDEN) return piola__json_fail(p, BAD_VALUE, "needs \"model\": \"ogden\"");
+  static const char *const keys[] = {"mu", "alpha", NULL};
+  PIOLA_TRY(piola__json_check_keys(p, og, keys));
+  PIOLA_TRY(piola__json_required(p, og, "mu"));
+  PIOLA_TRY(piola__json_required(p, og, "alpha"));
+  static const char *const names[2] = {"mu", "alpha"};
+  int counts[2];
+  for (int a = 0; a < 2; ++a) {
+    const cJSON *arr = piola__json_get(og, names[a]);
+    size_t o2 = piola__json_push_key(p, names[a]);
+    if (!cJSON_IsArray(arr) || cJSON_GetArraySize(arr) < 1 ||
+        cJSON_GetArraySize(arr) > PIOLA_OGDEN_MAX_TERMS)
+      return piola__json_fail(p, BAD_VALUE, "must be an array of 1 to %d numbers", PIOLA_OGDEN_MAX_TERMS);
+    counts[a] = cJSON_GetArraySize(arr);
+    for (int i = 0; i < counts[a]; ++i) {
+      size_t o3 = piola__json_push_index(p, i);
+      double v;
+      PIOLA_TRY(piola__json_number(p, cJSON_GetArrayItem(arr, i), ANY, &v));
+      if (v == 0) return piola__json_fail(p, BAD_VALUE, "must be nonzero");
+      (a == 0 ? m->ogden.mu : m->ogden.alpha)[i] = v;
+      piola__json_pop(p, o3);
+    }
+    piola__json_pop(p, o2);
+  }
+  if (counts[0] != counts[1])
+    return piola__json_fail(p, BAD_VALUE, "mu has %d terms and alpha %d: they must match", counts[0],
+                            counts[1]);
+  m->ogden.term_count = counts[0];
+  double shear = 0;
+  for (int i = 0; i < counts[0]; ++i) shear += 0.5 * m->ogden.mu[i] * m->ogden.alpha[i];
+  if (!(shear > 0))
+    return piola__json_fail(p, BAD_VALUE, "the shear modulus 1/2 sum mu_p alpha_p must be > 0 Pa, got %g", shear);
+  piola__json_pop(p, old);
+  return PIOLA_OK;
+}
+
 piola_status piola__scene_parse_material(scene_parser *p, const cJSON *obj, scene_solid_desc *d) {
-  static const char *const allowed[] = {"model", "youngs_modulus", "poisson_ratio",
-                                        "stiffness_scale", "inversion", "spline", "muscle", NULL};
+  static const char *const allowed[] = {"model",  "youngs_modulus", "poisson_ratio",
+                                        "stiffness_scale", "inversion", "spline", "muscle",
+                                        "ogden", "mooney_rivlin", NULL};
   PIOLA_TRY(piola__json_check_keys(p, obj, allowed));
   piola_material_def *m = &d->def.material;
   const cJSON *model = piola__json_get(obj, "model");
@@ -41,7 +84,7 @@ piola_status piola__scene_parse_material(scene_parser *p, const cJSON *obj, scen
       size_t o2 = piola__json_push_key(p, "mode");
       if (!cJSON_IsString(mode) ||
           !piola_inversion_mode_from_name(mode->valuestring, &m->inversion_mode))
-        return piola__json_fail(p, BAD_VALUE, "must be \"linear\" or \"clamp\"");
+        return piola__json_fail(p, BAD_VALUE, "must be \"linear\", \"clamp\" or \"energy\"");
       piola__json_pop(p, o2);
     }
     piola__json_pop(p, old);
@@ -79,6 +122,21 @@ piola_status piola__scene_parse_material(scene_parser *p, const cJSON *obj, scen
     PIOLA_TRY(piola__json_opt_number(p, mu, "optimal_stretch", POSITIVE, &md->optimal_stretch));
     PIOLA_TRY(
         piola__json_opt_number(p, mu, "active_width", (json_range){0, 1, 1, 1}, &md->active_width));
+    piola__json_pop(p, old);
+  }
+  PIOLA_TRY(parse_ogden(p, obj, m));
+  const cJSON *mr = piola__json_get(obj, "mooney_rivlin");
+  if (mr) {
+    size_t old = piola__json_push_key(p, "mooney_rivlin");
+    if (m->model != PIOLA_MODEL_MOONEY_RIVLIN)
+      return piola__json_fail(p, BAD_VALUE, "needs \"model\": \"mooney_rivlin\"");
+    static const char *const keys[] = {"c10", "c01", NULL};
+    PIOLA_TRY(piola__json_check_keys(p, mr, keys));
+    PIOLA_TRY(piola__json_opt_number(p, mr, "c10", ANY, &m->mooney_rivlin.c10));
+    PIOLA_TRY(piola__json_opt_number(p, mr, "c01", ANY, &m->mooney_rivlin.c01));
+    if (!(m->mooney_rivlin.c10 + m->mooney_rivlin.c01 > 0))
+      return piola__json_fail(p, BAD_VALUE, "c10 + c01 must be > 0 Pa (the shear modulus is 2 (c10 + c01)), got %g",
+                              m->mooney_rivlin.c10 + m->mooney_rivlin.c01);
     piola__json_pop(p, old);
   }
   return PIOLA_OK;

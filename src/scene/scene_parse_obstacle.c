@@ -1,4 +1,5 @@
 /* The `obstacles` section: shapes, friction and motion. */
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -119,7 +120,25 @@ piola_status piola__scene_parse_obstacles(scene_parser *p, const cJSON *v, scene
   for (const cJSON *e = v->child; e; e = e->next, ++i) {
     size_t o2 = piola__json_push_index(p, i);
     out->obstacle_count = i + 1;
-    PIOLA_TRY(piola__scene_parse_obstacle(p, e, NULL, &out->obstacles[i]));
+    static const char *const extra[] = {"name", NULL};
+    scene_obstacle_desc *d = &out->obstacles[i];
+    PIOLA_TRY(piola__scene_parse_obstacle(p, e, extra, d));
+    snprintf(d->name, sizeof d->name, "obstacle%d", i);
+    const cJSON *name = piola__json_get(e, "name");
+    if (name) {
+      size_t o3 = piola__json_push_key(p, "name");
+      if (!cJSON_IsString(name) || !name->valuestring[0] ||
+          strlen(name->valuestring) >= sizeof d->name)
+        return piola__json_fail(p, PIOLA_ERROR_PARSE,
+                                "must be a non-empty string of at most %d characters",
+                                (int)sizeof d->name - 1);
+      snprintf(d->name, sizeof d->name, "%s", name->valuestring);
+      for (int j = 0; j < i; ++j)
+        if (strcmp(out->obstacles[j].name, d->name) == 0)
+          return piola__json_fail(p, BAD_VALUE, "\"%s\" is already the name of obstacles[%d]",
+                                  d->name, j);
+      piola__json_pop(p, o3);
+    }
     piola__json_pop(p, o2);
   }
   piola__json_pop(p, old);

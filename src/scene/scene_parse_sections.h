@@ -27,9 +27,11 @@ piola_status piola__scene_parse_obstacle(scene_parser *p, const cJSON *obj,
 /* The `bones` array; solids must be parsed first (scene_parse_bone.c). */
 piola_status piola__scene_parse_bones(scene_parser *p, const cJSON *v, scene_desc *out);
 
-/* Keys solids and shells share (scene_parse_body_keys.c): name, transform (v is its value),
- * damping and self_collision (read from obj). */
-piola_status piola__scene_parse_name(scene_parser *p, const cJSON *obj, scene_solid_desc *d);
+/* Keys solids and shells share (scene_parse_body_keys.c): name (also of bones: into a buffer
+ * of capacity bytes), transform (v is its value), damping and self_collision (read from
+ * obj). */
+piola_status piola__scene_parse_name(scene_parser *p, const cJSON *obj, char *name,
+                                     size_t capacity);
 piola_status piola__scene_parse_transform(scene_parser *p, const cJSON *v, scene_solid_desc *d);
 piola_status piola__scene_parse_damping(scene_parser *p, const cJSON *obj, scene_solid_desc *d);
 piola_status piola__scene_parse_self_collision(scene_parser *p, const cJSON *obj,

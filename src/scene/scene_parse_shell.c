@@ -110,7 +110,7 @@ static piola_status parse_shell(scene_parser *p, const cJSON *obj, int index, sc
   d->base.def.density = d->def.density;
   d->base.scale = (piola_vec3){1, 1, 1};
   snprintf(d->base.name, sizeof d->base.name, "shell%d", index);
-  PIOLA_TRY(piola__scene_parse_name(p, obj, &d->base));
+  PIOLA_TRY(piola__scene_parse_name(p, obj, d->base.name, sizeof d->base.name));
   PIOLA_TRY(parse_shell_mesh(p, piola__json_get(obj, "mesh"), d));
   const cJSON *v;
   if ((v = piola__json_get(obj, "transform")))

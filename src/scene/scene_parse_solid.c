@@ -57,7 +57,7 @@ static piola_status parse_generator(scene_parser *p, const cJSON *obj, piola_mes
   PIOLA_TRY(piola__json_opt_vec3(p, obj, "half_extents", POSITIVE, &s->half_extents));
   PIOLA_TRY(piola__json_opt_number(p, obj, "cell_size", POSITIVE, &m->cell_size));
   int64_t levels = m->refinement_levels;
-  PIOLA_TRY(piola__json_opt_int(p, obj, "refinement_levels", 0, 8, &levels));
+  PIOLA_TRY(piola__json_opt_int(p, obj, "refinement_levels", 0, 6, &levels));
   m->refinement_levels = (int)levels;
   if (s->type == PIOLA_SHAPE_TORUS && !(s->minor_radius < s->radius)) {
     piola__json_push_key(p, "minor_radius");
@@ -77,7 +77,7 @@ static piola_status parse_solid(scene_parser *p, const cJSON *obj, int index, sc
   d->def = piola_default_solid_def();
   d->scale = (piola_vec3){1, 1, 1};
   snprintf(d->name, sizeof d->name, "solid%d", index);
-  PIOLA_TRY(piola__scene_parse_name(p, obj, d));
+  PIOLA_TRY(piola__scene_parse_name(p, obj, d->name, sizeof d->name));
   const cJSON *v = piola__json_get(obj, "mesh");
   size_t old = piola__json_push_key(p, "mesh");
   if (cJSON_IsObject(v)) {

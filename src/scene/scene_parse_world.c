@@ -12,7 +12,9 @@ piola_status piola__scene_parse_world(scene_parser *p, const cJSON *obj, scene_d
   if ((v = piola__json_get(obj, "integrator"))) {
     size_t old = piola__json_push_key(p, "integrator");
     static const char *const keys[] = {"max_dt", "cfl", "cg_tolerance", "cg_max_iterations",
-                                       "collision_interval", NULL};
+                                       "collision_interval", "type", "dt", "newton_tolerance",
+                                       "newton_max_iterations", "linear_tolerance",
+                                       "linear_max_iterations", NULL};
     PIOLA_TRY(piola__json_check_keys(p, v, keys));
     PIOLA_TRY(piola__json_opt_number(p, v, "max_dt", (json_range){0, 1, 1, 0}, &out->world.max_dt));
     PIOLA_TRY(piola__json_opt_number(p, v, "cfl", (json_range){0, 2, 1, 0}, &out->world.cfl));
@@ -23,7 +25,31 @@ piola_status piola__scene_parse_world(scene_parser *p, const cJSON *obj, scene_d
     out->world.cg_max_iterations = (int32_t)it;
     PIOLA_TRY(piola__json_opt_number(p, v, "collision_interval", (json_range){0, 1, 0, 0},
                                      &out->world.collision_interval));
+    const cJSON *type = piola__json_get(v, "type");
+    if (type) {
+      size_t o2 = piola__json_push_key(p, "type");
+      if (!cJSON_IsString(type) ||
+          !piola_integrator_type_from_name(type->valuestring, &out->world.integrator))
+        return piola__json_fail(p, BAD_VALUE,
+                                "must be \"newmark\", \"backward_euler\" or \"quasistatic\"");
+      piola__json_pop(p, o2);
+    }
+    /* the implicit step defaults to the frame time */
+    if (out->fps > 0) out->world.implicit_dt = 1.0 / out->fps;
+    PIOLA_TRY(piola__json_opt_number(p, v, "dt", POSITIVE, &out->world.implicit_dt));
+    PIOLA_TRY(piola__json_opt_number(p, v, "newton_tolerance", (json_range){0, 1, 1, 1},
+                                     &out->world.newton_tolerance));
+    it = out->world.newton_max_iterations;
+    PIOLA_TRY(piola__json_opt_int(p, v, "newton_max_iterations", 1, 1000000, &it));
+    out->world.newton_max_iterations = (int32_t)it;
+    PIOLA_TRY(piola__json_opt_number(p, v, "linear_tolerance", (json_range){0, 1, 1, 1},
+                                     &out->world.linear_tolerance));
+    it = out->world.linear_max_iterations;
+    PIOLA_TRY(piola__json_opt_int(p, v, "linear_max_iterations", 1, 1000000, &it));
+    out->world.linear_max_iterations = (int32_t)it;
     piola__json_pop(p, old);
+  } else if (out->fps > 0) {
+    out->world.implicit_dt = 1.0 / out->fps;
   }
   return PIOLA_OK;
 }

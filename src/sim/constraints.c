@@ -20,7 +20,7 @@ int piola__selector_contains(const piola_selector *sel, const double *p) {
   return 0;
 }
 
-piola_status piola__solid_apply_constraints(world_solid *s, const double *rest,
+piola_status piola__body_apply_constraints(world_body *s, const double *rest,
                                             const piola_constraint_def *constraints,
                                             int32_t count) {
   if (count < 0 || (count > 0 && !constraints))
@@ -37,7 +37,7 @@ piola_status piola__solid_apply_constraints(world_solid *s, const double *rest,
     if (sel->type == PIOLA_SELECT_SPHERE && !(sel->radius >= 0))
       return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "constraints[%d]: sphere radius must be >= 0 m",
                         (int)c);
-    uint8_t flag = con->driven ? SOLID_DRIVEN : SOLID_FIXED;
+    uint8_t flag = con->driven ? NODE_DRIVEN : NODE_FIXED;
     int32_t motion = -1;
     if (con->driven) {
       motion = s->motion_count++;
@@ -66,10 +66,10 @@ piola_status piola__solid_apply_constraints(world_solid *s, const double *rest,
   return PIOLA_OK;
 }
 
-void piola__solid_constrained_state(const world_solid *s, int32_t i, double t, double x[3],
-                                    double v[3]) {
+void piola__body_constrained_state(const world_body *s, int32_t i, double t, double x[3],
+                                   double v[3]) {
   const double *p0 = s->start + 3 * i;
-  if (s->flags[i] != SOLID_DRIVEN) {
+  if (s->flags[i] != NODE_DRIVEN) {
     x[0] = p0[0], x[1] = p0[1], x[2] = p0[2];
     v[0] = v[1] = v[2] = 0;
     return;

@@ -27,7 +27,7 @@
 int piola__step_reuse_first_product = 1;
 
 typedef struct damping_system {
-  const world_solid *s;
+  const world_body *s;
   double h;              /* dt / 2 */
   double beta, alpha;    /* shear and bulk viscosity, Pa s */
   int hold_normals;      /* filter the normal components of colliding nodes too */
@@ -37,26 +37,17 @@ typedef struct damping_system {
 
 static void damping_apply(void *ctx, const double *p, double *out) {
   const damping_system *d = ctx;
-  const world_solid *s = d->s;
   piola__step_profile_apply(d->profile, 1);
-  if (s->body) {
-    /* one pass: the damping's own chunk sum forms M p - h D p */
-    piola__elastic_body_damping_operator(s->body, p, d->beta, d->alpha, s->mass, d->h, out);
-  } else {
-    piola__solid_damping_forces(s, p, d->beta, d->alpha, d->scratch);
-    for (int32_t i = 0; i < s->n; ++i)
-      for (int k = 0; k < 3; ++k)
-        out[3 * i + k] = s->mass[i] * p[3 * i + k] - d->h * d->scratch[3 * i + k];
-  }
+  piola__body_damping_apply(d->s, p, d->beta, d->alpha, d->h, d->scratch, out);
   piola__step_profile_apply(d->profile, 0);
 }
 
 static void damping_filter(void *ctx, double *r, int32_t begin, int32_t end) {
   const damping_system *d = ctx;
-  const world_solid *s = d->s;
+  const world_body *s = d->s;
   for (int32_t i = begin; i < end; ++i) {
     double *ri = r + 3 * i;
-    if (s->flags[i] != SOLID_FREE) {
+    if (s->flags[i] != NODE_FREE) {
       ri[0] = ri[1] = ri[2] = 0;
     } else if (d->hold_normals && s->colliding[i]) {
       const double *nrm = s->normals + 3 * i;
@@ -75,16 +66,16 @@ static void damping_filter(void *ctx, double *r, int32_t begin, int32_t end) {
  * has no net force. CG's updates keep it so (1^T A p = 1^T M p = 1^T r for its directions),
  * so a free body's linear momentum comes out exact whatever the tolerance, instead of being
  * off by the net force left in the final residual. */
-static int32_t damping_solve(piola_world *w, world_solid *s, double h, double t,
+static int32_t damping_solve(piola_world *w, world_body *s, double h, double t,
                              int hold_normals, const double *rhs, double *v, const double uniform[3],
                              double *av, double *guess_copy, double *initial_av, int from_product) {
   double beta = piola_track_eval(&s->shear_viscosity, t);
   double alpha = piola_track_eval(&s->bulk_viscosity, t);
   damping_system d = {s, h, beta, alpha, hold_normals, s->tmp, &w->profile};
-  if (piola__solid_undamped(s, beta, alpha)) {
+  if (piola__body_undamped(s, beta, alpha)) {
     /* M is diagonal: the filtered solve is exact in one pass */
     for (int32_t i = 0; i < s->n; ++i) {
-      if (s->flags[i] != SOLID_FREE) continue;
+      if (s->flags[i] != NODE_FREE) continue;
       double *vi = v + 3 * i;
       double old[3] = {vi[0], vi[1], vi[2]};
       for (int k = 0; k < 3; ++k) vi[k] = rhs[3 * i + k] / s->mass[i];
@@ -111,7 +102,7 @@ static int32_t damping_solve(piola_world *w, world_solid *s, double h, double t,
 #pragma omp parallel for schedule(static) num_threads(piola_thread_count()) \
     if (s->n >= PIOLA_PARALLEL_MIN_VERTICES)
     for (int32_t i = 0; i < s->n; ++i) {
-      const int free_node = s->flags[i] == SOLID_FREE;
+      const int free_node = s->flags[i] == NODE_FREE;
       for (int k = 0; k < 3; ++k) {
         const int64_t j = 3 * (int64_t)i + k;
         e[j] = v[j] - s->v_product[j] - (free_node ? 0.0 : uniform[k]);
@@ -121,12 +112,12 @@ static int32_t damping_solve(piola_world *w, world_solid *s, double h, double t,
             s->mass[i] * v[j] - ratio * (s->mass[i] * s->v_product[j] - s->av_product[j]);
       }
     }
-    piola__elastic_body_damping_forces_add_sparse(s->body, e, beta, alpha, -h, initial_av);
+    piola__body_damping_add_sparse(s, e, beta, alpha, -h, initial_av);
   } else {
 #pragma omp parallel for schedule(static) num_threads(piola_thread_count()) \
     if (s->n >= PIOLA_PARALLEL_MIN_VERTICES)
     for (int32_t i = 0; i < s->n; ++i) {
-      if (s->flags[i] != SOLID_FREE) continue;
+      if (s->flags[i] != NODE_FREE) continue;
       double du[3] = {uniform[0], uniform[1], uniform[2]};
       if (hold_normals && s->colliding[i]) {
         const double *nrm = s->normals + 3 * i;
@@ -167,10 +158,10 @@ static int32_t damping_solve(piola_world *w, world_solid *s, double h, double t,
  * friction for it a block on an incline would feel half its Coulomb friction. Here that
  * impulse, dt/2 (f^n+1 + f_ext + D v^n+1) . n / m when it presses into the obstacle, limits
  * the relative tangential velocity the same way: vT <- max(0, 1 - mu dvN / |vT|) vT. */
-static void contact_friction(const piola_world *w, world_solid *s, double t1, double h,
+static void contact_friction(const piola_world *w, world_body *s, double t1, double h,
                              const double *g1, const double *av) {
   for (int32_t i = 0; i < s->n; ++i) {
-    if (!s->colliding[i] || s->flags[i] != SOLID_FREE) continue;
+    if (!s->colliding[i] || s->flags[i] != NODE_FREE) continue;
     const double *nrm = s->normals + 3 * i;
     double *vi = s->v + 3 * i;
     /* normal impulse per unit mass of the n+1 half: h (f + m g).n + (h D v).n, where
@@ -200,7 +191,7 @@ static void contact_friction(const piola_world *w, world_solid *s, double t1, do
   }
 }
 
-static double stiffness_bound(const world_solid *s, double t0, double t1) {
+static double stiffness_bound(const world_body *s, double t0, double t1) {
   /* the largest stiffness scale over [t0, t1]: the tracks are piecewise linear, so the
    * maximum is at an end or at a key inside */
   double m = fmax(piola_track_eval(&s->stiffness_scale, t0), piola_track_eval(&s->stiffness_scale, t1));
@@ -210,40 +201,12 @@ static double stiffness_bound(const world_solid *s, double t0, double t1) {
   return m;
 }
 
-/* The state-aware bound of solid s (stable_step.h), computed once per update. */
-static double solid_state_rate2(const world_solid *s) {
-  world_solid *cache = (world_solid *)s; /* a cache of a function of the const state */
-  if (!cache->state_rate_valid) {
-    cache->state_rate2 = piola__elastic_body_state_rate2(s->body, &cache->state_worst_tet);
-    cache->state_rate_valid = 1;
-  }
-  return s->state_rate2;
-}
-
-/* The step of solid s: its rest bound cfl h_min / c, or the state-aware bound cfl /
- * sqrt(max_e s k_e / (rho h_e^2)) where that is smaller (docs/time-stepping.md, "Step size").
- * At rest the two agree up to rounding, so the state bound takes over only when it is
- * smaller by more than rounding: a state at rest keeps the rest step's bits. */
-static double solid_stable_dt(const piola_world *w, const world_solid *s, double scale) {
-  const double stiffening = piola__solid_plastic_stiffening(s);
-  double speed = piola_elastic_body_max_wave_speed(s->body) * sqrt(scale);
-  double h = piola_elastic_body_min_rest_altitude(s->body) / stiffening;
-  if (!(speed > 0 && h > 0)) return INFINITY;
-  double rest = w->def.cfl * h / speed;
-  double rate2 = solid_state_rate2(s) * scale * stiffening * stiffening;
-  double state = rate2 > 0 ? w->def.cfl / sqrt(rate2) : INFINITY;
-  return state < rest * (1.0 - 1e-9) ? state : rest;
-}
-
 double piola_world_stable_dt(const piola_world *w) {
+  if (w->def.integrator != PIOLA_INTEGRATOR_NEWMARK) return w->def.implicit_dt;
   double dt = w->def.max_dt;
-  for (int32_t i = 0; i < w->solid_count; ++i) {
-    const world_solid *s = &w->solids[i];
-    dt = fmin(dt, solid_stable_dt(w, s, stiffness_bound(s, w->time, w->time + w->def.max_dt)));
-  }
-  for (int32_t i = 0; i < w->shell_count; ++i) {
-    const world_solid *s = &w->shells[i];
-    dt = fmin(dt, piola__shell_stable_dt(w, s, stiffness_bound(s, w->time, w->time + w->def.max_dt)));
+  for (int32_t i = 0; i < w->body_count; ++i) {
+    const world_body *b = &w->bodies[i];
+    dt = fmin(dt, piola__body_stable_dt(w, b, stiffness_bound(b, w->time, w->time + w->def.max_dt)));
   }
   return dt;
 }
@@ -252,16 +215,16 @@ static void gravity_at(const piola_world *w, double t, double g[3]) {
   for (int k = 0; k < 3; ++k) g[k] = piola_track_eval(&w->def.gravity[k], t);
 }
 
-static void restore(world_solid *s, double t) {
+static void restore(world_body *s, double t) {
   size_t v3 = 3 * (size_t)s->n * sizeof(double);
   s->product_valid = 0;
   memcpy(s->x, s->x_old, v3);
   memcpy(s->v, s->v_old, v3);
   memcpy(s->force, s->force_old, v3);
-  (void)piola__solid_update_forces(s, t);
+  (void)piola__body_update_forces(s, t);
 }
 
-static piola_status step_solid(piola_world *w, world_solid *s, double t, double dt,
+static piola_status step_body(piola_world *w, world_body *s, double t, double dt,
                                piola_step_stats *stats) {
   const int32_t n = s->n > 0 ? s->n : 0;
   const int64_t m = 3 * (int64_t)n;
@@ -283,27 +246,28 @@ static piola_status step_solid(piola_world *w, world_solid *s, double t, double 
     }
   if (n > 0) memset(s->colliding, 0, (size_t)n);
   for (int32_t i = 0; i < n; ++i) {
-    if (s->flags[i] == SOLID_FREE) continue;
+    if (s->flags[i] == NODE_FREE) continue;
     double xp[3], vp[3];
-    piola__solid_constrained_state(s, i, t1, xp, vp);
+    piola__body_constrained_state(s, i, t1, xp, vp);
     for (int k = 0; k < 3; ++k) s->v[3 * i + k] = (xp[k] - s->x[3 * i + k]) / dt;
   }
   piola__step_profile_mark(&w->profile, STEP_PHASE_SETUP);
   double beta0 = piola_track_eval(&s->shear_viscosity, t);
   double alpha0 = piola_track_eval(&s->bulk_viscosity, t);
-  const int damped = !piola__solid_undamped(s, beta0, alpha0);
-  if (s->body && damped) piola__elastic_body_damping_prepare(s->body, beta0, alpha0);
+  const int damped = !piola__body_undamped(s, beta0, alpha0);
+  const int reusable = piola__body_damping_reusable(s);
+  if (reusable && damped) piola__body_damping_prepare(s, beta0, alpha0);
   piola__step_profile_mark(&w->profile, STEP_PHASE_PREPARE);
   const double gravity1[3] = {h * g0[0], h * g0[1], h * g0[2]};
   /* for a damped body, keep the guess x0 (in tmp) and A x0 (in the fourth work vector, which
    * CG does not use): the second right-hand side's D_n v' is h D_n x0 = M x0 - A x0 plus a
    * correction on the few nodes where v' differs from the guess (see there) */
   double *initial_av = s->work + 3 * m;
-  const int reuse = damped && s->body && piola__step_reuse_first_product;
+  const int reuse = damped && reusable && piola__step_reuse_first_product;
   /* the last final solve ran with the same operator (same assembly) unless the body or the
    * viscosities changed since: start from its product instead of a fresh apply */
   const int from_product =
-      reuse && s->product_valid && s->product_generation == s->body->damping.generation;
+      reuse && s->product_valid && s->product_generation == piola__body_damping_generation(s);
   stats->cg_iterations += damping_solve(w, s, h, t, 0, s->rhs, s->v, gravity1, NULL,
                                         reuse ? s->tmp : NULL, reuse ? initial_av : NULL, from_product);
   s->product_valid = 0;
@@ -324,12 +288,12 @@ static piola_status step_solid(piola_world *w, world_solid *s, double t, double 
   if (w->obstacle_count > 0)
     colliding = piola_obstacles_collide(w->obstacles, w->obstacle_count, t1, dt, n, s->x, s->v,
                                         s->colliding, s->normals);
-  if (s->shell && s->collide_with_solids) colliding += piola__shell_collide_with_solids(w, s, t1, dt);
+  colliding += piola__body_collide_in_step(w, s, t1, dt);
   for (int32_t i = 0; i < n; ++i) {
-    if (s->flags[i] == SOLID_FREE) continue;
+    if (s->flags[i] == NODE_FREE) continue;
     if (s->colliding[i]) colliding--;
     s->colliding[i] = 0;
-    piola__solid_constrained_state(s, i, t1, s->x + 3 * i, s->v + 3 * i);
+    piola__body_constrained_state(s, i, t1, s->x + 3 * i, s->v + 3 * i);
   }
   stats->colliding += colliding;
   piola__step_profile_mark(&w->profile, STEP_PHASE_COLLIDE);
@@ -346,13 +310,13 @@ static piola_status step_solid(piola_world *w, world_solid *s, double t, double 
     for (int32_t i = 0; i < n; ++i) {
       double *x0 = s->tmp + 3 * i;
       const double *vi = s->v + 3 * i, *vo = s->v_old + 3 * i;
-      int moved = s->flags[i] != SOLID_FREE || vi[0] != vo[0] || vi[1] != vo[1] || vi[2] != vo[2];
+      int moved = s->flags[i] != NODE_FREE || vi[0] != vo[0] || vi[1] != vo[1] || vi[2] != vo[2];
       for (int k = 0; k < 3; ++k) {
         hd[3 * i + k] = s->mass[i] * x0[k] - hd[3 * i + k];
         x0[k] = moved ? x0[k] - vi[k] - gravity1[k] : 0.0;
       }
     }
-    piola__elastic_body_damping_forces_add_sparse(s->body, s->tmp, beta0, alpha0, -h, hd);
+    piola__body_damping_add_sparse(s, s->tmp, beta0, alpha0, -h, hd);
 #pragma omp parallel for schedule(static) num_threads(piola_thread_count()) \
     if (n >= PIOLA_PARALLEL_MIN_VERTICES)
     for (int32_t i = 0; i < n; ++i)
@@ -361,7 +325,7 @@ static piola_status step_solid(piola_world *w, world_solid *s, double t, double 
                             h * (s->force_old[3 * i + k] + s->mass[i] * g0[k]);
   } else {
     if (damped)
-      piola__solid_damping_forces(s, s->v, beta0, alpha0, s->tmp);
+      piola__body_damping_forces(s, s->v, beta0, alpha0, s->tmp);
     else
       memset(s->tmp, 0, v3);
     for (int32_t i = 0; i < n; ++i)
@@ -372,19 +336,19 @@ static piola_status step_solid(piola_world *w, world_solid *s, double t, double 
 
   piola__step_profile_mark(&w->profile, STEP_PHASE_RHS2);
   /* F, diagonalization and elastic force at x^n+1, once per step */
-  piola_status st = piola__solid_update_forces(s, t1);
+  piola_status st = piola__body_update_forces(s, t1);
   if (st != PIOLA_OK) {
     restore(s, t);
     return st;
   }
-  if (s->shell) piola_shell_body_plastic_flow(s->shell, dt);
+  piola__body_plastic_in_step(s, dt);
   piola__step_profile_mark(&w->profile, STEP_PHASE_UPDATE);
   int damped1 = 0;
-  if (s->body) {
+  if (reusable) {
     double beta1 = piola_track_eval(&s->shear_viscosity, t1);
     double alpha1 = piola_track_eval(&s->bulk_viscosity, t1);
-    damped1 = !piola__solid_undamped(s, beta1, alpha1);
-    if (damped1) piola__elastic_body_damping_prepare(s->body, beta1, alpha1);
+    damped1 = !piola__body_undamped(s, beta1, alpha1);
+    if (damped1) piola__body_damping_prepare(s, beta1, alpha1);
   }
   piola__step_profile_mark(&w->profile, STEP_PHASE_PREPARE);
 
@@ -406,7 +370,7 @@ static piola_status step_solid(piola_world *w, world_solid *s, double t, double 
     if (n >= PIOLA_PARALLEL_MIN_VERTICES)
     for (int64_t j = 0; j < m; ++j) s->v_product[j] = s->v[j];
     s->product_h = h;
-    s->product_generation = s->body->damping.generation;
+    s->product_generation = piola__body_damping_generation(s);
     s->product_valid = 1;
   }
   piola__step_profile_mark(&w->profile, STEP_PHASE_SOLVE2);
@@ -436,7 +400,8 @@ static piola_status step_solid(piola_world *w, world_solid *s, double t, double 
     if (bad_part[r] >= 0) {
       restore(s, t);
       return PIOLA_FAIL(PIOLA_ERROR_NOT_FINITE,
-                        "solid '%s': velocity of vertex %lld became non-finite at t = %g s", s->name,
+                        "%s '%s': velocity of vertex %lld became non-finite at t = %g s",
+                        piola__body_kind_name(s->kind), s->name,
                         (long long)(bad_part[r] / 3), t1);
     }
     kinetic += kinetic_part[r];
@@ -445,8 +410,8 @@ static piola_status step_solid(piola_world *w, world_solid *s, double t, double 
   if (!isfinite(kinetic) || !isfinite(force2)) {
     restore(s, t);
     return PIOLA_FAIL(PIOLA_ERROR_NOT_FINITE,
-                      "solid '%s': the %s became non-finite at t = %g s (the state blew up)",
-                      s->name, isfinite(kinetic) ? "elastic force's squared norm" : "kinetic energy", t1);
+                      "%s '%s': the %s became non-finite at t = %g s (the state blew up)",
+                      piola__body_kind_name(s->kind), s->name, isfinite(kinetic) ? "elastic force's squared norm" : "kinetic energy", t1);
   }
   piola__step_profile_mark(&w->profile, STEP_PHASE_CHECK);
   return PIOLA_OK;
@@ -456,14 +421,15 @@ static piola_status step_solid(piola_world *w, world_solid *s, double t, double 
  * piola_world_stable_dt) is below a tenth of its rest CFL step, naming the tet that sets it. */
 static void note_small_step(piola_world *w) {
   if (w->warnings[PIOLA_WARNING_SMALL_STEP]) return;
-  for (int32_t i = 0; i < w->solid_count; ++i) {
-    const world_solid *s = &w->solids[i];
+  for (int32_t i = 0; i < w->body_count; ++i) {
+    const world_body *s = &w->bodies[i];
+    if (s->kind != PIOLA_BODY_SOLID) continue;
     if (!s->state_rate_valid || !(s->state_rate2 > 0) || s->state_worst_tet < 0) continue;
-    const double speed = piola_elastic_body_max_wave_speed(s->body);
-    const double h = piola_elastic_body_min_rest_altitude(s->body);
+    const double speed = piola_elastic_body_max_wave_speed(s->solid);
+    const double h = piola_elastic_body_min_rest_altitude(s->solid);
     const double rest = w->def.cfl * h / speed, state = w->def.cfl / sqrt(s->state_rate2);
     if (!(speed > 0 && h > 0) || !(state < 0.1 * rest)) continue;
-    const double *f = piola_elastic_body_fhat(s->body) + 3 * s->state_worst_tet;
+    const double *f = piola_elastic_body_fhat(s->solid) + 3 * s->state_worst_tet;
     piola__world_warn(w, PIOLA_WARNING_SMALL_STEP,
                       "solid '%s': at t = %g s the stable step is %.3g s, %.0f times below the "
                       "CFL estimate of the rest state (%.3g s): tet %d is deformed to Fhat = "
@@ -476,8 +442,7 @@ static void note_small_step(piola_world *w) {
 }
 
 static void restore_all(piola_world *w, int32_t count) {
-  for (int32_t j = 0; j < count; ++j)
-    restore(j < w->solid_count ? &w->solids[j] : &w->shells[j - w->solid_count], w->time);
+  for (int32_t j = 0; j < count; ++j) restore(&w->bodies[j], w->time);
 }
 
 /* One try at a step of dt from the current state; on failure every body is back at the
@@ -489,20 +454,21 @@ static piola_status try_step(piola_world *w, double dt, piola_step_stats *local)
   PIOLA_TRY(piola__world_collision_open(w, &left));
   const int closes = dt >= left || dt == w->collision_deadline - w->time;
   piola__step_profile_mark(&w->profile, STEP_PHASE_WORLD);
-  for (int32_t i = 0; i < w->solid_count + w->shell_count; ++i) {
-    world_solid *s = i < w->solid_count ? &w->solids[i] : &w->shells[i - w->solid_count];
-    piola_status st = step_solid(w, s, w->time, dt, local);
+  for (int32_t i = 0; i < w->body_count; ++i) {
+    piola_status st = step_body(w, &w->bodies[i], w->time, dt, local);
     if (st != PIOLA_OK) {
       restore_all(w, i);
       return st;
     }
   }
   piola_status contact = piola__world_self_collide(w, dt, w->time + dt, closes, local);
-  if (contact != PIOLA_OK) restore_all(w, w->solid_count + w->shell_count);
+  if (contact != PIOLA_OK) restore_all(w, w->body_count);
   return contact;
 }
 
 piola_status piola_world_step(piola_world *w, double dt_limit, piola_step_stats *stats) {
+  if (w->def.integrator != PIOLA_INTEGRATOR_NEWMARK)
+    return piola__implicit_world_step(w, dt_limit, stats);
   piola_step_stats local = {0};
   piola__step_profile_start(&w->profile);
   double dt = piola_world_stable_dt(w);
@@ -523,7 +489,7 @@ piola_status piola_world_step(piola_world *w, double dt_limit, piola_step_stats 
     if (stats) *stats = local;
     return st;
   }
-  for (int32_t i = 0; i < w->solid_count; ++i) piola__solid_plastic_update(&w->solids[i], dt);
+  for (int32_t i = 0; i < w->body_count; ++i) piola__body_plastic_after_step(&w->bodies[i], dt);
   piola__step_profile_mark(&w->profile, STEP_PHASE_WORLD);
   if (w->profile.enabled) w->profile.steps++;
   w->time += dt;
@@ -542,6 +508,9 @@ piola_status piola_world_advance_to(piola_world *w, double t_end, piola_step_sta
     double dt = piola_world_stable_dt(w);
     double limit = left;
     if (left > dt && left < 2 * dt) limit = 0.5 * left;
+    /* the implicit step is the user's, usually a frame: a target a rounding error past it
+     * is reached in one step */
+    if (w->def.integrator != PIOLA_INTEGRATOR_NEWMARK && left <= dt * (1 + 1e-9)) limit = left;
     piola_step_stats one;
     w->collision_deadline = t_end;
     piola_status st = piola_world_step(w, limit, &one);
@@ -554,6 +523,9 @@ piola_status piola_world_advance_to(piola_world *w, double t_end, piola_step_sta
       stats->impacts += one.impacts;
       stats->impact_zones += one.impact_zones;
       stats->collision_steps += one.collision_steps;
+      stats->newton_iterations += one.newton_iterations;
+      stats->linear_iterations += one.linear_iterations;
+      stats->newton_failures += one.newton_failures;
       stats->step_retries += one.step_retries;
       if (one.substeps) stats->last_dt = one.last_dt;
     }

@@ -43,11 +43,11 @@ static int attachment_picks(const piola_attachment_def *a, const piola_obstacle 
 static piola_status check_attachment(const piola_world *w, const piola_attachment_def *a, int32_t k,
                                      const piola_obstacle *o, const piola__rigid_state *rest_pose,
                                      int32_t *count) {
-  if (a->solid < 0 || a->solid >= w->solid_count)
+  const world_body *s = piola__world_body_of(w, PIOLA_BODY_SOLID, a->solid);
+  if (!s)
     return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT,
                       "attachments[%d]: solid %d does not exist (the world has %d solids)", (int)k,
-                      (int)a->solid, (int)w->solid_count);
-  const world_solid *s = &w->solids[a->solid];
+                      (int)a->solid, (int)w->kind_count[PIOLA_BODY_SOLID]);
   const piola_selector *sel = &a->selector;
   int32_t n = 0;
   if (a->near_surface) {
@@ -84,13 +84,13 @@ static piola_status check_attachment(const piola_world *w, const piola_attachmen
   return PIOLA_OK;
 }
 
-static void drive(world_solid *s, int32_t i, int32_t motion, double t) {
-  s->flags[i] = SOLID_DRIVEN;
+static void drive(world_body *s, int32_t i, int32_t motion, double t) {
+  s->flags[i] = NODE_DRIVEN;
   s->motion_of[i] = motion;
-  piola__solid_constrained_state(s, i, t, s->x + 3 * i, s->v + 3 * i);
+  piola__body_constrained_state(s, i, t, s->x + 3 * i, s->v + 3 * i);
 }
 
-static void attach(world_solid *s, const piola_attachment_def *a, const piola_obstacle *o,
+static void attach(world_body *s, const piola_attachment_def *a, const piola_obstacle *o,
                    const piola__rigid_state *rest_pose, double t) {
   int32_t m = s->motion_count++;
   s->motions[m] = o->motion; /* validated: the bone's surface and its nodes share one pose */
@@ -133,7 +133,7 @@ piola_status piola_world_add_bone(piola_world *world, const piola_bone_def *def,
     }
   }
   for (int32_t k = 0; k < def->attachment_count && st == PIOLA_OK; ++k) {
-    world_solid *s = &world->solids[def->attachments[k].solid];
+    world_body *s = piola__world_body_of(world, PIOLA_BODY_SOLID, def->attachments[k].solid);
     int32_t more = 0;
     for (int32_t j = 0; j < def->attachment_count; ++j)
       more += def->attachments[j].solid == def->attachments[k].solid;
@@ -150,7 +150,7 @@ piola_status piola_world_add_bone(piola_world *world, const piola_bone_def *def,
     return st;
   }
   for (int32_t k = 0; k < def->attachment_count; ++k)
-    attach(&world->solids[def->attachments[k].solid], &def->attachments[k], o, &rest_pose,
+    attach(piola__world_body_of(world, PIOLA_BODY_SOLID, def->attachments[k].solid), &def->attachments[k], o, &rest_pose,
            world->time);
   world->obstacles[world->obstacle_count] = o;
   if (obstacle_index) *obstacle_index = world->obstacle_count;
@@ -160,7 +160,7 @@ piola_status piola_world_add_bone(piola_world *world, const piola_bone_def *def,
     int32_t solid = def->attachments[k].solid;
     int done = 0;
     for (int32_t j = 0; j < k; ++j) done |= def->attachments[j].solid == solid;
-    if (!done) PIOLA_TRY(piola__solid_update_forces(&world->solids[solid], world->time));
+    if (!done) PIOLA_TRY(piola__body_update_forces(piola__world_body_of(world, PIOLA_BODY_SOLID, solid), world->time));
   }
   return PIOLA_OK;
 }

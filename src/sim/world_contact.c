@@ -42,9 +42,9 @@
 
 typedef struct world_contact {
   piola_collision_surface *surface;
-  int32_t solid_count, shell_count; /* bodies in the world when built */
+  uint64_t bodies_version; /* the world's bodies_version when built */
   int32_t vertex_count;
-  int32_t *offset; /* per body (solids, then shells): first global vertex, or -1 when off */
+  int32_t *offset; /* per body of the table: first global vertex, or -1 when off */
   double *x0, *v, *v_before, *mass;
   /* collision_interval > 0: x0 holds the positions at t_start, the start of the open
    * interval */
@@ -61,40 +61,28 @@ void piola__world_contact_free(piola_world *w) {
   w->contact = NULL;
 }
 
-/* Body i of the surface: the solids first, then the shells. */
-static world_solid *body_at(piola_world *w, int32_t i) {
-  return i < w->solid_count ? &w->solids[i] : &w->shells[i - w->solid_count];
-}
-
 static piola_status build(piola_world *w) {
   piola__world_contact_free(w);
   world_contact *c = calloc(1, sizeof(*c));
   if (!c) return PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "self-collision: out of memory");
   w->contact = c;
-  c->solid_count = w->solid_count;
-  c->shell_count = w->shell_count;
-  const int32_t count = w->solid_count + w->shell_count;
+  c->bodies_version = w->bodies_version;
+  const int32_t count = w->body_count;
   c->offset = malloc(sizeof(int32_t) * (size_t)(count > 0 ? count : 1));
   if (!c->offset) return PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "self-collision: out of memory");
   int32_t nv = 0, nt = 0, bodies = 0;
   piola_tri_mesh *boundaries = calloc((size_t)(count > 0 ? count : 1), sizeof(piola_tri_mesh));
-  if (!boundaries) return PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "self-collision: out of memory");
+  int *owned = calloc((size_t)(count > 0 ? count : 1), sizeof(int));
+  if (!boundaries || !owned) {
+    free(boundaries), free(owned);
+    return PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "self-collision: out of memory");
+  }
   piola_status st = PIOLA_OK;
   for (int32_t i = 0; i < count; ++i) c->offset[i] = -1;
   for (int32_t i = 0; i < count && st == PIOLA_OK; ++i) {
-    world_solid *s = body_at(w, i);
+    const world_body *s = &w->bodies[i];
     if (!s->self_collision.enabled) continue;
-    if (s->shell) {
-      /* a shell's own triangles, borrowed (not freed below: vertex_count stays 0) */
-      boundaries[i].triangle_count = piola_shell_body_triangle_count(s->shell);
-      boundaries[i].triangles = (int32_t *)piola_shell_body_triangles(s->shell);
-    } else {
-      piola_tet_mesh mesh = {.vertex_count = s->n,
-                             .positions = s->x,
-                             .tet_count = piola_elastic_body_tet_count(s->body),
-                             .tets = (int32_t *)piola_elastic_body_tets(s->body)};
-      st = piola_tet_mesh_boundary(&mesh, &boundaries[i]);
-    }
+    st = piola__body_collision_triangles(s, &boundaries[i], &owned[i]);
     c->offset[i] = nv;
     nv += s->n, nt += boundaries[i].triangle_count, ++bodies;
   }
@@ -115,7 +103,7 @@ static piola_status build(piola_world *w) {
     int32_t t = 0, b = 0;
     for (int32_t i = 0; i < count; ++i) {
       if (c->offset[i] < 0) continue;
-      const world_solid *s = body_at(w, i);
+      const world_body *s = &w->bodies[i];
       for (int32_t k = 0; k < 3 * boundaries[i].triangle_count; ++k)
         tris[3 * t + k] = c->offset[i] + boundaries[i].triangles[k];
       t += boundaries[i].triangle_count;
@@ -133,22 +121,19 @@ static piola_status build(piola_world *w) {
   }
   c->vertex_count = nv;
   for (int32_t i = 0; i < count; ++i)
-    if (i < w->solid_count) piola_tri_mesh_free(&boundaries[i]);
-  free(boundaries), free(tris), free(vertex_body), free(defs);
+    if (owned[i]) piola_tri_mesh_free(&boundaries[i]);
+  free(boundaries), free(owned), free(tris), free(vertex_body), free(defs);
   return st;
 }
 
 static int any_self_collision(piola_world *w) {
   int any = 0;
-  for (int32_t i = 0; i < w->solid_count + w->shell_count; ++i)
-    any |= body_at(w, i)->self_collision.enabled;
+  for (int32_t i = 0; i < w->body_count; ++i) any |= w->bodies[i].self_collision.enabled;
   return any;
 }
 
 static piola_status ensure_built(piola_world *w) {
-  if (!w->contact || w->contact->solid_count != w->solid_count ||
-      w->contact->shell_count != w->shell_count)
-    PIOLA_TRY(build(w));
+  if (!w->contact || w->contact->bodies_version != w->bodies_version) PIOLA_TRY(build(w));
   return PIOLA_OK;
 }
 
@@ -162,9 +147,9 @@ piola_status piola__world_collision_open(piola_world *w, double *left) {
   PIOLA_TRY(ensure_built(w));
   world_contact *c = w->contact;
   if (!c->open) {
-    for (int32_t i = 0; i < w->solid_count + w->shell_count; ++i) {
+    for (int32_t i = 0; i < w->body_count; ++i) {
       if (c->offset[i] < 0) continue;
-      const world_solid *s = body_at(w, i);
+      const world_body *s = &w->bodies[i];
       memcpy(c->x0 + 3 * (size_t)c->offset[i], s->x, sizeof(double) * 3 * (size_t)s->n);
     }
     c->t_start = w->time;
@@ -182,7 +167,7 @@ piola_status piola__world_collision_open(piola_world *w, double *left) {
 
 piola_status piola__world_self_collide(piola_world *w, double dt, double t1, int closes,
                                        piola_step_stats *stats) {
-  const int32_t count = w->solid_count + w->shell_count;
+  const int32_t count = w->body_count;
   if (!any_self_collision(w)) return PIOLA_OK;
   const int per_step = !(w->def.collision_interval > 0);
   if (!per_step && (!closes || !w->contact || !w->contact->open)) return PIOLA_OK;
@@ -191,13 +176,13 @@ piola_status piola__world_self_collide(piola_world *w, double dt, double t1, int
   if (!per_step) dt = t1 - c->t_start; /* the collision step: the whole interval */
   for (int32_t i = 0; i < count; ++i) {
     if (c->offset[i] < 0) continue;
-    const world_solid *s = body_at(w, i);
+    const world_body *s = &w->bodies[i];
     for (int32_t k = 0; k < s->n; ++k) {
       const int32_t g = c->offset[i] + k;
       if (per_step)
         for (int d = 0; d < 3; ++d) c->x0[3 * g + d] = s->x_old[3 * k + d];
       for (int d = 0; d < 3; ++d) c->v[3 * g + d] = (s->x[3 * k + d] - c->x0[3 * g + d]) / dt;
-      c->mass[g] = s->flags[k] != SOLID_FREE || s->inverse_mass[k] == 0.0 ? INFINITY : s->mass[k];
+      c->mass[g] = s->flags[k] != NODE_FREE || s->inverse_mass[k] == 0.0 ? INFINITY : s->mass[k];
     }
   }
   memcpy(c->v_before, c->v, sizeof(double) * 3 * (size_t)c->vertex_count);
@@ -209,7 +194,7 @@ piola_status piola__world_self_collide(piola_world *w, double dt, double t1, int
   stats->collision_steps += 1;
   for (int32_t i = 0; i < count; ++i) {
     if (c->offset[i] < 0) continue;
-    world_solid *s = body_at(w, i);
+    world_body *s = &w->bodies[i];
     int changed = 0;
     for (int32_t k = 0; k < 3 * s->n; ++k) {
       const int32_t g = 3 * c->offset[i] + k;
@@ -219,7 +204,7 @@ piola_status piola__world_self_collide(piola_world *w, double dt, double t1, int
       s->x[k] = c->x0[g] + dt * c->v[g];
       s->v[k] += dv;
     }
-    if (changed) PIOLA_TRY(piola__solid_update_forces(s, t1));
+    if (changed) PIOLA_TRY(piola__body_update_forces(s, t1));
   }
   c->open = 0;
   return PIOLA_OK;

@@ -15,7 +15,31 @@ piola_world_def piola_default_world_def(void) {
   def.cfl = 0.5;
   def.cg_tolerance = 1e-4;
   def.cg_max_iterations = 200;
+  def.integrator = PIOLA_INTEGRATOR_NEWMARK;
+  def.implicit_dt = 1.0 / 30.0;
+  def.newton_tolerance = 1e-5;
+  def.newton_max_iterations = 30;
+  def.linear_tolerance = 1e-3;
+  def.linear_max_iterations = 1000;
   return def;
+}
+
+static const char *const integrator_names[PIOLA_INTEGRATOR_COUNT] = {"newmark", "backward_euler",
+                                                                     "quasistatic"};
+
+const char *piola_integrator_type_name(piola_integrator_type type) {
+  if ((int)type < 0 || type >= PIOLA_INTEGRATOR_COUNT) return "unknown";
+  return integrator_names[type];
+}
+
+bool piola_integrator_type_from_name(const char *name, piola_integrator_type *type) {
+  if (!name || !type) return false;
+  for (int k = 0; k < PIOLA_INTEGRATOR_COUNT; ++k)
+    if (strcmp(name, integrator_names[k]) == 0) {
+      *type = (piola_integrator_type)k;
+      return true;
+    }
+  return false;
 }
 
 piola_solid_def piola_default_solid_def(void) {

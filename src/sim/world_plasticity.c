@@ -15,34 +15,34 @@
 #include "common/status_report.h"
 #include "sim/world_internal.h"
 
-piola_status piola__solid_plastic_create(world_solid *s, const piola_solid_def *def) {
+piola_status piola__solid_plastic_create(world_body *s, const piola_solid_def *def) {
   s->plastic = NULL;
   s->plastic_stats = (piola_plastic_stats){0, 0, 1.0};
   if (!def->plasticity) return PIOLA_OK;
-  piola_status st = piola_plastic_state_create(s->body, def->plasticity, &s->plastic);
+  piola_status st = piola_plastic_state_create(s->solid, def->plasticity, &s->plastic);
   if (st != PIOLA_OK) return PIOLA_FAIL(st, "plasticity: %s", piola_last_error());
   return PIOLA_OK;
 }
 
-void piola__solid_plastic_update(world_solid *s, double dt) {
+void piola__solid_plastic_update(world_body *s, double dt) {
   if (!s->plastic) return;
   /* cannot fail: the state exists and dt > 0 is checked by the step */
   (void)piola_plastic_state_update(s->plastic, dt, &s->plastic_stats);
 }
 
-double piola__solid_plastic_stiffening(const world_solid *s) {
+double piola__solid_plastic_stiffening(const world_body *s) {
   if (!s->plastic) return 1.0;
   double k = s->plastic_stats.max_fp_stretch;
   return k > 1.0 && isfinite(k) ? k : 1.0;
 }
 
 const piola_plastic_state *piola_world_solid_plastic_state(const piola_world *world, int32_t solid) {
-  if (!world || solid < 0 || solid >= world->solid_count) return NULL;
-  return world->solids[solid].plastic;
+  const world_body *b = piola__world_body_of(world, PIOLA_BODY_SOLID, solid);
+  return b ? b->plastic : NULL;
 }
 
 piola_plastic_stats piola_world_solid_plastic_stats(const piola_world *world, int32_t solid) {
   piola_plastic_stats none = {0, 0, 1.0};
-  if (!world || solid < 0 || solid >= world->solid_count) return none;
-  return world->solids[solid].plastic_stats;
+  const world_body *b = piola__world_body_of(world, PIOLA_BODY_SOLID, solid);
+  return b ? b->plastic_stats : none;
 }

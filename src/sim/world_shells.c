@@ -1,7 +1,8 @@
-/* Shells in the world: adding them, the body-kind dispatch of the step loop (forces,
- * damping, step bound) and the shell accessors. A shell is a world_solid whose body is a
- * piola_shell_body, so it is stepped by the very same code as a solid (integrator.c):
- * constraints, collisions, the two damping solves and the trapezoidal velocity. */
+/* Shells in the world: adding them, the shell kind's operations (forces, step bound, stats,
+ * the one-way coupling to solids; dispatched by body.c) and the shell accessors. A shell is
+ * a world_body of kind PIOLA_BODY_SHELL whose object is a piola_shell_body, so it is stepped
+ * by the very same code as a solid (integrator.c): constraints, collisions, the two damping
+ * solves and the trapezoidal velocity. */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -26,34 +27,12 @@ piola_shell_def piola_default_shell_def(void) {
   return def;
 }
 
-static int track_ok(const piola_track *t) {
-  if (t->key_count < 0 || t->key_count > PIOLA_MAX_KEYS) return 0;
-  if (t->key_count == 0) return isfinite(t->value) && t->value >= 0;
-  for (int32_t k = 0; k < t->key_count; ++k)
-    if (!isfinite(t->values[k]) || t->values[k] < 0) return 0;
-  return 1;
-}
-
-void piola__solid_damping_forces(const world_solid *s, const double *v, double beta,
-                                 double alpha, double *out) {
-  if (s->shell)
-    piola_shell_body_damping_forces(s->shell, v, beta, alpha, out);
-  else
-    piola_elastic_body_damping_forces(s->body, v, beta, alpha, out);
-}
-
-/* A shell with bending damping is damped even with zero in-plane viscosities. */
-int piola__solid_undamped(const world_solid *s, double beta, double alpha) {
-  if (beta != 0 || alpha != 0) return 0;
-  return !s->shell || piola_shell_body_bending_damping(s->shell) == 0;
-}
-
-piola_status piola__shell_update_forces(world_solid *s, double t) {
+piola_status piola__shell_update_forces(world_body *s, double t) {
   double scale = piola_track_eval(&s->stiffness_scale, t);
   return piola_shell_body_update(s->shell, s->x, scale, s->force, &s->shell_stats);
 }
 
-double piola__shell_stable_dt(const piola_world *w, const world_solid *s, double scale) {
+double piola__shell_stable_dt(const piola_world *w, const world_body *s, double scale) {
   double dt = INFINITY;
   double speed = piola_shell_body_max_wave_speed(s->shell) * sqrt(scale);
   double h = piola_shell_body_min_rest_altitude(s->shell);
@@ -64,13 +43,11 @@ double piola__shell_stable_dt(const piola_world *w, const world_solid *s, double
   return dt;
 }
 
-piola_status piola_world_add_shell(piola_world *world, const piola_shell_def *def, int32_t *index) {
-  if (!world || !def) return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "add_shell: NULL argument");
-  int32_t id = world->shell_count;
+static piola_status check_shell_def(const piola_shell_def *def, int32_t id) {
   if (!def->mesh) return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "shell %d: mesh is required", (int)id);
-  if (!track_ok(&def->stiffness_scale))
+  if (!piola__track_ok(&def->stiffness_scale, 0))
     return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "shell %d: stiffness_scale must be >= 0", (int)id);
-  if (!track_ok(&def->shear_viscosity) || !track_ok(&def->bulk_viscosity))
+  if (!piola__track_ok(&def->shear_viscosity, 0) || !piola__track_ok(&def->bulk_viscosity, 0))
     return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "shell %d: viscosities must be >= 0 Pa s", (int)id);
   if (!isfinite(def->velocity.x) || !isfinite(def->velocity.y) || !isfinite(def->velocity.z))
     return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "shell %d: velocity must be finite", (int)id);
@@ -83,6 +60,13 @@ piola_status piola_world_add_shell(piola_world *world, const piola_shell_def *de
     return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT,
                       "shell %d: self_collision needs thickness > 0 m and friction >= 0, got %g, %g",
                       (int)id, sc->thickness, sc->friction);
+  return PIOLA_OK;
+}
+
+/* Everything of a new shell after its slot in the table: the shell body, the per-node
+ * state, constraints, the initial state and its forces. */
+static piola_status fill_shell(piola_world *world, world_body *s, const piola_shell_def *def,
+                               int32_t id) {
   piola_material material;
   PIOLA_TRY(piola_material_init(&def->material, &material));
   piola_shell_body_def bdef = piola_default_shell_body_def();
@@ -94,9 +78,6 @@ piola_status piola_world_add_shell(piola_world *world, const piola_shell_def *de
   bdef.bending = def->bending;
   bdef.plasticity = def->plasticity;
   bdef.use_reference_normals = def->use_reference_normals;
-
-  world_solid *s = piola__world_new_slot(&world->shells, world->shell_count, &world->shell_capacity);
-  if (!s) return PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "add_shell: out of memory");
   piola_status st = piola_shell_body_create(&bdef, &s->shell);
   if (st != PIOLA_OK) {
     s->shell = NULL;
@@ -104,71 +85,86 @@ piola_status piola_world_add_shell(piola_world *world, const piola_shell_def *de
   }
   int32_t n = piola_shell_body_vertex_count(s->shell);
   const double *rest = piola_shell_body_rest_positions(s->shell);
-  st = piola__solid_allocate(s, n, def->name, "shell", id, rest, piola_shell_body_masses(s->shell));
-  if (st != PIOLA_OK) {
-    piola__solid_free(s);
-    return st;
-  }
+  PIOLA_TRY(piola__body_allocate(s, n, def->name, id, rest, piola_shell_body_masses(s->shell)));
   s->stiffness_scale = def->stiffness_scale;
   s->shear_viscosity = def->shear_viscosity;
   s->bulk_viscosity = def->bulk_viscosity;
   s->collide_with_solids = def->collide_with_solids;
   s->solid_friction = def->solid_friction;
   s->self_collision = def->self_collision;
-  st = piola__solid_apply_constraints(s, rest, def->constraints, def->constraint_count);
-  if (st != PIOLA_OK) {
-    piola__solid_free(s);
-    return st;
-  }
-  piola__solid_finish_masses(s);
+  PIOLA_TRY(piola__body_apply_constraints(s, rest, def->constraints, def->constraint_count));
+  piola__body_finish_masses(s);
   for (int32_t i = 0; i < n; ++i) {
-    if (s->flags[i] != SOLID_FREE) {
-      piola__solid_constrained_state(s, i, world->time, s->x + 3 * i, s->v + 3 * i);
+    if (s->flags[i] != NODE_FREE) {
+      piola__body_constrained_state(s, i, world->time, s->x + 3 * i, s->v + 3 * i);
       continue;
     }
     memcpy(s->x + 3 * i, rest + 3 * i, 3 * sizeof(double));
     s->v[3 * i] = def->velocity.x, s->v[3 * i + 1] = def->velocity.y, s->v[3 * i + 2] = def->velocity.z;
   }
-  st = piola__solid_update_forces(s, world->time);
+  return piola__body_update_forces(s, world->time);
+}
+
+piola_status piola_world_add_shell(piola_world *world, const piola_shell_def *def, int32_t *index) {
+  if (!world || !def) return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "add_shell: NULL argument");
+  PIOLA_TRY(check_shell_def(def, world->kind_count[PIOLA_BODY_SHELL]));
+  int32_t id;
+  world_body *s = piola__world_insert_body(world, PIOLA_BODY_SHELL, &id);
+  if (!s) return PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "add_shell: out of memory");
+  piola_status st = fill_shell(world, s, def, id);
   if (st != PIOLA_OK) {
-    piola__solid_free(s);
+    piola__world_drop_body(world, s);
     return st;
   }
-  world->shell_count++;
   if (index) *index = id;
   return PIOLA_OK;
 }
 
-static const world_solid *shell_at(const piola_world *w, int32_t i) {
-  return (w && i >= 0 && i < w->shell_count) ? &w->shells[i] : NULL;
+static const world_body *shell_at(const piola_world *w, int32_t i) {
+  return piola__world_body_of(w, PIOLA_BODY_SHELL, i);
 }
 
-int32_t piola_world_shell_count(const piola_world *world) { return world ? world->shell_count : 0; }
+int32_t piola_world_shell_count(const piola_world *world) {
+  return world ? world->kind_count[PIOLA_BODY_SHELL] : 0;
+}
 const char *piola_world_shell_name(const piola_world *world, int32_t shell) {
-  const world_solid *s = shell_at(world, shell);
+  const world_body *s = shell_at(world, shell);
   return s ? s->name : NULL;
 }
 const piola_shell_body *piola_world_shell_body(const piola_world *world, int32_t shell) {
-  const world_solid *s = shell_at(world, shell);
+  const world_body *s = shell_at(world, shell);
   return s ? s->shell : NULL;
 }
 const double *piola_world_shell_positions(const piola_world *world, int32_t shell) {
-  const world_solid *s = shell_at(world, shell);
+  const world_body *s = shell_at(world, shell);
   return s ? s->x : NULL;
 }
 const double *piola_world_shell_velocities(const piola_world *world, int32_t shell) {
-  const world_solid *s = shell_at(world, shell);
+  const world_body *s = shell_at(world, shell);
   return s ? s->v : NULL;
 }
 const uint8_t *piola_world_shell_constraint_flags(const piola_world *world, int32_t shell) {
-  const world_solid *s = shell_at(world, shell);
+  const world_body *s = shell_at(world, shell);
   return s ? s->flags : NULL;
+}
+
+piola_body_stats piola__shell_stats(const world_body *b) {
+  piola_body_stats st;
+  memset(&st, 0, sizeof st);
+  for (int32_t i = 0; i < b->n; ++i) {
+    const double *v = b->v + 3 * i;
+    st.kinetic_energy += 0.5 * b->mass[i] * (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
+    for (int k = 0; k < 3; ++k) st.momentum[k] += b->mass[i] * v[k];
+  }
+  st.elastic_energy = b->shell_stats.membrane_energy + b->shell_stats.bending_energy;
+  st.inverted_count = b->shell_stats.inverted_count;
+  return st;
 }
 
 piola_world_shell_stats piola_world_shell_get_stats(const piola_world *world, int32_t shell) {
   piola_world_shell_stats st;
   memset(&st, 0, sizeof st);
-  const world_solid *s = shell_at(world, shell);
+  const world_body *s = shell_at(world, shell);
   if (!s) return st;
   for (int32_t i = 0; i < s->n; ++i) {
     const double *v = s->v + 3 * i;
@@ -219,9 +215,9 @@ static vec3 closest_on_triangle(vec3 p, vec3 a, vec3 b, vec3 c, double w[3]) {
 }
 
 /* The boundary surface of a solid, built once (rest topology; positions are read live). */
-static piola_status solid_boundary(world_solid *solid) {
+static piola_status solid_boundary(world_body *solid) {
   if (solid->boundary) return PIOLA_OK;
-  const piola_elastic_body *b = solid->body;
+  const piola_elastic_body *b = solid->solid;
   piola_tet_mesh tets = {piola_elastic_body_vertex_count(b),
                          (double *)piola_elastic_body_rest_positions(b),
                          piola_elastic_body_tet_count(b), (int32_t *)piola_elastic_body_tets(b), NULL, NULL};
@@ -244,11 +240,11 @@ static piola_status solid_boundary(world_solid *solid) {
   return PIOLA_OK;
 }
 
-int32_t piola__shell_collide_with_solids(piola_world *w, world_solid *s, double t1, double dt) {
+int32_t piola__shell_collide_with_solids(piola_world *w, world_body *s, double t1, double dt) {
   (void)t1;
   int32_t moved = 0;
-  for (int32_t k = 0; k < w->solid_count; ++k) {
-    world_solid *solid = &w->solids[k];
+  for (int32_t k = 0; k < w->kind_count[PIOLA_BODY_SOLID]; ++k) {
+    world_body *solid = piola__world_body_of(w, PIOLA_BODY_SOLID, k);
     /* both in the collision surface: the two-way contact after the step handles the pair */
     if (s->self_collision.enabled && solid->self_collision.enabled) continue;
     if (solid_boundary(solid) != PIOLA_OK) return moved;
@@ -260,7 +256,7 @@ int32_t piola__shell_collide_with_solids(piola_world *w, world_solid *s, double 
       for (int a = 0; a < 3; ++a) lo[a] = fmin(lo[a], sx[3 * i + a]), hi[a] = fmax(hi[a], sx[3 * i + a]);
     const double reach = solid->boundary_reach;
     for (int32_t i = 0; i < s->n; ++i) {
-      if (s->flags[i] != SOLID_FREE) continue;
+      if (s->flags[i] != NODE_FREE) continue;
       vec3 x = vec3_load(s->x + 3 * i);
       if (x.x < lo[0] - reach || x.x > hi[0] + reach || x.y < lo[1] - reach || x.y > hi[1] + reach ||
           x.z < lo[2] - reach || x.z > hi[2] + reach)

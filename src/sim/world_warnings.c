@@ -48,8 +48,8 @@ static int compare_doubles(const void *a, const void *b) {
   return (x > y) - (x < y);
 }
 
-void piola__world_check_slivers(piola_world *w, const world_solid *s) {
-  const piola_elastic_body *b = s->body;
+void piola__world_check_slivers(piola_world *w, const world_body *s) {
+  const piola_elastic_body *b = s->solid;
   const int32_t nt = b ? b->tet_count : 0;
   if (nt < 2 || w->warnings[PIOLA_WARNING_SLIVER]) return;
   double *step = malloc(2 * (size_t)nt * sizeof *step);

@@ -47,15 +47,51 @@ else
   echo "ffmpeg/ffprobe not installed: movie checks skipped"
 fi
 
-# --every 2: frames 0 and 2 only; the earlier PNGs are gone
+# --every 2: frames 0 and 2 are rendered again, and nothing this call did not make is
+# deleted: frames 1 and 3 and the contact sheet of the earlier render stay, as does a file
+# of the user's
+echo mine >"$out/render/notes.txt"
 "$PIOLA" render "$out" --width 160 --height 120 --every 2 >"$work/log" 2>&1 || { cat "$work/log"; fail "--every 2"; }
-pngs=$(cd "$out/render" && ls frame_*.png | tr '\n' ' ')
-[[ ! -e "$out/render/contact_sheet.png" ]] || fail "a stale contact sheet was kept"
-[[ $pngs == "frame_0000.png frame_0002.png " ]] || fail "--every 2 left: $pngs"
+[[ $(png_size "$out/render/frame_0002.png") == 160x120 ]] || fail "--every 2 did not rewrite frame 2"
+[[ $(png_size "$out/render/frame_0001.png") == 320x240 ]] || fail "--every 2 touched frame 1"
+[[ -s "$out/render/contact_sheet.png" && -s "$out/render/notes.txt" ]] || fail "an earlier file was deleted"
+[[ -z $(find "$out/render" -name '.movie_*') ]] || fail "the movie's temporary folder was left"
 if command -v ffprobe >/dev/null; then
   n=$(frames_in "$out/render/movie.mp4")
   [[ $n -eq 2 ]] || fail "--every 2 movie has $n frames"
+  # a later --no-movie render keeps the movie
+  "$PIOLA" render "$out" --width 160 --height 120 --no-movie >/dev/null 2>&1 || fail "--no-movie"
+  [[ -s "$out/render/movie.mp4" ]] || fail "--no-movie deleted the earlier movie.mp4"
 fi
+
+# thread count, --range auto and the default range give the same bytes
+"$PIOLA" render "$out" --width 160 --height 120 --no-movie --color energy --threads 1 >/dev/null 2>&1 || fail "--threads 1"
+cp "$out/render/frame_0003.png" "$work/t1.png"
+"$PIOLA" render "$out" --width 160 --height 120 --no-movie --color energy --threads 2 --range auto >/dev/null 2>&1 || fail "--threads 2"
+cmp -s "$out/render/frame_0003.png" "$work/t1.png" || fail "--threads 2 --range auto differs from --threads 1"
+
+# hiding obstacles: all of them, by type, by index and by name change the picture the
+# same way (the scene's only non-plane obstacle is the sphere "ball"); a name that names
+# nothing is refused
+python3 -c "import json,sys; d=json.load(open(sys.argv[1])); d['obstacles'][1]['name']='ball'; json.dump(d, open(sys.argv[2], 'w'))" "$out/scene.json" "$work/named.json"
+render0() { "$PIOLA" render "$out" --width 160 --height 120 --no-movie --scene "$work/named.json" "$@" >"$work/log" 2>&1 || { cat "$work/log"; fail "render $*"; }; cp "$out/render/frame_0000.png" "$work/hide.png"; }
+render0 --frame-obstacles; cp "$work/hide.png" "$work/shown.png"
+render0 --frame-obstacles --hide-obstacle ball; cp "$work/hide.png" "$work/by_name.png"
+cmp -s "$work/shown.png" "$work/by_name.png" && fail "--hide-obstacle ball changed nothing"
+render0 --frame-obstacles --hide-obstacle sphere; cmp -s "$work/hide.png" "$work/by_name.png" || fail "by type differs from by name"
+render0 --frame-obstacles --hide-obstacle 'obstacles[1]'; cmp -s "$work/hide.png" "$work/by_name.png" || fail "by index differs from by name"
+render0 --frame-obstacles --hide-obstacles; cmp -s "$work/hide.png" "$work/by_name.png" && fail "--hide-obstacles kept the plane"
+set +e
+"$PIOLA" render "$out" --no-movie --scene "$work/named.json" --hide-obstacle bal >"$work/log" 2>&1
+rc=$?
+set -e
+[[ $rc -eq 2 ]] && grep -q "ball (sphere)" "$work/log" || { cat "$work/log"; fail "--hide-obstacle bal: exit $rc, expected 2 naming ball"; }
+
+# up from gravity: a scene whose gravity points along -y renders as with --up 0,1,0
+python3 -c "import json,sys; d=json.load(open(sys.argv[1])); d['gravity']=[0, -9.81, 0]; json.dump(d, open(sys.argv[2], 'w'))" "$work/named.json" "$work/yup.json"
+render0 --scene "$work/yup.json"; cp "$work/hide.png" "$work/gravity_up.png"
+render0 --scene "$work/yup.json" --up 0,1,0; cmp -s "$work/hide.png" "$work/gravity_up.png" || fail "gravity -y is not up +y"
+render0 --scene "$work/yup.json" --up 0,0,1; cmp -s "$work/hide.png" "$work/gravity_up.png" && fail "--up 0,0,1 did not override the gravity"
 
 # pixels, decoded by ffmpeg: count strongly red ones (the inverted highlight)
 red_pixels() {

@@ -1,0 +1,60 @@
+/* piola: checkpoints, the complete state of a world at a frame, so a killed run continues
+ * where it stopped and writes the same bits as a run that never stopped.
+ *
+ * A checkpoint holds everything the next step reads that is not rebuilt from the scene:
+ * the time, every body's positions and velocities, the elastic force and per-element state
+ * of the last force update (the diagonalization, det F, the plastic Fp^-1, the shells'
+ * dihedral angles), the damping operator the next step starts from and the last solve's
+ * product it reuses, the plastic state (Fp^-1, hardening, bounds, refresh phase, control
+ * logarithms) and the statistics of the last step. Keyframe clocks and obstacle poses are
+ * functions of the time, and the initial scramble's random numbers are used once at
+ * creation, so the time covers them. The file layout is in docs/file-formats.md.
+ *
+ * Scenes with self-collision (contact between deformable surfaces) are not covered: the
+ * collision module's trees and candidate lists carry history that decides the order of its
+ * impulses. piola_world_checkpoint_supported says so before a run starts. */
+#ifndef PIOLA_CHECKPOINT_H
+#define PIOLA_CHECKPOINT_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#include "piola/export.h"
+#include "piola/status.h"
+#include "piola/world.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/* The checkpoint format this piola writes and reads (docs/file-formats.md). */
+#define PIOLA_CHECKPOINT_VERSION 1
+
+/* 1 when checkpoints cover every part of the world's state; 0 with a reason in *why (a
+ * static string) otherwise. */
+PIOLA_API int piola_world_checkpoint_supported(const piola_world *world, const char **why);
+
+/* A 64-bit key (FNV-1a) naming the scene a world was built from: the scene file's bytes
+ * (scene, length; NULL and 0 for none) and the rest state of every body (rest positions,
+ * elements and masses, so a changed mesh file changes the key). */
+PIOLA_API uint64_t piola_world_scene_key(const piola_world *world, const void *scene,
+                                         size_t length);
+
+/* Writes the world's state at frame `frame` to path, whole or not at all (a temporary
+ * renamed into place). */
+PIOLA_API piola_status piola_world_checkpoint_write(const piola_world *world, const char *path,
+                                                    uint64_t scene_key, int32_t frame);
+
+/* Reads a checkpoint into a world built from the same scene (as piola_world_scene_key says):
+ * PIOLA_ERROR_PARSE for a file that is not a whole, intact checkpoint (bad magic, size or
+ * checksum), PIOLA_ERROR_UNSUPPORTED for another format version or another scene, each
+ * with a message. The world is changed only when the whole file was checked. *frame
+ * receives the frame it was written at. */
+PIOLA_API piola_status piola_world_checkpoint_read(piola_world *world, const char *path,
+                                                   uint64_t scene_key, int32_t *frame);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif

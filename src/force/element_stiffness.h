@@ -1,0 +1,64 @@
+/* The stiffness of one element: dP/dF, made positive semi-definite, for the implicit
+ * integrators (src/sim/implicit_step.c).
+ *
+ * Why it looks like this. P = U Phat(Fhat) V^T, so in the frame of the diagonalization the
+ * derivative dPhat/dFhat (9 x 9) decouples (Teran, Sifakis, Irving and Fedkiw 2005, "Robust
+ * quasistatic finite elements and flesh simulation"): the diagonal entries of dFhat drive the
+ * diagonal of dPhat through the 3x3 block dPhat_i/dFhat_j that every material model gives
+ * (piola_material_stress_derivative), and each off-diagonal pair (dF_pq, dF_qp), p < q,
+ * drives only itself through a 2x2 block [[a, b], [b, a]] whose eigenvalues are
+ *   (P_p - P_q) / (f_p - f_q)   on (1, 1) (a symmetric shear), and
+ *   (P_p + P_q) / (f_p + f_q)   on (1, -1) (a rotation of the pair),
+ * with P = Phat and f = Fhat. Both quotients come from Phat alone, so any model that gives
+ * its stress and stress derivative gets its stiffness for free. Where a denominator
+ * vanishes (equal entries, or f_p = -f_q on an inverted element) the quotient is replaced by
+ * its limit, the matching combination of dPhat/dFhat, so the result stays finite on flat,
+ * collapsed and inverted elements. The definiteness fix clamps the 2x2 eigenvalues at zero
+ * and projects the symmetrized 3x3 block onto its non-negative eigenvalues; the sum is then
+ * positive semi-definite for every F. The projection also caps the rotation eigenvalue
+ * (P_p + P_q) / (f_p + f_q) at the element's largest other stiffness (the shear quotient and
+ * the diagonal of dPhat/dFhat): it grows without bound near a reflection (f_p = -f_q), where
+ * the extended stress of most models jumps, and a Newton iteration seeing it would stall.
+ *
+ * The muscle's fibre term P_f = (T(lambda) / lambda) F a a^T (lambda = |F a|) is not
+ * diagonal in that frame, but its derivative has a closed form in any frame:
+ *   dP_f/dF = s (I (x) a a^T) + c (w (x) a)(w (x) a)^T,  w = F a,  s = T / lambda,
+ *   c = (T' - s) / lambda^2,
+ * whose eigenvalues are s >= 0 (the fibre is tension-only) and T' on w (x) a. Projection
+ * replaces T' by max(T', 0). */
+#ifndef PIOLA_FORCE_ELEMENT_STIFFNESS_H
+#define PIOLA_FORCE_ELEMENT_STIFFNESS_H
+
+#include "piola/material.h"
+#include "piola/math_types.h"
+
+/* dPhat/dFhat of the isotropic part in the diagonal frame (Pa). Pair k is (0, 1), (0, 2),
+ * (1, 2) for k = 0, 1, 2; its block acts on (dFhat_pq, dFhat_qp). */
+typedef struct piola__diagonal_stiffness {
+  double block[3][3];          /* dPhat_i / dFhat_j */
+  double pair_a[3], pair_b[3]; /* the pair blocks [[a, b], [b, a]] */
+} piola__diagonal_stiffness;
+
+/* Fills out at fhat (the diagonalization's signed entries) and Phat = phat. With project,
+ * the blocks are made symmetric positive semi-definite. */
+void piola__diagonal_stiffness_eval(const piola_material *material, const double fhat[3],
+                                    const double phat[3], int project,
+                                    piola__diagonal_stiffness *out);
+
+/* The fibre term's two coefficients at fibre stretch lambda (see above), Pa: s and c with
+ * dP_f/dF = s (I (x) a a^T) + c (w (x) a)(w (x) a)^T for a unit a. With project, T' is
+ * replaced by max(T', 0). Zero for non-muscle materials and near lambda = 0 (where T = 0). */
+void piola__fiber_stiffness_terms(const piola_material *material, double stretch,
+                                  double activation, int project, double *s, double *c);
+
+/* The whole dP/dF at F as a 9 x 9 matrix (Pa), row 3 i + j = P_ij, column 3 k + l = F_kl:
+ * the isotropic part plus, when fiber is not NULL (a rest-space direction, normalised here),
+ * the muscle's fibre term at this activation. project as above. For tests and tools; the
+ * assembly works in the diagonal frame directly. */
+void piola__element_dpdf(const piola_material *material, const piola_mat3 *f,
+                         const double *fiber, double activation, int project, double dpdf[81]);
+
+/* Projects the symmetric part of a (3x3) onto its non-negative eigenvalues, in place. */
+void piola__project_symmetric3(double a[3][3]);
+
+#endif

@@ -1,0 +1,249 @@
+/* The implicit integrators' system matrix (stiffness_matrix.h): per-tet projected stiffness
+ * blocks, their assembly on the damping matrix's edge pattern, and the product. */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "common/status_report.h"
+#include "force/elastic_body_internal.h"
+#include "force/element_stiffness.h"
+#include "force/stiffness_matrix.h"
+
+static const int PAIR_A[6] = {0, 0, 0, 1, 1, 2}, PAIR_B[6] = {1, 2, 3, 2, 3, 3};
+
+piola_status piola__stiffness_matrix_init(piola__stiffness_matrix *m,
+                                          const piola_elastic_body *body) {
+  memset(m, 0, sizeof *m);
+  const piola__damping_matrix *d = &body->damping;
+  m->vertex_count = body->vertex_count;
+  m->slot_count = d->shared_count > 0 ? d->shared_slot_start[d->shared_count] : d->edge_count;
+  size_t nv = (size_t)(body->vertex_count > 0 ? body->vertex_count : 1);
+  m->blocks = malloc(sizeof(double) * 9 * (size_t)(m->slot_count > 0 ? m->slot_count : 1));
+  m->diagonal = malloc(sizeof(double) * 9 * nv);
+  m->inverse_diagonal = malloc(sizeof(double) * 9 * nv);
+  if (!m->blocks || !m->diagonal || !m->inverse_diagonal) {
+    piola__stiffness_matrix_free(m);
+    return PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "stiffness matrix: out of memory");
+  }
+  return PIOLA_OK;
+}
+
+void piola__stiffness_matrix_free(piola__stiffness_matrix *m) {
+  free(m->blocks);
+  free(m->diagonal);
+  free(m->inverse_diagonal);
+  memset(m, 0, sizeof *m);
+}
+
+void piola__tet_stiffness_blocks(const piola_elastic_body *body, int32_t t, double out[54]) {
+  double u[3][3], v[3][3], dm[3][3];
+  for (int k = 0; k < 9; ++k) {
+    u[k / 3][k % 3] = body->u[k][t];
+    v[k / 3][k % 3] = body->v[k][t];
+    dm[k / 3][k % 3] = body->dm_inv[k][t];
+  }
+  const piola_material *material = &body->materials[body->tet_material[t]];
+  const double *fhat = body->fhat + 3 * (size_t)t;
+  double phat[3];
+  piola_material_stress(material, fhat, phat);
+  piola__diagonal_stiffness k;
+  piola__diagonal_stiffness_eval(material, fhat, phat, 1, &k);
+  /* rows g_a of Dm^-1 (g_0 = -(g_1 + g_2 + g_3)) in the diagonal frame: gh_a = V^T g_a */
+  double g[4][3], gh[4][3];
+  for (int j = 0; j < 3; ++j) {
+    g[0][j] = -(dm[0][j] + dm[1][j] + dm[2][j]);
+    for (int a = 1; a < 4; ++a) g[a][j] = dm[a - 1][j];
+  }
+  for (int a = 0; a < 4; ++a)
+    for (int p = 0; p < 3; ++p) gh[a][p] = v[0][p] * g[a][0] + v[1][p] * g[a][1] + v[2][p] * g[a][2];
+  /* pair (p, q) of the diagonal frame: index of its 2x2 block */
+  static const int PAIR_OF[3][3] = {{-1, 0, 1}, {0, -1, 2}, {1, 2, -1}};
+  const double scale = -body->rest_volume[t] * body->last_stiffness_scale;
+  /* the fibre term: w = F a = U (fhat * (V^T a)) */
+  double fs = 0, fc = 0, fa[3] = {0, 0, 0}, w[3] = {0, 0, 0};
+  if (body->fiber[0] && material->model == PIOLA_MODEL_MUSCLE) {
+    for (int i = 0; i < 3; ++i) fa[i] = body->fiber[i][t];
+    double ah[3];
+    for (int p = 0; p < 3; ++p) ah[p] = v[0][p] * fa[0] + v[1][p] * fa[1] + v[2][p] * fa[2];
+    for (int i = 0; i < 3; ++i)
+      w[i] = u[i][0] * fhat[0] * ah[0] + u[i][1] * fhat[1] * ah[1] + u[i][2] * fhat[2] * ah[2];
+    piola__fiber_stiffness_terms(material, sqrt(w[0] * w[0] + w[1] * w[1] + w[2] * w[2]),
+                                 body->activation, 1, &fs, &fc);
+  }
+  for (int n = 0; n < 6; ++n) {
+    const double *ga = gh[PAIR_A[n]], *gb = gh[PAIR_B[n]];
+    double mm[3][3];
+    for (int p = 0; p < 3; ++p) {
+      double diag = ga[p] * gb[p] * k.block[p][p];
+      for (int q = 0; q < 3; ++q)
+        if (q != p) {
+          const int pr = PAIR_OF[p][q];
+          diag += ga[q] * gb[q] * k.pair_a[pr];
+          mm[p][q] = ga[p] * gb[q] * k.block[p][q] + ga[q] * gb[p] * k.pair_b[pr];
+        }
+      mm[p][p] = diag;
+    }
+    /* U M U^T */
+    double um[3][3];
+    for (int i = 0; i < 3; ++i)
+      for (int q = 0; q < 3; ++q) um[i][q] = u[i][0] * mm[0][q] + u[i][1] * mm[1][q] + u[i][2] * mm[2][q];
+    double fiber_weight = 0;
+    if (fs != 0 || fc != 0) {
+      const double *pa = g[PAIR_A[n]], *pb = g[PAIR_B[n]];
+      fiber_weight = (pa[0] * fa[0] + pa[1] * fa[1] + pa[2] * fa[2]) *
+                     (pb[0] * fa[0] + pb[1] * fa[1] + pb[2] * fa[2]);
+    }
+    for (int i = 0; i < 3; ++i)
+      for (int j = 0; j < 3; ++j) {
+        double kij = um[i][0] * u[j][0] + um[i][1] * u[j][1] + um[i][2] * u[j][2];
+        kij += fiber_weight * ((i == j ? fs : 0.0) + fc * w[i] * w[j]);
+        out[9 * n + 3 * i + j] = scale * kij;
+      }
+  }
+}
+
+/* Range k of the tets (the damping assembly's ranges): blocks into their slots, transposed
+ * where the edge is stored the other way round, stored by a slot's first writer. */
+static void assemble_part(piola__stiffness_matrix *m, const piola_elastic_body *body, int k,
+                          double weight) {
+  static const int TRANSPOSE[2][9] = {{0, 1, 2, 3, 4, 5, 6, 7, 8}, {0, 3, 6, 1, 4, 7, 2, 5, 8}};
+  const piola__damping_matrix *d = &body->damping;
+  const int32_t blocks = body->padded_tet_count / PIOLA_TET_BLOCK;
+  const int32_t t0 = piola__damping_part_start(blocks, k) * PIOLA_TET_BLOCK;
+  int32_t t1 = piola__damping_part_start(blocks, k + 1) * PIOLA_TET_BLOCK;
+  if (t1 > body->tet_count) t1 = body->tet_count;
+  double out[54];
+  for (int32_t t = t0; t < t1; ++t) {
+    piola__tet_stiffness_blocks(body, t, out);
+    const int32_t *slots = d->tet_slot + 6 * (size_t)t;
+    const unsigned flags = d->tet_flags[t];
+    for (int p = 0; p < 6; ++p) {
+      double *dst = m->blocks + 9 * (size_t)slots[p];
+      const int *order = TRANSPOSE[(flags >> p) & 1];
+      if ((flags >> (6 + p)) & 1)
+        for (int e = 0; e < 9; ++e) dst[e] = weight * out[9 * p + order[e]];
+      else
+        for (int e = 0; e < 9; ++e) dst[e] += weight * out[9 * p + order[e]];
+    }
+  }
+}
+
+static void reduce_shared(piola__stiffness_matrix *m, const piola__damping_matrix *d, int32_t k) {
+  double *dst = m->blocks + 9 * (size_t)d->shared_edge[k];
+  int32_t s0 = d->shared_slot_start[k], s1 = d->shared_slot_start[k + 1];
+  for (int i = 0; i < 9; ++i) {
+    double sum = m->blocks[9 * (size_t)s0 + i];
+    for (int32_t s = s0 + 1; s < s1; ++s) sum += m->blocks[9 * (size_t)s + i];
+    dst[i] = sum;
+  }
+}
+
+static void invert3(const double *a, double *inv) {
+  double c00 = a[4] * a[8] - a[5] * a[7], c01 = a[5] * a[6] - a[3] * a[8], c02 = a[3] * a[7] - a[4] * a[6];
+  double det = a[0] * c00 + a[1] * c01 + a[2] * c02;
+  if (!(fabs(det) > 0) || !isfinite(det)) {
+    /* a singular block (a massless node in quasistatics): its diagonal only */
+    memset(inv, 0, 9 * sizeof(double));
+    for (int i = 0; i < 3; ++i) inv[4 * i] = a[4 * i] > 0 ? 1.0 / a[4 * i] : 0.0;
+    return;
+  }
+  double r = 1.0 / det;
+  inv[0] = c00 * r;
+  inv[3] = c01 * r;
+  inv[6] = c02 * r;
+  inv[1] = (a[2] * a[7] - a[1] * a[8]) * r;
+  inv[4] = (a[0] * a[8] - a[2] * a[6]) * r;
+  inv[7] = (a[1] * a[6] - a[0] * a[7]) * r;
+  inv[2] = (a[1] * a[5] - a[2] * a[4]) * r;
+  inv[5] = (a[2] * a[3] - a[0] * a[5]) * r;
+  inv[8] = (a[0] * a[4] - a[1] * a[3]) * r;
+}
+
+/* Diagonal blocks of rows r0 .. r1 - 1: m_w m_i I + sum over the row's edges of S_ij. */
+static void diagonal_rows(piola__stiffness_matrix *m, const piola__damping_matrix *d,
+                          const double *mass, double mass_weight, int32_t r0, int32_t r1) {
+  for (int32_t r = r0; r < r1; ++r) {
+    const int32_t i = d->order[r];
+    double a[9] = {0};
+    for (int32_t k = d->row_start[r]; k < d->row_start[r + 1]; ++k)
+      for (int e = 0; e < 9; ++e) a[e] += m->blocks[9 * (size_t)k + e];
+    for (int32_t k = d->lower_start[r]; k < d->lower_start[r + 1]; ++k) {
+      const double *b = m->blocks + 9 * (size_t)d->lower_edge[k];
+      for (int c = 0; c < 3; ++c)
+        for (int e = 0; e < 3; ++e) a[3 * c + e] += b[3 * e + c];
+    }
+    for (int c = 0; c < 3; ++c) a[4 * c] += mass_weight * mass[i];
+    memcpy(m->diagonal + 9 * (size_t)i, a, sizeof a);
+    invert3(a, m->inverse_diagonal + 9 * (size_t)i);
+  }
+}
+
+void piola__stiffness_matrix_assemble(piola__stiffness_matrix *m, const piola_elastic_body *body,
+                                      double stiffness_weight, double damping_weight,
+                                      const double *mass, double mass_weight) {
+  const piola__damping_matrix *d = &body->damping;
+  const int32_t blocks = body->padded_tet_count / PIOLA_TET_BLOCK;
+  const int32_t nv = body->vertex_count;
+  enum { RANGES = 16 };
+#pragma omp parallel num_threads(piola_thread_count()) if (blocks >= PIOLA_PARALLEL_MIN_BLOCKS)
+  {
+#pragma omp for schedule(static)
+    for (int k = 0; k < PIOLA_DAMPING_PARTS; ++k) assemble_part(m, body, k, stiffness_weight);
+#pragma omp for schedule(static)
+    for (int32_t k = 0; k < d->shared_count; ++k) reduce_shared(m, d, k);
+#pragma omp for schedule(static)
+    for (int32_t e = 0; e < d->edge_count; ++e) {
+      if (damping_weight != 0)
+        for (int c = 0; c < 9; ++c) m->blocks[9 * (size_t)e + c] += damping_weight * d->blocks[9 * (size_t)e + c];
+    }
+#pragma omp for schedule(static)
+    for (int r = 0; r < RANGES; ++r)
+      diagonal_rows(m, d, mass, mass_weight, (int32_t)((int64_t)nv * r / RANGES),
+                    (int32_t)((int64_t)nv * (r + 1) / RANGES));
+  }
+}
+
+/* Rows r0 .. r1 - 1 of out = A p: each row gathers its edges in a fixed order, so results
+ * do not depend on the thread count. */
+static void product_rows(const piola__stiffness_matrix *m, const piola__damping_matrix *d,
+                         const double *mass, double mass_weight, const double *p, int32_t r0,
+                         int32_t r1, double *out) {
+  const double *blocks = m->blocks;
+  for (int32_t r = r0; r < r1; ++r) {
+    const int32_t i = d->order[r];
+    const double p0 = p[3 * i], p1 = p[3 * i + 1], p2 = p[3 * i + 2];
+    double f0 = 0, f1 = 0, f2 = 0;
+    for (int32_t k = d->row_start[r]; k < d->row_start[r + 1]; ++k) {
+      const double *a = blocks + 9 * (size_t)k, *pj = p + 3 * (size_t)d->col[k];
+      double d0 = pj[0] - p0, d1 = pj[1] - p1, d2 = pj[2] - p2;
+      f0 += a[0] * d0 + a[1] * d1 + a[2] * d2;
+      f1 += a[3] * d0 + a[4] * d1 + a[5] * d2;
+      f2 += a[6] * d0 + a[7] * d1 + a[8] * d2;
+    }
+    for (int32_t k = d->lower_start[r]; k < d->lower_start[r + 1]; ++k) {
+      const double *a = blocks + 9 * (size_t)d->lower_edge[k];
+      const double *pj = p + 3 * (size_t)d->lower_col[k];
+      double d0 = pj[0] - p0, d1 = pj[1] - p1, d2 = pj[2] - p2;
+      f0 += a[0] * d0 + a[3] * d1 + a[6] * d2;
+      f1 += a[1] * d0 + a[4] * d1 + a[7] * d2;
+      f2 += a[2] * d0 + a[5] * d1 + a[8] * d2;
+    }
+    const double mi = mass_weight * mass[i];
+    out[3 * i] = mi * p0 - f0;
+    out[3 * i + 1] = mi * p1 - f1;
+    out[3 * i + 2] = mi * p2 - f2;
+  }
+}
+
+void piola__stiffness_matrix_apply(const piola__stiffness_matrix *m, const piola_elastic_body *body,
+                                   const double *mass, double mass_weight, const double *p,
+                                   double *out) {
+  const piola__damping_matrix *d = &body->damping;
+  const int32_t nv = body->vertex_count;
+  enum { RANGES = 16 };
+#pragma omp parallel for schedule(static) num_threads(piola_thread_count()) \
+    if (nv >= PIOLA_PARALLEL_MIN_VERTICES)
+  for (int r = 0; r < RANGES; ++r)
+    product_rows(m, d, mass, mass_weight, p, (int32_t)((int64_t)nv * r / RANGES),
+                 (int32_t)((int64_t)nv * (r + 1) / RANGES), out);
+}

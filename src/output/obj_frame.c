@@ -1,0 +1,92 @@
+/* The OBJ surface of a frame, for Blender and Houdini: one named object per body
+ * (`o <name>`: each solid's boundary, each shell's triangles), with only the vertices its
+ * faces use. Interior nodes of the tets are left out: an importer would otherwise keep them
+ * as loose points. Positions only (no normals: importers compute smooth ones from the
+ * faces, and a frame stays small).
+ *
+ * The layout (which vertices, which faces, in which object) does not change between frames,
+ * so it is built once; each frame writes the current positions through it. */
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "common/status_report.h"
+#include "piola/files.h"
+#include "output/output_internal.h"
+
+void piola__obj_layout_free(obj_layout *l) {
+  if (!l) return;
+  free(l->vertices), free(l->faces), free(l->body_vertex_start), free(l->body_face_start);
+  free(l->names);
+  memset(l, 0, sizeof *l);
+}
+
+piola_status piola__obj_layout_build(const piola_tri_mesh *surface, const int32_t *body_first_vertex,
+                                     int32_t body_count, const char *const *names,
+                                     int32_t vertex_count, obj_layout *l) {
+  memset(l, 0, sizeof *l);
+  int32_t nt = surface->triangle_count;
+  l->body_count = body_count;
+  l->vertices = malloc((size_t)(vertex_count > 0 ? vertex_count : 1) * sizeof *l->vertices);
+  l->faces = malloc(3 * (size_t)(nt > 0 ? nt : 1) * sizeof *l->faces);
+  l->body_vertex_start = calloc((size_t)body_count + 1, sizeof *l->body_vertex_start);
+  l->body_face_start = calloc((size_t)body_count + 1, sizeof *l->body_face_start);
+  l->names = calloc((size_t)(body_count > 0 ? body_count : 1), sizeof *l->names);
+  int32_t *obj_index = malloc((size_t)(vertex_count > 0 ? vertex_count : 1) * sizeof *obj_index);
+  if (!l->vertices || !l->faces || !l->body_vertex_start || !l->body_face_start || !l->names ||
+      !obj_index) {
+    free(obj_index);
+    piola__obj_layout_free(l);
+    return PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "OBJ output: out of memory");
+  }
+  for (int32_t v = 0; v < vertex_count; ++v) obj_index[v] = -1;
+  int32_t nv_out = 0, nf_out = 0;
+  for (int32_t b = 0; b < body_count; ++b) {
+    snprintf(l->names[b], sizeof l->names[b], "%s", names[b]);
+    /* an OBJ name ends at whitespace */
+    for (char *c = l->names[b]; *c; ++c)
+      if (*c == ' ' || *c == '\t') *c = '_';
+    l->body_vertex_start[b] = nv_out;
+    l->body_face_start[b] = nf_out;
+    int32_t lo = body_first_vertex[b], hi = body_first_vertex[b + 1];
+    /* a body's faces use only its own vertices (bodies share no nodes) */
+    for (int32_t t = 0; t < nt; ++t) {
+      const int32_t *tri = surface->triangles + 3 * (size_t)t;
+      if (tri[0] < lo || tri[0] >= hi) continue;
+      for (int k = 0; k < 3; ++k) {
+        if (obj_index[tri[k]] < 0) {
+          obj_index[tri[k]] = nv_out;
+          l->vertices[nv_out++] = tri[k];
+        }
+        l->faces[3 * (size_t)nf_out + (size_t)k] = obj_index[tri[k]] + 1; /* OBJ is 1-based */
+      }
+      ++nf_out;
+    }
+  }
+  l->body_vertex_start[body_count] = nv_out;
+  l->body_face_start[body_count] = nf_out;
+  free(obj_index);
+  return PIOLA_OK;
+}
+
+piola_status piola__obj_layout_write(const obj_layout *l, const char *path, const double *positions) {
+  piola_atomic_file f;
+  PIOLA_TRY(piola_atomic_file_open(&f, path));
+  fprintf(f.stream, "# piola frame: one object per body, its surface only\n");
+  for (int32_t b = 0; b < l->body_count; ++b) {
+    fprintf(f.stream, "o %s\n", l->names[b]);
+    for (int32_t i = l->body_vertex_start[b]; i < l->body_vertex_start[b + 1]; ++i) {
+      const double *p = positions + 3 * (size_t)l->vertices[i];
+      fprintf(f.stream, "v %.9g %.9g %.9g\n", p[0], p[1], p[2]);
+    }
+    for (int32_t t = l->body_face_start[b]; t < l->body_face_start[b + 1]; ++t) {
+      const int32_t *tri = l->faces + 3 * (size_t)t;
+      fprintf(f.stream, "f %d %d %d\n", (int)tri[0], (int)tri[1], (int)tri[2]);
+    }
+  }
+  if (ferror(f.stream)) {
+    piola_atomic_file_abort(&f);
+    return PIOLA_FAIL(PIOLA_ERROR_IO, "%s: write failed", path);
+  }
+  return piola_atomic_file_commit(&f);
+}

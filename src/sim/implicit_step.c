@@ -1,0 +1,535 @@
+/* The implicit integrators: backward Euler and quasistatics (docs/time-stepping.md,
+ * "Implicit integrators").
+ *
+ * Backward Euler. From (x^n, v^n) a step of dt finds x = x^n+1 with
+ *   g(x) = M (x - x^n - dt v^n) - dt^2 (f_e(x) + D(x) v + M g(t^n+1)) = 0,  v = (x - x^n) / dt,
+ * the gradient of the incremental potential (inertia, elastic energy, gravity, damping as
+ * the rotated damping at the current iterate), by Newton's method: the system matrix
+ * M - dt^2 K - dt D (stiffness_matrix.h) with K the projected stiffness, so it is symmetric
+ * positive definite at any deformation, flat and inverted elements included; a
+ * block-Jacobi preconditioned conjugate gradient; and a backtracking line search.
+ *
+ * Why the line search is on the residual norm and not on the energy. The inversion
+ * extension (docs/materials.md) has no potential where some entries of Fhat are below the
+ * threshold and others above (its dPhat/dFhat is not symmetric there), and the rotated
+ * damping at the current iterate is not the gradient of anything either. So the merit
+ * function is |g|^2 in the M^-1 norm, which is consistent with the forces everywhere; a
+ * step is accepted when it decreases by the Armijo fraction. With the projected Hessian the
+ * Newton direction is a descent direction for it near a solution; far from one the
+ * backtracking may fail, and then the step is undone and retried at half the size (the only
+ * way the step shrinks).
+ *
+ * Constraints. Fixed, driven and bone nodes sit at their positions of t^n+1 before the
+ * first iteration and are filtered out of every residual and search direction. Obstacle
+ * contacts are an active set: nodes found inside an obstacle (at the prediction and after
+ * every Newton update) are projected to its surface and their normal component is filtered
+ * like the collision-held normals of the Newmark step; a node the obstacle would have to
+ * pull is released. After convergence the normal contact force (the filtered-out residual)
+ * limits the tangential velocity relative to the obstacle by Coulomb's law, as the Newmark
+ * step does with its normal impulse. Self-collision and plasticity run after the step as
+ * with Newmark.
+ *
+ * Momentum. K and D are translation invariant, so a free body's net residual changes only
+ * through M. The block-Jacobi CG does not keep the net residual at zero by itself, so each
+ * solution is moved by the uniform displacement that zeroes it: a free body's linear
+ * momentum changes by exactly dt M g per step, whatever the tolerances.
+ *
+ * Quasistatics. g(x) = -(f_e(x) + M g(t^n+1)), the same Newton with the matrix -K + mu M:
+ * mu (1/s^2) regularizes the rigid and soft modes (Levenberg-Marquardt), shrinking after
+ * full steps and growing when the line search has to backtrack. Velocities are reported as
+ * (x^n+1 - x^n) / dt; damping and contact friction do not act. */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "common/status_report.h"
+#include "force/elastic_body_internal.h"
+#include "force/stiffness_matrix.h"
+#include "sim/world_internal.h"
+
+#define STANDARD_GRAVITY 9.81
+#define RANGES 16
+
+struct implicit_state {
+  piola__stiffness_matrix matrix;
+  double *prediction; /* 3n: x^n + dt v^n (backward Euler) */
+  double *residual;   /* 3n: g, unfiltered */
+  double *step;       /* 3n: the Newton direction */
+  double *base;       /* 3n: x before the line search */
+  double *damping;    /* 3n: D v */
+  double *cg[4];      /* 3n each: r, z, p, q */
+  double *scratch_v;  /* 3n: velocities handed to the obstacle projection */
+  uint8_t *hit;       /* n: nodes the obstacle projection moved */
+  double mu;          /* quasistatic regularization, 1/s^2 (0: not chosen yet) */
+};
+
+void piola__implicit_state_free(struct implicit_state *st) {
+  if (!st) return;
+  piola__stiffness_matrix_free(&st->matrix);
+  free(st->prediction), free(st->residual), free(st->step), free(st->base), free(st->damping);
+  for (int k = 0; k < 4; ++k) free(st->cg[k]);
+  free(st->scratch_v), free(st->hit);
+  free(st);
+}
+
+static piola_status implicit_state_make(world_body *s) {
+  if (s->implicit) return PIOLA_OK;
+  struct implicit_state *st = calloc(1, sizeof *st);
+  if (!st) return PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "implicit step: out of memory");
+  size_t v3 = sizeof(double) * 3 * (size_t)(s->n > 0 ? s->n : 1);
+  st->prediction = malloc(v3), st->residual = malloc(v3), st->step = malloc(v3);
+  st->base = malloc(v3), st->damping = malloc(v3), st->scratch_v = malloc(v3);
+  for (int k = 0; k < 4; ++k) st->cg[k] = malloc(v3);
+  st->hit = malloc((size_t)(s->n > 0 ? s->n : 1));
+  int ok = st->prediction && st->residual && st->step && st->base && st->damping &&
+           st->scratch_v && st->hit && st->cg[0] && st->cg[1] && st->cg[2] && st->cg[3];
+  if (ok && piola__stiffness_matrix_init(&st->matrix, s->solid) != PIOLA_OK) ok = 0;
+  if (!ok) {
+    piola__implicit_state_free(st);
+    return PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "implicit step: out of memory");
+  }
+  s->implicit = st;
+  return PIOLA_OK;
+}
+
+/* ------------------------------------------------------------------ vector helpers
+ * Sums over 16 fixed node ranges, added in order: results do not depend on the thread count. */
+
+static double dot_ranges(const world_body *s, const double *a, const double *b,
+                         const double *inverse_mass) {
+  double part[RANGES];
+  const int32_t n = s->n;
+#pragma omp parallel for schedule(static) num_threads(piola_thread_count()) \
+    if (n >= PIOLA_PARALLEL_MIN_VERTICES)
+  for (int r = 0; r < RANGES; ++r) {
+    double sum = 0;
+    for (int32_t i = (int32_t)((int64_t)n * r / RANGES); i < (int32_t)((int64_t)n * (r + 1) / RANGES); ++i) {
+      double d = a[3 * i] * b[3 * i] + a[3 * i + 1] * b[3 * i + 1] + a[3 * i + 2] * b[3 * i + 2];
+      sum += inverse_mass ? inverse_mass[i] * d : d;
+    }
+    part[r] = sum;
+  }
+  double sum = 0;
+  for (int r = 0; r < RANGES; ++r) sum += part[r];
+  return sum;
+}
+
+/* Zeroes the constrained components of node i of r: all of a fixed/driven node, the normal
+ * of a node held by an obstacle. */
+static inline void filter_vector(const world_body *s, int32_t i, double ri[3]) {
+  if (s->flags[i] != NODE_FREE || s->inverse_mass[i] == 0) {
+    ri[0] = ri[1] = ri[2] = 0;
+  } else if (s->colliding[i]) {
+    const double *nrm = s->normals + 3 * i;
+    double dn = ri[0] * nrm[0] + ri[1] * nrm[1] + ri[2] * nrm[2];
+    for (int k = 0; k < 3; ++k) ri[k] -= dn * nrm[k];
+  }
+}
+
+static inline void filter_node(const world_body *s, int32_t i, double *r) {
+  filter_vector(s, i, r + 3 * i);
+}
+
+/* True when a node with mass is held (constrained or in contact): then external forces act.
+ * Massless vertices (in no tet) are held fixed but carry no momentum. */
+static int has_filtered_nodes(const world_body *s) {
+  for (int32_t i = 0; i < s->n; ++i)
+    if (s->mass[i] > 0 && (s->flags[i] != NODE_FREE || s->colliding[i])) return 1;
+  return 0;
+}
+
+/* ------------------------------------------------------------------ the step's problem */
+
+typedef struct newton_problem {
+  piola_world *w;
+  world_body *s;
+  struct implicit_state *st;
+  double t1, dt;
+  int quasistatic;
+  double beta, alpha;  /* viscosities at t1, Pa s */
+  int damped;
+  double g1[3];        /* gravity at t1 */
+  double force_weight; /* dt^2, or 1 in quasistatics */
+  double mass_weight;  /* 1, or 0 in quasistatics */
+  double total_mass;
+} newton_problem;
+
+/* The residual g at the body's current state (its last update is at s->x) into
+ * st->residual; returns the squared filtered norm |S g|^2_{M^-1}. */
+static double residual(newton_problem *pb) {
+  world_body *s = pb->s;
+  struct implicit_state *st = pb->st;
+  const int32_t n = s->n;
+  const double w = pb->force_weight, inv_dt = 1.0 / pb->dt;
+  if (pb->damped) {
+    double *v = st->scratch_v;
+    for (int64_t j = 0; j < 3 * (int64_t)n; ++j) v[j] = (s->x[j] - s->x_old[j]) * inv_dt;
+    piola_elastic_body_damping_forces(s->solid, v, pb->beta, pb->alpha, st->damping);
+  }
+  double part[RANGES];
+#pragma omp parallel for schedule(static) num_threads(piola_thread_count()) \
+    if (n >= PIOLA_PARALLEL_MIN_VERTICES)
+  for (int r = 0; r < RANGES; ++r) {
+    double sum = 0;
+    for (int32_t i = (int32_t)((int64_t)n * r / RANGES); i < (int32_t)((int64_t)n * (r + 1) / RANGES); ++i) {
+      double *g = st->residual + 3 * i;
+      for (int k = 0; k < 3; ++k) {
+        const int64_t j = 3 * (int64_t)i + k;
+        double f = s->force[j] + s->mass[i] * pb->g1[k] + (pb->damped ? st->damping[j] : 0.0);
+        g[k] = pb->mass_weight * s->mass[i] * (s->x[j] - st->prediction[j]) - w * f;
+      }
+      double gf[3] = {g[0], g[1], g[2]};
+      filter_vector(s, i, gf);
+      sum += s->inverse_mass[i] * (gf[0] * gf[0] + gf[1] * gf[1] + gf[2] * gf[2]);
+    }
+    part[r] = sum;
+  }
+  double sum = 0;
+  for (int r = 0; r < RANGES; ++r) sum += part[r];
+  return sum;
+}
+
+/* Solves A d = -S g by the filtered block-Jacobi CG from d = 0; returns the iterations. */
+static int32_t solve_newton_system(newton_problem *pb) {
+  world_body *s = pb->s;
+  struct implicit_state *st = pb->st;
+  const int32_t n = s->n;
+  const int64_t m = 3 * (int64_t)n;
+  const piola__stiffness_matrix *mx = &st->matrix;
+  const double mass_weight = pb->mass_weight + st->mu;
+  double *d = st->step, *r = st->cg[0], *z = st->cg[1], *p = st->cg[2], *q = st->cg[3];
+  for (int64_t j = 0; j < m; ++j) d[j] = 0, r[j] = -st->residual[j];
+  for (int32_t i = 0; i < n; ++i) filter_node(s, i, r);
+  /* z = S P^-1 r, P the diagonal blocks */
+#define PRECONDITION(out, in)                                                       \
+  for (int32_t i = 0; i < n; ++i) {                                                 \
+    const double *b = mx->inverse_diagonal + 9 * (size_t)i, *x = in + 3 * i;       \
+    double *y = out + 3 * i;                                                        \
+    y[0] = b[0] * x[0] + b[1] * x[1] + b[2] * x[2];                                 \
+    y[1] = b[3] * x[0] + b[4] * x[1] + b[5] * x[2];                                 \
+    y[2] = b[6] * x[0] + b[7] * x[1] + b[8] * x[2];                                 \
+    filter_node(s, i, out);                                                         \
+  }
+  PRECONDITION(z, r)
+  memcpy(p, z, sizeof(double) * (size_t)m);
+  double rz = dot_ranges(s, r, z, NULL);
+  const double stop = pb->w->def.linear_tolerance * pb->w->def.linear_tolerance * rz;
+  int32_t it = 0;
+  while (rz > stop && rz > 0 && it < pb->w->def.linear_max_iterations) {
+    piola__stiffness_matrix_apply(mx, s->solid, s->mass, mass_weight, p, q);
+    for (int32_t i = 0; i < n; ++i) filter_node(s, i, q);
+    double pq = dot_ranges(s, p, q, NULL);
+    if (!(pq > 0)) break;
+    double a = rz / pq;
+    for (int64_t j = 0; j < m; ++j) d[j] += a * p[j], r[j] -= a * q[j];
+    PRECONDITION(z, r)
+    double rz_new = dot_ranges(s, r, z, NULL);
+    double b = rz_new / rz;
+    rz = rz_new;
+    for (int64_t j = 0; j < m; ++j) p[j] = z[j] + b * p[j];
+    ++it;
+  }
+#undef PRECONDITION
+  /* a free body: move d by the uniform displacement that makes sum M d = -sum g (K and D
+   * ignore uniform fields, so the net residual after a full step is then zero whatever the
+   * CG's accuracy or the regularization), so the linear momentum comes out exact */
+  if (!pb->quasistatic && !has_filtered_nodes(s)) {
+    double net[3] = {0, 0, 0};
+    for (int32_t i = 0; i < n; ++i)
+      for (int k = 0; k < 3; ++k) net[k] += st->residual[3 * i + k] + s->mass[i] * d[3 * i + k];
+    for (int32_t i = 0; i < n; ++i)
+      if (s->mass[i] > 0)
+        for (int k = 0; k < 3; ++k) d[3 * i + k] -= net[k] / pb->total_mass;
+  }
+  return it;
+}
+
+static piola_status update(newton_problem *pb) {
+  return piola__body_update_forces(pb->s, pb->t1);
+}
+
+/* Projects free nodes that are inside an obstacle onto its surface and holds their normal
+ * from then on. Returns the number of nodes newly held (-1 on error). */
+static int32_t contacts(newton_problem *pb) {
+  piola_world *w = pb->w;
+  world_body *s = pb->s;
+  struct implicit_state *st = pb->st;
+  if (w->obstacle_count == 0 || pb->s->n == 0) return 0;
+  memset(st->scratch_v, 0, sizeof(double) * 3 * (size_t)s->n);
+  double *normals = st->cg[0]; /* free between solves */
+  int32_t moved = piola_obstacles_collide(w->obstacles, w->obstacle_count, pb->t1, 0.0, s->n, s->x,
+                                          st->scratch_v, st->hit, normals);
+  if (moved < 0) return -1;
+  int32_t added = 0;
+  for (int32_t i = 0; i < s->n; ++i) {
+    if (!st->hit[i]) continue;
+    if (s->flags[i] != NODE_FREE) {
+      /* prescribed nodes are never projected: put them back */
+      double xp[3], vp[3];
+      piola__body_constrained_state(s, i, pb->t1, xp, vp);
+      for (int k = 0; k < 3; ++k) s->x[3 * i + k] = xp[k];
+      continue;
+    }
+    if (!s->colliding[i]) added++;
+    s->colliding[i] = 1;
+    for (int k = 0; k < 3; ++k) s->normals[3 * i + k] = normals[3 * i + k];
+  }
+  return moved > 0 ? (added > 0 ? added : 1) : 0;
+}
+
+/* Releases held nodes whose contact force would pull them into the obstacle (g . n < 0 means
+ * the constraint force g / dt^2 points along -n). Returns how many. */
+static int32_t release_contacts(newton_problem *pb) {
+  world_body *s = pb->s;
+  int32_t released = 0;
+  for (int32_t i = 0; i < s->n; ++i) {
+    if (!s->colliding[i] || s->flags[i] != NODE_FREE) continue;
+    const double *g = pb->st->residual + 3 * i, *nrm = s->normals + 3 * i;
+    if (g[0] * nrm[0] + g[1] * nrm[1] + g[2] * nrm[2] < 0) {
+      s->colliding[i] = 0;
+      released++;
+    }
+  }
+  return released;
+}
+
+/* Coulomb friction with the converged contact force: the normal impulse dt (g . n) / dt^2
+ * per unit mass limits the tangential velocity relative to the nearest obstacle. Changes
+ * x and v of sliding nodes; returns how many. */
+static int32_t contact_friction(newton_problem *pb) {
+  piola_world *w = pb->w;
+  world_body *s = pb->s;
+  int32_t changed = 0;
+  for (int32_t i = 0; i < s->n; ++i) {
+    if (!s->colliding[i] || s->flags[i] != NODE_FREE) continue;
+    const double *g = pb->st->residual + 3 * i, *nrm = s->normals + 3 * i;
+    double dvn = (g[0] * nrm[0] + g[1] * nrm[1] + g[2] * nrm[2]) / (pb->dt * s->mass[i]);
+    if (!(dvn > 0)) continue;
+    piola_vec3 p = {s->x[3 * i], s->x[3 * i + 1], s->x[3 * i + 2]};
+    double best = INFINITY, mu = 0;
+    piola_vec3 vo = {0, 0, 0};
+    for (int32_t o = 0; o < w->obstacle_count; ++o) {
+      piola_vec3 vel;
+      double phi = fabs(piola_obstacle_signed_distance(w->obstacles[o], pb->t1, p, NULL, &vel));
+      if (phi < best) best = phi, mu = piola_obstacle_friction(w->obstacles[o]), vo = vel;
+    }
+    if (!(mu > 0)) continue;
+    double *vi = s->v + 3 * i;
+    double rel[3] = {vi[0] - vo.x, vi[1] - vo.y, vi[2] - vo.z};
+    double rn = rel[0] * nrm[0] + rel[1] * nrm[1] + rel[2] * nrm[2];
+    double vt[3] = {rel[0] - rn * nrm[0], rel[1] - rn * nrm[1], rel[2] - rn * nrm[2]};
+    double vtn = sqrt(vt[0] * vt[0] + vt[1] * vt[1] + vt[2] * vt[2]);
+    if (!(vtn > 0)) continue;
+    double keep = fmax(0.0, 1.0 - mu * dvn / vtn);
+    for (int k = 0; k < 3; ++k) {
+      vi[k] -= (1.0 - keep) * vt[k];
+      s->x[3 * i + k] = s->x_old[3 * i + k] + pb->dt * vi[k];
+    }
+    changed++;
+  }
+  return changed;
+}
+
+/* Newton's method for one solid over [t, t + dt]. Returns PIOLA_OK when converged,
+ * PIOLA_ERROR_NOT_CONVERGED when not (the caller undoes and halves), or another error. */
+static piola_status newton_solid(piola_world *w, world_body *s, double t, double dt,
+                                 int accept_unconverged, piola_step_stats *stats) {
+  PIOLA_TRY(implicit_state_make(s));
+  struct implicit_state *st = s->implicit;
+  const int32_t n = s->n;
+  const int64_t m = 3 * (int64_t)n;
+  newton_problem pb;
+  memset(&pb, 0, sizeof pb);
+  pb.w = w, pb.s = s, pb.st = st, pb.dt = dt, pb.t1 = t + dt;
+  pb.quasistatic = w->def.integrator == PIOLA_INTEGRATOR_QUASISTATIC;
+  for (int k = 0; k < 3; ++k) pb.g1[k] = piola_track_eval(&w->def.gravity[k], pb.t1);
+  pb.beta = piola_track_eval(&s->shear_viscosity, pb.t1);
+  pb.alpha = piola_track_eval(&s->bulk_viscosity, pb.t1);
+  pb.damped = !pb.quasistatic && !piola__body_undamped(s, pb.beta, pb.alpha);
+  pb.force_weight = pb.quasistatic ? 1.0 : dt * dt;
+  pb.mass_weight = pb.quasistatic ? 0.0 : 1.0;
+  for (int32_t i = 0; i < n; ++i) pb.total_mass += s->mass[i];
+  if (!pb.quasistatic) st->mu = 0;
+
+  /* the prediction, and the first guess: the prediction plus a step of gravity
+   * (backward Euler) or the last equilibrium (quasistatics); prescribed nodes at t1 */
+  memcpy(s->x_old, s->x, sizeof(double) * (size_t)m);
+  memcpy(s->v_old, s->v, sizeof(double) * (size_t)m);
+  memcpy(s->force_old, s->force, sizeof(double) * (size_t)m);
+  for (int32_t i = 0; i < n; ++i)
+    for (int k = 0; k < 3; ++k) {
+      const int64_t j = 3 * (int64_t)i + k;
+      st->prediction[j] = s->x[j] + (pb.quasistatic ? 0.0 : dt * s->v[j]);
+      if (!pb.quasistatic) s->x[j] = st->prediction[j] + dt * dt * pb.g1[k];
+    }
+  if (n > 0) memset(s->colliding, 0, (size_t)n);
+  for (int32_t i = 0; i < n; ++i) {
+    if (s->flags[i] == NODE_FREE) continue;
+    double vp[3];
+    piola__body_constrained_state(s, i, pb.t1, s->x + 3 * i, vp);
+  }
+  if (contacts(&pb) < 0) return PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "implicit step: out of memory");
+  PIOLA_TRY(update(&pb));
+
+  const double target = w->def.newton_tolerance * STANDARD_GRAVITY * pb.force_weight;
+  const double target2 = target * target * pb.total_mass;
+  double phi = residual(&pb);
+  int converged = 0;
+  for (int32_t iter = 0; iter < w->def.newton_max_iterations; ++iter) {
+    if (!isfinite(phi)) break;
+    if (phi <= target2) {
+      if (release_contacts(&pb) == 0) {
+        converged = 1;
+        break;
+      }
+      phi = residual(&pb);
+      if (phi <= target2) {
+        converged = 1;
+        break;
+      }
+    }
+    stats->newton_iterations++;
+    if (pb.damped) piola__elastic_body_damping_prepare(s->solid, pb.beta, pb.alpha);
+    piola__stiffness_matrix_assemble(&st->matrix, s->solid, pb.force_weight,
+                                     pb.damped ? dt : 0.0, s->mass, pb.mass_weight);
+    if (pb.quasistatic) {
+      if (!(st->mu > 0)) {
+        /* the first regularization: a small fraction of the mean stiffness per mass */
+        double trace = 0;
+        for (int32_t i = 0; i < n; ++i) {
+          const double *b = st->matrix.diagonal + 9 * (size_t)i;
+          trace += b[0] + b[4] + b[8];
+        }
+        st->mu = 1e-6 * trace / (3.0 * pb.total_mass);
+        if (!(st->mu > 0)) st->mu = 1.0;
+      }
+      piola__stiffness_matrix_assemble(&st->matrix, s->solid, pb.force_weight, 0.0, s->mass, st->mu);
+    } else if (st->mu > 0) {
+      piola__stiffness_matrix_assemble(&st->matrix, s->solid, pb.force_weight,
+                                       pb.damped ? dt : 0.0, s->mass, pb.mass_weight + st->mu);
+    }
+    stats->linear_iterations += solve_newton_system(&pb);
+    /* backtracking line search on |S g|^2 */
+    memcpy(st->base, s->x, sizeof(double) * (size_t)m);
+    double alpha = 1.0, best_phi = phi, best_alpha = 0.0;
+    int accepted = 0;
+    for (int tries = 0; tries < 12; ++tries) {
+      for (int64_t j = 0; j < m; ++j) s->x[j] = st->base[j] + alpha * st->step[j];
+      piola_status us = update(&pb);
+      double trial = us == PIOLA_OK ? residual(&pb) : INFINITY;
+      if (trial <= (1.0 - 1e-4 * alpha) * phi) {
+        phi = trial;
+        accepted = 1;
+        break;
+      }
+      if (trial < best_phi) best_phi = trial, best_alpha = alpha;
+      alpha *= 0.5;
+    }
+    if (!accepted) {
+      if (!(best_alpha > 0)) break; /* no decrease at all: Newton failed */
+      alpha = best_alpha;
+      for (int64_t j = 0; j < m; ++j) s->x[j] = st->base[j] + alpha * st->step[j];
+      PIOLA_TRY(update(&pb));
+      phi = residual(&pb);
+    }
+    if (pb.quasistatic) {
+      if (alpha == 1.0)
+        st->mu = fmax(st->mu / 10.0, 1e-300);
+      else if (alpha < 0.25)
+        st->mu *= 10.0;
+    } else {
+      /* backward Euler: an iteration that had to backtrack far adds a multiple of M to the
+       * matrix (Levenberg-Marquardt: shorter, more gradient-like steps), full steps take it
+       * away again */
+      if (alpha < 0.25)
+        st->mu = st->mu > 0 ? fmin(4.0 * st->mu, 1e8) : 1.0;
+      else if (alpha == 1.0)
+        st->mu = st->mu > 1e-3 ? 0.25 * st->mu : 0.0;
+    }
+    int32_t added = contacts(&pb);
+    if (added < 0) return PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "implicit step: out of memory");
+    if (added > 0) {
+      PIOLA_TRY(update(&pb));
+      phi = residual(&pb);
+    }
+  }
+  if (!converged) {
+    if (!accept_unconverged || !isfinite(phi)) return PIOLA_ERROR_NOT_CONVERGED;
+    stats->newton_failures++;
+  }
+  /* velocities; friction; prescribed velocities */
+  const double inv_dt = 1.0 / dt;
+  for (int64_t j = 0; j < m; ++j) s->v[j] = (s->x[j] - s->x_old[j]) * inv_dt;
+  if (!pb.quasistatic && w->obstacle_count > 0 && contact_friction(&pb) > 0) PIOLA_TRY(update(&pb));
+  int32_t colliding = 0;
+  for (int32_t i = 0; i < n; ++i) {
+    colliding += s->colliding[i] && s->flags[i] == NODE_FREE;
+    if (s->flags[i] == NODE_FREE) continue;
+    piola__body_constrained_state(s, i, pb.t1, s->x + 3 * i, s->v + 3 * i);
+  }
+  stats->colliding += colliding;
+  for (int64_t j = 0; j < m; ++j)
+    if (!isfinite(s->v[j]) || !isfinite(s->x[j]))
+      return PIOLA_FAIL(PIOLA_ERROR_NOT_FINITE,
+                        "solid '%s': state of vertex %lld became non-finite at t = %g s", s->name,
+                        (long long)(j / 3), pb.t1);
+  return PIOLA_OK;
+}
+
+static void restore(world_body *s, double t) {
+  size_t v3 = 3 * (size_t)s->n * sizeof(double);
+  s->product_valid = 0;
+  memcpy(s->x, s->x_old, v3);
+  memcpy(s->v, s->v_old, v3);
+  memcpy(s->force, s->force_old, v3);
+  (void)piola__body_update_forces(s, t);
+}
+
+/* A step whose Newton does not converge is undone and retried at half the size up to this
+ * many times; the last try keeps its best iterate (a force field that jumps, as the
+ * extended stress of an element passing through a reflection does, may have no exact
+ * root) and the step goes on, counted in newton_failures. */
+#define MAX_HALVINGS 3
+
+piola_status piola__implicit_world_step(piola_world *w, double dt_limit, piola_step_stats *stats) {
+  piola_step_stats local = {0};
+  double dt = w->def.implicit_dt;
+  /* a limit a rounding error above the step is the caller's target: land on it */
+  if (dt_limit > 0 && dt_limit <= dt * (1 + 1e-9)) dt = dt_limit;
+  if (!(dt > 0)) return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "step: dt must be > 0, got %g", dt);
+  int shells = 0;
+  for (int32_t i = 0; i < w->body_count; ++i) shells += w->bodies[i].kind != PIOLA_BODY_SOLID;
+  if (shells > 0)
+    return PIOLA_FAIL(PIOLA_ERROR_UNSUPPORTED,
+                      "integrator '%s' does not step shells yet: use \"newmark\" for scenes with "
+                      "shells", piola_integrator_type_name(w->def.integrator));
+  double left;
+  PIOLA_TRY(piola__world_collision_open(w, &left));
+  for (int halvings = 0;; ++halvings) {
+    piola_status st = PIOLA_OK;
+    int32_t done = 0;
+    for (; done < w->body_count && st == PIOLA_OK; ++done)
+      st = newton_solid(w, &w->bodies[done], w->time, dt, halvings == MAX_HALVINGS, &local);
+    if (st == PIOLA_OK) break;
+    for (int32_t j = 0; j < done; ++j) restore(&w->bodies[j], w->time);
+    if (st != PIOLA_ERROR_NOT_CONVERGED) {
+      if (stats) *stats = local;
+      return st;
+    }
+    local.newton_failures++;
+    dt *= 0.5;
+  }
+  const int closes = dt >= left || dt == w->collision_deadline - w->time;
+  piola_status contact = piola__world_self_collide(w, dt, w->time + dt, closes, &local);
+  if (contact != PIOLA_OK) {
+    for (int32_t j = 0; j < w->body_count; ++j) restore(&w->bodies[j], w->time);
+    if (stats) *stats = local;
+    return contact;
+  }
+  for (int32_t i = 0; i < w->body_count; ++i) piola__body_plastic_after_step(&w->bodies[i], dt);
+  w->time += dt;
+  local.substeps = 1;
+  local.last_dt = dt;
+  if (stats) *stats = local;
+  return PIOLA_OK;
+}

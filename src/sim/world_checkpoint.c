@@ -1,0 +1,430 @@
+/* Checkpoints (piola/checkpoint.h): the world's state as a flat, checksummed byte stream.
+ *
+ * Layout (docs/file-formats.md): a 48-byte header (magic, format version, byte-order mark,
+ * scene key, frame, payload length, body counts), the payload, and an FNV-1a 64 checksum
+ * of everything before it. The payload is a sequence of arrays, each a u64 element count
+ * then the elements, in a fixed order per body of the world's body table (its order: by
+ * kind, then as added), each by its kind's own function (a switch on the kind, so a new kind
+ * without checkpoint code does not compile, -Wswitch). Reading runs the
+ * payload twice: a dry pass that checks every count against the world, then the pass that
+ * stores, so a mismatched file changes nothing.
+ *
+ * Why raw per-element state instead of recomputing it from the positions: the force of the
+ * last update was computed before the plastic update changed Dm^-1 Fp^-1 (the plastic lag
+ * is one step, world_plasticity.c), and the damping operator assembled then is reused by
+ * the next step, so a recomputation would not reproduce their bits. What is saved is what
+ * the next step reads; scratch arrays are not. */
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "common/status_report.h"
+#include "force/elastic_body_internal.h"
+#include "piola/files.h"
+#include "piola/checkpoint.h"
+#include "plasticity/plastic_state.h"
+#include "shell/shell_body_internal.h"
+#include "sim/world_internal.h"
+
+enum { HEADER_BYTES = 48 };
+static const char magic[8] = {'P', 'I', 'O', 'L', 'A', 'C', 'K', 'P'};
+static const uint32_t byte_order_mark = 0x01020304u;
+
+static uint64_t fnv1a(uint64_t h, const void *data, size_t n) {
+  const unsigned char *p = data;
+  for (size_t i = 0; i < n; ++i) {
+    h ^= p[i];
+    h *= 0x100000001b3ull;
+  }
+  return h;
+}
+#define FNV_OFFSET 0xcbf29ce484222325ull
+
+int piola_world_checkpoint_supported(const piola_world *w, const char **why) {
+  static const char *const contact =
+      "checkpoints do not cover self-collision (contact between deformable surfaces)";
+  *why = NULL;
+  for (int32_t i = 0; i < w->body_count; ++i) {
+    if (w->bodies[i].self_collision.enabled) {
+      *why = contact;
+      return 0;
+    }
+  }
+  return 1;
+}
+
+uint64_t piola_world_scene_key(const piola_world *w, const void *scene, size_t length) {
+  uint64_t h = FNV_OFFSET;
+  if (scene) h = fnv1a(h, scene, length);
+  for (int32_t i = 0; i < w->body_count; ++i) {
+    const world_body *b = &w->bodies[i];
+    int32_t kind = (int32_t)b->kind;
+    h = fnv1a(h, &kind, sizeof kind);
+    switch (b->kind) {
+      case PIOLA_BODY_SOLID: {
+        const piola_elastic_body *e = b->solid;
+        h = fnv1a(h, e->rest_positions, 3 * (size_t)e->vertex_count * sizeof(double));
+        h = fnv1a(h, e->tets, 4 * (size_t)e->tet_count * sizeof(int32_t));
+        h = fnv1a(h, e->masses, (size_t)e->vertex_count * sizeof(double));
+        break;
+      }
+      case PIOLA_BODY_SHELL: {
+        const piola_shell_body *sh = b->shell;
+        h = fnv1a(h, sh->rest_positions, 3 * (size_t)sh->vertex_count * sizeof(double));
+        h = fnv1a(h, sh->triangle_indices, 3 * (size_t)sh->triangle_count * sizeof(int32_t));
+        h = fnv1a(h, sh->masses, (size_t)sh->vertex_count * sizeof(double));
+        break;
+      }
+      case PIOLA_BODY_NONE:
+        break;
+    }
+  }
+  int32_t counts[2] = {w->body_count, w->obstacle_count};
+  return fnv1a(h, counts, sizeof counts);
+}
+
+/* ------------------------------------------------------------------ the byte stream */
+
+/* Writing appends to data; reading (data fixed) advances pos and, when store is 0, only
+ * checks. failed is set on a count mismatch, a short payload or out of memory. */
+typedef struct stream {
+  unsigned char *data;
+  size_t length, capacity, pos;
+  int reading, store, failed;
+  char what[160]; /* the first mismatch, for the message */
+} stream;
+
+static void put(stream *s, const void *p, size_t n) {
+  if (s->failed) return;
+  if (s->length + n > s->capacity) {
+    size_t cap = s->capacity ? s->capacity : 1 << 16;
+    while (cap < s->length + n) cap *= 2;
+    unsigned char *grown = realloc(s->data, cap);
+    if (!grown) {
+      s->failed = 1;
+      snprintf(s->what, sizeof s->what, "out of memory");
+      return;
+    }
+    s->data = grown;
+    s->capacity = cap;
+  }
+  memcpy(s->data + s->length, p, n);
+  s->length += n;
+}
+
+static int take(stream *s, void *p, size_t n, const char *what) {
+  if (s->failed) return 0;
+  if (s->length - s->pos < n) {
+    s->failed = 1;
+    snprintf(s->what, sizeof s->what, "%s: the payload ends early", what);
+    return 0;
+  }
+  if (s->store && p) memcpy(p, s->data + s->pos, n);
+  s->pos += n;
+  return 1;
+}
+
+/* One array of count elements of size bytes: its count, then the bytes. */
+static void field(stream *s, void *p, uint64_t count, size_t size, const char *what) {
+  if (!s->reading) {
+    put(s, &count, sizeof count);
+    if (count) put(s, p, (size_t)count * size);
+    return;
+  }
+  uint64_t stored;
+  int store = s->store;
+  s->store = 1; /* the count is always read */
+  int ok = take(s, &stored, sizeof stored, what);
+  s->store = store;
+  if (!ok) return;
+  if (stored != count) {
+    s->failed = 1;
+    snprintf(s->what, sizeof s->what, "%s: %llu values, this scene has %llu", what,
+             (unsigned long long)stored, (unsigned long long)count);
+    return;
+  }
+  if (count) take(s, p, (size_t)count * size, what);
+}
+
+static void doubles(stream *s, double *p, uint64_t n, const char *what) {
+  field(s, p, n, sizeof(double), what);
+}
+static void one_double(stream *s, double *p, const char *what) {
+  field(s, p, 1, sizeof(double), what);
+}
+static void one_int(stream *s, int32_t *p, const char *what) {
+  field(s, p, 1, sizeof(int32_t), what);
+}
+
+/* Values the reader needs on both passes (flags that decide later counts): stored into the
+ * caller's locals even on the dry pass. */
+static void local_doubles(stream *s, double *p, uint64_t n, const char *what) {
+  int store = s->store;
+  s->store = 1;
+  doubles(s, p, n, what);
+  s->store = store;
+}
+static void local_int(stream *s, int32_t *p, const char *what) {
+  int store = s->store;
+  s->store = 1;
+  one_int(s, p, what);
+  s->store = store;
+}
+
+/* ------------------------------------------------------------------ per body */
+
+static void elastic_state(stream *s, world_body *b) {
+  piola_elastic_body *e = b->solid;
+  const uint64_t np = (uint64_t)e->padded_tet_count, n3 = 3 * (uint64_t)b->n;
+  doubles(s, b->force, n3, "elastic force");
+  doubles(s, e->u[0], 9 * np, "U");
+  doubles(s, e->v[0], 9 * np, "V");
+  doubles(s, e->fhat, 3 * np, "Fhat");
+  doubles(s, e->det_f, np, "det F");
+  doubles(s, e->positions, 3 * (uint64_t)e->vertex_count, "update positions");
+  for (int k = 0; k < 9; ++k) doubles(s, e->dm_inv[k], np, "effective Dm^-1");
+  one_double(s, &e->activation, "activation");
+  one_double(s, &e->last_stiffness_scale, "stiffness scale");
+  int32_t has_state = e->has_state;
+  local_int(s, &has_state, "has_state");
+  /* the damping operator the next step starts from: its viscosities and blocks, and
+   * whether the last solve's product (taken with it) is current */
+  piola__damping_matrix *m = &e->damping;
+  int32_t ready = m->ready && m->blocks;
+  local_int(s, &ready, "damping ready");
+  double visc[2] = {m->shear_viscosity, m->bulk_viscosity};
+  local_doubles(s, visc, 2, "damping viscosities");
+  const uint64_t blocks = ready ? 9 * (uint64_t)m->edge_count : 0;
+  double *saved = NULL;
+  if (s->reading && s->store && blocks && !(saved = malloc((size_t)blocks * sizeof(double)))) {
+    s->failed = 1;
+    snprintf(s->what, sizeof s->what, "out of memory");
+    return;
+  }
+  doubles(s, s->reading ? saved : m->blocks, blocks, "damping blocks");
+  int32_t product = b->product_valid && ready && b->product_generation == m->generation;
+  local_int(s, &product, "product valid");
+  one_double(s, &b->product_h, "product h");
+  doubles(s, b->av_product, product ? n3 : 0, "product A v");
+  doubles(s, b->v_product, product ? n3 : 0, "product v");
+  if (s->reading && s->store && !s->failed) {
+    e->has_state = has_state;
+    e->energy_valid = 0; /* recomputed from Fhat when asked */
+    b->elastic_stale = 1;
+    b->state_rate_valid = 0; /* the step bound: recomputed from the restored Fhat */
+    m->ready = 0;
+    if (ready) {
+      /* allocate and assemble (the structure), then put back the saved blocks */
+      piola__elastic_body_damping_prepare(e, visc[0], visc[1]);
+      memcpy(m->blocks, saved, (size_t)blocks * sizeof(double));
+    }
+    b->product_valid = product;
+    if (product) b->product_generation = m->generation;
+  }
+  free(saved);
+}
+
+static void plastic_state(stream *s, world_body *b) {
+  piola_plastic_state *p = b->plastic;
+  int32_t present = p != NULL;
+  local_int(s, &present, "plasticity");
+  if (s->failed || !present || !p) {
+    if (s->reading && !s->failed && present != (p != NULL)) {
+      s->failed = 1;
+      snprintf(s->what, sizeof s->what, "solid '%s': plasticity differs from this scene", b->name);
+    }
+    return;
+  }
+  const uint64_t np = (uint64_t)p->padded_count;
+  doubles(s, p->fp_inv, 9 * np, "Fp^-1");
+  doubles(s, p->alpha, np, "plastic strain");
+  doubles(s, p->stretch_bound, np, "stretch bound");
+  doubles(s, p->block_bound, np / PIOLA_PLASTIC_LANES, "block bound");
+  one_int(s, &p->refresh_phase, "refresh phase");
+  doubles(s, p->log_fp, p->controlled ? 6 * (uint64_t)p->tet_count : 0, "log Fp");
+  field(s, &b->plastic_stats, 1, sizeof b->plastic_stats, "plastic stats");
+}
+
+static void shell_state(stream *s, world_body *b) {
+  piola_shell_body *sh = b->shell;
+  const uint64_t nt = (uint64_t)sh->triangle_count, nh = (uint64_t)sh->hinge_count;
+  doubles(s, b->force, 3 * (uint64_t)b->n, "shell force");
+  for (uint64_t t = 0; t < nt; ++t) {
+    shell_triangle *tri = &sh->triangles[t];
+    doubles(s, tri->fp_inv, 4, "triangle Fp^-1");
+    doubles(s, tri->dm_inv_eff, 4, "triangle Dm^-1 Fp^-1");
+    doubles(s, tri->u, 6, "triangle U");
+    doubles(s, tri->vrot, 4, "triangle V");
+    doubles(s, tri->fhat, 2, "triangle Fhat");
+    one_double(s, &tri->energy_density, "triangle energy density");
+  }
+  for (uint64_t h = 0; h < nh; ++h) {
+    one_double(s, &sh->hinges[h].angle, "hinge angle");
+    one_double(s, &sh->hinges[h].rest_angle, "hinge rest angle"); /* bending plasticity moves it */
+    doubles(s, sh->hinges[h].grad, 12, "hinge gradient");
+  }
+  doubles(s, sh->triangle_forces, 9 * nt, "triangle forces");
+  doubles(s, sh->hinge_forces, sh->hinge_forces ? 12 * nh : 0, "hinge forces");
+  doubles(s, sh->angles, sh->angles ? nh : 0, "angles");
+  doubles(s, sh->rest_angles, sh->rest_angles ? nh : 0, "rest angles");
+  doubles(s, sh->fhat, 2 * nt, "shell Fhat");
+  doubles(s, sh->fp_inv, 4 * nt, "shell Fp^-1");
+  one_double(s, &sh->last_stiffness_scale, "shell stiffness scale");
+  field(s, &b->shell_stats, 1, sizeof b->shell_stats, "shell stats");
+}
+
+static void world_state(stream *s, piola_world *w) {
+  one_double(s, &w->time, "time");
+  for (int32_t i = 0; i < w->body_count && !s->failed; ++i) {
+    world_body *b = &w->bodies[i];
+    int32_t kind = (int32_t)b->kind;
+    local_int(s, &kind, "body kind");
+    if (!s->failed && kind != (int32_t)b->kind) {
+      s->failed = 1;
+      snprintf(s->what, sizeof s->what, "body %d is a %s in this scene", (int)i,
+               piola__body_kind_name(b->kind));
+      return;
+    }
+    doubles(s, b->x, 3 * (uint64_t)b->n, "positions");
+    doubles(s, b->v, 3 * (uint64_t)b->n, "velocities");
+    switch (b->kind) {
+      case PIOLA_BODY_SOLID:
+        elastic_state(s, b);
+        plastic_state(s, b);
+        break;
+      case PIOLA_BODY_SHELL:
+        shell_state(s, b);
+        break;
+      case PIOLA_BODY_NONE:
+        break;
+    }
+  }
+}
+
+/* ------------------------------------------------------------------ files */
+
+static void put_u32(unsigned char *p, uint32_t v) { memcpy(p, &v, 4); }
+static void put_u64(unsigned char *p, uint64_t v) { memcpy(p, &v, 8); }
+static uint32_t get_u32(const unsigned char *p) {
+  uint32_t v;
+  memcpy(&v, p, 4);
+  return v;
+}
+static uint64_t get_u64(const unsigned char *p) {
+  uint64_t v;
+  memcpy(&v, p, 8);
+  return v;
+}
+
+piola_status piola_world_checkpoint_write(const piola_world *world, const char *path,
+                                          uint64_t scene_key, int32_t frame) {
+  if (!world || !path) return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "checkpoint: NULL argument");
+  const char *why;
+  if (!piola_world_checkpoint_supported(world, &why))
+    return PIOLA_FAIL(PIOLA_ERROR_UNSUPPORTED, "%s: %s", path, why);
+  stream s = {0};
+  unsigned char header[HEADER_BYTES] = {0};
+  put(&s, header, sizeof header);
+  world_state(&s, (piola_world *)world); /* writing only reads the world */
+  if (s.failed) {
+    free(s.data);
+    return PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "%s: %s", path, s.what);
+  }
+  unsigned char *h = s.data;
+  memcpy(h, magic, 8);
+  put_u32(h + 8, PIOLA_CHECKPOINT_VERSION);
+  put_u32(h + 12, byte_order_mark);
+  put_u64(h + 16, scene_key);
+  put_u32(h + 24, (uint32_t)frame);
+  put_u32(h + 28, (uint32_t)(world->body_count));
+  put_u64(h + 32, (uint64_t)(s.length - HEADER_BYTES));
+  put_u32(h + 40, (uint32_t)(world->obstacle_count));
+  put_u32(h + 44, 0);
+  uint64_t sum = fnv1a(FNV_OFFSET, s.data, s.length);
+  put(&s, &sum, sizeof sum);
+  if (s.failed) {
+    free(s.data);
+    return PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "%s: out of memory", path);
+  }
+  piola_atomic_file f;
+  piola_status st = piola_atomic_file_open(&f, path);
+  if (st == PIOLA_OK) {
+    if (fwrite(s.data, 1, s.length, f.stream) != s.length) {
+      piola_atomic_file_abort(&f);
+      st = PIOLA_FAIL(PIOLA_ERROR_IO, "%s: write failed", path);
+    } else {
+      st = piola_atomic_file_commit(&f);
+    }
+  }
+  free(s.data);
+  return st;
+}
+
+static piola_status read_file(const char *path, stream *s) {
+  FILE *f = fopen(path, "rb");
+  if (!f) return PIOLA_FAIL(PIOLA_ERROR_IO, "%s: cannot open", path);
+  unsigned char buf[1 << 16];
+  size_t n;
+  while ((n = fread(buf, 1, sizeof buf, f)) > 0) put(s, buf, n);
+  int bad = ferror(f);
+  fclose(f);
+  if (bad) return PIOLA_FAIL(PIOLA_ERROR_IO, "%s: read error", path);
+  if (s->failed) return PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "%s: out of memory", path);
+  return PIOLA_OK;
+}
+
+piola_status piola_world_checkpoint_read(piola_world *world, const char *path, uint64_t scene_key,
+                                         int32_t *frame) {
+  if (!world || !path || !frame)
+    return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "checkpoint: NULL argument");
+  stream s = {0};
+  piola_status st = read_file(path, &s);
+  if (st != PIOLA_OK) {
+    free(s.data);
+    return st;
+  }
+  const unsigned char *h = s.data;
+  if (s.length < HEADER_BYTES + 8 || memcmp(h, magic, 8) != 0)
+    st = PIOLA_FAIL(PIOLA_ERROR_PARSE, "%s: not a piola checkpoint", path);
+  else if (get_u32(h + 8) != PIOLA_CHECKPOINT_VERSION)
+    st = PIOLA_FAIL(PIOLA_ERROR_UNSUPPORTED,
+                    "%s: checkpoint format version %u, this piola reads version %d only", path,
+                    (unsigned)get_u32(h + 8), PIOLA_CHECKPOINT_VERSION);
+  else if (get_u32(h + 12) != byte_order_mark)
+    st =
+        PIOLA_FAIL(PIOLA_ERROR_UNSUPPORTED, "%s: written on a machine of another byte order", path);
+  else if (get_u64(h + 32) != s.length - HEADER_BYTES - 8)
+    st = PIOLA_FAIL(PIOLA_ERROR_PARSE, "%s: %zu bytes, the header says %llu (a truncated file)",
+                    path, s.length, (unsigned long long)get_u64(h + 32) + HEADER_BYTES + 8);
+  else if (fnv1a(FNV_OFFSET, s.data, s.length - 8) != get_u64(s.data + s.length - 8))
+    st = PIOLA_FAIL(PIOLA_ERROR_PARSE, "%s: checksum mismatch (a damaged file)", path);
+  else if (get_u64(h + 16) != scene_key)
+    st = PIOLA_FAIL(PIOLA_ERROR_UNSUPPORTED,
+                    "%s was written for another scene (its scene file or meshes differ: key "
+                    "%016llx, this scene's %016llx)",
+                    path, (unsigned long long)get_u64(h + 16), (unsigned long long)scene_key);
+  else if ((int32_t)get_u32(h + 28) != world->body_count ||
+           (int32_t)get_u32(h + 40) != world->obstacle_count)
+    st = PIOLA_FAIL(PIOLA_ERROR_UNSUPPORTED, "%s: body or obstacle counts differ from this scene",
+                    path);
+  if (st == PIOLA_OK) {
+    s.length -= 8; /* the checksum */
+    s.reading = 1;
+    for (int pass = 0; pass < 2 && !s.failed; ++pass) {
+      s.pos = HEADER_BYTES;
+      s.store = pass;
+      world_state(&s, world);
+      if (!s.failed && s.pos != s.length) {
+        s.failed = 1;
+        snprintf(s.what, sizeof s.what, "%zu bytes left over", s.length - s.pos);
+      }
+    }
+    if (s.failed)
+      st = PIOLA_FAIL(PIOLA_ERROR_PARSE, "%s: does not fit this scene: %s", path, s.what);
+    else
+      *frame = (int32_t)get_u32(h + 24);
+  }
+  if (st == PIOLA_OK) piola__world_collision_reset(world);
+  free(s.data);
+  return st;
+}

@@ -1,0 +1,264 @@
+/* Solids in the world: adding them, the solid kind's operations (forces, step bound, stats;
+ * dispatched by body.c) and the solid accessors of piola/world.h. A solid is a world_body of
+ * kind PIOLA_BODY_SOLID whose object is a piola_elastic_body. */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "common/status_report.h"
+#include "force/elastic_body_internal.h"
+#include "force/stable_step.h"
+#include "math/mat3.h"
+#include "sim/world_internal.h"
+
+/* Without stats: the energy goes through the scalar material function per tet, which cost
+ * more than the whole vectorized force loop (measured 10 ms against 8.5 ms per update on
+ * the 97,878-tet torus, one thread) and stepping does not need it. piola_world_solid_stats
+ * computes it from the update's per-tet state when asked (once per frame in `piola run`). */
+piola_status piola__solid_update_forces(world_body *b, double t) {
+  double scale = piola_track_eval(&b->stiffness_scale, t);
+  piola_elastic_body_set_activation(b->solid, piola_track_eval(&b->activation, t));
+  b->elastic_stale = 1;
+  b->state_rate_valid = 0;
+  return piola_elastic_body_update(b->solid, b->x, scale, b->force, NULL);
+}
+
+/* The state-aware bound of solid b (stable_step.h), computed once per update. */
+static double solid_state_rate2(const world_body *b) {
+  world_body *cache = (world_body *)b; /* a cache of a function of the const state */
+  if (!cache->state_rate_valid) {
+    cache->state_rate2 = piola__elastic_body_state_rate2(b->solid, &cache->state_worst_tet);
+    cache->state_rate_valid = 1;
+  }
+  return b->state_rate2;
+}
+
+/* The step of solid b: its rest bound cfl h_min / c, or the state-aware bound cfl /
+ * sqrt(max_e s k_e / (rho h_e^2)) where that is smaller (docs/time-stepping.md, "Step size").
+ * At rest the two agree up to rounding, so the state bound takes over only when it is
+ * smaller by more than rounding: a state at rest keeps the rest step's bits. */
+double piola__solid_stable_dt(const piola_world *w, const world_body *b, double scale) {
+  const double stiffening = piola__solid_plastic_stiffening(b);
+  double speed = piola_elastic_body_max_wave_speed(b->solid) * sqrt(scale);
+  double h = piola_elastic_body_min_rest_altitude(b->solid) / stiffening;
+  if (!(speed > 0 && h > 0)) return INFINITY;
+  double rest = w->def.cfl * h / speed;
+  double rate2 = solid_state_rate2(b) * scale * stiffening * stiffening;
+  double state = rate2 > 0 ? w->def.cfl / sqrt(rate2) : INFINITY;
+  return state < rest * (1.0 - 1e-9) ? state : rest;
+}
+
+/* The elastic statistics of the last update, from its per-tet state (energy density lazily
+ * by the body), summed serially in tet order. */
+static void refresh_elastic_stats(world_body *s) {
+  if (!s->elastic_stale) return;
+  const piola_elastic_body *b = s->solid;
+  const double *psi = piola_elastic_body_energy_density(b), *det = piola_elastic_body_det_f(b);
+  double energy = 0, min_det = INFINITY;
+  int32_t inverted = 0;
+  for (int32_t t = 0; t < b->tet_count; ++t) {
+    energy += b->rest_volume[t] * psi[t];
+    inverted += det[t] < 0;
+    min_det = fmin(min_det, det[t]);
+  }
+  s->elastic.elastic_energy = energy;
+  s->elastic.inverted_count = inverted;
+  s->elastic.min_det_f = min_det;
+  s->elastic_stale = 0;
+}
+
+/* 1/2 sum m |v|^2 and sum m v over the nodes, in node order. */
+static void kinetic(const world_body *b, double *energy, double momentum[3]) {
+  double ke = 0, p[3] = {0, 0, 0};
+  for (int32_t i = 0; i < b->n; ++i) {
+    const double *v = b->v + 3 * i;
+    ke += 0.5 * b->mass[i] * (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
+    for (int k = 0; k < 3; ++k) p[k] += b->mass[i] * v[k];
+  }
+  *energy = ke;
+  for (int k = 0; k < 3; ++k) momentum[k] = p[k];
+}
+
+piola_body_stats piola__solid_stats(world_body *b) {
+  piola_body_stats st;
+  memset(&st, 0, sizeof st);
+  refresh_elastic_stats(b);
+  kinetic(b, &st.kinetic_energy, st.momentum);
+  st.elastic_energy = b->elastic.elastic_energy;
+  st.inverted_count = b->elastic.inverted_count;
+  return st;
+}
+
+/* splitmix64: a small, well-mixed, seedable generator so scrambles reproduce. */
+static uint64_t splitmix(uint64_t *state) {
+  uint64_t z = (*state += 0x9E3779B97F4A7C15ull);
+  z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
+  z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
+  return z ^ (z >> 31);
+}
+
+static double uniform(uint64_t *state) { return (double)(splitmix(state) >> 11) * 0x1.0p-53; }
+
+static vec3 random_in_ball(uint64_t *state, double radius) {
+  for (;;) {
+    vec3 p = {2 * uniform(state) - 1, 2 * uniform(state) - 1, 2 * uniform(state) - 1};
+    if (vec3_norm2(p) <= 1) return vec3_scale(p, radius);
+  }
+}
+
+/* Every value of a track (checked by piola__track_ok) is at most hi. */
+static int track_at_most(const piola_track *t, double hi) {
+  if (t->key_count == 0) return t->value <= hi;
+  for (int32_t k = 0; k < t->key_count; ++k)
+    if (t->values[k] > hi) return 0;
+  return 1;
+}
+
+static piola_status check_solid_def(const piola_solid_def *def, int32_t id) {
+  if (!def->mesh) return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "solid %d: mesh is required", (int)id);
+  if (!(def->density > 0) || !isfinite(def->density))
+    return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "solid %d: density must be > 0 kg/m^3, got %g",
+                      (int)id, def->density);
+  if (!piola__track_ok(&def->stiffness_scale, 0))
+    return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "solid %d: stiffness_scale must be >= 0", (int)id);
+  if (!piola__track_ok(&def->shear_viscosity, 0) || !piola__track_ok(&def->bulk_viscosity, 0))
+    return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "solid %d: viscosities must be >= 0 Pa s", (int)id);
+  if (!(def->scramble_radius >= 0) || !isfinite(def->scramble_radius))
+    return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "solid %d: scramble radius must be >= 0 m",
+                      (int)id);
+  if (!mat3_is_finite(def->initial_matrix))
+    return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "solid %d: initial matrix must be finite", (int)id);
+  if (def->self_collision.enabled &&
+      (!(def->self_collision.thickness > 0) || !isfinite(def->self_collision.thickness) ||
+       !(def->self_collision.friction >= 0) || !isfinite(def->self_collision.friction)))
+    return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT,
+                      "solid %d: self_collision needs thickness > 0 m and friction >= 0, got %g, %g",
+                      (int)id, def->self_collision.thickness, def->self_collision.friction);
+  if (!isfinite(def->velocity.x) || !isfinite(def->velocity.y) || !isfinite(def->velocity.z))
+    return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "solid %d: velocity must be finite", (int)id);
+  if (!piola__track_ok(&def->activation, 0) || !track_at_most(&def->activation, 1))
+    return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "solid %d: activation must be in [0, 1]", (int)id);
+  if (def->fiber_directions && def->plasticity)
+    return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT,
+                      "solid %d: fiber directions cannot be combined with plasticity (not supported)",
+                      (int)id);
+  return PIOLA_OK;
+}
+
+/* Everything of a new solid after its slot in the table: the elastic body, the per-node
+ * state, constraints, plasticity, the initial state and its forces. */
+static piola_status fill_solid(piola_world *world, world_body *s, const piola_solid_def *def,
+                               int32_t id) {
+  piola_material material;
+  PIOLA_TRY(piola_material_init(&def->material, &material));
+  piola_elastic_body_def bdef = piola_default_elastic_body_def();
+  bdef.rest_mesh = def->mesh;
+  bdef.materials = &material;
+  bdef.material_count = 1;
+  bdef.density = def->density;
+  bdef.fiber_directions = def->fiber_directions;
+  piola_status st = piola_elastic_body_create(&bdef, &s->solid);
+  if (st != PIOLA_OK) {
+    s->solid = NULL;
+    return st;
+  }
+  int32_t n = piola_elastic_body_vertex_count(s->solid);
+  const double *rest = piola_elastic_body_rest_positions(s->solid);
+  PIOLA_TRY(piola__body_allocate(s, n, def->name, id, rest, piola_elastic_body_masses(s->solid)));
+  s->stiffness_scale = def->stiffness_scale;
+  s->shear_viscosity = def->shear_viscosity;
+  s->bulk_viscosity = def->bulk_viscosity;
+  s->activation = def->activation;
+  s->self_collision = def->self_collision;
+  PIOLA_TRY(piola__body_apply_constraints(s, rest, def->constraints, def->constraint_count));
+  PIOLA_TRY(piola__solid_plastic_create(s, def));
+  piola__body_finish_masses(s);
+  /* initial state: free nodes deformed about the rest centroid, constrained ones at rest */
+  vec3 c = {0, 0, 0};
+  for (int32_t i = 0; i < n; ++i) c = vec3_add(c, vec3_load(rest + 3 * i));
+  if (n > 0) c = vec3_scale(c, 1.0 / n);
+  uint64_t rng = def->scramble_seed;
+  for (int32_t i = 0; i < n; ++i) {
+    if (s->flags[i] != NODE_FREE) {
+      piola__body_constrained_state(s, i, world->time, s->x + 3 * i, s->v + 3 * i);
+      continue;
+    }
+    vec3 p = vec3_add(c, mat3_mul_vec(def->initial_matrix, vec3_sub(vec3_load(rest + 3 * i), c)));
+    if (def->scramble_radius > 0) p = vec3_add(p, random_in_ball(&rng, def->scramble_radius));
+    vec3_store(s->x + 3 * i, p);
+    vec3_store(s->v + 3 * i, def->velocity);
+  }
+  PIOLA_TRY(piola__body_update_forces(s, world->time));
+  /* the step bound's per-tet weights come from the rest Dm^-1: built now, before plasticity
+   * or a checkpoint's restored state changes Dm^-1, so a resumed run uses the same ones */
+  (void)solid_state_rate2(s);
+  return PIOLA_OK;
+}
+
+piola_status piola_world_add_solid(piola_world *world, const piola_solid_def *def, int32_t *index) {
+  if (!world || !def) return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "add_solid: NULL argument");
+  PIOLA_TRY(check_solid_def(def, world->kind_count[PIOLA_BODY_SOLID]));
+  int32_t id;
+  world_body *s = piola__world_insert_body(world, PIOLA_BODY_SOLID, &id);
+  if (!s) return PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "add_solid: out of memory");
+  piola_status st = fill_solid(world, s, def, id);
+  if (st != PIOLA_OK) {
+    piola__world_drop_body(world, s);
+    return st;
+  }
+  piola__world_check_slivers(world, s);
+  if (index) *index = id;
+  return PIOLA_OK;
+}
+
+/* ------------------------------------------------------------------ accessors */
+
+int32_t piola_world_solid_count(const piola_world *world) {
+  return world->kind_count[PIOLA_BODY_SOLID];
+}
+
+static const world_body *solid_at(const piola_world *w, int32_t i) {
+  return piola__world_body_of(w, PIOLA_BODY_SOLID, i);
+}
+
+const char *piola_world_solid_name(const piola_world *world, int32_t solid) {
+  const world_body *s = solid_at(world, solid);
+  return s ? s->name : NULL;
+}
+const piola_elastic_body *piola_world_solid_body(const piola_world *world, int32_t solid) {
+  const world_body *s = solid_at(world, solid);
+  return s ? s->solid : NULL;
+}
+const double *piola_world_solid_positions(const piola_world *world, int32_t solid) {
+  const world_body *s = solid_at(world, solid);
+  return s ? s->x : NULL;
+}
+const double *piola_world_solid_velocities(const piola_world *world, int32_t solid) {
+  const world_body *s = solid_at(world, solid);
+  return s ? s->v : NULL;
+}
+const uint8_t *piola_world_solid_constraint_flags(const piola_world *world, int32_t solid) {
+  const world_body *s = solid_at(world, solid);
+  return s ? s->flags : NULL;
+}
+
+piola_status piola_world_solid_set_state(piola_world *world, int32_t solid, const double *positions,
+                                         const double *velocities) {
+  if (!solid_at(world, solid))
+    return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "set_state: no solid %d", (int)solid);
+  return piola_world_body_set_state(world, piola_world_body_of(world, PIOLA_BODY_SOLID, solid),
+                                    positions, velocities);
+}
+
+piola_solid_stats piola_world_solid_stats(const piola_world *world, int32_t solid) {
+  piola_solid_stats st = {0, 0, 0, 1};
+  world_body *s = (world_body *)solid_at(world, solid); /* the stats are a cache */
+  if (!s) return st;
+  piola_body_stats b = piola__solid_stats(s);
+  st.kinetic_energy = b.kinetic_energy;
+  st.elastic_energy = b.elastic_energy;
+  st.inverted_count = b.inverted_count;
+  st.min_det_f = s->elastic.min_det_f;
+  return st;
+}

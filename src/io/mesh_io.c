@@ -99,6 +99,11 @@ piola_status piola_tet_mesh_read(const char *path, piola_tet_mesh *out) {
   if (strcasecmp(ext, ".msh") == 0) reader = piola__read_gmsh_mem;
   else if (strcasecmp(ext, ".mesh") == 0) reader = piola__read_medit_mem;
   else if (strcasecmp(ext, ".vtu") == 0) reader = piola__read_vtu_mem;
+  else if (strcasecmp(ext, ".obj") == 0 || strcasecmp(ext, ".off") == 0 || strcasecmp(ext, ".stl") == 0)
+    /* a closed surface is the most common wrong input here: say how to get a tet mesh from it */
+    return PIOLA_FAIL(PIOLA_ERROR_UNSUPPORTED,
+                      "%s: '%s' is a surface, not a tet mesh; fill it with tets first: "
+                      "piola mesh generate %s -o mesh.msh (docs/mesher.md)", path, ext, path);
   else
     return PIOLA_FAIL(PIOLA_ERROR_UNSUPPORTED,
                       "%s: unknown tet mesh extension '%s' (expected .node, .ele, .msh, .mesh, .veg, .vtu)", path,

@@ -52,6 +52,10 @@ expect_bad obstacle '{"solids": [{"mesh": {"generate": "box", "half_extents": [0
 expect_bad missing_mesh '{"solids": [{"mesh": "no_such_mesh.veg"}]}' "solids[0].mesh"
 expect_bad bad_index '{"solids": [{"mesh": {"generate": "box", "half_extents": [0.1, 0.1, 0.1], "cell_size": 0.1}, "fixed": [{"indices": [100000]}]}]}' \
   "solids[0].fixed[0].indices[0]: vertex 100000 is out of range"
+# a closed surface given as a solid's mesh: the message says how to fill it with tets
+cp "${PIOLA_DATA_DIR:?}/surface/sphere.obj" "$work/sphere.obj"
+expect_bad surface_mesh "{\"solids\": [{\"mesh\": \"$work/sphere.obj\"}]}" \
+  "is a surface, not a tet mesh; fill it with tets first: piola mesh generate"
 expect_bad not_json '{"solids": [' "invalid JSON"
 
 # a folder that holds anything is refused without --force, and left alone

@@ -113,8 +113,9 @@ static void scrambles_run_to_the_end(void **state) {
           fail_msg("%s, %s, scramble %g m: %s", meshes[mi], piola_material_model_name(models[k]),
                    radius, piola_last_error());
         if (getenv("PIOLA_TEST_VERBOSE"))
-          print_message("%s %s scramble %g m: %d steps\n", meshes[mi],
-                        piola_material_model_name(models[k]), radius, (int)st.substeps);
+          print_message("%s %s scramble %g m: %d steps, %d energy redos\n", meshes[mi],
+                        piola_material_model_name(models[k]), radius, (int)st.substeps,
+                        (int)st.energy_redos);
         piola_world_destroy(w);
       }
     piola_tet_mesh_free(&mesh);

@@ -145,8 +145,8 @@ static piola_status partition_blocks(const piola_elastic_body *body, int parts, 
   const int32_t tets = piola_elastic_body_tet_count(body);
   const int32_t blocks = piola_elastic_body_block_count(body);
   const int32_t *tv = piola_elastic_body_tets(body);
-  if (blocks <= parts) {
-    for (int32_t b = 0; b < blocks; ++b) block_part[b] = b;
+  if (parts == 1 || blocks <= parts) { /* METIS divides by zero for one part */
+    for (int32_t b = 0; b < blocks; ++b) block_part[b] = parts == 1 ? 0 : b;
     return PIOLA_OK;
   }
   idx_t ne = tets, nn = piola_elastic_body_vertex_count(body), ncommon = 3, numflag = 0;

@@ -108,10 +108,11 @@ static void progress(bool tty, int frame, int frames, double t, double elapsed, 
  * mistyped fps (1e-300) or frame count would otherwise run for ever. The estimate uses the
  * step at t = 0; steps shrink under stiffening and contact, so it is a lower bound. */
 static bool budget_ok(const char *scene_path, const piola_world *world, int frames, double fps,
-                      double max_steps) {
+                      double max_steps, bool quiet) {
   double simulated = frames / fps, dt = piola_world_stable_dt(world);
   double steps = simulated / dt;
   if (isfinite(steps) && steps <= max_steps) return true;
+  if (quiet) return false; /* MPI processes other than 0 */
   fprintf(stderr,
           "piola run: %s: %d frames at %g fps are %.3g s of simulated time, about %.3g steps of "
           "%.3g s: more than the limit of %.3g steps. Check fps and frames, or raise the limit "
@@ -199,7 +200,7 @@ static int run(int argc, char **argv, run_mpi *mpi) {
   }
   int frames = frames_override >= 0 ? (int)frames_override : (int)piola_scene_frames(scene);
   double fps = piola_scene_fps(scene);
-  if (!budget_ok(scene_path, world, frames, fps, max_steps)) {
+  if (!budget_ok(scene_path, world, frames, fps, max_steps, !lead)) {
     piola_scene_destroy(scene);
     return 2;
   }

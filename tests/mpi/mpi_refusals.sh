@@ -6,6 +6,8 @@ set -uo pipefail
 piola=$1 examples=$2
 export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1
 export OMPI_MCA_rmaps_base_oversubscribe=1 OMPI_MCA_mpi_yield_when_idle=1
+# in a sanitizer build: OpenMPI does not free its own allocations at exit
+export ASAN_OPTIONS=${ASAN_OPTIONS:-detect_leaks=0}
 mpirun=${PIOLA_MPIEXEC:-mpirun}
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT

@@ -55,14 +55,15 @@ PIOLA_KERNEL_INLINE double fiber_lane(const piola_elastic_body *body, const piol
 /* One lane of an HGO material: its two fibre families from the tet's fibre direction, the
  * stress P_f = g F + sum_a r_a (F a)(a)^T (hgo_kernels.h) in world space, and its forces
  * G_f = -V0 scale P_f Dm^-T added to tf. Returns the energy density. */
-static double hgo_lane(const piola_elastic_body *body, const piola_hgo_def *h, int32_t base, int l,
+static double hgo_lane(const piola_elastic_body *body, const piola_material *mat, int32_t base, int l,
                        double fhat[3][B], double scale, double *tf) {
   const long stride = body->padded_tet_count;
   const double *u = body->u[0] + base, *v = body->v[0] + base;
   const int32_t t = base + l;
   const double m[3] = {body->fiber[0][t], body->fiber[1][t], body->fiber[2][t]};
   double fam[2][3], ahat[2][3];
-  (void)hgo_families_from_fiber(h, m, fam); /* checked when the body was built */
+  const piola_hgo_def *h = &mat->hgo;
+  (void)hgo_families_from_fiber(mat, m, fam); /* checked when the body was built */
   for (int a = 0; a < 2; ++a)
     for (int k = 0; k < 3; ++k)
       ahat[a][k] = v[k * stride + l] * fam[a][0] + v[(3 + k) * stride + l] * fam[a][1] +
@@ -106,7 +107,7 @@ PIOLA_WIDE_VECTORS void piola__fiber_forces_lanes(const piola_elastic_body *body
   if (body->uniform_material >= 0) {
     const piola_material *mat = &body->materials[body->uniform_material];
     if (mat->model == PIOLA_MODEL_HGO) {
-      for (int l = 0; l < B; ++l) energy[l] = hgo_lane(body, &mat->hgo, base, l, fhat, scale, tf);
+      for (int l = 0; l < B; ++l) energy[l] = hgo_lane(body, mat, base, l, fhat, scale, tf);
       if (psi)
         for (int l = 0; l < B; ++l) psi[l] += energy[l];
       return;
@@ -120,7 +121,7 @@ PIOLA_WIDE_VECTORS void piola__fiber_forces_lanes(const piola_elastic_body *body
       const piola_material *mat = &body->materials[body->tet_material[base + l]];
       energy[l] = mat->model == PIOLA_MODEL_MUSCLE
                       ? fiber_lane(body, &mat->muscle, activation, base, l, fhat, scale, tf)
-                  : mat->model == PIOLA_MODEL_HGO ? hgo_lane(body, &mat->hgo, base, l, fhat, scale, tf)
+                  : mat->model == PIOLA_MODEL_HGO ? hgo_lane(body, mat, base, l, fhat, scale, tf)
                                                   : 0.0;
     }
   }
@@ -136,7 +137,7 @@ double piola__fiber_energy_density(const piola_elastic_body *body, int32_t t) {
   if (mat->model == PIOLA_MODEL_HGO) {
     const double m[3] = {body->fiber[0][t], body->fiber[1][t], body->fiber[2][t]};
     double fam[2][3], ahat[2][3], g, r[2];
-    (void)hgo_families_from_fiber(&mat->hgo, m, fam);
+    (void)hgo_families_from_fiber(mat, m, fam);
     for (int a = 0; a < 2; ++a)
       for (int k = 0; k < 3; ++k)
         ahat[a][k] = v[k * stride] * fam[a][0] + v[(3 + k) * stride] * fam[a][1] + v[(6 + k) * stride] * fam[a][2];
@@ -173,7 +174,7 @@ piola_status piola__fiber_copy(piola_elastic_body *body, const piola_elastic_bod
     }
     const piola_material *mat = &body->materials[body->tet_material[t]];
     double unit[3] = {a[0] / n, a[1] / n, a[2] / n}, fam[2][3];
-    if (mat->model == PIOLA_MODEL_HGO && !hgo_families_from_fiber(&mat->hgo, unit, fam))
+    if (mat->model == PIOLA_MODEL_HGO && !hgo_families_from_fiber(mat, unit, fam))
       return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT,
                         "fiber direction of tet %d is parallel to material.hgo.axis: the plane of "
                         "the two fibre families is undefined",

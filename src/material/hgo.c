@@ -51,6 +51,9 @@ piola_status piola__hgo_init(const piola_material_def *def, piola_material *out)
   const double nu = def->poisson_ratio;
   out->mu = h->mu;
   out->lambda = 2.0 * h->mu * nu / (1.0 - 2.0 * nu);
+  const double angle = h->fiber_angle_degrees * (M_PI / 180.0);
+  out->model_constants[HGO_COS_ANGLE] = cos(angle);
+  out->model_constants[HGO_SIN_ANGLE] = h->fiber_angle_degrees == 0.0 ? 0.0 : sin(angle);
   const double q = 1.0 - 2.0 * h->kappa;
   out->fiber_modulus = 8.0 * h->k1 * q * q; /* hgo_fiber_modulus_bound at rest */
   return PIOLA_OK;
@@ -67,7 +70,7 @@ piola_status piola_material_hgo_families(const piola_material *material, const d
     return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "hgo_families: zero or non-finite fibre");
   const double m[3] = {fiber[0] / n, fiber[1] / n, fiber[2] / n};
   double fam[2][3];
-  const int ok = hgo_families_from_fiber(&material->hgo, m, fam);
+  const int ok = hgo_families_from_fiber(material, m, fam);
   memcpy(families, fam, sizeof fam);
   if (!ok)
     return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT,

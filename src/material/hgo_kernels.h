@@ -80,15 +80,15 @@ MATERIAL_KERNEL double hgo_fiber_terms_diagonal(const piola_hgo_def *h, double f
   return energy;
 }
 
-/* The two unit family directions from a unit fibre direction m and the unit axis: false when
- * m is parallel to the axis (to 1e-12) and the angle is not 0. */
-MATERIAL_KERNEL int hgo_families_from_fiber(const piola_hgo_def *h, const double m[3],
+/* The two unit family directions from a unit fibre direction m and the unit axis of an HGO
+ * material: false when m is parallel to the axis (to 1e-12) and the angle is not 0. */
+MATERIAL_KERNEL int hgo_families_from_fiber(const piola_material *material, const double m[3],
                                             double families[2][3]) {
+  const piola_hgo_def *h = &material->hgo;
   const double d = h->axis[0] * m[0] + h->axis[1] * m[1] + h->axis[2] * m[2];
   double n[3] = {h->axis[0] - d * m[0], h->axis[1] - d * m[1], h->axis[2] - d * m[2]};
   const double len = sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
-  const double angle = h->fiber_angle_degrees * (M_PI / 180.0);
-  const double c = cos(angle), s = h->fiber_angle_degrees == 0.0 ? 0.0 : sin(angle);
+  const double c = material->model_constants[HGO_COS_ANGLE], s = material->model_constants[HGO_SIN_ANGLE];
   const int ok = len > 1e-12 || s == 0.0;
   for (int i = 0; i < 3; ++i) n[i] = len > 1e-12 ? n[i] / len : 0.0;
   for (int i = 0; i < 3; ++i) {

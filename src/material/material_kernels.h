@@ -82,7 +82,9 @@ enum {
   ENERGY_GROWTH_4 = 6, /* Pa: a4 */
   OGDEN_COUNT = 7,     /* Ogden and Mooney-Rivlin (as two Ogden terms): the number of terms */
   OGDEN_MU_SUM = 8,    /* Pa: sum_p mu_p, the coefficient of -ln J */
-  OGDEN_TERMS = 9      /* mu_p (Pa) at OGDEN_TERMS + 2 p, alpha_p at OGDEN_TERMS + 2 p + 1 */
+  OGDEN_TERMS = 9,     /* mu_p (Pa) at OGDEN_TERMS + 2 p, alpha_p at OGDEN_TERMS + 2 p + 1 */
+  HGO_COS_ANGLE = 7,   /* HGO (no Ogden terms): cos and sin of hgo.fiber_angle_degrees */
+  HGO_SIN_ANGLE = 8
 };
 
 /* Ogden and Mooney-Rivlin share one code path (Mooney-Rivlin is stored as the Ogden terms

@@ -170,11 +170,12 @@ r = subprocess.run([PIOLA, "run", other, "-o", out, "--resume"], capture_output=
 check(r.returncode == 2 and "another scene" in r.stderr, "a checkpoint of another scene is refused: " + r.stderr.strip())
 newest = f"{out}/checkpoint_0008.bin"
 data = bytearray(open(newest, "rb").read())
+version = data[8]
 data[8] = 99  # the format version
 open(newest, "wb").write(bytes(data))
 r = piola_run(out, "--resume")
 check(r.returncode == 2 and "format version 99" in r.stderr, "another format version is refused: " + r.stderr.strip())
-data[8] = 1
+data[8] = version
 data[len(data) // 2] ^= 0xFF  # damage the payload
 open(newest, "wb").write(bytes(data))
 r = piola_run(out, "--resume")

@@ -22,8 +22,11 @@ typedef struct sheets {
 } sheets;
 
 /* Two GRID x GRID sheets, the upper one a thickness above the lower, shifted and noisy,
- * falling onto it; a few corners pinned. */
-static void make_sheets(sheets *s, test_rng *rng) {
+ * falling onto it; a corner of each pinned (malloc'ed). */
+static sheets *new_sheets(uint64_t seed) {
+  test_rng r = test_rng_seeded(seed), *rng = &r;
+  sheets *s = malloc(sizeof *s);
+  assert_non_null(s);
   int32_t t = 0;
   for (int32_t i = 0; i < VERTICES; ++i) {
     const int32_t layer = i / (GRID * GRID), col = i % GRID, row = (i / GRID) % GRID;
@@ -41,6 +44,7 @@ static void make_sheets(sheets *s, test_rng *rng) {
       t += 2;
     }
   }
+  return s;
 }
 
 static piola_collision_surface *surface_of(const sheets *s) {
@@ -73,10 +77,7 @@ static unsigned char *history_of(const piola_collision_surface *surface, size_t 
 
 static void history_carries_the_impulse_order(void **state) {
   (void)state;
-  test_rng rng = test_rng_seeded(18);
-  sheets *s = malloc(sizeof *s);
-  assert_non_null(s);
-  make_sheets(s, &rng);
+  sheets *s = new_sheets(18);
   piola_collision_surface *ran = surface_of(s);
   for (int call = 0; call < 3; ++call) step(ran, s->x, s->v, s->mass);
   assert_int_equal(ran->tree_age, 3);
@@ -133,10 +134,7 @@ static void assert_refused(piola_collision_surface *surface, const unsigned char
 
 static void histories_that_do_not_fit_are_refused(void **state) {
   (void)state;
-  test_rng rng = test_rng_seeded(7);
-  sheets *s = malloc(sizeof *s);
-  assert_non_null(s);
-  make_sheets(s, &rng);
+  sheets *s = new_sheets(7);
   piola_collision_surface *surface = surface_of(s);
   step(surface, s->x, s->v, s->mass);
   size_t n;

@@ -44,6 +44,11 @@ int piola_world_checkpoint_supported(const piola_world *w, const char **why) {
   static const char *const contact =
       "checkpoints do not cover self-collision (contact between deformable surfaces)";
   *why = NULL;
+  for (int32_t i = 0; i < w->body_count; ++i)
+    if (w->bodies[i].fracture) {
+      *why = "checkpoints do not cover fracture (solids whose mesh is cut during the run)";
+      return 0;
+    }
   for (int32_t i = 0; i < w->body_count; ++i) {
     if (w->bodies[i].self_collision.enabled) {
       *why = contact;

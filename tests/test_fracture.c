@@ -373,6 +373,30 @@ static void cut_body_recovers_from_collapse(void **state) {
   piola_world_destroy(w);
 }
 
+/* Two cuts due at once with max_cuts_per_step 1: the first is applied when the def is set
+ * (time 0), the second before the next step; parallel planes, 3 fragments. */
+static void max_cuts_per_step_spreads_cuts(void **state) {
+  (void)state;
+  piola_tet_mesh mesh;
+  assert_int_equal(piola_tet_mesh_box_grid(5, 5, 5, (piola_vec3){0.2, 0.2, 0.2}, &mesh), PIOLA_OK);
+  piola_world *w = make_world(1e-3);
+  add_solid(w, &mesh, 0);
+  piola_fracture_cut cuts[2] = {{.time = 0, .point = {0.33, 0.5, 0.5}, .normal = {1, 0.1, 0}},
+                                {.time = 0, .point = {0.67, 0.5, 0.5}, .normal = {1, 0.1, 0}}};
+  piola_fracture_def def = piola_default_fracture_def();
+  def.cuts = cuts, def.cut_count = 2, def.max_cuts_per_step = 1;
+  assert_int_equal(piola_world_solid_set_fracture(w, 0, &def), PIOLA_OK);
+  assert_int_equal(piola_world_solid_fragment_count(w, 0), 2);
+  const int32_t first = piola_world_solid_cut_tet_count(w, 0);
+  assert_true(first > 0);
+  assert_int_equal(piola_world_step(w, 0, NULL), PIOLA_OK);
+  assert_int_equal(piola_world_solid_fragment_count(w, 0), 3);
+  assert_true(piola_world_solid_cut_tet_count(w, 0) > first);
+  check_cut_solid(w, 0);
+  free(mesh.positions), free(mesh.tets);
+  piola_world_destroy(w);
+}
+
 static void bad_cuts_are_refused(void **state) {
   (void)state;
   piola_tet_mesh mesh;
@@ -401,6 +425,7 @@ int main(void) {
       cmocka_unit_test(cut_in_free_flight_keeps_momentum),
       cmocka_unit_test(random_cuts_keep_every_invariant),
       cmocka_unit_test(cut_body_recovers_from_collapse),
+      cmocka_unit_test(max_cuts_per_step_spreads_cuts),
       cmocka_unit_test(bad_cuts_are_refused),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);

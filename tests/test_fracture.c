@@ -14,6 +14,7 @@
 #include "piola/elastic_body.h"
 #include "piola/mesh.h"
 #include "piola/mesh_io.h"
+#include "piola/plasticity.h"
 #include "piola/world.h"
 #include "piola/world_fracture.h"
 #include "sim/fracture_internal.h"
@@ -373,6 +374,52 @@ static void cut_body_recovers_from_collapse(void **state) {
   piola_world_destroy(w);
 }
 
+/* A plastic cube squeezed until it yields, then cut: every copy has its original tet's Fp
+ * (bit for bit), and the elastic energy is the same before and after (each copy has its
+ * tet's F and Fp, and the fractions of a tet add up to 1). */
+static void cut_keeps_plastic_state_and_energy(void **state) {
+  (void)state;
+  piola_tet_mesh mesh;
+  assert_int_equal(piola_tet_mesh_box_grid(3, 3, 3, (piola_vec3){0.05, 0.05, 0.05}, &mesh), PIOLA_OK);
+  piola_world *w = make_world(1e-3);
+  piola_solid_def sd = piola_default_solid_def();
+  sd.mesh = &mesh;
+  sd.material.youngs_modulus = 1e5;
+  sd.shear_viscosity = piola_track_constant(2);
+  sd.initial_matrix = (piola_mat3){{{1.25, 0.1, 0}, {0, 1, 0}, {0, 0, 0.8}}};
+  piola_plasticity_def plasticity = piola_default_plasticity_def();
+  plasticity.yield = 0.02;
+  sd.plasticity = &plasticity;
+  assert_int_equal(piola_world_add_solid(w, &sd, NULL), PIOLA_OK);
+  for (int s = 0; s < 5; ++s) assert_int_equal(piola_world_step(w, 0, NULL), PIOLA_OK);
+  double stretch = 0;
+  piola_plastic_state_measure(piola_world_solid_plastic_state(w, 0), &stretch, NULL);
+  assert_true(stretch > 0.01); /* it yielded */
+  const int32_t nt = mesh.tet_count;
+  double *fp = malloc(9 * sizeof(double) * (size_t)nt);
+  memcpy(fp, piola_plastic_state_fp_inverse(piola_world_solid_plastic_state(w, 0)), 9 * sizeof(double) * (size_t)nt);
+  /* refresh the forces and energy for the Fp the step's plastic update left */
+  const int32_t n = mesh.vertex_count;
+  double *x = malloc(3 * sizeof(double) * (size_t)n);
+  memcpy(x, piola_world_solid_positions(w, 0), 3 * sizeof(double) * (size_t)n);
+  assert_int_equal(piola_world_solid_set_state(w, 0, x, NULL), PIOLA_OK);
+  free(x);
+  const double energy = piola_world_solid_stats(w, 0).elastic_energy;
+  assert_true(energy > 0);
+  const double point[3] = {0.07, 0.08, 0.075}, normal[3] = {1, 0.4, -0.3};
+  int32_t count = 0;
+  assert_int_equal(piola_world_solid_cut(w, 0, point, normal, &count), PIOLA_OK);
+  assert_true(count > 0);
+  const piola_plastic_state *plastic = piola_world_solid_plastic_state(w, 0);
+  const int32_t *parent = piola_world_solid_parent_tets(w, 0);
+  assert_int_equal(piola_plastic_state_tet_count(plastic), nt + count);
+  for (int32_t t = 0; t < nt + count; ++t)
+    assert_memory_equal(piola_plastic_state_fp_inverse(plastic) + 9 * t, fp + 9 * parent[t], 9 * sizeof(double));
+  assert_close(piola_world_solid_stats(w, 0).elastic_energy, energy, 1e-12 * energy);
+  free(fp), free(mesh.positions), free(mesh.tets);
+  piola_world_destroy(w);
+}
+
 /* Two cuts due at once with max_cuts_per_step 1: the first is applied when the def is set
  * (time 0), the second before the next step; parallel planes, 3 fragments. */
 static void max_cuts_per_step_spreads_cuts(void **state) {
@@ -425,6 +472,7 @@ int main(void) {
       cmocka_unit_test(cut_in_free_flight_keeps_momentum),
       cmocka_unit_test(random_cuts_keep_every_invariant),
       cmocka_unit_test(cut_body_recovers_from_collapse),
+      cmocka_unit_test(cut_keeps_plastic_state_and_energy),
       cmocka_unit_test(max_cuts_per_step_spreads_cuts),
       cmocka_unit_test(bad_cuts_are_refused),
   };

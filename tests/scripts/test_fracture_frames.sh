@@ -5,7 +5,8 @@
 # `material_fraction` in (0, 1]; the material volumes per fragment and the volumes enclosed
 # by the OBJ objects box_0 and box_1 (each closed: every directed edge has its opposite) are
 # the analytic 0.0048 and 0.0032 m^3 within 0.5%; stats.csv's last columns are `fragments`
-# and `cut_tets`. A fracture key with a criterion or with self_collision is refused naming
+# and `cut_tets`. Next to a ball and a sheet, a box cut at 0.05 s is one object before the
+# cut and two after, each object using exactly its own vertices. A fracture key with a criterion or with self_collision is refused naming
 # its key path, and --checkpoint-every is refused for a scene with fracture.
 set -euo pipefail
 : "${PIOLA:?path of the piola program}"
@@ -94,6 +95,36 @@ header = open(f"{out}/stats.csv").readline().strip().split(",")
 assert header[-2:] == ["fragments", "cut_tets"], header[-2:]
 assert all(r["fragments"] == "2" and int(r["cut_tets"]) > 0 for r in rows), rows
 print("fracture frames ok")
+PY
+# with other bodies: a ball before and a sheet after the cut box, cut at t = 0.05 s (frame 1):
+# frame 0 has one box object, frame 2 two, each object's faces use exactly its own vertices
+cat >"$work/two.json" <<'JSON'
+{"fps": 20, "frames": 2, "gravity": [0, 0, 0],
+ "solids": [
+   {"name": "ball", "mesh": {"generate": "sphere", "center": [0.5, 0, 0], "radius": 0.1, "cell_size": 0.04},
+    "material": {"youngs_modulus": 1e4, "poisson_ratio": 0.3}},
+   {"name": "box", "mesh": "box.mesh", "material": {"youngs_modulus": 1e4, "poisson_ratio": 0.3},
+    "fracture": {"cuts": [{"time": 0.05, "plane": {"point": [0.02, 0, 0], "normal": [1, 0.2, 0.1]}}]}}],
+ "shells": [{"name": "sheet", "mesh": {"generate": "rectangle", "size": [0.4, 0.4], "resolution": [4, 4]},
+             "transform": {"translate": [0, 0, 0.6]}, "thickness": 0.001,
+             "material": {"youngs_modulus": 1e5, "poisson_ratio": 0.3}}]}
+JSON
+"$PIOLA" run "$work/two.json" -o "$work/two" >"$work/log" 2>&1 || { cat "$work/log"; exit 1; }
+python3 - "$work/two/surface" <<'PY'
+import sys
+for frame, names in ((0, ["ball", "box_0", "sheet"]), (2, ["ball", "box_0", "box_1", "sheet"])):
+    objs, nv, owner = [], 0, []
+    for line in open(f"{sys.argv[1]}/frame_{frame:04d}.obj"):
+        w = line.split()
+        if not w or w[0] == "#": continue
+        if w[0] == "o": objs.append({"n": w[1], "f": []})
+        elif w[0] == "v": nv += 1; owner.append(len(objs) - 1)
+        elif w[0] == "f": objs[-1]["f"].append([int(x) for x in w[1:]])
+    assert [o["n"] for o in objs] == names, (frame, [o["n"] for o in objs])
+    for k, o in enumerate(objs):
+        used = {i for f in o["f"] for i in f}
+        assert used == {i + 1 for i in range(nv) if owner[i] == k}, (frame, o["n"])
+print("fracture frames with other bodies ok")
 PY
 # refusals: unbuilt criteria, self_collision, checkpoints
 sed 's/"fracture": {/"fracture": {"criterion": "stress", /' "$work/scene.json" >"$work/criterion.json"

@@ -1,13 +1,14 @@
 #!/usr/bin/env bash
-# Frames of a cut solid (docs/fracture.md, docs/file-formats.md): a 0.2 m box cut at t = 0
+# Frames of a cut solid (docs/fracture.md, docs/cli.md "Output"): a 0.2 m box cut at t = 0
 # by a slanted plane through its tets. Read back by Debian's python3-meshio, every VTU frame
 # holds that frame's tets with the cell fields `fragment` (two values) and
 # `material_fraction` in (0, 1]; the material volumes per fragment and the volumes enclosed
 # by the OBJ objects box_0 and box_1 (each closed: every directed edge has its opposite) are
 # the analytic 0.0048 and 0.0032 m^3 within 0.5%; stats.csv's last columns are `fragments`
 # and `cut_tets`. Next to a ball and a sheet, a box cut at 0.05 s is one object before the
-# cut and two after, each object using exactly its own vertices. A fracture key with a criterion or with self_collision is refused naming
-# its key path, and --checkpoint-every is refused for a scene with fracture.
+# cut and two after, each object using exactly its own vertices. A fracture key with a
+# criterion or with self_collision is refused naming its key path, and --checkpoint-every is
+# refused for a scene with fracture.
 set -euo pipefail
 : "${PIOLA:?path of the piola program}"
 work=$(mktemp -d)

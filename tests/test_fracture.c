@@ -148,6 +148,13 @@ static void check_cut_solid(const piola_world *w, int strict) {
   piola_fracture_surface_free(&s);
 }
 
+static void check_cut_solid_positions_finite(const piola_world *w) {
+  const piola_elastic_body *b = piola_world_solid_body(w, 0);
+  const double *x = piola_world_solid_positions(w, 0), *f = piola_world_solid_material_fractions(w, 0);
+  for (int32_t i = 0; i < 3 * piola_elastic_body_vertex_count(b); ++i) assert_true(isfinite(x[i]));
+  for (int32_t t = 0; t < piola_elastic_body_tet_count(b); ++t) assert_true(f[t] > 0 && f[t] <= 1);
+}
+
 /* One tet cut with one corner alone: its side is the corner tet of edge ratios t_k, the
  * analytic volume prod t_k; both sides' fractions sum to 1 and their surfaces close. */
 static void one_tet_matches_the_corner_volume(void **state) {
@@ -420,6 +427,70 @@ static void cut_keeps_plastic_state_and_energy(void **state) {
   piola_world_destroy(w);
 }
 
+/* A bar fixed at x = 0 and pulled at its other end at 0.5 m/s: with the stress criterion it
+ * breaks once the tension passes the threshold (not before), the pulled end ends in another
+ * fragment than the fixed one, and every invariant holds; with a threshold it never reaches
+ * it stays whole. */
+static int32_t pulled_bar(double threshold, double t_end, double *first_cut_time, piola_world **out) {
+  piola_tet_mesh mesh;
+  assert_int_equal(piola_tet_mesh_box_grid(12, 2, 2, (piola_vec3){0.025, 0.025, 0.025}, &mesh), PIOLA_OK);
+  piola_world *w = make_world(1e-3);
+  piola_solid_def sd = piola_default_solid_def();
+  sd.mesh = &mesh;
+  sd.material.youngs_modulus = 1e5;
+  sd.material.poisson_ratio = 0.3;
+  sd.shear_viscosity = piola_track_constant(5);
+  sd.bulk_viscosity = piola_track_constant(5);
+  piola_constraint_def ends[2];
+  memset(ends, 0, sizeof ends);
+  for (int k = 0; k < 2; ++k) {
+    ends[k].selector.type = PIOLA_SELECT_BOX;
+    ends[k].selector.box_min = (piola_vec3){k ? 0.299 : -0.001, -1, -1};
+    ends[k].selector.box_max = (piola_vec3){k ? 0.301 : 0.001, 1, 1};
+  }
+  ends[1].driven = true;
+  ends[1].motion = piola_default_rigid_motion_def();
+  ends[1].motion.velocity[0] = piola_track_constant(0.5);
+  sd.constraints = ends, sd.constraint_count = 2;
+  assert_int_equal(piola_world_add_solid(w, &sd, NULL), PIOLA_OK);
+  piola_fracture_def def = piola_default_fracture_def();
+  def.criterion = PIOLA_FRACTURE_STRESS, def.threshold = threshold;
+  assert_int_equal(piola_world_solid_set_fracture(w, 0, &def), PIOLA_OK);
+  *first_cut_time = INFINITY;
+  while (piola_world_time(w) < t_end) {
+    assert_int_equal(piola_world_step(w, 0, NULL), PIOLA_OK);
+    if (piola_world_solid_cut_tet_count(w, 0) > 0 && !isfinite(*first_cut_time)) *first_cut_time = piola_world_time(w);
+  }
+  free(mesh.positions), free(mesh.tets);
+  *out = w;
+  return piola_world_solid_fragment_count(w, 0);
+}
+
+static void stress_criterion_breaks_a_pulled_bar(void **state) {
+  (void)state;
+  piola_world *w;
+  double first;
+  assert_int_equal(pulled_bar(1e9, 0.2, &first, &w), 1);
+  assert_false(isfinite(first));
+  piola_world_destroy(w);
+  assert_true(pulled_bar(1.5e4, 0.3, &first, &w) >= 2);
+  assert_true(first > 0.02 && first < 0.3); /* the tension had to build up */
+  /* the pulled end (x = 0.3 + 0.5 t) and the fixed end (x = 0) are in different fragments */
+  const piola_elastic_body *b = piola_world_solid_body(w, 0);
+  const double *x = piola_world_solid_positions(w, 0);
+  const int32_t *tets = piola_elastic_body_tets(b), *frag = piola_world_solid_fragments(w, 0);
+  int32_t fixed = -1, pulled = -1;
+  for (int32_t t = 0; t < piola_elastic_body_tet_count(b); ++t)
+    for (int k = 0; k < 4; ++k) {
+      const double px = x[3 * tets[4 * t + k]];
+      if (fabs(px) < 1e-9) fixed = frag[t];
+      if (fabs(px - (0.3 + 0.5 * piola_world_time(w))) < 1e-6) pulled = frag[t];
+    }
+  assert_true(fixed >= 0 && pulled >= 0 && fixed != pulled);
+  check_cut_solid_positions_finite(w);
+  piola_world_destroy(w);
+}
+
 /* Two cuts due at once with max_cuts_per_step 1: the first is applied when the def is set
  * (time 0), the second before the next step; parallel planes, 3 fragments. */
 static void max_cuts_per_step_spreads_cuts(void **state) {
@@ -474,6 +545,7 @@ int main(void) {
       cmocka_unit_test(cut_body_recovers_from_collapse),
       cmocka_unit_test(cut_keeps_plastic_state_and_energy),
       cmocka_unit_test(max_cuts_per_step_spreads_cuts),
+      cmocka_unit_test(stress_criterion_breaks_a_pulled_bar),
       cmocka_unit_test(bad_cuts_are_refused),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);

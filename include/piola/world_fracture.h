@@ -8,7 +8,7 @@
  * connected piece of material around them, so the pieces move apart. The crack inside a
  * copy is a polygon kept in the tet's barycentric coordinates. A tet is cut at most once:
  * a later plane leaves the tets it finds already cut as they are (the new crack stops
- * there).
+ * there). The stress criterion makes such cuts where the stress passes a threshold.
  *
  *   piola_fracture_cut cut = {.time = 0.1, .point = {0, 0, 0.5}, .normal = {0, 0, 1}};
  *   piola_fracture_def def = piola_default_fracture_def();
@@ -37,11 +37,23 @@ typedef struct piola_fracture_cut {
   piola_vec3 point, normal;
 } piola_fracture_cut;
 
+/* When material breaks by itself (besides the scripted cuts). */
+typedef enum piola_fracture_criterion {
+  PIOLA_FRACTURE_SCRIPTED = 0, /* only the scripted cuts (default) */
+  PIOLA_FRACTURE_STRESS = 1,   /* brittle: before each step, the uncut tet with the largest
+                                  principal Cauchy stress, if it exceeds threshold, is cut with
+                                  its whole solid by the plane through its centroid normal to
+                                  that stress's direction; at most one such cut per step */
+} piola_fracture_criterion;
+
 typedef struct piola_fracture_def {
   const piola_fracture_cut *cuts; /* cut_count cuts, copied; any order (applied by time) */
   int32_t cut_count;
-  int32_t max_cuts_per_step;      /* at most this many cuts are applied before one step; the
-                                     others wait for the next steps. 0 (default): no limit */
+  int32_t max_cuts_per_step;      /* at most this many scripted cuts are applied before one
+                                     step; the others wait for the next steps. 0 (default): no
+                                     limit */
+  piola_fracture_criterion criterion; /* default PIOLA_FRACTURE_SCRIPTED */
+  double threshold;               /* Pa, > 0: the stress criterion's largest principal stress */
 } piola_fracture_def;
 
 PIOLA_API piola_fracture_def piola_default_fracture_def(void);

@@ -1,6 +1,7 @@
-/* A solid's `fracture` key: scripted plane cuts by the virtual node algorithm
- * (docs/fracture.md). */
+/* A solid's `fracture` key: scripted plane cuts by the virtual node algorithm and the stress
+ * criterion (docs/fracture.md). */
 #include <stdlib.h>
+#include <string.h>
 
 #include "scene/scene_parse_sections.h"
 
@@ -27,30 +28,42 @@ static piola_status parse_cut(scene_parser *p, const cJSON *obj, piola_fracture_
 }
 
 /* "fracture": {"cuts": [{"time": t, "plane": {"point": [..], "normal": [..]}}, ...],
- * "max_cuts_per_step": n}. */
+ * "max_cuts_per_step": n, "criterion": "stress", "threshold": Pa}. */
 piola_status piola__scene_parse_fracture(scene_parser *p, const cJSON *obj, scene_solid_desc *d) {
   static const char *const allowed[] = {"cuts", "max_cuts_per_step", "criterion", "threshold", NULL};
   PIOLA_TRY(piola__json_check_keys(p, obj, allowed));
-  if (piola__json_get(obj, "criterion") || piola__json_get(obj, "threshold")) {
-    piola__json_push_key(p, piola__json_get(obj, "criterion") ? "criterion" : "threshold");
-    return piola__json_fail(p, BAD_VALUE,
-                            "fracture by a stress or plastic strain criterion is not supported: "
-                            "give scripted \"cuts\"");
-  }
   if (d->def.self_collision.enabled)
     return piola__json_fail(p, BAD_VALUE, "cannot be combined with self_collision (not supported)");
-  PIOLA_TRY(piola__json_required(p, obj, "cuts"));
+  d->fractures = 1;
+  d->fracture = piola_default_fracture_def();
+  const cJSON *criterion = piola__json_get(obj, "criterion");
+  if (criterion) {
+    size_t o2 = piola__json_push_key(p, "criterion");
+    if (cJSON_IsString(criterion) && strcmp(criterion->valuestring, "plastic_strain") == 0)
+      return piola__json_fail(p, BAD_VALUE, "\"plastic_strain\" is not supported: use \"stress\"");
+    if (!cJSON_IsString(criterion) || strcmp(criterion->valuestring, "stress") != 0)
+      return piola__json_fail(p, BAD_VALUE, "must be \"stress\"");
+    piola__json_pop(p, o2);
+    PIOLA_TRY(piola__json_required(p, obj, "threshold"));
+    d->fracture.criterion = PIOLA_FRACTURE_STRESS;
+    PIOLA_TRY(piola__json_opt_number(p, obj, "threshold", POSITIVE, &d->fracture.threshold));
+  } else if (piola__json_get(obj, "threshold")) {
+    piola__json_push_key(p, "threshold");
+    return piola__json_fail(p, BAD_VALUE, "needs \"criterion\": \"stress\"");
+  } else {
+    PIOLA_TRY(piola__json_required(p, obj, "cuts"));
+  }
   int64_t most = 0;
   PIOLA_TRY(piola__json_opt_int(p, obj, "max_cuts_per_step", 1, 1000000, &most));
   d->fracture.max_cuts_per_step = (int32_t)most;
   const cJSON *cuts = piola__json_get(obj, "cuts");
+  if (!cuts) return PIOLA_OK;
   size_t old = piola__json_push_key(p, "cuts");
   if (!cJSON_IsArray(cuts) || cJSON_GetArraySize(cuts) < 1)
     return piola__json_fail(p, PIOLA_ERROR_PARSE, "must be a non-empty array of cuts");
   const int count = cJSON_GetArraySize(cuts);
   d->fracture_cuts = calloc((size_t)count, sizeof *d->fracture_cuts);
   if (!d->fracture_cuts) return piola__json_fail(p, PIOLA_ERROR_OUT_OF_MEMORY, "out of memory");
-  d->fractures = 1;
   int i = 0;
   for (const cJSON *e = cuts->child; e; e = e->next, ++i) {
     size_t o2 = piola__json_push_index(p, i);

@@ -430,10 +430,47 @@ static piola_status apply_due(piola_world *w, world_body *b) {
   return PIOLA_OK;
 }
 
+/* The stress criterion: the uncut copy with the largest principal Cauchy stress of the last
+ * update. With F = U Fhat V^T and P = U Phat V^T, sigma = P F^T / J = U diag(Phat Fhat / J)
+ * U^T: its principal values are Phat_i Fhat_i / J, along the columns of U. */
+static piola_status apply_criterion(piola_world *w, world_body *b) {
+  solid_fracture *f = b->fracture;
+  if (f->criterion != PIOLA_FRACTURE_STRESS) return PIOLA_OK;
+  const piola_elastic_body *e = b->solid;
+  const double *fhat = piola_elastic_body_fhat(e);
+  const double scale = piola_track_eval(&b->stiffness_scale, w->time);
+  double worst = f->threshold, normal[3] = {0, 0, 0};
+  int32_t pick = -1;
+  for (int32_t c = 0; c < f->copy_count; ++c) {
+    if (f->event[c] >= 0) continue;
+    const double *fc = fhat + 3 * c;
+    const double j = fc[0] * fc[1] * fc[2];
+    if (!(j > 0)) continue; /* inverted or flat: no tension to speak of */
+    double phat[3];
+    piola_material_stress(&e->materials[e->tet_material[c]], fc, phat);
+    for (int i = 0; i < 3; ++i) {
+      const double sigma = scale * phat[i] * fc[i] / j;
+      if (sigma > worst) {
+        worst = sigma, pick = c;
+        for (int k = 0; k < 3; ++k) normal[k] = e->u[3 * k + i][c];
+      }
+    }
+  }
+  if (pick < 0) return PIOLA_OK;
+  const int32_t *corner = piola_elastic_body_tets(e) + 4 * pick;
+  double point[3] = {0, 0, 0};
+  for (int k = 0; k < 4; ++k)
+    for (int a = 0; a < 3; ++a) point[a] += 0.25 * b->x[3 * corner[k] + a];
+  int32_t count;
+  return cut_event(w, b, point, normal, &count);
+}
+
 piola_status piola__world_fracture_step(piola_world *w) {
   for (int32_t i = 0; i < w->body_count; ++i)
-    if (w->bodies[i].kind == PIOLA_BODY_SOLID && w->bodies[i].fracture)
+    if (w->bodies[i].kind == PIOLA_BODY_SOLID && w->bodies[i].fracture) {
       PIOLA_TRY(apply_due(w, &w->bodies[i]));
+      PIOLA_TRY(apply_criterion(w, &w->bodies[i]));
+    }
   return PIOLA_OK;
 }
 
@@ -454,6 +491,12 @@ piola_status piola_world_solid_set_fracture(piola_world *w, int32_t solid, const
   if (!b || !def) return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "set_fracture: no solid %d", (int)solid);
   if (def->cut_count < 0 || (def->cut_count > 0 && !def->cuts) || def->max_cuts_per_step < 0)
     return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "fracture of '%s': bad cut list", b->name);
+  if (def->criterion != PIOLA_FRACTURE_SCRIPTED && def->criterion != PIOLA_FRACTURE_STRESS)
+    return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "fracture of '%s': unknown criterion %d", b->name,
+                      (int)def->criterion);
+  if (def->criterion == PIOLA_FRACTURE_STRESS && !(def->threshold > 0 && isfinite(def->threshold)))
+    return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT,
+                      "fracture of '%s': the stress threshold must be > 0 Pa, got %g", b->name, def->threshold);
   for (int32_t i = 0; i < def->cut_count; ++i) {
     const piola_fracture_cut *c = &def->cuts[i];
     const double point[3] = {c->point.x, c->point.y, c->point.z};
@@ -481,6 +524,8 @@ piola_status piola_world_solid_set_fracture(piola_world *w, int32_t solid, const
   b->fracture->cut_count = def->cut_count;
   b->fracture->next_cut = 0;
   b->fracture->max_cuts_per_step = def->max_cuts_per_step;
+  b->fracture->criterion = def->criterion;
+  b->fracture->threshold = def->threshold;
   return apply_due(w, b);
 }
 

@@ -20,6 +20,8 @@ typedef struct solid_fracture {
   piola_fracture_cut *cuts;
   int32_t cut_count, next_cut, max_cuts_per_step;
   int32_t events;             /* cuts applied so far */
+  piola_fracture_criterion criterion;
+  double threshold;           /* Pa */
   /* the original mesh (after the elastic body's reorientation) and its face adjacency:
    * per tet and local face k (opposite corner k) the neighbour tet, or -1 on the boundary */
   int32_t tet_count;

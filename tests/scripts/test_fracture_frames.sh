@@ -6,8 +6,9 @@
 # by the OBJ objects box_0 and box_1 (each closed: every directed edge has its opposite) are
 # the analytic 0.0048 and 0.0032 m^3 within 0.5%; stats.csv's last columns are `fragments`
 # and `cut_tets`. Next to a ball and a sheet, a box cut at 0.05 s is one object before the
-# cut and two after, each object using exactly its own vertices. A fracture key with a
-# criterion or with self_collision is refused naming its key path, and --checkpoint-every is
+# cut and two after, each object using exactly its own vertices. A bar pulled at one end
+# with the stress criterion breaks, and a threshold without criterion is refused. A fracture
+# key with the plastic_strain criterion or with self_collision is refused naming its key path, and --checkpoint-every is
 # refused for a scene with fracture.
 set -euo pipefail
 : "${PIOLA:?path of the piola program}"
@@ -127,8 +128,25 @@ for frame, names in ((0, ["ball", "box_0", "sheet"]), (2, ["ball", "box_0", "box
         assert used == {i + 1 for i in range(nv) if owner[i] == k}, (frame, o["n"])
 print("fracture frames with other bodies ok")
 PY
-# refusals: unbuilt criteria, self_collision, checkpoints
-sed 's/"fracture": {/"fracture": {"criterion": "stress", /' "$work/scene.json" >"$work/criterion.json"
+# the stress criterion from a scene: a bar pulled at one end breaks (fragments in stats.csv);
+# threshold without criterion is refused
+cat >"$work/pull.json" <<'JSON'
+{"fps": 50, "frames": 6, "gravity": [0, 0, 0],
+ "solids": [{"name": "bar", "mesh": {"generate": "box", "center": [0.15, 0, 0], "half_extents": [0.15, 0.025, 0.025], "cell_size": 0.02},
+   "material": {"youngs_modulus": 1e5, "poisson_ratio": 0.3}, "damping": {"shear": 5, "bulk": 5},
+   "fixed": [{"box": [[-0.1, -1, -1], [0.001, 1, 1]]}],
+   "driven": [{"box": [[0.299, -1, -1], [0.4, 1, 1]], "motion": {"velocity": [0.5, 0, 0]}}],
+   "fracture": {"criterion": "stress", "threshold": 1.5e4}}]}
+JSON
+"$PIOLA" run "$work/pull.json" -o "$work/pull" >"$work/log" 2>&1 || { cat "$work/log"; exit 1; }
+awk -F, 'NR == 1 { for (i = 1; i <= NF; ++i) if ($i == "fragments") c = i }
+         NR == 2 && $c != 1 { exit 1 } END { if ($c < 2) exit 1 }' "$work/pull/stats.csv" ||
+  { echo "FAIL: the pulled bar did not break (or was broken at frame 0)"; cat "$work/pull/stats.csv"; exit 1; }
+sed 's/"criterion": "stress", //' "$work/pull.json" >"$work/threshold.json"
+if "$PIOLA" run "$work/threshold.json" -o "$work/t" >"$work/log" 2>&1; then echo "FAIL: threshold alone accepted"; exit 1; fi
+grep -q "solids\[0\].fracture.threshold" "$work/log" || { echo "FAIL: threshold message:"; cat "$work/log"; exit 1; }
+# refusals: the unbuilt plastic_strain criterion, self_collision, checkpoints
+sed 's/"fracture": {/"fracture": {"criterion": "plastic_strain", "threshold": 0.5, /' "$work/scene.json" >"$work/criterion.json"
 if "$PIOLA" run "$work/criterion.json" -o "$work/c" >"$work/log" 2>&1; then echo "FAIL: criterion accepted"; exit 1; fi
 grep -q "solids\[0\].fracture.criterion" "$work/log" || { echo "FAIL: criterion message:"; cat "$work/log"; exit 1; }
 [[ ! -e "$work/c/stats.csv" ]] || { echo "FAIL: partial output"; exit 1; }

@@ -8,8 +8,8 @@
 # and `cut_tets`. Next to a ball and a sheet, a box cut at 0.05 s is one object before the
 # cut and two after, each object using exactly its own vertices. A bar pulled at one end
 # with the stress criterion breaks, and a threshold without criterion is refused. A fracture
-# key with the plastic_strain criterion or with self_collision is refused naming its key path, and --checkpoint-every is
-# refused for a scene with fracture.
+# key with the plastic_strain criterion or with self_collision is refused naming its key
+# path, and --checkpoint-every is refused for a scene with fracture.
 set -euo pipefail
 : "${PIOLA:?path of the piola program}"
 work=$(mktemp -d)

@@ -15,6 +15,7 @@
 #include "piola/mesh.h"
 #include "piola/mesh_io.h"
 #include "piola/plasticity.h"
+#include "piola/work_split.h"
 #include "piola/world.h"
 #include "piola/world_fracture.h"
 #include "sim/fracture_internal.h"
@@ -503,7 +504,9 @@ static void max_cuts_per_step_spreads_cuts(void **state) {
                                 {.time = 0, .point = {0.67, 0.5, 0.5}, .normal = {1, 0.1, 0}}};
   piola_fracture_def def = piola_default_fracture_def();
   def.cuts = cuts, def.cut_count = 2, def.max_cuts_per_step = 1;
+  assert_null(piola_world_split_unsupported(w));
   assert_int_equal(piola_world_solid_set_fracture(w, 0, &def), PIOLA_OK);
+  assert_string_equal(piola_world_split_unsupported(w), "fracture runs on one process only");
   assert_int_equal(piola_world_solid_fragment_count(w, 0), 2);
   const int32_t first = piola_world_solid_cut_tet_count(w, 0);
   assert_true(first > 0);

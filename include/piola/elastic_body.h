@@ -45,6 +45,12 @@ typedef struct piola_elastic_body_def {
                                        non-finite one is an error naming the tet. NULL
                                        (default): no fibres. Used by tets whose material is
                                        PIOLA_MODEL_MUSCLE (paper section 6.1) */
+  const double *material_fractions; /* per tet, in (0, 1]: the share of the tet's volume that
+                                       holds material (a tet copy of the virtual node
+                                       algorithm, docs/fracture.md). Its mass and its elastic
+                                       and damping forces are scaled by it; the geometry (and
+                                       so the step bound) is the full tet's. NULL (default):
+                                       every tet is whole */
 } piola_elastic_body_def;
 
 PIOLA_API piola_elastic_body_def piola_default_elastic_body_def(void);

@@ -43,6 +43,17 @@ static int scene_init(PyObject *self_obj, PyObject *args, PyObject *kwds) {
     pypiola_raise(pypiola_scene_error, st);
     return -1;
   }
+  /* a cut gives a solid new arrays, which the NumPy views over the world's memory assume
+   * never happens */
+  const piola_world *world = piola_scene_world(scene);
+  for (int32_t s = 0; s < piola_world_solid_count(world); ++s)
+    if (piola_world_solid_has_fracture(world, s)) {
+      PyErr_Format(pypiola_scene_error, "solids[%d] ('%s') has fracture, which the Python package "
+                   "does not support (docs/fracture.md); run the scene with `piola run`", (int)s,
+                   piola_world_solid_name(world, s));
+      piola_scene_destroy(scene); /* after the message: it owns the name */
+      return -1;
+    }
   self->scene = scene;
   return 0;
 }

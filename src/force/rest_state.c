@@ -63,6 +63,12 @@ static piola_status validate_def(const piola_elastic_body_def *def) {
   if (!(def->density > 0) || !isfinite(def->density))
     return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "density must be > 0 kg/m^3, got %g",
                       def->density);
+  if (def->material_fractions)
+    for (int32_t t = 0; t < mesh->tet_count; ++t)
+      if (!(def->material_fractions[t] > 0 && def->material_fractions[t] <= 1))
+        return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT,
+                          "tet %d: material fraction must be in (0, 1], got %g", (int)t,
+                          def->material_fractions[t]);
   return piola__check_element_input("elastic body", "tet", 4, mesh->vertex_count, mesh->positions,
                                     mesh->tet_count, mesh->tets, def->materials,
                                     def->material_count, def->tet_materials);
@@ -146,6 +152,8 @@ piola_status piola__elastic_body_build_rest_state(piola_elastic_body *body,
       volume = -volume;
     }
     mat3 dm_inv = mat3_inverse(dm);
+    const double geometric_volume = volume;
+    if (def->material_fractions) volume *= def->material_fractions[t];
     for (int c = 0; c < 4; ++c) {
       body->tets[4 * t + c] = idx[c];
       body->tet_vertices[c][t] = idx[c];
@@ -159,7 +167,7 @@ piola_status piola__elastic_body_build_rest_state(piola_elastic_body *body,
     /* altitude from each corner = 3 V0 / area of the opposite face */
     double areas[4] = {triangle_area(x1, x2, x3), triangle_area(x0, x2, x3),
                        triangle_area(x0, x1, x3), triangle_area(x0, x1, x2)};
-    for (int c = 0; c < 4; ++c) min_altitude = fmin(min_altitude, 3.0 * volume / areas[c]);
+    for (int c = 0; c < 4; ++c) min_altitude = fmin(min_altitude, 3.0 * geometric_volume / areas[c]);
   }
   /* padding tets: zero Dm^-1 and volume, all corners at vertex 0, the first material */
   for (int32_t t = nt; t < np; ++t) body->tet_material[t] = body->uniform_material >= 0 ? body->uniform_material : 0;

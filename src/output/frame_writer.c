@@ -23,6 +23,7 @@
 #include "piola/files.h"
 #include "piola/mesh_io.h"
 #include "piola/world_bodies.h"
+#include "piola/world_fracture.h"
 #include "piola/world_shells.h"
 
 typedef struct pvd_entry {
@@ -45,6 +46,11 @@ struct piola_output {
   pvd_entry *pvd;
   int32_t pvd_count, pvd_cap;
   obj_layout obj;           /* the OBJ surface: one object per body (obj_frame.c) */
+  bool fractures;           /* a solid has fracture state: topology is rebuilt every frame,
+                               cells get fragment and material_fraction, fractured solids'
+                               OBJ objects are their fragments */
+  double *fragment, *fraction; /* per cell, when fractures */
+  const piola_world *world; /* of the frame being written */
 };
 
 static piola_status csv_append(piola_output *o, const char *line) {
@@ -62,15 +68,12 @@ static piola_status csv_append(piola_output *o, const char *line) {
   return PIOLA_OK;
 }
 
+static void free_topology(piola_output *o);
+
 void piola_output_close(piola_output *o) {
   if (!o) return;
-  piola_tet_mesh_free(&o->tets);
-  piola_tri_mesh_free(&o->surface);
-  o->shells.positions = NULL; /* borrowed */
-  piola_tri_mesh_free(&o->shells);
-  free(o->rest), free(o->velocity), free(o->displacement), free(o->det_f), free(o->inverted);
-  free(o->energy), free(o->solid), free(o->csv), free(o->pvd);
-  piola__obj_layout_free(&o->obj);
+  free_topology(o);
+  free(o->csv), free(o->pvd);
   free(o);
 }
 
@@ -113,15 +116,9 @@ static body_mesh body_mesh_at(const piola_world *world, int32_t position) {
   return m;
 }
 
-/* resume_frame < 0: a new run (force as in piola_output_open); else a resume after it. */
-static piola_status open_output(const char *dir, bool force, int32_t resume_frame,
-                                const piola_world *world, piola_output **out) {
-  if (!dir || !world || !out) return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "output: NULL argument");
-  *out = NULL;
-  if (strlen(dir) > 3500) return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "output: path too long");
-  piola_output *o = calloc(1, sizeof *o);
-  if (!o) return PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "output: out of memory");
-  snprintf(o->dir, sizeof o->dir, "%s", dir);
+/* The frame's topology: the concatenated tets, shell triangles, rest positions, the
+ * boundary surface and the OBJ layout, for the world's current meshes. */
+static piola_status build_topology(piola_output *o, const piola_world *world) {
   /* points: every body's nodes in the body table's order (the solids, then the shells);
    * cells: the solids' tets, then the shells' triangles */
   const int32_t nb = piola_world_body_count(world);
@@ -149,11 +146,10 @@ static piola_status open_output(const char *dir, bool force, int32_t resume_fram
   o->rest = malloc(v3), o->velocity = malloc(v3), o->displacement = malloc(v3);
   o->det_f = malloc(tc * sizeof(double)), o->inverted = malloc(tc * sizeof(double));
   o->energy = malloc(tc * sizeof(double)), o->solid = malloc(tc * sizeof(double));
+  if (o->fractures) o->fragment = malloc(tc * sizeof(double)), o->fraction = malloc(tc * sizeof(double));
   if (!o->tets.positions || !o->tets.tets || !o->shells.triangles || !o->rest || !o->velocity || !o->displacement ||
-      !o->det_f || !o->inverted || !o->energy || !o->solid) {
-    piola_output_close(o);
+      !o->det_f || !o->inverted || !o->energy || !o->solid || (o->fractures && (!o->fragment || !o->fraction)))
     return PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "output: out of memory");
-  }
   int32_t point = 0, toff = 0, stoff = 0;
   for (int32_t p = 0; p < nb; ++p) {
     const body_mesh m = body_mesh_at(world, p);
@@ -164,12 +160,20 @@ static piola_status open_output(const char *dir, bool force, int32_t resume_fram
         for (int64_t k = 0; k < 4 * (int64_t)m.cells; ++k)
           o->tets.tets[4 * (int64_t)toff + k] = m.elements[k] + point;
         for (int32_t k = 0; k < m.cells; ++k) o->solid[toff + k] = m.index;
+        if (o->fractures) {
+          const int32_t *frag = piola_world_solid_fragments(world, m.index);
+          const double *fraction = piola_world_solid_material_fractions(world, m.index);
+          for (int32_t k = 0; k < m.cells; ++k)
+            o->fragment[toff + k] = frag ? frag[k] : 0, o->fraction[toff + k] = fraction ? fraction[k] : 1;
+        }
         toff += m.cells;
         break;
       case PIOLA_BODY_SHELL: /* numbered from the first shell node */
         for (int64_t k = 0; k < 3 * (int64_t)m.cells; ++k)
           o->shells.triangles[3 * (int64_t)stoff + k] = m.elements[k] + point - nv;
         for (int32_t k = 0; k < m.cells; ++k) o->solid[nt + stoff + k] = -1 - m.index;
+        if (o->fractures)
+          for (int32_t k = 0; k < m.cells; ++k) o->fragment[nt + stoff + k] = -1, o->fraction[nt + stoff + k] = 1;
         stoff += m.cells;
         break;
       case PIOLA_BODY_NONE:
@@ -216,11 +220,41 @@ static piola_status open_output(const char *dir, bool force, int32_t resume_fram
     free(first);
     free(names);
   }
+  return st;
+}
+
+static void free_topology(piola_output *o) {
+  piola_tet_mesh_free(&o->tets);
+  piola_tri_mesh_free(&o->surface);
+  o->shells.positions = NULL; /* borrowed */
+  piola_tri_mesh_free(&o->shells);
+  free(o->rest), free(o->velocity), free(o->displacement), free(o->det_f), free(o->inverted);
+  free(o->energy), free(o->solid), free(o->fragment), free(o->fraction);
+  o->rest = o->velocity = o->displacement = o->det_f = o->inverted = NULL;
+  o->energy = o->solid = o->fragment = o->fraction = NULL;
+  piola__obj_layout_free(&o->obj);
+  memset(&o->tets, 0, sizeof o->tets), memset(&o->surface, 0, sizeof o->surface);
+  memset(&o->shells, 0, sizeof o->shells);
+}
+
+
+/* resume_frame < 0: a new run (force as in piola_output_open); else a resume after it. */
+static piola_status open_output(const char *dir, bool force, int32_t resume_frame,
+                                const piola_world *world, piola_output **out) {
+  if (!dir || !world || !out) return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "output: NULL argument");
+  *out = NULL;
+  if (strlen(dir) > 3500) return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "output: path too long");
+  piola_output *o = calloc(1, sizeof *o);
+  if (!o) return PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "output: out of memory");
+  snprintf(o->dir, sizeof o->dir, "%s", dir);
+  for (int32_t s = 0; s < piola_world_solid_count(world); ++s)
+    if (piola_world_solid_has_fracture(world, s)) o->fractures = true;
+  piola_status st = build_topology(o, world);
   if (st == PIOLA_OK && resume_frame < 0) st = piola__output_prepare_folder(dir, force);
   if (st == PIOLA_OK) st = csv_append(o, "frame,time,substeps,cg_iterations,kinetic_energy,elastic_energy,"
                                          "inverted,min_det_f,wall_seconds,plastic_yielded,max_fp_log_stretch,"
                                          "contacts,impacts,impact_zones,newton_iterations,"
-                                         "linear_iterations,newton_failures,step_retries,energy_redos\n");
+                                         "linear_iterations,newton_failures,step_retries,energy_redos,fragments,cut_tets\n");
   if (st == PIOLA_OK && resume_frame >= 0) st = resume_indexes(o, resume_frame);
   if (st != PIOLA_OK) {
     piola_output_close(o);
@@ -285,7 +319,8 @@ static piola_status commit_frame(piola_output *o, const piola_vtu_frame *frame, 
   piola__frame_commit_add(&commit, pending, path, 0);
   snprintf(path, sizeof path, "%s/surface/frame_%04d.obj", o->dir, (int)number);
   piola__frame_pending_name(path, pending, sizeof pending);
-  piola_status st = piola__obj_layout_write(&o->obj, pending, o->tets.positions);
+  piola_status st = o->fractures ? piola__obj_write_fragments(&o->obj, pending, o->tets.positions, o->world)
+                                 : piola__obj_layout_write(&o->obj, pending, o->tets.positions);
   if (st == PIOLA_OK) piola__frame_commit_add(&commit, pending, path, 0);
   size_t csv_len = o->csv_len;
   int32_t pvd_count = o->pvd_count;
@@ -308,6 +343,16 @@ piola_status piola_output_write_frame(piola_output *o, const piola_world *world,
                                       const piola_frame_info *info) {
   if (!o || !world || !info) return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "output: NULL argument");
   int32_t ns = piola_world_solid_count(world);
+  long long fragments = 0, cut_tets = 0;
+  for (int32_t s = 0; s < ns; ++s) {
+    fragments += piola_world_solid_fragment_count(world, s);
+    cut_tets += piola_world_solid_cut_tet_count(world, s);
+  }
+  if (o->fractures) {
+    /* cuts change the meshes between frames */
+    free_topology(o);
+    PIOLA_TRY(build_topology(o, world));
+  }
   int32_t voff = 0, toff = 0;
   double ke = 0, ee = 0, min_det = INFINITY;
   long long inverted = 0, yielded = 0;
@@ -367,21 +412,24 @@ piola_status piola_output_write_frame(piola_output *o, const piola_world *world,
   }
   o->shells.positions = o->tets.positions + 3 * (size_t)o->solid_vertices;
   piola_vtu_field points[2] = {{"velocity", 3, o->velocity}, {"displacement", 3, o->displacement}};
-  piola_vtu_field cells[4] = {{"det_f", 1, o->det_f},
+  piola_vtu_field cells[6] = {{"det_f", 1, o->det_f},
                               {"inverted", 1, o->inverted},
                               {"energy_density", 1, o->energy},
-                              {"solid", 1, o->solid}};
+                              {"solid", 1, o->solid},
+                              {"fragment", 1, o->fragment},
+                              {"material_fraction", 1, o->fraction}};
   piola_vtu_frame frame = {.tets = o->solid_cells > 0 ? &o->tets : NULL,
                            .triangles = o->shells.triangle_count > 0 ? &o->shells : NULL,
                            .point_fields = points, .point_field_count = 2, .cell_fields = cells,
-                           .cell_field_count = 4, .positions = o->tets.positions};
-  char line[512];
-  snprintf(line, sizeof line, "%d,%.17g,%d,%d,%.17g,%.17g,%lld,%.17g,%.6f,%lld,%.17g,%lld,%lld,%d,%d,%d,%d,%d,%d\n",
+                           .cell_field_count = o->fractures ? 6 : 4, .positions = o->tets.positions};
+  char line[600];
+  snprintf(line, sizeof line, "%d,%.17g,%d,%d,%.17g,%.17g,%lld,%.17g,%.6f,%lld,%.17g,%lld,%lld,%d,%d,%d,%d,%d,%d,%lld,%lld\n",
            (int)info->frame, piola_world_time(world), (int)info->substeps, (int)info->cg_iterations,
            ke, ee, inverted, ns > 0 ? min_det : 1.0, info->wall_seconds, yielded, max_fp_log,
            (long long)info->contacts, (long long)info->impacts, (int)info->impact_zones,
            (int)info->newton_iterations, (int)info->linear_iterations, (int)info->newton_failures,
-           (int)info->step_retries, (int)info->energy_redos);
+           (int)info->step_retries, (int)info->energy_redos, fragments, cut_tets);
+  o->world = world;
   return commit_frame(o, &frame, info->frame, line, piola_world_time(world));
 }
 

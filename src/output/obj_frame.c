@@ -13,6 +13,7 @@
 #include "common/status_report.h"
 #include "piola/files.h"
 #include "output/output_internal.h"
+#include "piola/world_fracture.h"
 
 void piola__obj_layout_free(obj_layout *l) {
   if (!l) return;
@@ -87,6 +88,65 @@ piola_status piola__obj_layout_write(const obj_layout *l, const char *path, cons
   if (ferror(f.stream)) {
     piola_atomic_file_abort(&f);
     return PIOLA_FAIL(PIOLA_ERROR_IO, "%s: write failed", path);
+  }
+  return piola_atomic_file_commit(&f);
+}
+
+piola_status piola__obj_write_fragments(const obj_layout *l, const char *path, const double *positions,
+                                        const piola_world *world) {
+  piola_atomic_file f;
+  PIOLA_TRY(piola_atomic_file_open(&f, path));
+  fprintf(f.stream, "# piola frame: one object per body, its surface only; a cut solid: one per fragment\n");
+  const int32_t ns = piola_world_solid_count(world);
+  int32_t written = 0; /* vertices so far: OBJ indices are global */
+  piola_status st = PIOLA_OK;
+  for (int32_t b = 0; b < l->body_count && st == PIOLA_OK; ++b) {
+    if (b >= ns || !piola_world_solid_has_fracture(world, b)) {
+      /* the layout's 1-based indices count from the body's first vertex in the layout */
+      const int32_t shift = written - l->body_vertex_start[b];
+      fprintf(f.stream, "o %s\n", l->names[b]);
+      for (int32_t i = l->body_vertex_start[b]; i < l->body_vertex_start[b + 1]; ++i) {
+        const double *p = positions + 3 * (size_t)l->vertices[i];
+        fprintf(f.stream, "v %.9g %.9g %.9g\n", p[0], p[1], p[2]);
+      }
+      for (int32_t t = l->body_face_start[b]; t < l->body_face_start[b + 1]; ++t) {
+        const int32_t *tri = l->faces + 3 * (size_t)t;
+        fprintf(f.stream, "f %d %d %d\n", (int)(tri[0] + shift), (int)(tri[1] + shift), (int)(tri[2] + shift));
+      }
+      written += l->body_vertex_start[b + 1] - l->body_vertex_start[b];
+      continue;
+    }
+    piola_fracture_surface s;
+    st = piola_world_solid_fracture_surface(world, b, &s);
+    if (st != PIOLA_OK) break;
+    int32_t first_vertex = 0; /* fragments' vertices are consecutive, in fragment order */
+    for (int32_t g = 0; g < s.fragment_count; ++g) {
+      int32_t lo = s.vertex_count, hi = -1;
+      for (int32_t t = s.fragment_start[g]; t < s.fragment_start[g + 1]; ++t)
+        for (int k = 0; k < 3; ++k) {
+          int32_t v = s.triangles[3 * (size_t)t + k];
+          lo = v < lo ? v : lo, hi = v > hi ? v : hi;
+        }
+      if (hi < 0) lo = first_vertex, hi = first_vertex - 1;
+      fprintf(f.stream, "o %s_%d\n", l->names[b], (int)g);
+      for (int32_t v = lo; v <= hi; ++v) {
+        const double *p = s.positions + 3 * (size_t)v;
+        fprintf(f.stream, "v %.9g %.9g %.9g\n", p[0], p[1], p[2]);
+      }
+      for (int32_t t = s.fragment_start[g]; t < s.fragment_start[g + 1]; ++t) {
+        const int32_t *tri = s.triangles + 3 * (size_t)t;
+        fprintf(f.stream, "f %d %d %d\n", (int)(tri[0] - lo + written + 1), (int)(tri[1] - lo + written + 1),
+                (int)(tri[2] - lo + written + 1));
+      }
+      written += hi - lo + 1;
+      first_vertex = hi + 1;
+    }
+    piola_fracture_surface_free(&s);
+  }
+  if (st == PIOLA_OK && ferror(f.stream)) st = PIOLA_FAIL(PIOLA_ERROR_IO, "%s: write failed", path);
+  if (st != PIOLA_OK) {
+    piola_atomic_file_abort(&f);
+    return st;
   }
   return piola_atomic_file_commit(&f);
 }

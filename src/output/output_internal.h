@@ -8,6 +8,7 @@
 
 #include "piola/mesh.h"
 #include "piola/output.h"
+#include "piola/world.h"
 
 /* Checks the folder policy, creates DIR, DIR/frames and DIR/surface, and when forced
  * removes an earlier run's results. */
@@ -41,5 +42,9 @@ piola_status piola__obj_layout_build(const piola_tri_mesh *surface, const int32_
 piola_status piola__obj_layout_write(const obj_layout *layout, const char *path,
                                      const double *positions);
 void piola__obj_layout_free(obj_layout *layout);
+/* As piola__obj_layout_write, but a solid with fracture state is written as one object
+ * per fragment, `o <name>_<fragment>`, its closed surface with the crack faces. */
+piola_status piola__obj_write_fragments(const obj_layout *layout, const char *path,
+                                        const double *positions, const piola_world *world);
 
 #endif

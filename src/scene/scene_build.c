@@ -217,6 +217,15 @@ piola_status piola__scene_build(const scene_desc *desc, const char *label, piola
       return PIOLA_FAIL(st, "%s: bones[%d]%s%s", label, (int)i, attachment ? "." : ": ", msg);
     }
   }
+  /* last: a cut due at t = 0 renumbers nodes, which bones select by index */
+  for (int32_t i = 0; i < desc->solid_count; ++i) {
+    if (!desc->solids[i].fractures) continue;
+    piola_status st = piola_world_solid_set_fracture(world, i, &desc->solids[i].fracture);
+    if (st != PIOLA_OK) {
+      piola_world_destroy(world);
+      return PIOLA_FAIL(st, "%s: solids[%d].fracture: %s", label, (int)i, piola_last_error());
+    }
+  }
   *out = world;
   return PIOLA_OK;
 }

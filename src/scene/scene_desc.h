@@ -13,6 +13,7 @@
 #include "piola/obstacle.h"
 #include "piola/world.h"
 #include "piola/world_bones.h"
+#include "piola/world_fracture.h"
 #include "piola/world_shells.h"
 
 #define SCENE_PATH_MAX 4096
@@ -53,6 +54,9 @@ typedef struct scene_solid_desc {
   char goal_mesh_path[SCENE_PATH_MAX]; /* plasticity.control.goal.mesh, resolved */
   scene_fibers fibers;            /* `fibers` (muscle), turned into per-tet directions by the
                                      builder (scene_fibers.c) */
+  int fractures;                  /* 1: "fracture" given */
+  piola_fracture_def fracture;    /* its cuts point at fracture_cuts */
+  piola_fracture_cut *fracture_cuts; /* owned */
 } scene_solid_desc;
 
 /* A shell: the solid fields it shares (name, transform, density, material, damping,

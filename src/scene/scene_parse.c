@@ -39,6 +39,7 @@ void piola__scene_desc_free(scene_desc *desc) {
     free(s->index_lists);
     free(s->constraints);
     free(s->fibers.curve);
+    free(s->fracture_cuts);
   }
   free(desc->solids);
   free(desc->obstacles);

@@ -43,6 +43,9 @@ piola_status piola__scene_parse_material(scene_parser *p, const cJSON *obj, scen
 /* A solid's `plasticity` object (scene_parse_plasticity.c). */
 piola_status piola__scene_parse_plasticity(scene_parser *p, const cJSON *obj, scene_solid_desc *d);
 
+/* A solid's `fracture` object (scene_parse_fracture.c); after self_collision is read. */
+piola_status piola__scene_parse_fracture(scene_parser *p, const cJSON *obj, scene_solid_desc *d);
+
 /* A solid's `fibers` object (scene_parse_fibers.c). */
 piola_status piola__scene_parse_fibers(scene_parser *p, const cJSON *obj, scene_fibers *f);
 

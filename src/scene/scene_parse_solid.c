@@ -71,7 +71,7 @@ static piola_status parse_solid(scene_parser *p, const cJSON *obj, int index, sc
   static const char *const allowed[] = {"name", "mesh", "transform", "density", "material",
                                         "damping", "velocity", "fixed", "driven", "initial",
                                         "plasticity", "self_collision", "fibers", "activation",
-                                        NULL};
+                                        "fracture", NULL};
   PIOLA_TRY(piola__json_check_keys(p, obj, allowed));
   PIOLA_TRY(piola__json_required(p, obj, "mesh"));
   d->def = piola_default_solid_def();
@@ -104,6 +104,12 @@ static piola_status parse_solid(scene_parser *p, const cJSON *obj, int index, sc
   if ((v = piola__json_get(obj, "plasticity"))) {
     old = piola__json_push_key(p, "plasticity");
     PIOLA_TRY(piola__scene_parse_plasticity(p, v, d));
+    piola__json_pop(p, old);
+  }
+  if ((v = piola__json_get(obj, "fracture"))) {
+    old = piola__json_push_key(p, "fracture");
+    if (!cJSON_IsObject(v)) return piola__json_fail(p, PIOLA_ERROR_PARSE, "must be an object");
+    PIOLA_TRY(piola__scene_parse_fracture(p, v, d));
     piola__json_pop(p, old);
   }
   PIOLA_TRY(piola__scene_parse_constraints(p, obj, "fixed", 0, d));

@@ -10,6 +10,7 @@
 
 #include "common/status_report.h"
 #include "force/elastic_body_internal.h"
+#include "sim/fracture_internal.h"
 #include "sim/world_internal.h"
 
 const char *piola__body_kind_name(piola_body_kind kind) {
@@ -187,6 +188,7 @@ void piola__body_free_kind(world_body *b) {
       piola_elastic_body_destroy(b->solid);
       if (b->boundary) piola_tri_mesh_free(b->boundary);
       free(b->boundary);
+      piola__fracture_free(b->fracture);
       return;
     case PIOLA_BODY_SHELL: piola_shell_body_destroy(b->shell); return;
     case PIOLA_BODY_NONE: return;

@@ -83,6 +83,8 @@ typedef struct world_body {
   double state_rate2;
   int32_t state_worst_tet;
   int state_rate_valid;
+  struct solid_fracture *fracture; /* solids: the virtual node state, NULL until the solid
+                                      is first cut or given a fracture def (fracture.c) */
   struct implicit_state *implicit; /* the implicit integrators' matrix and vectors, made on
                                       their first step of a solid (implicit_step.c) */
 } world_body;
@@ -156,6 +158,9 @@ typedef struct body_change {
   const int32_t *element_parent; /* per new element: the old element whose material, fibre
                                    direction and plastic state it takes, -1: material 0,
                                    Fp = I. NULL: all -1 */
+  const double *element_fraction; /* per new element of a solid: its material fraction in
+                                   (0, 1] (piola_elastic_body_def.material_fractions). NULL:
+                                   all whole */
 } body_change;
 
 /* Gives body b of world w the mesh and state of change and rebuilds every structure sized

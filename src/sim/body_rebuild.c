@@ -85,6 +85,7 @@ static piola_status rebuild_solid_object(const world_body *b, const body_change 
     def.tet_materials = materials;
     def.density = old->density;
     def.fiber_directions = fibers;
+    def.material_fractions = c->element_fraction;
     st = piola_elastic_body_create(&def, &nb->solid);
     if (st != PIOLA_OK) nb->solid = NULL;
   }
@@ -166,6 +167,8 @@ piola_status piola__body_rebuild(piola_world *w, world_body *b, const body_chang
     return st;
   }
   nb.slot = b->slot;
+  nb.fracture = b->fracture; /* the caller updates it to the new mesh */
+  b->fracture = NULL;
   piola__body_free(b);
   *b = nb;
   w->bodies_version++;           /* the world's collision surface is rebuilt on next use */

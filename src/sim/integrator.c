@@ -520,6 +520,7 @@ static piola_status try_step(piola_world *w, double dt, piola_step_stats *local,
 }
 
 piola_status piola_world_step(piola_world *w, double dt_limit, piola_step_stats *stats) {
+  PIOLA_TRY(piola__world_fracture_step(w));
   if (w->def.integrator != PIOLA_INTEGRATOR_NEWMARK)
     return piola__implicit_world_step(w, dt_limit, stats);
   piola_step_stats local = {0};

@@ -145,4 +145,8 @@ extern int piola__step_energy_check;
 piola_status piola__implicit_world_step(piola_world *w, double dt_limit, piola_step_stats *stats);
 void piola__implicit_state_free(struct implicit_state *state);
 
+/* Applies the scripted cuts due at the world's time to every solid with fracture state
+ * (fracture.c); called before each step. */
+piola_status piola__world_fracture_step(piola_world *w);
+
 #endif

@@ -12,6 +12,7 @@ const char *piola_world_split_unsupported(const piola_world *world) {
     const world_body *b = &world->bodies[i];
     if (b->kind == PIOLA_BODY_SHELL) return "shells run on one process only";
     if (b->self_collision.enabled) return "self-collision runs on one process only";
+    if (b->fracture) return "fracture runs on one process only";
   }
   return NULL;
 }

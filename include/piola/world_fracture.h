@@ -1,0 +1,106 @@
+/* piola: fracture of solids by the virtual node algorithm (Molino, Bao and Fedkiw 2004),
+ * see docs/fracture.md.
+ *
+ * A cut is a plane in world space, applied to a solid's current (deformed) shape. Every tet
+ * the plane crosses is replaced by two copies, one per side; each copy keeps the whole tet's
+ * shape functions and carries only its side's share of the material (its material
+ * fraction: mass, elastic and damping forces are scaled by it). Nodes are duplicated per
+ * connected piece of material around them, so the pieces move apart. The crack inside a
+ * copy is a polygon kept in the tet's barycentric coordinates. A tet is cut at most once:
+ * a later plane leaves the tets it finds already cut as they are (the new crack stops
+ * there). The stress criterion makes such cuts where the stress passes a threshold.
+ *
+ *   piola_fracture_cut cut = {.time = 0.1, .point = {0, 0, 0.5}, .normal = {0, 0, 1}};
+ *   piola_fracture_def def = piola_default_fracture_def();
+ *   def.cuts = &cut; def.cut_count = 1;
+ *   piola_world_solid_set_fracture(world, 0, &def);   // cut at the first step from t = 0.1 s
+ *   ...
+ *   printf("%d fragments\n", piola_world_solid_fragment_count(world, 0)); */
+#ifndef PIOLA_WORLD_FRACTURE_H
+#define PIOLA_WORLD_FRACTURE_H
+
+#include <stdint.h>
+
+#include "piola/export.h"
+#include "piola/math_types.h"
+#include "piola/status.h"
+#include "piola/world.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/* A scripted cut: the plane through point (m) with normal (any length > 0), world space,
+ * applied to the solid's shape at the first step that starts at or after time (s). */
+typedef struct piola_fracture_cut {
+  double time;
+  piola_vec3 point, normal;
+} piola_fracture_cut;
+
+/* When material breaks by itself (besides the scripted cuts). */
+typedef enum piola_fracture_criterion {
+  PIOLA_FRACTURE_SCRIPTED = 0, /* only the scripted cuts (default) */
+  PIOLA_FRACTURE_STRESS = 1,   /* brittle: before each step, the uncut tet with the largest
+                                  principal Cauchy stress, if it exceeds threshold, is cut with
+                                  its whole solid by the plane through its centroid normal to
+                                  that stress's direction; at most one such cut per step */
+} piola_fracture_criterion;
+
+typedef struct piola_fracture_def {
+  const piola_fracture_cut *cuts; /* cut_count cuts, copied; any order (applied by time) */
+  int32_t cut_count;
+  int32_t max_cuts_per_step;      /* at most this many scripted cuts are applied before one
+                                     step; the others wait for the next steps. 0 (default): no
+                                     limit */
+  piola_fracture_criterion criterion; /* default PIOLA_FRACTURE_SCRIPTED */
+  double threshold;               /* Pa, > 0: the stress criterion's largest principal stress */
+} piola_fracture_def;
+
+PIOLA_API piola_fracture_def piola_default_fracture_def(void);
+
+/* Gives solid `solid` its fracture def. Cuts due at the world's current time are applied at
+ * once. Bad cuts (non-finite, zero normal) are refused naming their index. */
+PIOLA_API piola_status piola_world_solid_set_fracture(piola_world *world, int32_t solid,
+                                                      const piola_fracture_def *def);
+
+/* Cuts solid `solid` now by the plane through point (m) with normal (any length > 0).
+ * *cut_tets (may be NULL) receives how many tets this cut split. */
+PIOLA_API piola_status piola_world_solid_cut(piola_world *world, int32_t solid,
+                                             const double point[3], const double normal[3],
+                                             int32_t *cut_tets);
+
+/* Whether the solid has fracture state (a def or a cut so far). */
+PIOLA_API int piola_world_solid_has_fracture(const piola_world *world, int32_t solid);
+/* Connected pieces of material (1 for a solid never cut). */
+PIOLA_API int32_t piola_world_solid_fragment_count(const piola_world *world, int32_t solid);
+/* Tets of the solid's original mesh split so far. */
+PIOLA_API int32_t piola_world_solid_cut_tet_count(const piola_world *world, int32_t solid);
+/* Per tet of the current mesh (piola_elastic_body_tets): its fragment (0 ..
+ * fragment_count - 1, numbered in order of first tet) and material fraction in (0, 1], and
+ * the tet of the original mesh it is a copy of. NULL for a solid without fracture state. */
+PIOLA_API const int32_t *piola_world_solid_fragments(const piola_world *world, int32_t solid);
+PIOLA_API const double *piola_world_solid_material_fractions(const piola_world *world,
+                                                              int32_t solid);
+PIOLA_API const int32_t *piola_world_solid_parent_tets(const piola_world *world, int32_t solid);
+
+/* The surface of each fragment at the current positions: the solid's boundary faces
+ * clipped to each copy's material and the crack polygons, triangulated, outward oriented.
+ * Triangles of fragment f are [fragment_start[f], fragment_start[f + 1]); vertices are not
+ * shared between fragments. Free with piola_fracture_surface_free. */
+typedef struct piola_fracture_surface {
+  int32_t fragment_count;
+  int32_t vertex_count, triangle_count;
+  double *positions;       /* 3 per vertex, m */
+  int32_t *triangles;      /* 3 per triangle */
+  int32_t *fragment_start; /* fragment_count + 1 triangle offsets */
+} piola_fracture_surface;
+
+PIOLA_API piola_status piola_world_solid_fracture_surface(const piola_world *world, int32_t solid,
+                                                          piola_fracture_surface *out);
+PIOLA_API void piola_fracture_surface_free(piola_fracture_surface *surface);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif

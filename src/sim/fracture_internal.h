@@ -1,0 +1,71 @@
+/* Fracture state of a solid (fracture.c, fracture_surface.c): the virtual node algorithm
+ * of Molino, Bao and Fedkiw 2004 for plane cuts. See docs/fracture.md.
+ *
+ * The solid's current mesh is made of copies of the tets of its original mesh. A copy that
+ * is whole has fraction 1; a cut copy holds the material on one side of one plane. The
+ * plane is kept as the signed distances (m, at the time of the cut, each at least `snap`
+ * from zero) of the copy's four corners: inside the tet the crack is the zero set of their
+ * linear interpolant, a polygon in barycentric coordinates. The copy's corners are in the
+ * order of its original tet (positively oriented), so corner k of a copy and of its
+ * original tet are the same material point. */
+#ifndef PIOLA_SIM_FRACTURE_INTERNAL_H
+#define PIOLA_SIM_FRACTURE_INTERNAL_H
+
+#include <stdint.h>
+
+#include "piola/world_fracture.h"
+
+typedef struct solid_fracture {
+  /* scripted cuts, sorted by time, and the next one to apply */
+  piola_fracture_cut *cuts;
+  int32_t cut_count, next_cut, max_cuts_per_step;
+  int32_t events;             /* cuts applied so far */
+  piola_fracture_criterion criterion;
+  double threshold;           /* Pa */
+  /* the original mesh (after the elastic body's reorientation) and its face adjacency:
+   * per tet and local face k (opposite corner k) the neighbour tet, or -1 on the boundary */
+  int32_t tet_count;
+  int32_t *tets;              /* 4 per original tet, original vertex ids */
+  int32_t *neighbor;          /* 4 per original tet */
+  /* per copy (element of the current mesh) */
+  int32_t copy_count;
+  int32_t *parent;            /* original tet */
+  int32_t *event;             /* the cut that made it, -1: whole */
+  double *dist;               /* 4 per copy: signed corner distances of that cut, m; the
+                                 copy's material is where their interpolant has sign side */
+  int8_t *side;               /* +1 or -1 */
+  double *fraction;           /* material fraction in (0, 1] */
+  int32_t *fragment;          /* connected piece of material */
+  int32_t fragment_count;
+  int32_t cut_tets;           /* original tets split so far */
+  int32_t *copies;            /* 2 per original tet: its copies (the second -1 when whole) */
+} solid_fracture;
+
+/* A point of a copy's polygons: corner lo when lo == hi, else the crossing of the cut at
+ * lo + t (hi - lo) on the edge between corners lo and hi, lo the corner whose original
+ * vertex id is smaller (so neighbouring copies compute the same t). */
+typedef struct cut_point {
+  int8_t lo, hi;
+  double t;
+} cut_point;
+
+/* The polygons of one cut copy: the part of each face (k opposite corner k, outward) that
+ * holds material, the crack polygon (outward from the material) and the material fraction.
+ * dist: the 4 corner distances (none zero), side: +1 or -1, ids: original vertex ids. */
+typedef struct copy_polygons {
+  cut_point face[4][4];
+  int32_t face_size[4];
+  cut_point crack[4];
+  int32_t crack_size;
+  double fraction;
+} copy_polygons;
+
+void piola__fracture_copy_polygons(const double dist[4], int side, const int32_t ids[4],
+                                   copy_polygons *out);
+
+/* The outward faces of a positively oriented tet: face k is opposite corner k. */
+extern const int8_t piola__cut_tet_face[4][3];
+
+void piola__fracture_free(solid_fracture *f);
+
+#endif

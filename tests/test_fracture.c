@@ -1,0 +1,555 @@
+/* Fracture by the virtual node algorithm (src/sim/fracture*.c, docs/fracture.md): the
+ * polygons of one cut tet against the analytic corner volume; a box cut by a slanted plane
+ * through its tets splits into two fragments whose closed surfaces enclose the analytic
+ * volumes, with the body's mass; momentum across a cut in free flight; random planes through
+ * generated and real meshes (no NaN, fractions in (0, 1] summing to 1 per tet, closed
+ * consistently oriented fragment surfaces enclosing exactly their material); a cut body
+ * collapsed to a point recovers. */
+#include "test_support.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "piola/elastic_body.h"
+#include "piola/mesh.h"
+#include "piola/mesh_io.h"
+#include "piola/plasticity.h"
+#include "piola/work_split.h"
+#include "piola/world.h"
+#include "piola/world_fracture.h"
+#include "sim/fracture_internal.h"
+
+static piola_world *make_world(double max_dt) {
+  piola_world_def wd = piola_default_world_def();
+  for (int k = 0; k < 3; ++k) wd.gravity[k] = piola_track_constant(0);
+  wd.max_dt = max_dt;
+  piola_world *w = NULL;
+  assert_int_equal(piola_world_create(&wd, &w), PIOLA_OK);
+  return w;
+}
+
+static void add_solid(piola_world *w, const piola_tet_mesh *mesh, double viscosity) {
+  piola_solid_def sd = piola_default_solid_def();
+  sd.mesh = mesh;
+  sd.material.youngs_modulus = 2e4;
+  sd.material.poisson_ratio = 0.3;
+  sd.shear_viscosity = piola_track_constant(viscosity);
+  sd.bulk_viscosity = piola_track_constant(viscosity);
+  assert_int_equal(piola_world_add_solid(w, &sd, NULL), PIOLA_OK);
+}
+
+static double total_mass(const piola_world *w) {
+  const piola_elastic_body *b = piola_world_solid_body(w, 0);
+  const double *m = piola_elastic_body_masses(b);
+  double sum = 0;
+  for (int32_t i = 0; i < piola_elastic_body_vertex_count(b); ++i) sum += m[i];
+  return sum;
+}
+
+static double tet_volume(const double *x, const int32_t *t) {
+  double a[3], b[3], c[3];
+  for (int k = 0; k < 3; ++k)
+    a[k] = x[3 * t[1] + k] - x[3 * t[0] + k], b[k] = x[3 * t[2] + k] - x[3 * t[0] + k],
+    c[k] = x[3 * t[3] + k] - x[3 * t[0] + k];
+  return (a[0] * (b[1] * c[2] - b[2] * c[1]) - a[1] * (b[0] * c[2] - b[2] * c[0]) +
+          a[2] * (b[0] * c[1] - b[1] * c[0])) / 6.0;
+}
+
+/* Enclosed volume of the triangles [first, end) of s (divergence theorem). */
+static double enclosed_volume(const piola_fracture_surface *s, int32_t first, int32_t end) {
+  double v = 0;
+  for (int32_t i = first; i < end; ++i) {
+    const double *a = s->positions + 3 * s->triangles[3 * i], *b = s->positions + 3 * s->triangles[3 * i + 1],
+                 *c = s->positions + 3 * s->triangles[3 * i + 2];
+    v += (a[0] * (b[1] * c[2] - b[2] * c[1]) - a[1] * (b[0] * c[2] - b[2] * c[0]) +
+          a[2] * (b[0] * c[1] - b[1] * c[0])) / 6.0;
+  }
+  return v;
+}
+
+typedef struct directed_edge {
+  int32_t a, b;
+} directed_edge;
+
+static int by_edge(const void *pa, const void *pb) {
+  const directed_edge *p = pa, *q = pb;
+  if (p->a != q->a) return p->a < q->a ? -1 : 1;
+  return p->b < q->b ? -1 : p->b > q->b;
+}
+
+/* Number of directed edges of triangles [first, end) that have no opposite edge to pair
+ * with (0: closed and consistently oriented). */
+static int32_t unpaired_edges(const piola_fracture_surface *s, int32_t first, int32_t end) {
+  const int32_t n = 3 * (end - first);
+  directed_edge *e = malloc(sizeof *e * (size_t)(n > 0 ? n : 1));
+  assert_non_null(e);
+  for (int32_t i = first; i < end; ++i)
+    for (int k = 0; k < 3; ++k)
+      e[3 * (i - first) + k] = (directed_edge){s->triangles[3 * i + k], s->triangles[3 * i + (k + 1) % 3]};
+  qsort(e, (size_t)n, sizeof *e, by_edge);
+  int32_t unpaired = 0;
+  for (int32_t i = 0; i < n; ++i) {
+    directed_edge r = {e[i].b, e[i].a};
+    int32_t same = 0, opposite = 0;
+    for (int32_t j = 0; j < n; ++j) /* small surfaces: a linear search is fine */
+      same += !by_edge(&e[j], &e[i]), opposite += !by_edge(&e[j], &r);
+    if (same != opposite) ++unpaired;
+  }
+  free(e);
+  return unpaired;
+}
+
+/* Per fragment: its material volume, sum of fraction x rest volume of its copies. */
+static double *material_volumes(const piola_world *w) {
+  const piola_elastic_body *b = piola_world_solid_body(w, 0);
+  const int32_t nt = piola_elastic_body_tet_count(b), nf = piola_world_solid_fragment_count(w, 0);
+  const int32_t *frag = piola_world_solid_fragments(w, 0);
+  const double *f = piola_world_solid_material_fractions(w, 0);
+  double *v = calloc((size_t)nf, sizeof(double));
+  assert_non_null(v);
+  for (int32_t t = 0; t < nt; ++t)
+    v[frag[t]] += f[t] * tet_volume(piola_elastic_body_rest_positions(b), piola_elastic_body_tets(b) + 4 * t);
+  return v;
+}
+
+/* Every invariant of a cut solid at rest: fractions, their sum per original tet, masses,
+ * finite state, and each fragment's surface closed and enclosing exactly its material.
+ * strict: also every edge paired (no T-junctions: a single cut plane). */
+static void check_cut_solid(const piola_world *w, int strict) {
+  const piola_elastic_body *b = piola_world_solid_body(w, 0);
+  const int32_t nt = piola_elastic_body_tet_count(b);
+  const double *f = piola_world_solid_material_fractions(w, 0);
+  const int32_t *parent = piola_world_solid_parent_tets(w, 0);
+  assert_non_null(f);
+  int32_t original = 0;
+  for (int32_t t = 0; t < nt; ++t) original = parent[t] + 1 > original ? parent[t] + 1 : original;
+  double *sum = calloc((size_t)original, sizeof(double));
+  for (int32_t t = 0; t < nt; ++t) {
+    if (!(f[t] > 0 && f[t] <= 1)) fail_msg("tet %d has material fraction %g", (int)t, f[t]);
+    sum[parent[t]] += f[t];
+  }
+  for (int32_t t = 0; t < original; ++t) assert_close(sum[t], 1.0, 1e-12);
+  free(sum);
+  const double *x = piola_world_solid_positions(w, 0);
+  for (int32_t i = 0; i < 3 * piola_elastic_body_vertex_count(b); ++i) assert_true(isfinite(x[i]));
+  piola_fracture_surface s;
+  assert_int_equal(piola_world_solid_fracture_surface(w, 0, &s), PIOLA_OK);
+  double *material = material_volumes(w);
+  for (int32_t g = 0; g < s.fragment_count; ++g) {
+    double enclosed = enclosed_volume(&s, s.fragment_start[g], s.fragment_start[g + 1]);
+    if (!(fabs(enclosed - material[g]) <= 1e-9 * (fabs(material[g]) + 1e-12)))
+      fail_msg("fragment %d encloses %.12g m^3, holds %.12g m^3", (int)g, enclosed, material[g]);
+    if (strict) {
+      int32_t open = unpaired_edges(&s, s.fragment_start[g], s.fragment_start[g + 1]);
+      if (open) fail_msg("fragment %d: %d edges without their opposite", (int)g, (int)open);
+    }
+  }
+  free(material);
+  piola_fracture_surface_free(&s);
+}
+
+static void check_cut_solid_positions_finite(const piola_world *w) {
+  const piola_elastic_body *b = piola_world_solid_body(w, 0);
+  const double *x = piola_world_solid_positions(w, 0), *f = piola_world_solid_material_fractions(w, 0);
+  for (int32_t i = 0; i < 3 * piola_elastic_body_vertex_count(b); ++i) assert_true(isfinite(x[i]));
+  for (int32_t t = 0; t < piola_elastic_body_tet_count(b); ++t) assert_true(f[t] > 0 && f[t] <= 1);
+}
+
+/* One tet cut with one corner alone: its side is the corner tet of edge ratios t_k, the
+ * analytic volume prod t_k; both sides' fractions sum to 1 and their surfaces close. */
+static void one_tet_matches_the_corner_volume(void **state) {
+  (void)state;
+  test_rng rng = test_rng_seeded(7);
+  const int32_t ids[4] = {10, 3, 7, 5};
+  for (int trial = 0; trial < 200; ++trial) {
+    double d[4];
+    int alone = (int)(test_rng_next(&rng) % 4);
+    for (int k = 0; k < 4; ++k) d[k] = k == alone ? test_rng_uniform(&rng, 0.01, 1) : -test_rng_uniform(&rng, 0.01, 1);
+    copy_polygons plus, minus;
+    piola__fracture_copy_polygons(d, 1, ids, &plus);
+    piola__fracture_copy_polygons(d, -1, ids, &minus);
+    double expected = 1;
+    for (int k = 0; k < 4; ++k)
+      if (k != alone) expected *= d[alone] / (d[alone] - d[k]);
+    assert_close(plus.fraction, expected, 1e-14);
+    assert_close(plus.fraction + minus.fraction, 1.0, 1e-14);
+    assert_int_equal(plus.crack_size, 3);
+    /* a 2-2 split: a quadrilateral crack */
+    for (int k = 0; k < 4; ++k) d[k] = (k < 2 ? 1 : -1) * test_rng_uniform(&rng, 0.01, 1);
+    piola__fracture_copy_polygons(d, 1, ids, &plus);
+    piola__fracture_copy_polygons(d, -1, ids, &minus);
+    assert_int_equal(plus.crack_size, 4);
+    assert_int_equal(minus.crack_size, 4);
+    assert_true(plus.fraction > 0 && minus.fraction > 0);
+    assert_close(plus.fraction + minus.fraction, 1.0, 1e-14);
+  }
+}
+
+/* The unit box of 5 x 5 x 5 cubes cut by the plane through (0.4, 0.5, 0.5) with normal
+ * (1, 0.2, 0.1): it crosses tets, not faces, stays within x in [0.25, 0.55] on the box, so
+ * the side x < plane holds exactly 0.4 m^3. */
+static void box_splits_into_the_analytic_volumes(void **state) {
+  (void)state;
+  piola_tet_mesh mesh;
+  assert_int_equal(piola_tet_mesh_box_grid(5, 5, 5, (piola_vec3){0.2, 0.2, 0.2}, &mesh), PIOLA_OK);
+  piola_world *w = make_world(1e-3);
+  add_solid(w, &mesh, 0);
+  const double mass = total_mass(w);
+  assert_int_equal(piola_world_solid_fragment_count(w, 0), 1);
+  piola_fracture_cut cut = {.time = 0, .point = {0.4, 0.5, 0.5}, .normal = {1, 0.2, 0.1}};
+  piola_fracture_def def = piola_default_fracture_def();
+  def.cuts = &cut, def.cut_count = 1;
+  assert_int_equal(piola_world_solid_set_fracture(w, 0, &def), PIOLA_OK); /* due at t = 0 */
+  assert_int_equal(piola_world_solid_fragment_count(w, 0), 2);
+  assert_true(piola_world_solid_cut_tet_count(w, 0) > 0);
+  assert_close(total_mass(w), mass, 1e-13 * mass);
+  check_cut_solid(w, 1);
+  piola_fracture_surface s;
+  assert_int_equal(piola_world_solid_fracture_surface(w, 0, &s), PIOLA_OK);
+  assert_int_equal(s.fragment_count, 2);
+  double volume[2] = {enclosed_volume(&s, s.fragment_start[0], s.fragment_start[1]),
+                      enclosed_volume(&s, s.fragment_start[1], s.fragment_start[2])};
+  double low = fmin(volume[0], volume[1]), high = fmax(volume[0], volume[1]);
+  assert_close(low, 0.4, 0.005 * 0.4);
+  assert_close(high, 0.6, 0.005 * 0.6);
+  piola_fracture_surface_free(&s);
+  /* the pieces move apart: each fragment moves rigidly away from the plane at 0.5 m/s */
+  const piola_elastic_body *body = piola_world_solid_body(w, 0);
+  const int32_t n = piola_elastic_body_vertex_count(body), nt = piola_elastic_body_tet_count(body);
+  const int32_t *frag = piola_world_solid_fragments(w, 0), *tets = piola_elastic_body_tets(body);
+  const double nn = sqrt(1 + 0.04 + 0.01);
+  double mean[2] = {0, 0};
+  const double *x = piola_world_solid_positions(w, 0);
+#define PLANE(p) (((p)[0] - 0.4 + 0.2 * ((p)[1] - 0.5) + 0.1 * ((p)[2] - 0.5)) / nn)
+  for (int32_t t = 0; t < nt; ++t)
+    for (int k = 0; k < 4; ++k) mean[frag[t]] += PLANE(x + 3 * tets[4 * t + k]);
+  assert_true(mean[0] * mean[1] < 0); /* one fragment on each side */
+  double *v = calloc(3 * (size_t)n, sizeof(double));
+  for (int32_t t = 0; t < nt; ++t)
+    for (int k = 0; k < 4; ++k)
+      for (int c = 0; c < 3; ++c)
+        v[3 * tets[4 * t + k] + c] = (mean[frag[t]] > 0 ? 0.5 : -0.5) * (c == 0 ? 1 : c == 1 ? 0.2 : 0.1) / nn;
+  assert_int_equal(piola_world_solid_set_state(w, 0, NULL, v), PIOLA_OK);
+  assert_int_equal(piola_world_advance_to(w, 0.2, NULL), PIOLA_OK);
+  /* the crack opened by 0.2 m: the fragments' surfaces are that far apart across the plane */
+  assert_int_equal(piola_world_solid_fracture_surface(w, 0, &s), PIOLA_OK);
+  double inner[2] = {INFINITY, INFINITY};
+  for (int g = 0; g < 2; ++g)
+    for (int32_t i = s.fragment_start[g]; i < s.fragment_start[g + 1]; ++i)
+      for (int k = 0; k < 3; ++k)
+        inner[g] = fmin(inner[g], fabs(PLANE(s.positions + 3 * s.triangles[3 * i + k])));
+#undef PLANE
+  assert_close(inner[0], 0.1, 1e-3);
+  assert_close(inner[1], 0.1, 1e-3);
+  piola_fracture_surface_free(&s);
+  free(v);
+  free(mesh.positions), free(mesh.tets);
+  piola_world_destroy(w);
+}
+
+static void momenta(const piola_world *w, double p[3], double l[3]) {
+  const piola_elastic_body *b = piola_world_solid_body(w, 0);
+  const double *m = piola_elastic_body_masses(b);
+  const double *x = piola_world_solid_positions(w, 0), *v = piola_world_solid_velocities(w, 0);
+  for (int k = 0; k < 3; ++k) p[k] = l[k] = 0;
+  for (int32_t i = 0; i < piola_elastic_body_vertex_count(b); ++i) {
+    const double *xi = x + 3 * i, *vi = v + 3 * i;
+    for (int k = 0; k < 3; ++k) p[k] += m[i] * vi[k];
+    l[0] += m[i] * (xi[1] * vi[2] - xi[2] * vi[1]);
+    l[1] += m[i] * (xi[2] * vi[0] - xi[0] * vi[2]);
+    l[2] += m[i] * (xi[0] * vi[1] - xi[1] * vi[0]);
+  }
+}
+
+/* A spinning, stretched bar in free flight is cut at t = 0.05 s by two planes: momentum is
+ * the same to rounding right after the cut and (undamped, so angular too) after it flies on. */
+static void cut_in_free_flight_keeps_momentum(void **state) {
+  (void)state;
+  piola_tet_mesh mesh;
+  assert_int_equal(piola_tet_mesh_box_grid(6, 2, 2, (piola_vec3){0.05, 0.05, 0.05}, &mesh), PIOLA_OK);
+  piola_world *w = make_world(5e-4);
+  add_solid(w, &mesh, 0);
+  int32_t n = mesh.vertex_count;
+  double *x = malloc(3 * sizeof(double) * (size_t)n), *v = malloc(3 * sizeof(double) * (size_t)n);
+  for (int32_t i = 0; i < n; ++i) {
+    const double *p = mesh.positions + 3 * i;
+    x[3 * i] = 1.2 * p[0] + 0.1 * p[1], x[3 * i + 1] = 0.9 * p[1], x[3 * i + 2] = p[2] + 0.05 * p[0];
+    v[3 * i] = 0.5 - 3.0 * (p[1] - 0.05), v[3 * i + 1] = -0.2 + 3.0 * (p[0] - 0.15), v[3 * i + 2] = 0.1 + p[1];
+  }
+  assert_int_equal(piola_world_solid_set_state(w, 0, x, v), PIOLA_OK);
+  piola_fracture_cut cuts[2] = {{.time = 0.05, .point = {0.17, 0.05, 0.05}, .normal = {1, 0.3, -0.2}},
+                                {.time = 0.05, .point = {0.0, 0.05, 0.05}, .normal = {0.1, 1, 0.3}}};
+  piola_fracture_def def = piola_default_fracture_def();
+  def.cuts = cuts, def.cut_count = 2;
+  assert_int_equal(piola_world_solid_set_fracture(w, 0, &def), PIOLA_OK);
+  assert_int_equal(piola_world_advance_to(w, 0.05, NULL), PIOLA_OK);
+  assert_int_equal(piola_world_solid_cut_tet_count(w, 0), 0); /* not yet: due at the next step */
+  double p0[3], l0[3], p1[3], l1[3];
+  momenta(w, p0, l0);
+  const double mass = total_mass(w);
+  assert_int_equal(piola_world_step(w, 0, NULL), PIOLA_OK);
+  assert_true(piola_world_solid_cut_tet_count(w, 0) > 0);
+  assert_true(piola_world_solid_fragment_count(w, 0) >= 2);
+  assert_close(total_mass(w), mass, 1e-13 * mass);
+  /* one step on: the cut moved no node, so the step's change is the usual rounding */
+  momenta(w, p1, l1);
+  double ls = sqrt(l0[0] * l0[0] + l0[1] * l0[1] + l0[2] * l0[2]);
+  double ps = sqrt(p0[0] * p0[0] + p0[1] * p0[1] + p0[2] * p0[2]);
+  for (int k = 0; k < 3; ++k) {
+    assert_close(p1[k], p0[k], 1e-12 * ps);
+    assert_close(l1[k], l0[k], 1e-9 * ls);
+  }
+  assert_int_equal(piola_world_advance_to(w, 0.2, NULL), PIOLA_OK);
+  momenta(w, p1, l1);
+  for (int k = 0; k < 3; ++k) {
+    assert_close(p1[k], p0[k], 1e-12 * ps);
+    assert_close(l1[k], l0[k], 1e-6 * ls);
+  }
+  free(x), free(v), free(mesh.positions), free(mesh.tets);
+  piola_world_destroy(w);
+}
+
+/* Random planes through a jittered box and real meshes: every invariant holds after one
+ * plane (strictly closed surfaces) and after a second (closed up to T-junctions where the
+ * second plane meets tets the first one cut), and the cut body steps without NaN. */
+static void random_cuts_keep_every_invariant_mesh(const piola_tet_mesh *mesh, test_rng *rng, int trials) {
+  double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+  for (int32_t i = 0; i < mesh->vertex_count; ++i)
+    for (int k = 0; k < 3; ++k)
+      lo[k] = fmin(lo[k], mesh->positions[3 * i + k]), hi[k] = fmax(hi[k], mesh->positions[3 * i + k]);
+  for (int trial = 0; trial < trials; ++trial) {
+    piola_world *w = make_world(1e-3);
+    add_solid(w, mesh, 1);
+    const double mass = total_mass(w);
+    for (int plane = 0; plane < 2; ++plane) {
+      double point[3], normal[3];
+      for (int k = 0; k < 3; ++k)
+        point[k] = test_rng_uniform(rng, lo[k], hi[k]), normal[k] = test_rng_normal(rng);
+      assert_int_equal(piola_world_solid_cut(w, 0, point, normal, NULL), PIOLA_OK);
+      assert_close(total_mass(w), mass, 1e-12 * mass);
+      check_cut_solid(w, plane == 0);
+    }
+    assert_int_equal(piola_world_advance_to(w, 0.01, NULL), PIOLA_OK);
+    const double *x = piola_world_solid_positions(w, 0);
+    for (int32_t i = 0; i < 3 * piola_elastic_body_vertex_count(piola_world_solid_body(w, 0)); ++i)
+      assert_true(isfinite(x[i]));
+    piola_world_destroy(w);
+  }
+}
+
+static void random_cuts_keep_every_invariant(void **state) {
+  (void)state;
+  test_rng rng = test_rng_seeded(2026);
+  const int trials = (int)test_samples(12, 2);
+  piola_tet_mesh box;
+  assert_int_equal(piola_tet_mesh_box_grid(4, 3, 3, (piola_vec3){0.1, 0.1, 0.1}, &box), PIOLA_OK);
+  for (int32_t i = 0; i < box.vertex_count; ++i)
+    for (int k = 0; k < 3; ++k) box.positions[3 * i + k] += test_rng_uniform(&rng, -0.02, 0.02);
+  random_cuts_keep_every_invariant_mesh(&box, &rng, trials);
+  free(box.positions), free(box.tets);
+  static const char *const real[] = {"medit/unit_ball.mesh", "gmsh/bar-186.msh"};
+  for (int r = 0; r < 2; ++r) {
+    piola_tet_mesh mesh;
+    assert_int_equal(piola_tet_mesh_read(test_data_path(real[r]), &mesh), PIOLA_OK);
+    random_cuts_keep_every_invariant_mesh(&mesh, &rng, (trials + 1) / 2);
+    piola_tet_mesh_free(&mesh);
+  }
+}
+
+/* A cut box collapsed to a point: its copies are inverted like any tet, and it recovers. */
+static void cut_body_recovers_from_collapse(void **state) {
+  (void)state;
+  piola_tet_mesh mesh;
+  assert_int_equal(piola_tet_mesh_box_grid(3, 3, 3, (piola_vec3){0.1, 0.1, 0.1}, &mesh), PIOLA_OK);
+  piola_world *w = make_world(1e-3);
+  add_solid(w, &mesh, 20);
+  /* both fragments at least one and a half tets thick (docs/fracture.md: a fragment about
+   * one tet thick, mostly virtual, can stay tangled after a collapse to a point) */
+  const double point[3] = {0.16, 0.15, 0.15}, normal[3] = {1, 0.1, 0.05};
+  assert_int_equal(piola_world_solid_cut(w, 0, point, normal, NULL), PIOLA_OK);
+  assert_int_equal(piola_world_solid_fragment_count(w, 0), 2);
+  int32_t n = piola_elastic_body_vertex_count(piola_world_solid_body(w, 0));
+  double *x = malloc(3 * sizeof(double) * (size_t)n);
+  for (int32_t i = 0; i < 3 * n; ++i) x[i] = 0.15;
+  assert_int_equal(piola_world_solid_set_state(w, 0, x, NULL), PIOLA_OK);
+  assert_true(piola_world_solid_stats(w, 0).min_det_f == 0);
+  assert_int_equal(piola_world_advance_to(w, 2.0, NULL), PIOLA_OK);
+  piola_solid_stats rec = piola_world_solid_stats(w, 0);
+  if (!(rec.inverted_count == 0 && rec.min_det_f > 0.8))
+    fail_msg("after collapse to a point: %d inverted, min det F %g", (int)rec.inverted_count, rec.min_det_f);
+  free(x), free(mesh.positions), free(mesh.tets);
+  piola_world_destroy(w);
+}
+
+/* A plastic cube squeezed until it yields, then cut: every copy has its original tet's Fp
+ * (bit for bit), and the elastic energy is the same before and after (each copy has its
+ * tet's F and Fp, and the fractions of a tet add up to 1). */
+static void cut_keeps_plastic_state_and_energy(void **state) {
+  (void)state;
+  piola_tet_mesh mesh;
+  assert_int_equal(piola_tet_mesh_box_grid(3, 3, 3, (piola_vec3){0.05, 0.05, 0.05}, &mesh), PIOLA_OK);
+  piola_world *w = make_world(1e-3);
+  piola_solid_def sd = piola_default_solid_def();
+  sd.mesh = &mesh;
+  sd.material.youngs_modulus = 1e5;
+  sd.shear_viscosity = piola_track_constant(2);
+  sd.initial_matrix = (piola_mat3){{{1.25, 0.1, 0}, {0, 1, 0}, {0, 0, 0.8}}};
+  piola_plasticity_def plasticity = piola_default_plasticity_def();
+  plasticity.yield = 0.02;
+  sd.plasticity = &plasticity;
+  assert_int_equal(piola_world_add_solid(w, &sd, NULL), PIOLA_OK);
+  for (int s = 0; s < 5; ++s) assert_int_equal(piola_world_step(w, 0, NULL), PIOLA_OK);
+  double stretch = 0;
+  piola_plastic_state_measure(piola_world_solid_plastic_state(w, 0), &stretch, NULL);
+  assert_true(stretch > 0.01); /* it yielded */
+  const int32_t nt = mesh.tet_count;
+  double *fp = malloc(9 * sizeof(double) * (size_t)nt);
+  memcpy(fp, piola_plastic_state_fp_inverse(piola_world_solid_plastic_state(w, 0)), 9 * sizeof(double) * (size_t)nt);
+  /* refresh the forces and energy for the Fp the step's plastic update left */
+  const int32_t n = mesh.vertex_count;
+  double *x = malloc(3 * sizeof(double) * (size_t)n);
+  memcpy(x, piola_world_solid_positions(w, 0), 3 * sizeof(double) * (size_t)n);
+  assert_int_equal(piola_world_solid_set_state(w, 0, x, NULL), PIOLA_OK);
+  free(x);
+  const double energy = piola_world_solid_stats(w, 0).elastic_energy;
+  assert_true(energy > 0);
+  const double point[3] = {0.07, 0.08, 0.075}, normal[3] = {1, 0.4, -0.3};
+  int32_t count = 0;
+  assert_int_equal(piola_world_solid_cut(w, 0, point, normal, &count), PIOLA_OK);
+  assert_true(count > 0);
+  const piola_plastic_state *plastic = piola_world_solid_plastic_state(w, 0);
+  const int32_t *parent = piola_world_solid_parent_tets(w, 0);
+  assert_int_equal(piola_plastic_state_tet_count(plastic), nt + count);
+  for (int32_t t = 0; t < nt + count; ++t)
+    assert_memory_equal(piola_plastic_state_fp_inverse(plastic) + 9 * t, fp + 9 * parent[t], 9 * sizeof(double));
+  assert_close(piola_world_solid_stats(w, 0).elastic_energy, energy, 1e-12 * energy);
+  free(fp), free(mesh.positions), free(mesh.tets);
+  piola_world_destroy(w);
+}
+
+/* A bar fixed at x = 0 and pulled at its other end at 0.5 m/s: with the stress criterion it
+ * breaks once the tension passes the threshold (not before), the pulled end ends in another
+ * fragment than the fixed one, and every invariant holds; with a threshold it never reaches
+ * it stays whole. */
+static int32_t pulled_bar(double threshold, double t_end, double *first_cut_time, piola_world **out) {
+  piola_tet_mesh mesh;
+  assert_int_equal(piola_tet_mesh_box_grid(12, 2, 2, (piola_vec3){0.025, 0.025, 0.025}, &mesh), PIOLA_OK);
+  piola_world *w = make_world(1e-3);
+  piola_solid_def sd = piola_default_solid_def();
+  sd.mesh = &mesh;
+  sd.material.youngs_modulus = 1e5;
+  sd.material.poisson_ratio = 0.3;
+  sd.shear_viscosity = piola_track_constant(5);
+  sd.bulk_viscosity = piola_track_constant(5);
+  piola_constraint_def ends[2];
+  memset(ends, 0, sizeof ends);
+  for (int k = 0; k < 2; ++k) {
+    ends[k].selector.type = PIOLA_SELECT_BOX;
+    ends[k].selector.box_min = (piola_vec3){k ? 0.299 : -0.001, -1, -1};
+    ends[k].selector.box_max = (piola_vec3){k ? 0.301 : 0.001, 1, 1};
+  }
+  ends[1].driven = true;
+  ends[1].motion = piola_default_rigid_motion_def();
+  ends[1].motion.velocity[0] = piola_track_constant(0.5);
+  sd.constraints = ends, sd.constraint_count = 2;
+  assert_int_equal(piola_world_add_solid(w, &sd, NULL), PIOLA_OK);
+  piola_fracture_def def = piola_default_fracture_def();
+  def.criterion = PIOLA_FRACTURE_STRESS, def.threshold = threshold;
+  assert_int_equal(piola_world_solid_set_fracture(w, 0, &def), PIOLA_OK);
+  *first_cut_time = INFINITY;
+  while (piola_world_time(w) < t_end) {
+    assert_int_equal(piola_world_step(w, 0, NULL), PIOLA_OK);
+    if (piola_world_solid_cut_tet_count(w, 0) > 0 && !isfinite(*first_cut_time)) *first_cut_time = piola_world_time(w);
+  }
+  free(mesh.positions), free(mesh.tets);
+  *out = w;
+  return piola_world_solid_fragment_count(w, 0);
+}
+
+static void stress_criterion_breaks_a_pulled_bar(void **state) {
+  (void)state;
+  piola_world *w;
+  double first;
+  assert_int_equal(pulled_bar(1e9, 0.2, &first, &w), 1);
+  assert_false(isfinite(first));
+  piola_world_destroy(w);
+  assert_true(pulled_bar(1.5e4, 0.3, &first, &w) >= 2);
+  assert_true(first > 0.02 && first < 0.3); /* the tension had to build up */
+  /* the pulled end (x = 0.3 + 0.5 t) and the fixed end (x = 0) are in different fragments */
+  const piola_elastic_body *b = piola_world_solid_body(w, 0);
+  const double *x = piola_world_solid_positions(w, 0);
+  const int32_t *tets = piola_elastic_body_tets(b), *frag = piola_world_solid_fragments(w, 0);
+  int32_t fixed = -1, pulled = -1;
+  for (int32_t t = 0; t < piola_elastic_body_tet_count(b); ++t)
+    for (int k = 0; k < 4; ++k) {
+      const double px = x[3 * tets[4 * t + k]];
+      if (fabs(px) < 1e-9) fixed = frag[t];
+      if (fabs(px - (0.3 + 0.5 * piola_world_time(w))) < 1e-6) pulled = frag[t];
+    }
+  assert_true(fixed >= 0 && pulled >= 0 && fixed != pulled);
+  check_cut_solid_positions_finite(w);
+  piola_world_destroy(w);
+}
+
+/* Two cuts due at once with max_cuts_per_step 1: the first is applied when the def is set
+ * (time 0), the second before the next step; parallel planes, 3 fragments. */
+static void max_cuts_per_step_spreads_cuts(void **state) {
+  (void)state;
+  piola_tet_mesh mesh;
+  assert_int_equal(piola_tet_mesh_box_grid(5, 5, 5, (piola_vec3){0.2, 0.2, 0.2}, &mesh), PIOLA_OK);
+  piola_world *w = make_world(1e-3);
+  add_solid(w, &mesh, 0);
+  piola_fracture_cut cuts[2] = {{.time = 0, .point = {0.33, 0.5, 0.5}, .normal = {1, 0.1, 0}},
+                                {.time = 0, .point = {0.67, 0.5, 0.5}, .normal = {1, 0.1, 0}}};
+  piola_fracture_def def = piola_default_fracture_def();
+  def.cuts = cuts, def.cut_count = 2, def.max_cuts_per_step = 1;
+  assert_null(piola_world_split_unsupported(w));
+  assert_int_equal(piola_world_solid_set_fracture(w, 0, &def), PIOLA_OK);
+  assert_string_equal(piola_world_split_unsupported(w), "fracture runs on one process only");
+  assert_int_equal(piola_world_solid_fragment_count(w, 0), 2);
+  const int32_t first = piola_world_solid_cut_tet_count(w, 0);
+  assert_true(first > 0);
+  assert_int_equal(piola_world_step(w, 0, NULL), PIOLA_OK);
+  assert_int_equal(piola_world_solid_fragment_count(w, 0), 3);
+  assert_true(piola_world_solid_cut_tet_count(w, 0) > first);
+  check_cut_solid(w, 0);
+  free(mesh.positions), free(mesh.tets);
+  piola_world_destroy(w);
+}
+
+static void bad_cuts_are_refused(void **state) {
+  (void)state;
+  piola_tet_mesh mesh;
+  assert_int_equal(piola_tet_mesh_box_grid(2, 2, 2, (piola_vec3){0.1, 0.1, 0.1}, &mesh), PIOLA_OK);
+  piola_world *w = make_world(1e-3);
+  add_solid(w, &mesh, 0);
+  const double point[3] = {0.1, 0.1, 0.1}, zero[3] = {0, 0, 0}, nan_normal[3] = {NAN, 0, 1};
+  assert_int_equal(piola_world_solid_cut(w, 0, point, zero, NULL), PIOLA_ERROR_INVALID_ARGUMENT);
+  assert_int_equal(piola_world_solid_cut(w, 0, point, nan_normal, NULL), PIOLA_ERROR_INVALID_ARGUMENT);
+  assert_int_equal(piola_world_solid_cut(w, 1, point, point, NULL), PIOLA_ERROR_INVALID_ARGUMENT);
+  /* a plane that misses the body cuts nothing and leaves one fragment */
+  const double far[3] = {5, 5, 5}, up[3] = {0, 0, 1};
+  int32_t count = -1;
+  assert_int_equal(piola_world_solid_cut(w, 0, far, up, &count), PIOLA_OK);
+  assert_int_equal(count, 0);
+  assert_int_equal(piola_world_solid_fragment_count(w, 0), 1);
+  free(mesh.positions), free(mesh.tets);
+  piola_world_destroy(w);
+}
+
+int main(void) {
+  piola_set_thread_count(1);
+  const struct CMUnitTest tests[] = {
+      cmocka_unit_test(one_tet_matches_the_corner_volume),
+      cmocka_unit_test(box_splits_into_the_analytic_volumes),
+      cmocka_unit_test(cut_in_free_flight_keeps_momentum),
+      cmocka_unit_test(random_cuts_keep_every_invariant),
+      cmocka_unit_test(cut_body_recovers_from_collapse),
+      cmocka_unit_test(cut_keeps_plastic_state_and_energy),
+      cmocka_unit_test(max_cuts_per_step_spreads_cuts),
+      cmocka_unit_test(stress_criterion_breaks_a_pulled_bar),
+      cmocka_unit_test(bad_cuts_are_refused),
+  };
+  return cmocka_run_group_tests(tests, NULL, NULL);
+}

@@ -92,27 +92,7 @@ static piola_status implicit_state_make(world_body *s) {
   return PIOLA_OK;
 }
 
-/* ------------------------------------------------------------------ vector helpers
- * Sums over 16 fixed node ranges, added in order: results do not depend on the thread count. */
-
-static double dot_ranges(const world_body *s, const double *a, const double *b,
-                         const double *inverse_mass) {
-  double part[RANGES];
-  const int32_t n = s->n;
-#pragma omp parallel for schedule(static) num_threads(piola_thread_count()) \
-    if (n >= PIOLA_PARALLEL_MIN_VERTICES)
-  for (int r = 0; r < RANGES; ++r) {
-    double sum = 0;
-    for (int32_t i = (int32_t)((int64_t)n * r / RANGES); i < (int32_t)((int64_t)n * (r + 1) / RANGES); ++i) {
-      double d = a[3 * i] * b[3 * i] + a[3 * i + 1] * b[3 * i + 1] + a[3 * i + 2] * b[3 * i + 2];
-      sum += inverse_mass ? inverse_mass[i] * d : d;
-    }
-    part[r] = sum;
-  }
-  double sum = 0;
-  for (int r = 0; r < RANGES; ++r) sum += part[r];
-  return sum;
-}
+/* ------------------------------------------------------------------ constraints */
 
 /* Zeroes the constrained components of node i of r: all of a fixed/driven node, the normal
  * of a node held by an obstacle. */
@@ -189,47 +169,121 @@ static double residual(newton_problem *pb) {
   return sum;
 }
 
+/* The CG's vector work: one pass per CG phase over the 16 fixed node ranges (in parallel
+ * for large bodies, each range's sum added in order, so results do not depend on the thread
+ * count), so each vector is read once per phase and no phase runs on one core alone. */
+typedef struct cg_vectors {
+  const world_body *s;
+  const piola__stiffness_matrix *mx;
+  double *d, *r, *z, *p, *q;
+} cg_vectors;
+
+static inline int32_t range_start(int32_t n, int range) {
+  return (int32_t)((int64_t)n * range / RANGES);
+}
+
+static double sum_parts(const double part[RANGES]) {
+  double sum = 0;
+  for (int k = 0; k < RANGES; ++k) sum += part[k];
+  return sum;
+}
+
+/* z_i = S_i P_i^-1 r_i, P_i the diagonal block; returns r_i . z_i. */
+static inline double precondition_node(const cg_vectors *c, int32_t i) {
+  const double *b = c->mx->inverse_diagonal + 9 * (size_t)i, *x = c->r + 3 * i;
+  double *y = c->z + 3 * i;
+  y[0] = b[0] * x[0] + b[1] * x[1] + b[2] * x[2];
+  y[1] = b[3] * x[0] + b[4] * x[1] + b[5] * x[2];
+  y[2] = b[6] * x[0] + b[7] * x[1] + b[8] * x[2];
+  filter_node(c->s, i, c->z);
+  return x[0] * y[0] + x[1] * y[1] + x[2] * y[2];
+}
+
+/* d = 0, r = -S g, z = S P^-1 r, p = z; returns r . z. */
+static double cg_start(const cg_vectors *c, const double *g) {
+  const int32_t n = c->s->n;
+  double part[RANGES];
+#pragma omp parallel for schedule(static) num_threads(piola_thread_count()) \
+    if (n >= PIOLA_PARALLEL_MIN_VERTICES)
+  for (int range = 0; range < RANGES; ++range) {
+    double sum = 0;
+    for (int32_t i = range_start(n, range); i < range_start(n, range + 1); ++i) {
+      for (int k = 0; k < 3; ++k) c->d[3 * i + k] = 0, c->r[3 * i + k] = -g[3 * i + k];
+      filter_node(c->s, i, c->r);
+      sum += precondition_node(c, i);
+      for (int k = 0; k < 3; ++k) c->p[3 * i + k] = c->z[3 * i + k];
+    }
+    part[range] = sum;
+  }
+  return sum_parts(part);
+}
+
+/* q = S q (q = A p on entry); returns p . q. */
+static double cg_curvature(const cg_vectors *c) {
+  const int32_t n = c->s->n;
+  double part[RANGES];
+#pragma omp parallel for schedule(static) num_threads(piola_thread_count()) \
+    if (n >= PIOLA_PARALLEL_MIN_VERTICES)
+  for (int range = 0; range < RANGES; ++range) {
+    double sum = 0;
+    for (int32_t i = range_start(n, range); i < range_start(n, range + 1); ++i) {
+      filter_node(c->s, i, c->q);
+      const double *p = c->p + 3 * i, *q = c->q + 3 * i;
+      sum += p[0] * q[0] + p[1] * q[1] + p[2] * q[2];
+    }
+    part[range] = sum;
+  }
+  return sum_parts(part);
+}
+
+/* d += a p, r -= a q, z = S P^-1 r; returns r . z. */
+static double cg_update(const cg_vectors *c, double a) {
+  const int32_t n = c->s->n;
+  double part[RANGES];
+#pragma omp parallel for schedule(static) num_threads(piola_thread_count()) \
+    if (n >= PIOLA_PARALLEL_MIN_VERTICES)
+  for (int range = 0; range < RANGES; ++range) {
+    double sum = 0;
+    for (int32_t i = range_start(n, range); i < range_start(n, range + 1); ++i) {
+      for (int k = 0; k < 3; ++k) {
+        c->d[3 * i + k] += a * c->p[3 * i + k];
+        c->r[3 * i + k] -= a * c->q[3 * i + k];
+      }
+      sum += precondition_node(c, i);
+    }
+    part[range] = sum;
+  }
+  return sum_parts(part);
+}
+
+/* p = z + b p. */
+static void cg_direction(const cg_vectors *c, double b) {
+  const int64_t m = 3 * (int64_t)c->s->n;
+#pragma omp parallel for schedule(static) num_threads(piola_thread_count()) \
+    if (c->s->n >= PIOLA_PARALLEL_MIN_VERTICES)
+  for (int64_t j = 0; j < m; ++j) c->p[j] = c->z[j] + b * c->p[j];
+}
+
 /* Solves A d = -S g by the filtered block-Jacobi CG from d = 0; returns the iterations. */
 static int32_t solve_newton_system(newton_problem *pb) {
   world_body *s = pb->s;
   struct implicit_state *st = pb->st;
   const int32_t n = s->n;
-  const int64_t m = 3 * (int64_t)n;
-  const piola__stiffness_matrix *mx = &st->matrix;
   const double mass_weight = pb->mass_weight + st->mu;
-  double *d = st->step, *r = st->cg[0], *z = st->cg[1], *p = st->cg[2], *q = st->cg[3];
-  for (int64_t j = 0; j < m; ++j) d[j] = 0, r[j] = -st->residual[j];
-  for (int32_t i = 0; i < n; ++i) filter_node(s, i, r);
-  /* z = S P^-1 r, P the diagonal blocks */
-#define PRECONDITION(out, in)                                                       \
-  for (int32_t i = 0; i < n; ++i) {                                                 \
-    const double *b = mx->inverse_diagonal + 9 * (size_t)i, *x = in + 3 * i;       \
-    double *y = out + 3 * i;                                                        \
-    y[0] = b[0] * x[0] + b[1] * x[1] + b[2] * x[2];                                 \
-    y[1] = b[3] * x[0] + b[4] * x[1] + b[5] * x[2];                                 \
-    y[2] = b[6] * x[0] + b[7] * x[1] + b[8] * x[2];                                 \
-    filter_node(s, i, out);                                                         \
-  }
-  PRECONDITION(z, r)
-  memcpy(p, z, sizeof(double) * (size_t)m);
-  double rz = dot_ranges(s, r, z, NULL);
+  double *d = st->step;
+  const cg_vectors c = {s, &st->matrix, d, st->cg[0], st->cg[1], st->cg[2], st->cg[3]};
+  double rz = cg_start(&c, st->residual);
   const double stop = pb->w->def.linear_tolerance * pb->w->def.linear_tolerance * rz;
   int32_t it = 0;
   while (rz > stop && rz > 0 && it < pb->w->def.linear_max_iterations) {
-    piola__stiffness_matrix_apply(mx, s->solid, s->mass, mass_weight, p, q);
-    for (int32_t i = 0; i < n; ++i) filter_node(s, i, q);
-    double pq = dot_ranges(s, p, q, NULL);
+    piola__stiffness_matrix_apply(c.mx, s->solid, s->mass, mass_weight, c.p, c.q);
+    const double pq = cg_curvature(&c);
     if (!(pq > 0)) break;
-    double a = rz / pq;
-    for (int64_t j = 0; j < m; ++j) d[j] += a * p[j], r[j] -= a * q[j];
-    PRECONDITION(z, r)
-    double rz_new = dot_ranges(s, r, z, NULL);
-    double b = rz_new / rz;
+    const double rz_new = cg_update(&c, rz / pq);
+    cg_direction(&c, rz_new / rz);
     rz = rz_new;
-    for (int64_t j = 0; j < m; ++j) p[j] = z[j] + b * p[j];
     ++it;
   }
-#undef PRECONDITION
   /* a free body: move d by the uniform displacement that makes sum M d = -sum g (K and D
    * ignore uniform fields, so the net residual after a full step is then zero whatever the
    * CG's accuracy or the regularization), so the linear momentum comes out exact */
@@ -389,6 +443,7 @@ static piola_status newton_solid(piola_world *w, world_body *s, double t, double
       }
     }
     stats->newton_iterations++;
+    piola__step_profile_mark(&w->profile, STEP_PHASE_UPDATE);
     if (pb.damped) piola__elastic_body_damping_prepare(s->solid, pb.beta, pb.alpha);
     piola__stiffness_matrix_assemble(&st->matrix, s->solid, pb.force_weight,
                                      pb.damped ? dt : 0.0, s->mass, pb.mass_weight);
@@ -408,7 +463,9 @@ static piola_status newton_solid(piola_world *w, world_body *s, double t, double
       piola__stiffness_matrix_assemble(&st->matrix, s->solid, pb.force_weight,
                                        pb.damped ? dt : 0.0, s->mass, pb.mass_weight + st->mu);
     }
+    piola__step_profile_mark(&w->profile, STEP_PHASE_ASSEMBLE);
     stats->linear_iterations += solve_newton_system(&pb);
+    piola__step_profile_mark(&w->profile, STEP_PHASE_LINEAR);
     /* backtracking line search on |S g|^2 */
     memcpy(st->base, s->x, sizeof(double) * (size_t)m);
     double alpha = 1.0, best_phi = phi, best_alpha = 0.0;
@@ -503,6 +560,7 @@ piola_status piola__implicit_world_step(piola_world *w, double dt_limit, piola_s
     return PIOLA_FAIL(PIOLA_ERROR_UNSUPPORTED,
                       "integrator '%s' does not step shells yet: use \"newmark\" for scenes with "
                       "shells", piola_integrator_type_name(w->def.integrator));
+  piola__step_profile_start(&w->profile);
   double left;
   PIOLA_TRY(piola__world_collision_open(w, &left));
   for (int halvings = 0;; ++halvings) {
@@ -527,6 +585,8 @@ piola_status piola__implicit_world_step(piola_world *w, double dt_limit, piola_s
     return contact;
   }
   for (int32_t i = 0; i < w->body_count; ++i) piola__body_plastic_after_step(&w->bodies[i], dt);
+  piola__step_profile_mark(&w->profile, STEP_PHASE_WORLD);
+  if (w->profile.enabled) w->profile.steps++;
   w->time += dt;
   local.substeps = 1;
   local.last_dt = dt;

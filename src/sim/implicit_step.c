@@ -171,7 +171,12 @@ static double residual(newton_problem *pb) {
 
 /* The CG's vector work: one pass per CG phase over the 16 fixed node ranges (in parallel
  * for large bodies, each range's sum added in order, so results do not depend on the thread
- * count), so each vector is read once per phase and no phase runs on one core alone. */
+ * count), so each vector is read once per phase and no phase runs on one core alone. A pass
+ * is a few microseconds per thousand nodes, so below CG_PARALLEL_MIN_VERTICES the fork and
+ * the barrier cost more than they save (and on a loaded machine a barrier can wait a whole
+ * scheduler slice for a descheduled thread). */
+#define CG_PARALLEL_MIN_VERTICES 16384
+
 typedef struct cg_vectors {
   const world_body *s;
   const piola__stiffness_matrix *mx;
@@ -204,7 +209,7 @@ static double cg_start(const cg_vectors *c, const double *g) {
   const int32_t n = c->s->n;
   double part[RANGES];
 #pragma omp parallel for schedule(static) num_threads(piola_thread_count()) \
-    if (n >= PIOLA_PARALLEL_MIN_VERTICES)
+    if (n >= CG_PARALLEL_MIN_VERTICES)
   for (int range = 0; range < RANGES; ++range) {
     double sum = 0;
     for (int32_t i = range_start(n, range); i < range_start(n, range + 1); ++i) {
@@ -223,7 +228,7 @@ static double cg_curvature(const cg_vectors *c) {
   const int32_t n = c->s->n;
   double part[RANGES];
 #pragma omp parallel for schedule(static) num_threads(piola_thread_count()) \
-    if (n >= PIOLA_PARALLEL_MIN_VERTICES)
+    if (n >= CG_PARALLEL_MIN_VERTICES)
   for (int range = 0; range < RANGES; ++range) {
     double sum = 0;
     for (int32_t i = range_start(n, range); i < range_start(n, range + 1); ++i) {
@@ -241,7 +246,7 @@ static double cg_update(const cg_vectors *c, double a) {
   const int32_t n = c->s->n;
   double part[RANGES];
 #pragma omp parallel for schedule(static) num_threads(piola_thread_count()) \
-    if (n >= PIOLA_PARALLEL_MIN_VERTICES)
+    if (n >= CG_PARALLEL_MIN_VERTICES)
   for (int range = 0; range < RANGES; ++range) {
     double sum = 0;
     for (int32_t i = range_start(n, range); i < range_start(n, range + 1); ++i) {
@@ -260,7 +265,7 @@ static double cg_update(const cg_vectors *c, double a) {
 static void cg_direction(const cg_vectors *c, double b) {
   const int64_t m = 3 * (int64_t)c->s->n;
 #pragma omp parallel for schedule(static) num_threads(piola_thread_count()) \
-    if (c->s->n >= PIOLA_PARALLEL_MIN_VERTICES)
+    if (c->s->n >= CG_PARALLEL_MIN_VERTICES)
   for (int64_t j = 0; j < m; ++j) c->p[j] = c->z[j] + b * c->p[j];
 }
 

@@ -50,6 +50,10 @@
 #define STANDARD_GRAVITY 9.81
 #define RANGES 16
 
+/* Values of world_body.colliding during an implicit step: a node held along its normal by
+ * an obstacle, or along the push of the self-collision pass (see resolve_after_collisions). */
+enum { HELD_BY_OBSTACLE = 1, HELD_BY_COLLISION = 2 };
+
 struct implicit_state {
   piola__stiffness_matrix matrix;
   double *prediction; /* 3n: x^n + dt v^n (backward Euler) */
@@ -330,7 +334,7 @@ static int32_t contacts(newton_problem *pb) {
       continue;
     }
     if (!s->colliding[i]) added++;
-    s->colliding[i] = 1;
+    s->colliding[i] = HELD_BY_OBSTACLE;
     for (int k = 0; k < 3; ++k) s->normals[3 * i + k] = normals[3 * i + k];
   }
   return moved > 0 ? (added > 0 ? added : 1) : 0;
@@ -360,7 +364,7 @@ static int32_t contact_friction(newton_problem *pb) {
   world_body *s = pb->s;
   int32_t changed = 0;
   for (int32_t i = 0; i < s->n; ++i) {
-    if (!s->colliding[i] || s->flags[i] != NODE_FREE) continue;
+    if (s->colliding[i] != HELD_BY_OBSTACLE || s->flags[i] != NODE_FREE) continue;
     const double *g = pb->st->residual + 3 * i, *nrm = s->normals + 3 * i;
     double dvn = (g[0] * nrm[0] + g[1] * nrm[1] + g[2] * nrm[2]) / (pb->dt * s->mass[i]);
     if (!(dvn > 0)) continue;
@@ -389,6 +393,25 @@ static int32_t contact_friction(newton_problem *pb) {
   return changed;
 }
 
+/* The step's problem for solid s over [t, t + dt]; reads no state. */
+static newton_problem problem_of(piola_world *w, world_body *s, double t, double dt) {
+  newton_problem pb;
+  memset(&pb, 0, sizeof pb);
+  pb.w = w, pb.s = s, pb.st = s->implicit, pb.dt = dt, pb.t1 = t + dt;
+  pb.quasistatic = w->def.integrator == PIOLA_INTEGRATOR_QUASISTATIC;
+  for (int k = 0; k < 3; ++k) pb.g1[k] = piola_track_eval(&w->def.gravity[k], pb.t1);
+  pb.beta = piola_track_eval(&s->shear_viscosity, pb.t1);
+  pb.alpha = piola_track_eval(&s->bulk_viscosity, pb.t1);
+  pb.damped = !pb.quasistatic && !piola__body_undamped(s, pb.beta, pb.alpha);
+  pb.force_weight = pb.quasistatic ? 1.0 : dt * dt;
+  pb.mass_weight = pb.quasistatic ? 0.0 : 1.0;
+  for (int32_t i = 0; i < s->n; ++i) pb.total_mass += s->mass[i];
+  return pb;
+}
+
+static piola_status newton_iterate(const newton_problem *problem, int accept_unconverged,
+                                   piola_step_stats *stats);
+
 /* Newton's method for one solid over [t, t + dt]. Returns PIOLA_OK when converged,
  * PIOLA_ERROR_NOT_CONVERGED when not (the caller undoes and halves), or another error. */
 static piola_status newton_solid(piola_world *w, world_body *s, double t, double dt,
@@ -397,17 +420,7 @@ static piola_status newton_solid(piola_world *w, world_body *s, double t, double
   struct implicit_state *st = s->implicit;
   const int32_t n = s->n;
   const int64_t m = 3 * (int64_t)n;
-  newton_problem pb;
-  memset(&pb, 0, sizeof pb);
-  pb.w = w, pb.s = s, pb.st = st, pb.dt = dt, pb.t1 = t + dt;
-  pb.quasistatic = w->def.integrator == PIOLA_INTEGRATOR_QUASISTATIC;
-  for (int k = 0; k < 3; ++k) pb.g1[k] = piola_track_eval(&w->def.gravity[k], pb.t1);
-  pb.beta = piola_track_eval(&s->shear_viscosity, pb.t1);
-  pb.alpha = piola_track_eval(&s->bulk_viscosity, pb.t1);
-  pb.damped = !pb.quasistatic && !piola__body_undamped(s, pb.beta, pb.alpha);
-  pb.force_weight = pb.quasistatic ? 1.0 : dt * dt;
-  pb.mass_weight = pb.quasistatic ? 0.0 : 1.0;
-  for (int32_t i = 0; i < n; ++i) pb.total_mass += s->mass[i];
+  newton_problem pb = problem_of(w, s, t, dt);
   if (!pb.quasistatic) st->mu = 0;
 
   /* the prediction, and the first guess: the prediction plus a step of gravity
@@ -429,7 +442,20 @@ static piola_status newton_solid(piola_world *w, world_body *s, double t, double
   }
   if (contacts(&pb) < 0) return PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "implicit step: out of memory");
   PIOLA_TRY(update(&pb));
+  return newton_iterate(&pb, accept_unconverged, stats);
+}
 
+/* Newton's iterations from the body's current state (its forces up to date), then the
+ * velocities, friction and prescribed nodes. */
+static piola_status newton_iterate(const newton_problem *problem, int accept_unconverged,
+                                   piola_step_stats *stats) {
+  newton_problem pb = *problem;
+  piola_world *w = pb.w;
+  world_body *s = pb.s;
+  struct implicit_state *st = pb.st;
+  const int32_t n = s->n;
+  const int64_t m = 3 * (int64_t)n;
+  const double dt = pb.dt;
   const double target = w->def.newton_tolerance * STANDARD_GRAVITY * pb.force_weight;
   const double target2 = target * target * pb.total_mass;
   double phi = residual(&pb);
@@ -547,6 +573,62 @@ static void restore(world_body *s, double t) {
   (void)piola__body_update_forces(s, t);
 }
 
+/* Contacts between bodies (self_collision) are resolved after the Newton solves by the
+ * collision pass (contact.md), which changes the velocities of surface nodes only. A Newmark
+ * step is short enough for the elastic forces to carry that change inwards before the next
+ * one; a frame-sized step is not: the interior would keep the velocity the surface lost and
+ * pass through it, inverting the elements behind every impact. So each body whose nodes
+ * the pass moved is solved again from there, each moved node held along the push it got
+ * (as an obstacle holds a node along its normal; released if it would have to pull), and
+ * the pass runs once more on the result, which leaves the surfaces apart as before. Only
+ * with the per-step collision pass (collision_interval 0), where each pass covers exactly
+ * this step. */
+static piola_status self_collide_and_resolve(piola_world *w, double dt, int closes,
+                                             piola_step_stats *stats) {
+  const double t1 = w->time + dt;
+  const int per_step = !(w->def.collision_interval > 0);
+  for (int32_t b = 0; b < w->body_count && per_step; ++b) {
+    world_body *s = &w->bodies[b];
+    if (s->implicit) memcpy(s->implicit->base, s->x, sizeof(double) * 3 * (size_t)s->n);
+  }
+  PIOLA_TRY(piola__world_self_collide(w, dt, t1, closes, stats));
+  if (!per_step || stats->impacts + stats->contacts == 0) return PIOLA_OK;
+  int resolved = 0;
+  for (int32_t b = 0; b < w->body_count; ++b) {
+    world_body *s = &w->bodies[b];
+    if (!s->implicit) continue;
+    const double *before = s->implicit->base;
+    int32_t held = 0;
+    for (int32_t i = 0; i < s->n; ++i) {
+      if (s->flags[i] != NODE_FREE || s->inverse_mass[i] == 0) continue;
+      double push[3], len2 = 0;
+      for (int k = 0; k < 3; ++k) {
+        push[k] = s->x[3 * i + k] - before[3 * i + k];
+        len2 += push[k] * push[k];
+      }
+      if (!(len2 > 0)) continue;
+      const double inv = 1.0 / sqrt(len2);
+      s->colliding[i] = HELD_BY_COLLISION;
+      for (int k = 0; k < 3; ++k) s->normals[3 * i + k] = push[k] * inv;
+      held++;
+    }
+    if (held == 0) continue;
+    newton_problem pb = problem_of(w, s, w->time, dt);
+    const int64_t colliding = stats->colliding;
+    PIOLA_TRY(newton_iterate(&pb, 1, stats));
+    stats->colliding = colliding;
+    resolved = 1;
+  }
+  if (!resolved) return PIOLA_OK;
+  /* the step's contact counts are those of the first pass */
+  const piola_step_stats first = *stats;
+  PIOLA_TRY(piola__world_self_collide(w, dt, t1, closes, stats));
+  stats->contacts = first.contacts, stats->impacts = first.impacts;
+  stats->impact_zones = first.impact_zones, stats->collision_steps = first.collision_steps;
+  stats->colliding = first.colliding;
+  return PIOLA_OK;
+}
+
 /* A step whose Newton does not converge is undone and retried at half the size up to this
  * many times; the last try keeps its best iterate (a force field that jumps, as the
  * extended stress of an element passing through a reflection does, may have no exact
@@ -583,7 +665,7 @@ piola_status piola__implicit_world_step(piola_world *w, double dt_limit, piola_s
     dt *= 0.5;
   }
   const int closes = dt >= left || dt == w->collision_deadline - w->time;
-  piola_status contact = piola__world_self_collide(w, dt, w->time + dt, closes, &local);
+  piola_status contact = self_collide_and_resolve(w, dt, closes, &local);
   if (contact != PIOLA_OK) {
     for (int32_t j = 0; j < w->body_count; ++j) restore(&w->bodies[j], w->time);
     if (stats) *stats = local;

@@ -473,6 +473,11 @@ static piola_status newton_iterate(const newton_problem *problem, int accept_unc
         break;
       }
     }
+    /* contacts whose force pulls are released at every iteration after the first (whose
+     * residual reflects the first guess more than the contact): releasing them only once
+     * converged costs a whole Newton solve per round of releases (measured on a torus
+     * landing on a plane: 22-24 iterations per frame, 10-13 this way) */
+    if (iter > 0 && release_contacts(&pb) > 0) phi = residual(&pb);
     stats->newton_iterations++;
     piola__step_profile_mark(&w->profile, STEP_PHASE_UPDATE);
     if (pb.damped) piola__elastic_body_damping_prepare(s->solid, pb.beta, pb.alpha);

@@ -26,8 +26,9 @@
  * like the collision-held normals of the Newmark step; a node the obstacle would have to
  * pull is released. After convergence the normal contact force (the filtered-out residual)
  * limits the tangential velocity relative to the obstacle by Coulomb's law, as the Newmark
- * step does with its normal impulse. Self-collision and plasticity run after the step as
- * with Newmark.
+ * step does with its normal impulse. Self-collision runs after the step as with Newmark, and
+ * the bodies it moved are solved again behind their pushed surfaces (self_collide_and_resolve);
+ * plasticity runs after the step.
  *
  * Momentum. K and D are translation invariant, so a free body's net residual changes only
  * through M. The block-Jacobi CG does not keep the net residual at zero by itself, so each
@@ -51,7 +52,7 @@
 #define RANGES 16
 
 /* Values of world_body.colliding during an implicit step: a node held along its normal by
- * an obstacle, or along the push of the self-collision pass (see resolve_after_collisions). */
+ * an obstacle, or along the push of the self-collision pass (see self_collide_and_resolve). */
 enum { HELD_BY_OBSTACLE = 1, HELD_BY_COLLISION = 2 };
 
 struct implicit_state {

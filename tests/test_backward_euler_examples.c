@@ -10,7 +10,7 @@
  *    at PIOLA_TEST_SCALE >= 1): at most 2% of the tets inverted in any frame. The collision
  *    pass stops only the surface nodes; before the implicit step re-solved the bodies behind
  *    it (implicit_step.c, self_collide_and_resolve) the interiors ran through their surfaces
- *    and 416 of the 2,952 tets (14%) were inverted at frame 10 (measured since: at most 21,
+ *    and 416 of the 2,952 tets (14%) were inverted at frame 10 (measured since: at most 28,
  *    at frame 8). */
 #include "test_support.h"
 

@@ -285,6 +285,12 @@ PIOLA_WIDE_VECTORS static void update_blocks(piola_elastic_body *body, const dou
 #undef LANES
 
 /* Blocks [b0, b1) in pairs (the pairing depends only on b0 and b1, not on threads). */
+void piola__elastic_body_update_block_pair(piola_elastic_body *body, const double *x,
+                                           double stiffness_scale, int want_energy, int32_t first,
+                                           int count, double *out) {
+  update_blocks(body, x, stiffness_scale, want_energy, first, count, out);
+}
+
 static void update_block_range(piola_elastic_body *body, const double *x, double stiffness_scale,
                                int want_energy, int32_t b0, int32_t b1, double *out) {
   for (int32_t b = b0; b < b1; b += 2)
@@ -313,7 +319,9 @@ piola_status piola_elastic_body_update(piola_elastic_body *body, const double *x
   }
   int32_t blocks = body->padded_tet_count / B;
   const int64_t n = 3 * (int64_t)body->vertex_count;
-  if (blocks < PIOLA_PARALLEL_MIN_BLOCKS || !body->chunk_forces) {
+  if (body->split) {
+    piola__elastic_body_split_update(body, x, stiffness_scale, stats != NULL, forces);
+  } else if (blocks < PIOLA_PARALLEL_MIN_BLOCKS || !body->chunk_forces) {
     for (int64_t i = 0; i < n; ++i) forces[i] = 0.0;
     update_block_range(body, x, stiffness_scale, stats != NULL, 0, blocks, forces);
   } else {

@@ -220,7 +220,7 @@ static piola_status open_output(const char *dir, bool force, int32_t resume_fram
   if (st == PIOLA_OK) st = csv_append(o, "frame,time,substeps,cg_iterations,kinetic_energy,elastic_energy,"
                                          "inverted,min_det_f,wall_seconds,plastic_yielded,max_fp_log_stretch,"
                                          "contacts,impacts,impact_zones,newton_iterations,"
-                                         "linear_iterations,newton_failures,step_retries\n");
+                                         "linear_iterations,newton_failures,step_retries,energy_redos\n");
   if (st == PIOLA_OK && resume_frame >= 0) st = resume_indexes(o, resume_frame);
   if (st != PIOLA_OK) {
     piola_output_close(o);
@@ -376,12 +376,12 @@ piola_status piola_output_write_frame(piola_output *o, const piola_world *world,
                            .point_fields = points, .point_field_count = 2, .cell_fields = cells,
                            .cell_field_count = 4, .positions = o->tets.positions};
   char line[512];
-  snprintf(line, sizeof line, "%d,%.17g,%d,%d,%.17g,%.17g,%lld,%.17g,%.6f,%lld,%.17g,%lld,%lld,%d,%d,%d,%d,%d\n",
+  snprintf(line, sizeof line, "%d,%.17g,%d,%d,%.17g,%.17g,%lld,%.17g,%.6f,%lld,%.17g,%lld,%lld,%d,%d,%d,%d,%d,%d\n",
            (int)info->frame, piola_world_time(world), (int)info->substeps, (int)info->cg_iterations,
            ke, ee, inverted, ns > 0 ? min_det : 1.0, info->wall_seconds, yielded, max_fp_log,
            (long long)info->contacts, (long long)info->impacts, (int)info->impact_zones,
            (int)info->newton_iterations, (int)info->linear_iterations, (int)info->newton_failures,
-           (int)info->step_retries);
+           (int)info->step_retries, (int)info->energy_redos);
   return commit_frame(o, &frame, info->frame, line, piola_world_time(world));
 }
 

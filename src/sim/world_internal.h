@@ -135,6 +135,9 @@ piola_status piola__world_contact_prepare(piola_world *w, int built);
  * initial product plus a correction on the nodes collisions and constraints moved
  * (integrator.c); 0: a full damping pass. For tests comparing the two. */
 extern int piola__step_reuse_first_product;
+/* 1 (default): Newmark steps that fail the energy check are redone (integrator.c); tests set
+ * 0 to see what the check prevents. */
+extern int piola__step_energy_check;
 
 /* The implicit integrators (implicit_step.c): piola_world_step for
  * PIOLA_INTEGRATOR_BACKWARD_EULER and PIOLA_INTEGRATOR_QUASISTATIC; implicit_state_free frees

@@ -1,13 +1,16 @@
 /* Benchmark of the backward Euler integrator against Newmark on one scene: a mesh (default
- * torus-easy.veg, 97,878 tets) as a neo-Hookean solid (E and nu from the command line,
+ * torus-easy.veg, 97,878 tets; BENCHMARKS.md also runs the paper's Figure 2 torus, 113,512
+ * tets from `piola mesh generate`) as a neo-Hookean solid (E and nu from the command line,
  * default 1 MPa and 0.45, 1000 kg/m^3, shear viscosity 1 Pa s) dropped from 1 cm onto a
  * plane (friction 0.5) under gravity.
  *
- * Backward Euler: `frames` frames of 1/30 s at one step per frame (median wall time per frame,
- * Newton and CG iterations per frame, and wall time per Newton iteration: each iteration is
- * one stiffness assembly, one preconditioned CG solve to 1e-3 and the line search's force
- * evaluations). Newmark: the CFL step of the same scene and the median wall time of a step
- * over `newmark_steps` steps, so the time of one frame is steps per frame times that.
+ * Backward Euler: `frames` frames of 1/30 s at one step per frame: median wall time per
+ * frame, Newton and CG iterations per frame, and the time of one Newton iteration proper,
+ * the assembly of the projected stiffness plus the preconditioned CG to 1e-3 (the world's
+ * step profile, src/sim/step_profile.h; the line search's force evaluations are not in it),
+ * in wall time and in process CPU time (all threads: on a loaded machine the steadier
+ * figure). Newmark: the CFL step of the same scene and the median wall time of a step over
+ * `newmark_steps` steps, so the time of one frame is steps per frame times that.
  *
  * usage: bench_newton [frames=3] [newmark_steps=20] [mesh] [E] [nu] [threads=2] */
 #include <math.h>
@@ -18,6 +21,7 @@
 #include "piola/mesh_io.h"
 #include "piola/threads.h"
 #include "piola/world.h"
+#include "sim/world_internal.h"
 #include "support/bench_support.h"
 
 static piola_world *make_world(const piola_tet_mesh *mesh, piola_integrator_type type, double e,
@@ -73,22 +77,35 @@ int main(int argc, char **argv) {
   }
   double *frame_ms = malloc(sizeof(double) * (size_t)frames);
   double *iter_ms = malloc(sizeof(double) * (size_t)frames);
+  double *assemble_ms = malloc(sizeof(double) * (size_t)frames);
+  double *solve_ms = malloc(sizeof(double) * (size_t)frames);
+  double *iter_cpu_ms = malloc(sizeof(double) * (size_t)frames);
   long newton = 0, linear = 0, failures = 0;
   for (int f = 1; f <= frames; ++f) {
     piola_step_stats st;
     memset(&st, 0, sizeof st);
+    piola__step_profile_reset(&w->profile, 1);
     double t0 = bench_wall_seconds();
     if (piola_world_advance_to(w, f / 30.0, &st) != PIOLA_OK) {
       fprintf(stderr, "bench_newton: frame %d: %s\n", f, piola_last_error());
       return 1;
     }
     frame_ms[f - 1] = 1e3 * (bench_wall_seconds() - t0);
-    iter_ms[f - 1] = frame_ms[f - 1] / (st.newton_iterations > 0 ? st.newton_iterations : 1);
+    const double per = st.newton_iterations > 0 ? 1e3 / (double)st.newton_iterations : 0;
+    assemble_ms[f - 1] = per * w->profile.wall[STEP_PHASE_ASSEMBLE];
+    solve_ms[f - 1] = per * w->profile.wall[STEP_PHASE_LINEAR];
+    iter_ms[f - 1] = assemble_ms[f - 1] + solve_ms[f - 1];
+    iter_cpu_ms[f - 1] =
+        per * (w->profile.cpu[STEP_PHASE_ASSEMBLE] + w->profile.cpu[STEP_PHASE_LINEAR]);
     newton += st.newton_iterations, linear += st.linear_iterations, failures += st.newton_failures;
-    printf("  backward Euler frame %d: %.1f ms, %d Newton, %d CG, %d failures\n", f, frame_ms[f - 1],
-           (int)st.newton_iterations, (int)st.linear_iterations, (int)st.newton_failures);
+    printf("  backward Euler frame %d: %.1f ms, %d Newton, %d CG, %d failures; per Newton iteration "
+           "%.1f ms assembly + %.1f ms linear solve\n",
+           f, frame_ms[f - 1], (int)st.newton_iterations, (int)st.linear_iterations,
+           (int)st.newton_failures, assemble_ms[f - 1], solve_ms[f - 1]);
   }
   double be_frame = bench_median(frame_ms, frames), be_iter = bench_median(iter_ms, frames);
+  double be_assemble = bench_median(assemble_ms, frames), be_solve = bench_median(solve_ms, frames);
+  double be_iter_cpu = bench_median(iter_cpu_ms, frames);
   piola_world_destroy(w);
 
   w = make_world(&mesh, PIOLA_INTEGRATOR_NEWMARK, e, nu, zmin);
@@ -106,13 +123,17 @@ int main(int argc, char **argv) {
   double steps_per_frame = ceil((1.0 / 30) / dt);
   piola_world_destroy(w);
   printf("backward Euler: %.1f ms per frame (median of %d), %.1f Newton and %.0f CG iterations per "
-         "frame, %.1f ms per Newton iteration, %ld failed steps\n",
-         be_frame, frames, (double)newton / frames, (double)linear / frames, be_iter, failures);
+         "frame, %ld failed steps\n",
+         be_frame, frames, (double)newton / frames, (double)linear / frames, failures);
+  printf("one Newton iteration (assembly + linear solve): %.1f ms wall (%.1f + %.1f), %.1f ms "
+         "process CPU (all threads; medians over the frames)\n",
+         be_iter, be_assemble, be_solve, be_iter_cpu);
   printf("Newmark: dt %.3g s (%.0f steps per frame), %.2f ms per step (median of %d), so %.0f ms "
          "per frame\n",
          dt, steps_per_frame, nm_step, newmark_steps, steps_per_frame * nm_step);
   printf("speed-up per frame: %.1f\n", steps_per_frame * nm_step / be_frame);
-  free(frame_ms), free(iter_ms), free(step_ms);
+  free(frame_ms), free(iter_ms), free(assemble_ms), free(solve_ms), free(iter_cpu_ms);
+  free(step_ms);
   free(mesh.positions), free(mesh.tets), free(mesh.tet_regions);
   return 0;
 }

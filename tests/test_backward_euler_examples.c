@@ -5,7 +5,13 @@
  *  - no free node is inside an analytic obstacle of the scene (signed distance >= -1e-6 m;
  *    mesh obstacles are not checked here);
  *  - where no external force acts (ball_recovers: zero gravity, no obstacle, no constraint)
- *    each solid's linear momentum stays zero. */
+ *    each solid's linear momentum stays zero;
+ *  - solids_stack through the torus's impact on the ball (frame 7 of 60 fps; 12 frames, only
+ *    at PIOLA_TEST_SCALE >= 1): at most 2% of the tets inverted in any frame. The collision
+ *    pass stops only the surface nodes; before the implicit step re-solved the bodies behind
+ *    it (implicit_step.c, self_collide_and_resolve) the interiors ran through their surfaces
+ *    and 416 of the 2,952 tets (14%) were inverted at frame 10 (measured since: at most 28,
+ *    at frame 8). */
 #include "test_support.h"
 
 #include <math.h>
@@ -40,7 +46,7 @@ static char *backward_euler_text(const char *path) {
   return out;
 }
 
-static void run(const char *file, int frames, int free_momentum) {
+static void run_checked(const char *file, int frames, int free_momentum, double max_inverted_fraction) {
   char path[1024], dir[1024];
   snprintf(path, sizeof path, "%s/examples/%s", PIOLA_SOURCE_DIR, file);
   snprintf(dir, sizeof dir, "%s/examples", PIOLA_SOURCE_DIR);
@@ -67,6 +73,16 @@ static void run(const char *file, int frames, int free_momentum) {
       fail_msg("%s frame %d: %s", file, f, piola_last_error());
     if (st.newton_failures == 0) assert_int_equal(st.substeps, 1);
     const double t = piola_world_time(w);
+    int32_t inverted = 0, tets = 0;
+    for (int32_t s = 0; s < piola_world_solid_count(w); ++s) {
+      inverted += piola_world_solid_stats(w, s).inverted_count;
+      tets += piola_elastic_body_tet_count(piola_world_solid_body(w, s));
+    }
+    if (max_inverted_fraction >= 0) {
+      print_message("%s frame %d: %d of %d tets inverted\n", file, f, (int)inverted, (int)tets);
+      if (!(inverted <= max_inverted_fraction * tets))
+        fail_msg("%s frame %d: %d of %d tets inverted", file, f, (int)inverted, (int)tets);
+    }
     for (int32_t s = 0; s < piola_world_solid_count(w); ++s) {
       const piola_elastic_body *b = piola_world_solid_body(w, s);
       const int32_t n = piola_elastic_body_vertex_count(b);
@@ -104,6 +120,10 @@ static void run(const char *file, int frames, int free_momentum) {
   free(text);
 }
 
+static void run(const char *file, int frames, int free_momentum) {
+  run_checked(file, frames, free_momentum, -1);
+}
+
 static int frames_light(void) { return (int)test_samples(6, 2); }
 static int frames_heavy(void) { return test_scale() >= 1.0 ? 2 : 0; }
 
@@ -111,6 +131,10 @@ static void ball_recovers(void **state) { (void)state; run("ball_recovers.json",
 static void squeezed_solid(void **state) { (void)state; run("squeezed_solid.json", frames_light(), 0); }
 static void torus_puddle(void **state) { (void)state; run("torus_puddle.json", frames_light(), 0); }
 static void solids_stack(void **state) { (void)state; run("solids_stack.json", frames_light(), 0); }
+static void solids_stack_impact(void **state) {
+  (void)state;
+  if (test_scale() >= 1.0) run_checked("solids_stack.json", 12, 0, 0.02);
+}
 static void muscle_spindle(void **state) { (void)state; run("muscle_spindle.json", frames_light(), 0); }
 static void muscle_spindle_hanging(void **state) {
   (void)state;
@@ -132,6 +156,7 @@ int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(ball_recovers),     cmocka_unit_test(squeezed_solid),
       cmocka_unit_test(torus_puddle),      cmocka_unit_test(solids_stack),
+      cmocka_unit_test(solids_stack_impact),
       cmocka_unit_test(muscle_spindle),    cmocka_unit_test(muscle_spindle_hanging),
       cmocka_unit_test(plastic_control),   cmocka_unit_test(plastic_bar_bend),
       cmocka_unit_test(arm_flex),          cmocka_unit_test(gears),

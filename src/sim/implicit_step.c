@@ -26,8 +26,9 @@
  * like the collision-held normals of the Newmark step; a node the obstacle would have to
  * pull is released. After convergence the normal contact force (the filtered-out residual)
  * limits the tangential velocity relative to the obstacle by Coulomb's law, as the Newmark
- * step does with its normal impulse. Self-collision and plasticity run after the step as
- * with Newmark.
+ * step does with its normal impulse. Self-collision runs after the step as with Newmark, and
+ * the bodies it moved are solved again behind their pushed surfaces (self_collide_and_resolve);
+ * plasticity runs after the step.
  *
  * Momentum. K and D are translation invariant, so a free body's net residual changes only
  * through M. The block-Jacobi CG does not keep the net residual at zero by itself, so each
@@ -49,6 +50,10 @@
 
 #define STANDARD_GRAVITY 9.81
 #define RANGES 16
+
+/* Values of world_body.colliding during an implicit step: a node held along its normal by
+ * an obstacle, or along the push of the self-collision pass (see self_collide_and_resolve). */
+enum { HELD_BY_OBSTACLE = 1, HELD_BY_COLLISION = 2 };
 
 struct implicit_state {
   piola__stiffness_matrix matrix;
@@ -92,27 +97,7 @@ static piola_status implicit_state_make(world_body *s) {
   return PIOLA_OK;
 }
 
-/* ------------------------------------------------------------------ vector helpers
- * Sums over 16 fixed node ranges, added in order: results do not depend on the thread count. */
-
-static double dot_ranges(const world_body *s, const double *a, const double *b,
-                         const double *inverse_mass) {
-  double part[RANGES];
-  const int32_t n = s->n;
-#pragma omp parallel for schedule(static) num_threads(piola_thread_count()) \
-    if (n >= PIOLA_PARALLEL_MIN_VERTICES)
-  for (int r = 0; r < RANGES; ++r) {
-    double sum = 0;
-    for (int32_t i = (int32_t)((int64_t)n * r / RANGES); i < (int32_t)((int64_t)n * (r + 1) / RANGES); ++i) {
-      double d = a[3 * i] * b[3 * i] + a[3 * i + 1] * b[3 * i + 1] + a[3 * i + 2] * b[3 * i + 2];
-      sum += inverse_mass ? inverse_mass[i] * d : d;
-    }
-    part[r] = sum;
-  }
-  double sum = 0;
-  for (int r = 0; r < RANGES; ++r) sum += part[r];
-  return sum;
-}
+/* ------------------------------------------------------------------ constraints */
 
 /* Zeroes the constrained components of node i of r: all of a fixed/driven node, the normal
  * of a node held by an obstacle. */
@@ -189,47 +174,126 @@ static double residual(newton_problem *pb) {
   return sum;
 }
 
+/* The CG's vector work: one pass per CG phase over the 16 fixed node ranges (in parallel
+ * for large bodies, each range's sum added in order, so results do not depend on the thread
+ * count), so each vector is read once per phase and no phase runs on one core alone. A pass
+ * is a few microseconds per thousand nodes, so below CG_PARALLEL_MIN_VERTICES the fork and
+ * the barrier cost more than they save (and on a loaded machine a barrier can wait a whole
+ * scheduler slice for a descheduled thread). */
+#define CG_PARALLEL_MIN_VERTICES 16384
+
+typedef struct cg_vectors {
+  const world_body *s;
+  const piola__stiffness_matrix *mx;
+  double *d, *r, *z, *p, *q;
+} cg_vectors;
+
+static inline int32_t range_start(int32_t n, int range) {
+  return (int32_t)((int64_t)n * range / RANGES);
+}
+
+static double sum_parts(const double part[RANGES]) {
+  double sum = 0;
+  for (int k = 0; k < RANGES; ++k) sum += part[k];
+  return sum;
+}
+
+/* z_i = S_i P_i^-1 r_i, P_i the diagonal block; returns r_i . z_i. */
+static inline double precondition_node(const cg_vectors *c, int32_t i) {
+  const double *b = c->mx->inverse_diagonal + 9 * (size_t)i, *x = c->r + 3 * i;
+  double *y = c->z + 3 * i;
+  y[0] = b[0] * x[0] + b[1] * x[1] + b[2] * x[2];
+  y[1] = b[3] * x[0] + b[4] * x[1] + b[5] * x[2];
+  y[2] = b[6] * x[0] + b[7] * x[1] + b[8] * x[2];
+  filter_node(c->s, i, c->z);
+  return x[0] * y[0] + x[1] * y[1] + x[2] * y[2];
+}
+
+/* d = 0, r = -S g, z = S P^-1 r, p = z; returns r . z. */
+static double cg_start(const cg_vectors *c, const double *g) {
+  const int32_t n = c->s->n;
+  double part[RANGES];
+#pragma omp parallel for schedule(static) num_threads(piola_thread_count()) \
+    if (n >= CG_PARALLEL_MIN_VERTICES)
+  for (int range = 0; range < RANGES; ++range) {
+    double sum = 0;
+    for (int32_t i = range_start(n, range); i < range_start(n, range + 1); ++i) {
+      for (int k = 0; k < 3; ++k) c->d[3 * i + k] = 0, c->r[3 * i + k] = -g[3 * i + k];
+      filter_node(c->s, i, c->r);
+      sum += precondition_node(c, i);
+      for (int k = 0; k < 3; ++k) c->p[3 * i + k] = c->z[3 * i + k];
+    }
+    part[range] = sum;
+  }
+  return sum_parts(part);
+}
+
+/* q = S q (q = A p on entry); returns p . q. */
+static double cg_curvature(const cg_vectors *c) {
+  const int32_t n = c->s->n;
+  double part[RANGES];
+#pragma omp parallel for schedule(static) num_threads(piola_thread_count()) \
+    if (n >= CG_PARALLEL_MIN_VERTICES)
+  for (int range = 0; range < RANGES; ++range) {
+    double sum = 0;
+    for (int32_t i = range_start(n, range); i < range_start(n, range + 1); ++i) {
+      filter_node(c->s, i, c->q);
+      const double *p = c->p + 3 * i, *q = c->q + 3 * i;
+      sum += p[0] * q[0] + p[1] * q[1] + p[2] * q[2];
+    }
+    part[range] = sum;
+  }
+  return sum_parts(part);
+}
+
+/* d += a p, r -= a q, z = S P^-1 r; returns r . z. */
+static double cg_update(const cg_vectors *c, double a) {
+  const int32_t n = c->s->n;
+  double part[RANGES];
+#pragma omp parallel for schedule(static) num_threads(piola_thread_count()) \
+    if (n >= CG_PARALLEL_MIN_VERTICES)
+  for (int range = 0; range < RANGES; ++range) {
+    double sum = 0;
+    for (int32_t i = range_start(n, range); i < range_start(n, range + 1); ++i) {
+      for (int k = 0; k < 3; ++k) {
+        c->d[3 * i + k] += a * c->p[3 * i + k];
+        c->r[3 * i + k] -= a * c->q[3 * i + k];
+      }
+      sum += precondition_node(c, i);
+    }
+    part[range] = sum;
+  }
+  return sum_parts(part);
+}
+
+/* p = z + b p. */
+static void cg_direction(const cg_vectors *c, double b) {
+  const int64_t m = 3 * (int64_t)c->s->n;
+#pragma omp parallel for schedule(static) num_threads(piola_thread_count()) \
+    if (c->s->n >= CG_PARALLEL_MIN_VERTICES)
+  for (int64_t j = 0; j < m; ++j) c->p[j] = c->z[j] + b * c->p[j];
+}
+
 /* Solves A d = -S g by the filtered block-Jacobi CG from d = 0; returns the iterations. */
 static int32_t solve_newton_system(newton_problem *pb) {
   world_body *s = pb->s;
   struct implicit_state *st = pb->st;
   const int32_t n = s->n;
-  const int64_t m = 3 * (int64_t)n;
-  const piola__stiffness_matrix *mx = &st->matrix;
   const double mass_weight = pb->mass_weight + st->mu;
-  double *d = st->step, *r = st->cg[0], *z = st->cg[1], *p = st->cg[2], *q = st->cg[3];
-  for (int64_t j = 0; j < m; ++j) d[j] = 0, r[j] = -st->residual[j];
-  for (int32_t i = 0; i < n; ++i) filter_node(s, i, r);
-  /* z = S P^-1 r, P the diagonal blocks */
-#define PRECONDITION(out, in)                                                       \
-  for (int32_t i = 0; i < n; ++i) {                                                 \
-    const double *b = mx->inverse_diagonal + 9 * (size_t)i, *x = in + 3 * i;       \
-    double *y = out + 3 * i;                                                        \
-    y[0] = b[0] * x[0] + b[1] * x[1] + b[2] * x[2];                                 \
-    y[1] = b[3] * x[0] + b[4] * x[1] + b[5] * x[2];                                 \
-    y[2] = b[6] * x[0] + b[7] * x[1] + b[8] * x[2];                                 \
-    filter_node(s, i, out);                                                         \
-  }
-  PRECONDITION(z, r)
-  memcpy(p, z, sizeof(double) * (size_t)m);
-  double rz = dot_ranges(s, r, z, NULL);
+  double *d = st->step;
+  const cg_vectors c = {s, &st->matrix, d, st->cg[0], st->cg[1], st->cg[2], st->cg[3]};
+  double rz = cg_start(&c, st->residual);
   const double stop = pb->w->def.linear_tolerance * pb->w->def.linear_tolerance * rz;
   int32_t it = 0;
   while (rz > stop && rz > 0 && it < pb->w->def.linear_max_iterations) {
-    piola__stiffness_matrix_apply(mx, s->solid, s->mass, mass_weight, p, q);
-    for (int32_t i = 0; i < n; ++i) filter_node(s, i, q);
-    double pq = dot_ranges(s, p, q, NULL);
+    piola__stiffness_matrix_apply(c.mx, s->solid, s->mass, mass_weight, c.p, c.q);
+    const double pq = cg_curvature(&c);
     if (!(pq > 0)) break;
-    double a = rz / pq;
-    for (int64_t j = 0; j < m; ++j) d[j] += a * p[j], r[j] -= a * q[j];
-    PRECONDITION(z, r)
-    double rz_new = dot_ranges(s, r, z, NULL);
-    double b = rz_new / rz;
+    const double rz_new = cg_update(&c, rz / pq);
+    cg_direction(&c, rz_new / rz);
     rz = rz_new;
-    for (int64_t j = 0; j < m; ++j) p[j] = z[j] + b * p[j];
     ++it;
   }
-#undef PRECONDITION
   /* a free body: move d by the uniform displacement that makes sum M d = -sum g (K and D
    * ignore uniform fields, so the net residual after a full step is then zero whatever the
    * CG's accuracy or the regularization), so the linear momentum comes out exact */
@@ -271,7 +335,7 @@ static int32_t contacts(newton_problem *pb) {
       continue;
     }
     if (!s->colliding[i]) added++;
-    s->colliding[i] = 1;
+    s->colliding[i] = HELD_BY_OBSTACLE;
     for (int k = 0; k < 3; ++k) s->normals[3 * i + k] = normals[3 * i + k];
   }
   return moved > 0 ? (added > 0 ? added : 1) : 0;
@@ -301,7 +365,7 @@ static int32_t contact_friction(newton_problem *pb) {
   world_body *s = pb->s;
   int32_t changed = 0;
   for (int32_t i = 0; i < s->n; ++i) {
-    if (!s->colliding[i] || s->flags[i] != NODE_FREE) continue;
+    if (s->colliding[i] != HELD_BY_OBSTACLE || s->flags[i] != NODE_FREE) continue;
     const double *g = pb->st->residual + 3 * i, *nrm = s->normals + 3 * i;
     double dvn = (g[0] * nrm[0] + g[1] * nrm[1] + g[2] * nrm[2]) / (pb->dt * s->mass[i]);
     if (!(dvn > 0)) continue;
@@ -330,6 +394,25 @@ static int32_t contact_friction(newton_problem *pb) {
   return changed;
 }
 
+/* The step's problem for solid s over [t, t + dt]; reads no state. */
+static newton_problem problem_of(piola_world *w, world_body *s, double t, double dt) {
+  newton_problem pb;
+  memset(&pb, 0, sizeof pb);
+  pb.w = w, pb.s = s, pb.st = s->implicit, pb.dt = dt, pb.t1 = t + dt;
+  pb.quasistatic = w->def.integrator == PIOLA_INTEGRATOR_QUASISTATIC;
+  for (int k = 0; k < 3; ++k) pb.g1[k] = piola_track_eval(&w->def.gravity[k], pb.t1);
+  pb.beta = piola_track_eval(&s->shear_viscosity, pb.t1);
+  pb.alpha = piola_track_eval(&s->bulk_viscosity, pb.t1);
+  pb.damped = !pb.quasistatic && !piola__body_undamped(s, pb.beta, pb.alpha);
+  pb.force_weight = pb.quasistatic ? 1.0 : dt * dt;
+  pb.mass_weight = pb.quasistatic ? 0.0 : 1.0;
+  for (int32_t i = 0; i < s->n; ++i) pb.total_mass += s->mass[i];
+  return pb;
+}
+
+static piola_status newton_iterate(const newton_problem *problem, int accept_unconverged,
+                                   piola_step_stats *stats);
+
 /* Newton's method for one solid over [t, t + dt]. Returns PIOLA_OK when converged,
  * PIOLA_ERROR_NOT_CONVERGED when not (the caller undoes and halves), or another error. */
 static piola_status newton_solid(piola_world *w, world_body *s, double t, double dt,
@@ -338,17 +421,7 @@ static piola_status newton_solid(piola_world *w, world_body *s, double t, double
   struct implicit_state *st = s->implicit;
   const int32_t n = s->n;
   const int64_t m = 3 * (int64_t)n;
-  newton_problem pb;
-  memset(&pb, 0, sizeof pb);
-  pb.w = w, pb.s = s, pb.st = st, pb.dt = dt, pb.t1 = t + dt;
-  pb.quasistatic = w->def.integrator == PIOLA_INTEGRATOR_QUASISTATIC;
-  for (int k = 0; k < 3; ++k) pb.g1[k] = piola_track_eval(&w->def.gravity[k], pb.t1);
-  pb.beta = piola_track_eval(&s->shear_viscosity, pb.t1);
-  pb.alpha = piola_track_eval(&s->bulk_viscosity, pb.t1);
-  pb.damped = !pb.quasistatic && !piola__body_undamped(s, pb.beta, pb.alpha);
-  pb.force_weight = pb.quasistatic ? 1.0 : dt * dt;
-  pb.mass_weight = pb.quasistatic ? 0.0 : 1.0;
-  for (int32_t i = 0; i < n; ++i) pb.total_mass += s->mass[i];
+  newton_problem pb = problem_of(w, s, t, dt);
   if (!pb.quasistatic) st->mu = 0;
 
   /* the prediction, and the first guess: the prediction plus a step of gravity
@@ -370,7 +443,20 @@ static piola_status newton_solid(piola_world *w, world_body *s, double t, double
   }
   if (contacts(&pb) < 0) return PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "implicit step: out of memory");
   PIOLA_TRY(update(&pb));
+  return newton_iterate(&pb, accept_unconverged, stats);
+}
 
+/* Newton's iterations from the body's current state (its forces up to date), then the
+ * velocities, friction and prescribed nodes. */
+static piola_status newton_iterate(const newton_problem *problem, int accept_unconverged,
+                                   piola_step_stats *stats) {
+  newton_problem pb = *problem;
+  piola_world *w = pb.w;
+  world_body *s = pb.s;
+  struct implicit_state *st = pb.st;
+  const int32_t n = s->n;
+  const int64_t m = 3 * (int64_t)n;
+  const double dt = pb.dt;
   const double target = w->def.newton_tolerance * STANDARD_GRAVITY * pb.force_weight;
   const double target2 = target * target * pb.total_mass;
   double phi = residual(&pb);
@@ -388,7 +474,13 @@ static piola_status newton_solid(piola_world *w, world_body *s, double t, double
         break;
       }
     }
+    /* contacts whose force pulls are released at every iteration after the first (whose
+     * residual reflects the first guess more than the contact): releasing them only once
+     * converged costs a whole Newton solve per round of releases (measured on a torus
+     * landing on a plane: 22-24 iterations per frame, 10-13 this way) */
+    if (iter > 0 && release_contacts(&pb) > 0) phi = residual(&pb);
     stats->newton_iterations++;
+    piola__step_profile_mark(&w->profile, STEP_PHASE_UPDATE);
     if (pb.damped) piola__elastic_body_damping_prepare(s->solid, pb.beta, pb.alpha);
     piola__stiffness_matrix_assemble(&st->matrix, s->solid, pb.force_weight,
                                      pb.damped ? dt : 0.0, s->mass, pb.mass_weight);
@@ -408,7 +500,9 @@ static piola_status newton_solid(piola_world *w, world_body *s, double t, double
       piola__stiffness_matrix_assemble(&st->matrix, s->solid, pb.force_weight,
                                        pb.damped ? dt : 0.0, s->mass, pb.mass_weight + st->mu);
     }
+    piola__step_profile_mark(&w->profile, STEP_PHASE_ASSEMBLE);
     stats->linear_iterations += solve_newton_system(&pb);
+    piola__step_profile_mark(&w->profile, STEP_PHASE_LINEAR);
     /* backtracking line search on |S g|^2 */
     memcpy(st->base, s->x, sizeof(double) * (size_t)m);
     double alpha = 1.0, best_phi = phi, best_alpha = 0.0;
@@ -485,6 +579,62 @@ static void restore(world_body *s, double t) {
   (void)piola__body_update_forces(s, t);
 }
 
+/* Contacts between bodies (self_collision) are resolved after the Newton solves by the
+ * collision pass (contact.md), which changes the velocities of surface nodes only. A Newmark
+ * step is short enough for the elastic forces to carry that change inwards before the next
+ * one; a frame-sized step is not: the interior would keep the velocity the surface lost and
+ * pass through it, inverting the elements behind every impact. So each body whose nodes
+ * the pass moved is solved again from there, each moved node held along the push it got
+ * (as an obstacle holds a node along its normal; released if it would have to pull), and
+ * the pass runs once more on the result, which leaves the surfaces apart as before. Only
+ * with the per-step collision pass (collision_interval 0), where each pass covers exactly
+ * this step. */
+static piola_status self_collide_and_resolve(piola_world *w, double dt, int closes,
+                                             piola_step_stats *stats) {
+  const double t1 = w->time + dt;
+  const int per_step = !(w->def.collision_interval > 0);
+  for (int32_t b = 0; b < w->body_count && per_step; ++b) {
+    world_body *s = &w->bodies[b];
+    if (s->implicit) memcpy(s->implicit->base, s->x, sizeof(double) * 3 * (size_t)s->n);
+  }
+  PIOLA_TRY(piola__world_self_collide(w, dt, t1, closes, stats));
+  if (!per_step || stats->impacts + stats->contacts == 0) return PIOLA_OK;
+  int resolved = 0;
+  for (int32_t b = 0; b < w->body_count; ++b) {
+    world_body *s = &w->bodies[b];
+    if (!s->implicit) continue;
+    const double *before = s->implicit->base;
+    int32_t held = 0;
+    for (int32_t i = 0; i < s->n; ++i) {
+      if (s->flags[i] != NODE_FREE || s->inverse_mass[i] == 0) continue;
+      double push[3], len2 = 0;
+      for (int k = 0; k < 3; ++k) {
+        push[k] = s->x[3 * i + k] - before[3 * i + k];
+        len2 += push[k] * push[k];
+      }
+      if (!(len2 > 0)) continue;
+      const double inv = 1.0 / sqrt(len2);
+      s->colliding[i] = HELD_BY_COLLISION;
+      for (int k = 0; k < 3; ++k) s->normals[3 * i + k] = push[k] * inv;
+      held++;
+    }
+    if (held == 0) continue;
+    newton_problem pb = problem_of(w, s, w->time, dt);
+    const int64_t colliding = stats->colliding;
+    PIOLA_TRY(newton_iterate(&pb, 1, stats));
+    stats->colliding = colliding;
+    resolved = 1;
+  }
+  if (!resolved) return PIOLA_OK;
+  /* the step's contact counts are those of the first pass */
+  const piola_step_stats first = *stats;
+  PIOLA_TRY(piola__world_self_collide(w, dt, t1, closes, stats));
+  stats->contacts = first.contacts, stats->impacts = first.impacts;
+  stats->impact_zones = first.impact_zones, stats->collision_steps = first.collision_steps;
+  stats->colliding = first.colliding;
+  return PIOLA_OK;
+}
+
 /* A step whose Newton does not converge is undone and retried at half the size up to this
  * many times; the last try keeps its best iterate (a force field that jumps, as the
  * extended stress of an element passing through a reflection does, may have no exact
@@ -503,6 +653,7 @@ piola_status piola__implicit_world_step(piola_world *w, double dt_limit, piola_s
     return PIOLA_FAIL(PIOLA_ERROR_UNSUPPORTED,
                       "integrator '%s' does not step shells yet: use \"newmark\" for scenes with "
                       "shells", piola_integrator_type_name(w->def.integrator));
+  piola__step_profile_start(&w->profile);
   double left;
   PIOLA_TRY(piola__world_collision_open(w, &left));
   for (int halvings = 0;; ++halvings) {
@@ -520,13 +671,15 @@ piola_status piola__implicit_world_step(piola_world *w, double dt_limit, piola_s
     dt *= 0.5;
   }
   const int closes = dt >= left || dt == w->collision_deadline - w->time;
-  piola_status contact = piola__world_self_collide(w, dt, w->time + dt, closes, &local);
+  piola_status contact = self_collide_and_resolve(w, dt, closes, &local);
   if (contact != PIOLA_OK) {
     for (int32_t j = 0; j < w->body_count; ++j) restore(&w->bodies[j], w->time);
     if (stats) *stats = local;
     return contact;
   }
   for (int32_t i = 0; i < w->body_count; ++i) piola__body_plastic_after_step(&w->bodies[i], dt);
+  piola__step_profile_mark(&w->profile, STEP_PHASE_WORLD);
+  if (w->profile.enabled) w->profile.steps++;
   w->time += dt;
   local.substeps = 1;
   local.last_dt = dt;

@@ -6,7 +6,8 @@
 #include <time.h>
 
 const char *const piola__step_phase_names[STEP_PHASE_COUNT] = {
-    "setup", "prepare", "solve 1", "collide", "rhs 2", "update", "solve 2", "friction", "check", "world"};
+    "setup", "prepare", "solve 1", "collide", "rhs 2", "update", "solve 2", "friction", "check", "world",
+    "assemble", "linear solve"};
 
 static double seconds_of(clockid_t clock) {
   struct timespec ts;

@@ -23,6 +23,9 @@ typedef enum step_phase {
   STEP_PHASE_FRICTION,  /* A v^n+1 and the friction of the held normal impulse */
   STEP_PHASE_CHECK,     /* finiteness and energy checks */
   STEP_PHASE_WORLD,     /* stable dt, self-collision, plasticity: outside the solids' steps */
+  /* the implicit integrators (implicit_step.c); their force evaluations count as update */
+  STEP_PHASE_ASSEMBLE,  /* the projected stiffness and the Newton system's preconditioner */
+  STEP_PHASE_LINEAR,    /* the Newton system's linear solve */
   STEP_PHASE_COUNT
 } step_phase;
 

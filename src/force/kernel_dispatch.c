@@ -1,0 +1,29 @@
+/* The force kernels' entry points under their plain names: each runs the variant the CPU
+ * runs best, or the one PIOLA_ISA asks for (common/isa.h). The calls are per block range,
+ * per body or per batch, so the indirection costs nothing measurable. */
+#include "force/damping_matrix.h"
+#include "force/fiber_lanes.h"
+#include "force/force_lanes.h"
+#include "force/svd_kernel.h"
+
+void piola__force_block_range(piola_elastic_body *body, const double *x, double stiffness_scale,
+                              int want_energy, int32_t b0, int32_t b1, double *out) {
+  PIOLA_ISA_SELECT(piola__force_block_range)(body, x, stiffness_scale, want_energy, b0, b1, out);
+}
+
+double piola__fiber_energy_density(const piola_elastic_body *body, int32_t t) {
+  return PIOLA_ISA_SELECT(piola__fiber_energy_density)(body, t);
+}
+
+piola_status piola__fiber_copy(piola_elastic_body *body, const piola_elastic_body_def *def) {
+  return PIOLA_ISA_SELECT(piola__fiber_copy)(body, def);
+}
+
+void piola__damping_matrix_assemble(piola__damping_matrix *matrix, const piola_elastic_body *body,
+                                    double shear_viscosity, double bulk_viscosity) {
+  PIOLA_ISA_SELECT(piola__damping_matrix_assemble)(matrix, body, shear_viscosity, bulk_viscosity);
+}
+
+void piola__svd3_kernel_batch(int32_t n, const double *f, double *u, double *fhat, double *v) {
+  PIOLA_ISA_SELECT(piola__svd3_kernel_batch)(n, f, u, fhat, v);
+}

@@ -1,7 +1,7 @@
 /* Muscle fibres in the force loop: the anisotropic part of paper section 6.1, added to a
  * block's nodal forces after its isotropic part.
  *
- * The hook is one call in update_block (elastic_body.c), made only for bodies with fibres,
+ * The hook is one call in finish_blocks (force_lanes.c), made only for bodies with fibres,
  * so bodies without them pay nothing and the isotropic loop stays as it is. The fibre a of
  * each tet is rotated into the diagonal frame, ahat = V^T a, and its stress there is
  * Phat_f = Fhat (T / lambda) ahat ahat^T (muscle_kernels.h). Back in world space that is the

@@ -4,6 +4,7 @@
 #include "force/damping_matrix.h"
 #include "force/fiber_lanes.h"
 #include "force/force_lanes.h"
+#include "force/stable_step.h"
 #include "force/svd_kernel.h"
 
 void piola__force_block_range(piola_elastic_body *body, const double *x, double stiffness_scale,
@@ -26,4 +27,17 @@ void piola__damping_matrix_assemble(piola__damping_matrix *matrix, const piola_e
 
 void piola__svd3_kernel_batch(int32_t n, const double *f, double *u, double *fhat, double *v) {
   PIOLA_ISA_SELECT(piola__svd3_kernel_batch)(n, f, u, fhat, v);
+}
+
+double piola__elastic_body_state_rate2(piola_elastic_body *body, int32_t *worst_tet) {
+  return PIOLA_ISA_SELECT(piola__elastic_body_state_rate2)(body, worst_tet);
+}
+
+double piola__elastic_body_tet_modulus(const piola_elastic_body *body, int32_t tet,
+                                       const double fhat[3]) {
+  return PIOLA_ISA_SELECT(piola__elastic_body_tet_modulus)(body, tet, fhat);
+}
+
+double piola__elastic_body_tet_rest_altitude(const piola_elastic_body *body, int32_t tet) {
+  return PIOLA_ISA_SELECT(piola__elastic_body_tet_rest_altitude)(body, tet);
 }

@@ -12,6 +12,7 @@
 #include "force/damping_matrix.h"
 #include "force/elastic_body_internal.h"
 #include "force/force_lanes.h"
+#include "force/stable_step.h"
 #include "force/svd_kernel.h"
 #include "piola/kernels.h"
 #include "test_elastic_body_fixtures.h"
@@ -21,6 +22,7 @@ typedef void (*block_range_fn)(piola_elastic_body *, const double *, double, int
                                double *);
 typedef void (*damping_assemble_fn)(piola__damping_matrix *, const piola_elastic_body *, double,
                                     double);
+typedef double (*state_rate2_fn)(piola_elastic_body *, int32_t *);
 
 /* The variants of this build, indexed by piola__isa (NULL where a build has fewer). */
 #if defined(PIOLA_KERNEL_DISPATCH)
@@ -32,11 +34,15 @@ static const block_range_fn FORCES[] = {piola__force_block_range_baseline,
 static const damping_assemble_fn DAMPING[] = {piola__damping_matrix_assemble_baseline,
                                               piola__damping_matrix_assemble_avx2,
                                               piola__damping_matrix_assemble_avx512};
+static const state_rate2_fn RATE2[] = {piola__elastic_body_state_rate2_baseline,
+                                       piola__elastic_body_state_rate2_avx2,
+                                       piola__elastic_body_state_rate2_avx512};
 #else
 static const svd_batch_fn SVD[] = {PIOLA_ISA_SELECT(piola__svd3_kernel_batch), NULL, NULL};
 static const block_range_fn FORCES[] = {PIOLA_ISA_SELECT(piola__force_block_range), NULL, NULL};
 static const damping_assemble_fn DAMPING[] = {PIOLA_ISA_SELECT(piola__damping_matrix_assemble),
                                               NULL, NULL};
+static const state_rate2_fn RATE2[] = {PIOLA_ISA_SELECT(piola__elastic_body_state_rate2), NULL, NULL};
 #endif
 enum { VARIANTS = 3 };
 
@@ -163,10 +169,11 @@ static piola_material muscle(void) {
 }
 
 /* A 4 x 4 x 4 grid (48 blocks, one range: the serial path) of neo-Hookean, corotated and
- * muscle tets with random fibres, randomly deformed with some tets inverted: the forces,
- * energy densities and damping blocks of every variant agree to 1e-13 of their largest
- * entry, and the update (the plain names) gives the chosen variant's bits. */
-static void force_and_damping_variants_agree(void **state) {
+ * muscle tets with random fibres, randomly deformed with some tets inverted: the step bound
+ * of every variant is the same to the bit; the forces, energy densities and damping blocks
+ * agree to 1e-13 of their largest entry; the update (the plain names) gives the chosen
+ * variant's bits. */
+static void force_damping_and_step_variants_agree(void **state) {
   (void)state;
   test_rng rng = test_rng_seeded(77);
   piola_tet_mesh mesh = fixture_grid(4, 0.1);
@@ -211,6 +218,19 @@ static void force_and_damping_variants_agree(void **state) {
   for (int i = 0; i < n; ++i) v[i] = test_rng_uniform(&rng, -1, 1);
   piola_elastic_body_damping_forces(body, v, 2.0, 0.5, fd);
   memcpy(damp[VARIANTS], body->damping.blocks, sizeof(double) * edge_values);
+
+  /* the step bound: no fused multiply-adds, only max reductions, so the same bits */
+  int32_t worst_chosen = -2;
+  const double rate2_chosen = piola__elastic_body_state_rate2(body, &worst_chosen);
+  assert_true(rate2_chosen > 0 && worst_chosen >= 0);
+  for (int isa = 0; isa < VARIANTS; ++isa) {
+    if (!RATE2[isa] || !runs(isa)) continue;
+    int32_t worst = -2;
+    const double rate2 = RATE2[isa](body, &worst);
+    if (rate2 != rate2_chosen || worst != worst_chosen)
+      fail_msg("step bound rate^2 %.17g (tet %d) under %s, %.17g (tet %d) chosen", rate2,
+               (int)worst, piola__isa_name((piola__isa)isa), rate2_chosen, (int)worst_chosen);
+  }
 
   int first = -1;
   for (int isa = 0; isa < VARIANTS; ++isa) {
@@ -265,7 +285,7 @@ int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(chosen_variant_follows_cpu_and_environment),
       cmocka_unit_test(svd_variants_agree),
-      cmocka_unit_test(force_and_damping_variants_agree),
+      cmocka_unit_test(force_damping_and_step_variants_agree),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -17,6 +17,8 @@ packages=(
   python3-dev python3-pytest python3-matplotlib
   # movies from `piola render`
   ffmpeg
+  # MPI domain decomposition (docs/mpi.md): OpenMPI and METIS graph partitions
+  libopenmpi-dev openmpi-bin libmetis-dev
 )
 
 missing=()

@@ -33,6 +33,7 @@
 #include "piola/world.h"
 #include "piola/world_bodies.h"
 #include "piola/world_bones.h"
+#include "piola/work_split.h"
 #include "piola/world_shells.h"
 
 /* scene files: libpiola_scene */

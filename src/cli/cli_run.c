@@ -16,6 +16,7 @@
 #include "cli/cli_numbers.h"
 #include "cli/commands.h"
 #include "cli/run_checkpoints.h"
+#include "cli/run_mpi.h"
 #include "piola/checkpoint.h"
 #include "piola/elastic_body.h"
 #include "piola/output.h"
@@ -68,6 +69,7 @@ static void format_duration(double s, char *buf, size_t n) {
  * DIR/warnings.txt with all of them (docs/cli.md). */
 static void report_warnings(piola_output *out, const piola_world *world, bool warned[],
                             bool tty) {
+  if (!out) return; /* another MPI process than 0: process 0 reports */
   bool fresh = false;
   for (int k = 0; k < PIOLA_WARNING_KIND_COUNT; ++k) {
     const char *w = piola_world_warning(world, (piola_warning_kind)k);
@@ -106,10 +108,11 @@ static void progress(bool tty, int frame, int frames, double t, double elapsed, 
  * mistyped fps (1e-300) or frame count would otherwise run for ever. The estimate uses the
  * step at t = 0; steps shrink under stiffening and contact, so it is a lower bound. */
 static bool budget_ok(const char *scene_path, const piola_world *world, int frames, double fps,
-                      double max_steps) {
+                      double max_steps, bool quiet) {
   double simulated = frames / fps, dt = piola_world_stable_dt(world);
   double steps = simulated / dt;
   if (isfinite(steps) && steps <= max_steps) return true;
+  if (quiet) return false; /* MPI processes other than 0 */
   fprintf(stderr,
           "piola run: %s: %d frames at %g fps are %.3g s of simulated time, about %.3g steps of "
           "%.3g s: more than the limit of %.3g steps. Check fps and frames, or raise the limit "
@@ -118,7 +121,7 @@ static bool budget_ok(const char *scene_path, const piola_world *world, int fram
   return false;
 }
 
-int cli_run(int argc, char **argv) {
+static int run(int argc, char **argv, run_mpi *mpi) {
   const char *scene_path = NULL, *out_dir = NULL;
   long threads = 0, frames_override = -1, checkpoint_every = -1; /* -1: the default */
   double max_steps = 1e7; /* the time-budget guard (see budget_ok) */
@@ -170,28 +173,46 @@ int cli_run(int argc, char **argv) {
     fprintf(stderr, "piola run: --force and --resume exclude each other (start over, or continue)\n");
     return 2;
   }
-  if (piola_output_check_folder(out_dir, force || resume) != PIOLA_OK) {
-    fprintf(stderr, "piola run: %s\n", piola_last_error());
+  const bool lead = mpi->rank == 0; /* the process that writes and reports */
+  if (mpi->size > 1 && (resume || checkpoint_every > 0)) {
+    if (lead)
+      fprintf(stderr, "piola run: %s: checkpoints are single-process only, and this run has %d "
+                      "MPI processes (docs/mpi.md)\n", resume ? "--resume" : "--checkpoint-every",
+              mpi->size);
+    return 2;
+  }
+  if (!run_mpi_all(mpi, piola_output_check_folder(out_dir, force || resume) == PIOLA_OK)) {
+    if (lead) fprintf(stderr, "piola run: %s\n", piola_last_error());
     return 2;
   }
   if (threads > 0) piola_set_thread_count((int)threads); /* every parallel loop of piola */
   double t_start = now_seconds();
   piola_scene *scene = NULL;
-  if (piola_scene_load(scene_path, &scene) != PIOLA_OK) {
-    fprintf(stderr, "piola run: %s\n", piola_last_error());
+  if (!run_mpi_all(mpi, piola_scene_load(scene_path, &scene) == PIOLA_OK)) {
+    if (lead) fprintf(stderr, "piola run: %s\n", scene ? "another MPI process could not load the scene" : piola_last_error());
+    piola_scene_destroy(scene);
     return 2;
   }
   piola_world *world = piola_scene_world(scene);
+  if (!run_mpi_split(mpi, world)) {
+    piola_scene_destroy(scene);
+    return 2;
+  }
   int frames = frames_override >= 0 ? (int)frames_override : (int)piola_scene_frames(scene);
   double fps = piola_scene_fps(scene);
-  if (!budget_ok(scene_path, world, frames, fps, max_steps)) {
+  if (!budget_ok(scene_path, world, frames, fps, max_steps, !lead)) {
     piola_scene_destroy(scene);
     return 2;
   }
   /* checkpoints: on by default where they cover the whole state */
   const char *why = NULL;
   uint64_t scene_key = 0;
-  if (!piola_world_checkpoint_supported(world, &why)) {
+  if (mpi->size > 1) {
+    if (checkpoint_every < 0 && lead)
+      fprintf(stderr, "piola run: no checkpoints: this run has %d MPI processes (docs/mpi.md)\n",
+              mpi->size);
+    checkpoint_every = 0;
+  } else if (!piola_world_checkpoint_supported(world, &why)) {
     if (resume || checkpoint_every > 0) {
       fprintf(stderr, "piola run: %s: %s\n", resume ? "--resume" : "--checkpoint-every", why);
       piola_scene_destroy(scene);
@@ -223,10 +244,12 @@ int cli_run(int argc, char **argv) {
     }
   }
   piola_output *out = NULL;
-  piola_status opened = resume_frame >= 0 ? piola_output_open_resume(out_dir, resume_frame, world, &out)
-                                          : piola_output_open(out_dir, force, world, &out);
-  if (opened != PIOLA_OK) {
-    fprintf(stderr, "piola run: %s\n", piola_last_error());
+  piola_status opened = !lead ? PIOLA_OK
+                        : resume_frame >= 0 ? piola_output_open_resume(out_dir, resume_frame, world, &out)
+                                            : piola_output_open(out_dir, force, world, &out);
+  if (!run_mpi_all(mpi, opened == PIOLA_OK)) {
+    if (lead) fprintf(stderr, "piola run: %s\n", piola_last_error());
+    piola_output_close(out);
     piola_scene_destroy(scene);
     return opened == PIOLA_ERROR_INVALID_ARGUMENT ? 2 : 1;
   }
@@ -236,24 +259,25 @@ int cli_run(int argc, char **argv) {
   const double checkpoint_wall = 300; /* s: the default's time bound */
   int32_t last_checkpoint = resume_frame >= 0 ? resume_frame : 0;
   double last_checkpoint_time = now_seconds();
-  bool tty = isatty(STDERR_FILENO);
+  bool tty = lead && isatty(STDERR_FILENO);
   bool warned[PIOLA_WARNING_KIND_COUNT] = {false};
   report_warnings(out, world, warned, false);
-  fprintf(stderr, "piola run: %s -> %s: %d frames at %g fps, %d solids, %d shells, %d obstacles, first dt %.3g s\n",
-          scene_path, out_dir, frames, fps, (int)piola_world_solid_count(world),
-          (int)piola_world_shell_count(world), (int)piola_world_obstacle_count(world),
-          piola_world_stable_dt(world));
+  if (lead)
+    fprintf(stderr, "piola run: %s -> %s: %d frames at %g fps, %d solids, %d shells, %d obstacles, first dt %.3g s%s\n",
+            scene_path, out_dir, frames, fps, (int)piola_world_solid_count(world),
+            (int)piola_world_shell_count(world), (int)piola_world_obstacle_count(world),
+            piola_world_stable_dt(world), mpi->size > 1 ? ", on MPI processes" : "");
   /* previews (src/render): DIR/scene.json, DIR/preview.png and, with --render, every frame */
   piola_preview *preview = NULL;
-  if (piola_preview_open(out_dir, scene_path, render_frames, &preview) != PIOLA_OK)
+  if (lead && piola_preview_open(out_dir, scene_path, render_frames, &preview) != PIOLA_OK)
     fprintf(stderr, "piola run: no preview: %s\n", piola_last_error());
   int rc = 0;
   long long total_steps = 0, total_cg = 0, total_newton = 0, total_linear = 0, total_failures = 0;
   int max_inverted = 0;
   double sim_start = now_seconds();
   piola_frame_info info = {0};
-  if (resume_frame >= 0) {
-    /* frames up to resume_frame are on disk already */
+  if (resume_frame >= 0 || !lead) {
+    /* frames up to resume_frame are on disk already; only process 0 writes */
   } else if (piola_output_write_frame(out, world, &info) != PIOLA_OK) {
     fprintf(stderr, "piola run: %s\n", piola_last_error());
     rc = 1;
@@ -262,12 +286,16 @@ int cli_run(int argc, char **argv) {
       fprintf(stderr, "piola run: preview: %s\n", piola_last_error());
     if (checkpoint_every != 0 && !run_checkpoint_save(out_dir, world, scene_key, 0)) rc = 1;
   }
+  if (!run_mpi_all(mpi, rc == 0)) rc = 1;
   int frame = 0, frames_written = 0;
   int first = resume_frame >= 0 ? resume_frame + 1 : 1;
   for (frame = first; rc == 0 && frame <= frames; ++frame) {
     double t0 = now_seconds();
     piola_step_stats st = {0};
     if (piola_world_advance_to(world, frame / fps, &st) != PIOLA_OK) {
+      /* every MPI process fails the same step: their states are the same bits */
+      rc = 1;
+      if (!lead) break;
       char message[1024];
       snprintf(message, sizeof message, "%s", piola_last_error());
       if (tty) fputc('\n', stderr);
@@ -300,9 +328,9 @@ int cli_run(int argc, char **argv) {
     for (int32_t s = 0; s < piola_world_solid_count(world); ++s)
       inverted += piola_world_solid_stats(world, s).inverted_count;
     if (inverted > max_inverted) max_inverted = inverted;
-    if (piola_output_write_frame(out, world, &info) != PIOLA_OK) {
+    if (!run_mpi_all(mpi, !lead || piola_output_write_frame(out, world, &info) == PIOLA_OK)) {
       if (tty) fputc('\n', stderr);
-      fprintf(stderr, "piola run: %s\n", piola_last_error());
+      if (lead) fprintf(stderr, "piola run: %s\n", piola_last_error());
       rc = 1;
       break;
     }
@@ -322,11 +350,13 @@ int cli_run(int argc, char **argv) {
       last_checkpoint_time = now_seconds();
     }
     report_warnings(out, world, warned, tty);
-    progress(tty, frame, frames, piola_world_time(world), now_seconds() - sim_start, st.substeps, inverted);
+    if (lead) progress(tty, frame, frames, piola_world_time(world), now_seconds() - sim_start, st.substeps, inverted);
   }
   double wall = now_seconds() - t_start;
   double sim_wall = now_seconds() - sim_start;
   int written = frames_written;
+  run_mpi_report(mpi);
+  if (lead)
   fprintf(stderr,
           "piola run: %s. %d frames (%.3f s simulated) in %.2f s wall (%.2f frames/s), %lld steps, "
           "%lld CG iterations, %lld Newton iterations, %lld linear iterations, %lld failed "
@@ -340,5 +370,13 @@ int cli_run(int argc, char **argv) {
     fprintf(stderr, "piola run: preview of the last frame: %s/preview.png\n", out_dir);
   piola_output_close(out);
   piola_scene_destroy(scene);
+  return rc;
+}
+
+int cli_run(int argc, char **argv) {
+  run_mpi mpi;
+  if (!run_mpi_start(&mpi)) return 1;
+  int rc = run(argc, argv, &mpi);
+  run_mpi_finish(&mpi, NULL); /* the world is gone: the split only drops its own arrays */
   return rc;
 }

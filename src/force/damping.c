@@ -50,10 +50,12 @@ void piola__elastic_body_damping_prepare(piola_elastic_body *body, double shear_
  * its edges to vertices ranked after it (blocks D_ij) and before it (D_ji^T), in a fixed
  * order. */
 static void product_rows(const piola__damping_matrix *m, const double *v, const double *mass,
-                         double h, int32_t r0, int32_t r1, double *out) {
+                         double h, int32_t r0, int32_t r1, const piola_work_split *split,
+                         double *out) {
   const double *blocks = m->blocks;
   for (int32_t r = r0; r < r1; ++r) {
     const int32_t i = m->order[r];
+    if (split && split->node_part[i] != split->part) continue; /* another process's row */
     const double v0 = v[3 * i], v1 = v[3 * i + 1], v2 = v[3 * i + 2];
     double f0 = 0, f1 = 0, f2 = 0;
     for (int32_t k = m->row_start[r]; k < m->row_start[r + 1]; ++k) {
@@ -83,7 +85,9 @@ static void product_rows(const piola__damping_matrix *m, const double *v, const 
   }
 }
 
-/* forces = D v, or with mass given, out = M v - h D v (the implicit step's operator). */
+/* forces = D v, or with mass given, out = M v - h D v (the implicit step's operator). With a
+ * work split each process computes its own nodes' rows, the same bits as the whole
+ * product's, and the split shares them. */
 static void damping_pass(const piola_elastic_body *body, const double *v, double shear_viscosity,
                          double bulk_viscosity, const double *mass, double h, double *out) {
   /* the matrix is assembled in place, like the lazy energy: concurrent calls on one body are
@@ -91,13 +95,15 @@ static void damping_pass(const piola_elastic_body *body, const double *v, double
   piola__elastic_body_damping_prepare((piola_elastic_body *)body, shear_viscosity, bulk_viscosity);
   const piola__damping_matrix *m = &body->damping;
   const int32_t nv = body->vertex_count;
+  const piola_work_split *split = body->split && body->split->part_count > 1 ? body->split : NULL;
   /* fixed row ranges; each row is summed alone, so the split does not change any bit */
   enum { RANGES = 16 };
 #pragma omp parallel for schedule(static) num_threads(piola_thread_count()) \
     if (nv >= PIOLA_PARALLEL_MIN_VERTICES)
   for (int r = 0; r < RANGES; ++r)
     product_rows(m, v, mass, h, (int32_t)((int64_t)nv * r / RANGES),
-                 (int32_t)((int64_t)nv * (r + 1) / RANGES), out);
+                 (int32_t)((int64_t)nv * (r + 1) / RANGES), split, out);
+  if (split) split->share_nodes(split->context, out);
 }
 
 void piola_elastic_body_damping_forces(const piola_elastic_body *body, const double *v,

@@ -94,7 +94,9 @@ piola_status piola_elastic_body_update(piola_elastic_body *body, const double *x
   }
   int32_t blocks = body->padded_tet_count / B;
   const int64_t n = 3 * (int64_t)body->vertex_count;
-  if (blocks < PIOLA_PARALLEL_MIN_BLOCKS || !body->chunk_forces) {
+  if (body->split) {
+    piola__elastic_body_split_update(body, x, stiffness_scale, stats != NULL, forces);
+  } else if (blocks < PIOLA_PARALLEL_MIN_BLOCKS || !body->chunk_forces) {
     for (int64_t i = 0; i < n; ++i) forces[i] = 0.0;
     piola__force_block_range(body, x, stiffness_scale, stats != NULL, 0, blocks, forces);
   } else {

@@ -33,9 +33,11 @@
 
 #include <stdint.h>
 
+#include "common/isa.h"
 #include "force/damping_matrix.h"
 #include "piola/elastic_body.h"
 #include "piola/threads.h"
+#include "piola/work_split.h"
 
 #define PIOLA_TET_BLOCK 8
 
@@ -102,7 +104,27 @@ struct piola_elastic_body {
   /* damping (damping.c): the operator as a sparse matrix, assembled from the last update by
    * the first damping call after it (the update clears damping.ready) */
   piola__damping_matrix damping;
+
+  /* work split among processes (piola/work_split.h, work_split.c), or NULL: this process's
+   * blocks in increasing order, and the exchange buffer of the per-tet state */
+  const piola_work_split *split;
+  int32_t *split_blocks;
+  int32_t split_block_count;
+  double *split_buffer; /* block count * SPLIT_STATE_WIDTH_MAX doubles */
 };
+
+/* The split force loop and damping product (work_split.c). */
+void piola__elastic_body_split_update(piola_elastic_body *body, const double *x,
+                                      double stiffness_scale, int want_energy, double *forces);
+void piola__elastic_body_split_free(piola_elastic_body *body);
+/* One or two consecutive blocks of the force loop from first, forces added into out in tet
+ * order (force_lanes.c, a kernel built once per instruction set, common/isa.h; the plain
+ * name runs the chosen variant). */
+#define PIOLA_UPDATE_BLOCK_PAIR_PARAMS                                                        \
+  (piola_elastic_body * body, const double *x, double stiffness_scale, int want_energy,      \
+   int32_t first, int count, double *out)
+PIOLA_ISA_DECLARE(void, piola__elastic_body_update_block_pair, PIOLA_UPDATE_BLOCK_PAIR_PARAMS);
+void piola__elastic_body_update_block_pair PIOLA_UPDATE_BLOCK_PAIR_PARAMS;
 
 /* Bodies of at least PIOLA_PARALLEL_MIN_BLOCKS blocks sum their elastic forces in this many
  * fixed tet ranges (each its own partial sum), whatever the thread count. */

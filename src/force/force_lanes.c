@@ -225,6 +225,13 @@ PIOLA_WIDE_VECTORS static void update_blocks(piola_elastic_body *body, const dou
 
 #undef LANES
 
+/* One or two consecutive blocks (the work split's unit, work_split.c). */
+void PIOLA_ISA_NAME(piola__elastic_body_update_block_pair)(piola_elastic_body *body, const double *x,
+                                                           double stiffness_scale, int want_energy,
+                                                           int32_t first, int count, double *out) {
+  update_blocks(body, x, stiffness_scale, want_energy, first, count, out);
+}
+
 /* Blocks [b0, b1) in pairs (the pairing depends only on b0 and b1, not on threads). */
 void PIOLA_ISA_NAME(piola__force_block_range)(piola_elastic_body *body, const double *x,
                                               double stiffness_scale, int want_energy, int32_t b0,

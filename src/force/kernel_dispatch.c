@@ -12,6 +12,13 @@ void piola__force_block_range(piola_elastic_body *body, const double *x, double 
   PIOLA_ISA_SELECT(piola__force_block_range)(body, x, stiffness_scale, want_energy, b0, b1, out);
 }
 
+void piola__elastic_body_update_block_pair(piola_elastic_body *body, const double *x,
+                                           double stiffness_scale, int want_energy, int32_t first,
+                                           int count, double *out) {
+  PIOLA_ISA_SELECT(piola__elastic_body_update_block_pair)(body, x, stiffness_scale, want_energy,
+                                                          first, count, out);
+}
+
 double piola__fiber_energy_density(const piola_elastic_body *body, int32_t t) {
   return PIOLA_ISA_SELECT(piola__fiber_energy_density)(body, t);
 }

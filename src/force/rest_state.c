@@ -41,6 +41,7 @@ void piola__elastic_body_free_arrays(piola_elastic_body *body) {
   free(body->masses);
   free(body->positions);
   free(body->chunk_forces);
+  piola__elastic_body_split_free(body);
   free(body->step_weight);
   piola__damping_matrix_free(&body->damping);
   for (int k = 0; k < 3; ++k) free(body->fiber[k]);

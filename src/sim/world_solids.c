@@ -262,3 +262,11 @@ piola_solid_stats piola_world_solid_stats(const piola_world *world, int32_t soli
   st.min_det_f = s->elastic.min_det_f;
   return st;
 }
+
+piola_status piola_world_solid_set_work_split(piola_world *world, int32_t solid,
+                                              const piola_work_split *split) {
+  world_body *s = (world_body *)solid_at(world, solid);
+  if (!s) return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "work split: no solid %d", (int)solid);
+  s->product_valid = 0;
+  return piola_elastic_body_set_work_split(s->solid, split);
+}

@@ -1,0 +1,100 @@
+/* Weak scaling of the split Newmark step (docs/scaling.md): a box of generated tets, the
+ * same number per process, stepped on every process of MPI_COMM_WORLD.
+ *
+ *   mpirun -np 1 build/test/bench_mpi_weak [TETS_PER_PROCESS] [STEPS] [REPEATS]
+ *   mpirun -np 2 build/test/bench_mpi_weak [TETS_PER_PROCESS] [STEPS] [REPEATS]
+ *
+ * The box is n x n x (P n) cubes of 6 tets (P processes), a neo-Hookean jelly (E = 100 kPa,
+ * nu = 0.4) with shear and bulk viscosity, starting stretched by 10% along x and swinging
+ * back under gravity; steps of 1e-4 s. Each repeat times STEPS steps (median over repeats),
+ * and process 0 prints: tets, steps, wall s/step, each process's time in the halo sums and
+ * in the replication gathers per step, and their bytes per step. Efficiency of weak scaling
+ * is the 1-process s/step over the P-process one. Only built with PIOLA_MPI. */
+#include <math.h>
+#include <mpi.h>
+#include <stdio.h>
+#include <stdlib.h>
+
+#include "support/bench_support.h"
+#include "piola/mpi.h"
+#include "piola/world.h"
+
+static piola_world *jelly_box(int n, int stack) {
+  piola_tet_mesh mesh;
+  const double h = 0.01;
+  if (piola_tet_mesh_box_grid(n, n, stack * n, (piola_vec3){h, h, h}, &mesh) != PIOLA_OK) return NULL;
+  piola_world_def wd = piola_default_world_def();
+  wd.max_dt = 1e-4;
+  wd.cfl = 2; /* every step max_dt long */
+  piola_world *w = NULL;
+  if (piola_world_create(&wd, &w) != PIOLA_OK) return NULL;
+  piola_solid_def sd = piola_default_solid_def();
+  sd.mesh = &mesh;
+  sd.material.model = PIOLA_MODEL_NEOHOOKEAN;
+  sd.material.youngs_modulus = 1e5;
+  sd.material.poisson_ratio = 0.4;
+  sd.shear_viscosity = piola_track_constant(2.0);
+  sd.bulk_viscosity = piola_track_constant(2.0);
+  sd.initial_matrix = (piola_mat3){{{1.1, 0, 0}, {0, 1, 0}, {0, 0, 1}}};
+  piola_status st = piola_world_add_solid(w, &sd, NULL);
+  piola_tet_mesh_free(&mesh);
+  if (st != PIOLA_OK) {
+    piola_world_destroy(w);
+    return NULL;
+  }
+  return w;
+}
+
+int main(int argc, char **argv) {
+  MPI_Init(&argc, &argv);
+  int rank, size;
+  MPI_Comm_rank(MPI_COMM_WORLD, &rank);
+  MPI_Comm_size(MPI_COMM_WORLD, &size);
+  const long per_process = argc > 1 ? atol(argv[1]) : 48000;
+  const int steps = argc > 2 ? atoi(argv[2]) : 20, repeats = argc > 3 ? atoi(argv[3]) : 3;
+  const int n = (int)fmax(2, round(cbrt(per_process / 6.0)));
+  piola_world *w = jelly_box(n, size);
+  piola_mpi_split *split = NULL;
+  if (!w || piola_mpi_split_world(w, &split) != PIOLA_OK) {
+    fprintf(stderr, "bench_mpi_weak: %s\n", piola_last_error());
+    MPI_Abort(MPI_COMM_WORLD, 1);
+  }
+  double *per_step = malloc(sizeof(double) * (size_t)repeats);
+  piola_mpi_split_stats before = piola_mpi_split_stats_of(split);
+  (void)piola_world_step(w, 0, NULL); /* warm-up */
+  before = piola_mpi_split_stats_of(split);
+  for (int r = 0; r < repeats; ++r) {
+    MPI_Barrier(MPI_COMM_WORLD);
+    double t0 = bench_wall_seconds();
+    for (int s = 0; s < steps; ++s)
+      if (piola_world_step(w, 0, NULL) != PIOLA_OK) MPI_Abort(MPI_COMM_WORLD, 1);
+    MPI_Barrier(MPI_COMM_WORLD);
+    per_step[r] = (bench_wall_seconds() - t0) / steps;
+  }
+  piola_mpi_split_stats after = piola_mpi_split_stats_of(split);
+  const double total_steps = (double)steps * repeats;
+  double mine[5] = {(after.halo_seconds - before.halo_seconds) / total_steps,
+                    (after.gather_seconds - before.gather_seconds) / total_steps,
+                    (double)(after.halo_bytes - before.halo_bytes) / total_steps,
+                    (double)(after.gather_bytes - before.gather_bytes) / total_steps,
+                    (double)after.shared_nodes};
+  double *all = malloc(sizeof mine * (size_t)size);
+  MPI_Gather(mine, 5, MPI_DOUBLE, all, 5, MPI_DOUBLE, 0, MPI_COMM_WORLD);
+  if (rank == 0) {
+    const piola_elastic_body *b = piola_world_solid_body(w, 0);
+    printf("bench_mpi_weak: %d processes, %d tets (%ld per process asked), %d nodes, %d steps x %d\n",
+           size, (int)piola_elastic_body_tet_count(b), per_process,
+           (int)piola_elastic_body_vertex_count(b), steps, repeats);
+    printf("  wall per step (median): %.4f s\n", bench_median(per_step, repeats));
+    for (int q = 0; q < size; ++q)
+      printf("  rank %d: halo %.5f s/step (%.0f B sent/step), gathers %.5f s/step (%.0f B "
+             "received/step), %.0f shared nodes\n",
+             q, all[5 * q], all[5 * q + 2], all[5 * q + 1], all[5 * q + 3], all[5 * q + 4]);
+  }
+  free(all);
+  free(per_step);
+  piola_mpi_split_destroy(split, w);
+  piola_world_destroy(w);
+  MPI_Finalize();
+  return 0;
+}

@@ -1,0 +1,94 @@
+/* `piola run` on several MPI processes (run_mpi.h, docs/mpi.md). */
+#include "cli/run_mpi.h"
+
+#include <stdio.h>
+#include <stdlib.h>
+
+#ifdef PIOLA_MPI
+#include <mpi.h>
+
+#include "piola/mpi.h"
+#include "piola/work_split.h"
+
+/* mpirun (OpenMPI) and other launchers set these in the processes they start. */
+static bool launched_by_mpirun(void) {
+  return getenv("OMPI_COMM_WORLD_SIZE") || getenv("PMI_SIZE") || getenv("PMIX_RANK");
+}
+
+bool run_mpi_start(run_mpi *m) {
+  *m = (run_mpi){0, 1, false, NULL};
+  if (!launched_by_mpirun()) return true;
+  if (MPI_Init(NULL, NULL) != MPI_SUCCESS) {
+    fprintf(stderr, "piola run: MPI_Init failed\n");
+    return false;
+  }
+  m->started = true;
+  MPI_Comm_rank(MPI_COMM_WORLD, &m->rank);
+  MPI_Comm_size(MPI_COMM_WORLD, &m->size);
+  return true;
+}
+
+bool run_mpi_split(run_mpi *m, piola_world *world) {
+  if (m->size <= 1) return true;
+  piola_mpi_split *split = NULL;
+  if (piola_mpi_split_world(world, &split) != PIOLA_OK) {
+    if (m->rank == 0)
+      fprintf(stderr, "piola run: cannot run on %d MPI processes: %s (run it without mpirun, "
+                      "or with -np 1; docs/mpi.md)\n", m->size, piola_last_error());
+    return false;
+  }
+  m->split = split;
+  return true;
+}
+
+bool run_mpi_all(run_mpi *m, bool ok) {
+  if (!m->started) return ok;
+  int mine = ok, all = 0;
+  MPI_Allreduce(&mine, &all, 1, MPI_INT, MPI_MIN, MPI_COMM_WORLD);
+  return all != 0;
+}
+
+void run_mpi_report(run_mpi *m) {
+  if (!m->split) return;
+  piola_mpi_split_stats st = piola_mpi_split_stats_of(m->split);
+  double mine[7] = {(double)st.tets, (double)st.owned_nodes, (double)st.shared_nodes,
+                    (double)st.halo_bytes, st.halo_seconds, (double)st.gather_bytes,
+                    st.gather_seconds};
+  double *all = m->rank == 0 ? malloc(sizeof mine * (size_t)m->size) : NULL;
+  MPI_Gather(mine, 7, MPI_DOUBLE, all, 7, MPI_DOUBLE, 0, MPI_COMM_WORLD);
+  if (m->rank != 0 || !all) return;
+  for (int r = 0; r < m->size; ++r) {
+    const double *a = all + 7 * r;
+    fprintf(stderr,
+            "piola run: MPI rank %d/%d: %.0f tets, %.0f owned nodes, %.0f shared nodes; halo "
+            "sent %.3f MB in %.3f s, gathers received %.3f MB in %.3f s\n",
+            r, m->size, a[0], a[1], a[2], a[3] / 1e6, a[4], a[5] / 1e6, a[6]);
+  }
+  free(all);
+}
+
+void run_mpi_finish(run_mpi *m, piola_world *world) {
+  piola_mpi_split_destroy(m->split, world);
+  m->split = NULL;
+  if (m->started) MPI_Finalize();
+  m->started = false;
+}
+
+#else /* a build without MPI: always the single process */
+
+bool run_mpi_start(run_mpi *m) {
+  *m = (run_mpi){0, 1, false, NULL};
+  return true;
+}
+bool run_mpi_split(run_mpi *m, piola_world *world) {
+  (void)m, (void)world;
+  return true;
+}
+bool run_mpi_all(run_mpi *m, bool ok) {
+  (void)m;
+  return ok;
+}
+void run_mpi_report(run_mpi *m) { (void)m; }
+void run_mpi_finish(run_mpi *m, piola_world *world) { (void)m, (void)world; }
+
+#endif

@@ -1,0 +1,374 @@
+/* A world's solids split among the processes of MPI_COMM_WORLD (piola/mpi.h, docs/mpi.md).
+ *
+ * Partition. Each solid's blocks of PIOLA_WORK_SPLIT_BLOCK consecutive tets (the force
+ * loop's unit of work) are the vertices of a graph: the tets' dual graph (METIS_MeshToDual,
+ * tets sharing a face) collapsed onto blocks, each edge weighted by the faces it stands for,
+ * each block weighted by its real tets. METIS_PartGraphKway cuts it into one part per process
+ * on rank 0, which broadcasts it, so every process holds the same partition. A node is owned
+ * by the lowest process whose blocks touch it (process 0 for a node no tet touches).
+ *
+ * Exchanges (the three operations of piola/work_split.h):
+ *   sum_nodes    halo: each process sends its partial forces on the nodes it shares with a
+ *                lower-numbered owner to that owner (MPI_Isend / MPI_Irecv, one message per
+ *                neighbour pair); the owner adds them to its own in process order, so the
+ *                sum has one fixed order. Then share_nodes.
+ *   share_nodes  replication: MPI_Allgatherv of the owned nodes' values (3 per node).
+ *   share_blocks replication: MPI_Allgatherv of each process's blocks' per-tet state.
+ * The replication gathers exist because every process keeps the whole state (the first
+ * design, docs/mpi.md); with owned and ghost storage only the halo would remain. */
+#include <metis.h>
+#include <mpi.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "common/status_report.h"
+#include "piola/mpi.h"
+#include "piola/work_split.h"
+
+typedef struct solid_plan {
+  struct piola_mpi_split *owner;
+  int32_t node_count, block_count;
+  int32_t *block_part, *node_part;
+  /* items of each process in increasing order: node_order[node_start[p] .. node_start[p+1]) */
+  int32_t *node_order, *node_start, *block_order, *block_start;
+  /* halo: neighbours in increasing order; per neighbour the nodes whose partial this process
+   * sends (owned by the neighbour) and those whose partial it receives (owned here) */
+  int32_t neighbor_count;
+  int32_t *neighbors, *send_start, *send_nodes, *recv_start, *recv_nodes;
+  double *send_values, *recv_values, *gather;
+  size_t gather_capacity;
+  int *counts, *displs;
+  MPI_Request *requests;
+  piola_work_split split;
+} solid_plan;
+
+struct piola_mpi_split {
+  int rank, size;
+  int32_t solid_count;
+  solid_plan *plans;
+  piola_mpi_split_stats stats;
+};
+
+static void plan_free(solid_plan *p) {
+  free(p->block_part), free(p->node_part), free(p->node_order), free(p->node_start);
+  free(p->block_order), free(p->block_start), free(p->neighbors), free(p->send_start);
+  free(p->send_nodes), free(p->recv_start), free(p->recv_nodes), free(p->send_values);
+  free(p->recv_values), free(p->gather), free(p->counts), free(p->displs), free(p->requests);
+}
+
+/* ---------------------------------------------------------------- the three operations */
+
+static int ensure_gather(solid_plan *p, size_t doubles) {
+  if (doubles <= p->gather_capacity) return 1;
+  double *g = realloc(p->gather, doubles * sizeof(double));
+  if (!g) return 0;
+  p->gather = g;
+  p->gather_capacity = doubles;
+  return 1;
+}
+
+/* Every process's items (order/start by process) of `width` doubles each: written by their
+ * process, read by all. */
+static void share_items(solid_plan *p, double *values, int32_t width, const int32_t *order,
+                        const int32_t *start) {
+  piola_mpi_split *s = p->owner;
+  double t0 = MPI_Wtime();
+  const int32_t total = start[s->size];
+  if (!ensure_gather(p, (size_t)total * (size_t)width))
+    MPI_Abort(MPI_COMM_WORLD, 1); /* the processes cannot go on apart */
+  for (int q = 0; q < s->size; ++q) {
+    p->counts[q] = (start[q + 1] - start[q]) * width;
+    p->displs[q] = start[q] * width;
+  }
+  for (int32_t k = start[s->rank]; k < start[s->rank + 1]; ++k)
+    memcpy(p->gather + (size_t)k * (size_t)width, values + (size_t)order[k] * (size_t)width,
+           (size_t)width * sizeof(double));
+  MPI_Allgatherv(MPI_IN_PLACE, 0, MPI_DATATYPE_NULL, p->gather, p->counts, p->displs, MPI_DOUBLE,
+                 MPI_COMM_WORLD);
+  for (int32_t k = 0; k < total; ++k)
+    if (k < start[s->rank] || k >= start[s->rank + 1])
+      memcpy(values + (size_t)order[k] * (size_t)width, p->gather + (size_t)k * (size_t)width,
+             (size_t)width * sizeof(double));
+  s->stats.gather_bytes += (int64_t)(total - (start[s->rank + 1] - start[s->rank])) * width * 8;
+  s->stats.gather_seconds += MPI_Wtime() - t0;
+}
+
+static void share_nodes(void *context, double *values) {
+  solid_plan *p = context;
+  share_items(p, values, 3, p->node_order, p->node_start);
+}
+
+static void share_blocks(void *context, double *values, int32_t width) {
+  solid_plan *p = context;
+  share_items(p, values, width, p->block_order, p->block_start);
+}
+
+static void sum_nodes(void *context, double *values) {
+  solid_plan *p = context;
+  piola_mpi_split *s = p->owner;
+  double t0 = MPI_Wtime();
+  int r = 0;
+  for (int32_t k = 0; k < p->neighbor_count; ++k) {
+    const int32_t n0 = p->recv_start[k], n1 = p->recv_start[k + 1];
+    if (n1 > n0)
+      MPI_Irecv(p->recv_values + 3 * (size_t)n0, 3 * (n1 - n0), MPI_DOUBLE, p->neighbors[k], 7,
+                MPI_COMM_WORLD, &p->requests[r++]);
+  }
+  for (int32_t k = 0; k < p->neighbor_count; ++k) {
+    const int32_t n0 = p->send_start[k], n1 = p->send_start[k + 1];
+    if (n1 == n0) continue;
+    for (int32_t j = n0; j < n1; ++j)
+      memcpy(p->send_values + 3 * (size_t)j, values + 3 * (size_t)p->send_nodes[j], 3 * sizeof(double));
+    MPI_Isend(p->send_values + 3 * (size_t)n0, 3 * (n1 - n0), MPI_DOUBLE, p->neighbors[k], 7,
+              MPI_COMM_WORLD, &p->requests[r++]);
+    s->stats.halo_bytes += 24 * (int64_t)(n1 - n0);
+  }
+  MPI_Waitall(r, p->requests, MPI_STATUSES_IGNORE);
+  /* the owner is the lowest process touching a node, so its own partial comes first and
+   * the neighbours' follow in process order */
+  for (int32_t k = 0; k < p->neighbor_count; ++k)
+    for (int32_t j = p->recv_start[k]; j < p->recv_start[k + 1]; ++j)
+      for (int c = 0; c < 3; ++c) values[3 * (size_t)p->recv_nodes[j] + c] += p->recv_values[3 * (size_t)j + c];
+  s->stats.halo_seconds += MPI_Wtime() - t0;
+  share_nodes(context, values);
+}
+
+/* ---------------------------------------------------------------- partition */
+
+static int compare_i64(const void *a, const void *b) {
+  int64_t x = *(const int64_t *)a, y = *(const int64_t *)b;
+  return (x > y) - (x < y);
+}
+
+/* block_part of a solid's blocks over `parts` processes (rank 0 only). */
+static piola_status partition_blocks(const piola_elastic_body *body, int parts, int32_t *block_part) {
+  const int32_t tets = piola_elastic_body_tet_count(body);
+  const int32_t blocks = piola_elastic_body_block_count(body);
+  const int32_t *tv = piola_elastic_body_tets(body);
+  if (parts == 1 || blocks <= parts) { /* METIS divides by zero for one part */
+    for (int32_t b = 0; b < blocks; ++b) block_part[b] = parts == 1 ? 0 : b;
+    return PIOLA_OK;
+  }
+  idx_t ne = tets, nn = piola_elastic_body_vertex_count(body), ncommon = 3, numflag = 0;
+  idx_t *eptr = malloc(sizeof(idx_t) * ((size_t)tets + 1)), *eind = malloc(sizeof(idx_t) * 4 * (size_t)tets);
+  idx_t *xadj = NULL, *adjncy = NULL;
+  int64_t *pairs = NULL;
+  idx_t *bxadj = NULL, *badj = NULL, *bw = NULL, *vw = NULL, *part = NULL;
+  piola_status st = PIOLA_OK;
+  if (!eptr || !eind) goto oom;
+  for (int32_t t = 0; t <= tets; ++t) eptr[t] = 4 * (idx_t)t;
+  for (int64_t k = 0; k < 4 * (int64_t)tets; ++k) eind[k] = tv[k];
+  if (METIS_MeshToDual(&ne, &nn, eptr, eind, &ncommon, &numflag, &xadj, &adjncy) != METIS_OK)
+    goto oom;
+  /* the dual graph's edges between different blocks, as (block, neighbour block) keys */
+  const int64_t edges = xadj[tets];
+  pairs = malloc(sizeof(int64_t) * (size_t)(edges > 0 ? edges : 1));
+  bxadj = calloc((size_t)blocks + 1, sizeof(idx_t));
+  badj = malloc(sizeof(idx_t) * (size_t)(edges > 0 ? edges : 1));
+  bw = malloc(sizeof(idx_t) * (size_t)(edges > 0 ? edges : 1));
+  vw = calloc((size_t)blocks, sizeof(idx_t));
+  part = malloc(sizeof(idx_t) * (size_t)blocks);
+  if (!pairs || !bxadj || !badj || !bw || !vw || !part) goto oom;
+  int64_t count = 0;
+  for (int32_t t = 0; t < tets; ++t) {
+    vw[t / PIOLA_WORK_SPLIT_BLOCK]++;
+    for (idx_t k = xadj[t]; k < xadj[t + 1]; ++k) {
+      int32_t b = t / PIOLA_WORK_SPLIT_BLOCK, c = (int32_t)adjncy[k] / PIOLA_WORK_SPLIT_BLOCK;
+      if (b != c) pairs[count++] = (int64_t)b * blocks + c;
+    }
+  }
+  qsort(pairs, (size_t)count, sizeof(int64_t), compare_i64);
+  int64_t unique = 0;
+  for (int64_t k = 0; k < count; ++k) {
+    if (unique > 0 && pairs[k] == pairs[k - 1]) {
+      bw[unique - 1]++;
+      continue;
+    }
+    badj[unique] = (idx_t)(pairs[k] % blocks);
+    bw[unique] = 1;
+    bxadj[pairs[k] / blocks + 1]++;
+    unique++;
+  }
+  for (int32_t b = 0; b < blocks; ++b) bxadj[b + 1] += bxadj[b];
+  idx_t nv = blocks, ncon = 1, np = parts, objval = 0;
+  idx_t options[METIS_NOPTIONS];
+  METIS_SetDefaultOptions(options);
+  options[METIS_OPTION_SEED] = 1;
+  int ok = METIS_PartGraphKway(&nv, &ncon, bxadj, badj, vw, NULL, bw, &np, NULL, NULL, options,
+                               &objval, part);
+  if (ok != METIS_OK) {
+    st = PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "METIS could not partition %d blocks into %d parts",
+                    (int)blocks, parts);
+  } else {
+    for (int32_t b = 0; b < blocks; ++b) block_part[b] = (int32_t)part[b];
+  }
+  goto done;
+oom:
+  st = PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "partition of %d tets: out of memory", (int)tets);
+done:
+  if (xadj) METIS_Free(xadj);
+  if (adjncy) METIS_Free(adjncy);
+  free(eptr), free(eind), free(pairs), free(bxadj), free(badj), free(bw), free(vw), free(part);
+  return st;
+}
+
+/* Items 0 .. n-1 sorted by their process (stable: increasing within a process). */
+static int order_by_part(const int32_t *part_of, int32_t n, int parts, int32_t **order, int32_t **start) {
+  *order = malloc(sizeof(int32_t) * (size_t)(n > 0 ? n : 1));
+  *start = calloc((size_t)parts + 1, sizeof(int32_t));
+  if (!*order || !*start) return 0;
+  for (int32_t i = 0; i < n; ++i) (*start)[part_of[i] + 1]++;
+  for (int q = 0; q < parts; ++q) (*start)[q + 1] += (*start)[q];
+  int32_t *fill = malloc(sizeof(int32_t) * (size_t)parts);
+  if (!fill) return 0;
+  memcpy(fill, *start, sizeof(int32_t) * (size_t)parts);
+  for (int32_t i = 0; i < n; ++i) (*order)[fill[part_of[i]]++] = i;
+  free(fill);
+  return 1;
+}
+
+static piola_status plan_solid(piola_mpi_split *s, piola_world *world, int32_t solid, solid_plan *p) {
+  const piola_elastic_body *body = piola_world_solid_body(world, solid);
+  const int32_t tets = piola_elastic_body_tet_count(body);
+  const int32_t *tv = piola_elastic_body_tets(body);
+  const int parts = s->size, me = s->rank;
+  p->owner = s;
+  p->node_count = piola_elastic_body_vertex_count(body);
+  p->block_count = piola_elastic_body_block_count(body);
+  p->block_part = malloc(sizeof(int32_t) * (size_t)(p->block_count > 0 ? p->block_count : 1));
+  p->node_part = malloc(sizeof(int32_t) * (size_t)(p->node_count > 0 ? p->node_count : 1));
+  p->counts = malloc(sizeof(int) * (size_t)parts);
+  p->displs = malloc(sizeof(int) * (size_t)parts);
+  uint8_t *touch = calloc((size_t)p->node_count * (size_t)parts, 1); /* node x process */
+  if (!p->block_part || !p->node_part || !p->counts || !p->displs || !touch) {
+    free(touch);
+    return PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "MPI split: out of memory");
+  }
+  int failed = 0;
+  if (me == 0) {
+    piola_status st = partition_blocks(body, parts, p->block_part);
+    failed = st != PIOLA_OK;
+  }
+  MPI_Bcast(&failed, 1, MPI_INT, 0, MPI_COMM_WORLD);
+  if (failed) {
+    free(touch);
+    return me == 0 ? PIOLA_ERROR_INVALID_ARGUMENT
+                   : PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "MPI split: rank 0 could not partition");
+  }
+  MPI_Bcast(p->block_part, p->block_count, MPI_INT32_T, 0, MPI_COMM_WORLD);
+  /* which processes touch each node; its owner is the lowest */
+  for (int32_t t = 0; t < tets; ++t)
+    for (int c = 0; c < 4; ++c)
+      touch[(size_t)tv[4 * t + c] * parts + p->block_part[t / PIOLA_WORK_SPLIT_BLOCK]] = 1;
+  for (int32_t i = 0; i < p->node_count; ++i) {
+    p->node_part[i] = 0;
+    for (int q = 0; q < parts; ++q)
+      if (touch[(size_t)i * parts + q]) {
+        p->node_part[i] = q;
+        break;
+      }
+  }
+  /* halo plan: nodes this process touches together with another, by neighbour */
+  p->neighbors = malloc(sizeof(int32_t) * (size_t)parts);
+  p->send_start = calloc((size_t)parts + 1, sizeof(int32_t));
+  p->recv_start = calloc((size_t)parts + 1, sizeof(int32_t));
+  if (!p->neighbors || !p->send_start || !p->recv_start) goto oom;
+  int64_t shared = 0;
+  for (int32_t i = 0; i < p->node_count; ++i) {
+    if (!touch[(size_t)i * parts + me]) continue;
+    int other = 0;
+    for (int q = 0; q < parts; ++q) other |= q != me && touch[(size_t)i * parts + q];
+    shared += other;
+  }
+  p->send_nodes = malloc(sizeof(int32_t) * (size_t)(shared > 0 ? shared : 1));
+  p->recv_nodes = malloc(sizeof(int32_t) * (size_t)(shared * parts > 0 ? shared * parts : 1));
+  if (!p->send_nodes || !p->recv_nodes) goto oom;
+  int32_t sends = 0, recvs = 0;
+  p->neighbor_count = 0;
+  for (int q = 0; q < parts; ++q) {
+    if (q == me) continue;
+    int32_t s0 = sends, r0 = recvs;
+    for (int32_t i = 0; i < p->node_count; ++i) {
+      if (!touch[(size_t)i * parts + me] || !touch[(size_t)i * parts + q]) continue;
+      if (p->node_part[i] == q) p->send_nodes[sends++] = i;    /* q owns it: send my partial */
+      else if (p->node_part[i] == me) p->recv_nodes[recvs++] = i; /* mine: q's partial comes */
+    }
+    if (sends == s0 && recvs == r0) continue;
+    p->neighbors[p->neighbor_count++] = q;
+    p->send_start[p->neighbor_count] = sends;
+    p->recv_start[p->neighbor_count] = recvs;
+  }
+  p->send_values = malloc(3 * sizeof(double) * (size_t)(sends > 0 ? sends : 1));
+  p->recv_values = malloc(3 * sizeof(double) * (size_t)(recvs > 0 ? recvs : 1));
+  p->requests = malloc(sizeof(MPI_Request) * 2 * (size_t)parts);
+  if (!p->send_values || !p->recv_values || !p->requests) goto oom;
+  if (!order_by_part(p->node_part, p->node_count, parts, &p->node_order, &p->node_start) ||
+      !order_by_part(p->block_part, p->block_count, parts, &p->block_order, &p->block_start))
+    goto oom;
+  free(touch);
+  for (int32_t b = 0; b < p->block_count; ++b)
+    if (p->block_part[b] == me)
+      s->stats.tets += (b + 1) * PIOLA_WORK_SPLIT_BLOCK <= tets ? PIOLA_WORK_SPLIT_BLOCK
+                                                               : tets - b * PIOLA_WORK_SPLIT_BLOCK;
+  s->stats.owned_nodes += p->node_start[me + 1] - p->node_start[me];
+  s->stats.shared_nodes += shared;
+  p->split = (piola_work_split){.part = me,
+                                .part_count = parts,
+                                .block_part = p->block_part,
+                                .node_part = p->node_part,
+                                .context = p,
+                                .sum_nodes = sum_nodes,
+                                .share_nodes = share_nodes,
+                                .share_blocks = share_blocks};
+  return piola_world_solid_set_work_split(world, solid, &p->split);
+oom:
+  free(touch);
+  return PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "MPI split: out of memory");
+}
+
+piola_status piola_mpi_split_world(piola_world *world, piola_mpi_split **out) {
+  if (!world || !out) return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "MPI split: NULL argument");
+  *out = NULL;
+  const char *why = piola_world_split_unsupported(world);
+  if (why) return PIOLA_FAIL(PIOLA_ERROR_UNSUPPORTED, "%s", why);
+  piola_mpi_split *s = calloc(1, sizeof *s);
+  if (!s) return PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "MPI split: out of memory");
+  MPI_Comm_rank(MPI_COMM_WORLD, &s->rank);
+  MPI_Comm_size(MPI_COMM_WORLD, &s->size);
+  s->stats.rank = s->rank;
+  s->stats.size = s->size;
+  s->solid_count = piola_world_solid_count(world);
+  s->plans = calloc((size_t)(s->solid_count > 0 ? s->solid_count : 1), sizeof(solid_plan));
+  if (!s->plans) {
+    free(s);
+    return PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "MPI split: out of memory");
+  }
+  for (int32_t i = 0; i < s->solid_count; ++i) {
+    piola_status st = plan_solid(s, world, i, &s->plans[i]);
+    /* every process must agree before any goes on: a failure anywhere is one everywhere */
+    int bad = st != PIOLA_OK, any = 0;
+    MPI_Allreduce(&bad, &any, 1, MPI_INT, MPI_MAX, MPI_COMM_WORLD);
+    if (any) {
+      if (!bad) PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "MPI split: another process failed");
+      piola_mpi_split_destroy(s, world);
+      return bad ? st : PIOLA_ERROR_OUT_OF_MEMORY;
+    }
+  }
+  *out = s;
+  return PIOLA_OK;
+}
+
+piola_mpi_split_stats piola_mpi_split_stats_of(const piola_mpi_split *split) {
+  piola_mpi_split_stats none = {0};
+  return split ? split->stats : none;
+}
+
+void piola_mpi_split_destroy(piola_mpi_split *split, piola_world *world) {
+  if (!split) return;
+  for (int32_t i = 0; i < split->solid_count; ++i) {
+    if (world) (void)piola_world_solid_set_work_split(world, i, NULL);
+    plan_free(&split->plans[i]);
+  }
+  free(split->plans);
+  free(split);
+}

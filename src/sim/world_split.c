@@ -1,0 +1,17 @@
+/* What a world split among processes supports (piola/work_split.h): the split divides the
+ * solids' force loop and damping products of the Newmark step; everything else runs the same
+ * on every process. */
+#include "piola/work_split.h"
+#include "sim/world_internal.h"
+
+const char *piola_world_split_unsupported(const piola_world *world) {
+  if (!world) return "no world";
+  if (world->def.integrator != PIOLA_INTEGRATOR_NEWMARK)
+    return "the implicit integrators (integrator.type other than newmark) run on one process only";
+  for (int32_t i = 0; i < world->body_count; ++i) {
+    const world_body *b = &world->bodies[i];
+    if (b->kind == PIOLA_BODY_SHELL) return "shells run on one process only";
+    if (b->self_collision.enabled) return "self-collision runs on one process only";
+  }
+  return NULL;
+}

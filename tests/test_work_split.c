@@ -1,0 +1,197 @@
+/* The elastic body's work split (piola/work_split.h), without MPI: two "processes" are two
+ * bodies in this one process. Part 0's operations run part 1's update (or damping product)
+ * when they need its share, and part 1's operations only record what it hands over, so the
+ * exchanges happen in the order MPI would make them. Checked against the unsplit body:
+ *  - a split into one part changes no bit of forces, per-tet state or damping forces;
+ *  - split into two (contiguous halves, or alternating blocks that break the loop's block
+ *    pairs), the per-tet state (det F, Fhat) and the damping forces are bit-identical, and
+ *    the elastic forces equal the whole loop's to rounding (shared nodes add the parts'
+ *    partial sums, in another order);
+ *  - both for a small body (one serial pass) and for one large enough for the chunked loop;
+ *  - splits with parts out of range or missing operations are refused. */
+#include "test_support.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "piola/elastic_body.h"
+#include "piola/work_split.h"
+#include "test_elastic_body_fixtures.h"
+
+typedef struct fake_part {
+  piola_elastic_body *body;    /* this part's copy of the body */
+  struct fake_part *other;     /* part 1, seen from part 0 */
+  const double *x, *v;         /* the positions and velocities both parts use */
+  double *other_values;        /* part 1's recorded node values (3 per node) */
+  double *other_blocks;        /* part 1's recorded block buffer */
+  int32_t node_count;
+  int32_t block_count;
+  int32_t *block_part, *node_part;
+  piola_work_split split;
+} fake_part;
+
+/* part 1: record what would be sent */
+static void record_nodes(void *context, double *values) {
+  fake_part *p = context;
+  memcpy(p->other_values, values, 3 * sizeof(double) * (size_t)p->node_count);
+}
+static void record_blocks(void *context, double *values, int32_t width) {
+  fake_part *p = context;
+  memcpy(p->other_blocks, values, sizeof(double) * (size_t)width * (size_t)p->block_count);
+}
+
+/* part 0: run part 1 to get its share */
+static void sum_from_other(void *context, double *values) {
+  fake_part *p = context;
+  double *f1 = malloc(3 * sizeof(double) * (size_t)p->node_count);
+  assert_int_equal(piola_elastic_body_update(p->other->body, p->x, 1.0, f1, NULL), PIOLA_OK);
+  /* owner first, then the other part: the order the MPI halo sums in */
+  for (int32_t i = 0; i < 3 * p->node_count; ++i) values[i] += p->other->other_values[i];
+  free(f1);
+}
+static void share_from_other(void *context, double *values) {
+  fake_part *p = context;
+  double *d1 = malloc(3 * sizeof(double) * (size_t)p->node_count);
+  piola_elastic_body_damping_forces(p->other->body, p->v, 0.7, 0.3, d1);
+  for (int32_t i = 0; i < p->node_count; ++i)
+    if (p->node_part[i] == 1)
+      for (int c = 0; c < 3; ++c) values[3 * i + c] = p->other->other_values[3 * i + c];
+  free(d1);
+}
+static void blocks_from_other(void *context, double *values, int32_t width) {
+  fake_part *p = context;
+  for (int32_t b = 0; b < p->block_count; ++b)
+    if (p->block_part[b] == 1)
+      memcpy(values + (size_t)b * (size_t)width, p->other->other_blocks + (size_t)b * (size_t)width,
+             sizeof(double) * (size_t)width);
+}
+
+static void noop_nodes(void *context, double *values) { (void)context, (void)values; }
+static void noop_blocks(void *context, double *values, int32_t width) {
+  (void)context, (void)values, (void)width;
+}
+
+/* x: the rest positions stretched, sheared and jittered; v: a random velocity field. */
+static void deformed_state(const piola_tet_mesh *mesh, double *x, double *v) {
+  test_rng rng = test_rng_seeded(20);
+  for (int32_t i = 0; i < mesh->vertex_count; ++i) {
+    const double *p = mesh->positions + 3 * i;
+    x[3 * i] = 1.2 * p[0] + 0.3 * p[1] + test_rng_uniform(&rng, -0.01, 0.01);
+    x[3 * i + 1] = 0.9 * p[1] + test_rng_uniform(&rng, -0.01, 0.01);
+    x[3 * i + 2] = p[2] - 0.2 * p[0] + test_rng_uniform(&rng, -0.01, 0.01);
+    for (int c = 0; c < 3; ++c) v[3 * i + c] = test_rng_uniform(&rng, -1, 1);
+  }
+}
+
+static void check_split(int n, int alternate) {
+  piola_tet_mesh mesh = fixture_grid(n, 0.1);
+  piola_material material = fixture_material(PIOLA_MODEL_NEOHOOKEAN);
+  piola_elastic_body *whole = fixture_body(&mesh, &material);
+  const int32_t nv = mesh.vertex_count, nt = mesh.tet_count;
+  const int32_t blocks = piola_elastic_body_block_count(whole);
+  assert_int_equal(blocks, (nt + PIOLA_WORK_SPLIT_BLOCK - 1) / PIOLA_WORK_SPLIT_BLOCK);
+  double *x = malloc(sizeof(double) * 3 * (size_t)nv), *v = malloc(sizeof(double) * 3 * (size_t)nv);
+  deformed_state(&mesh, x, v);
+  double *f = malloc(sizeof(double) * 3 * (size_t)nv), *d = malloc(sizeof(double) * 3 * (size_t)nv);
+  assert_int_equal(piola_elastic_body_update(whole, x, 1.0, f, NULL), PIOLA_OK);
+  piola_elastic_body_damping_forces(whole, v, 0.7, 0.3, d);
+
+  /* one part: the same bits */
+  int32_t *all0 = calloc((size_t)blocks, sizeof(int32_t)), *nodes0 = calloc((size_t)nv, sizeof(int32_t));
+  piola_work_split one = {0, 1, all0, nodes0, NULL, noop_nodes, noop_nodes, noop_blocks};
+  piola_elastic_body *single = fixture_body(&mesh, &material);
+  assert_int_equal(piola_elastic_body_set_work_split(single, &one), PIOLA_OK);
+  double *fs = malloc(sizeof(double) * 3 * (size_t)nv), *ds = malloc(sizeof(double) * 3 * (size_t)nv);
+  assert_int_equal(piola_elastic_body_update(single, x, 1.0, fs, NULL), PIOLA_OK);
+  piola_elastic_body_damping_forces(single, v, 0.7, 0.3, ds);
+  assert_memory_equal(fs, f, sizeof(double) * 3 * (size_t)nv);
+  assert_memory_equal(ds, d, sizeof(double) * 3 * (size_t)nv);
+
+  /* two parts */
+  int32_t *block_part = malloc(sizeof(int32_t) * (size_t)blocks);
+  int32_t *node_part = malloc(sizeof(int32_t) * (size_t)nv);
+  for (int32_t b = 0; b < blocks; ++b)
+    block_part[b] = alternate ? b % 2 : (int32_t)(2 * (int64_t)b / blocks);
+  for (int32_t i = 0; i < nv; ++i) node_part[i] = 1;
+  const int32_t *tv = piola_elastic_body_tets(whole);
+  for (int32_t t = 0; t < nt; ++t)
+    for (int c = 0; c < 4; ++c)
+      if (block_part[t / PIOLA_WORK_SPLIT_BLOCK] == 0) node_part[tv[4 * t + c]] = 0;
+  fake_part p0 = {0}, p1 = {0};
+  double *values = malloc(sizeof(double) * 3 * (size_t)nv);
+  double *block_values = malloc(sizeof(double) * 256 * (size_t)blocks);
+  p1 = (fake_part){fixture_body(&mesh, &material), NULL, x, v, values, block_values, nv, blocks,
+                   block_part, node_part, {1, 2, block_part, node_part, &p1, record_nodes,
+                                           record_nodes, record_blocks}};
+  p0 = (fake_part){fixture_body(&mesh, &material), &p1, x, v, NULL, NULL, nv, blocks, block_part,
+                   node_part, {0, 2, block_part, node_part, &p0, sum_from_other, share_from_other,
+                               blocks_from_other}};
+  p1.split.context = &p1;
+  p0.split.context = &p0;
+  assert_int_equal(piola_elastic_body_set_work_split(p1.body, &p1.split), PIOLA_OK);
+  assert_int_equal(piola_elastic_body_set_work_split(p0.body, &p0.split), PIOLA_OK);
+  double *f0 = malloc(sizeof(double) * 3 * (size_t)nv), *d0 = malloc(sizeof(double) * 3 * (size_t)nv);
+  assert_int_equal(piola_elastic_body_update(p0.body, x, 1.0, f0, NULL), PIOLA_OK);
+  double scale = fixture_max_abs(f, 3 * nv), worst = 0;
+  assert_true(scale > 0);
+  for (int32_t i = 0; i < 3 * nv; ++i) worst = fmax(worst, fabs(f0[i] - f[i]));
+  assert_true(worst <= 1e-13 * scale);
+  assert_memory_equal(piola_elastic_body_det_f(p0.body), piola_elastic_body_det_f(whole),
+                      sizeof(double) * (size_t)nt);
+  assert_memory_equal(piola_elastic_body_fhat(p0.body), piola_elastic_body_fhat(whole),
+                      sizeof(double) * 3 * (size_t)nt);
+  /* the damping rows use the shared rotations: the same bits as the whole body's */
+  piola_elastic_body_damping_forces(p0.body, v, 0.7, 0.3, d0);
+  assert_memory_equal(d0, d, sizeof(double) * 3 * (size_t)nv);
+
+  /* refused splits */
+  piola_work_split bad = p0.split;
+  bad.part = 2;
+  assert_int_equal(piola_elastic_body_set_work_split(single, &bad), PIOLA_ERROR_INVALID_ARGUMENT);
+  bad = p0.split;
+  bad.share_blocks = NULL;
+  assert_int_equal(piola_elastic_body_set_work_split(single, &bad), PIOLA_ERROR_INVALID_ARGUMENT);
+  bad = p0.split;
+  int32_t *wrong = malloc(sizeof(int32_t) * (size_t)blocks);
+  memcpy(wrong, block_part, sizeof(int32_t) * (size_t)blocks);
+  wrong[blocks - 1] = 5;
+  bad.block_part = wrong;
+  assert_int_equal(piola_elastic_body_set_work_split(single, &bad), PIOLA_ERROR_INVALID_ARGUMENT);
+  assert_int_equal(piola_elastic_body_set_work_split(single, NULL), PIOLA_OK);
+
+  free(wrong), free(f0), free(d0), free(values), free(block_values), free(block_part);
+  free(node_part), free(fs), free(ds), free(all0), free(nodes0), free(x), free(v), free(f), free(d);
+  piola_elastic_body_destroy(p0.body);
+  piola_elastic_body_destroy(p1.body);
+  piola_elastic_body_destroy(single);
+  piola_elastic_body_destroy(whole);
+  fixture_mesh_free(&mesh);
+}
+
+static void small_body_halves(void **state) {
+  (void)state;
+  check_split(3, 0);
+}
+static void small_body_alternating_blocks(void **state) {
+  (void)state;
+  check_split(3, 1);
+}
+static void chunked_body_halves(void **state) {
+  (void)state;
+  check_split(12, 0); /* 10,368 tets: 1,296 blocks, 648 per part, the chunked loop */
+}
+static void chunked_body_alternating_blocks(void **state) {
+  (void)state;
+  check_split(12, 1);
+}
+
+int main(void) {
+  const struct CMUnitTest tests[] = {
+      cmocka_unit_test(small_body_halves),
+      cmocka_unit_test(small_body_alternating_blocks),
+      cmocka_unit_test(chunked_body_halves),
+      cmocka_unit_test(chunked_body_alternating_blocks),
+  };
+  return cmocka_run_group_tests(tests, NULL, NULL);
+}

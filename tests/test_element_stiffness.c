@@ -27,6 +27,19 @@ static void stress_at(const piola_material *m, const piola_mat3 *f, const double
   double fhat[3] = {fh.x, fh.y, fh.z}, ph[3][3] = {{0}}, d[3];
   piola_material_stress(m, fhat, d);
   for (int i = 0; i < 3; ++i) ph[i][i] = d[i];
+  if (fiber && m->model == PIOLA_MODEL_HGO) {
+    double fam[6], f9[9], pf[9];
+    assert_int_equal(piola_material_hgo_families(m, fiber, fam), PIOLA_OK);
+    for (int k = 0; k < 9; ++k) f9[k] = f->m[k / 3][k % 3];
+    piola_material_hgo_fiber_stress(m, f9, fam, pf);
+    for (int i = 0; i < 3; ++i)
+      for (int j = 0; j < 3; ++j) {
+        double s = pf[3 * i + j];
+        for (int a = 0; a < 3; ++a) s += u.m[i][a] * ph[a][a] * v.m[j][a];
+        p[3 * i + j] = s;
+      }
+    return;
+  }
   if (fiber) {
     double ah[3], pf[3][3];
     for (int r = 0; r < 3; ++r) ah[r] = v.m[0][r] * fiber[0] + v.m[1][r] * fiber[1] + v.m[2][r] * fiber[2];
@@ -146,6 +159,28 @@ static void check_model(piola_material_model model, piola_inversion_mode mode, d
           for (int i = 0; i < 3; ++i) fiber_store[i] = a[i] / n;
           fiber = fiber_store;
           break;
+        }
+        assert_non_null(fiber);
+      }
+      if (model == PIOLA_MODEL_HGO) {
+        /* a fibre whose families' E are away from the tension-only kink at E = 0 */
+        for (int tries = 0; tries < 200 && !fiber; ++tries) {
+          double a[3] = {test_rng_normal(&rng), test_rng_normal(&rng), test_rng_normal(&rng)};
+          double fam[6], f9[9];
+          if (piola_material_hgo_families(&m, a, fam) != PIOLA_OK) continue;
+          for (int k = 0; k < 9; ++k) f9[k] = f.m[k / 3][k % 3];
+          int far = 1;
+          for (int q = 0; q < 2; ++q) {
+            double w2 = 0;
+            for (int i = 0; i < 3; ++i) {
+              const double wi = f9[3 * i] * fam[3 * q] + f9[3 * i + 1] * fam[3 * q + 1] + f9[3 * i + 2] * fam[3 * q + 2];
+              w2 += wi * wi;
+            }
+            far &= fabs(w2 - 1) > 0.03; /* kappa = 0: E = I4 - 1 */
+          }
+          if (!far) continue;
+          for (int i = 0; i < 3; ++i) fiber_store[i] = a[i];
+          fiber = fiber_store;
         }
         assert_non_null(fiber);
       }
@@ -272,7 +307,7 @@ static void check_body_matrix(piola_material_model model, double squash) {
   def.materials = &mat;
   def.material_count = 1;
   double *fibers = NULL;
-  if (model == PIOLA_MODEL_MUSCLE) {
+  if (model == PIOLA_MODEL_MUSCLE || model == PIOLA_MODEL_HGO) {
     fibers = malloc(sizeof(double) * 3 * (size_t)mesh.tet_count);
     for (int32_t t = 0; t < mesh.tet_count; ++t) fibers[3 * t] = 0.6, fibers[3 * t + 1] = 0.8, fibers[3 * t + 2] = 0;
     def.fiber_directions = fibers;
@@ -363,11 +398,21 @@ static void check_body_matrix(piola_material_model model, double squash) {
  * of a neo-Hookean grid, rotated), the assembled stiffness is the derivative of the body's
  * own elastic forces: central differences of piola_elastic_body_update along random
  * directions. */
-static void test_matrix_is_force_derivative(void **state) {
-  (void)state;
+static void check_matrix_is_force_derivative(piola_material_model model) {
   piola_tet_mesh mesh = fixture_grid(3, 0.3);
-  piola_material mat = fixture_material(PIOLA_MODEL_NEOHOOKEAN);
-  piola_elastic_body *body = fixture_body(&mesh, &mat);
+  piola_material mat = fixture_material(model);
+  piola_elastic_body_def def = piola_default_elastic_body_def();
+  def.rest_mesh = &mesh;
+  def.materials = &mat;
+  def.material_count = 1;
+  double *fibers = NULL;
+  if (model == PIOLA_MODEL_HGO) { /* fibres in the x-y plane, stretched by the deformation */
+    fibers = malloc(sizeof(double) * 3 * (size_t)mesh.tet_count);
+    for (int32_t t = 0; t < mesh.tet_count; ++t) fibers[3 * t] = 1, fibers[3 * t + 1] = 0.3 * (t % 3), fibers[3 * t + 2] = 0;
+    def.fiber_directions = fibers;
+  }
+  piola_elastic_body *body;
+  assert_int_equal(piola_elastic_body_create(&def, &body), PIOLA_OK);
   const int32_t n = body->vertex_count, dim = 3 * n;
   double *x = malloc(sizeof(double) * dim), *xp = malloc(sizeof(double) * dim);
   double *f0 = malloc(sizeof(double) * dim), *fp = malloc(sizeof(double) * dim);
@@ -400,11 +445,18 @@ static void test_matrix_is_force_derivative(void **state) {
     err = fmax(err, fabs(fd - kp[j]));
     size = fmax(size, fabs(fd));
   }
-  if (!(err <= 1e-5 * size)) fail_msg("K p differs from -df/dx p by %g (scale %g)", err, size);
+  if (!(err <= 1e-5 * size))
+    fail_msg("%s: K p differs from -df/dx p by %g (scale %g)", piola_material_model_name(model), err, size);
   piola__stiffness_matrix_free(&mx);
-  free(x), free(xp), free(f0), free(fp), free(fm), free(p), free(kp);
+  free(x), free(xp), free(f0), free(fp), free(fm), free(p), free(kp), free(fibers);
   piola_elastic_body_destroy(body);
   fixture_mesh_free(&mesh);
+}
+
+static void test_matrix_is_force_derivative(void **state) {
+  (void)state;
+  check_matrix_is_force_derivative(PIOLA_MODEL_NEOHOOKEAN);
+  check_matrix_is_force_derivative(PIOLA_MODEL_HGO); /* the fibres' stiffness too */
 }
 
 static void test_assembled_matrix(void **state) {

@@ -112,8 +112,11 @@ static void uniaxial_small_strain_gives_youngs_modulus_and_poisson_ratio(void **
         f[1] += dx, f[2] += dx;
       }
       piola_material_stress(&m, f, p);
-      /* The Ogden models take their shear modulus from their terms (E follows from it). */
-      const double e = MATERIAL_IS_OGDEN(m.model) ? 2 * m.mu * (1 + nus[n]) : youngs;
+      /* The Ogden models and HGO take their shear modulus from their own parameters (E
+       * follows from it). */
+      const double e = MATERIAL_IS_OGDEN(m.model) || m.model == PIOLA_MODEL_HGO
+                           ? 2 * m.mu * (1 + nus[n])
+                           : youngs;
       assert_close(p[1], 0.0, 1e-7 * e * eps);
       assert_close(p[0] / eps, e, 1e-4 * e);
       assert_close((f[1] - 1) / eps, -nus[n], 1e-4);
@@ -537,7 +540,8 @@ static void lane_kernels_match_the_exact_kernels(void **state) {
   const kernel lanes[PIOLA_MODEL_COUNT] = {
       rotated_linear_stress_lanes, corotated_stress_lanes, stvk_stress_lanes,
       neohookean_stress_lanes,     spline_stress_lanes,    neohookean_stress_lanes,
-      stable_neohookean_stress_lanes, ogden_stress_lanes, ogden_stress_lanes};
+      stable_neohookean_stress_lanes, ogden_stress_lanes, ogden_stress_lanes,
+      neohookean_stress_lanes}; /* HGO's matrix is neo-Hookean */
   test_rng rng = test_rng_seeded(21);
   const long samples = test_samples(2000, 50);
   for (int model = 0; model < PIOLA_MODEL_COUNT; ++model)
@@ -566,13 +570,15 @@ static void kernels_and_public_functions_agree_bitwise(void **state) {
   const kernel kernels[PIOLA_MODEL_COUNT] = {rotated_linear_stress, corotated_stress, stvk_stress,
                                              neohookean_stress, spline_stress,
                                              neohookean_stress /* muscle's isotropic part */,
-                                             stable_neohookean_stress, ogden_stress, ogden_stress};
+                                             stable_neohookean_stress, ogden_stress, ogden_stress,
+                                             neohookean_stress /* HGO's matrix */};
   typedef void (*energy_kernel)(const piola_material *, double, double, double, double *, double *,
                                 double *, double *);
   const energy_kernel energy_kernels[PIOLA_MODEL_COUNT] = {
       rotated_linear_stress_energy, corotated_stress_energy, stvk_stress_energy,
       neohookean_stress_energy, spline_stress_energy, neohookean_stress_energy,
-      stable_neohookean_stress_energy, ogden_stress_energy, ogden_stress_energy};
+      stable_neohookean_stress_energy, ogden_stress_energy, ogden_stress_energy,
+      neohookean_stress_energy};
   test_rng rng = test_rng_seeded(18);
   for (int model = 0; model < PIOLA_MODEL_COUNT; ++model)
     for (int mode = 0; mode < N_MODES; ++mode) {

@@ -78,7 +78,8 @@ static void undamped_squashed_body_conserves_energy(void **state) {
   (void)state;
   const int steps = (int)test_samples(10000, 200);
   for (int model = 0; model < PIOLA_MODEL_COUNT; ++model) {
-    if (model == PIOLA_MODEL_MUSCLE) continue; /* its isotropic part is neo-Hookean */
+    if (model == PIOLA_MODEL_MUSCLE || model == PIOLA_MODEL_HGO)
+      continue; /* their isotropic part is neo-Hookean */
     const piola_material energy = material_in((piola_material_model)model, PIOLA_INVERSION_ENERGY);
     double e0;
     const double drift = squashed_flat_energy_drift(&energy, steps, &e0);

@@ -59,6 +59,10 @@ typedef enum piola_material_model {
                                      + lambda/2 (ln J)^2: see piola_mooney_rivlin_def */
   PIOLA_MODEL_OGDEN,              /* sum_p mu_p / alpha_p sum_i (f_i^alpha_p - 1) - (sum_p mu_p) ln J
                                      + lambda/2 (ln J)^2: see piola_ogden_def */
+  PIOLA_MODEL_HGO,                /* Holzapfel-Gasser-Ogden fibre-reinforced tissue (arteries): a
+                                     neo-Hookean matrix (shear modulus hgo.mu) plus two collagen
+                                     fibre families with exponential stiffening. See
+                                     piola_hgo_def and docs/materials.md */
   PIOLA_MODEL_COUNT
 } piola_material_model;
 
@@ -123,6 +127,29 @@ typedef struct piola_mooney_rivlin_def {
   double c01; /* Pa. Default 5e3 */
 } piola_mooney_rivlin_def;
 
+/* Holzapfel, Gasser, Ogden 2000 (J. Elasticity 61), with the fibre dispersion of Gasser,
+ * Ogden, Holzapfel 2006 (J. R. Soc. Interface 3):
+ *   psi = psi_nh(F; mu, lambda) + sum_{a = +,-} k1 / (2 k2) (exp(k2 <E_a>^2) - 1)
+ *   E_a = kappa (I1 - 3) + (1 - 3 kappa) (I4_a - 1),  I1 = |F|^2,  I4_a = |F a|^2
+ * with psi_nh the neo-Hookean energy (matrix and ln J volume term, its inversion
+ * extension), <E> = max(E, 0) (fibres bear no compression). The two unit family directions
+ * a_+- = cos(angle) m +- sin(angle) n lie in the plane of the tet's fibre direction m (the
+ * solid's fibre field, e.g. circumferential in an artery) and axis (n = the part of axis
+ * perpendicular to m, normalised), at +-fiber_angle_degrees from m. Beyond k2 E^2 = 12 the
+ * exponential is continued by its second-order Taylor expansion (finite for every F). */
+typedef struct piola_hgo_def {
+  double mu;                  /* Pa, > 0: shear modulus of the neo-Hookean matrix (HGO's c).
+                                 Default 3000 (HGO 2000, rabbit carotid media) */
+  double k1;                  /* Pa, >= 0: fibre stiffness. Default 2363.2 */
+  double k2;                  /* dimensionless, > 0: fibre stiffening. Default 0.8393 */
+  double kappa;               /* dimensionless, in [0, 1/3]: fibre dispersion (0 aligned,
+                                 1/3 isotropic). Default 0 */
+  double fiber_angle_degrees; /* degrees, in [0, 90]: angle of each family from the tet's
+                                 fibre direction. Default 29 */
+  double axis[3];             /* nonzero (normalised): the fibre plane's second direction, in
+                                 rest (scene) coordinates. Default (0, 0, 1) */
+} piola_hgo_def;
+
 typedef struct piola_material_def {
   piola_material_model model;
   double youngs_modulus;      /* Pa, > 0. Default 1e5 */
@@ -132,6 +159,8 @@ typedef struct piola_material_def {
   piola_spline_def spline;    /* used by PIOLA_MODEL_SPLINE only */
   piola_ogden_def ogden;      /* used by PIOLA_MODEL_OGDEN only */
   piola_mooney_rivlin_def mooney_rivlin; /* used by PIOLA_MODEL_MOONEY_RIVLIN only */
+  piola_hgo_def hgo;          /* used by PIOLA_MODEL_HGO only (youngs_modulus is not used;
+                                 poisson_ratio sets lambda with hgo.mu) */
   piola_muscle_def muscle;    /* used by PIOLA_MODEL_MUSCLE only; youngs_modulus and
                                  poisson_ratio give its matrix and volume part (use nu close
                                  to 0.5, e.g. 0.45, for a quasi-incompressible muscle) */
@@ -157,6 +186,7 @@ typedef struct piola_material {
                                  mu', lambda', alpha; the energy extension's slope; the
                                  Ogden / Mooney-Rivlin terms) */
   piola_muscle_def muscle;    /* PIOLA_MODEL_MUSCLE: the validated fibre parameters */
+  piola_hgo_def hgo;          /* PIOLA_MODEL_HGO: the validated parameters (axis unit) */
   double fiber_modulus;       /* Pa: bound on the fibre's tangent stiffness at full activation
                                  (0 for other models), added to lambda + 2 mu in the CFL
                                  wave speed */
@@ -233,8 +263,39 @@ PIOLA_API double piola_material_muscle_energy_density(const piola_material *mate
                                                       const double fhat[3], const double fiber[3],
                                                       double activation);
 
+/* ------------------------------------------------------------------ HGO fibres
+ * For a PIOLA_MODEL_HGO material (errors or zeros for other models). The functions above give
+ * the matrix (neo-Hookean) part; these give the two fibre families' part. */
+
+/* The two unit family directions (rest space, family a at families[3 a]) of a tet whose
+ * fibre direction is fiber (any length). The functions below take them in this layout. PIOLA_ERROR_INVALID_ARGUMENT for a zero fibre, or one parallel to hgo.axis while
+ * the fibre angle is not 0 (the fibre plane is undefined). */
+PIOLA_API piola_status piola_material_hgo_families(const piola_material *material,
+                                                   const double fiber[3], double families[6]);
+
+/* Fibre part of the stress, Pa, row-major P[3 i + j], at the deformation gradient f
+ * (row-major 3x3, any frame) for the unit family directions in that frame (e.g. the
+ * diagonal frame: f = Fhat, families V^T a):
+ *   P_f = sum_a 2 psi'(E_a) (kappa F + (1 - 3 kappa) F a a^T). Finite for every f. */
+PIOLA_API void piola_material_hgo_fiber_stress(const piola_material *material, const double f[9],
+                                               const double families[6], double p[9]);
+
+/* Fibre energy density, J/m^3 (zero at rest and wherever both E_a <= 0). */
+PIOLA_API double piola_material_hgo_fiber_energy_density(const piola_material *material,
+                                                         const double f[9],
+                                                         const double families[6]);
+
+/* dP_f/dF (Pa), 9 x 9, row 3 i + j = P_ij, column 3 k + l = F_kl:
+ *   sum_a 4 psi''(E_a) G_a (x) G_a + 2 psi'(E_a) (kappa I (x) I + (1 - 3 kappa) I (x) a a^T),
+ * G_a = kappa F + (1 - 3 kappa) F a a^T: symmetric positive semi-definite (psi', psi'' >= 0),
+ * so an implicit solver needs no projection for it. */
+PIOLA_API void piola_material_hgo_fiber_stress_derivative(const piola_material *material,
+                                                          const double f[9],
+                                                          const double families[6],
+                                                          double dpdf[81]);
+
 /* Name used in scene files: "rotated_linear", "corotated", "stvk", "neohookean", "spline",
- * "muscle", "stable_neohookean", "mooney_rivlin", "ogden". */
+ * "muscle", "stable_neohookean", "mooney_rivlin", "ogden", "hgo". */
 PIOLA_API const char *piola_material_model_name(piola_material_model model);
 
 /* Parses a scene-file name; false if unknown. */

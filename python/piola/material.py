@@ -6,6 +6,36 @@ _DEFAULT = _piola.defaults()["material"]
 _SPLINE_KEYS = ("compression_stretch", "elongation_stretch", "stiffening")
 _MUSCLE_KEYS = ("passive_stiffness", "passive_toe_stretch", "max_active_stress",
                 "optimal_stretch", "active_width")
+_MOONEY_KEYS = ("c10", "c01")
+_HGO_KEYS = ("mu", "k1", "k2", "kappa", "fiber_angle_degrees")
+
+
+def _ogden(values):
+    """{"mu": [Pa, ...], "alpha": [...]} (the scene keys) as two tuples of numbers."""
+    if values is None:
+        return _DEFAULT[7]
+    check_keys(values, ("mu", "alpha"), "ogden")
+    out = []
+    for key in ("mu", "alpha"):
+        if key not in values:
+            raise ValueError(f"ogden.{key} is required")
+        terms = values[key]
+        if isinstance(terms, (str, bytes)) or not hasattr(terms, "__len__"):
+            raise ValueError(f"ogden.{key} must be a list of 1 to 6 numbers")
+        out.append(tuple(number(v, f"ogden.{key}[{i}]") for i, v in enumerate(terms)))
+    return tuple(out)
+
+
+def _hgo(values):
+    """{"mu", "k1", "k2", "kappa", "fiber_angle_degrees", "axis"} (the scene keys)."""
+    if values is None:
+        return _DEFAULT[9]
+    check_keys(values, _HGO_KEYS + ("axis",), "hgo")
+    scalars = tuple(number(values.get(k, d), f"hgo.{k}") for k, d in zip(_HGO_KEYS, _DEFAULT[9]))
+    axis = values.get("axis", _DEFAULT[9][5])
+    if isinstance(axis, (str, bytes)) or not hasattr(axis, "__len__") or len(axis) != 3:
+        raise ValueError("hgo.axis must be 3 numbers")
+    return scalars + (tuple(number(a, "hgo.axis") for a in axis),)
 
 
 def _sub(values, keys, defaults, what):
@@ -16,47 +46,51 @@ def _sub(values, keys, defaults, what):
 
 
 class Material:
-    """An isotropic model of the paper (section 6), extended through inversion.
+    """A constitutive model (docs/materials.md), extended through inversion.
 
     Material(model="neohookean", youngs_modulus=1e5 Pa, poisson_ratio=0.3,
-             inversion_threshold=0.3, inversion_mode="linear", spline=None, muscle=None)
-    `spline` and `muscle` are dicts with the scene keys of docs/scene-format.md. Invalid
-    parameters raise ValueError naming the parameter."""
+             inversion_threshold=0.3, inversion_mode="linear", spline=None, muscle=None,
+             ogden=None, mooney_rivlin=None, hgo=None)
+    `spline`, `muscle`, `ogden`, `mooney_rivlin` and `hgo` are dicts with the scene keys of
+    docs/scene-format.md, each for its own model only. Invalid parameters raise ValueError
+    naming the parameter."""
 
     def __init__(self, model=_DEFAULT[0], youngs_modulus=_DEFAULT[1], poisson_ratio=_DEFAULT[2],
                  inversion_threshold=_DEFAULT[3], inversion_mode=_DEFAULT[4], spline=None,
-                 muscle=None):
+                 muscle=None, ogden=None, mooney_rivlin=None, hgo=None):
         if not isinstance(model, str) or not isinstance(inversion_mode, str):
             raise TypeError("model and inversion_mode are strings")
-        if spline is not None and model != "spline":
-            raise ValueError("spline parameters need model 'spline'")
-        if muscle is not None and model != "muscle":
-            raise ValueError("muscle parameters need model 'muscle'")
+        for name, values in (("spline", spline), ("muscle", muscle), ("ogden", ogden),
+                             ("mooney_rivlin", mooney_rivlin), ("hgo", hgo)):
+            if values is not None and model != name:
+                raise ValueError(f"{name} parameters need model '{name}'")
         self._def = (model, number(youngs_modulus, "youngs_modulus"),
                      number(poisson_ratio, "poisson_ratio"),
                      number(inversion_threshold, "inversion_threshold"), inversion_mode,
                      _sub(spline, _SPLINE_KEYS, _DEFAULT[5], "spline"),
-                     _sub(muscle, _MUSCLE_KEYS, _DEFAULT[6], "muscle"))
+                     _sub(muscle, _MUSCLE_KEYS, _DEFAULT[6], "muscle"), _ogden(ogden),
+                     _sub(mooney_rivlin, _MOONEY_KEYS, _DEFAULT[8], "mooney_rivlin"), _hgo(hgo))
         self._lame = _piola.material_check(self._def)
 
     @classmethod
     def from_dict(cls, d):
         """From a scene's `material` object (model, youngs_modulus, poisson_ratio,
-        inversion {threshold, mode}, spline, muscle); stiffness_scale is a solid's, not a
-        material's, and is refused here."""
+        inversion {threshold, mode}, spline, muscle, ogden, mooney_rivlin, hgo);
+        stiffness_scale is a solid's, not a material's, and is refused here."""
         check_keys(d, ("model", "youngs_modulus", "poisson_ratio", "inversion", "spline",
-                       "muscle"), "material")
+                       "muscle", "ogden", "mooney_rivlin", "hgo"), "material")
         inv = d.get("inversion", {})
         check_keys(inv, ("threshold", "mode"), "material.inversion")
         return cls(d.get("model", _DEFAULT[0]), d.get("youngs_modulus", _DEFAULT[1]),
                    d.get("poisson_ratio", _DEFAULT[2]), inv.get("threshold", _DEFAULT[3]),
-                   inv.get("mode", _DEFAULT[4]), d.get("spline"), d.get("muscle"))
+                   inv.get("mode", _DEFAULT[4]), d.get("spline"), d.get("muscle"),
+                   d.get("ogden"), d.get("mooney_rivlin"), d.get("hgo"))
 
     model = property(lambda self: self._def[0], doc="model name")
     youngs_modulus = property(lambda self: self._def[1], doc="Pa")
     poisson_ratio = property(lambda self: self._def[2], doc="dimensionless")
     inversion_threshold = property(lambda self: self._def[3], doc="dimensionless")
-    inversion_mode = property(lambda self: self._def[4], doc="'linear' or 'clamp'")
+    inversion_mode = property(lambda self: self._def[4], doc="'linear', 'clamp' or 'energy'")
     mu = property(lambda self: self._lame["mu"], doc="shear modulus (Lame mu), Pa")
     lam = property(lambda self: self._lame["lambda"], doc="Lame lambda, Pa")
 
@@ -67,8 +101,8 @@ class Material:
     def evaluate(self, F, fibers=None, activation=0.0):
         """(P, psi): the first Piola-Kirchhoff stress (Pa, shape (..., 3, 3)) and the energy
         density (J/m^3, shape (...)) at deformation gradients F of shape (..., 3, 3).
-        fibers (..., 3), for the muscle model: each F's fibre direction in material space;
-        activation in [0, 1]."""
+        fibers (..., 3), for the muscle and hgo models: each F's fibre direction in material
+        space (for hgo the bisector of its two families); activation in [0, 1] (muscle)."""
         F = float_stack(F, "F", (3, 3))
         lead = F.shape[:-2]
         flat = F.reshape(-1, 3, 3)

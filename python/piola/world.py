@@ -297,7 +297,7 @@ class World:
         {"sphere": {"center", "radius"}} or {"indices": [...]}, on rest positions); driven:
         selectors with a "motion". stiffness_scale and activation: keyframable. initial
         {"matrix", "scramble" m, "seed"}. self_collision {"enabled", "thickness" m,
-        "friction"}. fibers (m, 3): per-tet fibre directions (muscle model)."""
+        "friction"}. fibers (m, 3): per-tet fibre directions (muscle and hgo models)."""
         if isinstance(mesh, (str, bytes)) or hasattr(mesh, "__fspath__"):
             mesh = read_mesh(mesh)
         if isinstance(mesh, Mesh) and mesh.tets is None:

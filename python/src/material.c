@@ -100,11 +100,19 @@ static PyObject *material_eval(PyObject *self, PyObject *args) {
     npy_intp fd[2] = {n, 3};
     PyArrayObject *fa = pypiola_check_array(fibobj, "fibers", NPY_DOUBLE, 2, fd, 0);
     if (!fa) return NULL;
-    if (def.model != PIOLA_MODEL_MUSCLE) {
-      PyErr_SetString(PyExc_ValueError, "fibers need the muscle model");
+    if (def.model != PIOLA_MODEL_MUSCLE && def.model != PIOLA_MODEL_HGO) {
+      PyErr_SetString(PyExc_ValueError, "fibers need the muscle or the hgo model");
       return NULL;
     }
     fib = PyArray_DATA(fa);
+    if (def.model == PIOLA_MODEL_HGO) /* every fibre must give a plane for the two families */
+      for (npy_intp i = 0; i < n; ++i) {
+        double fam[6];
+        if (piola_material_hgo_families(&mat, fib + 3 * i, fam) != PIOLA_OK) {
+          PyErr_Format(PyExc_ValueError, "fibers[%zd]: %s", (Py_ssize_t)i, piola_last_error());
+          return NULL;
+        }
+      }
   }
   npy_intp d33[3] = {n, 3, 3}, d1[1] = {n};
   PyArrayObject *p = pypiola_new_array(NPY_DOUBLE, 3, d33),
@@ -127,6 +135,19 @@ static PyObject *material_eval(PyObject *self, PyObject *args) {
       continue;
     }
     double fhat[3] = {h.x, h.y, h.z}, phat[3][3] = {{0}};
+    if (fib && mat.model == PIOLA_MODEL_HGO) {
+      /* the matrix through the diagonalization, the fibres on the full F */
+      double d[3], fam[6], pf[9];
+      piola_material_stress(&mat, fhat, d);
+      for (int r = 0; r < 3; ++r) phat[r][r] = d[r];
+      (void)piola_material_hgo_families(&mat, fib + 3 * i, fam); /* checked above */
+      piola_material_hgo_fiber_stress(&mat, fp + 9 * i, fam, pf);
+      ep[i] = piola_material_energy_density(&mat, fhat) +
+              piola_material_hgo_fiber_energy_density(&mat, fp + 9 * i, fam);
+      rotate_back(&um, phat, &vm, pp + 9 * i);
+      for (int k = 0; k < 9; ++k) pp[9 * i + k] += pf[k];
+      continue;
+    }
     if (fib) {
       const double *a = fib + 3 * i;
       double ahat[3];

@@ -110,25 +110,51 @@ int pypiola_track_converter(PyObject *obj, void *out) {
   return ok;
 }
 
-/* (model, E, nu, threshold, mode, (spline 3), (muscle 5)) */
+/* A tuple of 1..PIOLA_OGDEN_MAX_TERMS numbers into out; the count, or -1 with an error set. */
+static int ogden_terms(PyObject *seq, const char *what, double *out) {
+  if (!PyTuple_Check(seq) || PyTuple_GET_SIZE(seq) < 1 || PyTuple_GET_SIZE(seq) > PIOLA_OGDEN_MAX_TERMS) {
+    PyErr_Format(PyExc_ValueError, "ogden.%s must be 1 to %d numbers", what, PIOLA_OGDEN_MAX_TERMS);
+    return -1;
+  }
+  const int n = (int)PyTuple_GET_SIZE(seq);
+  for (int i = 0; i < n; ++i) {
+    out[i] = PyFloat_AsDouble(PyTuple_GET_ITEM(seq, i));
+    if (out[i] == -1.0 && PyErr_Occurred()) return -1;
+  }
+  return n;
+}
+
+/* (model, E, nu, threshold, mode, (spline 3), (muscle 5), ((ogden mu...), (ogden alpha...)),
+ * (mooney_rivlin c10, c01), (hgo mu, k1, k2, kappa, fiber_angle_degrees, (axis 3))) */
 int pypiola_material_converter(PyObject *obj, void *out) {
   piola_material_def *def = out;
   *def = piola_default_material_def();
   const char *model = NULL, *mode = NULL;
   piola_spline_def *sp = &def->spline;
   piola_muscle_def *mu = &def->muscle;
-  if (!PyArg_ParseTuple(obj, "sddds(ddd)(ddddd);bad material tuple", &model, &def->youngs_modulus,
-                        &def->poisson_ratio, &def->inversion_threshold, &mode,
+  piola_hgo_def *h = &def->hgo;
+  PyObject *omu = NULL, *oalpha = NULL;
+  if (!PyArg_ParseTuple(obj, "sddds(ddd)(ddddd)(OO)(dd)(ddddd(ddd));bad material tuple", &model,
+                        &def->youngs_modulus, &def->poisson_ratio, &def->inversion_threshold, &mode,
                         &sp->compression_stretch, &sp->elongation_stretch, &sp->stiffening,
                         &mu->passive_stiffness, &mu->passive_toe_stretch, &mu->max_active_stress,
-                        &mu->optimal_stretch, &mu->active_width))
+                        &mu->optimal_stretch, &mu->active_width, &omu, &oalpha,
+                        &def->mooney_rivlin.c10, &def->mooney_rivlin.c01, &h->mu, &h->k1, &h->k2,
+                        &h->kappa, &h->fiber_angle_degrees, &h->axis[0], &h->axis[1], &h->axis[2]))
     return 0;
+  const int nm = ogden_terms(omu, "mu", def->ogden.mu), na = ogden_terms(oalpha, "alpha", def->ogden.alpha);
+  if (nm < 0 || na < 0) return 0;
+  if (nm != na) {
+    PyErr_Format(PyExc_ValueError, "ogden.mu has %d terms and ogden.alpha %d: they must match", nm, na);
+    return 0;
+  }
+  def->ogden.term_count = nm;
   if (!piola_material_model_from_name(model, &def->model)) {
     PyErr_Format(PyExc_ValueError, "unknown material model '%s'", model);
     return 0;
   }
   if (!piola_inversion_mode_from_name(mode, &def->inversion_mode)) {
-    PyErr_Format(PyExc_ValueError, "unknown inversion mode '%s' (linear or clamp)", mode);
+    PyErr_Format(PyExc_ValueError, "unknown inversion mode '%s' (linear, clamp or energy)", mode);
     return 0;
   }
   return 1;
@@ -174,14 +200,25 @@ static PyObject *defaults(PyObject *self, PyObject *unused) {
   piola_world_def w = piola_default_world_def();
   piola_solid_def s = piola_default_solid_def();
   piola_mesher_def g = piola_default_mesher_def();
+  PyObject *omu = PyTuple_New(m.ogden.term_count), *oalpha = PyTuple_New(m.ogden.term_count);
+  if (!omu || !oalpha) {
+    Py_XDECREF(omu), Py_XDECREF(oalpha);
+    return NULL;
+  }
+  for (int i = 0; i < m.ogden.term_count; ++i) {
+    PyTuple_SET_ITEM(omu, i, PyFloat_FromDouble(m.ogden.mu[i]));
+    PyTuple_SET_ITEM(oalpha, i, PyFloat_FromDouble(m.ogden.alpha[i]));
+  }
   return Py_BuildValue(
-      "{s:(sddds(ddd)(ddddd)),s:{s:(ddd),s:d,s:d,s:d,s:i,s:d},s:{s:d,s:d,s:d,s:d,s:K,s:(idd)},s:{s:"
-      "i}}",
+      "{s:(sddds(ddd)(ddddd)(NN)(dd)(ddddd(ddd))),s:{s:(ddd),s:d,s:d,s:d,s:i,s:d},s:{s:d,s:d,s:d,s:d,"
+      "s:K,s:(idd)},s:{s:i}}",
       "material", piola_material_model_name(m.model), m.youngs_modulus, m.poisson_ratio,
       m.inversion_threshold, piola_inversion_mode_name(m.inversion_mode),
       m.spline.compression_stretch, m.spline.elongation_stretch, m.spline.stiffening,
       m.muscle.passive_stiffness, m.muscle.passive_toe_stretch, m.muscle.max_active_stress,
-      m.muscle.optimal_stretch, m.muscle.active_width, "world", "gravity", w.gravity[0].value,
+      m.muscle.optimal_stretch, m.muscle.active_width, omu, oalpha, m.mooney_rivlin.c10,
+      m.mooney_rivlin.c01, m.hgo.mu, m.hgo.k1, m.hgo.k2, m.hgo.kappa, m.hgo.fiber_angle_degrees,
+      m.hgo.axis[0], m.hgo.axis[1], m.hgo.axis[2], "world", "gravity", w.gravity[0].value,
       w.gravity[1].value, w.gravity[2].value, "max_dt", w.max_dt, "cfl", w.cfl, "cg_tolerance",
       w.cg_tolerance, "cg_max_iterations", (int)w.cg_max_iterations, "collision_interval",
       w.collision_interval, "solid", "density", s.density, "stiffness_scale",

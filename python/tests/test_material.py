@@ -138,3 +138,56 @@ def test_misuse_raises():
         piola._piola.material_eval(mat._def, np.zeros((2, 3, 3, 2))[..., 0], None, 0.0)
     with pytest.raises(ValueError):
         piola._piola.diagonalize(np.zeros((2, 3, 4)))
+
+
+def test_rubber_and_artery_parameters_reach_the_model():
+    """ogden, mooney_rivlin and hgo take their scene keys: the shear modulus follows from them
+    (youngs_modulus is not used), and unknown or misplaced keys are refused by name."""
+    og = piola.Material("ogden", poisson_ratio=0.45, ogden={"mu": [4e5, -2e4], "alpha": [2.0, -2.0]})
+    assert og.mu == pytest.approx(0.5 * (4e5 * 2.0 + 2e4 * 2.0))
+    mr = piola.Material("mooney_rivlin", poisson_ratio=0.45, mooney_rivlin={"c10": 2e5, "c01": 1e4})
+    assert mr.mu == pytest.approx(2 * (2e5 + 1e4))
+    # Mooney-Rivlin is the two-term Ogden model (2 C10, 2), (-2 C01, -2)
+    twin = piola.Material("ogden", poisson_ratio=0.45, ogden={"mu": [4e5, -2e4], "alpha": [2, -2]})
+    rng = np.random.default_rng(5)
+    F = random_f(rng, 50, 0.1)
+    assert np.allclose(piola.Material.from_dict(
+        {"model": "mooney_rivlin", "poisson_ratio": 0.45,
+         "mooney_rivlin": {"c10": 2e5, "c01": 1e4}}).stress(F), twin.stress(F), rtol=1e-9, atol=1e-6)
+    h = piola.Material("hgo", poisson_ratio=0.45,
+                       hgo={"mu": 7640, "k1": 996600, "k2": 524.6, "kappa": 0.226,
+                            "fiber_angle_degrees": 49.98, "axis": [0, 0, 2]})
+    assert h.mu == pytest.approx(7640)
+    assert piola.Material("hgo").mu == pytest.approx(3000)  # HGO 2000's media by default
+    with pytest.raises(ValueError, match="ogden parameters need model 'ogden'"):
+        piola.Material("neohookean", ogden={"mu": [1e5], "alpha": [2]})
+    with pytest.raises(ValueError, match="hgo.kappa"):
+        piola.Material("hgo", hgo={"kappa": 0.5})
+    with pytest.raises(ValueError, match="unknown key 'beta'"):
+        piola.Material("hgo", hgo={"beta": 30})
+    with pytest.raises(ValueError, match="ogden.alpha"):
+        piola.Material("ogden", ogden={"mu": [1e5, 2e3], "alpha": [2]})
+    with pytest.raises(ValueError, match="c10 \\+ c01"):
+        piola.Material("mooney_rivlin", mooney_rivlin={"c10": -1e4, "c01": 0})
+    with pytest.raises(ValueError, match="unknown key"):
+        piola.Material.from_dict({"model": "hgo", "hgo": {"k3": 1}})
+
+
+@pytest.mark.parametrize("kappa", [0.0, 0.226])
+def test_hgo_fibre_stress_is_energy_gradient(kappa):
+    """With fibres the stress is the gradient of the whole energy (matrix and both families),
+    the fibres stiffen the response along them, and a fibre along the axis is refused."""
+    rng = np.random.default_rng(11)
+    mat = piola.Material("hgo", poisson_ratio=0.45,
+                         hgo={"k1": 2e4, "k2": 2.0, "kappa": kappa, "fiber_angle_degrees": 35})
+    F = random_f(rng, 80, 0.2)
+    F = F[np.linalg.svd(F, compute_uv=False).min(axis=1) > 0.45]
+    fibers = rng.standard_normal((len(F), 3))
+    fibers[:, 0] += 0.5  # never along the axis z
+    P = mat.stress(F, fibers=fibers)
+    assert np.allclose(P, fd_stress(mat, F, fibers=fibers), rtol=1e-5, atol=1e-2)
+    stretch = np.diag([1.3, 1.0, 1.0])[None]
+    with_fibres = mat.stress(stretch, fibers=np.array([[1.0, 0, 0]]))[0, 0, 0]
+    assert with_fibres > mat.stress(stretch)[0, 0, 0]
+    with pytest.raises(ValueError, match="parallel"):
+        mat.stress(stretch, fibers=np.array([[0, 0, 1.0]]))

@@ -152,6 +152,15 @@ void piola__element_dpdf(const piola_material *material, const piola_mat3 *f,
       for (int e = 0; e < 9; ++e) sum += rot[a][e] * tmp[9 * e + b];
       dpdf[9 * a + b] = sum;
     }
+  if (fiber && material->model == PIOLA_MODEL_HGO) {
+    /* HGO's fibres: their dP/dF is positive semi-definite as it is (material.h) */
+    double fam[6], fm[9], d[81];
+    if (piola_material_hgo_families(material, fiber, fam) != PIOLA_OK) return;
+    for (int e = 0; e < 9; ++e) fm[e] = f->m[e / 3][e % 3];
+    piola_material_hgo_fiber_stress_derivative(material, fm, fam, d);
+    for (int e = 0; e < 81; ++e) dpdf[e] += d[e];
+    return;
+  }
   if (!fiber || material->model != PIOLA_MODEL_MUSCLE) return;
   double an = sqrt(fiber[0] * fiber[0] + fiber[1] * fiber[1] + fiber[2] * fiber[2]);
   if (!(an > 0)) return;

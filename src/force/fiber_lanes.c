@@ -10,6 +10,7 @@
 #include "common/status_report.h"
 #include "force/fiber_lanes.h"
 #include "force/svd_kernel.h"
+#include "material/hgo_kernels.h"
 #include "material/muscle_kernels.h"
 
 #define B PIOLA_TET_BLOCK
@@ -52,6 +53,53 @@ PIOLA_KERNEL_INLINE double fiber_lane(const piola_elastic_body *body, const piol
   return energy;
 }
 
+/* One lane of an HGO material: its two fibre families from the tet's fibre direction, the
+ * stress P_f = g F + sum_a r_a (F a)(a)^T (hgo_kernels.h) in world space, and its forces
+ * G_f = -V0 scale P_f Dm^-T added to tf. Returns the energy density. */
+static double hgo_lane(const piola_elastic_body *body, const piola_material *mat, int32_t base, int l,
+                       double fhat[3][B], double scale, double *tf) {
+  const long stride = body->padded_tet_count;
+  const double *u = body->u[0] + base, *v = body->v[0] + base;
+  const int32_t t = base + l;
+  const double m[3] = {body->fiber[0][t], body->fiber[1][t], body->fiber[2][t]};
+  double fam[2][3], ahat[2][3];
+  const piola_hgo_def *h = &mat->hgo;
+  (void)hgo_families_from_fiber(mat, m, fam); /* checked when the body was built */
+  for (int a = 0; a < 2; ++a)
+    for (int k = 0; k < 3; ++k)
+      ahat[a][k] = v[k * stride + l] * fam[a][0] + v[(3 + k) * stride + l] * fam[a][1] +
+                   v[(6 + k) * stride + l] * fam[a][2];
+  const double f[3] = {fhat[0][l], fhat[1][l], fhat[2][l]};
+  double g, r[2];
+  const double energy = hgo_fiber_terms_diagonal(h, f[0], f[1], f[2], ahat, &g, r);
+  /* P = U [g Fhat + sum_a r_a (Fhat ahat_a) ahat_a^T] V^T */
+  double ph[3][3];
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j)
+      ph[i][j] = (i == j ? g * f[i] : 0.0) + f[i] * (r[0] * ahat[0][i] * ahat[0][j] + r[1] * ahat[1][i] * ahat[1][j]);
+  double pv[3][3], p[3][3]; /* ph V^T, then U (ph V^T) */
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j)
+      pv[i][j] = ph[i][0] * v[(3 * j) * stride + l] + ph[i][1] * v[(3 * j + 1) * stride + l] +
+                 ph[i][2] * v[(3 * j + 2) * stride + l];
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j)
+      p[i][j] = u[(3 * i) * stride + l] * pv[0][j] + u[(3 * i + 1) * stride + l] * pv[1][j] +
+                u[(3 * i + 2) * stride + l] * pv[2][j];
+  const double w = -body->rest_volume[t] * scale;
+  for (int i = 0; i < 3; ++i) {
+    double g0 = 0.0;
+    for (int j = 0; j < 3; ++j) {
+      const double gij = w * (p[i][0] * body->dm_inv[3 * j][t] + p[i][1] * body->dm_inv[3 * j + 1][t] +
+                              p[i][2] * body->dm_inv[3 * j + 2][t]);
+      tf[(3 * (j + 1) + i) * B + l] += gij;
+      g0 -= gij;
+    }
+    tf[i * B + l] += g0;
+  }
+  return energy;
+}
+
 PIOLA_WIDE_VECTORS void PIOLA_ISA_NAME(piola__fiber_forces_lanes)(const piola_elastic_body *body, int32_t base,
                                                   double fhat[3][B], double scale,
                                                   double *tf, double *psi) {
@@ -59,6 +107,12 @@ PIOLA_WIDE_VECTORS void PIOLA_ISA_NAME(piola__fiber_forces_lanes)(const piola_el
   double energy[B];
   if (body->uniform_material >= 0) {
     const piola_material *mat = &body->materials[body->uniform_material];
+    if (mat->model == PIOLA_MODEL_HGO) {
+      for (int l = 0; l < B; ++l) energy[l] = hgo_lane(body, mat, base, l, fhat, scale, tf);
+      if (psi)
+        for (int l = 0; l < B; ++l) psi[l] += energy[l];
+      return;
+    }
     if (mat->model != PIOLA_MODEL_MUSCLE) return;
     const piola_muscle_def m = mat->muscle;
 #pragma omp simd
@@ -68,7 +122,8 @@ PIOLA_WIDE_VECTORS void PIOLA_ISA_NAME(piola__fiber_forces_lanes)(const piola_el
       const piola_material *mat = &body->materials[body->tet_material[base + l]];
       energy[l] = mat->model == PIOLA_MODEL_MUSCLE
                       ? fiber_lane(body, &mat->muscle, activation, base, l, fhat, scale, tf)
-                      : 0.0;
+                  : mat->model == PIOLA_MODEL_HGO ? hgo_lane(body, mat, base, l, fhat, scale, tf)
+                                                  : 0.0;
     }
   }
   if (psi)
@@ -78,9 +133,19 @@ PIOLA_WIDE_VECTORS void PIOLA_ISA_NAME(piola__fiber_forces_lanes)(const piola_el
 double PIOLA_ISA_NAME(piola__fiber_energy_density)(const piola_elastic_body *body, int32_t t) {
   if (!body->fiber[0]) return 0.0;
   const piola_material *mat = &body->materials[body->tet_material[t]];
-  if (mat->model != PIOLA_MODEL_MUSCLE) return 0.0;
   const long stride = body->padded_tet_count;
   const double *v = body->v[0] + t;
+  if (mat->model == PIOLA_MODEL_HGO) {
+    const double m[3] = {body->fiber[0][t], body->fiber[1][t], body->fiber[2][t]};
+    double fam[2][3], ahat[2][3], g, r[2];
+    (void)hgo_families_from_fiber(mat, m, fam);
+    for (int a = 0; a < 2; ++a)
+      for (int k = 0; k < 3; ++k)
+        ahat[a][k] = v[k * stride] * fam[a][0] + v[(3 + k) * stride] * fam[a][1] + v[(6 + k) * stride] * fam[a][2];
+    const double *f = body->fhat + 3 * (size_t)t;
+    return hgo_fiber_terms_diagonal(&mat->hgo, f[0], f[1], f[2], ahat, &g, r);
+  }
+  if (mat->model != PIOLA_MODEL_MUSCLE) return 0.0;
   double ahat[3];
   for (int k = 0; k < 3; ++k)
     ahat[k] = v[k * stride] * body->fiber[0][t] + v[(3 + k) * stride] * body->fiber[1][t] +
@@ -108,6 +173,13 @@ piola_status PIOLA_ISA_NAME(piola__fiber_copy)(piola_elastic_body *body, const p
       body->fiber[k][t] = a[k] / n;
       body->fiber_aos[3 * (size_t)t + k] = a[k] / n;
     }
+    const piola_material *mat = &body->materials[body->tet_material[t]];
+    double unit[3] = {a[0] / n, a[1] / n, a[2] / n}, fam[2][3];
+    if (mat->model == PIOLA_MODEL_HGO && !hgo_families_from_fiber(mat, unit, fam))
+      return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT,
+                        "fiber direction of tet %d is parallel to material.hgo.axis: the plane of "
+                        "the two fibre families is undefined",
+                        (int)t);
   }
   return PIOLA_OK;
 }

@@ -1,5 +1,7 @@
-/* Muscle fibres in the force loop: the anisotropic part of paper section 6.1, added to a
- * block's nodal forces after its isotropic part.
+/* Fibres in the force loop: the muscle's (the anisotropic part of paper section 6.1) and the
+ * Holzapfel-Gasser-Ogden model's two families (hgo_kernels.h, formed per tet from the fibre
+ * direction and the material's axis, applied as -V0 P_f Dm^-T), added to a block's nodal
+ * forces after its isotropic part.
  *
  * The hook is one call in finish_blocks (force_lanes.c), made only for bodies with fibres,
  * so bodies without them pay nothing and the isotropic loop stays as it is. The fibre a of

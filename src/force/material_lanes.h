@@ -71,6 +71,7 @@
         case PIOLA_MODEL_COROTATED: PIOLA_MATERIAL_LANE_LOOP(corotated_stress_energy_mode_lanes, lanes); return; \
         case PIOLA_MODEL_STVK: PIOLA_MATERIAL_LANE_LOOP(stvk_stress_energy_mode_lanes, lanes); return; \
         case PIOLA_MODEL_NEOHOOKEAN:                                                       \
+        case PIOLA_MODEL_HGO:                                                              \
         case PIOLA_MODEL_MUSCLE:                                                           \
           PIOLA_SPLIT_BY_BLOCK(neohookean_lane_unclamped, neohookean_stress_lanes_unclamped, \
                                neohookean_stress_energy_mode_lanes, lanes);                \
@@ -90,6 +91,7 @@
       case PIOLA_MODEL_COROTATED: PIOLA_MATERIAL_LANE_LOOP(corotated_stress_lanes, lanes); return; \
       case PIOLA_MODEL_STVK: PIOLA_MATERIAL_LANE_LOOP(stvk_stress_lanes, lanes); return;          \
       case PIOLA_MODEL_NEOHOOKEAN:                                                         \
+      case PIOLA_MODEL_HGO:                                                                \
       case PIOLA_MODEL_MUSCLE:                                                             \
         PIOLA_SPLIT_BY_BLOCK(neohookean_lane_unclamped, neohookean_stress_lanes_unclamped, \
                              neohookean_stress_lanes, lanes);                              \

@@ -29,6 +29,7 @@
 #include "common/status_report.h"
 #include "force/elastic_body_internal.h"
 #include "force/stable_step.h"
+#include "material/hgo_kernels.h"
 #include "material/material_kernels.h"
 
 #define STABLE_STEP_KERNEL static inline __attribute__((always_inline))
@@ -65,8 +66,10 @@ STABLE_STEP_KERNEL double model_modulus(piola_material_model model, const piola_
   k = kernel_max(k, pair_modulus(c, p0, p1, f0, f1, k0, k1, pa.k[0][1]));
   k = kernel_max(k, pair_modulus(c, p0, p2, f0, f2, k0, k2, pa.k[0][2]));
   k = kernel_max(k, pair_modulus(c, p1, p2, f1, f2, k1, k2, pa.k[1][2]));
-  /* muscle fibres: their tangent stiffness bound, as in the rest bound */
-  return k + m->fiber_modulus;
+  /* muscle fibres: their tangent stiffness bound, as in the rest bound; HGO's exponential
+   * fibres: a bound at this state (hgo_kernels.h) */
+  return k + (model == PIOLA_MODEL_HGO ? hgo_fiber_modulus_bound(&m->hgo, f0, f1, f2)
+                                       : m->fiber_modulus);
 }
 
 /* Neo-Hookean (and the muscle's matrix) with every entry at or above the threshold: the
@@ -96,6 +99,7 @@ static double material_modulus(const piola_material *m, double f0, double f1, do
     case PIOLA_MODEL_STVK: return model_modulus(PIOLA_MODEL_STVK, m, f0, f1, f2);
     case PIOLA_MODEL_NEOHOOKEAN: return model_modulus(PIOLA_MODEL_NEOHOOKEAN, m, f0, f1, f2);
     case PIOLA_MODEL_MUSCLE: return model_modulus(PIOLA_MODEL_MUSCLE, m, f0, f1, f2);
+    case PIOLA_MODEL_HGO: return model_modulus(PIOLA_MODEL_HGO, m, f0, f1, f2);
     case PIOLA_MODEL_SPLINE: return model_modulus(PIOLA_MODEL_SPLINE, m, f0, f1, f2);
     case PIOLA_MODEL_ROTATED_LINEAR:
     default: return model_modulus(PIOLA_MODEL_ROTATED_LINEAR, m, f0, f1, f2);
@@ -192,6 +196,7 @@ static double range_rate2(const piola_elastic_body *body, const double *w, int32
       case PIOLA_MODEL_NEOHOOKEAN:
         return neohookean_range(PIOLA_MODEL_NEOHOOKEAN, m, f, w, begin, end);
       case PIOLA_MODEL_MUSCLE: return neohookean_range(PIOLA_MODEL_MUSCLE, m, f, w, begin, end);
+      case PIOLA_MODEL_HGO: MODEL_LANE_LOOP(PIOLA_MODEL_HGO)
       case PIOLA_MODEL_SPLINE: MODEL_LANE_LOOP(PIOLA_MODEL_SPLINE)
       case PIOLA_MODEL_ROTATED_LINEAR:
       default: MODEL_LANE_LOOP(PIOLA_MODEL_ROTATED_LINEAR)

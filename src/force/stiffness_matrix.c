@@ -70,6 +70,18 @@ void piola__tet_stiffness_blocks(const piola_elastic_body *body, int32_t t, doub
     piola__fiber_stiffness_terms(material, sqrt(w[0] * w[0] + w[1] * w[1] + w[2] * w[2]),
                                  body->activation, 1, &fs, &fc);
   }
+  /* HGO's fibres: dP_f/dF at F = U Fhat V^T, positive semi-definite as it is (material.h) */
+  double hgo_dpdf[81];
+  const int hgo = body->fiber[0] && material->model == PIOLA_MODEL_HGO;
+  if (hgo) {
+    double fm[9], fam[6];
+    for (int i = 0; i < 3; ++i)
+      for (int j = 0; j < 3; ++j)
+        fm[3 * i + j] = u[i][0] * fhat[0] * v[j][0] + u[i][1] * fhat[1] * v[j][1] + u[i][2] * fhat[2] * v[j][2];
+    const double m[3] = {body->fiber[0][t], body->fiber[1][t], body->fiber[2][t]};
+    (void)piola_material_hgo_families(material, m, fam); /* checked when the body was built */
+    piola_material_hgo_fiber_stress_derivative(material, fm, fam, hgo_dpdf);
+  }
   for (int n = 0; n < 6; ++n) {
     const double *ga = gh[PAIR_A[n]], *gb = gh[PAIR_B[n]];
     double mm[3][3];
@@ -97,6 +109,11 @@ void piola__tet_stiffness_blocks(const piola_elastic_body *body, int32_t t, doub
       for (int j = 0; j < 3; ++j) {
         double kij = um[i][0] * u[j][0] + um[i][1] * u[j][1] + um[i][2] * u[j][2];
         kij += fiber_weight * ((i == j ? fs : 0.0) + fc * w[i] * w[j]);
+        if (hgo) {
+          const double *pa = g[PAIR_A[n]], *pb = g[PAIR_B[n]];
+          for (int jj = 0; jj < 3; ++jj)
+            for (int l = 0; l < 3; ++l) kij += pa[jj] * hgo_dpdf[9 * (3 * i + jj) + 3 * j + l] * pb[l];
+        }
         out[9 * n + 3 * i + j] = scale * kij;
       }
   }

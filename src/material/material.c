@@ -7,6 +7,7 @@
 #include <string.h>
 
 #include "common/status_report.h"
+#include "material/hgo.h"
 #include "material/material_kernels.h"
 #include "material/muscle.h"
 #include "piola/material.h"
@@ -31,6 +32,7 @@ piola_material_def piola_default_material_def(void) {
   def.ogden.mu[2] = -0.1 * 98066.5, def.ogden.alpha[2] = -2.0;
   def.mooney_rivlin.c10 = 1.5e4;
   def.mooney_rivlin.c01 = 5e3;
+  def.hgo = piola__default_hgo_def();
   return def;
 }
 
@@ -115,12 +117,13 @@ piola_status piola_material_init(const piola_material_def *def, piola_material *
     return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "inversion.mode: unknown mode %d",
                       (int)def->inversion_mode);
   const double e = def->youngs_modulus, nu = def->poisson_ratio, c = def->inversion_threshold;
-  if (def->model != PIOLA_MODEL_OGDEN && def->model != PIOLA_MODEL_MOONEY_RIVLIN)
-    PIOLA_TRY(check_finite("youngs_modulus", e));
+  /* the Ogden models and HGO take their shear modulus from their own parameters */
+  const int own_shear = def->model == PIOLA_MODEL_OGDEN || def->model == PIOLA_MODEL_MOONEY_RIVLIN ||
+                        def->model == PIOLA_MODEL_HGO;
+  if (!own_shear) PIOLA_TRY(check_finite("youngs_modulus", e));
   PIOLA_TRY(check_finite("poisson_ratio", nu));
   PIOLA_TRY(check_finite("inversion.threshold", c));
-  const int ogden = def->model == PIOLA_MODEL_OGDEN || def->model == PIOLA_MODEL_MOONEY_RIVLIN;
-  if (!(e > 0.0) && !ogden) /* the Ogden models take their shear modulus from their terms */
+  if (!(e > 0.0) && !own_shear)
     return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "youngs_modulus must be > 0 Pa, got %g", e);
   if (!(nu > -1.0 && nu < 0.5))
     return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "poisson_ratio must be in (-1, 0.5), got %g",
@@ -161,6 +164,7 @@ piola_status piola_material_init(const piola_material_def *def, piola_material *
     s[SPLINE_INV_WC] = 1.0 / s[SPLINE_WC];
   }
   if (def->model == PIOLA_MODEL_MUSCLE) PIOLA_TRY(piola__muscle_init(def, &m));
+  if (def->model == PIOLA_MODEL_HGO) PIOLA_TRY(piola__hgo_init(def, &m));
   if (def->model == PIOLA_MODEL_OGDEN || def->model == PIOLA_MODEL_MOONEY_RIVLIN)
     PIOLA_TRY(ogden_init(def, nu, &m));
   material_derive_constants(&m);
@@ -170,7 +174,7 @@ piola_status piola_material_init(const piola_material_def *def, piola_material *
 
 static const char *const model_names[PIOLA_MODEL_COUNT] = {
     "rotated_linear", "corotated", "stvk", "neohookean", "spline", "muscle", "stable_neohookean",
-    "mooney_rivlin", "ogden"};
+    "mooney_rivlin", "ogden", "hgo"};
 
 const char *piola_material_model_name(piola_material_model model) {
   if ((int)model < 0 || model >= PIOLA_MODEL_COUNT) return "unknown";
@@ -244,6 +248,7 @@ static double entry_third(const piola_material *m, double f) {
     case PIOLA_MODEL_STVK:
       return 6.0 * m->mu * f;
     case PIOLA_MODEL_NEOHOOKEAN:
+    case PIOLA_MODEL_HGO: /* its matrix is neo-Hookean too */
     case PIOLA_MODEL_MUSCLE:
       return -2.0 * m->mu / (f * f * f);
     case PIOLA_MODEL_MOONEY_RIVLIN:
@@ -276,7 +281,7 @@ static void model_third_derivative(const piola_material *m, const double f[3], d
     for (int j = 0; j < 3; ++j)
       for (int k = 0; k < 3; ++k) {
         double tq = 0.0; /* third derivative of the invariant q */
-        if ((m->model == PIOLA_MODEL_NEOHOOKEAN || m->model == PIOLA_MODEL_MUSCLE ||
+        if ((m->model == PIOLA_MODEL_NEOHOOKEAN || MATERIAL_IS_NEOHOOKEAN_MATRIX(m->model) ||
              MATERIAL_IS_OGDEN(m->model)) &&
             i == j && j == k)
           tq = 2.0 / (f[i] * f[i] * f[i]);
@@ -477,9 +482,10 @@ piola_status piola_material_projected_hessian_eigensystem(const piola_material *
   if (!material || !fhat || !eigenvalues || !eigenvectors)
     return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "projected_hessian_eigensystem: NULL argument");
   const piola_material *m = material;
-  if (m->model == PIOLA_MODEL_MUSCLE)
+  if (MATERIAL_IS_NEOHOOKEAN_MATRIX(m->model))
     return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT,
-                      "projected_hessian_eigensystem: the muscle's fibres are not isotropic");
+                      "projected_hessian_eigensystem: the %s model's fibres are not isotropic",
+                      piola_material_model_name(m->model));
   const double c = m->threshold;
   const int clamped = !(fhat[0] >= c && fhat[1] >= c && fhat[2] >= c);
   if (clamped && m->inversion_mode != PIOLA_INVERSION_ENERGY)

@@ -82,12 +82,18 @@ enum {
   ENERGY_GROWTH_4 = 6, /* Pa: a4 */
   OGDEN_COUNT = 7,     /* Ogden and Mooney-Rivlin (as two Ogden terms): the number of terms */
   OGDEN_MU_SUM = 8,    /* Pa: sum_p mu_p, the coefficient of -ln J */
-  OGDEN_TERMS = 9      /* mu_p (Pa) at OGDEN_TERMS + 2 p, alpha_p at OGDEN_TERMS + 2 p + 1 */
+  OGDEN_TERMS = 9,     /* mu_p (Pa) at OGDEN_TERMS + 2 p, alpha_p at OGDEN_TERMS + 2 p + 1 */
+  HGO_COS_ANGLE = 7,   /* HGO (no Ogden terms): cos and sin of hgo.fiber_angle_degrees */
+  HGO_SIN_ANGLE = 8
 };
 
 /* Ogden and Mooney-Rivlin share one code path (Mooney-Rivlin is stored as the Ogden terms
  * (2 C10, 2), (-2 C01, -2)). */
 #define MATERIAL_IS_OGDEN(model) ((model) == PIOLA_MODEL_OGDEN || (model) == PIOLA_MODEL_MOONEY_RIVLIN)
+
+/* The muscle's and HGO's isotropic part (matrix and volume) is neo-Hookean: same code path. */
+#define MATERIAL_IS_NEOHOOKEAN_MATRIX(model) \
+  ((model) == PIOLA_MODEL_MUSCLE || (model) == PIOLA_MODEL_HGO)
 
 /* f^a for f > 0 (clamped entries): libm's pow. Not vectorizable; the Ogden models have no
  * speed target. */
@@ -199,6 +205,7 @@ MATERIAL_KERNEL void entry_slope_curvature(piola_material_model model, const pio
       *a2 = mu * (3.0 * f * f - 1.0);
       return;
     case PIOLA_MODEL_NEOHOOKEAN: /* muscle: its matrix and volume part is neo-Hookean */
+    case PIOLA_MODEL_HGO: /* its matrix is neo-Hookean too */
     case PIOLA_MODEL_MUSCLE: { /* A = mu (f^2 - 1)/2 - mu ln f */
       const double inv = kernel_recip(f, dv);
       *a1 = mu * (f - inv);
@@ -261,6 +268,7 @@ MATERIAL_KERNEL double invariant_terms(piola_material_model model, const piola_m
       h[0][0] = h[1][1] = h[2][2] = 2.0;
       return f0 * f0 + f1 * f1 + f2 * f2 - 3.0;
     case PIOLA_MODEL_NEOHOOKEAN:
+    case PIOLA_MODEL_HGO: /* its matrix is neo-Hookean too */
     case PIOLA_MODEL_MUSCLE:
     case PIOLA_MODEL_MOONEY_RIVLIN:
     case PIOLA_MODEL_OGDEN: { /* q = ln J, kappa = lambda */
@@ -480,7 +488,7 @@ MATERIAL_KERNEL void material_derive_constants(piola_material *m) {
     m->model_constants[SNH_ALPHA] = alpha;
     m->model_constants[SNH_REST] = 0.5 * lambda_s * (1.0 - alpha) * (1.0 - alpha);
   }
-  const piola_material_model model = m->model == PIOLA_MODEL_MUSCLE        ? PIOLA_MODEL_NEOHOOKEAN
+  const piola_material_model model = MATERIAL_IS_NEOHOOKEAN_MATRIX(m->model) ? PIOLA_MODEL_NEOHOOKEAN
                                      : m->model == PIOLA_MODEL_MOONEY_RIVLIN ? PIOLA_MODEL_OGDEN
                                                                              : m->model;
   const double c = m->threshold;
@@ -555,6 +563,7 @@ MATERIAL_KERNEL double entry_energy(piola_material_model model, const piola_mate
     case PIOLA_MODEL_STVK:
       return 0.25 * mu * (f * f - 1.0) * (f * f - 1.0);
     case PIOLA_MODEL_NEOHOOKEAN:
+    case PIOLA_MODEL_HGO: /* its matrix is neo-Hookean too */
     case PIOLA_MODEL_MUSCLE:
       return mu * (0.5 * (f * f - 1.0) - kernel_log(f));
     case PIOLA_MODEL_SPLINE: {
@@ -801,6 +810,7 @@ MATERIAL_KERNEL void material_stress_kernel(const piola_material *m, double f0, 
         stvk_stress_energy_mode(m, f0, f1, f2, p0, p1, p2);
         return;
       case PIOLA_MODEL_NEOHOOKEAN:
+      case PIOLA_MODEL_HGO: /* its matrix is neo-Hookean too */
       case PIOLA_MODEL_MUSCLE:
         neohookean_stress_energy_mode(m, f0, f1, f2, p0, p1, p2);
         return;
@@ -828,6 +838,7 @@ MATERIAL_KERNEL void material_stress_kernel(const piola_material *m, double f0, 
       stvk_stress(m, f0, f1, f2, p0, p1, p2);
       return;
     case PIOLA_MODEL_NEOHOOKEAN:
+    case PIOLA_MODEL_HGO: /* its matrix is neo-Hookean too */
     case PIOLA_MODEL_MUSCLE:
       neohookean_stress(m, f0, f1, f2, p0, p1, p2);
       return;
@@ -888,7 +899,7 @@ MATERIAL_KERNEL void material_stress_energy_kernel(const piola_material *m, doub
   if (m->inversion_mode == PIOLA_INVERSION_ENERGY) {
     /* Off the hot path: the model is a run-time value here. */
     const piola_material_model model =
-        m->model == PIOLA_MODEL_MUSCLE ? PIOLA_MODEL_NEOHOOKEAN : m->model;
+        MATERIAL_IS_NEOHOOKEAN_MATRIX(m->model) ? PIOLA_MODEL_NEOHOOKEAN : m->model;
     switch (model) {
       case PIOLA_MODEL_COROTATED:
         material_energy_extended_stress_energy(PIOLA_MODEL_COROTATED, m, f0, f1, f2, p0, p1, p2, psi);
@@ -924,6 +935,7 @@ MATERIAL_KERNEL void material_stress_energy_kernel(const piola_material *m, doub
       stvk_stress_energy(m, f0, f1, f2, p0, p1, p2, psi);
       return;
     case PIOLA_MODEL_NEOHOOKEAN:
+    case PIOLA_MODEL_HGO: /* its matrix is neo-Hookean too */
     case PIOLA_MODEL_MUSCLE:
       neohookean_stress_energy(m, f0, f1, f2, p0, p1, p2, psi);
       return;

@@ -23,11 +23,13 @@ typedef enum scene_fiber_kind {
   SCENE_FIBERS_AXIS,      /* one direction for every tet */
   SCENE_FIBERS_CURVE,     /* polyline: the tangent of the segment nearest each tet's centroid */
   SCENE_FIBERS_FROM_MESH, /* per-tet data read with the mesh */
+  SCENE_FIBERS_AROUND,    /* circumferential about a line: axis x (centroid - point) */
 } scene_fiber_kind;
 
 typedef struct scene_fibers {
   scene_fiber_kind kind;
-  piola_vec3 axis;        /* SCENE_FIBERS_AXIS: unit */
+  piola_vec3 axis;        /* SCENE_FIBERS_AXIS, SCENE_FIBERS_AROUND: unit */
+  piola_vec3 point;       /* SCENE_FIBERS_AROUND: a point of the line (m) */
   double *curve;          /* SCENE_FIBERS_CURVE: 3 per point, owned */
   int32_t curve_points;   /* >= 2 */
 } scene_fibers;

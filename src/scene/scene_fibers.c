@@ -38,11 +38,24 @@ piola_status piola__scene_fiber_directions(const scene_fibers *fibers, const pio
   }
   for (int32_t t = 0; t < mesh->tet_count; ++t) {
     vec3 d = fibers->axis;
+    vec3 c = {0, 0, 0};
+    for (int k = 0; k < 4; ++k)
+      c = vec3_add(c, vec3_load(mesh->positions + 3 * (size_t)mesh->tets[4 * (size_t)t + k]));
+    c = vec3_scale(c, 0.25);
+    if (fibers->kind == SCENE_FIBERS_AROUND) {
+      const vec3 point = {fibers->point.x, fibers->point.y, fibers->point.z};
+      d = vec3_cross(d, vec3_sub(c, point));
+      const double n = vec3_norm(d);
+      if (!(n > 0)) {
+        free(a);
+        return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT,
+                          "fibers.around: the centroid of tet %d lies on the axis, so it has no "
+                          "circumferential direction",
+                          (int)t);
+      }
+      d = vec3_scale(d, 1.0 / n);
+    }
     if (fibers->kind == SCENE_FIBERS_CURVE) {
-      vec3 c = {0, 0, 0};
-      for (int k = 0; k < 4; ++k)
-        c = vec3_add(c, vec3_load(mesh->positions + 3 * (size_t)mesh->tets[4 * (size_t)t + k]));
-      c = vec3_scale(c, 0.25);
       double best = INFINITY;
       for (int32_t s = 0; s + 1 < fibers->curve_points; ++s) {
         const vec3 p0 = vec3_load(fibers->curve + 3 * s), p1 = vec3_load(fibers->curve + 3 * s + 3);

@@ -4,15 +4,30 @@
 
 #include "scene/scene_parse_sections.h"
 
-/* "fibers": {"axis": [x, y, z]} | {"curve": [[x, y, z], ...]} | {"from_mesh": true}. */
+/* "fibers": {"axis": [x, y, z]} | {"curve": [[x, y, z], ...]} | {"from_mesh": true} |
+ * {"around": {"axis": [x, y, z], "point": [x, y, z]}}. */
 piola_status piola__scene_parse_fibers(scene_parser *p, const cJSON *obj, scene_fibers *f) {
-  static const char *const allowed[] = {"axis", "curve", "from_mesh", NULL};
+  static const char *const allowed[] = {"axis", "curve", "from_mesh", "around", NULL};
   PIOLA_TRY(piola__json_check_keys(p, obj, allowed));
   const cJSON *axis = piola__json_get(obj, "axis"), *curve = piola__json_get(obj, "curve"),
-              *mesh = piola__json_get(obj, "from_mesh");
-  if ((axis != NULL) + (curve != NULL) + (mesh != NULL) != 1)
+              *mesh = piola__json_get(obj, "from_mesh"), *around = piola__json_get(obj, "around");
+  if ((axis != NULL) + (curve != NULL) + (mesh != NULL) + (around != NULL) != 1)
     return piola__json_fail(p, PIOLA_ERROR_PARSE,
-                            "needs exactly one of \"axis\", \"curve\" and \"from_mesh\"");
+                            "needs exactly one of \"axis\", \"curve\", \"from_mesh\" and \"around\"");
+  if (around) {
+    size_t old = piola__json_push_key(p, "around");
+    if (!cJSON_IsObject(around))
+      return piola__json_fail(p, PIOLA_ERROR_PARSE, "must be an object {\"axis\": [x, y, z], \"point\": [x, y, z]}");
+    static const char *const keys[] = {"axis", "point", NULL};
+    PIOLA_TRY(piola__json_check_keys(p, around, keys));
+    PIOLA_TRY(piola__json_required(p, around, "axis"));
+    PIOLA_TRY(piola__json_opt_direction(p, around, "axis", &f->axis));
+    f->point = (piola_vec3){0, 0, 0};
+    PIOLA_TRY(piola__json_opt_vec3(p, around, "point", ANY, &f->point));
+    f->kind = SCENE_FIBERS_AROUND;
+    piola__json_pop(p, old);
+    return PIOLA_OK;
+  }
   if (axis) {
     f->kind = SCENE_FIBERS_AXIS;
     return piola__json_opt_direction(p, obj, "axis", &f->axis);

@@ -48,10 +48,34 @@ static piola_status parse_ogden(scene_parser *p, const cJSON *obj, piola_materia
   return PIOLA_OK;
 }
 
+/* `hgo`: {"mu", "k1", "k2", "kappa", "fiber_angle_degrees", "axis"} (materials.md). */
+static piola_status parse_hgo(scene_parser *p, const cJSON *obj, piola_material_def *m) {
+  const cJSON *h = piola__json_get(obj, "hgo");
+  if (!h) return PIOLA_OK;
+  size_t old = piola__json_push_key(p, "hgo");
+  if (m->model != PIOLA_MODEL_HGO) return piola__json_fail(p, BAD_VALUE, "needs \"model\": \"hgo\"");
+  static const char *const keys[] = {"mu", "k1", "k2", "kappa", "fiber_angle_degrees", "axis", NULL};
+  PIOLA_TRY(piola__json_check_keys(p, h, keys));
+  piola_hgo_def *hd = &m->hgo;
+  PIOLA_TRY(piola__json_opt_number(p, h, "mu", POSITIVE, &hd->mu));
+  PIOLA_TRY(piola__json_opt_number(p, h, "k1", NONNEGATIVE, &hd->k1));
+  PIOLA_TRY(piola__json_opt_number(p, h, "k2", POSITIVE, &hd->k2));
+  PIOLA_TRY(piola__json_opt_number(p, h, "kappa", (json_range){0, 1.0 / 3.0, 0, 0}, &hd->kappa));
+  PIOLA_TRY(piola__json_opt_number(p, h, "fiber_angle_degrees", (json_range){0, 90, 0, 0},
+                                   &hd->fiber_angle_degrees));
+  if (piola__json_get(h, "axis")) {
+    piola_vec3 a;
+    PIOLA_TRY(piola__json_opt_direction(p, h, "axis", &a));
+    hd->axis[0] = a.x, hd->axis[1] = a.y, hd->axis[2] = a.z;
+  }
+  piola__json_pop(p, old);
+  return PIOLA_OK;
+}
+
 piola_status piola__scene_parse_material(scene_parser *p, const cJSON *obj, scene_solid_desc *d) {
   static const char *const allowed[] = {"model",  "youngs_modulus", "poisson_ratio",
                                         "stiffness_scale", "inversion", "spline", "muscle",
-                                        "ogden", "mooney_rivlin", NULL};
+                                        "ogden", "mooney_rivlin", "hgo", NULL};
   PIOLA_TRY(piola__json_check_keys(p, obj, allowed));
   piola_material_def *m = &d->def.material;
   const cJSON *model = piola__json_get(obj, "model");
@@ -125,6 +149,7 @@ piola_status piola__scene_parse_material(scene_parser *p, const cJSON *obj, scen
     piola__json_pop(p, old);
   }
   PIOLA_TRY(parse_ogden(p, obj, m));
+  PIOLA_TRY(parse_hgo(p, obj, m));
   const cJSON *mr = piola__json_get(obj, "mooney_rivlin");
   if (mr) {
     size_t old = piola__json_push_key(p, "mooney_rivlin");

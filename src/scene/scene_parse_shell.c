@@ -120,10 +120,11 @@ static piola_status parse_shell(scene_parser *p, const cJSON *obj, int index, sc
   if ((v = piola__json_get(obj, "material"))) {
     size_t old = piola__json_push_key(p, "material");
     PIOLA_TRY(piola__scene_parse_material(p, v, &d->base));
-    if (d->base.def.material.model == PIOLA_MODEL_MUSCLE) {
+    if (d->base.def.material.model == PIOLA_MODEL_MUSCLE ||
+        d->base.def.material.model == PIOLA_MODEL_HGO) {
       piola__json_push_key(p, "model");
-      return piola__json_fail(p, BAD_VALUE,
-                              "\"muscle\" is for solids only (shells have no fibres)");
+      return piola__json_fail(p, BAD_VALUE, "\"%s\" is for solids only (shells have no fibres)",
+                              piola_material_model_name(d->base.def.material.model));
     }
     piola__json_pop(p, old);
   }

@@ -111,8 +111,8 @@ static piola_status parse_solid(scene_parser *p, const cJSON *obj, int index, sc
   PIOLA_TRY(piola__scene_parse_constraints(p, obj, "driven", 1, d));
   if ((v = piola__json_get(obj, "fibers"))) {
     old = piola__json_push_key(p, "fibers");
-    if (d->def.material.model != PIOLA_MODEL_MUSCLE)
-      return piola__json_fail(p, BAD_VALUE, "needs material.model \"muscle\"");
+    if (d->def.material.model != PIOLA_MODEL_MUSCLE && d->def.material.model != PIOLA_MODEL_HGO)
+      return piola__json_fail(p, BAD_VALUE, "needs material.model \"muscle\" or \"hgo\"");
     if (d->plastic)
       return piola__json_fail(p, BAD_VALUE, "cannot be combined with plasticity (not supported)");
     PIOLA_TRY(piola__scene_parse_fibers(p, v, &d->fibers));

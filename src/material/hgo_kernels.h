@@ -1,0 +1,117 @@
+/* The fibre part of the Holzapfel-Gasser-Ogden model (PIOLA_MODEL_HGO) as inline kernels:
+ * one source of truth for the public functions (hgo.c), the force loop's lane kernel
+ * (force/fiber_lanes.c) and the step bound (force/stable_step.c).
+ *
+ * Why the model is shaped like this
+ * ---------------------------------
+ * Each family a contributes psi_f(E) = k1 / (2 k2) (exp(k2 <E>^2) - 1) with
+ * E = kappa (I1 - 3) + (1 - 3 kappa) (I4 - 1), I1 = |F|^2, I4 = |F a|^2. Both invariants are
+ * defined for every F (flat and inverted ones included), so, as for the muscle's fibres,
+ * nothing needs extending past the inversion threshold: the matrix is neo-Hookean with its
+ * extension, the fibres are evaluated as they are. Their stress
+ *     P_f = 2 psi'(E) (kappa F + (1 - 3 kappa) F a a^T) = F [2 psi'(E) (kappa I + (1 - 3 kappa) a a^T)]
+ * is F times a symmetric matrix (angular momentum preserved), and in the diagonal frame its
+ * diagonal entry k is 2 psi' f_k (kappa + (1 - 3 kappa) ahat_k^2): the sign of f_k, since
+ * psi' >= 0. So for an entry f_k <= 0 the fibres push the same way as the matrix's restoring
+ * stress: they never hold an element inverted.
+ *
+ * The Macaulay bracket <E> = max(E, 0) is HGO 2000's "fibres bear no compression" (for kappa = 0
+ * it is their I4 > 1 switch); psi' = k1 E exp(k2 E^2) is 0 at E = 0, so the stress is C1.
+ * The exponential overflows at k2 E^2 = 709 (fibre stretch ~29 for k2 = 0.84); beyond
+ * k2 E^2 = HGO_EXP_CAP the energy is continued by its second-order Taylor expansion in E,
+ * which keeps energy, stress and stiffness finite and C2 for every F. At the cap the fibre
+ * stress is k1 E e^12 ~ 1.6e5 k1 E: far past collagen's rupture, so no physical state sees
+ * the continuation. */
+#ifndef PIOLA_MATERIAL_HGO_KERNELS_H
+#define PIOLA_MATERIAL_HGO_KERNELS_H
+
+#include <math.h>
+
+#include "material/material_kernels.h"
+#include "piola/material.h"
+
+#define HGO_EXP_CAP 12.0
+
+/* psi_f(E) (J/m^3), its slope psi' (Pa) and curvature psi'' (Pa) for one family. */
+MATERIAL_KERNEL void hgo_fiber_curve(const piola_hgo_def *h, double e, double *psi, double *slope,
+                                     double *curvature) {
+  const double k1 = h->k1, k2 = h->k2;
+  const double ep = kernel_max(e, 0.0);
+  const double cap = sqrt(HGO_EXP_CAP / k2);
+  const double x = kernel_min(ep, cap), y = ep - x;
+  const double ex = exp(k2 * x * x);
+  const double p0 = 0.5 * k1 / k2 * (ex - 1.0), s0 = k1 * x * ex,
+               c0 = e > 0.0 ? k1 * (1.0 + 2.0 * k2 * x * x) * ex : 0.0;
+  *psi = p0 + y * (s0 + 0.5 * c0 * y);
+  *slope = s0 + c0 * y;
+  *curvature = c0;
+}
+
+/* E of one unit family a at a 3x3 f (row-major), with w = f a. */
+MATERIAL_KERNEL double hgo_invariant(const piola_hgo_def *h, const double f[9], const double a[3],
+                                     double w[3]) {
+  double i1 = 0.0;
+  for (int k = 0; k < 9; ++k) i1 += f[k] * f[k];
+  for (int i = 0; i < 3; ++i) w[i] = f[3 * i] * a[0] + f[3 * i + 1] * a[1] + f[3 * i + 2] * a[2];
+  const double i4 = w[0] * w[0] + w[1] * w[1] + w[2] * w[2];
+  return h->kappa * (i1 - 3.0) + (1.0 - 3.0 * h->kappa) * (i4 - 1.0);
+}
+
+/* The diagonal-frame fibre stress of both families: with Fhat = diag(f) and unit ahat_a,
+ * Phat_f = Fhat S, S = sum_a 2 psi'_a (kappa I + (1 - 3 kappa) ahat_a ahat_a^T). Writes
+ * g = sum_a 2 psi'_a kappa (the isotropic coefficient), r_a = 2 psi'_a (1 - 3 kappa) and
+ * returns the energy. (The force loop uses these; P_f = g F + sum_a r_a (F a)(a)^T.) */
+MATERIAL_KERNEL double hgo_fiber_terms_diagonal(const piola_hgo_def *h, double f0, double f1,
+                                                double f2, double ahat[2][3], double *g,
+                                                double r[2]) {
+  const double i1 = f0 * f0 + f1 * f1 + f2 * f2;
+  double energy = 0.0, iso = 0.0;
+  for (int a = 0; a < 2; ++a) {
+    const double x0 = f0 * ahat[a][0], x1 = f1 * ahat[a][1], x2 = f2 * ahat[a][2];
+    const double i4 = x0 * x0 + x1 * x1 + x2 * x2;
+    const double e = h->kappa * (i1 - 3.0) + (1.0 - 3.0 * h->kappa) * (i4 - 1.0);
+    double psi, slope, curvature;
+    hgo_fiber_curve(h, e, &psi, &slope, &curvature);
+    energy += psi;
+    iso += 2.0 * slope * h->kappa;
+    r[a] = 2.0 * slope * (1.0 - 3.0 * h->kappa);
+  }
+  *g = iso;
+  return energy;
+}
+
+/* The two unit family directions from a unit fibre direction m and the unit axis of an HGO
+ * material: false when m is parallel to the axis (to 1e-12) and the angle is not 0. */
+MATERIAL_KERNEL int hgo_families_from_fiber(const piola_material *material, const double m[3],
+                                            double families[2][3]) {
+  const piola_hgo_def *h = &material->hgo;
+  const double d = h->axis[0] * m[0] + h->axis[1] * m[1] + h->axis[2] * m[2];
+  double n[3] = {h->axis[0] - d * m[0], h->axis[1] - d * m[1], h->axis[2] - d * m[2]};
+  const double len = sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+  const double c = material->model_constants[HGO_COS_ANGLE], s = material->model_constants[HGO_SIN_ANGLE];
+  const int ok = len > 1e-12 || s == 0.0;
+  for (int i = 0; i < 3; ++i) n[i] = len > 1e-12 ? n[i] / len : 0.0;
+  for (int i = 0; i < 3; ++i) {
+    families[0][i] = c * m[i] + s * n[i];
+    families[1][i] = c * m[i] - s * n[i];
+  }
+  return ok;
+}
+
+/* A bound on the fibres' tangent stiffness for a plane wave (Pa) at a state with diagonal
+ * entries f: for a unit rank-one dF, dF : C_f : dF = sum_a 4 psi''(E_a) (G_a : dF)^2
+ * + 2 psi'(E_a) (kappa |dF|^2 + (1 - 3 kappa) |dF a|^2) with |G_a : dF| <= |G_a|_2 <=
+ * (1 - 2 kappa) max|f_i|, and psi', psi'' grow with E, which is at most
+ * kappa (I1 - 3) + (1 - 3 kappa) (max f_i^2 - 1) whatever the direction a. 8 k1 (1 - 2 kappa)^2
+ * at rest. */
+MATERIAL_KERNEL double hgo_fiber_modulus_bound(const piola_hgo_def *h, double f0, double f1,
+                                               double f2) {
+  const double big = kernel_max(f0 * f0, kernel_max(f1 * f1, f2 * f2));
+  const double e = h->kappa * (f0 * f0 + f1 * f1 + f2 * f2 - 3.0) + (1.0 - 3.0 * h->kappa) * (big - 1.0);
+  double psi, slope, curvature;
+  hgo_fiber_curve(h, kernel_max(e, 1e-300), &psi, &slope, &curvature);
+  const double q = 1.0 - 2.0 * h->kappa;
+  return 2.0 * (4.0 * curvature * q * q * kernel_max(big, 1.0) + 2.0 * slope);
+}
+
+#endif

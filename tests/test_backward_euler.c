@@ -15,21 +15,10 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "block_scenes.h"
 #include "piola/mesh.h"
 #include "piola/scene.h"
 #include "piola/world.h"
-
-static piola_tet_mesh block(int nx, int ny, int nz, double a, double b, double c) {
-  piola_tet_mesh m;
-  assert_int_equal(piola_tet_mesh_box_grid(nx, ny, nz, (piola_vec3){a / nx, b / ny, c / nz}, &m),
-                   PIOLA_OK);
-  return m;
-}
-
-static void free_mesh(piola_tet_mesh *m) {
-  free(m->positions);
-  free(m->tets);
-}
 
 static piola_world *make_world(piola_integrator_type type, double gz, double dt) {
   piola_world_def wd = piola_default_world_def();
@@ -41,25 +30,9 @@ static piola_world *make_world(piola_integrator_type type, double gz, double dt)
   return w;
 }
 
-static void momenta(const piola_world *w, double p[3], double l[3], double *kinetic) {
-  const piola_elastic_body *b = piola_world_solid_body(w, 0);
-  const double *m = piola_elastic_body_masses(b);
-  const double *x = piola_world_solid_positions(w, 0), *v = piola_world_solid_velocities(w, 0);
-  p[0] = p[1] = p[2] = l[0] = l[1] = l[2] = 0;
-  *kinetic = 0;
-  for (int32_t i = 0; i < piola_elastic_body_vertex_count(b); ++i) {
-    const double *xi = x + 3 * i, *vi = v + 3 * i;
-    for (int k = 0; k < 3; ++k) p[k] += m[i] * vi[k];
-    l[0] += m[i] * (xi[1] * vi[2] - xi[2] * vi[1]);
-    l[1] += m[i] * (xi[2] * vi[0] - xi[0] * vi[2]);
-    l[2] += m[i] * (xi[0] * vi[1] - xi[1] * vi[0]);
-    *kinetic += 0.5 * m[i] * (vi[0] * vi[0] + vi[1] * vi[1] + vi[2] * vi[2]);
-  }
-}
-
 static void free_flight(piola_material_model model, int damped) {
   piola_world *w = make_world(PIOLA_INTEGRATOR_BACKWARD_EULER, 0, 1.0 / 30);
-  piola_tet_mesh mesh = block(3, 2, 2, 0.3, 0.2, 0.2);
+  piola_tet_mesh mesh = block_mesh(3, 2, 2, 0.3, 0.2, 0.2);
   piola_solid_def sd = piola_default_solid_def();
   sd.mesh = &mesh;
   sd.material.model = model;
@@ -69,18 +42,9 @@ static void free_flight(piola_material_model model, int damped) {
   sd.bulk_viscosity = piola_track_constant(damped ? 10 : 0);
   sd.initial_matrix = (piola_mat3){{{1.3, 0.2, 0}, {0, 0.8, 0.1}, {0.1, 0, 1.1}}};
   assert_int_equal(piola_world_add_solid(w, &sd, NULL), PIOLA_OK);
-  int32_t n = piola_elastic_body_vertex_count(piola_world_solid_body(w, 0));
-  double *v = malloc(3 * (size_t)n * sizeof(double));
-  const double *x = piola_world_solid_positions(w, 0);
-  for (int32_t i = 0; i < n; ++i) {
-    const double *xi = x + 3 * i;
-    v[3 * i] = 0.5 - 3.0 * (xi[1] - 0.1);
-    v[3 * i + 1] = -0.2 + 3.0 * (xi[0] - 0.15);
-    v[3 * i + 2] = 0.3;
-  }
-  assert_int_equal(piola_world_solid_set_state(w, 0, NULL, v), PIOLA_OK);
+  spin_block(w, 0.3, 0);
   double p0[3], l0[3], e0, p1[3], l1[3], e1;
-  momenta(w, p0, l0, &e0);
+  solid_momenta(w, p0, l0, &e0);
   piola_solid_stats s0 = piola_world_solid_stats(w, 0);
   const double energy0 = e0 + s0.elastic_energy;
   double lnorm0 = sqrt(l0[0] * l0[0] + l0[1] * l0[1] + l0[2] * l0[2]);
@@ -92,7 +56,7 @@ static void free_flight(piola_material_model model, int damped) {
     assert_int_equal(piola_world_advance_to(w, f / 30.0, &st), PIOLA_OK);
     if (st.substeps != 1) fail_msg("model %d damped %d frame %d: %d steps, %d Newton failures, %d Newton iterations", (int)model, damped, f, (int)st.substeps, (int)st.newton_failures, (int)st.newton_iterations);
     assert_true(st.newton_iterations >= 1);
-    momenta(w, p1, l1, &e1);
+    solid_momenta(w, p1, l1, &e1);
     for (int k = 0; k < 3; ++k) assert_close(p1[k], p0[k], 1e-10 * pnorm0);
     piola_solid_stats s1 = piola_world_solid_stats(w, 0);
     double energy = e1 + s1.elastic_energy;
@@ -102,8 +66,7 @@ static void free_flight(piola_material_model model, int damped) {
     last_energy = energy;
   }
   assert_true(lnorm0 > 0);
-  free(v);
-  free_mesh(&mesh);
+  block_mesh_free(&mesh);
   piola_world_destroy(w);
 }
 
@@ -128,7 +91,7 @@ static piola_obstacle_def plane(piola_vec3 normal, double friction) {
 static void drop_on_ground(void **state) {
   (void)state;
   piola_world *w = make_world(PIOLA_INTEGRATOR_BACKWARD_EULER, -9.81, 1.0 / 30);
-  piola_tet_mesh mesh = block(3, 3, 2, 0.3, 0.3, 0.2);
+  piola_tet_mesh mesh = block_mesh(3, 3, 2, 0.3, 0.3, 0.2);
   for (int32_t i = 0; i < mesh.vertex_count; ++i) mesh.positions[3 * i + 2] += 0.3;
   piola_solid_def sd = piola_default_solid_def();
   sd.mesh = &mesh;
@@ -146,14 +109,14 @@ static void drop_on_ground(void **state) {
   }
   /* at rest on the ground: slow, bottom on the plane, squashed by its weight only slightly */
   double p[3], l[3], ke;
-  momenta(w, p, l, &ke);
+  solid_momenta(w, p, l, &ke);
   const double *x = piola_world_solid_positions(w, 0);
   double zmin = INFINITY, zmax = -INFINITY;
   for (int32_t i = 0; i < n; ++i) zmin = fmin(zmin, x[3 * i + 2]), zmax = fmax(zmax, x[3 * i + 2]);
   assert_true(zmin < 1e-6);
   assert_true(zmax > 0.19 && zmax < 0.21);
   if (!(ke < 1e-4)) fail_msg("kinetic energy %g", ke);
-  free_mesh(&mesh);
+  block_mesh_free(&mesh);
   piola_world_destroy(w);
 }
 
@@ -161,7 +124,7 @@ static void drop_on_ground(void **state) {
  * acceleration g (sin - mu cos); with mu > tan(theta) it stays. */
 static double incline_slide(double theta, double mu) {
   piola_world *w = make_world(PIOLA_INTEGRATOR_BACKWARD_EULER, -9.81, 1.0 / 120);
-  piola_tet_mesh mesh = block(2, 2, 1, 0.2, 0.2, 0.1);
+  piola_tet_mesh mesh = block_mesh(2, 2, 1, 0.2, 0.2, 0.1);
   /* rotate the block onto the plane through the origin with normal (sin, 0, cos) */
   const double c = cos(theta), s = sin(theta);
   for (int32_t i = 0; i < mesh.vertex_count; ++i) {
@@ -181,13 +144,13 @@ static double incline_slide(double theta, double mu) {
   const double t_end = 0.5;
   assert_int_equal(piola_world_advance_to(w, t_end, &st), PIOLA_OK);
   double p[3], l[3], ke;
-  momenta(w, p, l, &ke);
+  solid_momenta(w, p, l, &ke);
   double mass = 0;
   const double *m = piola_elastic_body_masses(piola_world_solid_body(w, 0));
   for (int32_t i = 0; i < mesh.vertex_count; ++i) mass += m[i];
   /* velocity along the slope (down-slope direction (c, 0, -s)) divided by the time */
   double along = (p[0] * c - p[2] * s) / mass;
-  free_mesh(&mesh);
+  block_mesh_free(&mesh);
   piola_world_destroy(w);
   return along / t_end;
 }

@@ -11,22 +11,10 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "block_scenes.h"
 #include "piola/mesh.h"
 #include "piola/world.h"
 #include "piola/threads.h"
-
-/* A box [0,a]x[0,b]x[0,c] of nx*ny*nz cubes, 6 tets each (piola_tet_mesh_box_grid). */
-static piola_tet_mesh block(int nx, int ny, int nz, double a, double b, double c) {
-  piola_tet_mesh m;
-  assert_int_equal(piola_tet_mesh_box_grid(nx, ny, nz, (piola_vec3){a / nx, b / ny, c / nz}, &m),
-                   PIOLA_OK);
-  return m;
-}
-
-static void free_mesh(piola_tet_mesh *m) {
-  free(m->positions);
-  free(m->tets);
-}
 
 static piola_world *make_world(double gz, double max_dt) {
   piola_world_def wd = piola_default_world_def();
@@ -39,25 +27,11 @@ static piola_world *make_world(double gz, double max_dt) {
   return w;
 }
 
-static void momenta(const piola_world *w, double p[3], double l[3]) {
-  const piola_elastic_body *b = piola_world_solid_body(w, 0);
-  const double *m = piola_elastic_body_masses(b);
-  const double *x = piola_world_solid_positions(w, 0), *v = piola_world_solid_velocities(w, 0);
-  p[0] = p[1] = p[2] = l[0] = l[1] = l[2] = 0;
-  for (int32_t i = 0; i < piola_elastic_body_vertex_count(b); ++i) {
-    const double *xi = x + 3 * i, *vi = v + 3 * i;
-    for (int k = 0; k < 3; ++k) p[k] += m[i] * vi[k];
-    l[0] += m[i] * (xi[1] * vi[2] - xi[2] * vi[1]);
-    l[1] += m[i] * (xi[2] * vi[0] - xi[0] * vi[2]);
-    l[2] += m[i] * (xi[0] * vi[1] - xi[1] * vi[0]);
-  }
-}
-
 /* Damping of the rotated frame (section 6.2) is not invariant under spin of a deformed
  * element, so angular momentum is checked without damping; linear momentum with it. */
 static void free_flight(int damped) {
   piola_world *w = make_world(0, 5e-4);
-  piola_tet_mesh mesh = block(3, 2, 2, 0.3, 0.2, 0.2);
+  piola_tet_mesh mesh = block_mesh(3, 2, 2, 0.3, 0.2, 0.2);
   piola_solid_def sd = piola_default_solid_def();
   sd.mesh = &mesh;
   sd.material.youngs_modulus = 2e4;
@@ -67,24 +41,14 @@ static void free_flight(int damped) {
   /* start stretched and sheared so elastic and damping forces are large */
   sd.initial_matrix = (piola_mat3){{{1.3, 0.2, 0}, {0, 0.8, 0.1}, {0.1, 0, 1.1}}};
   assert_int_equal(piola_world_add_solid(w, &sd, NULL), PIOLA_OK);
-  /* spin about z and translate */
-  int32_t n = piola_elastic_body_vertex_count(piola_world_solid_body(w, 0));
-  double *v = malloc(3 * (size_t)n * sizeof(double));
-  const double *x = piola_world_solid_positions(w, 0);
-  for (int32_t i = 0; i < n; ++i) {
-    const double *xi = x + 3 * i;
-    v[3 * i] = 0.5 - 3.0 * (xi[1] - 0.1);
-    v[3 * i + 1] = -0.2 + 3.0 * (xi[0] - 0.15);
-    v[3 * i + 2] = 0.1 + 1.0 * (xi[1] - 0.1);
-  }
-  assert_int_equal(piola_world_solid_set_state(w, 0, NULL, v), PIOLA_OK);
+  spin_block(w, 0.1, 1.0); /* spin about z, translate, tumble a little */
   double p0[3], l0[3], p1[3], l1[3];
-  momenta(w, p0, l0);
+  solid_momenta(w, p0, l0, NULL);
   double lscale = sqrt(l0[0] * l0[0] + l0[1] * l0[1] + l0[2] * l0[2]);
   piola_step_stats st = {0};
   for (int f = 1; f <= 10; ++f) {
     assert_int_equal(piola_world_advance_to(w, 0.02 * f, &st), PIOLA_OK);
-    momenta(w, p1, l1);
+    solid_momenta(w, p1, l1, NULL);
     for (int k = 0; k < 3; ++k) {
       assert_close(p1[k], p0[k], 1e-12 * (fabs(p0[k]) + 1e-3));
       if (!damped) assert_close(l1[k], l0[k], 1e-6 * lscale);
@@ -93,8 +57,7 @@ static void free_flight(int damped) {
   if (damped) assert_true(st.cg_iterations > 0); /* damping solves really ran */
   piola_solid_stats ss = piola_world_solid_stats(w, 0);
   assert_true(ss.elastic_energy > 0);
-  free(v);
-  free_mesh(&mesh);
+  block_mesh_free(&mesh);
   piola_world_destroy(w);
 }
 
@@ -133,7 +96,7 @@ static void undamped_bounce_gains_no_energy(void **state) {
   (void)state;
   const double g = 9.81;
   piola_world *w = make_world(-g, 5e-4);
-  piola_tet_mesh mesh = block(2, 2, 2, 0.2, 0.2, 0.2);
+  piola_tet_mesh mesh = block_mesh(2, 2, 2, 0.2, 0.2, 0.2);
   for (int32_t i = 0; i < mesh.vertex_count; ++i) mesh.positions[3 * i + 2] += 0.1;
   piola_solid_def sd = piola_default_solid_def();
   sd.mesh = &mesh;
@@ -153,14 +116,14 @@ static void undamped_bounce_gains_no_energy(void **state) {
     assert_true(min_z(w) >= -1e-9);
   }
   assert_true(bounced);
-  free_mesh(&mesh);
+  block_mesh_free(&mesh);
   piola_world_destroy(w);
 }
 
 static void resting_body_stays_on_the_plane(void **state) {
   (void)state;
   piola_world *w = make_world(-9.81, 1e-3);
-  piola_tet_mesh mesh = block(3, 3, 2, 0.3, 0.3, 0.2);
+  piola_tet_mesh mesh = block_mesh(3, 3, 2, 0.3, 0.3, 0.2);
   for (int32_t i = 0; i < mesh.vertex_count; ++i) mesh.positions[3 * i + 2] += 0.05;
   piola_solid_def sd = piola_default_solid_def();
   sd.mesh = &mesh;
@@ -180,7 +143,7 @@ static void resting_body_stays_on_the_plane(void **state) {
   if (!(s.kinetic_energy < 1e-4 * mass * 9.81 * 0.1))
     fail_msg("still moving: kinetic energy %g J", s.kinetic_energy);
   assert_true(min_z(w) < 1e-6);
-  free_mesh(&mesh);
+  block_mesh_free(&mesh);
   piola_world_destroy(w);
 }
 
@@ -213,7 +176,7 @@ static void incline(double theta, double mu, double *accel, double *slid) {
   wd.max_dt = 5e-4;
   piola_world *w = NULL;
   assert_int_equal(piola_world_create(&wd, &w), PIOLA_OK);
-  piola_tet_mesh mesh = block(2, 2, 1, 0.2, 0.2, 0.1);
+  piola_tet_mesh mesh = block_mesh(2, 2, 1, 0.2, 0.2, 0.1);
   piola_solid_def sd = piola_default_solid_def();
   sd.mesh = &mesh;
   sd.material.youngs_modulus = 1e5;
@@ -229,7 +192,7 @@ static void incline(double theta, double mu, double *accel, double *slid) {
   double v2 = mean_vx(w);
   *accel = (v2 - v1) / 0.4;
   *slid = mean_x(w) - x0;
-  free_mesh(&mesh);
+  block_mesh_free(&mesh);
   piola_world_destroy(w);
 }
 
@@ -257,7 +220,7 @@ static void incline_sticks_or_slides_as_coulomb_says(void **state) {
 static void constraints_hold_and_drive_nodes_exactly(void **state) {
   (void)state;
   piola_world *w = make_world(-9.81, 1e-3);
-  piola_tet_mesh mesh = block(1, 1, 4, 0.1, 0.1, 0.4);
+  piola_tet_mesh mesh = block_mesh(1, 1, 4, 0.1, 0.1, 0.4);
   piola_constraint_def cons[2];
   memset(cons, 0, sizeof cons);
   cons[0].selector.type = PIOLA_SELECT_BOX;
@@ -298,7 +261,7 @@ static void constraints_hold_and_drive_nodes_exactly(void **state) {
   }
   /* the middle of the bar follows about half way */
   assert_true(mid_lift > 0.02 && mid_lift < 0.08);
-  free_mesh(&mesh);
+  block_mesh_free(&mesh);
   piola_world_destroy(w);
 }
 
@@ -307,7 +270,7 @@ static void constraints_hold_and_drive_nodes_exactly(void **state) {
 static void initial_state_is_deformed_as_asked(void **state) {
   (void)state;
   piola_world *w = make_world(0, 1e-3);
-  piola_tet_mesh mesh = block(2, 2, 2, 0.2, 0.2, 0.2);
+  piola_tet_mesh mesh = block_mesh(2, 2, 2, 0.2, 0.2, 0.2);
   piola_solid_def sd = piola_default_solid_def();
   sd.mesh = &mesh;
   sd.shear_viscosity = piola_track_constant(20);
@@ -335,7 +298,7 @@ static void initial_state_is_deformed_as_asked(void **state) {
   piola_solid_stats rec = piola_world_solid_stats(w, 0);
   if (!(rec.inverted_count == 0 && rec.min_det_f > 0.8))
     fail_msg("after collapse to a point: %d inverted, min det F %g", (int)rec.inverted_count, rec.min_det_f);
-  free_mesh(&mesh);
+  block_mesh_free(&mesh);
   piola_world_destroy(w);
 }
 

@@ -8,6 +8,7 @@
 #include <string.h>
 
 #include "material/material_kernels.h"
+#include "material_checks.h"
 #include "piola/material.h"
 
 #define N_MODES 2
@@ -15,14 +16,7 @@ static const piola_inversion_mode modes[N_MODES] = {PIOLA_INVERSION_LINEAR, PIOL
 static const double youngs = 1e5;
 
 static piola_material make(piola_material_model model, piola_inversion_mode mode, double nu) {
-  piola_material_def def = piola_default_material_def();
-  def.model = model;
-  def.inversion_mode = mode;
-  def.youngs_modulus = youngs;
-  def.poisson_ratio = nu;
-  piola_material m;
-  assert_int_equal(piola_material_init(&def, &m), PIOLA_OK);
-  return m;
+  return material_of(model, mode, youngs, nu, 0);
 }
 
 static double energy(const piola_material *m, double f0, double f1, double f2) {
@@ -46,29 +40,11 @@ static void stress_fd(const piola_material *m, const double f[3], int j, double 
   for (int i = 0; i < 3; ++i) col[i] = (pa[i] - pb[i]) / (2 * h);
 }
 
-/* Scale of the stress around f, for relative tolerances. */
-static double stress_scale(const piola_material *m, const double f[3]) {
-  double p[3];
-  piola_material_stress(m, f, p);
-  return fabs(p[0]) + fabs(p[1]) + fabs(p[2]) + 2 * m->mu + fabs(m->lambda);
-}
-
-static void random_point(test_rng *rng, double lo, double hi, double f[3]) {
-  for (int i = 0; i < 3; ++i) f[i] = test_rng_uniform(rng, lo, hi);
-}
-
 /* True when f is within `gap` of a place where the stress derivative jumps: the threshold,
  * and for the spline model its breakpoints. */
 static int near_kink(const piola_material *m, const double f[3], double gap) {
-  for (int i = 0; i < 3; ++i) {
-    if (fabs(f[i] - m->threshold) < gap) return 1;
-    if (m->model == PIOLA_MODEL_SPLINE) {
-      const piola_material_def def = piola_default_material_def();
-      if (fabs(f[i] - 1.0) < gap || fabs(f[i] - def.spline.compression_stretch) < gap ||
-          fabs(f[i] - def.spline.elongation_stretch) < gap)
-        return 1;
-    }
-  }
+  for (int i = 0; i < 3; ++i)
+    if (fabs(f[i] - m->threshold) < gap || near_spline_breakpoint(m, f[i], gap)) return 1;
   return 0;
 }
 

@@ -9,22 +9,11 @@
 #include <string.h>
 
 #include "material/material_kernels.h"
+#include "material_checks.h"
 #include "piola/material.h"
 
 static piola_material make(piola_material_model model, double nu, double threshold) {
-  piola_material_def def = piola_default_material_def();
-  def.model = model;
-  def.inversion_mode = PIOLA_INVERSION_ENERGY;
-  def.youngs_modulus = 1e5;
-  def.poisson_ratio = nu;
-  def.inversion_threshold = threshold;
-  piola_material m;
-  assert_int_equal(piola_material_init(&def, &m), PIOLA_OK);
-  return m;
-}
-
-static void random_point(test_rng *rng, double lo, double hi, double f[3]) {
-  for (int i = 0; i < 3; ++i) f[i] = test_rng_uniform(rng, lo, hi);
+  return material_of(model, PIOLA_INVERSION_ENERGY, 1e5, nu, threshold);
 }
 
 /* Random points that visit every region: all above the threshold, one, two or three entries
@@ -34,12 +23,6 @@ static void region_point(test_rng *rng, long s, double c, double f[3]) {
   const int below = (int)(s % 4);
   for (int i = 0; i < below; ++i) f[(s / 4 + i) % 3] = test_rng_uniform(rng, -2.0, c);
   if (s % 11 == 0) f[s % 3] = c + test_rng_uniform(rng, -1e-7, 1e-7);
-}
-
-static double stress_scale(const piola_material *m, const double f[3]) {
-  double p[3];
-  piola_material_stress(m, f, p);
-  return fabs(p[0]) + fabs(p[1]) + fabs(p[2]) + 2 * m->mu + fabs(m->lambda);
 }
 
 /* Where the derivative jumps: the threshold, the spline's breakpoints, and a clamped entry
@@ -53,12 +36,7 @@ static int near_kink(const piola_material *m, const double f[3], double gap) {
   for (int i = 0; i < 3; ++i) {
     if (fabs(f[i] - c) < gap) return 1;
     if (f[i] < c && fabs(pc[i]) < 1e-3 * ps) return 1;
-    if (m->model == PIOLA_MODEL_SPLINE) {
-      const piola_material_def def = piola_default_material_def();
-      if (fabs(f[i] - 1.0) < gap || fabs(f[i] - def.spline.compression_stretch) < gap ||
-          fabs(f[i] - def.spline.elongation_stretch) < gap)
-        return 1;
-    }
+    if (near_spline_breakpoint(m, f[i], gap)) return 1;
   }
   return 0;
 }

@@ -10,6 +10,7 @@
 #include "piola/scene.h"
 #include "piola/world.h"
 #include "scene/scene_desc.h"
+#include "scene_cases.h"
 #include "test_support.h"
 
 static void keys_reach_their_definitions(void **state) {
@@ -41,14 +42,9 @@ static void keys_reach_their_definitions(void **state) {
   piola__scene_desc_free(&d);
 }
 
-typedef struct bad_case {
-  const char *json;
-  const char *expected;
-} bad_case;
-
 #define SOLID(m) "{\"solids\": [{\"mesh\": \"a.veg\", \"material\": " m "}]}"
 
-static const bad_case BAD[] = {
+static const bad_scene_case BAD[] = {
     {SOLID("{\"inversion\": {\"mode\": \"energetic\"}}"),
      "solids[0].material.inversion.mode: must be \"linear\", \"clamp\" or \"energy\""},
     {SOLID("{\"model\": \"stable-neohookean\"}"), "solids[0].material.model: must be one of"},
@@ -73,14 +69,7 @@ static const bad_case BAD[] = {
 
 static void bad_keys_name_their_path(void **state) {
   (void)state;
-  for (size_t i = 0; i < sizeof BAD / sizeof BAD[0]; ++i) {
-    scene_desc d;
-    piola_clear_error();
-    if (piola__scene_parse(BAD[i].json, ".", "bad.json", &d) == PIOLA_OK)
-      fail_msg("case %zu was accepted: %s", i, BAD[i].json);
-    if (!strstr(piola_last_error(), BAD[i].expected))
-      fail_msg("case %zu: message '%s' does not contain '%s'", i, piola_last_error(), BAD[i].expected);
-  }
+  assert_bad_scenes_refused(BAD, sizeof BAD / sizeof BAD[0]);
 }
 
 /* Each new model and the energy mode load and run a few steps with finite results. */

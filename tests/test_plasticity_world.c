@@ -8,18 +8,11 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "block_scenes.h"
 #include "piola/plasticity.h"
 #include "piola/mesh.h"
 #include "piola/world.h"
 #include "test_elastic_body_fixtures.h"
-
-/* A box [0,a]x[0,b]x[0,c] of nx*ny*nz cubes, 6 tets each (piola_tet_mesh_box_grid). */
-static piola_tet_mesh block(int nx, int ny, int nz, double a, double b, double c) {
-  piola_tet_mesh m;
-  assert_int_equal(piola_tet_mesh_box_grid(nx, ny, nz, (piola_vec3){a / nx, b / ny, c / nz}, &m),
-                   PIOLA_OK);
-  return m;
-}
 
 static piola_world *weightless_world(double max_dt) {
   piola_world_def wd = piola_default_world_def();
@@ -43,7 +36,7 @@ static double span(const piola_world *w, int32_t a, int32_t b) {
  * bar without plasticity returns to its rest length. */
 static void stretched_bar_keeps_its_permanent_set(void **state) {
   (void)state;
-  piola_tet_mesh mesh = block(6, 1, 1, 0.6, 0.1, 0.1);
+  piola_tet_mesh mesh = block_mesh(6, 1, 1, 0.6, 0.1, 0.1);
   const double s = 1.3, gamma = 0.05;
   for (int plastic = 0; plastic < 2; ++plastic) {
     piola_world *w = weightless_world(2e-3);
@@ -61,7 +54,7 @@ static void stretched_bar_keeps_its_permanent_set(void **state) {
     assert_int_equal(piola_world_add_solid(w, &sd, NULL), PIOLA_OK);
     assert_int_equal(piola_world_advance_to(w, 1.5, NULL), PIOLA_OK);
     double want = plastic ? s * exp(-gamma) : 1.0;
-    /* block(6, 1, 1): vertex (i, j, k) is i + 7 (j + 2 k) */
+    /* block_mesh(6, 1, 1): vertex (i, j, k) is i + 7 (j + 2 k) */
     assert_close(span(w, 0, 6) / 0.6, want, 0.01 * want);
     assert_close(span(w, 3, 10) / 0.1, 1.0, 0.01);
     if (plastic) {
@@ -81,7 +74,7 @@ static void stretched_bar_keeps_its_permanent_set(void **state) {
  * near zero; the goal squashes the rest shape (not volume preserving). */
 static void controlled_solid_moves_to_its_goal_without_load(void **state) {
   (void)state;
-  piola_tet_mesh mesh = block(2, 2, 2, 0.1, 0.1, 0.1);
+  piola_tet_mesh mesh = block_mesh(2, 2, 2, 0.1, 0.1, 0.1);
   piola_world *w = weightless_world(2e-3);
   piola_solid_def sd = piola_default_solid_def();
   sd.mesh = &mesh;
@@ -107,7 +100,7 @@ static void controlled_solid_moves_to_its_goal_without_load(void **state) {
     prev = d;
   }
   assert_true(prev < 0.1 * d0);
-  /* block(2, 2, 2): vertex (i, j, k) is i + 3 (j + 3 k); edges along x, y, z */
+  /* block_mesh(2, 2, 2): vertex (i, j, k) is i + 3 (j + 3 k); edges along x, y, z */
   assert_close(span(w, 0, 2), 0.13, 0.005);
   assert_close(span(w, 0, 6), 0.13, 0.005);
   assert_close(span(w, 0, 18), 0.06, 0.005);
@@ -115,25 +108,11 @@ static void controlled_solid_moves_to_its_goal_without_load(void **state) {
   fixture_mesh_free(&mesh);
 }
 
-static void momenta(const piola_world *w, double p[3], double l[3]) {
-  const piola_elastic_body *b = piola_world_solid_body(w, 0);
-  const double *m = piola_elastic_body_masses(b);
-  const double *x = piola_world_solid_positions(w, 0), *v = piola_world_solid_velocities(w, 0);
-  p[0] = p[1] = p[2] = l[0] = l[1] = l[2] = 0;
-  for (int32_t i = 0; i < piola_elastic_body_vertex_count(b); ++i) {
-    const double *xi = x + 3 * i, *vi = v + 3 * i;
-    for (int k = 0; k < 3; ++k) p[k] += m[i] * vi[k];
-    l[0] += m[i] * (xi[1] * vi[2] - xi[2] * vi[1]);
-    l[1] += m[i] * (xi[2] * vi[0] - xi[0] * vi[2]);
-    l[2] += m[i] * (xi[0] * vi[1] - xi[1] * vi[0]);
-  }
-}
-
 /* A flying, stretched, plastically flowing body: momentum to rounding, angular momentum
  * closely, while many tets yield. */
 static void plastic_flow_keeps_momentum(void **state) {
   (void)state;
-  piola_tet_mesh mesh = block(3, 2, 2, 0.3, 0.2, 0.2);
+  piola_tet_mesh mesh = block_mesh(3, 2, 2, 0.3, 0.2, 0.2);
   piola_world *w = weightless_world(1e-3);
   piola_solid_def sd = piola_default_solid_def();
   sd.mesh = &mesh;
@@ -144,14 +123,14 @@ static void plastic_flow_keeps_momentum(void **state) {
   sd.plasticity = &pd;
   assert_int_equal(piola_world_add_solid(w, &sd, NULL), PIOLA_OK);
   double p0[3], l0[3], p[3], l[3];
-  momenta(w, p0, l0);
+  solid_momenta(w, p0, l0, NULL);
   int32_t yielded = 0;
   for (int k = 0; k < 100; ++k) {
     assert_int_equal(piola_world_step(w, 0, NULL), PIOLA_OK);
     yielded += piola_world_solid_plastic_stats(w, 0).yielded_count;
   }
   assert_true(yielded > 100);
-  momenta(w, p, l);
+  solid_momenta(w, p, l, NULL);
   double pn = sqrt(p0[0] * p0[0] + p0[1] * p0[1] + p0[2] * p0[2]);
   double ln = sqrt(l0[0] * l0[0] + l0[1] * l0[1] + l0[2] * l0[2]);
   for (int k = 0; k < 3; ++k) {

@@ -6,13 +6,11 @@
  * of the last force update (the diagonalization, det F, the plastic Fp^-1, the shells'
  * dihedral angles), the damping operator the next step starts from and the last solve's
  * product it reuses, the plastic state (Fp^-1, hardening, bounds, refresh phase, control
- * logarithms) and the statistics of the last step. Keyframe clocks and obstacle poses are
+ * logarithms), the statistics of the last step, and what self-collision carries from step
+ * to step (the shapes and age of the collision trees, which decide the order of its
+ * impulses, and an open collision interval). Keyframe clocks and obstacle poses are
  * functions of the time, and the initial scramble's random numbers are used once at
- * creation, so the time covers them. The file layout is in docs/file-formats.md.
- *
- * Scenes with self-collision (contact between deformable surfaces) are not covered: the
- * collision module's trees and candidate lists carry history that decides the order of its
- * impulses. piola_world_checkpoint_supported says so before a run starts. */
+ * creation, so the time covers them. The file layout is in docs/file-formats.md. */
 #ifndef PIOLA_CHECKPOINT_H
 #define PIOLA_CHECKPOINT_H
 
@@ -28,7 +26,7 @@ extern "C" {
 #endif
 
 /* The checkpoint format this piola writes and reads (docs/file-formats.md). */
-#define PIOLA_CHECKPOINT_VERSION 1
+#define PIOLA_CHECKPOINT_VERSION 2
 
 /* 1 when checkpoints cover every part of the world's state; 0 with a reason in *why (a
  * static string) otherwise. */

@@ -61,6 +61,8 @@ typedef struct piola_frame_info {
   int32_t newton_failures;   /* implicit integrators: steps retried at half the size because
                                 Newton did not converge */
   int32_t step_retries;   /* steps redone at a smaller size since the previous frame */
+  int32_t energy_redos;   /* Newmark steps redone at a smaller size since the previous frame
+                             because their energy rose (docs/time-stepping.md) */
 } piola_frame_info;
 
 /* Writes the VTU and OBJ of the world's current state and appends a row to stats.csv and

@@ -182,6 +182,9 @@ typedef struct piola_step_stats {
                                 undone and retried at half the step */
   int32_t step_retries;   /* steps redone at a quarter of their size because the state blew
                              up (docs/time-stepping.md, "Step retries") */
+  int32_t energy_redos;   /* Newmark: steps redone at a quarter of their size because their
+                             energy rose beyond what a stable step allows
+                             (docs/time-stepping.md, "Energy check") */
 } piola_step_stats;
 
 /* The step size the next step would take with no target time: min(max_dt, CFL bound), s. */

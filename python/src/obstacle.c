@@ -154,13 +154,7 @@ static PyMethodDef obstacle_methods[] = {
     {NULL, NULL, 0, NULL},
 };
 
-PyTypeObject pypiola_obstacle_type = {
-    PyVarObject_HEAD_INIT(NULL, 0).tp_name = "_piola.Obstacle",
-    .tp_basicsize = sizeof(obstacle_object),
-    .tp_dealloc = obstacle_dealloc,
-    .tp_flags = Py_TPFLAGS_DEFAULT,
-    .tp_doc = "A rigid obstacle built from a definition tuple (use piola.Obstacle).",
-    .tp_methods = obstacle_methods,
-    .tp_init = obstacle_init,
-    .tp_new = PyType_GenericNew,
-};
+PyTypeObject pypiola_obstacle_type =
+    PYPIOLA_TYPE("_piola.Obstacle", obstacle_object,
+                 "A rigid obstacle built from a definition tuple (use piola.Obstacle).",
+                 obstacle_methods, NULL, obstacle_init, obstacle_dealloc);

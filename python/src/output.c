@@ -98,13 +98,7 @@ static PyMethodDef output_methods[] = {
     {NULL, NULL, 0, NULL},
 };
 
-PyTypeObject pypiola_output_type = {
-    PyVarObject_HEAD_INIT(NULL, 0).tp_name = "_piola.Output",
-    .tp_basicsize = sizeof(output_object),
-    .tp_dealloc = output_dealloc,
-    .tp_flags = Py_TPFLAGS_DEFAULT,
-    .tp_doc = "A results folder (used by piola.Scene.run).",
-    .tp_methods = output_methods,
-    .tp_init = output_init,
-    .tp_new = PyType_GenericNew,
-};
+PyTypeObject pypiola_output_type =
+    PYPIOLA_TYPE("_piola.Output", output_object,
+                 "A results folder (used by piola.Scene.run).",
+                 output_methods, NULL, output_init, output_dealloc);

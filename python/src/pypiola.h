@@ -53,6 +53,15 @@ int pypiola_motion_converter(PyObject *obj, void *out);   /* piola_rigid_motion_
 extern PyMethodDef pypiola_material_methods[];
 extern PyMethodDef pypiola_mesh_methods[];
 
+/* The type object of a class of the module: instances of the C struct `object`, made by
+ * `init` (after the generic tp_new) and freed by `dealloc`; methods and getset may be NULL. */
+#define PYPIOLA_TYPE(name, object, doc, methods, getset, init, dealloc)                         \
+  {                                                                                              \
+    PyVarObject_HEAD_INIT(NULL, 0).tp_name = (name), .tp_basicsize = sizeof(object),             \
+    .tp_dealloc = (dealloc), .tp_flags = Py_TPFLAGS_DEFAULT, .tp_doc = (doc),                    \
+    .tp_methods = (methods), .tp_getset = (getset), .tp_init = (init), .tp_new = PyType_GenericNew \
+  }
+
 /* Types. */
 extern PyTypeObject pypiola_world_type;
 extern PyTypeObject pypiola_scene_type;

@@ -119,14 +119,7 @@ static PyGetSetDef scene_getset[] = {
     {NULL, NULL, NULL, NULL, NULL},
 };
 
-PyTypeObject pypiola_scene_type = {
-    PyVarObject_HEAD_INIT(NULL, 0).tp_name = "_piola.Scene",
-    .tp_basicsize = sizeof(scene_object),
-    .tp_dealloc = scene_dealloc,
-    .tp_flags = Py_TPFLAGS_DEFAULT,
-    .tp_doc = "A loaded scene (use piola.Scene).",
-    .tp_methods = scene_methods,
-    .tp_getset = scene_getset,
-    .tp_init = scene_init,
-    .tp_new = PyType_GenericNew,
-};
+PyTypeObject pypiola_scene_type =
+    PYPIOLA_TYPE("_piola.Scene", scene_object,
+                 "A loaded scene (use piola.Scene).",
+                 scene_methods, scene_getset, scene_init, scene_dealloc);

@@ -534,14 +534,7 @@ static PyGetSetDef world_getset[] = {
     {NULL, NULL, NULL, NULL, NULL},
 };
 
-PyTypeObject pypiola_world_type = {
-    PyVarObject_HEAD_INIT(NULL, 0).tp_name = "_piola.World",
-    .tp_basicsize = sizeof(world_object),
-    .tp_dealloc = world_dealloc,
-    .tp_flags = Py_TPFLAGS_DEFAULT,
-    .tp_doc = "A piola world (use piola.World).",
-    .tp_methods = world_methods,
-    .tp_getset = world_getset,
-    .tp_init = world_init,
-    .tp_new = PyType_GenericNew,
-};
+PyTypeObject pypiola_world_type =
+    PYPIOLA_TYPE("_piola.World", world_object,
+                 "A piola world (use piola.World).",
+                 world_methods, world_getset, world_init, world_dealloc);

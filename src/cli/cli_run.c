@@ -315,6 +315,7 @@ static int run(int argc, char **argv, run_mpi *mpi) {
     info.impacts = st.impacts;
     info.impact_zones = st.impact_zones;
     info.step_retries = st.step_retries;
+    info.energy_redos = st.energy_redos;
     info.newton_iterations = st.newton_iterations;
     info.linear_iterations = st.linear_iterations;
     info.newton_failures = st.newton_failures;

@@ -88,7 +88,7 @@ static int32_t build_node(piola__bvh *bvh, const piola__box *boxes, int32_t begi
   return index;
 }
 
-int piola__bvh_build(piola__bvh *bvh, const piola__box *boxes, int32_t n) {
+int piola__bvh_reserve(piola__bvh *bvh, int32_t n) {
   if (n > bvh->primitive_count || !bvh->nodes) {
     piola__bvh_node *nodes = realloc(bvh->nodes, sizeof(*nodes) * (size_t)(2 * (n > 0 ? n : 1)));
     if (!nodes) return -1;
@@ -103,6 +103,11 @@ int piola__bvh_build(piola__bvh *bvh, const piola__box *boxes, int32_t n) {
   }
   bvh->primitive_count = n;
   bvh->node_count = 0;
+  return 0;
+}
+
+int piola__bvh_build(piola__bvh *bvh, const piola__box *boxes, int32_t n) {
+  if (piola__bvh_reserve(bvh, n)) return -1;
   if (n == 0) return 0;
   for (int32_t i = 0; i < n; ++i) bvh->order[i] = i;
   build_node(bvh, boxes, 0, n);

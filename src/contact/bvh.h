@@ -39,6 +39,10 @@ typedef struct piola__index_list {
   size_t capacity; /* items (common/grow.h) */
 } piola__index_list;
 
+/* Makes room for a tree over n primitives (2n nodes, n order and leaf entries; memory is
+ * reused when it suffices) and empties it. Returns 0, or -1 when memory runs out. */
+int piola__bvh_reserve(piola__bvh *bvh, int32_t n);
+
 /* Builds (or rebuilds, reusing memory) the tree over n boxes. Returns 0, or -1 when memory
  * runs out. */
 int piola__bvh_build(piola__bvh *bvh, const piola__box *boxes, int32_t n);

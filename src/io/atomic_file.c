@@ -35,6 +35,7 @@ piola_status piola_atomic_file_open(piola_atomic_file *file, const char *path) {
 }
 
 piola_status piola__atomic_file_finish(piola_atomic_file *file) {
+  piola__fault_during_write(file->stream);
   int failed = ferror(file->stream) || fflush(file->stream) != 0;
   int err = errno;
   if (!failed && piola__fault_write_fails()) failed = 1, err = ENOSPC;

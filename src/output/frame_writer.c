@@ -77,6 +77,42 @@ void piola_output_close(piola_output *o) {
 static piola_status resume_indexes(piola_output *o, int32_t frame);
 static piola_status pvd_append(piola_output *o, int32_t frame, double time);
 
+/* One body as the output lays it out, whatever its kind. */
+typedef struct body_mesh {
+  piola_body_id id;
+  piola_body_kind kind;
+  int32_t index; /* among the bodies of its kind */
+  const char *name;
+  int32_t nodes, cells;   /* cells: a solid's tets, a shell's triangles */
+  const double *rest;     /* 3 per node, m */
+  const int32_t *elements; /* 4 (tets) or 3 (triangles) node indices per cell */
+} body_mesh;
+
+static body_mesh body_mesh_at(const piola_world *world, int32_t position) {
+  const piola_body_id id = piola_world_body_at(world, position);
+  body_mesh m = {.id = id,
+                 .kind = piola_world_body_kind(world, id),
+                 .index = piola_world_body_index(world, id),
+                 .name = piola_world_body_name(world, id)};
+  switch (m.kind) {
+    case PIOLA_BODY_SOLID: {
+      const piola_elastic_body *b = piola_world_solid_body(world, m.index);
+      m.nodes = piola_elastic_body_vertex_count(b), m.cells = piola_elastic_body_tet_count(b);
+      m.rest = piola_elastic_body_rest_positions(b), m.elements = piola_elastic_body_tets(b);
+      break;
+    }
+    case PIOLA_BODY_SHELL: {
+      const piola_shell_body *b = piola_world_shell_body(world, m.index);
+      m.nodes = piola_shell_body_vertex_count(b), m.cells = piola_shell_body_triangle_count(b);
+      m.rest = piola_shell_body_rest_positions(b), m.elements = piola_shell_body_triangles(b);
+      break;
+    }
+    case PIOLA_BODY_NONE:
+      break;
+  }
+  return m;
+}
+
 /* resume_frame < 0: a new run (force as in piola_output_open); else a resume after it. */
 static piola_status open_output(const char *dir, bool force, int32_t resume_frame,
                                 const piola_world *world, piola_output **out) {
@@ -86,18 +122,18 @@ static piola_status open_output(const char *dir, bool force, int32_t resume_fram
   piola_output *o = calloc(1, sizeof *o);
   if (!o) return PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "output: out of memory");
   snprintf(o->dir, sizeof o->dir, "%s", dir);
-  int32_t nv = 0, nt = 0, ns = piola_world_solid_count(world);
-  for (int32_t s = 0; s < ns; ++s) {
-    const piola_elastic_body *b = piola_world_solid_body(world, s);
-    nv += piola_elastic_body_vertex_count(b);
-    nt += piola_elastic_body_tet_count(b);
+  /* points: every body's nodes in the body table's order (the solids, then the shells);
+   * cells: the solids' tets, then the shells' triangles */
+  const int32_t nb = piola_world_body_count(world);
+  int32_t nodes[PIOLA_BODY_KIND_COUNT] = {0}, cells[PIOLA_BODY_KIND_COUNT] = {0};
+  for (int32_t p = 0; p < nb; ++p) {
+    const body_mesh m = body_mesh_at(world, p);
+    if (m.kind == PIOLA_BODY_NONE) continue;
+    nodes[m.kind] += m.nodes;
+    cells[m.kind] += m.cells;
   }
-  int32_t snv = 0, snt = 0;
-  for (int32_t s = 0; s < piola_world_shell_count(world); ++s) {
-    const piola_shell_body *b = piola_world_shell_body(world, s);
-    snv += piola_shell_body_vertex_count(b);
-    snt += piola_shell_body_triangle_count(b);
-  }
+  const int32_t nv = nodes[PIOLA_BODY_SOLID], nt = cells[PIOLA_BODY_SOLID];
+  const int32_t snv = nodes[PIOLA_BODY_SHELL], snt = cells[PIOLA_BODY_SHELL];
   o->solid_vertices = nv;
   o->solid_cells = nt;
   /* point arrays hold the solids' vertices then the shells'; cell arrays tets then triangles */
@@ -118,28 +154,28 @@ static piola_status open_output(const char *dir, bool force, int32_t resume_fram
     piola_output_close(o);
     return PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "output: out of memory");
   }
-  int32_t voff = 0, toff = 0;
-  for (int32_t s = 0; s < ns; ++s) {
-    const piola_elastic_body *b = piola_world_solid_body(world, s);
-    int32_t n = piola_elastic_body_vertex_count(b), t = piola_elastic_body_tet_count(b);
-    memcpy(o->rest + 3 * (size_t)voff, piola_elastic_body_rest_positions(b), 3 * (size_t)n * sizeof(double));
-    const int32_t *tets = piola_elastic_body_tets(b);
-    for (int64_t k = 0; k < 4 * (int64_t)t; ++k) o->tets.tets[4 * (int64_t)toff + k] = tets[k] + voff;
-    for (int32_t k = 0; k < t; ++k) o->solid[toff + k] = s;
-    voff += n;
-    toff += t;
-  }
-  int32_t soff = 0, stoff = 0;
-  for (int32_t s = 0; s < piola_world_shell_count(world); ++s) {
-    const piola_shell_body *b = piola_world_shell_body(world, s);
-    int32_t n = piola_shell_body_vertex_count(b), t = piola_shell_body_triangle_count(b);
-    memcpy(o->rest + 3 * (size_t)(nv + soff), piola_shell_body_rest_positions(b),
-           3 * (size_t)n * sizeof(double));
-    const int32_t *tris = piola_shell_body_triangles(b);
-    for (int64_t k = 0; k < 3 * (int64_t)t; ++k) o->shells.triangles[3 * (int64_t)stoff + k] = tris[k] + soff;
-    for (int32_t k = 0; k < t; ++k) o->solid[nt + stoff + k] = -1 - s;
-    soff += n;
-    stoff += t;
+  int32_t point = 0, toff = 0, stoff = 0;
+  for (int32_t p = 0; p < nb; ++p) {
+    const body_mesh m = body_mesh_at(world, p);
+    if (m.kind == PIOLA_BODY_NONE) continue;
+    memcpy(o->rest + 3 * (size_t)point, m.rest, 3 * (size_t)m.nodes * sizeof(double));
+    switch (m.kind) {
+      case PIOLA_BODY_SOLID:
+        for (int64_t k = 0; k < 4 * (int64_t)m.cells; ++k)
+          o->tets.tets[4 * (int64_t)toff + k] = m.elements[k] + point;
+        for (int32_t k = 0; k < m.cells; ++k) o->solid[toff + k] = m.index;
+        toff += m.cells;
+        break;
+      case PIOLA_BODY_SHELL: /* numbered from the first shell node */
+        for (int64_t k = 0; k < 3 * (int64_t)m.cells; ++k)
+          o->shells.triangles[3 * (int64_t)stoff + k] = m.elements[k] + point - nv;
+        for (int32_t k = 0; k < m.cells; ++k) o->solid[nt + stoff + k] = -1 - m.index;
+        stoff += m.cells;
+        break;
+      case PIOLA_BODY_NONE:
+        break;
+    }
+    point += m.nodes;
   }
   memcpy(o->tets.positions, o->rest, 3 * (size_t)(nv + snv) * sizeof(double));
   piola_status st = PIOLA_OK;
@@ -162,22 +198,17 @@ static piola_status open_output(const char *dir, bool force, int32_t resume_fram
     }
   }
   if (st == PIOLA_OK) {
-    /* bodies in point order: the solids, then the shells */
-    int32_t nb = ns + piola_world_shell_count(world);
+    /* bodies in point order */
     int32_t *first = malloc((size_t)(nb + 1) * sizeof *first);
     const char **names = malloc((size_t)(nb > 0 ? nb : 1) * sizeof *names);
     if (!first || !names) st = PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "output: out of memory");
     else {
       int32_t v = 0;
       for (int32_t b = 0; b < nb; ++b) {
+        const body_mesh m = body_mesh_at(world, b);
         first[b] = v;
-        if (b < ns) {
-          v += piola_elastic_body_vertex_count(piola_world_solid_body(world, b));
-          names[b] = piola_world_solid_name(world, b);
-        } else {
-          v += piola_shell_body_vertex_count(piola_world_shell_body(world, b - ns));
-          names[b] = piola_world_shell_name(world, b - ns);
-        }
+        names[b] = m.name;
+        v += m.nodes;
       }
       first[nb] = v;
       st = piola__obj_layout_build(&o->surface, first, nb, names, nv + snv, &o->obj);
@@ -189,7 +220,7 @@ static piola_status open_output(const char *dir, bool force, int32_t resume_fram
   if (st == PIOLA_OK) st = csv_append(o, "frame,time,substeps,cg_iterations,kinetic_energy,elastic_energy,"
                                          "inverted,min_det_f,wall_seconds,plastic_yielded,max_fp_log_stretch,"
                                          "contacts,impacts,impact_zones,newton_iterations,"
-                                         "linear_iterations,newton_failures,step_retries\n");
+                                         "linear_iterations,newton_failures,step_retries,energy_redos\n");
   if (st == PIOLA_OK && resume_frame >= 0) st = resume_indexes(o, resume_frame);
   if (st != PIOLA_OK) {
     piola_output_close(o);
@@ -345,12 +376,12 @@ piola_status piola_output_write_frame(piola_output *o, const piola_world *world,
                            .point_fields = points, .point_field_count = 2, .cell_fields = cells,
                            .cell_field_count = 4, .positions = o->tets.positions};
   char line[512];
-  snprintf(line, sizeof line, "%d,%.17g,%d,%d,%.17g,%.17g,%lld,%.17g,%.6f,%lld,%.17g,%lld,%lld,%d,%d,%d,%d,%d\n",
+  snprintf(line, sizeof line, "%d,%.17g,%d,%d,%.17g,%.17g,%lld,%.17g,%.6f,%lld,%.17g,%lld,%lld,%d,%d,%d,%d,%d,%d\n",
            (int)info->frame, piola_world_time(world), (int)info->substeps, (int)info->cg_iterations,
            ke, ee, inverted, ns > 0 ? min_det : 1.0, info->wall_seconds, yielded, max_fp_log,
            (long long)info->contacts, (long long)info->impacts, (int)info->impact_zones,
            (int)info->newton_iterations, (int)info->linear_iterations, (int)info->newton_failures,
-           (int)info->step_retries);
+           (int)info->step_retries, (int)info->energy_redos);
   return commit_frame(o, &frame, info->frame, line, piola_world_time(world));
 }
 
@@ -392,13 +423,74 @@ static piola_status resume_indexes(piola_output *o, int32_t frame) {
 }
 
 typedef struct ranked {
-  int32_t tet;
+  int32_t element;
   double key;
 } ranked;
 
 static int by_key(const void *a, const void *b) {
   double x = ((const ranked *)a)->key, y = ((const ranked *)b)->key;
   return (x > y) - (x < y);
+}
+
+enum { WORST = 10 }; /* elements listed per ranking */
+
+/* Ranks cells by key times sign (ascending; non-finite keys first) into r. */
+static void rank(ranked *r, int32_t cells, const double *key, double sign) {
+  for (int32_t k = 0; k < cells; ++k) {
+    double v = sign * key[k];
+    r[k].element = k;
+    r[k].key = isfinite(v) ? v : -INFINITY; /* non-finite values rank worst */
+  }
+  qsort(r, (size_t)cells, sizeof *r, by_key);
+}
+
+/* A solid: its stats and the tets with the smallest det F and the largest energy density. */
+static void report_solid(FILE *out, const piola_world *world, const body_mesh *m, ranked *r) {
+  const piola_elastic_body *b = piola_world_solid_body(world, m->index);
+  const double *det = piola_elastic_body_det_f(b);
+  const double *psi = piola_elastic_body_energy_density(b);
+  const double *fhat = piola_elastic_body_fhat(b);
+  const int32_t *tets = m->elements;
+  piola_solid_stats st = piola_world_solid_stats(world, m->index);
+  fprintf(out, "solid '%s': %d tets, %d inverted, min det F %.6g, kinetic %.6g J, elastic %.6g J\n",
+          m->name, (int)m->cells, (int)st.inverted_count, st.min_det_f, st.kinetic_energy,
+          st.elastic_energy);
+  for (int pass = 0; pass < 2; ++pass) {
+    rank(r, m->cells, pass == 0 ? det : psi, pass == 0 ? 1.0 : -1.0);
+    fprintf(out, "  worst by %s:\n", pass == 0 ? "smallest det F" : "largest energy density");
+    for (int32_t k = 0; k < m->cells && k < WORST; ++k) {
+      int32_t e = r[k].element;
+      fprintf(out,
+              "    tet %d (vertices %d %d %d %d): det F %.6g, energy density %.6g J/m^3, "
+              "Fhat (%.4g, %.4g, %.4g)\n",
+              (int)e, (int)tets[4 * e], (int)tets[4 * e + 1], (int)tets[4 * e + 2],
+              (int)tets[4 * e + 3], det[e], psi[e], fhat[3 * e], fhat[3 * e + 1], fhat[3 * e + 2]);
+    }
+  }
+}
+
+/* A shell: its stats and the triangles with the smallest signed area ratio fhat0 * fhat1
+ * (negative: the triangle opposes its reference normal). */
+static piola_status report_shell(FILE *out, const piola_world *world, const body_mesh *m,
+                                 ranked *r) {
+  const double *fhat = piola_shell_body_fhat(piola_world_shell_body(world, m->index));
+  const int32_t *tris = m->elements;
+  piola_body_stats st = piola_world_body_stats(world, m->id);
+  fprintf(out, "shell '%s': %d triangles, %d inverted, kinetic %.6g J, elastic %.6g J\n", m->name,
+          (int)m->cells, (int)st.inverted_count, st.kinetic_energy, st.elastic_energy);
+  double *ratio = malloc((size_t)(m->cells > 0 ? m->cells : 1) * sizeof *ratio);
+  if (!ratio) return PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "failure report: out of memory");
+  for (int32_t k = 0; k < m->cells; ++k) ratio[k] = fhat[2 * k] * fhat[2 * k + 1];
+  rank(r, m->cells, ratio, 1.0);
+  fprintf(out, "  worst by smallest area ratio (Fhat1 Fhat2):\n");
+  for (int32_t k = 0; k < m->cells && k < WORST; ++k) {
+    int32_t e = r[k].element;
+    fprintf(out, "    triangle %d (vertices %d %d %d): area ratio %.6g, Fhat (%.4g, %.4g)\n", (int)e,
+            (int)tris[3 * e], (int)tris[3 * e + 1], (int)tris[3 * e + 2], ratio[e], fhat[2 * e],
+            fhat[2 * e + 1]);
+  }
+  free(ratio);
+  return PIOLA_OK;
 }
 
 piola_status piola_output_write_failure_report(piola_output *o, const piola_world *world,
@@ -410,41 +502,30 @@ piola_status piola_output_write_failure_report(piola_output *o, const piola_worl
   fprintf(f.stream, "piola run stopped: %s\n", message ? message : "(no message)");
   fprintf(f.stream, "last good state: t = %.9g s (frames written up to that point are complete)\n\n",
           piola_world_time(world));
-  enum { WORST = 10 };
-  for (int32_t s = 0; s < piola_world_solid_count(world); ++s) {
-    const piola_elastic_body *b = piola_world_solid_body(world, s);
-    int32_t t = piola_elastic_body_tet_count(b);
-    const double *det = piola_elastic_body_det_f(b);
-    const double *psi = piola_elastic_body_energy_density(b);
-    const double *fhat = piola_elastic_body_fhat(b);
-    const int32_t *tets = piola_elastic_body_tets(b);
-    piola_solid_stats st = piola_world_solid_stats(world, s);
-    fprintf(f.stream, "solid '%s': %d tets, %d inverted, min det F %.6g, kinetic %.6g J, elastic %.6g J\n",
-            piola_world_solid_name(world, s), (int)t, (int)st.inverted_count, st.min_det_f,
-            st.kinetic_energy, st.elastic_energy);
-    ranked *r = malloc((size_t)(t > 0 ? t : 1) * sizeof *r);
+  for (int32_t p = 0; p < piola_world_body_count(world); ++p) {
+    const body_mesh m = body_mesh_at(world, p);
+    if (m.kind == PIOLA_BODY_NONE) continue;
+    ranked *r = malloc((size_t)(m.cells > 0 ? m.cells : 1) * sizeof *r);
     if (!r) {
       piola_atomic_file_abort(&f);
       return PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "failure report: out of memory");
     }
-    for (int pass = 0; pass < 2; ++pass) {
-      for (int32_t k = 0; k < t; ++k) {
-        r[k].tet = k;
-        double key = pass == 0 ? det[k] : -psi[k];
-        r[k].key = isfinite(key) ? key : -INFINITY; /* non-finite values rank worst */
-      }
-      qsort(r, (size_t)t, sizeof *r, by_key);
-      fprintf(f.stream, "  worst by %s:\n", pass == 0 ? "smallest det F" : "largest energy density");
-      for (int32_t k = 0; k < t && k < WORST; ++k) {
-        int32_t e = r[k].tet;
-        fprintf(f.stream,
-                "    tet %d (vertices %d %d %d %d): det F %.6g, energy density %.6g J/m^3, "
-                "Fhat (%.4g, %.4g, %.4g)\n",
-                (int)e, (int)tets[4 * e], (int)tets[4 * e + 1], (int)tets[4 * e + 2],
-                (int)tets[4 * e + 3], det[e], psi[e], fhat[3 * e], fhat[3 * e + 1], fhat[3 * e + 2]);
-      }
+    piola_status st = PIOLA_OK;
+    switch (m.kind) {
+      case PIOLA_BODY_SOLID:
+        report_solid(f.stream, world, &m, r);
+        break;
+      case PIOLA_BODY_SHELL:
+        st = report_shell(f.stream, world, &m, r);
+        break;
+      case PIOLA_BODY_NONE:
+        break;
     }
     free(r);
+    if (st != PIOLA_OK) {
+      piola_atomic_file_abort(&f);
+      return st;
+    }
   }
   return piola_atomic_file_commit(&f);
 }

@@ -99,40 +99,55 @@ piola_status piola__json_number(scene_parser *p, const cJSON *v, json_range r, d
   return PIOLA_OK;
 }
 
-/* obj.key as a number if present (else *out keeps its default). */
+/* The optional readers (piola__json_opt_*): obj.key read by the plain reader when present,
+ * with the key on the error path; when absent *out keeps its default. optional() gives the
+ * value (NULL when absent) and pushes the key; popped() takes it off again after a read that
+ * succeeded (a failure leaves the path as the message named it). */
+static const cJSON *optional(scene_parser *p, const cJSON *obj, const char *key, size_t *old) {
+  const cJSON *v = piola__json_get(obj, key);
+  if (v) *old = piola__json_push_key(p, key);
+  return v;
+}
+
+static piola_status popped(scene_parser *p, size_t old, piola_status read) {
+  if (read == PIOLA_OK) piola__json_pop(p, old);
+  return read;
+}
+
 piola_status piola__json_opt_number(scene_parser *p, const cJSON *obj, const char *key,
                                     json_range r, double *out) {
-  const cJSON *v = piola__json_get(obj, key);
-  if (!v) return PIOLA_OK;
-  size_t old = piola__json_push_key(p, key);
-  PIOLA_TRY(piola__json_number(p, v, r, out));
-  piola__json_pop(p, old);
+  size_t old = 0;
+  const cJSON *v = optional(p, obj, key, &old);
+  return v ? popped(p, old, piola__json_number(p, v, r, out)) : PIOLA_OK;
+}
+
+static piola_status integer(scene_parser *p, const cJSON *v, double lo, double hi, int64_t *out) {
+  double d;
+  PIOLA_TRY(piola__json_number(p, v, (json_range){lo, hi, 0, 0}, &d));
+  if (d != floor(d)) return piola__json_fail(p, PIOLA_ERROR_PARSE, "must be an integer, got %g", d);
+  *out = (int64_t)d;
   return PIOLA_OK;
 }
 
 piola_status piola__json_opt_int(scene_parser *p, const cJSON *obj, const char *key, double lo,
                                  double hi, int64_t *out) {
-  const cJSON *v = piola__json_get(obj, key);
-  if (!v) return PIOLA_OK;
-  size_t old = piola__json_push_key(p, key);
-  double d;
-  PIOLA_TRY(piola__json_number(p, v, (json_range){lo, hi, 0, 0}, &d));
-  if (d != floor(d)) return piola__json_fail(p, PIOLA_ERROR_PARSE, "must be an integer, got %g", d);
-  *out = (int64_t)d;
-  piola__json_pop(p, old);
-  return PIOLA_OK;
+  size_t old = 0;
+  const cJSON *v = optional(p, obj, key, &old);
+  return v ? popped(p, old, integer(p, v, lo, hi, out)) : PIOLA_OK;
 }
 
-piola_status piola__json_opt_bool(scene_parser *p, const cJSON *obj, const char *key, bool *out) {
-  const cJSON *v = piola__json_get(obj, key);
-  if (!v) return PIOLA_OK;
-  size_t old = piola__json_push_key(p, key);
+static piola_status boolean(scene_parser *p, const cJSON *v, bool *out) {
   if (!cJSON_IsBool(v))
     return piola__json_fail(p, PIOLA_ERROR_PARSE, "must be true or false, got %s",
                             piola__json_type_name(v));
   *out = cJSON_IsTrue(v);
-  piola__json_pop(p, old);
   return PIOLA_OK;
+}
+
+piola_status piola__json_opt_bool(scene_parser *p, const cJSON *obj, const char *key, bool *out) {
+  size_t old = 0;
+  const cJSON *v = optional(p, obj, key, &old);
+  return v ? popped(p, old, boolean(p, v, out)) : PIOLA_OK;
 }
 
 /* A scalar or {"keys": [[t, v], ...]} at the current path. */
@@ -179,12 +194,9 @@ piola_status piola__json_track(scene_parser *p, const cJSON *v, json_range r, pi
 
 piola_status piola__json_opt_track(scene_parser *p, const cJSON *obj, const char *key, json_range r,
                                    piola_track *out) {
-  const cJSON *v = piola__json_get(obj, key);
-  if (!v) return PIOLA_OK;
-  size_t old = piola__json_push_key(p, key);
-  PIOLA_TRY(piola__json_track(p, v, r, out));
-  piola__json_pop(p, old);
-  return PIOLA_OK;
+  size_t old = 0;
+  const cJSON *v = optional(p, obj, key, &old);
+  return v ? popped(p, old, piola__json_track(p, v, r, out)) : PIOLA_OK;
 }
 
 piola_status piola__json_vec3(scene_parser *p, const cJSON *v, json_range r, piola_vec3 *out) {
@@ -204,45 +216,46 @@ piola_status piola__json_vec3(scene_parser *p, const cJSON *v, json_range r, pio
 
 piola_status piola__json_opt_vec3(scene_parser *p, const cJSON *obj, const char *key, json_range r,
                                   piola_vec3 *out) {
-  const cJSON *v = piola__json_get(obj, key);
-  if (!v) return PIOLA_OK;
-  size_t old = piola__json_push_key(p, key);
-  PIOLA_TRY(piola__json_vec3(p, v, r, out));
-  piola__json_pop(p, old);
-  return PIOLA_OK;
+  size_t old = 0;
+  const cJSON *v = optional(p, obj, key, &old);
+  return v ? popped(p, old, piola__json_vec3(p, v, r, out)) : PIOLA_OK;
 }
 
-piola_status piola__json_opt_direction(scene_parser *p, const cJSON *obj, const char *key,
-                                       piola_vec3 *out) {
-  const cJSON *v = piola__json_get(obj, key);
-  if (!v) return PIOLA_OK;
-  size_t old = piola__json_push_key(p, key);
+static piola_status direction(scene_parser *p, const cJSON *v, piola_vec3 *out) {
   piola_vec3 d;
   PIOLA_TRY(piola__json_vec3(p, v, ANY, &d));
   double len = vec3_norm(d);
   if (!(len > 1e-300)) return piola__json_fail(p, BAD_VALUE, "must be a nonzero vector");
   *out = vec3_scale(d, 1.0 / len);
-  piola__json_pop(p, old);
   return PIOLA_OK;
 }
 
-piola_status piola__json_opt_vec3_tracks(scene_parser *p, const cJSON *obj, const char *key,
-                                         piola_track out[3]) {
-  const cJSON *v = piola__json_get(obj, key);
-  if (!v) return PIOLA_OK;
-  size_t old = piola__json_push_key(p, key);
+piola_status piola__json_opt_direction(scene_parser *p, const cJSON *obj, const char *key,
+                                       piola_vec3 *out) {
+  size_t old = 0;
+  const cJSON *v = optional(p, obj, key, &old);
+  return v ? popped(p, old, direction(p, v, out)) : PIOLA_OK;
+}
+
+static piola_status vec3_tracks(scene_parser *p, const cJSON *v, piola_track out[3]) {
   if (!cJSON_IsArray(v) || cJSON_GetArraySize(v) != 3)
     return piola__json_fail(p, PIOLA_ERROR_PARSE,
                             "must be an array of 3 numbers (or keyframes), got %s",
                             piola__json_type_name(v));
   int i = 0;
   for (const cJSON *e = v->child; e; e = e->next, ++i) {
-    size_t o2 = piola__json_push_index(p, i);
+    size_t old = piola__json_push_index(p, i);
     PIOLA_TRY(piola__json_track(p, e, ANY, &out[i]));
-    piola__json_pop(p, o2);
+    piola__json_pop(p, old);
   }
-  piola__json_pop(p, old);
   return PIOLA_OK;
+}
+
+piola_status piola__json_opt_vec3_tracks(scene_parser *p, const cJSON *obj, const char *key,
+                                         piola_track out[3]) {
+  size_t old = 0;
+  const cJSON *v = optional(p, obj, key, &old);
+  return v ? popped(p, old, vec3_tracks(p, v, out)) : PIOLA_OK;
 }
 
 piola_status piola__json_required(scene_parser *p, const cJSON *obj, const char *key) {

@@ -25,6 +25,7 @@
 #include "sim/world_internal.h"
 
 int piola__step_reuse_first_product = 1;
+int piola__step_energy_check = 1;
 
 typedef struct damping_system {
   const world_body *s;
@@ -225,7 +226,7 @@ static void restore(world_body *s, double t) {
 }
 
 static piola_status step_body(piola_world *w, world_body *s, double t, double dt,
-                               piola_step_stats *stats) {
+                               piola_step_stats *stats, int *energy_rose) {
   const int32_t n = s->n > 0 ? s->n : 0;
   const int64_t m = 3 * (int64_t)n;
   const double h = 0.5 * dt, t1 = t + dt;
@@ -379,24 +380,50 @@ static piola_status step_body(piola_world *w, world_body *s, double t, double dt
   /* a state whose energies overflow has blown up even if each coordinate is still finite.
    * The elastic energy is not computed per step (world.c); the squared norm of the elastic
    * force overflows with it (both grow as |F|^2), and costs one pass over 3n numbers.
-   * Summed by fixed node ranges (only their finiteness is used). */
+   * The same pass sums the step's energy balance over the free nodes that did not collide
+   * (docs/time-stepping.md, "Energy check"): the kinetic energy gained minus the work of the
+   * elastic force and gravity by the trapezoidal rule, and the terms of what a stable step
+   * allows. Summed by fixed node ranges, so the sums do not depend on the thread count. */
   enum { CHECK_RANGES = 16 };
-  double kinetic_part[CHECK_RANGES], force2_part[CHECK_RANGES];
+  double kinetic_part[CHECK_RANGES], force2_part[CHECK_RANGES], gain_part[CHECK_RANGES];
+  double fm_part[CHECK_RANGES], mdx_part[CHECK_RANGES], mv_part[CHECK_RANGES], mdv_part[CHECK_RANGES];
   int64_t bad_part[CHECK_RANGES];
+  int driven_part[CHECK_RANGES];
+  const double gmid[3] = {0.5 * (g0[0] + g1[0]), 0.5 * (g0[1] + g1[1]), 0.5 * (g0[2] + g1[2])};
 #pragma omp parallel for schedule(static) num_threads(piola_thread_count()) \
     if (n >= PIOLA_PARALLEL_MIN_VERTICES)
   for (int r = 0; r < CHECK_RANGES; ++r) {
-    double ke = 0, f2 = 0;
+    double ke = 0, f2 = 0, gain = 0, fm = 0, mdx = 0, mv = 0, mdv = 0;
     int64_t bad = -1;
-    for (int64_t j = 3 * (m / 3 * r / CHECK_RANGES); j < 3 * (m / 3 * (r + 1) / CHECK_RANGES); ++j) {
-      if (bad < 0 && !isfinite(s->v[j])) bad = j;
-      ke += s->mass[j / 3] * s->v[j] * s->v[j];
-      f2 += s->force[j] * s->force[j];
+    int driven = 0;
+    for (int32_t i = (int32_t)((int64_t)n * r / CHECK_RANGES); i < (int32_t)((int64_t)n * (r + 1) / CHECK_RANGES); ++i) {
+      const double mi = s->mass[i];
+      driven |= s->flags[i] == NODE_DRIVEN;
+      const int balanced = s->flags[i] == NODE_FREE && !s->colliding[i] && mi > 0;
+      for (int k = 0; k < 3; ++k) {
+        const int64_t j = 3 * (int64_t)i + k;
+        if (bad < 0 && !isfinite(s->v[j])) bad = j;
+        ke += mi * s->v[j] * s->v[j];
+        f2 += s->force[j] * s->force[j];
+        if (!balanced) continue;
+        const double fbar = 0.5 * (s->force_old[j] + s->force[j]) + mi * gmid[k];
+        const double dx = s->x[j] - s->x_old[j], dv = s->v[j] - s->v_old[j];
+        const double vbar = 0.5 * (s->v[j] + s->v_old[j]);
+        gain += mi * vbar * dv - fbar * dx;
+        fm += fbar * fbar / mi;
+        mdx += mi * dx * dx;
+        mv += mi * vbar * vbar;
+        mdv += mi * dv * dv;
+      }
     }
-    kinetic_part[r] = ke, force2_part[r] = f2, bad_part[r] = bad;
+    kinetic_part[r] = ke, force2_part[r] = f2, bad_part[r] = bad, driven_part[r] = driven;
+    gain_part[r] = gain, fm_part[r] = fm, mdx_part[r] = mdx, mv_part[r] = mv, mdv_part[r] = mdv;
   }
-  double kinetic = 0, force2 = 0;
+  double kinetic = 0, force2 = 0, gain = 0, fm = 0, mdx = 0, mv = 0, mdv = 0;
+  int driven = 0;
   for (int r = 0; r < CHECK_RANGES; ++r) {
+    driven |= driven_part[r];
+    gain += gain_part[r], fm += fm_part[r], mdx += mdx_part[r], mv += mv_part[r], mdv += mdv_part[r];
     if (bad_part[r] >= 0) {
       restore(s, t);
       return PIOLA_FAIL(PIOLA_ERROR_NOT_FINITE,
@@ -412,6 +439,23 @@ static piola_status step_body(piola_world *w, world_body *s, double t, double dt
     return PIOLA_FAIL(PIOLA_ERROR_NOT_FINITE,
                       "%s '%s': the %s became non-finite at t = %g s (the state blew up)",
                       piola__body_kind_name(s->kind), s->name, isfinite(kinetic) ? "elastic force's squared norm" : "kinetic energy", t1);
+  }
+  /* for a stable step of a linear system the gain is at most |fbar|_M^-1 |dx|_M (equal
+   * only at the stability limit); the damping solves' tolerance adds up to 2 tol
+   * |vbar|_M |dv|_M (their velocity error is at most tol |dv|_M in the M norm). Not checked
+   * with driven nodes or in a step where a node collided: the damping couples the free
+   * nodes to those nodes' imposed motion, work the balance does not see. Gains below the
+   * energy of a uniform strain of 1e-9 at the rest modulus, (lambda + 2 mu) V 1e-18 / 2 =
+   * M c^2 1e-18 / 2, are rounding (a body at rest has forces of ~1e-16 of its stresses).
+   * Solids only: shells are not checked. */
+  *energy_rose = 0;
+  if (s->kind == PIOLA_BODY_SOLID && !driven && colliding == 0) {
+    const double tol = w->def.cg_tolerance, c = piola_elastic_body_max_wave_speed(s->solid);
+    double total_mass = 0;
+    for (int32_t i = 0; i < n; ++i) total_mass += s->mass[i];
+    const double floor = 0.5e-18 * total_mass * c * c;
+    const double allowed = (1 + tol) * sqrt(fm * mdx) + 2 * tol * sqrt(mv * mdv);
+    *energy_rose = gain > allowed * (1 + 1e-9) + floor;
   }
   piola__step_profile_mark(&w->profile, STEP_PHASE_CHECK);
   return PIOLA_OK;
@@ -446,8 +490,11 @@ static void restore_all(piola_world *w, int32_t count) {
 }
 
 /* One try at a step of dt from the current state; on failure every body is back at the
- * state before it. */
-static piola_status try_step(piola_world *w, double dt, piola_step_stats *local) {
+ * state before it. With check_energy, a body whose energy check fails (step_body) undoes
+ * the try as well and sets *energy_rose. */
+static piola_status try_step(piola_world *w, double dt, piola_step_stats *local, int check_energy,
+                             int *energy_rose) {
+  *energy_rose = 0;
   /* a collision interval (world_contact.c) ends with the first step that reaches its end
    * (steps are not shortened for it), or on advance_to's target */
   double left;
@@ -455,10 +502,16 @@ static piola_status try_step(piola_world *w, double dt, piola_step_stats *local)
   const int closes = dt >= left || dt == w->collision_deadline - w->time;
   piola__step_profile_mark(&w->profile, STEP_PHASE_WORLD);
   for (int32_t i = 0; i < w->body_count; ++i) {
-    piola_status st = step_body(w, &w->bodies[i], w->time, dt, local);
+    int rose = 0;
+    piola_status st = step_body(w, &w->bodies[i], w->time, dt, local, &rose);
     if (st != PIOLA_OK) {
       restore_all(w, i);
       return st;
+    }
+    if (rose && check_energy) {
+      restore_all(w, i + 1);
+      *energy_rose = 1;
+      return PIOLA_OK;
     }
   }
   piola_status contact = piola__world_self_collide(w, dt, w->time + dt, closes, local);
@@ -475,15 +528,25 @@ piola_status piola_world_step(piola_world *w, double dt_limit, piola_step_stats 
   if (dt_limit > 0 && dt_limit < dt) dt = dt_limit;
   if (!(dt > 0)) return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "step: dt must be > 0, got %g", dt);
   note_small_step(w);
-  /* a step that blows up is redone from the restored state at a quarter of its size: the
-   * bound is a bound on the fastest wave, not a proof, and the paper's promise is that the
-   * run goes on. Only after the last retry does the failure reach the caller. */
-  piola_status st = try_step(w, dt, &local);
-  while (st == PIOLA_ERROR_NOT_FINITE &&
-         local.step_retries < PIOLA_STEP_MAX_RETRIES) {
-    local.step_retries++;
-    dt *= 0.25;
-    st = try_step(w, dt, &local);
+  /* a step that blows up, or whose energy rises beyond what a stable step allows, is redone
+   * from the restored state at a quarter of its size: the bound is a bound on the fastest
+   * wave, not a proof, and the paper's promise is that the run goes on. Only after the last
+   * retry does a blow-up reach the caller; a step still failing the energy check after the
+   * last redo is kept (its state is finite). */
+  int energy_rose = 0;
+  piola_status st = try_step(w, dt, &local, piola__step_energy_check, &energy_rose);
+  for (;;) {
+    if (st == PIOLA_OK && energy_rose) {
+      local.energy_redos++;
+      dt *= 0.25;
+    } else if (st == PIOLA_ERROR_NOT_FINITE && local.step_retries < PIOLA_STEP_MAX_RETRIES) {
+      local.step_retries++;
+      dt *= 0.25;
+    } else {
+      break;
+    }
+    st = try_step(w, dt, &local, piola__step_energy_check && local.energy_redos < PIOLA_STEP_MAX_RETRIES,
+                  &energy_rose);
   }
   if (st != PIOLA_OK) {
     if (stats) *stats = local;
@@ -527,6 +590,7 @@ piola_status piola_world_advance_to(piola_world *w, double t_end, piola_step_sta
       stats->linear_iterations += one.linear_iterations;
       stats->newton_failures += one.newton_failures;
       stats->step_retries += one.step_retries;
+      stats->energy_redos += one.energy_redos;
       if (one.substeps) stats->last_dt = one.last_dt;
     }
     if (st != PIOLA_OK) return st;

@@ -141,6 +141,25 @@ void piola__world_collision_reset(piola_world *w) {
   if (w->contact) w->contact->open = 0;
 }
 
+piola__contact_state piola__world_contact_state(const piola_world *w) {
+  world_contact *c = w->contact; /* the state points into it, for reading it back */
+  if (!c || c->bodies_version != w->bodies_version) return (piola__contact_state){0};
+  return (piola__contact_state){.built = 1,
+                                .open = &c->open,
+                                .t_start = &c->t_start,
+                                .x0 = c->x0,
+                                .vertex_count = c->vertex_count,
+                                .surface = c->surface};
+}
+
+piola_status piola__world_contact_prepare(piola_world *w, int built) {
+  if (!built) {
+    piola__world_contact_free(w);
+    return PIOLA_OK;
+  }
+  return ensure_built(w);
+}
+
 piola_status piola__world_collision_open(piola_world *w, double *left) {
   *left = INFINITY;
   if (!(w->def.collision_interval > 0) || !any_self_collision(w)) return PIOLA_OK;

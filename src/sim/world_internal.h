@@ -112,10 +112,32 @@ piola_status piola__world_self_collide(piola_world *w, double dt, double t1, int
 void piola__world_collision_reset(piola_world *w);
 void piola__world_contact_free(piola_world *w);
 
+/* What self-collision carries from one step to the next (for checkpoints): whether the
+ * collision surface is built for the current bodies (a surface built anew starts without
+ * history, contact/surface_history.h), and the open interval (collision_interval > 0): its
+ * start time (s) and the positions then (3 * vertex_count, m). */
+typedef struct piola__contact_state {
+  int built;
+  int *open;
+  double *t_start;
+  double *x0;
+  int32_t vertex_count;
+  struct piola_collision_surface *surface;
+} piola__contact_state;
+/* The state of w's contact, pointing into it ({0} when no surface is built for the current
+ * bodies). */
+piola__contact_state piola__world_contact_state(const piola_world *w);
+/* built != 0: builds the surface when it is not built for the current bodies (as the first
+ * step that needs it would); 0: drops it (the next step that needs it builds it). */
+piola_status piola__world_contact_prepare(piola_world *w, int built);
+
 /* 1 (default): the step's second right-hand side takes D_n v' from the first solve's
  * initial product plus a correction on the nodes collisions and constraints moved
  * (integrator.c); 0: a full damping pass. For tests comparing the two. */
 extern int piola__step_reuse_first_product;
+/* 1 (default): Newmark steps that fail the energy check are redone (integrator.c); tests set
+ * 0 to see what the check prevents. */
+extern int piola__step_energy_check;
 
 /* The implicit integrators (implicit_step.c): piola_world_step for
  * PIOLA_INTEGRATOR_BACKWARD_EULER and PIOLA_INTEGRATOR_QUASISTATIC; implicit_state_free frees

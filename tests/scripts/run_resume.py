@@ -1,5 +1,5 @@
-"""Checks behind test_run_resume.sh: a run killed (SIGKILL) at any rename of its output, or at
-a random moment, leaves a consistent folder, and `piola run --resume` then finishes it with
+"""Checks behind test_run_resume.sh: a run killed (SIGKILL) at any rename of its output, in the
+middle of any file it writes (checkpoints included), or at a random moment, leaves a consistent folder, and `piola run --resume` then finishes it with
 frames byte-identical to a run that was never stopped; checkpoints of another scene, another
 format version or damaged ones are refused or skipped as docs/cli.md says."""
 import csv
@@ -126,6 +126,30 @@ for k in range(1, 1000, stride):
     shutil.rmtree(out)
 check(killed >= max(2, 40 // stride), f"killed at {killed} renames, each resumed to frames identical to the uninterrupted run")
 
+# Kill in the middle of every write (every 1/PIOLA_TEST_SCALE-th one with a smaller scale):
+# the file's temporary holds half its bytes, checkpoints' included; then resume.
+killed, in_checkpoint = 0, 0
+for k in range(1, 1000, stride):
+    out = os.path.join(work, f"write{k}")
+    r = piola_run(out, env=dict(os.environ, PIOLA_FAULT_KILL_IN_WRITE=str(k)))
+    if r.returncode == 0:
+        break  # the run wrote fewer files than k
+    killed += 1
+    partial = [n for n in strays(out) if n.startswith("checkpoint_")]
+    in_checkpoint += bool(partial)
+    problem = consistent(out) if r.returncode == -signal.SIGKILL else f"exit {r.returncode}: {r.stderr[-300:]}"
+    if problem:
+        check(False, f"kill in write {k}: {problem}")
+        continue
+    r = piola_run(out, "--resume")
+    differ = same_frames(ref, out) if r.returncode == 0 else ["(resume failed)"]
+    if differ or strays(out) or consistent(out) or listed(out)[0] != list(range(FRAMES + 1)):
+        check(False, f"kill in write {k}: after resume differ {differ}, strays {strays(out)}, {consistent(out)} {r.stderr[-300:]}")
+    shutil.rmtree(out)
+check(killed >= max(2, 40 // stride) and in_checkpoint >= (4 if stride == 1 else 0),
+      f"killed in {killed} writes ({in_checkpoint} of them checkpoints, left half written), "
+      "each resumed to frames identical to the uninterrupted run")
+
 # kill -9 from outside at random moments
 rng = random.Random(18)
 for trial in range(max(1, round(3 * SCALE))):
@@ -170,11 +194,12 @@ r = subprocess.run([PIOLA, "run", other, "-o", out, "--resume"], capture_output=
 check(r.returncode == 2 and "another scene" in r.stderr, "a checkpoint of another scene is refused: " + r.stderr.strip())
 newest = f"{out}/checkpoint_0008.bin"
 data = bytearray(open(newest, "rb").read())
+version = data[8]
 data[8] = 99  # the format version
 open(newest, "wb").write(bytes(data))
 r = piola_run(out, "--resume")
 check(r.returncode == 2 and "format version 99" in r.stderr, "another format version is refused: " + r.stderr.strip())
-data[8] = 1
+data[8] = version
 data[len(data) // 2] ^= 0xFF  # damage the payload
 open(newest, "wb").write(bytes(data))
 r = piola_run(out, "--resume")

@@ -1,0 +1,103 @@
+"""Checks behind test_run_resume_examples.sh: examples whose state goes beyond what
+run_resume.py's scene has (self-collision, whose collision trees carry history from step to
+step; a shell in one-way contact with a solid), run a few frames into their contact phase
+and killed with SIGKILL at several renames of their output (frame files, indexes and the
+checkpoint's own), resume to frames byte-identical to an uninterrupted run. One run is
+killed, resumed, killed again and so on (each process counts its renames from 1), then
+finished; stats.csv must match too, wall time aside.
+
+Usage: run_resume_examples.py [EXAMPLE ...] checks the examples named (all of examples/ for
+"all"; by hand, not in the suite) instead of the list below."""
+import csv
+import filecmp
+import os
+import re
+import shutil
+import signal
+import subprocess
+import sys
+import tempfile
+
+from script_checks import PIOLA, SOURCE, check, finish
+
+SCALE = float(os.environ.get("PIOLA_TEST_SCALE", "1"))
+# example: the frame from which its bodies are in contact (stats.csv: contacts > 0)
+CONTACT_FROM = {"cloth_on_jelly": 2, "cloth_folds": 5, "solids_stack": 1, "squeezed_solid": 22,
+                "cloth_cape_on_body": 4}
+EVERY = 2  # frames between checkpoints
+# Renames of a run (src/output/frame_commit.c): scene.json, then per frame six (VTU and OBJ
+# temporaries to pending names, both into place, stats.csv, sim.pvd), then the checkpoint
+# when one is due. A resumed run first renames stats.csv, sim.pvd and scene.json. From a
+# checkpoint after frame c, a resumed run's renames are therefore: 1-3 the indexes and the
+# scene, 4-9 frame c+1, 10-15 frame c+2, 16 checkpoint c+2, 17-22 frame c+3, ...
+# The first run dies at frame c+1's OBJ temporary (c the first checkpoint in contact); the
+# resumed ones before the checkpoint's rename (no progress: the next resumes from the same
+# checkpoint), the VTU's final rename, stats.csv and sim.pvd, each after a new checkpoint.
+RESUMED_KILLS = [16, 19, 21, 28]
+
+
+def frames_of(out):
+    return sorted(n for sub in ("frames", "surface") if os.path.isdir(f"{out}/{sub}")
+                  for n in (f"{sub}/{f}" for f in os.listdir(f"{out}/{sub}")))
+
+
+def stats(out):
+    rows = list(csv.DictReader(open(f"{out}/stats.csv")))
+    for r in rows:
+        del r["wall_seconds"]
+    return rows
+
+
+def run(scene, out, frames, *extra, kill=None, threads=1):
+    env = dict(os.environ)
+    if kill is not None:
+        env["PIOLA_FAULT_KILL_AT_RENAME"] = str(kill)
+    return subprocess.run([PIOLA, "run", scene, "-o", out, "--frames", str(frames), "--threads", str(threads),
+                           "--checkpoint-every", str(EVERY), *extra], capture_output=True, text=True, env=env)
+
+
+def check_example(name, work):
+    scene = os.path.join(SOURCE, "examples", name + ".json")
+    start = CONTACT_FROM.get(name, 1)
+    c = start + start % EVERY  # the first checkpoint inside the contact phase
+    kills = [1 + 6 * (c + 1) + c // EVERY + 1 + 2] + (RESUMED_KILLS if SCALE >= 1 else RESUMED_KILLS[:2])
+    frames = c + (8 if SCALE >= 1 else 4)
+    ref = os.path.join(work, name + "_ref")
+    r = run(scene, ref, frames)
+    check(r.returncode == 0, f"{name}: the uninterrupted run of {frames} frames succeeds {r.stderr[-300:] if r.returncode else ''}")
+    if r.returncode != 0:
+        return
+    out = os.path.join(work, name)
+    resumed_from, extra = [], []
+    for i, k in enumerate(kills):
+        r = run(scene, out, frames, *extra, kill=k, threads=1 + i % 2)
+        resumed_from += [int(m) for m in re.findall(r"resuming after frame (\d+)", r.stderr)]
+        if r.returncode == 0:
+            break  # finished before its k-th rename
+        if r.returncode != -signal.SIGKILL:
+            check(False, f"{name}: killed at rename {k}: exit {r.returncode} {r.stderr[-300:]}")
+            return
+        extra = ["--resume"]
+    r = run(scene, out, frames, "--resume")
+    resumed_from += [int(m) for m in re.findall(r"resuming after frame (\d+)", r.stderr)]
+    check(r.returncode == 0, f"{name}: the last --resume finishes {r.stderr[-300:] if r.returncode else ''}")
+    # the run killed before the checkpoint's rename resumes from the same checkpoint again
+    expected = [c, c] + [c + EVERY * k for k in range(1, len(kills) - 1)]
+    check(resumed_from == expected,
+          f"{name}: every run was killed where planned and resumed from the checkpoints after frames {expected} "
+          f"(contact from frame {start}): {resumed_from}")
+    names = frames_of(ref)
+    differ = [n for n in names if not (os.path.exists(f"{out}/{n}") and filecmp.cmp(f"{ref}/{n}", f"{out}/{n}", shallow=False))]
+    check(len(names) == 2 * (frames + 1) and not differ and frames_of(out) == names,
+          f"{name}: after {len(kills)} kills the {len(names)} frame files equal the uninterrupted run's (differ: {differ})")
+    check(stats(out) == stats(ref), f"{name}: stats.csv equals the uninterrupted run's (contacts and impacts included), wall time aside")
+
+
+examples = sys.argv[1:] or (list(CONTACT_FROM) if SCALE >= 1 else ["cloth_on_jelly"])
+if examples == ["all"]:
+    examples = sorted(n[:-5] for n in os.listdir(os.path.join(SOURCE, "examples")) if n.endswith(".json"))
+work = tempfile.mkdtemp()
+for name in examples:
+    check_example(name, work)
+shutil.rmtree(work)
+finish()

@@ -15,6 +15,7 @@
 #include "piola/elastic_body.h"
 #include "piola/export.h"
 #include "piola/files.h"
+#include "piola/kernels.h"
 #include "piola/keyframes.h"
 #include "piola/material.h"
 #include "piola/math_types.h"

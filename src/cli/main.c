@@ -5,6 +5,7 @@
 #include <unistd.h>
 
 #include "cli/commands.h"
+#include "piola/kernels.h"
 
 static void print_usage(FILE *out) {
   fprintf(out,
@@ -47,7 +48,7 @@ int main(int argc, char **argv) {
     return 0;
   }
   if (strcmp(command, "version") == 0 || strcmp(command, "--version") == 0) {
-    printf("piola %s\n", PIOLA_VERSION_STRING);
+    printf("piola %s\nkernels: %s\n", PIOLA_VERSION_STRING, piola_kernel_isa());
     return 0;
   }
   fprintf(stderr, "piola: unknown command '%s'\n", command);

@@ -16,7 +16,9 @@
  * Cost: about 1100 flops per tet, vectorized across a SIMD block of tets, then 54 scalar
  * additions into the edge blocks. Fixed tet ranges run in parallel, edges they share
  * through private slots (damping_matrix.h), so each block is summed in a fixed order for
- * any thread count. */
+ * any thread count.
+ *
+ * A kernel, compiled once per instruction set (common/isa.h). */
 #include <math.h>
 
 #include "force/damping_matrix.h"
@@ -225,7 +227,7 @@ static void reduce_shared(piola__damping_matrix *m, int32_t k) {
   }
 }
 
-void piola__damping_matrix_assemble(piola__damping_matrix *m, const piola_elastic_body *body,
+void PIOLA_ISA_NAME(piola__damping_matrix_assemble)(piola__damping_matrix *m, const piola_elastic_body *body,
                                     double shear_viscosity, double bulk_viscosity) {
   const int32_t blocks = body->padded_tet_count / B;
 #pragma omp parallel num_threads(piola_thread_count()) if (blocks >= PIOLA_PARALLEL_MIN_BLOCKS)

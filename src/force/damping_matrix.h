@@ -34,6 +34,7 @@
 
 #include <stdint.h>
 
+#include "common/isa.h"
 #include "piola/elastic_body.h"
 
 typedef struct piola__damping_matrix {
@@ -73,8 +74,12 @@ piola_status piola__damping_matrix_init(piola__damping_matrix *matrix,
 
 void piola__damping_matrix_free(piola__damping_matrix *matrix);
 
-/* Assembles the blocks from the body's last update (damping_assembly.c). */
-void piola__damping_matrix_assemble(piola__damping_matrix *matrix, const piola_elastic_body *body,
-                                    double shear_viscosity, double bulk_viscosity);
+/* Assembles the blocks from the body's last update (damping_assembly.c, a kernel built once
+ * per instruction set, common/isa.h; the plain name runs the chosen variant). */
+#define PIOLA_DAMPING_MATRIX_ASSEMBLE_PARAMS                                                \
+  (piola__damping_matrix * matrix, const piola_elastic_body *body, double shear_viscosity, \
+   double bulk_viscosity)
+PIOLA_ISA_DECLARE(void, piola__damping_matrix_assemble, PIOLA_DAMPING_MATRIX_ASSEMBLE_PARAMS);
+void piola__damping_matrix_assemble PIOLA_DAMPING_MATRIX_ASSEMBLE_PARAMS;
 
 #endif

@@ -33,6 +33,7 @@
 
 #include <stdint.h>
 
+#include "common/isa.h"
 #include "force/damping_matrix.h"
 #include "piola/elastic_body.h"
 #include "piola/threads.h"
@@ -117,10 +118,13 @@ void piola__elastic_body_split_update(piola_elastic_body *body, const double *x,
                                       double stiffness_scale, int want_energy, double *forces);
 void piola__elastic_body_split_free(piola_elastic_body *body);
 /* One or two consecutive blocks of the force loop from first, forces added into out in tet
- * order (elastic_body.c). */
-void piola__elastic_body_update_block_pair(piola_elastic_body *body, const double *x,
-                                           double stiffness_scale, int want_energy, int32_t first,
-                                           int count, double *out);
+ * order (force_lanes.c, a kernel built once per instruction set, common/isa.h; the plain
+ * name runs the chosen variant). */
+#define PIOLA_UPDATE_BLOCK_PAIR_PARAMS                                                        \
+  (piola_elastic_body * body, const double *x, double stiffness_scale, int want_energy,      \
+   int32_t first, int count, double *out)
+PIOLA_ISA_DECLARE(void, piola__elastic_body_update_block_pair, PIOLA_UPDATE_BLOCK_PAIR_PARAMS);
+void piola__elastic_body_update_block_pair PIOLA_UPDATE_BLOCK_PAIR_PARAMS;
 
 /* Bodies of at least PIOLA_PARALLEL_MIN_BLOCKS blocks sum their elastic forces in this many
  * fixed tet ranges (each its own partial sum), whatever the thread count. */

@@ -1,4 +1,5 @@
-/* Muscle fibre forces for one block of tets (see fiber_lanes.h for the why). */
+/* Muscle fibre forces for one block of tets (see fiber_lanes.h for the why), the fibre
+ * energy and the fibre directions: a kernel, compiled once per instruction set (common/isa.h). */
 #if defined(__GNUC__) && !defined(__clang__)
 #pragma GCC optimize("fp-contract=fast")
 #endif
@@ -99,7 +100,7 @@ static double hgo_lane(const piola_elastic_body *body, const piola_material *mat
   return energy;
 }
 
-PIOLA_WIDE_VECTORS void piola__fiber_forces_lanes(const piola_elastic_body *body, int32_t base,
+PIOLA_WIDE_VECTORS void PIOLA_ISA_NAME(piola__fiber_forces_lanes)(const piola_elastic_body *body, int32_t base,
                                                   double fhat[3][B], double scale,
                                                   double *tf, double *psi) {
   const double activation = body->activation;
@@ -129,7 +130,7 @@ PIOLA_WIDE_VECTORS void piola__fiber_forces_lanes(const piola_elastic_body *body
     for (int l = 0; l < B; ++l) psi[l] += energy[l];
 }
 
-double piola__fiber_energy_density(const piola_elastic_body *body, int32_t t) {
+double PIOLA_ISA_NAME(piola__fiber_energy_density)(const piola_elastic_body *body, int32_t t) {
   if (!body->fiber[0]) return 0.0;
   const piola_material *mat = &body->materials[body->tet_material[t]];
   const long stride = body->padded_tet_count;
@@ -153,7 +154,7 @@ double piola__fiber_energy_density(const piola_elastic_body *body, int32_t t) {
                                              body->activation);
 }
 
-piola_status piola__fiber_copy(piola_elastic_body *body, const piola_elastic_body_def *def) {
+piola_status PIOLA_ISA_NAME(piola__fiber_copy)(piola_elastic_body *body, const piola_elastic_body_def *def) {
   if (!def->fiber_directions) return PIOLA_OK;
   const int32_t nt = body->tet_count, np = body->padded_tet_count;
   for (int k = 0; k < 3; ++k)
@@ -181,16 +182,4 @@ piola_status piola__fiber_copy(piola_elastic_body *body, const piola_elastic_bod
                         (int)t);
   }
   return PIOLA_OK;
-}
-
-void piola_elastic_body_set_activation(piola_elastic_body *body, double activation) {
-  if (body) body->activation = muscle_clamp_activation(activation);
-}
-
-double piola_elastic_body_activation(const piola_elastic_body *body) {
-  return body ? body->activation : 0.0;
-}
-
-const double *piola_elastic_body_fiber_directions(const piola_elastic_body *body) {
-  return body ? body->fiber_aos : NULL;
 }

@@ -18,7 +18,11 @@
  * bounds the squared plane-wave speed times density; at rest both terms are lambda + 2 mu.
  * Past the inversion threshold the slopes are those of the extension at the threshold (the
  * diagonal raised as the extension raises it); the denominator f_i + f_j is kept away from 0
- * by the threshold c (the rotational block is singular there for any invertible model). */
+ * by the threshold c (the rotational block is singular there for any invertible model).
+ *
+ * A kernel, compiled once per instruction set (common/isa.h): its lane loops are a few
+ * percent of a step, and at baseline x86-64 four times that. Without fused multiply-adds
+ * and with only max reductions, every variant computes the same bits. */
 #include <math.h>
 #include <stdlib.h>
 
@@ -102,7 +106,7 @@ static double material_modulus(const piola_material *m, double f0, double f1, do
   }
 }
 
-double piola__elastic_body_tet_rest_altitude(const piola_elastic_body *body, int32_t t) {
+double PIOLA_ISA_NAME(piola__elastic_body_tet_rest_altitude)(const piola_elastic_body *body, int32_t t) {
   /* grad N_c of corners 1..3 are the rows of Dm^-1, corner 0's is minus their sum */
   double g0[3] = {0, 0, 0}, worst = 0;
   for (int r = 0; r < 3; ++r) {
@@ -118,8 +122,8 @@ double piola__elastic_body_tet_rest_altitude(const piola_elastic_body *body, int
   return worst > 0 ? 1.0 / sqrt(worst) : INFINITY;
 }
 
-double piola__elastic_body_tet_modulus(const piola_elastic_body *body, int32_t tet,
-                                       const double fhat[3]) {
+double PIOLA_ISA_NAME(piola__elastic_body_tet_modulus)(const piola_elastic_body *body, int32_t tet,
+                                                      const double fhat[3]) {
   return material_modulus(&body->materials[body->tet_material[tet]], fhat[0], fhat[1], fhat[2]);
 }
 
@@ -129,7 +133,7 @@ static const double *rate_weights(piola_elastic_body *body) {
     double *w = malloc((size_t)(body->tet_count > 0 ? body->tet_count : 1) * sizeof *w);
     if (!w) return NULL;
     for (int32_t t = 0; t < body->tet_count; ++t) {
-      const double h = piola__elastic_body_tet_rest_altitude(body, t);
+      const double h = PIOLA_ISA_NAME(piola__elastic_body_tet_rest_altitude)(body, t);
       w[t] = 1.0 / (body->density * h * h);
     }
     body->step_weight = w;
@@ -199,14 +203,14 @@ static double range_rate2(const piola_elastic_body *body, const double *w, int32
     }
   } else {
     for (int32_t t = begin; t < end; ++t) {
-      const double r = w[t] * piola__elastic_body_tet_modulus(body, t, f + 3 * t);
+      const double r = w[t] * PIOLA_ISA_NAME(piola__elastic_body_tet_modulus)(body, t, f + 3 * t);
       best = r > best ? r : best;
     }
   }
   return best;
 }
 
-double piola__elastic_body_state_rate2(piola_elastic_body *body, int32_t *worst_tet) {
+double PIOLA_ISA_NAME(piola__elastic_body_state_rate2)(piola_elastic_body *body, int32_t *worst_tet) {
   const double *w = rate_weights(body);
   const int32_t nt = body->tet_count;
   if (worst_tet) *worst_tet = -1;
@@ -222,7 +226,7 @@ double piola__elastic_body_state_rate2(piola_elastic_body *body, int32_t *worst_
   for (int r = 0; r < RANGES; ++r) best = part[r] > best ? part[r] : best;
   if (worst_tet && best > 0)
     for (int32_t t = 0; t < nt; ++t)
-      if (w[t] * piola__elastic_body_tet_modulus(body, t, body->fhat + 3 * t) >= best * (1 - 1e-12)) {
+      if (w[t] * PIOLA_ISA_NAME(piola__elastic_body_tet_modulus)(body, t, body->fhat + 3 * t) >= best * (1 - 1e-12)) {
         *worst_tet = t;
         break;
       }

@@ -12,7 +12,17 @@
 
 #include <stdint.h>
 
+#include "common/isa.h"
 #include "piola/elastic_body.h"
+
+/* stable_step.c is a kernel built once per instruction set (common/isa.h): the plain names
+ * below run the chosen variant (kernel_dispatch.c). */
+PIOLA_ISA_DECLARE(double, piola__elastic_body_state_rate2,
+                  (piola_elastic_body * body, int32_t *worst_tet));
+PIOLA_ISA_DECLARE(double, piola__elastic_body_tet_modulus,
+                  (const piola_elastic_body *body, int32_t tet, const double fhat[3]));
+PIOLA_ISA_DECLARE(double, piola__elastic_body_tet_rest_altitude,
+                  (const piola_elastic_body *body, int32_t tet));
 
 /* max over tets of k_e / (rho h_e^2) at the body's last update (1/s^2, stiffness scale 1),
  * the plastic stiffening left out (the caller multiplies by its square). *worst_tet (may be

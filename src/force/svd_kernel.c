@@ -1,5 +1,6 @@
 /* The vectorized SVD kernel over a batch of matrices (for benchmarks and accuracy tests;
- * the force loop inlines piola__svd3_kernel_v8 directly). */
+ * the force loop inlines piola__svd3_kernel_v8 directly): a kernel, compiled once per
+ * instruction set (common/isa.h). */
 /* Fused multiply-adds in this file's kernels (see "Fused multiply-adds" in svd_kernel.h). */
 #if defined(__GNUC__) && !defined(__clang__)
 #pragma GCC optimize("fp-contract=fast")
@@ -8,7 +9,7 @@
 
 #define BATCH_LANES 8
 
-PIOLA_WIDE_VECTORS void piola__svd3_kernel_batch(int32_t n, const double *f, double *u, double *fhat, double *v) {
+PIOLA_WIDE_VECTORS void PIOLA_ISA_NAME(piola__svd3_kernel_batch)(int32_t n, const double *f, double *u, double *fhat, double *v) {
   /* two blocks at a time through the interleaved kernel, as the force loop does */
   for (int32_t base = 0; base < n; base += 2 * BATCH_LANES) {
     int32_t lanes = n - base < 2 * BATCH_LANES ? n - base : 2 * BATCH_LANES;

@@ -47,6 +47,7 @@
 #include <immintrin.h>
 #endif
 
+#include "common/isa.h"
 #include "math/v8.h"
 
 #ifndef PIOLA_SVD_JACOBI_SWEEPS
@@ -381,7 +382,10 @@ PIOLA_KERNEL_INLINE void piola__svd3_kernel_v8x2(const double *fa, const double 
 }
 
 /* For benchmarks and tests: n matrices, row-major AoS (9 each), through the kernel in
- * vectorized blocks. */
+ * vectorized blocks; the plain name runs the variant piola__isa_variant() chose
+ * (kernel_dispatch.c), the suffixed ones (common/isa.h) a given one. */
+PIOLA_ISA_DECLARE(void, piola__svd3_kernel_batch,
+                  (int32_t n, const double *f, double *u, double *fhat, double *v));
 void piola__svd3_kernel_batch(int32_t n, const double *f, double *u, double *fhat, double *v);
 
 #endif

@@ -1,6 +1,7 @@
 /* The blocked plastic update: the return mapping of 8 tets at once on explicit 8-lane
  * vectors (design in plastic_state.h; the scalar path it must agree with is update_tet in
- * plastic_state.c, the per-tet math in return_mapping.h). */
+ * plastic_state.c, the per-tet math in return_mapping.h). A kernel, compiled once per
+ * instruction set (common/isa.h). */
 /* Fused multiply-adds, as in the force loop (see "Fused multiply-adds" in svd_kernel.h). */
 #if defined(__GNUC__) && !defined(__clang__)
 #pragma GCC optimize("fp-contract=fast")
@@ -374,8 +375,9 @@ static inline __attribute__((always_inline)) int32_t flow_block(piola_plastic_st
  * a long chain of dependent operations: log, norm, exp, products). */
 enum { CHUNK_BLOCKS = 16 };
 
-PIOLA_WIDE_VECTORS int32_t piola__plastic_update_blocks(piola_plastic_state *s, int32_t first, int32_t end,
-                                                      int32_t *limited, double *bound) {
+PIOLA_WIDE_VECTORS int32_t PIOLA_ISA_NAME(piola__plastic_update_blocks)(piola_plastic_state *s, int32_t first,
+                                                                      int32_t end, int32_t *limited,
+                                                                      double *bound) {
   double *dm_inv[9];
   const double *vk[9];
   int32_t padded;

@@ -42,6 +42,7 @@
 
 #include <stdint.h>
 
+#include "common/isa.h"
 #include "piola/plasticity.h"
 #include "plasticity/return_mapping.h"
 
@@ -87,9 +88,12 @@ double piola__plastic_exact_limit(double a[9], const plastic_params *p);
 
 /* The blocked update of blocks [first, end) (not for controlled states): returns the number
  * of tets that yielded, adds the limited ones to *limited, refreshes their block_bound and
- * writes the largest of them (at least 1) to *bound. */
-int32_t piola__plastic_update_blocks(piola_plastic_state *s, int32_t first, int32_t end, int32_t *limited,
-                                     double *bound);
+ * writes the largest of them (at least 1) to *bound. plastic_lanes.c, a kernel built once
+ * per instruction set (common/isa.h); the plain name runs the chosen variant. */
+#define PIOLA_PLASTIC_UPDATE_BLOCKS_PARAMS \
+  (piola_plastic_state * s, int32_t first, int32_t end, int32_t *limited, double *bound)
+PIOLA_ISA_DECLARE(int32_t, piola__plastic_update_blocks, PIOLA_PLASTIC_UPDATE_BLOCKS_PARAMS);
+int32_t piola__plastic_update_blocks PIOLA_PLASTIC_UPDATE_BLOCKS_PARAMS;
 
 /* The scalar per-tet update of every tet (the path of controlled states, and the tests'
  * reference for the blocked one); same contract as piola_plastic_state_update. */

@@ -65,7 +65,6 @@ struct implicit_state {
   double *cg[4];      /* 3n each: r, z, p, q */
   double *scratch_v;  /* 3n: velocities handed to the obstacle projection */
   uint8_t *hit;       /* n: nodes the obstacle projection moved */
-  double mu;          /* quasistatic regularization, 1/s^2 (0: not chosen yet) */
 };
 
 void piola__implicit_state_free(struct implicit_state *st) {
@@ -279,7 +278,7 @@ static int32_t solve_newton_system(newton_problem *pb) {
   world_body *s = pb->s;
   struct implicit_state *st = pb->st;
   const int32_t n = s->n;
-  const double mass_weight = pb->mass_weight + st->mu;
+  const double mass_weight = pb->mass_weight + s->quasistatic_mu;
   double *d = st->step;
   const cg_vectors c = {s, &st->matrix, d, st->cg[0], st->cg[1], st->cg[2], st->cg[3]};
   double rz = cg_start(&c, st->residual);
@@ -422,7 +421,7 @@ static piola_status newton_solid(piola_world *w, world_body *s, double t, double
   const int32_t n = s->n;
   const int64_t m = 3 * (int64_t)n;
   newton_problem pb = problem_of(w, s, t, dt);
-  if (!pb.quasistatic) st->mu = 0;
+  if (!pb.quasistatic) s->quasistatic_mu = 0;
 
   /* the prediction, and the first guess: the prediction plus a step of gravity
    * (backward Euler) or the last equilibrium (quasistatics); prescribed nodes at t1 */
@@ -485,20 +484,22 @@ static piola_status newton_iterate(const newton_problem *problem, int accept_unc
     piola__stiffness_matrix_assemble(&st->matrix, s->solid, pb.force_weight,
                                      pb.damped ? dt : 0.0, s->mass, pb.mass_weight);
     if (pb.quasistatic) {
-      if (!(st->mu > 0)) {
+      if (!(s->quasistatic_mu > 0)) {
         /* the first regularization: a small fraction of the mean stiffness per mass */
         double trace = 0;
         for (int32_t i = 0; i < n; ++i) {
           const double *b = st->matrix.diagonal + 9 * (size_t)i;
           trace += b[0] + b[4] + b[8];
         }
-        st->mu = 1e-6 * trace / (3.0 * pb.total_mass);
-        if (!(st->mu > 0)) st->mu = 1.0;
+        s->quasistatic_mu = 1e-6 * trace / (3.0 * pb.total_mass);
+        if (!(s->quasistatic_mu > 0)) s->quasistatic_mu = 1.0;
       }
-      piola__stiffness_matrix_assemble(&st->matrix, s->solid, pb.force_weight, 0.0, s->mass, st->mu);
-    } else if (st->mu > 0) {
+      piola__stiffness_matrix_assemble(&st->matrix, s->solid, pb.force_weight, 0.0, s->mass,
+                                       s->quasistatic_mu);
+    } else if (s->quasistatic_mu > 0) {
       piola__stiffness_matrix_assemble(&st->matrix, s->solid, pb.force_weight,
-                                       pb.damped ? dt : 0.0, s->mass, pb.mass_weight + st->mu);
+                                       pb.damped ? dt : 0.0, s->mass,
+                                       pb.mass_weight + s->quasistatic_mu);
     }
     piola__step_profile_mark(&w->profile, STEP_PHASE_ASSEMBLE);
     stats->linear_iterations += solve_newton_system(&pb);
@@ -528,17 +529,17 @@ static piola_status newton_iterate(const newton_problem *problem, int accept_unc
     }
     if (pb.quasistatic) {
       if (alpha == 1.0)
-        st->mu = fmax(st->mu / 10.0, 1e-300);
+        s->quasistatic_mu = fmax(s->quasistatic_mu / 10.0, 1e-300);
       else if (alpha < 0.25)
-        st->mu *= 10.0;
+        s->quasistatic_mu *= 10.0;
     } else {
       /* backward Euler: an iteration that had to backtrack far adds a multiple of M to the
        * matrix (Levenberg-Marquardt: shorter, more gradient-like steps), full steps take it
        * away again */
       if (alpha < 0.25)
-        st->mu = st->mu > 0 ? fmin(4.0 * st->mu, 1e8) : 1.0;
+        s->quasistatic_mu = s->quasistatic_mu > 0 ? fmin(4.0 * s->quasistatic_mu, 1e8) : 1.0;
       else if (alpha == 1.0)
-        st->mu = st->mu > 1e-3 ? 0.25 * st->mu : 0.0;
+        s->quasistatic_mu = s->quasistatic_mu > 1e-3 ? 0.25 * s->quasistatic_mu : 0.0;
     }
     int32_t added = contacts(&pb);
     if (added < 0) return PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "implicit step: out of memory");

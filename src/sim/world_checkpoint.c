@@ -185,6 +185,7 @@ static void elastic_state(stream *s, world_body *b) {
   for (int k = 0; k < 9; ++k) doubles(s, e->dm_inv[k], np, "effective Dm^-1");
   one_double(s, &e->activation, "activation");
   one_double(s, &e->last_stiffness_scale, "stiffness scale");
+  one_double(s, &b->quasistatic_mu, "quasistatic regularization");
   int32_t has_state = e->has_state;
   local_int(s, &has_state, "has_state");
   /* the damping operator the next step starts from: its viscosities and blocks, and

@@ -678,12 +678,5 @@ piola_status piola__implicit_world_step(piola_world *w, double dt_limit, piola_s
     if (stats) *stats = local;
     return contact;
   }
-  for (int32_t i = 0; i < w->body_count; ++i) piola__body_plastic_after_step(&w->bodies[i], dt);
-  piola__step_profile_mark(&w->profile, STEP_PHASE_WORLD);
-  if (w->profile.enabled) w->profile.steps++;
-  w->time += dt;
-  local.substeps = 1;
-  local.last_dt = dt;
-  if (stats) *stats = local;
-  return PIOLA_OK;
+  return piola__world_finish_step(w, dt, &local, stats);
 }

@@ -553,13 +553,18 @@ piola_status piola_world_step(piola_world *w, double dt_limit, piola_step_stats 
     if (stats) *stats = local;
     return st;
   }
+  return piola__world_finish_step(w, dt, &local, stats);
+}
+
+piola_status piola__world_finish_step(piola_world *w, double dt, piola_step_stats *local,
+                                      piola_step_stats *stats) {
   for (int32_t i = 0; i < w->body_count; ++i) piola__body_plastic_after_step(&w->bodies[i], dt);
   piola__step_profile_mark(&w->profile, STEP_PHASE_WORLD);
   if (w->profile.enabled) w->profile.steps++;
   w->time += dt;
-  local.substeps = 1;
-  local.last_dt = dt;
-  if (stats) *stats = local;
+  local->substeps = 1;
+  local->last_dt = dt;
+  if (stats) *stats = *local;
   return PIOLA_OK;
 }
 

@@ -139,6 +139,11 @@ extern int piola__step_reuse_first_product;
  * 0 to see what the check prevents. */
 extern int piola__step_energy_check;
 
+/* The end of an accepted step of any integrator (integrator.c): plasticity after the step,
+ * the profile, the clock advanced by dt, and local (one substep of dt) handed to stats. */
+piola_status piola__world_finish_step(piola_world *w, double dt, piola_step_stats *local,
+                                      piola_step_stats *stats);
+
 /* The implicit integrators (implicit_step.c): piola_world_step for
  * PIOLA_INTEGRATOR_BACKWARD_EULER and PIOLA_INTEGRATOR_QUASISTATIC; implicit_state_free frees
  * a body's implicit state (NULL is fine). */

@@ -35,6 +35,11 @@ void piola__shell_body_free_arrays(piola_shell_body *body) {
   free(body->materials);
   free(body->rest_positions);
   free(body->masses);
+  if (body->pattern) {
+    free(body->pattern->row_start), free(body->pattern->col);
+    free(body->pattern->triangle_slot), free(body->pattern->hinge_slot);
+    free(body->pattern);
+  }
   memset(body, 0, sizeof *body);
 }
 

@@ -40,6 +40,16 @@ typedef struct shell_triangle {
   double energy_density; /* J/m^3 */
 } shell_triangle;
 
+/* The implicit system matrix's pattern (shell_stiffness.h): row i lists the vertices that
+ * share a triangle or a hinge with vertex i, increasing, in col[row_start[i] ..
+ * row_start[i + 1]); triangle_slot[6 t + k] and hinge_slot[12 h + k] are the entries of the
+ * element's ordered vertex pairs (a, b), a != b, in the order of shell_stiffness_matrix.c. */
+typedef struct shell_matrix_pattern {
+  int32_t *row_start, *col;
+  int32_t *triangle_slot, *hinge_slot;
+  int32_t entry_count;
+} shell_matrix_pattern;
+
 typedef struct shell_hinge {
   int32_t v[4];          /* x1, x2 opposite corners; x3 -> x4 the edge */
   double weight;         /* w = 2 |e0|^2 / (A1 + A2), dimensionless */
@@ -77,6 +87,7 @@ struct piola_shell_body {
   double *masses;
   double min_rest_altitude, max_wave_speed, bending_time_scale;
   double last_stiffness_scale;
+  shell_matrix_pattern *pattern; /* built on the first implicit step, NULL before */
 };
 
 /* Builds the rest state from def (rest_state.c). body must be zeroed. */

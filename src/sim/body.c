@@ -10,6 +10,8 @@
 
 #include "common/status_report.h"
 #include "force/elastic_body_internal.h"
+#include "force/stiffness_matrix.h"
+#include "shell/shell_stiffness.h"
 #include "sim/fracture_internal.h"
 #include "sim/world_internal.h"
 
@@ -137,14 +139,55 @@ void piola__body_plastic_after_step(world_body *b, double dt) {
   }
 }
 
-int32_t piola__body_collide_in_step(piola_world *w, world_body *b, double t1, double dt) {
+int32_t piola__body_collide_in_step(piola_world *w, world_body *b, double t1, double dt,
+                                    uint8_t mark, double *surface_velocity) {
   switch (b->kind) {
     case PIOLA_BODY_SOLID: return 0;
     case PIOLA_BODY_SHELL:
-      return b->collide_with_solids ? piola__shell_collide_with_solids(w, b, t1, dt) : 0;
+      return b->collide_with_solids
+                 ? piola__shell_collide_with_solids(w, b, t1, dt, mark, surface_velocity)
+                 : 0;
     case PIOLA_BODY_NONE: break;
   }
   return 0;
+}
+
+piola_status piola__body_stiffness_init(world_body *b, piola__stiffness_matrix *matrix) {
+  switch (b->kind) {
+    case PIOLA_BODY_SOLID: return piola__stiffness_matrix_init(matrix, b->solid);
+    case PIOLA_BODY_SHELL: return piola__shell_stiffness_matrix_init(matrix, b->shell);
+    case PIOLA_BODY_NONE: break;
+  }
+  return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "body of no kind");
+}
+
+void piola__body_stiffness_assemble(const world_body *b, piola__stiffness_matrix *matrix,
+                                    double stiffness_weight, double damping_weight, double beta,
+                                    double alpha, double mass_weight) {
+  switch (b->kind) {
+    case PIOLA_BODY_SOLID:
+      piola__stiffness_matrix_assemble(matrix, b->solid, stiffness_weight, damping_weight, b->mass,
+                                       mass_weight);
+      return;
+    case PIOLA_BODY_SHELL:
+      piola__shell_stiffness_matrix_assemble(matrix, b->shell, stiffness_weight, damping_weight,
+                                             beta, alpha, b->mass, mass_weight);
+      return;
+    case PIOLA_BODY_NONE: return;
+  }
+}
+
+void piola__body_stiffness_apply(const world_body *b, const piola__stiffness_matrix *matrix,
+                                 double mass_weight, const double *p, double *out) {
+  switch (b->kind) {
+    case PIOLA_BODY_SOLID:
+      piola__stiffness_matrix_apply(matrix, b->solid, b->mass, mass_weight, p, out);
+      return;
+    case PIOLA_BODY_SHELL:
+      piola__shell_stiffness_matrix_apply(matrix, b->shell, b->mass, mass_weight, p, out);
+      return;
+    case PIOLA_BODY_NONE: return;
+  }
 }
 
 piola_status piola__body_collision_triangles(const world_body *b, piola_tri_mesh *out, int *owned) {

@@ -34,6 +34,8 @@
 #include "piola/world_bodies.h"
 #include "piola/world_shells.h"
 
+struct piola__stiffness_matrix; /* force/stiffness_matrix.h */
+
 /* Node flags (world_body.flags). */
 enum { NODE_FREE = 0, NODE_FIXED = 1, NODE_DRIVEN = 2 };
 
@@ -124,9 +126,22 @@ void piola__body_plastic_in_step(world_body *b, double dt);
 /* Plasticity once every body has stepped and contact is done (solids). */
 void piola__body_plastic_after_step(world_body *b, double dt);
 /* Collisions with other bodies inside the step, after the obstacles' (the shells' one-way
- * coupling to solids): moves nodes, flags them colliding with their normals; returns how
- * many newly collide. */
-int32_t piola__body_collide_in_step(piola_world *w, world_body *b, double t1, double dt);
+ * coupling to solids): moves nodes, flags them colliding (with the value mark) with their
+ * normals, and when surface_velocity (3n) is not NULL stores there the velocity of the
+ * surface each moved node touches; returns how many newly collide. */
+int32_t piola__body_collide_in_step(piola_world *w, world_body *b, double t1, double dt,
+                                    uint8_t mark, double *surface_velocity);
+/* The implicit integrators' system matrix (force/stiffness_matrix.h for solids,
+ * shell/shell_stiffness.h for shells): init sizes it for b; assemble forms
+ * stiffness_weight K + damping_weight D (D at viscosities beta, alpha in Pa s; a solid's
+ * damping matrix must have been prepared for them) with mass_weight M on the diagonal from
+ * b's last update; apply gives out = A p. */
+piola_status piola__body_stiffness_init(world_body *b, struct piola__stiffness_matrix *matrix);
+void piola__body_stiffness_assemble(const world_body *b, struct piola__stiffness_matrix *matrix,
+                                    double stiffness_weight, double damping_weight, double beta,
+                                    double alpha, double mass_weight);
+void piola__body_stiffness_apply(const world_body *b, const struct piola__stiffness_matrix *matrix,
+                                 double mass_weight, const double *p, double *out);
 /* The body's triangles in the world's collision surface, over its own node numbering.
  * *owned says whether out must be freed with piola_tri_mesh_free (else it is borrowed). */
 piola_status piola__body_collision_triangles(const world_body *b, piola_tri_mesh *out, int *owned);
@@ -183,8 +198,10 @@ piola_status piola__shell_update_forces(world_body *b, double t);
 double piola__shell_stable_dt(const piola_world *w, const world_body *b, double scale);
 piola_body_stats piola__shell_stats(const world_body *b);
 /* One-way coupling: pushes the free nodes of shell b out of the solids' current boundary
- * surfaces at t1 after a step of dt, as obstacle collisions do. */
-int32_t piola__shell_collide_with_solids(piola_world *w, world_body *b, double t1, double dt);
+ * surfaces at t1 after a step of dt, as obstacle collisions do (mark and surface_velocity
+ * as for piola__body_collide_in_step). */
+int32_t piola__shell_collide_with_solids(piola_world *w, world_body *b, double t1, double dt,
+                                         uint8_t mark, double *surface_velocity);
 /* world_plasticity.c: creation binds a plastic state to b->solid when def asks for one; the
  * update runs once per step, after the whole step succeeded, from the diagonalization of
  * the step's force evaluation; the stiffening factor (>= 1) divides the CFL step. */

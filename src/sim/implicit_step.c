@@ -52,8 +52,9 @@
 #define RANGES 16
 
 /* Values of world_body.colliding during an implicit step: a node held along its normal by
- * an obstacle, or along the push of the self-collision pass (see self_collide_and_resolve). */
-enum { HELD_BY_OBSTACLE = 1, HELD_BY_COLLISION = 2 };
+ * an obstacle, along the push of the self-collision pass (see self_collide_and_resolve), or
+ * by a solid's surface (a shell's one-way coupling, collide_with_solids). */
+enum { HELD_BY_OBSTACLE = 1, HELD_BY_COLLISION = 2, HELD_BY_SOLID = 3 };
 
 struct implicit_state {
   piola__stiffness_matrix matrix;
@@ -64,6 +65,7 @@ struct implicit_state {
   double *damping;    /* 3n: D v */
   double *cg[4];      /* 3n each: r, z, p, q */
   double *scratch_v;  /* 3n: velocities handed to the obstacle projection */
+  double *surface_v;  /* 3n: velocity of the solid surface a HELD_BY_SOLID node touches */
   uint8_t *hit;       /* n: nodes the obstacle projection moved */
 };
 
@@ -72,7 +74,7 @@ void piola__implicit_state_free(struct implicit_state *st) {
   piola__stiffness_matrix_free(&st->matrix);
   free(st->prediction), free(st->residual), free(st->step), free(st->base), free(st->damping);
   for (int k = 0; k < 4; ++k) free(st->cg[k]);
-  free(st->scratch_v), free(st->hit);
+  free(st->scratch_v), free(st->surface_v), free(st->hit);
   free(st);
 }
 
@@ -83,11 +85,13 @@ static piola_status implicit_state_make(world_body *s) {
   size_t v3 = sizeof(double) * 3 * (size_t)(s->n > 0 ? s->n : 1);
   st->prediction = malloc(v3), st->residual = malloc(v3), st->step = malloc(v3);
   st->base = malloc(v3), st->damping = malloc(v3), st->scratch_v = malloc(v3);
+  st->surface_v = malloc(v3);
   for (int k = 0; k < 4; ++k) st->cg[k] = malloc(v3);
   st->hit = malloc((size_t)(s->n > 0 ? s->n : 1));
   int ok = st->prediction && st->residual && st->step && st->base && st->damping &&
-           st->scratch_v && st->hit && st->cg[0] && st->cg[1] && st->cg[2] && st->cg[3];
-  if (ok && piola__stiffness_matrix_init(&st->matrix, s->solid) != PIOLA_OK) ok = 0;
+           st->scratch_v && st->surface_v && st->hit && st->cg[0] && st->cg[1] && st->cg[2] &&
+           st->cg[3];
+  if (ok && piola__body_stiffness_init(s, &st->matrix) != PIOLA_OK) ok = 0;
   if (!ok) {
     piola__implicit_state_free(st);
     return PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "implicit step: out of memory");
@@ -148,7 +152,7 @@ static double residual(newton_problem *pb) {
   if (pb->damped) {
     double *v = st->scratch_v;
     for (int64_t j = 0; j < 3 * (int64_t)n; ++j) v[j] = (s->x[j] - s->x_old[j]) * inv_dt;
-    piola_elastic_body_damping_forces(s->solid, v, pb->beta, pb->alpha, st->damping);
+    piola__body_damping_forces(s, v, pb->beta, pb->alpha, st->damping);
   }
   double part[RANGES];
 #pragma omp parallel for schedule(static) num_threads(piola_thread_count()) \
@@ -285,7 +289,7 @@ static int32_t solve_newton_system(newton_problem *pb) {
   const double stop = pb->w->def.linear_tolerance * pb->w->def.linear_tolerance * rz;
   int32_t it = 0;
   while (rz > stop && rz > 0 && it < pb->w->def.linear_max_iterations) {
-    piola__stiffness_matrix_apply(c.mx, s->solid, s->mass, mass_weight, c.p, c.q);
+    piola__body_stiffness_apply(s, c.mx, mass_weight, c.p, c.q);
     const double pq = cg_curvature(&c);
     if (!(pq > 0)) break;
     const double rz_new = cg_update(&c, rz / pq);
@@ -311,13 +315,30 @@ static piola_status update(newton_problem *pb) {
   return piola__body_update_forces(pb->s, pb->t1);
 }
 
-/* Projects free nodes that are inside an obstacle onto its surface and holds their normal
- * from then on. Returns the number of nodes newly held (-1 on error). */
+/* A shell's one-way coupling to the solids (collide_with_solids; the solids have stepped
+ * already): free nodes inside a solid's surface are projected onto it and held along its
+ * normal like obstacle contacts, the surface's velocity kept for friction. Returns 1 when
+ * it moved a node, else 0. */
+static int32_t coupling_contacts(newton_problem *pb) {
+  world_body *s = pb->s;
+  struct implicit_state *st = pb->st;
+  if (!s->collide_with_solids) return 0;
+  const size_t v3 = sizeof(double) * 3 * (size_t)s->n;
+  memcpy(st->scratch_v, s->x, v3);
+  (void)piola__body_collide_in_step(pb->w, s, pb->t1, pb->dt, HELD_BY_SOLID, st->surface_v);
+  return memcmp(st->scratch_v, s->x, v3) != 0;
+}
+
+/* Projects free nodes that are inside an obstacle (or, for a coupled shell, a solid) onto
+ * its surface and holds their normal from then on. Returns the number of nodes newly held
+ * (at least 1 when any node moved; -1 on error). */
 static int32_t contacts(newton_problem *pb) {
   piola_world *w = pb->w;
   world_body *s = pb->s;
   struct implicit_state *st = pb->st;
-  if (w->obstacle_count == 0 || pb->s->n == 0) return 0;
+  if (s->n == 0) return 0;
+  const int32_t coupled = coupling_contacts(pb);
+  if (w->obstacle_count == 0) return coupled;
   memset(st->scratch_v, 0, sizeof(double) * 3 * (size_t)s->n);
   double *normals = st->cg[0]; /* free between solves */
   int32_t moved = piola_obstacles_collide(w->obstacles, w->obstacle_count, pb->t1, 0.0, s->n, s->x,
@@ -337,7 +358,7 @@ static int32_t contacts(newton_problem *pb) {
     s->colliding[i] = HELD_BY_OBSTACLE;
     for (int k = 0; k < 3; ++k) s->normals[3 * i + k] = normals[3 * i + k];
   }
-  return moved > 0 ? (added > 0 ? added : 1) : 0;
+  return moved > 0 ? (added > 0 ? added : 1) : coupled;
 }
 
 /* Releases held nodes whose contact force would pull them into the obstacle (g . n < 0 means
@@ -364,14 +385,20 @@ static int32_t contact_friction(newton_problem *pb) {
   world_body *s = pb->s;
   int32_t changed = 0;
   for (int32_t i = 0; i < s->n; ++i) {
-    if (s->colliding[i] != HELD_BY_OBSTACLE || s->flags[i] != NODE_FREE) continue;
+    const int on_solid = s->colliding[i] == HELD_BY_SOLID;
+    if ((s->colliding[i] != HELD_BY_OBSTACLE && !on_solid) || s->flags[i] != NODE_FREE) continue;
     const double *g = pb->st->residual + 3 * i, *nrm = s->normals + 3 * i;
     double dvn = (g[0] * nrm[0] + g[1] * nrm[1] + g[2] * nrm[2]) / (pb->dt * s->mass[i]);
     if (!(dvn > 0)) continue;
     piola_vec3 p = {s->x[3 * i], s->x[3 * i + 1], s->x[3 * i + 2]};
     double best = INFINITY, mu = 0;
     piola_vec3 vo = {0, 0, 0};
-    for (int32_t o = 0; o < w->obstacle_count; ++o) {
+    if (on_solid) {
+      /* against the solid's surface: the shell's solid_friction, the surface's velocity */
+      const double *vs = pb->st->surface_v + 3 * i;
+      mu = s->solid_friction, vo = (piola_vec3){vs[0], vs[1], vs[2]};
+    }
+    for (int32_t o = 0; o < w->obstacle_count && !on_solid; ++o) {
       piola_vec3 vel;
       double phi = fabs(piola_obstacle_signed_distance(w->obstacles[o], pb->t1, p, NULL, &vel));
       if (phi < best) best = phi, mu = piola_obstacle_friction(w->obstacles[o]), vo = vel;
@@ -412,9 +439,9 @@ static newton_problem problem_of(piola_world *w, world_body *s, double t, double
 static piola_status newton_iterate(const newton_problem *problem, int accept_unconverged,
                                    piola_step_stats *stats);
 
-/* Newton's method for one solid over [t, t + dt]. Returns PIOLA_OK when converged,
+/* Newton's method for one body over [t, t + dt]. Returns PIOLA_OK when converged,
  * PIOLA_ERROR_NOT_CONVERGED when not (the caller undoes and halves), or another error. */
-static piola_status newton_solid(piola_world *w, world_body *s, double t, double dt,
+static piola_status newton_body(piola_world *w, world_body *s, double t, double dt,
                                  int accept_unconverged, piola_step_stats *stats) {
   PIOLA_TRY(implicit_state_make(s));
   struct implicit_state *st = s->implicit;
@@ -480,9 +507,9 @@ static piola_status newton_iterate(const newton_problem *problem, int accept_unc
     if (iter > 0 && release_contacts(&pb) > 0) phi = residual(&pb);
     stats->newton_iterations++;
     piola__step_profile_mark(&w->profile, STEP_PHASE_UPDATE);
-    if (pb.damped) piola__elastic_body_damping_prepare(s->solid, pb.beta, pb.alpha);
-    piola__stiffness_matrix_assemble(&st->matrix, s->solid, pb.force_weight,
-                                     pb.damped ? dt : 0.0, s->mass, pb.mass_weight);
+    if (pb.damped) piola__body_damping_prepare(s, pb.beta, pb.alpha);
+    piola__body_stiffness_assemble(s, &st->matrix, pb.force_weight, pb.damped ? dt : 0.0,
+                                   pb.beta, pb.alpha, pb.mass_weight);
     if (pb.quasistatic) {
       if (!(s->quasistatic_mu > 0)) {
         /* the first regularization: a small fraction of the mean stiffness per mass */
@@ -494,12 +521,11 @@ static piola_status newton_iterate(const newton_problem *problem, int accept_unc
         s->quasistatic_mu = 1e-6 * trace / (3.0 * pb.total_mass);
         if (!(s->quasistatic_mu > 0)) s->quasistatic_mu = 1.0;
       }
-      piola__stiffness_matrix_assemble(&st->matrix, s->solid, pb.force_weight, 0.0, s->mass,
-                                       s->quasistatic_mu);
+      piola__body_stiffness_assemble(s, &st->matrix, pb.force_weight, 0.0, pb.beta, pb.alpha,
+                                     s->quasistatic_mu);
     } else if (s->quasistatic_mu > 0) {
-      piola__stiffness_matrix_assemble(&st->matrix, s->solid, pb.force_weight,
-                                       pb.damped ? dt : 0.0, s->mass,
-                                       pb.mass_weight + s->quasistatic_mu);
+      piola__body_stiffness_assemble(s, &st->matrix, pb.force_weight, pb.damped ? dt : 0.0,
+                                     pb.beta, pb.alpha, pb.mass_weight + s->quasistatic_mu);
     }
     piola__step_profile_mark(&w->profile, STEP_PHASE_ASSEMBLE);
     stats->linear_iterations += solve_newton_system(&pb);
@@ -555,7 +581,7 @@ static piola_status newton_iterate(const newton_problem *problem, int accept_unc
   /* velocities; friction; prescribed velocities */
   const double inv_dt = 1.0 / dt;
   for (int64_t j = 0; j < m; ++j) s->v[j] = (s->x[j] - s->x_old[j]) * inv_dt;
-  if (!pb.quasistatic && w->obstacle_count > 0 && contact_friction(&pb) > 0) PIOLA_TRY(update(&pb));
+  if (!pb.quasistatic && contact_friction(&pb) > 0) PIOLA_TRY(update(&pb));
   int32_t colliding = 0;
   for (int32_t i = 0; i < n; ++i) {
     colliding += s->colliding[i] && s->flags[i] == NODE_FREE;
@@ -566,8 +592,8 @@ static piola_status newton_iterate(const newton_problem *problem, int accept_unc
   for (int64_t j = 0; j < m; ++j)
     if (!isfinite(s->v[j]) || !isfinite(s->x[j]))
       return PIOLA_FAIL(PIOLA_ERROR_NOT_FINITE,
-                        "solid '%s': state of vertex %lld became non-finite at t = %g s", s->name,
-                        (long long)(j / 3), pb.t1);
+                        "%s '%s': state of vertex %lld became non-finite at t = %g s",
+                        piola__body_kind_name(s->kind), s->name, (long long)(j / 3), pb.t1);
   return PIOLA_OK;
 }
 
@@ -648,12 +674,6 @@ piola_status piola__implicit_world_step(piola_world *w, double dt_limit, piola_s
   /* a limit a rounding error above the step is the caller's target: land on it */
   if (dt_limit > 0 && dt_limit <= dt * (1 + 1e-9)) dt = dt_limit;
   if (!(dt > 0)) return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "step: dt must be > 0, got %g", dt);
-  int shells = 0;
-  for (int32_t i = 0; i < w->body_count; ++i) shells += w->bodies[i].kind != PIOLA_BODY_SOLID;
-  if (shells > 0)
-    return PIOLA_FAIL(PIOLA_ERROR_UNSUPPORTED,
-                      "integrator '%s' does not step shells yet: use \"newmark\" for scenes with "
-                      "shells", piola_integrator_type_name(w->def.integrator));
   piola__step_profile_start(&w->profile);
   double left;
   PIOLA_TRY(piola__world_collision_open(w, &left));
@@ -661,7 +681,7 @@ piola_status piola__implicit_world_step(piola_world *w, double dt_limit, piola_s
     piola_status st = PIOLA_OK;
     int32_t done = 0;
     for (; done < w->body_count && st == PIOLA_OK; ++done)
-      st = newton_solid(w, &w->bodies[done], w->time, dt, halvings == MAX_HALVINGS, &local);
+      st = newton_body(w, &w->bodies[done], w->time, dt, halvings == MAX_HALVINGS, &local);
     if (st == PIOLA_OK) break;
     for (int32_t j = 0; j < done; ++j) restore(&w->bodies[j], w->time);
     if (st != PIOLA_ERROR_NOT_CONVERGED) {
@@ -678,5 +698,7 @@ piola_status piola__implicit_world_step(piola_world *w, double dt_limit, piola_s
     if (stats) *stats = local;
     return contact;
   }
+  /* shells' plastic flow, from the update at the step's end (solids': in finish_step) */
+  for (int32_t i = 0; i < w->body_count; ++i) piola__body_plastic_in_step(&w->bodies[i], dt);
   return piola__world_finish_step(w, dt, &local, stats);
 }

@@ -289,7 +289,7 @@ static piola_status step_body(piola_world *w, world_body *s, double t, double dt
   if (w->obstacle_count > 0)
     colliding = piola_obstacles_collide(w->obstacles, w->obstacle_count, t1, dt, n, s->x, s->v,
                                         s->colliding, s->normals);
-  colliding += piola__body_collide_in_step(w, s, t1, dt);
+  colliding += piola__body_collide_in_step(w, s, t1, dt, 1, NULL);
   for (int32_t i = 0; i < n; ++i) {
     if (s->flags[i] == NODE_FREE) continue;
     if (s->colliding[i]) colliding--;

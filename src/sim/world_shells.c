@@ -240,7 +240,8 @@ static piola_status solid_boundary(world_body *solid) {
   return PIOLA_OK;
 }
 
-int32_t piola__shell_collide_with_solids(piola_world *w, world_body *s, double t1, double dt) {
+int32_t piola__shell_collide_with_solids(piola_world *w, world_body *s, double t1, double dt,
+                                         uint8_t mark, double *surface_velocity) {
   (void)t1;
   int32_t moved = 0;
   for (int32_t k = 0; k < w->kind_count[PIOLA_BODY_SOLID]; ++k) {
@@ -306,8 +307,9 @@ int32_t piola__shell_collide_with_solids(piola_world *w, world_body *s, double t
       vec3_store(s->v + 3 * i, vec3_add(vs, rel_new));
       vec3_store(s->x + 3 * i, best_p);
       vec3_store(s->normals + 3 * i, normal);
+      if (surface_velocity) vec3_store(surface_velocity + 3 * i, vs);
       if (!s->colliding[i]) ++moved;
-      s->colliding[i] = 1;
+      s->colliding[i] = mark;
     }
   }
   return moved;

@@ -1,9 +1,12 @@
-/* Every example in examples/ without shells (the implicit integrators do not step shells
- * yet) runs with "backward_euler" at one step per frame (the default integrator.dt): the
- * first frames (more with PIOLA_TEST_SCALE >= 1), and at every frame
- *  - every coordinate and velocity is finite;
- *  - no free node is inside an analytic obstacle of the scene (signed distance >= -1e-6 m;
- *    mesh obstacles are not checked here);
+/* Every example in examples/, solids and shells, runs with "backward_euler" at one step per
+ * frame (the default integrator.dt): the first frames (more with PIOLA_TEST_SCALE >= 1),
+ * and at every frame
+ *  - every coordinate and velocity of every solid and shell is finite;
+ *  - no free node of a solid or a shell is inside an analytic obstacle of the scene (signed
+ *    distance >= -1e-6 m; mesh obstacles are not checked here);
+ *  - no free node of the shell coupled one way to a solid (collide_with_solids: the cape)
+ *    is inside that solid by more than 1% of its longest boundary edge (inside: by the side
+ *    of the closest boundary triangle, as the coupling decides);
  *  - where no external force acts (ball_recovers: zero gravity, no obstacle, no constraint)
  *    each solid's linear momentum stays zero;
  *  - solids_stack through the torus's impact on the ball (frame 7 of 60 fps; 12 frames, only
@@ -21,6 +24,7 @@
 #include <string.h>
 
 #include "piola/scene.h"
+#include "piola/world_shells.h"
 
 /* The scene text with "type": "backward_euler" in its integrator object. */
 static char *backward_euler_text(const char *path) {
@@ -46,7 +50,88 @@ static char *backward_euler_text(const char *path) {
   return out;
 }
 
-static void run_checked(const char *file, int frames, int free_momentum, double max_inverted_fraction) {
+/* Squared distance from p to triangle (a, b, c) and the closest point cp: the minimum over
+ * the face (when p projects inside it) and the three edges. */
+static double closest_on_triangle(const double *p, const double *a, const double *b,
+                                  const double *c, double cp[3]) {
+  double best = INFINITY;
+  const double *ends[3][2] = {{a, b}, {b, c}, {c, a}};
+  for (int e = 0; e < 3; ++e) {
+    const double *u = ends[e][0], *v = ends[e][1];
+    const double d[3] = {v[0] - u[0], v[1] - u[1], v[2] - u[2]};
+    const double dd = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
+    double s = dd > 0 ? ((p[0] - u[0]) * d[0] + (p[1] - u[1]) * d[1] + (p[2] - u[2]) * d[2]) / dd : 0;
+    s = fmin(1.0, fmax(0.0, s));
+    const double q[3] = {u[0] + s * d[0], u[1] + s * d[1], u[2] + s * d[2]};
+    const double d2 = (p[0] - q[0]) * (p[0] - q[0]) + (p[1] - q[1]) * (p[1] - q[1]) + (p[2] - q[2]) * (p[2] - q[2]);
+    if (d2 < best) best = d2, memcpy(cp, q, sizeof q);
+  }
+  const double e1[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]}, e2[3] = {c[0] - a[0], c[1] - a[1], c[2] - a[2]};
+  const double w[3] = {p[0] - a[0], p[1] - a[1], p[2] - a[2]};
+  const double d11 = e1[0] * e1[0] + e1[1] * e1[1] + e1[2] * e1[2];
+  const double d12 = e1[0] * e2[0] + e1[1] * e2[1] + e1[2] * e2[2];
+  const double d22 = e2[0] * e2[0] + e2[1] * e2[1] + e2[2] * e2[2];
+  const double w1 = w[0] * e1[0] + w[1] * e1[1] + w[2] * e1[2], w2 = w[0] * e2[0] + w[1] * e2[1] + w[2] * e2[2];
+  const double det = d11 * d22 - d12 * d12;
+  if (det > 0) {
+    const double s = (d22 * w1 - d12 * w2) / det, t = (d11 * w2 - d12 * w1) / det;
+    if (s >= 0 && t >= 0 && s + t <= 1) {
+      const double q[3] = {a[0] + s * e1[0] + t * e2[0], a[1] + s * e1[1] + t * e2[1],
+                           a[2] + s * e1[2] + t * e2[2]};
+      const double d2 = (p[0] - q[0]) * (p[0] - q[0]) + (p[1] - q[1]) * (p[1] - q[1]) + (p[2] - q[2]) * (p[2] - q[2]);
+      if (d2 < best) best = d2, memcpy(cp, q, sizeof q);
+    }
+  }
+  return best;
+}
+
+/* Fails when a free shell node (x, n nodes) lies inside solid k of w by more than 1% of the
+ * solid's longest boundary edge: inside by the side of the closest boundary triangle, as
+ * the coupling decides (docs/shells.md), searched over every boundary triangle. */
+static void check_outside_solid(const char *file, int frame, const piola_world *w, int32_t k,
+                                const double *x, const uint8_t *flags, int32_t n) {
+  const piola_elastic_body *b = piola_world_solid_body(w, k);
+  piola_tet_mesh mesh = {.vertex_count = piola_elastic_body_vertex_count(b),
+                         .positions = (double *)piola_world_solid_positions(w, k),
+                         .tet_count = piola_elastic_body_tet_count(b),
+                         .tets = (int32_t *)piola_elastic_body_tets(b)};
+  piola_tri_mesh surface;
+  assert_int_equal(piola_tet_mesh_boundary(&mesh, &surface), PIOLA_OK);
+  const double *sx = mesh.positions;
+  double reach = 0;
+  for (int32_t t = 0; t < surface.triangle_count; ++t)
+    for (int c = 0; c < 3; ++c) {
+      const double *p = sx + 3 * surface.triangles[3 * t + c];
+      const double *q = sx + 3 * surface.triangles[3 * t + (c + 1) % 3];
+      reach = fmax(reach, sqrt((p[0] - q[0]) * (p[0] - q[0]) + (p[1] - q[1]) * (p[1] - q[1]) +
+                               (p[2] - q[2]) * (p[2] - q[2])));
+    }
+  for (int32_t i = 0; i < n; ++i) {
+    if (flags && flags[i]) continue;
+    const double *p = x + 3 * i;
+    double best = INFINITY, side = 0;
+    for (int32_t t = 0; t < surface.triangle_count; ++t) {
+      const int32_t *tri = surface.triangles + 3 * t;
+      const double *a = sx + 3 * tri[0], *bb = sx + 3 * tri[1], *c = sx + 3 * tri[2];
+      double cp[3] = {0, 0, 0};
+      const double d2 = closest_on_triangle(p, a, bb, c, cp);
+      if (!(d2 < best)) continue;
+      const double e1[3] = {bb[0] - a[0], bb[1] - a[1], bb[2] - a[2]};
+      const double e2[3] = {c[0] - a[0], c[1] - a[1], c[2] - a[2]};
+      const double nrm[3] = {e1[1] * e2[2] - e1[2] * e2[1], e1[2] * e2[0] - e1[0] * e2[2],
+                             e1[0] * e2[1] - e1[1] * e2[0]};
+      best = d2;
+      side = (p[0] - cp[0]) * nrm[0] + (p[1] - cp[1]) * nrm[1] + (p[2] - cp[2]) * nrm[2];
+    }
+    if (side < 0 && sqrt(best) > 0.01 * reach)
+      fail_msg("%s frame %d: shell vertex %d is %g m inside solid %d", file, frame, (int)i,
+               sqrt(best), (int)k);
+  }
+  piola_tri_mesh_free(&surface);
+}
+
+static void run_checked(const char *file, int frames, int free_momentum, double max_inverted_fraction,
+                        int coupled_shells) {
   char path[1024], dir[1024];
   snprintf(path, sizeof path, "%s/examples/%s", PIOLA_SOURCE_DIR, file);
   snprintf(dir, sizeof dir, "%s/examples", PIOLA_SOURCE_DIR);
@@ -112,6 +197,29 @@ static void run_checked(const char *file, int frames, int free_momentum, double 
           if (!(fabs(p[k]) <= 1e-9 * (scale + 1e-12)))
             fail_msg("%s frame %d: solid %d momentum %g (scale %g)", file, f, (int)s, p[k], scale);
     }
+    for (int32_t s = 0; s < piola_world_shell_count(w); ++s) {
+      const piola_shell_body *b = piola_world_shell_body(w, s);
+      const int32_t n = piola_shell_body_vertex_count(b);
+      const double *x = piola_world_shell_positions(w, s), *v = piola_world_shell_velocities(w, s);
+      const uint8_t *flags = piola_world_shell_constraint_flags(w, s);
+      for (int32_t i = 0; i < n; ++i) {
+        for (int k = 0; k < 3; ++k)
+          if (!isfinite(x[3 * i + k]) || !isfinite(v[3 * i + k]))
+            fail_msg("%s frame %d: shell %d vertex %d not finite", file, f, (int)s, (int)i);
+        if (flags && flags[i]) continue;
+        piola_vec3 q = {x[3 * i], x[3 * i + 1], x[3 * i + 2]};
+        for (int32_t o = 0; o < no; ++o) {
+          if (!obstacles[o]) continue;
+          double phi = piola_obstacle_signed_distance(obstacles[o], t, q, NULL, NULL);
+          if (!(phi >= -1e-6))
+            fail_msg("%s frame %d: shell %d vertex %d is %g m inside obstacle %d", file, f, (int)s,
+                     (int)i, -phi, (int)o);
+        }
+      }
+      if (coupled_shells)
+        for (int32_t k = 0; k < piola_world_solid_count(w); ++k)
+          check_outside_solid(file, f, w, k, x, flags, n);
+    }
   }
   for (int32_t o = 0; o < no; ++o) piola_obstacle_destroy(obstacles[o]);
   free(obstacles);
@@ -121,7 +229,7 @@ static void run_checked(const char *file, int frames, int free_momentum, double 
 }
 
 static void run(const char *file, int frames, int free_momentum) {
-  run_checked(file, frames, free_momentum, -1);
+  run_checked(file, frames, free_momentum, -1, 0);
 }
 
 static int frames_light(void) { return (int)test_samples(6, 2); }
@@ -133,7 +241,7 @@ static void torus_puddle(void **state) { (void)state; run("torus_puddle.json", f
 static void solids_stack(void **state) { (void)state; run("solids_stack.json", frames_light(), 0); }
 static void solids_stack_impact(void **state) {
   (void)state;
-  if (test_scale() >= 1.0) run_checked("solids_stack.json", 12, 0, 0.02);
+  if (test_scale() >= 1.0) run_checked("solids_stack.json", 12, 0, 0.02, 0);
 }
 static void muscle_spindle(void **state) { (void)state; run("muscle_spindle.json", frames_light(), 0); }
 static void muscle_spindle_hanging(void **state) {
@@ -150,6 +258,15 @@ static void plastic_sphere_gears(void **state) {
   run("plastic_sphere_gears.json", frames_heavy(), 0);
 }
 
+static void cloth_on_sphere(void **state) { (void)state; run("cloth_on_sphere.json", frames_light(), 0); }
+static void dented_torus_shell(void **state) { (void)state; run("dented_torus_shell.json", frames_light(), 0); }
+static void cloth_cape_on_body(void **state) {
+  (void)state;
+  run_checked("cloth_cape_on_body.json", (int)frames_light(), 0, -1, 1);
+}
+static void cloth_folds(void **state) { (void)state; run("cloth_folds.json", frames_light(), 0); }
+static void cloth_on_jelly(void **state) { (void)state; run("cloth_on_jelly.json", frames_light(), 0); }
+
 int main(void) {
   piola_set_thread_count(1);
   omp_set_num_threads(1);
@@ -161,6 +278,9 @@ int main(void) {
       cmocka_unit_test(plastic_control),   cmocka_unit_test(plastic_bar_bend),
       cmocka_unit_test(arm_flex),          cmocka_unit_test(gears),
       cmocka_unit_test(armadillo_incline), cmocka_unit_test(plastic_sphere_gears),
+      cmocka_unit_test(cloth_on_sphere),   cmocka_unit_test(dented_torus_shell),
+      cmocka_unit_test(cloth_cape_on_body), cmocka_unit_test(cloth_folds),
+      cmocka_unit_test(cloth_on_jelly),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
 }

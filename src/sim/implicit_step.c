@@ -662,6 +662,31 @@ static piola_status self_collide_and_resolve(piola_world *w, double dt, int clos
   return PIOLA_OK;
 }
 
+/* The collision pass between bodies can push a node into an obstacle (a layer of cloth
+ * pressed onto the ground by the layer landing on it). A Newmark step's next collision
+ * processing puts it back; a frame-sized step must not end there. So after the pass every
+ * free node inside an obstacle is put back on its surface with the obstacle's normal
+ * velocity, as collisions do (piola_obstacles_collide), and its body's forces are updated. */
+static piola_status obstacles_after_contact(piola_world *w, double t1, double dt) {
+  for (int32_t b = 0; b < w->body_count && w->obstacle_count > 0; ++b) {
+    world_body *s = &w->bodies[b];
+    struct implicit_state *st = s->implicit;
+    if (!st || s->n == 0) continue;
+    memcpy(st->scratch_v, s->x, sizeof(double) * 3 * (size_t)s->n);
+    memcpy(st->base, s->v, sizeof(double) * 3 * (size_t)s->n);
+    int32_t moved = piola_obstacles_collide(w->obstacles, w->obstacle_count, t1, dt, s->n, s->x,
+                                            s->v, st->hit, st->cg[0]);
+    if (moved < 0) return PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "implicit step: out of memory");
+    if (moved == 0) continue;
+    for (int32_t i = 0; i < s->n; ++i)
+      if (st->hit[i] && s->flags[i] != NODE_FREE) /* prescribed nodes stay where they are */
+        for (int k = 0; k < 3; ++k)
+          s->x[3 * i + k] = st->scratch_v[3 * i + k], s->v[3 * i + k] = st->base[3 * i + k];
+    PIOLA_TRY(piola__body_update_forces(s, t1));
+  }
+  return PIOLA_OK;
+}
+
 /* A step whose Newton does not converge is undone and retried at half the size up to this
  * many times; the last try keeps its best iterate (a force field that jumps, as the
  * extended stress of an element passing through a reflection does, may have no exact
@@ -698,6 +723,7 @@ piola_status piola__implicit_world_step(piola_world *w, double dt_limit, piola_s
     if (stats) *stats = local;
     return contact;
   }
+  if (local.impacts + local.contacts > 0) PIOLA_TRY(obstacles_after_contact(w, w->time + dt, dt));
   /* shells' plastic flow, from the update at the step's end (solids': in finish_step) */
   for (int32_t i = 0; i < w->body_count; ++i) piola__body_plastic_in_step(&w->bodies[i], dt);
   return piola__world_finish_step(w, dt, &local, stats);

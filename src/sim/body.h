@@ -89,7 +89,7 @@ typedef struct world_body {
                                       is first cut or given a fracture def (fracture.c) */
   struct implicit_state *implicit; /* the implicit integrators' matrix and vectors, made on
                                       their first step of a solid (implicit_step.c) */
-  double quasistatic_mu; /* solids, quasistatics: the regularization carried from step to
+  double quasistatic_mu; /* the implicit integrators' regularization carried from step to
                             step, 1/s^2 (0: not chosen yet; implicit_step.c); checkpointed */
 } world_body;
 

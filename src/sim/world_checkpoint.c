@@ -271,6 +271,7 @@ static void shell_state(stream *s, world_body *b) {
   doubles(s, sh->fhat, 2 * nt, "shell Fhat");
   doubles(s, sh->fp_inv, 4 * nt, "shell Fp^-1");
   one_double(s, &sh->last_stiffness_scale, "shell stiffness scale");
+  one_double(s, &b->quasistatic_mu, "shell quasistatic regularization");
   field(s, &b->shell_stats, 1, sizeof b->shell_stats, "shell stats");
 }
 

@@ -1,7 +1,7 @@
 """Checks behind test_run_resume_examples.sh: examples whose state goes beyond what
 run_resume.py's scene has (self-collision, whose collision trees carry history from step to
-step; a shell in one-way contact with a solid), run a few frames into their contact phase (and a quasistatic bar, whose
-solver carries its regularization between steps)
+step; a shell in one-way contact with a solid), run a few frames into their contact phase (and a quasistatic bar and
+plate strip, whose solver carries its regularization between steps)
 and killed with SIGKILL at several renames of their output (frame files, indexes and the
 checkpoint's own), resume to frames byte-identical to an uninterrupted run. One run is
 killed, resumed, killed again and so on (each process counts its renames from 1), then
@@ -42,6 +42,19 @@ QUASISTATIC_BAR = """{
     "mesh": {"generate": "box", "center": [0.25, 0, 0], "half_extents": [0.25, 0.04, 0.04], "cell_size": 0.04},
     "density": 1000, "material": {"model": "neohookean", "youngs_modulus": 2e4, "poisson_ratio": 0.3},
     "fixed": [{"box": [[-0.1, -0.1, -0.1], [0.03, 0.1, 0.1]]}]}]
+}"""
+
+# a plate strip clamped at one end, bent by a gravity that turns and grows: a shell's
+# quasistatic regularization is carried between steps too
+QUASISTATIC_PLATE = """{
+  "fps": 30, "frames": 10, "gravity": [0, {"keys": [[0, 0], [0.4, 5]]}, {"keys": [[0, -2], [0.4, -20]]}],
+  "integrator": {"type": "quasistatic"},
+  "shells": [{"name": "plate",
+    "mesh": {"generate": "rectangle", "size": [0.3, 0.05], "resolution": [12, 2]},
+    "thickness": 0.001, "density": 1000,
+    "material": {"model": "neohookean", "youngs_modulus": 1e7, "poisson_ratio": 0.3},
+    "bending": {"stiffness": 1.0},
+    "fixed": [{"box": [[-1, -1, -1], [-0.124, 1, 1]]}]}]
 }"""
 
 
@@ -115,5 +128,9 @@ if not sys.argv[1:]:
     with open(scene, "w") as f:
         f.write(QUASISTATIC_BAR)
     check_example("quasistatic_bar", work, scene)
+    scene = os.path.join(work, "quasistatic_plate.json")
+    with open(scene, "w") as f:
+        f.write(QUASISTATIC_PLATE)
+    check_example("quasistatic_plate", work, scene)
 shutil.rmtree(work)
 finish()

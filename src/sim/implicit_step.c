@@ -38,7 +38,12 @@
  * Quasistatics. g(x) = -(f_e(x) + M g(t^n+1)), the same Newton with the matrix -K + mu M:
  * mu (1/s^2) regularizes the rigid and soft modes (Levenberg-Marquardt), shrinking after
  * full steps and growing when the line search has to backtrack. Velocities are reported as
- * (x^n+1 - x^n) / dt; damping and contact friction do not act. */
+ * (x^n+1 - x^n) / dt; damping and contact friction do not act.
+ *
+ * Bodies. Solids and shells take the same steps; what differs (the matrix, the damping
+ * force, the one-way coupling of shells to solids) goes through body.h's per-kind
+ * operations. Bodies are solved one after the other in the world's order, solids first, so
+ * a shell coupled to the solids sees them at t^n+1. */
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>

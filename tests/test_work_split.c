@@ -99,7 +99,7 @@ static void check_split(int n, int alternate) {
 
   /* one part: the same bits */
   int32_t *all0 = calloc((size_t)blocks, sizeof(int32_t)), *nodes0 = calloc((size_t)nv, sizeof(int32_t));
-  piola_work_split one = {0, 1, all0, nodes0, NULL, noop_nodes, noop_nodes, noop_blocks};
+  piola_work_split one = {0, 1, all0, nodes0, NULL, noop_nodes, noop_nodes, noop_blocks, NULL, NULL, NULL};
   piola_elastic_body *single = fixture_body(&mesh, &material);
   assert_int_equal(piola_elastic_body_set_work_split(single, &one), PIOLA_OK);
   double *fs = malloc(sizeof(double) * 3 * (size_t)nv), *ds = malloc(sizeof(double) * 3 * (size_t)nv);
@@ -123,10 +123,10 @@ static void check_split(int n, int alternate) {
   double *block_values = malloc(sizeof(double) * 256 * (size_t)blocks);
   p1 = (fake_part){fixture_body(&mesh, &material), NULL, x, v, values, block_values, nv, blocks,
                    block_part, node_part, {1, 2, block_part, node_part, &p1, record_nodes,
-                                           record_nodes, record_blocks}};
+                                           record_nodes, record_blocks, NULL, NULL, NULL}};
   p0 = (fake_part){fixture_body(&mesh, &material), &p1, x, v, NULL, NULL, nv, blocks, block_part,
                    node_part, {0, 2, block_part, node_part, &p0, sum_from_other, share_from_other,
-                               blocks_from_other}};
+                               blocks_from_other, NULL, NULL, NULL}};
   p1.split.context = &p1;
   p0.split.context = &p0;
   assert_int_equal(piola_elastic_body_set_work_split(p1.body, &p1.split), PIOLA_OK);

@@ -276,6 +276,7 @@ static int run(int argc, char **argv, run_mpi *mpi) {
   int max_inverted = 0;
   double sim_start = now_seconds();
   piola_frame_info info = {0};
+  if (resume_frame < 0) run_mpi_collect(mpi, world); /* process 0 writes frame 0 */
   if (resume_frame >= 0 || !lead) {
     /* frames up to resume_frame are on disk already; only process 0 writes */
   } else if (piola_output_write_frame(out, world, &info) != PIOLA_OK) {
@@ -293,8 +294,9 @@ static int run(int argc, char **argv, run_mpi *mpi) {
     double t0 = now_seconds();
     piola_step_stats st = {0};
     if (piola_world_advance_to(world, frame / fps, &st) != PIOLA_OK) {
-      /* every MPI process fails the same step: their states are the same bits */
+      /* every MPI process fails the same step: their node states are the same bits */
       rc = 1;
+      run_mpi_collect(mpi, world); /* for the failure report */
       if (!lead) break;
       char message[1024];
       snprintf(message, sizeof message, "%s", piola_last_error());
@@ -326,7 +328,8 @@ static int run(int argc, char **argv, run_mpi *mpi) {
     total_steps += st.substeps;
     total_cg += st.cg_iterations;
     int inverted = 0;
-    for (int32_t s = 0; s < piola_world_solid_count(world); ++s)
+    run_mpi_collect(mpi, world); /* process 0 alone reads the per-tet state, from here on */
+    for (int32_t s = 0; lead && s < piola_world_solid_count(world); ++s)
       inverted += piola_world_solid_stats(world, s).inverted_count;
     if (inverted > max_inverted) max_inverted = inverted;
     if (!run_mpi_all(mpi, !lead || piola_output_write_frame(out, world, &info) == PIOLA_OK)) {

@@ -17,6 +17,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <sys/resource.h>
+#include <unistd.h>
 
 #include "support/bench_support.h"
 #include "piola/mpi.h"
@@ -78,13 +79,21 @@ int main(int argc, char **argv) {
   const double total_steps = (double)steps * repeats;
   struct rusage usage;
   getrusage(RUSAGE_SELF, &usage); /* ru_maxrss: KiB on Linux */
-  double mine[6] = {(after.halo_seconds - before.halo_seconds) / total_steps,
+  double resident = 0; /* now, after the steps: /proc/self/statm's second field, in pages */
+  FILE *statm = fopen("/proc/self/statm", "r");
+  if (statm) {
+    long pages_total = 0, pages_resident = 0;
+    if (fscanf(statm, "%ld %ld", &pages_total, &pages_resident) == 2)
+      resident = (double)pages_resident * (double)sysconf(_SC_PAGESIZE);
+    fclose(statm);
+  }
+  double mine[7] = {(after.halo_seconds - before.halo_seconds) / total_steps,
                     (after.gather_seconds - before.gather_seconds) / total_steps,
                     (double)(after.halo_bytes - before.halo_bytes) / total_steps,
                     (double)(after.gather_bytes - before.gather_bytes) / total_steps,
-                    (double)after.shared_nodes, 1024.0 * (double)usage.ru_maxrss};
+                    (double)after.shared_nodes, 1024.0 * (double)usage.ru_maxrss, resident};
   double *all = malloc(sizeof mine * (size_t)size);
-  MPI_Gather(mine, 6, MPI_DOUBLE, all, 6, MPI_DOUBLE, 0, MPI_COMM_WORLD);
+  MPI_Gather(mine, 7, MPI_DOUBLE, all, 7, MPI_DOUBLE, 0, MPI_COMM_WORLD);
   if (rank == 0) {
     const piola_elastic_body *b = piola_world_solid_body(w, 0);
     printf("bench_mpi_weak: %d processes, %d tets (%ld per process asked), %d nodes, %d steps x %d\n",
@@ -93,11 +102,12 @@ int main(int argc, char **argv) {
     printf("  wall per step (median): %.4f s\n", bench_median(per_step, repeats));
     const double tets = (double)piola_elastic_body_tet_count(b);
     for (int q = 0; q < size; ++q) {
-      const double *a = all + 6 * q;
+      const double *a = all + 7 * q;
       printf("  rank %d: halo %.5f s/step (%.0f B sent/step), gathers %.5f s/step (%.0f B "
              "received/step), %.0f shared nodes, peak RSS %.1f MB (%.0f B per tet of the box, "
-             "%.0f B per tet of its share)\n",
-             q, a[0], a[2], a[1], a[3], a[4], a[5] / 1e6, a[5] / tets, a[5] * size / tets);
+             "%.0f B per tet of its share), resident after the steps %.1f MB (%.0f B per tet)\n",
+             q, a[0], a[2], a[1], a[3], a[4], a[5] / 1e6, a[5] / tets, a[5] * size / tets,
+             a[6] / 1e6, a[6] / tets);
     }
   }
   free(all);

@@ -99,6 +99,10 @@ piola_status piola_elastic_body_update(piola_elastic_body *body, const double *x
         return PIOLA_FAIL(PIOLA_ERROR_NOT_FINITE, "position of vertex %d is not finite",
                           (int)(i / 3));
   }
+  if (body->split_partial && !piola__local_split(body))
+    return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT,
+                      "elastic body update: the body was split among processes (local mode) and "
+                      "holds only its part; it cannot step without that split");
   int32_t blocks = body->padded_tet_count / B;
   const int64_t n = 3 * (int64_t)body->vertex_count;
   if (body->split) {

@@ -114,6 +114,7 @@ struct piola_elastic_body {
   double *split_buffer; /* replicated: block count * SPLIT_STATE_WIDTH_MAX doubles */
   int split_local;      /* the local mode */
   uint8_t *split_held;  /* local: per block, 1 for own and ghost blocks */
+  int split_partial;    /* a local split dropped the other blocks' rest data (for good) */
 };
 
 /* The split of a body in the local mode with more than one process, or NULL. */

@@ -49,12 +49,15 @@ static void mark_held(piola_elastic_body *body, const piola_work_split *split) {
   }
 }
 
-/* Local mode: fresh per-tet state arrays in which only the held blocks are written (the rest
- * state's U = V = I, Fhat = (1, 1, 1), det F = 1), so the memory of the other blocks is never
- * touched (calloc leaves fresh pages unmapped until written); the old arrays, written for
- * every tet by the rest state, are freed. */
+/* Local mode: fresh per-tet arrays (state, Dm^-1, damping slots) in which only the held
+ * blocks are written, so the memory of the other blocks is never touched (calloc leaves fresh
+ * pages unmapped until written); the old arrays, written for every tet, are freed. From here
+ * on the body is partial: it can only step with this split (piola_elastic_body_update
+ * refuses it without one). The step bound's per-tet weights were built from every tet's
+ * Dm^-1 when the solid was added (world_solids.c). */
 static int localize_state(piola_elastic_body *body) {
   const size_t np = (size_t)body->padded_tet_count;
+  body->split_partial = 1; /* also when this fails half way */
   double *u = calloc(9 * np, sizeof(double)), *v = calloc(9 * np, sizeof(double));
   double *fhat = calloc(3 * np, sizeof(double)), *det = calloc(np, sizeof(double));
   double *psi = calloc(np, sizeof(double));
@@ -84,6 +87,31 @@ static int localize_state(piola_elastic_body *body) {
   body->fhat = fhat;
   body->det_f = det;
   body->energy_density = psi;
+  /* the rest data only held blocks read: Dm^-1 and the damping matrix's tet slots */
+  for (int k = 0; k < 9; ++k) {
+    double *d = calloc(np, sizeof(double));
+    if (!d) return 0;
+    for (size_t b = 0; b < np / B; ++b)
+      if (body->split_held[b]) memcpy(d + b * B, body->dm_inv[k] + b * B, B * sizeof(double));
+    free(body->dm_inv[k]);
+    body->dm_inv[k] = d;
+  }
+  const size_t nt = (size_t)body->tet_count;
+  piola__damping_matrix *m = &body->damping;
+  int32_t *slot = calloc(6 * (nt > 0 ? nt : 1), sizeof(int32_t));
+  uint16_t *flags = calloc(nt > 0 ? nt : 1, sizeof(uint16_t));
+  if (!slot || !flags) {
+    free(slot), free(flags);
+    return 0;
+  }
+  for (size_t t = 0; t < nt; ++t)
+    if (body->split_held[t / B]) {
+      memcpy(slot + 6 * t, m->tet_slot + 6 * t, 6 * sizeof(int32_t));
+      flags[t] = m->tet_flags[t];
+    }
+  free(m->tet_slot), free(m->tet_flags);
+  m->tet_slot = slot;
+  m->tet_flags = flags;
   return 1;
 }
 
@@ -101,6 +129,9 @@ piola_status piola__elastic_body_set_work_split(piola_elastic_body *body,
   if (!body) return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "work split: body is NULL");
   piola__elastic_body_split_free(body);
   if (!split) return PIOLA_OK;
+  if (body->split_partial)
+    return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT,
+                      "work split: the body holds only its part of an earlier split (local mode)");
   if (split->part_count < 1 || split->part < 0 || split->part >= split->part_count ||
       !split->block_part || !split->node_part || !split->sum_nodes || !split->share_nodes ||
       !split->share_blocks)

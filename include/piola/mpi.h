@@ -38,6 +38,9 @@ typedef struct piola_mpi_split_stats {
   int64_t gather_bytes;    /* bytes this process received in the replication gathers so far */
   double halo_seconds;     /* s spent in halo exchanges (pack, wait, sum) so far */
   double gather_seconds;   /* s spent in the replication gathers so far */
+  double exchange_cpu_seconds; /* s of CPU time of the calling thread in all the exchanges
+                                  (halo, ghosts, gathers, reductions) so far: the rest of a
+                                  step's CPU time is its own work */
 } piola_mpi_split_stats;
 
 /* Splits every solid of world among the processes of MPI_COMM_WORLD (MPI initialized).

@@ -26,6 +26,7 @@
 #include <mpi.h>
 #include <stdlib.h>
 #include <string.h>
+#include <time.h>
 
 #include "common/status_report.h"
 #include "piola/mpi.h"
@@ -62,6 +63,13 @@ struct piola_mpi_split {
   piola_mpi_split_stats stats;
 };
 
+/* CPU time of the calling thread, s (the exchanges' own CPU share, docs/scaling.md). */
+static double cpu_now(void) {
+  struct timespec t;
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
+  return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
+}
+
 static void plan_free(solid_plan *p) {
   free(p->block_part), free(p->node_part), free(p->node_order), free(p->node_start);
   free(p->block_order), free(p->block_start), free(p->neighbors), free(p->send_start);
@@ -89,7 +97,7 @@ static int ensure_gather(solid_plan *p, size_t doubles) {
 static void share_items(solid_plan *p, double *values, int32_t width, const int32_t *order,
                         const int32_t *start) {
   piola_mpi_split *s = p->owner;
-  double t0 = MPI_Wtime();
+  double t0 = MPI_Wtime(), c0 = cpu_now();
   const int32_t total = start[s->size];
   if (!ensure_gather(p, (size_t)total * (size_t)width))
     MPI_Abort(MPI_COMM_WORLD, 1); /* the processes cannot go on apart */
@@ -108,6 +116,7 @@ static void share_items(solid_plan *p, double *values, int32_t width, const int3
              (size_t)width * sizeof(double));
   s->stats.gather_bytes += (int64_t)(total - (start[s->rank + 1] - start[s->rank])) * width * 8;
   s->stats.gather_seconds += MPI_Wtime() - t0;
+  s->stats.exchange_cpu_seconds += cpu_now() - c0;
 }
 
 static void share_nodes(void *context, double *values) {
@@ -123,7 +132,7 @@ static void share_blocks(void *context, double *values, int32_t width) {
 static void sum_nodes(void *context, double *values) {
   solid_plan *p = context;
   piola_mpi_split *s = p->owner;
-  double t0 = MPI_Wtime();
+  double t0 = MPI_Wtime(), c0 = cpu_now();
   int r = 0;
   for (int32_t k = 0; k < p->neighbor_count; ++k) {
     const int32_t n0 = p->recv_start[k], n1 = p->recv_start[k + 1];
@@ -147,6 +156,7 @@ static void sum_nodes(void *context, double *values) {
     for (int32_t j = p->recv_start[k]; j < p->recv_start[k + 1]; ++j)
       for (int c = 0; c < 3; ++c) values[3 * (size_t)p->recv_nodes[j] + c] += p->recv_values[3 * (size_t)j + c];
   s->stats.halo_seconds += MPI_Wtime() - t0;
+  s->stats.exchange_cpu_seconds += cpu_now() - c0;
   share_nodes(context, values);
 }
 
@@ -163,7 +173,7 @@ static void share_ghosts(void *context, void *owner, piola_work_split_pack pack,
                          piola_work_split_unpack unpack, int32_t width) {
   solid_plan *p = context;
   piola_mpi_split *s = p->owner;
-  double t0 = MPI_Wtime();
+  double t0 = MPI_Wtime(), c0 = cpu_now();
   const int32_t nk = p->ghost_neighbor_count;
   const size_t sends = (size_t)p->ghost_send_start[nk], recvs = (size_t)p->ghost_recv_start[nk];
   double *buf = ensure(&p->ghost_buffer, &p->ghost_capacity, (sends + recvs) * (size_t)width);
@@ -186,12 +196,14 @@ static void share_ghosts(void *context, void *owner, piola_work_split_pack pack,
   MPI_Waitall(r, p->requests, MPI_STATUSES_IGNORE);
   for (size_t j = 0; j < recvs; ++j) unpack(owner, p->ghost_recv[j], in + j * (size_t)width);
   s->stats.halo_seconds += MPI_Wtime() - t0;
+  s->stats.exchange_cpu_seconds += cpu_now() - c0;
 }
 
 static void reduce(void *context, double *values, int32_t count, piola_work_split_reduction op) {
   solid_plan *p = context;
   piola_mpi_split *s = p->owner;
   if (count > REDUCE_MAX) MPI_Abort(MPI_COMM_WORLD, 1); /* a programming error */
+  const double c0 = cpu_now();
   MPI_Allgather(values, count, MPI_DOUBLE, p->reduce_buffer, count, MPI_DOUBLE, MPI_COMM_WORLD);
   for (int32_t i = 0; i < count; ++i) {
     double r = p->reduce_buffer[i];
@@ -201,13 +213,14 @@ static void reduce(void *context, double *values, int32_t count, piola_work_spli
     }
     values[i] = r;
   }
+  s->stats.exchange_cpu_seconds += cpu_now() - c0;
 }
 
 static void collect_blocks(void *context, void *owner, piola_work_split_pack pack,
                            piola_work_split_unpack unpack, int32_t width) {
   solid_plan *p = context;
   piola_mpi_split *s = p->owner;
-  double t0 = MPI_Wtime();
+  double t0 = MPI_Wtime(), c0 = cpu_now();
   const int32_t *start = p->block_start, *order = p->block_order;
   const int32_t mine = start[s->rank + 1] - start[s->rank];
   /* process 0 receives every other process's blocks, the others send theirs */
@@ -229,6 +242,7 @@ static void collect_blocks(void *context, void *owner, piola_work_split_pack pac
     s->stats.gather_bytes += 8 * (int64_t)items * width;
   }
   s->stats.gather_seconds += MPI_Wtime() - t0;
+  s->stats.exchange_cpu_seconds += cpu_now() - c0;
 }
 
 /* Ghost plan: the blocks this process sends to each neighbour (its blocks with a tet on a

@@ -262,11 +262,12 @@ static int run(int argc, char **argv, run_mpi *mpi) {
   bool tty = lead && isatty(STDERR_FILENO);
   bool warned[PIOLA_WARNING_KIND_COUNT] = {false};
   report_warnings(out, world, warned, false);
+  const double first_dt = piola_world_stable_dt(world); /* collective when split: all ask */
   if (lead)
     fprintf(stderr, "piola run: %s -> %s: %d frames at %g fps, %d solids, %d shells, %d obstacles, first dt %.3g s%s\n",
             scene_path, out_dir, frames, fps, (int)piola_world_solid_count(world),
             (int)piola_world_shell_count(world), (int)piola_world_obstacle_count(world),
-            piola_world_stable_dt(world), mpi->size > 1 ? ", on MPI processes" : "");
+            first_dt, mpi->size > 1 ? ", on MPI processes" : "");
   /* previews (src/render): DIR/scene.json, DIR/preview.png and, with --render, every frame */
   piola_preview *preview = NULL;
   if (lead && piola_preview_open(out_dir, scene_path, render_frames, &preview) != PIOLA_OK)

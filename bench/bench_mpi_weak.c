@@ -8,12 +8,22 @@
  * nu = 0.4) with shear and bulk viscosity, starting stretched by 10% along x and swinging
  * back under gravity; steps of 1e-4 s. Each repeat times STEPS steps (median over repeats),
  * and process 0 prints: tets, steps, wall s/step, each process's time in the halo sums and
- * in the replication gathers per step, and their bytes per step. Efficiency of weak scaling
- * is the 1-process s/step over the P-process one. Only built with PIOLA_MPI. */
+ * in the replication gathers per step, and their bytes per step, and its peak resident
+ * memory (the largest over the run: setup, partition and steps) per tet of the box, and
+ * its thread's CPU time per step, less what the exchanges took of it (their polling
+ * included): the process's own work, which on a loaded machine scales where the wall time,
+ * waiting for the other process's time slice, does not.
+ * Efficiency of weak scaling is the 1-process s/step over the P-process one. The box is
+ * generated in memory (piola_tet_mesh_box_grid), no mesh file. Only built with PIOLA_MPI. */
 #include <math.h>
 #include <mpi.h>
 #include <stdio.h>
 #include <stdlib.h>
+#include <sys/resource.h>
+#include <time.h>
+#include <unistd.h>
+
+#include "piola/threads.h"
 
 #include "support/bench_support.h"
 #include "piola/mpi.h"
@@ -45,8 +55,15 @@ static piola_world *jelly_box(int n, int stack) {
   return w;
 }
 
+static double thread_cpu_seconds(void) {
+  struct timespec t;
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
+  return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
+}
+
 int main(int argc, char **argv) {
   MPI_Init(&argc, &argv);
+  piola_set_thread_count(1); /* one thread per process */
   int rank, size;
   MPI_Comm_rank(MPI_COMM_WORLD, &rank);
   MPI_Comm_size(MPI_COMM_WORLD, &size);
@@ -63,33 +80,54 @@ int main(int argc, char **argv) {
   piola_mpi_split_stats before = piola_mpi_split_stats_of(split);
   (void)piola_world_step(w, 0, NULL); /* warm-up */
   before = piola_mpi_split_stats_of(split);
+  double cpu = 0; /* the steps' CPU time, not the barriers' */
   for (int r = 0; r < repeats; ++r) {
     MPI_Barrier(MPI_COMM_WORLD);
-    double t0 = bench_wall_seconds();
+    double t0 = bench_wall_seconds(), c0 = thread_cpu_seconds();
     for (int s = 0; s < steps; ++s)
       if (piola_world_step(w, 0, NULL) != PIOLA_OK) MPI_Abort(MPI_COMM_WORLD, 1);
+    cpu += thread_cpu_seconds() - c0;
     MPI_Barrier(MPI_COMM_WORLD);
     per_step[r] = (bench_wall_seconds() - t0) / steps;
   }
   piola_mpi_split_stats after = piola_mpi_split_stats_of(split);
   const double total_steps = (double)steps * repeats;
-  double mine[5] = {(after.halo_seconds - before.halo_seconds) / total_steps,
+  struct rusage usage;
+  getrusage(RUSAGE_SELF, &usage); /* ru_maxrss: KiB on Linux */
+  double resident = 0; /* now, after the steps: /proc/self/statm's second field, in pages */
+  FILE *statm = fopen("/proc/self/statm", "r");
+  if (statm) {
+    long pages_total = 0, pages_resident = 0;
+    if (fscanf(statm, "%ld %ld", &pages_total, &pages_resident) == 2)
+      resident = (double)pages_resident * (double)sysconf(_SC_PAGESIZE);
+    fclose(statm);
+  }
+  double mine[9] = {(after.halo_seconds - before.halo_seconds) / total_steps,
                     (after.gather_seconds - before.gather_seconds) / total_steps,
                     (double)(after.halo_bytes - before.halo_bytes) / total_steps,
                     (double)(after.gather_bytes - before.gather_bytes) / total_steps,
-                    (double)after.shared_nodes};
+                    (double)after.shared_nodes, 1024.0 * (double)usage.ru_maxrss, resident,
+                    cpu / total_steps,
+                    (after.exchange_cpu_seconds - before.exchange_cpu_seconds) / total_steps};
   double *all = malloc(sizeof mine * (size_t)size);
-  MPI_Gather(mine, 5, MPI_DOUBLE, all, 5, MPI_DOUBLE, 0, MPI_COMM_WORLD);
+  MPI_Gather(mine, 9, MPI_DOUBLE, all, 9, MPI_DOUBLE, 0, MPI_COMM_WORLD);
   if (rank == 0) {
     const piola_elastic_body *b = piola_world_solid_body(w, 0);
     printf("bench_mpi_weak: %d processes, %d tets (%ld per process asked), %d nodes, %d steps x %d\n",
            size, (int)piola_elastic_body_tet_count(b), per_process,
            (int)piola_elastic_body_vertex_count(b), steps, repeats);
     printf("  wall per step (median): %.4f s\n", bench_median(per_step, repeats));
-    for (int q = 0; q < size; ++q)
+    const double tets = (double)piola_elastic_body_tet_count(b);
+    for (int q = 0; q < size; ++q) {
+      const double *a = all + 9 * q;
       printf("  rank %d: halo %.5f s/step (%.0f B sent/step), gathers %.5f s/step (%.0f B "
-             "received/step), %.0f shared nodes\n",
-             q, all[5 * q], all[5 * q + 2], all[5 * q + 1], all[5 * q + 3], all[5 * q + 4]);
+             "received/step), %.0f shared nodes, peak RSS %.1f MB (%.0f B per tet of the box, "
+             "%.0f B per tet of its share), resident after the steps %.1f MB (%.0f B per tet)\n",
+             q, a[0], a[2], a[1], a[3], a[4], a[5] / 1e6, a[5] / tets, a[5] * size / tets,
+             a[6] / 1e6, a[6] / tets);
+      printf("  rank %d: CPU %.5f s/step, of which exchanges %.5f: own work %.5f s/step\n", q,
+             a[7], a[8], a[7] - a[8]);
+    }
   }
   free(all);
   free(per_step);

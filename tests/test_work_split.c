@@ -8,6 +8,10 @@
  *    the elastic forces equal the whole loop's to rounding (shared nodes add the parts'
  *    partial sums, in another order);
  *  - both for a small body (one serial pass) and for one large enough for the chunked loop;
+ *  - in the local mode (part 0 holds its own blocks and the ghost blocks part 1 sends), its
+ *    own tets' state and the damping forces of every node are the same bits (the ghosts
+ *    matter: without them part 0's rows differ), and the body, once its split is taken off,
+ *    refuses to step alone or to be split again;
  *  - splits with parts out of range or missing operations are refused. */
 #include "test_support.h"
 
@@ -67,6 +71,45 @@ static void blocks_from_other(void *context, double *values, int32_t width) {
              sizeof(double) * (size_t)width);
 }
 
+/* The local mode's ghost blocks: part 1's blocks with a tet on a node part 0 owns. */
+static int ghost_of_part0(const fake_part *p, const int32_t *tv, int32_t tet_count, int32_t b) {
+  if (p->block_part[b] != 1) return 0;
+  for (int32_t t = b * PIOLA_WORK_SPLIT_BLOCK; t < (b + 1) * PIOLA_WORK_SPLIT_BLOCK && t < tet_count; ++t)
+    for (int c = 0; c < 4; ++c)
+      if (p->node_part[tv[4 * t + c]] == 0) return 1;
+  return 0;
+}
+/* part 1: record what it would send to part 0 */
+static void record_ghosts(void *context, void *owner, piola_work_split_pack pack,
+                          piola_work_split_unpack unpack, int32_t width) {
+  fake_part *p = context;
+  (void)unpack;
+  const int32_t *tv = piola_elastic_body_tets(p->body);
+  const int32_t nt = piola_elastic_body_tet_count(p->body);
+  for (int32_t b = 0; b < p->block_count; ++b)
+    if (ghost_of_part0(p, tv, nt, b)) pack(owner, b, p->other_blocks + (size_t)b * (size_t)width);
+}
+/* part 0: its ghosts from part 1's record (part 1 ran inside sum_from_other) */
+static void ghosts_from_other(void *context, void *owner, piola_work_split_pack pack,
+                              piola_work_split_unpack unpack, int32_t width) {
+  fake_part *p = context;
+  (void)pack;
+  const int32_t *tv = piola_elastic_body_tets(p->body);
+  const int32_t nt = piola_elastic_body_tet_count(p->body);
+  for (int32_t b = 0; b < p->block_count; ++b)
+    if (ghost_of_part0(p, tv, nt, b))
+      unpack(owner, b, p->other->other_blocks + (size_t)b * (size_t)width);
+}
+static void unused_reduce(void *context, double *values, int32_t count, piola_work_split_reduction op) {
+  (void)context, (void)values, (void)count, (void)op;
+  fail_msg("no reduction in a force update or a damping product");
+}
+static void unused_collect(void *context, void *owner, piola_work_split_pack pack,
+                           piola_work_split_unpack unpack, int32_t width) {
+  (void)context, (void)owner, (void)pack, (void)unpack, (void)width;
+  fail_msg("no collect in a force update or a damping product");
+}
+
 static void noop_nodes(void *context, double *values) { (void)context, (void)values; }
 static void noop_blocks(void *context, double *values, int32_t width) {
   (void)context, (void)values, (void)width;
@@ -84,7 +127,7 @@ static void deformed_state(const piola_tet_mesh *mesh, double *x, double *v) {
   }
 }
 
-static void check_split(int n, int alternate) {
+static void check_split(int n, int alternate, int local) {
   piola_tet_mesh mesh = fixture_grid(n, 0.1);
   piola_material material = fixture_material(PIOLA_MODEL_NEOHOOKEAN);
   piola_elastic_body *whole = fixture_body(&mesh, &material);
@@ -99,7 +142,7 @@ static void check_split(int n, int alternate) {
 
   /* one part: the same bits */
   int32_t *all0 = calloc((size_t)blocks, sizeof(int32_t)), *nodes0 = calloc((size_t)nv, sizeof(int32_t));
-  piola_work_split one = {0, 1, all0, nodes0, NULL, noop_nodes, noop_nodes, noop_blocks};
+  piola_work_split one = {0, 1, all0, nodes0, NULL, noop_nodes, noop_nodes, noop_blocks, NULL, NULL, NULL};
   piola_elastic_body *single = fixture_body(&mesh, &material);
   assert_int_equal(piola_elastic_body_set_work_split(single, &one), PIOLA_OK);
   double *fs = malloc(sizeof(double) * 3 * (size_t)nv), *ds = malloc(sizeof(double) * 3 * (size_t)nv);
@@ -123,12 +166,18 @@ static void check_split(int n, int alternate) {
   double *block_values = malloc(sizeof(double) * 256 * (size_t)blocks);
   p1 = (fake_part){fixture_body(&mesh, &material), NULL, x, v, values, block_values, nv, blocks,
                    block_part, node_part, {1, 2, block_part, node_part, &p1, record_nodes,
-                                           record_nodes, record_blocks}};
+                                           record_nodes, record_blocks, NULL, NULL, NULL}};
   p0 = (fake_part){fixture_body(&mesh, &material), &p1, x, v, NULL, NULL, nv, blocks, block_part,
                    node_part, {0, 2, block_part, node_part, &p0, sum_from_other, share_from_other,
-                               blocks_from_other}};
+                               blocks_from_other, NULL, NULL, NULL}};
   p1.split.context = &p1;
   p0.split.context = &p0;
+  if (local) {
+    p1.split.share_ghosts = record_ghosts;
+    p0.split.share_ghosts = ghosts_from_other;
+    p0.split.reduce = p1.split.reduce = unused_reduce;
+    p0.split.collect_blocks = p1.split.collect_blocks = unused_collect;
+  }
   assert_int_equal(piola_elastic_body_set_work_split(p1.body, &p1.split), PIOLA_OK);
   assert_int_equal(piola_elastic_body_set_work_split(p0.body, &p0.split), PIOLA_OK);
   double *f0 = malloc(sizeof(double) * 3 * (size_t)nv), *d0 = malloc(sizeof(double) * 3 * (size_t)nv);
@@ -137,13 +186,31 @@ static void check_split(int n, int alternate) {
   assert_true(scale > 0);
   for (int32_t i = 0; i < 3 * nv; ++i) worst = fmax(worst, fabs(f0[i] - f[i]));
   assert_true(worst <= 1e-13 * scale);
-  assert_memory_equal(piola_elastic_body_det_f(p0.body), piola_elastic_body_det_f(whole),
-                      sizeof(double) * (size_t)nt);
-  assert_memory_equal(piola_elastic_body_fhat(p0.body), piola_elastic_body_fhat(whole),
-                      sizeof(double) * 3 * (size_t)nt);
-  /* the damping rows use the shared rotations: the same bits as the whole body's */
+  assert_int_equal(piola_elastic_body_split_is_local(p0.body), local);
+  if (local) { /* part 0 holds the state of its own tets */
+    for (int32_t t = 0; t < nt; ++t) {
+      if (block_part[t / PIOLA_WORK_SPLIT_BLOCK] != 0) continue;
+      assert_memory_equal(&piola_elastic_body_det_f(p0.body)[t], &piola_elastic_body_det_f(whole)[t],
+                          sizeof(double));
+      assert_memory_equal(piola_elastic_body_fhat(p0.body) + 3 * t,
+                          piola_elastic_body_fhat(whole) + 3 * t, 3 * sizeof(double));
+    }
+  } else {
+    assert_memory_equal(piola_elastic_body_det_f(p0.body), piola_elastic_body_det_f(whole),
+                        sizeof(double) * (size_t)nt);
+    assert_memory_equal(piola_elastic_body_fhat(p0.body), piola_elastic_body_fhat(whole),
+                        sizeof(double) * 3 * (size_t)nt);
+  }
+  /* the damping rows use the shared (replicated) or ghost (local) rotations: the same bits
+   * as the whole body's */
   piola_elastic_body_damping_forces(p0.body, v, 0.7, 0.3, d0);
   assert_memory_equal(d0, d, sizeof(double) * 3 * (size_t)nv);
+  if (local) {
+    /* a local split keeps only its part: the body cannot step alone again, nor be split anew */
+    assert_int_equal(piola_elastic_body_set_work_split(p0.body, NULL), PIOLA_OK);
+    assert_int_equal(piola_elastic_body_update(p0.body, x, 1.0, f0, NULL), PIOLA_ERROR_INVALID_ARGUMENT);
+    assert_int_equal(piola_elastic_body_set_work_split(p0.body, &p0.split), PIOLA_ERROR_INVALID_ARGUMENT);
+  }
 
   /* refused splits */
   piola_work_split bad = p0.split;
@@ -171,19 +238,32 @@ static void check_split(int n, int alternate) {
 
 static void small_body_halves(void **state) {
   (void)state;
-  check_split(3, 0);
+  check_split(3, 0, 0);
 }
 static void small_body_alternating_blocks(void **state) {
   (void)state;
-  check_split(3, 1);
+  check_split(3, 1, 0);
 }
 static void chunked_body_halves(void **state) {
   (void)state;
-  check_split(12, 0); /* 10,368 tets: 1,296 blocks, 648 per part, the chunked loop */
+  check_split(12, 0, 0); /* 10,368 tets: 1,296 blocks, 648 per part, the chunked loop */
 }
 static void chunked_body_alternating_blocks(void **state) {
   (void)state;
-  check_split(12, 1);
+  check_split(12, 1, 0);
+}
+/* The local mode: part 0 holds its blocks and the ghosts part 1 sends. */
+static void local_small_body_halves(void **state) {
+  (void)state;
+  check_split(3, 0, 1);
+}
+static void local_small_body_alternating_blocks(void **state) {
+  (void)state;
+  check_split(3, 1, 1);
+}
+static void local_chunked_body_halves(void **state) {
+  (void)state;
+  check_split(12, 0, 1);
 }
 
 int main(void) {
@@ -192,6 +272,9 @@ int main(void) {
       cmocka_unit_test(small_body_alternating_blocks),
       cmocka_unit_test(chunked_body_halves),
       cmocka_unit_test(chunked_body_alternating_blocks),
+      cmocka_unit_test(local_small_body_halves),
+      cmocka_unit_test(local_small_body_alternating_blocks),
+      cmocka_unit_test(local_chunked_body_halves),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -4,9 +4,12 @@
  * initializes MPI; piola_mpi_split_world then splits the per-tet work of every solid of
  * `world` among the processes of MPI_COMM_WORLD: METIS partitions each solid's blocks of
  * PIOLA_WORK_SPLIT_BLOCK tets (their dual graph, weighted by real tets), and each process
- * computes the force loop of its blocks and the damping rows of its nodes
- * (piola/work_split.h). Every process must build the same world and call this, and then
- * step it in the same way: the states stay bit-identical on all of them.
+ * computes the force loop of its blocks and the damping rows of its nodes; solids without
+ * plasticity keep only their own and ghost blocks' per-tet state (the local mode,
+ * piola/work_split.h). Every process must build the same world and call this, and then
+ * step it in the same way: the node states stay bit-identical on all of them. Before
+ * process 0 reads per-tet state (frames, statistics), every process calls
+ * piola_world_split_collect.
  *
  *   MPI_Init(&argc, &argv);
  *   piola_mpi_split *split;
@@ -34,10 +37,14 @@ typedef struct piola_mpi_split_stats {
   int64_t tets;            /* real tets whose force loop this process runs, all solids */
   int64_t owned_nodes;     /* nodes whose damping rows this process computes */
   int64_t shared_nodes;    /* nodes of this process's tets that other processes' tets touch */
-  int64_t halo_bytes;      /* bytes this process sent in halo messages so far */
-  int64_t gather_bytes;    /* bytes this process received in the replication gathers so far */
+  int64_t halo_bytes;      /* bytes this process sent in halo messages (node sums and ghost
+                              blocks) so far */
+  int64_t gather_bytes;    /* bytes this process received in the gathers (nodes, blocks) so far */
   double halo_seconds;     /* s spent in halo exchanges (pack, wait, sum) so far */
-  double gather_seconds;   /* s spent in the replication gathers so far */
+  double gather_seconds;   /* s spent in the gathers so far */
+  double exchange_cpu_seconds; /* s of CPU time of the calling thread in all the exchanges
+                                  (halo, ghosts, gathers, reductions) so far: the rest of a
+                                  step's CPU time is its own work */
 } piola_mpi_split_stats;
 
 /* Splits every solid of world among the processes of MPI_COMM_WORLD (MPI initialized).

@@ -3,19 +3,29 @@
  * The core knows nothing of MPI: a process that runs with others (libpiola_mpi,
  * docs/mpi.md) hands each elastic body a piola_work_split, which says which blocks of
  * PIOLA_WORK_SPLIT_BLOCK consecutive tets this process computes and which process owns each
- * node, and gives the three collective operations the body calls. Every process keeps the
- * whole body (positions, velocities, per-tet state): the split divides the work of the
- * force loop and of the damping products, not the memory.
+ * node, and gives the collective operations the body calls. Every process keeps the whole
+ * mesh and the whole node state (positions, velocities, forces); the split divides the work
+ * of the force loop and of the damping products, and, in the local mode, the per-tet state.
  *
  * With a split set, piola_elastic_body_update runs the force loop (F, its diagonalization,
- * stress, muscle fibres, nodal forces) on this process's blocks only, then
- *   - sum_nodes turns each process's partial nodal forces (3 per node, zero away from its
- *     tets) into the total on every process, bit-identical on all of them;
- *   - share_blocks gives every process every block's per-tet state (width doubles per block,
- *     written by the block's process);
- * and the damping products compute the rows of this process's nodes only, then
- *   - share_nodes gives every process every node's 3 values (written by the node's owner).
- * All processes must make the same calls in the same order (they do: their states are
+ * stress, muscle fibres, nodal forces) on this process's blocks only, then sum_nodes turns
+ * each process's partial nodal forces (3 per node, zero away from its tets) into the total on
+ * every process, bit-identical on all of them, and the damping products compute the rows of
+ * this process's nodes only, then share_nodes gives every process every node's 3 values
+ * (written by the node's owner). What happens to the per-tet state (U, V, Fhat, det F) of
+ * the force loop depends on the mode:
+ *   - replicated (a split without the local operations, or a solid with plasticity, whose
+ *     return mapping runs on every tet of every process): share_blocks gives every process
+ *     every block's state, written by the block's process;
+ *   - local (share_ghosts, reduce and collect_blocks given, no plasticity): a process holds
+ *     the state of its own blocks and of its ghost blocks, the other processes' blocks with
+ *     a tet on one of its nodes (the damping rows of its nodes need their rotations), which
+ *     share_ghosts brings (U and V); the step bound and the statistics of
+ *     piola_elastic_body_update are reduced over the processes. The state of the other
+ *     blocks is never written here: its memory stays untouched (allocated, not resident),
+ *     and the getters (det F, Fhat, energy density) hold it only on process 0 after
+ *     piola_world_split_collect.
+ * All processes must make the same calls in the same order (they do: their node states are
  * bit-identical). */
 #ifndef PIOLA_WORK_SPLIT_H
 #define PIOLA_WORK_SPLIT_H
@@ -34,6 +44,17 @@ extern "C" {
 /* Tets per block: the force loop's SIMD group, the unit of work a split assigns. */
 #define PIOLA_WORK_SPLIT_BLOCK 8
 
+/* Reductions of piola_work_split.reduce. */
+typedef enum piola_work_split_reduction {
+  PIOLA_WORK_SPLIT_SUM, /* summed in process order, the same bits on every process */
+  PIOLA_WORK_SPLIT_MAX,
+  PIOLA_WORK_SPLIT_MIN
+} piola_work_split_reduction;
+
+/* Writes block `block`'s values (width doubles) to out, or reads them from in. */
+typedef void (*piola_work_split_pack)(void *owner, int32_t block, double *out);
+typedef void (*piola_work_split_unpack)(void *owner, int32_t block, const double *in);
+
 typedef struct piola_work_split {
   int32_t part;              /* this process, 0 .. part_count - 1 */
   int32_t part_count;
@@ -43,6 +64,16 @@ typedef struct piola_work_split {
   void (*sum_nodes)(void *context, double *values);
   void (*share_nodes)(void *context, double *values);
   void (*share_blocks)(void *context, double *values, int32_t width);
+  /* The local mode's operations (all NULL: the replicated mode). share_ghosts: each process
+   * packs those of its blocks that have a tet on a node another process owns and sends them
+   * there; each receiving process unpacks them (its ghost blocks). reduce: count values
+   * combined over the processes, the result on every process. collect_blocks: every block's
+   * values on process 0 (packed by the block's process; unpack runs on process 0 only). */
+  void (*share_ghosts)(void *context, void *owner, piola_work_split_pack pack,
+                       piola_work_split_unpack unpack, int32_t width);
+  void (*reduce)(void *context, double *values, int32_t count, piola_work_split_reduction op);
+  void (*collect_blocks)(void *context, void *owner, piola_work_split_pack pack,
+                         piola_work_split_unpack unpack, int32_t width);
 } piola_work_split;
 
 /* Number of blocks of PIOLA_WORK_SPLIT_BLOCK tets (the last one padded). */
@@ -52,6 +83,14 @@ PIOLA_API int32_t piola_elastic_body_block_count(const piola_elastic_body *body)
  * must outlive the body or the next call. A split with part_count 1 changes no bit. */
 PIOLA_API piola_status piola_elastic_body_set_work_split(piola_elastic_body *body,
                                                          const piola_work_split *split);
+
+/* Whether body runs its split in the local mode (above). */
+PIOLA_API int piola_elastic_body_split_is_local(const piola_elastic_body *body);
+
+/* Collective, for the frames: makes the per-tet state (Fhat, det F, energy density) of every
+ * tet whole on process 0 for every solid split in the local mode (nothing to do otherwise).
+ * Every process calls it; process 0 may then read the getters and the solid statistics. */
+PIOLA_API piola_status piola_world_split_collect(piola_world *world);
 
 /* NULL when every solid of world can be split, else why not (shells, self-collision and the
  * implicit integrators run on one process only). */

@@ -262,11 +262,12 @@ static int run(int argc, char **argv, run_mpi *mpi) {
   bool tty = lead && isatty(STDERR_FILENO);
   bool warned[PIOLA_WARNING_KIND_COUNT] = {false};
   report_warnings(out, world, warned, false);
+  const double first_dt = piola_world_stable_dt(world); /* collective when split: all ask */
   if (lead)
     fprintf(stderr, "piola run: %s -> %s: %d frames at %g fps, %d solids, %d shells, %d obstacles, first dt %.3g s%s\n",
             scene_path, out_dir, frames, fps, (int)piola_world_solid_count(world),
             (int)piola_world_shell_count(world), (int)piola_world_obstacle_count(world),
-            piola_world_stable_dt(world), mpi->size > 1 ? ", on MPI processes" : "");
+            first_dt, mpi->size > 1 ? ", on MPI processes" : "");
   /* previews (src/render): DIR/scene.json, DIR/preview.png and, with --render, every frame */
   piola_preview *preview = NULL;
   if (lead && piola_preview_open(out_dir, scene_path, render_frames, &preview) != PIOLA_OK)
@@ -276,6 +277,7 @@ static int run(int argc, char **argv, run_mpi *mpi) {
   int max_inverted = 0;
   double sim_start = now_seconds();
   piola_frame_info info = {0};
+  if (resume_frame < 0) run_mpi_collect(mpi, world); /* process 0 writes frame 0 */
   if (resume_frame >= 0 || !lead) {
     /* frames up to resume_frame are on disk already; only process 0 writes */
   } else if (piola_output_write_frame(out, world, &info) != PIOLA_OK) {
@@ -293,8 +295,9 @@ static int run(int argc, char **argv, run_mpi *mpi) {
     double t0 = now_seconds();
     piola_step_stats st = {0};
     if (piola_world_advance_to(world, frame / fps, &st) != PIOLA_OK) {
-      /* every MPI process fails the same step: their states are the same bits */
+      /* every MPI process fails the same step: their node states are the same bits */
       rc = 1;
+      run_mpi_collect(mpi, world); /* for the failure report */
       if (!lead) break;
       char message[1024];
       snprintf(message, sizeof message, "%s", piola_last_error());
@@ -326,7 +329,8 @@ static int run(int argc, char **argv, run_mpi *mpi) {
     total_steps += st.substeps;
     total_cg += st.cg_iterations;
     int inverted = 0;
-    for (int32_t s = 0; s < piola_world_solid_count(world); ++s)
+    run_mpi_collect(mpi, world); /* process 0 alone reads the per-tet state, from here on */
+    for (int32_t s = 0; lead && s < piola_world_solid_count(world); ++s)
       inverted += piola_world_solid_stats(world, s).inverted_count;
     if (inverted > max_inverted) max_inverted = inverted;
     if (!run_mpi_all(mpi, !lead || piola_output_write_frame(out, world, &info) == PIOLA_OK)) {

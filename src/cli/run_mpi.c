@@ -48,6 +48,10 @@ bool run_mpi_all(run_mpi *m, bool ok) {
   return all != 0;
 }
 
+void run_mpi_collect(run_mpi *m, piola_world *world) {
+  if (m->split) (void)piola_world_split_collect(world);
+}
+
 void run_mpi_report(run_mpi *m) {
   if (!m->split) return;
   piola_mpi_split_stats st = piola_mpi_split_stats_of(m->split);
@@ -88,6 +92,7 @@ bool run_mpi_all(run_mpi *m, bool ok) {
   (void)m;
   return ok;
 }
+void run_mpi_collect(run_mpi *m, piola_world *world) { (void)m, (void)world; }
 void run_mpi_report(run_mpi *m) { (void)m; }
 void run_mpi_finish(run_mpi *m, piola_world *world) { (void)m, (void)world; }
 

@@ -20,6 +20,9 @@ bool run_mpi_start(run_mpi *m);
 /* Splits world's solids among the processes (size > 1 only); false with a message on stderr
  * when the world has something that runs on one process only. Collective. */
 bool run_mpi_split(run_mpi *m, piola_world *world);
+/* Before process 0 reads the solids' per-tet state (a frame, statistics, a failure report):
+ * brings every process's share of it to process 0 (collective; nothing without a split). */
+void run_mpi_collect(run_mpi *m, piola_world *world);
 /* Prints each process's share and exchange figures (process 0), at the end of a run. */
 void run_mpi_report(run_mpi *m);
 /* Whether every process says ok (collective; ok itself for a single process). */

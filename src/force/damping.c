@@ -113,6 +113,12 @@ void piola__elastic_body_damping_forces_add_sparse(const piola_elastic_body *bod
                                                    double scale, double *forces) {
   piola__elastic_body_damping_prepare((piola_elastic_body *)body, shear_viscosity, bulk_viscosity);
   const piola__damping_matrix *m = &body->damping;
+  /* a split in the local mode holds the edges of its own nodes only: it adds to those, in
+   * the same order, and shares them */
+  const piola_work_split *local = piola__local_split(body);
+  const int32_t *owner = local ? local->node_part : NULL;
+  const int32_t me = local ? local->part : 0;
+#define MINE(i) (!owner || owner[i] == me)
   /* every edge with a moving end, once: from its first-ranked end if that one moves, else
    * from the other. An edge whose ends are both at rest adds exactly zero. */
   for (int32_t j = 0; j < body->vertex_count; ++j) {
@@ -123,9 +129,10 @@ void piola__elastic_body_damping_forces_add_sparse(const piola_elastic_body *bod
       const double *a = m->blocks + 9 * (size_t)k;
       double d[3] = {scale * (v[3 * i] - v[3 * j]), scale * (v[3 * i + 1] - v[3 * j + 1]),
                      scale * (v[3 * i + 2] - v[3 * j + 2])};
+      if (!MINE(i) && !MINE(j)) continue;
       for (int c = 0; c < 3; ++c) {
-        forces[3 * j + c] += a[3 * c] * d[0] + a[3 * c + 1] * d[1] + a[3 * c + 2] * d[2];
-        forces[3 * i + c] -= a[c] * d[0] + a[3 + c] * d[1] + a[6 + c] * d[2];
+        if (MINE(j)) forces[3 * j + c] += a[3 * c] * d[0] + a[3 * c + 1] * d[1] + a[3 * c + 2] * d[2];
+        if (MINE(i)) forces[3 * i + c] -= a[c] * d[0] + a[3 + c] * d[1] + a[6 + c] * d[2];
       }
     }
     for (int32_t k = m->lower_start[r]; k < m->lower_start[r + 1]; ++k) {
@@ -134,10 +141,13 @@ void piola__elastic_body_damping_forces_add_sparse(const piola_elastic_body *bod
       const double *a = m->blocks + 9 * (size_t)m->lower_edge[k];
       double d[3] = {scale * (v[3 * j] - v[3 * i]), scale * (v[3 * j + 1] - v[3 * i + 1]),
                      scale * (v[3 * j + 2] - v[3 * i + 2])};
+      if (!MINE(i) && !MINE(j)) continue;
       for (int c = 0; c < 3; ++c) {
-        forces[3 * i + c] += a[3 * c] * d[0] + a[3 * c + 1] * d[1] + a[3 * c + 2] * d[2];
-        forces[3 * j + c] -= a[c] * d[0] + a[3 + c] * d[1] + a[6 + c] * d[2];
+        if (MINE(i)) forces[3 * i + c] += a[3 * c] * d[0] + a[3 * c + 1] * d[1] + a[3 * c + 2] * d[2];
+        if (MINE(j)) forces[3 * j + c] -= a[c] * d[0] + a[3 + c] * d[1] + a[6 + c] * d[2];
       }
     }
   }
+#undef MINE
+  if (local) local->share_nodes(local->context, forces);
 }

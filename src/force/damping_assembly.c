@@ -210,7 +210,11 @@ static void assemble_part(piola__damping_matrix *m, const piola_elastic_body *bo
   const int32_t blocks = body->padded_tet_count / B;
   const int32_t b0 = piola__damping_part_start(blocks, k), b1 = piola__damping_part_start(blocks, k + 1);
   double out[54 * B];
+  /* a split in the local mode assembles only the blocks it holds: every tet on one of its
+   * nodes, so the edges of its nodes' rows get all their tets, in the same order */
+  const uint8_t *held = piola__local_split(body) ? body->split_held : NULL;
   for (int32_t b = b0; b < b1; ++b) {
+    if (held && !held[b]) continue;
     tet_blocks(body, b, beta, alpha, out);
     scatter_tets(m, b, body->tet_count, out);
   }

@@ -61,11 +61,18 @@ const double *piola_elastic_body_det_f(const piola_elastic_body *body) { return 
 const double *piola_elastic_body_energy_density(const piola_elastic_body *body) {
   if (!body->energy_valid) {
     piola_elastic_body *mutable_body = (piola_elastic_body *)body;
-    for (int32_t t = 0; t < body->tet_count; ++t)
+    /* a split in the local mode holds the state of its own blocks only */
+    const int own_only = piola__local_split(body) != NULL;
+    for (int32_t t = 0; t < body->tet_count; ++t) {
+      if (own_only && body->split->block_part[t / B] != body->split->part) {
+        t = (t / B + 1) * B - 1;
+        continue;
+      }
       mutable_body->energy_density[t] =
           body->last_stiffness_scale *
           (piola_material_energy_density(&body->materials[body->tet_material[t]], body->fhat + 3 * t) +
            piola__fiber_energy_density(body, t));
+    }
     mutable_body->energy_valid = 1;
   }
   return body->energy_density;
@@ -125,6 +132,10 @@ piola_status piola_elastic_body_update(piola_elastic_body *body, const double *x
         return PIOLA_FAIL(PIOLA_ERROR_NOT_FINITE, "position of vertex %d is not finite",
                           (int)(i / 3));
   }
+  if (body->split_partial && !piola__local_split(body))
+    return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT,
+                      "elastic body update: the body was split among processes (local mode) and "
+                      "holds only its part; it cannot step without that split");
   int32_t blocks = body->padded_tet_count / B;
   if (body->split) {
     piola__elastic_body_split_update(body, x, stiffness_scale, stats != NULL, forces);
@@ -140,10 +151,19 @@ piola_status piola_elastic_body_update(piola_elastic_body *body, const double *x
   if (stats) {
     double energy = 0, min_det = INFINITY;
     int32_t inverted = 0;
+    const piola_work_split *local = piola__local_split(body);
     for (int32_t b = 0; b < blocks; ++b) {
+      if (local && local->block_part[b] != local->part) continue; /* held elsewhere */
       energy += body->block_energy[b];
       inverted += body->block_inverted[b];
       min_det = fmin(min_det, body->block_min_det[b]);
+    }
+    if (local) {
+      double sums[2] = {energy, inverted};
+      local->reduce(local->context, sums, 2, PIOLA_WORK_SPLIT_SUM);
+      local->reduce(local->context, &min_det, 1, PIOLA_WORK_SPLIT_MIN);
+      energy = sums[0];
+      inverted = (int32_t)sums[1];
     }
     stats->elastic_energy = energy;
     stats->inverted_count = inverted;

@@ -106,12 +106,26 @@ struct piola_elastic_body {
   piola__damping_matrix damping;
 
   /* work split among processes (piola/work_split.h, work_split.c), or NULL: this process's
-   * blocks in increasing order, and the exchange buffer of the per-tet state */
+   * blocks in increasing order; in the replicated mode the exchange buffer of the per-tet
+   * state, in the local mode the blocks whose state this process holds (own and ghost) */
   const piola_work_split *split;
   int32_t *split_blocks;
   int32_t split_block_count;
-  double *split_buffer; /* block count * SPLIT_STATE_WIDTH_MAX doubles */
+  double *split_buffer; /* replicated: block count * SPLIT_STATE_WIDTH_MAX doubles */
+  int split_local;      /* the local mode */
+  uint8_t *split_held;  /* local: per block, 1 for own and ghost blocks */
+  int split_partial;    /* a local split dropped the other blocks' rest data (for good) */
 };
+
+/* The split of a body in the local mode with more than one process, or NULL. */
+static inline const piola_work_split *piola__local_split(const piola_elastic_body *body) {
+  return body->split && body->split_local && body->split->part_count > 1 ? body->split : NULL;
+}
+
+/* piola_elastic_body_set_work_split, with the local mode allowed or not (the world forbids
+ * it for solids with plasticity). */
+piola_status piola__elastic_body_set_work_split(piola_elastic_body *body,
+                                                const piola_work_split *split, int allow_local);
 
 /* A range [k0, k1) of the force loop's blocks (block indices, or positions in a block list),
  * forces added into out in tet order. */
@@ -129,6 +143,8 @@ void piola__elastic_body_sum_block_ranges(piola_elastic_body *body, const double
 void piola__elastic_body_split_update(piola_elastic_body *body, const double *x,
                                       double stiffness_scale, int want_energy, double *forces);
 void piola__elastic_body_split_free(piola_elastic_body *body);
+/* Local mode: every block's Fhat, det F and energy density onto process 0 (collective). */
+void piola__elastic_body_split_collect(piola_elastic_body *body);
 /* One or two consecutive blocks of the force loop from first, forces added into out in tet
  * order (force_lanes.c, a kernel built once per instruction set, common/isa.h; the plain
  * name runs the chosen variant). */

@@ -210,11 +210,51 @@ static double range_rate2(const piola_elastic_body *body, const double *w, int32
   return best;
 }
 
+/* A split in the local mode: the largest rate over this process's blocks (runs of consecutive
+ * blocks), then over the processes; the worst tet is the first one near it over all
+ * processes, and its Fhat is sent to every process (the warning quotes it). The maximum is
+ * exact, so every process gets the single process's bits. */
+static double local_rate2(piola_elastic_body *body, const double *w, const piola_work_split *split,
+                          int32_t *worst_tet) {
+  const int32_t nt = body->tet_count, *list = body->split_blocks, count = body->split_block_count;
+  double best = 0;
+  for (int32_t k = 0; k < count;) {
+    int32_t end = k + 1;
+    while (end < count && list[end] == list[end - 1] + 1) ++end;
+    const int32_t t0 = list[k] * PIOLA_TET_BLOCK;
+    const int32_t t1 = (list[end - 1] + 1) * PIOLA_TET_BLOCK < nt ? (list[end - 1] + 1) * PIOLA_TET_BLOCK : nt;
+    const double r = t1 > t0 ? range_rate2(body, w, t0, t1) : 0;
+    best = r > best ? r : best;
+    k = end;
+  }
+  split->reduce(split->context, &best, 1, PIOLA_WORK_SPLIT_MAX);
+  if (!worst_tet || !(best > 0)) return best;
+  double first = (double)nt;
+  for (int32_t k = 0; k < count && first == nt; ++k)
+    for (int32_t t = list[k] * PIOLA_TET_BLOCK; t < (list[k] + 1) * PIOLA_TET_BLOCK && t < nt; ++t)
+      if (w[t] * PIOLA_ISA_NAME(piola__elastic_body_tet_modulus)(body, t, body->fhat + 3 * t) >= best * (1 - 1e-12)) {
+        first = t;
+        break;
+      }
+  split->reduce(split->context, &first, 1, PIOLA_WORK_SPLIT_MIN);
+  const int32_t t = (int32_t)first;
+  if (t >= nt) return best;
+  double f[3] = {-INFINITY, -INFINITY, -INFINITY};
+  if (split->block_part[t / PIOLA_TET_BLOCK] == split->part)
+    for (int c = 0; c < 3; ++c) f[c] = body->fhat[3 * t + c];
+  split->reduce(split->context, f, 3, PIOLA_WORK_SPLIT_MAX);
+  for (int c = 0; c < 3; ++c) body->fhat[3 * t + c] = f[c];
+  *worst_tet = t;
+  return best;
+}
+
 double PIOLA_ISA_NAME(piola__elastic_body_state_rate2)(piola_elastic_body *body, int32_t *worst_tet) {
   const double *w = rate_weights(body);
   const int32_t nt = body->tet_count;
   if (worst_tet) *worst_tet = -1;
   if (!w || nt <= 0) return 0;
+  const piola_work_split *local = piola__local_split(body);
+  if (local) return local_rate2(body, w, local, worst_tet);
   enum { RANGES = 16 };
   double part[RANGES];
   const int parallel = nt >= PIOLA_PARALLEL_MIN_BLOCKS * PIOLA_TET_BLOCK;

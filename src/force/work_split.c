@@ -28,23 +28,120 @@ int32_t piola_elastic_body_block_count(const piola_elastic_body *body) {
 void piola__elastic_body_split_free(piola_elastic_body *body) {
   free(body->split_blocks);
   free(body->split_buffer);
+  free(body->split_held);
   body->split_blocks = NULL;
   body->split_buffer = NULL;
+  body->split_held = NULL;
   body->split = NULL;
   body->split_block_count = 0;
+  body->split_local = 0;
+}
+
+/* Local mode: which blocks this process holds, its own and those with a tet on one of its
+ * nodes (their rotations enter its nodes' damping rows). */
+static void mark_held(piola_elastic_body *body, const piola_work_split *split) {
+  const int32_t blocks = body->padded_tet_count / B;
+  for (int32_t b = 0; b < blocks; ++b) {
+    int held = split->block_part[b] == split->part;
+    for (int32_t t = b * B; !held && t < (b + 1) * B && t < body->tet_count; ++t)
+      for (int c = 0; c < 4; ++c) held |= split->node_part[body->tet_vertices[c][t]] == split->part;
+    body->split_held[b] = (uint8_t)held;
+  }
+}
+
+/* Local mode: fresh per-tet arrays (state, Dm^-1, damping slots) in which only the held
+ * blocks are written, so the memory of the other blocks is never touched (calloc leaves fresh
+ * pages unmapped until written); the old arrays, written for every tet, are freed. From here
+ * on the body is partial: it can only step with this split (piola_elastic_body_update
+ * refuses it without one). The step bound's per-tet weights were built from every tet's
+ * Dm^-1 when the solid was added (world_solids.c). */
+static int localize_state(piola_elastic_body *body) {
+  const size_t np = (size_t)body->padded_tet_count;
+  body->split_partial = 1; /* also when this fails half way */
+  double *u = calloc(9 * np, sizeof(double)), *v = calloc(9 * np, sizeof(double));
+  double *fhat = calloc(3 * np, sizeof(double)), *det = calloc(np, sizeof(double));
+  double *psi = calloc(np, sizeof(double));
+  if (!u || !v || !fhat || !det || !psi) {
+    free(u), free(v), free(fhat), free(det), free(psi);
+    return 0;
+  }
+  const double *u0 = body->u[0], *v0 = body->v[0];
+  for (size_t b = 0; b < np / B; ++b) {
+    if (!body->split_held[b]) continue;
+    for (size_t t = b * B; t < (b + 1) * B; ++t) {
+      for (int k = 0; k < 9; ++k) {
+        u[k * np + t] = u0[k * np + t];
+        v[k * np + t] = v0[k * np + t];
+      }
+      for (int k = 0; k < 3; ++k) fhat[3 * t + k] = body->fhat[3 * t + k];
+      det[t] = body->det_f[t];
+      psi[t] = body->energy_density[t];
+    }
+  }
+  free(body->u[0]), free(body->v[0]), free(body->fhat), free(body->det_f);
+  free(body->energy_density);
+  for (int k = 0; k < 9; ++k) {
+    body->u[k] = u + (size_t)k * np;
+    body->v[k] = v + (size_t)k * np;
+  }
+  body->fhat = fhat;
+  body->det_f = det;
+  body->energy_density = psi;
+  /* the rest data only held blocks read: Dm^-1 and the damping matrix's tet slots */
+  for (int k = 0; k < 9; ++k) {
+    double *d = calloc(np, sizeof(double));
+    if (!d) return 0;
+    for (size_t b = 0; b < np / B; ++b)
+      if (body->split_held[b]) memcpy(d + b * B, body->dm_inv[k] + b * B, B * sizeof(double));
+    free(body->dm_inv[k]);
+    body->dm_inv[k] = d;
+  }
+  const size_t nt = (size_t)body->tet_count;
+  piola__damping_matrix *m = &body->damping;
+  int32_t *slot = calloc(6 * (nt > 0 ? nt : 1), sizeof(int32_t));
+  uint16_t *flags = calloc(nt > 0 ? nt : 1, sizeof(uint16_t));
+  if (!slot || !flags) {
+    free(slot), free(flags);
+    return 0;
+  }
+  for (size_t t = 0; t < nt; ++t)
+    if (body->split_held[t / B]) {
+      memcpy(slot + 6 * t, m->tet_slot + 6 * t, 6 * sizeof(int32_t));
+      flags[t] = m->tet_flags[t];
+    }
+  free(m->tet_slot), free(m->tet_flags);
+  m->tet_slot = slot;
+  m->tet_flags = flags;
+  return 1;
+}
+
+int piola_elastic_body_split_is_local(const piola_elastic_body *body) {
+  return body && piola__local_split(body) != NULL;
 }
 
 piola_status piola_elastic_body_set_work_split(piola_elastic_body *body,
                                                const piola_work_split *split) {
+  return piola__elastic_body_set_work_split(body, split, 1);
+}
+
+piola_status piola__elastic_body_set_work_split(piola_elastic_body *body,
+                                                const piola_work_split *split, int allow_local) {
   if (!body) return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "work split: body is NULL");
   piola__elastic_body_split_free(body);
   if (!split) return PIOLA_OK;
+  if (body->split_partial)
+    return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT,
+                      "work split: the body holds only its part of an earlier split (local mode)");
   if (split->part_count < 1 || split->part < 0 || split->part >= split->part_count ||
       !split->block_part || !split->node_part || !split->sum_nodes || !split->share_nodes ||
       !split->share_blocks)
     return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT,
                       "work split: part %d of %d, or a NULL array or operation", (int)split->part,
                       (int)split->part_count);
+  const int local_ops = split->share_ghosts && split->reduce && split->collect_blocks;
+  if (!local_ops && (split->share_ghosts || split->reduce || split->collect_blocks))
+    return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT,
+                      "work split: the local mode needs share_ghosts, reduce and collect_blocks");
   const int32_t blocks = body->padded_tet_count / B;
   int32_t mine = 0;
   for (int32_t b = 0; b < blocks; ++b) {
@@ -57,15 +154,27 @@ piola_status piola_elastic_body_set_work_split(piola_elastic_body *body,
     if (split->node_part[i] < 0 || split->node_part[i] >= split->part_count)
       return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "work split: node %d has part %d of %d",
                         (int)i, (int)split->node_part[i], (int)split->part_count);
+  const int local = allow_local && local_ops && split->part_count > 1;
   body->split_blocks = malloc(sizeof(int32_t) * (size_t)(mine > 0 ? mine : 1));
-  body->split_buffer = malloc(sizeof(double) * STATE_WIDTH_MAX * (size_t)(blocks > 0 ? blocks : 1));
-  if (!body->split_blocks || !body->split_buffer) {
+  if (local)
+    body->split_held = malloc((size_t)(blocks > 0 ? blocks : 1));
+  else
+    body->split_buffer = malloc(sizeof(double) * STATE_WIDTH_MAX * (size_t)(blocks > 0 ? blocks : 1));
+  if (!body->split_blocks || (local ? !body->split_held : !body->split_buffer)) {
     piola__elastic_body_split_free(body);
     return PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "work split: out of memory");
+  }
+  if (local) {
+    mark_held(body, split);
+    if (!localize_state(body)) {
+      piola__elastic_body_split_free(body);
+      return PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "work split: out of memory");
+    }
   }
   for (int32_t b = 0; b < blocks; ++b)
     if (split->block_part[b] == split->part) body->split_blocks[body->split_block_count++] = b;
   body->split = split;
+  body->split_local = local;
   body->damping.ready = 0;
   return PIOLA_OK;
 }
@@ -108,6 +217,45 @@ static void unpack_state(piola_elastic_body *body, int32_t b, int want_energy, c
   body->block_min_det[b] = o[STATE_WIDTH + B + 2];
 }
 
+/* Local mode: a ghost block's U and V, what the damping assembly reads of it. */
+#define ROTATION_WIDTH (B * 18)
+static void pack_rotations(void *owner, int32_t b, double *o) {
+  const piola_elastic_body *body = owner;
+  const size_t base = (size_t)b * B, stride = (size_t)body->padded_tet_count;
+  for (int k = 0; k < 9; ++k) memcpy(o + k * B, body->u[0] + k * stride + base, B * sizeof(double));
+  for (int k = 0; k < 9; ++k) memcpy(o + (9 + k) * B, body->v[0] + k * stride + base, B * sizeof(double));
+}
+static void unpack_rotations(void *owner, int32_t b, const double *o) {
+  piola_elastic_body *body = owner;
+  const size_t base = (size_t)b * B, stride = (size_t)body->padded_tet_count;
+  for (int k = 0; k < 9; ++k) memcpy(body->u[0] + k * stride + base, o + k * B, B * sizeof(double));
+  for (int k = 0; k < 9; ++k) memcpy(body->v[0] + k * stride + base, o + (9 + k) * B, B * sizeof(double));
+}
+
+/* For the frames: a block's Fhat, det F and energy density. */
+#define FRAME_WIDTH (B * 5)
+static void pack_frame(void *owner, int32_t b, double *o) {
+  const piola_elastic_body *body = owner;
+  const size_t base = (size_t)b * B;
+  memcpy(o, body->fhat + 3 * base, 3 * B * sizeof(double));
+  memcpy(o + 3 * B, body->det_f + base, B * sizeof(double));
+  memcpy(o + 4 * B, body->energy_density + base, B * sizeof(double));
+}
+static void unpack_frame(void *owner, int32_t b, const double *o) {
+  piola_elastic_body *body = owner;
+  const size_t base = (size_t)b * B;
+  memcpy(body->fhat + 3 * base, o, 3 * B * sizeof(double));
+  memcpy(body->det_f + base, o + 3 * B, B * sizeof(double));
+  memcpy(body->energy_density + base, o + 4 * B, B * sizeof(double));
+}
+
+void piola__elastic_body_split_collect(piola_elastic_body *body) {
+  const piola_work_split *split = piola__local_split(body);
+  if (!split) return;
+  (void)piola_elastic_body_energy_density(body); /* this process's tets */
+  split->collect_blocks(split->context, body, pack_frame, unpack_frame, FRAME_WIDTH);
+}
+
 void piola__elastic_body_split_update(piola_elastic_body *body, const double *x,
                                       double stiffness_scale, int want_energy, double *forces) {
   const piola_work_split *split = body->split;
@@ -116,6 +264,10 @@ void piola__elastic_body_split_update(piola_elastic_body *body, const double *x,
                                        update_listed, forces);
   if (split->part_count == 1) return;
   split->sum_nodes(split->context, forces);
+  if (body->split_local) {
+    split->share_ghosts(split->context, body, pack_rotations, unpack_rotations, ROTATION_WIDTH);
+    return;
+  }
   const int32_t width = want_energy ? STATE_WIDTH_MAX : STATE_WIDTH;
   for (int32_t k = 0; k < count; ++k) {
     const int32_t b = body->split_blocks[k];

@@ -13,13 +13,20 @@
  *                neighbour pair); the owner adds them to its own in process order, so the
  *                sum has one fixed order. Then share_nodes.
  *   share_nodes  replication: MPI_Allgatherv of the owned nodes' values (3 per node).
- *   share_blocks replication: MPI_Allgatherv of each process's blocks' per-tet state.
- * The replication gathers exist because every process keeps the whole state (the first
- * design, docs/mpi.md); with owned and ghost storage only the halo would remain. */
+ *   share_blocks replication: MPI_Allgatherv of each process's blocks' per-tet state (only
+ *                for solids with plasticity, which keep the replicated mode).
+ *   share_ghosts halo of blocks (the local mode): each process sends the rotations of its
+ *                blocks with a tet on a node a neighbour owns to that neighbour (MPI_Isend /
+ *                MPI_Irecv), which holds them as ghosts for its damping rows.
+ *   reduce       MPI_Allgather of each process's values, combined in process order, so
+ *                every process gets the same bits.
+ *   collect_blocks  MPI_Gatherv of every process's blocks to process 0 (frames only). */
+#include <math.h>
 #include <metis.h>
 #include <mpi.h>
 #include <stdlib.h>
 #include <string.h>
+#include <time.h>
 
 #include "common/status_report.h"
 #include "piola/mpi.h"
@@ -37,6 +44,13 @@ typedef struct solid_plan {
   int32_t *neighbors, *send_start, *send_nodes, *recv_start, *recv_nodes;
   double *send_values, *recv_values, *gather;
   size_t gather_capacity;
+  /* ghost blocks: per neighbour (ghost_neighbors) the blocks this process sends and those it
+   * receives, increasing; the message buffer */
+  int32_t ghost_neighbor_count;
+  int32_t *ghost_neighbors, *ghost_send_start, *ghost_send, *ghost_recv_start, *ghost_recv;
+  double *ghost_buffer;
+  size_t ghost_capacity;
+  double *reduce_buffer; /* size * REDUCE_MAX doubles */
   int *counts, *displs;
   MPI_Request *requests;
   piola_work_split split;
@@ -49,12 +63,23 @@ struct piola_mpi_split {
   piola_mpi_split_stats stats;
 };
 
+/* CPU time of the calling thread, s (the exchanges' own CPU share, docs/scaling.md). */
+static double cpu_now(void) {
+  struct timespec t;
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
+  return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
+}
+
 static void plan_free(solid_plan *p) {
   free(p->block_part), free(p->node_part), free(p->node_order), free(p->node_start);
   free(p->block_order), free(p->block_start), free(p->neighbors), free(p->send_start);
   free(p->send_nodes), free(p->recv_start), free(p->recv_nodes), free(p->send_values);
   free(p->recv_values), free(p->gather), free(p->counts), free(p->displs), free(p->requests);
+  free(p->ghost_neighbors), free(p->ghost_send_start), free(p->ghost_send);
+  free(p->ghost_recv_start), free(p->ghost_recv), free(p->ghost_buffer), free(p->reduce_buffer);
 }
+
+#define REDUCE_MAX 8
 
 /* ---------------------------------------------------------------- the three operations */
 
@@ -72,7 +97,7 @@ static int ensure_gather(solid_plan *p, size_t doubles) {
 static void share_items(solid_plan *p, double *values, int32_t width, const int32_t *order,
                         const int32_t *start) {
   piola_mpi_split *s = p->owner;
-  double t0 = MPI_Wtime();
+  double t0 = MPI_Wtime(), c0 = cpu_now();
   const int32_t total = start[s->size];
   if (!ensure_gather(p, (size_t)total * (size_t)width))
     MPI_Abort(MPI_COMM_WORLD, 1); /* the processes cannot go on apart */
@@ -91,6 +116,7 @@ static void share_items(solid_plan *p, double *values, int32_t width, const int3
              (size_t)width * sizeof(double));
   s->stats.gather_bytes += (int64_t)(total - (start[s->rank + 1] - start[s->rank])) * width * 8;
   s->stats.gather_seconds += MPI_Wtime() - t0;
+  s->stats.exchange_cpu_seconds += cpu_now() - c0;
 }
 
 static void share_nodes(void *context, double *values) {
@@ -106,7 +132,7 @@ static void share_blocks(void *context, double *values, int32_t width) {
 static void sum_nodes(void *context, double *values) {
   solid_plan *p = context;
   piola_mpi_split *s = p->owner;
-  double t0 = MPI_Wtime();
+  double t0 = MPI_Wtime(), c0 = cpu_now();
   int r = 0;
   for (int32_t k = 0; k < p->neighbor_count; ++k) {
     const int32_t n0 = p->recv_start[k], n1 = p->recv_start[k + 1];
@@ -130,7 +156,155 @@ static void sum_nodes(void *context, double *values) {
     for (int32_t j = p->recv_start[k]; j < p->recv_start[k + 1]; ++j)
       for (int c = 0; c < 3; ++c) values[3 * (size_t)p->recv_nodes[j] + c] += p->recv_values[3 * (size_t)j + c];
   s->stats.halo_seconds += MPI_Wtime() - t0;
+  s->stats.exchange_cpu_seconds += cpu_now() - c0;
   share_nodes(context, values);
+}
+
+static double *ensure(double **buffer, size_t *capacity, size_t doubles) {
+  if (doubles <= *capacity) return *buffer;
+  double *g = realloc(*buffer, (doubles > 0 ? doubles : 1) * sizeof(double));
+  if (!g) MPI_Abort(MPI_COMM_WORLD, 1); /* the processes cannot go on apart */
+  *buffer = g;
+  *capacity = doubles;
+  return g;
+}
+
+static void share_ghosts(void *context, void *owner, piola_work_split_pack pack,
+                         piola_work_split_unpack unpack, int32_t width) {
+  solid_plan *p = context;
+  piola_mpi_split *s = p->owner;
+  double t0 = MPI_Wtime(), c0 = cpu_now();
+  const int32_t nk = p->ghost_neighbor_count;
+  const size_t sends = (size_t)p->ghost_send_start[nk], recvs = (size_t)p->ghost_recv_start[nk];
+  double *buf = ensure(&p->ghost_buffer, &p->ghost_capacity, (sends + recvs) * (size_t)width);
+  double *in = buf + sends * (size_t)width;
+  int r = 0;
+  for (int32_t k = 0; k < nk; ++k) {
+    const int32_t b0 = p->ghost_recv_start[k], b1 = p->ghost_recv_start[k + 1];
+    if (b1 > b0)
+      MPI_Irecv(in + (size_t)b0 * (size_t)width, (b1 - b0) * width, MPI_DOUBLE, p->ghost_neighbors[k],
+                8, MPI_COMM_WORLD, &p->requests[r++]);
+  }
+  for (int32_t k = 0; k < nk; ++k) {
+    const int32_t b0 = p->ghost_send_start[k], b1 = p->ghost_send_start[k + 1];
+    if (b1 == b0) continue;
+    for (int32_t j = b0; j < b1; ++j) pack(owner, p->ghost_send[j], buf + (size_t)j * (size_t)width);
+    MPI_Isend(buf + (size_t)b0 * (size_t)width, (b1 - b0) * width, MPI_DOUBLE, p->ghost_neighbors[k],
+              8, MPI_COMM_WORLD, &p->requests[r++]);
+    s->stats.halo_bytes += 8 * (int64_t)(b1 - b0) * width;
+  }
+  MPI_Waitall(r, p->requests, MPI_STATUSES_IGNORE);
+  for (size_t j = 0; j < recvs; ++j) unpack(owner, p->ghost_recv[j], in + j * (size_t)width);
+  s->stats.halo_seconds += MPI_Wtime() - t0;
+  s->stats.exchange_cpu_seconds += cpu_now() - c0;
+}
+
+static void reduce(void *context, double *values, int32_t count, piola_work_split_reduction op) {
+  solid_plan *p = context;
+  piola_mpi_split *s = p->owner;
+  if (count > REDUCE_MAX) MPI_Abort(MPI_COMM_WORLD, 1); /* a programming error */
+  const double c0 = cpu_now();
+  MPI_Allgather(values, count, MPI_DOUBLE, p->reduce_buffer, count, MPI_DOUBLE, MPI_COMM_WORLD);
+  for (int32_t i = 0; i < count; ++i) {
+    double r = p->reduce_buffer[i];
+    for (int q = 1; q < s->size; ++q) {
+      const double x = p->reduce_buffer[(size_t)q * (size_t)count + i];
+      r = op == PIOLA_WORK_SPLIT_SUM ? r + x : op == PIOLA_WORK_SPLIT_MAX ? fmax(r, x) : fmin(r, x);
+    }
+    values[i] = r;
+  }
+  s->stats.exchange_cpu_seconds += cpu_now() - c0;
+}
+
+static void collect_blocks(void *context, void *owner, piola_work_split_pack pack,
+                           piola_work_split_unpack unpack, int32_t width) {
+  solid_plan *p = context;
+  piola_mpi_split *s = p->owner;
+  double t0 = MPI_Wtime(), c0 = cpu_now();
+  const int32_t *start = p->block_start, *order = p->block_order;
+  const int32_t mine = start[s->rank + 1] - start[s->rank];
+  /* process 0 receives every other process's blocks, the others send theirs */
+  const size_t items = s->rank == 0 ? (size_t)(start[s->size] - mine) : (size_t)mine;
+  double *buf = ensure(&p->gather, &p->gather_capacity, items * (size_t)width);
+  if (s->rank != 0)
+    for (int32_t k = 0; k < mine; ++k) pack(owner, order[start[s->rank] + k], buf + (size_t)k * (size_t)width);
+  for (int q = 0; q < s->size; ++q) {
+    p->counts[q] = q == 0 ? 0 : (start[q + 1] - start[q]) * width;
+    p->displs[q] = q == 0 ? 0 : (start[q] - mine) * width;
+  }
+  if (s->rank == 0)
+    MPI_Gatherv(MPI_IN_PLACE, 0, MPI_DOUBLE, buf, p->counts, p->displs, MPI_DOUBLE, 0, MPI_COMM_WORLD);
+  else
+    MPI_Gatherv(buf, mine * width, MPI_DOUBLE, NULL, NULL, NULL, MPI_DOUBLE, 0, MPI_COMM_WORLD);
+  if (s->rank == 0) {
+    for (int32_t k = mine; k < start[s->size]; ++k)
+      unpack(owner, order[k], buf + (size_t)(k - mine) * (size_t)width);
+    s->stats.gather_bytes += 8 * (int64_t)items * width;
+  }
+  s->stats.gather_seconds += MPI_Wtime() - t0;
+  s->stats.exchange_cpu_seconds += cpu_now() - c0;
+}
+
+/* Ghost plan: the blocks this process sends to each neighbour (its blocks with a tet on a
+ * node the neighbour owns) and receives (the neighbour's blocks with a tet on a node owned
+ * here), the rule the core's held blocks follow (work_split.c). */
+static int plan_ghosts(solid_plan *p, const int32_t *tv, int32_t tets, int parts, int me) {
+  int32_t *send_count = calloc((size_t)parts, sizeof(int32_t));
+  int32_t *recv_count = calloc((size_t)parts, sizeof(int32_t));
+  uint8_t *seen = calloc((size_t)parts, 1);
+  int ok = send_count && recv_count && seen;
+  for (int pass = 0; ok && pass < 2; ++pass) {
+    if (pass == 1) {
+      p->ghost_neighbor_count = 0;
+      for (int q = 0; q < parts; ++q)
+        if (send_count[q] || recv_count[q]) p->ghost_neighbor_count++;
+      const int32_t nk = p->ghost_neighbor_count;
+      p->ghost_neighbors = malloc(sizeof(int32_t) * (size_t)(nk > 0 ? nk : 1));
+      p->ghost_send_start = calloc((size_t)nk + 1, sizeof(int32_t));
+      p->ghost_recv_start = calloc((size_t)nk + 1, sizeof(int32_t));
+      if (!p->ghost_neighbors || !p->ghost_send_start || !p->ghost_recv_start) {
+        ok = 0;
+        break;
+      }
+      int32_t k = 0;
+      for (int q = 0; q < parts; ++q) {
+        if (!send_count[q] && !recv_count[q]) continue;
+        p->ghost_neighbors[k] = q;
+        p->ghost_send_start[k + 1] = p->ghost_send_start[k] + send_count[q];
+        p->ghost_recv_start[k + 1] = p->ghost_recv_start[k] + recv_count[q];
+        send_count[q] = p->ghost_send_start[k]; /* now the fill positions */
+        recv_count[q] = p->ghost_recv_start[k];
+        k++;
+      }
+      p->ghost_send = malloc(sizeof(int32_t) * (size_t)(p->ghost_send_start[nk] + 1));
+      p->ghost_recv = malloc(sizeof(int32_t) * (size_t)(p->ghost_recv_start[nk] + 1));
+      if (!p->ghost_send || !p->ghost_recv) {
+        ok = 0;
+        break;
+      }
+    }
+    for (int32_t b = 0; b < p->block_count; ++b) {
+      const int own = p->block_part[b] == me;
+      int touches_me = 0;
+      memset(seen, 0, (size_t)parts);
+      for (int32_t t = b * PIOLA_WORK_SPLIT_BLOCK; t < (b + 1) * PIOLA_WORK_SPLIT_BLOCK && t < tets; ++t)
+        for (int c = 0; c < 4; ++c) {
+          const int32_t o = p->node_part[tv[4 * t + c]];
+          touches_me |= o == me;
+          if (own && o != me && !seen[o]) {
+            seen[o] = 1;
+            if (pass == 0) send_count[o]++;
+            else p->ghost_send[send_count[o]++] = b;
+          }
+        }
+      if (!own && touches_me) {
+        if (pass == 0) recv_count[p->block_part[b]]++;
+        else p->ghost_recv[recv_count[p->block_part[b]]++] = b;
+      }
+    }
+  }
+  free(send_count), free(recv_count), free(seen);
+  return ok;
 }
 
 /* ---------------------------------------------------------------- partition */
@@ -301,7 +475,9 @@ static piola_status plan_solid(piola_mpi_split *s, piola_world *world, int32_t s
   p->send_values = malloc(3 * sizeof(double) * (size_t)(sends > 0 ? sends : 1));
   p->recv_values = malloc(3 * sizeof(double) * (size_t)(recvs > 0 ? recvs : 1));
   p->requests = malloc(sizeof(MPI_Request) * 2 * (size_t)parts);
-  if (!p->send_values || !p->recv_values || !p->requests) goto oom;
+  p->reduce_buffer = malloc(sizeof(double) * REDUCE_MAX * (size_t)parts);
+  if (!p->send_values || !p->recv_values || !p->requests || !p->reduce_buffer) goto oom;
+  if (!plan_ghosts(p, tv, tets, parts, me)) goto oom;
   if (!order_by_part(p->node_part, p->node_count, parts, &p->node_order, &p->node_start) ||
       !order_by_part(p->block_part, p->block_count, parts, &p->block_order, &p->block_start))
     goto oom;
@@ -319,7 +495,10 @@ static piola_status plan_solid(piola_mpi_split *s, piola_world *world, int32_t s
                                 .context = p,
                                 .sum_nodes = sum_nodes,
                                 .share_nodes = share_nodes,
-                                .share_blocks = share_blocks};
+                                .share_blocks = share_blocks,
+                                .share_ghosts = share_ghosts,
+                                .reduce = reduce,
+                                .collect_blocks = collect_blocks};
   return piola_world_solid_set_work_split(world, solid, &p->split);
 oom:
   free(touch);

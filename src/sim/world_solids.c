@@ -268,5 +268,6 @@ piola_status piola_world_solid_set_work_split(piola_world *world, int32_t solid,
   world_body *s = (world_body *)solid_at(world, solid);
   if (!s) return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "work split: no solid %d", (int)solid);
   s->product_valid = 0;
-  return piola_elastic_body_set_work_split(s->solid, split);
+  /* plasticity's return mapping reads every tet's Fhat on every process: replicated mode */
+  return piola__elastic_body_set_work_split(s->solid, split, s->plastic == NULL);
 }

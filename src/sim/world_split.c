@@ -1,6 +1,8 @@
 /* What a world split among processes supports (piola/work_split.h): the split divides the
  * solids' force loop and damping products of the Newmark step; everything else runs the same
  * on every process. */
+#include "common/status_report.h"
+#include "force/elastic_body_internal.h"
 #include "piola/work_split.h"
 #include "sim/world_internal.h"
 
@@ -15,4 +17,15 @@ const char *piola_world_split_unsupported(const piola_world *world) {
     if (b->fracture) return "fracture runs on one process only";
   }
   return NULL;
+}
+
+piola_status piola_world_split_collect(piola_world *world) {
+  if (!world) return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "split collect: world is NULL");
+  for (int32_t i = 0; i < world->body_count; ++i) {
+    world_body *b = &world->bodies[i];
+    if (b->kind != PIOLA_BODY_SOLID || !piola__local_split(b->solid)) continue;
+    piola__elastic_body_split_collect(b->solid);
+    b->elastic_stale = 1; /* process 0's statistics now see every tet */
+  }
+  return PIOLA_OK;
 }

@@ -5,7 +5,8 @@ usage: compare_frames.py DIR_A DIR_B TOLERANCE
 
 Both folders must hold the same frame files. For every frames/*.vtu, the positions of B
 must equal A's to TOLERANCE relative: max |x_B - x_A| <= TOLERANCE * max |x_A| (the
-largest coordinate of the frame sets the scale). Prints the largest relative difference
+largest coordinate of the frame sets the scale), and the cell fields det_f and
+energy_density to 1e-6 relative to their largest magnitude. Prints the largest relative difference
 and how many frames were bit-identical. stats.csv must have the same rows (frame, time,
 substeps) and the same kinetic and elastic energies and smallest det F to 1e-6 relative.
 Exits 1 on a difference or a missing frame."""
@@ -38,6 +39,16 @@ def main():
         if not rel <= tol:
             print(f"{name}: positions differ by {rel:.3g} relative (> {tol:g})")
             return 1
+        # the per-tet fields come from every process's tets (gathered to process 0)
+        for key in ("det_f", "energy_density"):
+            ca, cb = ma.cell_data.get(key), mb.cell_data.get(key)
+            if ca is None or cb is None:
+                continue
+            ca, cb = np.concatenate(ca), np.concatenate(cb)
+            cscale = max(np.abs(ca).max(), 1e-12)
+            if ca.shape != cb.shape or not np.abs(cb - ca).max() <= max(1e-6, 1000 * tol) * cscale:
+                print(f"{name}: cell field {key} differs")
+                return 1
     # stats.csv (written by process 0 alone): the same rows, and the global energies and
     # the smallest det F within the tolerance scaled up to 1e-6 (energies are sums over
     # every node and tet; a difference of positions at rounding shows in them amplified)

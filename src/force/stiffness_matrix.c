@@ -7,6 +7,7 @@
 #include "common/status_report.h"
 #include "force/elastic_body_internal.h"
 #include "force/element_stiffness.h"
+#include "force/stiffness_lanes.h"
 #include "force/stiffness_matrix.h"
 
 static const int PAIR_A[6] = {0, 0, 0, 1, 1, 2}, PAIR_B[6] = {1, 2, 3, 2, 3, 3};
@@ -119,28 +120,46 @@ void piola__tet_stiffness_blocks(const piola_elastic_body *body, int32_t t, doub
   }
 }
 
-/* Range k of the tets (the damping assembly's ranges): blocks into their slots, transposed
- * where the edge is stored the other way round, stored by a slot's first writer. */
+/* Adds (or, for a slot's first writer, stores) weight times tet t's six blocks out[9 p + e]
+ * (entry e of pair p, at stride `stride` in out) into their slots, transposed where the edge
+ * is stored the other way round. */
+static void scatter_tet(piola__stiffness_matrix *m, const piola__damping_matrix *d, int32_t t,
+                        const double *out, size_t stride, double weight) {
+  static const int TRANSPOSE[2][9] = {{0, 1, 2, 3, 4, 5, 6, 7, 8}, {0, 3, 6, 1, 4, 7, 2, 5, 8}};
+  const int32_t *slots = d->tet_slot + 6 * (size_t)t;
+  const unsigned flags = d->tet_flags[t];
+  for (int p = 0; p < 6; ++p) {
+    double *dst = m->blocks + 9 * (size_t)slots[p];
+    const int *order = TRANSPOSE[(flags >> p) & 1];
+    if ((flags >> (6 + p)) & 1)
+      for (int e = 0; e < 9; ++e) dst[e] = weight * out[stride * (size_t)(9 * p + order[e])];
+    else
+      for (int e = 0; e < 9; ++e) dst[e] += weight * out[stride * (size_t)(9 * p + order[e])];
+  }
+}
+
+/* Range k of the tets (the damping assembly's ranges), in tet order. Whole blocks of a body
+ * without fibres go through the lane kernel (stiffness_lanes.h, the same bits), the rest
+ * tet by tet. */
 static void assemble_part(piola__stiffness_matrix *m, const piola_elastic_body *body, int k,
                           double weight) {
-  static const int TRANSPOSE[2][9] = {{0, 1, 2, 3, 4, 5, 6, 7, 8}, {0, 3, 6, 1, 4, 7, 2, 5, 8}};
   const piola__damping_matrix *d = &body->damping;
   const int32_t blocks = body->padded_tet_count / PIOLA_TET_BLOCK;
   const int32_t t0 = piola__damping_part_start(blocks, k) * PIOLA_TET_BLOCK;
   int32_t t1 = piola__damping_part_start(blocks, k + 1) * PIOLA_TET_BLOCK;
   if (t1 > body->tet_count) t1 = body->tet_count;
-  double out[54];
-  for (int32_t t = t0; t < t1; ++t) {
-    piola__tet_stiffness_blocks(body, t, out);
-    const int32_t *slots = d->tet_slot + 6 * (size_t)t;
-    const unsigned flags = d->tet_flags[t];
-    for (int p = 0; p < 6; ++p) {
-      double *dst = m->blocks + 9 * (size_t)slots[p];
-      const int *order = TRANSPOSE[(flags >> p) & 1];
-      if ((flags >> (6 + p)) & 1)
-        for (int e = 0; e < 9; ++e) dst[e] = weight * out[9 * p + order[e]];
-      else
-        for (int e = 0; e < 9; ++e) dst[e] += weight * out[9 * p + order[e]];
+  const int lanes = !body->fiber[0];
+  double out[54], lane_out[54][PIOLA_TET_BLOCK];
+  for (int32_t t = t0; t < t1;) {
+    if (lanes && t + PIOLA_TET_BLOCK <= t1) {
+      piola__stiffness_block_lanes(body, t / PIOLA_TET_BLOCK, lane_out);
+      for (int l = 0; l < PIOLA_TET_BLOCK; ++l)
+        scatter_tet(m, d, t + l, &lane_out[0][l], PIOLA_TET_BLOCK, weight);
+      t += PIOLA_TET_BLOCK;
+    } else {
+      piola__tet_stiffness_blocks(body, t, out);
+      scatter_tet(m, d, t, out, 1, weight);
+      ++t;
     }
   }
 }
@@ -208,6 +227,19 @@ void piola__stiffness_matrix_assemble(piola__stiffness_matrix *m, const piola_el
       diagonal_rows(m, d, mass, mass_weight, (int32_t)((int64_t)nv * r / RANGES),
                     (int32_t)((int64_t)nv * (r + 1) / RANGES));
   }
+}
+
+void piola__stiffness_matrix_set_mass_weight(piola__stiffness_matrix *m,
+                                             const piola_elastic_body *body, const double *mass,
+                                             double mass_weight) {
+  const piola__damping_matrix *d = &body->damping;
+  const int32_t nv = body->vertex_count;
+  enum { RANGES = 16 };
+#pragma omp parallel for schedule(static) num_threads(piola_thread_count()) \
+    if (nv >= PIOLA_PARALLEL_MIN_VERTICES)
+  for (int r = 0; r < RANGES; ++r)
+    diagonal_rows(m, d, mass, mass_weight, (int32_t)((int64_t)nv * r / RANGES),
+                  (int32_t)((int64_t)nv * (r + 1) / RANGES));
 }
 
 /* Rows r0 .. r1 - 1 of out = A p: each row gathers its edges in a fixed order, so results

@@ -48,6 +48,13 @@ void piola__stiffness_matrix_assemble(piola__stiffness_matrix *matrix,
                                       double damping_weight, const double *mass,
                                       double mass_weight);
 
+/* Recomputes the diagonal blocks and their inverses with mass_weight M, the edge blocks as
+ * last assembled: the same bits as assembling again with this mass weight, for the cost of
+ * one pass over the rows. */
+void piola__stiffness_matrix_set_mass_weight(piola__stiffness_matrix *matrix,
+                                             const piola_elastic_body *body, const double *mass,
+                                             double mass_weight);
+
 /* out = A p (3 * vertex_count). */
 void piola__stiffness_matrix_apply(const piola__stiffness_matrix *matrix,
                                    const piola_elastic_body *body, const double *mass,

@@ -486,12 +486,10 @@ static piola_status newton_iterate(const newton_problem *problem, int accept_unc
         s->quasistatic_mu = 1e-6 * trace / (3.0 * pb.total_mass);
         if (!(s->quasistatic_mu > 0)) s->quasistatic_mu = 1.0;
       }
-      piola__stiffness_matrix_assemble(&st->matrix, s->solid, pb.force_weight, 0.0, s->mass,
-                                       s->quasistatic_mu);
+      piola__stiffness_matrix_set_mass_weight(&st->matrix, s->solid, s->mass, s->quasistatic_mu);
     } else if (s->quasistatic_mu > 0) {
-      piola__stiffness_matrix_assemble(&st->matrix, s->solid, pb.force_weight,
-                                       pb.damped ? dt : 0.0, s->mass,
-                                       pb.mass_weight + s->quasistatic_mu);
+      piola__stiffness_matrix_set_mass_weight(&st->matrix, s->solid, s->mass,
+                                              pb.mass_weight + s->quasistatic_mu);
     }
     piola__step_profile_mark(&w->profile, STEP_PHASE_ASSEMBLE);
     stats->linear_iterations += solve_newton_system(&pb);

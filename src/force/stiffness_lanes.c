@@ -1,7 +1,7 @@
 /* The projected stiffness blocks of PIOLA_TET_BLOCK tets at once (stiffness_lanes.h).
  *
  * The material's part, dPhat/dFhat made semi-definite, goes through the public material
- * functions tet by tet (any model, no copy of them here); the six corner-pair blocks
+ * functions tet by tet (piola__tet_diagonal_stiffness: any model, no copy of them here); the six corner-pair blocks
  * -V0 U M_ab U^T, most of the arithmetic, run in one loop over the lanes that vectorizes.
  * The loop repeats piola__tet_stiffness_blocks's operations in its order and this file
  * fuses no multiply-adds, so each lane gives that function's bits. */
@@ -9,6 +9,7 @@
 
 #include "force/element_stiffness.h"
 #include "force/stiffness_lanes.h"
+#include "force/stiffness_matrix.h"
 #include "force/svd_kernel.h"
 
 #define B PIOLA_TET_BLOCK
@@ -20,13 +21,8 @@ PIOLA_WIDE_VECTORS void PIOLA_ISA_NAME(piola__stiffness_block_lanes)(const piola
   const int32_t base = block * B;
   double kd[9][B], ka[3][B], kb[3][B];
   for (int l = 0; l < B; ++l) {
-    const int32_t t = base + l;
-    const piola_material *material = &body->materials[body->tet_material[t]];
-    const double *fhat = body->fhat + 3 * (size_t)t;
-    double phat[3];
-    piola_material_stress(material, fhat, phat);
     piola__diagonal_stiffness k;
-    piola__diagonal_stiffness_eval(material, fhat, phat, 1, &k);
+    piola__tet_diagonal_stiffness(body, base + l, &k);
     for (int e = 0; e < 9; ++e) kd[e][l] = k.block[e / 3][e % 3];
     for (int p = 0; p < 3; ++p) ka[p][l] = k.pair_a[p], kb[p][l] = k.pair_b[p];
   }

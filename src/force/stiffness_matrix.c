@@ -36,6 +36,15 @@ void piola__stiffness_matrix_free(piola__stiffness_matrix *m) {
   memset(m, 0, sizeof *m);
 }
 
+void piola__tet_diagonal_stiffness(const piola_elastic_body *body, int32_t t,
+                                   piola__diagonal_stiffness *k) {
+  const piola_material *material = &body->materials[body->tet_material[t]];
+  const double *fhat = body->fhat + 3 * (size_t)t;
+  double phat[3];
+  piola_material_stress(material, fhat, phat);
+  piola__diagonal_stiffness_eval(material, fhat, phat, 1, k);
+}
+
 void piola__tet_stiffness_blocks(const piola_elastic_body *body, int32_t t, double out[54]) {
   double u[3][3], v[3][3], dm[3][3];
   for (int k = 0; k < 9; ++k) {
@@ -45,10 +54,8 @@ void piola__tet_stiffness_blocks(const piola_elastic_body *body, int32_t t, doub
   }
   const piola_material *material = &body->materials[body->tet_material[t]];
   const double *fhat = body->fhat + 3 * (size_t)t;
-  double phat[3];
-  piola_material_stress(material, fhat, phat);
   piola__diagonal_stiffness k;
-  piola__diagonal_stiffness_eval(material, fhat, phat, 1, &k);
+  piola__tet_diagonal_stiffness(body, t, &k);
   /* rows g_a of Dm^-1 (g_0 = -(g_1 + g_2 + g_3)) in the diagonal frame: gh_a = V^T g_a */
   double g[4][3], gh[4][3];
   for (int j = 0; j < 3; ++j) {
@@ -209,8 +216,6 @@ void piola__stiffness_matrix_assemble(piola__stiffness_matrix *m, const piola_el
                                       const double *mass, double mass_weight) {
   const piola__damping_matrix *d = &body->damping;
   const int32_t blocks = body->padded_tet_count / PIOLA_TET_BLOCK;
-  const int32_t nv = body->vertex_count;
-  enum { RANGES = 16 };
 #pragma omp parallel num_threads(piola_thread_count()) if (blocks >= PIOLA_PARALLEL_MIN_BLOCKS)
   {
 #pragma omp for schedule(static)
@@ -222,11 +227,8 @@ void piola__stiffness_matrix_assemble(piola__stiffness_matrix *m, const piola_el
       if (damping_weight != 0)
         for (int c = 0; c < 9; ++c) m->blocks[9 * (size_t)e + c] += damping_weight * d->blocks[9 * (size_t)e + c];
     }
-#pragma omp for schedule(static)
-    for (int r = 0; r < RANGES; ++r)
-      diagonal_rows(m, d, mass, mass_weight, (int32_t)((int64_t)nv * r / RANGES),
-                    (int32_t)((int64_t)nv * (r + 1) / RANGES));
   }
+  piola__stiffness_matrix_set_mass_weight(m, body, mass, mass_weight);
 }
 
 void piola__stiffness_matrix_set_mass_weight(piola__stiffness_matrix *m,

@@ -192,9 +192,35 @@ static void invert3(const double *a, double *inv) {
   inv[8] = (a[0] * a[4] - a[1] * a[3]) * r;
 }
 
+/* What a pass over the matrix's rows reads and writes. */
+typedef struct row_pass {
+  int32_t rows;                     /* the body's vertex count */
+  const double *blocks;             /* the edge blocks */
+  piola__stiffness_matrix *diagonal; /* gets the diagonal blocks (NULL for the product) */
+  const piola__damping_matrix *d;
+  const double *mass;
+  double mass_weight;
+  const double *p; /* the product's operand */
+  double *out;     /* the product */
+} row_pass;
+
+/* rows(c, r0, r1) over 16 fixed ranges of the rows, in parallel for large bodies; each row
+ * is computed by one thread, so results do not depend on the thread count. */
+static void over_row_ranges(const row_pass *c, void (*rows)(const row_pass *, int32_t, int32_t)) {
+  const int32_t nv = c->rows;
+  enum { RANGES = 16 };
+#pragma omp parallel for schedule(static) num_threads(piola_thread_count()) \
+    if (nv >= PIOLA_PARALLEL_MIN_VERTICES)
+  for (int r = 0; r < RANGES; ++r)
+    rows(c, (int32_t)((int64_t)nv * r / RANGES), (int32_t)((int64_t)nv * (r + 1) / RANGES));
+}
+
 /* Diagonal blocks of rows r0 .. r1 - 1: m_w m_i I + sum over the row's edges of S_ij. */
-static void diagonal_rows(piola__stiffness_matrix *m, const piola__damping_matrix *d,
-                          const double *mass, double mass_weight, int32_t r0, int32_t r1) {
+static void diagonal_rows(const row_pass *pass, int32_t r0, int32_t r1) {
+  piola__stiffness_matrix *m = pass->diagonal;
+  const piola__damping_matrix *d = pass->d;
+  const double *mass = pass->mass;
+  const double mass_weight = pass->mass_weight;
   for (int32_t r = r0; r < r1; ++r) {
     const int32_t i = d->order[r];
     double a[9] = {0};
@@ -234,27 +260,23 @@ void piola__stiffness_matrix_assemble(piola__stiffness_matrix *m, const piola_el
 void piola__stiffness_matrix_set_mass_weight(piola__stiffness_matrix *m,
                                              const piola_elastic_body *body, const double *mass,
                                              double mass_weight) {
-  const piola__damping_matrix *d = &body->damping;
-  const int32_t nv = body->vertex_count;
-  enum { RANGES = 16 };
-#pragma omp parallel for schedule(static) num_threads(piola_thread_count()) \
-    if (nv >= PIOLA_PARALLEL_MIN_VERTICES)
-  for (int r = 0; r < RANGES; ++r)
-    diagonal_rows(m, d, mass, mass_weight, (int32_t)((int64_t)nv * r / RANGES),
-                  (int32_t)((int64_t)nv * (r + 1) / RANGES));
+  const row_pass c = {body->vertex_count, m->blocks, m, &body->damping, mass, mass_weight,
+                      NULL, NULL};
+  over_row_ranges(&c, diagonal_rows);
 }
 
 /* Rows r0 .. r1 - 1 of out = A p: each row gathers its edges in a fixed order, so results
  * do not depend on the thread count. */
-static void product_rows(const piola__stiffness_matrix *m, const piola__damping_matrix *d,
-                         const double *mass, double mass_weight, const double *p, int32_t r0,
-                         int32_t r1, double *out) {
+static void product_rows(const row_pass *c, int32_t r0, int32_t r1) {
+  const piola__damping_matrix *d = c->d;
+  const double *p = c->p, *mass = c->mass;
+  double *out = c->out;
   for (int32_t r = r0; r < r1; ++r) {
     const int32_t i = d->order[r];
     const double p0 = p[3 * i], p1 = p[3 * i + 1], p2 = p[3 * i + 2];
     double f[3];
-    piola__edge_row_product(d, m->blocks, p, r, f);
-    const double mi = mass_weight * mass[i];
+    piola__edge_row_product(d, c->blocks, p, r, f);
+    const double mi = c->mass_weight * mass[i];
     out[3 * i] = mi * p0 - f[0];
     out[3 * i + 1] = mi * p1 - f[1];
     out[3 * i + 2] = mi * p2 - f[2];
@@ -264,12 +286,7 @@ static void product_rows(const piola__stiffness_matrix *m, const piola__damping_
 void piola__stiffness_matrix_apply(const piola__stiffness_matrix *m, const piola_elastic_body *body,
                                    const double *mass, double mass_weight, const double *p,
                                    double *out) {
-  const piola__damping_matrix *d = &body->damping;
-  const int32_t nv = body->vertex_count;
-  enum { RANGES = 16 };
-#pragma omp parallel for schedule(static) num_threads(piola_thread_count()) \
-    if (nv >= PIOLA_PARALLEL_MIN_VERTICES)
-  for (int r = 0; r < RANGES; ++r)
-    product_rows(m, d, mass, mass_weight, p, (int32_t)((int64_t)nv * r / RANGES),
-                 (int32_t)((int64_t)nv * (r + 1) / RANGES), out);
+  const row_pass c = {body->vertex_count, m->blocks, NULL, &body->damping, mass, mass_weight,
+                      p, out};
+  over_row_ranges(&c, product_rows);
 }

@@ -1,6 +1,7 @@
 /* Blocks of tets and what the world dynamics tests measure on them (test_dynamics.c,
- * test_backward_euler.c, test_plasticity_world.c): the mesh, the momenta of solid 0, and
- * the spinning, drifting start of the free-flight tests. */
+ * test_backward_euler.c, test_plasticity_world.c, test_stable_step.c,
+ * test_energy_check.c): the mesh, a world holding a deformed block, the momenta of solid 0,
+ * and the spinning, drifting start of the free-flight tests. */
 #ifndef PIOLA_TEST_BLOCK_SCENES_H
 #define PIOLA_TEST_BLOCK_SCENES_H
 
@@ -10,6 +11,13 @@
 /* The box [0,a]x[0,b]x[0,c] (m) of nx*ny*nz cubes, 6 tets each (piola_tet_mesh_box_grid). */
 piola_tet_mesh block_mesh(int nx, int ny, int nz, double a, double b, double c);
 void block_mesh_free(piola_tet_mesh *m);
+
+/* A world without gravity (max_dt 1 s, the given cfl; cg_max_iterations > 0 replaces the
+ * default) holding one solid: n x n x n cubes of edge 0.1 m (E = 10 kPa, nu = 0.3,
+ * 1000 kg/m^3, both viscosities `viscosity` in Pa s), its free nodes deformed by initial
+ * about the rest centroid. */
+piola_world *deformed_block_world(piola_material_model model, int n, piola_mat3 initial,
+                                  double viscosity, double cfl, int32_t cg_max_iterations);
 
 /* Linear momentum p (kg m/s), angular momentum l about the origin (kg m^2/s) and, when
  * kinetic is not NULL, the kinetic energy (J) of solid 0. */

@@ -11,31 +11,9 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "block_scenes.h"
 #include "piola/world.h"
 #include "sim/world_internal.h"
-#include "test_elastic_body_fixtures.h"
-
-static piola_world *block(piola_material_model model, double stretch, double viscosity, double cfl) {
-  piola_world_def wd = piola_default_world_def();
-  for (int k = 0; k < 3; ++k) wd.gravity[k] = piola_track_constant(0);
-  wd.max_dt = 1;
-  wd.cfl = cfl;
-  piola_world *w = NULL;
-  assert_int_equal(piola_world_create(&wd, &w), PIOLA_OK);
-  piola_tet_mesh mesh = fixture_grid(4, 0.1);
-  piola_solid_def sd = piola_default_solid_def();
-  sd.mesh = &mesh;
-  sd.material.model = model;
-  sd.material.youngs_modulus = 1e4;
-  sd.material.poisson_ratio = 0.3;
-  sd.density = 1000;
-  sd.shear_viscosity = piola_track_constant(viscosity);
-  sd.bulk_viscosity = piola_track_constant(viscosity);
-  sd.initial_matrix = (piola_mat3){{{stretch, 0, 0}, {0, 1, 0}, {0, 0, 1}}};
-  assert_int_equal(piola_world_add_solid(w, &sd, NULL), PIOLA_OK);
-  fixture_mesh_free(&mesh);
-  return w;
-}
 
 static double total_energy(const piola_world *w) {
   piola_solid_stats es = piola_world_solid_stats(w, 0);
@@ -46,7 +24,8 @@ static double total_energy(const piola_world *w) {
  * and the redos of those steps. */
 static double peak_energy(piola_material_model model, double cfl, double viscosity, int steps,
                           int *redos) {
-  piola_world *w = block(model, 1.2, viscosity, cfl);
+  const piola_mat3 stretch = {{{1.2, 0, 0}, {0, 1, 0}, {0, 0, 1}}};
+  piola_world *w = deformed_block_world(model, 4, stretch, viscosity, cfl, 0);
   const double e0 = total_energy(w);
   double peak = e0;
   *redos = 0;

@@ -4,6 +4,7 @@
  * fibres' stiffness at the current state, and the scene keys (material.hgo, fibers.around)
  * reach the body or fail naming their key. */
 #include <math.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -41,19 +42,6 @@ static double *random_fibers(test_rng *rng, int32_t tets) {
   return a;
 }
 
-static piola_elastic_body *make_body(const piola_tet_mesh *mesh, const piola_material *mats,
-                                     int32_t count, const int32_t *which, const double *fibers) {
-  piola_elastic_body_def def = piola_default_elastic_body_def();
-  def.rest_mesh = mesh;
-  def.materials = mats;
-  def.material_count = count;
-  def.tet_materials = which;
-  def.fiber_directions = fibers;
-  piola_elastic_body *body;
-  assert_int_equal(piola_elastic_body_create(&def, &body), PIOLA_OK);
-  return body;
-}
-
 static void forces_are_minus_the_energy_gradient(void **state) {
   (void)state;
   test_rng rng = test_rng_seeded(191);
@@ -67,8 +55,8 @@ static void forces_are_minus_the_energy_gradient(void **state) {
   double *x = malloc(sizeof(double) * (size_t)n), *f = malloc(sizeof(double) * (size_t)n);
   double *scratch = malloc(sizeof(double) * (size_t)n);
   for (int variant = 0; variant < 3; ++variant) {
-    piola_elastic_body *body = variant < 2 ? make_body(&mesh, &mats[variant], 1, NULL, fibers)
-                                           : make_body(&mesh, mixed, 2, which, fibers);
+    piola_elastic_body *body = variant < 2 ? fixture_body_with_fibers(&mesh, &mats[variant], 1, NULL, fibers)
+                                           : fixture_body_with_fibers(&mesh, mixed, 2, which, fibers);
     for (int s = 0; s < 2; ++s) {
       /* stretched (fibres engaged, far up the exponential for s = 1) plus noise */
       for (int i = 0; i < n; ++i)
@@ -76,22 +64,13 @@ static void forces_are_minus_the_energy_gradient(void **state) {
                0.005 * test_rng_uniform(&rng, -1, 1);
       piola_elastic_stats st;
       assert_int_equal(piola_elastic_body_update(body, x, 1.0, f, &st), PIOLA_OK);
-      const double scale = fixture_max_abs(f, n), h = 1e-7;
-      for (int i = 0; i < n; ++i) {
-        const double xi = x[i];
-        piola_elastic_stats ep, em;
-        x[i] = xi + h;
-        assert_int_equal(piola_elastic_body_update(body, x, 1.0, scratch, &ep), PIOLA_OK);
-        x[i] = xi - h;
-        assert_int_equal(piola_elastic_body_update(body, x, 1.0, scratch, &em), PIOLA_OK);
-        x[i] = xi;
-        const double d = -(ep.elastic_energy - em.elastic_energy) / (2 * h);
-        if (!(fabs(d - f[i]) <= 1e-5 * scale))
-          fail_msg("variant %d sample %d dof %d: -dE/dx = %.10g, force %.10g", variant, s, i, d, f[i]);
-      }
+      char what[48];
+      snprintf(what, sizeof what, "variant %d sample %d", variant, s);
+      fixture_check_energy_gradient(body, x, n, f, 1e-7, 1e-5, what);
+      const double scale = fixture_max_abs(f, n);
       /* the fibres matter: without them the forces differ */
-      piola_elastic_body *plain = variant < 2 ? make_body(&mesh, &mats[variant], 1, NULL, NULL)
-                                              : make_body(&mesh, mixed, 2, which, NULL);
+      piola_elastic_body *plain = variant < 2 ? fixture_body_with_fibers(&mesh, &mats[variant], 1, NULL, NULL)
+                                              : fixture_body_with_fibers(&mesh, mixed, 2, which, NULL);
       assert_int_equal(piola_elastic_body_update(plain, x, 1.0, scratch, NULL), PIOLA_OK);
       double diff = 0;
       for (int i = 0; i < n; ++i) diff = fmax(diff, fabs(scratch[i] - f[i]));
@@ -118,20 +97,9 @@ static void inverted_tet_with_stiff_fibres_is_pushed_back(void **state) {
   assert_int_equal(piola_material_init(&def, &m), PIOLA_OK);
   for (long k = 0; k < test_samples(300, 20); ++k) {
     double a[3] = {test_rng_normal(&rng) + 1e-3, test_rng_normal(&rng), test_rng_normal(&rng)};
-    piola_elastic_body *body = make_body(&mesh, &m, 1, NULL, a);
-    double x[12];
-    memcpy(x, mesh.positions, sizeof x);
-    const double depth = test_rng_uniform(&rng, 0.0, 0.9);
-    x[9] = test_rng_uniform(&rng, -0.3, 0.6);
-    x[10] = test_rng_uniform(&rng, -0.3, 0.6);
-    x[11] = -depth; /* apex below the face z = 0 */
-    double f[12];
-    piola_elastic_stats st;
-    assert_int_equal(piola_elastic_body_update(body, x, 1.0, f, &st), PIOLA_OK);
-    for (int i = 0; i < 12; ++i) assert_true(isfinite(f[i]));
-    if (!(f[11] > 0))
-      fail_msg("apex at (%g %g %g), fibre (%g %g %g): force z %g does not push it back", x[9],
-               x[10], x[11], a[0], a[1], a[2], f[11]);
+    piola_elastic_body *body = fixture_body_with_fibers(&mesh, &m, 1, NULL, a);
+    int32_t inverted;
+    (void)fixture_check_apex_pushed_back(body, &mesh, &rng, a, &inverted);
     piola_elastic_body_destroy(body);
   }
   fixture_mesh_free(&mesh);
@@ -145,7 +113,7 @@ static void step_modulus_bounds_the_fibre_stiffness(void **state) {
   piola_tet_mesh mesh = fixture_single_tet(1.0);
   const piola_material m = hgo(0.1);
   const double fiber[3] = {1, 0.2, 0.1};
-  piola_elastic_body *body = make_body(&mesh, &m, 1, NULL, fiber);
+  piola_elastic_body *body = fixture_body_with_fibers(&mesh, &m, 1, NULL, fiber);
   double previous = 0;
   for (int s = 0; s < 6; ++s) {
     const double stretch = 1.0 + 0.25 * s;

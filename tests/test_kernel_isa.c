@@ -11,8 +11,11 @@
 #include "common/isa.h"
 #include "force/damping_matrix.h"
 #include "force/elastic_body_internal.h"
+#include "force/element_stiffness.h"
 #include "force/force_lanes.h"
 #include "force/stable_step.h"
+#include "force/stiffness_lanes.h"
+#include "force/stiffness_matrix.h"
 #include "force/svd_kernel.h"
 #include "piola/kernels.h"
 #include "test_elastic_body_fixtures.h"
@@ -23,6 +26,7 @@ typedef void (*block_range_fn)(piola_elastic_body *, const double *, double, int
 typedef void (*damping_assemble_fn)(piola__damping_matrix *, const piola_elastic_body *, double,
                                     double);
 typedef double (*state_rate2_fn)(piola_elastic_body *, int32_t *);
+typedef void (*stiffness_lanes_fn)(const piola_elastic_body *, int32_t, double[54][PIOLA_TET_BLOCK]);
 
 /* The variants of this build, indexed by piola__isa (NULL where a build has fewer). */
 #if defined(PIOLA_KERNEL_DISPATCH)
@@ -37,12 +41,17 @@ static const damping_assemble_fn DAMPING[] = {piola__damping_matrix_assemble_bas
 static const state_rate2_fn RATE2[] = {piola__elastic_body_state_rate2_baseline,
                                        piola__elastic_body_state_rate2_avx2,
                                        piola__elastic_body_state_rate2_avx512};
+static const stiffness_lanes_fn STIFFNESS[] = {piola__stiffness_block_lanes_baseline,
+                                               piola__stiffness_block_lanes_avx2,
+                                               piola__stiffness_block_lanes_avx512};
 #else
 static const svd_batch_fn SVD[] = {PIOLA_ISA_SELECT(piola__svd3_kernel_batch), NULL, NULL};
 static const block_range_fn FORCES[] = {PIOLA_ISA_SELECT(piola__force_block_range), NULL, NULL};
 static const damping_assemble_fn DAMPING[] = {PIOLA_ISA_SELECT(piola__damping_matrix_assemble),
                                               NULL, NULL};
 static const state_rate2_fn RATE2[] = {PIOLA_ISA_SELECT(piola__elastic_body_state_rate2), NULL, NULL};
+static const stiffness_lanes_fn STIFFNESS[] = {PIOLA_ISA_SELECT(piola__stiffness_block_lanes), NULL,
+                                               NULL};
 #endif
 enum { VARIANTS = 3 };
 
@@ -281,11 +290,64 @@ static void force_damping_and_step_variants_agree(void **state) {
   fixture_mesh_free(&mesh);
 }
 
+/* The projected stiffness lanes give the scalar piola__tet_stiffness_blocks's bits in every
+ * variant (they fuse no multiply-adds), on stretched, compressed and inverted tets of two
+ * materials. */
+static void stiffness_lanes_give_the_scalar_bits(void **state) {
+  (void)state;
+  test_rng rng = test_rng_seeded(78);
+  piola_tet_mesh mesh = fixture_grid(3, 0.1);
+  piola_material mats[2] = {fixture_material(PIOLA_MODEL_NEOHOOKEAN),
+                            fixture_material(PIOLA_MODEL_STVK)};
+  int32_t *which = malloc(sizeof(int32_t) * (size_t)mesh.tet_count);
+  for (int32_t t = 0; t < mesh.tet_count; ++t) which[t] = t % 5 == 2;
+  piola_elastic_body_def def = piola_default_elastic_body_def();
+  def.rest_mesh = &mesh;
+  def.materials = mats;
+  def.material_count = 2;
+  def.tet_materials = which;
+  piola_elastic_body *body = NULL;
+  assert_int_equal(piola_elastic_body_create(&def, &body), PIOLA_OK);
+  const int n = 3 * mesh.vertex_count;
+  double *x = malloc(sizeof(double) * (size_t)n), *f = malloc(sizeof(double) * (size_t)n);
+  for (int i = 0; i < n; ++i) x[i] = mesh.positions[i] * 1.1 + test_rng_uniform(&rng, -0.05, 0.05);
+  for (int v = 0; v < 6; ++v) x[3 * (5 * v + 3) + 2] += 0.15; /* inverts some tets */
+  piola_elastic_stats st;
+  assert_int_equal(piola_elastic_body_update(body, x, 0.7, f, &st), PIOLA_OK);
+  assert_true(st.inverted_count > 0);
+  const int32_t blocks = mesh.tet_count / PIOLA_TET_BLOCK;
+  assert_true(blocks > 0);
+  for (int isa = 0; isa <= VARIANTS; ++isa) {
+    if (isa < VARIANTS && (!STIFFNESS[isa] || !runs(isa))) continue;
+    for (int32_t b = 0; b < blocks; ++b) {
+      double lanes[54][PIOLA_TET_BLOCK], scalar[54];
+      if (isa < VARIANTS)
+        STIFFNESS[isa](body, b, lanes);
+      else
+        piola__stiffness_block_lanes(body, b, lanes);
+      for (int l = 0; l < PIOLA_TET_BLOCK; ++l) {
+        piola__tet_stiffness_blocks(body, b * PIOLA_TET_BLOCK + l, scalar);
+        for (int e = 0; e < 54; ++e)
+          if (memcmp(&lanes[e][l], &scalar[e], sizeof(double)) != 0)
+            fail_msg("%s: tet %d entry %d: lanes %.17g, scalar %.17g",
+                     isa < VARIANTS ? piola__isa_name((piola__isa)isa) : "plain name",
+                     (int)(b * PIOLA_TET_BLOCK + l), e, lanes[e][l], scalar[e]);
+      }
+    }
+  }
+  free(x);
+  free(f);
+  free(which);
+  piola_elastic_body_destroy(body);
+  fixture_mesh_free(&mesh);
+}
+
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(chosen_variant_follows_cpu_and_environment),
       cmocka_unit_test(svd_variants_agree),
       cmocka_unit_test(force_damping_and_step_variants_agree),
+      cmocka_unit_test(stiffness_lanes_give_the_scalar_bits),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -8,6 +8,7 @@
 
 #include "piola/diagonalize.h"
 #include "piola/material.h"
+#include "material_checks.h"
 #include "test_support.h"
 
 static piola_material muscle_material(double youngs, double nu) {
@@ -23,49 +24,6 @@ static piola_material muscle_material(double youngs, double nu) {
   piola_material m;
   assert_int_equal(piola_material_init(&def, &m), PIOLA_OK);
   return m;
-}
-
-static void random_unit(test_rng *rng, double a[3]) {
-  double n;
-  do {
-    for (int i = 0; i < 3; ++i) a[i] = test_rng_normal(rng);
-    n = sqrt(a[0] * a[0] + a[1] * a[1] + a[2] * a[2]);
-  } while (n < 1e-3);
-  for (int i = 0; i < 3; ++i) a[i] /= n;
-}
-
-static piola_mat3 random_rotation(test_rng *rng) {
-  double q[4], n = 0;
-  for (int i = 0; i < 4; ++i) q[i] = test_rng_normal(rng), n += q[i] * q[i];
-  n = sqrt(n);
-  const double w = q[0] / n, x = q[1] / n, y = q[2] / n, z = q[3] / n;
-  piola_mat3 r = {{{1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)},
-                   {2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)},
-                   {2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)}}};
-  return r;
-}
-
-static piola_mat3 mul(piola_mat3 a, piola_mat3 b) {
-  piola_mat3 c;
-  for (int i = 0; i < 3; ++i)
-    for (int j = 0; j < 3; ++j) {
-      c.m[i][j] = 0;
-      for (int k = 0; k < 3; ++k) c.m[i][j] += a.m[i][k] * b.m[k][j];
-    }
-  return c;
-}
-
-static piola_mat3 transpose(piola_mat3 a) {
-  piola_mat3 t;
-  for (int i = 0; i < 3; ++i)
-    for (int j = 0; j < 3; ++j) t.m[i][j] = a.m[j][i];
-  return t;
-}
-
-/* F = R1 diag(s) R2^T with the given singular values (a negative one inverts). */
-static piola_mat3 f_with_singular_values(test_rng *rng, const double s[3]) {
-  piola_mat3 d = {{{s[0], 0, 0}, {0, s[1], 0}, {0, 0, s[2]}}};
-  return mul(mul(random_rotation(rng), d), transpose(random_rotation(rng)));
 }
 
 /* What an element computes: diagonalize F, rotate the material fibre a by V, evaluate in the
@@ -276,13 +234,13 @@ static void stress_rotates_with_world_and_material(void **state) {
     for (int i = 0; i < 3; ++i) ra[i] = r.m[i][0] * a[0] + r.m[i][1] * a[1] + r.m[i][2] * a[2];
     piola_mat3 p, pr;
     const double psi = world_stress(&m, f, a, act, 0, &p);
-    const double psi_r = world_stress(&m, mul(mul(q, f), transpose(r)), ra, act, 0, &pr);
-    const piola_mat3 expect = mul(mul(q, p), transpose(r));
+    const double psi_r = world_stress(&m, mat3_mul(mat3_mul(q, f), mat3_transpose(r)), ra, act, 0, &pr);
+    const piola_mat3 expect = mat3_mul(mat3_mul(q, p), mat3_transpose(r));
     const double tol = 1e-9 * (max_abs(p) + 1e3);
     assert_close(psi, psi_r, 1e-9 * (fabs(psi) + 1e3));
     for (int i = 0; i < 3; ++i)
       for (int j = 0; j < 3; ++j) assert_close(pr.m[i][j], expect.m[i][j], tol);
-    const piola_mat3 pft = mul(p, transpose(f));
+    const piola_mat3 pft = mat3_mul(p, mat3_transpose(f));
     for (int i = 0; i < 3; ++i)
       for (int j = 0; j < i; ++j) assert_close(pft.m[i][j], pft.m[j][i], tol * 3);
   }

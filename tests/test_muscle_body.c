@@ -5,6 +5,7 @@
  * rejected by tet, and an activated bar held at one end shortens along its fibres and
  * bulges sideways. */
 #include <math.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -33,20 +34,6 @@ static double *random_fibers(test_rng *rng, int32_t tets) {
   return a;
 }
 
-static piola_elastic_body *make_body(const piola_tet_mesh *mesh, const piola_material *mats,
-                                     int32_t count, const int32_t *tet_materials,
-                                     const double *fibers) {
-  piola_elastic_body_def def = piola_default_elastic_body_def();
-  def.rest_mesh = mesh;
-  def.materials = mats;
-  def.material_count = count;
-  def.tet_materials = tet_materials;
-  def.fiber_directions = fibers;
-  piola_elastic_body *body;
-  assert_int_equal(piola_elastic_body_create(&def, &body), PIOLA_OK);
-  return body;
-}
-
 static void fast_loop_matches_reference_with_fibres(void **state) {
   (void)state;
   test_rng rng = test_rng_seeded(91);
@@ -59,7 +46,7 @@ static void fast_loop_matches_reference_with_fibres(void **state) {
   double *x = malloc(sizeof(double) * (size_t)n), *f = malloc(sizeof(double) * (size_t)n);
   double *g = malloc(sizeof(double) * (size_t)n);
   for (int mixed = 0; mixed < 2; ++mixed) {
-    piola_elastic_body *body = make_body(&mesh, mats, mixed ? 2 : 1, mixed ? which : NULL, fibers);
+    piola_elastic_body *body = fixture_body_with_fibers(&mesh, mats, mixed ? 2 : 1, mixed ? which : NULL, fibers);
     for (int s = 0; s < 4; ++s) {
       for (int i = 0; i < n; ++i) x[i] = mesh.positions[i] * (1.05 + 0.2 * s) + 0.01 * (s + 1) * test_rng_uniform(&rng, -1, 1);
       if (s == 3) /* flatten a layer and invert some tets */
@@ -104,9 +91,8 @@ static void forces_are_minus_the_energy_gradient(void **state) {
   const int n = 3 * mesh.vertex_count;
   double *fibers = random_fibers(&rng, mesh.tet_count);
   const piola_material m = muscle(3e4);
-  piola_elastic_body *body = make_body(&mesh, &m, 1, NULL, fibers);
+  piola_elastic_body *body = fixture_body_with_fibers(&mesh, &m, 1, NULL, fibers);
   double *x = malloc(sizeof(double) * (size_t)n), *f = malloc(sizeof(double) * (size_t)n);
-  double *scratch = malloc(sizeof(double) * (size_t)n);
   for (int s = 0; s < 3; ++s) {
     /* a stretch along x (fibres past the toe) plus noise */
     for (int i = 0; i < n; ++i)
@@ -115,25 +101,14 @@ static void forces_are_minus_the_energy_gradient(void **state) {
     piola_elastic_stats st;
     assert_int_equal(piola_elastic_body_update(body, x, 1.0, f, &st), PIOLA_OK);
     assert_int_equal(st.inverted_count, 0);
-    const double scale = fixture_max_abs(f, n), h = 1e-7;
-    for (int i = 0; i < n; ++i) {
-      const double xi = x[i];
-      piola_elastic_stats ep, em;
-      x[i] = xi + h;
-      assert_int_equal(piola_elastic_body_update(body, x, 1.0, scratch, &ep), PIOLA_OK);
-      x[i] = xi - h;
-      assert_int_equal(piola_elastic_body_update(body, x, 1.0, scratch, &em), PIOLA_OK);
-      x[i] = xi;
-      const double d = -(ep.elastic_energy - em.elastic_energy) / (2 * h);
-      if (!(fabs(d - f[i]) <= 1e-5 * scale))
-        fail_msg("sample %d dof %d: -dE/dx = %.10g, force %.10g", s, i, d, f[i]);
-    }
+    char what[32];
+    snprintf(what, sizeof what, "sample %d", s);
+    fixture_check_energy_gradient(body, x, n, f, 1e-7, 1e-5, what);
   }
   piola_elastic_body_destroy(body);
   free(fibers);
   free(x);
   free(f);
-  free(scratch);
   fixture_mesh_free(&mesh);
 }
 
@@ -158,9 +133,9 @@ static void forces_rotate_with_world_and_material(void **state) {
     for (int i = 0; i < 3; ++i)
       turned_fibers[3 * t + i] = r[i][0] * fibers[3 * t] + r[i][1] * fibers[3 * t + 1] + r[i][2] * fibers[3 * t + 2];
   const piola_material m = muscle(3e4);
-  piola_elastic_body *a = make_body(&mesh, &m, 1, NULL, fibers);
-  piola_elastic_body *b = make_body(&turned, &m, 1, NULL, turned_fibers);
-  piola_elastic_body *wrong = make_body(&turned, &m, 1, NULL, fibers);
+  piola_elastic_body *a = fixture_body_with_fibers(&mesh, &m, 1, NULL, fibers);
+  piola_elastic_body *b = fixture_body_with_fibers(&turned, &m, 1, NULL, turned_fibers);
+  piola_elastic_body *wrong = fixture_body_with_fibers(&turned, &m, 1, NULL, fibers);
   double *x = malloc(sizeof(double) * (size_t)n), *y = malloc(sizeof(double) * (size_t)n);
   double *fa = malloc(sizeof(double) * (size_t)n), *fb = malloc(sizeof(double) * (size_t)n);
   for (int i = 0; i < n; ++i)
@@ -219,25 +194,14 @@ static void inverted_tet_with_active_fibres_is_pushed_back(void **state) {
   const long samples = test_samples(400, 20);
   for (long k = 0; k < samples; ++k) {
     double a[3] = {test_rng_normal(&rng), test_rng_normal(&rng), test_rng_normal(&rng) + 1e-3};
-    piola_elastic_body *body = make_body(&mesh, &m, 1, NULL, a);
+    piola_elastic_body *body = fixture_body_with_fibers(&mesh, &m, 1, NULL, a);
     piola_elastic_body_set_activation(body, test_rng_uniform(&rng, 0.5, 1.0));
-    double x[12];
-    memcpy(x, mesh.positions, sizeof x);
     /* below depth ~1 (the size of the tet) the smallest entry of Fhat is the inverted one;
      * deeper, the diagonalization's guess of the inverted direction (paper section 5) no
      * longer points along z, with or without fibres */
-    const double depth = test_rng_uniform(&rng, 0.0, 0.9);
-    x[9] = test_rng_uniform(&rng, -0.3, 0.6);
-    x[10] = test_rng_uniform(&rng, -0.3, 0.6);
-    x[11] = -depth; /* apex below the face z = 0 */
-    double f[12];
-    piola_elastic_stats st;
-    assert_int_equal(piola_elastic_body_update(body, x, 1.0, f, &st), PIOLA_OK);
-    for (int i = 0; i < 12; ++i) assert_true(isfinite(f[i]));
-    if (depth > 0) assert_int_equal(st.inverted_count, 1);
-    if (!(f[11] > 0))
-      fail_msg("apex at (%g %g %g), fibre (%g %g %g): force z %g does not push it back", x[9],
-               x[10], x[11], a[0], a[1], a[2], f[11]);
+    int32_t inverted;
+    const double depth = fixture_check_apex_pushed_back(body, &mesh, &rng, a, &inverted);
+    if (depth > 0) assert_int_equal(inverted, 1);
     piola_elastic_body_destroy(body);
   }
   fixture_mesh_free(&mesh);

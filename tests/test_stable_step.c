@@ -18,6 +18,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "block_scenes.h"
 #include "force/elastic_body_internal.h"
 #include "force/stable_step.h"
 #include "piola/diagonalize.h"
@@ -117,28 +118,11 @@ static void modulus_bounds_every_plane_wave(void **state) {
   fixture_mesh_free(&mesh);
 }
 
-static piola_world *world_with_block(piola_material_model model, double stretch, double viscosity,
+/* A 3x3x3 block stretched by s in every direction (block_scenes.h). */
+static piola_world *world_with_block(piola_material_model model, double s, double viscosity,
                                      double cfl, int32_t cg_max_iterations) {
-  piola_world_def wd = piola_default_world_def();
-  for (int k = 0; k < 3; ++k) wd.gravity[k] = piola_track_constant(0);
-  wd.max_dt = 1;
-  wd.cfl = cfl;
-  wd.cg_max_iterations = cg_max_iterations;
-  piola_world *w = NULL;
-  assert_int_equal(piola_world_create(&wd, &w), PIOLA_OK);
-  piola_tet_mesh mesh = fixture_grid(3, 0.1);
-  piola_solid_def sd = piola_default_solid_def();
-  sd.mesh = &mesh;
-  sd.material.model = model;
-  sd.material.youngs_modulus = 1e4;
-  sd.material.poisson_ratio = 0.3;
-  sd.density = 1000;
-  sd.shear_viscosity = piola_track_constant(viscosity);
-  sd.bulk_viscosity = piola_track_constant(viscosity);
-  sd.initial_matrix = (piola_mat3){{{stretch, 0, 0}, {0, stretch, 0}, {0, 0, stretch}}};
-  assert_int_equal(piola_world_add_solid(w, &sd, NULL), PIOLA_OK);
-  fixture_mesh_free(&mesh);
-  return w;
+  const piola_mat3 stretch = {{{s, 0, 0}, {0, s, 0}, {0, 0, s}}};
+  return deformed_block_world(model, 3, stretch, viscosity, cfl, cg_max_iterations);
 }
 
 static void step_follows_the_state(void **state) {

@@ -5,6 +5,7 @@
 #include "force/fiber_lanes.h"
 #include "force/force_lanes.h"
 #include "force/stable_step.h"
+#include "force/stiffness_lanes.h"
 #include "force/svd_kernel.h"
 
 void piola__force_block_range(piola_elastic_body *body, const double *x, double stiffness_scale,
@@ -30,6 +31,11 @@ piola_status piola__fiber_copy(piola_elastic_body *body, const piola_elastic_bod
 void piola__damping_matrix_assemble(piola__damping_matrix *matrix, const piola_elastic_body *body,
                                     double shear_viscosity, double bulk_viscosity) {
   PIOLA_ISA_SELECT(piola__damping_matrix_assemble)(matrix, body, shear_viscosity, bulk_viscosity);
+}
+
+void piola__stiffness_block_lanes(const piola_elastic_body *body, int32_t block,
+                                  double out[54][PIOLA_TET_BLOCK]) {
+  PIOLA_ISA_SELECT(piola__stiffness_block_lanes)(body, block, out);
 }
 
 void piola__svd3_kernel_batch(int32_t n, const double *f, double *u, double *fhat, double *v) {

@@ -7,6 +7,7 @@
 #include "common/status_report.h"
 #include "force/elastic_body_internal.h"
 #include "force/element_stiffness.h"
+#include "force/stiffness_lanes.h"
 #include "force/stiffness_matrix.h"
 
 static const int PAIR_A[6] = {0, 0, 0, 1, 1, 2}, PAIR_B[6] = {1, 2, 3, 2, 3, 3};
@@ -35,6 +36,15 @@ void piola__stiffness_matrix_free(piola__stiffness_matrix *m) {
   memset(m, 0, sizeof *m);
 }
 
+void piola__tet_diagonal_stiffness(const piola_elastic_body *body, int32_t t,
+                                   piola__diagonal_stiffness *k) {
+  const piola_material *material = &body->materials[body->tet_material[t]];
+  const double *fhat = body->fhat + 3 * (size_t)t;
+  double phat[3];
+  piola_material_stress(material, fhat, phat);
+  piola__diagonal_stiffness_eval(material, fhat, phat, 1, k);
+}
+
 void piola__tet_stiffness_blocks(const piola_elastic_body *body, int32_t t, double out[54]) {
   double u[3][3], v[3][3], dm[3][3];
   for (int k = 0; k < 9; ++k) {
@@ -44,10 +54,8 @@ void piola__tet_stiffness_blocks(const piola_elastic_body *body, int32_t t, doub
   }
   const piola_material *material = &body->materials[body->tet_material[t]];
   const double *fhat = body->fhat + 3 * (size_t)t;
-  double phat[3];
-  piola_material_stress(material, fhat, phat);
   piola__diagonal_stiffness k;
-  piola__diagonal_stiffness_eval(material, fhat, phat, 1, &k);
+  piola__tet_diagonal_stiffness(body, t, &k);
   /* rows g_a of Dm^-1 (g_0 = -(g_1 + g_2 + g_3)) in the diagonal frame: gh_a = V^T g_a */
   double g[4][3], gh[4][3];
   for (int j = 0; j < 3; ++j) {
@@ -119,28 +127,46 @@ void piola__tet_stiffness_blocks(const piola_elastic_body *body, int32_t t, doub
   }
 }
 
-/* Range k of the tets (the damping assembly's ranges): blocks into their slots, transposed
- * where the edge is stored the other way round, stored by a slot's first writer. */
+/* Adds (or, for a slot's first writer, stores) weight times tet t's six blocks out[9 p + e]
+ * (entry e of pair p, at stride `stride` in out) into their slots, transposed where the edge
+ * is stored the other way round. */
+static void scatter_tet(piola__stiffness_matrix *m, const piola__damping_matrix *d, int32_t t,
+                        const double *out, size_t stride, double weight) {
+  static const int TRANSPOSE[2][9] = {{0, 1, 2, 3, 4, 5, 6, 7, 8}, {0, 3, 6, 1, 4, 7, 2, 5, 8}};
+  const int32_t *slots = d->tet_slot + 6 * (size_t)t;
+  const unsigned flags = d->tet_flags[t];
+  for (int p = 0; p < 6; ++p) {
+    double *dst = m->blocks + 9 * (size_t)slots[p];
+    const int *order = TRANSPOSE[(flags >> p) & 1];
+    if ((flags >> (6 + p)) & 1)
+      for (int e = 0; e < 9; ++e) dst[e] = weight * out[stride * (size_t)(9 * p + order[e])];
+    else
+      for (int e = 0; e < 9; ++e) dst[e] += weight * out[stride * (size_t)(9 * p + order[e])];
+  }
+}
+
+/* Range k of the tets (the damping assembly's ranges), in tet order. Whole blocks of a body
+ * without fibres go through the lane kernel (stiffness_lanes.h, the same bits), the rest
+ * tet by tet. */
 static void assemble_part(piola__stiffness_matrix *m, const piola_elastic_body *body, int k,
                           double weight) {
-  static const int TRANSPOSE[2][9] = {{0, 1, 2, 3, 4, 5, 6, 7, 8}, {0, 3, 6, 1, 4, 7, 2, 5, 8}};
   const piola__damping_matrix *d = &body->damping;
   const int32_t blocks = body->padded_tet_count / PIOLA_TET_BLOCK;
   const int32_t t0 = piola__damping_part_start(blocks, k) * PIOLA_TET_BLOCK;
   int32_t t1 = piola__damping_part_start(blocks, k + 1) * PIOLA_TET_BLOCK;
   if (t1 > body->tet_count) t1 = body->tet_count;
-  double out[54];
-  for (int32_t t = t0; t < t1; ++t) {
-    piola__tet_stiffness_blocks(body, t, out);
-    const int32_t *slots = d->tet_slot + 6 * (size_t)t;
-    const unsigned flags = d->tet_flags[t];
-    for (int p = 0; p < 6; ++p) {
-      double *dst = m->blocks + 9 * (size_t)slots[p];
-      const int *order = TRANSPOSE[(flags >> p) & 1];
-      if ((flags >> (6 + p)) & 1)
-        for (int e = 0; e < 9; ++e) dst[e] = weight * out[9 * p + order[e]];
-      else
-        for (int e = 0; e < 9; ++e) dst[e] += weight * out[9 * p + order[e]];
+  const int lanes = !body->fiber[0];
+  double out[54], lane_out[54][PIOLA_TET_BLOCK];
+  for (int32_t t = t0; t < t1;) {
+    if (lanes && t + PIOLA_TET_BLOCK <= t1) {
+      piola__stiffness_block_lanes(body, t / PIOLA_TET_BLOCK, lane_out);
+      for (int l = 0; l < PIOLA_TET_BLOCK; ++l)
+        scatter_tet(m, d, t + l, &lane_out[0][l], PIOLA_TET_BLOCK, weight);
+      t += PIOLA_TET_BLOCK;
+    } else {
+      piola__tet_stiffness_blocks(body, t, out);
+      scatter_tet(m, d, t, out, 1, weight);
+      ++t;
     }
   }
 }
@@ -166,9 +192,35 @@ static void invert3(const double *a, double *inv) {
   inv[8] = (a[0] * a[4] - a[1] * a[3]) * r;
 }
 
+/* What a pass over the matrix's rows reads and writes. */
+typedef struct row_pass {
+  int32_t rows;                     /* the body's vertex count */
+  const double *blocks;             /* the edge blocks */
+  piola__stiffness_matrix *diagonal; /* gets the diagonal blocks (NULL for the product) */
+  const piola__damping_matrix *d;
+  const double *mass;
+  double mass_weight;
+  const double *p; /* the product's operand */
+  double *out;     /* the product */
+} row_pass;
+
+/* rows(c, r0, r1) over 16 fixed ranges of the rows, in parallel for large bodies; each row
+ * is computed by one thread, so results do not depend on the thread count. */
+static void over_row_ranges(const row_pass *c, void (*rows)(const row_pass *, int32_t, int32_t)) {
+  const int32_t nv = c->rows;
+  enum { RANGES = 16 };
+#pragma omp parallel for schedule(static) num_threads(piola_thread_count()) \
+    if (nv >= PIOLA_PARALLEL_MIN_VERTICES)
+  for (int r = 0; r < RANGES; ++r)
+    rows(c, (int32_t)((int64_t)nv * r / RANGES), (int32_t)((int64_t)nv * (r + 1) / RANGES));
+}
+
 /* Diagonal blocks of rows r0 .. r1 - 1: m_w m_i I + sum over the row's edges of S_ij. */
-static void diagonal_rows(piola__stiffness_matrix *m, const piola__damping_matrix *d,
-                          const double *mass, double mass_weight, int32_t r0, int32_t r1) {
+static void diagonal_rows(const row_pass *pass, int32_t r0, int32_t r1) {
+  piola__stiffness_matrix *m = pass->diagonal;
+  const piola__damping_matrix *d = pass->d;
+  const double *mass = pass->mass;
+  const double mass_weight = pass->mass_weight;
   for (int32_t r = r0; r < r1; ++r) {
     const int32_t i = d->order[r];
     double a[9] = {0};
@@ -190,8 +242,6 @@ void piola__stiffness_matrix_assemble(piola__stiffness_matrix *m, const piola_el
                                       const double *mass, double mass_weight) {
   const piola__damping_matrix *d = &body->damping;
   const int32_t blocks = body->padded_tet_count / PIOLA_TET_BLOCK;
-  const int32_t nv = body->vertex_count;
-  enum { RANGES = 16 };
 #pragma omp parallel num_threads(piola_thread_count()) if (blocks >= PIOLA_PARALLEL_MIN_BLOCKS)
   {
 #pragma omp for schedule(static)
@@ -203,24 +253,30 @@ void piola__stiffness_matrix_assemble(piola__stiffness_matrix *m, const piola_el
       if (damping_weight != 0)
         for (int c = 0; c < 9; ++c) m->blocks[9 * (size_t)e + c] += damping_weight * d->blocks[9 * (size_t)e + c];
     }
-#pragma omp for schedule(static)
-    for (int r = 0; r < RANGES; ++r)
-      diagonal_rows(m, d, mass, mass_weight, (int32_t)((int64_t)nv * r / RANGES),
-                    (int32_t)((int64_t)nv * (r + 1) / RANGES));
   }
+  piola__stiffness_matrix_set_mass_weight(m, body, mass, mass_weight);
+}
+
+void piola__stiffness_matrix_set_mass_weight(piola__stiffness_matrix *m,
+                                             const piola_elastic_body *body, const double *mass,
+                                             double mass_weight) {
+  const row_pass c = {body->vertex_count, m->blocks, m, &body->damping, mass, mass_weight,
+                      NULL, NULL};
+  over_row_ranges(&c, diagonal_rows);
 }
 
 /* Rows r0 .. r1 - 1 of out = A p: each row gathers its edges in a fixed order, so results
  * do not depend on the thread count. */
-static void product_rows(const piola__stiffness_matrix *m, const piola__damping_matrix *d,
-                         const double *mass, double mass_weight, const double *p, int32_t r0,
-                         int32_t r1, double *out) {
+static void product_rows(const row_pass *c, int32_t r0, int32_t r1) {
+  const piola__damping_matrix *d = c->d;
+  const double *p = c->p, *mass = c->mass;
+  double *out = c->out;
   for (int32_t r = r0; r < r1; ++r) {
     const int32_t i = d->order[r];
     const double p0 = p[3 * i], p1 = p[3 * i + 1], p2 = p[3 * i + 2];
     double f[3];
-    piola__edge_row_product(d, m->blocks, p, r, f);
-    const double mi = mass_weight * mass[i];
+    piola__edge_row_product(d, c->blocks, p, r, f);
+    const double mi = c->mass_weight * mass[i];
     out[3 * i] = mi * p0 - f[0];
     out[3 * i + 1] = mi * p1 - f[1];
     out[3 * i + 2] = mi * p2 - f[2];
@@ -230,12 +286,7 @@ static void product_rows(const piola__stiffness_matrix *m, const piola__damping_
 void piola__stiffness_matrix_apply(const piola__stiffness_matrix *m, const piola_elastic_body *body,
                                    const double *mass, double mass_weight, const double *p,
                                    double *out) {
-  const piola__damping_matrix *d = &body->damping;
-  const int32_t nv = body->vertex_count;
-  enum { RANGES = 16 };
-#pragma omp parallel for schedule(static) num_threads(piola_thread_count()) \
-    if (nv >= PIOLA_PARALLEL_MIN_VERTICES)
-  for (int r = 0; r < RANGES; ++r)
-    product_rows(m, d, mass, mass_weight, p, (int32_t)((int64_t)nv * r / RANGES),
-                 (int32_t)((int64_t)nv * (r + 1) / RANGES), out);
+  const row_pass c = {body->vertex_count, m->blocks, NULL, &body->damping, mass, mass_weight,
+                      p, out};
+  over_row_ranges(&c, product_rows);
 }

@@ -23,6 +23,7 @@
 #include <stdint.h>
 
 #include "force/damping_matrix.h"
+#include "force/element_stiffness.h"
 #include "piola/elastic_body.h"
 
 typedef struct piola__stiffness_matrix {
@@ -48,10 +49,22 @@ void piola__stiffness_matrix_assemble(piola__stiffness_matrix *matrix,
                                       double damping_weight, const double *mass,
                                       double mass_weight);
 
+/* Recomputes the diagonal blocks and their inverses with mass_weight M, the edge blocks as
+ * last assembled: the same bits as assembling again with this mass weight, for the cost of
+ * one pass over the rows. */
+void piola__stiffness_matrix_set_mass_weight(piola__stiffness_matrix *matrix,
+                                             const piola_elastic_body *body, const double *mass,
+                                             double mass_weight);
+
 /* out = A p (3 * vertex_count). */
 void piola__stiffness_matrix_apply(const piola__stiffness_matrix *matrix,
                                    const piola_elastic_body *body, const double *mass,
                                    double mass_weight, const double *p, double *out);
+
+/* The material's part of tet t's stiffness at the body's last update: dPhat/dFhat in the
+ * diagonal frame, projected (element_stiffness.h). */
+void piola__tet_diagonal_stiffness(const piola_elastic_body *body, int32_t t,
+                                   piola__diagonal_stiffness *k);
 
 /* The 6 corner-pair blocks df_a/dx_b (a < b in the order 01 02 03 12 13 23, row-major) of
  * tet t of body at its last update, projected, times the body's stiffness scale. For tests

@@ -177,6 +177,21 @@ void piola__body_stiffness_assemble(const world_body *b, piola__stiffness_matrix
   }
 }
 
+void piola__body_stiffness_set_mass_weight(const world_body *b, piola__stiffness_matrix *matrix,
+                                           double stiffness_weight, double damping_weight,
+                                           double beta, double alpha, double mass_weight) {
+  switch (b->kind) {
+    case PIOLA_BODY_SOLID:
+      piola__stiffness_matrix_set_mass_weight(matrix, b->solid, b->mass, mass_weight);
+      return;
+    case PIOLA_BODY_SHELL:
+      piola__shell_stiffness_matrix_assemble(matrix, b->shell, stiffness_weight, damping_weight,
+                                             beta, alpha, b->mass, mass_weight);
+      return;
+    case PIOLA_BODY_NONE: return;
+  }
+}
+
 void piola__body_stiffness_apply(const world_body *b, const piola__stiffness_matrix *matrix,
                                  double mass_weight, const double *p, double *out) {
   switch (b->kind) {

@@ -140,6 +140,13 @@ piola_status piola__body_stiffness_init(world_body *b, struct piola__stiffness_m
 void piola__body_stiffness_assemble(const world_body *b, struct piola__stiffness_matrix *matrix,
                                     double stiffness_weight, double damping_weight, double beta,
                                     double alpha, double mass_weight);
+/* The matrix as last assembled with its mass term changed to mass_weight M (the other weights
+ * as that assembly had them): a solid recomputes only its diagonal blocks, a shell assembles
+ * again. */
+void piola__body_stiffness_set_mass_weight(const world_body *b,
+                                           struct piola__stiffness_matrix *matrix,
+                                           double stiffness_weight, double damping_weight,
+                                           double beta, double alpha, double mass_weight);
 void piola__body_stiffness_apply(const world_body *b, const struct piola__stiffness_matrix *matrix,
                                  double mass_weight, const double *p, double *out);
 /* The body's triangles in the world's collision surface, over its own node numbering.

@@ -519,11 +519,12 @@ static piola_status newton_iterate(const newton_problem *problem, int accept_unc
         s->quasistatic_mu = 1e-6 * trace / (3.0 * pb.total_mass);
         if (!(s->quasistatic_mu > 0)) s->quasistatic_mu = 1.0;
       }
-      piola__body_stiffness_assemble(s, &st->matrix, pb.force_weight, 0.0, pb.beta, pb.alpha,
-                                     s->quasistatic_mu);
+      piola__body_stiffness_set_mass_weight(s, &st->matrix, pb.force_weight, 0.0, pb.beta,
+                                            pb.alpha, s->quasistatic_mu);
     } else if (s->quasistatic_mu > 0) {
-      piola__body_stiffness_assemble(s, &st->matrix, pb.force_weight, pb.damped ? dt : 0.0,
-                                     pb.beta, pb.alpha, pb.mass_weight + s->quasistatic_mu);
+      piola__body_stiffness_set_mass_weight(s, &st->matrix, pb.force_weight,
+                                            pb.damped ? dt : 0.0, pb.beta, pb.alpha,
+                                            pb.mass_weight + s->quasistatic_mu);
     }
     piola__step_profile_mark(&w->profile, STEP_PHASE_ASSEMBLE);
     stats->linear_iterations += solve_newton_system(&pb);

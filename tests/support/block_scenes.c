@@ -18,6 +18,31 @@ void block_mesh_free(piola_tet_mesh *m) {
   free(m->tets);
 }
 
+piola_world *deformed_block_world(piola_material_model model, int n, piola_mat3 initial,
+                                  double viscosity, double cfl, int32_t cg_max_iterations) {
+  piola_world_def wd = piola_default_world_def();
+  for (int k = 0; k < 3; ++k) wd.gravity[k] = piola_track_constant(0);
+  wd.max_dt = 1;
+  wd.cfl = cfl;
+  if (cg_max_iterations > 0) wd.cg_max_iterations = cg_max_iterations;
+  piola_world *w = NULL;
+  assert_int_equal(piola_world_create(&wd, &w), PIOLA_OK);
+  piola_tet_mesh mesh;
+  assert_int_equal(piola_tet_mesh_box_grid(n, n, n, (piola_vec3){0.1, 0.1, 0.1}, &mesh), PIOLA_OK);
+  piola_solid_def sd = piola_default_solid_def();
+  sd.mesh = &mesh;
+  sd.material.model = model;
+  sd.material.youngs_modulus = 1e4;
+  sd.material.poisson_ratio = 0.3;
+  sd.density = 1000;
+  sd.shear_viscosity = piola_track_constant(viscosity);
+  sd.bulk_viscosity = piola_track_constant(viscosity);
+  sd.initial_matrix = initial;
+  assert_int_equal(piola_world_add_solid(w, &sd, NULL), PIOLA_OK);
+  piola_tet_mesh_free(&mesh);
+  return w;
+}
+
 void solid_momenta(const piola_world *w, double p[3], double l[3], double *kinetic) {
   const piola_elastic_body *b = piola_world_solid_body(w, 0);
   const double *m = piola_elastic_body_masses(b);

@@ -34,3 +34,45 @@ int near_spline_breakpoint(const piola_material *m, double x, double gap) {
   return fabs(x - 1.0) < gap || fabs(x - def.spline.compression_stretch) < gap ||
          fabs(x - def.spline.elongation_stretch) < gap;
 }
+
+void random_unit(test_rng *rng, double a[3]) {
+  double n;
+  do {
+    for (int i = 0; i < 3; ++i) a[i] = test_rng_normal(rng);
+    n = sqrt(a[0] * a[0] + a[1] * a[1] + a[2] * a[2]);
+  } while (n < 1e-3);
+  for (int i = 0; i < 3; ++i) a[i] /= n;
+}
+
+piola_mat3 random_rotation(test_rng *rng) {
+  double q[4], n = 0;
+  for (int i = 0; i < 4; ++i) q[i] = test_rng_normal(rng), n += q[i] * q[i];
+  n = sqrt(n);
+  const double w = q[0] / n, x = q[1] / n, y = q[2] / n, z = q[3] / n;
+  piola_mat3 r = {{{1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)},
+                   {2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)},
+                   {2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)}}};
+  return r;
+}
+
+piola_mat3 mat3_mul(piola_mat3 a, piola_mat3 b) {
+  piola_mat3 c;
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j) {
+      c.m[i][j] = 0;
+      for (int k = 0; k < 3; ++k) c.m[i][j] += a.m[i][k] * b.m[k][j];
+    }
+  return c;
+}
+
+piola_mat3 mat3_transpose(piola_mat3 a) {
+  piola_mat3 t;
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j) t.m[i][j] = a.m[j][i];
+  return t;
+}
+
+piola_mat3 f_with_singular_values(test_rng *rng, const double s[3]) {
+  piola_mat3 d = {{{s[0], 0, 0}, {0, s[1], 0}, {0, 0, s[2]}}};
+  return mat3_mul(mat3_mul(random_rotation(rng), d), mat3_transpose(random_rotation(rng)));
+}

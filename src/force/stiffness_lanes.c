@@ -1,0 +1,93 @@
+/* The projected stiffness blocks of PIOLA_TET_BLOCK tets at once (stiffness_lanes.h).
+ *
+ * The material's part, dPhat/dFhat made semi-definite, goes through the public material
+ * functions tet by tet (piola__tet_diagonal_stiffness: any model, no copy of them here); the six corner-pair blocks
+ * -V0 U M_ab U^T, most of the arithmetic, run in one loop over the lanes that vectorizes.
+ * The loop repeats piola__tet_stiffness_blocks's operations in its order and this file
+ * fuses no multiply-adds, so each lane gives that function's bits. */
+#include <string.h>
+
+#include "force/element_stiffness.h"
+#include "force/stiffness_lanes.h"
+#include "force/stiffness_matrix.h"
+#include "force/svd_kernel.h"
+
+#define B PIOLA_TET_BLOCK
+
+static const int PAIR_A[6] = {0, 0, 0, 1, 1, 2}, PAIR_B[6] = {1, 2, 3, 2, 3, 3};
+
+PIOLA_WIDE_VECTORS void PIOLA_ISA_NAME(piola__stiffness_block_lanes)(const piola_elastic_body *body, int32_t block,
+                                                  double out[54][B]) {
+  const int32_t base = block * B;
+  double kd[9][B], ka[3][B], kb[3][B];
+  for (int l = 0; l < B; ++l) {
+    piola__diagonal_stiffness k;
+    piola__tet_diagonal_stiffness(body, base + l, &k);
+    for (int e = 0; e < 9; ++e) kd[e][l] = k.block[e / 3][e % 3];
+    for (int p = 0; p < 3; ++p) ka[p][l] = k.pair_a[p], kb[p][l] = k.pair_b[p];
+  }
+  const double *u0 = body->u[0] + base, *v0 = body->v[0] + base;
+  const size_t stride = (size_t)body->padded_tet_count;
+  const double *const d0 = body->dm_inv[0] + base, *const d1 = body->dm_inv[1] + base;
+  const double *const d2 = body->dm_inv[2] + base, *const d3 = body->dm_inv[3] + base;
+  const double *const d4 = body->dm_inv[4] + base, *const d5 = body->dm_inv[5] + base;
+  const double *const d6 = body->dm_inv[6] + base, *const d7 = body->dm_inv[7] + base;
+  const double *const d8 = body->dm_inv[8] + base, *const volume = body->rest_volume + base;
+  const double stiffness_scale = body->last_stiffness_scale;
+#pragma omp simd
+  for (int l = 0; l < B; ++l) {
+    double u[3][3], v[3][3];
+    PIOLA_UNROLL
+    for (int k = 0; k < 9; ++k) {
+      u[k / 3][k % 3] = u0[k * stride + l];
+      v[k / 3][k % 3] = v0[k * stride + l];
+    }
+    const double dm[3][3] = {{d0[l], d1[l], d2[l]}, {d3[l], d4[l], d5[l]}, {d6[l], d7[l], d8[l]}};
+    double g[4][3], gh[4][3];
+    PIOLA_UNROLL
+    for (int j = 0; j < 3; ++j) {
+      g[0][j] = -(dm[0][j] + dm[1][j] + dm[2][j]);
+      PIOLA_UNROLL
+      for (int a = 1; a < 4; ++a) g[a][j] = dm[a - 1][j];
+    }
+    PIOLA_UNROLL
+    for (int a = 0; a < 4; ++a)
+      PIOLA_UNROLL
+      for (int p = 0; p < 3; ++p)
+        gh[a][p] = v[0][p] * g[a][0] + v[1][p] * g[a][1] + v[2][p] * g[a][2];
+    const double scale = -volume[l] * stiffness_scale;
+    PIOLA_UNROLL
+    for (int n = 0; n < 6; ++n) {
+      const int a = PAIR_A[n], b = PAIR_B[n];
+      /* M_ab as piola__tet_stiffness_blocks builds it: pair (p, q) of the diagonal frame is
+       * 2x2 block k = p + q - 1 */
+      double mm[3][3];
+      PIOLA_UNROLL
+      for (int p = 0; p < 3; ++p) {
+        double diag = gh[a][p] * gh[b][p] * kd[4 * p][l];
+        PIOLA_UNROLL
+        for (int q = 0; q < 3; ++q)
+          if (q != p) {
+            const int pr = p + q - 1;
+            diag += gh[a][q] * gh[b][q] * ka[pr][l];
+            mm[p][q] = gh[a][p] * gh[b][q] * kd[3 * p + q][l] + gh[a][q] * gh[b][p] * kb[pr][l];
+          }
+        mm[p][p] = diag;
+      }
+      double um[3][3];
+      PIOLA_UNROLL
+      for (int i = 0; i < 3; ++i)
+        PIOLA_UNROLL
+        for (int q = 0; q < 3; ++q)
+          um[i][q] = u[i][0] * mm[0][q] + u[i][1] * mm[1][q] + u[i][2] * mm[2][q];
+      PIOLA_UNROLL
+      for (int i = 0; i < 3; ++i)
+        PIOLA_UNROLL
+        for (int j = 0; j < 3; ++j) {
+          double kij = um[i][0] * u[j][0] + um[i][1] * u[j][1] + um[i][2] * u[j][2];
+          kij += 0.0; /* the fibre term's place (no fibres here): keeps the sign of a zero */
+          out[9 * n + 3 * i + j][l] = scale * kij;
+        }
+    }
+  }
+}

@@ -101,8 +101,12 @@ static double material_modulus(const piola_material *m, double f0, double f1, do
     case PIOLA_MODEL_MUSCLE: return model_modulus(PIOLA_MODEL_MUSCLE, m, f0, f1, f2);
     case PIOLA_MODEL_HGO: return model_modulus(PIOLA_MODEL_HGO, m, f0, f1, f2);
     case PIOLA_MODEL_SPLINE: return model_modulus(PIOLA_MODEL_SPLINE, m, f0, f1, f2);
-    case PIOLA_MODEL_ROTATED_LINEAR:
-    default: return model_modulus(PIOLA_MODEL_ROTATED_LINEAR, m, f0, f1, f2);
+    case PIOLA_MODEL_STABLE_NEOHOOKEAN:
+      return model_modulus(PIOLA_MODEL_STABLE_NEOHOOKEAN, m, f0, f1, f2);
+    case PIOLA_MODEL_MOONEY_RIVLIN: /* stored as two Ogden terms: the same code path */
+    case PIOLA_MODEL_OGDEN: return model_modulus(PIOLA_MODEL_OGDEN, m, f0, f1, f2);
+    case PIOLA_MODEL_ROTATED_LINEAR: return model_modulus(PIOLA_MODEL_ROTATED_LINEAR, m, f0, f1, f2);
+    default: abort(); /* every model has its case: a new one must get its modulus */
   }
 }
 
@@ -198,8 +202,11 @@ static double range_rate2(const piola_elastic_body *body, const double *w, int32
       case PIOLA_MODEL_MUSCLE: return neohookean_range(PIOLA_MODEL_MUSCLE, m, f, w, begin, end);
       case PIOLA_MODEL_HGO: MODEL_LANE_LOOP(PIOLA_MODEL_HGO)
       case PIOLA_MODEL_SPLINE: MODEL_LANE_LOOP(PIOLA_MODEL_SPLINE)
-      case PIOLA_MODEL_ROTATED_LINEAR:
-      default: MODEL_LANE_LOOP(PIOLA_MODEL_ROTATED_LINEAR)
+      case PIOLA_MODEL_STABLE_NEOHOOKEAN: MODEL_LANE_LOOP(PIOLA_MODEL_STABLE_NEOHOOKEAN)
+      case PIOLA_MODEL_MOONEY_RIVLIN: /* stored as two Ogden terms */
+      case PIOLA_MODEL_OGDEN: MODEL_LANE_LOOP(PIOLA_MODEL_OGDEN)
+      case PIOLA_MODEL_ROTATED_LINEAR: MODEL_LANE_LOOP(PIOLA_MODEL_ROTATED_LINEAR)
+      default: abort(); /* every model has its case (material_modulus) */
     }
   } else {
     for (int32_t t = begin; t < end; ++t) {

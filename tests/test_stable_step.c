@@ -3,7 +3,12 @@
  *  - at rest the per-tet modulus is lambda + 2 mu (+ the fibre modulus): the rest CFL bound;
  *  - above the inversion threshold it bounds dF : dP/dF : dF over unit rank-one dF = a n^T
  *    (every plane wave), with dP/dF from central differences of the public stress through
- *    the diagonalization, and is within a small factor of the largest sampled one;
+ *    the diagonalization, and is within a small factor of the largest sampled one, for every
+ *    isotropic model; past the threshold it bounds the principal waves with both the stress
+ *    and the energy extension;
+ *  - every model takes its own modulus on both paths (one material hoisted, mixed per tet);
+ *  - the stable range of cfl: the largest eigenvalue of M^-1 K by power iteration on a block
+ *    (at rest and stretched, every isotropic model) and three real meshes;
  *  - a world at rest steps at exactly the rest CFL step; a uniformly stretched StVK block at
  *    the step of its analytic longitudinal modulus (s^2 - 1)(mu + 3 lambda / 2) +
  *    s^2 (2 mu + lambda);

@@ -6,10 +6,11 @@
  *    unit_ball.mesh, octahedron.node and octopus-low.mesh (min dihedral angle 0.84 degrees,
  *    14% of tets with mean ratio < 0.1) run 2 s of simulated time (octopus-low 0.05 s: its
  *    slivers make 2 s too many steps for a test) with every step succeeding and a finite
- *    state: 0.5, 1 and 2 diagonals for neo-Hookean, rotated linear, Ogden, Mooney-Rivlin and
- *    the muscle on all three; corotated, StVK, the spline and Stable Neo-Hookean only half a
- *    diagonal on the unit ball, HGO not at all (their explicit runs are not affordable in a
- *    test, see docs/time-stepping.md "Recovery");
+ *    state: 0.5, 1 and 2 diagonals for neo-Hookean and rotated linear on all three, Ogden,
+ *    Mooney-Rivlin and the muscle on the unit ball and the octahedron; corotated, StVK, the
+ *    spline and Stable Neo-Hookean only half a diagonal on the unit ball, HGO not at all
+ *    (their explicit runs are not affordable in a test, see docs/time-stepping.md
+ *    "Recovery");
  *  - point, line and plane collapses of every model on unit_ball and octahedron reach a shape
  *    error (largest distance to the rest shape after the best rigid motion) below 1% of the
  *    diagonal within the settling time docs/time-stepping.md "Recovery" predicts from E,
@@ -135,6 +136,8 @@ static void scrambles_run_to_the_end(void **state) {
                             model == PIOLA_MODEL_OGDEN || model == PIOLA_MODEL_MOONEY_RIVLIN ||
                             model == PIOLA_MODEL_MUSCLE;
         if (!bounded && (r > 0 || mi > 0)) continue;
+        /* octopus-low's runs are the dearest (its slivers): the paper's bounded models only */
+        if (mi == 2 && model != PIOLA_MODEL_NEOHOOKEAN && model != PIOLA_MODEL_ROTATED_LINEAR) continue;
         if ((index++ + mi) % stride) continue; /* a different radius on each mesh */
         const double radius = (r == 0 ? 0.5 : r == 1 ? 1.0 : 2.0) * DIAGONAL;
         piola_world *w = make_world(&mesh, model, identity, radius);

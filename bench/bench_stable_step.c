@@ -1,11 +1,11 @@
 /* Cost of the state-aware step bound (src/force/stable_step.c) against the force loop it
  * must stay under 5% of (issue 21).
  *
- *   build/<dir>/bench_stable_step [repeats]
+ *   build/<dir>/bench_stable_step [repeats [model ...]]
  *
  * Vega's torus-easy.veg (97,878 tets) when the data folder is there, else a generated
  * 105,456-tet grid, deformed by a random stretch of up to 30% plus noise of 5% of an edge,
- * for neo-Hookean and corotated. Per model and thread count (1, 2) the update
+ * for the models named (default: neohookean, corotated, stable_neohookean, ogden). Per model and thread count (1, 2) the update
  * (piola_elastic_body_update, forces only) and the bound pass are timed interleaved, one of
  * each per repeat; the medians (default 15 repeats) and their ratio are printed. The bound
  * reads the Fhat the update stored, so each pass follows an update as in a step. */
@@ -74,8 +74,17 @@ int main(int argc, char **argv) {
     }
   }
   printf("| mesh             | model      |    tets | threads | update ms | bound ms | bound/update |\n");
-  bench_model(name, &mesh, PIOLA_MODEL_NEOHOOKEAN, repeats);
-  bench_model(name, &mesh, PIOLA_MODEL_COROTATED, repeats);
+  static const char *const defaults[] = {"neohookean", "corotated", "stable_neohookean", "ogden"};
+  const int named = argc > 2 ? argc - 2 : 4;
+  for (int k = 0; k < named; ++k) {
+    const char *model_name = argc > 2 ? argv[2 + k] : defaults[k];
+    piola_material_model model;
+    if (!piola_material_model_from_name(model_name, &model)) {
+      fprintf(stderr, "bench_stable_step: unknown model \"%s\"\n", model_name);
+      return 1;
+    }
+    bench_model(name, &mesh, model, repeats);
+  }
   piola_tet_mesh_free(&mesh);
   return 0;
 }

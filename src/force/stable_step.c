@@ -47,25 +47,55 @@ STABLE_STEP_KERNEL double pair_modulus(double c, double pi, double pj, double fi
   return a + fabs(b + kij);
 }
 
-/* k of one tet of model MODEL (a compile-time constant in the lane loops). */
-STABLE_STEP_KERNEL double model_modulus(piola_material_model model, const piola_material *m,
-                                        double f0, double f1, double f2) {
+/* k of one tet of model MODEL with the stress extension of mode ENERGY (both compile-time
+ * constants in the lane loops: 0 for the LINEAR and CLAMP stress extensions, 1 for
+ * PIOLA_INVERSION_ENERGY). */
+STABLE_STEP_KERNEL double model_modulus(piola_material_model model, int energy,
+                                        const piola_material *m, double f0, double f1, double f2) {
   const double c = m->threshold;
   const double fc0 = kernel_max(f0, c), fc1 = kernel_max(f1, c), fc2 = kernel_max(f2, c);
   const double d0 = f0 - fc0, d1 = f1 - fc1, d2 = f2 - fc2;
   material_parts pa;
   material_model_parts(model, m, KERNEL_FAST_RECIPROCAL, fc0, fc1, fc2, &pa);
-  double p0, p1, p2;
-  material_extend(m, KERNEL_FAST_RECIPROCAL, &pa, d0, d1, d2, &p0, &p1, &p2);
-  /* a clamped entry's diagonal slope is at most the extension's threshold slope */
-  const double floor_slope = m->mu;
-  const double k0 = d0 < 0.0 ? kernel_max(pa.k[0][0], floor_slope + kernel_max(pa.p[0], 0.0) / c) : pa.k[0][0];
-  const double k1 = d1 < 0.0 ? kernel_max(pa.k[1][1], floor_slope + kernel_max(pa.p[1], 0.0) / c) : pa.k[1][1];
-  const double k2 = d2 < 0.0 ? kernel_max(pa.k[2][2], floor_slope + kernel_max(pa.p[2], 0.0) / c) : pa.k[2][2];
+  double p0, p1, p2, k0, k1, k2;
+  double k01 = pa.k[0][1], k02 = pa.k[0][2], k12 = pa.k[1][2];
+  if (energy) {
+    /* The energy extension (material_kernels.h) has no closed-form slopes worth writing out:
+     * a clamped entry's diagonal is the extension's k, which grows with the other entries'
+     * stretch (as its fourth power for the J models), and the unclamped entries' slopes and
+     * the couplings carry derivatives of the clamped point's coefficients times the offsets.
+     * So its 3x3 Jacobian is taken by differences of the extended stress: the larger
+     * one-sided slope on the diagonal (the slope jumps at the threshold), central ones off
+     * it. Six more stress evaluations, in this mode only. */
+    material_energy_extended_stress(model, m, KERNEL_FAST_RECIPROCAL, f0, f1, f2, &p0, &p1, &p2);
+    const double h0 = 1e-6 * kernel_max(fabs(f0), 1.0), h1 = 1e-6 * kernel_max(fabs(f1), 1.0),
+                 h2 = 1e-6 * kernel_max(fabs(f2), 1.0);
+    double a0, a1, a2, b0, b1, b2, e0, e1, e2, g0, g1, g2, q0, q1, q2, r0, r1, r2;
+    material_energy_extended_stress(model, m, KERNEL_FAST_RECIPROCAL, f0 + h0, f1, f2, &a0, &a1, &a2);
+    material_energy_extended_stress(model, m, KERNEL_FAST_RECIPROCAL, f0 - h0, f1, f2, &b0, &b1, &b2);
+    material_energy_extended_stress(model, m, KERNEL_FAST_RECIPROCAL, f0, f1 + h1, f2, &e0, &e1, &e2);
+    material_energy_extended_stress(model, m, KERNEL_FAST_RECIPROCAL, f0, f1 - h1, f2, &g0, &g1, &g2);
+    material_energy_extended_stress(model, m, KERNEL_FAST_RECIPROCAL, f0, f1, f2 + h2, &q0, &q1, &q2);
+    material_energy_extended_stress(model, m, KERNEL_FAST_RECIPROCAL, f0, f1, f2 - h2, &r0, &r1, &r2);
+    k0 = kernel_max((a0 - p0) / h0, (p0 - b0) / h0);
+    k1 = kernel_max((e1 - p1) / h1, (p1 - g1) / h1);
+    k2 = kernel_max((q2 - p2) / h2, (p2 - r2) / h2);
+    /* symmetric (a gradient), averaged */
+    k01 = 0.25 * ((a1 - b1) / h0 + (e0 - g0) / h1);
+    k02 = 0.25 * ((a2 - b2) / h0 + (q0 - r0) / h2);
+    k12 = 0.25 * ((e2 - g2) / h1 + (q1 - r1) / h2);
+  } else {
+    material_extend(m, KERNEL_FAST_RECIPROCAL, &pa, d0, d1, d2, &p0, &p1, &p2);
+    /* a clamped entry's diagonal slope is at most the extension's threshold slope */
+    const double floor_slope = m->mu;
+    k0 = d0 < 0.0 ? kernel_max(pa.k[0][0], floor_slope + kernel_max(pa.p[0], 0.0) / c) : pa.k[0][0];
+    k1 = d1 < 0.0 ? kernel_max(pa.k[1][1], floor_slope + kernel_max(pa.p[1], 0.0) / c) : pa.k[1][1];
+    k2 = d2 < 0.0 ? kernel_max(pa.k[2][2], floor_slope + kernel_max(pa.p[2], 0.0) / c) : pa.k[2][2];
+  }
   double k = kernel_max(k0, kernel_max(k1, k2));
-  k = kernel_max(k, pair_modulus(c, p0, p1, f0, f1, k0, k1, pa.k[0][1]));
-  k = kernel_max(k, pair_modulus(c, p0, p2, f0, f2, k0, k2, pa.k[0][2]));
-  k = kernel_max(k, pair_modulus(c, p1, p2, f1, f2, k1, k2, pa.k[1][2]));
+  k = kernel_max(k, pair_modulus(c, p0, p1, f0, f1, k0, k1, k01));
+  k = kernel_max(k, pair_modulus(c, p0, p2, f0, f2, k0, k2, k02));
+  k = kernel_max(k, pair_modulus(c, p1, p2, f1, f2, k1, k2, k12));
   /* muscle fibres: their tangent stiffness bound, as in the rest bound; HGO's exponential
    * fibres: a bound at this state (hgo_kernels.h) */
   return k + (model == PIOLA_MODEL_HGO ? hgo_fiber_modulus_bound(&m->hgo, f0, f1, f2)
@@ -93,17 +123,28 @@ STABLE_STEP_KERNEL double neohookean_plain_modulus(const piola_material *m, doub
   return k + m->fiber_modulus;
 }
 
-static double material_modulus(const piola_material *m, double f0, double f1, double f2) {
+/* Per tet: the model and the extension mode chosen at run time. */
+static double mode_modulus(int energy, const piola_material *m, double f0, double f1, double f2) {
   switch (m->model) {
-    case PIOLA_MODEL_COROTATED: return model_modulus(PIOLA_MODEL_COROTATED, m, f0, f1, f2);
-    case PIOLA_MODEL_STVK: return model_modulus(PIOLA_MODEL_STVK, m, f0, f1, f2);
-    case PIOLA_MODEL_NEOHOOKEAN: return model_modulus(PIOLA_MODEL_NEOHOOKEAN, m, f0, f1, f2);
-    case PIOLA_MODEL_MUSCLE: return model_modulus(PIOLA_MODEL_MUSCLE, m, f0, f1, f2);
-    case PIOLA_MODEL_HGO: return model_modulus(PIOLA_MODEL_HGO, m, f0, f1, f2);
-    case PIOLA_MODEL_SPLINE: return model_modulus(PIOLA_MODEL_SPLINE, m, f0, f1, f2);
+    case PIOLA_MODEL_COROTATED: return model_modulus(PIOLA_MODEL_COROTATED, energy, m, f0, f1, f2);
+    case PIOLA_MODEL_STVK: return model_modulus(PIOLA_MODEL_STVK, energy, m, f0, f1, f2);
+    case PIOLA_MODEL_NEOHOOKEAN: return model_modulus(PIOLA_MODEL_NEOHOOKEAN, energy, m, f0, f1, f2);
+    case PIOLA_MODEL_MUSCLE: return model_modulus(PIOLA_MODEL_MUSCLE, energy, m, f0, f1, f2);
+    case PIOLA_MODEL_HGO: return model_modulus(PIOLA_MODEL_HGO, energy, m, f0, f1, f2);
+    case PIOLA_MODEL_SPLINE: return model_modulus(PIOLA_MODEL_SPLINE, energy, m, f0, f1, f2);
+    case PIOLA_MODEL_STABLE_NEOHOOKEAN:
+      return model_modulus(PIOLA_MODEL_STABLE_NEOHOOKEAN, energy, m, f0, f1, f2);
+    case PIOLA_MODEL_MOONEY_RIVLIN: /* stored as two Ogden terms: the same code path */
+    case PIOLA_MODEL_OGDEN: return model_modulus(PIOLA_MODEL_OGDEN, energy, m, f0, f1, f2);
     case PIOLA_MODEL_ROTATED_LINEAR:
-    default: return model_modulus(PIOLA_MODEL_ROTATED_LINEAR, m, f0, f1, f2);
+      return model_modulus(PIOLA_MODEL_ROTATED_LINEAR, energy, m, f0, f1, f2);
+    default: abort(); /* every model has its case: a new one must get its modulus */
   }
+}
+
+static double material_modulus(const piola_material *m, double f0, double f1, double f2) {
+  return m->inversion_mode == PIOLA_INVERSION_ENERGY ? mode_modulus(1, m, f0, f1, f2)
+                                                     : mode_modulus(0, m, f0, f1, f2);
 }
 
 double PIOLA_ISA_NAME(piola__elastic_body_tet_rest_altitude)(const piola_elastic_body *body, int32_t t) {
@@ -144,7 +185,7 @@ static const double *rate_weights(piola_elastic_body *body) {
 /* Neo-Hookean by blocks of PIOLA_TET_BLOCK: the plain closed form when no lane of the block
  * is below the threshold (neohookean_lane_unclamped, as the force loop decides), else the
  * general one. */
-static double neohookean_range(piola_material_model model, const piola_material *m,
+static double neohookean_range(piola_material_model model, int energy, const piola_material *m,
                                const double *f, const double *w, int32_t begin, int32_t end) {
   double best = 0;
   int32_t t = begin;
@@ -164,24 +205,46 @@ static double neohookean_range(piola_material_model model, const piola_material 
 #pragma omp simd reduction(max:best)
       for (int l = 0; l < PIOLA_TET_BLOCK; ++l) {
         const double *fl = f + 3 * (t + l);
-        const double r = w[t + l] * model_modulus(model, m, fl[0], fl[1], fl[2]);
+        const double r = w[t + l] * model_modulus(model, energy, m, fl[0], fl[1], fl[2]);
         best = r > best ? r : best;
       }
     }
   }
   for (; t < end; ++t) {
-    const double r = w[t] * model_modulus(model, m, f[3 * t], f[3 * t + 1], f[3 * t + 2]);
+    const double r = w[t] * model_modulus(model, energy, m, f[3 * t], f[3 * t + 1], f[3 * t + 2]);
     best = r > best ? r : best;
   }
   return best;
 }
 
-#define MODEL_LANE_LOOP(model)                                                             \
-  _Pragma("omp simd reduction(max:best)") for (int32_t t = begin; t < end; ++t) {          \
-    const double r = w[t] * model_modulus(model, m, f[3 * t], f[3 * t + 1], f[3 * t + 2]);  \
-    best = r > best ? r : best;                                                            \
-  }                                                                                        \
+#define MODEL_LANE_LOOP(model)                                                                  \
+  _Pragma("omp simd reduction(max:best)") for (int32_t t = begin; t < end; ++t) {               \
+    const double r = w[t] * model_modulus(model, energy, m, f[3 * t], f[3 * t + 1], f[3 * t + 2]); \
+    best = r > best ? r : best;                                                                 \
+  }                                                                                             \
   break;
+
+/* max over tets [begin, end) of w_e k_e, one material, its mode ENERGY a compile-time
+ * constant */
+STABLE_STEP_KERNEL double uniform_range_rate2(int energy, const piola_material *m, const double *f,
+                                              const double *w, int32_t begin, int32_t end) {
+  double best = 0;
+  switch (m->model) {
+    case PIOLA_MODEL_COROTATED: MODEL_LANE_LOOP(PIOLA_MODEL_COROTATED)
+    case PIOLA_MODEL_STVK: MODEL_LANE_LOOP(PIOLA_MODEL_STVK)
+    case PIOLA_MODEL_NEOHOOKEAN:
+      return neohookean_range(PIOLA_MODEL_NEOHOOKEAN, energy, m, f, w, begin, end);
+    case PIOLA_MODEL_MUSCLE: return neohookean_range(PIOLA_MODEL_MUSCLE, energy, m, f, w, begin, end);
+    case PIOLA_MODEL_HGO: MODEL_LANE_LOOP(PIOLA_MODEL_HGO)
+    case PIOLA_MODEL_SPLINE: MODEL_LANE_LOOP(PIOLA_MODEL_SPLINE)
+    case PIOLA_MODEL_STABLE_NEOHOOKEAN: MODEL_LANE_LOOP(PIOLA_MODEL_STABLE_NEOHOOKEAN)
+    case PIOLA_MODEL_MOONEY_RIVLIN: /* stored as two Ogden terms */
+    case PIOLA_MODEL_OGDEN: MODEL_LANE_LOOP(PIOLA_MODEL_OGDEN)
+    case PIOLA_MODEL_ROTATED_LINEAR: MODEL_LANE_LOOP(PIOLA_MODEL_ROTATED_LINEAR)
+    default: abort(); /* every model has its case (material_modulus) */
+  }
+  return best;
+}
 
 /* max over tets [begin, end) of w_e k_e */
 static double range_rate2(const piola_elastic_body *body, const double *w, int32_t begin,
@@ -190,17 +253,8 @@ static double range_rate2(const piola_elastic_body *body, const double *w, int32
   double best = 0;
   if (body->uniform_material >= 0) {
     const piola_material *m = &body->materials[body->uniform_material];
-    switch (m->model) {
-      case PIOLA_MODEL_COROTATED: MODEL_LANE_LOOP(PIOLA_MODEL_COROTATED)
-      case PIOLA_MODEL_STVK: MODEL_LANE_LOOP(PIOLA_MODEL_STVK)
-      case PIOLA_MODEL_NEOHOOKEAN:
-        return neohookean_range(PIOLA_MODEL_NEOHOOKEAN, m, f, w, begin, end);
-      case PIOLA_MODEL_MUSCLE: return neohookean_range(PIOLA_MODEL_MUSCLE, m, f, w, begin, end);
-      case PIOLA_MODEL_HGO: MODEL_LANE_LOOP(PIOLA_MODEL_HGO)
-      case PIOLA_MODEL_SPLINE: MODEL_LANE_LOOP(PIOLA_MODEL_SPLINE)
-      case PIOLA_MODEL_ROTATED_LINEAR:
-      default: MODEL_LANE_LOOP(PIOLA_MODEL_ROTATED_LINEAR)
-    }
+    return m->inversion_mode == PIOLA_INVERSION_ENERGY ? uniform_range_rate2(1, m, f, w, begin, end)
+                                                       : uniform_range_rate2(0, m, f, w, begin, end);
   } else {
     for (int32_t t = begin; t < end; ++t) {
       const double r = w[t] * PIOLA_ISA_NAME(piola__elastic_body_tet_modulus)(body, t, f + 3 * t);

@@ -24,7 +24,10 @@ from script_checks import PIOLA, SOURCE, check, finish
 SCALE = float(os.environ.get("PIOLA_TEST_SCALE", "1"))
 # example: the frame from which its bodies are in contact (stats.csv: contacts > 0)
 CONTACT_FROM = {"cloth_on_jelly": 2, "cloth_folds": 5, "solids_stack": 1, "squeezed_solid": 22,
-                "cloth_cape_on_body": 4}
+                "cloth_cape_on_body": 4,
+                # fracture: cut at frames 9 and 19 (0.3 s and 0.6 s), so the runs resume from
+                # cut states and the second cut comes after the resumes
+                "scripted_cut": 12}
 EVERY = 2  # frames between checkpoints
 # Renames of a run (src/output/frame_commit.c): scene.json, then per frame six (VTU and OBJ
 # temporaries to pending names, both into place, stats.csv, sim.pvd), then the checkpoint

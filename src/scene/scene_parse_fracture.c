@@ -32,8 +32,6 @@ static piola_status parse_cut(scene_parser *p, const cJSON *obj, piola_fracture_
 piola_status piola__scene_parse_fracture(scene_parser *p, const cJSON *obj, scene_solid_desc *d) {
   static const char *const allowed[] = {"cuts", "max_cuts_per_step", "criterion", "threshold", NULL};
   PIOLA_TRY(piola__json_check_keys(p, obj, allowed));
-  if (d->def.self_collision.enabled)
-    return piola__json_fail(p, BAD_VALUE, "cannot be combined with self_collision (not supported)");
   d->fractures = 1;
   d->fracture = piola_default_fracture_def();
   const cJSON *criterion = piola__json_get(obj, "criterion");

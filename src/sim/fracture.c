@@ -197,6 +197,16 @@ static int faces_overlap(const solid_fracture *f, const int32_t *event, const do
 
 /* ------------------------------------------------------------------ the cut event */
 
+double piola__fracture_snap(const world_body *b) {
+  const double altitude = piola_elastic_body_min_rest_altitude(b->solid);
+  double snap = SNAP_SHARE * altitude;
+  /* with self-collision, each crack face's collision surface lies up to half the thickness
+   * inside its material (world_contact.c), which needs that much room on either side */
+  if (b->self_collision.enabled)
+    snap = fmax(snap, fmin(0.5 * b->self_collision.thickness, 0.05 * altitude));
+  return snap;
+}
+
 typedef struct new_mesh {
   int32_t copies, nodes;
   int32_t *parent, *event, *element_parent, *node_of, *node_parent, *up, *fragment;
@@ -238,7 +248,7 @@ static piola_status cut_event(piola_world *w, world_body *b, const double point[
   const piola_elastic_body *old = b->solid;
   const int32_t *old_tets = piola_elastic_body_tets(old);
   const double nn = sqrt(normal[0] * normal[0] + normal[1] * normal[1] + normal[2] * normal[2]);
-  const double snap = SNAP_SHARE * piola_elastic_body_min_rest_altitude(old);
+  const double snap = piola__fracture_snap(b);
   double *s = malloc(sizeof(double) * (size_t)b->n);
   if (!s) return PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "cut of '%s': out of memory", b->name);
   for (int32_t i = 0; i < b->n; ++i) {
@@ -408,10 +418,6 @@ static piola_status check_plane(const double point[3], const double normal[3], c
 
 static piola_status ensure_state(world_body *b) {
   if (b->fracture) return PIOLA_OK;
-  if (b->self_collision.enabled)
-    return PIOLA_FAIL(PIOLA_ERROR_UNSUPPORTED,
-                      "fracture of '%s': not with self_collision (the collision surface would be "
-                      "the copies' whole tets, which overlap across every crack)", b->name);
   return fracture_create(b, &b->fracture);
 }
 

@@ -68,4 +68,24 @@ extern const int8_t piola__cut_tet_face[4][3];
 
 void piola__fracture_free(solid_fracture *f);
 
+/* A vertex of a fragment surface: the point a + t (b - a) between nodes a and b (a == b and
+ * t = 0 for a corner). */
+typedef struct fracture_surface_point {
+  int32_t a, b;
+  double t;
+} fracture_surface_point;
+
+struct world_body;
+/* The distance (m) from a cut's plane below which node distances are pushed away from it:
+ * a share of the smallest rest altitude, and with self-collision up to half the thickness
+ * (capped at 5% of that altitude), so the crack faces' collision surfaces fit inside. */
+double piola__fracture_snap(const struct world_body *b);
+/* The fragment surfaces of solid b (piola_world_solid_fracture_surface), with each crack
+ * face moved into its copy's material by inset (m, below the cut's snap distance, so every
+ * polygon keeps its shape; 0: the crack itself), and when where is given, each vertex as a
+ * point between two nodes (*where, vertex_count entries, freed by the caller). */
+piola_status piola__fracture_surface_build(const struct world_body *b, double inset,
+                                           piola_fracture_surface *out,
+                                           fracture_surface_point **where);
+
 #endif

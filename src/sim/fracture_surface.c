@@ -64,6 +64,13 @@ piola_status piola_world_solid_fracture_surface(const piola_world *w, int32_t so
   const world_body *b = w ? piola__world_body_of(w, PIOLA_BODY_SOLID, solid) : NULL;
   if (!b || !b->fracture)
     return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "fracture surface: solid %d has no fracture state", (int)solid);
+  return piola__fracture_surface_build(b, 0, out, NULL);
+}
+
+piola_status piola__fracture_surface_build(const world_body *b, double inset, piola_fracture_surface *out,
+                                           fracture_surface_point **where) {
+  memset(out, 0, sizeof *out);
+  if (where) *where = NULL;
   const solid_fracture *f = b->fracture;
   const int32_t *nodes = piola_elastic_body_tets(b->solid);
   /* at most 4 faces of 4 points and a crack of 4 per copy */
@@ -88,7 +95,9 @@ piola_status piola_world_solid_fracture_surface(const piola_world *w, int32_t so
       }
     } else {
       copy_polygons poly;
-      piola__fracture_copy_polygons(f->dist + 4 * c, f->side[c], f->tets + 4 * t, &poly);
+      double dist[4]; /* inset: the level set side * inset instead of 0 (same edges crossed) */
+      for (int k = 0; k < 4; ++k) dist[k] = f->dist[4 * c + k] - f->side[c] * inset;
+      piola__fracture_copy_polygons(dist, f->side[c], f->tets + 4 * t, &poly);
       for (int k = 0; k < 4; ++k)
         if (f->neighbor[4 * t + k] < 0) emit(f, nodes, c, poly.face[k], poly.face_size[k], points, &np, tri, &nt);
       emit(f, nodes, c, poly.crack, poly.crack_size, points, &np, tri, &nt);
@@ -102,8 +111,9 @@ piola_status piola_world_solid_fracture_surface(const piola_world *w, int32_t so
   out->triangles = malloc(3 * sizeof(int32_t) * (size_t)(nt > 0 ? nt : 1));
   out->fragment_start = calloc((size_t)f->fragment_count + 1, sizeof(int32_t));
   int32_t *fill = calloc((size_t)f->fragment_count + 1, sizeof(int32_t));
-  if (!out->positions || !out->triangles || !out->fragment_start || !fill) {
-    free(points), free(tri), free(index), free(triangle_fragment), free(fill);
+  fracture_surface_point *at = where ? malloc(sizeof *at * (size_t)(np > 0 ? np : 1)) : NULL;
+  if (!out->positions || !out->triangles || !out->fragment_start || !fill || (where && !at)) {
+    free(points), free(tri), free(index), free(triangle_fragment), free(fill), free(at);
     piola_fracture_surface_free(out);
     return PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "fracture surface: out of memory");
   }
@@ -112,6 +122,7 @@ piola_status piola_world_solid_fracture_surface(const piola_world *w, int32_t so
     if (i == 0 || by_name(&(surface_point){p->fragment, p->a, p->b, p->event, 0, -1}, &points[i - 1]) > 0) {
       const double *xa = b->x + 3 * (size_t)p->a, *xb = b->x + 3 * (size_t)p->b;
       for (int k = 0; k < 3; ++k) out->positions[3 * (size_t)nv + k] = xa[k] + p->t * (xb[k] - xa[k]);
+      if (at) at[nv] = (fracture_surface_point){p->a, p->b, p->t};
       ++nv;
     }
     index[p->order] = nv - 1;
@@ -128,5 +139,6 @@ piola_status piola_world_solid_fracture_surface(const piola_world *w, int32_t so
   out->vertex_count = nv;
   out->triangle_count = nt;
   free(points), free(tri), free(index), free(triangle_fragment), free(fill);
+  if (where) *where = at;
   return PIOLA_OK;
 }

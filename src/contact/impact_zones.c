@@ -2,26 +2,8 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "common/union_find.h"
 #include "contact/contact_internal.h"
-
-int32_t piola__zone_root(int32_t *parent, int32_t i) {
-  while (parent[i] != i) {
-    parent[i] = parent[parent[i]];
-    i = parent[i];
-  }
-  return i;
-}
-
-/* Joins the sets of a and b; the smaller index becomes the root, so zones do not depend on
- * the order of the unions. */
-static void zone_union(int32_t *parent, int32_t a, int32_t b) {
-  a = piola__zone_root(parent, a), b = piola__zone_root(parent, b);
-  if (a == b) return;
-  if (a < b)
-    parent[b] = a;
-  else
-    parent[a] = b;
-}
 
 /* Solves m w = b for the symmetric positive semi-definite inertia-like matrix m; when it is
  * (nearly) singular (a zone whose points are collinear) a small multiple of the trace is added
@@ -68,7 +50,7 @@ static int32_t rigid_zones(piola_collision_surface *s, const zone_points *z, int
   if (!start) return -1;
   int32_t members = 0;
   for (int32_t i = 0; i < n; ++i)
-    if (z->in_zone[i]) ++start[piola__zone_root(parent, i) + 1], ++members;
+    if (z->in_zone[i]) ++start[piola__union_find_root(parent, i) + 1], ++members;
   for (int32_t i = 0; i < n; ++i) start[i + 1] += start[i];
   int32_t *fill = malloc(sizeof(int32_t) * ((size_t)n + 1));
   if (!fill) {
@@ -77,7 +59,7 @@ static int32_t rigid_zones(piola_collision_surface *s, const zone_points *z, int
   }
   for (int32_t i = 0; i <= n; ++i) fill[i] = start[i];
   for (int32_t i = 0; i < n; ++i)
-    if (z->in_zone[i]) z->order[fill[piola__zone_root(parent, i)]++] = i;
+    if (z->in_zone[i]) z->order[fill[piola__union_find_root(parent, i)]++] = i;
   free(fill);
 
   int32_t zones = 0;
@@ -152,7 +134,7 @@ int32_t piola__impact_zones_apply(piola_collision_surface *s, const piola__conta
   for (int64_t i = 0; i < hits->count; ++i) {
     const piola__contact *c = &hits->items[i];
     for (int k = 0; k < 4; ++k) s->in_zone[c->v[k]] = 1;
-    for (int k = 1; k < 4; ++k) zone_union(parent, c->v[0], c->v[k]);
+    for (int k = 1; k < 4; ++k) piola__union_find_join(parent, c->v[0], c->v[k]);
   }
   const zone_points z = {.n = s->vertex_count, .parent = parent, .order = s->zone_order,
                          .in_zone = s->in_zone, .dirty = s->dirty,
@@ -172,7 +154,7 @@ int32_t piola__embedded_zones_apply(piola_collision_surface *s, const piola__con
         if (node < 0) continue;
         s->node_in_zone[node] = 1;
         if (first < 0) first = node;
-        else zone_union(parent, first, node);
+        else piola__union_find_join(parent, first, node);
       }
   }
   memset(s->node_dirty, 0, (size_t)s->node_count);
@@ -206,7 +188,7 @@ int piola__embedded_same_zone(piola_collision_surface *s, const piola__contact *
       const int32_t node = s->embed_nodes[PIOLA_COLLISION_EMBED_NODES * c->v[k] + j];
       if (node < 0) continue;
       if (!s->node_in_zone[node]) return 0;
-      const int32_t r = piola__zone_root(s->node_zone_parent, node);
+      const int32_t r = piola__union_find_root(s->node_zone_parent, node);
       if (root >= 0 && r != root) return 0;
       root = r;
     }

@@ -212,6 +212,7 @@ static void fracture_state(stream *s, piola_world *w, world_body *b) {
   if (s->failed) return;
   const int32_t nc = counts[0];
   if (s->reading && (nc < f->tet_count || nc > 2 * f->tet_count || counts[1] < 1 ||
+                     counts[1] > 4 * nc || /* every node is a corner of a copy */
                      counts[4] < 0 || counts[4] > f->cut_count || counts[5] < 0 ||
                      counts[5] > f->tet_count)) {
     s->failed = 1;

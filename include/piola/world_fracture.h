@@ -53,9 +53,10 @@ typedef enum piola_fracture_criterion {
 /* Before each step, every uncut tet past the threshold that touches a crack (a neighbour's
  * crack crosses their shared face) is cut so that the crack runs on into it: the crack's
  * points on the shared faces are kept and it turns as close to normal to the tet's largest
- * principal stress as they allow. If no tet continues a crack, the tet with the largest
- * measure starts one: the plane through its centroid normal to its largest principal stress,
- * in that tet only. So cracks grow tet by tet as surfaces (docs/fracture.md). */
+ * principal stress as they allow. If no crack grows, the tet with the largest measure starts
+ * a new one unless a crack touches it: the plane through its centroid normal to its largest
+ * principal stress, in that tet only. So cracks grow tet by tet as surfaces
+ * (docs/fracture.md). */
 
 typedef struct piola_fracture_def {
   const piola_fracture_cut *cuts; /* cut_count cuts, copied; any order (applied by time) */

@@ -775,9 +775,10 @@ static int by_measure(const void *pa, const void *pb) {
 
 /* The breaking criteria (stress, plastic strain): before each step, every uncut copy whose
  * measure passes the threshold and that touches a crack is cut so that the crack runs on
- * into it (continued_crack), in order of decreasing measure; if none does, the copy with the
- * largest measure starts a new crack, the plane through its centroid normal to its largest
- * principal stress. At most max_tets_per_step copies (0: no limit). */
+ * into it (continued_crack), in order of decreasing measure, at most max_tets_per_step (0: no
+ * limit). If none does, the one with the largest measure starts a new crack unless a crack
+ * touches it (a corner holds a crack's value): the plane through its centroid normal to its
+ * largest principal stress, in that copy only. */
 static piola_status apply_criterion(piola_world *w, world_body *b) {
   solid_fracture *f = b->fracture;
   if (f->criterion == PIOLA_FRACTURE_SCRIPTED) return PIOLA_OK;
@@ -827,10 +828,15 @@ static piola_status apply_criterion(piola_world *w, world_body *b) {
     memcpy(map.dist + 4 * t, cut->dist, sizeof cut->dist);
     ++count;
   }
+  /* when no crack grew: a new crack at the candidate with the largest measure, unless a
+   * crack touches it (cracks relieve the stress by growing first; the worst place is where
+   * the next one starts, never a second-best one) */
   int started = 0;
-  if (count == 0) {
-    /* a new crack at the first candidate (the largest measure) */
-    const int32_t c = list[0].copy;
+  const int32_t c = list[0].copy;
+  const int32_t *ids = f->tets + 4 * f->parent[c];
+  int touched = 0;
+  for (int k = 0; k < 4; ++k) touched |= f->vertex_crack[ids[k]] >= 0;
+  if (count == 0 && !touched) {
     double point[3] = {0, 0, 0};
     for (int k = 0; k < 4; ++k)
       for (int a = 0; a < 3; ++a) point[a] += 0.25 * b->x[3 * nodes[4 * c + k] + a];
@@ -842,11 +848,8 @@ static piola_status apply_criterion(piola_world *w, world_body *b) {
       if (cuts[0].dist[k] > 0) pos = 1;
       else neg = 1;
     }
-    int owned = 0;
-    for (int k = 0; k < 4; ++k) owned |= f->vertex_crack[f->tets[4 * f->parent[c] + k]] >= 0;
     cuts[0].copy = c, cuts[0].crack = f->events;
-    count = pos && neg && !owned;
-    started = count;
+    started = count = pos && neg;
   }
   piola_status st = split_copies(w, b, cuts, count);
   if (st == PIOLA_OK && started) b->fracture->events++;

@@ -97,6 +97,7 @@ static piola_status fracture_create(const world_body *b, solid_fracture **out) {
   }
   memcpy(f->tets, piola_elastic_body_tets(b->solid), 4 * sizeof(int32_t) * (size_t)nt);
   for (int32_t i = 0; i < b->n; ++i) f->vertex_crack[i] = -1;
+  f->grown_crack = -1;
   for (int32_t t = 0; t < nt; ++t) {
     f->parent[t] = t, f->event[t] = -1, f->side[t] = 1, f->fraction[t] = 1.0;
     f->copies[2 * t] = t, f->copies[2 * t + 1] = -1;
@@ -694,71 +695,76 @@ static int barycentric_gradients(const double *x, const int32_t p[4], double g[4
   return 1;
 }
 
-/* The cracks around original tets during one criterion pass: per tet its crack (-1: none)
- * and corner distances, for the copies cut before and the ones planned in this pass. */
-typedef struct crack_map {
-  int32_t *crack;
-  double *dist; /* 4 per tet, in the tet's corner order */
-} crack_map;
-
-/* Whether the values v[3] on a face cross zero (have both signs). */
-static int crosses(const double v[3]) {
-  return (v[0] > 0 || v[1] > 0 || v[2] > 0) && (v[0] < 0 || v[1] < 0 || v[2] < 0);
+/* Snaps v (a new corner value) away from zero and keeps it as crack's value at vertex. */
+static double keep_value(solid_fracture *f, int32_t vertex, int32_t crack, double v, double snap) {
+  v = snapped(v, snap);
+  f->vertex_crack[vertex] = crack, f->vertex_value[vertex] = v;
+  return v;
 }
 
-/* The crack of copy c (original tet t, uncut) continued from a neighbour's: when a face
- * neighbour's crack crosses their shared face, t takes that crack's values at its corners
- * (a crack is the zero set of one value per original vertex, so cracks meet edge to edge);
- * the one corner without a value takes the one that turns the crack closest to normal to
- * dir (the direction of the largest principal stress). Returns 0 when no neighbour's crack
- * crosses a shared face, 1 with dist and crack filled in (and the new corner value kept), -1
- * when it cannot continue: neighbours of different cracks, or a corner that holds another
- * crack's value. */
-static int continued_crack(solid_fracture *f, const crack_map *map, const double *x, const int32_t *nodes,
-                           int32_t t, const double dir[3], double snap, double dist[4], int32_t *crack) {
+/* The crack of copy c (original tet t, uncut, corners `nodes`) continued from the crack values
+ * its corners hold (a crack is the zero set of one value per original vertex, so its pieces
+ * meet edge to edge). It continues where two corners of an edge hold values of opposite sign
+ * (the crack crosses that edge): with three known corners the fourth takes the value that
+ * turns the crack closest to normal to dir (the direction of the largest principal stress);
+ * with two, the crack is the plane through their crossing normal to dir. Returns 0 when no
+ * edge is crossed, 1 with dist and crack filled in (the new corner values kept), -1 when it
+ * cannot continue (corners of different cracks, a degenerate tet or direction). */
+static int continued_crack(solid_fracture *f, const double *x, const int32_t *nodes, int32_t t,
+                           const double dir[3], double snap, double dist[4], int32_t *crack) {
   const int32_t *ids = f->tets + 4 * t;
+  int known[4], count = 0, pos = 0, neg = 0;
   *crack = -1;
   for (int k = 0; k < 4; ++k) {
-    const int32_t u = f->neighbor[4 * t + k];
-    if (u < 0 || map->crack[u] < 0) continue;
-    double face[3];
-    for (int i = 0; i < 3; ++i)
-      face[i] = map->dist[4 * u + local_corner(f->tets + 4 * u, ids[piola__cut_tet_face[k][i]])];
-    if (!crosses(face)) continue;
-    if (*crack >= 0 && map->crack[u] != *crack) return -1;
-    *crack = map->crack[u];
-  }
-  if (*crack < 0) return 0;
-  int free_corner = -1;
-  for (int k = 0; k < 4; ++k) {
     const int32_t owner = f->vertex_crack[ids[k]];
-    if (owner == *crack) dist[k] = f->vertex_value[ids[k]];
-    else if (owner >= 0 || free_corner >= 0) return -1;
-    else free_corner = k;
+    known[k] = owner >= 0;
+    if (!known[k]) continue;
+    if (*crack >= 0 && owner != *crack) return -1;
+    *crack = owner, dist[k] = f->vertex_value[ids[k]], ++count;
+    if (dist[k] > 0) pos = 1;
+    else neg = 1;
   }
-  if (free_corner >= 0) {
+  if (!(pos && neg)) return 0;
+  if (count == 3) {
     /* maximize (g . n)^2 / |g|^2 over d, g = g0 + d g1: d = (a e - b c) / (b e - a h) */
     double g[4][3], g0[3] = {0, 0, 0};
     if (!barycentric_gradients(x, nodes, g)) return -1;
-    for (int k = 0; k < 4; ++k)
-      if (k != free_corner)
+    int free_corner = 0;
+    for (int k = 0; k < 4; ++k) {
+      if (!known[k]) free_corner = k;
+      else
         for (int i = 0; i < 3; ++i) g0[i] += dist[k] * g[k][i];
+    }
     const double *g1 = g[free_corner];
     double a = 0, bb = 0, c = 0, e = 0, h = 0;
     for (int i = 0; i < 3; ++i)
       a += g0[i] * dir[i], bb += g1[i] * dir[i], c += g0[i] * g0[i], e += g0[i] * g1[i], h += g1[i] * g1[i];
     const double d = (a * e - bb * c) / (bb * e - a * h);
     if (!isfinite(d)) return -1;
-    dist[free_corner] = snapped(d, snap);
-    f->vertex_crack[ids[free_corner]] = *crack;
-    f->vertex_value[ids[free_corner]] = dist[free_corner];
+    dist[free_corner] = keep_value(f, ids[free_corner], *crack, d, snap);
+  } else if (count == 2) {
+    /* the plane through the crossing X of the known edge p q, normal to dir, scaled to p's
+     * value (q's matches: X divides p q in the ratio of their values) */
+    int p = -1, q = -1;
+    for (int k = 0; k < 4; ++k)
+      if (known[k]) {
+        if (p < 0) p = k;
+        else q = k;
+      }
+    const double r = dist[p] / (dist[p] - dist[q]);
+    double cross[3], along_p = 0;
+    for (int i = 0; i < 3; ++i) cross[i] = x[3 * nodes[p] + i] + r * (x[3 * nodes[q] + i] - x[3 * nodes[p] + i]);
+    for (int i = 0; i < 3; ++i) along_p += (x[3 * nodes[p] + i] - cross[i]) * dir[i];
+    const double scale = dist[p] / along_p;
+    if (!isfinite(scale) || !(fabs(along_p) > 1e-6 * snap)) return -1;
+    for (int k = 0; k < 4; ++k) {
+      if (known[k]) continue;
+      double along = 0;
+      for (int i = 0; i < 3; ++i) along += (x[3 * nodes[k] + i] - cross[i]) * dir[i];
+      dist[k] = keep_value(f, ids[k], *crack, scale * along, snap);
+    }
   }
-  int pos = 0, neg = 0;
-  for (int k = 0; k < 4; ++k) {
-    if (dist[k] > 0) pos = 1;
-    else neg = 1;
-  }
-  return pos && neg ? 1 : -1;
+  return 1;
 }
 
 typedef struct candidate {
@@ -804,18 +810,11 @@ static piola_status apply_criterion(piola_world *w, world_body *b) {
     return PIOLA_OK;
   }
   tet_cut *cuts = malloc(sizeof *cuts * (size_t)n);
-  crack_map map = {malloc(sizeof(int32_t) * (size_t)f->tet_count), malloc(4 * sizeof(double) * (size_t)f->tet_count)};
-  if (!cuts || !map.crack || !map.dist) {
-    free(list), free(cuts), free(map.crack), free(map.dist);
+  if (!cuts) {
+    free(list);
     return PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "fracture of '%s': out of memory", b->name);
   }
   qsort(list, (size_t)n, sizeof *list, by_measure);
-  for (int32_t t = 0; t < f->tet_count; ++t) map.crack[t] = -1;
-  for (int32_t c = 0; c < f->copy_count; ++c)
-    if (f->event[c] >= 0) {
-      map.crack[f->parent[c]] = f->event[c];
-      memcpy(map.dist + 4 * f->parent[c], f->dist + 4 * c, 4 * sizeof(double));
-    }
   const double snap = SNAP_SHARE * piola_elastic_body_min_rest_altitude(e);
   const int32_t most = f->max_tets_per_step > 0 ? f->max_tets_per_step : INT32_MAX;
   int32_t count = 0;
@@ -823,19 +822,19 @@ static piola_status apply_criterion(piola_world *w, world_body *b) {
     const int32_t c = list[i].copy, t = f->parent[c];
     tet_cut *cut = &cuts[count];
     cut->copy = c;
-    if (continued_crack(f, &map, b->x, nodes + 4 * c, t, list[i].dir, snap, cut->dist, &cut->crack) != 1) continue;
-    map.crack[t] = cut->crack;
-    memcpy(map.dist + 4 * t, cut->dist, sizeof cut->dist);
+    if (continued_crack(f, b->x, nodes + 4 * c, t, list[i].dir, snap, cut->dist, &cut->crack) != 1) continue;
     ++count;
   }
-  /* when no crack grew: a new crack at the candidate with the largest measure, unless a
-   * crack touches it (cracks relieve the stress by growing first; the worst place is where
-   * the next one starts, never a second-best one) */
-  int started = 0;
-  const int32_t c = list[0].copy;
-  const int32_t *ids = f->tets + 4 * f->parent[c];
-  int touched = 0;
-  for (int k = 0; k < 4; ++k) touched |= f->vertex_crack[ids[k]] >= 0;
+  /* when no crack grew (cracks relieve the stress by growing first): a new crack at the
+   * candidate with the largest measure that no crack touches */
+  int started = 0, touched = 1;
+  int32_t pick = -1;
+  while (count == 0 && touched && ++pick < n) {
+    const int32_t *ids = f->tets + 4 * f->parent[list[pick].copy];
+    touched = 0;
+    for (int k = 0; k < 4; ++k) touched |= f->vertex_crack[ids[k]] >= 0;
+  }
+  const int32_t c = pick < n ? list[pick].copy : -1;
   if (count == 0 && !touched) {
     double point[3] = {0, 0, 0};
     for (int k = 0; k < 4; ++k)
@@ -843,17 +842,17 @@ static piola_status apply_criterion(piola_world *w, world_body *b) {
     int pos = 0, neg = 0;
     for (int k = 0; k < 4; ++k) {
       double d = 0;
-      for (int a = 0; a < 3; ++a) d += (b->x[3 * nodes[4 * c + k] + a] - point[a]) * list[0].dir[a];
+      for (int a = 0; a < 3; ++a) d += (b->x[3 * nodes[4 * c + k] + a] - point[a]) * list[pick].dir[a];
       cuts[0].dist[k] = snapped(d, snap);
       if (cuts[0].dist[k] > 0) pos = 1;
       else neg = 1;
     }
-    cuts[0].copy = c, cuts[0].crack = f->events;
+    cuts[0].copy = c, cuts[0].crack = f->grown_crack >= 0 ? f->grown_crack : f->events;
     started = count = pos && neg;
   }
   piola_status st = split_copies(w, b, cuts, count);
-  if (st == PIOLA_OK && started) b->fracture->events++;
-  free(list), free(cuts), free(map.crack), free(map.dist);
+  if (st == PIOLA_OK && started && b->fracture->grown_crack < 0) b->fracture->grown_crack = b->fracture->events++;
+  free(list), free(cuts);
   return st;
 }
 

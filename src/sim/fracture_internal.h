@@ -21,8 +21,10 @@ typedef struct solid_fracture {
   piola_fracture_cut *cuts;   /* a blade cut's blade points into blades */
   piola_tri_mesh *blades;     /* per scripted cut: its blade's copy (empty for a plane) */
   int32_t cut_count, next_cut, max_cuts_per_step, max_tets_per_step;
-  int32_t events;             /* cracks started so far (plane and blade cuts, new cracks of
-                                 the criterion): the crack ids */
+  int32_t events;             /* cracks started so far (plane and blade cuts, the criterion's
+                                 cracks): the crack ids */
+  int32_t grown_crack;        /* the id all the criterion's cracks share (-1: none yet): their
+                                 values are one field, so two of them that meet join */
   piola_fracture_criterion criterion;
   double threshold;           /* Pa, or plastic log strain */
   /* the original mesh (after the elastic body's reorientation) and its face adjacency:

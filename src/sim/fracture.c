@@ -39,7 +39,7 @@ void piola__fracture_free(solid_fracture *f) {
   if (!f) return;
   free_blades(f->blades, f->cut_count);
   free(f->cuts), free(f->tets), free(f->neighbor), free(f->parent), free(f->event), free(f->dist);
-  free(f->side), free(f->fraction), free(f->fragment), free(f->copies), free(f->vertex_crack);
+  free(f->side), free(f->fraction), free(f->fragment), free(f->copies), free(f->vertex_crack), free(f->last_strain);
   free(f->vertex_value);
   free(f);
 }
@@ -376,6 +376,13 @@ static piola_status split_copies(piola_world *w, world_body *b, const tet_cut *c
     f->parent = m.parent, f->event = m.event, f->dist = m.dist, f->side = m.side;
     f->fraction = m.fraction, f->fragment = m.fragment, f->copies = copies;
     m.parent = m.event = m.fragment = NULL, m.dist = m.fraction = NULL, m.side = NULL, copies = NULL;
+    if (f->last_strain) {
+      double *last = malloc(sizeof(double) * (size_t)nc);
+      if (!last) st = PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "cut of '%s': out of memory", b->name);
+      for (int32_t i = 0; last && i < nc; ++i) last[i] = f->last_strain[m.element_parent[i]];
+      free(f->last_strain);
+      f->last_strain = last;
+    }
     f->copy_count = nc;
     f->cut_tets += split;
     number_fragments(nc, piola_elastic_body_tets(b->solid), m.nodes, m.up, f->fragment,
@@ -794,11 +801,19 @@ static piola_status apply_criterion(piola_world *w, world_body *b) {
   const double *strain = f->criterion == PIOLA_FRACTURE_PLASTIC_STRAIN && b->plastic
                              ? piola_plastic_state_plastic_strain(b->plastic) : NULL;
   if (f->criterion == PIOLA_FRACTURE_PLASTIC_STRAIN && !strain) return PIOLA_OK;
+  if (strain && !f->last_strain) {
+    f->last_strain = malloc(sizeof(double) * (size_t)f->copy_count);
+    if (!f->last_strain) return PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "fracture of '%s': out of memory", b->name);
+    memcpy(f->last_strain, strain, sizeof(double) * (size_t)f->copy_count);
+  }
   candidate *list = malloc(sizeof *list * (size_t)f->copy_count);
   if (!list) return PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "fracture of '%s': out of memory", b->name);
   int32_t n = 0;
   for (int32_t c = 0; c < f->copy_count; ++c) {
-    if (f->event[c] >= 0 || (strain && !(strain[c] > f->threshold))) continue;
+    /* ductile: only while the tet still flows (a piece that unloaded tears no further) */
+    const int flowing = strain && strain[c] > f->last_strain[c];
+    if (strain) f->last_strain[c] = strain[c];
+    if (f->event[c] >= 0 || (strain && !(flowing && strain[c] > f->threshold))) continue;
     candidate k;
     const double stress = principal_stress(e, c, scale, k.dir);
     k.measure = strain ? strain[c] : stress;

@@ -44,6 +44,8 @@ typedef struct solid_fracture {
   int32_t fragment_count;
   int32_t cut_tets;           /* original tets split so far */
   int32_t *copies;            /* 2 per original tet: its copies (the second -1 when whole) */
+  double *last_strain;        /* per copy, plastic_strain criterion only (else NULL): its
+                                 accumulated plastic strain at the last criterion pass */
   /* per original vertex: the crack that reached it first (-1: none) and that crack's value
    * there, m: a crack grows by continuing these values into the next tet */
   int32_t vertex_count;

@@ -231,6 +231,16 @@ static void fracture_state(stream *s, piola_world *w, world_body *b) {
   local_array(s, &fragment, (uint64_t)nc, sizeof(int32_t), "fragments");
   local_array(s, &tets, 4 * (uint64_t)nc, sizeof(int32_t), "copy nodes");
   local_array(s, &copies, 2 * (uint64_t)f->tet_count, sizeof(int32_t), "copies of tets");
+  /* the criterion's state: the plastic strain per copy at its last pass (plastic_strain
+   * criterion, once it ran), the crack all its cracks share, and per original vertex the
+   * crack that reached it first and that crack's value there */
+  int32_t has_last = f->last_strain != NULL;
+  local_int(s, &has_last, "criterion strains present");
+  void *last = s->reading ? NULL : f->last_strain;
+  if (!s->failed && has_last) local_array(s, &last, (uint64_t)nc, sizeof(double), "criterion strains");
+  one_int(s, &f->grown_crack, "grown crack");
+  field(s, f->vertex_crack, (uint64_t)f->vertex_count, sizeof(int32_t), "cracks at vertices");
+  doubles(s, f->vertex_value, (uint64_t)f->vertex_count, "crack values at vertices");
   if (s->reading) {
     if (!s->failed) {
       fracture_saved saved = {.copy_count = nc, .node_count = counts[1], .events = counts[2],
@@ -243,8 +253,12 @@ static void fracture_state(stream *s, piola_world *w, world_body *b) {
       } else if (s->store) {
         f = b->fracture;
         f->events = counts[2], f->next_cut = counts[4], f->cut_tets = counts[5];
+        free(f->last_strain);
+        f->last_strain = has_last ? last : NULL;
+        last = NULL;
       }
     }
+    free(last);
     free(parent), free(event), free(fragment), free(copies), free(tets), free(side), free(dist);
     free(fraction);
   }

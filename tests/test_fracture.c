@@ -357,6 +357,191 @@ static void random_cuts_keep_every_invariant(void **state) {
   }
 }
 
+/* A sheet of (m - 1)^2 x 2 triangles: the square of half-size `half` around center spanned by
+ * the unit vectors u, v, bent along n = u x v by bend (1/m) times the squared distance. */
+static piola_tri_mesh sheet(const double center[3], const double u[3], const double v[3], double half,
+                            double bend, int m) {
+  piola_tri_mesh s = {.vertex_count = m * m, .triangle_count = 2 * (m - 1) * (m - 1)};
+  s.positions = malloc(3 * sizeof(double) * (size_t)s.vertex_count);
+  s.triangles = malloc(3 * sizeof(int32_t) * (size_t)s.triangle_count);
+  assert_non_null(s.positions), assert_non_null(s.triangles);
+  const double n[3] = {u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2], u[0] * v[1] - u[1] * v[0]};
+  for (int i = 0; i < m; ++i)
+    for (int j = 0; j < m; ++j) {
+      const double a = half * (2.0 * i / (m - 1) - 1), b = half * (2.0 * j / (m - 1) - 1);
+      for (int k = 0; k < 3; ++k)
+        s.positions[3 * (i * m + j) + k] = center[k] + a * u[k] + b * v[k] + bend * (a * a + b * b) * n[k];
+    }
+  int32_t *t = s.triangles;
+  for (int i = 0; i + 1 < m; ++i)
+    for (int j = 0; j + 1 < m; ++j) {
+      const int32_t c = i * m + j;
+      t[0] = c, t[1] = c + m, t[2] = c + m + 1, t[3] = c, t[4] = c + m + 1, t[5] = c + 1;
+      t += 6;
+    }
+  return s;
+}
+
+/* A flat blade larger than the box cuts exactly as its plane does (same tets, fractions to
+ * rounding); one that reaches only halfway through splits only the tets it passes all the way
+ * through, on its side, and leaves one fragment whose closed surface holds the slit. */
+static void blade_cuts_like_its_plane_and_only_where_it_reaches(void **state) {
+  (void)state;
+  piola_tet_mesh mesh;
+  assert_int_equal(piola_tet_mesh_box_grid(5, 5, 5, (piola_vec3){0.2, 0.2, 0.2}, &mesh), PIOLA_OK);
+  const double center[3] = {0.4, 0.5, 0.5}, normal[3] = {1, 0.2, 0.1};
+  const double nn = sqrt(1.05), n[3] = {1 / nn, 0.2 / nn, 0.1 / nn};
+  double u[3] = {-n[1], n[0], 0}, v[3];
+  const double un = sqrt(u[0] * u[0] + u[1] * u[1]);
+  u[0] /= un, u[1] /= un;
+  v[0] = n[1] * u[2] - n[2] * u[1], v[1] = n[2] * u[0] - n[0] * u[2], v[2] = n[0] * u[1] - n[1] * u[0];
+  piola_world *plane = make_world(1e-3), *blade = make_world(1e-3);
+  add_solid(plane, &mesh, 0), add_solid(blade, &mesh, 0);
+  int32_t by_plane = 0, by_blade = 0;
+  assert_int_equal(piola_world_solid_cut(plane, 0, center, normal, &by_plane), PIOLA_OK);
+  piola_tri_mesh big = sheet(center, u, v, 2.0, 0, 3);
+  assert_int_equal(piola_world_solid_cut_by_surface(blade, 0, &big, &by_blade), PIOLA_OK);
+  assert_int_equal(by_blade, by_plane);
+  assert_int_equal(piola_world_solid_fragment_count(blade, 0), 2);
+  const int32_t nt = piola_elastic_body_tet_count(piola_world_solid_body(blade, 0));
+  assert_int_equal(nt, piola_elastic_body_tet_count(piola_world_solid_body(plane, 0)));
+  for (int32_t t = 0; t < nt; ++t) {
+    assert_int_equal(piola_world_solid_parent_tets(blade, 0)[t], piola_world_solid_parent_tets(plane, 0)[t]);
+    assert_close(piola_world_solid_material_fractions(blade, 0)[t], piola_world_solid_material_fractions(plane, 0)[t], 1e-12);
+  }
+  check_cut_solid(blade, 1);
+  piola_world_destroy(blade), piola_world_destroy(plane);
+  piola_tri_mesh_free(&big);
+  /* half a blade: a square of half-size 0.6 centred 0.6 m from the plane's point along u
+   * (mostly +y) reaches into the box only for y > ~0.5 */
+  blade = make_world(1e-3);
+  add_solid(blade, &mesh, 0);
+  double c2[3];
+  if (u[1] < 0)
+    for (int k = 0; k < 3; ++k) u[k] = -u[k], v[k] = -v[k];
+  for (int k = 0; k < 3; ++k) c2[k] = center[k] + 0.6 * u[k];
+  piola_tri_mesh half = sheet(c2, u, v, 0.6, 0, 4);
+  int32_t count = 0;
+  assert_int_equal(piola_world_solid_cut_by_surface(blade, 0, &half, &count), PIOLA_OK);
+  assert_true(count > 0 && count < by_plane);
+  assert_int_equal(piola_world_solid_fragment_count(blade, 0), 1);
+  check_cut_solid(blade, 1);
+  const piola_elastic_body *b = piola_world_solid_body(blade, 0);
+  const double *rest = piola_elastic_body_rest_positions(b), *f = piola_world_solid_material_fractions(blade, 0);
+  for (int32_t t = 0; t < piola_elastic_body_tet_count(b); ++t) {
+    if (f[t] == 1) continue;
+    double lowest = INFINITY; /* every cut tet lies where the blade is: its far corner beyond y ~ 0.5 */
+    for (int k = 0; k < 4; ++k) lowest = fmin(lowest, rest[3 * piola_elastic_body_tets(b)[4 * t + k] + 1]);
+    assert_true(lowest > 0.2);
+  }
+  piola_world_destroy(blade);
+  piola_tri_mesh_free(&half);
+  /* bad blades are refused */
+  blade = make_world(1e-3);
+  add_solid(blade, &mesh, 0);
+  piola_tri_mesh bad = sheet(center, u, v, 1, 0, 2);
+  bad.triangles[1] = 7;
+  assert_int_equal(piola_world_solid_cut_by_surface(blade, 0, &bad, NULL), PIOLA_ERROR_INVALID_ARGUMENT);
+  bad.triangles[1] = 1, bad.positions[4] = NAN;
+  assert_int_equal(piola_world_solid_cut_by_surface(blade, 0, &bad, NULL), PIOLA_ERROR_INVALID_ARGUMENT);
+  piola_tri_mesh_free(&bad);
+  piola_world_destroy(blade);
+  free(mesh.positions), free(mesh.tets);
+}
+
+/* Cracks grown by the stress criterion from a random stretch of a random mesh, then a random
+ * bent blade: no NaN, fractions in (0, 1] summing to 1 per tet, the mass kept, every fragment's
+ * surface closed around exactly its material (strictly, every edge paired, while only grown
+ * cracks cut the body: they meet edge to edge), and the body steps on. */
+static void grown_and_blade_cuts_keep_every_invariant_mesh(const piola_tet_mesh *mesh, test_rng *rng, int trials,
+                                                           int32_t *grown_tets, int32_t *blade_tets) {
+  double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+  for (int32_t i = 0; i < mesh->vertex_count; ++i)
+    for (int k = 0; k < 3; ++k)
+      lo[k] = fmin(lo[k], mesh->positions[3 * i + k]), hi[k] = fmax(hi[k], mesh->positions[3 * i + k]);
+  double size = 0;
+  for (int k = 0; k < 3; ++k) size = fmax(size, hi[k] - lo[k]);
+  for (int trial = 0; trial < trials; ++trial) {
+    piola_world *w = make_world(1e-3);
+    add_solid(w, mesh, 1);
+    const double mass = total_mass(w);
+    piola_fracture_def def = piola_default_fracture_def();
+    def.criterion = PIOLA_FRACTURE_STRESS;
+    def.threshold = test_rng_uniform(rng, 500, 3000);
+    def.max_tets_per_step = (int32_t)test_rng_uniform(rng, 0, 4);
+    assert_int_equal(piola_world_solid_set_fracture(w, 0, &def), PIOLA_OK);
+    double stretch[9];
+    for (int k = 0; k < 9; ++k) stretch[k] = (k % 4 == 0) + 0.3 * test_rng_normal(rng);
+    for (int step = 0; step < 6; ++step) {
+      /* stretch the current mesh about the rest box's corner and let the criterion act */
+      const piola_elastic_body *b = piola_world_solid_body(w, 0);
+      const int32_t n = piola_elastic_body_vertex_count(b);
+      const double *rest = piola_elastic_body_rest_positions(b);
+      double *x = malloc(3 * sizeof(double) * (size_t)n);
+      for (int32_t i = 0; i < n; ++i)
+        for (int r = 0; r < 3; ++r) {
+          x[3 * i + r] = lo[r];
+          for (int c = 0; c < 3; ++c) x[3 * i + r] += stretch[3 * r + c] * (rest[3 * i + c] - lo[c]);
+          x[3 * i + r] += 0.01 * size * test_rng_normal(rng);
+        }
+      assert_int_equal(piola_world_solid_set_state(w, 0, x, NULL), PIOLA_OK);
+      free(x);
+      assert_int_equal(piola_world_step(w, 0, NULL), PIOLA_OK);
+    }
+    /* the invariants at the rest shape (material volumes are rest volumes) */
+    const piola_elastic_body *b = piola_world_solid_body(w, 0);
+    assert_int_equal(piola_world_solid_set_state(w, 0, piola_elastic_body_rest_positions(b), NULL), PIOLA_OK);
+    assert_close(total_mass(w), mass, 1e-12 * mass);
+    check_cut_solid(w, 1);
+    const int32_t grown = piola_world_solid_cut_tet_count(w, 0);
+    *grown_tets += grown;
+    /* a bent blade through a random point */
+    double center[3], u[3], v[3], n[3];
+    for (int k = 0; k < 3; ++k) center[k] = test_rng_uniform(rng, lo[k], hi[k]), n[k] = test_rng_normal(rng);
+    const double nn = sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+    for (int k = 0; k < 3; ++k) n[k] /= nn;
+    const double a[3] = {fabs(n[0]) < 0.9 ? 1 : 0, fabs(n[0]) < 0.9 ? 0 : 1, 0};
+    u[0] = a[1] * n[2] - a[2] * n[1], u[1] = a[2] * n[0] - a[0] * n[2], u[2] = a[0] * n[1] - a[1] * n[0];
+    const double un = sqrt(u[0] * u[0] + u[1] * u[1] + u[2] * u[2]);
+    for (int k = 0; k < 3; ++k) u[k] /= un;
+    v[0] = n[1] * u[2] - n[2] * u[1], v[1] = n[2] * u[0] - n[0] * u[2], v[2] = n[0] * u[1] - n[1] * u[0];
+    piola_tri_mesh blade = sheet(center, u, v, test_rng_uniform(rng, 0.3, 1.0) * size,
+                                 test_rng_uniform(rng, -0.5, 0.5) / size, 6);
+    int32_t count = 0;
+    assert_int_equal(piola_world_solid_cut_by_surface(w, 0, &blade, &count), PIOLA_OK);
+    piola_tri_mesh_free(&blade);
+    *blade_tets += count;
+    print_message("grown: %d tets cut, %d fragments; blade: %d tets\n", (int)grown,
+                  (int)piola_world_solid_fragment_count(w, 0), (int)count);
+    assert_close(total_mass(w), mass, 1e-12 * mass);
+    check_cut_solid(w, 0); /* T-junctions where the blade meets grown cracks */
+    assert_int_equal(piola_world_advance_to(w, piola_world_time(w) + 0.01, NULL), PIOLA_OK);
+    check_cut_solid_positions_finite(w);
+    piola_world_destroy(w);
+  }
+}
+
+static void grown_and_blade_cuts_keep_every_invariant(void **state) {
+  (void)state;
+  test_rng rng = test_rng_seeded(1515);
+  const int trials = (int)test_samples(10, 2);
+  piola_tet_mesh box;
+  assert_int_equal(piola_tet_mesh_box_grid(5, 4, 3, (piola_vec3){0.1, 0.1, 0.1}, &box), PIOLA_OK);
+  for (int32_t i = 0; i < box.vertex_count; ++i)
+    for (int k = 0; k < 3; ++k) box.positions[3 * i + k] += test_rng_uniform(&rng, -0.02, 0.02);
+  int32_t grown = 0, bladed = 0;
+  grown_and_blade_cuts_keep_every_invariant_mesh(&box, &rng, trials, &grown, &bladed);
+  free(box.positions), free(box.tets);
+  static const char *const real[] = {"medit/unit_ball.mesh", "gmsh/bar-186.msh"};
+  for (int r = 0; r < 2; ++r) {
+    piola_tet_mesh mesh;
+    assert_int_equal(piola_tet_mesh_read(test_data_path(real[r]), &mesh), PIOLA_OK);
+    grown_and_blade_cuts_keep_every_invariant_mesh(&mesh, &rng, (trials + 1) / 2, &grown, &bladed);
+    piola_tet_mesh_free(&mesh);
+  }
+  assert_true(grown > 0 && bladed > 0); /* the cases happened */
+}
+
 /* A cut box collapsed to a point: its copies are inverted like any tet, and it recovers. */
 static void cut_body_recovers_from_collapse(void **state) {
   (void)state;
@@ -545,6 +730,8 @@ int main(void) {
       cmocka_unit_test(box_splits_into_the_analytic_volumes),
       cmocka_unit_test(cut_in_free_flight_keeps_momentum),
       cmocka_unit_test(random_cuts_keep_every_invariant),
+      cmocka_unit_test(blade_cuts_like_its_plane_and_only_where_it_reaches),
+      cmocka_unit_test(grown_and_blade_cuts_keep_every_invariant),
       cmocka_unit_test(cut_body_recovers_from_collapse),
       cmocka_unit_test(cut_keeps_plastic_state_and_energy),
       cmocka_unit_test(max_cuts_per_step_spreads_cuts),

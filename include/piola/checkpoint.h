@@ -6,7 +6,8 @@
  * of the last force update (the diagonalization, det F, the plastic Fp^-1, the shells'
  * dihedral angles), the damping operator the next step starts from and the last solve's
  * product it reuses, the plastic state (Fp^-1, hardening, bounds, refresh phase, control
- * logarithms), the statistics of the last step, and what self-collision carries from step
+ * logarithms), the cut state of solids with fracture (their copies, nodes, fractions and
+ * cracks), the statistics of the last step, and what self-collision carries from step
  * to step (the shapes and age of the collision trees, which decide the order of its
  * impulses, and an open collision interval). Keyframe clocks and obstacle poses are
  * functions of the time, and the initial scramble's random numbers are used once at
@@ -26,7 +27,7 @@ extern "C" {
 #endif
 
 /* The checkpoint format this piola writes and reads (docs/file-formats.md). */
-#define PIOLA_CHECKPOINT_VERSION 2
+#define PIOLA_CHECKPOINT_VERSION 3
 
 /* 1 when checkpoints cover every part of the world's state; 0 with a reason in *why (a
  * static string) otherwise. */
@@ -46,8 +47,9 @@ PIOLA_API piola_status piola_world_checkpoint_write(const piola_world *world, co
 /* Reads a checkpoint into a world built from the same scene (as piola_world_scene_key says):
  * PIOLA_ERROR_PARSE for a file that is not a whole, intact checkpoint (bad magic, size or
  * checksum), PIOLA_ERROR_UNSUPPORTED for another format version or another scene, each
- * with a message. The world is changed only when the whole file was checked. *frame
- * receives the frame it was written at. */
+ * with a message. The world is changed only when the whole file was checked (a cut solid
+ * takes the file's cut state while the rest is checked, and is put back as it was when the
+ * file does not fit). *frame receives the frame it was written at. */
 PIOLA_API piola_status piola_world_checkpoint_read(piola_world *world, const char *path,
                                                    uint64_t scene_key, int32_t *frame);
 

@@ -49,7 +49,20 @@ typedef struct piola_collision_surface_def {
   int32_t body_count;                     /* >= 1 */
   const piola_collision_body_def *bodies; /* body_count entries, copied */
   const int32_t *vertex_body; /* vertex_count body indices, copied; NULL: all in body 0 */
+  /* Embedded vertices (optional; all NULL and node_count 0: vertex i is the moving point i).
+   * Otherwise the moving points are node_count nodes and vertex i is the fixed combination
+   * sum_k embed_weights[4i+k] x(embed_nodes[4i+k]) of up to four of them (barycentric
+   * weights in [0, 1] summing to 1; an unused slot has weight 0 and node -1), such as a
+   * point of a crack face inside a cut tet. piola_collision_surface_process then takes x0, v
+   * and mass per node, and every impulse on a vertex acts on its nodes by these weights,
+   * so the vertices' paths it checks are the ones the nodes' velocities give. Copied. */
+  int32_t node_count;
+  const int32_t *embed_nodes; /* 4 per vertex */
+  const double *embed_weights; /* 4 per vertex */
 } piola_collision_surface_def;
+
+/* Nodes a vertex of an embedded collision surface can combine. */
+#define PIOLA_COLLISION_EMBED_NODES 4
 
 PIOLA_API piola_collision_surface_def piola_default_collision_surface_def(void);
 
@@ -94,7 +107,9 @@ PIOLA_API int32_t piola_collision_surface_edge_count(const piola_collision_surfa
 
 /* One call per step. x0 (m, 3 * vertex_count): positions at the start of the step; v (m/s,
  * 3 * vertex_count): proposed velocities, changed in place; mass (kg, vertex_count): > 0, or
- * INFINITY for a pinned vertex, whose velocity is never changed; dt (s) > 0. settings and
+ * INFINITY for a pinned vertex, whose velocity is never changed (on an embedded surface all
+ * three are per node, node_count of them, and a vertex is pinned when all its nodes are);
+ * dt (s) > 0. settings and
  * stats may be NULL (defaults; no statistics). Fails with PIOLA_ERROR_NOT_FINITE on NaN/Inf
  * in x0 or v and PIOLA_ERROR_INVALID_ARGUMENT on a bad mass, dt or setting, leaving v
  * unchanged; after PIOLA_ERROR_OUT_OF_MEMORY v may hold partly processed velocities (each

@@ -23,6 +23,7 @@
 
 #include "piola/export.h"
 #include "piola/math_types.h"
+#include "piola/mesh.h"
 #include "piola/status.h"
 #include "piola/world.h"
 
@@ -30,21 +31,32 @@
 extern "C" {
 #endif
 
-/* A scripted cut: the plane through point (m) with normal (any length > 0), world space,
- * applied to the solid's shape at the first step that starts at or after time (s). */
+/* A scripted cut, applied to the solid's shape at the first step that starts at or after
+ * time (s): the plane through point (m) with normal (any length > 0), world space, or, when
+ * blade is not NULL, that triangle surface (world space, m; copied): it splits the tets it
+ * passes all the way through (piola_world_solid_cut_by_surface). */
 typedef struct piola_fracture_cut {
   double time;
   piola_vec3 point, normal;
+  const piola_tri_mesh *blade;
 } piola_fracture_cut;
 
 /* When material breaks by itself (besides the scripted cuts). */
 typedef enum piola_fracture_criterion {
   PIOLA_FRACTURE_SCRIPTED = 0, /* only the scripted cuts (default) */
-  PIOLA_FRACTURE_STRESS = 1,   /* brittle: before each step, the uncut tet with the largest
-                                  principal Cauchy stress, if it exceeds threshold, is cut with
-                                  its whole solid by the plane through its centroid normal to
-                                  that stress's direction; at most one such cut per step */
+  PIOLA_FRACTURE_STRESS = 1,   /* brittle: a tet whose largest principal Cauchy stress
+                                  exceeds threshold (Pa) cracks */
+  PIOLA_FRACTURE_PLASTIC_STRAIN = 2, /* ductile: a tet whose accumulated plastic log strain
+                                  exceeds threshold (dimensionless) cracks; the solid needs
+                                  plasticity */
 } piola_fracture_criterion;
+/* Before each step, every uncut tet past the threshold that touches a crack (a neighbour's
+ * crack crosses their shared face) is cut so that the crack runs on into it: the crack's
+ * points on the shared faces are kept and it turns as close to normal to the tet's largest
+ * principal stress as they allow. If no crack grows, the tet with the largest measure starts
+ * a new one unless a crack touches it: the plane through its centroid normal to its largest
+ * principal stress, in that tet only. So cracks grow tet by tet as surfaces
+ * (docs/fracture.md). */
 
 typedef struct piola_fracture_def {
   const piola_fracture_cut *cuts; /* cut_count cuts, copied; any order (applied by time) */
@@ -53,7 +65,9 @@ typedef struct piola_fracture_def {
                                      step; the others wait for the next steps. 0 (default): no
                                      limit */
   piola_fracture_criterion criterion; /* default PIOLA_FRACTURE_SCRIPTED */
-  double threshold;               /* Pa, > 0: the stress criterion's largest principal stress */
+  double threshold;               /* > 0: Pa (stress) or plastic log strain (plastic_strain) */
+  int32_t max_tets_per_step;      /* the criterion cuts at most this many tets before one step.
+                                     0 (default): no limit */
 } piola_fracture_def;
 
 PIOLA_API piola_fracture_def piola_default_fracture_def(void);
@@ -68,6 +82,15 @@ PIOLA_API piola_status piola_world_solid_set_fracture(piola_world *world, int32_
 PIOLA_API piola_status piola_world_solid_cut(piola_world *world, int32_t solid,
                                              const double point[3], const double normal[3],
                                              int32_t *cut_tets);
+
+/* Cuts solid `solid` now by a triangle surface (world space, m): each tet the surface passes
+ * all the way through (every edge whose ends lie on opposite sides of it crosses one of its
+ * triangles) and that was never cut is split along the zero set of the corner distances to
+ * the surface (signed by the nearest triangle's normal). Tets the surface only enters keep
+ * their material whole. *cut_tets (may be NULL) receives how many tets it split. */
+PIOLA_API piola_status piola_world_solid_cut_by_surface(piola_world *world, int32_t solid,
+                                                        const piola_tri_mesh *surface,
+                                                        int32_t *cut_tets);
 
 /* Whether the solid has fracture state (a def or a cut so far). */
 PIOLA_API int piola_world_solid_has_fracture(const piola_world *world, int32_t solid);

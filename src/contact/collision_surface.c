@@ -73,6 +73,7 @@ void piola_collision_surface_destroy(piola_collision_surface *s) {
   free(s->vertex_slabs);
   free(s->triangle_slabs);
   free(s->edge_slabs);
+  piola__embedding_free(s);
   free(s);
 }
 
@@ -197,6 +198,15 @@ piola_status piola_collision_surface_create(const piola_collision_surface_def *d
     piola_collision_surface_destroy(s);
     return PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "collision surface: out of memory");
   }
+  if (def->node_count != 0 || def->embed_nodes || def->embed_weights) {
+    const char *message = NULL;
+    int made = piola__embedding_create(s, def, &message);
+    if (made != 0) {
+      piola_collision_surface_destroy(s);
+      if (made == -1) return PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "collision surface: out of memory");
+      return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "collision surface: %s", message);
+    }
+  }
   *out = s;
   return PIOLA_OK;
 }
@@ -217,6 +227,13 @@ static void apply_relative_change(piola_collision_surface *s, const piola__conta
     change = vec3_sub(change, vec3_scale(tangential, fraction));
   }
   vec3 impulse = vec3_scale(change, 1.0 / denom); /* kg m/s per unit weight */
+  if (s->node_count > 0) {
+    int32_t node[16];
+    double weight[16];
+    const int n = piola__pair_nodes(s, c->v, c->w, node, weight);
+    piola__embedding_apply(s, n, node, weight, impulse);
+    return;
+  }
   for (int k = 0; k < 4; ++k) {
     double f = c->w[k] * s->inverse_mass[c->v[k]];
     if (f == 0.0) continue;
@@ -228,6 +245,13 @@ static void apply_relative_change(piola_collision_surface *s, const piola__conta
 
 static double weight_denominator(const piola_collision_surface *s, const piola__contact *c) {
   double denom = 0.0;
+  if (s->node_count > 0) {
+    int32_t node[16];
+    double weight[16];
+    const int n = piola__pair_nodes(s, c->v, c->w, node, weight);
+    for (int j = 0; j < n; ++j) denom += weight[j] * weight[j] * s->node_inverse_mass[node[j]];
+    return denom;
+  }
   for (int k = 0; k < 4; ++k) denom += c->w[k] * c->w[k] * s->inverse_mass[c->v[k]];
   return denom;
 }
@@ -288,6 +312,7 @@ static double lap(double *clock) {
 }
 
 static int same_zone(piola_collision_surface *s, const piola__contact *c) {
+  if (s->node_count > 0) return piola__embedded_same_zone(s, c);
   if (!s->in_zone[c->v[0]]) return 0;
   int32_t root = piola__union_find_root(s->zone_parent, c->v[0]);
   for (int k = 1; k < 4; ++k)
@@ -312,17 +337,26 @@ piola_status piola_collision_surface_process(piola_collision_surface *s, const d
                       "collision processing: settings need collision_iterations >= 0 (got %d), "
                       "max_zone_iterations >= 1 (got %d), repulsion_stiffness > 0 N/m (got %g)",
                       set.collision_iterations, set.max_zone_iterations, set.repulsion_stiffness);
-  for (int32_t i = 0; i < s->vertex_count; ++i) {
+  /* the moving points: the vertices, or an embedded surface's nodes */
+  const int embedded = s->node_count > 0;
+  const int32_t points = embedded ? s->node_count : s->vertex_count;
+  double *inverse_mass = embedded ? s->node_inverse_mass : s->inverse_mass;
+  for (int32_t i = 0; i < points; ++i) {
     for (int k = 0; k < 3; ++k)
       if (!isfinite(x0[3 * i + k]) || !isfinite(v[3 * i + k]))
         return PIOLA_FAIL(PIOLA_ERROR_NOT_FINITE,
-                          "collision processing: vertex %d has a non-finite position or velocity",
-                          i);
+                          "collision processing: %s %d has a non-finite position or velocity",
+                          embedded ? "node" : "vertex", i);
     if (!(mass[i] > 0.0))
       return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT,
-                        "collision processing: vertex %d mass must be > 0 kg or INFINITY, got %g",
-                        i, mass[i]);
-    s->inverse_mass[i] = isinf(mass[i]) ? 0.0 : 1.0 / mass[i];
+                        "collision processing: %s %d mass must be > 0 kg or INFINITY, got %g",
+                        embedded ? "node" : "vertex", i, mass[i]);
+    inverse_mass[i] = isinf(mass[i]) ? 0.0 : 1.0 / mass[i];
+  }
+  if (embedded) {
+    /* the stages below work on the vertices; impulses reach the nodes (embedding.c) */
+    piola__embedding_gather(s, x0, v);
+    x0 = s->vertex_x0, v = s->vertex_v;
   }
   piola_collision_stats st = {0};
   int tree_built = 0;
@@ -369,6 +403,7 @@ piola_status piola_collision_surface_process(piola_collision_surface *s, const d
   s->zone_misfit = 0;
   if (!clean) {
     for (int32_t i = 0; i < s->vertex_count; ++i) s->zone_parent[i] = i, s->in_zone[i] = 0;
+    for (int32_t i = 0; i < s->node_count; ++i) s->node_zone_parent[i] = i, s->node_in_zone[i] = 0;
     for (int pass = 0; pass < set.max_zone_iterations; ++pass) {
       if (piola__detect(s, x0, v, dt, PIOLA__DETECT_CCD, first_pass ? NULL : s->dirty, &tree_built))
         goto out_of_memory;
@@ -386,7 +421,8 @@ piola_status piola_collision_surface_process(piola_collision_surface *s, const d
         break;
       }
       memset(s->dirty, 0, (size_t)s->vertex_count);
-      int32_t zones = piola__impact_zones_apply(s, &s->found, x0, v, &st.zone_vertices);
+      int32_t zones = embedded ? piola__embedded_zones_apply(s, &s->found, &st.zone_vertices)
+                               : piola__impact_zones_apply(s, &s->found, x0, v, &st.zone_vertices);
       if (zones < 0) goto out_of_memory;
       st.impact_zones = zones;
       s->profile.zones += lap(&clock);

@@ -128,7 +128,49 @@ struct piola_collision_surface {
   int32_t near_valid;              /* near holds the contacts at x0 (reach boxes were used) */
   piola__contact_profile profile;
   double *vertex_slabs, *triangle_slabs, *edge_slabs; /* 12 per primitive (detection.c) */
+  /* Embedded vertices (node_count > 0; embedding.c): per vertex four nodes and weights (an
+   * unused slot: node -1, weight 0), per node the vertices that use it (CSR). During a call
+   * the stages work on the vertices' positions and velocities (vertex_x0, vertex_v, computed
+   * from the nodes'), and every impulse goes to the nodes (node_v: the caller's v) and from
+   * them back to their vertices; rigid impact zones are zones of nodes. */
+  int32_t node_count;
+  int32_t *embed_nodes;
+  double *embed_weights;
+  int32_t *node_vertex_start, *node_vertices;
+  double *vertex_x0, *vertex_v;
+  double *node_v;            /* the caller's velocities, during a call */
+  const double *node_x0;     /* the caller's positions, during a call */
+  double *node_inverse_mass;
+  int32_t *node_zone_parent, *node_zone_order;
+  uint8_t *node_in_zone, *node_dirty;
 };
+
+/* Embedded surfaces (embedding.c). */
+/* Validates the embedding of def and copies it into s (with its CSR); 0, or -1 out of
+ * memory; -2 (with *message) for a bad embedding. */
+int piola__embedding_create(piola_collision_surface *s, const piola_collision_surface_def *def,
+                            const char **message);
+void piola__embedding_free(piola_collision_surface *s);
+/* The vertices' x0 and v (and vertex inverse masses: sum of weight^2 / node mass, 0 when
+ * every node is pinned) from the nodes'. */
+void piola__embedding_gather(piola_collision_surface *s, const double *node_x0, double *node_v);
+/* The pair's nodes and their weights in its relative position (nodes of several of its
+ * vertices merged); returns how many (<= 16). */
+int piola__pair_nodes(const piola_collision_surface *s, const int32_t v[4], const double w[4],
+                      int32_t node[16], double weight[16]);
+/* Adds the velocity change weight * inverse mass * impulse to each node of the pair and
+ * brings the velocities of their vertices (vertex_v) up to date, marking them dirty. */
+void piola__embedding_apply(piola_collision_surface *s, int n, const int32_t node[16],
+                            const double weight[16], vec3 impulse);
+/* 1 when a vertex of one side of the pair (the point, or the first edge) shares a node with
+ * one of the other side (the pair takes no part, as a vertex and a triangle that contains it
+ * do not). */
+int piola__pair_shares_node(const piola_collision_surface *s, const int32_t v[4], int edge_edge);
+/* Rigid impact zones of nodes for an embedded surface (see piola__impact_zones_apply). */
+int32_t piola__embedded_zones_apply(piola_collision_surface *s, const piola__contact_list *hits,
+                                    int32_t *zone_vertices);
+/* Whether every node of the pair is in one zone (embedded surfaces). */
+int piola__embedded_same_zone(piola_collision_surface *s, const piola__contact *c);
 
 /* Collects the candidate pairs of a call (into surface->candidates): reach boxes from x0 and
  * the velocities v, the trees fit to them (built when *tree_built is 0 and the trees are old

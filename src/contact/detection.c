@@ -198,7 +198,10 @@ static double pair_friction(const piola_collision_surface *s, const int32_t v[4]
          (s->bodies[s->vertex_body[v[0]]].friction + s->bodies[s->vertex_body[v[3]]].friction);
 }
 
-static int all_pinned(const piola_collision_surface *s, const int32_t v[4]) {
+/* Pairs that take no part: all four vertices pinned, or (embedded surfaces) two vertices
+ * sharing a node, the embedded form of a vertex in the triangle or edge it is tested with. */
+static int left_out(const piola_collision_surface *s, const int32_t v[4], int edge_edge) {
+  if (s->node_count > 0 && piola__pair_shares_node(s, v, edge_edge)) return 1;
   return s->inverse_mass[v[0]] == 0.0 && s->inverse_mass[v[1]] == 0.0 &&
          s->inverse_mass[v[2]] == 0.0 && s->inverse_mass[v[3]] == 0.0;
 }
@@ -396,7 +399,7 @@ typedef struct task_output {
  * 0, or -1 out of memory. */
 static int classify_pair(const piola_collision_surface *s, const double *x0, const int32_t v[4],
                          int edge_edge, int with_near, task_output *out) {
-  if (all_pinned(s, v)) return 0;
+  if (left_out(s, v, edge_edge)) return 0;
   vec3 x[4];
   load_pair(x0, v, x);
   piola__contact c = {.v = {v[0], v[1], v[2], v[3]}, .edge_edge = edge_edge};
@@ -605,7 +608,7 @@ static int query_pairs(const piola_collision_surface *s, const double *x0, const
       const int32_t *tri = s->triangles + 3 * candidates->items[j];
       if (tri[0] == q || tri[1] == q || tri[2] == q) continue;
       piola__contact c = {.v = {q, tri[0], tri[1], tri[2]}};
-      if (all_pinned(s, c.v) || (filter && !any_flag(filter, c.v))) continue;
+      if (left_out(s, c.v, 0) || (filter && !any_flag(filter, c.v))) continue;
       if (narrow_phase(s, x0, v, dt, mode, 0, &c) && piola__contact_list_push(list, &c)) return -1;
     }
   } else if (kind == QUERY_TRIANGLE) {
@@ -616,7 +619,7 @@ static int query_pairs(const piola_collision_surface *s, const double *x0, const
       const int32_t p = candidates->items[j];
       if (dirty[p] || !s->on_surface[p] || tri[0] == p || tri[1] == p || tri[2] == p) continue;
       piola__contact c = {.v = {p, tri[0], tri[1], tri[2]}};
-      if (all_pinned(s, c.v) || (filter && !any_flag(filter, c.v))) continue;
+      if (left_out(s, c.v, 0) || (filter && !any_flag(filter, c.v))) continue;
       if (narrow_phase(s, x0, v, dt, mode, 0, &c) && piola__contact_list_push(list, &c)) return -1;
     }
   } else {
@@ -631,7 +634,7 @@ static int query_pairs(const piola_collision_surface *s, const double *x0, const
       if (dirty && e < q && (dirty[b0] || dirty[b1])) continue;
       if (a0 == b0 || a0 == b1 || a1 == b0 || a1 == b1) continue;
       piola__contact c = {.v = {a0, a1, b0, b1}};
-      if (all_pinned(s, c.v) || (filter && !any_flag(filter, c.v))) continue;
+      if (left_out(s, c.v, 1) || (filter && !any_flag(filter, c.v))) continue;
       if (narrow_phase(s, x0, v, dt, mode, 1, &c) && piola__contact_list_push(list, &c)) return -1;
     }
   }
@@ -743,7 +746,7 @@ int piola__detect_all_pairs(const piola_collision_surface *s, const double *x0, 
       const int32_t *tri = s->triangles + 3 * t;
       if (tri[0] == p || tri[1] == p || tri[2] == p) continue;
       piola__contact c = {.v = {p, tri[0], tri[1], tri[2]}};
-      if (all_pinned(s, c.v)) continue;
+      if (left_out(s, c.v, 0)) continue;
       if (narrow_phase(s, x0, v, dt, mode, 0, &c) && piola__contact_list_push(out, &c)) return -1;
     }
   }
@@ -753,7 +756,7 @@ int piola__detect_all_pairs(const piola_collision_surface *s, const double *x0, 
       const int32_t b0 = s->edges[2 * b], b1 = s->edges[2 * b + 1];
       if (a0 == b0 || a0 == b1 || a1 == b0 || a1 == b1) continue;
       piola__contact c = {.v = {a0, a1, b0, b1}};
-      if (all_pinned(s, c.v)) continue;
+      if (left_out(s, c.v, 1)) continue;
       if (narrow_phase(s, x0, v, dt, mode, 1, &c) && piola__contact_list_push(out, &c)) return -1;
     }
   return 0;

@@ -105,6 +105,33 @@ static piola_status build_bone(piola_world *world, const scene_bone_desc *d) {
   return st;
 }
 
+/* A solid's fracture: the blades of cuts by a mesh are read here (the def keeps copies). */
+static piola_status build_fracture(piola_world *world, int32_t i, const scene_solid_desc *d,
+                                   const char *label) {
+  piola_fracture_def def = d->fracture;
+  const int32_t n = def.cut_count;
+  piola_fracture_cut *cuts = calloc((size_t)(n > 0 ? n : 1), sizeof *cuts);
+  piola_tri_mesh *blades = calloc((size_t)(n > 0 ? n : 1), sizeof *blades);
+  piola_status st = cuts && blades ? PIOLA_OK
+                                   : PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "%s: out of memory", label);
+  for (int32_t c = 0; c < n && st == PIOLA_OK; ++c) {
+    cuts[c] = def.cuts[c];
+    if (!d->fracture_blade_paths[c][0]) continue;
+    st = piola_tri_mesh_read(d->fracture_blade_paths[c], &blades[c]);
+    if (st != PIOLA_OK)
+      st = PIOLA_FAIL(st, "%s: solids[%d].fracture.cuts[%d].mesh: %s", label, (int)i, (int)c, piola_last_error());
+    cuts[c].blade = &blades[c];
+  }
+  def.cuts = cuts;
+  if (st == PIOLA_OK) {
+    st = piola_world_solid_set_fracture(world, i, &def);
+    if (st != PIOLA_OK) st = PIOLA_FAIL(st, "%s: solids[%d].fracture: %s", label, (int)i, piola_last_error());
+  }
+  for (int32_t c = 0; blades && c < n; ++c) piola_tri_mesh_free(&blades[c]);
+  free(blades), free(cuts);
+  return st;
+}
+
 piola_status piola__scene_build(const scene_desc *desc, const char *label, piola_world **out) {
   *out = NULL;
   if (!label) label = "scene";
@@ -220,10 +247,10 @@ piola_status piola__scene_build(const scene_desc *desc, const char *label, piola
   /* last: a cut due at t = 0 renumbers nodes, which bones select by index */
   for (int32_t i = 0; i < desc->solid_count; ++i) {
     if (!desc->solids[i].fractures) continue;
-    piola_status st = piola_world_solid_set_fracture(world, i, &desc->solids[i].fracture);
+    piola_status st = build_fracture(world, i, &desc->solids[i], label);
     if (st != PIOLA_OK) {
       piola_world_destroy(world);
-      return PIOLA_FAIL(st, "%s: solids[%d].fracture: %s", label, (int)i, piola_last_error());
+      return st;
     }
   }
   *out = world;

@@ -52,6 +52,8 @@ piola_status piola_scene_copy_resolved(const char *scene_path, const char *out_p
     cJSON *control = cJSON_GetObjectItemCaseSensitive(plasticity, "control");
     cJSON *goal = cJSON_GetObjectItemCaseSensitive(control, "goal");
     make_absolute(cJSON_GetObjectItemCaseSensitive(goal, "mesh"), folder);
+    cJSON *fracture = cJSON_GetObjectItemCaseSensitive(solid, "fracture");
+    make_list_absolute(fracture, "cuts", "mesh", folder);
   }
   char *out = cJSON_Print(root);
   cJSON_Delete(root);

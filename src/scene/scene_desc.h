@@ -57,6 +57,8 @@ typedef struct scene_solid_desc {
   int fractures;                  /* 1: "fracture" given */
   piola_fracture_def fracture;    /* its cuts point at fracture_cuts */
   piola_fracture_cut *fracture_cuts; /* owned */
+  char (*fracture_blade_paths)[SCENE_PATH_MAX]; /* owned, per cut: its "mesh" resolved, "" for
+                                     a plane */
 } scene_solid_desc;
 
 /* A shell: the solid fields it shares (name, transform, density, material, damping,

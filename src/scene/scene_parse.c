@@ -40,6 +40,7 @@ void piola__scene_desc_free(scene_desc *desc) {
     free(s->constraints);
     free(s->fibers.curve);
     free(s->fracture_cuts);
+    free(s->fracture_blade_paths);
   }
   free(desc->solids);
   free(desc->obstacles);

@@ -1,20 +1,27 @@
-/* A solid's `fracture` key: scripted plane cuts by the virtual node algorithm and the stress
- * criterion (docs/fracture.md). */
+/* A solid's `fracture` key: scripted cuts by planes and triangle surfaces (the virtual node
+ * algorithm) and the stress and plastic strain criteria (docs/fracture.md). */
 #include <stdlib.h>
 #include <string.h>
 
 #include "scene/scene_parse_sections.h"
 
-static piola_status parse_cut(scene_parser *p, const cJSON *obj, piola_fracture_cut *cut) {
+/* {"time": t, "plane": {...}} or {"time": t, "mesh": "blade.obj"}; a mesh's path goes to
+ * blade_path (resolved against the scene's folder; the builder reads it). */
+static piola_status parse_cut(scene_parser *p, const cJSON *obj, piola_fracture_cut *cut, char *blade_path) {
   static const char *const allowed[] = {"time", "plane", "mesh", NULL};
   PIOLA_TRY(piola__json_check_keys(p, obj, allowed));
-  if (piola__json_get(obj, "mesh")) {
-    piola__json_push_key(p, "mesh");
-    return piola__json_fail(p, BAD_VALUE, "cuts by a surface mesh are not supported: give a \"plane\"");
-  }
   PIOLA_TRY(piola__json_required(p, obj, "time"));
-  PIOLA_TRY(piola__json_required(p, obj, "plane"));
   PIOLA_TRY(piola__json_opt_number(p, obj, "time", NONNEGATIVE, &cut->time));
+  const cJSON *mesh = piola__json_get(obj, "mesh");
+  if (mesh && piola__json_get(obj, "plane"))
+    return piola__json_fail(p, BAD_VALUE, "give either \"plane\" or \"mesh\", not both");
+  if (mesh) {
+    size_t old = piola__json_push_key(p, "mesh");
+    PIOLA_TRY(piola__json_path(p, mesh, blade_path));
+    piola__json_pop(p, old);
+    return PIOLA_OK;
+  }
+  PIOLA_TRY(piola__json_required(p, obj, "plane"));
   const cJSON *plane = piola__json_get(obj, "plane");
   size_t old = piola__json_push_key(p, "plane");
   static const char *const plane_keys[] = {"point", "normal", NULL};
@@ -27,29 +34,33 @@ static piola_status parse_cut(scene_parser *p, const cJSON *obj, piola_fracture_
   return PIOLA_OK;
 }
 
-/* "fracture": {"cuts": [{"time": t, "plane": {"point": [..], "normal": [..]}}, ...],
- * "max_cuts_per_step": n, "criterion": "stress", "threshold": Pa}. */
+/* "fracture": {"cuts": [{"time": t, "plane": {"point": [..], "normal": [..]}} or
+ * {"time": t, "mesh": path}, ...], "max_cuts_per_step": n, "criterion": "stress" or
+ * "plastic_strain", "threshold": Pa or strain, "max_tets_per_step": n}. */
 piola_status piola__scene_parse_fracture(scene_parser *p, const cJSON *obj, scene_solid_desc *d) {
-  static const char *const allowed[] = {"cuts", "max_cuts_per_step", "criterion", "threshold", NULL};
+  static const char *const allowed[] = {"cuts", "max_cuts_per_step", "criterion", "threshold",
+                                        "max_tets_per_step", NULL};
   PIOLA_TRY(piola__json_check_keys(p, obj, allowed));
-  if (d->def.self_collision.enabled)
-    return piola__json_fail(p, BAD_VALUE, "cannot be combined with self_collision (not supported)");
   d->fractures = 1;
   d->fracture = piola_default_fracture_def();
   const cJSON *criterion = piola__json_get(obj, "criterion");
   if (criterion) {
     size_t o2 = piola__json_push_key(p, "criterion");
-    if (cJSON_IsString(criterion) && strcmp(criterion->valuestring, "plastic_strain") == 0)
-      return piola__json_fail(p, BAD_VALUE, "\"plastic_strain\" is not supported: use \"stress\"");
-    if (!cJSON_IsString(criterion) || strcmp(criterion->valuestring, "stress") != 0)
-      return piola__json_fail(p, BAD_VALUE, "must be \"stress\"");
+    const int plastic = cJSON_IsString(criterion) && strcmp(criterion->valuestring, "plastic_strain") == 0;
+    if (!plastic && (!cJSON_IsString(criterion) || strcmp(criterion->valuestring, "stress") != 0))
+      return piola__json_fail(p, BAD_VALUE, "must be \"stress\" or \"plastic_strain\"");
+    if (plastic && !d->plastic)
+      return piola__json_fail(p, BAD_VALUE, "\"plastic_strain\" needs the solid's \"plasticity\"");
     piola__json_pop(p, o2);
     PIOLA_TRY(piola__json_required(p, obj, "threshold"));
-    d->fracture.criterion = PIOLA_FRACTURE_STRESS;
+    d->fracture.criterion = plastic ? PIOLA_FRACTURE_PLASTIC_STRAIN : PIOLA_FRACTURE_STRESS;
     PIOLA_TRY(piola__json_opt_number(p, obj, "threshold", POSITIVE, &d->fracture.threshold));
-  } else if (piola__json_get(obj, "threshold")) {
-    piola__json_push_key(p, "threshold");
-    return piola__json_fail(p, BAD_VALUE, "needs \"criterion\": \"stress\"");
+    int64_t tets = 0;
+    PIOLA_TRY(piola__json_opt_int(p, obj, "max_tets_per_step", 1, 100000000, &tets));
+    d->fracture.max_tets_per_step = (int32_t)tets;
+  } else if (piola__json_get(obj, "threshold") || piola__json_get(obj, "max_tets_per_step")) {
+    piola__json_push_key(p, piola__json_get(obj, "threshold") ? "threshold" : "max_tets_per_step");
+    return piola__json_fail(p, BAD_VALUE, "needs a \"criterion\"");
   } else {
     PIOLA_TRY(piola__json_required(p, obj, "cuts"));
   }
@@ -63,12 +74,13 @@ piola_status piola__scene_parse_fracture(scene_parser *p, const cJSON *obj, scen
     return piola__json_fail(p, PIOLA_ERROR_PARSE, "must be a non-empty array of cuts");
   const int count = cJSON_GetArraySize(cuts);
   d->fracture_cuts = calloc((size_t)count, sizeof *d->fracture_cuts);
-  if (!d->fracture_cuts) return piola__json_fail(p, PIOLA_ERROR_OUT_OF_MEMORY, "out of memory");
+  d->fracture_blade_paths = calloc((size_t)count, sizeof *d->fracture_blade_paths);
+  if (!d->fracture_cuts || !d->fracture_blade_paths) return piola__json_fail(p, PIOLA_ERROR_OUT_OF_MEMORY, "out of memory");
   int i = 0;
   for (const cJSON *e = cuts->child; e; e = e->next, ++i) {
     size_t o2 = piola__json_push_index(p, i);
     if (!cJSON_IsObject(e)) return piola__json_fail(p, PIOLA_ERROR_PARSE, "must be an object");
-    PIOLA_TRY(parse_cut(p, e, &d->fracture_cuts[i]));
+    PIOLA_TRY(parse_cut(p, e, &d->fracture_cuts[i], d->fracture_blade_paths[i]));
     d->fracture.cut_count = i + 1;
     piola__json_pop(p, o2);
   }

@@ -24,6 +24,7 @@
 #include "common/status_report.h"
 #include "common/union_find.h"
 #include "force/elastic_body_internal.h"
+#include "piola/plasticity.h"
 #include "sim/fracture_internal.h"
 #include "sim/world_internal.h"
 
@@ -33,10 +34,14 @@
 /* shared face areas below this share of the face are no material contact */
 #define OVERLAP_SHARE 1e-12
 
+static void free_blades(piola_tri_mesh *blades, int32_t count);
+
 void piola__fracture_free(solid_fracture *f) {
   if (!f) return;
+  free_blades(f->blades, f->cut_count);
   free(f->cuts), free(f->tets), free(f->neighbor), free(f->parent), free(f->event), free(f->dist);
-  free(f->side), free(f->fraction), free(f->fragment), free(f->copies);
+  free(f->side), free(f->fraction), free(f->fragment), free(f->copies), free(f->vertex_crack), free(f->last_strain);
+  free(f->vertex_value);
   free(f);
 }
 
@@ -81,14 +86,19 @@ static piola_status fracture_create(const world_body *b, solid_fracture **out) {
     f->fraction = malloc(sizeof(double) * (size_t)nt);
     f->fragment = calloc((size_t)nt, sizeof(int32_t));
     f->copies = malloc(2 * sizeof(int32_t) * (size_t)nt);
+    f->vertex_count = b->n;
+    f->vertex_crack = malloc(sizeof(int32_t) * (size_t)b->n);
+    f->vertex_value = calloc((size_t)b->n, sizeof(double));
   }
   if (!f || !keys || !f->tets || !f->neighbor || !f->parent || !f->event || !f->dist || !f->side ||
-      !f->fraction || !f->fragment || !f->copies) {
+      !f->fraction || !f->fragment || !f->copies || !f->vertex_crack || !f->vertex_value) {
     free(keys);
     piola__fracture_free(f);
     return PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "fracture of '%s': out of memory", b->name);
   }
   memcpy(f->tets, piola_elastic_body_tets(b->solid), 4 * sizeof(int32_t) * (size_t)nt);
+  for (int32_t i = 0; i < b->n; ++i) f->vertex_crack[i] = -1;
+  f->grown_crack = -1;
   for (int32_t t = 0; t < nt; ++t) {
     f->parent[t] = t, f->event[t] = -1, f->side[t] = 1, f->fraction[t] = 1.0;
     f->copies[2 * t] = t, f->copies[2 * t + 1] = -1;
@@ -182,6 +192,23 @@ static int faces_overlap(const solid_fracture *f, const int32_t *event, const do
 
 /* ------------------------------------------------------------------ the cut event */
 
+double piola__fracture_snap(const world_body *b) {
+  const double altitude = piola_elastic_body_min_rest_altitude(b->solid);
+  double snap = SNAP_SHARE * altitude;
+  /* with self-collision, each crack face's collision surface lies up to half the thickness
+   * inside its material (world_contact.c), which needs that much room on either side */
+  if (b->self_collision.enabled)
+    snap = fmax(snap, fmin(0.5 * b->self_collision.thickness, 0.05 * altitude));
+  return snap;
+}
+
+/* One uncut copy to split: its corner distances (none zero, both signs) and the crack it
+ * belongs to (copies of one crack name their crack points alike: fracture_surface.c). */
+typedef struct tet_cut {
+  int32_t copy, crack;
+  double dist[4];
+} tet_cut;
+
 typedef struct new_mesh {
   int32_t copies, nodes;
   int32_t *parent, *event, *element_parent, *node_of, *node_parent, *up, *fragment;
@@ -217,37 +244,24 @@ static void number_fragments(int32_t copies, const int32_t *node_of, int32_t nod
   *count = n;
 }
 
-static piola_status cut_event(piola_world *w, world_body *b, const double point[3],
-                              const double normal[3], int32_t *cut_count) {
+/* Splits the uncut copies cuts[i].copy (each once, corner distances of both signs, none
+ * zero) into two copies each, rebuilding nodes, body and fragments (steps 2 to 5 above). */
+static piola_status split_copies(piola_world *w, world_body *b, const tet_cut *cuts, int32_t count) {
   solid_fracture *f = b->fracture;
   const piola_elastic_body *old = b->solid;
   const int32_t *old_tets = piola_elastic_body_tets(old);
-  const double nn = sqrt(normal[0] * normal[0] + normal[1] * normal[1] + normal[2] * normal[2]);
-  const double snap = SNAP_SHARE * piola_elastic_body_min_rest_altitude(old);
-  double *s = malloc(sizeof(double) * (size_t)b->n);
-  if (!s) return PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "cut of '%s': out of memory", b->name);
-  for (int32_t i = 0; i < b->n; ++i) {
-    double d = 0;
-    for (int k = 0; k < 3; ++k) d += (b->x[3 * i + k] - point[k]) * normal[k] / nn;
-    s[i] = fabs(d) >= snap ? d : (d < 0 ? -snap : snap);
-  }
-  /* 2: the new copies */
-  int32_t split = 0;
-  for (int32_t c = 0; c < f->copy_count; ++c) {
-    if (f->event[c] >= 0) continue;
-    int pos = 0, neg = 0;
+  if (count == 0) return PIOLA_OK;
+  const int32_t split = count;
+  /* the cracks' values at the vertices they reach first (continued_crack reads them) */
+  for (int32_t i = 0; i < count; ++i)
     for (int k = 0; k < 4; ++k) {
-      if (s[old_tets[4 * c + k]] > 0) pos = 1;
-      else neg = 1;
+      const int32_t vertex = f->tets[4 * f->parent[cuts[i].copy] + k];
+      if (f->vertex_crack[vertex] < 0) f->vertex_crack[vertex] = cuts[i].crack, f->vertex_value[vertex] = cuts[i].dist[k];
     }
-    split += pos && neg;
-  }
-  *cut_count = split;
-  if (split == 0) {
-    free(s);
-    f->events++;
-    return PIOLA_OK;
-  }
+  int32_t *plan = malloc(sizeof(int32_t) * (size_t)f->copy_count);
+  if (!plan) return PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "cut of '%s': out of memory", b->name);
+  for (int32_t c = 0; c < f->copy_count; ++c) plan[c] = -1;
+  for (int32_t i = 0; i < count; ++i) plan[cuts[i].copy] = i;
   new_mesh m = {0};
   const int32_t nc = f->copy_count + split;
   m.copies = nc;
@@ -272,21 +286,16 @@ static piola_status cut_event(piola_world *w, world_body *b, const double point[
   int32_t n = 0;
   for (int32_t c = 0; c < f->copy_count && st == PIOLA_OK; ++c) {
     const int32_t *corners = old_tets + 4 * c;
-    int pos = 0, neg = 0;
-    for (int k = 0; k < 4; ++k) {
-      if (s[corners[k]] > 0) pos = 1;
-      else neg = 1;
-    }
-    const int cut = f->event[c] < 0 && pos && neg;
+    const tet_cut *cut = plan[c] >= 0 ? &cuts[plan[c]] : NULL;
     for (int copy = 0; copy < (cut ? 2 : 1); ++copy) {
       m.parent[n] = f->parent[c];
       m.element_parent[n] = c;
-      m.event[n] = cut ? f->events : f->event[c];
+      m.event[n] = cut ? cut->crack : f->event[c];
       m.side[n] = cut ? (copy == 0 ? 1 : -1) : f->side[c];
       m.fraction[n] = f->fraction[c];
       memcpy(m.dist + 4 * n, f->dist + 4 * c, 4 * sizeof(double));
       if (cut) {
-        for (int k = 0; k < 4; ++k) m.dist[4 * n + k] = s[corners[k]], m.fresh[corners[k]] = 1;
+        for (int k = 0; k < 4; ++k) m.dist[4 * n + k] = cut->dist[k], m.fresh[corners[k]] = 1;
         copy_polygons poly;
         piola__fracture_copy_polygons(m.dist + 4 * n, m.side[n], f->tets + 4 * m.parent[n], &poly);
         m.fraction[n] = poly.fraction;
@@ -295,6 +304,7 @@ static piola_status cut_event(piola_world *w, world_body *b, const double point[
       ++n;
     }
   }
+  free(plan);
   /* 3: nodes. Items of nodes no new copy touches stay together; elsewhere MBF04's rule */
   if (st == PIOLA_OK) {
     for (int32_t t = 0; t < f->tet_count; ++t) copies[2 * t] = copies[2 * t + 1] = -1;
@@ -361,14 +371,209 @@ static piola_status cut_event(piola_world *w, world_body *b, const double point[
     f->parent = m.parent, f->event = m.event, f->dist = m.dist, f->side = m.side;
     f->fraction = m.fraction, f->fragment = m.fragment, f->copies = copies;
     m.parent = m.event = m.fragment = NULL, m.dist = m.fraction = NULL, m.side = NULL, copies = NULL;
+    if (f->last_strain) {
+      double *last = malloc(sizeof(double) * (size_t)nc);
+      if (!last) st = PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "cut of '%s': out of memory", b->name);
+      for (int32_t i = 0; last && i < nc; ++i) last[i] = f->last_strain[m.element_parent[i]];
+      free(f->last_strain);
+      f->last_strain = last;
+    }
     f->copy_count = nc;
     f->cut_tets += split;
-    f->events++;
     number_fragments(nc, piola_elastic_body_tets(b->solid), m.nodes, m.up, f->fragment,
                      &f->fragment_count);
   }
   new_mesh_free(&m);
-  free(copies), free(x), free(v), free(rest), free(s);
+  free(copies), free(x), free(v), free(rest);
+  return st;
+}
+
+/* Snaps a distance at least snap away from zero (0 counts as positive). */
+static double snapped(double d, double snap) { return fabs(d) >= snap ? d : (d < 0 ? -snap : snap); }
+
+/* The whole-solid cut by a plane: every uncut copy the plane crosses, one new crack. */
+static piola_status cut_event(piola_world *w, world_body *b, const double point[3],
+                              const double normal[3], int32_t *cut_count) {
+  solid_fracture *f = b->fracture;
+  const int32_t *tets = piola_elastic_body_tets(b->solid);
+  const double nn = sqrt(normal[0] * normal[0] + normal[1] * normal[1] + normal[2] * normal[2]);
+  const double snap = piola__fracture_snap(b);
+  double *s = malloc(sizeof(double) * (size_t)b->n);
+  tet_cut *cuts = malloc(sizeof *cuts * (size_t)f->copy_count);
+  if (!s || !cuts) {
+    free(s), free(cuts);
+    return PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "cut of '%s': out of memory", b->name);
+  }
+  for (int32_t i = 0; i < b->n; ++i) {
+    double d = 0;
+    for (int k = 0; k < 3; ++k) d += (b->x[3 * i + k] - point[k]) * normal[k] / nn;
+    s[i] = snapped(d, snap);
+  }
+  int32_t count = 0;
+  for (int32_t c = 0; c < f->copy_count; ++c) {
+    if (f->event[c] >= 0) continue;
+    int pos = 0, neg = 0;
+    for (int k = 0; k < 4; ++k) {
+      if (s[tets[4 * c + k]] > 0) pos = 1;
+      else neg = 1;
+    }
+    if (!(pos && neg)) continue;
+    cuts[count].copy = c, cuts[count].crack = f->events;
+    for (int k = 0; k < 4; ++k) cuts[count].dist[k] = s[tets[4 * c + k]];
+    ++count;
+  }
+  piola_status st = split_copies(w, b, cuts, count);
+  if (st == PIOLA_OK) b->fracture->events++;
+  *cut_count = count;
+  free(s), free(cuts);
+  return st;
+}
+
+/* ------------------------------------------------------------------ cuts by a surface */
+
+static void sub3(const double *a, const double *b, double out[3]) {
+  for (int k = 0; k < 3; ++k) out[k] = a[k] - b[k];
+}
+static double dot3(const double *a, const double *b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
+static void cross3(const double *a, const double *b, double out[3]) {
+  out[0] = a[1] * b[2] - a[2] * b[1], out[1] = a[2] * b[0] - a[0] * b[2], out[2] = a[0] * b[1] - a[1] * b[0];
+}
+
+/* The point of triangle (a, b, c) closest to p (by regions of the triangle's plane). */
+static void closest_on_triangle(const double *p, const double *a, const double *b, const double *c,
+                                double out[3]) {
+  double ab[3], ac[3], ap[3], bp[3], cp[3];
+  sub3(b, a, ab), sub3(c, a, ac), sub3(p, a, ap);
+  const double d1 = dot3(ab, ap), d2 = dot3(ac, ap);
+  if (d1 <= 0 && d2 <= 0) { memcpy(out, a, 3 * sizeof(double)); return; }
+  sub3(p, b, bp);
+  const double d3 = dot3(ab, bp), d4 = dot3(ac, bp);
+  if (d3 >= 0 && d4 <= d3) { memcpy(out, b, 3 * sizeof(double)); return; }
+  const double vc = d1 * d4 - d3 * d2;
+  if (vc <= 0 && d1 >= 0 && d3 <= 0) {
+    const double v = d1 / (d1 - d3);
+    for (int k = 0; k < 3; ++k) out[k] = a[k] + v * ab[k];
+    return;
+  }
+  sub3(p, c, cp);
+  const double d5 = dot3(ab, cp), d6 = dot3(ac, cp);
+  if (d6 >= 0 && d5 <= d6) { memcpy(out, c, 3 * sizeof(double)); return; }
+  const double vb = d5 * d2 - d1 * d6;
+  if (vb <= 0 && d2 >= 0 && d6 <= 0) {
+    const double v = d2 / (d2 - d6);
+    for (int k = 0; k < 3; ++k) out[k] = a[k] + v * ac[k];
+    return;
+  }
+  const double va = d3 * d6 - d5 * d4;
+  if (va <= 0 && d4 - d3 >= 0 && d5 - d6 >= 0) {
+    const double v = (d4 - d3) / ((d4 - d3) + (d5 - d6));
+    for (int k = 0; k < 3; ++k) out[k] = b[k] + v * (c[k] - b[k]);
+    return;
+  }
+  const double denom = 1.0 / (va + vb + vc), v = vb * denom, u = vc * denom;
+  for (int k = 0; k < 3; ++k) out[k] = a[k] + v * ab[k] + u * ac[k];
+}
+
+/* Signed distance of p to the surface: the distance to the nearest triangle, signed by
+ * that triangle's normal (of two equally near, the one p lies more squarely in front of). */
+static double surface_distance(const piola_tri_mesh *s, const double *p) {
+  double best = INFINITY, value = 0, best_dot = 0;
+  for (int32_t i = 0; i < s->triangle_count; ++i) {
+    const int32_t *t = s->triangles + 3 * i;
+    const double *a = s->positions + 3 * t[0], *b = s->positions + 3 * t[1], *c = s->positions + 3 * t[2];
+    double q[3], d[3], ab[3], ac[3], n[3];
+    closest_on_triangle(p, a, b, c, q);
+    sub3(p, q, d);
+    const double dd = sqrt(dot3(d, d));
+    sub3(b, a, ab), sub3(c, a, ac), cross3(ab, ac, n);
+    const double nn = sqrt(dot3(n, n));
+    if (!(nn > 0)) continue;
+    const double along = dot3(d, n) / nn;
+    if (dd < best * (1 - 1e-12) || (dd <= best * (1 + 1e-12) && fabs(along) > fabs(best_dot))) {
+      best = dd, best_dot = along;
+      value = along >= 0 ? dd : -dd;
+    }
+  }
+  return value;
+}
+
+/* Whether segment p q crosses a triangle of the surface (edges and corners included, to a
+ * relative 1e-9, so a segment through an edge between two triangles counts). */
+static int segment_crosses(const piola_tri_mesh *s, const double *p, const double *q) {
+  for (int32_t i = 0; i < s->triangle_count; ++i) {
+    const int32_t *t = s->triangles + 3 * i;
+    const double *a = s->positions + 3 * t[0], *b = s->positions + 3 * t[1], *c = s->positions + 3 * t[2];
+    double ab[3], ac[3], n[3], ap[3], aq[3];
+    sub3(b, a, ab), sub3(c, a, ac), cross3(ab, ac, n), sub3(p, a, ap), sub3(q, a, aq);
+    const double sp = dot3(ap, n), sq = dot3(aq, n);
+    if ((sp > 0 && sq > 0) || (sp < 0 && sq < 0) || sp == sq) continue;
+    const double r = sp / (sp - sq);
+    double x[3];
+    for (int k = 0; k < 3; ++k) x[k] = p[k] + r * (q[k] - p[k]);
+    const double nn = dot3(n, n), tol = -1e-9 * nn;
+    const double *corner[3] = {a, b, c};
+    int inside = 1;
+    for (int e = 0; e < 3 && inside; ++e) {
+      double edge[3], to[3], w[3];
+      sub3(corner[(e + 1) % 3], corner[e], edge), sub3(x, corner[e], to), cross3(edge, to, w);
+      inside = dot3(w, n) >= tol;
+    }
+    if (inside) return 1;
+  }
+  return 0;
+}
+
+static const int8_t tet_edge[6][2] = {{0, 1}, {0, 2}, {0, 3}, {1, 2}, {1, 3}, {2, 3}};
+
+/* The cut by a surface: every uncut copy it passes all the way through, one new crack. */
+static piola_status surface_cut_event(piola_world *w, world_body *b, const piola_tri_mesh *surface,
+                                      int32_t *cut_count) {
+  solid_fracture *f = b->fracture;
+  const int32_t *tets = piola_elastic_body_tets(b->solid);
+  const double snap = piola__fracture_snap(b);
+  double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+  for (int32_t i = 0; i < surface->vertex_count; ++i)
+    for (int k = 0; k < 3; ++k)
+      lo[k] = fmin(lo[k], surface->positions[3 * i + k]), hi[k] = fmax(hi[k], surface->positions[3 * i + k]);
+  double *s = malloc(sizeof(double) * (size_t)b->n);
+  tet_cut *cuts = malloc(sizeof *cuts * (size_t)f->copy_count);
+  if (!s || !cuts) {
+    free(s), free(cuts);
+    return PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "cut of '%s': out of memory", b->name);
+  }
+  for (int32_t i = 0; i < b->n; ++i) s[i] = NAN; /* computed on demand */
+  int32_t count = 0;
+  for (int32_t c = 0; c < f->copy_count; ++c) {
+    if (f->event[c] >= 0) continue;
+    const int32_t *corner = tets + 4 * c;
+    int apart = 0; /* the copy's box misses the surface's */
+    for (int k = 0; k < 3 && !apart; ++k) {
+      double a = INFINITY, z = -INFINITY;
+      for (int j = 0; j < 4; ++j) a = fmin(a, b->x[3 * corner[j] + k]), z = fmax(z, b->x[3 * corner[j] + k]);
+      apart = z < lo[k] || a > hi[k];
+    }
+    if (apart) continue;
+    int pos = 0, neg = 0;
+    for (int j = 0; j < 4; ++j) {
+      if (isnan(s[corner[j]])) s[corner[j]] = snapped(surface_distance(surface, b->x + 3 * corner[j]), snap);
+      if (s[corner[j]] > 0) pos = 1;
+      else neg = 1;
+    }
+    if (!(pos && neg)) continue;
+    int through = 1;
+    for (int e = 0; e < 6 && through; ++e) {
+      const int32_t p = corner[tet_edge[e][0]], q = corner[tet_edge[e][1]];
+      if ((s[p] > 0) != (s[q] > 0)) through = segment_crosses(surface, b->x + 3 * p, b->x + 3 * q);
+    }
+    if (!through) continue;
+    cuts[count].copy = c, cuts[count].crack = f->events;
+    for (int k = 0; k < 4; ++k) cuts[count].dist[k] = s[corner[k]];
+    ++count;
+  }
+  piola_status st = split_copies(w, b, cuts, count);
+  if (st == PIOLA_OK) b->fracture->events++;
+  *cut_count = count;
+  free(s), free(cuts);
   return st;
 }
 
@@ -391,12 +596,40 @@ static piola_status check_plane(const double point[3], const double normal[3], c
   return PIOLA_OK;
 }
 
+static piola_status check_blade(const piola_tri_mesh *s, const char *name, int32_t index) {
+  if (!s || s->triangle_count < 1 || s->vertex_count < 3 || !s->positions || !s->triangles)
+    return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "fracture of '%s': cut %d has no triangles", name,
+                      (int)index);
+  for (int32_t i = 0; i < 3 * s->vertex_count; ++i)
+    if (!isfinite(s->positions[i]))
+      return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "fracture of '%s': cut %d: vertex %d is not finite",
+                        name, (int)index, (int)(i / 3));
+  for (int32_t i = 0; i < 3 * s->triangle_count; ++i)
+    if (s->triangles[i] < 0 || s->triangles[i] >= s->vertex_count)
+      return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT,
+                        "fracture of '%s': cut %d: triangle %d names vertex %d of %d", name, (int)index,
+                        (int)(i / 3), (int)s->triangles[i], (int)s->vertex_count);
+  return PIOLA_OK;
+}
+
+static piola_status copy_blade(const piola_tri_mesh *s, piola_tri_mesh *out) {
+  out->vertex_count = s->vertex_count, out->triangle_count = s->triangle_count;
+  out->positions = malloc(3 * sizeof(double) * (size_t)s->vertex_count);
+  out->triangles = malloc(3 * sizeof(int32_t) * (size_t)s->triangle_count);
+  if (!out->positions || !out->triangles)
+    return PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "fracture: out of memory");
+  memcpy(out->positions, s->positions, 3 * sizeof(double) * (size_t)s->vertex_count);
+  memcpy(out->triangles, s->triangles, 3 * sizeof(int32_t) * (size_t)s->triangle_count);
+  return PIOLA_OK;
+}
+
+static void free_blades(piola_tri_mesh *blades, int32_t count) {
+  for (int32_t i = 0; blades && i < count; ++i) piola_tri_mesh_free(&blades[i]);
+  free(blades);
+}
+
 static piola_status ensure_state(world_body *b) {
   if (b->fracture) return PIOLA_OK;
-  if (b->self_collision.enabled)
-    return PIOLA_FAIL(PIOLA_ERROR_UNSUPPORTED,
-                      "fracture of '%s': not with self_collision (the collision surface would be "
-                      "the copies' whole tets, which overlap across every crack)", b->name);
   return fracture_create(b, &b->fracture);
 }
 
@@ -408,46 +641,225 @@ static piola_status apply_due(piola_world *w, world_body *b) {
     const double point[3] = {c->point.x, c->point.y, c->point.z};
     const double normal[3] = {c->normal.x, c->normal.y, c->normal.z};
     int32_t count;
-    PIOLA_TRY(cut_event(w, b, point, normal, &count));
+    if (c->blade) PIOLA_TRY(surface_cut_event(w, b, c->blade, &count));
+    else PIOLA_TRY(cut_event(w, b, point, normal, &count));
     f = b->fracture;
     f->next_cut++;
   }
   return PIOLA_OK;
 }
 
-/* The stress criterion: the uncut copy with the largest principal Cauchy stress of the last
- * update. With F = U Fhat V^T and P = U Phat V^T, sigma = P F^T / J = U diag(Phat Fhat / J)
- * U^T: its principal values are Phat_i Fhat_i / J, along the columns of U. */
-static piola_status apply_criterion(piola_world *w, world_body *b) {
-  solid_fracture *f = b->fracture;
-  if (f->criterion != PIOLA_FRACTURE_STRESS) return PIOLA_OK;
-  const piola_elastic_body *e = b->solid;
-  const double *fhat = piola_elastic_body_fhat(e);
-  const double scale = piola_track_eval(&b->stiffness_scale, w->time);
-  double worst = f->threshold, normal[3] = {0, 0, 0};
-  int32_t pick = -1;
-  for (int32_t c = 0; c < f->copy_count; ++c) {
-    if (f->event[c] >= 0) continue;
-    const double *fc = fhat + 3 * c;
-    const double j = fc[0] * fc[1] * fc[2];
-    if (!(j > 0)) continue; /* inverted or flat: no tension to speak of */
-    double phat[3];
-    piola_material_stress(&e->materials[e->tet_material[c]], fc, phat);
-    for (int i = 0; i < 3; ++i) {
-      const double sigma = scale * phat[i] * fc[i] / j;
-      if (sigma > worst) {
-        worst = sigma, pick = c;
-        for (int k = 0; k < 3; ++k) normal[k] = e->u[3 * k + i][c];
-      }
+/* ------------------------------------------------------------------ the criteria */
+
+/* The largest principal Cauchy stress of copy c from the last update (Pa) and its direction.
+ * With F = U Fhat V^T and P = U Phat V^T, sigma = P F^T / J = U diag(Phat Fhat / J) U^T: its
+ * principal values are Phat_i Fhat_i / J, along the columns of U. -inf for an inverted or
+ * flat copy (no tension to speak of). */
+static double principal_stress(const piola_elastic_body *e, int32_t c, double scale, double dir[3]) {
+  const double *fc = piola_elastic_body_fhat(e) + 3 * c;
+  const double j = fc[0] * fc[1] * fc[2];
+  if (!(j > 0)) return -INFINITY;
+  double phat[3], worst = -INFINITY;
+  piola_material_stress(&e->materials[e->tet_material[c]], fc, phat);
+  for (int i = 0; i < 3; ++i) {
+    const double sigma = scale * phat[i] * fc[i] / j;
+    if (sigma > worst) {
+      worst = sigma;
+      for (int k = 0; k < 3; ++k) dir[k] = e->u[3 * k + i][c];
     }
   }
-  if (pick < 0) return PIOLA_OK;
-  const int32_t *corner = piola_elastic_body_tets(e) + 4 * pick;
-  double point[3] = {0, 0, 0};
-  for (int k = 0; k < 4; ++k)
-    for (int a = 0; a < 3; ++a) point[a] += 0.25 * b->x[3 * corner[k] + a];
-  int32_t count;
-  return cut_event(w, b, point, normal, &count);
+  return worst;
+}
+
+/* Gradients (world space, current positions x) of the four barycentric coordinates of a
+ * tet with corners p[4]; 0 when the tet is flat. */
+static int barycentric_gradients(const double *x, const int32_t p[4], double g[4][3]) {
+  double d[3][3];
+  for (int r = 0; r < 3; ++r)
+    for (int k = 0; k < 3; ++k) d[r][k] = x[3 * p[r + 1] + k] - x[3 * p[0] + k];
+  /* rows of d are the edges; the gradients of lambda_1..3 are the columns of d^-1 */
+  const double c0[3] = {d[1][1] * d[2][2] - d[1][2] * d[2][1], d[1][2] * d[2][0] - d[1][0] * d[2][2],
+                        d[1][0] * d[2][1] - d[1][1] * d[2][0]};
+  const double det = d[0][0] * c0[0] + d[0][1] * c0[1] + d[0][2] * c0[2];
+  if (!(fabs(det) > 0) || !isfinite(det)) return 0;
+  const double c1[3] = {d[2][1] * d[0][2] - d[2][2] * d[0][1], d[2][2] * d[0][0] - d[2][0] * d[0][2],
+                        d[2][0] * d[0][1] - d[2][1] * d[0][0]};
+  const double c2[3] = {d[0][1] * d[1][2] - d[0][2] * d[1][1], d[0][2] * d[1][0] - d[0][0] * d[1][2],
+                        d[0][0] * d[1][1] - d[0][1] * d[1][0]};
+  for (int k = 0; k < 3; ++k) {
+    g[1][k] = c0[k] / det, g[2][k] = c1[k] / det, g[3][k] = c2[k] / det;
+    g[0][k] = -(g[1][k] + g[2][k] + g[3][k]);
+  }
+  return 1;
+}
+
+/* Snaps v (a new corner value) away from zero and keeps it as crack's value at vertex. */
+static double keep_value(solid_fracture *f, int32_t vertex, int32_t crack, double v, double snap) {
+  v = snapped(v, snap);
+  f->vertex_crack[vertex] = crack, f->vertex_value[vertex] = v;
+  return v;
+}
+
+/* The crack of copy c (original tet t, uncut, corners `nodes`) continued from the crack values
+ * its corners hold (a crack is the zero set of one value per original vertex, so its pieces
+ * meet edge to edge). It continues where two corners of an edge hold values of opposite sign
+ * (the crack crosses that edge): with three known corners the fourth takes the value that
+ * turns the crack closest to normal to dir (the direction of the largest principal stress);
+ * with two, the crack is the plane through their crossing normal to dir. Returns 0 when no
+ * edge is crossed, 1 with dist and crack filled in (the new corner values kept), -1 when it
+ * cannot continue (corners of different cracks, a degenerate tet or direction). */
+static int continued_crack(solid_fracture *f, const double *x, const int32_t *nodes, int32_t t,
+                           const double dir[3], double snap, double dist[4], int32_t *crack) {
+  const int32_t *ids = f->tets + 4 * t;
+  int known[4], count = 0, pos = 0, neg = 0;
+  *crack = -1;
+  for (int k = 0; k < 4; ++k) {
+    const int32_t owner = f->vertex_crack[ids[k]];
+    known[k] = owner >= 0;
+    if (!known[k]) continue;
+    if (*crack >= 0 && owner != *crack) return -1;
+    *crack = owner, dist[k] = f->vertex_value[ids[k]], ++count;
+    if (dist[k] > 0) pos = 1;
+    else neg = 1;
+  }
+  if (!(pos && neg)) return 0;
+  if (count == 3) {
+    /* maximize (g . n)^2 / |g|^2 over d, g = g0 + d g1: d = (a e - b c) / (b e - a h) */
+    double g[4][3], g0[3] = {0, 0, 0};
+    if (!barycentric_gradients(x, nodes, g)) return -1;
+    int free_corner = 0;
+    for (int k = 0; k < 4; ++k) {
+      if (!known[k]) free_corner = k;
+      else
+        for (int i = 0; i < 3; ++i) g0[i] += dist[k] * g[k][i];
+    }
+    const double *g1 = g[free_corner];
+    double a = 0, bb = 0, c = 0, e = 0, h = 0;
+    for (int i = 0; i < 3; ++i)
+      a += g0[i] * dir[i], bb += g1[i] * dir[i], c += g0[i] * g0[i], e += g0[i] * g1[i], h += g1[i] * g1[i];
+    const double d = (a * e - bb * c) / (bb * e - a * h);
+    if (!isfinite(d)) return -1;
+    dist[free_corner] = keep_value(f, ids[free_corner], *crack, d, snap);
+  } else if (count == 2) {
+    /* the plane through the crossing X of the known edge p q, normal to dir, scaled to p's
+     * value (q's matches: X divides p q in the ratio of their values) */
+    int p = -1, q = -1;
+    for (int k = 0; k < 4; ++k)
+      if (known[k]) {
+        if (p < 0) p = k;
+        else q = k;
+      }
+    const double r = dist[p] / (dist[p] - dist[q]);
+    double cross[3], along_p = 0;
+    for (int i = 0; i < 3; ++i) cross[i] = x[3 * nodes[p] + i] + r * (x[3 * nodes[q] + i] - x[3 * nodes[p] + i]);
+    for (int i = 0; i < 3; ++i) along_p += (x[3 * nodes[p] + i] - cross[i]) * dir[i];
+    const double scale = dist[p] / along_p;
+    if (!isfinite(scale) || !(fabs(along_p) > 1e-6 * snap)) return -1;
+    for (int k = 0; k < 4; ++k) {
+      if (known[k]) continue;
+      double along = 0;
+      for (int i = 0; i < 3; ++i) along += (x[3 * nodes[k] + i] - cross[i]) * dir[i];
+      dist[k] = keep_value(f, ids[k], *crack, scale * along, snap);
+    }
+  }
+  return 1;
+}
+
+typedef struct candidate {
+  double measure, dir[3];
+  int32_t copy;
+} candidate;
+
+/* decreasing measure, then copy order: a deterministic pass */
+static int by_measure(const void *pa, const void *pb) {
+  const candidate *a = pa, *b = pb;
+  if (a->measure != b->measure) return a->measure > b->measure ? -1 : 1;
+  return a->copy < b->copy ? -1 : a->copy > b->copy;
+}
+
+/* The breaking criteria (stress, plastic strain): before each step, every uncut copy whose
+ * measure passes the threshold and that touches a crack is cut so that the crack runs on
+ * into it (continued_crack), in order of decreasing measure, at most max_tets_per_step (0: no
+ * limit). If none does, the one with the largest measure starts a new crack unless a crack
+ * touches it (a corner holds a crack's value): the plane through its centroid normal to its
+ * largest principal stress, in that copy only. */
+static piola_status apply_criterion(piola_world *w, world_body *b) {
+  solid_fracture *f = b->fracture;
+  if (f->criterion == PIOLA_FRACTURE_SCRIPTED) return PIOLA_OK;
+  const piola_elastic_body *e = b->solid;
+  const int32_t *nodes = piola_elastic_body_tets(e);
+  const double scale = piola_track_eval(&b->stiffness_scale, w->time);
+  const double *strain = f->criterion == PIOLA_FRACTURE_PLASTIC_STRAIN && b->plastic
+                             ? piola_plastic_state_plastic_strain(b->plastic) : NULL;
+  if (f->criterion == PIOLA_FRACTURE_PLASTIC_STRAIN && !strain) return PIOLA_OK;
+  if (strain && !f->last_strain) {
+    f->last_strain = malloc(sizeof(double) * (size_t)f->copy_count);
+    if (!f->last_strain) return PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "fracture of '%s': out of memory", b->name);
+    memcpy(f->last_strain, strain, sizeof(double) * (size_t)f->copy_count);
+  }
+  candidate *list = malloc(sizeof *list * (size_t)f->copy_count);
+  if (!list) return PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "fracture of '%s': out of memory", b->name);
+  int32_t n = 0;
+  for (int32_t c = 0; c < f->copy_count; ++c) {
+    /* ductile: only while the tet still flows (a piece that unloaded tears no further) */
+    const int flowing = strain && strain[c] > f->last_strain[c];
+    if (strain) f->last_strain[c] = strain[c];
+    if (f->event[c] >= 0 || (strain && !(flowing && strain[c] > f->threshold))) continue;
+    candidate k;
+    const double stress = principal_stress(e, c, scale, k.dir);
+    k.measure = strain ? strain[c] : stress;
+    k.copy = c;
+    if (k.measure > f->threshold && isfinite(stress)) list[n++] = k;
+  }
+  if (n == 0) {
+    free(list);
+    return PIOLA_OK;
+  }
+  tet_cut *cuts = malloc(sizeof *cuts * (size_t)n);
+  if (!cuts) {
+    free(list);
+    return PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "fracture of '%s': out of memory", b->name);
+  }
+  qsort(list, (size_t)n, sizeof *list, by_measure);
+  const double snap = piola__fracture_snap(b);
+  const int32_t most = f->max_tets_per_step > 0 ? f->max_tets_per_step : INT32_MAX;
+  int32_t count = 0;
+  for (int32_t i = 0; i < n && count < most; ++i) {
+    const int32_t c = list[i].copy, t = f->parent[c];
+    tet_cut *cut = &cuts[count];
+    cut->copy = c;
+    if (continued_crack(f, b->x, nodes + 4 * c, t, list[i].dir, snap, cut->dist, &cut->crack) != 1) continue;
+    ++count;
+  }
+  /* when no crack grew (cracks relieve the stress by growing first): a new crack at the
+   * candidate with the largest measure that no crack touches */
+  int started = 0, touched = 1;
+  int32_t pick = -1;
+  while (count == 0 && touched && ++pick < n) {
+    const int32_t *ids = f->tets + 4 * f->parent[list[pick].copy];
+    touched = 0;
+    for (int k = 0; k < 4; ++k) touched |= f->vertex_crack[ids[k]] >= 0;
+  }
+  const int32_t c = pick < n ? list[pick].copy : -1;
+  if (count == 0 && !touched) {
+    double point[3] = {0, 0, 0};
+    for (int k = 0; k < 4; ++k)
+      for (int a = 0; a < 3; ++a) point[a] += 0.25 * b->x[3 * nodes[4 * c + k] + a];
+    int pos = 0, neg = 0;
+    for (int k = 0; k < 4; ++k) {
+      double d = 0;
+      for (int a = 0; a < 3; ++a) d += (b->x[3 * nodes[4 * c + k] + a] - point[a]) * list[pick].dir[a];
+      cuts[0].dist[k] = snapped(d, snap);
+      if (cuts[0].dist[k] > 0) pos = 1;
+      else neg = 1;
+    }
+    cuts[0].copy = c, cuts[0].crack = f->grown_crack >= 0 ? f->grown_crack : f->events;
+    started = count = pos && neg;
+  }
+  piola_status st = split_copies(w, b, cuts, count);
+  if (st == PIOLA_OK && started && b->fracture->grown_crack < 0) b->fracture->grown_crack = b->fracture->events++;
+  free(list), free(cuts);
+  return st;
 }
 
 piola_status piola__world_fracture_step(piola_world *w) {
@@ -476,22 +888,35 @@ piola_status piola_world_solid_set_fracture(piola_world *w, int32_t solid, const
   if (!b || !def) return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "set_fracture: no solid %d", (int)solid);
   if (def->cut_count < 0 || (def->cut_count > 0 && !def->cuts) || def->max_cuts_per_step < 0)
     return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "fracture of '%s': bad cut list", b->name);
-  if (def->criterion != PIOLA_FRACTURE_SCRIPTED && def->criterion != PIOLA_FRACTURE_STRESS)
+  if (def->criterion != PIOLA_FRACTURE_SCRIPTED && def->criterion != PIOLA_FRACTURE_STRESS &&
+      def->criterion != PIOLA_FRACTURE_PLASTIC_STRAIN)
     return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "fracture of '%s': unknown criterion %d", b->name,
                       (int)def->criterion);
-  if (def->criterion == PIOLA_FRACTURE_STRESS && !(def->threshold > 0 && isfinite(def->threshold)))
+  if (def->criterion != PIOLA_FRACTURE_SCRIPTED && !(def->threshold > 0 && isfinite(def->threshold)))
     return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT,
-                      "fracture of '%s': the stress threshold must be > 0 Pa, got %g", b->name, def->threshold);
+                      "fracture of '%s': the threshold must be > 0 (%s), got %g", b->name,
+                      def->criterion == PIOLA_FRACTURE_STRESS ? "Pa" : "plastic log strain", def->threshold);
+  if (def->criterion == PIOLA_FRACTURE_PLASTIC_STRAIN && !b->plastic)
+    return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT,
+                      "fracture of '%s': the plastic_strain criterion needs the solid's plasticity", b->name);
+  if (def->max_tets_per_step < 0)
+    return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "fracture of '%s': max_tets_per_step must be >= 0", b->name);
   for (int32_t i = 0; i < def->cut_count; ++i) {
     const piola_fracture_cut *c = &def->cuts[i];
     const double point[3] = {c->point.x, c->point.y, c->point.z};
     const double normal[3] = {c->normal.x, c->normal.y, c->normal.z};
-    PIOLA_TRY(check_plane(point, normal, b->name, i));
+    if (c->blade) PIOLA_TRY(check_blade(c->blade, b->name, i));
+    else PIOLA_TRY(check_plane(point, normal, b->name, i));
     if (!isfinite(c->time))
       return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "fracture of '%s': cut %d time is not finite", b->name, (int)i);
   }
-  piola_fracture_cut *cuts = malloc(sizeof *cuts * (size_t)(def->cut_count > 0 ? def->cut_count : 1));
-  if (!cuts) return PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "fracture of '%s': out of memory", b->name);
+  const size_t slots = (size_t)(def->cut_count > 0 ? def->cut_count : 1);
+  piola_fracture_cut *cuts = malloc(sizeof *cuts * slots);
+  piola_tri_mesh *blades = calloc(slots, sizeof *blades);
+  if (!cuts || !blades) {
+    free(cuts), free(blades);
+    return PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "fracture of '%s': out of memory", b->name);
+  }
   if (def->cut_count > 0) memcpy(cuts, def->cuts, sizeof *cuts * (size_t)def->cut_count);
   /* insertion sort keeps cuts of equal time in the given order (qsort need not) */
   for (int32_t i = 1; i < def->cut_count; ++i)
@@ -499,16 +924,26 @@ piola_status piola_world_solid_set_fracture(piola_world *w, int32_t solid, const
       piola_fracture_cut tmp = cuts[j];
       cuts[j] = cuts[j - 1], cuts[j - 1] = tmp;
     }
-  piola_status st = ensure_state(b);
+  piola_status st = PIOLA_OK;
+  for (int32_t i = 0; i < def->cut_count && st == PIOLA_OK; ++i)
+    if (cuts[i].blade) {
+      st = copy_blade(cuts[i].blade, &blades[i]);
+      cuts[i].blade = &blades[i];
+    }
+  if (st == PIOLA_OK) st = ensure_state(b);
   if (st != PIOLA_OK) {
+    free_blades(blades, def->cut_count);
     free(cuts);
     return st;
   }
+  free_blades(b->fracture->blades, b->fracture->cut_count);
   free(b->fracture->cuts);
   b->fracture->cuts = cuts;
+  b->fracture->blades = blades;
   b->fracture->cut_count = def->cut_count;
   b->fracture->next_cut = 0;
   b->fracture->max_cuts_per_step = def->max_cuts_per_step;
+  b->fracture->max_tets_per_step = def->max_tets_per_step;
   b->fracture->criterion = def->criterion;
   b->fracture->threshold = def->threshold;
   return apply_due(w, b);
@@ -522,6 +957,18 @@ piola_status piola_world_solid_cut(piola_world *w, int32_t solid, const double p
   PIOLA_TRY(ensure_state(b));
   int32_t count = 0;
   PIOLA_TRY(cut_event(w, b, point, normal, &count));
+  if (cut_tets) *cut_tets = count;
+  return PIOLA_OK;
+}
+
+piola_status piola_world_solid_cut_by_surface(piola_world *w, int32_t solid, const piola_tri_mesh *surface,
+                                              int32_t *cut_tets) {
+  world_body *b = solid_of(w, solid);
+  if (!b) return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "cut: no solid %d", (int)solid);
+  PIOLA_TRY(check_blade(surface, b->name, 0));
+  PIOLA_TRY(ensure_state(b));
+  int32_t count = 0;
+  PIOLA_TRY(surface_cut_event(w, b, surface, &count));
   if (cut_tets) *cut_tets = count;
   return PIOLA_OK;
 }

@@ -13,15 +13,20 @@
 
 #include <stdint.h>
 
+#include "piola/mesh.h"
 #include "piola/world_fracture.h"
 
 typedef struct solid_fracture {
   /* scripted cuts, sorted by time, and the next one to apply */
-  piola_fracture_cut *cuts;
-  int32_t cut_count, next_cut, max_cuts_per_step;
-  int32_t events;             /* cuts applied so far */
+  piola_fracture_cut *cuts;   /* a blade cut's blade points into blades */
+  piola_tri_mesh *blades;     /* per scripted cut: its blade's copy (empty for a plane) */
+  int32_t cut_count, next_cut, max_cuts_per_step, max_tets_per_step;
+  int32_t events;             /* cracks started so far (plane and blade cuts, the criterion's
+                                 cracks): the crack ids */
+  int32_t grown_crack;        /* the id all the criterion's cracks share (-1: none yet): their
+                                 values are one field, so two of them that meet join */
   piola_fracture_criterion criterion;
-  double threshold;           /* Pa */
+  double threshold;           /* Pa, or plastic log strain */
   /* the original mesh (after the elastic body's reorientation) and its face adjacency:
    * per tet and local face k (opposite corner k) the neighbour tet, or -1 on the boundary */
   int32_t tet_count;
@@ -30,7 +35,7 @@ typedef struct solid_fracture {
   /* per copy (element of the current mesh) */
   int32_t copy_count;
   int32_t *parent;            /* original tet */
-  int32_t *event;             /* the cut that made it, -1: whole */
+  int32_t *event;             /* the crack it belongs to, -1: whole */
   double *dist;               /* 4 per copy: signed corner distances of that cut, m; the
                                  copy's material is where their interpolant has sign side */
   int8_t *side;               /* +1 or -1 */
@@ -39,6 +44,13 @@ typedef struct solid_fracture {
   int32_t fragment_count;
   int32_t cut_tets;           /* original tets split so far */
   int32_t *copies;            /* 2 per original tet: its copies (the second -1 when whole) */
+  double *last_strain;        /* per copy, plastic_strain criterion only (else NULL): its
+                                 accumulated plastic strain at the last criterion pass */
+  /* per original vertex: the crack that reached it first (-1: none) and that crack's value
+   * there, m: a crack grows by continuing these values into the next tet */
+  int32_t vertex_count;
+  int32_t *vertex_crack;
+  double *vertex_value;
 } solid_fracture;
 
 /* A point of a copy's polygons: corner lo when lo == hi, else the crossing of the cut at
@@ -67,5 +79,25 @@ void piola__fracture_copy_polygons(const double dist[4], int side, const int32_t
 extern const int8_t piola__cut_tet_face[4][3];
 
 void piola__fracture_free(solid_fracture *f);
+
+/* A vertex of a fragment surface: the point a + t (b - a) between nodes a and b (a == b and
+ * t = 0 for a corner). */
+typedef struct fracture_surface_point {
+  int32_t a, b;
+  double t;
+} fracture_surface_point;
+
+struct world_body;
+/* The distance (m) from a cut's plane below which node distances are pushed away from it:
+ * a share of the smallest rest altitude, and with self-collision up to half the thickness
+ * (capped at 5% of that altitude), so the crack faces' collision surfaces fit inside. */
+double piola__fracture_snap(const struct world_body *b);
+/* The fragment surfaces of solid b (piola_world_solid_fracture_surface), with each crack
+ * face moved into its copy's material by inset (m, below the cut's snap distance, so every
+ * polygon keeps its shape; 0: the crack itself), and when where is given, each vertex as a
+ * point between two nodes (*where, vertex_count entries, freed by the caller). */
+piola_status piola__fracture_surface_build(const struct world_body *b, double inset,
+                                           piola_fracture_surface *out,
+                                           fracture_surface_point **where);
 
 #endif

@@ -37,11 +37,11 @@ void piola_fracture_surface_free(piola_fracture_surface *s) {
   memset(s, 0, sizeof *s);
 }
 
-/* Appends polygon poly of copy c as a fan of triangles (points then triangles). */
+/* Appends polygon poly of copy c (its points, named, and a record of it). */
 static void emit(const solid_fracture *f, const int32_t *nodes, int32_t c, const cut_point *poly,
-                 int32_t size, surface_point *points, int32_t *np, int32_t *tri, int32_t *nt) {
+                 int32_t size, surface_point *points, int32_t *np, int32_t *polygon, int32_t *npoly) {
   if (size < 3) return;
-  const int32_t base = *np;
+  polygon[2 * *npoly] = *np, polygon[2 * *npoly + 1] = size, ++*npoly;
   for (int32_t i = 0; i < size; ++i) {
     surface_point *p = &points[(*np)++];
     p->fragment = f->fragment[c];
@@ -49,12 +49,16 @@ static void emit(const solid_fracture *f, const int32_t *nodes, int32_t c, const
     p->b = nodes[4 * c + poly[i].hi];
     p->event = poly[i].lo == poly[i].hi ? -1 : f->event[c];
     p->t = poly[i].t;
-    p->order = base + i;
   }
-  for (int32_t i = 1; i + 1 < size; ++i) {
-    int32_t *t = tri + 3 * (size_t)(*nt)++;
-    t[0] = base, t[1] = base + i, t[2] = base + i + 1;
-  }
+}
+
+static int by_edge_name(const void *pa, const void *pb) {
+  const surface_point *p = pa, *q = pb;
+  if (p->fragment != q->fragment) return p->fragment < q->fragment ? -1 : 1;
+  int32_t pl = p->a < p->b ? p->a : p->b, ph = p->a < p->b ? p->b : p->a;
+  int32_t ql = q->a < q->b ? q->a : q->b, qh = q->a < q->b ? q->b : q->a;
+  if (pl != ql) return pl < ql ? -1 : 1;
+  return ph < qh ? -1 : ph > qh;
 }
 
 piola_status piola_world_solid_fracture_surface(const piola_world *w, int32_t solid,
@@ -64,37 +68,76 @@ piola_status piola_world_solid_fracture_surface(const piola_world *w, int32_t so
   const world_body *b = w ? piola__world_body_of(w, PIOLA_BODY_SOLID, solid) : NULL;
   if (!b || !b->fracture)
     return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "fracture surface: solid %d has no fracture state", (int)solid);
+  return piola__fracture_surface_build(b, 0, out, NULL);
+}
+
+piola_status piola__fracture_surface_build(const world_body *b, double inset, piola_fracture_surface *out,
+                                           fracture_surface_point **where) {
+  memset(out, 0, sizeof *out);
+  if (where) *where = NULL;
   const solid_fracture *f = b->fracture;
   const int32_t *nodes = piola_elastic_body_tets(b->solid);
-  /* at most 4 faces of 4 points and a crack of 4 per copy */
+  /* at most 4 faces of 4 points and a crack of 4 per copy; a polygon's edge between two
+   * corners gains at most one point, so the points at most double */
   const size_t cap = 20 * (size_t)f->copy_count + 1;
-  surface_point *points = malloc(sizeof *points * cap);
-  int32_t *tri = malloc(3 * sizeof(int32_t) * cap), *index = malloc(sizeof(int32_t) * cap);
-  int32_t *triangle_fragment = malloc(sizeof(int32_t) * cap);
-  if (!points || !tri || !index || !triangle_fragment) {
-    free(points), free(tri), free(index), free(triangle_fragment);
+  surface_point *raw = malloc(sizeof *raw * cap), *points = malloc(2 * sizeof *points * cap);
+  surface_point *crossings = malloc(sizeof *crossings * cap);
+  int32_t *polygon = malloc(2 * sizeof(int32_t) * cap);
+  int32_t *tri = malloc(3 * sizeof(int32_t) * 2 * cap), *index = malloc(2 * sizeof(int32_t) * cap);
+  int32_t *triangle_fragment = malloc(2 * sizeof(int32_t) * cap);
+  if (!raw || !points || !crossings || !polygon || !tri || !index || !triangle_fragment) {
+    free(raw), free(points), free(crossings), free(polygon), free(tri), free(index), free(triangle_fragment);
     return PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "fracture surface: out of memory");
   }
-  int32_t np = 0, nt = 0;
+  int32_t nraw = 0, npoly = 0;
   for (int32_t c = 0; c < f->copy_count; ++c) {
     const int32_t t = f->parent[c];
-    const int32_t before = nt;
     if (f->event[c] < 0) {
       for (int k = 0; k < 4; ++k) {
         if (f->neighbor[4 * t + k] >= 0) continue;
         cut_point face[3];
         for (int i = 0; i < 3; ++i) face[i] = (cut_point){piola__cut_tet_face[k][i], piola__cut_tet_face[k][i], 0};
-        emit(f, nodes, c, face, 3, points, &np, tri, &nt);
+        emit(f, nodes, c, face, 3, raw, &nraw, polygon, &npoly);
       }
     } else {
       copy_polygons poly;
-      piola__fracture_copy_polygons(f->dist + 4 * c, f->side[c], f->tets + 4 * t, &poly);
+      double dist[4]; /* inset: the level set side * inset instead of 0 (same edges crossed) */
+      for (int k = 0; k < 4; ++k) dist[k] = f->dist[4 * c + k] - f->side[c] * inset;
+      piola__fracture_copy_polygons(dist, f->side[c], f->tets + 4 * t, &poly);
       for (int k = 0; k < 4; ++k)
-        if (f->neighbor[4 * t + k] < 0) emit(f, nodes, c, poly.face[k], poly.face_size[k], points, &np, tri, &nt);
-      emit(f, nodes, c, poly.crack, poly.crack_size, points, &np, tri, &nt);
+        if (f->neighbor[4 * t + k] < 0) emit(f, nodes, c, poly.face[k], poly.face_size[k], raw, &nraw, polygon, &npoly);
+      emit(f, nodes, c, poly.crack, poly.crack_size, raw, &nraw, polygon, &npoly);
     }
-    for (int32_t i = before; i < nt; ++i) triangle_fragment[i] = f->fragment[c];
   }
+  /* A crack that ends inside the solid's surface (a crack front, a blade that does not reach
+   * all the way) puts a point on an edge that a whole neighbour's boundary face has between
+   * two corners: that face takes the point too, so the surface has no T-junction there. */
+  int32_t ncross = 0;
+  for (int32_t i = 0; i < nraw; ++i)
+    if (raw[i].event >= 0) crossings[ncross++] = raw[i];
+  qsort(crossings, (size_t)ncross, sizeof *crossings, by_edge_name);
+  int32_t np = 0, nt = 0;
+  for (int32_t g = 0; g < npoly; ++g) {
+    const int32_t first = polygon[2 * g], size = polygon[2 * g + 1], base = np;
+    int32_t apex = 0;
+    for (int32_t i = 0; i < size; ++i) {
+      const surface_point *p = &raw[first + i], *q = &raw[first + (i + 1) % size];
+      points[np] = *p, points[np].order = np, ++np;
+      if (p->event >= 0 || q->event >= 0 || ncross == 0) continue;
+      const surface_point key = {p->fragment, p->a, q->a, -1, 0, 0};
+      const surface_point *hit = bsearch(&key, crossings, (size_t)ncross, sizeof *crossings, by_edge_name);
+      if (!hit) continue;
+      if (apex == 0) apex = np - base;
+      points[np] = *hit, points[np].order = np, ++np;
+    }
+    const int32_t n = np - base;
+    for (int32_t i = 1; i + 1 < n; ++i) {
+      int32_t *t3 = tri + 3 * (size_t)nt;
+      t3[0] = base + apex, t3[1] = base + (apex + i) % n, t3[2] = base + (apex + i + 1) % n;
+      triangle_fragment[nt++] = raw[first].fragment;
+    }
+  }
+  free(raw), free(crossings), free(polygon);
   /* one vertex per distinct name, numbered in order of fragment */
   qsort(points, (size_t)np, sizeof *points, by_name);
   int32_t nv = 0;
@@ -102,8 +145,9 @@ piola_status piola_world_solid_fracture_surface(const piola_world *w, int32_t so
   out->triangles = malloc(3 * sizeof(int32_t) * (size_t)(nt > 0 ? nt : 1));
   out->fragment_start = calloc((size_t)f->fragment_count + 1, sizeof(int32_t));
   int32_t *fill = calloc((size_t)f->fragment_count + 1, sizeof(int32_t));
-  if (!out->positions || !out->triangles || !out->fragment_start || !fill) {
-    free(points), free(tri), free(index), free(triangle_fragment), free(fill);
+  fracture_surface_point *at = where ? malloc(sizeof *at * (size_t)(np > 0 ? np : 1)) : NULL;
+  if (!out->positions || !out->triangles || !out->fragment_start || !fill || (where && !at)) {
+    free(points), free(tri), free(index), free(triangle_fragment), free(fill), free(at);
     piola_fracture_surface_free(out);
     return PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "fracture surface: out of memory");
   }
@@ -112,6 +156,7 @@ piola_status piola_world_solid_fracture_surface(const piola_world *w, int32_t so
     if (i == 0 || by_name(&(surface_point){p->fragment, p->a, p->b, p->event, 0, -1}, &points[i - 1]) > 0) {
       const double *xa = b->x + 3 * (size_t)p->a, *xb = b->x + 3 * (size_t)p->b;
       for (int k = 0; k < 3; ++k) out->positions[3 * (size_t)nv + k] = xa[k] + p->t * (xb[k] - xa[k]);
+      if (at) at[nv] = (fracture_surface_point){p->a, p->b, p->t};
       ++nv;
     }
     index[p->order] = nv - 1;
@@ -128,5 +173,6 @@ piola_status piola_world_solid_fracture_surface(const piola_world *w, int32_t so
   out->vertex_count = nv;
   out->triangle_count = nt;
   free(points), free(tri), free(index), free(triangle_fragment), free(fill);
+  if (where) *where = at;
   return PIOLA_OK;
 }

@@ -26,6 +26,8 @@
 #include "piola/checkpoint.h"
 #include "plasticity/plastic_state.h"
 #include "shell/shell_body_internal.h"
+#include "sim/fracture_internal.h"
+#include "sim/fracture_restore.h"
 #include "sim/world_internal.h"
 
 enum { HEADER_BYTES = 48 };
@@ -43,13 +45,8 @@ static uint64_t fnv1a(uint64_t h, const void *data, size_t n) {
 #define FNV_OFFSET 0xcbf29ce484222325ull
 
 int piola_world_checkpoint_supported(const piola_world *w, const char **why) {
-  /* every part of a world is covered but fracture state */
+  (void)w; /* every part of a world is covered */
   *why = NULL;
-  for (int32_t i = 0; i < w->body_count; ++i)
-    if (w->bodies[i].fracture) {
-      *why = "checkpoints do not cover fracture (solids whose mesh is cut during the run)";
-      return 0;
-    }
   return 1;
 }
 
@@ -172,6 +169,101 @@ static void local_int(stream *s, int32_t *p, const char *what) {
 }
 
 /* ------------------------------------------------------------------ per body */
+
+/* An array the reader needs on both passes, into memory of its own (*p, allocated when
+ * reading; the caller frees it). */
+static void local_array(stream *s, void **p, uint64_t count, size_t size, const char *what) {
+  if (s->reading) {
+    if (s->failed) return;
+    if (!(*p = malloc((size_t)(count > 0 ? count : 1) * size))) {
+      s->failed = 1;
+      snprintf(s->what, sizeof s->what, "out of memory");
+      return;
+    }
+  }
+  int store = s->store;
+  s->store = 1;
+  field(s, *p, count, size, what);
+  s->store = store;
+}
+
+/* A cut solid's cut state (sim/fracture_internal.h), before its positions: the node and
+ * element counts of everything after it depend on it. On reading, the solid is given that
+ * state on the dry pass already (fracture_restore.c), so the dry pass can check the rest
+ * against it; the counters of scripted cuts are stored on the second pass. */
+static void fracture_state(stream *s, piola_world *w, world_body *b) {
+  solid_fracture *f = b->fracture;
+  int32_t present = f != NULL;
+  local_int(s, &present, "fracture");
+  if (s->failed) return;
+  if (present != (f != NULL)) {
+    s->failed = 1;
+    snprintf(s->what, sizeof s->what, "solid '%s': fracture differs from this scene", b->name);
+    return;
+  }
+  if (!f) return;
+  int32_t counts[6] = {f->copy_count, b->n, f->events, f->fragment_count, f->next_cut, f->cut_tets};
+  {
+    int store = s->store;
+    s->store = 1; /* the counts decide what follows: read on both passes */
+    field(s, counts, 6, sizeof(int32_t), "fracture counts");
+    s->store = store;
+  }
+  if (s->failed) return;
+  const int32_t nc = counts[0];
+  if (s->reading && (nc < f->tet_count || nc > 2 * f->tet_count || counts[1] < 1 ||
+                     counts[1] > 4 * nc || /* every node is a corner of a copy */
+                     counts[4] < 0 || counts[4] > f->cut_count || counts[5] < 0 ||
+                     counts[5] > f->tet_count)) {
+    s->failed = 1;
+    snprintf(s->what, sizeof s->what, "solid '%s': fracture counts do not fit its mesh", b->name);
+    return;
+  }
+  void *parent = f->parent, *event = f->event, *fragment = f->fragment, *copies = f->copies;
+  void *tets = (void *)piola_elastic_body_tets(b->solid), *side = f->side, *dist = f->dist;
+  void *fraction = f->fraction;
+  if (s->reading) parent = event = fragment = copies = tets = side = dist = fraction = NULL;
+  local_array(s, &parent, (uint64_t)nc, sizeof(int32_t), "copy tets");
+  local_array(s, &event, (uint64_t)nc, sizeof(int32_t), "copy cuts");
+  local_array(s, &side, (uint64_t)nc, 1, "copy sides");
+  local_array(s, &dist, 4 * (uint64_t)nc, sizeof(double), "copy distances");
+  local_array(s, &fraction, (uint64_t)nc, sizeof(double), "material fractions");
+  local_array(s, &fragment, (uint64_t)nc, sizeof(int32_t), "fragments");
+  local_array(s, &tets, 4 * (uint64_t)nc, sizeof(int32_t), "copy nodes");
+  local_array(s, &copies, 2 * (uint64_t)f->tet_count, sizeof(int32_t), "copies of tets");
+  /* the criterion's state: the plastic strain per copy at its last pass (plastic_strain
+   * criterion, once it ran), the crack all its cracks share, and per original vertex the
+   * crack that reached it first and that crack's value there */
+  int32_t has_last = f->last_strain != NULL;
+  local_int(s, &has_last, "criterion strains present");
+  void *last = s->reading ? NULL : f->last_strain;
+  if (!s->failed && has_last) local_array(s, &last, (uint64_t)nc, sizeof(double), "criterion strains");
+  one_int(s, &f->grown_crack, "grown crack");
+  field(s, f->vertex_crack, (uint64_t)f->vertex_count, sizeof(int32_t), "cracks at vertices");
+  doubles(s, f->vertex_value, (uint64_t)f->vertex_count, "crack values at vertices");
+  if (s->reading) {
+    if (!s->failed) {
+      fracture_saved saved = {.copy_count = nc, .node_count = counts[1], .events = counts[2],
+                              .fragment_count = counts[3], .parent = parent, .event = event,
+                              .fragment = fragment, .tets = tets, .copies = copies, .side = side,
+                              .dist = dist, .fraction = fraction};
+      if (piola__fracture_restore(w, b, &saved) != PIOLA_OK) {
+        s->failed = 1;
+        snprintf(s->what, sizeof s->what, "%s", piola_last_error());
+      } else if (s->store) {
+        f = b->fracture;
+        f->events = counts[2], f->next_cut = counts[4], f->cut_tets = counts[5];
+        free(f->last_strain);
+        f->last_strain = has_last ? last : NULL;
+        last = NULL;
+      }
+    }
+    free(last);
+    free(parent), free(event), free(fragment), free(copies), free(tets), free(side), free(dist);
+    free(fraction);
+  }
+}
+
 
 static void elastic_state(stream *s, world_body *b) {
   piola_elastic_body *e = b->solid;
@@ -358,6 +450,8 @@ static void world_state(stream *s, piola_world *w) {
                piola__body_kind_name(b->kind));
       return;
     }
+    if (b->kind == PIOLA_BODY_SOLID) fracture_state(s, w, b);
+    if (s->failed) return;
     doubles(s, b->x, 3 * (uint64_t)b->n, "positions");
     doubles(s, b->v, 3 * (uint64_t)b->n, "velocities");
     switch (b->kind) {
@@ -434,6 +528,28 @@ piola_status piola_world_checkpoint_write(const piola_world *world, const char *
   return st;
 }
 
+static int has_fracture(const piola_world *w) {
+  for (int32_t i = 0; i < w->body_count; ++i)
+    if (w->bodies[i].fracture) return 1;
+  return 0;
+}
+
+/* Reads a whole payload (after its header) into world: a checking pass, then the storing
+ * one. Returns 1 when it fitted. */
+static int read_state(stream *s, piola_world *world) {
+  s->reading = 1;
+  for (int pass = 0; pass < 2 && !s->failed; ++pass) {
+    s->pos = HEADER_BYTES;
+    s->store = pass;
+    world_state(s, world);
+    if (!s->failed && s->pos != s->length) {
+      s->failed = 1;
+      snprintf(s->what, sizeof s->what, "%zu bytes left over", s->length - s->pos);
+    }
+  }
+  return !s->failed;
+}
+
 static piola_status read_file(const char *path, stream *s) {
   FILE *f = fopen(path, "rb");
   if (!f) return PIOLA_FAIL(PIOLA_ERROR_IO, "%s: cannot open", path);
@@ -481,23 +597,27 @@ piola_status piola_world_checkpoint_read(piola_world *world, const char *path, u
            (int32_t)get_u32(h + 40) != world->obstacle_count)
     st = PIOLA_FAIL(PIOLA_ERROR_UNSUPPORTED, "%s: body or obstacle counts differ from this scene",
                     path);
+  /* A cut solid takes the file's cut state on the checking pass (fracture_state): the world
+   * as it is now is kept in memory first, and put back when the file turns out not to fit. */
+  stream before = {0};
+  if (st == PIOLA_OK && has_fracture(world)) {
+    unsigned char header[HEADER_BYTES] = {0};
+    put(&before, header, sizeof header);
+    world_state(&before, world);
+    if (before.failed) st = PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "%s: out of memory", path);
+  }
   if (st == PIOLA_OK) {
     s.length -= 8; /* the checksum */
-    s.reading = 1;
-    for (int pass = 0; pass < 2 && !s.failed; ++pass) {
-      s.pos = HEADER_BYTES;
-      s.store = pass;
-      world_state(&s, world);
-      if (!s.failed && s.pos != s.length) {
-        s.failed = 1;
-        snprintf(s.what, sizeof s.what, "%zu bytes left over", s.length - s.pos);
-      }
-    }
-    if (s.failed)
+    if (!read_state(&s, world)) {
       st = PIOLA_FAIL(PIOLA_ERROR_PARSE, "%s: does not fit this scene: %s", path, s.what);
-    else
+      if (before.data && !read_state(&before, world)) /* it fits: it was written from world */
+        st = PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "%s: does not fit, and the world could not be put "
+                        "back (%s)", path, before.what);
+    } else {
       *frame = (int32_t)get_u32(h + 24);
+    }
   }
+  free(before.data);
   free(s.data);
   return st;
 }

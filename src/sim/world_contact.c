@@ -38,6 +38,7 @@
 
 #include "common/status_report.h"
 #include "piola/collision_surface.h"
+#include "sim/fracture_internal.h"
 #include "sim/world_internal.h"
 
 typedef struct world_contact {
@@ -61,6 +62,39 @@ void piola__world_contact_free(piola_world *w) {
   w->contact = NULL;
 }
 
+/* The collision triangles of body i: a cut solid's fragment surfaces, with crack faces
+ * moved into their material (below), as points between two nodes (*where); otherwise its
+ * boundary or shell triangles over its own nodes. */
+typedef struct body_surface {
+  piola_tri_mesh triangles;
+  int owned;
+  piola_fracture_surface fragments;
+  fracture_surface_point *where; /* per vertex, for a cut solid */
+  int32_t vertices;              /* collision vertices */
+} body_surface;
+
+static piola_status body_surface_build(const world_body *s, body_surface *out) {
+  if (s->kind == PIOLA_BODY_SOLID && s->fracture) {
+    /* The two faces of a crack coincide when it is made: each is moved into its material
+     * by up to half the thickness (less than the cut's snap distance, so every polygon
+     * keeps its shape), and they start that far apart instead of touching. */
+    const double inset = fmin(0.5 * s->self_collision.thickness, 0.9 * piola__fracture_snap(s));
+    PIOLA_TRY(piola__fracture_surface_build(s, inset, &out->fragments, &out->where));
+    out->triangles.triangle_count = out->fragments.triangle_count;
+    out->triangles.triangles = out->fragments.triangles;
+    out->vertices = out->fragments.vertex_count;
+    return PIOLA_OK;
+  }
+  out->vertices = s->n;
+  return piola__body_collision_triangles(s, &out->triangles, &out->owned);
+}
+
+static void body_surface_free(body_surface *b) {
+  if (b->owned) piola_tri_mesh_free(&b->triangles);
+  piola_fracture_surface_free(&b->fragments);
+  free(b->where);
+}
+
 static piola_status build(piola_world *w) {
   piola__world_contact_free(w);
   world_contact *c = calloc(1, sizeof(*c));
@@ -70,11 +104,14 @@ static piola_status build(piola_world *w) {
   const int32_t count = w->body_count;
   c->offset = malloc(sizeof(int32_t) * (size_t)(count > 0 ? count : 1));
   if (!c->offset) return PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "self-collision: out of memory");
-  int32_t nv = 0, nt = 0, bodies = 0;
-  piola_tri_mesh *boundaries = calloc((size_t)(count > 0 ? count : 1), sizeof(piola_tri_mesh));
-  int *owned = calloc((size_t)(count > 0 ? count : 1), sizeof(int));
-  if (!boundaries || !owned) {
-    free(boundaries), free(owned);
+  /* nv nodes (every body's, the arrays processing takes), nsv collision vertices: the same
+   * unless a cut solid is in the surface, whose vertices are embedded in its nodes */
+  int32_t nv = 0, nsv = 0, nt = 0, bodies = 0;
+  int embedded = 0;
+  body_surface *surfaces = calloc((size_t)(count > 0 ? count : 1), sizeof(body_surface));
+  int32_t *vertex_offset = calloc((size_t)(count > 0 ? count : 1), sizeof(int32_t));
+  if (!surfaces || !vertex_offset) {
+    free(surfaces), free(vertex_offset);
     return PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "self-collision: out of memory");
   }
   piola_status st = PIOLA_OK;
@@ -82,21 +119,28 @@ static piola_status build(piola_world *w) {
   for (int32_t i = 0; i < count && st == PIOLA_OK; ++i) {
     const world_body *s = &w->bodies[i];
     if (!s->self_collision.enabled) continue;
-    st = piola__body_collision_triangles(s, &boundaries[i], &owned[i]);
-    c->offset[i] = nv;
-    nv += s->n, nt += boundaries[i].triangle_count, ++bodies;
+    st = body_surface_build(s, &surfaces[i]);
+    embedded |= surfaces[i].where != NULL;
+    c->offset[i] = nv, vertex_offset[i] = nsv;
+    nv += s->n, nsv += surfaces[i].vertices, nt += surfaces[i].triangles.triangle_count, ++bodies;
   }
-  int32_t *tris = NULL, *vertex_body = NULL;
+  int32_t *tris = NULL, *vertex_body = NULL, *embed_nodes = NULL;
+  double *embed_weights = NULL;
   piola_collision_body_def *defs = NULL;
   if (st == PIOLA_OK) {
     tris = malloc(sizeof(int32_t) * 3 * (size_t)(nt > 0 ? nt : 1));
-    vertex_body = malloc(sizeof(int32_t) * (size_t)(nv > 0 ? nv : 1));
+    vertex_body = malloc(sizeof(int32_t) * (size_t)(nsv > 0 ? nsv : 1));
     defs = malloc(sizeof(*defs) * (size_t)(bodies > 0 ? bodies : 1));
     c->x0 = malloc(sizeof(double) * 3 * (size_t)(nv > 0 ? nv : 1));
     c->v = malloc(sizeof(double) * 3 * (size_t)(nv > 0 ? nv : 1));
     c->v_before = malloc(sizeof(double) * 3 * (size_t)(nv > 0 ? nv : 1));
     c->mass = malloc(sizeof(double) * (size_t)(nv > 0 ? nv : 1));
-    if (!tris || !vertex_body || !defs || !c->x0 || !c->v || !c->v_before || !c->mass)
+    if (embedded) {
+      embed_nodes = malloc(sizeof(int32_t) * PIOLA_COLLISION_EMBED_NODES * (size_t)(nsv > 0 ? nsv : 1));
+      embed_weights = malloc(sizeof(double) * PIOLA_COLLISION_EMBED_NODES * (size_t)(nsv > 0 ? nsv : 1));
+    }
+    if (!tris || !vertex_body || !defs || !c->x0 || !c->v || !c->v_before || !c->mass ||
+        (embedded && (!embed_nodes || !embed_weights)))
       st = PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "self-collision: out of memory");
   }
   if (st == PIOLA_OK) {
@@ -104,25 +148,40 @@ static piola_status build(piola_world *w) {
     for (int32_t i = 0; i < count; ++i) {
       if (c->offset[i] < 0) continue;
       const world_body *s = &w->bodies[i];
-      for (int32_t k = 0; k < 3 * boundaries[i].triangle_count; ++k)
-        tris[3 * t + k] = c->offset[i] + boundaries[i].triangles[k];
-      t += boundaries[i].triangle_count;
-      for (int32_t k = 0; k < s->n; ++k) vertex_body[c->offset[i] + k] = b;
+      const body_surface *bs = &surfaces[i];
+      for (int32_t k = 0; k < 3 * bs->triangles.triangle_count; ++k)
+        tris[3 * t + k] = vertex_offset[i] + bs->triangles.triangles[k];
+      t += bs->triangles.triangle_count;
+      for (int32_t k = 0; k < bs->vertices; ++k) vertex_body[vertex_offset[i] + k] = b;
+      for (int32_t k = 0; embedded && k < bs->vertices; ++k) {
+        int32_t *node = embed_nodes + PIOLA_COLLISION_EMBED_NODES * (size_t)(vertex_offset[i] + k);
+        double *weight = embed_weights + PIOLA_COLLISION_EMBED_NODES * (size_t)(vertex_offset[i] + k);
+        for (int j = 0; j < PIOLA_COLLISION_EMBED_NODES; ++j) node[j] = -1, weight[j] = 0;
+        if (!bs->where) {
+          node[0] = c->offset[i] + k, weight[0] = 1;
+        } else {
+          const fracture_surface_point *p = &bs->where[k];
+          node[0] = c->offset[i] + p->a, weight[0] = 1 - p->t;
+          if (p->b != p->a && p->t > 0) node[1] = c->offset[i] + p->b, weight[1] = p->t;
+          if (node[1] >= 0) weight[0] = 1 - weight[1];
+        }
+      }
       defs[b] = piola_default_collision_body_def();
       defs[b].thickness = s->self_collision.thickness;
       defs[b].friction = s->self_collision.friction;
       ++b;
     }
     piola_collision_surface_def def = piola_default_collision_surface_def();
-    def.vertex_count = nv, def.triangle_count = nt, def.triangles = tris;
+    def.vertex_count = nsv, def.triangle_count = nt, def.triangles = tris;
     def.body_count = bodies > 0 ? bodies : 1, def.bodies = defs, def.vertex_body = vertex_body;
+    if (embedded) def.node_count = nv, def.embed_nodes = embed_nodes, def.embed_weights = embed_weights;
     if (bodies == 0) defs[0] = piola_default_collision_body_def();
     st = piola_collision_surface_create(&def, &c->surface);
   }
   c->vertex_count = nv;
-  for (int32_t i = 0; i < count; ++i)
-    if (owned[i]) piola_tri_mesh_free(&boundaries[i]);
-  free(boundaries), free(owned), free(tris), free(vertex_body), free(defs);
+  for (int32_t i = 0; i < count; ++i) body_surface_free(&surfaces[i]);
+  free(surfaces), free(vertex_offset), free(tris), free(vertex_body), free(defs);
+  free(embed_nodes), free(embed_weights);
   return st;
 }
 

@@ -1,7 +1,8 @@
 """Checks behind test_run_resume_examples.sh: examples whose state goes beyond what
 run_resume.py's scene has (self-collision, whose collision trees carry history from step to
 step; a shell in one-way contact with a solid), run a few frames into their contact phase (and a quasistatic bar and
-plate strip, whose solver carries its regularization between steps)
+plate strip, whose solver carries its regularization between steps; scenes with fracture, whose
+meshes are cut during the run: examples/scripted_cut.json and a cut bar with self-collision)
 and killed with SIGKILL at several renames of their output (frame files, indexes and the
 checkpoint's own), resume to frames byte-identical to an uninterrupted run. One run is
 killed, resumed, killed again and so on (each process counts its renames from 1), then
@@ -24,7 +25,13 @@ from script_checks import PIOLA, SOURCE, check, finish
 SCALE = float(os.environ.get("PIOLA_TEST_SCALE", "1"))
 # example: the frame from which its bodies are in contact (stats.csv: contacts > 0)
 CONTACT_FROM = {"cloth_on_jelly": 2, "cloth_folds": 5, "solids_stack": 1, "squeezed_solid": 22,
-                "cloth_cape_on_body": 4}
+                "cloth_cape_on_body": 4,
+                # fracture: cut at frames 9 and 19 (0.3 s and 0.6 s), so the runs resume from
+                # cut states and the second cut comes after the resumes
+                "scripted_cut": 12,
+                # the stress criterion's cracks grow tet by tet from frame 2 (their state:
+                # the cracks' values at the vertices)
+                "brittle_slab": 2}
 EVERY = 2  # frames between checkpoints
 # Renames of a run (src/output/frame_commit.c): scene.json, then per frame six (VTU and OBJ
 # temporaries to pending names, both into place, stats.csv, sim.pvd), then the checkpoint
@@ -56,6 +63,23 @@ QUASISTATIC_PLATE = """{
     "bending": {"stiffness": 1.0},
     "fixed": [{"box": [[-1, -1, -1], [-0.124, 1, 1]]}]}]
 }"""
+
+# a bar cut by scripted planes with self-collision, so the fragments are in contact: cut at
+# 0.1 s (frame 3) and 0.3 s (frame 9), resumed from cut states before the second cut
+CUT_BAR_SELF_COLLISION = """{
+  "fps": 30, "frames": 12, "gravity": [0, 0, -9.81],
+  "solids": [{"name": "bar",
+    "mesh": {"generate": "box", "center": [0.5, 0, 0.3], "half_extents": [0.5, 0.06, 0.06], "cell_size": 0.04},
+    "density": 1000, "material": {"model": "neohookean", "youngs_modulus": 2e5, "poisson_ratio": 0.3},
+    "damping": {"shear": 5, "bulk": 5},
+    "self_collision": {"enabled": true, "thickness": 0.002},
+    "fixed": [{"box": [[-0.1, -0.1, 0.2], [0.05, 0.1, 0.4]]}],
+    "fracture": {"cuts": [
+      {"time": 0.1, "plane": {"point": [0.23, 0, 0.3], "normal": [1, 0, 0.35]}},
+      {"time": 0.3, "plane": {"point": [0.61, 0, 0.2], "normal": [1, 0.2, -0.3]}}]}}],
+  "obstacles": [{"type": "plane", "point": [0, 0, 0], "normal": [0, 0, 1], "friction": 0.4}]
+}"""
+CONTACT_FROM["cut_bar_self_collision"] = 4
 
 
 def frames_of(out):
@@ -115,7 +139,8 @@ def check_example(name, work, scene=None):
     check(stats(out) == stats(ref), f"{name}: stats.csv equals the uninterrupted run's (contacts and impacts included), wall time aside")
 
 
-examples = sys.argv[1:] or (list(CONTACT_FROM) if SCALE >= 1 else ["cloth_on_jelly"])
+examples = [e for e in sys.argv[1:] if e != "cut_bar_self_collision"] if sys.argv[1:] else \
+    ([e for e in CONTACT_FROM if e != "cut_bar_self_collision"] if SCALE >= 1 else ["cloth_on_jelly"])
 if examples == ["all"]:
     examples = sorted(n[:-5] for n in os.listdir(os.path.join(SOURCE, "examples")) if n.endswith(".json"))
 work = tempfile.mkdtemp()
@@ -132,5 +157,10 @@ if not sys.argv[1:]:
     with open(scene, "w") as f:
         f.write(QUASISTATIC_PLATE)
     check_example("quasistatic_plate", work, scene)
+if not sys.argv[1:] or "cut_bar_self_collision" in sys.argv[1:]:
+    scene = os.path.join(work, "cut_bar_self_collision.json")
+    with open(scene, "w") as f:
+        f.write(CUT_BAR_SELF_COLLISION)
+    check_example("cut_bar_self_collision", work, scene)
 shutil.rmtree(work)
 finish()

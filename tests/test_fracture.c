@@ -310,6 +310,51 @@ static void cut_in_free_flight_keeps_momentum(void **state) {
   piola_world_destroy(w);
 }
 
+/* The same spinning, stretched bar with the stress criterion: cracks start and grow while it
+ * flies, and every step that cuts keeps the momentum (linear to rounding, angular to the
+ * step's usual rounding) and the mass. */
+static void grown_cracks_in_free_flight_keep_momentum(void **state) {
+  (void)state;
+  piola_tet_mesh mesh;
+  assert_int_equal(piola_tet_mesh_box_grid(6, 2, 2, (piola_vec3){0.05, 0.05, 0.05}, &mesh), PIOLA_OK);
+  piola_world *w = make_world(5e-4);
+  add_solid(w, &mesh, 0);
+  int32_t n = mesh.vertex_count;
+  double *x = malloc(3 * sizeof(double) * (size_t)n), *v = malloc(3 * sizeof(double) * (size_t)n);
+  for (int32_t i = 0; i < n; ++i) {
+    const double *p = mesh.positions + 3 * i;
+    x[3 * i] = 1.3 * p[0] + 0.1 * p[1], x[3 * i + 1] = 0.9 * p[1], x[3 * i + 2] = p[2] + 0.05 * p[0];
+    v[3 * i] = 0.5 - 3.0 * (p[1] - 0.05), v[3 * i + 1] = -0.2 + 3.0 * (p[0] - 0.15), v[3 * i + 2] = 0.1 + p[1];
+  }
+  assert_int_equal(piola_world_solid_set_state(w, 0, x, v), PIOLA_OK);
+  piola_fracture_def def = piola_default_fracture_def();
+  def.criterion = PIOLA_FRACTURE_STRESS, def.threshold = 3e3;
+  assert_int_equal(piola_world_solid_set_fracture(w, 0, &def), PIOLA_OK);
+  const double mass = total_mass(w);
+  double p0[3], l0[3];
+  momenta(w, p0, l0);
+  const double ls = sqrt(l0[0] * l0[0] + l0[1] * l0[1] + l0[2] * l0[2]);
+  const double ps = sqrt(p0[0] * p0[0] + p0[1] * p0[1] + p0[2] * p0[2]);
+  int cutting_steps = 0;
+  for (int step = 0; step < 100; ++step) {
+    const int32_t before = piola_world_solid_cut_tet_count(w, 0);
+    double pa[3], la[3], pb[3], lb[3];
+    momenta(w, pa, la);
+    assert_int_equal(piola_world_step(w, 0, NULL), PIOLA_OK);
+    momenta(w, pb, lb);
+    cutting_steps += piola_world_solid_cut_tet_count(w, 0) > before;
+    for (int k = 0; k < 3; ++k) {
+      assert_close(pb[k], pa[k], 1e-12 * ps);
+      assert_close(lb[k], la[k], 1e-9 * ls);
+    }
+    assert_close(total_mass(w), mass, 1e-13 * mass);
+  }
+  assert_true(cutting_steps >= 2); /* a crack started and grew */
+  check_cut_solid_positions_finite(w);
+  free(x), free(v), free(mesh.positions), free(mesh.tets);
+  piola_world_destroy(w);
+}
+
 /* Random planes through a jittered box and real meshes: every invariant holds after one
  * plane (strictly closed surfaces) and after a second (closed up to T-junctions where the
  * second plane meets tets the first one cut), and the cut body steps without NaN. */
@@ -729,6 +774,7 @@ int main(void) {
       cmocka_unit_test(one_tet_matches_the_corner_volume),
       cmocka_unit_test(box_splits_into_the_analytic_volumes),
       cmocka_unit_test(cut_in_free_flight_keeps_momentum),
+      cmocka_unit_test(grown_cracks_in_free_flight_keep_momentum),
       cmocka_unit_test(random_cuts_keep_every_invariant),
       cmocka_unit_test(blade_cuts_like_its_plane_and_only_where_it_reaches),
       cmocka_unit_test(grown_and_blade_cuts_keep_every_invariant),

@@ -1,14 +1,14 @@
 /* piola: fracture of solids by the virtual node algorithm (Molino, Bao and Fedkiw 2004),
  * see docs/fracture.md.
  *
- * A cut is a plane in world space, applied to a solid's current (deformed) shape. Every tet
- * the plane crosses is replaced by two copies, one per side; each copy keeps the whole tet's
+ * A cut is a plane or a triangle surface in world space, applied to a solid's current
+ * (deformed) shape, or a crack grown tet by tet by a breaking criterion (stress or plastic
+ * strain). Every tet it splits is replaced by two copies, one per side; each copy keeps the whole tet's
  * shape functions and carries only its side's share of the material (its material
  * fraction: mass, elastic and damping forces are scaled by it). Nodes are duplicated per
  * connected piece of material around them, so the pieces move apart. The crack inside a
  * copy is a polygon kept in the tet's barycentric coordinates. A tet is cut at most once:
- * a later plane leaves the tets it finds already cut as they are (the new crack stops
- * there). The stress criterion makes such cuts where the stress passes a threshold.
+ * a later cut leaves the tets it finds already cut as they are (the new crack stops there).
  *
  *   piola_fracture_cut cut = {.time = 0.1, .point = {0, 0, 0.5}, .normal = {0, 0, 1}};
  *   piola_fracture_def def = piola_default_fracture_def();

@@ -840,7 +840,7 @@ static piola_status apply_criterion(piola_world *w, world_body *b) {
     touched = 0;
     for (int k = 0; k < 4; ++k) touched |= f->vertex_crack[ids[k]] >= 0;
   }
-  const int32_t c = pick < n ? list[pick].copy : -1;
+  const int32_t c = pick >= 0 && pick < n ? list[pick].copy : -1;
   if (count == 0 && !touched) {
     double point[3] = {0, 0, 0};
     for (int k = 0; k < 4; ++k)

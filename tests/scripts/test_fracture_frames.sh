@@ -142,6 +142,11 @@ JSON
 awk -F, 'NR == 1 { for (i = 1; i <= NF; ++i) if ($i == "fragments") c = i }
          NR == 2 && $c != 1 { exit 1 } END { if ($c < 2) exit 1 }' "$work/pull/stats.csv" ||
   { echo "FAIL: the pulled bar did not break (or was broken at frame 0)"; cat "$work/pull/stats.csv"; exit 1; }
+sed 's/"threshold": 1.5e4}/"threshold": 1.5e4, "max_tets_per_step": 4}/' "$work/pull.json" >"$work/most.json"
+"$PIOLA" run "$work/most.json" -o "$work/most" --frames 1 >"$work/log" 2>&1 || { echo "FAIL: max_tets_per_step refused"; cat "$work/log"; exit 1; }
+sed 's/"criterion": "stress", //' "$work/most.json" >"$work/most_alone.json"
+if "$PIOLA" run "$work/most_alone.json" -o "$work/ma" >"$work/log" 2>&1; then echo "FAIL: max_tets_per_step without criterion accepted"; exit 1; fi
+grep -q "solids\[0\].fracture.threshold" "$work/log" || { echo "FAIL: max_tets_per_step message:"; cat "$work/log"; exit 1; }
 sed 's/"criterion": "stress", //' "$work/pull.json" >"$work/threshold.json"
 if "$PIOLA" run "$work/threshold.json" -o "$work/t" >"$work/log" 2>&1; then echo "FAIL: threshold alone accepted"; exit 1; fi
 grep -q "solids\[0\].fracture.threshold" "$work/log" || { echo "FAIL: threshold message:"; cat "$work/log"; exit 1; }
@@ -180,4 +185,7 @@ grep -q "solids\[0\].fracture.cuts\[0\].mesh: .*blade.obj.*4" "$work/log" || { e
 rm "$work/blade.obj"
 if "$PIOLA" run "$work/blade.json" -o "$work/bm" >"$work/log" 2>&1; then echo "FAIL: missing blade accepted"; exit 1; fi
 grep -q "solids\[0\].fracture.cuts\[0\].mesh: .*blade.obj" "$work/log" || { echo "FAIL: missing blade message:"; cat "$work/log"; exit 1; }
+sed 's/"mesh": "blade.obj"/"mesh": "blade.obj", "plane": {"point": [0, 0, 0], "normal": [1, 0, 0]}/' "$work/blade.json" >"$work/both.json"
+if "$PIOLA" run "$work/both.json" -o "$work/both" >"$work/log" 2>&1; then echo "FAIL: plane and mesh accepted"; exit 1; fi
+grep -q "solids\[0\].fracture.cuts\[0\]" "$work/log" || { echo "FAIL: plane and mesh message:"; cat "$work/log"; exit 1; }
 echo "ok   fracture frames and refusals"

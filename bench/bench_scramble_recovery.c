@@ -6,13 +6,14 @@
  * E = 10 kPa, nu = 0.3, 1000 kg/m^3 (models with their own moduli scaled to the same rest
  * shear modulus; fibres along x). Start: every node at a uniformly random point of the unit
  * cube, at rest. Then 12 s of elastic and damping forces (beta = 300, alpha = 100 Pa s), the
- * integrator and fixed step of tests/test_recovery.c. Outcome per seed:
+ * integrator and fixed step of tests/test_recovery.c (HGO: capped by half the state-aware
+ * bound, see recovery_runs.h). Outcome per seed:
  *   recovered   max |fhat - 1| <= 1e-6 and nothing inverted (the test's criterion);
  *   slow        not within 1e-6 yet but the elastic energy is below 1e-3 J (on its way);
  *   stuck-model stuck with every Fhat entry at or above the threshold: an equilibrium of the
  *               constitutive model itself, which no inversion extension can change;
  *   stuck-ext   stuck with some entry below the threshold: the extension takes part;
- *   diverged    a position or force stopped being finite (the fixed step was too long for
+ *   diverged    a position or force stopped being finite (the step was too long for
  *               the stiffness the body reached).
  *
  * usage: bench_scramble_recovery [seeds] [name]   (default 40; seeds 1..N; name keeps the rows

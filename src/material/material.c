@@ -18,8 +18,8 @@ piola_material_def piola_default_material_def(void) {
   def.model = PIOLA_MODEL_NEOHOOKEAN;
   def.youngs_modulus = 1e5;
   def.poisson_ratio = 0.3;
-  def.inversion_threshold = 0.3;
-  def.inversion_mode = PIOLA_INVERSION_LINEAR;
+  def.inversion_threshold = 0.0; /* the model's default, resolved by piola_material_init */
+  def.inversion_mode = PIOLA_INVERSION_MODEL_DEFAULT;
   def.spline.compression_stretch = 0.8;
   def.spline.elongation_stretch = 1.2;
   def.spline.stiffening = 10.0;
@@ -34,6 +34,35 @@ piola_material_def piola_default_material_def(void) {
   def.mooney_rivlin.c01 = 5e3;
   def.hgo = piola__default_hgo_def();
   return def;
+}
+
+/* Per model, the inversion setting a default def gets: the setting that recovered from the
+ * most scrambles of bench/bench_scramble_recovery's grid (every seed any setting recovers
+ * from) and from point, line and plane collapse of the real meshes (bench/
+ * bench_collapse_recovery), preferring, among equals, the smoothest mode (LINEAR or the
+ * energy over CLAMP) and the smallest threshold (the model is used further). The table of
+ * measurements is in docs/materials.md, "Defaults that recover". */
+static const struct {
+  piola_inversion_mode mode;
+  double threshold;
+} model_default_inversion[PIOLA_MODEL_COUNT] = {
+    [PIOLA_MODEL_ROTATED_LINEAR] = {PIOLA_INVERSION_CLAMP, 0.3},
+    [PIOLA_MODEL_COROTATED] = {PIOLA_INVERSION_CLAMP, 0.3},
+    [PIOLA_MODEL_STVK] = {PIOLA_INVERSION_LINEAR, 0.3},
+    [PIOLA_MODEL_NEOHOOKEAN] = {PIOLA_INVERSION_CLAMP, 0.5},
+    [PIOLA_MODEL_SPLINE] = {PIOLA_INVERSION_CLAMP, 0.3},
+    [PIOLA_MODEL_MUSCLE] = {PIOLA_INVERSION_CLAMP, 0.5},
+    [PIOLA_MODEL_STABLE_NEOHOOKEAN] = {PIOLA_INVERSION_CLAMP, 0.3},
+    [PIOLA_MODEL_MOONEY_RIVLIN] = {PIOLA_INVERSION_CLAMP, 0.5},
+    [PIOLA_MODEL_OGDEN] = {PIOLA_INVERSION_CLAMP, 0.5},
+    [PIOLA_MODEL_HGO] = {PIOLA_INVERSION_CLAMP, 0.5},
+};
+
+void piola_material_default_inversion(piola_material_model model, piola_inversion_mode *mode,
+                                      double *threshold) {
+  const int known = (int)model >= 0 && model < PIOLA_MODEL_COUNT;
+  if (mode) *mode = known ? model_default_inversion[model].mode : PIOLA_INVERSION_LINEAR;
+  if (threshold) *threshold = known ? model_default_inversion[model].threshold : 0.3;
 }
 
 piola_status piola_youngs_poisson_from_lame(double mu, double lambda, double *youngs_modulus,
@@ -113,10 +142,16 @@ piola_status piola_material_init(const piola_material_def *def, piola_material *
     return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "model: unknown material model %d",
                       (int)def->model);
   if (def->inversion_mode != PIOLA_INVERSION_LINEAR && def->inversion_mode != PIOLA_INVERSION_CLAMP &&
-      def->inversion_mode != PIOLA_INVERSION_ENERGY)
+      def->inversion_mode != PIOLA_INVERSION_ENERGY &&
+      def->inversion_mode != PIOLA_INVERSION_MODEL_DEFAULT)
     return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "inversion.mode: unknown mode %d",
                       (int)def->inversion_mode);
-  const double e = def->youngs_modulus, nu = def->poisson_ratio, c = def->inversion_threshold;
+  piola_inversion_mode mode;
+  double default_threshold;
+  piola_material_default_inversion(def->model, &mode, &default_threshold);
+  if (def->inversion_mode != PIOLA_INVERSION_MODEL_DEFAULT) mode = def->inversion_mode;
+  const double e = def->youngs_modulus, nu = def->poisson_ratio;
+  const double c = def->inversion_threshold == 0.0 ? default_threshold : def->inversion_threshold;
   /* the Ogden models and HGO take their shear modulus from their own parameters */
   const int own_shear = def->model == PIOLA_MODEL_OGDEN || def->model == PIOLA_MODEL_MOONEY_RIVLIN ||
                         def->model == PIOLA_MODEL_HGO;
@@ -129,7 +164,8 @@ piola_status piola_material_init(const piola_material_def *def, piola_material *
     return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "poisson_ratio must be in (-1, 0.5), got %g",
                       nu);
   if (!(c > 0.0 && c < 1.0))
-    return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "inversion.threshold must be in (0, 1), got %g",
+    return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT,
+                      "inversion.threshold must be in (0, 1) (or 0 for the model's default), got %g",
                       c);
 
   piola_material m;
@@ -138,7 +174,7 @@ piola_status piola_material_init(const piola_material_def *def, piola_material *
   m.mu = e / (2.0 * (1.0 + nu));
   m.lambda = e * nu / ((1.0 + nu) * (1.0 - 2.0 * nu));
   m.threshold = c;
-  m.inversion_mode = def->inversion_mode;
+  m.inversion_mode = mode;
 
   if (def->model == PIOLA_MODEL_SPLINE) {
     const double a = def->spline.compression_stretch, b = def->spline.elongation_stretch;
@@ -199,6 +235,8 @@ const char *piola_inversion_mode_name(piola_inversion_mode mode) {
       return "clamp";
     case PIOLA_INVERSION_ENERGY:
       return "energy";
+    case PIOLA_INVERSION_MODEL_DEFAULT:
+      return "default";
     default:
       return "unknown";
   }
@@ -212,6 +250,8 @@ bool piola_inversion_mode_from_name(const char *name, piola_inversion_mode *mode
     *mode = PIOLA_INVERSION_CLAMP;
   else if (strcmp(name, "energy") == 0)
     *mode = PIOLA_INVERSION_ENERGY;
+  else if (strcmp(name, "default") == 0)
+    *mode = PIOLA_INVERSION_MODEL_DEFAULT;
   else
     return false;
   return true;

@@ -5,7 +5,8 @@
  * Two protocols:
  *   - the scramble grid (docs/materials.md, "Tangled equilibria"): the 3 x 3 x 3 grid of unit
  *     size (162 tets), every node at a uniformly random point of the unit cube (seed s), 12 s
- *     with beta = 300, alpha = 100 Pa s and a fixed step (a fraction of the rest CFL step);
+ *     with beta = 300, alpha = 100 Pa s and a fixed step (a fraction of the rest CFL step;
+ *     for HGO, whose fibres stiffen exponentially, capped by half the state-aware bound);
  *   - collapse of a real mesh scaled to a 1 m bounding box (as tests/test_recovery_real_meshes.c):
  *     every vertex to one point, onto a line or onto a plane, 12 s with beta = 1000,
  *     alpha = 300 Pa s and a step shortened with the body's largest stretch. */

@@ -8,6 +8,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "common/union_find.h"
 #include "contact/contact_internal.h"
 #include "contact/triangle_intersection.h"
 #include "piola/collision_surface.h"
@@ -360,7 +361,7 @@ static void impact_zones_conserve_momentum(void **state) {
     for (int32_t i = 0; i < s.nv; ++i)
       for (int32_t j = i + 1; j < s.nv; ++j) {
         if (!surface->in_zone[i] || !surface->in_zone[j]) continue;
-        if (piola__zone_root(surface->zone_parent, i) != piola__zone_root(surface->zone_parent, j))
+        if (piola__union_find_root(surface->zone_parent, i) != piola__union_find_root(surface->zone_parent, j))
           continue;
         double dot = 0.0;
         for (int k = 0; k < 3; ++k)

@@ -7,6 +7,7 @@
 
 #include "common/grow.h"
 #include "common/status_report.h"
+#include "common/union_find.h"
 #include "contact/contact_internal.h"
 
 piola_collision_body_def piola_default_collision_body_def(void) {
@@ -288,9 +289,9 @@ static double lap(double *clock) {
 
 static int same_zone(piola_collision_surface *s, const piola__contact *c) {
   if (!s->in_zone[c->v[0]]) return 0;
-  int32_t root = piola__zone_root(s->zone_parent, c->v[0]);
+  int32_t root = piola__union_find_root(s->zone_parent, c->v[0]);
   for (int k = 1; k < 4; ++k)
-    if (!s->in_zone[c->v[k]] || piola__zone_root(s->zone_parent, c->v[k]) != root) return 0;
+    if (!s->in_zone[c->v[k]] || piola__union_find_root(s->zone_parent, c->v[k]) != root) return 0;
   return 1;
 }
 

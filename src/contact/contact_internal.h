@@ -160,7 +160,4 @@ int piola__detect_all_pairs(const piola_collision_surface *surface, const double
 int32_t piola__impact_zones_apply(piola_collision_surface *surface, const piola__contact_list *hits,
                                   const double *x0, double *v, int32_t *zone_vertices);
 
-/* Union-find root of a vertex, with path halving. */
-int32_t piola__zone_root(int32_t *parent, int32_t i);
-
 #endif

@@ -1,26 +1,8 @@
 /* Rigid impact zones (Provot 1997, BFA02 section 7.3): the fail-safe of collision processing. */
 #include <stdlib.h>
 
+#include "common/union_find.h"
 #include "contact/contact_internal.h"
-
-int32_t piola__zone_root(int32_t *parent, int32_t i) {
-  while (parent[i] != i) {
-    parent[i] = parent[parent[i]];
-    i = parent[i];
-  }
-  return i;
-}
-
-/* Joins the sets of a and b; the smaller index becomes the root, so zones do not depend on
- * the order of the unions. */
-static void zone_union(int32_t *parent, int32_t a, int32_t b) {
-  a = piola__zone_root(parent, a), b = piola__zone_root(parent, b);
-  if (a == b) return;
-  if (a < b)
-    parent[b] = a;
-  else
-    parent[a] = b;
-}
 
 /* Solves m w = b for the symmetric positive semi-definite inertia-like matrix m; when it is
  * (nearly) singular (a zone whose points are collinear) a small multiple of the trace is added
@@ -52,7 +34,7 @@ int32_t piola__impact_zones_apply(piola_collision_surface *s, const piola__conta
   for (int64_t i = 0; i < hits->count; ++i) {
     const piola__contact *c = &hits->items[i];
     for (int k = 0; k < 4; ++k) s->in_zone[c->v[k]] = 1;
-    for (int k = 1; k < 4; ++k) zone_union(parent, c->v[0], c->v[k]);
+    for (int k = 1; k < 4; ++k) piola__union_find_join(parent, c->v[0], c->v[k]);
   }
   /* Group zone vertices by root with a counting sort (zone_order), roots ascending. */
   const int32_t n = s->vertex_count;
@@ -60,7 +42,7 @@ int32_t piola__impact_zones_apply(piola_collision_surface *s, const piola__conta
   if (!start) return -1;
   int32_t members = 0;
   for (int32_t i = 0; i < n; ++i)
-    if (s->in_zone[i]) ++start[piola__zone_root(parent, i) + 1], ++members;
+    if (s->in_zone[i]) ++start[piola__union_find_root(parent, i) + 1], ++members;
   for (int32_t i = 0; i < n; ++i) start[i + 1] += start[i];
   int32_t *fill = malloc(sizeof(int32_t) * ((size_t)n + 1));
   if (!fill) {
@@ -69,7 +51,7 @@ int32_t piola__impact_zones_apply(piola_collision_surface *s, const piola__conta
   }
   for (int32_t i = 0; i <= n; ++i) fill[i] = start[i];
   for (int32_t i = 0; i < n; ++i)
-    if (s->in_zone[i]) s->zone_order[fill[piola__zone_root(parent, i)]++] = i;
+    if (s->in_zone[i]) s->zone_order[fill[piola__union_find_root(parent, i)]++] = i;
   free(fill);
 
   int32_t zones = 0;

@@ -52,35 +52,20 @@ void piola__elastic_body_damping_prepare(piola_elastic_body *body, double shear_
 static void product_rows(const piola__damping_matrix *m, const double *v, const double *mass,
                          double h, int32_t r0, int32_t r1, const piola_work_split *split,
                          double *out) {
-  const double *blocks = m->blocks;
   for (int32_t r = r0; r < r1; ++r) {
     const int32_t i = m->order[r];
     if (split && split->node_part[i] != split->part) continue; /* another process's row */
     const double v0 = v[3 * i], v1 = v[3 * i + 1], v2 = v[3 * i + 2];
-    double f0 = 0, f1 = 0, f2 = 0;
-    for (int32_t k = m->row_start[r]; k < m->row_start[r + 1]; ++k) {
-      const double *a = blocks + 9 * (size_t)k, *vj = v + 3 * (size_t)m->col[k];
-      double d0 = vj[0] - v0, d1 = vj[1] - v1, d2 = vj[2] - v2;
-      f0 += a[0] * d0 + a[1] * d1 + a[2] * d2;
-      f1 += a[3] * d0 + a[4] * d1 + a[5] * d2;
-      f2 += a[6] * d0 + a[7] * d1 + a[8] * d2;
-    }
-    for (int32_t k = m->lower_start[r]; k < m->lower_start[r + 1]; ++k) {
-      const double *a = blocks + 9 * (size_t)m->lower_edge[k];
-      const double *vj = v + 3 * (size_t)m->lower_col[k];
-      double d0 = vj[0] - v0, d1 = vj[1] - v1, d2 = vj[2] - v2;
-      f0 += a[0] * d0 + a[3] * d1 + a[6] * d2;
-      f1 += a[1] * d0 + a[4] * d1 + a[7] * d2;
-      f2 += a[2] * d0 + a[5] * d1 + a[8] * d2;
-    }
+    double f[3];
+    piola__edge_row_product(m, m->blocks, v, r, f);
     if (mass) {
-      out[3 * i] = mass[i] * v0 - h * f0;
-      out[3 * i + 1] = mass[i] * v1 - h * f1;
-      out[3 * i + 2] = mass[i] * v2 - h * f2;
+      out[3 * i] = mass[i] * v0 - h * f[0];
+      out[3 * i + 1] = mass[i] * v1 - h * f[1];
+      out[3 * i + 2] = mass[i] * v2 - h * f[2];
     } else {
-      out[3 * i] = f0;
-      out[3 * i + 1] = f1;
-      out[3 * i + 2] = f2;
+      out[3 * i] = f[0];
+      out[3 * i + 1] = f[1];
+      out[3 * i + 2] = f[2];
     }
   }
 }

@@ -216,17 +216,6 @@ static void assemble_part(piola__damping_matrix *m, const piola_elastic_body *bo
   }
 }
 
-/* Edge shared_edge[k] = the sum of its private slots, in range order. */
-static void reduce_shared(piola__damping_matrix *m, int32_t k) {
-  double *dst = m->blocks + 9 * (size_t)m->shared_edge[k];
-  int32_t s0 = m->shared_slot_start[k], s1 = m->shared_slot_start[k + 1];
-  for (int i = 0; i < 9; ++i) {
-    double sum = m->blocks[9 * (size_t)s0 + i];
-    for (int32_t s = s0 + 1; s < s1; ++s) sum += m->blocks[9 * (size_t)s + i];
-    dst[i] = sum;
-  }
-}
-
 void PIOLA_ISA_NAME(piola__damping_matrix_assemble)(piola__damping_matrix *m, const piola_elastic_body *body,
                                     double shear_viscosity, double bulk_viscosity) {
   const int32_t blocks = body->padded_tet_count / B;
@@ -236,7 +225,7 @@ void PIOLA_ISA_NAME(piola__damping_matrix_assemble)(piola__damping_matrix *m, co
     for (int k = 0; k < PIOLA_DAMPING_PARTS; ++k)
       assemble_part(m, body, k, shear_viscosity, bulk_viscosity);
 #pragma omp for schedule(static)
-    for (int32_t k = 0; k < m->shared_count; ++k) reduce_shared(m, k);
+    for (int32_t k = 0; k < m->shared_count; ++k) piola__edge_reduce_shared(m, m->blocks, k);
   }
   m->shear_viscosity = shear_viscosity;
   m->bulk_viscosity = bulk_viscosity;

@@ -82,4 +82,46 @@ void piola__damping_matrix_free(piola__damping_matrix *matrix);
 PIOLA_ISA_DECLARE(void, piola__damping_matrix_assemble, PIOLA_DAMPING_MATRIX_ASSEMBLE_PARAMS);
 void piola__damping_matrix_assemble PIOLA_DAMPING_MATRIX_ASSEMBLE_PARAMS;
 
+/* The pattern serves every edge-block matrix of the body (this damping operator, the
+ * implicit step's stiffness matrix): `blocks` below is such a matrix's block array, laid
+ * out as the pattern says. */
+
+/* f = the sum over row r's edges (i, j), i = order[r], of A_ij (v_j - v_i): the row's upper
+ * edges, then its lower ones (A_ji transposed), in the pattern's fixed order. */
+static inline void piola__edge_row_product(const piola__damping_matrix *pattern,
+                                           const double *blocks, const double *v, int32_t r,
+                                           double f[3]) {
+  const int32_t i = pattern->order[r];
+  const double v0 = v[3 * i], v1 = v[3 * i + 1], v2 = v[3 * i + 2];
+  double f0 = 0, f1 = 0, f2 = 0;
+  for (int32_t k = pattern->row_start[r]; k < pattern->row_start[r + 1]; ++k) {
+    const double *a = blocks + 9 * (size_t)k, *vj = v + 3 * (size_t)pattern->col[k];
+    double d0 = vj[0] - v0, d1 = vj[1] - v1, d2 = vj[2] - v2;
+    f0 += a[0] * d0 + a[1] * d1 + a[2] * d2;
+    f1 += a[3] * d0 + a[4] * d1 + a[5] * d2;
+    f2 += a[6] * d0 + a[7] * d1 + a[8] * d2;
+  }
+  for (int32_t k = pattern->lower_start[r]; k < pattern->lower_start[r + 1]; ++k) {
+    const double *a = blocks + 9 * (size_t)pattern->lower_edge[k];
+    const double *vj = v + 3 * (size_t)pattern->lower_col[k];
+    double d0 = vj[0] - v0, d1 = vj[1] - v1, d2 = vj[2] - v2;
+    f0 += a[0] * d0 + a[3] * d1 + a[6] * d2;
+    f1 += a[1] * d0 + a[4] * d1 + a[7] * d2;
+    f2 += a[2] * d0 + a[5] * d1 + a[8] * d2;
+  }
+  f[0] = f0, f[1] = f1, f[2] = f2;
+}
+
+/* The block of edge shared_edge[k] = the sum of its private slots, in range order. */
+static inline void piola__edge_reduce_shared(const piola__damping_matrix *pattern,
+                                             double *blocks, int32_t k) {
+  double *dst = blocks + 9 * (size_t)pattern->shared_edge[k];
+  int32_t s0 = pattern->shared_slot_start[k], s1 = pattern->shared_slot_start[k + 1];
+  for (int i = 0; i < 9; ++i) {
+    double sum = blocks[9 * (size_t)s0 + i];
+    for (int32_t s = s0 + 1; s < s1; ++s) sum += blocks[9 * (size_t)s + i];
+    dst[i] = sum;
+  }
+}
+
 #endif

@@ -78,6 +78,39 @@ static int positions_are_finite(const double *x, int32_t n) {
   return finite;
 }
 
+void piola__elastic_body_sum_block_ranges(piola_elastic_body *body, const double *x,
+                                          double stiffness_scale, int want_energy,
+                                          int32_t count, piola__block_range_update *update,
+                                          double *forces) {
+  const int64_t n = 3 * (int64_t)body->vertex_count;
+  if (count < PIOLA_PARALLEL_MIN_BLOCKS || !body->chunk_forces) {
+    for (int64_t i = 0; i < n; ++i) forces[i] = 0.0;
+    update(body, x, stiffness_scale, want_energy, 0, count, forces);
+    return;
+  }
+  /* Determinism without a per-tet buffer: PIOLA_FORCE_CHUNKS fixed ranges of blocks, each
+   * summed in tet order into its own array, the arrays added in chunk order; which thread
+   * runs a chunk changes nothing. */
+  double *partial = body->chunk_forces;
+#pragma omp parallel num_threads(piola_thread_count())
+  {
+#pragma omp for schedule(static)
+    for (int k = 0; k < PIOLA_FORCE_CHUNKS; ++k) {
+      double *fk = partial + (size_t)k * (size_t)n;
+      for (int64_t i = 0; i < n; ++i) fk[i] = 0.0;
+      update(body, x, stiffness_scale, want_energy,
+             (int32_t)((int64_t)count * k / PIOLA_FORCE_CHUNKS),
+             (int32_t)((int64_t)count * (k + 1) / PIOLA_FORCE_CHUNKS), fk);
+    }
+#pragma omp for schedule(static)
+    for (int64_t i = 0; i < n; ++i) {
+      double sum = partial[i];
+      for (int k = 1; k < PIOLA_FORCE_CHUNKS; ++k) sum += partial[(size_t)k * (size_t)n + i];
+      forces[i] = sum;
+    }
+  }
+}
+
 piola_status piola_elastic_body_update(piola_elastic_body *body, const double *x,
                                        double stiffness_scale, double *forces,
                                        piola_elastic_stats *stats) {
@@ -93,34 +126,11 @@ piola_status piola_elastic_body_update(piola_elastic_body *body, const double *x
                           (int)(i / 3));
   }
   int32_t blocks = body->padded_tet_count / B;
-  const int64_t n = 3 * (int64_t)body->vertex_count;
   if (body->split) {
     piola__elastic_body_split_update(body, x, stiffness_scale, stats != NULL, forces);
-  } else if (blocks < PIOLA_PARALLEL_MIN_BLOCKS || !body->chunk_forces) {
-    for (int64_t i = 0; i < n; ++i) forces[i] = 0.0;
-    piola__force_block_range(body, x, stiffness_scale, stats != NULL, 0, blocks, forces);
   } else {
-    /* Determinism without a per-tet buffer: PIOLA_FORCE_CHUNKS fixed
-     * ranges of blocks, each summed in tet order into its own array, the arrays added in
-     * chunk order; which thread runs a chunk changes nothing. */
-    double *partial = body->chunk_forces;
-#pragma omp parallel num_threads(piola_thread_count())
-    {
-#pragma omp for schedule(static)
-      for (int k = 0; k < PIOLA_FORCE_CHUNKS; ++k) {
-        double *fk = partial + (size_t)k * (size_t)n;
-        for (int64_t i = 0; i < n; ++i) fk[i] = 0.0;
-        int32_t b0 = (int32_t)((int64_t)blocks * k / PIOLA_FORCE_CHUNKS);
-        int32_t b1 = (int32_t)((int64_t)blocks * (k + 1) / PIOLA_FORCE_CHUNKS);
-        piola__force_block_range(body, x, stiffness_scale, stats != NULL, b0, b1, fk);
-      }
-#pragma omp for schedule(static)
-      for (int64_t i = 0; i < n; ++i) {
-        double sum = partial[i];
-        for (int k = 1; k < PIOLA_FORCE_CHUNKS; ++k) sum += partial[(size_t)k * (size_t)n + i];
-        forces[i] = sum;
-      }
-    }
+    piola__elastic_body_sum_block_ranges(body, x, stiffness_scale, stats != NULL, blocks,
+                                         piola__force_block_range, forces);
   }
   body->has_state = 1;
   body->damping.ready = 0;

@@ -113,6 +113,18 @@ struct piola_elastic_body {
   double *split_buffer; /* block count * SPLIT_STATE_WIDTH_MAX doubles */
 };
 
+/* A range [k0, k1) of the force loop's blocks (block indices, or positions in a block list),
+ * forces added into out in tet order. */
+typedef void piola__block_range_update(piola_elastic_body *body, const double *x,
+                                       double stiffness_scale, int want_energy, int32_t k0,
+                                       int32_t k1, double *out);
+/* forces = the sum of update over blocks [0, count) (elastic_body.c): in parallel as
+ * PIOLA_FORCE_CHUNKS fixed ranges, each summed into its own array, the arrays added in
+ * range order, so which thread runs a range changes nothing. */
+void piola__elastic_body_sum_block_ranges(piola_elastic_body *body, const double *x,
+                                          double stiffness_scale, int want_energy,
+                                          int32_t count, piola__block_range_update *update,
+                                          double *forces);
 /* The split force loop and damping product (work_split.c). */
 void piola__elastic_body_split_update(piola_elastic_body *body, const double *x,
                                       double stiffness_scale, int want_energy, double *forces);

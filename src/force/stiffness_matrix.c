@@ -145,16 +145,6 @@ static void assemble_part(piola__stiffness_matrix *m, const piola_elastic_body *
   }
 }
 
-static void reduce_shared(piola__stiffness_matrix *m, const piola__damping_matrix *d, int32_t k) {
-  double *dst = m->blocks + 9 * (size_t)d->shared_edge[k];
-  int32_t s0 = d->shared_slot_start[k], s1 = d->shared_slot_start[k + 1];
-  for (int i = 0; i < 9; ++i) {
-    double sum = m->blocks[9 * (size_t)s0 + i];
-    for (int32_t s = s0 + 1; s < s1; ++s) sum += m->blocks[9 * (size_t)s + i];
-    dst[i] = sum;
-  }
-}
-
 static void invert3(const double *a, double *inv) {
   double c00 = a[4] * a[8] - a[5] * a[7], c01 = a[5] * a[6] - a[3] * a[8], c02 = a[3] * a[7] - a[4] * a[6];
   double det = a[0] * c00 + a[1] * c01 + a[2] * c02;
@@ -207,7 +197,7 @@ void piola__stiffness_matrix_assemble(piola__stiffness_matrix *m, const piola_el
 #pragma omp for schedule(static)
     for (int k = 0; k < PIOLA_DAMPING_PARTS; ++k) assemble_part(m, body, k, stiffness_weight);
 #pragma omp for schedule(static)
-    for (int32_t k = 0; k < d->shared_count; ++k) reduce_shared(m, d, k);
+    for (int32_t k = 0; k < d->shared_count; ++k) piola__edge_reduce_shared(d, m->blocks, k);
 #pragma omp for schedule(static)
     for (int32_t e = 0; e < d->edge_count; ++e) {
       if (damping_weight != 0)
@@ -225,30 +215,15 @@ void piola__stiffness_matrix_assemble(piola__stiffness_matrix *m, const piola_el
 static void product_rows(const piola__stiffness_matrix *m, const piola__damping_matrix *d,
                          const double *mass, double mass_weight, const double *p, int32_t r0,
                          int32_t r1, double *out) {
-  const double *blocks = m->blocks;
   for (int32_t r = r0; r < r1; ++r) {
     const int32_t i = d->order[r];
     const double p0 = p[3 * i], p1 = p[3 * i + 1], p2 = p[3 * i + 2];
-    double f0 = 0, f1 = 0, f2 = 0;
-    for (int32_t k = d->row_start[r]; k < d->row_start[r + 1]; ++k) {
-      const double *a = blocks + 9 * (size_t)k, *pj = p + 3 * (size_t)d->col[k];
-      double d0 = pj[0] - p0, d1 = pj[1] - p1, d2 = pj[2] - p2;
-      f0 += a[0] * d0 + a[1] * d1 + a[2] * d2;
-      f1 += a[3] * d0 + a[4] * d1 + a[5] * d2;
-      f2 += a[6] * d0 + a[7] * d1 + a[8] * d2;
-    }
-    for (int32_t k = d->lower_start[r]; k < d->lower_start[r + 1]; ++k) {
-      const double *a = blocks + 9 * (size_t)d->lower_edge[k];
-      const double *pj = p + 3 * (size_t)d->lower_col[k];
-      double d0 = pj[0] - p0, d1 = pj[1] - p1, d2 = pj[2] - p2;
-      f0 += a[0] * d0 + a[3] * d1 + a[6] * d2;
-      f1 += a[1] * d0 + a[4] * d1 + a[7] * d2;
-      f2 += a[2] * d0 + a[5] * d1 + a[8] * d2;
-    }
+    double f[3];
+    piola__edge_row_product(d, m->blocks, p, r, f);
     const double mi = mass_weight * mass[i];
-    out[3 * i] = mi * p0 - f0;
-    out[3 * i + 1] = mi * p1 - f1;
-    out[3 * i + 2] = mi * p2 - f2;
+    out[3 * i] = mi * p0 - f[0];
+    out[3 * i + 1] = mi * p1 - f[1];
+    out[3 * i + 2] = mi * p2 - f[2];
   }
 }
 

@@ -112,30 +112,8 @@ void piola__elastic_body_split_update(piola_elastic_body *body, const double *x,
                                       double stiffness_scale, int want_energy, double *forces) {
   const piola_work_split *split = body->split;
   const int32_t count = body->split_block_count;
-  const int64_t n = 3 * (int64_t)body->vertex_count;
-  if (count < PIOLA_PARALLEL_MIN_BLOCKS || !body->chunk_forces) {
-    for (int64_t i = 0; i < n; ++i) forces[i] = 0.0;
-    update_listed(body, x, stiffness_scale, want_energy, 0, count, forces);
-  } else {
-    double *partial = body->chunk_forces;
-#pragma omp parallel num_threads(piola_thread_count())
-    {
-#pragma omp for schedule(static)
-      for (int k = 0; k < PIOLA_FORCE_CHUNKS; ++k) {
-        double *fk = partial + (size_t)k * (size_t)n;
-        for (int64_t i = 0; i < n; ++i) fk[i] = 0.0;
-        update_listed(body, x, stiffness_scale, want_energy,
-                      (int32_t)((int64_t)count * k / PIOLA_FORCE_CHUNKS),
-                      (int32_t)((int64_t)count * (k + 1) / PIOLA_FORCE_CHUNKS), fk);
-      }
-#pragma omp for schedule(static)
-      for (int64_t i = 0; i < n; ++i) {
-        double sum = partial[i];
-        for (int k = 1; k < PIOLA_FORCE_CHUNKS; ++k) sum += partial[(size_t)k * (size_t)n + i];
-        forces[i] = sum;
-      }
-    }
-  }
+  piola__elastic_body_sum_block_ranges(body, x, stiffness_scale, want_energy, count,
+                                       update_listed, forces);
   if (split->part_count == 1) return;
   split->sum_nodes(split->context, forces);
   const int32_t width = want_energy ? STATE_WIDTH_MAX : STATE_WIDTH;

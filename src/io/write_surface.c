@@ -1,5 +1,6 @@
 /* Surface writers: OBJ, OFF and binary STL. */
 #include <stdint.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -25,40 +26,37 @@ piola_status piola__tri_mesh_compact(piola_tri_mesh *mesh) {
   return PIOLA_OK;
 }
 
-piola_status piola__write_obj(const char *path, const piola_tri_mesh *mesh) {
-  piola_atomic_file f;
-  PIOLA_TRY(piola_atomic_file_open(&f, path));
+/* The vertices as lines "<prefix><x> <y> <z>", then the triangles as "<prefix> <i> <j> <k>"
+ * with the indices counted from base: OBJ and OFF differ only in these. */
+static void write_lines(FILE *stream, const piola_tri_mesh *mesh, const char *vertex_prefix,
+                        const char *face_prefix, int base) {
   char a[32], b[32], c[32];
-  fprintf(f.stream, "# written by piola: %d vertices, %d triangles\n", (int)mesh->vertex_count,
-          (int)mesh->triangle_count);
   for (int32_t v = 0; v < mesh->vertex_count; ++v) {
     piola__format_double(a, mesh->positions[3 * v]);
     piola__format_double(b, mesh->positions[3 * v + 1]);
     piola__format_double(c, mesh->positions[3 * v + 2]);
-    fprintf(f.stream, "v %s %s %s\n", a, b, c);
+    fprintf(stream, "%s%s %s %s\n", vertex_prefix, a, b, c);
   }
   for (int32_t t = 0; t < mesh->triangle_count; ++t) {
     const int32_t *q = mesh->triangles + 3 * (size_t)t;
-    fprintf(f.stream, "f %d %d %d\n", q[0] + 1, q[1] + 1, q[2] + 1);
+    fprintf(stream, "%s %d %d %d\n", face_prefix, q[0] + base, q[1] + base, q[2] + base);
   }
+}
+
+piola_status piola__write_obj(const char *path, const piola_tri_mesh *mesh) {
+  piola_atomic_file f;
+  PIOLA_TRY(piola_atomic_file_open(&f, path));
+  fprintf(f.stream, "# written by piola: %d vertices, %d triangles\n", (int)mesh->vertex_count,
+          (int)mesh->triangle_count);
+  write_lines(f.stream, mesh, "v ", "f", 1); /* OBJ counts from 1 */
   return piola_atomic_file_commit(&f);
 }
 
 piola_status piola__write_off(const char *path, const piola_tri_mesh *mesh) {
   piola_atomic_file f;
   PIOLA_TRY(piola_atomic_file_open(&f, path));
-  char a[32], b[32], c[32];
   fprintf(f.stream, "OFF\n%d %d 0\n", (int)mesh->vertex_count, (int)mesh->triangle_count);
-  for (int32_t v = 0; v < mesh->vertex_count; ++v) {
-    piola__format_double(a, mesh->positions[3 * v]);
-    piola__format_double(b, mesh->positions[3 * v + 1]);
-    piola__format_double(c, mesh->positions[3 * v + 2]);
-    fprintf(f.stream, "%s %s %s\n", a, b, c);
-  }
-  for (int32_t t = 0; t < mesh->triangle_count; ++t) {
-    const int32_t *q = mesh->triangles + 3 * (size_t)t;
-    fprintf(f.stream, "3 %d %d %d\n", q[0], q[1], q[2]);
-  }
+  write_lines(f.stream, mesh, "", "3", 0);
   return piola_atomic_file_commit(&f);
 }
 

@@ -7,6 +7,7 @@
 #include <string.h>
 
 #include "common/status_report.h"
+#include "common/union_find.h"
 #include "mesher/bcc_lattice.h"
 #include "mesher/boundary_snap.h"
 #include "mesher/lattice_phi.h"
@@ -231,14 +232,6 @@ static int64_t drop_boundary_only_tets(const piola__tet_soup *soup, const lattic
   return dropped;
 }
 
-static int32_t find_root(int32_t *parent, int32_t v) {
-  while (parent[v] != v) {
-    parent[v] = parent[parent[v]];
-    v = parent[v];
-  }
-  return v;
-}
-
 /* Drops face-connected pieces of the kept tets whose volume is below min_volume: crumbs cut off
  * thin, unresolved parts (an ear tip thinner than the lattice), not shapes of their own.
  * Pieces never touch (the repair made the boundary manifold), so this keeps it manifold.
@@ -259,14 +252,13 @@ static int64_t drop_crumbs(const piola__tet_soup *soup, const lattice_topology *
     for (int f = 0; f < 4; ++f) {
       int32_t u = topo->neighbor[4 * (size_t)t + f];
       if (u < 0 || !keep[u]) continue;
-      int32_t a = find_root(parent, t), b = find_root(parent, u);
-      if (a != b) parent[a < b ? b : a] = a < b ? a : b;
+      piola__union_find_join(parent, t, u);
     }
   }
   for (int32_t t = 0; t < nt; ++t) {
     if (!keep[t]) continue;
     const int32_t *tet = soup->tets + 4 * (size_t)t;
-    volume[find_root(parent, t)] += piola__tet_volume(
+    volume[piola__union_find_root(parent, t)] += piola__tet_volume(
         vec3_load(soup->positions + 3 * (size_t)tet[0]), vec3_load(soup->positions + 3 * (size_t)tet[1]),
         vec3_load(soup->positions + 3 * (size_t)tet[2]), vec3_load(soup->positions + 3 * (size_t)tet[3]));
   }
@@ -275,7 +267,7 @@ static int64_t drop_crumbs(const piola__tet_soup *soup, const lattice_topology *
   int64_t dropped = 0;
   for (int32_t t = 0; t < nt; ++t) {
     if (!keep[t]) continue;
-    double v = volume[find_root(parent, t)];
+    double v = volume[piola__union_find_root(parent, t)];
     /* Never drop the largest piece, so a small shape still gets a mesh. */
     if (v < min_volume && v < largest) {
       keep[t] = 0;

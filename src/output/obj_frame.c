@@ -70,21 +70,26 @@ piola_status piola__obj_layout_build(const piola_tri_mesh *surface, const int32_
   return PIOLA_OK;
 }
 
+/* Body b of the layout as one object, its face indices shifted by shift. */
+static void write_body(FILE *stream, const obj_layout *l, const double *positions, int32_t b,
+                       int32_t shift) {
+  fprintf(stream, "o %s\n", l->names[b]);
+  for (int32_t i = l->body_vertex_start[b]; i < l->body_vertex_start[b + 1]; ++i) {
+    const double *p = positions + 3 * (size_t)l->vertices[i];
+    fprintf(stream, "v %.9g %.9g %.9g\n", p[0], p[1], p[2]);
+  }
+  for (int32_t t = l->body_face_start[b]; t < l->body_face_start[b + 1]; ++t) {
+    const int32_t *tri = l->faces + 3 * (size_t)t;
+    fprintf(stream, "f %d %d %d\n", (int)(tri[0] + shift), (int)(tri[1] + shift),
+            (int)(tri[2] + shift));
+  }
+}
+
 piola_status piola__obj_layout_write(const obj_layout *l, const char *path, const double *positions) {
   piola_atomic_file f;
   PIOLA_TRY(piola_atomic_file_open(&f, path));
   fprintf(f.stream, "# piola frame: one object per body, its surface only\n");
-  for (int32_t b = 0; b < l->body_count; ++b) {
-    fprintf(f.stream, "o %s\n", l->names[b]);
-    for (int32_t i = l->body_vertex_start[b]; i < l->body_vertex_start[b + 1]; ++i) {
-      const double *p = positions + 3 * (size_t)l->vertices[i];
-      fprintf(f.stream, "v %.9g %.9g %.9g\n", p[0], p[1], p[2]);
-    }
-    for (int32_t t = l->body_face_start[b]; t < l->body_face_start[b + 1]; ++t) {
-      const int32_t *tri = l->faces + 3 * (size_t)t;
-      fprintf(f.stream, "f %d %d %d\n", (int)tri[0], (int)tri[1], (int)tri[2]);
-    }
-  }
+  for (int32_t b = 0; b < l->body_count; ++b) write_body(f.stream, l, positions, b, 0);
   if (ferror(f.stream)) {
     piola_atomic_file_abort(&f);
     return PIOLA_FAIL(PIOLA_ERROR_IO, "%s: write failed", path);
@@ -104,15 +109,7 @@ piola_status piola__obj_write_fragments(const obj_layout *l, const char *path, c
     if (b >= ns || !piola_world_solid_has_fracture(world, b)) {
       /* the layout's 1-based indices count from the body's first vertex in the layout */
       const int32_t shift = written - l->body_vertex_start[b];
-      fprintf(f.stream, "o %s\n", l->names[b]);
-      for (int32_t i = l->body_vertex_start[b]; i < l->body_vertex_start[b + 1]; ++i) {
-        const double *p = positions + 3 * (size_t)l->vertices[i];
-        fprintf(f.stream, "v %.9g %.9g %.9g\n", p[0], p[1], p[2]);
-      }
-      for (int32_t t = l->body_face_start[b]; t < l->body_face_start[b + 1]; ++t) {
-        const int32_t *tri = l->faces + 3 * (size_t)t;
-        fprintf(f.stream, "f %d %d %d\n", (int)(tri[0] + shift), (int)(tri[1] + shift), (int)(tri[2] + shift));
-      }
+      write_body(f.stream, l, positions, b, shift);
       written += l->body_vertex_start[b + 1] - l->body_vertex_start[b];
       continue;
     }

@@ -234,6 +234,15 @@ void piola__body_finish_masses(world_body *b) {
   }
 }
 
+void piola__body_restore_step(world_body *b, double t) {
+  size_t v3 = 3 * (size_t)b->n * sizeof(double);
+  b->product_valid = 0;
+  memcpy(b->x, b->x_old, v3);
+  memcpy(b->v, b->v_old, v3);
+  memcpy(b->force, b->force_old, v3);
+  (void)piola__body_update_forces(b, t);
+}
+
 void piola__body_free(world_body *b) {
   piola__body_free_kind(b);
   free(b->name);

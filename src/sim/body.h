@@ -144,6 +144,9 @@ piola_status piola__body_allocate(world_body *b, int32_t n, const char *name, in
                                   const double *rest, const double *mass);
 /* Sets inverse masses once constraints are in, fixing massless nodes. */
 void piola__body_finish_masses(world_body *b);
+/* Puts x, v and the force back to the step's start (x_old, v_old, force_old) and updates
+ * the forces there at time t: a step that is undone, to be retried or abandoned. */
+void piola__body_restore_step(world_body *b, double t);
 /* Frees everything b owns and zeroes it. */
 void piola__body_free(world_body *b);
 

@@ -22,6 +22,7 @@
 #include <string.h>
 
 #include "common/status_report.h"
+#include "common/union_find.h"
 #include "force/elastic_body_internal.h"
 #include "sim/fracture_internal.h"
 #include "sim/world_internal.h"
@@ -119,22 +120,6 @@ static piola_status fracture_create(const world_body *b, solid_fracture **out) {
   return PIOLA_OK;
 }
 
-/* ------------------------------------------------------------------ union-find */
-
-static int32_t find(int32_t *up, int32_t i) {
-  while (up[i] != i) {
-    up[i] = up[up[i]];
-    i = up[i];
-  }
-  return i;
-}
-
-static void unite(int32_t *up, int32_t a, int32_t b) {
-  a = find(up, a), b = find(up, b);
-  if (a < b) up[b] = a;
-  else if (b < a) up[a] = b;
-}
-
 /* ------------------------------------------------------------------ face overlap */
 
 /* Area (times a constant) of the part of triangle (e0, e1, e2) in barycentric coordinates
@@ -220,13 +205,13 @@ static void number_fragments(int32_t copies, const int32_t *node_of, int32_t nod
       for (int k = 0; k < 4; ++k) {
         int32_t node = node_of[4 * c + k];
         if (first[node] < 0) first[node] = c;
-        else unite(up, first[node], c);
+        else piola__union_find_join(up, first[node], c);
       }
   }
   free(first);
   int32_t n = 0;
   for (int32_t c = 0; c < copies; ++c) {
-    int32_t r = find(up, c);
+    int32_t r = piola__union_find_root(up, c);
     fragment[c] = r == c ? n++ : fragment[r];
   }
   *count = n;
@@ -322,7 +307,7 @@ static piola_status cut_event(piola_world *w, world_body *b, const double point[
       int32_t p = m.node_parent[i];
       if (m.fresh[p]) continue;
       if (first[p] < 0) first[p] = i;
-      else unite(m.up, first[p], i);
+      else piola__union_find_join(m.up, first[p], i);
     }
     free(first);
     for (int32_t c = 0; c < nc && st == PIOLA_OK; ++c) {
@@ -337,7 +322,7 @@ static piola_status cut_event(piola_world *w, world_body *b, const double point[
             int32_t vertex = f->tets[4 * t + piola__cut_tet_face[k][i]];
             int32_t a = 4 * c + local_corner(f->tets + 4 * t, vertex);
             int32_t e = 4 * d + local_corner(f->tets + 4 * u, vertex);
-            if (m.node_parent[a] == m.node_parent[e]) unite(m.up, a, e);
+            if (m.node_parent[a] == m.node_parent[e]) piola__union_find_join(m.up, a, e);
           }
         }
       }
@@ -345,7 +330,7 @@ static piola_status cut_event(piola_world *w, world_body *b, const double point[
     /* number the classes in item order */
     const double *old_rest = piola_elastic_body_rest_positions(old);
     for (int32_t i = 0; i < 4 * nc; ++i) {
-      int32_t r = find(m.up, i);
+      int32_t r = piola__union_find_root(m.up, i);
       if (r == i) {
         int32_t p = m.node_parent[i];
         m.node_of[i] = m.nodes;

@@ -46,6 +46,7 @@
 #include "common/status_report.h"
 #include "force/elastic_body_internal.h"
 #include "force/stiffness_matrix.h"
+#include "sim/obstacle_friction.h"
 #include "sim/world_internal.h"
 
 #define STANDARD_GRAVITY 9.81
@@ -122,6 +123,29 @@ static int has_filtered_nodes(const world_body *s) {
   return 0;
 }
 
+/* ------------------------------------------------------------------ fixed node ranges */
+
+/* The vector passes (the residual, the CG's phases) run over RANGES fixed node ranges, in
+ * parallel from parallel_min nodes on; each range is summed by one thread and the ranges'
+ * sums are added in order, so results do not depend on the thread count. */
+typedef double range_pass(const void *context, int32_t i0, int32_t i1);
+
+static inline int32_t range_start(int32_t n, int range) {
+  return (int32_t)((int64_t)n * range / RANGES);
+}
+
+static double sum_over_ranges(int32_t n, int32_t parallel_min, range_pass *pass,
+                              const void *context) {
+  double part[RANGES];
+#pragma omp parallel for schedule(static) num_threads(piola_thread_count()) \
+    if (n >= parallel_min)
+  for (int range = 0; range < RANGES; ++range)
+    part[range] = pass(context, range_start(n, range), range_start(n, range + 1));
+  double sum = 0;
+  for (int range = 0; range < RANGES; ++range) sum += part[range];
+  return sum;
+}
+
 /* ------------------------------------------------------------------ the step's problem */
 
 typedef struct newton_problem {
@@ -138,39 +162,40 @@ typedef struct newton_problem {
   double total_mass;
 } newton_problem;
 
+/* Nodes i0 .. i1 - 1 of the residual; returns their part of |S g|^2_{M^-1}. */
+static double residual_range(const void *ctx, int32_t i0, int32_t i1) {
+  const newton_problem *pb = ctx;
+  const world_body *s = pb->s;
+  struct implicit_state *st = pb->st;
+  const double w = pb->force_weight;
+  double sum = 0;
+  for (int32_t i = i0; i < i1; ++i) {
+    double *g = st->residual + 3 * i;
+    for (int k = 0; k < 3; ++k) {
+      const int64_t j = 3 * (int64_t)i + k;
+      double f = s->force[j] + s->mass[i] * pb->g1[k] + (pb->damped ? st->damping[j] : 0.0);
+      g[k] = pb->mass_weight * s->mass[i] * (s->x[j] - st->prediction[j]) - w * f;
+    }
+    double gf[3] = {g[0], g[1], g[2]};
+    filter_vector(s, i, gf);
+    sum += s->inverse_mass[i] * (gf[0] * gf[0] + gf[1] * gf[1] + gf[2] * gf[2]);
+  }
+  return sum;
+}
+
 /* The residual g at the body's current state (its last update is at s->x) into
  * st->residual; returns the squared filtered norm |S g|^2_{M^-1}. */
 static double residual(newton_problem *pb) {
   world_body *s = pb->s;
   struct implicit_state *st = pb->st;
   const int32_t n = s->n;
-  const double w = pb->force_weight, inv_dt = 1.0 / pb->dt;
+  const double inv_dt = 1.0 / pb->dt;
   if (pb->damped) {
     double *v = st->scratch_v;
     for (int64_t j = 0; j < 3 * (int64_t)n; ++j) v[j] = (s->x[j] - s->x_old[j]) * inv_dt;
     piola_elastic_body_damping_forces(s->solid, v, pb->beta, pb->alpha, st->damping);
   }
-  double part[RANGES];
-#pragma omp parallel for schedule(static) num_threads(piola_thread_count()) \
-    if (n >= PIOLA_PARALLEL_MIN_VERTICES)
-  for (int r = 0; r < RANGES; ++r) {
-    double sum = 0;
-    for (int32_t i = (int32_t)((int64_t)n * r / RANGES); i < (int32_t)((int64_t)n * (r + 1) / RANGES); ++i) {
-      double *g = st->residual + 3 * i;
-      for (int k = 0; k < 3; ++k) {
-        const int64_t j = 3 * (int64_t)i + k;
-        double f = s->force[j] + s->mass[i] * pb->g1[k] + (pb->damped ? st->damping[j] : 0.0);
-        g[k] = pb->mass_weight * s->mass[i] * (s->x[j] - st->prediction[j]) - w * f;
-      }
-      double gf[3] = {g[0], g[1], g[2]};
-      filter_vector(s, i, gf);
-      sum += s->inverse_mass[i] * (gf[0] * gf[0] + gf[1] * gf[1] + gf[2] * gf[2]);
-    }
-    part[r] = sum;
-  }
-  double sum = 0;
-  for (int r = 0; r < RANGES; ++r) sum += part[r];
-  return sum;
+  return sum_over_ranges(n, PIOLA_PARALLEL_MIN_VERTICES, residual_range, pb);
 }
 
 /* The CG's vector work: one pass per CG phase over the 16 fixed node ranges (in parallel
@@ -185,17 +210,9 @@ typedef struct cg_vectors {
   const world_body *s;
   const piola__stiffness_matrix *mx;
   double *d, *r, *z, *p, *q;
+  const double *g; /* the residual the solve starts from */
+  double alpha;    /* the step length of cg_update_range */
 } cg_vectors;
-
-static inline int32_t range_start(int32_t n, int range) {
-  return (int32_t)((int64_t)n * range / RANGES);
-}
-
-static double sum_parts(const double part[RANGES]) {
-  double sum = 0;
-  for (int k = 0; k < RANGES; ++k) sum += part[k];
-  return sum;
-}
 
 /* z_i = S_i P_i^-1 r_i, P_i the diagonal block; returns r_i . z_i. */
 static inline double precondition_node(const cg_vectors *c, int32_t i) {
@@ -208,61 +225,50 @@ static inline double precondition_node(const cg_vectors *c, int32_t i) {
   return x[0] * y[0] + x[1] * y[1] + x[2] * y[2];
 }
 
-/* d = 0, r = -S g, z = S P^-1 r, p = z; returns r . z. */
-static double cg_start(const cg_vectors *c, const double *g) {
-  const int32_t n = c->s->n;
-  double part[RANGES];
-#pragma omp parallel for schedule(static) num_threads(piola_thread_count()) \
-    if (n >= CG_PARALLEL_MIN_VERTICES)
-  for (int range = 0; range < RANGES; ++range) {
-    double sum = 0;
-    for (int32_t i = range_start(n, range); i < range_start(n, range + 1); ++i) {
-      for (int k = 0; k < 3; ++k) c->d[3 * i + k] = 0, c->r[3 * i + k] = -g[3 * i + k];
-      filter_node(c->s, i, c->r);
-      sum += precondition_node(c, i);
-      for (int k = 0; k < 3; ++k) c->p[3 * i + k] = c->z[3 * i + k];
-    }
-    part[range] = sum;
+/* d = 0, r = -S g, z = S P^-1 r, p = z over nodes i0 .. i1 - 1 (g = c->g);
+ * returns their part of r . z. */
+static double cg_start_range(const void *context, int32_t i0, int32_t i1) {
+  const cg_vectors *c = context;
+  const double *g = c->g;
+  double sum = 0;
+  for (int32_t i = i0; i < i1; ++i) {
+    for (int k = 0; k < 3; ++k) c->d[3 * i + k] = 0, c->r[3 * i + k] = -g[3 * i + k];
+    filter_node(c->s, i, c->r);
+    sum += precondition_node(c, i);
+    for (int k = 0; k < 3; ++k) c->p[3 * i + k] = c->z[3 * i + k];
   }
-  return sum_parts(part);
+  return sum;
 }
 
-/* q = S q (q = A p on entry); returns p . q. */
-static double cg_curvature(const cg_vectors *c) {
-  const int32_t n = c->s->n;
-  double part[RANGES];
-#pragma omp parallel for schedule(static) num_threads(piola_thread_count()) \
-    if (n >= CG_PARALLEL_MIN_VERTICES)
-  for (int range = 0; range < RANGES; ++range) {
-    double sum = 0;
-    for (int32_t i = range_start(n, range); i < range_start(n, range + 1); ++i) {
-      filter_node(c->s, i, c->q);
-      const double *p = c->p + 3 * i, *q = c->q + 3 * i;
-      sum += p[0] * q[0] + p[1] * q[1] + p[2] * q[2];
-    }
-    part[range] = sum;
+/* q = S q (q = A p on entry); returns this range's part of p . q. */
+static double cg_curvature_range(const void *context, int32_t i0, int32_t i1) {
+  const cg_vectors *c = context;
+  double sum = 0;
+  for (int32_t i = i0; i < i1; ++i) {
+    filter_node(c->s, i, c->q);
+    const double *p = c->p + 3 * i, *q = c->q + 3 * i;
+    sum += p[0] * q[0] + p[1] * q[1] + p[2] * q[2];
   }
-  return sum_parts(part);
+  return sum;
 }
 
-/* d += a p, r -= a q, z = S P^-1 r; returns r . z. */
-static double cg_update(const cg_vectors *c, double a) {
-  const int32_t n = c->s->n;
-  double part[RANGES];
-#pragma omp parallel for schedule(static) num_threads(piola_thread_count()) \
-    if (n >= CG_PARALLEL_MIN_VERTICES)
-  for (int range = 0; range < RANGES; ++range) {
-    double sum = 0;
-    for (int32_t i = range_start(n, range); i < range_start(n, range + 1); ++i) {
-      for (int k = 0; k < 3; ++k) {
-        c->d[3 * i + k] += a * c->p[3 * i + k];
-        c->r[3 * i + k] -= a * c->q[3 * i + k];
-      }
-      sum += precondition_node(c, i);
+/* d += a p, r -= a q, z = S P^-1 r (a in c->alpha); returns this range's part of r . z. */
+static double cg_update_range(const void *context, int32_t i0, int32_t i1) {
+  const cg_vectors *c = context;
+  const double a = c->alpha;
+  double sum = 0;
+  for (int32_t i = i0; i < i1; ++i) {
+    for (int k = 0; k < 3; ++k) {
+      c->d[3 * i + k] += a * c->p[3 * i + k];
+      c->r[3 * i + k] -= a * c->q[3 * i + k];
     }
-    part[range] = sum;
+    sum += precondition_node(c, i);
   }
-  return sum_parts(part);
+  return sum;
+}
+
+static double cg_pass(const cg_vectors *c, range_pass *pass) {
+  return sum_over_ranges(c->s->n, CG_PARALLEL_MIN_VERTICES, pass, c);
 }
 
 /* p = z + b p. */
@@ -280,15 +286,16 @@ static int32_t solve_newton_system(newton_problem *pb) {
   const int32_t n = s->n;
   const double mass_weight = pb->mass_weight + s->quasistatic_mu;
   double *d = st->step;
-  const cg_vectors c = {s, &st->matrix, d, st->cg[0], st->cg[1], st->cg[2], st->cg[3]};
-  double rz = cg_start(&c, st->residual);
+  cg_vectors c = {s, &st->matrix, d, st->cg[0], st->cg[1], st->cg[2], st->cg[3], st->residual, 0};
+  double rz = cg_pass(&c, cg_start_range);
   const double stop = pb->w->def.linear_tolerance * pb->w->def.linear_tolerance * rz;
   int32_t it = 0;
   while (rz > stop && rz > 0 && it < pb->w->def.linear_max_iterations) {
     piola__stiffness_matrix_apply(c.mx, s->solid, s->mass, mass_weight, c.p, c.q);
-    const double pq = cg_curvature(&c);
+    const double pq = cg_pass(&c, cg_curvature_range);
     if (!(pq > 0)) break;
-    const double rz_new = cg_update(&c, rz / pq);
+    c.alpha = rz / pq;
+    const double rz_new = cg_pass(&c, cg_update_range);
     cg_direction(&c, rz_new / rz);
     rz = rz_new;
     ++it;
@@ -368,26 +375,11 @@ static int32_t contact_friction(newton_problem *pb) {
     const double *g = pb->st->residual + 3 * i, *nrm = s->normals + 3 * i;
     double dvn = (g[0] * nrm[0] + g[1] * nrm[1] + g[2] * nrm[2]) / (pb->dt * s->mass[i]);
     if (!(dvn > 0)) continue;
-    piola_vec3 p = {s->x[3 * i], s->x[3 * i + 1], s->x[3 * i + 2]};
-    double best = INFINITY, mu = 0;
-    piola_vec3 vo = {0, 0, 0};
-    for (int32_t o = 0; o < w->obstacle_count; ++o) {
-      piola_vec3 vel;
-      double phi = fabs(piola_obstacle_signed_distance(w->obstacles[o], pb->t1, p, NULL, &vel));
-      if (phi < best) best = phi, mu = piola_obstacle_friction(w->obstacles[o]), vo = vel;
-    }
-    if (!(mu > 0)) continue;
-    double *vi = s->v + 3 * i;
-    double rel[3] = {vi[0] - vo.x, vi[1] - vo.y, vi[2] - vo.z};
-    double rn = rel[0] * nrm[0] + rel[1] * nrm[1] + rel[2] * nrm[2];
-    double vt[3] = {rel[0] - rn * nrm[0], rel[1] - rn * nrm[1], rel[2] - rn * nrm[2]};
-    double vtn = sqrt(vt[0] * vt[0] + vt[1] * vt[1] + vt[2] * vt[2]);
-    if (!(vtn > 0)) continue;
-    double keep = fmax(0.0, 1.0 - mu * dvn / vtn);
-    for (int k = 0; k < 3; ++k) {
-      vi[k] -= (1.0 - keep) * vt[k];
-      s->x[3 * i + k] = s->x_old[3 * i + k] + pb->dt * vi[k];
-    }
+    piola_vec3 p = {s->x[3 * i], s->x[3 * i + 1], s->x[3 * i + 2]}, vo;
+    double mu, *vi = s->v + 3 * i;
+    piola__nearest_obstacle_motion(w->obstacles, w->obstacle_count, pb->t1, p, &mu, &vo);
+    if (!piola__coulomb_limit(vi, vo, nrm, mu, dvn)) continue;
+    for (int k = 0; k < 3; ++k) s->x[3 * i + k] = s->x_old[3 * i + k] + pb->dt * vi[k];
     changed++;
   }
   return changed;
@@ -571,15 +563,6 @@ static piola_status newton_iterate(const newton_problem *problem, int accept_unc
   return PIOLA_OK;
 }
 
-static void restore(world_body *s, double t) {
-  size_t v3 = 3 * (size_t)s->n * sizeof(double);
-  s->product_valid = 0;
-  memcpy(s->x, s->x_old, v3);
-  memcpy(s->v, s->v_old, v3);
-  memcpy(s->force, s->force_old, v3);
-  (void)piola__body_update_forces(s, t);
-}
-
 /* Contacts between bodies (self_collision) are resolved after the Newton solves by the
  * collision pass (contact.md), which changes the velocities of surface nodes only. A Newmark
  * step is short enough for the elastic forces to carry that change inwards before the next
@@ -663,7 +646,7 @@ piola_status piola__implicit_world_step(piola_world *w, double dt_limit, piola_s
     for (; done < w->body_count && st == PIOLA_OK; ++done)
       st = newton_solid(w, &w->bodies[done], w->time, dt, halvings == MAX_HALVINGS, &local);
     if (st == PIOLA_OK) break;
-    for (int32_t j = 0; j < done; ++j) restore(&w->bodies[j], w->time);
+    for (int32_t j = 0; j < done; ++j) piola__body_restore_step(&w->bodies[j], w->time);
     if (st != PIOLA_ERROR_NOT_CONVERGED) {
       if (stats) *stats = local;
       return st;
@@ -674,7 +657,7 @@ piola_status piola__implicit_world_step(piola_world *w, double dt_limit, piola_s
   const int closes = dt >= left || dt == w->collision_deadline - w->time;
   piola_status contact = self_collide_and_resolve(w, dt, closes, &local);
   if (contact != PIOLA_OK) {
-    for (int32_t j = 0; j < w->body_count; ++j) restore(&w->bodies[j], w->time);
+    for (int32_t j = 0; j < w->body_count; ++j) piola__body_restore_step(&w->bodies[j], w->time);
     if (stats) *stats = local;
     return contact;
   }

@@ -22,6 +22,7 @@
 #include "force/stable_step.h"
 #include "math/mat3.h"
 #include "sim/conjugate_gradient.h"
+#include "sim/obstacle_friction.h"
 #include "sim/world_internal.h"
 
 int piola__step_reuse_first_product = 1;
@@ -173,22 +174,10 @@ static void contact_friction(const piola_world *w, world_body *s, double t1, dou
     double dvn = -push / s->mass[i];
     if (!(dvn > 0)) continue;
     /* the obstacle the node touches: the one nearest to it */
-    piola_vec3 p = {s->x[3 * i], s->x[3 * i + 1], s->x[3 * i + 2]};
-    double best = INFINITY, mu = 0;
-    piola_vec3 vo = {0, 0, 0};
-    for (int32_t o = 0; o < w->obstacle_count; ++o) {
-      piola_vec3 vel;
-      double phi = fabs(piola_obstacle_signed_distance(w->obstacles[o], t1, p, NULL, &vel));
-      if (phi < best) best = phi, mu = piola_obstacle_friction(w->obstacles[o]), vo = vel;
-    }
-    if (!(mu > 0)) continue;
-    double rel[3] = {vi[0] - vo.x, vi[1] - vo.y, vi[2] - vo.z};
-    double rn = rel[0] * nrm[0] + rel[1] * nrm[1] + rel[2] * nrm[2];
-    double vt[3] = {rel[0] - rn * nrm[0], rel[1] - rn * nrm[1], rel[2] - rn * nrm[2]};
-    double vtn = sqrt(vt[0] * vt[0] + vt[1] * vt[1] + vt[2] * vt[2]);
-    if (!(vtn > 0)) continue;
-    double keep = fmax(0.0, 1.0 - mu * dvn / vtn);
-    for (int k = 0; k < 3; ++k) vi[k] -= (1.0 - keep) * vt[k];
+    piola_vec3 p = {s->x[3 * i], s->x[3 * i + 1], s->x[3 * i + 2]}, vo;
+    double mu;
+    piola__nearest_obstacle_motion(w->obstacles, w->obstacle_count, t1, p, &mu, &vo);
+    (void)piola__coulomb_limit(vi, vo, nrm, mu, dvn);
   }
 }
 
@@ -214,15 +203,6 @@ double piola_world_stable_dt(const piola_world *w) {
 
 static void gravity_at(const piola_world *w, double t, double g[3]) {
   for (int k = 0; k < 3; ++k) g[k] = piola_track_eval(&w->def.gravity[k], t);
-}
-
-static void restore(world_body *s, double t) {
-  size_t v3 = 3 * (size_t)s->n * sizeof(double);
-  s->product_valid = 0;
-  memcpy(s->x, s->x_old, v3);
-  memcpy(s->v, s->v_old, v3);
-  memcpy(s->force, s->force_old, v3);
-  (void)piola__body_update_forces(s, t);
 }
 
 static piola_status step_body(piola_world *w, world_body *s, double t, double dt,
@@ -339,7 +319,7 @@ static piola_status step_body(piola_world *w, world_body *s, double t, double dt
   /* F, diagonalization and elastic force at x^n+1, once per step */
   piola_status st = piola__body_update_forces(s, t1);
   if (st != PIOLA_OK) {
-    restore(s, t);
+    piola__body_restore_step(s, t);
     return st;
   }
   piola__body_plastic_in_step(s, dt);
@@ -425,7 +405,7 @@ static piola_status step_body(piola_world *w, world_body *s, double t, double dt
     driven |= driven_part[r];
     gain += gain_part[r], fm += fm_part[r], mdx += mdx_part[r], mv += mv_part[r], mdv += mdv_part[r];
     if (bad_part[r] >= 0) {
-      restore(s, t);
+      piola__body_restore_step(s, t);
       return PIOLA_FAIL(PIOLA_ERROR_NOT_FINITE,
                         "%s '%s': velocity of vertex %lld became non-finite at t = %g s",
                         piola__body_kind_name(s->kind), s->name,
@@ -435,7 +415,7 @@ static piola_status step_body(piola_world *w, world_body *s, double t, double dt
     force2 += force2_part[r];
   }
   if (!isfinite(kinetic) || !isfinite(force2)) {
-    restore(s, t);
+    piola__body_restore_step(s, t);
     return PIOLA_FAIL(PIOLA_ERROR_NOT_FINITE,
                       "%s '%s': the %s became non-finite at t = %g s (the state blew up)",
                       piola__body_kind_name(s->kind), s->name, isfinite(kinetic) ? "elastic force's squared norm" : "kinetic energy", t1);
@@ -486,7 +466,7 @@ static void note_small_step(piola_world *w) {
 }
 
 static void restore_all(piola_world *w, int32_t count) {
-  for (int32_t j = 0; j < count; ++j) restore(&w->bodies[j], w->time);
+  for (int32_t j = 0; j < count; ++j) piola__body_restore_step(&w->bodies[j], w->time);
 }
 
 /* One try at a step of dt from the current state; on failure every body is back at the

@@ -28,6 +28,11 @@ static piola_world *block(piola_material_model model, double stretch, double vis
   sd.material.model = model;
   sd.material.youngs_modulus = 1e4;
   sd.material.poisson_ratio = 0.3;
+  /* the setting these checks were measured with (the default before issue 19 item 4): the
+   * unstable runs reach the threshold, and CLAMP's energy (neo-Hookean's default now) is not
+   * the potential of its stress there, so the check catches less of the blow-up */
+  sd.material.inversion_mode = PIOLA_INVERSION_LINEAR;
+  sd.material.inversion_threshold = 0.3;
   sd.density = 1000;
   sd.shear_viscosity = piola_track_constant(viscosity);
   sd.bulk_viscosity = piola_track_constant(viscosity);

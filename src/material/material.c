@@ -40,13 +40,13 @@ piola_material_def piola_default_material_def(void) {
  * (docs/materials.md, "Defaults that recover"): the setting that recovered from the most
  * scrambles of bench/bench_scramble_recovery's grid, then the fewest stuck (not merely slow),
  * then the smaller threshold, then LINEAR over CLAMP; thresholds up to 0.5, and below the
- * stretches of the model's own reference use: Mooney-Rivlin and Ogden stay at 0.3 because
- * rubber in uniaxial tension to 7.6x (Treloar) has lateral stretches of 0.36, which 0.5 would
- * replace (tests/test_material_rubber.c); they recover fewer scrambles there. Every one recovers
- * from point, line and plane collapse (tests/test_default_inversion.c). HGO (not measured on
- * scrambles: its fibres make the grid's runs too long) takes neo-Hookean's best mode at 0.3:
- * the wall of an inflated artery reaches radial stretches of 0.33-0.45, where 0.5 would
- * replace the model (tests/test_material_hgo.c, the inflation curve). */
+ * stretches of the model's own reference use. Mooney-Rivlin and Ogden (rubber in uniaxial
+ * tension to 7.6x has lateral stretches of 0.36, tests/test_material_rubber.c) and HGO (an
+ * inflated artery's wall reaches radial stretches of 0.33-0.45, tests/test_material_hgo.c)
+ * stay at 0.3, and there with LINEAR: CLAMP at 0.3 recovers more scrambles, but its zero
+ * slope past the threshold left backward Euler unable to recover a Mooney-Rivlin ball from a
+ * point (tests/test_backward_euler_recovery.c). Every default recovers from point, line and
+ * plane collapse (tests/test_default_inversion.c). */
 static const struct {
   piola_inversion_mode mode;
   double threshold;
@@ -58,9 +58,9 @@ static const struct {
     [PIOLA_MODEL_SPLINE] = {PIOLA_INVERSION_CLAMP, 0.3},
     [PIOLA_MODEL_MUSCLE] = {PIOLA_INVERSION_CLAMP, 0.5},
     [PIOLA_MODEL_STABLE_NEOHOOKEAN] = {PIOLA_INVERSION_CLAMP, 0.3},
-    [PIOLA_MODEL_MOONEY_RIVLIN] = {PIOLA_INVERSION_CLAMP, 0.3},
-    [PIOLA_MODEL_OGDEN] = {PIOLA_INVERSION_CLAMP, 0.3},
-    [PIOLA_MODEL_HGO] = {PIOLA_INVERSION_CLAMP, 0.3},
+    [PIOLA_MODEL_MOONEY_RIVLIN] = {PIOLA_INVERSION_LINEAR, 0.3},
+    [PIOLA_MODEL_OGDEN] = {PIOLA_INVERSION_LINEAR, 0.3},
+    [PIOLA_MODEL_HGO] = {PIOLA_INVERSION_LINEAR, 0.3},
 };
 
 void piola_material_default_inversion(piola_material_model model, piola_inversion_mode *mode,

@@ -18,6 +18,12 @@ void block_mesh_free(piola_tet_mesh *m);
  * about the rest centroid. */
 piola_world *deformed_block_world(piola_material_model model, int n, piola_mat3 initial,
                                   double viscosity, double cfl, int32_t cg_max_iterations);
+/* The same with the material's inversion mode and threshold set (the other is the model's
+ * default where mode is PIOLA_INVERSION_MODEL_DEFAULT or threshold 0). */
+piola_world *deformed_block_world_inverting(piola_material_model model, piola_inversion_mode mode,
+                                            double threshold, int n, piola_mat3 initial,
+                                            double viscosity, double cfl,
+                                            int32_t cg_max_iterations);
 
 /* Linear momentum p (kg m/s), angular momentum l about the origin (kg m^2/s) and, when
  * kinetic is not NULL, the kinetic energy (J) of solid 0. */

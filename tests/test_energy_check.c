@@ -25,7 +25,11 @@ static double total_energy(const piola_world *w) {
 static double peak_energy(piola_material_model model, double cfl, double viscosity, int steps,
                           int *redos) {
   const piola_mat3 stretch = {{{1.2, 0, 0}, {0, 1, 0}, {0, 0, 1}}};
-  piola_world *w = deformed_block_world(model, 4, stretch, viscosity, cfl, 0);
+  /* the setting these checks were measured with (the default before issue 19 item 4): the
+   * unstable runs reach the threshold, and CLAMP's energy (neo-Hookean's default now) is not
+   * the potential of its stress there, so the check catches less of the blow-up */
+  piola_world *w = deformed_block_world_inverting(model, PIOLA_INVERSION_LINEAR, 0.3, 4, stretch,
+                                                  viscosity, cfl, 0);
   const double e0 = total_energy(w);
   double peak = e0;
   *redos = 0;

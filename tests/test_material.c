@@ -601,7 +601,7 @@ static void invalid_parameters_are_rejected_by_name(void **state) {
   d = base, d.poisson_ratio = 0.5, expect_rejected(d, "poisson_ratio", "0.5");
   d = base, d.poisson_ratio = -1.0, expect_rejected(d, "poisson_ratio", "-1");
   d = base, d.poisson_ratio = NAN, expect_rejected(d, "poisson_ratio", "nan");
-  d = base, d.inversion_threshold = 0.0, expect_rejected(d, "inversion.threshold", "0");
+  d = base, d.inversion_threshold = -0.1, expect_rejected(d, "inversion.threshold", "-0.1");
   d = base, d.inversion_threshold = 1.0, expect_rejected(d, "inversion.threshold", "1");
   d = base, d.inversion_threshold = -INFINITY, expect_rejected(d, "inversion.threshold", "inf");
   d = base, d.inversion_mode = (piola_inversion_mode)7, expect_rejected(d, "inversion.mode", "7");
@@ -648,6 +648,9 @@ static void names_and_lame_parameters_round_trip(void **state) {
               parsed_mode == PIOLA_INVERSION_ENERGY);
   assert_string_equal(piola_material_model_name(PIOLA_MODEL_STABLE_NEOHOOKEAN), "stable_neohookean");
   assert_false(piola_inversion_mode_from_name("C1", &parsed_mode));
+  assert_true(piola_inversion_mode_from_name("default", &parsed_mode) &&
+              parsed_mode == PIOLA_INVERSION_MODEL_DEFAULT);
+  assert_string_equal(piola_inversion_mode_name(PIOLA_INVERSION_MODEL_DEFAULT), "default");
 
   const double nus[] = {-0.9, -0.1, 0.0, 0.3, 0.499};
   for (size_t n = 0; n < sizeof nus / sizeof nus[0]; ++n) {

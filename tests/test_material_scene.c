@@ -46,7 +46,7 @@ static void keys_reach_their_definitions(void **state) {
 
 static const bad_scene_case BAD[] = {
     {SOLID("{\"inversion\": {\"mode\": \"energetic\"}}"),
-     "solids[0].material.inversion.mode: must be \"linear\", \"clamp\" or \"energy\""},
+     "solids[0].material.inversion.mode: must be \"linear\", \"clamp\", \"energy\" or \"default\""},
     {SOLID("{\"model\": \"stable-neohookean\"}"), "solids[0].material.model: must be one of"},
     {SOLID("{\"ogden\": {\"mu\": [1], \"alpha\": [2]}}"),
      "solids[0].material.ogden: needs \"model\": \"ogden\""},

@@ -7,13 +7,14 @@
  *
  * Inversion extension: below the compression threshold c on any entry of Fhat the model is
  * replaced, in that entry, by its value at the clamped point (PIOLA_INVERSION_CLAMP, C0) or
- * by its first-order Taylor expansion around the clamped point (PIOLA_INVERSION_LINEAR, C1,
- * the default), continued through zero into negative (inverted) entries, with the slope
+ * by its first-order Taylor expansion around the clamped point (PIOLA_INVERSION_LINEAR, C1),
+ * continued through zero into negative (inverted) entries, with the slope
  * relaxing towards at most the rest stiffness and the cross terms into unclamped entries
  * saturating away from the threshold (exact Taylor value and slope at it); all entries below
- * c are expanded together. Neo-Hookean bodies that may start scrambled or tangled should use
- * threshold 0.5 or CLAMP: with LINEAR at 0.3 they can stop in a tangled equilibrium
- * (docs/materials.md). In clamped entries the slope is raised where the plain expansion
+ * c are expanded together. Each model has its own default mode and threshold
+ * (piola_material_default_inversion), chosen so that a scrambled or collapsed body recovers
+ * (docs/materials.md, "Defaults that recover"). In clamped entries the slope is raised where
+ * the plain expansion
  * would not push back (e.g. St. Venant-Kirchhoff, whose own slope there is negative), so the
  * result is finite for every Fhat with entries up to 1e30 in magnitude (flat, collapsed and
  * inverted included; only the models' own growth, e.g. corotated's energy ~ f^6, overflows
@@ -67,10 +68,13 @@ typedef enum piola_material_model {
 } piola_material_model;
 
 typedef enum piola_inversion_mode {
-  PIOLA_INVERSION_LINEAR = 0, /* C1: first-order Taylor expansion at the threshold (default) */
+  PIOLA_INVERSION_LINEAR = 0, /* C1: first-order Taylor expansion at the threshold */
   PIOLA_INVERSION_CLAMP,      /* C0: the stress at the clamped point */
   PIOLA_INVERSION_ENERGY,     /* the energy extended past the threshold (Stomakhin, Howes,
                                  Schroeder, Teran 2012): the stress is its exact gradient */
+  PIOLA_INVERSION_MODEL_DEFAULT, /* in a piola_material_def only: the model's default mode
+                                    (piola_material_default_inversion); never in an
+                                    initialized piola_material */
 } piola_inversion_mode;
 
 /* Shape of the spline ("biological") model: soft near rest, stiffer past the thresholds. */
@@ -154,8 +158,11 @@ typedef struct piola_material_def {
   piola_material_model model;
   double youngs_modulus;      /* Pa, > 0. Default 1e5 */
   double poisson_ratio;       /* dimensionless, in (-1, 0.5). Default 0.3 */
-  double inversion_threshold; /* dimensionless, in (0, 1): compression threshold c. Default 0.3 */
-  piola_inversion_mode inversion_mode; /* Default PIOLA_INVERSION_LINEAR */
+  double inversion_threshold; /* dimensionless, in (0, 1): compression threshold c, or 0
+                                 (default): the model's default threshold */
+  piola_inversion_mode inversion_mode; /* Default PIOLA_INVERSION_MODEL_DEFAULT: the model's
+                                          default mode. The defaults of both per model:
+                                          piola_material_default_inversion */
   piola_spline_def spline;    /* used by PIOLA_MODEL_SPLINE only */
   piola_ogden_def ogden;      /* used by PIOLA_MODEL_OGDEN only */
   piola_mooney_rivlin_def mooney_rivlin; /* used by PIOLA_MODEL_MOONEY_RIVLIN only */
@@ -168,6 +175,13 @@ typedef struct piola_material_def {
 
 /* The defaults above, written once. */
 PIOLA_API piola_material_def piola_default_material_def(void);
+
+/* The inversion mode and threshold (dimensionless) that a model gets when its def leaves them
+ * at their defaults (PIOLA_INVERSION_MODEL_DEFAULT, 0): per model, the setting measured to
+ * recover from the most scrambles and from point, line and plane collapse
+ * (docs/materials.md, "Defaults that recover"). */
+PIOLA_API void piola_material_default_inversion(piola_material_model model,
+                                                piola_inversion_mode *mode, double *threshold);
 
 /* Young's modulus (Pa) and Poisson's ratio from Lame parameters mu, lambda (Pa). */
 PIOLA_API piola_status piola_youngs_poisson_from_lame(double mu, double lambda,
@@ -301,10 +315,11 @@ PIOLA_API const char *piola_material_model_name(piola_material_model model);
 /* Parses a scene-file name; false if unknown. */
 PIOLA_API bool piola_material_model_from_name(const char *name, piola_material_model *model);
 
-/* Name used in scene files for the inversion mode: "linear" (C1), "clamp" (C0) or "energy". */
+/* Name used in scene files for the inversion mode: "linear" (C1), "clamp" (C0), "energy", or
+ * "default" (PIOLA_INVERSION_MODEL_DEFAULT). */
 PIOLA_API const char *piola_inversion_mode_name(piola_inversion_mode mode);
 
-/* Parses "linear", "clamp" or "energy"; false if unknown. */
+/* Parses "linear", "clamp", "energy" or "default"; false if unknown. */
 PIOLA_API bool piola_inversion_mode_from_name(const char *name, piola_inversion_mode *mode);
 
 /* ------------------------------------------------------------------ membrane models (shells) */

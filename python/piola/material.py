@@ -49,8 +49,10 @@ class Material:
     """A constitutive model (docs/materials.md), extended through inversion.
 
     Material(model="neohookean", youngs_modulus=1e5 Pa, poisson_ratio=0.3,
-             inversion_threshold=0.3, inversion_mode="linear", spline=None, muscle=None,
+             inversion_threshold=0, inversion_mode="default", spline=None, muscle=None,
              ogden=None, mooney_rivlin=None, hgo=None)
+    inversion_threshold 0 and inversion_mode "default" take the model's own defaults
+    (docs/materials.md, "Defaults that recover"); the properties give the values in force.
     `spline`, `muscle`, `ogden`, `mooney_rivlin` and `hgo` are dicts with the scene keys of
     docs/scene-format.md, each for its own model only. Invalid parameters raise ValueError
     naming the parameter."""
@@ -89,8 +91,10 @@ class Material:
     model = property(lambda self: self._def[0], doc="model name")
     youngs_modulus = property(lambda self: self._def[1], doc="Pa")
     poisson_ratio = property(lambda self: self._def[2], doc="dimensionless")
-    inversion_threshold = property(lambda self: self._def[3], doc="dimensionless")
-    inversion_mode = property(lambda self: self._def[4], doc="'linear', 'clamp' or 'energy'")
+    inversion_threshold = property(lambda self: self._lame["threshold"],
+                                   doc="dimensionless, in force (the model's default if unset)")
+    inversion_mode = property(lambda self: self._lame["inversion_mode"],
+                              doc="'linear', 'clamp' or 'energy', in force")
     mu = property(lambda self: self._lame["mu"], doc="shear modulus (Lame mu), Pa")
     lam = property(lambda self: self._lame["lambda"], doc="Lame lambda, Pa")
 

@@ -19,8 +19,10 @@ static PyObject *material_check(PyObject *self, PyObject *args) {
   if (!PyArg_ParseTuple(args, "O&", pypiola_material_converter, &def)) return NULL;
   piola_material mat;
   if (init_material(&def, &mat) < 0) return NULL;
-  return Py_BuildValue("{s:d,s:d,s:d}", "mu", mat.mu, "lambda", mat.lambda, "fiber_modulus",
-                       mat.fiber_modulus);
+  /* threshold and mode as resolved: a def left at "default" gets the model's own */
+  return Py_BuildValue("{s:d,s:d,s:d,s:d,s:s}", "mu", mat.mu, "lambda", mat.lambda,
+                       "fiber_modulus", mat.fiber_modulus, "threshold", mat.threshold,
+                       "inversion_mode", piola_inversion_mode_name(mat.inversion_mode));
 }
 
 /* out = U diag-or-full(phat) V^T */

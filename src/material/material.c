@@ -18,8 +18,8 @@ piola_material_def piola_default_material_def(void) {
   def.model = PIOLA_MODEL_NEOHOOKEAN;
   def.youngs_modulus = 1e5;
   def.poisson_ratio = 0.3;
-  def.inversion_threshold = 0.3;
-  def.inversion_mode = PIOLA_INVERSION_LINEAR;
+  def.inversion_threshold = 0.0; /* the model's default, resolved by piola_material_init */
+  def.inversion_mode = PIOLA_INVERSION_MODEL_DEFAULT;
   def.spline.compression_stretch = 0.8;
   def.spline.elongation_stretch = 1.2;
   def.spline.stiffening = 10.0;
@@ -34,6 +34,40 @@ piola_material_def piola_default_material_def(void) {
   def.mooney_rivlin.c01 = 5e3;
   def.hgo = piola__default_hgo_def();
   return def;
+}
+
+/* Per model, the inversion setting a default def gets, chosen from measurements
+ * (docs/materials.md, "Defaults that recover"): the setting that recovered from the most
+ * scrambles of bench/bench_scramble_recovery's grid, then the fewest stuck (not merely slow),
+ * then the smaller threshold, then LINEAR over CLAMP; thresholds up to 0.5, and below the
+ * stretches of the model's own reference use. Mooney-Rivlin and Ogden (rubber in uniaxial
+ * tension to 7.6x has lateral stretches of 0.36, tests/test_material_rubber.c) and HGO (an
+ * inflated artery's wall reaches radial stretches of 0.33-0.45, tests/test_material_hgo.c)
+ * stay at 0.3, and there with LINEAR: CLAMP at 0.3 recovers more scrambles, but its zero
+ * slope past the threshold left backward Euler unable to recover a Mooney-Rivlin ball from a
+ * point (tests/test_backward_euler_recovery.c). Every default recovers from point, line and
+ * plane collapse (tests/test_default_inversion.c). */
+static const struct {
+  piola_inversion_mode mode;
+  double threshold;
+} model_default_inversion[PIOLA_MODEL_COUNT] = {
+    [PIOLA_MODEL_ROTATED_LINEAR] = {PIOLA_INVERSION_CLAMP, 0.3},
+    [PIOLA_MODEL_COROTATED] = {PIOLA_INVERSION_CLAMP, 0.4},
+    [PIOLA_MODEL_STVK] = {PIOLA_INVERSION_LINEAR, 0.4},
+    [PIOLA_MODEL_NEOHOOKEAN] = {PIOLA_INVERSION_CLAMP, 0.5},
+    [PIOLA_MODEL_SPLINE] = {PIOLA_INVERSION_CLAMP, 0.3},
+    [PIOLA_MODEL_MUSCLE] = {PIOLA_INVERSION_CLAMP, 0.5},
+    [PIOLA_MODEL_STABLE_NEOHOOKEAN] = {PIOLA_INVERSION_CLAMP, 0.3},
+    [PIOLA_MODEL_MOONEY_RIVLIN] = {PIOLA_INVERSION_LINEAR, 0.3},
+    [PIOLA_MODEL_OGDEN] = {PIOLA_INVERSION_LINEAR, 0.3},
+    [PIOLA_MODEL_HGO] = {PIOLA_INVERSION_LINEAR, 0.3},
+};
+
+void piola_material_default_inversion(piola_material_model model, piola_inversion_mode *mode,
+                                      double *threshold) {
+  const int known = (int)model >= 0 && model < PIOLA_MODEL_COUNT;
+  if (mode) *mode = known ? model_default_inversion[model].mode : PIOLA_INVERSION_LINEAR;
+  if (threshold) *threshold = known ? model_default_inversion[model].threshold : 0.3;
 }
 
 piola_status piola_youngs_poisson_from_lame(double mu, double lambda, double *youngs_modulus,
@@ -113,10 +147,16 @@ piola_status piola_material_init(const piola_material_def *def, piola_material *
     return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "model: unknown material model %d",
                       (int)def->model);
   if (def->inversion_mode != PIOLA_INVERSION_LINEAR && def->inversion_mode != PIOLA_INVERSION_CLAMP &&
-      def->inversion_mode != PIOLA_INVERSION_ENERGY)
+      def->inversion_mode != PIOLA_INVERSION_ENERGY &&
+      def->inversion_mode != PIOLA_INVERSION_MODEL_DEFAULT)
     return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "inversion.mode: unknown mode %d",
                       (int)def->inversion_mode);
-  const double e = def->youngs_modulus, nu = def->poisson_ratio, c = def->inversion_threshold;
+  piola_inversion_mode mode;
+  double default_threshold;
+  piola_material_default_inversion(def->model, &mode, &default_threshold);
+  if (def->inversion_mode != PIOLA_INVERSION_MODEL_DEFAULT) mode = def->inversion_mode;
+  const double e = def->youngs_modulus, nu = def->poisson_ratio;
+  const double c = def->inversion_threshold == 0.0 ? default_threshold : def->inversion_threshold;
   /* the Ogden models and HGO take their shear modulus from their own parameters */
   const int own_shear = def->model == PIOLA_MODEL_OGDEN || def->model == PIOLA_MODEL_MOONEY_RIVLIN ||
                         def->model == PIOLA_MODEL_HGO;
@@ -129,7 +169,8 @@ piola_status piola_material_init(const piola_material_def *def, piola_material *
     return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "poisson_ratio must be in (-1, 0.5), got %g",
                       nu);
   if (!(c > 0.0 && c < 1.0))
-    return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "inversion.threshold must be in (0, 1), got %g",
+    return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT,
+                      "inversion.threshold must be in (0, 1) (or 0 for the model's default), got %g",
                       c);
 
   piola_material m;
@@ -138,7 +179,7 @@ piola_status piola_material_init(const piola_material_def *def, piola_material *
   m.mu = e / (2.0 * (1.0 + nu));
   m.lambda = e * nu / ((1.0 + nu) * (1.0 - 2.0 * nu));
   m.threshold = c;
-  m.inversion_mode = def->inversion_mode;
+  m.inversion_mode = mode;
 
   if (def->model == PIOLA_MODEL_SPLINE) {
     const double a = def->spline.compression_stretch, b = def->spline.elongation_stretch;
@@ -199,6 +240,8 @@ const char *piola_inversion_mode_name(piola_inversion_mode mode) {
       return "clamp";
     case PIOLA_INVERSION_ENERGY:
       return "energy";
+    case PIOLA_INVERSION_MODEL_DEFAULT:
+      return "default";
     default:
       return "unknown";
   }
@@ -212,6 +255,8 @@ bool piola_inversion_mode_from_name(const char *name, piola_inversion_mode *mode
     *mode = PIOLA_INVERSION_CLAMP;
   else if (strcmp(name, "energy") == 0)
     *mode = PIOLA_INVERSION_ENERGY;
+  else if (strcmp(name, "default") == 0)
+    *mode = PIOLA_INVERSION_MODEL_DEFAULT;
   else
     return false;
   return true;

@@ -108,7 +108,8 @@ piola_status piola__scene_parse_material(scene_parser *p, const cJSON *obj, scen
       size_t o2 = piola__json_push_key(p, "mode");
       if (!cJSON_IsString(mode) ||
           !piola_inversion_mode_from_name(mode->valuestring, &m->inversion_mode))
-        return piola__json_fail(p, BAD_VALUE, "must be \"linear\", \"clamp\" or \"energy\"");
+        return piola__json_fail(p, BAD_VALUE,
+                                "must be \"linear\", \"clamp\", \"energy\" or \"default\"");
       piola__json_pop(p, o2);
     }
     piola__json_pop(p, old);

@@ -67,8 +67,14 @@ static piola_status check_shell_def(const piola_shell_def *def, int32_t id) {
  * state, constraints, the initial state and its forces. */
 static piola_status fill_shell(piola_world *world, world_body *s, const piola_shell_def *def,
                                int32_t id) {
+  /* The per-model inversion defaults (piola_material_default_inversion) were chosen from
+   * measurements on solids; a shell's membrane keeps LINEAR at 0.3 where its def leaves them
+   * unset (docs/shells.md). */
+  piola_material_def mdef = def->material;
+  if (mdef.inversion_mode == PIOLA_INVERSION_MODEL_DEFAULT) mdef.inversion_mode = PIOLA_INVERSION_LINEAR;
+  if (mdef.inversion_threshold == 0.0) mdef.inversion_threshold = 0.3;
   piola_material material;
-  PIOLA_TRY(piola_material_init(&def->material, &material));
+  PIOLA_TRY(piola_material_init(&mdef, &material));
   piola_shell_body_def bdef = piola_default_shell_body_def();
   bdef.rest_mesh = def->mesh;
   bdef.materials = &material;

@@ -20,6 +20,14 @@ void block_mesh_free(piola_tet_mesh *m) {
 
 piola_world *deformed_block_world(piola_material_model model, int n, piola_mat3 initial,
                                   double viscosity, double cfl, int32_t cg_max_iterations) {
+  return deformed_block_world_inverting(model, PIOLA_INVERSION_MODEL_DEFAULT, 0, n, initial,
+                                        viscosity, cfl, cg_max_iterations);
+}
+
+piola_world *deformed_block_world_inverting(piola_material_model model, piola_inversion_mode mode,
+                                            double threshold, int n, piola_mat3 initial,
+                                            double viscosity, double cfl,
+                                            int32_t cg_max_iterations) {
   piola_world_def wd = piola_default_world_def();
   for (int k = 0; k < 3; ++k) wd.gravity[k] = piola_track_constant(0);
   wd.max_dt = 1;
@@ -34,6 +42,8 @@ piola_world *deformed_block_world(piola_material_model model, int n, piola_mat3 
   sd.material.model = model;
   sd.material.youngs_modulus = 1e4;
   sd.material.poisson_ratio = 0.3;
+  sd.material.inversion_mode = mode;
+  sd.material.inversion_threshold = threshold;
   sd.density = 1000;
   sd.shear_viscosity = piola_track_constant(viscosity);
   sd.bulk_viscosity = piola_track_constant(viscosity);

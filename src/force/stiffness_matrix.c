@@ -9,6 +9,7 @@
 #include "force/element_stiffness.h"
 #include "force/stiffness_lanes.h"
 #include "force/stiffness_matrix.h"
+#include "math/mat3.h"
 
 static const int PAIR_A[6] = {0, 0, 0, 1, 1, 2}, PAIR_B[6] = {1, 2, 3, 2, 3, 3};
 
@@ -171,27 +172,6 @@ static void assemble_part(piola__stiffness_matrix *m, const piola_elastic_body *
   }
 }
 
-static void invert3(const double *a, double *inv) {
-  double c00 = a[4] * a[8] - a[5] * a[7], c01 = a[5] * a[6] - a[3] * a[8], c02 = a[3] * a[7] - a[4] * a[6];
-  double det = a[0] * c00 + a[1] * c01 + a[2] * c02;
-  if (!(fabs(det) > 0) || !isfinite(det)) {
-    /* a singular block (a massless node in quasistatics): its diagonal only */
-    memset(inv, 0, 9 * sizeof(double));
-    for (int i = 0; i < 3; ++i) inv[4 * i] = a[4 * i] > 0 ? 1.0 / a[4 * i] : 0.0;
-    return;
-  }
-  double r = 1.0 / det;
-  inv[0] = c00 * r;
-  inv[3] = c01 * r;
-  inv[6] = c02 * r;
-  inv[1] = (a[2] * a[7] - a[1] * a[8]) * r;
-  inv[4] = (a[0] * a[8] - a[2] * a[6]) * r;
-  inv[7] = (a[1] * a[6] - a[0] * a[7]) * r;
-  inv[2] = (a[1] * a[5] - a[2] * a[4]) * r;
-  inv[5] = (a[2] * a[3] - a[0] * a[5]) * r;
-  inv[8] = (a[0] * a[4] - a[1] * a[3]) * r;
-}
-
 /* What a pass over the matrix's rows reads and writes. */
 typedef struct row_pass {
   int32_t rows;                     /* the body's vertex count */
@@ -233,7 +213,7 @@ static void diagonal_rows(const row_pass *pass, int32_t r0, int32_t r1) {
     }
     for (int c = 0; c < 3; ++c) a[4 * c] += mass_weight * mass[i];
     memcpy(m->diagonal + 9 * (size_t)i, a, sizeof a);
-    invert3(a, m->inverse_diagonal + 9 * (size_t)i);
+    piola__invert3_or_diagonal(a, m->inverse_diagonal + 9 * (size_t)i);
   }
 }
 

@@ -7,6 +7,7 @@
 #define PIOLA_MATH_MAT3_H
 
 #include <math.h>
+#include <string.h>
 
 #include "piola/math_types.h"
 
@@ -204,6 +205,31 @@ static inline mat2 mat2_mul(mat2 a, mat2 b) {
 static inline mat2 mat2_inverse(mat2 a) {
   double inv = 1.0 / mat2_det(a);
   return (mat2){{{a.m[1][1] * inv, -a.m[0][1] * inv}, {-a.m[1][0] * inv, a.m[0][0] * inv}}};
+}
+
+/* ------------------------------------------------------- row-major arrays */
+/* inv = a^-1 for a 3x3 block a[9] (row-major) of a system matrix; a singular or non-finite
+ * block (a massless node in quasistatics) gets the inverse of its diagonal only, 0 where that
+ * is not positive, so a preconditioner built from it stays finite. */
+static inline void piola__invert3_or_diagonal(const double *a, double *inv) {
+  double c00 = a[4] * a[8] - a[5] * a[7], c01 = a[5] * a[6] - a[3] * a[8], c02 = a[3] * a[7] - a[4] * a[6];
+  double det = a[0] * c00 + a[1] * c01 + a[2] * c02;
+  if (!(fabs(det) > 0) || !isfinite(det)) {
+    /* a singular block (a massless node in quasistatics): its diagonal only */
+    memset(inv, 0, 9 * sizeof(double));
+    for (int i = 0; i < 3; ++i) inv[4 * i] = a[4 * i] > 0 ? 1.0 / a[4 * i] : 0.0;
+    return;
+  }
+  double r = 1.0 / det;
+  inv[0] = c00 * r;
+  inv[3] = c01 * r;
+  inv[6] = c02 * r;
+  inv[1] = (a[2] * a[7] - a[1] * a[8]) * r;
+  inv[4] = (a[0] * a[8] - a[2] * a[6]) * r;
+  inv[7] = (a[1] * a[6] - a[0] * a[7]) * r;
+  inv[2] = (a[1] * a[5] - a[2] * a[4]) * r;
+  inv[5] = (a[2] * a[3] - a[0] * a[5]) * r;
+  inv[8] = (a[0] * a[4] - a[1] * a[3]) * r;
 }
 
 #endif

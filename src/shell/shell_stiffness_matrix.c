@@ -5,6 +5,7 @@
 #include <string.h>
 
 #include "common/status_report.h"
+#include "math/mat3.h"
 #include "piola/threads.h"
 #include "shell/shell_body_internal.h"
 #include "shell/shell_stiffness.h"
@@ -124,25 +125,6 @@ static void add_block(double *blocks, int32_t slot, const double *element, int s
     for (int j = 0; j < 3; ++j) dst[3 * i + j] += weight * element[stride * (3 * a + i) + 3 * b + j];
 }
 
-static void invert3(const double *a, double *inv) {
-  double c00 = a[4] * a[8] - a[5] * a[7], c01 = a[5] * a[6] - a[3] * a[8], c02 = a[3] * a[7] - a[4] * a[6];
-  double det = a[0] * c00 + a[1] * c01 + a[2] * c02;
-  if (!(fabs(det) > 0) || !isfinite(det)) {
-    /* singular (a massless node in quasistatics): its diagonal only */
-    memset(inv, 0, 9 * sizeof(double));
-    for (int i = 0; i < 3; ++i) inv[4 * i] = a[4 * i] > 0 ? 1.0 / a[4 * i] : 0.0;
-    return;
-  }
-  double r = 1.0 / det;
-  inv[0] = c00 * r, inv[3] = c01 * r, inv[6] = c02 * r;
-  inv[1] = (a[2] * a[7] - a[1] * a[8]) * r;
-  inv[4] = (a[0] * a[8] - a[2] * a[6]) * r;
-  inv[7] = (a[1] * a[6] - a[0] * a[7]) * r;
-  inv[2] = (a[1] * a[5] - a[2] * a[4]) * r;
-  inv[5] = (a[2] * a[3] - a[0] * a[5]) * r;
-  inv[8] = (a[0] * a[4] - a[1] * a[3]) * r;
-}
-
 void piola__shell_stiffness_matrix_assemble(piola__stiffness_matrix *m, const piola_shell_body *body,
                                             double stiffness_weight, double damping_weight,
                                             double beta, double alpha, const double *mass,
@@ -181,7 +163,7 @@ void piola__shell_stiffness_matrix_assemble(piola__stiffness_matrix *m, const pi
       for (int c = 0; c < 9; ++c) a[c] += m->blocks[9 * (size_t)e + c];
     for (int c = 0; c < 3; ++c) a[4 * c] += mass_weight * mass[i];
     memcpy(m->diagonal + 9 * (size_t)i, a, sizeof a);
-    invert3(a, m->inverse_diagonal + 9 * (size_t)i);
+    piola__invert3_or_diagonal(a, m->inverse_diagonal + 9 * (size_t)i);
   }
 }
 

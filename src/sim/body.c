@@ -185,8 +185,8 @@ void piola__body_stiffness_set_mass_weight(const world_body *b, piola__stiffness
       piola__stiffness_matrix_set_mass_weight(matrix, b->solid, b->mass, mass_weight);
       return;
     case PIOLA_BODY_SHELL:
-      piola__shell_stiffness_matrix_assemble(matrix, b->shell, stiffness_weight, damping_weight,
-                                             beta, alpha, b->mass, mass_weight);
+      piola__body_stiffness_assemble(b, matrix, stiffness_weight, damping_weight, beta, alpha,
+                                     mass_weight);
       return;
     case PIOLA_BODY_NONE: return;
   }

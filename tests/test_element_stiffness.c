@@ -56,39 +56,6 @@ static void stress_at(const piola_material *m, const piola_mat3 *f, const double
     }
 }
 
-/* Eigenvalues of a symmetric n x n (n <= 12) by cyclic Jacobi; a is destroyed. */
-static void symmetric_eigenvalues(double *a, int n, double *lam) {
-  for (int sweep = 0; sweep < 60; ++sweep) {
-    double off = 0, diag = 0;
-    for (int i = 0; i < n; ++i)
-      for (int j = 0; j < n; ++j) {
-        if (i == j)
-          diag += a[n * i + j] * a[n * i + j];
-        else
-          off += a[n * i + j] * a[n * i + j];
-      }
-    if (!(off > 1e-30 * diag)) break;
-    for (int p = 0; p < n; ++p)
-      for (int q = p + 1; q < n; ++q) {
-        if (a[n * p + q] == 0) continue;
-        double theta = (a[n * q + q] - a[n * p + p]) / (2 * a[n * p + q]);
-        double t = (theta >= 0 ? 1.0 : -1.0) / (fabs(theta) + sqrt(theta * theta + 1));
-        double c = 1 / sqrt(t * t + 1), s = t * c;
-        for (int i = 0; i < n; ++i) {
-          double aip = a[n * i + p], aiq = a[n * i + q];
-          a[n * i + p] = c * aip - s * aiq;
-          a[n * i + q] = s * aip + c * aiq;
-        }
-        for (int j = 0; j < n; ++j) {
-          double apj = a[n * p + j], aqj = a[n * q + j];
-          a[n * p + j] = c * apj - s * aqj;
-          a[n * q + j] = s * apj + c * aqj;
-        }
-      }
-  }
-  for (int i = 0; i < n; ++i) lam[i] = a[n * i + i];
-}
-
 static void random_rotation(test_rng *rng, double r[3][3]) {
   double q[9];
   fixture_random_rotation(rng, q);
@@ -219,7 +186,7 @@ static void check_model(piola_material_model model, piola_inversion_mode mode, d
         }
       assert_true(sym <= 1e-10 * pscale);
       memcpy(work, cp, sizeof work);
-      symmetric_eigenvalues(work, 9, lam);
+      test_symmetric_eigenvalues(work, 9, lam);
       for (int k = 0; k < 9; ++k)
         if (!(lam[k] >= -1e-9 * pscale))
           fail_msg("%s shape %d: projected dP/dF has eigenvalue %g (scale %g)",
@@ -250,7 +217,7 @@ static void test_projection_keeps_definite(void **state) {
     piola__element_dpdf(&m, &f, NULL, 0, 1, cp);
     memcpy(lam, c, sizeof lam);
     double ev[9];
-    symmetric_eigenvalues(lam, 9, ev);
+    test_symmetric_eigenvalues(lam, 9, ev);
     int definite = 1;
     for (int k = 0; k < 9; ++k) definite &= ev[k] > 0;
     if (!definite) continue; /* rotated linear/corotated have a zero rotation mode at rest */
@@ -338,7 +305,7 @@ static void check_body_matrix(piola_material_model model, double squash) {
     double lam[12], work[144], kscale = 0;
     for (int e = 0; e < 144; ++e) kscale = fmax(kscale, fabs(ke[e]));
     memcpy(work, ke, sizeof work);
-    symmetric_eigenvalues(work, 12, lam);
+    test_symmetric_eigenvalues(work, 12, lam);
     for (int e = 0; e < 12; ++e) assert_true(lam[e] >= -1e-9 * kscale);
     for (int r = 0; r < 12; ++r)
       for (int c = 0; c < 3; ++c) {

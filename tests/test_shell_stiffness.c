@@ -21,39 +21,6 @@
 #include "shell/shell_stiffness.h"
 #include "test_shell_fixtures.h"
 
-/* Eigenvalues of a symmetric n x n (n <= 12) by cyclic Jacobi; a is destroyed. */
-static void symmetric_eigenvalues(double *a, int n, double *lambda) {
-  for (int sweep = 0; sweep < 100; ++sweep) {
-    double off = 0, diag = 0;
-    for (int i = 0; i < n; ++i)
-      for (int j = 0; j < n; ++j) {
-        if (i == j)
-          diag += a[n * i + j] * a[n * i + j];
-        else
-          off += a[n * i + j] * a[n * i + j];
-      }
-    if (!(off > 1e-30 * diag)) break;
-    for (int p = 0; p < n; ++p)
-      for (int q = p + 1; q < n; ++q) {
-        if (a[n * p + q] == 0) continue;
-        double theta = (a[n * q + q] - a[n * p + p]) / (2 * a[n * p + q]);
-        double t = (theta >= 0 ? 1.0 : -1.0) / (fabs(theta) + sqrt(theta * theta + 1));
-        double c = 1 / sqrt(t * t + 1), s = t * c;
-        for (int k = 0; k < n; ++k) {
-          double akp = a[n * k + p], akq = a[n * k + q];
-          a[n * k + p] = c * akp - s * akq;
-          a[n * k + q] = s * akp + c * akq;
-        }
-        for (int k = 0; k < n; ++k) {
-          double apk = a[n * p + k], aqk = a[n * q + k];
-          a[n * p + k] = c * apk - s * aqk;
-          a[n * q + k] = s * apk + c * aqk;
-        }
-      }
-  }
-  for (int i = 0; i < n; ++i) lambda[i] = a[n * i + i];
-}
-
 static double max_abs(const double *a, int n) { return shell_max_abs(a, (size_t)n); }
 
 /* Checks that a (n x n) is symmetric and negative semi-definite, relative to its size. */
@@ -65,7 +32,7 @@ static void assert_symmetric_nsd(const double *a, int n, const char *what) {
       if (!(fabs(a[n * i + j] - a[n * j + i]) <= 1e-12 * scale))
         fail_msg("%s: not symmetric at (%d, %d): %g vs %g", what, i, j, a[n * i + j], a[n * j + i]);
   memcpy(copy, a, sizeof(double) * (size_t)(n * n));
-  symmetric_eigenvalues(copy, n, lambda);
+  test_symmetric_eigenvalues(copy, n, lambda);
   for (int i = 0; i < n; ++i)
     if (!(lambda[i] <= 1e-10 * scale)) fail_msg("%s: eigenvalue %g > 0 (scale %g)", what, lambda[i], scale);
 }

@@ -25,6 +25,10 @@ uint64_t test_rng_next(test_rng *rng);
 double test_rng_uniform(test_rng *rng, double lo, double hi); /* in [lo, hi) */
 double test_rng_normal(test_rng *rng);                         /* standard normal */
 
+/* Eigenvalues of the symmetric n x n matrix a (row-major) by cyclic Jacobi, unsorted: the
+ * dense reference the projected stiffnesses are checked against. a is destroyed. */
+void test_symmetric_eigenvalues(double *a, int n, double *lambda);
+
 /* Asserts |a - b| <= tol with a message that prints both values. */
 #define assert_close(a, b, tol)                                                            \
   do {                                                                                     \

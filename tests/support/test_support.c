@@ -70,3 +70,35 @@ void test_replace_first(char *text, const char *from, const char *to) {
   memcpy(at, to, b);
   memmove(at + b, at + a, strlen(at + a) + 1);
 }
+
+void test_symmetric_eigenvalues(double *a, int n, double *lambda) {
+  for (int sweep = 0; sweep < 100; ++sweep) {
+    double off = 0, diag = 0;
+    for (int i = 0; i < n; ++i)
+      for (int j = 0; j < n; ++j) {
+        if (i == j)
+          diag += a[n * i + j] * a[n * i + j];
+        else
+          off += a[n * i + j] * a[n * i + j];
+      }
+    if (!(off > 1e-30 * diag)) break;
+    for (int p = 0; p < n; ++p)
+      for (int q = p + 1; q < n; ++q) {
+        if (a[n * p + q] == 0) continue;
+        const double theta = (a[n * q + q] - a[n * p + p]) / (2 * a[n * p + q]);
+        const double t = (theta >= 0 ? 1.0 : -1.0) / (fabs(theta) + sqrt(theta * theta + 1));
+        const double c = 1 / sqrt(t * t + 1), s = t * c;
+        for (int k = 0; k < n; ++k) { /* columns p and q */
+          const double kp = a[n * k + p], kq = a[n * k + q];
+          a[n * k + p] = c * kp - s * kq;
+          a[n * k + q] = s * kp + c * kq;
+        }
+        for (int k = 0; k < n; ++k) { /* rows p and q */
+          const double pk = a[n * p + k], qk = a[n * q + k];
+          a[n * p + k] = c * pk - s * qk;
+          a[n * q + k] = s * pk + c * qk;
+        }
+      }
+  }
+  for (int i = 0; i < n; ++i) lambda[i] = a[n * i + i];
+}

@@ -26,6 +26,7 @@
 
 #include "piola/diagonalize.h"
 #include "piola/mesh_io.h"
+#include "support/recovery_runs.h"
 #include "test_elastic_body_fixtures.h"
 
 typedef enum { COLLAPSE_POINT, COLLAPSE_LINE, COLLAPSE_PLANE, SCRAMBLE } start_kind;
@@ -66,46 +67,6 @@ static void starting_positions(test_rng *rng, const double *rest, int32_t nv, st
         break;
     }
   }
-}
-
-/* Largest distance between x, optimally rotated and translated, and rest (m). Mass-weighted
- * centroids; rotation R maximizing sum m (x - cx) . R^T (rest - cr) from the invertible
- * diagonalization of the cross-covariance H = sum m (rest - cr)(x - cx)^T = U S V^T:
- * R = U V^T is proper (det +1), which is what a rigid motion is (a mirror image is not). */
-static double procrustes_error(const double *x, const double *rest, const double *mass,
-                               int32_t nv) {
-  double cx[3] = {0}, cr[3] = {0}, mt = 0;
-  for (int32_t v = 0; v < nv; ++v) {
-    mt += mass[v];
-    for (int i = 0; i < 3; ++i) {
-      cx[i] += mass[v] * x[3 * v + i];
-      cr[i] += mass[v] * rest[3 * v + i];
-    }
-  }
-  for (int i = 0; i < 3; ++i) cx[i] /= mt, cr[i] /= mt;
-  piola_mat3 h, u, w;
-  memset(&h, 0, sizeof h);
-  for (int32_t v = 0; v < nv; ++v)
-    for (int i = 0; i < 3; ++i)
-      for (int j = 0; j < 3; ++j)
-        h.m[i][j] += mass[v] * (rest[3 * v + i] - cr[i]) * (x[3 * v + j] - cx[j]);
-  piola_vec3 s;
-  assert_int_equal(piola_diagonalize3(&h, &u, &s, &w), PIOLA_OK);
-  double r[3][3]; /* maps x - cx onto rest - cr */
-  for (int i = 0; i < 3; ++i)
-    for (int j = 0; j < 3; ++j)
-      r[i][j] = u.m[i][0] * w.m[j][0] + u.m[i][1] * w.m[j][1] + u.m[i][2] * w.m[j][2];
-  double worst = 0;
-  for (int32_t v = 0; v < nv; ++v) {
-    double d2 = 0;
-    for (int i = 0; i < 3; ++i) {
-      double y = cr[i];
-      for (int j = 0; j < 3; ++j) y += r[i][j] * (x[3 * v + j] - cx[j]);
-      d2 += (y - rest[3 * v + i]) * (y - rest[3 * v + i]);
-    }
-    worst = fmax(worst, sqrt(d2));
-  }
-  return worst;
 }
 
 typedef struct outcome {
@@ -150,7 +111,7 @@ static outcome simulate(piola_elastic_body *body, double *x, double dt_rest, dou
   *steps_taken = s;
   piola_elastic_stats stats;
   assert_int_equal(piola_elastic_body_update(body, x, 1.0, fe, &stats), PIOLA_OK);
-  outcome out = {procrustes_error(x, piola_elastic_body_rest_positions(body), mass, nv), 0,
+  outcome out = {recovery_procrustes_error(x, piola_elastic_body_rest_positions(body), mass, nv), 0,
                  stats.inverted_count};
   for (int32_t t = 0; t < 3 * nt; ++t) out.fhat_error = fmax(out.fhat_error, fabs(fhat[t] - 1.0));
   free(v);

@@ -154,10 +154,8 @@ int recovery_read_unit_mesh(const char *data_dir, const char *relative, piola_te
   return 0;
 }
 
-/* Largest distance between x, optimally rotated and translated (mass-weighted centroids, the
- * proper rotation from the diagonalization of the cross-covariance), and rest (m). */
-static double procrustes_error(const double *x, const double *rest, const double *mass,
-                               int32_t nv) {
+double recovery_procrustes_error(const double *x, const double *rest, const double *mass,
+                                 int32_t nv) {
   double cx[3] = {0}, cr[3] = {0}, mt = 0;
   for (int32_t v = 0; v < nv; ++v) {
     mt += mass[v];
@@ -228,7 +226,7 @@ recovery_collapse_outcome recovery_collapse_run(const piola_tet_mesh *mesh,
     piola_elastic_stats stats;
     if (finite && piola_elastic_body_update(body, x, 1.0, fe, &stats) == PIOLA_OK) {
       const double *fhat = piola_elastic_body_fhat(body);
-      out.position_error = procrustes_error(x, rest, mass, nv);
+      out.position_error = recovery_procrustes_error(x, rest, mass, nv);
       out.fhat_error = 0.0;
       for (int32_t t = 0; t < 3 * nt; ++t) out.fhat_error = fmax(out.fhat_error, fabs(fhat[t] - 1.0));
       out.inverted = stats.inverted_count;

@@ -63,4 +63,12 @@ recovery_collapse_outcome recovery_collapse_run(const piola_tet_mesh *mesh,
                                                 const piola_material *material,
                                                 recovery_collapse_kind kind);
 
+/* Largest distance (m) between x, optimally rotated and translated, and rest: mass-weighted
+ * centroids, and the rotation R maximizing sum m (x - cx) . R^T (rest - cr) from the
+ * invertible diagonalization of the cross-covariance H = sum m (rest - cr)(x - cx)^T =
+ * U S V^T, R = U V^T, which is proper (det +1) as a rigid motion is (a mirror image is not).
+ * INFINITY if H cannot be diagonalized. */
+double recovery_procrustes_error(const double *x, const double *rest, const double *mass,
+                                 int32_t nv);
+
 #endif

@@ -35,7 +35,8 @@ typedef struct outcome {
   int failed[1024]; /* the seeds not recovered (first 1024) */
 } outcome;
 
-static void run_config(const piola_tet_mesh *mesh, const piola_material_def *def, int seeds) {
+static void run_config(const piola_tet_mesh *mesh, const piola_material_def *def, int first,
+                       int seeds) {
   piola_material material;
   if (piola_material_init(def, &material) != PIOLA_OK) {
     fprintf(stderr, "bench_scramble_recovery: %s\n", piola_last_error());
@@ -44,7 +45,7 @@ static void run_config(const piola_tet_mesh *mesh, const piola_material_def *def
   static outcome out;
   memset(&out, 0, sizeof out);
   const double t0 = bench_wall_seconds();
-  for (int s = 1; s <= seeds; ++s) {
+  for (int s = first; s <= seeds; ++s) {
     const recovery_result r = recovery_scramble_run(mesh, &material, s);
     ++out.count[r];
     if (r != RECOVERY_RECOVERED && out.failed_count < 1024) out.failed[out.failed_count++] = s;
@@ -61,15 +62,19 @@ static void run_config(const piola_tet_mesh *mesh, const piola_material_def *def
 }
 
 int main(int argc, char **argv) {
-  int seeds = argc > 1 ? atoi(argv[1]) : 40;
-  if (seeds < 1) seeds = 1;
+  int first = 1, seeds = argc > 1 ? atoi(argv[1]) : 40;
+  if (argc > 1 && strchr(argv[1], '-')) sscanf(argv[1], "%d-%d", &first, &seeds);
+  if (first < 1) first = 1;
+  if (seeds < first) seeds = first;
   piola_set_thread_count(1);
   piola_tet_mesh mesh;
   if (recovery_grid(&mesh) != 0) return 1;
-  printf("scrambled 3x3x3 grid (%d tets), seeds 1..%d, 12 s each\n", (int)mesh.tet_count, seeds);
+  if (argc == 6) recovery_scramble_seconds = atof(argv[5]);
+  printf("scrambled 3x3x3 grid (%d tets), seeds %d..%d, %g s each\n", (int)mesh.tet_count, first,
+         seeds, recovery_scramble_seconds);
   printf("| model | extension | threshold | recovered | slow | stuck (model) | stuck (extension) | diverged | wall s |\n");
   printf("|---|---|---|---|---|---|---|---|---|\n");
-  if (argc == 5) { /* one configuration from the command line */
+  if (argc == 5 || argc == 6) { /* one configuration from the command line */
     piola_material_model model;
     if (!piola_material_model_from_name(argv[2], &model)) {
       fprintf(stderr, "bench_scramble_recovery: unknown model '%s'\n", argv[2]);
@@ -82,7 +87,7 @@ int main(int argc, char **argv) {
       return 1;
     }
     if (strcmp(argv[4], "default") != 0) def.inversion_threshold = atof(argv[4]);
-    run_config(&mesh, &def, seeds);
+    run_config(&mesh, &def, first, seeds);
     piola_tet_mesh_free(&mesh);
     return 0;
   }
@@ -126,7 +131,7 @@ int main(int argc, char **argv) {
     piola_material_def def = recovery_material_def(c->model);
     def.inversion_mode = c->mode;
     def.inversion_threshold = c->threshold;
-    run_config(&mesh, &def, seeds);
+    run_config(&mesh, &def, first, seeds);
   }
   piola_tet_mesh_free(&mesh);
   return 0;

@@ -18,7 +18,8 @@ static piola_material hgo_material(double kappa, double angle, double nu) {
   def.model = PIOLA_MODEL_HGO;
   def.poisson_ratio = nu;
   /* the gradient checks sample flat and inverted F, where LINEAR's stress is the energy's
-   * gradient along the clamped entries (CLAMP's, HGO's default, is not) */
+   * gradient along the clamped entries (CLAMP's is not); set explicitly so that they do not
+   * follow HGO's default */
   def.inversion_mode = PIOLA_INVERSION_LINEAR;
   def.inversion_threshold = 0.3;
   def.hgo.kappa = kappa;

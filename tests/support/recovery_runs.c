@@ -90,6 +90,8 @@ static recovery_result judge(piola_elastic_body *body, const piola_material *mat
   return smallest >= material->threshold ? RECOVERY_STUCK_MODEL : RECOVERY_STUCK_EXTENSION;
 }
 
+double recovery_scramble_seconds = 12.0;
+
 recovery_result recovery_scramble_run(const piola_tet_mesh *mesh, const piola_material *material,
                                       int seed) {
   piola_elastic_body *body = make_body(mesh, material);
@@ -99,7 +101,7 @@ recovery_result recovery_scramble_run(const piola_tet_mesh *mesh, const piola_ma
   const double beta = 300.0, alpha = 100.0, h = piola_elastic_body_min_rest_altitude(body);
   const double dt = fmin(0.5 * h / (piola_elastic_body_max_wave_speed(body) * sqrt(12.0)),
                          0.25 * 1000.0 * h * h / (beta + alpha));
-  const int steps = (int)(12.0 / dt);
+  const int steps = (int)(recovery_scramble_seconds / dt);
   double *x = malloc(sizeof(double) * 3 * (size_t)nv), *v = calloc(3 * (size_t)nv, sizeof(double));
   double *fe = malloc(sizeof(double) * 3 * (size_t)nv), *fd = malloc(sizeof(double) * 3 * (size_t)nv);
   recovery_result result = RECOVERY_DIVERGED;
@@ -114,7 +116,7 @@ recovery_result recovery_scramble_run(const piola_tet_mesh *mesh, const piola_ma
     const int adaptive = material->model == PIOLA_MODEL_HGO;
     int finite = 1;
     double t = 0.0;
-    for (int k = 0; adaptive ? t < 12.0 : k < steps; ++k) {
+    for (int k = 0; adaptive ? t < recovery_scramble_seconds : k < steps; ++k) {
       finite = piola_elastic_body_update(body, x, 1.0, fe, NULL) == PIOLA_OK;
       if (!finite) break;
       const double step =

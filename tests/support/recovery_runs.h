@@ -38,6 +38,10 @@ piola_material_def recovery_material_def(piola_material_model model);
 /* The grid of the scramble protocol (caller frees with piola_tet_mesh_free). */
 int recovery_grid(piola_tet_mesh *mesh);
 
+/* Simulated time of a scramble run (s): 12, the tables' protocol; bench_scramble_recovery
+ * takes a longer one to tell a slow recovery from a stuck one. */
+extern double recovery_scramble_seconds;
+
 /* Runs seed `seed` of the scramble protocol on `mesh` (the grid) with `material`. */
 recovery_result recovery_scramble_run(const piola_tet_mesh *mesh, const piola_material *material,
                                       int seed);

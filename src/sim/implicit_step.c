@@ -7,7 +7,9 @@
  * the rotated damping at the current iterate), by Newton's method: the system matrix
  * M - dt^2 K - dt D (stiffness_matrix.h) with K the projected stiffness, so it is symmetric
  * positive definite at any deformation, flat and inverted elements included; a
- * block-Jacobi preconditioned conjugate gradient; and a backtracking line search.
+ * conjugate gradient preconditioned by block Jacobi or block IC(0)
+ * (force/stiffness_incomplete_cholesky.h), solved to Eisenstat and Walker's forcing term or a
+ * fixed tolerance (forcing_term); and a backtracking line search.
  *
  * Why the line search is on the residual norm and not on the energy. The inversion
  * extension (docs/materials.md) has no potential where some entries of Fhat are below the
@@ -31,7 +33,7 @@
  * plasticity runs after the step.
  *
  * Momentum. K and D are translation invariant, so a free body's net residual changes only
- * through M. The block-Jacobi CG does not keep the net residual at zero by itself, so each
+ * through M. The preconditioned CG does not keep the net residual at zero by itself, so each
  * solution is moved by the uniform displacement that zeroes it: a free body's linear
  * momentum changes by exactly dt M g per step, whatever the tolerances.
  *

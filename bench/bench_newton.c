@@ -100,17 +100,19 @@ int main(int argc, char **argv) {
   double *assemble_ms = malloc(sizeof(double) * (size_t)frames);
   double *solve_ms = malloc(sizeof(double) * (size_t)frames);
   double *iter_cpu_ms = malloc(sizeof(double) * (size_t)frames);
+  double *frame_cpu_ms = malloc(sizeof(double) * (size_t)frames);
   long newton = 0, linear = 0, failures = 0;
   for (int f = 1; f <= frames; ++f) {
     piola_step_stats st;
     memset(&st, 0, sizeof st);
     piola__step_profile_reset(&w->profile, 1);
-    double t0 = bench_wall_seconds();
+    double t0 = bench_wall_seconds(), c0 = bench_cpu_seconds();
     if (piola_world_advance_to(w, f / 30.0, &st) != PIOLA_OK) {
       fprintf(stderr, "bench_newton: frame %d: %s\n", f, piola_last_error());
       return 1;
     }
     frame_ms[f - 1] = 1e3 * (bench_wall_seconds() - t0);
+    frame_cpu_ms[f - 1] = 1e3 * (bench_cpu_seconds() - c0);
     const double per = st.newton_iterations > 0 ? 1e3 / (double)st.newton_iterations : 0;
     assemble_ms[f - 1] = per * w->profile.wall[STEP_PHASE_ASSEMBLE];
     solve_ms[f - 1] = per * w->profile.wall[STEP_PHASE_LINEAR];
@@ -118,14 +120,15 @@ int main(int argc, char **argv) {
     iter_cpu_ms[f - 1] =
         per * (w->profile.cpu[STEP_PHASE_ASSEMBLE] + w->profile.cpu[STEP_PHASE_LINEAR]);
     newton += st.newton_iterations, linear += st.linear_iterations, failures += st.newton_failures;
-    printf("  backward Euler frame %d: %.1f ms, %d Newton, %d CG, %d failures; per Newton iteration "
+    printf("  backward Euler frame %d: %.1f ms (%.1f ms process CPU), %d Newton, %d CG, %d failures; per Newton iteration "
            "%.1f ms assembly + %.1f ms linear solve\n",
-           f, frame_ms[f - 1], (int)st.newton_iterations, (int)st.linear_iterations,
+           f, frame_ms[f - 1], frame_cpu_ms[f - 1], (int)st.newton_iterations, (int)st.linear_iterations,
            (int)st.newton_failures, assemble_ms[f - 1], solve_ms[f - 1]);
   }
   double be_frame = bench_median(frame_ms, frames), be_iter = bench_median(iter_ms, frames);
   double be_assemble = bench_median(assemble_ms, frames), be_solve = bench_median(solve_ms, frames);
   double be_iter_cpu = bench_median(iter_cpu_ms, frames);
+  double be_frame_cpu = bench_median(frame_cpu_ms, frames);
   piola_world_destroy(w);
 
   w = make_world(&mesh, PIOLA_INTEGRATOR_NEWMARK, e, nu, zmin);
@@ -142,9 +145,9 @@ int main(int argc, char **argv) {
   double nm_step = bench_median(step_ms, newmark_steps);
   double steps_per_frame = ceil((1.0 / 30) / dt);
   piola_world_destroy(w);
-  printf("backward Euler: %.1f ms per frame (median of %d), %.1f Newton and %.0f CG iterations per "
+  printf("backward Euler: %.1f ms per frame, %.1f ms process CPU (medians of %d), %.1f Newton and %.0f CG iterations per "
          "frame, %ld failed steps\n",
-         be_frame, frames, (double)newton / frames, (double)linear / frames, failures);
+         be_frame, be_frame_cpu, frames, (double)newton / frames, (double)linear / frames, failures);
   printf("one Newton iteration (assembly + linear solve): %.1f ms wall (%.1f + %.1f), %.1f ms "
          "process CPU (all threads; medians over the frames)\n",
          be_iter, be_assemble, be_solve, be_iter_cpu);
@@ -153,6 +156,7 @@ int main(int argc, char **argv) {
          dt, steps_per_frame, nm_step, newmark_steps, steps_per_frame * nm_step);
   printf("speed-up per frame: %.1f\n", steps_per_frame * nm_step / be_frame);
   free(frame_ms), free(iter_ms), free(assemble_ms), free(solve_ms), free(iter_cpu_ms);
+  free(frame_cpu_ms);
   free(step_ms);
   free(mesh.positions), free(mesh.tets), free(mesh.tet_regions);
   return 0;

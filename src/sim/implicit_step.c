@@ -343,9 +343,9 @@ static void factor_newton_system(const newton_problem *pb) {
  * tolerance of a Newton system, from the squared residual norms phi of this iteration and
  * the last (phi_last < 0: the first iteration) and the last tolerance. Loose while Newton
  * is far from the solution or converging slowly (solving a linear model accurately there
- * buys nothing: the next iteration has another one), tight where it converges fast; never
- * looser than needed to land on the Newton target target2 (no oversolving on the last
- * iteration), never tighter than linear_tolerance, never above FORCING_MAX. */
+ * buys nothing: the next iteration has another one), tight where it converges fast; not
+ * tighter than half of what lands on the Newton target target2 (no oversolving on the last
+ * iteration), nor than linear_tolerance; never above FORCING_MAX. */
 #define FORCING_MAX 0.5
 
 static double forcing_term(const piola_world_def *def, double phi, double phi_last,

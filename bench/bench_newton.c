@@ -6,13 +6,19 @@
  *
  * Backward Euler: `frames` frames of 1/30 s at one step per frame: median wall time per
  * frame, Newton and CG iterations per frame, and the time of one Newton iteration proper,
- * the assembly of the projected stiffness plus the preconditioned CG to 1e-3 (the world's
+ * the assembly of the projected stiffness (and the IC(0) factorization) plus the
+ * preconditioned CG (to 1e-3 with fixed forcing) (the world's
  * step profile, src/sim/step_profile.h; the line search's force evaluations are not in it),
  * in wall time and in process CPU time (all threads: on a loaded machine the steadier
  * figure). Newmark: the CFL step of the same scene and the median wall time of a step over
  * `newmark_steps` steps, so the time of one frame is steps per frame times that.
  *
- * usage: bench_newton [frames=3] [newmark_steps=20] [mesh] [E] [nu] [threads=2] */
+ * usage: bench_newton [frames=3] [newmark_steps=20] [mesh] [E] [nu] [threads=2]
+ *                     [preconditioner=block_jacobi|incomplete_cholesky]
+ *                     [forcing=eisenstat_walker|fixed]
+ * (block_jacobi fixed is the solver as it was before issue 14's preconditioner and forcing
+ * work; "one Newton iteration" is the issue's target only with fixed forcing, where every
+ * CG runs to linear_tolerance = 1e-3.) */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -24,6 +30,9 @@
 #include "sim/world_internal.h"
 #include "support/bench_support.h"
 
+static piola_preconditioner_type preconditioner = PIOLA_PRECONDITIONER_BLOCK_JACOBI;
+static piola_linear_forcing forcing = PIOLA_FORCING_EISENSTAT_WALKER;
+
 static piola_world *make_world(const piola_tet_mesh *mesh, piola_integrator_type type, double e,
                                double nu, double zmin) {
   piola_world_def wd = piola_default_world_def();
@@ -31,6 +40,8 @@ static piola_world *make_world(const piola_tet_mesh *mesh, piola_integrator_type
   wd.implicit_dt = 1.0 / 30;
   wd.max_dt = 1.0 / 30;
   wd.cfl = 0.5;
+  wd.preconditioner = preconditioner;
+  wd.linear_forcing = forcing;
   piola_world *w = NULL;
   if (piola_world_create(&wd, &w) != PIOLA_OK) return NULL;
   piola_solid_def sd = piola_default_solid_def();
@@ -57,6 +68,14 @@ int main(int argc, char **argv) {
   const char *path = argc > 3 ? argv[3] : PIOLA_DATA_DIR "/vega/torus-easy.veg";
   double e = argc > 4 ? atof(argv[4]) : 1e6, nu = argc > 5 ? atof(argv[5]) : 0.45;
   int threads = argc > 6 ? atoi(argv[6]) : 2;
+  if (argc > 7 && !piola_preconditioner_type_from_name(argv[7], &preconditioner)) {
+    fprintf(stderr, "bench_newton: unknown preconditioner '%s'\n", argv[7]);
+    return 2;
+  }
+  if (argc > 8 && !piola_linear_forcing_from_name(argv[8], &forcing)) {
+    fprintf(stderr, "bench_newton: unknown linear forcing '%s'\n", argv[8]);
+    return 2;
+  }
   if (frames < 1) frames = 1;
   if (newmark_steps < 1) newmark_steps = 1;
   piola_set_thread_count(threads);
@@ -67,8 +86,9 @@ int main(int argc, char **argv) {
   }
   double zmin = INFINITY;
   for (int32_t i = 0; i < mesh.vertex_count; ++i) zmin = fmin(zmin, mesh.positions[3 * i + 2]);
-  printf("bench_newton: %s, %d tets, E = %g Pa, nu = %g, %d threads\n", path, (int)mesh.tet_count,
-         e, nu, threads);
+  printf("bench_newton: %s, %d tets, E = %g Pa, nu = %g, %d threads, %s, %s forcing\n", path,
+         (int)mesh.tet_count, e, nu, threads, piola_preconditioner_type_name(preconditioner),
+         piola_linear_forcing_name(forcing));
 
   piola_world *w = make_world(&mesh, PIOLA_INTEGRATOR_BACKWARD_EULER, e, nu, zmin);
   if (!w) {
@@ -80,17 +100,19 @@ int main(int argc, char **argv) {
   double *assemble_ms = malloc(sizeof(double) * (size_t)frames);
   double *solve_ms = malloc(sizeof(double) * (size_t)frames);
   double *iter_cpu_ms = malloc(sizeof(double) * (size_t)frames);
+  double *frame_cpu_ms = malloc(sizeof(double) * (size_t)frames);
   long newton = 0, linear = 0, failures = 0;
   for (int f = 1; f <= frames; ++f) {
     piola_step_stats st;
     memset(&st, 0, sizeof st);
     piola__step_profile_reset(&w->profile, 1);
-    double t0 = bench_wall_seconds();
+    double t0 = bench_wall_seconds(), c0 = bench_cpu_seconds();
     if (piola_world_advance_to(w, f / 30.0, &st) != PIOLA_OK) {
       fprintf(stderr, "bench_newton: frame %d: %s\n", f, piola_last_error());
       return 1;
     }
     frame_ms[f - 1] = 1e3 * (bench_wall_seconds() - t0);
+    frame_cpu_ms[f - 1] = 1e3 * (bench_cpu_seconds() - c0);
     const double per = st.newton_iterations > 0 ? 1e3 / (double)st.newton_iterations : 0;
     assemble_ms[f - 1] = per * w->profile.wall[STEP_PHASE_ASSEMBLE];
     solve_ms[f - 1] = per * w->profile.wall[STEP_PHASE_LINEAR];
@@ -98,14 +120,15 @@ int main(int argc, char **argv) {
     iter_cpu_ms[f - 1] =
         per * (w->profile.cpu[STEP_PHASE_ASSEMBLE] + w->profile.cpu[STEP_PHASE_LINEAR]);
     newton += st.newton_iterations, linear += st.linear_iterations, failures += st.newton_failures;
-    printf("  backward Euler frame %d: %.1f ms, %d Newton, %d CG, %d failures; per Newton iteration "
+    printf("  backward Euler frame %d: %.1f ms (%.1f ms process CPU), %d Newton, %d CG, %d failures; per Newton iteration "
            "%.1f ms assembly + %.1f ms linear solve\n",
-           f, frame_ms[f - 1], (int)st.newton_iterations, (int)st.linear_iterations,
+           f, frame_ms[f - 1], frame_cpu_ms[f - 1], (int)st.newton_iterations, (int)st.linear_iterations,
            (int)st.newton_failures, assemble_ms[f - 1], solve_ms[f - 1]);
   }
   double be_frame = bench_median(frame_ms, frames), be_iter = bench_median(iter_ms, frames);
   double be_assemble = bench_median(assemble_ms, frames), be_solve = bench_median(solve_ms, frames);
   double be_iter_cpu = bench_median(iter_cpu_ms, frames);
+  double be_frame_cpu = bench_median(frame_cpu_ms, frames);
   piola_world_destroy(w);
 
   w = make_world(&mesh, PIOLA_INTEGRATOR_NEWMARK, e, nu, zmin);
@@ -122,9 +145,9 @@ int main(int argc, char **argv) {
   double nm_step = bench_median(step_ms, newmark_steps);
   double steps_per_frame = ceil((1.0 / 30) / dt);
   piola_world_destroy(w);
-  printf("backward Euler: %.1f ms per frame (median of %d), %.1f Newton and %.0f CG iterations per "
+  printf("backward Euler: %.1f ms per frame, %.1f ms process CPU (medians of %d), %.1f Newton and %.0f CG iterations per "
          "frame, %ld failed steps\n",
-         be_frame, frames, (double)newton / frames, (double)linear / frames, failures);
+         be_frame, be_frame_cpu, frames, (double)newton / frames, (double)linear / frames, failures);
   printf("one Newton iteration (assembly + linear solve): %.1f ms wall (%.1f + %.1f), %.1f ms "
          "process CPU (all threads; medians over the frames)\n",
          be_iter, be_assemble, be_solve, be_iter_cpu);
@@ -133,6 +156,7 @@ int main(int argc, char **argv) {
          dt, steps_per_frame, nm_step, newmark_steps, steps_per_frame * nm_step);
   printf("speed-up per frame: %.1f\n", steps_per_frame * nm_step / be_frame);
   free(frame_ms), free(iter_ms), free(assemble_ms), free(solve_ms), free(iter_cpu_ms);
+  free(frame_cpu_ms);
   free(step_ms);
   free(mesh.positions), free(mesh.tets), free(mesh.tet_regions);
   return 0;

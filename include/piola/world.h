@@ -56,6 +56,32 @@ typedef enum piola_integrator_type {
 PIOLA_API const char *piola_integrator_type_name(piola_integrator_type type);
 PIOLA_API bool piola_integrator_type_from_name(const char *name, piola_integrator_type *type);
 
+/* The preconditioner of the implicit integrators' conjugate gradient
+ * (docs/time-stepping.md, "Implicit integrators"). */
+typedef enum piola_preconditioner_type {
+  PIOLA_PRECONDITIONER_BLOCK_JACOBI = 0,  /* the inverse 3x3 diagonal blocks */
+  PIOLA_PRECONDITIONER_INCOMPLETE_CHOLESKY, /* block IC(0) on the mesh edges (solids;
+                                              shells use block Jacobi) */
+  PIOLA_PRECONDITIONER_COUNT
+} piola_preconditioner_type;
+
+/* Scene names "block_jacobi", "incomplete_cholesky". */
+PIOLA_API const char *piola_preconditioner_type_name(piola_preconditioner_type type);
+PIOLA_API bool piola_preconditioner_type_from_name(const char *name,
+                                                   piola_preconditioner_type *type);
+
+/* How tightly each Newton system is solved (docs/time-stepping.md, "Implicit integrators"). */
+typedef enum piola_linear_forcing {
+  PIOLA_FORCING_EISENSTAT_WALKER = 0, /* loose while Newton is far from converged, down to
+                                         linear_tolerance as it converges */
+  PIOLA_FORCING_FIXED,                /* every system to linear_tolerance */
+  PIOLA_FORCING_COUNT
+} piola_linear_forcing;
+
+/* Scene names "eisenstat_walker", "fixed". */
+PIOLA_API const char *piola_linear_forcing_name(piola_linear_forcing forcing);
+PIOLA_API bool piola_linear_forcing_from_name(const char *name, piola_linear_forcing *forcing);
+
 typedef struct piola_world_def {
   piola_track gravity[3];    /* m/s^2, keyframable. Default (0, 0, -9.81): z is up */
   double max_dt;             /* s, > 0: the user's cap on the step size. Default 1e-3 */
@@ -85,6 +111,12 @@ typedef struct piola_world_def {
                                   preconditioned CG to this fraction of its initial residual.
                                   Default 1e-3 */
   int32_t linear_max_iterations; /* >= 1: CG iterations per Newton system. Default 1000 */
+  piola_preconditioner_type preconditioner; /* the CG's preconditioner. Default
+                                  PIOLA_PRECONDITIONER_BLOCK_JACOBI */
+  piola_linear_forcing linear_forcing; /* each Newton system's CG tolerance: adapted
+                                  (Eisenstat-Walker, never tighter than linear_tolerance) or
+                                  fixed at linear_tolerance. Default
+                                  PIOLA_FORCING_EISENSTAT_WALKER */
 } piola_world_def;
 
 PIOLA_API piola_world_def piola_default_world_def(void);

@@ -14,7 +14,8 @@ piola_status piola__scene_parse_world(scene_parser *p, const cJSON *obj, scene_d
     static const char *const keys[] = {"max_dt", "cfl", "cg_tolerance", "cg_max_iterations",
                                        "collision_interval", "type", "dt", "newton_tolerance",
                                        "newton_max_iterations", "linear_tolerance",
-                                       "linear_max_iterations", NULL};
+                                       "linear_max_iterations", "preconditioner",
+                                       "linear_forcing", NULL};
     PIOLA_TRY(piola__json_check_keys(p, v, keys));
     PIOLA_TRY(piola__json_opt_number(p, v, "max_dt", (json_range){0, 1, 1, 0}, &out->world.max_dt));
     PIOLA_TRY(piola__json_opt_number(p, v, "cfl", (json_range){0, 2, 1, 0}, &out->world.cfl));
@@ -47,6 +48,23 @@ piola_status piola__scene_parse_world(scene_parser *p, const cJSON *obj, scene_d
     it = out->world.linear_max_iterations;
     PIOLA_TRY(piola__json_opt_int(p, v, "linear_max_iterations", 1, 1000000, &it));
     out->world.linear_max_iterations = (int32_t)it;
+    const cJSON *pc = piola__json_get(v, "preconditioner");
+    if (pc) {
+      size_t o2 = piola__json_push_key(p, "preconditioner");
+      if (!cJSON_IsString(pc) ||
+          !piola_preconditioner_type_from_name(pc->valuestring, &out->world.preconditioner))
+        return piola__json_fail(p, BAD_VALUE,
+                                "must be \"block_jacobi\" or \"incomplete_cholesky\"");
+      piola__json_pop(p, o2);
+    }
+    const cJSON *lf = piola__json_get(v, "linear_forcing");
+    if (lf) {
+      size_t o2 = piola__json_push_key(p, "linear_forcing");
+      if (!cJSON_IsString(lf) ||
+          !piola_linear_forcing_from_name(lf->valuestring, &out->world.linear_forcing))
+        return piola__json_fail(p, BAD_VALUE, "must be \"eisenstat_walker\" or \"fixed\"");
+      piola__json_pop(p, o2);
+    }
     piola__json_pop(p, old);
   } else if (out->fps > 0) {
     out->world.implicit_dt = 1.0 / out->fps;

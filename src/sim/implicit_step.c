@@ -7,7 +7,9 @@
  * the rotated damping at the current iterate), by Newton's method: the system matrix
  * M - dt^2 K - dt D (stiffness_matrix.h) with K the projected stiffness, so it is symmetric
  * positive definite at any deformation, flat and inverted elements included; a
- * block-Jacobi preconditioned conjugate gradient; and a backtracking line search.
+ * conjugate gradient preconditioned by block Jacobi or block IC(0)
+ * (force/stiffness_incomplete_cholesky.h), solved to Eisenstat and Walker's forcing term or a
+ * fixed tolerance (forcing_term); and a backtracking line search.
  *
  * Why the line search is on the residual norm and not on the energy. The inversion
  * extension (docs/materials.md) has no potential where some entries of Fhat are below the
@@ -31,7 +33,7 @@
  * plasticity runs after the step.
  *
  * Momentum. K and D are translation invariant, so a free body's net residual changes only
- * through M. The block-Jacobi CG does not keep the net residual at zero by itself, so each
+ * through M. The preconditioned CG does not keep the net residual at zero by itself, so each
  * solution is moved by the uniform displacement that zeroes it: a free body's linear
  * momentum changes by exactly dt M g per step, whatever the tolerances.
  *
@@ -50,6 +52,7 @@
 
 #include "common/status_report.h"
 #include "force/elastic_body_internal.h"
+#include "force/stiffness_incomplete_cholesky.h"
 #include "force/stiffness_matrix.h"
 #include "sim/obstacle_friction.h"
 #include "sim/world_internal.h"
@@ -64,6 +67,8 @@ enum { HELD_BY_OBSTACLE = 1, HELD_BY_COLLISION = 2, HELD_BY_SOLID = 3 };
 
 struct implicit_state {
   piola__stiffness_matrix matrix;
+  piola__incomplete_cholesky factor; /* a solid's IC(0), when that is the preconditioner */
+  int factored;                      /* factor holds the current Newton system's */
   double *prediction; /* 3n: x^n + dt v^n (backward Euler) */
   double *residual;   /* 3n: g, unfiltered */
   double *step;       /* 3n: the Newton direction */
@@ -78,13 +83,15 @@ struct implicit_state {
 void piola__implicit_state_free(struct implicit_state *st) {
   if (!st) return;
   piola__stiffness_matrix_free(&st->matrix);
+  piola__incomplete_cholesky_free(&st->factor);
   free(st->prediction), free(st->residual), free(st->step), free(st->base), free(st->damping);
   for (int k = 0; k < 4; ++k) free(st->cg[k]);
   free(st->scratch_v), free(st->surface_v), free(st->hit);
   free(st);
 }
 
-static piola_status implicit_state_make(world_body *s) {
+/* The state of s's implicit steps; with_factor: room for an IC(0) factor (solids). */
+static piola_status implicit_state_make(world_body *s, int with_factor) {
   if (s->implicit) return PIOLA_OK;
   struct implicit_state *st = calloc(1, sizeof *st);
   if (!st) return PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "implicit step: out of memory");
@@ -98,6 +105,9 @@ static piola_status implicit_state_make(world_body *s) {
            st->scratch_v && st->surface_v && st->hit && st->cg[0] && st->cg[1] && st->cg[2] &&
            st->cg[3];
   if (ok && piola__body_stiffness_init(s, &st->matrix) != PIOLA_OK) ok = 0;
+  if (ok && with_factor && s->kind == PIOLA_BODY_SOLID &&
+      piola__incomplete_cholesky_init(&st->factor, s->solid) != PIOLA_OK)
+    ok = 0;
   if (!ok) {
     piola__implicit_state_free(st);
     return PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "implicit step: out of memory");
@@ -218,13 +228,16 @@ static double residual(newton_problem *pb) {
 typedef struct cg_vectors {
   const world_body *s;
   const piola__stiffness_matrix *mx;
+  const piola__incomplete_cholesky *factor; /* NULL: block Jacobi */
   double *d, *r, *z, *p, *q;
   const double *g; /* the residual the solve starts from */
   double alpha;    /* the step length of cg_update_range */
 } cg_vectors;
 
-/* z_i = S_i P_i^-1 r_i, P_i the diagonal block; returns r_i . z_i. */
+/* z_i = S_i P_i^-1 r_i, P_i the diagonal block (block Jacobi; with the IC(0) factor z is
+ * formed after the pass, see precondition_factored); returns r_i . z_i. */
 static inline double precondition_node(const cg_vectors *c, int32_t i) {
+  if (c->factor) return 0;
   const double *b = c->mx->inverse_diagonal + 9 * (size_t)i, *x = c->r + 3 * i;
   double *y = c->z + 3 * i;
   y[0] = b[0] * x[0] + b[1] * x[1] + b[2] * x[2];
@@ -232,6 +245,25 @@ static inline double precondition_node(const cg_vectors *c, int32_t i) {
   y[2] = b[6] * x[0] + b[7] * x[1] + b[8] * x[2];
   filter_node(c->s, i, c->z);
   return x[0] * y[0] + x[1] * y[1] + x[2] * y[2];
+}
+
+/* z = S (U^T D U)^-1 r over the whole body (the substitutions are sequential); returns r . z.
+ * The factor is of the filtered matrix, so z is filtered already up to rounding; the filter
+ * keeps the constrained components exactly zero. */
+static double r_dot_z_range(const void *context, int32_t i0, int32_t i1) {
+  const cg_vectors *c = context;
+  double sum = 0;
+  for (int32_t i = i0; i < i1; ++i) {
+    filter_node(c->s, i, c->z);
+    const double *r = c->r + 3 * i, *z = c->z + 3 * i;
+    sum += r[0] * z[0] + r[1] * z[1] + r[2] * z[2];
+  }
+  return sum;
+}
+
+static double precondition_factored(const cg_vectors *c) {
+  piola__incomplete_cholesky_apply(c->factor, c->s->solid, c->r, c->z);
+  return sum_over_ranges(c->s->n, CG_PARALLEL_MIN_VERTICES, r_dot_z_range, c);
 }
 
 /* d = 0, r = -S g, z = S P^-1 r, p = z over nodes i0 .. i1 - 1 (g = c->g);
@@ -288,23 +320,73 @@ static void cg_direction(const cg_vectors *c, double b) {
   for (int64_t j = 0; j < m; ++j) c->p[j] = c->z[j] + b * c->p[j];
 }
 
-/* Solves A d = -S g by the filtered block-Jacobi CG from d = 0; returns the iterations. */
-static int32_t solve_newton_system(newton_problem *pb) {
+/* How a solid's vertex is held, for the IC(0) factor (filter_vector's projection). */
+static int vertex_constraint(const void *context, int32_t i, double normal[3]) {
+  const world_body *s = context;
+  if (s->flags[i] != NODE_FREE || s->inverse_mass[i] == 0) return 1;
+  if (!s->colliding[i]) return 0;
+  for (int k = 0; k < 3; ++k) normal[k] = s->normals[3 * i + k];
+  return 2;
+}
+
+/* Factors the Newton system just assembled when the preconditioner is IC(0) (solids). */
+static void factor_newton_system(const newton_problem *pb) {
+  struct implicit_state *st = pb->st;
+  st->factored = pb->w->def.preconditioner == PIOLA_PRECONDITIONER_INCOMPLETE_CHOLESKY &&
+                 pb->s->kind == PIOLA_BODY_SOLID && st->factor.pair_start;
+  if (st->factored)
+    piola__incomplete_cholesky_factor(&st->factor, &st->matrix, pb->s->solid, vertex_constraint,
+                                      pb->s);
+}
+
+/* Eisenstat and Walker's forcing term (1996, choice 2 with gamma 0.9, exponent 2): the CG
+ * tolerance of a Newton system, from the squared residual norms phi of this iteration and
+ * the last (phi_last < 0: the first iteration) and the last tolerance. Loose while Newton
+ * is far from the solution or converging slowly (solving a linear model accurately there
+ * buys nothing: the next iteration has another one), tight where it converges fast; not
+ * tighter than half of what lands on the Newton target target2 (no oversolving on the last
+ * iteration), nor than linear_tolerance; never above FORCING_MAX. */
+#define FORCING_MAX 0.5
+
+static double forcing_term(const piola_world_def *def, double phi, double phi_last,
+                           double eta_last, double target2) {
+  if (def->linear_forcing == PIOLA_FORCING_FIXED) return def->linear_tolerance;
+  double eta = FORCING_MAX;
+  if (phi_last > 0) {
+    eta = 0.9 * phi / phi_last; /* (|g_k| / |g_k-1|)^2 */
+    const double safeguard = 0.9 * eta_last * eta_last;
+    if (safeguard > 0.1) eta = fmax(eta, safeguard);
+  }
+  if (phi > 0) eta = fmax(eta, 0.5 * sqrt(target2 / phi));
+  return fmax(fmin(eta, FORCING_MAX), def->linear_tolerance);
+}
+
+/* Solves A d = -S g by the filtered preconditioned CG from d = 0 to the relative tolerance
+ * eta; returns the iterations. */
+static int32_t solve_newton_system(newton_problem *pb, double eta) {
   world_body *s = pb->s;
   struct implicit_state *st = pb->st;
   const int32_t n = s->n;
   const double mass_weight = pb->mass_weight + s->quasistatic_mu;
   double *d = st->step;
-  cg_vectors c = {s, &st->matrix, d, st->cg[0], st->cg[1], st->cg[2], st->cg[3], st->residual, 0};
+  cg_vectors c = {s,          &st->matrix, st->factored ? &st->factor : NULL,
+                  d,          st->cg[0],   st->cg[1],
+                  st->cg[2],  st->cg[3],   st->residual,
+                  0};
   double rz = cg_pass(&c, cg_start_range);
-  const double stop = pb->w->def.linear_tolerance * pb->w->def.linear_tolerance * rz;
+  if (c.factor) {
+    rz = precondition_factored(&c);
+    memcpy(c.p, c.z, sizeof(double) * 3 * (size_t)n);
+  }
+  const double stop = eta * eta * rz;
   int32_t it = 0;
   while (rz > stop && rz > 0 && it < pb->w->def.linear_max_iterations) {
     piola__body_stiffness_apply(s, c.mx, mass_weight, c.p, c.q);
     const double pq = cg_pass(&c, cg_curvature_range);
     if (!(pq > 0)) break;
     c.alpha = rz / pq;
-    const double rz_new = cg_pass(&c, cg_update_range);
+    double rz_new = cg_pass(&c, cg_update_range);
+    if (c.factor) rz_new = precondition_factored(&c);
     cg_direction(&c, rz_new / rz);
     rz = rz_new;
     ++it;
@@ -441,7 +523,8 @@ static piola_status newton_iterate(const newton_problem *problem, int accept_unc
  * PIOLA_ERROR_NOT_CONVERGED when not (the caller undoes and halves), or another error. */
 static piola_status newton_body(piola_world *w, world_body *s, double t, double dt,
                                  int accept_unconverged, piola_step_stats *stats) {
-  PIOLA_TRY(implicit_state_make(s));
+  PIOLA_TRY(implicit_state_make(
+      s, w->def.preconditioner == PIOLA_PRECONDITIONER_INCOMPLETE_CHOLESKY));
   struct implicit_state *st = s->implicit;
   const int32_t n = s->n;
   const int64_t m = 3 * (int64_t)n;
@@ -484,6 +567,7 @@ static piola_status newton_iterate(const newton_problem *problem, int accept_unc
   const double target = w->def.newton_tolerance * STANDARD_GRAVITY * pb.force_weight;
   const double target2 = target * target * pb.total_mass;
   double phi = residual(&pb);
+  double phi_last = -1, eta = w->def.linear_tolerance;
   int converged = 0;
   for (int32_t iter = 0; iter < w->def.newton_max_iterations; ++iter) {
     if (!isfinite(phi)) break;
@@ -526,8 +610,11 @@ static piola_status newton_iterate(const newton_problem *problem, int accept_unc
                                             pb.damped ? dt : 0.0, pb.beta, pb.alpha,
                                             pb.mass_weight + s->quasistatic_mu);
     }
+    factor_newton_system(&pb);
     piola__step_profile_mark(&w->profile, STEP_PHASE_ASSEMBLE);
-    stats->linear_iterations += solve_newton_system(&pb);
+    eta = forcing_term(&w->def, phi, phi_last, eta, target2);
+    phi_last = phi;
+    stats->linear_iterations += solve_newton_system(&pb, eta);
     piola__step_profile_mark(&w->profile, STEP_PHASE_LINEAR);
     /* backtracking line search on |S g|^2 */
     memcpy(st->base, s->x, sizeof(double) * (size_t)m);

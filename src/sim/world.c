@@ -52,6 +52,12 @@ piola_status piola_world_create(const piola_world_def *def, piola_world **out) {
   if (def->linear_max_iterations < 1)
     return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "linear_max_iterations must be >= 1, got %d",
                       (int)def->linear_max_iterations);
+  if ((int)def->preconditioner < 0 || def->preconditioner >= PIOLA_PRECONDITIONER_COUNT)
+    return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "unknown preconditioner %d",
+                      (int)def->preconditioner);
+  if ((int)def->linear_forcing < 0 || def->linear_forcing >= PIOLA_FORCING_COUNT)
+    return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "unknown linear forcing %d",
+                      (int)def->linear_forcing);
   piola_world *w = calloc(1, sizeof *w);
   if (!w) return PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "world: out of memory");
   w->def = *def;

@@ -21,6 +21,8 @@ piola_world_def piola_default_world_def(void) {
   def.newton_max_iterations = 30;
   def.linear_tolerance = 1e-3;
   def.linear_max_iterations = 1000;
+  def.preconditioner = PIOLA_PRECONDITIONER_BLOCK_JACOBI;
+  def.linear_forcing = PIOLA_FORCING_EISENSTAT_WALKER;
   return def;
 }
 
@@ -58,4 +60,39 @@ piola_solid_def piola_default_solid_def(void) {
   def.fiber_directions = NULL;
   def.activation = piola_track_constant(0);
   return def;
+}
+
+static const char *const preconditioner_names[PIOLA_PRECONDITIONER_COUNT] = {
+    "block_jacobi", "incomplete_cholesky"};
+
+const char *piola_preconditioner_type_name(piola_preconditioner_type type) {
+  if ((int)type < 0 || type >= PIOLA_PRECONDITIONER_COUNT) return "unknown";
+  return preconditioner_names[type];
+}
+
+bool piola_preconditioner_type_from_name(const char *name, piola_preconditioner_type *type) {
+  if (!name || !type) return false;
+  for (int k = 0; k < PIOLA_PRECONDITIONER_COUNT; ++k)
+    if (strcmp(name, preconditioner_names[k]) == 0) {
+      *type = (piola_preconditioner_type)k;
+      return true;
+    }
+  return false;
+}
+
+static const char *const forcing_names[PIOLA_FORCING_COUNT] = {"eisenstat_walker", "fixed"};
+
+const char *piola_linear_forcing_name(piola_linear_forcing forcing) {
+  if ((int)forcing < 0 || forcing >= PIOLA_FORCING_COUNT) return "unknown";
+  return forcing_names[forcing];
+}
+
+bool piola_linear_forcing_from_name(const char *name, piola_linear_forcing *forcing) {
+  if (!name || !forcing) return false;
+  for (int k = 0; k < PIOLA_FORCING_COUNT; ++k)
+    if (strcmp(name, forcing_names[k]) == 0) {
+      *forcing = (piola_linear_forcing)k;
+      return true;
+    }
+  return false;
 }

@@ -527,9 +527,8 @@ static int segment_crosses(const piola_tri_mesh *s, const double *p, const doubl
 static const int8_t tet_edge[6][2] = {{0, 1}, {0, 2}, {0, 3}, {1, 2}, {1, 3}, {2, 3}};
 
 /* The cut by a surface: every uncut copy it passes all the way through, one new crack or
- * (crack >= 0) more of that crack, from its values at the vertices that hold them (where
- * they are on the same side as now): so neighbouring copies cut at different times cross
- * their shared edges at the same points. Those values are kept for the later cuts, so a
+ * (crack >= 0) more of that crack, from its values at the vertices that hold them: so
+ * neighbouring copies cut at different times cross their shared edges at the same points. Those values are kept for the later cuts, so a
  * continued crack takes distances to the nearest triangle's plane: a corner beyond the
  * surface's border at this cut is not given a larger value than the surface there will
  * give it. */
@@ -574,14 +573,19 @@ piola_status piola__fracture_surface_cut(piola_world *w, world_body *b, const pi
     }
     if (!through) continue;
     cuts[count].copy = c, cuts[count].crack = crack >= 0 ? crack : f->events;
+    /* a continued crack keeps its values at the vertices it reached before; where they
+     * leave the copy on one side (the body moved across the surface since), the vertices
+     * now on the other side take their new distances */
+    int kept_pos = 0, kept_neg = 0;
     for (int k = 0; k < 4; ++k) {
-      /* a continued crack keeps its value at a vertex it reached before, unless the body
-       * has since moved that vertex to the surface's other side */
       const int32_t vertex = f->tets[4 * f->parent[c] + k];
-      const int kept = crack >= 0 && f->vertex_crack[vertex] == crack &&
-                       (f->vertex_value[vertex] > 0) == (s[corner[k]] > 0);
+      const int kept = crack >= 0 && f->vertex_crack[vertex] == crack;
       cuts[count].dist[k] = kept ? f->vertex_value[vertex] : s[corner[k]];
+      if (cuts[count].dist[k] > 0) kept_pos = 1;
+      else kept_neg = 1;
     }
+    for (int k = 0; k < 4 && !(kept_pos && kept_neg); ++k)
+      if ((cuts[count].dist[k] > 0) != (s[corner[k]] > 0)) cuts[count].dist[k] = s[corner[k]];
     ++count;
   }
   piola_status st = split_copies(w, b, cuts, count);

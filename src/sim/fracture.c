@@ -527,11 +527,11 @@ static int segment_crosses(const piola_tri_mesh *s, const double *p, const doubl
 static const int8_t tet_edge[6][2] = {{0, 1}, {0, 2}, {0, 3}, {1, 2}, {1, 3}, {2, 3}};
 
 /* The cut by a surface: every uncut copy it passes all the way through, one new crack or
- * (crack >= 0) more of that crack, from its values at the vertices that hold them: so
- * neighbouring copies cut at different times cross their shared edges at the same points. Those values are kept for the later cuts, so a
- * continued crack takes distances to the nearest triangle's plane: a corner beyond the
- * surface's border at this cut is not given a larger value than the surface there will
- * give it. */
+ * (crack >= 0, a moving blade: fracture_blade.c) more of that crack, from its values at the
+ * vertices that hold them, so neighbouring copies cut at different times cross their shared
+ * edges at the same points. As those values are kept for the later cuts, a continued crack
+ * takes distances to the nearest triangle's plane: a corner beyond the surface's border now
+ * does not get a larger value than the surface will give it once it is there. */
 piola_status piola__fracture_surface_cut(piola_world *w, world_body *b, const piola_tri_mesh *surface,
                                          int32_t crack, int32_t *cut_count) {
   solid_fracture *f = b->fracture;

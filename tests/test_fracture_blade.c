@@ -366,8 +366,8 @@ static void same_state(const piola_world *a, const piola_world *b) {
 /* Checkpointed halfway down the bar, a fresh world resumes the sweep bit for bit. */
 static void moving_blade_resumes_bit_for_bit(void **state) {
   (void)state;
-  piola_tet_mesh mesh;
-  piola_world *a = flying_bar(&mesh), *b = flying_bar(&mesh);
+  piola_tet_mesh mesh, again;
+  piola_world *a = flying_bar(&mesh), *b = flying_bar(&again);
   piola_tri_mesh blade = blade_at(0.14);
   piola_fracture_cut cut;
   piola_fracture_def def = blade_def(&cut, &blade);
@@ -393,7 +393,7 @@ static void moving_blade_resumes_bit_for_bit(void **state) {
   same_state(a, b);
   assert_true(piola_world_solid_cut_tet_count(b, 0) > halfway);
   assert_int_equal(piola_world_solid_fragment_count(b, 0), 2);
-  piola_world_destroy(a), piola_world_destroy(b), piola_tet_mesh_free(&mesh);
+  piola_world_destroy(a), piola_world_destroy(b), piola_tet_mesh_free(&mesh), piola_tet_mesh_free(&again);
 }
 
 static void bad_motions_are_refused(void **state) {

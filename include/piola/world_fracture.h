@@ -34,11 +34,20 @@ extern "C" {
 /* A scripted cut, applied to the solid's shape at the first step that starts at or after
  * time (s): the plane through point (m) with normal (any length > 0), world space, or, when
  * blade is not NULL, that triangle surface (world space, m; copied): it splits the tets it
- * passes all the way through (piola_world_solid_cut_by_surface). */
+ * passes all the way through (piola_world_solid_cut_by_surface).
+ *
+ * A moving blade: with end_time > time (s), the blade (given at its position at `time`)
+ * translates at velocity (m/s) until end_time, and before every step that starts in
+ * [time, end_time], and once more at the first step from end_time, it cuts the tets that
+ * its surface at that time, together with the band its border swept since its last cut,
+ * passes all the way through: one crack, growing step by step (docs/fracture.md, "A moving
+ * blade"). end_time <= time (the default 0 included) and velocity 0: a cut at one time. */
 typedef struct piola_fracture_cut {
   double time;
   piola_vec3 point, normal;
   const piola_tri_mesh *blade;
+  double end_time;     /* s; > time: a moving blade (needs blade) */
+  piola_vec3 velocity; /* m/s, world space; nonzero only with end_time > time */
 } piola_fracture_cut;
 
 /* When material breaks by itself (besides the scripted cuts). */

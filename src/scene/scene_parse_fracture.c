@@ -5,16 +5,36 @@
 
 #include "scene/scene_parse_sections.h"
 
-/* {"time": t, "plane": {...}} or {"time": t, "mesh": "blade.obj"}; a mesh's path goes to
- * blade_path (resolved against the scene's folder; the builder reads it). */
+/* A moving blade's "end_time" (s, > time) and "velocity" (m/s): both or neither. */
+static piola_status parse_motion(scene_parser *p, const cJSON *obj, piola_fracture_cut *cut) {
+  const cJSON *end = piola__json_get(obj, "end_time"), *velocity = piola__json_get(obj, "velocity");
+  if (!end && !velocity) return PIOLA_OK;
+  if (!piola__json_get(obj, "mesh")) {
+    piola__json_push_key(p, end ? "end_time" : "velocity");
+    return piola__json_fail(p, BAD_VALUE, "only a blade moves: needs \"mesh\"");
+  }
+  PIOLA_TRY(piola__json_required(p, obj, "end_time"));
+  PIOLA_TRY(piola__json_required(p, obj, "velocity"));
+  PIOLA_TRY(piola__json_opt_number(p, obj, "end_time", NONNEGATIVE, &cut->end_time));
+  if (!(cut->end_time > cut->time)) {
+    piola__json_push_key(p, "end_time");
+    return piola__json_fail(p, BAD_VALUE, "must be > \"time\" (%g s), got %g", cut->time, cut->end_time);
+  }
+  return piola__json_opt_vec3(p, obj, "velocity", ANY, &cut->velocity);
+}
+
+/* {"time": t, "plane": {...}} or {"time": t, "mesh": "blade.obj"} (a moving blade with
+ * "end_time" and "velocity"); a mesh's path goes to blade_path (resolved against the scene's
+ * folder; the builder reads it). */
 static piola_status parse_cut(scene_parser *p, const cJSON *obj, piola_fracture_cut *cut, char *blade_path) {
-  static const char *const allowed[] = {"time", "plane", "mesh", NULL};
+  static const char *const allowed[] = {"time", "plane", "mesh", "end_time", "velocity", NULL};
   PIOLA_TRY(piola__json_check_keys(p, obj, allowed));
   PIOLA_TRY(piola__json_required(p, obj, "time"));
   PIOLA_TRY(piola__json_opt_number(p, obj, "time", NONNEGATIVE, &cut->time));
   const cJSON *mesh = piola__json_get(obj, "mesh");
   if (mesh && piola__json_get(obj, "plane"))
     return piola__json_fail(p, BAD_VALUE, "give either \"plane\" or \"mesh\", not both");
+  PIOLA_TRY(parse_motion(p, obj, cut));
   if (mesh) {
     size_t old = piola__json_push_key(p, "mesh");
     PIOLA_TRY(piola__json_path(p, mesh, blade_path));
@@ -35,7 +55,7 @@ static piola_status parse_cut(scene_parser *p, const cJSON *obj, piola_fracture_
 }
 
 /* "fracture": {"cuts": [{"time": t, "plane": {"point": [..], "normal": [..]}} or
- * {"time": t, "mesh": path}, ...], "max_cuts_per_step": n, "criterion": "stress" or
+ * {"time": t, "mesh": path, "end_time": t1, "velocity": [..]}, ...], "max_cuts_per_step": n, "criterion": "stress" or
  * "plastic_strain", "threshold": Pa or strain, "max_tets_per_step": n}. */
 piola_status piola__scene_parse_fracture(scene_parser *p, const cJSON *obj, scene_solid_desc *d) {
   static const char *const allowed[] = {"cuts", "max_cuts_per_step", "criterion", "threshold",

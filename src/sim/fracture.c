@@ -41,7 +41,7 @@ void piola__fracture_free(solid_fracture *f) {
   free_blades(f->blades, f->cut_count);
   free(f->cuts), free(f->tets), free(f->neighbor), free(f->parent), free(f->event), free(f->dist);
   free(f->side), free(f->fraction), free(f->fragment), free(f->copies), free(f->vertex_crack), free(f->last_strain);
-  free(f->vertex_value);
+  free(f->vertex_value), free(f->sweep_crack), free(f->swept_to);
   free(f);
 }
 
@@ -475,8 +475,9 @@ static void closest_on_triangle(const double *p, const double *a, const double *
 }
 
 /* Signed distance of p to the surface: the distance to the nearest triangle, signed by
- * that triangle's normal (of two equally near, the one p lies more squarely in front of). */
-static double surface_distance(const piola_tri_mesh *s, const double *p) {
+ * that triangle's normal (of two equally near, the one p lies more squarely in front of);
+ * planar: the distance to that triangle's plane instead (no larger beyond its border). */
+static double surface_distance(const piola_tri_mesh *s, const double *p, int planar) {
   double best = INFINITY, value = 0, best_dot = 0;
   for (int32_t i = 0; i < s->triangle_count; ++i) {
     const int32_t *t = s->triangles + 3 * i;
@@ -491,7 +492,7 @@ static double surface_distance(const piola_tri_mesh *s, const double *p) {
     const double along = dot3(d, n) / nn;
     if (dd < best * (1 - 1e-12) || (dd <= best * (1 + 1e-12) && fabs(along) > fabs(best_dot))) {
       best = dd, best_dot = along;
-      value = along >= 0 ? dd : -dd;
+      value = planar ? along : along >= 0 ? dd : -dd;
     }
   }
   return value;
@@ -525,9 +526,14 @@ static int segment_crosses(const piola_tri_mesh *s, const double *p, const doubl
 
 static const int8_t tet_edge[6][2] = {{0, 1}, {0, 2}, {0, 3}, {1, 2}, {1, 3}, {2, 3}};
 
-/* The cut by a surface: every uncut copy it passes all the way through, one new crack. */
-static piola_status surface_cut_event(piola_world *w, world_body *b, const piola_tri_mesh *surface,
-                                      int32_t *cut_count) {
+/* The cut by a surface: every uncut copy it passes all the way through, one new crack or
+ * (crack >= 0, a moving blade: fracture_blade.c) more of that crack, from its values at the
+ * vertices that hold them, so neighbouring copies cut at different times cross their shared
+ * edges at the same points. As those values are kept for the later cuts, a continued crack
+ * takes distances to the nearest triangle's plane: a corner beyond the surface's border now
+ * does not get a larger value than the surface will give it once it is there. */
+piola_status piola__fracture_surface_cut(piola_world *w, world_body *b, const piola_tri_mesh *surface,
+                                         int32_t crack, int32_t *cut_count) {
   solid_fracture *f = b->fracture;
   const int32_t *tets = piola_elastic_body_tets(b->solid);
   const double snap = piola__fracture_snap(b);
@@ -555,7 +561,7 @@ static piola_status surface_cut_event(piola_world *w, world_body *b, const piola
     if (apart) continue;
     int pos = 0, neg = 0;
     for (int j = 0; j < 4; ++j) {
-      if (isnan(s[corner[j]])) s[corner[j]] = snapped(surface_distance(surface, b->x + 3 * corner[j]), snap);
+      if (isnan(s[corner[j]])) s[corner[j]] = snapped(surface_distance(surface, b->x + 3 * corner[j], crack >= 0), snap);
       if (s[corner[j]] > 0) pos = 1;
       else neg = 1;
     }
@@ -566,12 +572,24 @@ static piola_status surface_cut_event(piola_world *w, world_body *b, const piola
       if ((s[p] > 0) != (s[q] > 0)) through = segment_crosses(surface, b->x + 3 * p, b->x + 3 * q);
     }
     if (!through) continue;
-    cuts[count].copy = c, cuts[count].crack = f->events;
-    for (int k = 0; k < 4; ++k) cuts[count].dist[k] = s[corner[k]];
+    cuts[count].copy = c, cuts[count].crack = crack >= 0 ? crack : f->events;
+    /* a continued crack keeps its values at the vertices it reached before; where they
+     * leave the copy on one side (the body moved across the surface since), the vertices
+     * now on the other side take their new distances */
+    int kept_pos = 0, kept_neg = 0;
+    for (int k = 0; k < 4; ++k) {
+      const int32_t vertex = f->tets[4 * f->parent[c] + k];
+      const int kept = crack >= 0 && f->vertex_crack[vertex] == crack;
+      cuts[count].dist[k] = kept ? f->vertex_value[vertex] : s[corner[k]];
+      if (cuts[count].dist[k] > 0) kept_pos = 1;
+      else kept_neg = 1;
+    }
+    for (int k = 0; k < 4 && !(kept_pos && kept_neg); ++k)
+      if ((cuts[count].dist[k] > 0) != (s[corner[k]] > 0)) cuts[count].dist[k] = s[corner[k]];
     ++count;
   }
   piola_status st = split_copies(w, b, cuts, count);
-  if (st == PIOLA_OK) b->fracture->events++;
+  if (st == PIOLA_OK && crack < 0) b->fracture->events++;
   *cut_count = count;
   free(s), free(cuts);
   return st;
@@ -641,7 +659,8 @@ static piola_status apply_due(piola_world *w, world_body *b) {
     const double point[3] = {c->point.x, c->point.y, c->point.z};
     const double normal[3] = {c->normal.x, c->normal.y, c->normal.z};
     int32_t count;
-    if (c->blade) PIOLA_TRY(surface_cut_event(w, b, c->blade, &count));
+    if (piola__fracture_cut_moves(c)) PIOLA_TRY(piola__fracture_blade_start(w, b, f->next_cut));
+    else if (c->blade) PIOLA_TRY(piola__fracture_surface_cut(w, b, c->blade, -1, &count));
     else PIOLA_TRY(cut_event(w, b, point, normal, &count));
     f = b->fracture;
     f->next_cut++;
@@ -865,6 +884,7 @@ static piola_status apply_criterion(piola_world *w, world_body *b) {
 piola_status piola__world_fracture_step(piola_world *w) {
   for (int32_t i = 0; i < w->body_count; ++i)
     if (w->bodies[i].kind == PIOLA_BODY_SOLID && w->bodies[i].fracture) {
+      PIOLA_TRY(piola__fracture_blades_sweep(w, &w->bodies[i]));
       PIOLA_TRY(apply_due(w, &w->bodies[i]));
       PIOLA_TRY(apply_criterion(w, &w->bodies[i]));
     }
@@ -909,12 +929,15 @@ piola_status piola_world_solid_set_fracture(piola_world *w, int32_t solid, const
     else PIOLA_TRY(check_plane(point, normal, b->name, i));
     if (!isfinite(c->time))
       return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "fracture of '%s': cut %d time is not finite", b->name, (int)i);
+    PIOLA_TRY(piola__fracture_check_motion(c, b->name, i));
   }
   const size_t slots = (size_t)(def->cut_count > 0 ? def->cut_count : 1);
   piola_fracture_cut *cuts = malloc(sizeof *cuts * slots);
   piola_tri_mesh *blades = calloc(slots, sizeof *blades);
-  if (!cuts || !blades) {
-    free(cuts), free(blades);
+  int32_t *sweep_crack = malloc(sizeof(int32_t) * slots);
+  double *swept_to = malloc(sizeof(double) * slots);
+  if (!cuts || !blades || !sweep_crack || !swept_to) {
+    free(cuts), free(blades), free(sweep_crack), free(swept_to);
     return PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "fracture of '%s': out of memory", b->name);
   }
   if (def->cut_count > 0) memcpy(cuts, def->cuts, sizeof *cuts * (size_t)def->cut_count);
@@ -933,11 +956,13 @@ piola_status piola_world_solid_set_fracture(piola_world *w, int32_t solid, const
   if (st == PIOLA_OK) st = ensure_state(b);
   if (st != PIOLA_OK) {
     free_blades(blades, def->cut_count);
-    free(cuts);
+    free(cuts), free(sweep_crack), free(swept_to);
     return st;
   }
   free_blades(b->fracture->blades, b->fracture->cut_count);
-  free(b->fracture->cuts);
+  free(b->fracture->cuts), free(b->fracture->sweep_crack), free(b->fracture->swept_to);
+  for (int32_t i = 0; i < def->cut_count; ++i) sweep_crack[i] = -1, swept_to[i] = -INFINITY;
+  b->fracture->sweep_crack = sweep_crack, b->fracture->swept_to = swept_to;
   b->fracture->cuts = cuts;
   b->fracture->blades = blades;
   b->fracture->cut_count = def->cut_count;
@@ -968,7 +993,7 @@ piola_status piola_world_solid_cut_by_surface(piola_world *w, int32_t solid, con
   PIOLA_TRY(check_blade(surface, b->name, 0));
   PIOLA_TRY(ensure_state(b));
   int32_t count = 0;
-  PIOLA_TRY(surface_cut_event(w, b, surface, &count));
+  PIOLA_TRY(piola__fracture_surface_cut(w, b, surface, -1, &count));
   if (cut_tets) *cut_tets = count;
   return PIOLA_OK;
 }

@@ -21,6 +21,10 @@ typedef struct solid_fracture {
   piola_fracture_cut *cuts;   /* a blade cut's blade points into blades */
   piola_tri_mesh *blades;     /* per scripted cut: its blade's copy (empty for a plane) */
   int32_t cut_count, next_cut, max_cuts_per_step, max_tets_per_step;
+  /* per scripted cut, for moving blades (fracture_blade.c): the crack it grows (-1: not
+   * started, or not a moving blade) and the time of the blade's position at its last cut, s */
+  int32_t *sweep_crack;
+  double *swept_to;
   int32_t events;             /* cracks started so far (plane and blade cuts, the criterion's
                                  cracks): the crack ids */
   int32_t grown_crack;        /* the id all the criterion's cracks share (-1: none yet): their
@@ -88,6 +92,22 @@ typedef struct fracture_surface_point {
 } fracture_surface_point;
 
 struct world_body;
+struct piola_world;
+/* Cuts solid b by a triangle surface (world space): every uncut copy it passes all the way
+ * through. crack < 0: a new crack; else the cut continues that crack, taking its values at
+ * the vertices that hold them (so the crack stays one zero set across steps). *cut_count:
+ * copies split. */
+piola_status piola__fracture_surface_cut(struct piola_world *w, struct world_body *b,
+                                         const piola_tri_mesh *surface, int32_t crack,
+                                         int32_t *cut_count);
+/* A scripted cut that is a moving blade (end_time > time). */
+int piola__fracture_cut_moves(const piola_fracture_cut *cut);
+/* Refuses a cut's bad motion (non-finite, a moving plane, a velocity without end_time > time). */
+piola_status piola__fracture_check_motion(const piola_fracture_cut *cut, const char *name, int32_t index);
+/* Starts moving cut i of b (due now): a new crack and its first cut. */
+piola_status piola__fracture_blade_start(struct piola_world *w, struct world_body *b, int32_t i);
+/* Before a step: every started moving blade not done yet cuts once more (fracture_blade.c). */
+piola_status piola__fracture_blades_sweep(struct piola_world *w, struct world_body *b);
 /* The distance (m) from a cut's plane below which node distances are pushed away from it:
  * a share of the smallest rest altitude, and with self-collision up to half the thickness
  * (capped at 5% of that altitude), so the crack faces' collision surfaces fit inside. */

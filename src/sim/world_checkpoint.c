@@ -241,6 +241,9 @@ static void fracture_state(stream *s, piola_world *w, world_body *b) {
   one_int(s, &f->grown_crack, "grown crack");
   field(s, f->vertex_crack, (uint64_t)f->vertex_count, sizeof(int32_t), "cracks at vertices");
   doubles(s, f->vertex_value, (uint64_t)f->vertex_count, "crack values at vertices");
+  /* per scripted cut, a moving blade's crack and the time of its last cut (fracture_blade.c) */
+  field(s, f->sweep_crack, (uint64_t)f->cut_count, sizeof(int32_t), "moving blades' cracks");
+  doubles(s, f->swept_to, (uint64_t)f->cut_count, "moving blades' last cut times");
   if (s->reading) {
     if (!s->failed) {
       fracture_saved saved = {.copy_count = nc, .node_count = counts[1], .events = counts[2],

@@ -1,13 +1,14 @@
 /* How long recovery takes with piola's own integrator: the measurements behind
  * docs/time-stepping.md "Recovery". Not a timing benchmark: a table of settling times.
  *
- *   bench_recovery_time MESH MODEL START E VISCOSITY [SECONDS] [DENSITY]
+ *   bench_recovery_time MESH MODEL START E VISCOSITY [SECONDS] [DENSITY] [INTEGRATOR] [DIAGONAL]
  *
  * MESH a tet mesh file; MODEL a model name (corotated, neohookean, ...); START one of point,
  * line, plane, mirror or scramble:R (R in multiples of the bounding-box diagonal); E Young's
  * modulus (Pa, nu = 0.3); VISCOSITY the shear and bulk viscosity (Pa s); SECONDS of
- * simulated time (default 5); DENSITY kg/m^3 (default 1000). Zero gravity, default
- * integrator. Prints every 0.1 s the shape error (largest distance of a vertex from the rest
+ * simulated time (default 5); DENSITY kg/m^3 (default 1000); INTEGRATOR newmark (default)
+ * or backward_euler (at its default step); DIAGONAL m: the mesh is scaled about its box's
+ * centre to that bounding-box diagonal (default: as read). Zero gravity. Prints every 0.1 s the shape error (largest distance of a vertex from the rest
  * shape after the best rigid motion, Procrustes, in % of the diagonal), the kinetic and
  * elastic energy (J), the inverted tets and the steps, then the first times the shape error
  * fell below 10% and 1% and stayed there, next to the settling time piola_settling_time
@@ -21,6 +22,7 @@
 #include "piola/diagonalize.h"
 #include "piola/mesh_io.h"
 #include "piola/settling.h"
+#include "piola/threads.h"
 #include "piola/world.h"
 
 static double shape_error(const double *x, const double *rest, const double *mass, int32_t nv) {
@@ -56,16 +58,26 @@ static double shape_error(const double *x, const double *rest, const double *mas
 
 int main(int argc, char **argv) {
   if (argc < 6) {
-    fprintf(stderr, "usage: bench_recovery_time MESH MODEL START E VISCOSITY [SECONDS] [DENSITY]\n");
+    fprintf(stderr, "usage: bench_recovery_time MESH MODEL START E VISCOSITY [SECONDS] [DENSITY] [INTEGRATOR] [DIAGONAL]\n");
     return 2;
   }
+  /* one thread: on a loaded machine a small body's parallel regions mostly wait */
+  piola_set_thread_count(1);
   piola_tet_mesh mesh;
   if (piola_tet_mesh_read(argv[1], &mesh) != PIOLA_OK) return fprintf(stderr, "%s\n", piola_last_error()), 1;
   double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
   for (int32_t v = 0; v < mesh.vertex_count; ++v)
     for (int i = 0; i < 3; ++i) lo[i] = fmin(lo[i], mesh.positions[3 * v + i]), hi[i] = fmax(hi[i], mesh.positions[3 * v + i]);
-  const double diag = sqrt((hi[0] - lo[0]) * (hi[0] - lo[0]) + (hi[1] - lo[1]) * (hi[1] - lo[1]) + (hi[2] - lo[2]) * (hi[2] - lo[2]));
+  double diag = sqrt((hi[0] - lo[0]) * (hi[0] - lo[0]) + (hi[1] - lo[1]) * (hi[1] - lo[1]) + (hi[2] - lo[2]) * (hi[2] - lo[2]));
+  if (argc > 9) {
+    const double scale = atof(argv[9]) / diag;
+    for (int32_t v = 0; v < mesh.vertex_count; ++v)
+      for (int i = 0; i < 3; ++i) mesh.positions[3 * v + i] = (mesh.positions[3 * v + i] - 0.5 * (lo[i] + hi[i])) * scale;
+    diag = atof(argv[9]);
+  }
   piola_world_def wd = piola_default_world_def();
+  if (argc > 8 && !piola_integrator_type_from_name(argv[8], &wd.integrator))
+    return fprintf(stderr, "unknown integrator %s\n", argv[8]), 2;
   for (int k = 0; k < 3; ++k) wd.gravity[k] = piola_track_constant(0);
   piola_world *world = NULL;
   if (piola_world_create(&wd, &world) != PIOLA_OK) return fprintf(stderr, "%s\n", piola_last_error()), 1;

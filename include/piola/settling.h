@@ -32,7 +32,11 @@ typedef struct piola_settling_estimate {
                                floor of the overdamped modes' decay (infinite without damping) */
   double decay_rate;        /* r = min(lowest_decay_rate, relaxation_rate), 1/s */
   double crossing_time;     /* D / c_p, s: a dilatational wave across the bounding-box
-                               diagonal D (the re-expansion of a collapsed body) */
+                               diagonal D */
+  double reexpansion_time;  /* s: 3 max(D / c_p, 1 / relaxation_rate), how long a body
+                               collapsed to a point, a line or a plane takes to re-expand
+                               and untangle before its shape error decays at decay_rate (a
+                               measured bound, docs/time-stepping.md "Recovery") */
   double diagonal;          /* D, m: the rest bounding box's diagonal */
   int iterations;           /* inverse iterations taken */
 } piola_settling_estimate;
@@ -47,9 +51,9 @@ PIOLA_API piola_status piola_elastic_body_settling_estimate(const piola_elastic_
                                                             double bulk_viscosity,
                                                             piola_settling_estimate *out);
 
-/* Predicted time (s) for a shape error (m, the largest distance of a vertex from the rest
- * shape after the best rigid motion) to fall from initial_error to tolerance:
- * crossing_time + ln(initial_error / tolerance) / decay_rate; crossing_time alone when
+/* Predicted time (s) for the shape error (m, the largest distance of a vertex from the rest
+ * shape after the best rigid motion) of a collapsed body to fall from initial_error to
+ * tolerance: reexpansion_time + ln(initial_error / tolerance) / decay_rate; 0 when
  * initial_error <= tolerance, infinite when decay_rate is 0. */
 PIOLA_API double piola_settling_time(const piola_settling_estimate *estimate, double initial_error,
                                      double tolerance);

@@ -331,6 +331,7 @@ static int info_tets(const char *path, int json, const info_material *material,
       cJSON_AddNumberToObject(st, "relaxation_rate", est.relaxation_rate);
       cJSON_AddNumberToObject(st, "decay_rate", est.decay_rate);
       cJSON_AddNumberToObject(st, "crossing_time", est.crossing_time);
+      cJSON_AddNumberToObject(st, "reexpansion_time", est.reexpansion_time);
       cJSON_AddNumberToObject(st, "point_collapse_error", point_error);
       cJSON_AddNumberToObject(st, "point_collapse_settling_time", point_time);
     }

@@ -190,7 +190,12 @@ piola_status piola_elastic_body_settling_estimate(const piola_elastic_body *body
       lo[i] = fmin(lo[i], body->rest_positions[3 * v + i]), hi[i] = fmax(hi[i], body->rest_positions[3 * v + i]);
   out->diagonal = sqrt((hi[0] - lo[0]) * (hi[0] - lo[0]) + (hi[1] - lo[1]) * (hi[1] - lo[1]) +
                        (hi[2] - lo[2]) * (hi[2] - lo[2]));
-  out->crossing_time = out->diagonal / body->max_wave_speed;
+  /* the slowest material's dilatational speed, fibres left out (they add nothing in the
+   * compression a collapsed body re-expands from) */
+  double speed = INFINITY;
+  for (int32_t k = 0; k < body->material_count; ++k)
+    speed = fmin(speed, sqrt((body->materials[k].lambda + 2 * body->materials[k].mu) / body->density));
+  out->crossing_time = out->diagonal / speed;
 
   rest_diagonal(body, inv_diag);
   for (size_t k = 0; k < n; ++k) inv_diag[k] = inv_diag[k] > 0 ? 1 / inv_diag[k] : 0;
@@ -242,9 +247,9 @@ piola_status piola_elastic_body_settling_estimate(const piola_elastic_body *body
   out->relaxation_rate = relax;
   out->decay_rate = fmin(out->lowest_decay_rate, relax);
   /* measured on the unit ball, the octahedron and armadillo_4k (docs/time-stepping.md):
-   * about three wave crossings when the re-expansion is inertial, three relaxation times
-   * when it is overdamped */
-  out->reexpansion_time = 3 * fmax(out->crossing_time, relax > 0 ? 1 / relax : INFINITY);
+   * up to four wave crossings when the re-expansion is inertial, four relaxation times when
+   * it is overdamped */
+  out->reexpansion_time = 4 * fmax(out->crossing_time, relax > 0 ? 1 / relax : INFINITY);
   free(work);
   return PIOLA_OK;
 }

@@ -152,10 +152,29 @@ static void damping_and_decay_of_the_lowest_mode(void **state) {
   block_mesh_free(&mesh);
 }
 
+/* Two tets that share nothing: one moves freely against the other, so the lowest frequency
+ * is 0 and nothing predicts a settling. */
+static void separate_pieces_have_no_settling_time(void **state) {
+  (void)state;
+  double x[24] = {0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1, 3, 0, 0, 4, 0, 0, 3, 1, 0, 3, 0, 1};
+  int32_t tets[8] = {0, 1, 2, 3, 4, 5, 6, 7};
+  piola_tet_mesh mesh;
+  memset(&mesh, 0, sizeof mesh);
+  mesh.positions = x, mesh.vertex_count = 8, mesh.tets = tets, mesh.tet_count = 2;
+  piola_material material;
+  piola_elastic_body *body = make_body(&mesh, PIOLA_MODEL_NEOHOOKEAN, &material);
+  piola_settling_estimate est;
+  assert_int_equal(piola_elastic_body_settling_estimate(body, 100, 100, &est), PIOLA_OK);
+  assert_true(est.lowest_frequency == 0 && est.decay_rate == 0);
+  assert_true(isinf(piola_settling_time(&est, 1, 0.01)));
+  piola_elastic_body_destroy(body);
+}
+
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(lowest_frequency_matches_the_dense_eigenvalue),
       cmocka_unit_test(damping_and_decay_of_the_lowest_mode),
+      cmocka_unit_test(separate_pieces_have_no_settling_time),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
 }

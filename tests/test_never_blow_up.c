@@ -268,7 +268,8 @@ static void collapses_settle_in_the_predicted_time(void **state) {
  * diagonal within the predicted time. Backward Euler at its default step h = 1/30 s (an
  * explicit run is ~8,000 sliver-bound steps per simulated second): its discrete decay
  * ln(1 + h r) / h replaces r in the prediction. At reduced scale (the sanitizer pass) only
- * the neo-Hookean plane collapse. */
+ * the estimate at 1000 Pa s and its lowest mode (the runs cost minutes under the
+ * sanitizers). */
 static void armadillo_collapses_settle_in_the_predicted_time(void **state) {
   (void)state;
   static const piola_mat3 starts[3] = {{{{0, 0, 0}, {0, 0, 0}, {0, 0, 0}}},
@@ -286,18 +287,21 @@ static void armadillo_collapses_settle_in_the_predicted_time(void **state) {
   assert_int_equal(piola_elastic_body_settling_estimate(piola_world_solid_body(w, 0), VISCOSITY, VISCOSITY, &est),
                    PIOLA_OK);
   piola_world_destroy(w);
+  assert_true(est.lowest_frequency < 0.6 * M_PI * sqrt(mu / DENSITY) / DIAGONAL); /* not compact */
+  if (reduced) {
+    piola_tet_mesh_free(&mesh);
+    return;
+  }
   const double beta = sqrt(2 * mu * VISCOSITY / est.lowest_damping);
   /* the estimate is the same for both models: the same mu and lambda at rest */
   w = make_world(&mesh, PIOLA_MODEL_COROTATED, identity, 0);
   assert_int_equal(piola_elastic_body_settling_estimate(piola_world_solid_body(w, 0), beta, beta, &est), PIOLA_OK);
   piola_world_destroy(w);
-  assert_true(est.lowest_frequency < 0.6 * M_PI * sqrt(mu / DENSITY) / DIAGONAL); /* not compact */
   const double h = piola_default_world_def().implicit_dt;
   const double rate = log(1 + h * est.decay_rate) / h;
   int failures = 0;
   for (int si = 0; si < 3; ++si)
     for (int k = 0; k < 2; ++k) {
-      if (reduced && (si != 2 || k != 1)) continue;
       w = make_world_integrated(&mesh, models[k], starts[si], 0, beta, PIOLA_INTEGRATOR_BACKWARD_EULER);
       const double e0 = shape_error(w), limit = est.reexpansion_time + log(e0 / eps) / rate;
       double t = 0;

@@ -27,6 +27,7 @@
 #include "piola/output.h"
 #include "piola/plasticity.h"
 #include "piola/rigid_motion.h"
+#include "piola/settling.h"
 #include "piola/shell_body.h"
 #include "piola/status.h"
 #include "piola/threads.h"

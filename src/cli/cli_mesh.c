@@ -10,14 +10,18 @@
 #include "cli/commands.h"
 #include "piola/mesh.h"
 #include "piola/mesh_io.h"
+#include "piola/elastic_body.h"
 #include "piola/mesh_quality.h"
+#include "piola/settling.h"
 
 static void usage(FILE *out) {
   fprintf(out,
-          "usage: piola mesh info FILE [--json] [--material E,NU,RHO]\n"
+          "usage: piola mesh info FILE [--json] [--material E,NU,RHO [--viscosity BETA[,ALPHA]]]\n"
           "                                        counts, bounding box, volume, regions, quality,\n"
           "                                        smallest altitude, boundary checks; with\n"
-          "                                        --material (Pa, -, kg/m^3) the explicit time step\n"
+          "                                        --material (Pa, -, kg/m^3) the explicit time step;\n"
+          "                                        with --viscosity (shear, bulk; Pa s) the lowest\n"
+          "                                        vibration mode and the settling time\n"
           "       piola mesh convert IN OUT        convert by extension (.node/.ele .msh .mesh .veg\n"
           "                                        .vtu .obj .off .stl)\n"
           "       piola mesh generate ...          see `piola mesh generate --help`\n");
@@ -41,6 +45,58 @@ static bool parse_material(const char *s, info_material *m) {
   if (*end || !(v[0] > 0) || !(v[1] > -1 && v[1] < 0.5) || !(v[2] > 0)) return false;
   *m = (info_material){true, v[0], v[1], v[2]};
   return true;
+}
+
+/* --viscosity BETA[,ALPHA]: shear and bulk viscosity (Pa s, >= 0; ALPHA defaults to BETA). */
+static bool parse_viscosity(const char *s, double v[2]) {
+  char *end = NULL;
+  v[0] = strtod(s, &end);
+  if (end == s || !isfinite(v[0]) || !(v[0] >= 0)) return false;
+  v[1] = v[0];
+  if (*end == ',') {
+    const char *p = end + 1;
+    v[1] = strtod(p, &end);
+    if (end == p || !isfinite(v[1]) || !(v[1] >= 0)) return false;
+  }
+  return *end == 0;
+}
+
+/* The settling estimate (piola/settling.h) of mesh m in `material` (any model: near rest
+ * they all are linear elasticity with its mu and lambda) under viscosity; point_error is the
+ * shape error of a collapse to a point, the largest distance of a vertex from the
+ * mass-weighted centroid (m). */
+static piola_status settling(const piola_tet_mesh *m, const info_material *material,
+                             const double viscosity[2], piola_settling_estimate *est,
+                             double *point_error) {
+  piola_material_def def = piola_default_material_def();
+  def.model = PIOLA_MODEL_ROTATED_LINEAR;
+  def.youngs_modulus = material->youngs_modulus;
+  def.poisson_ratio = material->poisson_ratio;
+  piola_material mat;
+  piola_status s = piola_material_init(&def, &mat);
+  if (s != PIOLA_OK) return s;
+  piola_elastic_body_def bd = piola_default_elastic_body_def();
+  bd.rest_mesh = m;
+  bd.materials = &mat;
+  bd.material_count = 1;
+  bd.density = material->density;
+  piola_elastic_body *body = NULL;
+  s = piola_elastic_body_create(&bd, &body);
+  if (s != PIOLA_OK) return s;
+  s = piola_elastic_body_settling_estimate(body, viscosity[0], viscosity[1], est);
+  const double *x = piola_elastic_body_rest_positions(body), *mass = piola_elastic_body_masses(body);
+  double c[3] = {0}, total = 0, worst = 0;
+  for (int32_t v = 0; v < m->vertex_count; ++v) {
+    total += mass[v];
+    for (int i = 0; i < 3; ++i) c[i] += mass[v] * x[3 * v + i];
+  }
+  for (int32_t v = 0; v < m->vertex_count; ++v)
+    if (mass[v] > 0)
+      worst = fmax(worst, hypot(hypot(x[3 * v] - c[0] / total, x[3 * v + 1] - c[1] / total),
+                                x[3 * v + 2] - c[2] / total));
+  *point_error = worst;
+  piola_elastic_body_destroy(body);
+  return s;
 }
 
 /* The dilatational wave speed sqrt((lambda + 2 mu) / rho), m/s: the speed that bounds the
@@ -194,7 +250,8 @@ static int info_surface(const char *path, int json, const info_material *materia
   return rc;
 }
 
-static int info_tets(const char *path, int json, const info_material *material) {
+static int info_tets(const char *path, int json, const info_material *material,
+                     const double *viscosity) {
   piola_tet_mesh m;
   piola_status s = piola_tet_mesh_read(path, &m);
   if (s != PIOLA_OK) return fail(s);
@@ -226,6 +283,18 @@ static int info_tets(const char *path, int json, const info_material *material) 
   bounds(m.positions, m.vertex_count, lo, hi);
   double h_min = min_altitude(&m);
   double speed = material->given ? wave_speed(material) : 0;
+  piola_settling_estimate est = {0};
+  double point_error = 0, point_time = 0;
+  if (viscosity) {
+    s = settling(&m, material, viscosity, &est, &point_error);
+    if (s != PIOLA_OK) {
+      free(ids);
+      piola_tri_mesh_free(&boundary);
+      piola_tet_mesh_free(&m);
+      return fail(s);
+    }
+    point_time = piola_settling_time(&est, point_error, 0.01 * est.diagonal);
+  }
   int rc = 0;
   if (json) {
     cJSON *o = cJSON_CreateObject();
@@ -251,6 +320,20 @@ static int info_tets(const char *path, int json, const info_material *material) 
       cJSON_AddNumberToObject(mat, "wave_speed", speed);
       cJSON_AddNumberToObject(mat, "explicit_dt", h_min / speed);
       cJSON_AddNumberToObject(mat, "explicit_dt_default_cfl", INFO_DEFAULT_CFL * h_min / speed);
+    }
+    if (viscosity) {
+      cJSON *st = cJSON_AddObjectToObject(o, "settling");
+      cJSON_AddNumberToObject(st, "shear_viscosity", viscosity[0]);
+      cJSON_AddNumberToObject(st, "bulk_viscosity", viscosity[1]);
+      cJSON_AddNumberToObject(st, "lowest_frequency", est.lowest_frequency);
+      cJSON_AddNumberToObject(st, "lowest_damping", est.lowest_damping);
+      cJSON_AddNumberToObject(st, "lowest_decay_rate", est.lowest_decay_rate);
+      cJSON_AddNumberToObject(st, "relaxation_rate", est.relaxation_rate);
+      cJSON_AddNumberToObject(st, "decay_rate", est.decay_rate);
+      cJSON_AddNumberToObject(st, "crossing_time", est.crossing_time);
+      cJSON_AddNumberToObject(st, "reexpansion_time", est.reexpansion_time);
+      cJSON_AddNumberToObject(st, "point_collapse_error", point_error);
+      cJSON_AddNumberToObject(st, "point_collapse_settling_time", point_time);
     }
     cJSON *worst = cJSON_AddArrayToObject(o, "worst_aspect_ratios");
     for (int i = 0; i < q.worst_count; ++i) {
@@ -300,6 +383,15 @@ static int info_tets(const char *path, int json, const info_material *material) 
              "%.4g s at the scenes' default cfl %g\n",
              h_min / speed, speed, material->youngs_modulus, material->poisson_ratio,
              material->density, INFO_DEFAULT_CFL * h_min / speed, INFO_DEFAULT_CFL);
+    if (viscosity) {
+      printf("lowest mode:      %.4g rad/s (period %.4g s), damped at %.4g /s: decays at %.4g /s "
+             "(viscosity %g, %g Pa s)\n",
+             est.lowest_frequency, 2 * M_PI / est.lowest_frequency, est.lowest_damping,
+             est.lowest_decay_rate, viscosity[0], viscosity[1]);
+      printf("settling:         decay rate %.4g /s (overdamped floor %.4g /s), D / c_p %.4g s; "
+             "from a point collapse (%.4g m) to 1%% of the diagonal in %.4g s\n",
+             est.decay_rate, est.relaxation_rate, est.crossing_time, point_error, point_time);
+    }
   }
   free(ids);
   piola_tri_mesh_free(&boundary);
@@ -341,8 +433,18 @@ int cli_mesh(int argc, char **argv) {
     const char *path = NULL;
     int json = 0;
     info_material material = {0};
+    double viscosity[2];
+    bool viscosity_given = false;
     for (int i = 2; i < argc; ++i) {
       if (strcmp(argv[i], "--json") == 0) json = 1;
+      else if (strcmp(argv[i], "--viscosity") == 0) {
+        if (++i >= argc || !parse_viscosity(argv[i], viscosity)) {
+          fprintf(stderr, "piola mesh info: --viscosity needs BETA[,ALPHA]: shear and bulk "
+                          "viscosity >= 0 (Pa s)\n");
+          return 2;
+        }
+        viscosity_given = true;
+      }
       else if (strcmp(argv[i], "--material") == 0) {
         if (++i >= argc || !parse_material(argv[i], &material)) {
           fprintf(stderr, "piola mesh info: --material needs E,NU,RHO: Young's modulus > 0 (Pa), "
@@ -366,8 +468,17 @@ int cli_mesh(int argc, char **argv) {
       usage(stderr);
       return 2;
     }
+    if (viscosity_given && !material.given) {
+      fprintf(stderr, "piola mesh info: --viscosity needs --material E,NU,RHO\n");
+      return 2;
+    }
+    if (viscosity_given && is_surface_path(path)) {
+      fprintf(stderr, "piola mesh info: --viscosity: %s is a surface, it has no tets and so no "
+                      "vibration modes; fill it with `piola mesh generate` first\n", path);
+      return 2;
+    }
     return is_surface_path(path) ? info_surface(path, json, &material)
-                                 : info_tets(path, json, &material);
+                                 : info_tets(path, json, &material, viscosity_given ? viscosity : NULL);
   }
   if (strcmp(sub, "convert") == 0) {
     for (int i = 2; i < argc; ++i)

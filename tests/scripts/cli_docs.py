@@ -2,6 +2,7 @@
 snippets through `piola check`."""
 import glob
 import json
+import math
 import os
 import re
 import subprocess
@@ -49,7 +50,7 @@ def main():
     doc = open(os.path.join(SOURCE, "docs", "cli.md")).read()
     for args, title in [(["run"], "## piola run"), (["check"], "## piola check"),
                         (["render"], "## piola render"),
-                        (["mesh", "info"], "### piola mesh info FILE [--json] [--material E,NU,RHO]")]:
+                        (["mesh", "info"], "### piola mesh info FILE [--json] [--material E,NU,RHO [--viscosity BETA[,ALPHA]]]")]:
         helped = flags(subprocess.run([PIOLA, *args, "--help"], capture_output=True,
                                       text=True).stdout) - {"--help"}
         documented = flags(cli_section(doc, title)) - {"--help"}
@@ -57,6 +58,32 @@ def main():
               f"docs/cli.md (missing: {sorted(helped - documented)})")
         check(documented <= helped, f"piola {' '.join(args)}: every flag docs/cli.md gives is "
               f"in --help (missing: {sorted(documented - helped)})")
+
+    # --viscosity: the settling estimate of time-stepping.md "Recovery", its parts consistent
+    ball = os.path.join(SOURCE, "..", "shared", "data", "medit", "unit_ball.mesh")
+    p = subprocess.run([PIOLA, "mesh", "info", ball, "--json", "--material", "2e4,0.3,1000",
+                        "--viscosity", "1000,500"], capture_output=True, text=True)
+    check(p.returncode == 0, f"mesh info --viscosity runs (rc {p.returncode}: {p.stderr.strip()})")
+    if p.returncode == 0:
+        st = json.loads(p.stdout)["settling"]
+        mu, lam = 2e4 / 2.6, 2e4 * 0.3 / (1.3 * 0.4)
+        w, c = st["lowest_frequency"], st["lowest_damping"]
+        check(w > 0 and c > 0 and st["bulk_viscosity"] == 500, f"settling: omega_1 {w}, c_1 {c}")
+        r1 = c / 2 if c < 2 * w else (c - math.sqrt(c * c - 4 * w * w)) / 2
+        floor = min(mu / 1000, lam / 500)
+        r = min(r1, floor)
+        check(abs(st["lowest_decay_rate"] - r1) < 1e-9 * r1 and abs(st["relaxation_rate"] - floor) < 1e-9 * floor
+              and abs(st["decay_rate"] - r) < 1e-9 * r, f"settling: decay rates {st}")
+        lo, hi = json.loads(p.stdout)["bounding_box_min"], json.loads(p.stdout)["bounding_box_max"]
+        d = math.dist(lo, hi)
+        check(abs(st["crossing_time"] - d / math.sqrt((lam + 2 * mu) / 1000)) < 1e-9, "settling: D / c_p")
+        t = 4 * max(st["crossing_time"], 1 / floor) + math.log(st["point_collapse_error"] / (0.01 * d)) / r
+        check(abs(st["point_collapse_settling_time"] - t) < 1e-9 * t, f"settling: T {st} against {t}")
+    for bad in (["--viscosity", "1000"], ["--material", "2e4,0.3,1000", "--viscosity", "-1"],
+                ["--material", "2e4,0.3,1000", "--viscosity", "1000,"]):
+        p = subprocess.run([PIOLA, "mesh", "info", ball, *bad], capture_output=True, text=True)
+        check(p.returncode == 2 and "--viscosity" in p.stderr and not p.stdout,
+              f"mesh info {' '.join(bad)} is refused naming --viscosity (rc {p.returncode})")
 
     # --refine and a scene's refinement_levels have one range, 0..6 (mesher.md)
     with tempfile.TemporaryDirectory() as work:

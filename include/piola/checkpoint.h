@@ -27,7 +27,7 @@ extern "C" {
 #endif
 
 /* The checkpoint format this piola writes and reads (docs/file-formats.md). */
-#define PIOLA_CHECKPOINT_VERSION 3
+#define PIOLA_CHECKPOINT_VERSION 4
 
 /* 1 when checkpoints cover every part of the world's state; 0 with a reason in *why (a
  * static string) otherwise. */

@@ -68,6 +68,13 @@ typedef struct piola_fracture_def {
   double threshold;               /* > 0: Pa (stress) or plastic log strain (plastic_strain) */
   int32_t max_tets_per_step;      /* the criterion cuts at most this many tets before one step.
                                      0 (default): no limit */
+  double growth_threshold;        /* >= 0, the unit of threshold: a crack front grows into a
+                                     tet whose measure exceeds it; a new crack still needs
+                                     threshold. 0 (default): threshold */
+  double max_crack_speed;         /* m/s: a crack front crosses a tet (its mean rest edge) in
+                                     no less than that edge over this speed, counted from when
+                                     the crack reached the tet; while a front waits, no new
+                                     crack starts. 0 (default): no limit */
 } piola_fracture_def;
 
 PIOLA_API piola_fracture_def piola_default_fracture_def(void);

@@ -29,8 +29,8 @@ CONTACT_FROM = {"cloth_on_jelly": 2, "cloth_folds": 5, "solids_stack": 1, "squee
                 # fracture: cut at frames 9 and 19 (0.3 s and 0.6 s), so the runs resume from
                 # cut states and the second cut comes after the resumes
                 "scripted_cut": 12,
-                # the stress criterion's cracks grow tet by tet from frame 2 (their state:
-                # the cracks' values at the vertices)
+                # the stress criterion's crack starts at frame 4 and grows to frame 10 (its state:
+                # the values and times at the vertices)
                 "brittle_slab": 2}
 EVERY = 2  # frames between checkpoints
 # Renames of a run (src/output/frame_commit.c): scene.json, then per frame six (VTU and OBJ

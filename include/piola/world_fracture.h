@@ -50,12 +50,14 @@ typedef enum piola_fracture_criterion {
                                   exceeds threshold (dimensionless) cracks; the solid needs
                                   plasticity */
 } piola_fracture_criterion;
-/* Before each step, every uncut tet past the threshold that touches a crack (a neighbour's
- * crack crosses their shared face) is cut so that the crack runs on into it: the crack's
- * points on the shared faces are kept and it turns as close to normal to the tet's largest
- * principal stress as they allow. If no crack grows, the tet with the largest measure starts
- * a new one unless a crack touches it: the plane through its centroid normal to its largest
- * principal stress, in that tet only. So cracks grow tet by tet as surfaces
+/* Before each step, every uncut tet on a crack's front (it shares a face with a tet the
+ * crack cut, and the crack ends on an edge of that face) whose measure is past
+ * growth_threshold is cut so that the crack runs on into it: the crack's points on the
+ * shared faces are kept and it turns as close as they allow to normal to the neighbours'
+ * crack (stress criterion) or to the tet's largest principal stress (plastic strain). If no
+ * crack grows or waits (max_crack_speed), the tet past threshold with the largest measure
+ * starts a new one unless a crack touches it: the plane through its centroid normal to its
+ * largest principal stress, in that tet only. So cracks grow tet by tet as surfaces
  * (docs/fracture.md). */
 
 typedef struct piola_fracture_def {

@@ -147,6 +147,18 @@ sed 's/"threshold": 1.5e4}/"threshold": 1.5e4, "max_tets_per_step": 4}/' "$work/
 sed 's/"criterion": "stress", //' "$work/most.json" >"$work/most_alone.json"
 if "$PIOLA" run "$work/most_alone.json" -o "$work/ma" >"$work/log" 2>&1; then echo "FAIL: max_tets_per_step without criterion accepted"; exit 1; fi
 grep -q "solids\[0\].fracture.threshold" "$work/log" || { echo "FAIL: max_tets_per_step message:"; cat "$work/log"; exit 1; }
+# growth_threshold and max_crack_speed: accepted with a criterion, refused without one or
+# when not positive, naming the key
+sed 's/"threshold": 1.5e4}/"threshold": 1.5e4, "growth_threshold": 5e3, "max_crack_speed": 5}/' "$work/pull.json" >"$work/grow.json"
+"$PIOLA" run "$work/grow.json" -o "$work/grow" --frames 1 >"$work/log" 2>&1 || { echo "FAIL: growth_threshold, max_crack_speed refused"; cat "$work/log"; exit 1; }
+for key in growth_threshold max_crack_speed; do
+  sed "s/\"criterion\": \"stress\", \"threshold\": 1.5e4}/\"$key\": 5}/" "$work/pull.json" >"$work/alone.json"
+  if "$PIOLA" run "$work/alone.json" -o "$work/alone" >"$work/log" 2>&1; then echo "FAIL: $key without criterion accepted"; exit 1; fi
+  grep -q "solids\[0\].fracture.$key" "$work/log" || { echo "FAIL: $key message:"; cat "$work/log"; exit 1; }
+  sed "s/\"threshold\": 1.5e4}/\"threshold\": 1.5e4, \"$key\": -1}/" "$work/pull.json" >"$work/neg.json"
+  if "$PIOLA" run "$work/neg.json" -o "$work/neg" >"$work/log" 2>&1; then echo "FAIL: negative $key accepted"; exit 1; fi
+  grep -q "solids\[0\].fracture.$key" "$work/log" || { echo "FAIL: negative $key message:"; cat "$work/log"; exit 1; }
+done
 sed 's/"criterion": "stress", //' "$work/pull.json" >"$work/threshold.json"
 if "$PIOLA" run "$work/threshold.json" -o "$work/t" >"$work/log" 2>&1; then echo "FAIL: threshold alone accepted"; exit 1; fi
 grep -q "solids\[0\].fracture.threshold" "$work/log" || { echo "FAIL: threshold message:"; cat "$work/log"; exit 1; }

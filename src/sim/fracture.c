@@ -843,12 +843,13 @@ static int by_measure(const void *pa, const void *pb) {
   return a->copy < b->copy ? -1 : a->copy > b->copy;
 }
 
-/* The breaking criteria (stress, plastic strain): before each step, every uncut copy whose
- * measure passes the threshold and that touches a crack is cut so that the crack runs on
- * into it (continued_crack), in order of decreasing measure, at most max_tets_per_step (0: no
- * limit). If none does, the one with the largest measure starts a new crack unless a crack
- * touches it (a corner holds a crack's value): the plane through its centroid normal to its
- * largest principal stress, in that copy only. */
+/* The breaking criteria (stress, plastic strain): before each step, every uncut copy on a
+ * crack's front (front_reached) whose measure passes growth_threshold is cut so that the
+ * crack runs on into it (continued_crack), in order of decreasing measure, at most
+ * max_tets_per_step (0: no limit), once the crack has had the time to cross it at
+ * max_crack_speed. If none grows or waits, the one with the largest measure past threshold
+ * starts a new crack unless a crack touches it (a corner holds a crack's value): the plane
+ * through its centroid normal to its largest principal stress, in that copy only. */
 static piola_status apply_criterion(piola_world *w, world_body *b) {
   solid_fracture *f = b->fracture;
   if (f->criterion == PIOLA_FRACTURE_SCRIPTED) return PIOLA_OK;
@@ -901,7 +902,7 @@ static piola_status apply_criterion(piola_world *w, world_body *b) {
      * speed limit */
     const double reached = front_reached(f, t);
     if (!isfinite(reached)) continue;
-    if (f->max_crack_speed > 0 && isfinite(reached) && w->time < reached + rest_span(e, c) / f->max_crack_speed) {
+    if (f->max_crack_speed > 0 && w->time < reached + rest_span(e, c) / f->max_crack_speed) {
       waiting = 1;
       continue;
     }

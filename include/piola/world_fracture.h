@@ -59,12 +59,14 @@ typedef enum piola_fracture_criterion {
                                   exceeds threshold (dimensionless) cracks; the solid needs
                                   plasticity */
 } piola_fracture_criterion;
-/* Before each step, every uncut tet past the threshold that touches a crack (a neighbour's
- * crack crosses their shared face) is cut so that the crack runs on into it: the crack's
- * points on the shared faces are kept and it turns as close to normal to the tet's largest
- * principal stress as they allow. If no crack grows, the tet with the largest measure starts
- * a new one unless a crack touches it: the plane through its centroid normal to its largest
- * principal stress, in that tet only. So cracks grow tet by tet as surfaces
+/* Before each step, every uncut tet on a crack's front (it shares a face with a tet the
+ * crack cut, and the crack ends on an edge of that face) whose measure is past
+ * growth_threshold is cut so that the crack runs on into it: the crack's points on the
+ * shared faces are kept and it turns as close as they allow to normal to the neighbours'
+ * crack (stress criterion) or to the tet's largest principal stress (plastic strain). If no
+ * crack grows or waits (max_crack_speed), the tet past threshold with the largest measure
+ * starts a new one unless a crack touches it: the plane through its centroid normal to its
+ * largest principal stress, in that tet only. So cracks grow tet by tet as surfaces
  * (docs/fracture.md). */
 
 typedef struct piola_fracture_def {
@@ -77,6 +79,13 @@ typedef struct piola_fracture_def {
   double threshold;               /* > 0: Pa (stress) or plastic log strain (plastic_strain) */
   int32_t max_tets_per_step;      /* the criterion cuts at most this many tets before one step.
                                      0 (default): no limit */
+  double growth_threshold;        /* >= 0, the unit of threshold: a crack front grows into a
+                                     tet whose measure exceeds it; a new crack still needs
+                                     threshold. 0 (default): threshold */
+  double max_crack_speed;         /* m/s: a crack front crosses a tet (its mean rest edge) in
+                                     no less than that edge over this speed, counted from when
+                                     the crack reached the tet; while a front waits, no new
+                                     crack starts. 0 (default): no limit */
 } piola_fracture_def;
 
 PIOLA_API piola_fracture_def piola_default_fracture_def(void);

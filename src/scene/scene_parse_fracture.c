@@ -55,11 +55,12 @@ static piola_status parse_cut(scene_parser *p, const cJSON *obj, piola_fracture_
 }
 
 /* "fracture": {"cuts": [{"time": t, "plane": {"point": [..], "normal": [..]}} or
- * {"time": t, "mesh": path, "end_time": t1, "velocity": [..]}, ...], "max_cuts_per_step": n, "criterion": "stress" or
- * "plastic_strain", "threshold": Pa or strain, "max_tets_per_step": n}. */
+ * {"time": t, "mesh": path, "end_time": t1, "velocity": [..]}, ...], "max_cuts_per_step": n,
+ * "criterion": "stress" or "plastic_strain", "threshold": Pa or strain, "max_tets_per_step": n,
+ * "max_crack_speed": m/s, "growth_threshold": Pa or strain}. */
 piola_status piola__scene_parse_fracture(scene_parser *p, const cJSON *obj, scene_solid_desc *d) {
   static const char *const allowed[] = {"cuts", "max_cuts_per_step", "criterion", "threshold",
-                                        "max_tets_per_step", NULL};
+                                        "max_tets_per_step", "max_crack_speed", "growth_threshold", NULL};
   PIOLA_TRY(piola__json_check_keys(p, obj, allowed));
   d->fractures = 1;
   d->fracture = piola_default_fracture_def();
@@ -78,8 +79,15 @@ piola_status piola__scene_parse_fracture(scene_parser *p, const cJSON *obj, scen
     int64_t tets = 0;
     PIOLA_TRY(piola__json_opt_int(p, obj, "max_tets_per_step", 1, 100000000, &tets));
     d->fracture.max_tets_per_step = (int32_t)tets;
-  } else if (piola__json_get(obj, "threshold") || piola__json_get(obj, "max_tets_per_step")) {
-    piola__json_push_key(p, piola__json_get(obj, "threshold") ? "threshold" : "max_tets_per_step");
+    PIOLA_TRY(piola__json_opt_number(p, obj, "max_crack_speed", POSITIVE, &d->fracture.max_crack_speed));
+    PIOLA_TRY(piola__json_opt_number(p, obj, "growth_threshold", POSITIVE, &d->fracture.growth_threshold));
+  } else if (piola__json_get(obj, "threshold") || piola__json_get(obj, "max_tets_per_step") ||
+             piola__json_get(obj, "max_crack_speed") || piola__json_get(obj, "growth_threshold")) {
+    const char *key = piola__json_get(obj, "threshold")           ? "threshold"
+                      : piola__json_get(obj, "max_tets_per_step") ? "max_tets_per_step"
+                      : piola__json_get(obj, "max_crack_speed")   ? "max_crack_speed"
+                                                                  : "growth_threshold";
+    piola__json_push_key(p, key);
     return piola__json_fail(p, BAD_VALUE, "needs a \"criterion\"");
   } else {
     PIOLA_TRY(piola__json_required(p, obj, "cuts"));

@@ -41,7 +41,7 @@ void piola__fracture_free(solid_fracture *f) {
   free_blades(f->blades, f->cut_count);
   free(f->cuts), free(f->tets), free(f->neighbor), free(f->parent), free(f->event), free(f->dist);
   free(f->side), free(f->fraction), free(f->fragment), free(f->copies), free(f->vertex_crack), free(f->last_strain);
-  free(f->vertex_value), free(f->sweep_crack), free(f->swept_to);
+  free(f->vertex_value), free(f->vertex_time), free(f->sweep_crack), free(f->swept_to);
   free(f);
 }
 
@@ -89,9 +89,11 @@ static piola_status fracture_create(const world_body *b, solid_fracture **out) {
     f->vertex_count = b->n;
     f->vertex_crack = malloc(sizeof(int32_t) * (size_t)b->n);
     f->vertex_value = calloc((size_t)b->n, sizeof(double));
+    f->vertex_time = calloc((size_t)b->n, sizeof(double));
   }
   if (!f || !keys || !f->tets || !f->neighbor || !f->parent || !f->event || !f->dist || !f->side ||
-      !f->fraction || !f->fragment || !f->copies || !f->vertex_crack || !f->vertex_value) {
+      !f->fraction || !f->fragment || !f->copies || !f->vertex_crack || !f->vertex_value ||
+      !f->vertex_time) {
     free(keys);
     piola__fracture_free(f);
     return PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "fracture of '%s': out of memory", b->name);
@@ -256,7 +258,9 @@ static piola_status split_copies(piola_world *w, world_body *b, const tet_cut *c
   for (int32_t i = 0; i < count; ++i)
     for (int k = 0; k < 4; ++k) {
       const int32_t vertex = f->tets[4 * f->parent[cuts[i].copy] + k];
-      if (f->vertex_crack[vertex] < 0) f->vertex_crack[vertex] = cuts[i].crack, f->vertex_value[vertex] = cuts[i].dist[k];
+      if (f->vertex_crack[vertex] >= 0) continue;
+      f->vertex_crack[vertex] = cuts[i].crack, f->vertex_value[vertex] = cuts[i].dist[k];
+      f->vertex_time[vertex] = w->time;
     }
   int32_t *plan = malloc(sizeof(int32_t) * (size_t)f->copy_count);
   if (!plan) return PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "cut of '%s': out of memory", b->name);
@@ -712,11 +716,47 @@ static int barycentric_gradients(const double *x, const int32_t p[4], double g[4
   return 1;
 }
 
-/* Snaps v (a new corner value) away from zero and keeps it as crack's value at vertex. */
-static double keep_value(solid_fracture *f, int32_t vertex, int32_t crack, double v, double snap) {
+/* Snaps v (a new corner value) away from zero and keeps it as crack's value at vertex,
+ * reached at time now (s). */
+static double keep_value(solid_fracture *f, int32_t vertex, int32_t crack, double v, double snap, double now) {
   v = snapped(v, snap);
-  f->vertex_crack[vertex] = crack, f->vertex_value[vertex] = v;
+  f->vertex_crack[vertex] = crack, f->vertex_value[vertex] = v, f->vertex_time[vertex] = now;
   return v;
+}
+
+/* When a crack front reached original tet t (s), or +inf when t is not on a front. A
+ * front runs along the faces t shares with cut neighbours: an edge of such a face whose
+ * corners hold values of one crack with opposite signs is crossed by that neighbour's crack
+ * polygon (crossings elsewhere, where values continued from different tets happen to differ
+ * in sign, are no crack). The edge was reached when the later of its corners got its value;
+ * the front reached t at its earliest crossed edge. */
+static double front_reached(const solid_fracture *f, int32_t t) {
+  const int32_t *ids = f->tets + 4 * t;
+  double when = INFINITY;
+  for (int k = 0; k < 4; ++k) {
+    const int32_t nb = f->neighbor[4 * t + k];
+    if (nb < 0 || f->copies[2 * nb + 1] < 0) continue;
+    for (int e = 0; e < 3; ++e) {
+      const int32_t a = ids[piola__cut_tet_face[k][e]], c = ids[piola__cut_tet_face[k][(e + 1) % 3]];
+      if (f->vertex_crack[a] < 0 || f->vertex_crack[a] != f->vertex_crack[c] ||
+          (f->vertex_value[a] > 0) == (f->vertex_value[c] > 0))
+        continue;
+      when = fmin(when, fmax(f->vertex_time[a], f->vertex_time[c]));
+    }
+  }
+  return when;
+}
+
+/* The length a crack crosses in copy c (m): the mean of its six rest edges. */
+static double rest_span(const piola_elastic_body *e, int32_t c) {
+  const double *rest = piola_elastic_body_rest_positions(e);
+  const int32_t *p = piola_elastic_body_tets(e) + 4 * c;
+  double sum = 0;
+  for (int k = 0; k < 6; ++k) {
+    const double *a = rest + 3 * p[tet_edge[k][0]], *q = rest + 3 * p[tet_edge[k][1]];
+    sum += sqrt((a[0] - q[0]) * (a[0] - q[0]) + (a[1] - q[1]) * (a[1] - q[1]) + (a[2] - q[2]) * (a[2] - q[2]));
+  }
+  return sum / 6;
 }
 
 /* The crack of copy c (original tet t, uncut, corners `nodes`) continued from the crack values
@@ -728,7 +768,7 @@ static double keep_value(solid_fracture *f, int32_t vertex, int32_t crack, doubl
  * edge is crossed, 1 with dist and crack filled in (the new corner values kept), -1 when it
  * cannot continue (corners of different cracks, a degenerate tet or direction). */
 static int continued_crack(solid_fracture *f, const double *x, const int32_t *nodes, int32_t t,
-                           const double dir[3], double snap, double dist[4], int32_t *crack) {
+                           const double dir[3], double snap, double now, double dist[4], int32_t *crack) {
   const int32_t *ids = f->tets + 4 * t;
   int known[4], count = 0, pos = 0, neg = 0;
   *crack = -1;
@@ -758,7 +798,7 @@ static int continued_crack(solid_fracture *f, const double *x, const int32_t *no
       a += g0[i] * dir[i], bb += g1[i] * dir[i], c += g0[i] * g0[i], e += g0[i] * g1[i], h += g1[i] * g1[i];
     const double d = (a * e - bb * c) / (bb * e - a * h);
     if (!isfinite(d)) return -1;
-    dist[free_corner] = keep_value(f, ids[free_corner], *crack, d, snap);
+    dist[free_corner] = keep_value(f, ids[free_corner], *crack, d, snap, now);
   } else if (count == 2) {
     /* the plane through the crossing X of the known edge p q, normal to dir, scaled to p's
      * value (q's matches: X divides p q in the ratio of their values) */
@@ -778,9 +818,35 @@ static int continued_crack(solid_fracture *f, const double *x, const int32_t *no
       if (known[k]) continue;
       double along = 0;
       for (int i = 0; i < 3; ++i) along += (x[3 * nodes[k] + i] - cross[i]) * dir[i];
-      dist[k] = keep_value(f, ids[k], *crack, scale * along, snap);
+      dist[k] = keep_value(f, ids[k], *crack, scale * along, snap, now);
     }
   }
+  return 1;
+}
+
+/* The mean unit normal (current positions) of the cracks in the cut face neighbours of
+ * original tet t; 0 when none is cut. A crack front continues along it. */
+static int neighbour_crack_normal(const solid_fracture *f, const double *x, const int32_t *nodes, int32_t t,
+                                  double normal[3]) {
+  int found = 0;
+  normal[0] = normal[1] = normal[2] = 0;
+  for (int k = 0; k < 4; ++k) {
+    const int32_t nb = f->neighbor[4 * t + k];
+    if (nb < 0 || f->copies[2 * nb + 1] < 0) continue;
+    const int32_t c = f->copies[2 * nb];
+    double g[4][3], n[3] = {0, 0, 0};
+    if (!barycentric_gradients(x, nodes + 4 * c, g)) continue;
+    for (int i = 0; i < 4; ++i)
+      for (int a = 0; a < 3; ++a) n[a] += f->dist[4 * c + i] * g[i][a];
+    const double len = sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+    if (!(len > 0) || !isfinite(len)) continue;
+    const double sign = n[0] * normal[0] + n[1] * normal[1] + n[2] * normal[2] < 0 ? -1 : 1;
+    for (int a = 0; a < 3; ++a) normal[a] += sign * n[a] / len;
+    found = 1;
+  }
+  const double len = sqrt(normal[0] * normal[0] + normal[1] * normal[1] + normal[2] * normal[2]);
+  if (!found || !(len > 0)) return 0;
+  for (int a = 0; a < 3; ++a) normal[a] /= len;
   return 1;
 }
 
@@ -796,12 +862,13 @@ static int by_measure(const void *pa, const void *pb) {
   return a->copy < b->copy ? -1 : a->copy > b->copy;
 }
 
-/* The breaking criteria (stress, plastic strain): before each step, every uncut copy whose
- * measure passes the threshold and that touches a crack is cut so that the crack runs on
- * into it (continued_crack), in order of decreasing measure, at most max_tets_per_step (0: no
- * limit). If none does, the one with the largest measure starts a new crack unless a crack
- * touches it (a corner holds a crack's value): the plane through its centroid normal to its
- * largest principal stress, in that copy only. */
+/* The breaking criteria (stress, plastic strain): before each step, every uncut copy on a
+ * crack's front (front_reached) whose measure passes growth_threshold is cut so that the
+ * crack runs on into it (continued_crack), in order of decreasing measure, at most
+ * max_tets_per_step (0: no limit), once the crack has had the time to cross it at
+ * max_crack_speed. If none grows or waits, the one with the largest measure past threshold
+ * starts a new crack unless a crack touches it (a corner holds a crack's value): the plane
+ * through its centroid normal to its largest principal stress, in that copy only. */
 static piola_status apply_criterion(piola_world *w, world_body *b) {
   solid_fracture *f = b->fracture;
   if (f->criterion == PIOLA_FRACTURE_SCRIPTED) return PIOLA_OK;
@@ -816,6 +883,9 @@ static piola_status apply_criterion(piola_world *w, world_body *b) {
     if (!f->last_strain) return PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "fracture of '%s': out of memory", b->name);
     memcpy(f->last_strain, strain, sizeof(double) * (size_t)f->copy_count);
   }
+  /* a front grows past growth_threshold, a new crack starts past threshold */
+  const double grow = f->growth_threshold > 0 ? f->growth_threshold : f->threshold;
+  const double lowest = fmin(grow, f->threshold);
   candidate *list = malloc(sizeof *list * (size_t)f->copy_count);
   if (!list) return PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "fracture of '%s': out of memory", b->name);
   int32_t n = 0;
@@ -823,12 +893,12 @@ static piola_status apply_criterion(piola_world *w, world_body *b) {
     /* ductile: only while the tet still flows (a piece that unloaded tears no further) */
     const int flowing = strain && strain[c] > f->last_strain[c];
     if (strain) f->last_strain[c] = strain[c];
-    if (f->event[c] >= 0 || (strain && !(flowing && strain[c] > f->threshold))) continue;
+    if (f->event[c] >= 0 || (strain && !(flowing && strain[c] > lowest))) continue;
     candidate k;
     const double stress = principal_stress(e, c, scale, k.dir);
     k.measure = strain ? strain[c] : stress;
     k.copy = c;
-    if (k.measure > f->threshold && isfinite(stress)) list[n++] = k;
+    if (k.measure > lowest && isfinite(stress)) list[n++] = k;
   }
   if (n == 0) {
     free(list);
@@ -843,24 +913,41 @@ static piola_status apply_criterion(piola_world *w, world_body *b) {
   const double snap = piola__fracture_snap(b);
   const int32_t most = f->max_tets_per_step > 0 ? f->max_tets_per_step : INT32_MAX;
   int32_t count = 0;
+  int waiting = 0; /* a crack front that may not advance yet (max_crack_speed) */
   for (int32_t i = 0; i < n && count < most; ++i) {
     const int32_t c = list[i].copy, t = f->parent[c];
+    if (!(list[i].measure > grow)) continue;
+    /* only a front grows, and it crosses a tet in no less than the tet's span over the
+     * speed limit */
+    const double reached = front_reached(f, t);
+    if (!isfinite(reached)) continue;
+    if (f->max_crack_speed > 0 && w->time < reached + rest_span(e, c) / f->max_crack_speed) {
+      waiting = 1;
+      continue;
+    }
     tet_cut *cut = &cuts[count];
     cut->copy = c;
-    if (continued_crack(f, b->x, nodes + 4 * c, t, list[i].dir, snap, cut->dist, &cut->crack) != 1) continue;
+    /* a brittle crack runs on along its plane in the cut neighbours (a front that turned
+     * with each tet's own stress direction would crumple where the stress is noisy); a
+     * ductile one follows the stress across the band where the flow localized */
+    double dir[3];
+    if (f->criterion != PIOLA_FRACTURE_STRESS || !neighbour_crack_normal(f, b->x, nodes, t, dir))
+      memcpy(dir, list[i].dir, sizeof dir);
+    if (continued_crack(f, b->x, nodes + 4 * c, t, dir, snap, w->time, cut->dist, &cut->crack) != 1)
+      continue;
     ++count;
   }
-  /* when no crack grew (cracks relieve the stress by growing first): a new crack at the
-   * candidate with the largest measure that no crack touches */
+  /* when no crack grew or waits to (cracks relieve the stress by growing first): a new
+   * crack at the candidate with the largest measure that no crack touches */
   int started = 0, touched = 1;
   int32_t pick = -1;
-  while (count == 0 && touched && ++pick < n) {
+  while (count == 0 && !waiting && touched && ++pick < n && list[pick].measure > f->threshold) {
     const int32_t *ids = f->tets + 4 * f->parent[list[pick].copy];
     touched = 0;
     for (int k = 0; k < 4; ++k) touched |= f->vertex_crack[ids[k]] >= 0;
   }
   const int32_t c = pick >= 0 && pick < n ? list[pick].copy : -1;
-  if (count == 0 && !touched) {
+  if (count == 0 && !waiting && !touched && c >= 0 && list[pick].measure > f->threshold) {
     double point[3] = {0, 0, 0};
     for (int k = 0; k < 4; ++k)
       for (int a = 0; a < 3; ++a) point[a] += 0.25 * b->x[3 * nodes[4 * c + k] + a];
@@ -921,6 +1008,12 @@ piola_status piola_world_solid_set_fracture(piola_world *w, int32_t solid, const
                       "fracture of '%s': the plastic_strain criterion needs the solid's plasticity", b->name);
   if (def->max_tets_per_step < 0)
     return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "fracture of '%s': max_tets_per_step must be >= 0", b->name);
+  if (!(def->growth_threshold >= 0 && isfinite(def->growth_threshold)))
+    return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "fracture of '%s': growth_threshold must be >= 0, got %g",
+                      b->name, def->growth_threshold);
+  if (!(def->max_crack_speed >= 0 && isfinite(def->max_crack_speed)))
+    return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "fracture of '%s': max_crack_speed must be >= 0 (m/s), got %g",
+                      b->name, def->max_crack_speed);
   for (int32_t i = 0; i < def->cut_count; ++i) {
     const piola_fracture_cut *c = &def->cuts[i];
     const double point[3] = {c->point.x, c->point.y, c->point.z};
@@ -971,6 +1064,8 @@ piola_status piola_world_solid_set_fracture(piola_world *w, int32_t solid, const
   b->fracture->max_tets_per_step = def->max_tets_per_step;
   b->fracture->criterion = def->criterion;
   b->fracture->threshold = def->threshold;
+  b->fracture->max_crack_speed = def->max_crack_speed;
+  b->fracture->growth_threshold = def->growth_threshold;
   return apply_due(w, b);
 }
 

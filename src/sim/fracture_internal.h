@@ -30,7 +30,10 @@ typedef struct solid_fracture {
   int32_t grown_crack;        /* the id all the criterion's cracks share (-1: none yet): their
                                  values are one field, so two of them that meet join */
   piola_fracture_criterion criterion;
-  double threshold;           /* Pa, or plastic log strain */
+  double threshold;           /* Pa, or plastic log strain: a new crack starts past it */
+  double growth_threshold;    /* same unit: a crack front grows past it (0: threshold) */
+  double max_crack_speed;     /* m/s, 0: no limit (a front crosses every tet past the
+                                 threshold in one pass) */
   /* the original mesh (after the elastic body's reorientation) and its face adjacency:
    * per tet and local face k (opposite corner k) the neighbour tet, or -1 on the boundary */
   int32_t tet_count;
@@ -55,6 +58,7 @@ typedef struct solid_fracture {
   int32_t vertex_count;
   int32_t *vertex_crack;
   double *vertex_value;
+  double *vertex_time;        /* s: when that value was set (the crack front reached it) */
 } solid_fracture;
 
 /* A point of a copy's polygons: corner lo when lo == hi, else the crossing of the cut at

@@ -233,7 +233,7 @@ static void fracture_state(stream *s, piola_world *w, world_body *b) {
   local_array(s, &copies, 2 * (uint64_t)f->tet_count, sizeof(int32_t), "copies of tets");
   /* the criterion's state: the plastic strain per copy at its last pass (plastic_strain
    * criterion, once it ran), the crack all its cracks share, and per original vertex the
-   * crack that reached it first and that crack's value there */
+   * crack that reached it first, that crack's value there and when it got there */
   int32_t has_last = f->last_strain != NULL;
   local_int(s, &has_last, "criterion strains present");
   void *last = s->reading ? NULL : f->last_strain;
@@ -241,6 +241,7 @@ static void fracture_state(stream *s, piola_world *w, world_body *b) {
   one_int(s, &f->grown_crack, "grown crack");
   field(s, f->vertex_crack, (uint64_t)f->vertex_count, sizeof(int32_t), "cracks at vertices");
   doubles(s, f->vertex_value, (uint64_t)f->vertex_count, "crack values at vertices");
+  doubles(s, f->vertex_time, (uint64_t)f->vertex_count, "crack times at vertices");
   /* per scripted cut, a moving blade's crack and the time of its last cut (fracture_blade.c) */
   field(s, f->sweep_crack, (uint64_t)f->cut_count, sizeof(int32_t), "moving blades' cracks");
   doubles(s, f->swept_to, (uint64_t)f->cut_count, "moving blades' last cut times");

@@ -30,8 +30,8 @@ CONTACT_FROM = {"cloth_on_jelly": 2, "cloth_folds": 5, "solids_stack": 1, "squee
                 # runs resume in the middle of its sweep (its crack and last cut time are in
                 # the checkpoint) and from cut states
                 "scripted_cut": 4,
-                # the stress criterion's cracks grow tet by tet from frame 2 (their state:
-                # the cracks' values at the vertices)
+                # the stress criterion's crack starts at frame 4 and grows to frame 10 (its state:
+                # the values and times at the vertices)
                 "brittle_slab": 2}
 EVERY = 2  # frames between checkpoints
 # Renames of a run (src/output/frame_commit.c): scene.json, then per frame six (VTU and OBJ

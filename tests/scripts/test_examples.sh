@@ -4,6 +4,10 @@
 # whose bodies touch within those frames must show it in stats.csv's `contacts` column
 # (self_collision counts shells and solids alike).
 expect_contacts=" cloth_on_jelly "
+# Scenes too large to step for 2 frames here (115K tets: minutes on a shared machine) are
+# only checked (`piola check`: they load, mesh, build and time a few steps); their physics
+# is tested on a coarser mesh (tests/test_fracture_examples.c).
+check_only=" ductile_fracture "
 set -euo pipefail
 : "${PIOLA:?path of the piola program}" "${PIOLA_SOURCE_DIR:?}"
 work=$(mktemp -d)
@@ -11,6 +15,11 @@ trap 'rm -rf "$work"' EXIT
 failed=0
 for scene in "$PIOLA_SOURCE_DIR"/examples/*.json; do
   name=$(basename "$scene" .json)
+  if [[ "$check_only" == *" $name "* ]]; then
+    if "$PIOLA" check "$scene" --timing-seconds 0.1 > "$work/$name.log" 2>&1; then echo "ok   $name (check only)"
+    else echo "FAIL $name:"; cat "$work/$name.log"; failed=1; fi
+    continue
+  fi
   if "$PIOLA" run "$scene" -o "$work/$name" --frames 2 > "$work/$name.log" 2>&1; then
     rows=$(($(wc -l < "$work/$name/stats.csv") - 1))
     if [ "$rows" -ne 3 ]; then

@@ -29,3 +29,8 @@ piola_status piola_world_split_collect(piola_world *world) {
   }
   return PIOLA_OK;
 }
+
+void piola_world_set_work_split_planner(piola_world *world, const piola_work_split_planner *planner) {
+  if (!world) return;
+  world->split_planner = planner ? *planner : (piola_work_split_planner){NULL, NULL};
+}

@@ -49,7 +49,7 @@ typedef struct piola_mpi_split_stats {
 } piola_mpi_split_stats;
 
 /* Splits every solid of world among the processes of MPI_COMM_WORLD (MPI initialized).
- * Worlds with shells, self-collision, fracture or an implicit integrator are refused
+ * Worlds with shells, fracture or an implicit integrator are refused
  * (PIOLA_ERROR_UNSUPPORTED, naming what). Collective: every process calls it. Each process
  * has built the whole world first; to build only each process's part, use the planner
  * below instead. */

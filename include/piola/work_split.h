@@ -96,8 +96,7 @@ PIOLA_API piola_status piola_world_split_collect(piola_world *world);
 
 /* A split planned from a solid's rest mesh before its body is built (libpiola_mpi's
  * piola_mpi_split_planner): a world with a planner asks it for the split of each solid it
- * adds whose per-tet state can be local (no plasticity, no self-collision, the Newmark
- * integrator), sets the split before the solid's first update, and writes the per-tet state
+ * adds whose per-tet state can be local (no plasticity, the Newmark integrator), sets the split before the solid's first update, and writes the per-tet state
  * (U, V, Fhat, det F, Dm^-1, the damping matrix's tet slots) of this process's own and ghost
  * blocks only: no process ever holds every tet's state, not even while the world is built
  * (docs/mpi.md, "Memory"). plan gets the solid's index among the solids and its mesh as
@@ -121,7 +120,7 @@ PIOLA_API piola_status piola_scene_build_split(const piola_scene_desc *desc,
                                                const piola_work_split_planner *planner,
                                                piola_scene **out);
 
-/* NULL when every solid of world can be split, else why not (shells, self-collision and the
+/* NULL when every solid of world can be split, else why not (shells, fracture and the
  * implicit integrators run on one process only). */
 PIOLA_API const char *piola_world_split_unsupported(const piola_world *world);
 

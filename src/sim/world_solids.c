@@ -160,8 +160,7 @@ static piola_status fill_solid(piola_world *world, world_body *s, const piola_so
   bdef.fiber_directions = def->fiber_directions;
   /* a split known now keeps every process to its own blocks' per-tet state (work_split.h) */
   const piola_work_split *split = NULL;
-  if (world->split_planner.plan && !def->plasticity && !def->self_collision.enabled &&
-      world->def.integrator == PIOLA_INTEGRATOR_NEWMARK)
+  if (world->split_planner.plan && !def->plasticity && world->def.integrator == PIOLA_INTEGRATOR_NEWMARK)
     PIOLA_TRY(world->split_planner.plan(world->split_planner.context, id, def->mesh, &split));
   piola_status st = split ? piola__elastic_body_create_split(&bdef, split, &s->solid)
                           : piola_elastic_body_create(&bdef, &s->solid);

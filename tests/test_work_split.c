@@ -12,7 +12,9 @@
  *    own tets' state and the damping forces of every node are the same bits (the ghosts
  *    matter: without them part 0's rows differ), and the body, once its split is taken off,
  *    refuses to step alone or to be split again;
- *  - splits with parts out of range or missing operations are refused. */
+ *  - splits with parts out of range or missing operations are refused;
+ *  - a split planned before the solid is built (piola_world_set_work_split_planner) writes
+ *    its own tets' state with the whole solid's bits and never the tets it does not hold. */
 #include "test_support.h"
 
 #include <math.h>
@@ -21,6 +23,7 @@
 
 #include "piola/elastic_body.h"
 #include "piola/work_split.h"
+#include "piola/world.h"
 #include "test_elastic_body_fixtures.h"
 
 typedef struct fake_part {
@@ -84,8 +87,8 @@ static void record_ghosts(void *context, void *owner, piola_work_split_pack pack
                           piola_work_split_unpack unpack, int32_t width) {
   fake_part *p = context;
   (void)unpack;
-  const int32_t *tv = piola_elastic_body_tets(p->body);
-  const int32_t nt = piola_elastic_body_tet_count(p->body);
+  const int32_t *tv = piola_elastic_body_tets(owner); /* p->body may not be set yet */
+  const int32_t nt = piola_elastic_body_tet_count(owner);
   for (int32_t b = 0; b < p->block_count; ++b)
     if (ghost_of_part0(p, tv, nt, b)) pack(owner, b, p->other_blocks + (size_t)b * (size_t)width);
 }
@@ -94,8 +97,8 @@ static void ghosts_from_other(void *context, void *owner, piola_work_split_pack 
                               piola_work_split_unpack unpack, int32_t width) {
   fake_part *p = context;
   (void)pack;
-  const int32_t *tv = piola_elastic_body_tets(p->body);
-  const int32_t nt = piola_elastic_body_tet_count(p->body);
+  const int32_t *tv = piola_elastic_body_tets(owner); /* p->body may not be set yet */
+  const int32_t nt = piola_elastic_body_tet_count(owner);
   for (int32_t b = 0; b < p->block_count; ++b)
     if (ghost_of_part0(p, tv, nt, b))
       unpack(owner, b, p->other->other_blocks + (size_t)b * (size_t)width);
@@ -266,8 +269,128 @@ static void local_chunked_body_halves(void **state) {
   check_split(12, 0, 1);
 }
 
+/* ---- a split planned before the solid is built (piola_world_set_work_split_planner) */
+
+typedef struct planned_part {
+  fake_part part;
+  int calls;              /* the planner's calls */
+  int give;               /* 0: the planner leaves the solid whole */
+} planned_part;
+
+static piola_status plan_part(void *context, int32_t solid, const piola_tet_mesh *mesh,
+                              const piola_work_split **out) {
+  planned_part *p = context;
+  assert_int_equal(solid, 0);
+  assert_int_equal((mesh->tet_count + PIOLA_WORK_SPLIT_BLOCK - 1) / PIOLA_WORK_SPLIT_BLOCK,
+                   p->part.block_count);
+  p->calls++;
+  *out = p->give ? &p->part.split : NULL;
+  return PIOLA_OK;
+}
+
+/* One process's values are the combined ones (this test's parts hold the same bounds). */
+static void own_reduce(void *context, double *values, int32_t count, piola_work_split_reduction op) {
+  (void)context, (void)values, (void)count, (void)op;
+}
+
+/* A world of one stretched jelly solid; planner may be NULL. */
+static piola_world *planned_world(const piola_tet_mesh *mesh, const piola_work_split_planner *planner,
+                                  int plastic) {
+  piola_world *w = NULL;
+  piola_world_def wd = piola_default_world_def();
+  assert_int_equal(piola_world_create(&wd, &w), PIOLA_OK);
+  piola_world_set_work_split_planner(w, planner);
+  piola_solid_def sd = piola_default_solid_def();
+  sd.mesh = mesh;
+  sd.material.model = PIOLA_MODEL_NEOHOOKEAN;
+  sd.material.youngs_modulus = 1e5;
+  sd.material.poisson_ratio = 0.4;
+  sd.initial_matrix = (piola_mat3){{{1.1, 0.2, 0}, {0, 0.95, 0}, {0.1, 0, 1}}};
+  piola_plasticity_def plasticity = piola_default_plasticity_def();
+  if (plastic) sd.plasticity = &plasticity;
+  assert_int_equal(piola_world_add_solid(w, &sd, NULL), PIOLA_OK);
+  return w;
+}
+
+/* Two worlds play two processes whose planner hands each solid its split before the body is
+ * built (part 1's world first; part 0's halo sum runs part 1's update). Part 0 then holds
+ * its own tets' state with the whole solid's bits, and the tets of the blocks it neither
+ * owns nor ghosts were never written (zero, where the state at rest is det F = 1); a
+ * planner that leaves the solid whole changes no bit; a solid with plasticity is not
+ * offered to the planner. */
+static void planned_solid_holds_its_part_only(void **state) {
+  (void)state;
+  piola_tet_mesh mesh = fixture_grid(12, 0.1);
+  piola_world *whole = planned_world(&mesh, NULL, 0);
+  const piola_elastic_body *wb = piola_world_solid_body(whole, 0);
+  const int32_t nv = mesh.vertex_count, nt = mesh.tet_count;
+  const int32_t blocks = piola_elastic_body_block_count(wb);
+  const double *x = piola_world_solid_positions(whole, 0);
+  int32_t *block_part = malloc(sizeof(int32_t) * (size_t)blocks);
+  int32_t *node_part = malloc(sizeof(int32_t) * (size_t)nv);
+  for (int32_t b = 0; b < blocks; ++b) block_part[b] = (int32_t)(2 * (int64_t)b / blocks);
+  for (int32_t i = 0; i < nv; ++i) node_part[i] = 1;
+  const int32_t *tv = piola_elastic_body_tets(wb);
+  for (int32_t t = 0; t < nt; ++t)
+    for (int c = 0; c < 4; ++c)
+      if (block_part[t / PIOLA_WORK_SPLIT_BLOCK] == 0) node_part[tv[4 * t + c]] = 0;
+  double *values = malloc(sizeof(double) * 3 * (size_t)nv);
+  double *block_values = malloc(sizeof(double) * 256 * (size_t)blocks);
+  planned_part p0 = {0}, p1 = {0};
+  p1.part = (fake_part){NULL, NULL, x, NULL, values, block_values, nv, blocks, block_part, node_part,
+                        {1, 2, block_part, node_part, &p1.part, record_nodes, record_nodes,
+                         record_blocks, record_ghosts, own_reduce, unused_collect}};
+  p0.part = (fake_part){NULL, &p1.part, x, NULL, NULL, NULL, nv, blocks, block_part, node_part,
+                        {0, 2, block_part, node_part, &p0.part, sum_from_other, share_from_other,
+                         blocks_from_other, ghosts_from_other, own_reduce, unused_collect}};
+  p0.give = p1.give = 1;
+  piola_work_split_planner planner1 = {plan_part, &p1}, planner0 = {plan_part, &p0};
+  piola_world *w1 = planned_world(&mesh, &planner1, 0);
+  p1.part.body = (piola_elastic_body *)piola_world_solid_body(w1, 0);
+  piola_world *w0 = planned_world(&mesh, &planner0, 0);
+  p0.part.body = (piola_elastic_body *)piola_world_solid_body(w0, 0);
+  assert_int_equal(p0.calls, 1);
+  assert_true(piola_elastic_body_split_is_local(p0.part.body));
+  const double *det0 = piola_elastic_body_det_f(p0.part.body), *det = piola_elastic_body_det_f(wb);
+  int32_t unwritten = 0;
+  for (int32_t t = 0; t < nt; ++t) {
+    const int32_t b = t / PIOLA_WORK_SPLIT_BLOCK;
+    if (block_part[b] == 0) {
+      assert_memory_equal(&det0[t], &det[t], sizeof(double));
+      assert_memory_equal(piola_elastic_body_fhat(p0.part.body) + 3 * t,
+                          piola_elastic_body_fhat(wb) + 3 * t, 3 * sizeof(double));
+      assert_true(det[t] != 1.0); /* the stretch is in the state */
+    } else if (!ghost_of_part0(&p0.part, tv, nt, b)) {
+      assert_true(det0[t] == 0.0);
+      unwritten++;
+    }
+  }
+  assert_true(unwritten > nt / 4); /* most of part 1's tets */
+
+  /* a planner that leaves the solid whole: the same bits as no planner */
+  planned_part none = {0};
+  none.part.block_count = blocks;
+  piola_work_split_planner leave = {plan_part, &none};
+  piola_world *w2 = planned_world(&mesh, &leave, 0);
+  assert_int_equal(none.calls, 1);
+  assert_memory_equal(piola_elastic_body_det_f(piola_world_solid_body(w2, 0)), det,
+                      sizeof(double) * (size_t)nt);
+  /* plasticity keeps the replicated mode: not offered */
+  piola_world *w3 = planned_world(&mesh, &leave, 1);
+  assert_int_equal(none.calls, 1);
+
+  piola_world_destroy(w3);
+  piola_world_destroy(w2);
+  piola_world_destroy(w0);
+  piola_world_destroy(w1);
+  piola_world_destroy(whole);
+  free(values), free(block_values), free(block_part), free(node_part);
+  fixture_mesh_free(&mesh);
+}
+
 int main(void) {
   const struct CMUnitTest tests[] = {
+      cmocka_unit_test(planned_solid_holds_its_part_only),
       cmocka_unit_test(small_body_halves),
       cmocka_unit_test(small_body_alternating_blocks),
       cmocka_unit_test(chunked_body_halves),

@@ -24,6 +24,7 @@
 
 #include "piola/export.h"
 #include "piola/status.h"
+#include "piola/work_split.h"
 #include "piola/world.h"
 
 #ifdef __cplusplus
@@ -48,9 +49,29 @@ typedef struct piola_mpi_split_stats {
 } piola_mpi_split_stats;
 
 /* Splits every solid of world among the processes of MPI_COMM_WORLD (MPI initialized).
- * Worlds with shells, self-collision or an implicit integrator are refused
- * (PIOLA_ERROR_UNSUPPORTED, naming what). Collective: every process calls it. */
+ * Worlds with shells, fracture or an implicit integrator are refused
+ * (PIOLA_ERROR_UNSUPPORTED, naming what). Collective: every process calls it. Each process
+ * has built the whole world first; to build only each process's part, use the planner
+ * below instead. */
 PIOLA_API piola_status piola_mpi_split_world(piola_world *world, piola_mpi_split **out);
+
+/* The same in three steps, so that no process builds the whole world:
+ *
+ *   piola_mpi_split *split;
+ *   piola_mpi_split_create(&split);
+ *   piola_work_split_planner planner = piola_mpi_split_planner(split);
+ *   piola_world_set_work_split_planner(world, &planner);  // or piola_scene_build_split
+ *   ... piola_world_add_solid ...  // each solid partitioned (METIS) before its body is built
+ *   piola_mpi_split_finish(split, world);
+ *
+ * piola_mpi_split_create makes an empty split; the planner partitions each solid as it is
+ * added (piola/work_split.h: those that can run in the local mode); piola_mpi_split_finish
+ * takes the planner off the world, refuses what piola_mpi_split_world refuses, and splits
+ * the solids the planner left whole (with plasticity: the replicated mode). Every process
+ * makes the same calls. On failure, piola_mpi_split_destroy still frees the split. */
+PIOLA_API piola_status piola_mpi_split_create(piola_mpi_split **out);
+PIOLA_API piola_work_split_planner piola_mpi_split_planner(piola_mpi_split *split);
+PIOLA_API piola_status piola_mpi_split_finish(piola_mpi_split *split, piola_world *world);
 PIOLA_API piola_mpi_split_stats piola_mpi_split_stats_of(const piola_mpi_split *split);
 /* Takes the splits off the world's solids (world may be NULL if already destroyed). */
 PIOLA_API void piola_mpi_split_destroy(piola_mpi_split *split, piola_world *world);

@@ -34,6 +34,8 @@
 
 #include "piola/elastic_body.h"
 #include "piola/export.h"
+#include "piola/mesh.h"
+#include "piola/scene.h"
 #include "piola/status.h"
 #include "piola/world.h"
 
@@ -92,7 +94,33 @@ PIOLA_API int piola_elastic_body_split_is_local(const piola_elastic_body *body);
  * Every process calls it; process 0 may then read the getters and the solid statistics. */
 PIOLA_API piola_status piola_world_split_collect(piola_world *world);
 
-/* NULL when every solid of world can be split, else why not (shells, self-collision and the
+/* A split planned from a solid's rest mesh before its body is built (libpiola_mpi's
+ * piola_mpi_split_planner): a world with a planner asks it for the split of each solid it
+ * adds whose per-tet state can be local (no plasticity, the Newmark integrator), sets the split before the solid's first update, and writes the per-tet state
+ * (U, V, Fhat, det F, Dm^-1, the damping matrix's tet slots) of this process's own and ghost
+ * blocks only: no process ever holds every tet's state, not even while the world is built
+ * (docs/mpi.md, "Memory"). plan gets the solid's index among the solids and its mesh as
+ * given to piola_world_add_solid (blocks are its tets in order, PIOLA_WORK_SPLIT_BLOCK at a
+ * time); it sets *out to the split, which must outlive the body, or to NULL to leave the
+ * solid whole (split later, or never). Collective: every process adds the same solids in
+ * the same order, and plan fails on all of them or on none. */
+typedef struct piola_work_split_planner {
+  piola_status (*plan)(void *context, int32_t solid, const piola_tet_mesh *mesh,
+                       const piola_work_split **out);
+  void *context;
+} piola_work_split_planner;
+
+/* Sets (or with NULL clears) the planner of the solids added to world from now on. The
+ * planner is copied. */
+PIOLA_API void piola_world_set_work_split_planner(piola_world *world,
+                                                  const piola_work_split_planner *planner);
+
+/* piola_scene_build with planner set on the scene's world before its solids are added. */
+PIOLA_API piola_status piola_scene_build_split(const piola_scene_desc *desc,
+                                               const piola_work_split_planner *planner,
+                                               piola_scene **out);
+
+/* NULL when every solid of world can be split, else why not (shells, fracture and the
  * implicit integrators run on one process only). */
 PIOLA_API const char *piola_world_split_unsupported(const piola_world *world);
 

@@ -188,7 +188,7 @@ static int run(int argc, char **argv, run_mpi *mpi) {
   if (threads > 0) piola_set_thread_count((int)threads); /* every parallel loop of piola */
   double t_start = now_seconds();
   piola_scene *scene = NULL;
-  if (!run_mpi_all(mpi, piola_scene_load(scene_path, &scene) == PIOLA_OK)) {
+  if (!run_mpi_all(mpi, run_mpi_load(mpi, scene_path, &scene) == PIOLA_OK)) {
     if (lead) fprintf(stderr, "piola run: %s\n", scene ? "another MPI process could not load the scene" : piola_last_error());
     piola_scene_destroy(scene);
     return 2;

@@ -7,6 +7,7 @@
 #ifdef PIOLA_MPI
 #include <mpi.h>
 
+#include "common/status_report.h"
 #include "piola/mpi.h"
 #include "piola/work_split.h"
 
@@ -28,16 +29,38 @@ bool run_mpi_start(run_mpi *m) {
   return true;
 }
 
+piola_status run_mpi_load(run_mpi *m, const char *path, piola_scene **out) {
+  *out = NULL;
+  if (m->size <= 1) return piola_scene_load(path, out);
+  piola_scene_desc *desc = NULL;
+  PIOLA_TRY(piola_scene_parse_file(path, &desc));
+  piola_mpi_split *split = NULL;
+  piola_status st = piola_mpi_split_create(&split);
+  m->split = split;
+  if (st == PIOLA_OK) {
+    piola_work_split_planner planner = piola_mpi_split_planner(split);
+    st = piola_scene_build_split(desc, &planner, out);
+  }
+  piola_scene_desc_destroy(desc);
+  return st;
+}
+
 bool run_mpi_split(run_mpi *m, piola_world *world) {
   if (m->size <= 1) return true;
-  piola_mpi_split *split = NULL;
-  if (piola_mpi_split_world(world, &split) != PIOLA_OK) {
+  piola_status st;
+  if (m->split) {
+    st = piola_mpi_split_finish(m->split, world);
+  } else {
+    piola_mpi_split *split = NULL;
+    st = piola_mpi_split_world(world, &split);
+    m->split = split;
+  }
+  if (st != PIOLA_OK) {
     if (m->rank == 0)
       fprintf(stderr, "piola run: cannot run on %d MPI processes: %s (run it without mpirun, "
                       "or with -np 1; docs/mpi.md)\n", m->size, piola_last_error());
     return false;
   }
-  m->split = split;
   return true;
 }
 
@@ -83,6 +106,10 @@ void run_mpi_finish(run_mpi *m, piola_world *world) {
 bool run_mpi_start(run_mpi *m) {
   *m = (run_mpi){0, 1, false, NULL};
   return true;
+}
+piola_status run_mpi_load(run_mpi *m, const char *path, piola_scene **out) {
+  (void)m;
+  return piola_scene_load(path, out);
 }
 bool run_mpi_split(run_mpi *m, piola_world *world) {
   (void)m, (void)world;

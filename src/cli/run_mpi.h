@@ -7,6 +7,7 @@
 
 #include <stdbool.h>
 
+#include "piola/scene.h"
 #include "piola/world.h"
 
 typedef struct run_mpi {
@@ -17,8 +18,13 @@ typedef struct run_mpi {
 
 /* Starts MPI when the process was launched by mpirun; false (message printed) on failure. */
 bool run_mpi_start(run_mpi *m);
-/* Splits world's solids among the processes (size > 1 only); false with a message on stderr
- * when the world has something that runs on one process only. Collective. */
+/* Loads the scene at path (piola_scene_load); with more than one process each solid is
+ * partitioned as it is added, and each process builds only its own and ghost blocks' per-tet
+ * state (piola_mpi_split_planner). Collective. */
+piola_status run_mpi_load(run_mpi *m, const char *path, piola_scene **out);
+/* Splits world's solids among the processes (size > 1 only; those run_mpi_load planned are
+ * split already); false with a message on stderr when the world has something that runs on
+ * one process only. Collective. */
 bool run_mpi_split(run_mpi *m, piola_world *world);
 /* Before process 0 reads the solids' per-tet state (a frame, statistics, a failure report):
  * brings every process's share of it to process 0 (collective; nothing without a split). */

@@ -26,7 +26,28 @@ piola_status piola_elastic_body_create(const piola_elastic_body_def *def,
   *out = NULL;
   piola_elastic_body *body = calloc(1, sizeof *body);
   if (!body) return PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "elastic body: out of memory");
-  piola_status status = piola__elastic_body_build_rest_state(body, def);
+  piola_status status = piola__elastic_body_build_rest_state(body, def, 1);
+  if (status != PIOLA_OK) {
+    piola__elastic_body_free_arrays(body);
+    free(body);
+    return status;
+  }
+  *out = body;
+  return PIOLA_OK;
+}
+
+piola_status piola__elastic_body_create_split(const piola_elastic_body_def *def,
+                                              const piola_work_split *split,
+                                              piola_elastic_body **out) {
+  if (!out || !split) return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "elastic body: NULL argument");
+  *out = NULL;
+  piola_elastic_body *body = calloc(1, sizeof *body);
+  if (!body) return PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "elastic body: out of memory");
+  piola_status status = piola__elastic_body_build_rest_state(body, def, 0);
+  if (status == PIOLA_OK) {
+    body->state_unwritten = 1;
+    status = piola__elastic_body_set_work_split(body, split, 1); /* writes the held state */
+  }
   if (status != PIOLA_OK) {
     piola__elastic_body_free_arrays(body);
     free(body);

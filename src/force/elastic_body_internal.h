@@ -115,6 +115,8 @@ struct piola_elastic_body {
   int split_local;      /* the local mode */
   uint8_t *split_held;  /* local: per block, 1 for own and ghost blocks */
   int split_partial;    /* a local split dropped the other blocks' rest data (for good) */
+  int state_unwritten;  /* built for a split: U, V, Fhat, det F not written yet */
+  int rest_localized;   /* the other blocks' Dm^-1 and damping slots are dropped */
 };
 
 /* The split of a body in the local mode with more than one process, or NULL. */
@@ -159,9 +161,25 @@ void piola__elastic_body_update_block_pair PIOLA_UPDATE_BLOCK_PAIR_PARAMS;
 #define PIOLA_FORCE_CHUNKS 4
 
 /* Builds the rest state of body from def (rest_state.c): validates def, reorients, fills
- * the SoA arrays, masses, incidence, altitude and wave speed. body must be zeroed. */
+ * the SoA arrays, masses, incidence, altitude and wave speed. body must be zeroed. Without
+ * write_state the per-tet state (U, V, Fhat, det F) is left unwritten (zero, its pages not
+ * mapped) for piola__elastic_body_rest_rotations to fill. */
 piola_status piola__elastic_body_build_rest_state(piola_elastic_body *body,
-                                                  const piola_elastic_body_def *def);
+                                                  const piola_elastic_body_def *def,
+                                                  int write_state);
+/* The rest state's U = V = I, Fhat = (1, 1, 1), det F = 1, on the blocks with held[b] set
+ * (every block for NULL). */
+void piola__elastic_body_rest_rotations(piola_elastic_body *body, const uint8_t *held);
+/* A body built for a split known before its first update: its per-tet state is written for
+ * its own and ghost blocks only, never for the others (docs/mpi.md), then the split is set
+ * (piola__elastic_body_set_work_split). */
+piola_status piola__elastic_body_create_split(const piola_elastic_body_def *def,
+                                              const piola_work_split *split,
+                                              piola_elastic_body **out);
+/* Local mode: drops the rest data of the blocks this process does not hold (Dm^-1, the
+ * damping matrix's tet slots), once whatever reads every tet's Dm^-1 at setup (the step
+ * bound's weights, the sliver check) has run. Nothing to do for other bodies. */
+piola_status piola__elastic_body_split_localize_rest(piola_elastic_body *body);
 
 /* Frees everything body owns (not body itself). */
 void piola__elastic_body_free_arrays(piola_elastic_body *body);

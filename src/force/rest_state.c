@@ -78,8 +78,19 @@ static double triangle_area(vec3 a, vec3 b, vec3 c) {
   return 0.5 * vec3_norm(vec3_cross(vec3_sub(b, a), vec3_sub(c, a)));
 }
 
+void piola__elastic_body_rest_rotations(piola_elastic_body *body, const uint8_t *held) {
+  for (int32_t t = 0; t < body->padded_tet_count; ++t) {
+    if (held && !held[t / PIOLA_TET_BLOCK]) continue;
+    body->u[0][t] = body->u[4][t] = body->u[8][t] = 1.0;
+    body->v[0][t] = body->v[4][t] = body->v[8][t] = 1.0;
+    body->fhat[3 * t] = body->fhat[3 * t + 1] = body->fhat[3 * t + 2] = 1.0;
+    body->det_f[t] = 1.0;
+  }
+}
+
 piola_status piola__elastic_body_build_rest_state(piola_elastic_body *body,
-                                                  const piola_elastic_body_def *def) {
+                                                  const piola_elastic_body_def *def,
+                                                  int write_state) {
   PIOLA_TRY(validate_def(def));
   const piola_tet_mesh *mesh = def->rest_mesh;
   int32_t nv = mesh->vertex_count, nt = mesh->tet_count;
@@ -181,12 +192,7 @@ piola_status piola__elastic_body_build_rest_state(piola_elastic_body *body,
                               def->density));
   }
   body->max_wave_speed = speed;
-  for (int32_t t = 0; t < np; ++t) {
-    body->u[0][t] = body->u[4][t] = body->u[8][t] = 1.0;
-    body->v[0][t] = body->v[4][t] = body->v[8][t] = 1.0;
-    body->fhat[3 * t] = body->fhat[3 * t + 1] = body->fhat[3 * t + 2] = 1.0;
-    body->det_f[t] = 1.0;
-  }
+  if (write_state) piola__elastic_body_rest_rotations(body, NULL);
   body->energy_valid = 1; /* zero at rest */
   body->last_stiffness_scale = 1.0;
   return piola__damping_matrix_init(&body->damping, body);

@@ -49,12 +49,11 @@ static void mark_held(piola_elastic_body *body, const piola_work_split *split) {
   }
 }
 
-/* Local mode: fresh per-tet arrays (state, Dm^-1, damping slots) in which only the held
- * blocks are written, so the memory of the other blocks is never touched (calloc leaves fresh
- * pages unmapped until written); the old arrays, written for every tet, are freed. From here
- * on the body is partial: it can only step with this split (piola_elastic_body_update
- * refuses it without one). The step bound's per-tet weights were built from every tet's
- * Dm^-1 when the solid was added (world_solids.c). */
+/* Local mode: fresh per-tet state arrays (U, V, Fhat, det F, energy density) in which only
+ * the held blocks are written, so the memory of the other blocks is never touched (calloc
+ * leaves fresh pages unmapped until written); the old arrays, written for every tet, are
+ * freed. From here on the body is partial: it can only step with this split
+ * (piola_elastic_body_update refuses it without one). */
 static int localize_state(piola_elastic_body *body) {
   const size_t np = (size_t)body->padded_tet_count;
   body->split_partial = 1; /* also when this fails half way */
@@ -87,10 +86,18 @@ static int localize_state(piola_elastic_body *body) {
   body->fhat = fhat;
   body->det_f = det;
   body->energy_density = psi;
-  /* the rest data only held blocks read: Dm^-1 and the damping matrix's tet slots */
+  return 1;
+}
+
+/* The rest data only held blocks read: Dm^-1 and the damping matrix's tet slots, copied
+ * into fresh arrays written for the held blocks only. The step bound's per-tet weights are
+ * built from every tet's Dm^-1 before this (world_solids.c). */
+piola_status piola__elastic_body_split_localize_rest(piola_elastic_body *body) {
+  if (!body || !body->split_held || body->rest_localized) return PIOLA_OK; /* not local */
+  const size_t np = (size_t)body->padded_tet_count;
   for (int k = 0; k < 9; ++k) {
     double *d = calloc(np, sizeof(double));
-    if (!d) return 0;
+    if (!d) return PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "work split: out of memory");
     for (size_t b = 0; b < np / B; ++b)
       if (body->split_held[b]) memcpy(d + b * B, body->dm_inv[k] + b * B, B * sizeof(double));
     free(body->dm_inv[k]);
@@ -102,7 +109,7 @@ static int localize_state(piola_elastic_body *body) {
   uint16_t *flags = calloc(nt > 0 ? nt : 1, sizeof(uint16_t));
   if (!slot || !flags) {
     free(slot), free(flags);
-    return 0;
+    return PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "work split: out of memory");
   }
   for (size_t t = 0; t < nt; ++t)
     if (body->split_held[t / B]) {
@@ -112,7 +119,8 @@ static int localize_state(piola_elastic_body *body) {
   free(m->tet_slot), free(m->tet_flags);
   m->tet_slot = slot;
   m->tet_flags = flags;
-  return 1;
+  body->rest_localized = 1;
+  return PIOLA_OK;
 }
 
 int piola_elastic_body_split_is_local(const piola_elastic_body *body) {
@@ -166,11 +174,17 @@ piola_status piola__elastic_body_set_work_split(piola_elastic_body *body,
   }
   if (local) {
     mark_held(body, split);
-    if (!localize_state(body)) {
+    if (body->state_unwritten) { /* built for this split: write the held blocks only */
+      piola__elastic_body_rest_rotations(body, body->split_held);
+      body->split_partial = 1;
+    } else if (!localize_state(body) || piola__elastic_body_split_localize_rest(body) != PIOLA_OK) {
       piola__elastic_body_split_free(body);
       return PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "work split: out of memory");
     }
+  } else if (body->state_unwritten) {
+    piola__elastic_body_rest_rotations(body, NULL);
   }
+  body->state_unwritten = 0;
   for (int32_t b = 0; b < blocks; ++b)
     if (split->block_part[b] == split->part) body->split_blocks[body->split_block_count++] = b;
   body->split = split;

@@ -58,8 +58,9 @@ typedef struct solid_plan {
 
 struct piola_mpi_split {
   int rank, size;
-  int32_t solid_count;
-  solid_plan *plans;
+  int32_t solid_count;  /* entries of plans */
+  solid_plan **plans;   /* per solid, or NULL where not split (yet); each plan stays where it
+                           is, since the bodies hold its split */
   piola_mpi_split_stats stats;
 };
 
@@ -314,16 +315,27 @@ static int compare_i64(const void *a, const void *b) {
   return (x > y) - (x < y);
 }
 
+/* A solid's tets as the partition sees them: 4 node indices per tet; blocks are
+ * PIOLA_WORK_SPLIT_BLOCK consecutive tets. */
+typedef struct plan_mesh {
+  const int32_t *tets;
+  int32_t tet_count, node_count;
+} plan_mesh;
+
+static int32_t block_count_of(int32_t tets) {
+  return (tets + PIOLA_WORK_SPLIT_BLOCK - 1) / PIOLA_WORK_SPLIT_BLOCK;
+}
+
 /* block_part of a solid's blocks over `parts` processes (rank 0 only). */
-static piola_status partition_blocks(const piola_elastic_body *body, int parts, int32_t *block_part) {
-  const int32_t tets = piola_elastic_body_tet_count(body);
-  const int32_t blocks = piola_elastic_body_block_count(body);
-  const int32_t *tv = piola_elastic_body_tets(body);
+static piola_status partition_blocks(const plan_mesh *mesh, int parts, int32_t *block_part) {
+  const int32_t tets = mesh->tet_count;
+  const int32_t blocks = block_count_of(tets);
+  const int32_t *tv = mesh->tets;
   if (parts == 1 || blocks <= parts) { /* METIS divides by zero for one part */
     for (int32_t b = 0; b < blocks; ++b) block_part[b] = parts == 1 ? 0 : b;
     return PIOLA_OK;
   }
-  idx_t ne = tets, nn = piola_elastic_body_vertex_count(body), ncommon = 3, numflag = 0;
+  idx_t ne = tets, nn = mesh->node_count, ncommon = 3, numflag = 0;
   idx_t *eptr = malloc(sizeof(idx_t) * ((size_t)tets + 1)), *eind = malloc(sizeof(idx_t) * 4 * (size_t)tets);
   idx_t *xadj = NULL, *adjncy = NULL;
   int64_t *pairs = NULL;
@@ -401,14 +413,14 @@ static int order_by_part(const int32_t *part_of, int32_t n, int parts, int32_t *
   return 1;
 }
 
-static piola_status plan_solid(piola_mpi_split *s, piola_world *world, int32_t solid, solid_plan *p) {
-  const piola_elastic_body *body = piola_world_solid_body(world, solid);
-  const int32_t tets = piola_elastic_body_tet_count(body);
-  const int32_t *tv = piola_elastic_body_tets(body);
+/* The plan and split of one solid from its tets (collective). */
+static piola_status plan_solid(piola_mpi_split *s, const plan_mesh *mesh, solid_plan *p) {
+  const int32_t tets = mesh->tet_count;
+  const int32_t *tv = mesh->tets;
   const int parts = s->size, me = s->rank;
   p->owner = s;
-  p->node_count = piola_elastic_body_vertex_count(body);
-  p->block_count = piola_elastic_body_block_count(body);
+  p->node_count = mesh->node_count;
+  p->block_count = block_count_of(tets);
   p->block_part = malloc(sizeof(int32_t) * (size_t)(p->block_count > 0 ? p->block_count : 1));
   p->node_part = malloc(sizeof(int32_t) * (size_t)(p->node_count > 0 ? p->node_count : 1));
   p->counts = malloc(sizeof(int) * (size_t)parts);
@@ -420,7 +432,7 @@ static piola_status plan_solid(piola_mpi_split *s, piola_world *world, int32_t s
   }
   int failed = 0;
   if (me == 0) {
-    piola_status st = partition_blocks(body, parts, p->block_part);
+    piola_status st = partition_blocks(mesh, parts, p->block_part);
     failed = st != PIOLA_OK;
   }
   MPI_Bcast(&failed, 1, MPI_INT, 0, MPI_COMM_WORLD);
@@ -499,39 +511,105 @@ static piola_status plan_solid(piola_mpi_split *s, piola_world *world, int32_t s
                                 .share_ghosts = share_ghosts,
                                 .reduce = reduce,
                                 .collect_blocks = collect_blocks};
-  return piola_world_solid_set_work_split(world, solid, &p->split);
+  return PIOLA_OK;
 oom:
   free(touch);
   return PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "MPI split: out of memory");
 }
 
-piola_status piola_mpi_split_world(piola_world *world, piola_mpi_split **out) {
-  if (!world || !out) return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "MPI split: NULL argument");
+/* Plans solid `solid` (collective): a failure on any process is one on every process. */
+static piola_status plan_agreed(piola_mpi_split *s, int32_t solid, const plan_mesh *mesh,
+                                solid_plan **out) {
   *out = NULL;
-  const char *why = piola_world_split_unsupported(world);
-  if (why) return PIOLA_FAIL(PIOLA_ERROR_UNSUPPORTED, "%s", why);
+  piola_status st = PIOLA_OK;
+  if (solid >= s->solid_count) {
+    solid_plan **grown = realloc(s->plans, sizeof *grown * (size_t)(solid + 1));
+    if (grown) {
+      for (int32_t i = s->solid_count; i <= solid; ++i) grown[i] = NULL;
+      s->plans = grown;
+      s->solid_count = solid + 1;
+    } else {
+      st = PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "MPI split: out of memory");
+    }
+  }
+  solid_plan *p = NULL;
+  if (st == PIOLA_OK && s->plans[solid])
+    st = PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "MPI split: solid %d is split already", (int)solid);
+  if (st == PIOLA_OK && !(p = calloc(1, sizeof *p)))
+    st = PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "MPI split: out of memory");
+  /* plan_solid's broadcasts run on every process, whatever failed here before */
+  int skip = st != PIOLA_OK, any_skip = 0;
+  MPI_Allreduce(&skip, &any_skip, 1, MPI_INT, MPI_MAX, MPI_COMM_WORLD);
+  if (!any_skip) st = plan_solid(s, mesh, p);
+  int bad = st != PIOLA_OK || any_skip, any = 0;
+  MPI_Allreduce(&bad, &any, 1, MPI_INT, MPI_MAX, MPI_COMM_WORLD);
+  if (any) {
+    if (p) plan_free(p), free(p);
+    return st != PIOLA_OK ? st : PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "MPI split: another process failed");
+  }
+  s->plans[solid] = p;
+  *out = p;
+  return PIOLA_OK;
+}
+
+static piola_status plan_added_solid(void *context, int32_t solid, const piola_tet_mesh *mesh,
+                                     const piola_work_split **out) {
+  piola_mpi_split *s = context;
+  *out = NULL;
+  if (s->size == 1) return PIOLA_OK; /* one process: the solid stays whole */
+  plan_mesh m = {mesh->tets, mesh->tet_count, mesh->vertex_count};
+  solid_plan *p;
+  PIOLA_TRY(plan_agreed(s, solid, &m, &p));
+  *out = &p->split;
+  return PIOLA_OK;
+}
+
+piola_status piola_mpi_split_create(piola_mpi_split **out) {
+  if (!out) return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "MPI split: NULL argument");
   piola_mpi_split *s = calloc(1, sizeof *s);
+  *out = s;
   if (!s) return PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "MPI split: out of memory");
   MPI_Comm_rank(MPI_COMM_WORLD, &s->rank);
   MPI_Comm_size(MPI_COMM_WORLD, &s->size);
   s->stats.rank = s->rank;
   s->stats.size = s->size;
-  s->solid_count = piola_world_solid_count(world);
-  s->plans = calloc((size_t)(s->solid_count > 0 ? s->solid_count : 1), sizeof(solid_plan));
-  if (!s->plans) {
-    free(s);
-    return PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "MPI split: out of memory");
-  }
-  for (int32_t i = 0; i < s->solid_count; ++i) {
-    piola_status st = plan_solid(s, world, i, &s->plans[i]);
-    /* every process must agree before any goes on: a failure anywhere is one everywhere */
+  return PIOLA_OK;
+}
+
+piola_work_split_planner piola_mpi_split_planner(piola_mpi_split *split) {
+  return (piola_work_split_planner){split ? plan_added_solid : NULL, split};
+}
+
+piola_status piola_mpi_split_finish(piola_mpi_split *s, piola_world *world) {
+  if (!s || !world) return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "MPI split: NULL argument");
+  piola_world_set_work_split_planner(world, NULL);
+  const char *why = piola_world_split_unsupported(world);
+  if (why) return PIOLA_FAIL(PIOLA_ERROR_UNSUPPORTED, "%s", why);
+  const int32_t solids = piola_world_solid_count(world);
+  for (int32_t i = 0; i < solids; ++i) {
+    if (i < s->solid_count && s->plans[i]) continue; /* planned when it was added */
+    const piola_elastic_body *body = piola_world_solid_body(world, i);
+    plan_mesh m = {piola_elastic_body_tets(body), piola_elastic_body_tet_count(body),
+                   piola_elastic_body_vertex_count(body)};
+    solid_plan *p;
+    PIOLA_TRY(plan_agreed(s, i, &m, &p));
+    piola_status st = piola_world_solid_set_work_split(world, i, &p->split);
     int bad = st != PIOLA_OK, any = 0;
     MPI_Allreduce(&bad, &any, 1, MPI_INT, MPI_MAX, MPI_COMM_WORLD);
-    if (any) {
-      if (!bad) PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "MPI split: another process failed");
-      piola_mpi_split_destroy(s, world);
-      return bad ? st : PIOLA_ERROR_OUT_OF_MEMORY;
-    }
+    if (any) return bad ? st : PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "MPI split: another process failed");
+  }
+  return PIOLA_OK;
+}
+
+piola_status piola_mpi_split_world(piola_world *world, piola_mpi_split **out) {
+  if (!world || !out) return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "MPI split: NULL argument");
+  *out = NULL;
+  piola_mpi_split *s;
+  PIOLA_TRY(piola_mpi_split_create(&s));
+  piola_status st = piola_mpi_split_finish(s, world);
+  if (st != PIOLA_OK) {
+    piola_mpi_split_destroy(s, world);
+    return st;
   }
   *out = s;
   return PIOLA_OK;
@@ -545,8 +623,10 @@ piola_mpi_split_stats piola_mpi_split_stats_of(const piola_mpi_split *split) {
 void piola_mpi_split_destroy(piola_mpi_split *split, piola_world *world) {
   if (!split) return;
   for (int32_t i = 0; i < split->solid_count; ++i) {
+    if (!split->plans[i]) continue;
     if (world) (void)piola_world_solid_set_work_split(world, i, NULL);
-    plan_free(&split->plans[i]);
+    plan_free(split->plans[i]);
+    free(split->plans[i]);
   }
   free(split->plans);
   free(split);

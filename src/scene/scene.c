@@ -85,13 +85,18 @@ void piola_scene_desc_destroy(piola_scene_desc *desc) {
 }
 
 piola_status piola_scene_build(const piola_scene_desc *desc, piola_scene **out) {
+  return piola_scene_build_split(desc, NULL, out);
+}
+
+piola_status piola_scene_build_split(const piola_scene_desc *desc,
+                                     const piola_work_split_planner *planner, piola_scene **out) {
   if (!desc || !out) return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "scene: NULL argument");
   *out = NULL;
   piola_scene *scene = calloc(1, sizeof *scene);
   if (!scene) return PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "%s: out of memory", desc->label);
   scene->fps = desc->desc.fps;
   scene->frames = desc->desc.frames;
-  piola_status st = piola__scene_build(&desc->desc, desc->label, &scene->world);
+  piola_status st = piola__scene_build(&desc->desc, desc->label, planner, &scene->world);
   if (st != PIOLA_OK) {
     free(scene);
     return st;

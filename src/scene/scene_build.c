@@ -132,12 +132,14 @@ static piola_status build_fracture(piola_world *world, int32_t i, const scene_so
   return st;
 }
 
-piola_status piola__scene_build(const scene_desc *desc, const char *label, piola_world **out) {
+piola_status piola__scene_build(const scene_desc *desc, const char *label,
+                                const piola_work_split_planner *planner, piola_world **out) {
   *out = NULL;
   if (!label) label = "scene";
   piola_world *world = NULL;
   if (piola_world_create(&desc->world, &world) != PIOLA_OK)
     return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "%s: integrator: %s", label, piola_last_error());
+  piola_world_set_work_split_planner(world, planner);
   for (int32_t i = 0; i < desc->solid_count; ++i) {
     const scene_solid_desc *d = &desc->solids[i];
     piola_tet_mesh mesh;

@@ -11,6 +11,7 @@
 
 #include "piola/mesher.h"
 #include "piola/obstacle.h"
+#include "piola/work_split.h"
 #include "piola/world.h"
 #include "piola/world_bones.h"
 #include "piola/world_fracture.h"
@@ -124,7 +125,8 @@ piola_status piola__scene_fiber_directions(const scene_fibers *fibers, const pio
                                            double **out);
 
 /* Reads or generates the meshes, places them and builds the world. */
-piola_status piola__scene_build(const scene_desc *desc, const char *label, piola_world **out);
+piola_status piola__scene_build(const scene_desc *desc, const char *label,
+                                const piola_work_split_planner *planner, piola_world **out);
 
 /* Refuses a scene text whose strings hold the escape \u0000 (scene_text_check.c): it would
  * cut a path short. */

@@ -19,6 +19,7 @@
 
 #include <stdint.h>
 
+#include "piola/work_split.h"
 #include "piola/world.h"
 #include "piola/world_bodies.h"
 #include "piola/world_shells.h"
@@ -48,6 +49,7 @@ struct piola_world {
                                  NAN outside advance_to */
   step_profile profile;       /* per-phase step timers, off unless a benchmark turns them on */
   char *warnings[PIOLA_WARNING_KIND_COUNT]; /* first message of each kind, or NULL */
+  piola_work_split_planner split_planner; /* splits of solids added (plan NULL: none) */
 };
 
 /* Warnings (world_warnings.c). warn records the message of kind unless one is recorded

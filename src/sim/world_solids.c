@@ -158,7 +158,20 @@ static piola_status fill_solid(piola_world *world, world_body *s, const piola_so
   bdef.material_count = 1;
   bdef.density = def->density;
   bdef.fiber_directions = def->fiber_directions;
-  piola_status st = piola_elastic_body_create(&bdef, &s->solid);
+  /* a split known now keeps every process to its own blocks' per-tet state (work_split.h) */
+  const piola_work_split *split = NULL;
+  if (world->split_planner.plan && !def->plasticity && world->def.integrator == PIOLA_INTEGRATOR_NEWMARK)
+    PIOLA_TRY(world->split_planner.plan(world->split_planner.context, id, def->mesh, &split));
+  piola_status st = split ? piola__elastic_body_create_split(&bdef, split, &s->solid)
+                          : piola_elastic_body_create(&bdef, &s->solid);
+  if (split && split->reduce) { /* the processes go on together, or not at all */
+    double bad = st != PIOLA_OK;
+    split->reduce(split->context, &bad, 1, PIOLA_WORK_SPLIT_MAX);
+    if (bad > 0 && st == PIOLA_OK) {
+      piola_elastic_body_destroy(s->solid);
+      st = PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "solid %d: another process failed to build it", (int)id);
+    }
+  }
   if (st != PIOLA_OK) {
     s->solid = NULL;
     return st;
@@ -208,6 +221,12 @@ piola_status piola_world_add_solid(piola_world *world, const piola_solid_def *de
     return st;
   }
   piola__world_check_slivers(world, s);
+  /* the setup that reads every tet's Dm^-1 is done: a split solid drops the others' */
+  st = piola__elastic_body_split_localize_rest(s->solid);
+  if (st != PIOLA_OK) {
+    piola__world_drop_body(world, s);
+    return st;
+  }
   if (index) *index = id;
   return PIOLA_OK;
 }

@@ -1,6 +1,8 @@
 /* What a world split among processes supports (piola/work_split.h): the split divides the
  * solids' force loop and damping products of the Newmark step; everything else runs the same
- * on every process. */
+ * on every process, self-collision of the solids' surfaces included (it reads node state
+ * only, which every process holds bit for bit, and its detection does not depend on the
+ * thread count: every process makes the same corrections). */
 #include "common/status_report.h"
 #include "force/elastic_body_internal.h"
 #include "piola/work_split.h"
@@ -13,7 +15,6 @@ const char *piola_world_split_unsupported(const piola_world *world) {
   for (int32_t i = 0; i < world->body_count; ++i) {
     const world_body *b = &world->bodies[i];
     if (b->kind == PIOLA_BODY_SHELL) return "shells run on one process only";
-    if (b->self_collision.enabled) return "self-collision runs on one process only";
     if (b->fracture) return "fracture runs on one process only";
   }
   return NULL;
@@ -28,4 +29,9 @@ piola_status piola_world_split_collect(piola_world *world) {
     b->elastic_stale = 1; /* process 0's statistics now see every tet */
   }
   return PIOLA_OK;
+}
+
+void piola_world_set_work_split_planner(piola_world *world, const piola_work_split_planner *planner) {
+  if (!world) return;
+  world->split_planner = planner ? *planner : (piola_work_split_planner){NULL, NULL};
 }

@@ -25,7 +25,9 @@
 
 #include "block_scenes.h"
 #include "force/elastic_body_internal.h"
+#include "force/element_stiffness.h"
 #include "force/stable_step.h"
+#include "material/hgo_kernels.h"
 #include "piola/diagonalize.h"
 #include "piola/mesh_io.h"
 #include "piola/world.h"
@@ -128,6 +130,102 @@ static void modulus_bounds_every_plane_wave(void **state) {
     if (!(worst_ratio < 2.5)) fail_msg("model %d: bound up to %g times the largest plane wave", mi, worst_ratio);
     piola_elastic_body_destroy(body);
   }
+  fixture_mesh_free(&mesh);
+}
+
+/* HGO's fibre term follows each tet's actual fibre directions (issue 21: the bound assumed
+ * the fibres along the largest stretch, and a unit ball scrambled by half a diagonal stepped
+ * at 9.5e-8 s). A single tet with a fibre is deformed to random F = R1 diag(s) R2 and
+ * updated; the modulus at its Fhat must bound the largest plane wave of the whole dP/dF
+ * (matrix and fibres, acoustic tensor's top eigenvalue over many directions n), stay within
+ * a small factor of it, and never exceed the direction-free bound; with the fibres across
+ * the stretch it is far below that bound. */
+static piola_mat3 random_rotation(test_rng *rng) {
+  double q[4], n = 0;
+  for (int i = 0; i < 4; ++i) q[i] = test_rng_normal(rng), n += q[i] * q[i];
+  n = sqrt(n);
+  const double w = q[0] / n, x = q[1] / n, y = q[2] / n, z = q[3] / n;
+  const piola_mat3 r = {{{1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)},
+                         {2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)},
+                         {2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)}}};
+  return r;
+}
+
+static double largest_plane_wave(const double c[81], test_rng *rng) {
+  double best = -INFINITY;
+  for (int sample = 0; sample < 3000; ++sample) {
+    double n[3], nn = 0;
+    for (int i = 0; i < 3; ++i) n[i] = sample < 3 ? (i == sample) : test_rng_normal(rng), nn += n[i] * n[i];
+    double q[9] = {0}, lambda[3];
+    for (int i = 0; i < 3; ++i)
+      for (int k = 0; k < 3; ++k)
+        for (int j = 0; j < 3; ++j)
+          for (int l = 0; l < 3; ++l) q[3 * i + k] += c[9 * (3 * i + j) + 3 * k + l] * n[j] * n[l] / nn;
+    for (int i = 0; i < 3; ++i)
+      for (int k = 0; k < i; ++k) q[3 * i + k] = q[3 * k + i] = 0.5 * (q[3 * i + k] + q[3 * k + i]);
+    test_symmetric_eigenvalues(q, 3, lambda);
+    for (int i = 0; i < 3; ++i) best = fmax(best, lambda[i]);
+  }
+  return best;
+}
+
+static void hgo_bound_follows_the_fibres(void **state) {
+  (void)state;
+  test_rng rng = test_rng_seeded(2121);
+  piola_tet_mesh mesh = fixture_single_tet(1.0); /* Dm = I: the vertices are F's columns */
+  piola_material_def def = piola_default_material_def();
+  def.model = PIOLA_MODEL_HGO;
+  def.poisson_ratio = 0.45;
+  def.hgo.mu = 1e4, def.hgo.k1 = 2e4, def.hgo.k2 = 2.0, def.hgo.kappa = 0.1;
+  def.hgo.fiber_angle_degrees = 40.0;
+  piola_material m;
+  assert_int_equal(piola_material_init(&def, &m), PIOLA_OK);
+  const double fiber[3] = {1, 0.2, 0.1};
+  piola_elastic_body *body = fixture_body_with_fibers(&mesh, &m, 1, NULL, fiber);
+  piola_elastic_body *matrix = fixture_body_with_fibers(&mesh, &m, 1, NULL, NULL); /* no fibres */
+  double x[12] = {0}, forces[12], worst_ratio = 0;
+  for (long c = 0; c < test_samples(60, 10); ++c) {
+    const piola_mat3 r1 = random_rotation(&rng), r2 = random_rotation(&rng);
+    double s[3];
+    for (int i = 0; i < 3; ++i) s[i] = exp(test_rng_uniform(&rng, log(0.6), log(2.5)));
+    piola_mat3 f;
+    for (int i = 0; i < 3; ++i)
+      for (int j = 0; j < 3; ++j) {
+        f.m[i][j] = 0;
+        for (int k = 0; k < 3; ++k) f.m[i][j] += r1.m[i][k] * s[k] * r2.m[k][j];
+      }
+    for (int v = 1; v < 4; ++v)
+      for (int i = 0; i < 3; ++i) x[3 * v + i] = f.m[i][v - 1];
+    assert_int_equal(piola_elastic_body_update(body, x, 1.0, forces, NULL), PIOLA_OK);
+    const double *fhat = body->fhat;
+    const double k = piola__elastic_body_tet_modulus(body, 0, fhat);
+    double dpdf[81];
+    piola__element_dpdf(&m, &f, fiber, 0.0, 0, dpdf);
+    const double wave = largest_plane_wave(dpdf, &rng);
+    if (!(k >= wave * (1 - 1e-9)))
+      fail_msg("stretches (%g, %g, %g): bound %g below the largest plane wave %g", s[0], s[1], s[2], k, wave);
+    worst_ratio = fmax(worst_ratio, k / wave);
+    const double undirected = piola__elastic_body_tet_modulus(matrix, 0, fhat) +
+                              hgo_fiber_modulus_bound(&m.hgo, fhat[0], fhat[1], fhat[2]);
+    assert_true(k <= undirected * (1 + 1e-12));
+  }
+  if (!(worst_ratio < 3.0)) fail_msg("bound up to %g times the largest plane wave", worst_ratio);
+  /* stretched 2.5 times across the fibres' plane (z), fibres slack: the fibre term is their
+   * rest stiffness, the direction-free bound the exponential of a 2.5 stretch */
+  const double across[3] = {0.8, 0.8, 2.5};
+  for (int v = 1; v < 4; ++v)
+    for (int i = 0; i < 3; ++i) x[3 * v + i] = (i == v - 1) * across[i];
+  const double rest_fiber[3] = {1, 0, 0};
+  piola_elastic_body_destroy(body);
+  body = fixture_body_with_fibers(&mesh, &m, 1, NULL, rest_fiber);
+  assert_int_equal(piola_elastic_body_update(body, x, 1.0, forces, NULL), PIOLA_OK);
+  const double k = piola__elastic_body_tet_modulus(body, 0, body->fhat);
+  const double *fh = body->fhat;
+  const double undirected = piola__elastic_body_tet_modulus(matrix, 0, fh) +
+                            hgo_fiber_modulus_bound(&m.hgo, fh[0], fh[1], fh[2]);
+  if (!(k < 0.2 * undirected)) fail_msg("fibres across the stretch: %g against the direction-free %g", k, undirected);
+  piola_elastic_body_destroy(body);
+  piola_elastic_body_destroy(matrix);
   fixture_mesh_free(&mesh);
 }
 
@@ -479,6 +577,7 @@ int main(void) {
       cmocka_unit_test(modulus_bounds_every_plane_wave),
       cmocka_unit_test(every_model_takes_its_own_modulus),
       cmocka_unit_test(modulus_bounds_the_extensions),
+      cmocka_unit_test(hgo_bound_follows_the_fibres),
       cmocka_unit_test(cfl_limit_of_a_block),
       cmocka_unit_test(step_follows_the_state),
       cmocka_unit_test(stretched_block_loses_energy),

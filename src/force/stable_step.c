@@ -97,9 +97,50 @@ STABLE_STEP_KERNEL double model_modulus(piola_material_model model, int energy,
   k = kernel_max(k, pair_modulus(c, p0, p2, f0, f2, k0, k2, k02));
   k = kernel_max(k, pair_modulus(c, p1, p2, f1, f2, k1, k2, k12));
   /* muscle fibres: their tangent stiffness bound, as in the rest bound; HGO's exponential
-   * fibres: a bound at this state (hgo_kernels.h) */
-  return k + (model == PIOLA_MODEL_HGO ? hgo_fiber_modulus_bound(&m->hgo, f0, f1, f2)
-                                       : m->fiber_modulus);
+   * fibres depend on their direction: hgo_tet_fiber_modulus, added by the callers */
+  return k + (model == PIOLA_MODEL_HGO ? 0.0 : m->fiber_modulus);
+}
+
+/* HGO's fibre stiffness for a plane wave at Fhat f with the two families' unit directions
+ * ahat in the diagonal frame (docs/time-stepping.md, "The modulus"): per family a,
+ *   dF : C_a : dF = 4 psi''(E_a) (G_a : dF)^2 + 2 psi'(E_a) (kappa |dF|^2 + (1 - 3 kappa) |dF a|^2)
+ * with G_a = kappa Fhat + (1 - 3 kappa) (Fhat ahat) ahat^T. For a unit rank-one dF,
+ * |G_a : dF| <= |G_a|_2 <= kappa max|f_i| + (1 - 3 kappa) |Fhat ahat| (kappa <= 1/3), and the
+ * last factor is at most 1 - 2 kappa. psi'' jumps from 0 to k1 at E = 0: the larger side is
+ * taken. Exact along the largest stretch, 8 k1 (1 - 2 kappa)^2 at rest. */
+STABLE_STEP_KERNEL double hgo_directed_fiber_modulus(const piola_hgo_def *h, double f0, double f1,
+                                                    double f2, double ahat[2][3]) {
+  const double big = kernel_max(fabs(f0), kernel_max(fabs(f1), fabs(f2)));
+  const double i1 = f0 * f0 + f1 * f1 + f2 * f2, kappa = h->kappa;
+  double sum = 0.0;
+  for (int a = 0; a < 2; ++a) {
+    const double x0 = f0 * ahat[a][0], x1 = f1 * ahat[a][1], x2 = f2 * ahat[a][2];
+    const double i4 = x0 * x0 + x1 * x1 + x2 * x2;
+    const double e = kappa * (i1 - 3.0) + (1.0 - 3.0 * kappa) * (i4 - 1.0);
+    double psi, slope, curvature;
+    hgo_fiber_curve(h, kernel_max(e, 1e-300), &psi, &slope, &curvature);
+    const double g = kappa * big + (1.0 - 3.0 * kappa) * sqrt(i4);
+    sum += 4.0 * curvature * g * g + 2.0 * slope * (1.0 - 2.0 * kappa);
+  }
+  return sum;
+}
+
+/* The fibre term of HGO tet t at Fhat f: its families' directions in the diagonal frame of
+ * the last update (V^T a, as the force loop forms them). A body without fibres has no fibre
+ * force, so no term; before any update only the direction-free bound of hgo_kernels.h. */
+static double hgo_tet_fiber_modulus(const piola_elastic_body *body, const piola_material *m,
+                                    int32_t t, const double f[3]) {
+  if (!body->fiber[0]) return 0.0;
+  if (!body->has_state) return hgo_fiber_modulus_bound(&m->hgo, f[0], f[1], f[2]);
+  const long stride = body->padded_tet_count;
+  const double *v = body->v[0] + t;
+  const double dir[3] = {body->fiber[0][t], body->fiber[1][t], body->fiber[2][t]};
+  double fam[2][3], ahat[2][3];
+  (void)hgo_families_from_fiber(m, dir, fam); /* checked when the body was built */
+  for (int a = 0; a < 2; ++a)
+    for (int k = 0; k < 3; ++k)
+      ahat[a][k] = v[k * stride] * fam[a][0] + v[(3 + k) * stride] * fam[a][1] + v[(6 + k) * stride] * fam[a][2];
+  return hgo_directed_fiber_modulus(&m->hgo, f[0], f[1], f[2], ahat);
 }
 
 /* Neo-Hookean (and the muscle's matrix) with every entry at or above the threshold: the
@@ -165,7 +206,9 @@ double PIOLA_ISA_NAME(piola__elastic_body_tet_rest_altitude)(const piola_elastic
 
 double PIOLA_ISA_NAME(piola__elastic_body_tet_modulus)(const piola_elastic_body *body, int32_t tet,
                                                       const double fhat[3]) {
-  return material_modulus(&body->materials[body->tet_material[tet]], fhat[0], fhat[1], fhat[2]);
+  const piola_material *m = &body->materials[body->tet_material[tet]];
+  const double k = material_modulus(m, fhat[0], fhat[1], fhat[2]);
+  return m->model == PIOLA_MODEL_HGO ? k + hgo_tet_fiber_modulus(body, m, tet, fhat) : k;
 }
 
 /* 1 / (rho h_e^2) per tet, from the rest Dm^-1 (before plasticity changes it): built once. */
@@ -226,7 +269,8 @@ static double neohookean_range(piola_material_model model, int energy, const pio
 
 /* max over tets [begin, end) of w_e k_e, one material, its mode ENERGY a compile-time
  * constant */
-STABLE_STEP_KERNEL double uniform_range_rate2(int energy, const piola_material *m, const double *f,
+STABLE_STEP_KERNEL double uniform_range_rate2(const piola_elastic_body *body, int energy,
+                                              const piola_material *m, const double *f,
                                               const double *w, int32_t begin, int32_t end) {
   double best = 0;
   switch (m->model) {
@@ -235,7 +279,14 @@ STABLE_STEP_KERNEL double uniform_range_rate2(int energy, const piola_material *
     case PIOLA_MODEL_NEOHOOKEAN:
       return neohookean_range(PIOLA_MODEL_NEOHOOKEAN, energy, m, f, w, begin, end);
     case PIOLA_MODEL_MUSCLE: return neohookean_range(PIOLA_MODEL_MUSCLE, energy, m, f, w, begin, end);
-    case PIOLA_MODEL_HGO: MODEL_LANE_LOOP(PIOLA_MODEL_HGO)
+    case PIOLA_MODEL_HGO: /* the fibre term reads each tet's V and fibre: not a lane loop */
+      for (int32_t t = begin; t < end; ++t) {
+        const double *ft = f + 3 * t;
+        const double r = w[t] * (model_modulus(PIOLA_MODEL_HGO, energy, m, ft[0], ft[1], ft[2]) +
+                                 hgo_tet_fiber_modulus(body, m, t, ft));
+        best = r > best ? r : best;
+      }
+      break;
     case PIOLA_MODEL_SPLINE: MODEL_LANE_LOOP(PIOLA_MODEL_SPLINE)
     case PIOLA_MODEL_STABLE_NEOHOOKEAN: MODEL_LANE_LOOP(PIOLA_MODEL_STABLE_NEOHOOKEAN)
     case PIOLA_MODEL_MOONEY_RIVLIN: /* stored as two Ogden terms */
@@ -253,8 +304,8 @@ static double range_rate2(const piola_elastic_body *body, const double *w, int32
   double best = 0;
   if (body->uniform_material >= 0) {
     const piola_material *m = &body->materials[body->uniform_material];
-    return m->inversion_mode == PIOLA_INVERSION_ENERGY ? uniform_range_rate2(1, m, f, w, begin, end)
-                                                       : uniform_range_rate2(0, m, f, w, begin, end);
+    return m->inversion_mode == PIOLA_INVERSION_ENERGY ? uniform_range_rate2(body, 1, m, f, w, begin, end)
+                                                       : uniform_range_rate2(body, 0, m, f, w, begin, end);
   } else {
     for (int32_t t = begin; t < end; ++t) {
       const double r = w[t] * PIOLA_ISA_NAME(piola__elastic_body_tet_modulus)(body, t, f + 3 * t);

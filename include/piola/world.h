@@ -115,7 +115,7 @@ typedef struct piola_world_def {
                                   PIOLA_PRECONDITIONER_BLOCK_JACOBI */
   piola_linear_forcing linear_forcing; /* each Newton system's CG tolerance: adapted
                                   (Eisenstat-Walker, never tighter than linear_tolerance) or
-                                  fixed at linear_tolerance. Default
+                                  fixed at linear_tolerance (quasistatic steps: always fixed). Default
                                   PIOLA_FORCING_EISENSTAT_WALKER */
 } piola_world_def;
 

@@ -47,6 +47,23 @@ PIOLA_API void piola_output_close(piola_output *output);
 PIOLA_API piola_status piola_output_open_resume(const char *dir, int32_t frame,
                                                 const piola_world *world, piola_output **out);
 
+/* The output of one process of a split run (docs/mpi.md, "Output"): frames are written as
+ * pieces, DIR/frames/frame_NNNN_pK.vtu by process K (piola_output_write_piece), tied by
+ * DIR/frames/frame_NNNN.pvtu, which piece 0's piola_output_write_frame writes with the OBJ
+ * and the indexes once every piece is in place; sim.pvd lists the .pvtu files. Piece 0
+ * prepares the folder as piola_output_open does (resume_frame < 0), or reconciles it as
+ * piola_output_open_resume does (resume_frame >= 0, the pieces of frames 0..resume_frame
+ * included); the other pieces only write their own piece and must be opened after piece 0.
+ * Shells and fracture are not written as pieces (PIOLA_ERROR_UNSUPPORTED). */
+PIOLA_API piola_status piola_output_open_pieces(const char *dir, bool force, int32_t resume_frame,
+                                                const piola_world *world, int32_t piece,
+                                                int32_t piece_count, piola_output **out);
+
+/* Writes this process's piece of frame `frame` of the world's current state, whole, under
+ * its final name (no index lists it before piece 0's piola_output_write_frame). */
+PIOLA_API piola_status piola_output_write_piece(piola_output *output, const piola_world *world,
+                                                int32_t frame);
+
 typedef struct piola_frame_info {
   int32_t frame;          /* frame number, 0 is the initial state */
   int32_t substeps;       /* steps taken since the previous frame */
@@ -66,7 +83,8 @@ typedef struct piola_frame_info {
 } piola_frame_info;
 
 /* Writes the VTU and OBJ of the world's current state and appends a row to stats.csv and
- * an entry to sim.pvd. */
+ * an entry to sim.pvd. With pieces (piece 0 only): the .pvtu instead of the VTU, refused
+ * (PIOLA_ERROR_IO) when a piece of the frame is not in place. */
 PIOLA_API piola_status piola_output_write_frame(piola_output *output, const piola_world *world,
                                                 const piola_frame_info *info);
 

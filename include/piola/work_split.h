@@ -86,6 +86,9 @@ PIOLA_API int32_t piola_elastic_body_block_count(const piola_elastic_body *body)
 PIOLA_API piola_status piola_elastic_body_set_work_split(piola_elastic_body *body,
                                                          const piola_work_split *split);
 
+/* The body's split (as set), or NULL when it has none. */
+PIOLA_API const piola_work_split *piola_elastic_body_work_split(const piola_elastic_body *body);
+
 /* Whether body runs its split in the local mode (above). */
 PIOLA_API int piola_elastic_body_split_is_local(const piola_elastic_body *body);
 

@@ -17,6 +17,7 @@
 #include "cli/commands.h"
 #include "cli/run_checkpoints.h"
 #include "cli/run_mpi.h"
+#include "cli/run_split_checkpoints.h"
 #include "piola/checkpoint.h"
 #include "piola/elastic_body.h"
 #include "piola/output.h"
@@ -121,6 +122,31 @@ static bool budget_ok(const char *scene_path, const piola_world *world, int fram
   return false;
 }
 
+/* Writes a frame: process 0's VTU, or in a split run every process's piece and then, once
+ * all are in place, process 0's .pvtu (docs/mpi.md); the OBJ and the indexes last, by
+ * process 0. Collective; true when every process succeeded (a failure is printed where it
+ * happened). */
+static bool write_frame_everywhere(run_mpi *mpi, piola_output *out, const piola_world *world,
+                                   const piola_frame_info *info) {
+  const bool lead = mpi->rank == 0;
+  if (mpi->size > 1) {
+    bool ok = piola_output_write_piece(out, world, info->frame) == PIOLA_OK;
+    if (!ok) fprintf(stderr, "piola run: MPI process %d: %s\n", mpi->rank, piola_last_error());
+    if (!run_mpi_all(mpi, ok)) return false;
+  }
+  bool ok = !lead || piola_output_write_frame(out, world, info) == PIOLA_OK;
+  if (!ok) fprintf(stderr, "piola run: %s\n", piola_last_error());
+  return run_mpi_all(mpi, ok);
+}
+
+/* A checkpoint at frame: one file, or in a split run one file per process and process 0's
+ * manifest (run_split_checkpoints.h). Collective. */
+static int save_checkpoint(run_mpi *mpi, const char *dir, const piola_world *world, uint64_t key,
+                           int32_t frame) {
+  if (mpi->size > 1) return run_split_checkpoint_save(mpi, dir, world, key, frame);
+  return run_checkpoint_save(dir, world, key, frame);
+}
+
 static int run(int argc, char **argv, run_mpi *mpi) {
   const char *scene_path = NULL, *out_dir = NULL;
   long threads = 0, frames_override = -1, checkpoint_every = -1; /* -1: the default */
@@ -174,13 +200,6 @@ static int run(int argc, char **argv, run_mpi *mpi) {
     return 2;
   }
   const bool lead = mpi->rank == 0; /* the process that writes and reports */
-  if (mpi->size > 1 && (resume || checkpoint_every > 0)) {
-    if (lead)
-      fprintf(stderr, "piola run: %s: checkpoints are single-process only, and this run has %d "
-                      "MPI processes (docs/mpi.md)\n", resume ? "--resume" : "--checkpoint-every",
-              mpi->size);
-    return 2;
-  }
   if (!run_mpi_all(mpi, piola_output_check_folder(out_dir, force || resume) == PIOLA_OK)) {
     if (lead) fprintf(stderr, "piola run: %s\n", piola_last_error());
     return 2;
@@ -207,18 +226,13 @@ static int run(int argc, char **argv, run_mpi *mpi) {
   /* checkpoints: on by default where they cover the whole state */
   const char *why = NULL;
   uint64_t scene_key = 0;
-  if (mpi->size > 1) {
-    if (checkpoint_every < 0 && lead)
-      fprintf(stderr, "piola run: no checkpoints: this run has %d MPI processes (docs/mpi.md)\n",
-              mpi->size);
-    checkpoint_every = 0;
-  } else if (!piola_world_checkpoint_supported(world, &why)) {
+  if (!piola_world_checkpoint_supported(world, &why)) {
     if (resume || checkpoint_every > 0) {
-      fprintf(stderr, "piola run: %s: %s\n", resume ? "--resume" : "--checkpoint-every", why);
+      if (lead) fprintf(stderr, "piola run: %s: %s\n", resume ? "--resume" : "--checkpoint-every", why);
       piola_scene_destroy(scene);
       return 2;
     }
-    if (checkpoint_every < 0) fprintf(stderr, "piola run: no checkpoints: %s\n", why);
+    if (checkpoint_every < 0 && lead) fprintf(stderr, "piola run: no checkpoints: %s\n", why);
     checkpoint_every = 0;
   }
   if ((checkpoint_every != 0 || resume) && !run_scene_key(scene_path, world, &scene_key)) {
@@ -227,10 +241,12 @@ static int run(int argc, char **argv, run_mpi *mpi) {
   }
   int32_t resume_frame = -1;
   if (resume) {
-    int found = run_checkpoint_resume(out_dir, world, scene_key, &resume_frame);
+    /* a split run resumes from one file per process, on as many processes (docs/mpi.md) */
+    int found = mpi->size > 1 ? run_split_checkpoint_resume(mpi, out_dir, world, scene_key, &resume_frame)
+                              : run_checkpoint_resume(out_dir, world, scene_key, &resume_frame);
     int listed = found == 1 ? run_listed_frames(out_dir) : 0;
     if (found == 2 || listed > 1) {
-      if (found == 1)
+      if (found == 1 && lead)
         fprintf(stderr, "piola run: cannot resume: %s holds frames 0..%d but no checkpoint "
                         "(checkpoint_NNNN.bin); use --force to start over\n", out_dir, listed - 1);
       piola_scene_destroy(scene);
@@ -239,29 +255,41 @@ static int run(int argc, char **argv, run_mpi *mpi) {
     if (found == 1) {
       /* no checkpoint and at most frame 0: a missing or empty folder, or a run killed
        * before its first checkpoint; starting over loses nothing */
-      fprintf(stderr, "piola run: no checkpoint in %s, starting from frame 0\n", out_dir);
+      if (lead) fprintf(stderr, "piola run: no checkpoint in %s, starting from frame 0\n", out_dir);
       force = true;
     }
   }
+  /* a split run writes its frames as pieces, one per process (docs/mpi.md, "Output"):
+   * process 0 prepares the folder first, then the others open their pieces */
+  const int32_t pieces = mpi->size > 1 ? mpi->size : 0;
   piola_output *out = NULL;
   piola_status opened = !lead ? PIOLA_OK
+                        : pieces ? piola_output_open_pieces(out_dir, force, resume_frame, world, 0, pieces, &out)
                         : resume_frame >= 0 ? piola_output_open_resume(out_dir, resume_frame, world, &out)
                                             : piola_output_open(out_dir, force, world, &out);
-  if (!run_mpi_all(mpi, opened == PIOLA_OK)) {
-    if (lead) fprintf(stderr, "piola run: %s\n", piola_last_error());
+  bool open_ok = run_mpi_all(mpi, opened == PIOLA_OK);
+  if (open_ok && pieces && !lead) {
+    opened = piola_output_open_pieces(out_dir, force, resume_frame, world, mpi->rank, pieces, &out);
+    if (opened != PIOLA_OK)
+      fprintf(stderr, "piola run: MPI process %d: %s\n", mpi->rank, piola_last_error());
+  }
+  if (open_ok && pieces) open_ok = run_mpi_all(mpi, opened == PIOLA_OK);
+  if (!open_ok) {
+    if (lead) fprintf(stderr, "piola run: %s\n", opened == PIOLA_OK ? "another MPI process could not open its piece" : piola_last_error());
     piola_output_close(out);
     piola_scene_destroy(scene);
     return opened == PIOLA_ERROR_INVALID_ARGUMENT ? 2 : 1;
   }
-  if (resume_frame >= 0)
-    fprintf(stderr, "piola run: resuming after frame %d (t = %.9g s) from %s/checkpoint_%04d.bin\n",
-            (int)resume_frame, piola_world_time(world), out_dir, (int)resume_frame);
+  if (resume_frame >= 0 && lead)
+    fprintf(stderr, "piola run: resuming after frame %d (t = %.9g s) from %s/checkpoint_%04d.%s\n",
+            (int)resume_frame, piola_world_time(world), out_dir, (int)resume_frame,
+            pieces ? "manifest and one file per MPI process" : "bin");
   const double checkpoint_wall = 300; /* s: the default's time bound */
   int32_t last_checkpoint = resume_frame >= 0 ? resume_frame : 0;
   double last_checkpoint_time = now_seconds();
   bool tty = lead && isatty(STDERR_FILENO);
   bool warned[PIOLA_WARNING_KIND_COUNT] = {false};
-  report_warnings(out, world, warned, false);
+  report_warnings(lead ? out : NULL, world, warned, false);
   const double first_dt = piola_world_stable_dt(world); /* collective when split: all ask */
   if (lead)
     fprintf(stderr, "piola run: %s -> %s: %d frames at %g fps, %d solids, %d shells, %d obstacles, first dt %.3g s%s\n",
@@ -270,7 +298,11 @@ static int run(int argc, char **argv, run_mpi *mpi) {
             first_dt, mpi->size > 1 ? ", on MPI processes" : "");
   /* previews (src/render): DIR/scene.json, DIR/preview.png and, with --render, every frame */
   piola_preview *preview = NULL;
-  if (lead && piola_preview_open(out_dir, scene_path, render_frames, &preview) != PIOLA_OK)
+  if (lead && pieces)
+    fprintf(stderr, "piola run: no preview%s: the frames of a split run are pieces; `piola render "
+                    "%s` draws their surfaces afterwards (docs/mpi.md)\n",
+            render_frames ? " and no --render" : "", out_dir);
+  else if (lead && piola_preview_open(out_dir, scene_path, render_frames, &preview) != PIOLA_OK)
     fprintf(stderr, "piola run: no preview: %s\n", piola_last_error());
   int rc = 0;
   long long total_steps = 0, total_cg = 0, total_newton = 0, total_linear = 0, total_failures = 0;
@@ -278,15 +310,14 @@ static int run(int argc, char **argv, run_mpi *mpi) {
   double sim_start = now_seconds();
   piola_frame_info info = {0};
   if (resume_frame < 0) run_mpi_collect(mpi, world); /* process 0 writes frame 0 */
-  if (resume_frame >= 0 || !lead) {
-    /* frames up to resume_frame are on disk already; only process 0 writes */
-  } else if (piola_output_write_frame(out, world, &info) != PIOLA_OK) {
-    fprintf(stderr, "piola run: %s\n", piola_last_error());
+  if (resume_frame >= 0) {
+    /* frames up to resume_frame are on disk already */
+  } else if (!write_frame_everywhere(mpi, out, world, &info)) {
     rc = 1;
   } else {
     if (preview && piola_preview_frame_written(preview, 0, piola_world_time(world)) != PIOLA_OK)
       fprintf(stderr, "piola run: preview: %s\n", piola_last_error());
-    if (checkpoint_every != 0 && !run_checkpoint_save(out_dir, world, scene_key, 0)) rc = 1;
+    if (checkpoint_every != 0 && !save_checkpoint(mpi, out_dir, world, scene_key, 0)) rc = 1;
   }
   if (!run_mpi_all(mpi, rc == 0)) rc = 1;
   int frame = 0, frames_written = 0;
@@ -302,7 +333,7 @@ static int run(int argc, char **argv, run_mpi *mpi) {
       char message[1024];
       snprintf(message, sizeof message, "%s", piola_last_error());
       if (tty) fputc('\n', stderr);
-      report_warnings(out, world, warned, false);
+      report_warnings(lead ? out : NULL, world, warned, false);
       fprintf(stderr, "piola run: stopped at frame %d: %s\n", frame, message);
       if (piola_output_write_failure_report(out, world, message) == PIOLA_OK)
         fprintf(stderr, "piola run: frames 0..%d are kept; see %s/failure_report.txt\n", frame - 1, out_dir);
@@ -333,9 +364,7 @@ static int run(int argc, char **argv, run_mpi *mpi) {
     for (int32_t s = 0; lead && s < piola_world_solid_count(world); ++s)
       inverted += piola_world_solid_stats(world, s).inverted_count;
     if (inverted > max_inverted) max_inverted = inverted;
-    if (!run_mpi_all(mpi, !lead || piola_output_write_frame(out, world, &info) == PIOLA_OK)) {
-      if (tty) fputc('\n', stderr);
-      if (lead) fprintf(stderr, "piola run: %s\n", piola_last_error());
+    if (!write_frame_everywhere(mpi, out, world, &info)) {
       rc = 1;
       break;
     }
@@ -346,15 +375,16 @@ static int run(int argc, char **argv, run_mpi *mpi) {
     bool due = checkpoint_every > 0 ? frame - last_checkpoint >= checkpoint_every
                                     : frame - last_checkpoint >= 10 ||
                                           now_seconds() - last_checkpoint_time >= checkpoint_wall;
+    due = run_mpi_from_lead(mpi, due); /* process 0's clock decides for all */
     if (checkpoint_every != 0 && (due || frame == frames)) {
-      if (!run_checkpoint_save(out_dir, world, scene_key, frame)) {
+      if (!save_checkpoint(mpi, out_dir, world, scene_key, frame)) {
         rc = 1;
         break;
       }
       last_checkpoint = frame;
       last_checkpoint_time = now_seconds();
     }
-    report_warnings(out, world, warned, tty);
+    report_warnings(lead ? out : NULL, world, warned, tty);
     if (lead) progress(tty, frame, frames, piola_world_time(world), now_seconds() - sim_start, st.substeps, inverted);
   }
   double wall = now_seconds() - t_start;

@@ -8,6 +8,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include "cli/run_split_checkpoints.h"
 #include "piola/checkpoint.h"
 
 int run_scene_key(const char *scene_path, const piola_world *world, uint64_t *key) {
@@ -39,8 +40,11 @@ int run_scene_key(const char *scene_path, const piola_world *world, uint64_t *ke
   return 1;
 }
 
-/* The frame numbers of dir's checkpoint_NNNN.bin files, newest first (*count of them). */
 static int32_t *list_checkpoints(const char *dir, int *count) {
+  return run_checkpoint_list(dir, ".bin", count);
+}
+
+int32_t *run_checkpoint_list(const char *dir, const char *suffix, int *count) {
   *count = 0;
   DIR *d = opendir(dir);
   if (!d) return NULL;
@@ -50,7 +54,7 @@ static int32_t *list_checkpoints(const char *dir, int *count) {
     char *end;
     if (strncmp(e->d_name, "checkpoint_", 11) != 0) continue;
     long k = strtol(e->d_name + 11, &end, 10);
-    if (end == e->d_name + 11 || strcmp(end, ".bin") != 0 || k < 0 || k > 100000000) continue;
+    if (end == e->d_name + 11 || strcmp(end, suffix) != 0 || k < 0 || k > 100000000) continue;
     if (*count == cap) {
       int32_t *grown = realloc(frames, 2 * (size_t)cap * sizeof *frames);
       if (!grown) break;
@@ -74,7 +78,14 @@ int run_checkpoint_resume(const char *dir, piola_world *world, uint64_t key, int
   int32_t *frames = list_checkpoints(dir, &count);
   if (count == 0) {
     free(frames);
-    return 1;
+    const int processes = run_split_checkpoint_processes(dir);
+    if (processes == 0) return 1;
+    char n[32];
+    snprintf(n, sizeof n, processes > 0 ? "%d" : "N", processes);
+    fprintf(stderr, "piola run: cannot resume: %s holds the checkpoints of a run on %s MPI "
+                    "processes (checkpoint_NNNN.manifest); resume it with mpirun -np %s, or use "
+                    "--force to start over (docs/mpi.md)\n", dir, n, n);
+    return 2;
   }
   int rc = 2;
   for (int i = 0; i < count; ++i) {

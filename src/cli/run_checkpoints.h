@@ -17,6 +17,10 @@ int run_scene_key(const char *scene_path, const piola_world *world, uint64_t *ke
  * another format version, or none intact. Damaged newer ones are skipped with a warning. */
 int run_checkpoint_resume(const char *dir, piola_world *world, uint64_t key, int32_t *frame);
 
+/* The frame numbers of dir's checkpoint_NNNN<suffix> files (suffix ".bin": a single
+ * process's checkpoints), newest first (*count of them; malloc'ed, may be NULL). */
+int32_t *run_checkpoint_list(const char *dir, const char *suffix, int *count);
+
 /* The number of frame rows in dir/stats.csv (0 when it is missing). */
 int run_listed_frames(const char *dir);
 

@@ -94,6 +94,18 @@ void run_mpi_report(run_mpi *m) {
   free(all);
 }
 
+int run_mpi_max(run_mpi *m, int value) {
+  if (!m->started) return value;
+  int all = value;
+  MPI_Allreduce(&value, &all, 1, MPI_INT, MPI_MAX, MPI_COMM_WORLD);
+  return all;
+}
+
+int run_mpi_from_lead(run_mpi *m, int value) {
+  if (m->started) MPI_Bcast(&value, 1, MPI_INT, 0, MPI_COMM_WORLD);
+  return value;
+}
+
 void run_mpi_finish(run_mpi *m, piola_world *world) {
   piola_mpi_split_destroy(m->split, world);
   m->split = NULL;
@@ -121,6 +133,14 @@ bool run_mpi_all(run_mpi *m, bool ok) {
 }
 void run_mpi_collect(run_mpi *m, piola_world *world) { (void)m, (void)world; }
 void run_mpi_report(run_mpi *m) { (void)m; }
+int run_mpi_max(run_mpi *m, int value) {
+  (void)m;
+  return value;
+}
+int run_mpi_from_lead(run_mpi *m, int value) {
+  (void)m;
+  return value;
+}
 void run_mpi_finish(run_mpi *m, piola_world *world) { (void)m, (void)world; }
 
 #endif

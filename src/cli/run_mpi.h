@@ -33,6 +33,10 @@ void run_mpi_collect(run_mpi *m, piola_world *world);
 void run_mpi_report(run_mpi *m);
 /* Whether every process says ok (collective; ok itself for a single process). */
 bool run_mpi_all(run_mpi *m, bool ok);
+/* The largest value over the processes (collective; value itself for a single process). */
+int run_mpi_max(run_mpi *m, int value);
+/* Process 0's value on every process (collective; value itself for a single process). */
+int run_mpi_from_lead(run_mpi *m, int value);
 /* Takes the split off world and ends MPI. */
 void run_mpi_finish(run_mpi *m, piola_world *world);
 

@@ -25,6 +25,10 @@ int32_t piola_elastic_body_block_count(const piola_elastic_body *body) {
   return body ? body->padded_tet_count / B : 0;
 }
 
+const piola_work_split *piola_elastic_body_work_split(const piola_elastic_body *body) {
+  return body ? body->split : NULL;
+}
+
 void piola__elastic_body_split_free(piola_elastic_body *body) {
   free(body->split_blocks);
   free(body->split_buffer);

@@ -51,6 +51,9 @@ struct piola_output {
                                OBJ objects are their fragments */
   double *fragment, *fraction; /* per cell, when fractures */
   const piola_world *world; /* of the frame being written */
+  int32_t piece_count;      /* a split run's frames as pieces (frame_pieces.c), or 0 */
+  bool lead;                /* writes the frame's .pvtu (or .vtu), OBJ and indexes */
+  piece_layout piece;       /* this process's piece, when piece_count > 0 */
 };
 
 static piola_status csv_append(piola_output *o, const char *line) {
@@ -73,6 +76,7 @@ static void free_topology(piola_output *o);
 void piola_output_close(piola_output *o) {
   if (!o) return;
   free_topology(o);
+  piola__piece_layout_free(&o->piece);
   free(o->csv), free(o->pvd);
   free(o);
 }
@@ -238,9 +242,11 @@ static void free_topology(piola_output *o) {
 }
 
 
-/* resume_frame < 0: a new run (force as in piola_output_open); else a resume after it. */
+/* resume_frame < 0: a new run (force as in piola_output_open); else a resume after it.
+ * piece_count > 0: a split run's output for piece `piece` (piola_output_open_pieces). */
 static piola_status open_output(const char *dir, bool force, int32_t resume_frame,
-                                const piola_world *world, piola_output **out) {
+                                const piola_world *world, int32_t piece, int32_t piece_count,
+                                piola_output **out) {
   if (!dir || !world || !out) return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "output: NULL argument");
   *out = NULL;
   if (strlen(dir) > 3500) return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "output: path too long");
@@ -249,7 +255,17 @@ static piola_status open_output(const char *dir, bool force, int32_t resume_fram
   snprintf(o->dir, sizeof o->dir, "%s", dir);
   for (int32_t s = 0; s < piola_world_solid_count(world); ++s)
     if (piola_world_solid_has_fracture(world, s)) o->fractures = true;
-  piola_status st = build_topology(o, world);
+  o->piece_count = piece_count;
+  o->lead = piece == 0;
+  piola_status st = PIOLA_OK;
+  if (piece_count > 0 && o->fractures)
+    st = PIOLA_FAIL(PIOLA_ERROR_UNSUPPORTED, "output: fracture is not written as pieces");
+  if (st == PIOLA_OK && piece_count > 0) st = piola__piece_layout_build(&o->piece, world, piece, piece_count);
+  if (st == PIOLA_OK && !o->lead) { /* the folder and the indexes are piece 0's */
+    *out = o;
+    return PIOLA_OK;
+  }
+  if (st == PIOLA_OK) st = build_topology(o, world);
   if (st == PIOLA_OK && resume_frame < 0) st = piola__output_prepare_folder(dir, force);
   if (st == PIOLA_OK) st = csv_append(o, "frame,time,substeps,cg_iterations,kinetic_energy,elastic_energy,"
                                          "inverted,min_det_f,wall_seconds,plastic_yielded,max_fp_log_stretch,"
@@ -285,8 +301,8 @@ static piola_status stage_pvd(piola_output *o, frame_commit *c) {
   fprintf(f.stream, "<?xml version=\"1.0\"?>\n<VTKFile type=\"Collection\" version=\"0.1\" "
                     "byte_order=\"LittleEndian\">\n  <Collection>\n");
   for (int32_t i = 0; i < o->pvd_count; ++i)
-    fprintf(f.stream, "    <DataSet timestep=\"%.17g\" group=\"\" part=\"0\" file=\"frames/frame_%04d.vtu\"/>\n",
-            o->pvd[i].time, (int)o->pvd[i].frame);
+    fprintf(f.stream, "    <DataSet timestep=\"%.17g\" group=\"\" part=\"0\" file=\"frames/frame_%04d.%s\"/>\n",
+            o->pvd[i].time, (int)o->pvd[i].frame, o->piece_count > 0 ? "pvtu" : "vtu");
   fprintf(f.stream, "  </Collection>\n</VTKFile>\n");
   PIOLA_TRY(piola__atomic_file_finish(&f));
   piola__frame_commit_add(c, f.temporary, f.target, 1);
@@ -312,11 +328,15 @@ static piola_status commit_frame(piola_output *o, const piola_vtu_frame *frame, 
                                  const char *row, double time) {
   frame_commit commit = {0};
   char path[4200], pending[4200];
-  snprintf(path, sizeof path, "%s/frames/frame_%04d.vtu", o->dir, (int)number);
-  if (!piola__frame_pending_name(path, pending, sizeof pending))
-    return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "output: path too long");
-  PIOLA_TRY(piola_vtu_write(pending, frame));
-  piola__frame_commit_add(&commit, pending, path, 0);
+  if (o->piece_count > 0) { /* the pieces are in place (piola_output_write_piece) */
+    PIOLA_TRY(piola__pvtu_stage(&commit, o->dir, number, o->piece_count));
+  } else {
+    snprintf(path, sizeof path, "%s/frames/frame_%04d.vtu", o->dir, (int)number);
+    if (!piola__frame_pending_name(path, pending, sizeof pending))
+      return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "output: path too long");
+    PIOLA_TRY(piola_vtu_write(pending, frame));
+    piola__frame_commit_add(&commit, pending, path, 0);
+  }
   snprintf(path, sizeof path, "%s/surface/frame_%04d.obj", o->dir, (int)number);
   piola__frame_pending_name(path, pending, sizeof pending);
   piola_status st = o->fractures ? piola__obj_write_fragments(&o->obj, pending, o->tets.positions, o->world)
@@ -342,6 +362,9 @@ static piola_status commit_frame(piola_output *o, const piola_vtu_frame *frame, 
 piola_status piola_output_write_frame(piola_output *o, const piola_world *world,
                                       const piola_frame_info *info) {
   if (!o || !world || !info) return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "output: NULL argument");
+  if (!o->lead)
+    return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "output: piece %d writes its piece only",
+                      (int)o->piece.piece);
   int32_t ns = piola_world_solid_count(world);
   long long fragments = 0, cut_tets = 0;
   for (int32_t s = 0; s < ns; ++s) {
@@ -435,13 +458,29 @@ piola_status piola_output_write_frame(piola_output *o, const piola_world *world,
 
 piola_status piola_output_open(const char *dir, bool force, const piola_world *world,
                                piola_output **out) {
-  return open_output(dir, force, -1, world, out);
+  return open_output(dir, force, -1, world, 0, 0, out);
 }
 
 piola_status piola_output_open_resume(const char *dir, int32_t frame, const piola_world *world,
                                       piola_output **out) {
   if (frame < 0) return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "output: resume frame must be >= 0");
-  return open_output(dir, false, frame, world, out);
+  return open_output(dir, false, frame, world, 0, 0, out);
+}
+
+piola_status piola_output_open_pieces(const char *dir, bool force, int32_t resume_frame,
+                                      const piola_world *world, int32_t piece,
+                                      int32_t piece_count, piola_output **out) {
+  if (out) *out = NULL;
+  if (piece_count < 1 || piece < 0 || piece >= piece_count)
+    return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "output: piece %d of %d", (int)piece, (int)piece_count);
+  return open_output(dir, force, resume_frame < 0 ? -1 : resume_frame, world, piece, piece_count, out);
+}
+
+piola_status piola_output_write_piece(piola_output *o, const piola_world *world, int32_t frame) {
+  if (!o || !world) return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "output: NULL argument");
+  if (o->piece_count == 0)
+    return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "output: not opened for pieces");
+  return piola__piece_write(&o->piece, world, o->dir, frame);
 }
 
 /* Takes over frames 0..frame of the folder (output_reconcile.c) and rewrites both indexes
@@ -449,7 +488,7 @@ piola_status piola_output_open_resume(const char *dir, int32_t frame, const piol
 static piola_status resume_indexes(piola_output *o, int32_t frame) {
   char *rows;
   size_t length;
-  PIOLA_TRY(piola__output_reconcile(o->dir, frame, &rows, &length));
+  PIOLA_TRY(piola__output_reconcile(o->dir, frame, o->piece_count, &rows, &length));
   piola_status st = csv_append(o, rows);
   for (const char *line = rows; st == PIOLA_OK && *line;) {
     char *end;

@@ -123,18 +123,53 @@ static void remove_matching(const char *folder, const char *prefix, const char *
   closedir(d);
 }
 
+/* A split run's per-process checkpoints, checkpoint_NNNN_pK.bin. */
+static void remove_split_checkpoints(const char *dir) {
+  DIR *d = opendir(dir);
+  if (!d) return;
+  char path[8192];
+  for (struct dirent *e; (e = readdir(d));) {
+    const char *name = e->d_name;
+    if (strncmp(name, "checkpoint_", 11) != 0) continue;
+    char *end;
+    (void)strtol(name + 11, &end, 10);
+    if (end == name + 11 || name[11] < '0' || name[11] > '9' || strncmp(end, "_p", 2) != 0) continue;
+    const char *digits = end + 2;
+    (void)strtol(digits, &end, 10);
+    if (end == digits || *digits < '0' || *digits > '9' || strcmp(end, ".bin") != 0) continue;
+    snprintf(path, sizeof path, "%s/%s", dir, name);
+    unlink(path);
+  }
+  closedir(d);
+}
+
+/* Every frame file of a frames folder: VTUs, and a split run's .pvtu files and pieces. */
+static void remove_frames(const char *folder) {
+  DIR *d = opendir(folder);
+  if (!d) return;
+  char path[8192];
+  for (struct dirent *e; (e = readdir(d));)
+    if (piola__frame_file_number(e->d_name) >= 0) {
+      snprintf(path, sizeof path, "%s/%s", folder, e->d_name);
+      unlink(path);
+    }
+  closedir(d);
+}
+
 piola_status piola__output_prepare_folder(const char *dir, bool force) {
   PIOLA_TRY(piola_output_check_folder(dir, force));
   char path[4096];
   PIOLA_TRY(make_folders(dir));
   snprintf(path, sizeof path, "%s/frames", dir);
   PIOLA_TRY(make_folder(path));
-  if (force) remove_matching(path, "frame_", ".vtu");
+  if (force) remove_frames(path);
   snprintf(path, sizeof path, "%s/surface", dir);
   PIOLA_TRY(make_folder(path));
   if (force) {
     remove_matching(path, "frame_", ".obj");
     remove_matching(dir, "checkpoint_", ".bin");
+    remove_matching(dir, "checkpoint_", ".manifest"); /* a split run's (docs/mpi.md) */
+    remove_split_checkpoints(dir);
     piola__output_remove_strays(dir, -1);
     static const char *const files[] = {"stats.csv", "sim.pvd", "failure_report.txt", "warnings.txt"};
     for (int i = 0; i < 4; ++i) {

@@ -41,13 +41,27 @@ static long frame_number(const char *name, const char *ext) {
   return k;
 }
 
+long piola__frame_file_number(const char *name) {
+  long k = frame_number(name, ".vtu");
+  if (k < 0) k = frame_number(name, ".pvtu");
+  if (k >= 0 || strncmp(name, "frame_", 6) != 0) return k;
+  /* a split run's piece, frame_NNNN_pK.vtu */
+  char *end;
+  k = strtol(name + 6, &end, 10);
+  if (end == name + 6 || k < 0 || strncmp(end, "_p", 2) != 0) return -1;
+  const char *digits = end + 2;
+  (void)strtol(digits, &end, 10);
+  return end != digits && *digits >= '0' && *digits <= '9' && strcmp(end, ".vtu") == 0 ? k : -1;
+}
+
 /* Removes strays in folder, and with drop_after >= 0 the frames numbered above it. */
 static void clean_folder(const char *folder, long drop_after, const char *ext) {
   DIR *d = opendir(folder);
   if (!d) return;
   char path[4200];
   for (struct dirent *e; (e = readdir(d));) {
-    long k = ext ? frame_number(e->d_name, ext) : -1;
+    long k = !ext ? -1 : strcmp(ext, ".vtu") == 0 ? piola__frame_file_number(e->d_name)
+                                                   : frame_number(e->d_name, ext);
     if (is_stray(e->d_name) || (drop_after >= 0 && k > drop_after)) {
       snprintf(path, sizeof path, "%s/%s", folder, e->d_name);
       unlink(path);
@@ -65,15 +79,19 @@ void piola__output_remove_strays(const char *dir, long drop_after) {
   clean_folder(path, drop_after, ".obj");
 }
 
-piola_status piola__output_reconcile(const char *dir, int32_t last_frame, char **rows,
-                                     size_t *length) {
+piola_status piola__output_reconcile(const char *dir, int32_t last_frame, int32_t piece_count,
+                                     char **rows, size_t *length) {
   *rows = NULL;
   *length = 0;
   char path[4200];
   struct stat st;
   for (int32_t k = 0; k <= last_frame; ++k) {
-    snprintf(path, sizeof path, "%s/frames/frame_%04d.vtu", dir, (int)k);
+    snprintf(path, sizeof path, "%s/frames/frame_%04d.%s", dir, (int)k, piece_count > 0 ? "pvtu" : "vtu");
     int vtu = stat(path, &st) == 0 && S_ISREG(st.st_mode);
+    for (int32_t p = 0; vtu && p < piece_count; ++p) {
+      piola__piece_name(path, sizeof path, dir, k, p);
+      vtu = stat(path, &st) == 0 && S_ISREG(st.st_mode);
+    }
     snprintf(path, sizeof path, "%s/surface/frame_%04d.obj", dir, (int)k);
     if (!vtu || stat(path, &st) != 0 || !S_ISREG(st.st_mode))
       return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT,

@@ -121,26 +121,32 @@ static int take(stream *s, void *p, size_t n, const char *what) {
   return 1;
 }
 
-/* One array of count elements of size bytes: its count, then the bytes. */
-static void field(stream *s, void *p, uint64_t count, size_t size, const char *what) {
+/* An array's element count: written, or read and checked against count (1 when it fits). */
+static int count_of(stream *s, uint64_t count, const char *what) {
   if (!s->reading) {
     put(s, &count, sizeof count);
-    if (count) put(s, p, (size_t)count * size);
-    return;
+    return !s->failed;
   }
   uint64_t stored;
   int store = s->store;
   s->store = 1; /* the count is always read */
   int ok = take(s, &stored, sizeof stored, what);
   s->store = store;
-  if (!ok) return;
+  if (!ok) return 0;
   if (stored != count) {
     s->failed = 1;
     snprintf(s->what, sizeof s->what, "%s: %llu values, this scene has %llu", what,
              (unsigned long long)stored, (unsigned long long)count);
-    return;
+    return 0;
   }
-  if (count) take(s, p, (size_t)count * size, what);
+  return 1;
+}
+
+/* One array of count elements of size bytes: its count, then the bytes. */
+static void field(stream *s, void *p, uint64_t count, size_t size, const char *what) {
+  if (!count_of(s, count, what) || !count) return;
+  if (s->reading) take(s, p, (size_t)count * size, what);
+  else put(s, p, (size_t)count * size);
 }
 
 static void doubles(stream *s, double *p, uint64_t n, const char *what) {
@@ -269,16 +275,42 @@ static void fracture_state(stream *s, piola_world *w, world_body *b) {
 }
 
 
+/* A per-tet array of a body split in the local mode (piola/work_split.h): the runs of `run`
+ * doubles of the blocks this process holds (held[b]), its own and ghost blocks, the only
+ * ones it computes and reads; the other blocks' memory is never touched. */
+static void held_doubles(stream *s, const uint8_t *held, double *base, uint64_t blocks,
+                         uint64_t run, const char *what) {
+  uint64_t count = 0;
+  for (uint64_t b = 0; b < blocks; ++b) count += held[b] ? run : 0;
+  if (!count_of(s, count, what)) return;
+  for (uint64_t b = 0; b < blocks && !s->failed; ++b) {
+    if (!held[b]) continue;
+    if (s->reading) take(s, base + b * run, (size_t)run * sizeof(double), what);
+    else put(s, base + b * run, (size_t)run * sizeof(double));
+  }
+}
+
 static void elastic_state(stream *s, world_body *b) {
   piola_elastic_body *e = b->solid;
   const uint64_t np = (uint64_t)e->padded_tet_count, n3 = 3 * (uint64_t)b->n;
   doubles(s, b->force, n3, "elastic force");
-  doubles(s, e->u[0], 9 * np, "U");
-  doubles(s, e->v[0], 9 * np, "V");
-  doubles(s, e->fhat, 3 * np, "Fhat");
-  doubles(s, e->det_f, np, "det F");
+  const uint8_t *held = piola__local_split(e) ? e->split_held : NULL;
+  const uint64_t blocks = np / PIOLA_WORK_SPLIT_BLOCK, B = PIOLA_WORK_SPLIT_BLOCK;
+  if (held) { /* a process of a split run (docs/mpi.md, "Checkpoints") */
+    for (int k = 0; k < 9; ++k) held_doubles(s, held, e->u[0] + (uint64_t)k * np, blocks, B, "U");
+    for (int k = 0; k < 9; ++k) held_doubles(s, held, e->v[0] + (uint64_t)k * np, blocks, B, "V");
+    held_doubles(s, held, e->fhat, blocks, 3 * B, "Fhat");
+    held_doubles(s, held, e->det_f, blocks, B, "det F");
+  } else {
+    doubles(s, e->u[0], 9 * np, "U");
+    doubles(s, e->v[0], 9 * np, "V");
+    doubles(s, e->fhat, 3 * np, "Fhat");
+    doubles(s, e->det_f, np, "det F");
+  }
   doubles(s, e->positions, 3 * (uint64_t)e->vertex_count, "update positions");
-  for (int k = 0; k < 9; ++k) doubles(s, e->dm_inv[k], np, "effective Dm^-1");
+  for (int k = 0; k < 9; ++k)
+    if (held) held_doubles(s, held, e->dm_inv[k], blocks, B, "effective Dm^-1");
+    else doubles(s, e->dm_inv[k], np, "effective Dm^-1");
   one_double(s, &e->activation, "activation");
   one_double(s, &e->last_stiffness_scale, "stiffness scale");
   one_double(s, &b->quasistatic_mu, "quasistatic regularization");
@@ -291,14 +323,14 @@ static void elastic_state(stream *s, world_body *b) {
   local_int(s, &ready, "damping ready");
   double visc[2] = {m->shear_viscosity, m->bulk_viscosity};
   local_doubles(s, visc, 2, "damping viscosities");
-  const uint64_t blocks = ready ? 9 * (uint64_t)m->edge_count : 0;
+  const uint64_t edge_values = ready ? 9 * (uint64_t)m->edge_count : 0;
   double *saved = NULL;
-  if (s->reading && s->store && blocks && !(saved = malloc((size_t)blocks * sizeof(double)))) {
+  if (s->reading && s->store && edge_values && !(saved = malloc((size_t)edge_values * sizeof(double)))) {
     s->failed = 1;
     snprintf(s->what, sizeof s->what, "out of memory");
     return;
   }
-  doubles(s, s->reading ? saved : m->blocks, blocks, "damping blocks");
+  doubles(s, s->reading ? saved : m->blocks, edge_values, "damping blocks");
   int32_t product = b->product_valid && ready && b->product_generation == m->generation;
   local_int(s, &product, "product valid");
   one_double(s, &b->product_h, "product h");
@@ -313,7 +345,7 @@ static void elastic_state(stream *s, world_body *b) {
     if (ready) {
       /* allocate and assemble (the structure), then put back the saved blocks */
       piola__elastic_body_damping_prepare(e, visc[0], visc[1]);
-      memcpy(m->blocks, saved, (size_t)blocks * sizeof(double));
+      memcpy(m->blocks, saved, (size_t)edge_values * sizeof(double));
     }
     b->product_valid = product;
     if (product) b->product_generation = m->generation;
@@ -475,6 +507,17 @@ static void world_state(stream *s, piola_world *w) {
 
 /* ------------------------------------------------------------------ files */
 
+/* Header word 44: 0 for a single process's checkpoint; for a process of a split run
+ * (docs/mpi.md) its process count << 16 | its process, from the first split solid. */
+static uint32_t split_tag(const piola_world *w) {
+  for (int32_t i = 0; i < w->body_count; ++i) {
+    const world_body *b = &w->bodies[i];
+    if (b->kind != PIOLA_BODY_SOLID || !b->solid->split || b->solid->split->part_count < 2) continue;
+    return (uint32_t)b->solid->split->part_count << 16 | (uint32_t)b->solid->split->part;
+  }
+  return 0;
+}
+
 static void put_u32(unsigned char *p, uint32_t v) { memcpy(p, &v, 4); }
 static void put_u64(unsigned char *p, uint64_t v) { memcpy(p, &v, 8); }
 static uint32_t get_u32(const unsigned char *p) {
@@ -511,7 +554,7 @@ piola_status piola_world_checkpoint_write(const piola_world *world, const char *
   put_u32(h + 28, (uint32_t)(world->body_count));
   put_u64(h + 32, (uint64_t)(s.length - HEADER_BYTES));
   put_u32(h + 40, (uint32_t)(world->obstacle_count));
-  put_u32(h + 44, 0);
+  put_u32(h + 44, split_tag(world));
   uint64_t sum = fnv1a(FNV_OFFSET, s.data, s.length);
   put(&s, &sum, sizeof sum);
   if (s.failed) {
@@ -597,6 +640,12 @@ piola_status piola_world_checkpoint_read(piola_world *world, const char *path, u
                     "%s was written for another scene (its scene file or meshes differ: key "
                     "%016llx, this scene's %016llx)",
                     path, (unsigned long long)get_u64(h + 16), (unsigned long long)scene_key);
+  else if (get_u32(h + 44) != split_tag(world))
+    st = PIOLA_FAIL(PIOLA_ERROR_UNSUPPORTED, "%s was written by process %u of %u, this is process %u of %u "
+                    "(1 of 1: a single process)", path, (unsigned)(get_u32(h + 44) & 0xffff) + 1,
+                    get_u32(h + 44) ? (unsigned)(get_u32(h + 44) >> 16) : 1u,
+                    (unsigned)(split_tag(world) & 0xffff) + 1,
+                    split_tag(world) ? (unsigned)(split_tag(world) >> 16) : 1u);
   else if ((int32_t)get_u32(h + 28) != world->body_count ||
            (int32_t)get_u32(h + 40) != world->obstacle_count)
     st = PIOLA_FAIL(PIOLA_ERROR_UNSUPPORTED, "%s: body or obstacle counts differ from this scene",

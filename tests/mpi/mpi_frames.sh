@@ -4,9 +4,10 @@
 # usage: mpi_frames.sh PIOLA EXAMPLES_DIR EXAMPLE:FRAMES...
 # For each example, runs FRAMES frames (at least 100 steps, checked from stats.csv) without
 # mpirun, then with 1, 2 and 4 processes (oversubscribed: this machine has 2 cores). With
-# 1 process the frames must be bit-identical (the world is not split); with 2 and 4 the
-# positions must equal the single process's to 1e-9 relative (compare_frames.py), stats.csv
-# must have the same columns and frames, and only process 0 writes.
+# 1 process the frames must be bit-identical (the world is not split); with 2 and 4 each
+# frame is a .pvtu of one piece per process, which merged (compare_frames.py reads it with
+# VTK and the pieces with meshio) must be the single process's frame with positions equal
+# to 1e-9 relative; stats.csv must have the same columns and frames.
 set -euo pipefail
 piola=$1 examples=$2
 shift 2
@@ -47,7 +48,7 @@ for item in "$@"; do
     if ! diff <(cut -d, -f1-3 "$single/stats.csv") <(cut -d, -f1-3 "$out/stats.csv") >/dev/null; then
       echo "FAIL $ex -np $np: stats.csv frames, times or substeps differ"; fail=1
     fi
-    if result=$(/usr/bin/python3 "$here/compare_frames.py" "$single" "$out" 1e-9); then
+    if result=$(/usr/bin/python3 "$here/compare_frames.py" "$single" "$out" 1e-9 "$np"); then
       echo "ok $ex -np $np: $steps steps, $result"
     else
       echo "FAIL $ex -np $np: $result"; fail=1

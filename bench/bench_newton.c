@@ -22,6 +22,7 @@
  * usage: bench_newton [frames=3] [newmark_steps=20] [mesh] [E] [nu] [threads=2]
  *                     [preconditioner=block_jacobi|incomplete_cholesky]
  *                     [forcing=eisenstat_walker|fixed] [reference=0|1]
+ *                     [newton_tolerance=1e-5 (the default of integrator.newton_tolerance)]
  * (block_jacobi fixed is the solver as it was before issue 14's preconditioner and forcing
  * work; "one Newton iteration" is the issue's target only with fixed forcing, where every
  * CG runs to linear_tolerance = 1e-3.) */
@@ -38,6 +39,7 @@
 
 static piola_preconditioner_type preconditioner = PIOLA_PRECONDITIONER_BLOCK_JACOBI;
 static piola_linear_forcing forcing = PIOLA_FORCING_EISENSTAT_WALKER;
+static double newton_tolerance = 0; /* 0: the default */
 
 static piola_world *make_world(const piola_tet_mesh *mesh, piola_integrator_type type, double e,
                                double nu, double zmin) {
@@ -48,6 +50,7 @@ static piola_world *make_world(const piola_tet_mesh *mesh, piola_integrator_type
   wd.cfl = 0.5;
   wd.preconditioner = preconditioner;
   wd.linear_forcing = forcing;
+  if (newton_tolerance > 0) wd.newton_tolerance = newton_tolerance;
   piola_world *w = NULL;
   if (piola_world_create(&wd, &w) != PIOLA_OK) return NULL;
   piola_solid_def sd = piola_default_solid_def();
@@ -83,6 +86,7 @@ int main(int argc, char **argv) {
     return 2;
   }
   const int reference = argc > 9 && atoi(argv[9]) != 0;
+  if (argc > 10) newton_tolerance = atof(argv[10]);
   if (frames < 1) frames = 1;
   if (newmark_steps < 1) newmark_steps = 1;
   piola_set_thread_count(threads);

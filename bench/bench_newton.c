@@ -13,9 +13,16 @@
  * figure). Newmark: the CFL step of the same scene and the median wall time of a step over
  * `newmark_steps` steps, so the time of one frame is steps per frame times that.
  *
+ * With reference = 1 (issue 14's "speed-up at equal visual result"), Newmark instead runs
+ * all `frames` frames at its CFL step, the explicit reference (the tiny step it needs
+ * anyway), timed in process CPU; printed: the largest distance between a node of the two
+ * final shapes as a fraction of the diagonal of the reference shape's bounding box ("equal
+ * visual result": below 1%), and the CPU-time ratio of the two runs.
+ *
  * usage: bench_newton [frames=3] [newmark_steps=20] [mesh] [E] [nu] [threads=2]
  *                     [preconditioner=block_jacobi|incomplete_cholesky]
- *                     [forcing=eisenstat_walker|fixed]
+ *                     [forcing=eisenstat_walker|fixed] [reference=0|1]
+ *                     [newton_tolerance=1e-5 (the default of integrator.newton_tolerance)]
  * (block_jacobi fixed is the solver as it was before issue 14's preconditioner and forcing
  * work; "one Newton iteration" is the issue's target only with fixed forcing, where every
  * CG runs to linear_tolerance = 1e-3.) */
@@ -32,6 +39,7 @@
 
 static piola_preconditioner_type preconditioner = PIOLA_PRECONDITIONER_BLOCK_JACOBI;
 static piola_linear_forcing forcing = PIOLA_FORCING_EISENSTAT_WALKER;
+static double newton_tolerance = 0; /* 0: the default */
 
 static piola_world *make_world(const piola_tet_mesh *mesh, piola_integrator_type type, double e,
                                double nu, double zmin) {
@@ -42,6 +50,7 @@ static piola_world *make_world(const piola_tet_mesh *mesh, piola_integrator_type
   wd.cfl = 0.5;
   wd.preconditioner = preconditioner;
   wd.linear_forcing = forcing;
+  if (newton_tolerance > 0) wd.newton_tolerance = newton_tolerance;
   piola_world *w = NULL;
   if (piola_world_create(&wd, &w) != PIOLA_OK) return NULL;
   piola_solid_def sd = piola_default_solid_def();
@@ -76,6 +85,8 @@ int main(int argc, char **argv) {
     fprintf(stderr, "bench_newton: unknown linear forcing '%s'\n", argv[8]);
     return 2;
   }
+  const int reference = argc > 9 && atoi(argv[9]) != 0;
+  if (argc > 10) newton_tolerance = atof(argv[10]);
   if (frames < 1) frames = 1;
   if (newmark_steps < 1) newmark_steps = 1;
   piola_set_thread_count(threads);
@@ -129,10 +140,55 @@ int main(int argc, char **argv) {
   double be_assemble = bench_median(assemble_ms, frames), be_solve = bench_median(solve_ms, frames);
   double be_iter_cpu = bench_median(iter_cpu_ms, frames);
   double be_frame_cpu = bench_median(frame_cpu_ms, frames);
+  double be_total_cpu = 0;
+  for (int f = 0; f < frames; ++f) be_total_cpu += frame_cpu_ms[f];
+  const size_t v3 = sizeof(double) * 3 * (size_t)mesh.vertex_count;
+  double *be_final = malloc(v3);
+  memcpy(be_final, piola_world_solid_positions(w, 0), v3);
   piola_world_destroy(w);
 
   w = make_world(&mesh, PIOLA_INTEGRATOR_NEWMARK, e, nu, zmin);
   const double dt = piola_world_stable_dt(w);
+  if (reference) {
+    long steps = 0;
+    const double c0 = bench_cpu_seconds();
+    for (int f = 1; f <= frames; ++f) {
+      piola_step_stats st;
+      memset(&st, 0, sizeof st);
+      if (piola_world_advance_to(w, f / 30.0, &st) != PIOLA_OK) {
+        fprintf(stderr, "bench_newton: newmark frame %d: %s\n", f, piola_last_error());
+        return 1;
+      }
+      steps += st.substeps;
+    }
+    const double nm_cpu = bench_cpu_seconds() - c0;
+    const double *x = piola_world_solid_positions(w, 0);
+    double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+    double worst = 0;
+    for (int32_t i = 0; i < mesh.vertex_count; ++i) {
+      double d2 = 0;
+      for (int k = 0; k < 3; ++k) {
+        const double r = x[3 * i + k], d = be_final[3 * i + k] - r;
+        lo[k] = fmin(lo[k], r), hi[k] = fmax(hi[k], r), d2 += d * d;
+      }
+      worst = fmax(worst, sqrt(d2));
+    }
+    const double diagonal = sqrt((hi[0] - lo[0]) * (hi[0] - lo[0]) +
+                                 (hi[1] - lo[1]) * (hi[1] - lo[1]) +
+                                 (hi[2] - lo[2]) * (hi[2] - lo[2]));
+    printf("backward Euler: %d frames in %.2f s process CPU\n", frames, be_total_cpu / 1e3);
+    printf("Newmark reference: %ld steps (dt %.3g s) in %.2f s process CPU\n", steps, dt, nm_cpu);
+    printf("final shapes: largest node distance %.3g m = %.3g%% of the bounding-box diagonal "
+           "(%.3g m)\n",
+           worst, 100 * worst / diagonal, diagonal);
+    printf("speed-up (process CPU, Newmark reference / backward Euler): %.1f\n",
+           nm_cpu / (be_total_cpu / 1e3));
+    piola_world_destroy(w);
+    free(be_final), free(frame_ms), free(iter_ms), free(assemble_ms), free(solve_ms);
+    free(iter_cpu_ms), free(frame_cpu_ms);
+    free(mesh.positions), free(mesh.tets), free(mesh.tet_regions);
+    return 0;
+  }
   double *step_ms = malloc(sizeof(double) * (size_t)newmark_steps);
   for (int s = 0; s < newmark_steps; ++s) {
     double t0 = bench_wall_seconds();
@@ -156,7 +212,7 @@ int main(int argc, char **argv) {
          dt, steps_per_frame, nm_step, newmark_steps, steps_per_frame * nm_step);
   printf("speed-up per frame: %.1f\n", steps_per_frame * nm_step / be_frame);
   free(frame_ms), free(iter_ms), free(assemble_ms), free(solve_ms), free(iter_cpu_ms);
-  free(frame_cpu_ms);
+  free(frame_cpu_ms), free(be_final);
   free(step_ms);
   free(mesh.positions), free(mesh.tets), free(mesh.tet_regions);
   return 0;

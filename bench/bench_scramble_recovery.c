@@ -20,7 +20,11 @@
  *        of that model or inversion mode)
  *        bench_scramble_recovery seeds model mode|default threshold|default
  *                                one configuration ("default": the model's default) and the
- *                                seeds it does not recover, e.g. "... 160 ogden energy 0.5" */
+ *                                seeds it does not recover, e.g. "... 160 ogden energy 0.5"
+ *        bench_scramble_recovery seeds model mode threshold seconds high j_low j_high levels
+ *                                the same, the threshold raised towards `high` as J falls
+ *                                from j_high to j_low (recovery_threshold_by_volume: an
+ *                                experiment, docs/materials.md "Defaults that recover") */
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -69,12 +73,15 @@ int main(int argc, char **argv) {
   piola_set_thread_count(1);
   piola_tet_mesh mesh;
   if (recovery_grid(&mesh) != 0) return 1;
-  if (argc == 6) recovery_scramble_seconds = atof(argv[5]);
+  if (argc == 6 || argc == 10) recovery_scramble_seconds = atof(argv[5]);
+  if (argc == 10)
+    recovery_threshold_by_volume = (recovery_volume_threshold){atoi(argv[9]), atof(argv[6]),
+                                                               atof(argv[7]), atof(argv[8])};
   printf("scrambled 3x3x3 grid (%d tets), seeds %d..%d, %g s each\n", (int)mesh.tet_count, first,
          seeds, recovery_scramble_seconds);
   printf("| model | extension | threshold | recovered | slow | stuck (model) | stuck (extension) | diverged | wall s |\n");
   printf("|---|---|---|---|---|---|---|---|---|\n");
-  if (argc == 5 || argc == 6) { /* one configuration from the command line */
+  if (argc == 5 || argc == 6 || argc == 10) { /* one configuration from the command line */
     piola_material_model model;
     if (!piola_material_model_from_name(argv[2], &model)) {
       fprintf(stderr, "bench_scramble_recovery: unknown model '%s'\n", argv[2]);

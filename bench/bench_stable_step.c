@@ -8,7 +8,10 @@
  * for the models named (default: neohookean, corotated, stable_neohookean, ogden). Per model and thread count (1, 2) the update
  * (piola_elastic_body_update, forces only) and the bound pass are timed interleaved, one of
  * each per repeat; the medians (default 15 repeats) and their ratio are printed. The bound
- * reads the Fhat the update stored, so each pass follows an update as in a step. */
+ * reads the Fhat the update stored, so each pass follows an update as in a step. Medians of
+ * wall time and of process CPU time (the latter less disturbed on a loaded machine). Ogden
+ * and Mooney-Rivlin run two bodies, interleaved: with the force loop's cache of their powers
+ * (what the simulator does) and without it (the bound computing them again). */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -19,6 +22,22 @@
 #include "piola/mesh_io.h"
 #include "support/bench_support.h"
 
+/* For the Ogden models a second body without the force loop's cache (its update writes no
+ * slots and its bound computes the powers again: the cost before the cache), timed
+ * interleaved with the first, one update and one bound of each per repeat. */
+static piola_elastic_body *make_body(const piola_tet_mesh *mesh, const piola_material *material) {
+  piola_elastic_body *body = NULL;
+  piola_elastic_body_def def = piola_default_elastic_body_def();
+  def.rest_mesh = mesh;
+  def.materials = material;
+  def.material_count = 1;
+  if (piola_elastic_body_create(&def, &body) != PIOLA_OK) {
+    fprintf(stderr, "bench_stable_step: %s\n", piola_last_error());
+    exit(1);
+  }
+  return body;
+}
+
 static void bench_model(const char *name, const piola_tet_mesh *mesh, piola_material_model model,
                         int repeats) {
   piola_material_def md = piola_default_material_def();
@@ -27,41 +46,52 @@ static void bench_model(const char *name, const piola_tet_mesh *mesh, piola_mate
   md.inversion_mode = PIOLA_INVERSION_LINEAR;
   md.inversion_threshold = 0.3;
   piola_material material;
-  piola_elastic_body *body = NULL;
-  piola_elastic_body_def def = piola_default_elastic_body_def();
-  def.rest_mesh = mesh;
-  def.materials = &material;
-  def.material_count = 1;
-  if (piola_material_init(&md, &material) != PIOLA_OK || piola_elastic_body_create(&def, &body) != PIOLA_OK) {
+  if (piola_material_init(&md, &material) != PIOLA_OK) {
     fprintf(stderr, "bench_stable_step: %s\n", piola_last_error());
     exit(1);
+  }
+  piola_elastic_body *bodies[2] = {make_body(mesh, &material), NULL};
+  const int variants = bodies[0]->ogden_cache ? 2 : 1;
+  if (variants == 2) {
+    bodies[1] = make_body(mesh, &material);
+    free(bodies[1]->ogden_cache);
+    bodies[1]->ogden_cache = NULL;
   }
   const int32_t nv = mesh->vertex_count;
   double *x = malloc(sizeof(double) * 3 * (size_t)nv), *f = malloc(sizeof(double) * 3 * (size_t)nv);
   double a[3] = {1 + bench_uniform(-0.3, 0.3), 1 + bench_uniform(-0.3, 0.3), 1 + bench_uniform(-0.3, 0.3)};
-  const double noise = 0.05 * piola_elastic_body_min_rest_altitude(body) * 3;
+  const double noise = 0.05 * piola_elastic_body_min_rest_altitude(bodies[0]) * 3;
   for (int32_t i = 0; i < nv; ++i)
     for (int k = 0; k < 3; ++k) x[3 * i + k] = a[k] * mesh->positions[3 * i + k] + noise * bench_uniform(-1, 1);
-  double *tu = malloc(sizeof(double) * (size_t)repeats), *tb = malloc(sizeof(double) * (size_t)repeats);
+  double *t[2][4]; /* per variant: update wall, bound wall, update CPU, bound CPU */
+  for (int b = 0; b < 2; ++b)
+    for (int k = 0; k < 4; ++k) t[b][k] = malloc(sizeof(double) * (size_t)repeats);
   for (int threads = 1; threads <= 2; ++threads) {
     piola_set_thread_count(threads);
     double sink = 0;
-    for (int r = -1; r < repeats; ++r) { /* r = -1 warms up (and builds the weights) */
-      double t0 = bench_wall_seconds();
-      piola_elastic_body_update(body, x, 1.0, f, NULL);
-      double t1 = bench_wall_seconds();
-      sink += piola__elastic_body_state_rate2(body, NULL);
-      double t2 = bench_wall_seconds();
-      if (r >= 0) tu[r] = t1 - t0, tb[r] = t2 - t1;
+    for (int r = -1; r < repeats; ++r) /* r = -1 warms up (and builds the weights) */
+      for (int b = 0; b < variants; ++b) {
+        double c0 = bench_cpu_seconds(), t0 = bench_wall_seconds();
+        piola_elastic_body_update(bodies[b], x, 1.0, f, NULL);
+        double c1 = bench_cpu_seconds(), t1 = bench_wall_seconds();
+        sink += piola__elastic_body_state_rate2(bodies[b], NULL);
+        double c2 = bench_cpu_seconds(), t2 = bench_wall_seconds();
+        if (r >= 0) t[b][0][r] = t1 - t0, t[b][1][r] = t2 - t1, t[b][2][r] = c1 - c0, t[b][3][r] = c2 - c1;
+      }
+    for (int b = 0; b < variants; ++b) {
+      double m[4];
+      for (int k = 0; k < 4; ++k) m[k] = bench_median(t[b][k], repeats);
+      printf("| %-16s | %-17s%s | %7d | %d | %8.3f | %8.3f | %5.1f%% | %5.1f%% | (%g)\n", name,
+             piola_material_model_name(model), b ? " (no cache)" : variants == 2 ? " (cache)" : "",
+             (int)mesh->tet_count, threads, 1e3 * m[0], 1e3 * m[1], 100 * m[1] / m[0],
+             100 * m[3] / m[2], sink > 0 ? 1.0 : 0.0);
     }
-    double mu = bench_median(tu, repeats), mb = bench_median(tb, repeats);
-    printf("| %-16s | %-10s | %7d | %d | %8.3f | %8.3f | %5.1f%% | (%g)\n", name,
-           piola_material_model_name(model), (int)mesh->tet_count, threads, 1e3 * mu, 1e3 * mb,
-           100 * mb / mu, sink > 0 ? 1.0 : 0.0);
   }
   piola_set_thread_count(0);
-  free(tu), free(tb), free(x), free(f);
-  piola_elastic_body_destroy(body);
+  for (int b = 0; b < 2; ++b)
+    for (int k = 0; k < 4; ++k) free(t[b][k]);
+  free(x), free(f);
+  for (int b = 0; b < variants; ++b) piola_elastic_body_destroy(bodies[b]);
 }
 
 int main(int argc, char **argv) {
@@ -76,7 +106,7 @@ int main(int argc, char **argv) {
       return 1;
     }
   }
-  printf("| mesh             | model      |    tets | threads | update ms | bound ms | bound/update |\n");
+  printf("| mesh             | model             |    tets | threads | update ms | bound ms | bound/update (wall) | (process CPU) |\n");
   static const char *const defaults[] = {"neohookean", "corotated", "stable_neohookean", "ogden"};
   const int named = argc > 2 ? argc - 2 : 4;
   for (int k = 0; k < named; ++k) {

@@ -3,7 +3,8 @@
  *   - from a sample of the scrambles of bench/bench_scramble_recovery's grid (the seeds the
  *     measured table says the default recovers: `stuck_seeds` lists its misses), with the
  *     bench's own protocol (tests/support/recovery_runs.c;
- *     HGO is not in the scramble sample: its fibres make the grid's runs too long for a test);
+ *     HGO is not in the scramble sample: under the protocol's step, half the state-aware bound,
+ *     its scrambles diverge, docs/materials.md "Defaults that recover");
  *   - from collapse to a point, a line and a plane of a real mesh (gmsh/msh_tetra.msh of
  *     ../shared/data, 127 tets).
  * And the test can fail: neo-Hookean with the old default (LINEAR at 0.3) stays tangled on a

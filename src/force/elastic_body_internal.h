@@ -98,6 +98,9 @@ struct piola_elastic_body {
 
   double *step_weight;      /* per tet 1 / (rho h_e^2), m/kg: the step bound's geometric factor
                                (stable_step.c), built on first use */
+  double *ogden_cache;      /* Ogden and Mooney-Rivlin bodies of one material: the step bound's
+                               slots, OGDEN_CACHE_SLOTS * padded_tet_count (material_kernels.h),
+                               written by the force loop; NULL for the other bodies */
 
   double *chunk_forces; /* PIOLA_FORCE_CHUNKS * 3 * vertex_count partial sums of the force loop */
 

@@ -102,7 +102,17 @@
         return;                                                                            \
       case PIOLA_MODEL_SPLINE: PIOLA_MATERIAL_LANE_LOOP(spline_stress_lanes, lanes); return;      \
       case PIOLA_MODEL_MOONEY_RIVLIN:                                                      \
-      case PIOLA_MODEL_OGDEN: PIOLA_MATERIAL_LANE_LOOP(ogden_stress_lanes, lanes); return;         \
+      case PIOLA_MODEL_OGDEN:                                                              \
+        if (body->ogden_cache) { /* the step bound's powers (material_kernels.h) */        \
+          double *cache_ = body->ogden_cache + base;                                       \
+          const long stride_ = body->padded_tet_count;                                     \
+          _Pragma("omp simd") for (int l = 0; l < (lanes); ++l)                            \
+              ogden_stress_cached_lanes(m, fhat[0][l], fhat[1][l], fhat[2][l], &phat[0][l], \
+                                        &phat[1][l], &phat[2][l], cache_ + l, stride_);    \
+          return;                                                                          \
+        }                                                                                  \
+        PIOLA_MATERIAL_LANE_LOOP(ogden_stress_lanes, lanes);                               \
+        return;                                                                            \
       case PIOLA_MODEL_ROTATED_LINEAR:                                                     \
       default: PIOLA_MATERIAL_LANE_LOOP(rotated_linear_stress_lanes, lanes); return;             \
     }                                                                                      \

@@ -8,6 +8,7 @@
 #include "common/status_report.h"
 #include "force/elastic_body_internal.h"
 #include "force/fiber_lanes.h"
+#include "material/material_kernels.h"
 #include "math/mat3.h"
 #include "mesh/element_input.h"
 
@@ -43,6 +44,7 @@ void piola__elastic_body_free_arrays(piola_elastic_body *body) {
   free(body->chunk_forces);
   piola__elastic_body_split_free(body);
   free(body->step_weight);
+  free(body->ogden_cache);
   piola__damping_matrix_free(&body->damping);
   for (int k = 0; k < 3; ++k) free(body->fiber[k]);
   free(body->fiber_aos);
@@ -182,6 +184,13 @@ piola_status piola__elastic_body_build_rest_state(piola_elastic_body *body,
   }
   /* padding tets: zero Dm^-1 and volume, all corners at vertex 0, the first material */
   for (int32_t t = nt; t < np; ++t) body->tet_material[t] = body->uniform_material >= 0 ? body->uniform_material : 0;
+  if (body->uniform_material >= 0) {
+    const piola_material *um = &body->materials[body->uniform_material];
+    /* calloc: pages stay unmapped until the force loop writes them (a local split's) */
+    if (MATERIAL_IS_OGDEN(um->model) && um->inversion_mode != PIOLA_INVERSION_ENERGY &&
+        !(body->ogden_cache = calloc(OGDEN_CACHE_SLOTS * (size_t)np, sizeof(double))))
+      return PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "elastic body with %d tets: out of memory", (int)nt);
+  }
   body->min_rest_altitude = min_altitude;
   PIOLA_TRY(piola__fiber_copy(body, def));
 

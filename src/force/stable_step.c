@@ -49,14 +49,17 @@ STABLE_STEP_KERNEL double pair_modulus(double c, double pi, double pj, double fi
 
 /* k of one tet of model MODEL with the stress extension of mode ENERGY (both compile-time
  * constants in the lane loops: 0 for the LINEAR and CLAMP stress extensions, 1 for
- * PIOLA_INVERSION_ENERGY). */
-STABLE_STEP_KERNEL double model_modulus(piola_material_model model, int energy,
-                                        const piola_material *m, double f0, double f1, double f2) {
+ * PIOLA_INVERSION_ENERGY); the model's parts at the clamped point are GIVEN (the Ogden
+ * models' cache) or, when it is NULL, computed. */
+STABLE_STEP_KERNEL double model_modulus_from(piola_material_model model, int energy,
+                                             const piola_material *m, double f0, double f1,
+                                             double f2, const material_parts *given) {
   const double c = m->threshold;
   const double fc0 = kernel_max(f0, c), fc1 = kernel_max(f1, c), fc2 = kernel_max(f2, c);
   const double d0 = f0 - fc0, d1 = f1 - fc1, d2 = f2 - fc2;
   material_parts pa;
-  material_model_parts(model, m, KERNEL_FAST_RECIPROCAL, fc0, fc1, fc2, &pa);
+  if (given) pa = *given;
+  else material_model_parts(model, m, KERNEL_FAST_RECIPROCAL, fc0, fc1, fc2, &pa);
   double p0, p1, p2, k0, k1, k2;
   double k01 = pa.k[0][1], k02 = pa.k[0][2], k12 = pa.k[1][2];
   if (energy) {
@@ -99,6 +102,11 @@ STABLE_STEP_KERNEL double model_modulus(piola_material_model model, int energy,
   /* muscle fibres: their tangent stiffness bound, as in the rest bound; HGO's exponential
    * fibres depend on their direction: hgo_tet_fiber_modulus, added by the callers */
   return k + (model == PIOLA_MODEL_HGO ? 0.0 : m->fiber_modulus);
+}
+
+STABLE_STEP_KERNEL double model_modulus(piola_material_model model, int energy,
+                                        const piola_material *m, double f0, double f1, double f2) {
+  return model_modulus_from(model, energy, m, f0, f1, f2, NULL);
 }
 
 /* HGO's fibre stiffness for a plane wave at Fhat f with the two families' unit directions
@@ -260,6 +268,46 @@ static double neohookean_range(piola_material_model model, int energy, const pio
   return best;
 }
 
+/* Ogden and Mooney-Rivlin (LINEAR or CLAMP) by blocks of PIOLA_TET_BLOCK: the parts at the
+ * clamped point from the force loop's cache when it holds every lane's Fhat (no pow here),
+ * else computed. */
+static double ogden_range(const piola_elastic_body *body, const piola_material *m,
+                          const double *f, const double *w, int32_t begin, int32_t end) {
+  const double *cache = body->ogden_cache, c = m->threshold;
+  const long stride = body->padded_tet_count;
+  double best = 0;
+  int32_t t = begin;
+  for (; t + PIOLA_TET_BLOCK <= end; t += PIOLA_TET_BLOCK) {
+    int held = 1;
+#pragma omp simd reduction(&:held)
+    for (int l = 0; l < PIOLA_TET_BLOCK; ++l)
+      held &= ogden_cache_holds(cache + t + l, stride, f[3 * (t + l)], f[3 * (t + l) + 1], f[3 * (t + l) + 2]);
+    if (held) {
+#pragma omp simd reduction(max:best)
+      for (int l = 0; l < PIOLA_TET_BLOCK; ++l) {
+        const double *fl = f + 3 * (t + l);
+        material_parts pa;
+        ogden_cached_parts(m, cache + t + l, stride, kernel_max(fl[0], c), kernel_max(fl[1], c),
+                           kernel_max(fl[2], c), &pa);
+        const double r = w[t + l] * model_modulus_from(PIOLA_MODEL_OGDEN, 0, m, fl[0], fl[1], fl[2], &pa);
+        best = r > best ? r : best;
+      }
+    } else {
+#pragma omp simd reduction(max:best)
+      for (int l = 0; l < PIOLA_TET_BLOCK; ++l) {
+        const double *fl = f + 3 * (t + l);
+        const double r = w[t + l] * model_modulus(PIOLA_MODEL_OGDEN, 0, m, fl[0], fl[1], fl[2]);
+        best = r > best ? r : best;
+      }
+    }
+  }
+  for (; t < end; ++t) {
+    const double r = w[t] * model_modulus(PIOLA_MODEL_OGDEN, 0, m, f[3 * t], f[3 * t + 1], f[3 * t + 2]);
+    best = r > best ? r : best;
+  }
+  return best;
+}
+
 #define MODEL_LANE_LOOP(model)                                                                  \
   _Pragma("omp simd reduction(max:best)") for (int32_t t = begin; t < end; ++t) {               \
     const double r = w[t] * model_modulus(model, energy, m, f[3 * t], f[3 * t + 1], f[3 * t + 2]); \
@@ -290,7 +338,9 @@ STABLE_STEP_KERNEL double uniform_range_rate2(const piola_elastic_body *body, in
     case PIOLA_MODEL_SPLINE: MODEL_LANE_LOOP(PIOLA_MODEL_SPLINE)
     case PIOLA_MODEL_STABLE_NEOHOOKEAN: MODEL_LANE_LOOP(PIOLA_MODEL_STABLE_NEOHOOKEAN)
     case PIOLA_MODEL_MOONEY_RIVLIN: /* stored as two Ogden terms */
-    case PIOLA_MODEL_OGDEN: MODEL_LANE_LOOP(PIOLA_MODEL_OGDEN)
+    case PIOLA_MODEL_OGDEN:
+      if (!energy && body->ogden_cache) return ogden_range(body, m, f, w, begin, end);
+      MODEL_LANE_LOOP(PIOLA_MODEL_OGDEN)
     case PIOLA_MODEL_ROTATED_LINEAR: MODEL_LANE_LOOP(PIOLA_MODEL_ROTATED_LINEAR)
     default: abort(); /* every model has its case (material_modulus) */
   }

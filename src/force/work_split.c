@@ -14,6 +14,7 @@
 
 #include "common/status_report.h"
 #include "force/elastic_body_internal.h"
+#include "material/material_kernels.h"
 
 #define B PIOLA_TET_BLOCK
 #define STATE_WIDTH (B * (9 + 9 + 3 + 1))
@@ -83,6 +84,10 @@ static int localize_state(piola_elastic_body *body) {
   }
   free(body->u[0]), free(body->v[0]), free(body->fhat), free(body->det_f);
   free(body->energy_density);
+  if (body->ogden_cache) { /* fresh too: only the held blocks' slots get written */
+    free(body->ogden_cache);
+    body->ogden_cache = calloc(OGDEN_CACHE_SLOTS * np, sizeof(double)); /* NULL: no cache */
+  }
   for (int k = 0; k < 9; ++k) {
     body->u[k] = u + (size_t)k * np;
     body->v[k] = v + (size_t)k * np;

@@ -747,6 +747,65 @@ MATERIAL_KERNEL void ogden_stress_lanes(const piola_material *m, double f0, doub
                                         double *p0, double *p1, double *p2) {
   material_extended_stress(PIOLA_MODEL_OGDEN, m, KERNEL_FAST_RECIPROCAL, f0, f1, f2, p0, p1, p2);
 }
+/* The Ogden models' step-bound cache (LINEAR and CLAMP). Their powers f^(alpha_p - 1) are
+ * most of an update, and the state-aware step bound (force/stable_step.c) needs the same
+ * ones: the force loop keeps, per tet, the Fhat it evaluated and the model's Phat and
+ * diagonal slopes at the clamped point, and the bound takes them from there instead of
+ * calling pow again. The couplings are lambda / (fc_i fc_j) (the ln J term; the separable
+ * part has none): three reciprocals, formed again. Structure of arrays, slot s of a tet at
+ * s * stride from its first. */
+enum {
+  OGDEN_CACHE_KEY = 0,   /* Fhat of the update that wrote the slots */
+  OGDEN_CACHE_P = 3,     /* Pa: Phat at the clamped point */
+  OGDEN_CACHE_K = 6,     /* Pa: dPhat_i/dFhat_i there */
+  OGDEN_CACHE_SLOTS = 9
+};
+
+/* ogden_stress_lanes, and the tet's cache slots written (cache points at its first slot). */
+MATERIAL_KERNEL void ogden_stress_cached_lanes(const piola_material *m, double f0, double f1,
+                                               double f2, double *p0, double *p1, double *p2,
+                                               double *cache, long stride) {
+  const double c = m->threshold;
+  const double fc0 = kernel_max(f0, c), fc1 = kernel_max(f1, c), fc2 = kernel_max(f2, c);
+  material_parts parts;
+  material_model_parts(PIOLA_MODEL_OGDEN, m, KERNEL_FAST_RECIPROCAL, fc0, fc1, fc2, &parts);
+  material_extend(m, KERNEL_FAST_RECIPROCAL, &parts, f0 - fc0, f1 - fc1, f2 - fc2, p0, p1, p2);
+  cache[(OGDEN_CACHE_KEY + 0) * stride] = f0;
+  cache[(OGDEN_CACHE_KEY + 1) * stride] = f1;
+  cache[(OGDEN_CACHE_KEY + 2) * stride] = f2;
+  cache[(OGDEN_CACHE_P + 0) * stride] = parts.p[0];
+  cache[(OGDEN_CACHE_P + 1) * stride] = parts.p[1];
+  cache[(OGDEN_CACHE_P + 2) * stride] = parts.p[2];
+  cache[(OGDEN_CACHE_K + 0) * stride] = parts.k[0][0];
+  cache[(OGDEN_CACHE_K + 1) * stride] = parts.k[1][1];
+  cache[(OGDEN_CACHE_K + 2) * stride] = parts.k[2][2];
+}
+
+/* 1 when the cache holds the parts of Fhat f: written by the update that stored f (a state
+ * moved in from another process, or never computed here, has another key; the zero key of a
+ * never-written slot never matches). */
+MATERIAL_KERNEL int ogden_cache_holds(const double *cache, long stride, double f0, double f1,
+                                      double f2) {
+  return (cache[OGDEN_CACHE_KEY * stride] == f0) & (cache[(OGDEN_CACHE_KEY + 1) * stride] == f1) &
+         (cache[(OGDEN_CACHE_KEY + 2) * stride] == f2) & ((f0 != 0.0) | (f1 != 0.0) | (f2 != 0.0));
+}
+
+/* The parts at the clamped point fc from the cache: what material_model_parts(OGDEN) gives
+ * there, without its powers. */
+MATERIAL_KERNEL void ogden_cached_parts(const piola_material *m, const double *cache, long stride,
+                                        double fc0, double fc1, double fc2, material_parts *out) {
+  const double i0 = kernel_recip_fast(fc0), i1 = kernel_recip_fast(fc1), i2 = kernel_recip_fast(fc2);
+  out->p[0] = cache[OGDEN_CACHE_P * stride];
+  out->p[1] = cache[(OGDEN_CACHE_P + 1) * stride];
+  out->p[2] = cache[(OGDEN_CACHE_P + 2) * stride];
+  out->k[0][0] = cache[OGDEN_CACHE_K * stride];
+  out->k[1][1] = cache[(OGDEN_CACHE_K + 1) * stride];
+  out->k[2][2] = cache[(OGDEN_CACHE_K + 2) * stride];
+  out->k[0][1] = out->k[1][0] = m->lambda * i0 * i1;
+  out->k[0][2] = out->k[2][0] = m->lambda * i0 * i2;
+  out->k[1][2] = out->k[2][1] = m->lambda * i1 * i2;
+}
+
 MATERIAL_KERNEL void stable_neohookean_stress_lanes(const piola_material *m, double f0, double f1,
                                                     double f2, double *p0, double *p1, double *p2) {
   material_extended_stress(PIOLA_MODEL_STABLE_NEOHOOKEAN, m, KERNEL_FAST_RECIPROCAL, f0, f1, f2, p0,

@@ -7,6 +7,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "force/elastic_body_internal.h"
 #include "force/stable_step.h"
 #include "piola/diagonalize.h"
 #include "piola/elastic_body.h"
@@ -57,11 +58,22 @@ static piola_elastic_body *make_body(const piola_tet_mesh *mesh, const piola_mat
   bd.rest_mesh = mesh;
   bd.materials = material;
   bd.material_count = 1;
+  const recovery_volume_threshold *vt = &recovery_threshold_by_volume;
+  piola_material steps[16];
+  if (vt->levels >= 2 && vt->levels <= 16) { /* the experiment's materials, by threshold */
+    for (int k = 0; k < vt->levels; ++k) {
+      steps[k] = *material;
+      steps[k].threshold = material->threshold + (vt->high - material->threshold) * k / (vt->levels - 1);
+    }
+    bd.materials = steps;
+    bd.material_count = vt->levels;
+  }
   bd.density = 1000;
   if (material->model == PIOLA_MODEL_MUSCLE || material->model == PIOLA_MODEL_HGO)
     bd.fiber_directions = fibers;
   piola_elastic_body *body = NULL;
   if (piola_elastic_body_create(&bd, &body) != PIOLA_OK) body = NULL;
+  if (body && bd.material_count > 1) body->uniform_material = -1; /* tet_material decides */
   free(fibers);
   return body;
 }
@@ -92,6 +104,18 @@ static recovery_result judge(piola_elastic_body *body, const piola_material *mat
 
 double recovery_scramble_seconds = 12.0;
 
+recovery_volume_threshold recovery_threshold_by_volume = {0, 0.5, 0.5, 0.9};
+
+/* The experiment's step of each tet for the next update, from this update's J. */
+static void choose_thresholds_by_volume(piola_elastic_body *body) {
+  const recovery_volume_threshold *vt = &recovery_threshold_by_volume;
+  if (vt->levels < 2 || vt->levels > 16) return;
+  for (int32_t t = 0; t < body->tet_count; ++t) {
+    const double u = (vt->j_high - body->det_f[t]) / (vt->j_high - vt->j_low);
+    body->tet_material[t] = (int32_t)(fmin(fmax(u, 0.0), 1.0) * (vt->levels - 1) + 0.5);
+  }
+}
+
 recovery_result recovery_scramble_run(const piola_tet_mesh *mesh, const piola_material *material,
                                       int seed) {
   piola_elastic_body *body = make_body(mesh, material);
@@ -119,6 +143,7 @@ recovery_result recovery_scramble_run(const piola_tet_mesh *mesh, const piola_ma
     for (int k = 0; adaptive ? t < recovery_scramble_seconds : k < steps; ++k) {
       finite = piola_elastic_body_update(body, x, 1.0, fe, NULL) == PIOLA_OK;
       if (!finite) break;
+      choose_thresholds_by_volume(body);
       const double step =
           adaptive ? fmin(dt, 0.5 / sqrt(piola__elastic_body_state_rate2(body, NULL))) : dt;
       t += step;

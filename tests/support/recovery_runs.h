@@ -42,6 +42,18 @@ int recovery_grid(piola_tet_mesh *mesh);
  * takes a longer one to tell a slow recovery from a stuck one. */
 extern double recovery_scramble_seconds;
 
+/* An experiment of docs/materials.md ("Defaults that recover"), off unless levels >= 2: a
+ * threshold that rises as an element loses volume. Each tet takes, for each update, the
+ * material's threshold raised towards high: by the J of the previous update, from the
+ * material's own threshold at J >= j_high to `high` at J <= j_low, in `levels` steps (the
+ * body holds one material per step). A piecewise-constant, one-step-lagged stand-in for a
+ * threshold that depends on J, to measure whether one would recover more scrambles. */
+typedef struct recovery_volume_threshold {
+  int levels;
+  double high, j_low, j_high;
+} recovery_volume_threshold;
+extern recovery_volume_threshold recovery_threshold_by_volume;
+
 /* Runs seed `seed` of the scramble protocol on `mesh` (the grid) with `material`. */
 recovery_result recovery_scramble_run(const piola_tet_mesh *mesh, const piola_material *material,
                                       int seed);

@@ -11,9 +11,9 @@
  * its old size, then the old ones are freed. With glibc's defaults, arrays above its mmap
  * threshold (128 KiB at first) are mapped and unmapped one by one and the heap top is given
  * back beyond the trim threshold, so every rebuild touched fresh pages: on the project's
- * virtual machine the page faults cost more than the rebuild's arithmetic (the first force
- * update of a fresh 18,000-tet body took 9 ms instead of 1.4 ms; BENCHMARKS.md
- * "Fracture"). Arrays up to 32 MiB (glibc's largest mmap threshold) come from the heap
+ * virtual machine the page faults cost more than the rebuild's arithmetic (an 18,000-tet
+ * body's creation, first force update and first damping assembly: 24 ms instead of 7 ms,
+ * bench_fresh_body; BENCHMARKS.md "Fracture"). Arrays up to 32 MiB (glibc's largest mmap threshold) come from the heap
  * instead and up to 1 GiB of freed heap is kept, so a rebuild reuses the pages its
  * predecessor freed. No effect with other C libraries. */
 static inline void piola_cli_keep_freed_memory(void) {

@@ -1,7 +1,7 @@
 /* What fracture costs (docs/fracture.md): a cut event (cutting k tets, then the body's
  * rebuild) and a step of a body with about 10% of its tets cut against the same body uncut.
  *
- *   build/<dir>/bench_fracture [cubes along x] [steps per sample] [samples]
+ *   build/<dir>/bench_fracture [cubes along x] [steps per sample] [samples] [--default-allocator]
  *
  * The body is a grid of nx x nx/3 x nx/3 cubes (6 tets each), stretched and spinning in free
  * flight with damping. Parallel, slightly tilted planes cut it until at least 10% of its
@@ -17,39 +17,11 @@
 #include "piola/threads.h"
 #include "piola/world.h"
 #include "piola/world_fracture.h"
+#include "support/bench_fracture_body.h"
 #include "support/bench_support.h"
 
-static piola_world *make(const piola_tet_mesh *mesh) {
-  piola_world_def wd = piola_default_world_def();
-  for (int k = 0; k < 3; ++k) wd.gravity[k] = piola_track_constant(0);
-  piola_world *w = NULL;
-  if (piola_world_create(&wd, &w) != PIOLA_OK) return NULL;
-  piola_solid_def sd = piola_default_solid_def();
-  sd.mesh = mesh;
-  sd.material.youngs_modulus = 1e5;
-  sd.material.poisson_ratio = 0.3;
-  sd.shear_viscosity = piola_track_constant(1);
-  sd.bulk_viscosity = piola_track_constant(1);
-  sd.initial_matrix = (piola_mat3){{{1.1, 0.05, 0}, {0, 0.95, 0.02}, {0.03, 0, 1.05}}};
-  sd.velocity = (piola_vec3){0.1, 0, 0};
-  if (piola_world_add_solid(w, &sd, NULL) != PIOLA_OK) {
-    piola_world_destroy(w);
-    return NULL;
-  }
-  return w;
-}
-
-static double time_steps(piola_world *w, int steps, double dt) {
-  double t0 = bench_thread_cpu_seconds();
-  for (int s = 0; s < steps; ++s)
-    if (piola_world_step(w, dt, NULL) != PIOLA_OK) {
-      fprintf(stderr, "bench_fracture: %s\n", piola_last_error());
-      exit(1);
-    }
-  return (bench_thread_cpu_seconds() - t0) / steps;
-}
-
 int main(int argc, char **argv) {
+  bench_fracture_allocator(&argc, argv);
   const int nx = argc > 1 ? atoi(argv[1]) : 45;
   const int steps = argc > 2 ? atoi(argv[2]) : 20;
   const int samples = argc > 3 ? atoi(argv[3]) : 7;
@@ -61,7 +33,8 @@ int main(int argc, char **argv) {
   const double h = 0.01;
   piola_tet_mesh mesh;
   if (piola_tet_mesh_box_grid(nx, nx / 3, nx / 3, (piola_vec3){h, h, h}, &mesh) != PIOLA_OK) return 1;
-  piola_world *uncut = make(&mesh), *cut = make(&mesh);
+  const piola_vec3 velocity = (piola_vec3){0.1, 0, 0};
+  piola_world *uncut = bench_fracture_world(&mesh, velocity), *cut = bench_fracture_world(&mesh, velocity);
   if (!uncut || !cut) return 1;
   const int32_t tets = mesh.tet_count;
   printf("grid %d x %d x %d cubes: %d tets, %d nodes, 1 thread\n", nx, nx / 3, nx / 3, (int)tets,
@@ -91,12 +64,13 @@ int main(int argc, char **argv) {
   printf("median cut event: %.1f ms\n", 1e3 * bench_median(event_seconds, events));
   /* the same fixed step for both, below either's bound */
   double dt = fmin(piola_world_stable_dt(uncut), piola_world_stable_dt(cut));
-  time_steps(uncut, 2, dt), time_steps(cut, 2, dt); /* warm up (damping assembly) */
+  /* warm up (damping assembly) */
+  bench_fracture_time_steps(uncut, 2, dt), bench_fracture_time_steps(cut, 2, dt);
   double *a = malloc(sizeof(double) * (size_t)samples), *b = malloc(sizeof(double) * (size_t)samples);
   double *ratio = malloc(sizeof(double) * (size_t)samples);
   for (int s = 0; s < samples; ++s) {
-    a[s] = time_steps(uncut, steps, dt);
-    b[s] = time_steps(cut, steps, dt);
+    a[s] = bench_fracture_time_steps(uncut, steps, dt);
+    b[s] = bench_fracture_time_steps(cut, steps, dt);
     ratio[s] = b[s] / a[s];
   }
   printf("step (dt %.3g s, %d steps x %d samples, thread CPU time): uncut %.3f ms, cut %.3f ms, "

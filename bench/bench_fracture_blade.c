@@ -1,7 +1,7 @@
 /* What a moving blade costs (docs/fracture.md, "A moving blade"): a step during which the
  * blade cuts, against the same step of the body never cut.
  *
- *   build/<dir>/bench_fracture_blade [cubes along x] [sweep steps]
+ *   build/<dir>/bench_fracture_blade [cubes along x] [sweep steps] [--default-allocator]
  *
  * The body is a grid of nx x nx/3 x nx/3 cubes (6 tets each) of 1 cm, stretched and flying
  * with damping, as in bench_fracture. A flat, slightly tilted blade across the middle of its
@@ -17,38 +17,11 @@
 #include "piola/threads.h"
 #include "piola/world.h"
 #include "piola/world_fracture.h"
+#include "support/bench_fracture_body.h"
 #include "support/bench_support.h"
 
-static piola_world *make(const piola_tet_mesh *mesh) {
-  piola_world_def wd = piola_default_world_def();
-  for (int k = 0; k < 3; ++k) wd.gravity[k] = piola_track_constant(0);
-  piola_world *w = NULL;
-  if (piola_world_create(&wd, &w) != PIOLA_OK) return NULL;
-  piola_solid_def sd = piola_default_solid_def();
-  sd.mesh = mesh;
-  sd.material.youngs_modulus = 1e5;
-  sd.material.poisson_ratio = 0.3;
-  sd.shear_viscosity = piola_track_constant(1);
-  sd.bulk_viscosity = piola_track_constant(1);
-  sd.initial_matrix = (piola_mat3){{{1.1, 0.05, 0}, {0, 0.95, 0.02}, {0.03, 0, 1.05}}};
-  sd.velocity = (piola_vec3){0, 0.1, 0};
-  if (piola_world_add_solid(w, &sd, NULL) != PIOLA_OK) {
-    piola_world_destroy(w);
-    return NULL;
-  }
-  return w;
-}
-
-static double time_step(piola_world *w, double dt) {
-  double t0 = bench_thread_cpu_seconds();
-  if (piola_world_step(w, dt, NULL) != PIOLA_OK) {
-    fprintf(stderr, "bench_fracture_blade: %s\n", piola_last_error());
-    exit(1);
-  }
-  return bench_thread_cpu_seconds() - t0;
-}
-
 int main(int argc, char **argv) {
+  bench_fracture_allocator(&argc, argv);
   const int nx = argc > 1 ? atoi(argv[1]) : 30;
   const int sweep = argc > 2 ? atoi(argv[2]) : 40;
   if (nx < 6 || sweep < 2) {
@@ -59,7 +32,8 @@ int main(int argc, char **argv) {
   const double h = 0.01, length = nx * h, side = (nx / 3) * h;
   piola_tet_mesh mesh;
   if (piola_tet_mesh_box_grid(nx, nx / 3, nx / 3, (piola_vec3){h, h, h}, &mesh) != PIOLA_OK) return 1;
-  piola_world *uncut = make(&mesh), *cut = make(&mesh);
+  const piola_vec3 velocity = (piola_vec3){0, 0.1, 0};
+  piola_world *uncut = bench_fracture_world(&mesh, velocity), *cut = bench_fracture_world(&mesh, velocity);
   if (!uncut || !cut) return 1;
   printf("grid %d x %d x %d cubes: %d tets, %d nodes, 1 thread\n", nx, nx / 3, nx / 3, (int)mesh.tet_count,
          (int)mesh.vertex_count);
@@ -80,13 +54,13 @@ int main(int argc, char **argv) {
     fprintf(stderr, "bench_fracture_blade: %s\n", piola_last_error());
     return 1;
   }
-  time_step(uncut, dt); /* warm up (damping assembly) */
+  bench_fracture_time_steps(uncut, 1, dt); /* warm up (damping assembly) */
   double *a = malloc(sizeof(double) * (size_t)sweep), *b = malloc(sizeof(double) * (size_t)sweep);
   double *ratio = malloc(sizeof(double) * (size_t)sweep);
   int cutting = 0;
   int32_t before = piola_world_solid_cut_tet_count(cut, 0);
   for (int s = 0; s <= sweep; ++s) {
-    const double ta = time_step(uncut, dt), tb = time_step(cut, dt);
+    const double ta = bench_fracture_time_steps(uncut, 1, dt), tb = bench_fracture_time_steps(cut, 1, dt);
     const int32_t now = piola_world_solid_cut_tet_count(cut, 0);
     if (now > before) a[cutting] = ta, b[cutting] = tb, ratio[cutting] = tb / ta, ++cutting;
     before = now;

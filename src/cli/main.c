@@ -4,6 +4,7 @@
 #include <string.h>
 #include <unistd.h>
 
+#include "cli/allocator_policy.h"
 #include "cli/commands.h"
 #include "piola/kernels.h"
 
@@ -36,6 +37,7 @@ static void wait_passively(char **argv) {
 
 int main(int argc, char **argv) {
   wait_passively(argv);
+  piola_cli_keep_freed_memory();
   if (argc < 2) {
     print_usage(stderr);
     return 2;

@@ -11,9 +11,16 @@
 /* Corner pairs of a tet, in the order of tet_edges and of the assembly's blocks. */
 static const int PAIRS[6][2] = {{0, 1}, {0, 2}, {0, 3}, {1, 2}, {1, 3}, {2, 3}};
 
-static int compare_int32(const void *a, const void *b) {
-  int32_t x = *(const int32_t *)a, y = *(const int32_t *)b;
-  return (x > y) - (x < y);
+/* Sorts v[0 .. n-1] ascending. A row lists each of its edges once per tet around it, a few
+ * dozen entries: insertion sort does them in a fraction of qsort's time, which the pattern
+ * of every body built or rebuilt (a cut, docs/fracture.md) spent most of its sorting in. */
+static void sort_row(int32_t *v, int32_t n) {
+  for (int32_t i = 1; i < n; ++i) {
+    const int32_t x = v[i];
+    int32_t j = i;
+    for (; j > 0 && v[j - 1] > x; --j) v[j] = v[j - 1];
+    v[j] = x;
+  }
 }
 
 /* Index of the edge between vertices a and b (it exists: every pair of a tet is an edge):
@@ -66,7 +73,7 @@ static piola_status build_rows(piola__damping_matrix *m, const int32_t *tets, in
   int32_t edges = 0;
   for (int32_t r = 0; r < nv; ++r) {
     int32_t *row = all + count[r], len = count[r + 1] - count[r];
-    qsort(row, (size_t)len, sizeof(int32_t), compare_int32);
+    sort_row(row, len);
     m->row_start[r] = edges;
     for (int32_t k = 0; k < len; ++k)
       if (k == 0 || row[k] != row[k - 1]) all[edges++] = row[k];

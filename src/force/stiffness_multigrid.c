@@ -10,7 +10,10 @@
 #include "force/multigrid_aggregation.h"
 #include "piola/threads.h"
 
-enum { RANGES = 16, POWER_ITERATIONS = 12, LAST_LEVEL_SMOOTHING = 8 };
+/* power iterations for rho: at a setup from a fixed start, at a refresh from the last
+ * iterate (rho then only grows within a step: an overestimate only widens the smoother's
+ * interval, an underestimate could make it amplify the top of the spectrum) */
+enum { RANGES = 16, POWER_ITERATIONS = 12, REFRESH_POWER_ITERATIONS = 3, LAST_LEVEL_SMOOTHING = 8 };
 /* below this many rows the vector passes run on one thread */
 #define MULTIGRID_PARALLEL_MIN_ROWS 4096
 /* the Chebyshev interval [rho / CHEBYSHEV_RATIO, CHEBYSHEV_UPPER rho]: the upper bound
@@ -92,6 +95,7 @@ static void level_free(piola__multigrid_level *l) {
   piola__block_sparse_free(&l->a), piola__block_sparse_free(&l->p);
   piola__block_sparse_free(&l->pt);
   free(l->inverse_diagonal), free(l->x), free(l->f), free(l->r), free(l->d), free(l->q);
+  free(l->mode);
   memset(l, 0, sizeof *l);
 }
 
@@ -101,8 +105,8 @@ static piola_status level_vectors(piola__multigrid_level *l) {
   l->inverse_diagonal = malloc(sizeof(double) * n * b * b);
   l->x = malloc(sizeof(double) * n * b), l->f = malloc(sizeof(double) * n * b);
   l->r = malloc(sizeof(double) * n * b), l->d = malloc(sizeof(double) * n * b);
-  l->q = malloc(sizeof(double) * n * b);
-  if (!l->inverse_diagonal || !l->x || !l->f || !l->r || !l->d || !l->q)
+  l->q = malloc(sizeof(double) * n * b), l->mode = malloc(sizeof(double) * n * b);
+  if (!l->inverse_diagonal || !l->x || !l->f || !l->r || !l->d || !l->q || !l->mode)
     return PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "multigrid: out of memory");
   return PIOLA_OK;
 }
@@ -283,18 +287,20 @@ static void chebyshev(const piola__multigrid_level *l, int degree, int zero_star
   }
 }
 
-/* The largest eigenvalue of D^-1 A by power iteration from a fixed start, as the Rayleigh
- * quotient (v . A v) / (v . D v) of the last iterate (D^-1 A is self-adjoint in the D
- * inner product: the quotient converges from below). On one thread for the sums' order. */
-static double spectral_radius(const piola__multigrid_level *l) {
+/* The largest eigenvalue of D^-1 A by `iterations` power iterations from a fixed start
+ * (warm: from the last iterate, l->mode), as the Rayleigh quotient (v . A v) / (v . D v)
+ * (D^-1 A is self-adjoint in the D inner product: the quotient converges from below). On
+ * one thread for the sums' order. */
+static double spectral_radius(const piola__multigrid_level *l, int iterations, int warm) {
   const int b = l->a.rb;
   const int64_t m = (int64_t)l->a.rows * b;
   if (m == 0) return 1.0;
-  double *v = l->x, *av = l->q;
-  for (int64_t j = 0; j < m; ++j)
-    v[j] = (double)((uint32_t)(j * 2654435761u) % 2001u) / 1000.0 - 1.0;
+  double *v = l->mode, *av = l->q;
+  if (!warm)
+    for (int64_t j = 0; j < m; ++j)
+      v[j] = (double)((uint32_t)(j * 2654435761u) % 2001u) / 1000.0 - 1.0;
   double quotient = 0;
-  for (int it = 0; it < POWER_ITERATIONS; ++it) {
+  for (int it = 0; it < iterations; ++it) {
     piola__block_sparse_apply(&l->a, v, av, 0);
     /* v . A v and v . D v */
     double vav = 0, vdv = 0;
@@ -329,7 +335,7 @@ static double spectral_radius(const piola__multigrid_level *l) {
 /* The diagonal inverses and rho of level l's operator. */
 static void level_numbers(piola__multigrid_level *l) {
   over_rows(l, PASS_INVERT_DIAGONAL, 0, 0);
-  l->rho = spectral_radius(l);
+  l->rho = spectral_radius(l, POWER_ITERATIONS, 0);
 }
 
 /* ------------------------------------------------------------------ setup */
@@ -540,7 +546,9 @@ void piola__multigrid_refresh(piola__multigrid *mg, const piola__stiffness_matri
   if (!s) return; /* keeps the last numbers: still a valid preconditioner */
   fill_level0(mg, matrix, body, constraint, context, s);
   free(s);
-  level_numbers(&mg->level[0]);
+  piola__multigrid_level *l0 = &mg->level[0];
+  over_rows(l0, PASS_INVERT_DIAGONAL, 0, 0);
+  l0->rho = fmax(l0->rho, spectral_radius(l0, REFRESH_POWER_ITERATIONS, 1));
   mg->refreshes++;
 }
 

@@ -31,7 +31,8 @@
  * approximately).
  *
  * Reuse. The matrix changes little between the Newton iterations of a step: a refresh
- * (piola__multigrid_refresh) rebuilds level 0's values, its block diagonal and its rho and
+ * (piola__multigrid_refresh) rebuilds level 0's values and its block diagonal, updates its
+ * rho by 3 power iterations from the last one's vector (keeping the larger estimate), and
  * keeps the coarser levels as they are, which stay a valid (symmetric positive definite)
  * coarse correction; the caller sets up the whole hierarchy once per step.
  *
@@ -59,6 +60,7 @@ typedef struct piola__multigrid_level {
   double *inverse_diagonal;  /* b x b per row: the inverse diagonal blocks */
   double rho;                /* largest eigenvalue of D^-1 A (estimate) */
   double *x, *f, *r, *d, *q; /* work vectors of the cycle, rows * b each */
+  double *mode;              /* rows * b: the power iteration's last iterate (rho's vector) */
 } piola__multigrid_level;
 
 typedef struct piola__multigrid {

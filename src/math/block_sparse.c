@@ -132,6 +132,41 @@ static int32_t product_row_columns(const piola__block_sparse *a, const piola__bl
   return count;
 }
 
+/* c += a b for blocks R x K and K x C, fixed sizes for the products the multigrid setup
+ * forms (A T and A P: 3x3 by 3x6; P^T (A P): 6x3 by 3x6; the coarse levels: 6x6 by 6x6). */
+typedef void block_multiply_add(const double *a, const double *b, double *c, int r, int k, int cc);
+
+#define BLOCK_MULTIPLY_ADD(NAME, R, K, C)                                               \
+  static void NAME(const double *a, const double *b, double *c, int r, int k, int cc) { \
+    (void)r, (void)k, (void)cc;                                                         \
+    for (int i = 0; i < R; ++i)                                                         \
+      for (int j = 0; j < C; ++j) {                                                     \
+        double s = 0;                                                                   \
+        for (int p = 0; p < K; ++p) s += a[K * i + p] * b[C * p + j];                   \
+        c[C * i + j] += s;                                                              \
+      }                                                                                 \
+  }
+
+BLOCK_MULTIPLY_ADD(multiply_add_3x3x6, 3, 3, 6)
+BLOCK_MULTIPLY_ADD(multiply_add_6x3x6, 6, 3, 6)
+BLOCK_MULTIPLY_ADD(multiply_add_6x6x6, 6, 6, 6)
+
+static void multiply_add_any(const double *a, const double *b, double *c, int r, int k, int cc) {
+  for (int i = 0; i < r; ++i)
+    for (int j = 0; j < cc; ++j) {
+      double s = 0;
+      for (int p = 0; p < k; ++p) s += a[k * i + p] * b[cc * p + j];
+      c[cc * i + j] += s;
+    }
+}
+
+static block_multiply_add *multiply_add_for(int r, int k, int c) {
+  if (r == 3 && k == 3 && c == 6) return multiply_add_3x3x6;
+  if (r == 6 && k == 3 && c == 6) return multiply_add_6x3x6;
+  if (r == 6 && k == 6 && c == 6) return multiply_add_6x6x6;
+  return multiply_add_any;
+}
+
 piola_status piola__block_sparse_product(const piola__block_sparse *a, const piola__block_sparse *b,
                                          piola__block_sparse *c) {
   memset(c, 0, sizeof *c);
@@ -154,6 +189,7 @@ piola_status piola__block_sparse_product(const piola__block_sparse *a, const pio
   for (int32_t j = 0; j < cols; ++j) marker[j] = -1;
   const int ra = a->rb, inner = a->cb, cb = b->cb;
   const size_t abs = (size_t)(ra * inner), bbs = (size_t)(inner * cb), cbs = (size_t)(ra * cb);
+  block_multiply_add *multiply_add = multiply_add_for(ra, inner, cb);
   int64_t at = 0;
   for (int32_t r = 0; r < a->rows; ++r) {
     const int32_t count = product_row_columns(a, b, r, marker, list);
@@ -164,14 +200,8 @@ piola_status piola__block_sparse_product(const piola__block_sparse *a, const pio
       const double *ak = a->values + abs * (size_t)k;
       const int32_t m = a->col[k];
       for (int32_t l = b->row_start[m]; l < b->row_start[m + 1]; ++l) {
-        const double *bl = b->values + bbs * (size_t)l;
-        double *out = c->values + cbs * (size_t)position[b->col[l]];
-        for (int i = 0; i < ra; ++i)
-          for (int j = 0; j < cb; ++j) {
-            double s = 0;
-            for (int p = 0; p < inner; ++p) s += ak[inner * i + p] * bl[cb * p + j];
-            out[cb * i + j] += s;
-          }
+        multiply_add(ak, b->values + bbs * (size_t)l, c->values + cbs * (size_t)position[b->col[l]],
+                     ra, inner, cb);
       }
     }
     at += count;

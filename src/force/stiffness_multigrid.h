@@ -19,8 +19,9 @@
  *   omega = 4 / (3 rho), rho the largest eigenvalue of D^-1 A estimated by power iteration
  *   (D the block diagonal); the next level is the Galerkin product P^T A P (6x6 blocks);
  * - coarsening stops at PIOLA_MULTIGRID_COARSE_DOFS unknowns or less, solved by a dense
- *   Cholesky factorization (where aggregation stalls above that, the last level is only
- *   smoothed).
+ *   Cholesky factorization (where aggregation stalls above that, a last level of up to 4x
+ *   that size is still factored, a larger one, or the tenth level, only smoothed: a
+ *   degree-8 Chebyshev polynomial).
  *
  * The preconditioner is one V-cycle from a zero guess: on each level a Chebyshev smoother of
  * degree PIOLA_MULTIGRID_SMOOTHING in D^-1 A on [rho / 30, 1.1 rho] before and the same

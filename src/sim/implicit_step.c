@@ -7,8 +7,9 @@
  * the rotated damping at the current iterate), by Newton's method: the system matrix
  * M - dt^2 K - dt D (stiffness_matrix.h) with K the projected stiffness, so it is symmetric
  * positive definite at any deformation, flat and inverted elements included; a
- * conjugate gradient preconditioned by block Jacobi or block IC(0)
- * (force/stiffness_incomplete_cholesky.h), solved to Eisenstat and Walker's forcing term or a
+ * conjugate gradient preconditioned by block Jacobi, block IC(0)
+ * (force/stiffness_incomplete_cholesky.h) or smoothed aggregation multigrid
+ * (force/stiffness_multigrid.h), solved to Eisenstat and Walker's forcing term or a
  * fixed tolerance (forcing_term); and a backtracking line search.
  *
  * Why the line search is on the residual norm and not on the energy. The inversion

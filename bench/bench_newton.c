@@ -6,8 +6,8 @@
  *
  * Backward Euler: `frames` frames of 1/30 s at one step per frame: median wall time per
  * frame, Newton and CG iterations per frame, and the time of one Newton iteration proper,
- * the assembly of the projected stiffness (and the IC(0) factorization) plus the
- * preconditioned CG (to 1e-3 with fixed forcing) (the world's
+ * the assembly of the projected stiffness (and the IC(0) factorization or the multigrid
+ * setup/refresh) plus the preconditioned CG (to 1e-3 with fixed forcing) (the world's
  * step profile, src/sim/step_profile.h; the line search's force evaluations are not in it),
  * in wall time and in process CPU time (all threads: on a loaded machine the steadier
  * figure). Newmark: the CFL step of the same scene and the median wall time of a step over
@@ -20,7 +20,7 @@
  * visual result": below 1%), and the CPU-time ratio of the two runs.
  *
  * usage: bench_newton [frames=3] [newmark_steps=20] [mesh] [E] [nu] [threads=2]
- *                     [preconditioner=block_jacobi|incomplete_cholesky]
+ *                     [preconditioner=block_jacobi|incomplete_cholesky|multigrid]
  *                     [forcing=eisenstat_walker|fixed] [reference=0|1]
  *                     [newton_tolerance=1e-5 (the default of integrator.newton_tolerance)]
  * (block_jacobi fixed is the solver as it was before issue 14's preconditioner and forcing

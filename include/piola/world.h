@@ -62,10 +62,12 @@ typedef enum piola_preconditioner_type {
   PIOLA_PRECONDITIONER_BLOCK_JACOBI = 0,  /* the inverse 3x3 diagonal blocks */
   PIOLA_PRECONDITIONER_INCOMPLETE_CHOLESKY, /* block IC(0) on the mesh edges (solids;
                                               shells use block Jacobi) */
+  PIOLA_PRECONDITIONER_MULTIGRID, /* smoothed aggregation multigrid, one V-cycle (solids;
+                                     shells use block Jacobi) */
   PIOLA_PRECONDITIONER_COUNT
 } piola_preconditioner_type;
 
-/* Scene names "block_jacobi", "incomplete_cholesky". */
+/* Scene names "block_jacobi", "incomplete_cholesky", "multigrid". */
 PIOLA_API const char *piola_preconditioner_type_name(piola_preconditioner_type type);
 PIOLA_API bool piola_preconditioner_type_from_name(const char *name,
                                                    piola_preconditioner_type *type);

@@ -78,58 +78,6 @@ void piola__incomplete_cholesky_free(piola__incomplete_cholesky *f) {
   memset(f, 0, sizeof *f);
 }
 
-/* The projection S of vertex i: 0 free (S = I), 1 held (S = 0), 2 held along nrm. */
-typedef struct projection {
-  int kind;
-  double n[3];
-} projection;
-
-static projection projection_of(piola__vertex_constraint *constraint, const void *context,
-                                int32_t i) {
-  projection s = {0, {0, 0, 0}};
-  if (constraint) s.kind = constraint(context, i, s.n);
-  return s;
-}
-
-/* b = S b (left) or b S (right), b row-major 3x3. */
-static void project_rows(const projection *s, double b[9]) {
-  if (s->kind == 0) return;
-  if (s->kind == 1) {
-    memset(b, 0, 9 * sizeof(double));
-    return;
-  }
-  for (int c = 0; c < 3; ++c) {
-    double dn = s->n[0] * b[c] + s->n[1] * b[3 + c] + s->n[2] * b[6 + c];
-    for (int r = 0; r < 3; ++r) b[3 * r + c] -= s->n[r] * dn;
-  }
-}
-
-static void project_columns(const projection *s, double b[9]) {
-  if (s->kind == 0) return;
-  if (s->kind == 1) {
-    memset(b, 0, 9 * sizeof(double));
-    return;
-  }
-  for (int r = 0; r < 3; ++r) {
-    double dn = b[3 * r] * s->n[0] + b[3 * r + 1] * s->n[1] + b[3 * r + 2] * s->n[2];
-    for (int c = 0; c < 3; ++c) b[3 * r + c] -= dn * s->n[c];
-  }
-}
-
-/* The filtered diagonal block S A_ii S + (I - S), symmetrized. */
-static void filtered_diagonal(const projection *s, const double *a, double out[9]) {
-  for (int r = 0; r < 3; ++r)
-    for (int c = 0; c < 3; ++c) out[3 * r + c] = 0.5 * (a[3 * r + c] + a[3 * c + r]);
-  project_rows(s, out);
-  project_columns(s, out);
-  if (s->kind == 1) {
-    out[0] = out[4] = out[8] = 1;
-  } else if (s->kind == 2) {
-    for (int r = 0; r < 3; ++r)
-      for (int c = 0; c < 3; ++c) out[3 * r + c] += s->n[r] * s->n[c];
-  }
-}
-
 /* True when the symmetric block a is positive definite (leading minors). */
 static int positive_definite(const double a[9]) {
   const double m1 = a[0], m2 = a[0] * a[4] - a[1] * a[3];
@@ -163,19 +111,21 @@ static int factor_shifted(piola__incomplete_cholesky *f, const piola__stiffness_
   /* accumulators: pivots in inverse_pivot, edge blocks W_ij = S_i A_ij S_j in upper
    * (A_ij = -S_ij, the edge-difference form of stiffness_matrix.h) */
   for (int32_t i = 0; i < n; ++i) {
-    const projection s = projection_of(constraint, context, i);
+    const piola__vertex_projection s = piola__vertex_projection_of(constraint, context, i);
     double *a = f->inverse_pivot + 9 * (size_t)i;
-    filtered_diagonal(&s, matrix->diagonal + 9 * (size_t)i, a);
+    piola__filtered_diagonal(&s, matrix->diagonal + 9 * (size_t)i, a);
     for (int c = 0; c < 9; ++c) a[c] *= 1 + shift;
   }
   for (int32_t r = 0; r < n; ++r) {
-    const projection si = projection_of(constraint, context, d->order[r]);
+    const piola__vertex_projection si =
+        piola__vertex_projection_of(constraint, context, d->order[r]);
     for (int32_t e = d->row_start[r]; e < d->row_start[r + 1]; ++e) {
       double *w = f->upper + 9 * (size_t)e;
       for (int c = 0; c < 9; ++c) w[c] = -matrix->blocks[9 * (size_t)e + c];
-      const projection sj = projection_of(constraint, context, d->col[e]);
-      project_rows(&si, w);
-      project_columns(&sj, w);
+      const piola__vertex_projection sj =
+          piola__vertex_projection_of(constraint, context, d->col[e]);
+      piola__project_rows(&si, w, 3);
+      piola__project_columns(&sj, w);
     }
   }
   int32_t fallbacks = 0;
@@ -186,8 +136,8 @@ static int factor_shifted(piola__incomplete_cholesky *f, const piola__stiffness_
       for (int c = 0; c < 3; ++c) dblock[3 * rr + c] = 0.5 * (pivot[3 * rr + c] + pivot[3 * c + rr]);
     if (!positive_definite(dblock)) {
       if (!give_up) return 0;
-      const projection s = projection_of(constraint, context, i);
-      filtered_diagonal(&s, matrix->diagonal + 9 * (size_t)i, dblock);
+      const piola__vertex_projection s = piola__vertex_projection_of(constraint, context, i);
+      piola__filtered_diagonal(&s, matrix->diagonal + 9 * (size_t)i, dblock);
       for (int c = 0; c < 9; ++c) dblock[c] *= 1 + shift;
       fallbacks++;
     }

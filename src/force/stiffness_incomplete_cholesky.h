@@ -30,13 +30,10 @@
 #include <stdint.h>
 
 #include "force/stiffness_matrix.h"
+#include "force/vertex_projection.h"
 
 #define PIOLA_IC_FIRST_SHIFT 1e-3
 #define PIOLA_IC_LAST_SHIFT 1.0
-
-/* How vertex i is constrained: 0 free, 1 held in all directions, 2 held along normal[3]
- * (unit). */
-typedef int piola__vertex_constraint(const void *context, int32_t vertex, double normal[3]);
 
 typedef struct piola__incomplete_cholesky {
   int32_t vertex_count;

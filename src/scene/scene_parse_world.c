@@ -54,7 +54,7 @@ piola_status piola__scene_parse_world(scene_parser *p, const cJSON *obj, scene_d
       if (!cJSON_IsString(pc) ||
           !piola_preconditioner_type_from_name(pc->valuestring, &out->world.preconditioner))
         return piola__json_fail(p, BAD_VALUE,
-                                "must be \"block_jacobi\" or \"incomplete_cholesky\"");
+                                "must be \"block_jacobi\", \"incomplete_cholesky\" or \"multigrid\"");
       piola__json_pop(p, o2);
     }
     const cJSON *lf = piola__json_get(v, "linear_forcing");

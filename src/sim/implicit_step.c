@@ -7,8 +7,9 @@
  * the rotated damping at the current iterate), by Newton's method: the system matrix
  * M - dt^2 K - dt D (stiffness_matrix.h) with K the projected stiffness, so it is symmetric
  * positive definite at any deformation, flat and inverted elements included; a
- * conjugate gradient preconditioned by block Jacobi or block IC(0)
- * (force/stiffness_incomplete_cholesky.h), solved to Eisenstat and Walker's forcing term or a
+ * conjugate gradient preconditioned by block Jacobi, block IC(0)
+ * (force/stiffness_incomplete_cholesky.h) or smoothed aggregation multigrid
+ * (force/stiffness_multigrid.h), solved to Eisenstat and Walker's forcing term or a
  * fixed tolerance (forcing_term); and a backtracking line search.
  *
  * Why the line search is on the residual norm and not on the energy. The inversion
@@ -54,6 +55,7 @@
 #include "force/elastic_body_internal.h"
 #include "force/stiffness_incomplete_cholesky.h"
 #include "force/stiffness_matrix.h"
+#include "force/stiffness_multigrid.h"
 #include "sim/obstacle_friction.h"
 #include "sim/world_internal.h"
 
@@ -69,6 +71,9 @@ struct implicit_state {
   piola__stiffness_matrix matrix;
   piola__incomplete_cholesky factor; /* a solid's IC(0), when that is the preconditioner */
   int factored;                      /* factor holds the current Newton system's */
+  piola__multigrid multigrid; /* a solid's multigrid hierarchy, when that is the preconditioner */
+  int multigrid_ready;        /* multigrid serves the current Newton system */
+  int multigrid_fresh;        /* the hierarchy was set up in this step (else: set it up) */
   double *prediction; /* 3n: x^n + dt v^n (backward Euler) */
   double *residual;   /* 3n: g, unfiltered */
   double *step;       /* 3n: the Newton direction */
@@ -84,14 +89,16 @@ void piola__implicit_state_free(struct implicit_state *st) {
   if (!st) return;
   piola__stiffness_matrix_free(&st->matrix);
   piola__incomplete_cholesky_free(&st->factor);
+  piola__multigrid_free(&st->multigrid);
   free(st->prediction), free(st->residual), free(st->step), free(st->base), free(st->damping);
   for (int k = 0; k < 4; ++k) free(st->cg[k]);
   free(st->scratch_v), free(st->surface_v), free(st->hit);
   free(st);
 }
 
-/* The state of s's implicit steps; with_factor: room for an IC(0) factor (solids). */
-static piola_status implicit_state_make(world_body *s, int with_factor) {
+/* The state of s's implicit steps, with room for the preconditioner's factor or hierarchy
+ * (solids). */
+static piola_status implicit_state_make(world_body *s, piola_preconditioner_type preconditioner) {
   if (s->implicit) return PIOLA_OK;
   struct implicit_state *st = calloc(1, sizeof *st);
   if (!st) return PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "implicit step: out of memory");
@@ -105,8 +112,12 @@ static piola_status implicit_state_make(world_body *s, int with_factor) {
            st->scratch_v && st->surface_v && st->hit && st->cg[0] && st->cg[1] && st->cg[2] &&
            st->cg[3];
   if (ok && piola__body_stiffness_init(s, &st->matrix) != PIOLA_OK) ok = 0;
-  if (ok && with_factor && s->kind == PIOLA_BODY_SOLID &&
+  if (ok && preconditioner == PIOLA_PRECONDITIONER_INCOMPLETE_CHOLESKY &&
+      s->kind == PIOLA_BODY_SOLID &&
       piola__incomplete_cholesky_init(&st->factor, s->solid) != PIOLA_OK)
+    ok = 0;
+  if (ok && preconditioner == PIOLA_PRECONDITIONER_MULTIGRID && s->kind == PIOLA_BODY_SOLID &&
+      piola__multigrid_init(&st->multigrid, s->solid) != PIOLA_OK)
     ok = 0;
   if (!ok) {
     piola__implicit_state_free(st);
@@ -228,16 +239,17 @@ static double residual(newton_problem *pb) {
 typedef struct cg_vectors {
   const world_body *s;
   const piola__stiffness_matrix *mx;
-  const piola__incomplete_cholesky *factor; /* NULL: block Jacobi */
+  const piola__incomplete_cholesky *factor; /* NULL: block Jacobi (or multigrid) */
+  piola__multigrid *multigrid;              /* NULL: block Jacobi (or IC(0)) */
   double *d, *r, *z, *p, *q;
   const double *g; /* the residual the solve starts from */
   double alpha;    /* the step length of cg_update_range */
 } cg_vectors;
 
-/* z_i = S_i P_i^-1 r_i, P_i the diagonal block (block Jacobi; with the IC(0) factor z is
- * formed after the pass, see precondition_factored); returns r_i . z_i. */
+/* z_i = S_i P_i^-1 r_i, P_i the diagonal block (block Jacobi; with the IC(0) factor or the
+ * multigrid z is formed after the pass, see precondition_factored); returns r_i . z_i. */
 static inline double precondition_node(const cg_vectors *c, int32_t i) {
-  if (c->factor) return 0;
+  if (c->factor || c->multigrid) return 0;
   const double *b = c->mx->inverse_diagonal + 9 * (size_t)i, *x = c->r + 3 * i;
   double *y = c->z + 3 * i;
   y[0] = b[0] * x[0] + b[1] * x[1] + b[2] * x[2];
@@ -247,9 +259,11 @@ static inline double precondition_node(const cg_vectors *c, int32_t i) {
   return x[0] * y[0] + x[1] * y[1] + x[2] * y[2];
 }
 
-/* z = S (U^T D U)^-1 r over the whole body (the substitutions are sequential); returns r . z.
- * The factor is of the filtered matrix, so z is filtered already up to rounding; the filter
- * keeps the constrained components exactly zero. */
+/* z = S (U^T D U)^-1 r over the whole body (the substitutions are sequential), or
+ * z = S V-cycle(r); returns r . z. The factor is of the filtered matrix, so its z is filtered
+ * already up to rounding; the filter keeps the constrained components exactly zero (and
+ * makes the V-cycle, which maps the free subspace to itself only approximately, act on it
+ * as the filtered CG needs: S V S is symmetric positive definite there). */
 static double r_dot_z_range(const void *context, int32_t i0, int32_t i1) {
   const cg_vectors *c = context;
   double sum = 0;
@@ -262,7 +276,8 @@ static double r_dot_z_range(const void *context, int32_t i0, int32_t i1) {
 }
 
 static double precondition_factored(const cg_vectors *c) {
-  piola__incomplete_cholesky_apply(c->factor, c->s->solid, c->r, c->z);
+  if (c->multigrid) piola__multigrid_apply(c->multigrid, c->s->solid, c->r, c->z);
+  else piola__incomplete_cholesky_apply(c->factor, c->s->solid, c->r, c->z);
   return sum_over_ranges(c->s->n, CG_PARALLEL_MIN_VERTICES, r_dot_z_range, c);
 }
 
@@ -320,7 +335,8 @@ static void cg_direction(const cg_vectors *c, double b) {
   for (int64_t j = 0; j < m; ++j) c->p[j] = c->z[j] + b * c->p[j];
 }
 
-/* How a solid's vertex is held, for the IC(0) factor (filter_vector's projection). */
+/* How a solid's vertex is held, for the IC(0) factor and the multigrid (filter_vector's
+ * projection). */
 static int vertex_constraint(const void *context, int32_t i, double normal[3]) {
   const world_body *s = context;
   if (s->flags[i] != NODE_FREE || s->inverse_mass[i] == 0) return 1;
@@ -329,14 +345,29 @@ static int vertex_constraint(const void *context, int32_t i, double normal[3]) {
   return 2;
 }
 
-/* Factors the Newton system just assembled when the preconditioner is IC(0) (solids). */
-static void factor_newton_system(const newton_problem *pb) {
+/* Factors the Newton system just assembled when the preconditioner is IC(0), or prepares
+ * the multigrid hierarchy for it (solids): set up once per step, at its first Newton system,
+ * and refreshed on its finest level for the later ones (stiffness_multigrid.h; measured in
+ * BENCHMARKS.md, "Implicit integrators": the full setup at every Newton iteration costs more
+ * than the iterations it saves). */
+static piola_status factor_newton_system(const newton_problem *pb) {
   struct implicit_state *st = pb->st;
   st->factored = pb->w->def.preconditioner == PIOLA_PRECONDITIONER_INCOMPLETE_CHOLESKY &&
                  pb->s->kind == PIOLA_BODY_SOLID && st->factor.pair_start;
   if (st->factored)
     piola__incomplete_cholesky_factor(&st->factor, &st->matrix, pb->s->solid, vertex_constraint,
                                       pb->s);
+  st->multigrid_ready = pb->w->def.preconditioner == PIOLA_PRECONDITIONER_MULTIGRID &&
+                        pb->s->kind == PIOLA_BODY_SOLID && st->multigrid.entry_edge;
+  if (!st->multigrid_ready) return PIOLA_OK;
+  if (st->multigrid_fresh) {
+    piola__multigrid_refresh(&st->multigrid, &st->matrix, pb->s->solid, vertex_constraint, pb->s);
+    return PIOLA_OK;
+  }
+  PIOLA_TRY(piola__multigrid_setup(&st->multigrid, &st->matrix, pb->s->solid, vertex_constraint,
+                                   pb->s));
+  st->multigrid_fresh = 1;
+  return PIOLA_OK;
 }
 
 /* Eisenstat and Walker's forcing term (1996, choice 2 with gamma 0.9, exponent 2): the CG
@@ -380,11 +411,12 @@ static int32_t solve_newton_system(newton_problem *pb, double eta) {
   const double mass_weight = pb->mass_weight + s->quasistatic_mu;
   double *d = st->step;
   cg_vectors c = {s,          &st->matrix, st->factored ? &st->factor : NULL,
+                  st->multigrid_ready ? &st->multigrid : NULL,
                   d,          st->cg[0],   st->cg[1],
                   st->cg[2],  st->cg[3],   st->residual,
                   0};
   double rz = cg_pass(&c, cg_start_range);
-  if (c.factor) {
+  if (c.factor || c.multigrid) {
     rz = precondition_factored(&c);
     memcpy(c.p, c.z, sizeof(double) * 3 * (size_t)n);
   }
@@ -396,7 +428,7 @@ static int32_t solve_newton_system(newton_problem *pb, double eta) {
     if (!(pq > 0)) break;
     c.alpha = rz / pq;
     double rz_new = cg_pass(&c, cg_update_range);
-    if (c.factor) rz_new = precondition_factored(&c);
+    if (c.factor || c.multigrid) rz_new = precondition_factored(&c);
     cg_direction(&c, rz_new / rz);
     rz = rz_new;
     ++it;
@@ -533,9 +565,9 @@ static piola_status newton_iterate(const newton_problem *problem, int accept_unc
  * PIOLA_ERROR_NOT_CONVERGED when not (the caller undoes and halves), or another error. */
 static piola_status newton_body(piola_world *w, world_body *s, double t, double dt,
                                  int accept_unconverged, piola_step_stats *stats) {
-  PIOLA_TRY(implicit_state_make(
-      s, w->def.preconditioner == PIOLA_PRECONDITIONER_INCOMPLETE_CHOLESKY));
+  PIOLA_TRY(implicit_state_make(s, w->def.preconditioner));
   struct implicit_state *st = s->implicit;
+  st->multigrid_fresh = 0; /* a new step: the hierarchy is set up again */
   const int32_t n = s->n;
   const int64_t m = 3 * (int64_t)n;
   newton_problem pb = problem_of(w, s, t, dt);
@@ -621,7 +653,7 @@ static piola_status newton_iterate(const newton_problem *problem, int accept_unc
                                             pb.damped ? dt : 0.0, pb.beta, pb.alpha,
                                             pb.mass_weight + s->quasistatic_mu);
     }
-    factor_newton_system(&pb);
+    PIOLA_TRY(factor_newton_system(&pb));
     piola__step_profile_mark(&w->profile, STEP_PHASE_ASSEMBLE);
     eta = forcing_term(&w->def, phi, phi_last, eta, target2, last_alpha < 1.0);
     phi_last = phi;

@@ -63,7 +63,7 @@ piola_solid_def piola_default_solid_def(void) {
 }
 
 static const char *const preconditioner_names[PIOLA_PRECONDITIONER_COUNT] = {
-    "block_jacobi", "incomplete_cholesky"};
+    "block_jacobi", "incomplete_cholesky", "multigrid"};
 
 const char *piola_preconditioner_type_name(piola_preconditioner_type type) {
   if ((int)type < 0 || type >= PIOLA_PRECONDITIONER_COUNT) return "unknown";

@@ -1,0 +1,266 @@
+/* Block compressed sparse rows; see block_sparse.h. */
+#include "math/block_sparse.h"
+
+#include <stdlib.h>
+#include <string.h>
+
+#include "common/status_report.h"
+#include "piola/threads.h"
+
+/* below this many rows a product runs on one thread (the parallel region costs more) */
+#define BLOCK_SPARSE_PARALLEL_MIN_ROWS 4096
+enum { RANGES = 16 };
+
+piola_status piola__block_sparse_alloc(piola__block_sparse *m, int32_t rows, int32_t cols, int rb,
+                                       int cb, int64_t entries) {
+  memset(m, 0, sizeof *m);
+  m->rows = rows, m->cols = cols, m->rb = rb, m->cb = cb;
+  if (entries > INT32_MAX)
+    return PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "sparse matrix: %lld blocks are too many",
+                      (long long)entries);
+  m->row_start = malloc(sizeof(int32_t) * ((size_t)rows + 1));
+  m->col = malloc(sizeof(int32_t) * (size_t)(entries > 0 ? entries : 1));
+  m->values = malloc(sizeof(double) * (size_t)(rb * cb) * (size_t)(entries > 0 ? entries : 1));
+  if (!m->row_start || !m->col || !m->values) {
+    piola__block_sparse_free(m);
+    return PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "sparse matrix: out of memory");
+  }
+  m->row_start[0] = 0;
+  return PIOLA_OK;
+}
+
+void piola__block_sparse_free(piola__block_sparse *m) {
+  free(m->row_start), free(m->col), free(m->values);
+  memset(m, 0, sizeof *m);
+}
+
+typedef struct apply_pass {
+  const piola__block_sparse *a;
+  const double *x;
+  double *y;
+  int accumulate;
+} apply_pass;
+
+/* Rows r0 .. r1 - 1 of y = A x for blocks RB x CB, fixed sizes (3x3 and 6x6 on the levels,
+ * 3x6 and 6x3 between them) so the compiler unrolls the blocks. */
+#define APPLY_ROWS(NAME, RB, CB)                                                    \
+  static void NAME(const apply_pass *c, int32_t r0, int32_t r1) {                   \
+    const piola__block_sparse *a = c->a;                                            \
+    for (int32_t r = r0; r < r1; ++r) {                                             \
+      double sum[RB] = {0};                                                         \
+      for (int32_t k = a->row_start[r]; k < a->row_start[r + 1]; ++k) {             \
+        const double *b = a->values + (size_t)(RB * CB) * (size_t)k;                \
+        const double *xk = c->x + (size_t)CB * (size_t)a->col[k];                   \
+        for (int i = 0; i < RB; ++i) {                                              \
+          double s = 0;                                                             \
+          for (int j = 0; j < CB; ++j) s += b[CB * i + j] * xk[j];                  \
+          sum[i] += s;                                                              \
+        }                                                                           \
+      }                                                                             \
+      double *yr = c->y + (size_t)RB * (size_t)r;                                   \
+      for (int i = 0; i < RB; ++i) yr[i] = c->accumulate ? yr[i] + sum[i] : sum[i]; \
+    }                                                                               \
+  }
+
+APPLY_ROWS(apply_rows_3x3, 3, 3)
+APPLY_ROWS(apply_rows_3x6, 3, 6)
+APPLY_ROWS(apply_rows_6x3, 6, 3)
+APPLY_ROWS(apply_rows_6x6, 6, 6)
+
+/* Any other block size (up to 6 rows). */
+static void apply_rows(const apply_pass *c, int32_t r0, int32_t r1) {
+  const piola__block_sparse *a = c->a;
+  const int rb = a->rb, cb = a->cb, bs = rb * cb;
+  if (rb == 3 && cb == 3) {
+    apply_rows_3x3(c, r0, r1);
+    return;
+  }
+  if (rb == 3 && cb == 6) {
+    apply_rows_3x6(c, r0, r1);
+    return;
+  }
+  if (rb == 6 && cb == 3) {
+    apply_rows_6x3(c, r0, r1);
+    return;
+  }
+  if (rb == 6 && cb == 6) {
+    apply_rows_6x6(c, r0, r1);
+    return;
+  }
+  for (int32_t r = r0; r < r1; ++r) {
+    double sum[6] = {0, 0, 0, 0, 0, 0};
+    for (int32_t k = a->row_start[r]; k < a->row_start[r + 1]; ++k) {
+      const double *b = a->values + (size_t)bs * (size_t)k,
+                   *xk = c->x + (size_t)cb * (size_t)a->col[k];
+      for (int i = 0; i < rb; ++i) {
+        double s = 0;
+        for (int j = 0; j < cb; ++j) s += b[cb * i + j] * xk[j];
+        sum[i] += s;
+      }
+    }
+    double *yr = c->y + (size_t)rb * (size_t)r;
+    for (int i = 0; i < rb; ++i) yr[i] = c->accumulate ? yr[i] + sum[i] : sum[i];
+  }
+}
+
+void piola__block_sparse_apply(const piola__block_sparse *a, const double *x, double *y,
+                               int accumulate) {
+  const apply_pass c = {a, x, y, accumulate};
+  const int32_t n = a->rows;
+#pragma omp parallel for schedule(static) \
+    num_threads(piola_thread_count()) if (n >= BLOCK_SPARSE_PARALLEL_MIN_ROWS)
+  for (int r = 0; r < RANGES; ++r)
+    apply_rows(&c, (int32_t)((int64_t)n * r / RANGES), (int32_t)((int64_t)n * (r + 1) / RANGES));
+}
+
+static int compare_int32(const void *a, const void *b) {
+  const int32_t x = *(const int32_t *)a, y = *(const int32_t *)b;
+  return (x > y) - (x < y);
+}
+
+/* The distinct columns of row r of a b into list (marker[c] == r marks them), sorted;
+ * returns how many. */
+static int32_t product_row_columns(const piola__block_sparse *a, const piola__block_sparse *b,
+                                   int32_t r, int32_t *marker, int32_t *list) {
+  int32_t count = 0;
+  for (int32_t k = a->row_start[r]; k < a->row_start[r + 1]; ++k) {
+    const int32_t m = a->col[k];
+    for (int32_t l = b->row_start[m]; l < b->row_start[m + 1]; ++l)
+      if (marker[b->col[l]] != r) marker[b->col[l]] = r, list[count++] = b->col[l];
+  }
+  qsort(list, (size_t)count, sizeof(int32_t), compare_int32);
+  return count;
+}
+
+/* c += a b for blocks R x K and K x C, fixed sizes for the products the multigrid setup
+ * forms (A T and A P: 3x3 by 3x6; P^T (A P): 6x3 by 3x6; the coarse levels: 6x6 by 6x6). */
+typedef void block_multiply_add(const double *a, const double *b, double *c, int r, int k, int cc);
+
+#define BLOCK_MULTIPLY_ADD(NAME, R, K, C)                                               \
+  static void NAME(const double *a, const double *b, double *c, int r, int k, int cc) { \
+    (void)r, (void)k, (void)cc;                                                         \
+    for (int i = 0; i < R; ++i)                                                         \
+      for (int j = 0; j < C; ++j) {                                                     \
+        double s = 0;                                                                   \
+        for (int p = 0; p < K; ++p) s += a[K * i + p] * b[C * p + j];                   \
+        c[C * i + j] += s;                                                              \
+      }                                                                                 \
+  }
+
+BLOCK_MULTIPLY_ADD(multiply_add_3x3x6, 3, 3, 6)
+BLOCK_MULTIPLY_ADD(multiply_add_6x3x6, 6, 3, 6)
+BLOCK_MULTIPLY_ADD(multiply_add_6x6x6, 6, 6, 6)
+
+static void multiply_add_any(const double *a, const double *b, double *c, int r, int k, int cc) {
+  for (int i = 0; i < r; ++i)
+    for (int j = 0; j < cc; ++j) {
+      double s = 0;
+      for (int p = 0; p < k; ++p) s += a[k * i + p] * b[cc * p + j];
+      c[cc * i + j] += s;
+    }
+}
+
+static block_multiply_add *multiply_add_for(int r, int k, int c) {
+  if (r == 3 && k == 3 && c == 6) return multiply_add_3x3x6;
+  if (r == 6 && k == 3 && c == 6) return multiply_add_6x3x6;
+  if (r == 6 && k == 6 && c == 6) return multiply_add_6x6x6;
+  return multiply_add_any;
+}
+
+piola_status piola__block_sparse_product(const piola__block_sparse *a, const piola__block_sparse *b,
+                                         piola__block_sparse *c) {
+  memset(c, 0, sizeof *c);
+  const int32_t cols = b->cols > 0 ? b->cols : 1;
+  int32_t *marker = malloc(sizeof(int32_t) * (size_t)cols);
+  int32_t *list = malloc(sizeof(int32_t) * (size_t)cols);
+  int32_t *position = malloc(sizeof(int32_t) * (size_t)cols);
+  if (!marker || !list || !position) {
+    free(marker), free(list), free(position);
+    return PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "sparse product: out of memory");
+  }
+  for (int32_t j = 0; j < cols; ++j) marker[j] = -1;
+  int64_t entries = 0;
+  for (int32_t r = 0; r < a->rows; ++r) entries += product_row_columns(a, b, r, marker, list);
+  piola_status status = piola__block_sparse_alloc(c, a->rows, b->cols, a->rb, b->cb, entries);
+  if (status != PIOLA_OK) {
+    free(marker), free(list), free(position);
+    return status;
+  }
+  for (int32_t j = 0; j < cols; ++j) marker[j] = -1;
+  const int ra = a->rb, inner = a->cb, cb = b->cb;
+  const size_t abs = (size_t)(ra * inner), bbs = (size_t)(inner * cb), cbs = (size_t)(ra * cb);
+  block_multiply_add *multiply_add = multiply_add_for(ra, inner, cb);
+  int64_t at = 0;
+  for (int32_t r = 0; r < a->rows; ++r) {
+    const int32_t count = product_row_columns(a, b, r, marker, list);
+    for (int32_t q = 0; q < count; ++q) position[list[q]] = (int32_t)(at + q);
+    memcpy(c->col + at, list, sizeof(int32_t) * (size_t)count);
+    memset(c->values + cbs * (size_t)at, 0, sizeof(double) * cbs * (size_t)count);
+    for (int32_t k = a->row_start[r]; k < a->row_start[r + 1]; ++k) {
+      const double *ak = a->values + abs * (size_t)k;
+      const int32_t m = a->col[k];
+      for (int32_t l = b->row_start[m]; l < b->row_start[m + 1]; ++l) {
+        multiply_add(ak, b->values + bbs * (size_t)l, c->values + cbs * (size_t)position[b->col[l]],
+                     ra, inner, cb);
+      }
+    }
+    at += count;
+    c->row_start[r + 1] = (int32_t)at;
+  }
+  free(marker), free(list), free(position);
+  return PIOLA_OK;
+}
+
+piola_status piola__block_sparse_transpose(const piola__block_sparse *a, piola__block_sparse *t) {
+  const int64_t entries = piola__block_sparse_entries(a);
+  PIOLA_TRY(piola__block_sparse_alloc(t, a->cols, a->rows, a->cb, a->rb, entries));
+  memset(t->row_start, 0, sizeof(int32_t) * ((size_t)a->cols + 1));
+  for (int64_t k = 0; k < entries; ++k) t->row_start[a->col[k] + 1]++;
+  for (int32_t c = 0; c < a->cols; ++c) t->row_start[c + 1] += t->row_start[c];
+  int32_t *next = malloc(sizeof(int32_t) * (size_t)(a->cols > 0 ? a->cols : 1));
+  if (!next) {
+    piola__block_sparse_free(t);
+    return PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "sparse transpose: out of memory");
+  }
+  memcpy(next, t->row_start, sizeof(int32_t) * (size_t)a->cols);
+  const int rb = a->rb, cb = a->cb;
+  const size_t bs = (size_t)(rb * cb);
+  /* rows in order: each transposed row gets its columns increasing */
+  for (int32_t r = 0; r < a->rows; ++r)
+    for (int32_t k = a->row_start[r]; k < a->row_start[r + 1]; ++k) {
+      const int32_t at = next[a->col[k]]++;
+      t->col[at] = r;
+      const double *src = a->values + bs * (size_t)k;
+      double *dst = t->values + bs * (size_t)at;
+      for (int i = 0; i < rb; ++i)
+        for (int j = 0; j < cb; ++j) dst[rb * j + i] = src[cb * i + j];
+    }
+  free(next);
+  return PIOLA_OK;
+}
+
+void piola__block_sparse_symmetrize(piola__block_sparse *a) {
+  const int b = a->rb;
+  const size_t bs = (size_t)(b * b);
+  for (int32_t r = 0; r < a->rows; ++r)
+    for (int32_t k = a->row_start[r]; k < a->row_start[r + 1]; ++k) {
+      const int32_t c = a->col[k];
+      if (c < r) continue;
+      /* the entry (c, r): a binary search in row c */
+      int32_t lo = a->row_start[c], hi = a->row_start[c + 1];
+      while (lo < hi) {
+        const int32_t mid = lo + (hi - lo) / 2;
+        if (a->col[mid] < r)
+          lo = mid + 1;
+        else
+          hi = mid;
+      }
+      double *x = a->values + bs * (size_t)k, *y = a->values + bs * (size_t)lo;
+      for (int i = 0; i < b; ++i)
+        for (int j = 0; j < b; ++j) {
+          if (c == r && j <= i) continue;
+          const double mean = 0.5 * (x[b * i + j] + y[b * j + i]);
+          x[b * i + j] = y[b * j + i] = mean;
+        }
+    }
+}

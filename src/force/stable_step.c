@@ -47,9 +47,62 @@ STABLE_STEP_KERNEL double pair_modulus(double c, double pi, double pj, double fi
   return a + fabs(b + kij);
 }
 
+/* The extension a lane loop is compiled for (a compile-time constant there, like the model). */
+enum { STEP_EXTENSION_CLAMP = 0, STEP_EXTENSION_ENERGY = 1, STEP_EXTENSION_LINEAR = 2 };
+
+/* Increment of the LINEAR extension over the unextended stress, E(parts, d) - p, entry by entry. */
+STABLE_STEP_KERNEL void linear_increment(const piola_material *m, const material_parts *pa, double d0,
+                                         double d1, double d2, double e[3]) {
+  material_extend(m, KERNEL_FAST_RECIPROCAL, pa, d0, d1, d2, &e[0], &e[1], &e[2]);
+  for (int i = 0; i < 3; ++i) e[i] -= pa->p[i];
+}
+
+/* The LINEAR extension's slopes along the unclamped entries. Its stress depends on an
+ * unclamped entry f_u through the clamped point's p and K, which the extension multiplies by
+ * the clamped offsets (an unclamped row is p_i + sum_l K_il q(d_l), a clamped one carries
+ * its slopes times d_i): dP_i/df_u = K_iu + d(E_i - p_i)/df_u. The second term (third
+ * derivatives of the energy times the offsets) is taken by a forward difference of the
+ * extension's increment along each unclamped entry (three more evaluations of the clamped
+ * point, in this mode only; upward, so the entry stays unclamped); it is exactly zero when no
+ * entry is clamped, so the bound at rest is unchanged. Along a clamped entry l the slopes are
+ * closed forms: max(K_il, 0) into another clamped row, K_il q'(d_l) into an unclamped one
+ * (q' = (w / (w - d))^2, extension_saturation). The Jacobian has no potential where
+ * entries are clamped, so the plane-wave form takes its symmetric part. */
+STABLE_STEP_KERNEL void linear_extension_slopes(piola_material_model model, const piola_material *m,
+                                                const material_parts *pa, double fc0, double fc1,
+                                                double fc2, double d0, double d1, double d2,
+                                                double *k0, double *k1, double *k2, double *k01,
+                                                double *k02, double *k12) {
+  const double fc[3] = {fc0, fc1, fc2}, d[3] = {d0, d1, d2}, w = 0.25 * m->threshold;
+  double base[3], jac[3][3]; /* jac[i][u] = dP_i / df_u */
+  linear_increment(m, pa, d0, d1, d2, base);
+  for (int u = 0; u < 3; ++u) {
+    const double h = 1e-6 * kernel_max(fc[u], 1.0);
+    material_parts pu;
+    material_model_parts(model, m, KERNEL_FAST_RECIPROCAL, fc0 + (u == 0 ? h : 0.0),
+                         fc1 + (u == 1 ? h : 0.0), fc2 + (u == 2 ? h : 0.0), &pu);
+    double e[3];
+    linear_increment(m, &pu, d0, d1, d2, e);
+    const double dl = d[u], ql = w * kernel_recip_fast(w - dl), qprime = ql * ql;
+    for (int i = 0; i < 3; ++i) {
+      const double unclamped_column = pa->k[i][u] + (e[i] - base[i]) / h;
+      const double clamped_column = d[i] < 0.0 ? kernel_max(pa->k[i][u], 0.0) : pa->k[i][u] * qprime;
+      jac[i][u] = dl < 0.0 ? clamped_column : unclamped_column;
+    }
+  }
+  /* the diagonal of a clamped entry keeps the threshold bound above; an unclamped one's is
+   * the slope just taken */
+  *k0 = d0 < 0.0 ? *k0 : jac[0][0];
+  *k1 = d1 < 0.0 ? *k1 : jac[1][1];
+  *k2 = d2 < 0.0 ? *k2 : jac[2][2];
+  const int any = (d0 < 0.0) | (d1 < 0.0) | (d2 < 0.0);
+  *k01 = any ? 0.5 * (jac[0][1] + jac[1][0]) : *k01;
+  *k02 = any ? 0.5 * (jac[0][2] + jac[2][0]) : *k02;
+  *k12 = any ? 0.5 * (jac[1][2] + jac[2][1]) : *k12;
+}
+
 /* k of one tet of model MODEL with the stress extension of mode ENERGY (both compile-time
- * constants in the lane loops: 0 for the LINEAR and CLAMP stress extensions, 1 for
- * PIOLA_INVERSION_ENERGY). */
+ * constants in the lane loops: STEP_EXTENSION_CLAMP, _ENERGY or _LINEAR). */
 STABLE_STEP_KERNEL double model_modulus(piola_material_model model, int energy,
                                         const piola_material *m, double f0, double f1, double f2) {
   const double c = m->threshold;
@@ -59,7 +112,7 @@ STABLE_STEP_KERNEL double model_modulus(piola_material_model model, int energy,
   material_model_parts(model, m, KERNEL_FAST_RECIPROCAL, fc0, fc1, fc2, &pa);
   double p0, p1, p2, k0, k1, k2;
   double k01 = pa.k[0][1], k02 = pa.k[0][2], k12 = pa.k[1][2];
-  if (energy) {
+  if (energy == STEP_EXTENSION_ENERGY) {
     /* The energy extension (material_kernels.h) has no closed-form slopes worth writing out:
      * a clamped entry's diagonal is the extension's k, which grows with the other entries'
      * stretch (as its fourth power for the J models), and the unclamped entries' slopes and
@@ -91,6 +144,8 @@ STABLE_STEP_KERNEL double model_modulus(piola_material_model model, int energy,
     k0 = d0 < 0.0 ? kernel_max(pa.k[0][0], floor_slope + kernel_max(pa.p[0], 0.0) / c) : pa.k[0][0];
     k1 = d1 < 0.0 ? kernel_max(pa.k[1][1], floor_slope + kernel_max(pa.p[1], 0.0) / c) : pa.k[1][1];
     k2 = d2 < 0.0 ? kernel_max(pa.k[2][2], floor_slope + kernel_max(pa.p[2], 0.0) / c) : pa.k[2][2];
+    if (energy == STEP_EXTENSION_LINEAR)
+      linear_extension_slopes(model, m, &pa, fc0, fc1, fc2, d0, d1, d2, &k0, &k1, &k2, &k01, &k02, &k12);
   }
   double k = kernel_max(k0, kernel_max(k1, k2));
   k = kernel_max(k, pair_modulus(c, p0, p1, f0, f1, k0, k1, k01));
@@ -184,8 +239,11 @@ static double mode_modulus(int energy, const piola_material *m, double f0, doubl
 }
 
 static double material_modulus(const piola_material *m, double f0, double f1, double f2) {
-  return m->inversion_mode == PIOLA_INVERSION_ENERGY ? mode_modulus(1, m, f0, f1, f2)
-                                                     : mode_modulus(0, m, f0, f1, f2);
+  switch (m->inversion_mode) {
+    case PIOLA_INVERSION_ENERGY: return mode_modulus(STEP_EXTENSION_ENERGY, m, f0, f1, f2);
+    case PIOLA_INVERSION_LINEAR: return mode_modulus(STEP_EXTENSION_LINEAR, m, f0, f1, f2);
+    default: return mode_modulus(STEP_EXTENSION_CLAMP, m, f0, f1, f2);
+  }
 }
 
 double PIOLA_ISA_NAME(piola__elastic_body_tet_rest_altitude)(const piola_elastic_body *body, int32_t t) {
@@ -267,8 +325,8 @@ static double neohookean_range(piola_material_model model, int energy, const pio
   }                                                                                             \
   break;
 
-/* max over tets [begin, end) of w_e k_e, one material, its mode ENERGY a compile-time
- * constant */
+/* max over tets [begin, end) of w_e k_e, one material, its extension ENERGY (STEP_EXTENSION_*)
+ * a compile-time constant */
 STABLE_STEP_KERNEL double uniform_range_rate2(const piola_elastic_body *body, int energy,
                                               const piola_material *m, const double *f,
                                               const double *w, int32_t begin, int32_t end) {
@@ -304,8 +362,11 @@ static double range_rate2(const piola_elastic_body *body, const double *w, int32
   double best = 0;
   if (body->uniform_material >= 0) {
     const piola_material *m = &body->materials[body->uniform_material];
-    return m->inversion_mode == PIOLA_INVERSION_ENERGY ? uniform_range_rate2(body, 1, m, f, w, begin, end)
-                                                       : uniform_range_rate2(body, 0, m, f, w, begin, end);
+    switch (m->inversion_mode) {
+      case PIOLA_INVERSION_ENERGY: return uniform_range_rate2(body, STEP_EXTENSION_ENERGY, m, f, w, begin, end);
+      case PIOLA_INVERSION_LINEAR: return uniform_range_rate2(body, STEP_EXTENSION_LINEAR, m, f, w, begin, end);
+      default: return uniform_range_rate2(body, STEP_EXTENSION_CLAMP, m, f, w, begin, end);
+    }
   } else {
     for (int32_t t = begin; t < end; ++t) {
       const double r = w[t] * PIOLA_ISA_NAME(piola__elastic_body_tet_modulus)(body, t, f + 3 * t);

@@ -241,7 +241,9 @@ static double mode_modulus(int energy, const piola_material *m, double f0, doubl
 static double material_modulus(const piola_material *m, double f0, double f1, double f2) {
   switch (m->inversion_mode) {
     case PIOLA_INVERSION_ENERGY: return mode_modulus(STEP_EXTENSION_ENERGY, m, f0, f1, f2);
-    case PIOLA_INVERSION_LINEAR: return mode_modulus(STEP_EXTENSION_LINEAR, m, f0, f1, f2);
+    case PIOLA_INVERSION_LINEAR: /* with no entry clamped, the CLAMP numbers (linear_range) */
+      return mode_modulus(lane_unclamped(m, f0, f1, f2) ? STEP_EXTENSION_CLAMP : STEP_EXTENSION_LINEAR,
+                          m, f0, f1, f2);
     default: return mode_modulus(STEP_EXTENSION_CLAMP, m, f0, f1, f2);
   }
 }
@@ -318,7 +320,42 @@ static double neohookean_range(piola_material_model model, int energy, const pio
   return best;
 }
 
+/* LINEAR by blocks of PIOLA_TET_BLOCK: a block with no entry below the threshold takes the
+ * CLAMP instantiation, the same numbers there (the extension's terms vanish) without the
+ * LINEAR slopes' three extra evaluations of the clamped point (linear_extension_slopes). */
+STABLE_STEP_KERNEL double linear_range(piola_material_model model, const piola_material *m,
+                                       const double *f, const double *w, int32_t begin, int32_t end) {
+  double best = 0;
+  int32_t t = begin;
+  for (; t + PIOLA_TET_BLOCK <= end; t += PIOLA_TET_BLOCK) {
+    int plain = 1;
+#pragma omp simd reduction(&:plain)
+    for (int l = 0; l < PIOLA_TET_BLOCK; ++l)
+      plain &= lane_unclamped(m, f[3 * (t + l)], f[3 * (t + l) + 1], f[3 * (t + l) + 2]);
+    if (plain) {
+#pragma omp simd reduction(max:best)
+      for (int l = 0; l < PIOLA_TET_BLOCK; ++l) {
+        const double *fl = f + 3 * (t + l);
+        const double r = w[t + l] * model_modulus(model, STEP_EXTENSION_CLAMP, m, fl[0], fl[1], fl[2]);
+        best = r > best ? r : best;
+      }
+    } else {
+      for (int l = 0; l < PIOLA_TET_BLOCK; ++l) {
+        const double *fl = f + 3 * (t + l);
+        const double r = w[t + l] * model_modulus(model, STEP_EXTENSION_LINEAR, m, fl[0], fl[1], fl[2]);
+        best = r > best ? r : best;
+      }
+    }
+  }
+  for (; t < end; ++t) {
+    const double r = w[t] * model_modulus(model, STEP_EXTENSION_LINEAR, m, f[3 * t], f[3 * t + 1], f[3 * t + 2]);
+    best = r > best ? r : best;
+  }
+  return best;
+}
+
 #define MODEL_LANE_LOOP(model)                                                                  \
+  if (energy == STEP_EXTENSION_LINEAR) return linear_range(model, m, f, w, begin, end);         \
   _Pragma("omp simd reduction(max:best)") for (int32_t t = begin; t < end; ++t) {               \
     const double r = w[t] * model_modulus(model, energy, m, f[3 * t], f[3 * t + 1], f[3 * t + 2]); \
     best = r > best ? r : best;                                                                 \
@@ -340,8 +377,10 @@ STABLE_STEP_KERNEL double uniform_range_rate2(const piola_elastic_body *body, in
     case PIOLA_MODEL_HGO: /* the fibre term reads each tet's V and fibre: not a lane loop */
       for (int32_t t = begin; t < end; ++t) {
         const double *ft = f + 3 * t;
-        const double r = w[t] * (model_modulus(PIOLA_MODEL_HGO, energy, m, ft[0], ft[1], ft[2]) +
-                                 hgo_tet_fiber_modulus(body, m, t, ft));
+        const double k = energy == STEP_EXTENSION_LINEAR && lane_unclamped(m, ft[0], ft[1], ft[2])
+                             ? model_modulus(PIOLA_MODEL_HGO, STEP_EXTENSION_CLAMP, m, ft[0], ft[1], ft[2])
+                             : model_modulus(PIOLA_MODEL_HGO, energy, m, ft[0], ft[1], ft[2]);
+        const double r = w[t] * (k + hgo_tet_fiber_modulus(body, m, t, ft));
         best = r > best ? r : best;
       }
       break;

@@ -6,8 +6,9 @@
  * bounding box, E = 10 kPa, nu = 0.3, 1000 kg/m^3 (models with their own moduli scaled to the
  * same rest shear modulus; fibres along x), every vertex moved to one point, onto a line or
  * onto a plane, then 12 s of elastic and damping forces (beta = 1000, alpha = 300 Pa s),
- * symplectic Euler at half the simulator's state-aware step bound. Recovered: within 1e-3 m of
- * the rest shape after the best rigid alignment, every Fhat entry within 1e-3 of 1, nothing
+ * symplectic Euler at half the simulator's state-aware step bound and at most 1 / (1.1 c_max),
+ * c_max the largest damping rate of M^-1 D (recovery_runs.c). Recovered: within 1e-3 m of the
+ * rest shape after the best rigid alignment, every Fhat entry within 1e-3 of 1, nothing
  * inverted.
  *
  * usage: bench_collapse_recovery model mode|default threshold|default [mesh ...]

@@ -1,16 +1,7 @@
-/* Issue 21's acceptance runs with piola's own (explicit) integrator on real meshes from
+/* Issue 21's collapse acceptance runs with piola's own (explicit) integrator on real meshes from
  * ../shared/data, each moved and scaled to a 2 m bounding-box diagonal; E = 20 kPa,
  * nu = 0.3 (Ogden, Mooney-Rivlin and HGO given the same shear modulus), 1000 kg/m^3, shear and
  * bulk viscosity 1000 Pa s, zero gravity, one thread:
- *  - scrambles (every free node moved by a random point of a ball of the given radius) on
- *    unit_ball.mesh, octahedron.node and octopus-low.mesh (min dihedral angle 0.84 degrees,
- *    14% of tets with mean ratio < 0.1) run 2 s of simulated time (octopus-low 0.05 s: its
- *    slivers make 2 s too many steps for a test) with every step succeeding and a finite
- *    state: 0.5, 1 and 2 diagonals for neo-Hookean and rotated linear on all three, Ogden,
- *    Mooney-Rivlin and the muscle on the unit ball and the octahedron; corotated, StVK, the
- *    spline and Stable Neo-Hookean only half a diagonal on the unit ball, HGO not at all
- *    (their explicit runs are not affordable in a test, see docs/time-stepping.md
- *    "Recovery");
  *  - point, line and plane collapses of every model on unit_ball and octahedron reach a shape
  *    error (largest distance to the rest shape after the best rigid motion) below 1% of the
  *    diagonal within the settling time docs/time-stepping.md "Recovery" predicts from the
@@ -22,9 +13,11 @@
  *    collapses (it stayed at 17.5% and 12.6% of the diagonal at the predicted 3.1 s on the
  *    unit ball's line and the octahedron's point), HGO out of the octahedron (too slow for
  *    a test): docs/time-stepping.md "Recovery".
- * PIOLA_TEST_SCALE scales the scrambles' 2 s (at least 0.05 s); below 0.5 (the sanitizer
- * pass) it runs every third scramble for 0.02 s (octopus-low 0.002 s) and every ninth
- * collapse case, rotating through all of them. */
+ * The scrambles are tests/test_scrambles_every_model.c's (every model, three real meshes with
+ * slivers; it replaced the scramble runs that were here, on the unit ball, the octahedron and
+ * octopus-low's first 0.05 s).
+ * Below PIOLA_TEST_SCALE 0.5 (the sanitizer pass) it runs every ninth collapse case, rotating
+ * through all of them. */
 #include "test_support.h"
 
 #include <math.h>
@@ -36,46 +29,13 @@
 #include "piola/settling.h"
 #include "piola/threads.h"
 #include "piola/world.h"
+#include "real_mesh_scenes.h"
 
 #define DIAGONAL 2.0
 #define YOUNGS 2e4
 #define POISSON 0.3
 #define DENSITY 1000.0
 #define VISCOSITY 1000.0
-
-static piola_tet_mesh read_scaled(const char *relative) {
-  piola_tet_mesh mesh;
-  memset(&mesh, 0, sizeof mesh);
-  const char *path = test_data_path(relative);
-  if (piola_tet_mesh_read(path, &mesh) != PIOLA_OK) fail_msg("%s: %s", path, piola_last_error());
-  double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
-  for (int32_t v = 0; v < mesh.vertex_count; ++v)
-    for (int i = 0; i < 3; ++i)
-      lo[i] = fmin(lo[i], mesh.positions[3 * v + i]), hi[i] = fmax(hi[i], mesh.positions[3 * v + i]);
-  double d = sqrt((hi[0] - lo[0]) * (hi[0] - lo[0]) + (hi[1] - lo[1]) * (hi[1] - lo[1]) +
-                  (hi[2] - lo[2]) * (hi[2] - lo[2]));
-  for (int32_t v = 0; v < mesh.vertex_count; ++v)
-    for (int i = 0; i < 3; ++i)
-      mesh.positions[3 * v + i] = (mesh.positions[3 * v + i] - 0.5 * (lo[i] + hi[i])) * DIAGONAL / d;
-  return mesh;
-}
-
-/* E = 20 kPa and nu = 0.3 for every model: the models with their own parameters get the
- * same shear modulus mu = E / (2 (1 + nu)) (Ogden's default terms scaled, Mooney-Rivlin
- * with C10 = 3 C01, HGO's matrix), so that the settling time predicted from E holds. */
-static piola_material_def material_def(piola_material_model model) {
-  piola_material_def def = piola_default_material_def();
-  const double mu = YOUNGS / (2 * (1 + POISSON));
-  def.model = model;
-  def.youngs_modulus = YOUNGS;
-  def.poisson_ratio = POISSON;
-  double ogden_mu = 0;
-  for (int p = 0; p < def.ogden.term_count; ++p) ogden_mu += 0.5 * def.ogden.mu[p] * def.ogden.alpha[p];
-  for (int p = 0; p < def.ogden.term_count; ++p) def.ogden.mu[p] *= mu / ogden_mu;
-  def.mooney_rivlin.c10 = 0.375 * mu, def.mooney_rivlin.c01 = 0.125 * mu;
-  def.hgo.mu = mu;
-  return def;
-}
 
 static piola_world *make_world_integrated(const piola_tet_mesh *mesh, piola_material_model model,
                                           piola_mat3 start, double scramble, double viscosity,
@@ -87,7 +47,7 @@ static piola_world *make_world_integrated(const piola_tet_mesh *mesh, piola_mate
   assert_int_equal(piola_world_create(&wd, &w), PIOLA_OK);
   piola_solid_def sd = piola_default_solid_def();
   sd.mesh = mesh;
-  sd.material = material_def(model);
+  sd.material = real_mesh_material_def(model, YOUNGS, POISSON);
   sd.density = DENSITY;
   sd.shear_viscosity = sd.bulk_viscosity = piola_track_constant(viscosity);
   sd.initial_matrix = start;
@@ -99,69 +59,6 @@ static piola_world *make_world_integrated(const piola_tet_mesh *mesh, piola_mate
 static piola_world *make_world(const piola_tet_mesh *mesh, piola_material_model model,
                                piola_mat3 start, double scramble) {
   return make_world_integrated(mesh, model, start, scramble, VISCOSITY, PIOLA_INTEGRATOR_NEWMARK);
-}
-
-static int state_finite(const piola_world *w) {
-  const int32_t n = piola_elastic_body_vertex_count(piola_world_solid_body(w, 0));
-  const double *x = piola_world_solid_positions(w, 0), *v = piola_world_solid_velocities(w, 0);
-  for (int64_t j = 0; j < 3 * (int64_t)n; ++j)
-    if (!isfinite(x[j]) || !isfinite(v[j])) return 0;
-  return 1;
-}
-
-/* Every model but HGO (docs/materials.md); muscle with the default fibre-less body, its
- * passive fibre modulus in the bound. */
-static const piola_material_model scramble_models[] = {
-    PIOLA_MODEL_ROTATED_LINEAR, PIOLA_MODEL_COROTATED, PIOLA_MODEL_STVK, PIOLA_MODEL_NEOHOOKEAN,
-    PIOLA_MODEL_SPLINE, PIOLA_MODEL_STABLE_NEOHOOKEAN, PIOLA_MODEL_OGDEN,
-    PIOLA_MODEL_MOONEY_RIVLIN, PIOLA_MODEL_MUSCLE};
-enum { SCRAMBLE_MODELS = sizeof scramble_models / sizeof scramble_models[0] };
-
-static void scrambles_run_to_the_end(void **state) {
-  (void)state;
-  static const char *const meshes[] = {"medit/unit_ball.mesh", "tetgen/octahedron.node",
-                                       "medit/octopus-low.mesh"};
-  /* at reduced scale (the sanitizer pass) only every third case, rotating through them, for
-   * 0.02 s (octopus-low 0.002 s: its sliver-bound steps are most of the cost) */
-  const int reduced = test_scale() < 0.5, stride = reduced ? 3 : 1;
-  const double seconds = reduced ? 0.02 : fmax(0.05, 2.0 * test_scale());
-  const piola_mat3 identity = {{{1, 0, 0}, {0, 1, 0}, {0, 0, 1}}};
-  int index = 0;
-  for (int mi = 0; mi < 3; ++mi) {
-    piola_tet_mesh mesh = read_scaled(meshes[mi]);
-    for (int k = 0; k < SCRAMBLE_MODELS; ++k)
-      for (int r = 0; r < 3; ++r) {
-        const piola_material_model model = scramble_models[k];
-        /* corotated, StVK, the spline and Stable Neo-Hookean stiffen without limit under
-         * stretch (their volume terms with up to the fourth power of it): their stable step
-         * in these starts is 1e-2 to 1e-5 of the rest one (docs/time-stepping.md
-         * "Recovery"), affordable here only for half a diagonal on the unit ball. The
-         * others' stay within ~50 times the rest modulus. */
-        const int bounded = model == PIOLA_MODEL_NEOHOOKEAN || model == PIOLA_MODEL_ROTATED_LINEAR ||
-                            model == PIOLA_MODEL_OGDEN || model == PIOLA_MODEL_MOONEY_RIVLIN ||
-                            model == PIOLA_MODEL_MUSCLE;
-        if (!bounded && (r > 0 || mi > 0)) continue;
-        /* octopus-low's runs are the dearest (its slivers): the paper's bounded models only */
-        if (mi == 2 && model != PIOLA_MODEL_NEOHOOKEAN && model != PIOLA_MODEL_ROTATED_LINEAR) continue;
-        if ((index++ + mi) % stride) continue; /* a different radius on each mesh */
-        const double radius = (r == 0 ? 0.5 : r == 1 ? 1.0 : 2.0) * DIAGONAL;
-        piola_world *w = make_world(&mesh, model, identity, radius);
-        piola_step_stats st = {0};
-        /* octopus-low's slivers hold the step near 8e-6 s: 2 s there are 250,000 steps a
-         * case (over a minute each on the test machine), so it runs the first 0.05 s, the
-         * violent part of a scramble where the rest-state step blew up */
-        const double run = mi == 2 ? fmin(seconds, reduced ? 0.002 : 0.05) : seconds;
-        if (piola_world_advance_to(w, run, &st) != PIOLA_OK || !state_finite(w))
-          fail_msg("%s, %s, scramble %g m: %s", meshes[mi], piola_material_model_name(model),
-                   radius, piola_last_error());
-        if (getenv("PIOLA_TEST_VERBOSE"))
-          print_message("%s %s scramble %g m: %d steps, %d energy redos\n", meshes[mi],
-                        piola_material_model_name(model), radius, (int)st.substeps,
-                        (int)st.energy_redos);
-        piola_world_destroy(w);
-      }
-    piola_tet_mesh_free(&mesh);
-  }
 }
 
 /* Largest distance (m) of a vertex with mass from the rest shape after the best rigid motion
@@ -229,7 +126,7 @@ static void collapses_settle_in_the_predicted_time(void **state) {
   const int stride = test_scale() < 0.5 ? 9 : 1;
   int index = 0, failures = 0;
   for (int mi = 0; mi < 2; ++mi) {
-    piola_tet_mesh mesh = read_scaled(meshes[mi]);
+    piola_tet_mesh mesh = real_mesh_scaled(meshes[mi], DIAGONAL);
     for (int si = 0; si < 3; ++si)
       for (int k = 0; k < COLLAPSE_MODELS; ++k, ++index) {
         const piola_material_model model = collapse_models[k];
@@ -279,7 +176,7 @@ static void armadillo_collapses_settle_in_the_predicted_time(void **state) {
   static const piola_material_model models[2] = {PIOLA_MODEL_COROTATED, PIOLA_MODEL_NEOHOOKEAN};
   const int reduced = test_scale() < 0.5;
   const double eps = 0.01 * DIAGONAL, mu = YOUNGS / (2 * (1 + POISSON));
-  piola_tet_mesh mesh = read_scaled("tetgen/armadillo_4k.node");
+  piola_tet_mesh mesh = real_mesh_scaled("tetgen/armadillo_4k.node", DIAGONAL);
   const piola_mat3 identity = {{{1, 0, 0}, {0, 1, 0}, {0, 0, 1}}};
   /* the recommended viscosity: c_1 is linear in beta (shear = bulk) */
   piola_world *w = make_world(&mesh, PIOLA_MODEL_COROTATED, identity, 0);
@@ -333,7 +230,6 @@ int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(collapses_settle_in_the_predicted_time),
       cmocka_unit_test(armadillo_collapses_settle_in_the_predicted_time),
-      cmocka_unit_test(scrambles_run_to_the_end),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
 }

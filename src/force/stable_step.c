@@ -47,10 +47,63 @@ STABLE_STEP_KERNEL double pair_modulus(double c, double pi, double pj, double fi
   return a + fabs(b + kij);
 }
 
+/* The extension a lane loop is compiled for (a compile-time constant there, like the model). */
+enum { STEP_EXTENSION_CLAMP = 0, STEP_EXTENSION_ENERGY = 1, STEP_EXTENSION_LINEAR = 2 };
+
+/* Increment of the LINEAR extension over the unextended stress, E(parts, d) - p, entry by entry. */
+STABLE_STEP_KERNEL void linear_increment(const piola_material *m, const material_parts *pa, double d0,
+                                         double d1, double d2, double e[3]) {
+  material_extend(m, KERNEL_FAST_RECIPROCAL, pa, d0, d1, d2, &e[0], &e[1], &e[2]);
+  for (int i = 0; i < 3; ++i) e[i] -= pa->p[i];
+}
+
+/* The LINEAR extension's slopes along the unclamped entries. Its stress depends on an
+ * unclamped entry f_u through the clamped point's p and K, which the extension multiplies by
+ * the clamped offsets (an unclamped row is p_i + sum_l K_il q(d_l), a clamped one carries
+ * its slopes times d_i): dP_i/df_u = K_iu + d(E_i - p_i)/df_u. The second term (third
+ * derivatives of the energy times the offsets) is taken by a forward difference of the
+ * extension's increment along each unclamped entry (three more evaluations of the clamped
+ * point, in this mode only; upward, so the entry stays unclamped); it is exactly zero when no
+ * entry is clamped, so the bound at rest is unchanged. Along a clamped entry l the slopes are
+ * closed forms: max(K_il, 0) into another clamped row, K_il q'(d_l) into an unclamped one
+ * (q' = (w / (w - d))^2, extension_saturation). The Jacobian has no potential where
+ * entries are clamped, so the plane-wave form takes its symmetric part. */
+STABLE_STEP_KERNEL void linear_extension_slopes(piola_material_model model, const piola_material *m,
+                                                const material_parts *pa, double fc0, double fc1,
+                                                double fc2, double d0, double d1, double d2,
+                                                double *k0, double *k1, double *k2, double *k01,
+                                                double *k02, double *k12) {
+  const double fc[3] = {fc0, fc1, fc2}, d[3] = {d0, d1, d2}, w = 0.25 * m->threshold;
+  double base[3], jac[3][3]; /* jac[i][u] = dP_i / df_u */
+  linear_increment(m, pa, d0, d1, d2, base);
+  for (int u = 0; u < 3; ++u) {
+    const double h = 1e-6 * kernel_max(fc[u], 1.0);
+    material_parts pu;
+    material_model_parts(model, m, KERNEL_FAST_RECIPROCAL, fc0 + (u == 0 ? h : 0.0),
+                         fc1 + (u == 1 ? h : 0.0), fc2 + (u == 2 ? h : 0.0), &pu);
+    double e[3];
+    linear_increment(m, &pu, d0, d1, d2, e);
+    const double dl = d[u], ql = w * kernel_recip_fast(w - dl), qprime = ql * ql;
+    for (int i = 0; i < 3; ++i) {
+      const double unclamped_column = pa->k[i][u] + (e[i] - base[i]) / h;
+      const double clamped_column = d[i] < 0.0 ? kernel_max(pa->k[i][u], 0.0) : pa->k[i][u] * qprime;
+      jac[i][u] = dl < 0.0 ? clamped_column : unclamped_column;
+    }
+  }
+  /* the diagonal of a clamped entry keeps the threshold bound above; an unclamped one's is
+   * the slope just taken */
+  *k0 = d0 < 0.0 ? *k0 : jac[0][0];
+  *k1 = d1 < 0.0 ? *k1 : jac[1][1];
+  *k2 = d2 < 0.0 ? *k2 : jac[2][2];
+  const int any = (d0 < 0.0) | (d1 < 0.0) | (d2 < 0.0);
+  *k01 = any ? 0.5 * (jac[0][1] + jac[1][0]) : *k01;
+  *k02 = any ? 0.5 * (jac[0][2] + jac[2][0]) : *k02;
+  *k12 = any ? 0.5 * (jac[1][2] + jac[2][1]) : *k12;
+}
+
 /* k of one tet of model MODEL with the stress extension of mode ENERGY (both compile-time
- * constants in the lane loops: 0 for the LINEAR and CLAMP stress extensions, 1 for
- * PIOLA_INVERSION_ENERGY); the model's parts at the clamped point are GIVEN (the Ogden
- * models' cache) or, when it is NULL, computed. */
+ * constants in the lane loops: STEP_EXTENSION_CLAMP, _ENERGY or _LINEAR); the model's parts at
+ * the clamped point are GIVEN (the Ogden models' cache) or, when it is NULL, computed. */
 STABLE_STEP_KERNEL double model_modulus_from(piola_material_model model, int energy,
                                              const piola_material *m, double f0, double f1,
                                              double f2, const material_parts *given) {
@@ -62,7 +115,7 @@ STABLE_STEP_KERNEL double model_modulus_from(piola_material_model model, int ene
   else material_model_parts(model, m, KERNEL_FAST_RECIPROCAL, fc0, fc1, fc2, &pa);
   double p0, p1, p2, k0, k1, k2;
   double k01 = pa.k[0][1], k02 = pa.k[0][2], k12 = pa.k[1][2];
-  if (energy) {
+  if (energy == STEP_EXTENSION_ENERGY) {
     /* The energy extension (material_kernels.h) has no closed-form slopes worth writing out:
      * a clamped entry's diagonal is the extension's k, which grows with the other entries'
      * stretch (as its fourth power for the J models), and the unclamped entries' slopes and
@@ -94,6 +147,8 @@ STABLE_STEP_KERNEL double model_modulus_from(piola_material_model model, int ene
     k0 = d0 < 0.0 ? kernel_max(pa.k[0][0], floor_slope + kernel_max(pa.p[0], 0.0) / c) : pa.k[0][0];
     k1 = d1 < 0.0 ? kernel_max(pa.k[1][1], floor_slope + kernel_max(pa.p[1], 0.0) / c) : pa.k[1][1];
     k2 = d2 < 0.0 ? kernel_max(pa.k[2][2], floor_slope + kernel_max(pa.p[2], 0.0) / c) : pa.k[2][2];
+    if (energy == STEP_EXTENSION_LINEAR)
+      linear_extension_slopes(model, m, &pa, fc0, fc1, fc2, d0, d1, d2, &k0, &k1, &k2, &k01, &k02, &k12);
   }
   double k = kernel_max(k0, kernel_max(k1, k2));
   k = kernel_max(k, pair_modulus(c, p0, p1, f0, f1, k0, k1, k01));
@@ -192,8 +247,13 @@ static double mode_modulus(int energy, const piola_material *m, double f0, doubl
 }
 
 static double material_modulus(const piola_material *m, double f0, double f1, double f2) {
-  return m->inversion_mode == PIOLA_INVERSION_ENERGY ? mode_modulus(1, m, f0, f1, f2)
-                                                     : mode_modulus(0, m, f0, f1, f2);
+  switch (m->inversion_mode) {
+    case PIOLA_INVERSION_ENERGY: return mode_modulus(STEP_EXTENSION_ENERGY, m, f0, f1, f2);
+    case PIOLA_INVERSION_LINEAR: /* with no entry clamped, the CLAMP numbers (linear_range) */
+      return mode_modulus(lane_unclamped(m, f0, f1, f2) ? STEP_EXTENSION_CLAMP : STEP_EXTENSION_LINEAR,
+                          m, f0, f1, f2);
+    default: return mode_modulus(STEP_EXTENSION_CLAMP, m, f0, f1, f2);
+  }
 }
 
 double PIOLA_ISA_NAME(piola__elastic_body_tet_rest_altitude)(const piola_elastic_body *body, int32_t t) {
@@ -268,55 +328,97 @@ static double neohookean_range(piola_material_model model, int energy, const pio
   return best;
 }
 
-/* Ogden and Mooney-Rivlin (LINEAR or CLAMP) by blocks of PIOLA_TET_BLOCK: the parts at the
- * clamped point from the force loop's cache when it holds every lane's Fhat (no pow here),
- * else computed. */
-static double ogden_range(const piola_elastic_body *body, const piola_material *m,
+/* Ogden and Mooney-Rivlin (LINEAR or CLAMP: ENERGY is STEP_EXTENSION_LINEAR or _CLAMP) by
+ * blocks of PIOLA_TET_BLOCK: the parts at the clamped point from the force loop's cache when it
+ * holds every lane's Fhat (no pow here), else computed; a LINEAR block with an entry past the
+ * threshold takes the LINEAR slopes (linear_extension_slopes, which evaluate the clamped point
+ * again), one with none the CLAMP numbers, as linear_range. */
+static double ogden_range(const piola_elastic_body *body, int energy, const piola_material *m,
                           const double *f, const double *w, int32_t begin, int32_t end) {
   const double *cache = body->ogden_cache, c = m->threshold;
   const long stride = body->padded_tet_count;
   double best = 0;
   int32_t t = begin;
   for (; t + PIOLA_TET_BLOCK <= end; t += PIOLA_TET_BLOCK) {
-    int held = 1;
-#pragma omp simd reduction(&:held)
-    for (int l = 0; l < PIOLA_TET_BLOCK; ++l)
-      held &= ogden_cache_holds(cache + t + l, stride, f[3 * (t + l)], f[3 * (t + l) + 1], f[3 * (t + l) + 2]);
+    int held = 1, plain = 1;
+#pragma omp simd reduction(&:held, plain)
+    for (int l = 0; l < PIOLA_TET_BLOCK; ++l) {
+      const double *fl = f + 3 * (t + l);
+      held &= ogden_cache_holds(cache + t + l, stride, fl[0], fl[1], fl[2]);
+      plain &= lane_unclamped(m, fl[0], fl[1], fl[2]);
+    }
+    const int ext = energy == STEP_EXTENSION_LINEAR && !plain ? STEP_EXTENSION_LINEAR : STEP_EXTENSION_CLAMP;
     if (held) {
-#pragma omp simd reduction(max:best)
       for (int l = 0; l < PIOLA_TET_BLOCK; ++l) {
         const double *fl = f + 3 * (t + l);
         material_parts pa;
         ogden_cached_parts(m, cache + t + l, stride, kernel_max(fl[0], c), kernel_max(fl[1], c),
                            kernel_max(fl[2], c), &pa);
-        const double r = w[t + l] * model_modulus_from(PIOLA_MODEL_OGDEN, 0, m, fl[0], fl[1], fl[2], &pa);
+        const double r = w[t + l] * model_modulus_from(PIOLA_MODEL_OGDEN, ext, m, fl[0], fl[1], fl[2], &pa);
         best = r > best ? r : best;
       }
     } else {
-#pragma omp simd reduction(max:best)
       for (int l = 0; l < PIOLA_TET_BLOCK; ++l) {
         const double *fl = f + 3 * (t + l);
-        const double r = w[t + l] * model_modulus(PIOLA_MODEL_OGDEN, 0, m, fl[0], fl[1], fl[2]);
+        const double r = w[t + l] * model_modulus(PIOLA_MODEL_OGDEN, ext, m, fl[0], fl[1], fl[2]);
         best = r > best ? r : best;
       }
     }
   }
   for (; t < end; ++t) {
-    const double r = w[t] * model_modulus(PIOLA_MODEL_OGDEN, 0, m, f[3 * t], f[3 * t + 1], f[3 * t + 2]);
+    const double *ft = f + 3 * t;
+    const int ext = energy == STEP_EXTENSION_LINEAR && !lane_unclamped(m, ft[0], ft[1], ft[2])
+                        ? STEP_EXTENSION_LINEAR : STEP_EXTENSION_CLAMP;
+    const double r = w[t] * model_modulus(PIOLA_MODEL_OGDEN, ext, m, ft[0], ft[1], ft[2]);
+    best = r > best ? r : best;
+  }
+  return best;
+}
+
+/* LINEAR by blocks of PIOLA_TET_BLOCK: a block with no entry below the threshold takes the
+ * CLAMP instantiation, the same numbers there (the extension's terms vanish) without the
+ * LINEAR slopes' three extra evaluations of the clamped point (linear_extension_slopes). */
+STABLE_STEP_KERNEL double linear_range(piola_material_model model, const piola_material *m,
+                                       const double *f, const double *w, int32_t begin, int32_t end) {
+  double best = 0;
+  int32_t t = begin;
+  for (; t + PIOLA_TET_BLOCK <= end; t += PIOLA_TET_BLOCK) {
+    int plain = 1;
+#pragma omp simd reduction(&:plain)
+    for (int l = 0; l < PIOLA_TET_BLOCK; ++l)
+      plain &= lane_unclamped(m, f[3 * (t + l)], f[3 * (t + l) + 1], f[3 * (t + l) + 2]);
+    if (plain) {
+#pragma omp simd reduction(max:best)
+      for (int l = 0; l < PIOLA_TET_BLOCK; ++l) {
+        const double *fl = f + 3 * (t + l);
+        const double r = w[t + l] * model_modulus(model, STEP_EXTENSION_CLAMP, m, fl[0], fl[1], fl[2]);
+        best = r > best ? r : best;
+      }
+    } else {
+      for (int l = 0; l < PIOLA_TET_BLOCK; ++l) {
+        const double *fl = f + 3 * (t + l);
+        const double r = w[t + l] * model_modulus(model, STEP_EXTENSION_LINEAR, m, fl[0], fl[1], fl[2]);
+        best = r > best ? r : best;
+      }
+    }
+  }
+  for (; t < end; ++t) {
+    const double r = w[t] * model_modulus(model, STEP_EXTENSION_LINEAR, m, f[3 * t], f[3 * t + 1], f[3 * t + 2]);
     best = r > best ? r : best;
   }
   return best;
 }
 
 #define MODEL_LANE_LOOP(model)                                                                  \
+  if (energy == STEP_EXTENSION_LINEAR) return linear_range(model, m, f, w, begin, end);         \
   _Pragma("omp simd reduction(max:best)") for (int32_t t = begin; t < end; ++t) {               \
     const double r = w[t] * model_modulus(model, energy, m, f[3 * t], f[3 * t + 1], f[3 * t + 2]); \
     best = r > best ? r : best;                                                                 \
   }                                                                                             \
   break;
 
-/* max over tets [begin, end) of w_e k_e, one material, its mode ENERGY a compile-time
- * constant */
+/* max over tets [begin, end) of w_e k_e, one material, its extension ENERGY (STEP_EXTENSION_*)
+ * a compile-time constant */
 STABLE_STEP_KERNEL double uniform_range_rate2(const piola_elastic_body *body, int energy,
                                               const piola_material *m, const double *f,
                                               const double *w, int32_t begin, int32_t end) {
@@ -330,8 +432,10 @@ STABLE_STEP_KERNEL double uniform_range_rate2(const piola_elastic_body *body, in
     case PIOLA_MODEL_HGO: /* the fibre term reads each tet's V and fibre: not a lane loop */
       for (int32_t t = begin; t < end; ++t) {
         const double *ft = f + 3 * t;
-        const double r = w[t] * (model_modulus(PIOLA_MODEL_HGO, energy, m, ft[0], ft[1], ft[2]) +
-                                 hgo_tet_fiber_modulus(body, m, t, ft));
+        const double k = energy == STEP_EXTENSION_LINEAR && lane_unclamped(m, ft[0], ft[1], ft[2])
+                             ? model_modulus(PIOLA_MODEL_HGO, STEP_EXTENSION_CLAMP, m, ft[0], ft[1], ft[2])
+                             : model_modulus(PIOLA_MODEL_HGO, energy, m, ft[0], ft[1], ft[2]);
+        const double r = w[t] * (k + hgo_tet_fiber_modulus(body, m, t, ft));
         best = r > best ? r : best;
       }
       break;
@@ -339,7 +443,8 @@ STABLE_STEP_KERNEL double uniform_range_rate2(const piola_elastic_body *body, in
     case PIOLA_MODEL_STABLE_NEOHOOKEAN: MODEL_LANE_LOOP(PIOLA_MODEL_STABLE_NEOHOOKEAN)
     case PIOLA_MODEL_MOONEY_RIVLIN: /* stored as two Ogden terms */
     case PIOLA_MODEL_OGDEN:
-      if (!energy && body->ogden_cache) return ogden_range(body, m, f, w, begin, end);
+      if (energy != STEP_EXTENSION_ENERGY && body->ogden_cache)
+        return ogden_range(body, energy, m, f, w, begin, end);
       MODEL_LANE_LOOP(PIOLA_MODEL_OGDEN)
     case PIOLA_MODEL_ROTATED_LINEAR: MODEL_LANE_LOOP(PIOLA_MODEL_ROTATED_LINEAR)
     default: abort(); /* every model has its case (material_modulus) */
@@ -354,8 +459,11 @@ static double range_rate2(const piola_elastic_body *body, const double *w, int32
   double best = 0;
   if (body->uniform_material >= 0) {
     const piola_material *m = &body->materials[body->uniform_material];
-    return m->inversion_mode == PIOLA_INVERSION_ENERGY ? uniform_range_rate2(body, 1, m, f, w, begin, end)
-                                                       : uniform_range_rate2(body, 0, m, f, w, begin, end);
+    switch (m->inversion_mode) {
+      case PIOLA_INVERSION_ENERGY: return uniform_range_rate2(body, STEP_EXTENSION_ENERGY, m, f, w, begin, end);
+      case PIOLA_INVERSION_LINEAR: return uniform_range_rate2(body, STEP_EXTENSION_LINEAR, m, f, w, begin, end);
+      default: return uniform_range_rate2(body, STEP_EXTENSION_CLAMP, m, f, w, begin, end);
+    }
   } else {
     for (int32_t t = begin; t < end; ++t) {
       const double r = w[t] * PIOLA_ISA_NAME(piola__elastic_body_tet_modulus)(body, t, f + 3 * t);

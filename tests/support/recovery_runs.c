@@ -78,6 +78,49 @@ static piola_elastic_body *make_body(const piola_tet_mesh *mesh, const piola_mat
   return body;
 }
 
+/* The explicit damping step of the runs below: symplectic Euler with the damping force taken
+ * explicitly is stable for a mode of damping rate c and frequency omega while
+ * c dt < 2 - (omega dt)^2 / 2, so dt is held to 1 / c_max, c_max the largest eigenvalue of
+ * M^-1 D at rest (power iteration in the M inner product, 10% added for its convergence from
+ * below and for the damping's change with the current rotations, a few percent): then every
+ * state with omega dt < sqrt(2) is stable, twice the margin of the half state-aware bound.
+ * The estimate 0.25 rho h^2 / (beta + alpha) from the smallest altitude alone is not a bound:
+ * on vega/beam3_tet.veg it gave c dt = 2.11, and every collapse diverged after a few hundred
+ * to a few thousand steps (docs/materials.md, "A second real mesh"). */
+static double damping_step(piola_elastic_body *body, double beta, double alpha, double density) {
+  const int32_t nv = piola_elastic_body_vertex_count(body);
+  const double *mass = piola_elastic_body_masses(body), *rest = piola_elastic_body_rest_positions(body);
+  const double h = piola_elastic_body_min_rest_altitude(body);
+  const double estimate = 0.25 * density * h * h / (beta + alpha);
+  double *v = malloc(sizeof(double) * 3 * (size_t)nv), *f = malloc(sizeof(double) * 3 * (size_t)nv);
+  double c = 0.0;
+  if (v && f && piola_elastic_body_update(body, rest, 1.0, f, NULL) == PIOLA_OK) {
+    uint64_t state = 0x2545F4914F6CDD1Dull;
+    for (int32_t i = 0; i < 3 * nv; ++i) {
+      state ^= state << 13, state ^= state >> 7, state ^= state << 17;
+      v[i] = mass[i / 3] > 0 ? (double)(state >> 11) * (1.0 / 9007199254740992.0) - 0.5 : 0.0;
+    }
+    for (int it = 0; it < 200; ++it) {
+      piola_elastic_body_damping_forces(body, v, beta, alpha, f);
+      double vmv = 0.0, vdv = 0.0, next = 0.0;
+      for (int32_t i = 0; i < 3 * nv; ++i) {
+        const double m = mass[i / 3];
+        if (!(m > 0)) continue;
+        vmv += m * v[i] * v[i];
+        vdv -= v[i] * f[i];
+        f[i] = -f[i] / m;
+        next += m * f[i] * f[i];
+      }
+      c = vmv > 0 ? vdv / vmv : 0.0;
+      if (!(next > 0)) break;
+      for (int32_t i = 0; i < 3 * nv; ++i) v[i] = mass[i / 3] > 0 ? f[i] / sqrt(next) : 0.0;
+    }
+  }
+  free(v);
+  free(f);
+  return c > 0 ? fmin(estimate, 1.0 / (1.1 * c)) : estimate;
+}
+
 static uint64_t xorshift(uint64_t *s) {
   uint64_t x = *s;
   x ^= x << 13;
@@ -215,17 +258,18 @@ double recovery_procrustes_error(const double *x, const double *rest, const doub
   return worst;
 }
 
+double recovery_collapse_seconds = 12.0;
+
 recovery_collapse_outcome recovery_collapse_run(const piola_tet_mesh *mesh,
                                                 const piola_material *material,
                                                 recovery_collapse_kind kind) {
-  recovery_collapse_outcome out = {RECOVERY_DIVERGED, INFINITY, INFINITY, 0, 0};
+  recovery_collapse_outcome out = {RECOVERY_DIVERGED, INFINITY, INFINITY, 0, 0, NAN, NAN};
   piola_elastic_body *body = make_body(mesh, material);
   if (!body) return out;
   const int32_t nv = piola_elastic_body_vertex_count(body), nt = piola_elastic_body_tet_count(body);
   const double *mass = piola_elastic_body_masses(body), *rest = piola_elastic_body_rest_positions(body);
   const double beta = 1000.0, alpha = 300.0, density = 1000.0; /* Pa s, Pa s, kg/m^3 */
-  const double h = piola_elastic_body_min_rest_altitude(body);
-  const double dt_damping = 0.25 * density * h * h / (beta + alpha);
+  const double dt_damping = damping_step(body, beta, alpha, density);
   double *x = malloc(sizeof(double) * 3 * (size_t)nv), *v = calloc(3 * (size_t)nv, sizeof(double));
   double *fe = malloc(sizeof(double) * 3 * (size_t)nv), *fd = malloc(sizeof(double) * 3 * (size_t)nv);
   if (x && v && fe && fd) {
@@ -237,8 +281,10 @@ recovery_collapse_outcome recovery_collapse_run(const piola_tet_mesh *mesh,
       q[2] = 0.1;
     }
     int finite = 1, s = 0;
-    for (double t = 0; t < 12.0 && finite; ++s) {
-      finite = piola_elastic_body_update(body, x, 1.0, fe, NULL) == PIOLA_OK;
+    for (double t = 0; t < recovery_collapse_seconds && finite; ++s) {
+      piola_elastic_stats start;
+      finite = piola_elastic_body_update(body, x, 1.0, fe, s == 0 ? &start : NULL) == PIOLA_OK;
+      if (s == 0 && finite) out.start_energy = start.elastic_energy;
       /* the simulator's own state-aware bound (docs/time-stepping.md) at half its CFL number */
       const double dt = fmin(dt_damping, 0.5 / sqrt(piola__elastic_body_state_rate2(body, NULL)));
       t += dt;
@@ -257,6 +303,7 @@ recovery_collapse_outcome recovery_collapse_run(const piola_tet_mesh *mesh,
       out.fhat_error = 0.0;
       for (int32_t t = 0; t < 3 * nt; ++t) out.fhat_error = fmax(out.fhat_error, fabs(fhat[t] - 1.0));
       out.inverted = stats.inverted_count;
+      out.end_energy = stats.elastic_energy;
       double smallest = INFINITY;
       for (int32_t t = 0; t < 3 * nt; ++t) smallest = fmin(smallest, fhat[t]);
       if (out.position_error <= 1e-3 && out.fhat_error <= 1e-3 && out.inverted == 0)

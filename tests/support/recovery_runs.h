@@ -71,7 +71,11 @@ typedef struct recovery_collapse_outcome {
   double fhat_error;     /* max |fhat - 1| */
   int32_t inverted;      /* inverted tets at the end */
   int steps;
+  double start_energy, end_energy; /* J: elastic energy of the collapsed start and at the end */
 } recovery_collapse_outcome;
+
+/* Simulated time of a collapse run (s): 12, the protocol's; a test may take a shorter one. */
+extern double recovery_collapse_seconds;
 
 /* Collapses `mesh` (a unit mesh) and runs the collapse protocol with `material`. Recovered:
  * position error <= 1e-3 m, max |fhat - 1| <= 1e-3, nothing inverted. */

@@ -19,6 +19,8 @@ packages=(
   ffmpeg
   # MPI domain decomposition (docs/mpi.md): OpenMPI and METIS graph partitions
   libopenmpi-dev openmpi-bin libmetis-dev
+  # the implicit integrators' Newton systems on several MPI processes (docs/mpi.md)
+  petsc-dev
 )
 
 missing=()

@@ -145,7 +145,7 @@ static void check_split(int n, int alternate, int local) {
 
   /* one part: the same bits */
   int32_t *all0 = calloc((size_t)blocks, sizeof(int32_t)), *nodes0 = calloc((size_t)nv, sizeof(int32_t));
-  piola_work_split one = {0, 1, all0, nodes0, NULL, noop_nodes, noop_nodes, noop_blocks, NULL, NULL, NULL};
+  piola_work_split one = {0, 1, all0, nodes0, NULL, noop_nodes, noop_nodes, noop_blocks, NULL, NULL, NULL, NULL};
   piola_elastic_body *single = fixture_body(&mesh, &material);
   assert_int_equal(piola_elastic_body_set_work_split(single, &one), PIOLA_OK);
   double *fs = malloc(sizeof(double) * 3 * (size_t)nv), *ds = malloc(sizeof(double) * 3 * (size_t)nv);
@@ -169,10 +169,10 @@ static void check_split(int n, int alternate, int local) {
   double *block_values = malloc(sizeof(double) * 256 * (size_t)blocks);
   p1 = (fake_part){fixture_body(&mesh, &material), NULL, x, v, values, block_values, nv, blocks,
                    block_part, node_part, {1, 2, block_part, node_part, &p1, record_nodes,
-                                           record_nodes, record_blocks, NULL, NULL, NULL}};
+                                           record_nodes, record_blocks, NULL, NULL, NULL, NULL}};
   p0 = (fake_part){fixture_body(&mesh, &material), &p1, x, v, NULL, NULL, nv, blocks, block_part,
                    node_part, {0, 2, block_part, node_part, &p0, sum_from_other, share_from_other,
-                               blocks_from_other, NULL, NULL, NULL}};
+                               blocks_from_other, NULL, NULL, NULL, NULL}};
   p1.split.context = &p1;
   p0.split.context = &p0;
   if (local) {
@@ -339,10 +339,10 @@ static void planned_solid_holds_its_part_only(void **state) {
   planned_part p0 = {0}, p1 = {0};
   p1.part = (fake_part){NULL, NULL, x, NULL, values, block_values, nv, blocks, block_part, node_part,
                         {1, 2, block_part, node_part, &p1.part, record_nodes, record_nodes,
-                         record_blocks, record_ghosts, own_reduce, unused_collect}};
+                         record_blocks, record_ghosts, own_reduce, unused_collect, NULL}};
   p0.part = (fake_part){NULL, &p1.part, x, NULL, NULL, NULL, nv, blocks, block_part, node_part,
                         {0, 2, block_part, node_part, &p0.part, sum_from_other, share_from_other,
-                         blocks_from_other, ghosts_from_other, own_reduce, unused_collect}};
+                         blocks_from_other, ghosts_from_other, own_reduce, unused_collect, NULL}};
   p0.give = p1.give = 1;
   piola_work_split_planner planner1 = {plan_part, &p1}, planner0 = {plan_part, &p0};
   piola_world *w1 = planned_world(&mesh, &planner1, 0);

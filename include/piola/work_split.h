@@ -57,6 +57,26 @@ typedef enum piola_work_split_reduction {
 typedef void (*piola_work_split_pack)(void *owner, int32_t block, double *out);
 typedef void (*piola_work_split_unpack)(void *owner, int32_t block, const double *in);
 
+/* A Newton system of the implicit integrators on a split solid (docs/mpi.md, "Implicit
+ * integrators on several processes"): A d = b, A symmetric positive definite with 3x3 blocks
+ * on the mesh edges. Each process gives the rows of the nodes it owns (node_part), complete
+ * and with the single process's bits; constrained components are projected out (A's
+ * filtered rows and columns are those of the identity, b's components zero), so the solution
+ * is the one the single process's filtered conjugate gradient converges to. */
+typedef struct piola_split_newton_system {
+  int32_t node_count;
+  const double *positions; /* 3 per node, m: where the nodes are (the rigid body modes) */
+  const double *rhs;       /* 3 per node, every node (the same on every process): b */
+  int32_t max_row_blocks;  /* the most blocks a row has */
+  /* Row `node` (owned here): its columns (node indices, the diagonal first) and its 3x3
+   * blocks (9 each, row-major); returns how many. */
+  int32_t (*row)(const void *owner, int32_t node, int32_t *columns, double *blocks);
+  const void *owner;
+  double tolerance;       /* stop at this fraction of the initial residual (preconditioner norm) */
+  int32_t max_iterations; /* iterations at most */
+  piola_mpi_preconditioner preconditioner;
+} piola_split_newton_system;
+
 typedef struct piola_work_split {
   int32_t part;              /* this process, 0 .. part_count - 1 */
   int32_t part_count;
@@ -76,6 +96,12 @@ typedef struct piola_work_split {
   void (*reduce)(void *context, double *values, int32_t count, piola_work_split_reduction op);
   void (*collect_blocks)(void *context, void *owner, piola_work_split_pack pack,
                          piola_work_split_unpack unpack, int32_t width);
+  /* Optional, for the implicit integrators: solves system (collective) and
+   * writes every node's 3 values of the solution to solution on every process (the same
+   * bits everywhere); returns the iterations, or -1 with the error set. NULL: a world with
+   * an implicit integrator refuses the split. */
+  int32_t (*solve_newton)(void *context, const piola_split_newton_system *system,
+                          double *solution);
 } piola_work_split;
 
 /* Number of blocks of PIOLA_WORK_SPLIT_BLOCK tets (the last one padded). */
@@ -123,9 +149,12 @@ PIOLA_API piola_status piola_scene_build_split(const piola_scene_desc *desc,
                                                const piola_work_split_planner *planner,
                                                piola_scene **out);
 
-/* NULL when every solid of world can be split, else why not (shells, fracture and the
- * implicit integrators run on one process only). */
+/* NULL when every solid of world can be split by splits without solve_newton, else why not
+ * (shells, fracture and the implicit integrators run on one process only). */
 PIOLA_API const char *piola_world_split_unsupported(const piola_world *world);
+
+/* The same for splits with solve_newton: the implicit integrators can be split. */
+PIOLA_API const char *piola_world_split_unsupported_solving(const piola_world *world);
 
 /* The same for solid `solid` of a world (its index among the solids). */
 PIOLA_API piola_status piola_world_solid_set_work_split(piola_world *world, int32_t solid,

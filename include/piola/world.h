@@ -72,6 +72,22 @@ PIOLA_API const char *piola_preconditioner_type_name(piola_preconditioner_type t
 PIOLA_API bool piola_preconditioner_type_from_name(const char *name,
                                                    piola_preconditioner_type *type);
 
+/* The preconditioner of the Newton systems of a run split over MPI processes, solved by
+ * PETSc's conjugate gradient on the distributed matrix (docs/mpi.md, "Implicit integrators
+ * on several processes"). A single process ignores it. */
+typedef enum piola_mpi_preconditioner {
+  PIOLA_MPI_PRECONDITIONER_GAMG = 0,         /* PETSc's algebraic multigrid, told the rigid
+                                                body modes */
+  PIOLA_MPI_PRECONDITIONER_BLOCK_JACOBI_ICC, /* one block per process, each an incomplete
+                                                Cholesky IC(0) */
+  PIOLA_MPI_PRECONDITIONER_COUNT
+} piola_mpi_preconditioner;
+
+/* Scene names "gamg", "block_jacobi_icc". */
+PIOLA_API const char *piola_mpi_preconditioner_name(piola_mpi_preconditioner type);
+PIOLA_API bool piola_mpi_preconditioner_from_name(const char *name,
+                                                  piola_mpi_preconditioner *type);
+
 /* How tightly each Newton system is solved (docs/time-stepping.md, "Implicit integrators"). */
 typedef enum piola_linear_forcing {
   PIOLA_FORCING_EISENSTAT_WALKER = 0, /* loose while Newton is far from converged, down to
@@ -121,6 +137,9 @@ typedef struct piola_world_def {
                                   [linear_tolerance, 0.5], at most 0.1 after a step the line
                                   search shortened) or fixed at linear_tolerance. Default
                                   PIOLA_FORCING_EISENSTAT_WALKER */
+  piola_mpi_preconditioner mpi_preconditioner; /* the preconditioner of PETSc's CG when
+                                  the run is split over MPI processes. Default
+                                  PIOLA_MPI_PRECONDITIONER_GAMG */
 } piola_world_def;
 
 PIOLA_API piola_world_def piola_default_world_def(void);

@@ -20,7 +20,9 @@ piola_status piola__stiffness_matrix_init(piola__stiffness_matrix *m,
   m->vertex_count = body->vertex_count;
   m->slot_count = d->shared_count > 0 ? d->shared_slot_start[d->shared_count] : d->edge_count;
   size_t nv = (size_t)(body->vertex_count > 0 ? body->vertex_count : 1);
-  m->blocks = malloc(sizeof(double) * 9 * (size_t)(m->slot_count > 0 ? m->slot_count : 1));
+  /* zeroed: on a split in the local mode the slots of the tets this process does not hold
+   * are never written (see assemble_part) */
+  m->blocks = calloc(9 * (size_t)(m->slot_count > 0 ? m->slot_count : 1), sizeof(double));
   m->diagonal = malloc(sizeof(double) * 9 * nv);
   m->inverse_diagonal = malloc(sizeof(double) * 9 * nv);
   if (!m->blocks || !m->diagonal || !m->inverse_diagonal) {
@@ -157,8 +159,15 @@ static void assemble_part(piola__stiffness_matrix *m, const piola_elastic_body *
   int32_t t1 = piola__damping_part_start(blocks, k + 1) * PIOLA_TET_BLOCK;
   if (t1 > body->tet_count) t1 = body->tet_count;
   const int lanes = !body->fiber[0];
+  /* a split in the local mode assembles the blocks it holds, as the damping assembly does:
+   * every tet on one of its nodes, so its nodes' rows are complete, in the same order */
+  const uint8_t *held = piola__local_split(body) ? body->split_held : NULL;
   double out[54], lane_out[54][PIOLA_TET_BLOCK];
   for (int32_t t = t0; t < t1;) {
+    if (held && !held[t / PIOLA_TET_BLOCK]) {
+      t = (t / PIOLA_TET_BLOCK + 1) * PIOLA_TET_BLOCK;
+      continue;
+    }
     if (lanes && t + PIOLA_TET_BLOCK <= t1) {
       piola__stiffness_block_lanes(body, t / PIOLA_TET_BLOCK, lane_out);
       for (int l = 0; l < PIOLA_TET_BLOCK; ++l)

@@ -29,6 +29,9 @@
 #include <time.h>
 
 #include "common/status_report.h"
+#ifdef PIOLA_PETSC
+#include "mpi/mpi_petsc.h"
+#endif
 #include "piola/mpi.h"
 #include "piola/work_split.h"
 
@@ -53,6 +56,9 @@ typedef struct solid_plan {
   double *reduce_buffer; /* size * REDUCE_MAX doubles */
   int *counts, *displs;
   MPI_Request *requests;
+#ifdef PIOLA_PETSC
+  piola__petsc_solver *newton; /* the implicit step's systems, made on first use */
+#endif
   piola_work_split split;
 } solid_plan;
 
@@ -72,6 +78,9 @@ static double cpu_now(void) {
 }
 
 static void plan_free(solid_plan *p) {
+#ifdef PIOLA_PETSC
+  piola__petsc_solver_free(p->newton);
+#endif
   free(p->block_part), free(p->node_part), free(p->node_order), free(p->node_start);
   free(p->block_order), free(p->block_start), free(p->neighbors), free(p->send_start);
   free(p->send_nodes), free(p->recv_start), free(p->recv_nodes), free(p->send_values);
@@ -245,6 +254,18 @@ static void collect_blocks(void *context, void *owner, piola_work_split_pack pac
   s->stats.gather_seconds += MPI_Wtime() - t0;
   s->stats.exchange_cpu_seconds += cpu_now() - c0;
 }
+
+#ifdef PIOLA_PETSC
+static int32_t solve_newton(void *context, const piola_split_newton_system *system,
+                            double *solution) {
+  solid_plan *p = context;
+  piola_mpi_split *s = p->owner;
+  if (!p->newton && piola__petsc_solver_create(s->rank, p->node_count, p->node_order,
+                                               p->node_start, &p->newton) != PIOLA_OK)
+    return -1;
+  return piola__petsc_solve(p->newton, system, solution);
+}
+#endif
 
 /* Ghost plan: the blocks this process sends to each neighbour (its blocks with a tet on a
  * node the neighbour owns) and receives (the neighbour's blocks with a tet on a node owned
@@ -511,6 +532,9 @@ static piola_status plan_solid(piola_mpi_split *s, const plan_mesh *mesh, solid_
                                 .share_ghosts = share_ghosts,
                                 .reduce = reduce,
                                 .collect_blocks = collect_blocks};
+#ifdef PIOLA_PETSC
+  p->split.solve_newton = solve_newton;
+#endif
   return PIOLA_OK;
 oom:
   free(touch);
@@ -583,7 +607,11 @@ piola_work_split_planner piola_mpi_split_planner(piola_mpi_split *split) {
 piola_status piola_mpi_split_finish(piola_mpi_split *s, piola_world *world) {
   if (!s || !world) return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "MPI split: NULL argument");
   piola_world_set_work_split_planner(world, NULL);
+#ifdef PIOLA_PETSC
+  const char *why = piola_world_split_unsupported_solving(world);
+#else
   const char *why = piola_world_split_unsupported(world);
+#endif
   if (why) return PIOLA_FAIL(PIOLA_ERROR_UNSUPPORTED, "%s", why);
   const int32_t solids = piola_world_solid_count(world);
   for (int32_t i = 0; i < solids; ++i) {
@@ -630,4 +658,7 @@ void piola_mpi_split_destroy(piola_mpi_split *split, piola_world *world) {
   }
   free(split->plans);
   free(split);
+#ifdef PIOLA_PETSC
+  piola__petsc_finish();
+#endif
 }

@@ -15,7 +15,7 @@ piola_status piola__scene_parse_world(scene_parser *p, const cJSON *obj, scene_d
                                        "collision_interval", "type", "dt", "newton_tolerance",
                                        "newton_max_iterations", "linear_tolerance",
                                        "linear_max_iterations", "preconditioner",
-                                       "linear_forcing", NULL};
+                                       "linear_forcing", "mpi_preconditioner", NULL};
     PIOLA_TRY(piola__json_check_keys(p, v, keys));
     PIOLA_TRY(piola__json_opt_number(p, v, "max_dt", (json_range){0, 1, 1, 0}, &out->world.max_dt));
     PIOLA_TRY(piola__json_opt_number(p, v, "cfl", (json_range){0, 2, 1, 0}, &out->world.cfl));
@@ -63,6 +63,14 @@ piola_status piola__scene_parse_world(scene_parser *p, const cJSON *obj, scene_d
       if (!cJSON_IsString(lf) ||
           !piola_linear_forcing_from_name(lf->valuestring, &out->world.linear_forcing))
         return piola__json_fail(p, BAD_VALUE, "must be \"eisenstat_walker\" or \"fixed\"");
+      piola__json_pop(p, o2);
+    }
+    const cJSON *mp = piola__json_get(v, "mpi_preconditioner");
+    if (mp) {
+      size_t o2 = piola__json_push_key(p, "mpi_preconditioner");
+      if (!cJSON_IsString(mp) ||
+          !piola_mpi_preconditioner_from_name(mp->valuestring, &out->world.mpi_preconditioner))
+        return piola__json_fail(p, BAD_VALUE, "must be \"gamg\" or \"block_jacobi_icc\"");
       piola__json_pop(p, o2);
     }
     piola__json_pop(p, old);

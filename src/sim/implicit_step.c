@@ -56,6 +56,7 @@
 #include "force/stiffness_incomplete_cholesky.h"
 #include "force/stiffness_matrix.h"
 #include "force/stiffness_multigrid.h"
+#include "sim/implicit_split.h"
 #include "sim/obstacle_friction.h"
 #include "sim/world_internal.h"
 
@@ -353,12 +354,14 @@ static int vertex_constraint(const void *context, int32_t i, double normal[3]) {
 static piola_status factor_newton_system(const newton_problem *pb) {
   struct implicit_state *st = pb->st;
   st->factored = pb->w->def.preconditioner == PIOLA_PRECONDITIONER_INCOMPLETE_CHOLESKY &&
-                 pb->s->kind == PIOLA_BODY_SOLID && st->factor.pair_start;
+                 pb->s->kind == PIOLA_BODY_SOLID && st->factor.pair_start &&
+                 !piola__implicit_split_of(pb->s);
   if (st->factored)
     piola__incomplete_cholesky_factor(&st->factor, &st->matrix, pb->s->solid, vertex_constraint,
                                       pb->s);
   st->multigrid_ready = pb->w->def.preconditioner == PIOLA_PRECONDITIONER_MULTIGRID &&
-                        pb->s->kind == PIOLA_BODY_SOLID && st->multigrid.entry_edge;
+                        pb->s->kind == PIOLA_BODY_SOLID && st->multigrid.entry_edge &&
+                        !piola__implicit_split_of(pb->s);
   if (!st->multigrid_ready) return PIOLA_OK;
   if (st->multigrid_fresh) {
     piola__multigrid_refresh(&st->multigrid, &st->matrix, pb->s->solid, vertex_constraint, pb->s);
@@ -415,13 +418,18 @@ static int32_t solve_newton_system(newton_problem *pb, double eta) {
                   d,          st->cg[0],   st->cg[1],
                   st->cg[2],  st->cg[3],   st->residual,
                   0};
-  double rz = cg_pass(&c, cg_start_range);
-  if (c.factor || c.multigrid) {
+  /* a split solid: the split's solver (PETSc, docs/mpi.md) instead of the loop below */
+  const int split = piola__implicit_split_of(s) != NULL;
+  int32_t it = split ? piola__implicit_split_solve(s, &st->matrix, st->residual, eta, &pb->w->def,
+                                                   st->cg[0], d)
+                     : 0;
+  if (it < 0) it = 0; /* a failed solve leaves its best d; the line search judges it */
+  double rz = split ? 0.0 : cg_pass(&c, cg_start_range);
+  if (!split && (c.factor || c.multigrid)) {
     rz = precondition_factored(&c);
     memcpy(c.p, c.z, sizeof(double) * 3 * (size_t)n);
   }
   const double stop = eta * eta * rz;
-  int32_t it = 0;
   while (rz > stop && rz > 0 && it < pb->w->def.linear_max_iterations) {
     piola__body_stiffness_apply(s, c.mx, mass_weight, c.p, c.q);
     const double pq = cg_pass(&c, cg_curvature_range);
@@ -638,11 +646,7 @@ static piola_status newton_iterate(const newton_problem *problem, int accept_unc
     if (pb.quasistatic) {
       if (!(s->quasistatic_mu > 0)) {
         /* the first regularization: a small fraction of the mean stiffness per mass */
-        double trace = 0;
-        for (int32_t i = 0; i < n; ++i) {
-          const double *b = st->matrix.diagonal + 9 * (size_t)i;
-          trace += b[0] + b[4] + b[8];
-        }
+        const double trace = piola__implicit_matrix_trace(s, &st->matrix);
         s->quasistatic_mu = 1e-6 * trace / (3.0 * pb.total_mass);
         if (!(s->quasistatic_mu > 0)) s->quasistatic_mu = 1.0;
       }

@@ -58,6 +58,9 @@ piola_status piola_world_create(const piola_world_def *def, piola_world **out) {
   if ((int)def->linear_forcing < 0 || def->linear_forcing >= PIOLA_FORCING_COUNT)
     return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "unknown linear forcing %d",
                       (int)def->linear_forcing);
+  if ((int)def->mpi_preconditioner < 0 || def->mpi_preconditioner >= PIOLA_MPI_PRECONDITIONER_COUNT)
+    return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "unknown MPI preconditioner %d",
+                      (int)def->mpi_preconditioner);
   piola_world *w = calloc(1, sizeof *w);
   if (!w) return PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "world: out of memory");
   w->def = *def;

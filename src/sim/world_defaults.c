@@ -23,6 +23,7 @@ piola_world_def piola_default_world_def(void) {
   def.linear_max_iterations = 1000;
   def.preconditioner = PIOLA_PRECONDITIONER_BLOCK_JACOBI;
   def.linear_forcing = PIOLA_FORCING_EISENSTAT_WALKER;
+  def.mpi_preconditioner = PIOLA_MPI_PRECONDITIONER_GAMG;
   return def;
 }
 
@@ -92,6 +93,24 @@ bool piola_linear_forcing_from_name(const char *name, piola_linear_forcing *forc
   for (int k = 0; k < PIOLA_FORCING_COUNT; ++k)
     if (strcmp(name, forcing_names[k]) == 0) {
       *forcing = (piola_linear_forcing)k;
+      return true;
+    }
+  return false;
+}
+
+static const char *const mpi_preconditioner_names[PIOLA_MPI_PRECONDITIONER_COUNT] = {
+    "gamg", "block_jacobi_icc"};
+
+const char *piola_mpi_preconditioner_name(piola_mpi_preconditioner type) {
+  if ((int)type < 0 || type >= PIOLA_MPI_PRECONDITIONER_COUNT) return "unknown";
+  return mpi_preconditioner_names[type];
+}
+
+bool piola_mpi_preconditioner_from_name(const char *name, piola_mpi_preconditioner *type) {
+  if (!name || !type) return false;
+  for (int k = 0; k < PIOLA_MPI_PRECONDITIONER_COUNT; ++k)
+    if (strcmp(name, mpi_preconditioner_names[k]) == 0) {
+      *type = (piola_mpi_preconditioner)k;
       return true;
     }
   return false;

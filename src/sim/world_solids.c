@@ -287,6 +287,11 @@ piola_status piola_world_solid_set_work_split(piola_world *world, int32_t solid,
   world_body *s = (world_body *)solid_at(world, solid);
   if (!s) return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "work split: no solid %d", (int)solid);
   s->product_valid = 0;
+  if (split && split->part_count > 1 && world->def.integrator != PIOLA_INTEGRATOR_NEWMARK &&
+      !split->solve_newton)
+    return PIOLA_FAIL(PIOLA_ERROR_UNSUPPORTED,
+                      "work split: the implicit integrators need a split with solve_newton "
+                      "(libpiola_mpi built with PETSc)");
   /* plasticity's return mapping reads every tet's Fhat on every process: replicated mode */
   return piola__elastic_body_set_work_split(s->solid, split, s->plastic == NULL);
 }

@@ -1,5 +1,6 @@
 /* What a world split among processes supports (piola/work_split.h): the split divides the
- * solids' force loop and damping products of the Newmark step; everything else runs the same
+ * solids' force loop and damping products, and with a Newton solver (solve_newton) the
+ * implicit integrators' linear solves; everything else runs the same
  * on every process, self-collision of the solids' surfaces included (it reads node state
  * only, which every process holds bit for bit, and its detection does not depend on the
  * thread count: every process makes the same corrections). */
@@ -9,9 +10,14 @@
 #include "sim/world_internal.h"
 
 const char *piola_world_split_unsupported(const piola_world *world) {
+  if (world && world->def.integrator != PIOLA_INTEGRATOR_NEWMARK)
+    return "the implicit integrators (integrator.type backward_euler or quasistatic) run on "
+           "several processes only in a build with PETSc (petsc-dev), which this one lacks";
+  return piola_world_split_unsupported_solving(world);
+}
+
+const char *piola_world_split_unsupported_solving(const piola_world *world) {
   if (!world) return "no world";
-  if (world->def.integrator != PIOLA_INTEGRATOR_NEWMARK)
-    return "the implicit integrators (integrator.type other than newmark) run on one process only";
   for (int32_t i = 0; i < world->body_count; ++i) {
     const world_body *b = &world->bodies[i];
     if (b->kind == PIOLA_BODY_SHELL) return "shells run on one process only";

@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
-# What `mpirun -np 2 piola run` refuses (docs/mpi.md): shells, fracture and the implicit
-# integrators run on one process only. Each is refused before anything is written, with
-# exit code 2 and a message naming what. (Checkpoints of split runs: mpi_checkpoints.sh.)
+# What `mpirun -np 2 piola run` refuses (docs/mpi.md): shells and fracture run on one process
+# only, the implicit integrators without PETSc. Each is refused before anything is written,
+# with exit code 2 and a message naming what. (Checkpoints of split runs: mpi_checkpoints.sh.)
 set -uo pipefail
 piola=$1 examples=$2
 export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1
@@ -47,5 +47,18 @@ def fix(o):
 fix(scene)
 json.dump(scene, open(sys.argv[2], "w"))
 PY
-refused "$work/implicit.json" "implicit integrators"
+# the implicit integrators: refused naming the missing PETSc in a build without it
+# (PIOLA_PETSC=OFF, set by ctest); with it they run (mpi_implicit.sh), and a bad
+# integrator.mpi_preconditioner is refused naming the key
+if [ "${PIOLA_PETSC:-OFF}" = ON ]; then
+  /usr/bin/python3 - "$work/implicit.json" <<'PY'
+import json, sys
+scene = json.load(open(sys.argv[1]))
+scene["integrator"]["mpi_preconditioner"] = "hypre"
+json.dump(scene, open(sys.argv[1], "w"))
+PY
+  refused "$work/implicit.json" 'integrator.mpi_preconditioner.*must be "gamg" or "block_jacobi_icc"'
+else
+  refused "$work/implicit.json" "implicit integrators.*only in a build with PETSc"
+fi
 exit $fail

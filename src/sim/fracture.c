@@ -35,7 +35,7 @@
 #define OVERLAP_SHARE 1e-12
 /* a cut through a copy cut before splits it only where each side keeps more than this
  * share of the tet's material (below it the fraction is rounding) */
-#define MIN_PIECE 1e-9
+#define MIN_PIECE 1e-13
 
 static void free_blades(piola_tri_mesh *blades, int32_t count);
 

@@ -7,6 +7,7 @@
  *   shared machine): the plastic bar first necks (its smallest cross-section down by >= 30%
  *   before the first tet is cut), then tears into pieces that separate its two driven ends. */
 #include "test_support.h"
+#include "fracture_checks.h"
 
 #include <math.h>
 #include <omp.h>
@@ -34,67 +35,6 @@ static char *read_text(const char *path) {
   return s;
 }
 
-static double total_mass(const piola_world *w) {
-  const piola_elastic_body *b = piola_world_solid_body(w, 0);
-  const double *m = piola_elastic_body_masses(b);
-  double sum = 0;
-  for (int32_t i = 0; i < piola_elastic_body_vertex_count(b); ++i) sum += m[i];
-  return sum;
-}
-
-typedef struct edge {
-  int32_t a, b;
-} edge;
-
-static int by_edge(const void *pa, const void *pb) {
-  const edge *p = pa, *q = pb;
-  if (p->a != q->a) return p->a < q->a ? -1 : 1;
-  return p->b < q->b ? -1 : p->b > q->b;
-}
-
-/* Directed edges of triangles [first, end) of s without exactly as many opposite edges (0:
- * closed and consistently oriented). */
-static int32_t unpaired_edges(const piola_fracture_surface *s, int32_t first, int32_t end) {
-  const size_t n = 3 * (size_t)(end - first);
-  edge *e = malloc(sizeof *e * (n ? n : 1));
-  assert_non_null(e);
-  for (int32_t i = first; i < end; ++i)
-    for (int k = 0; k < 3; ++k)
-      e[3 * (size_t)(i - first) + (size_t)k] = (edge){s->triangles[3 * i + k], s->triangles[3 * i + (k + 1) % 3]};
-  qsort(e, n, sizeof *e, by_edge);
-  int32_t unpaired = 0;
-  for (size_t i = 0; i < n;) {
-    size_t j = i;
-    while (j < n && !by_edge(&e[j], &e[i])) ++j;
-    const edge r = {e[i].b, e[i].a};
-    /* count the opposite edges: the run of r in the sorted list */
-    size_t lo = 0, hi = n;
-    while (lo < hi) {
-      const size_t mid = (lo + hi) / 2;
-      if (by_edge(&e[mid], &r) < 0) lo = mid + 1;
-      else hi = mid;
-    }
-    size_t opposite = 0;
-    while (lo + opposite < n && !by_edge(&e[lo + opposite], &r)) ++opposite;
-    if (opposite != j - i) unpaired += (int32_t)(j - i);
-    i = j;
-  }
-  free(e);
-  return unpaired;
-}
-
-/* Enclosed volume of the triangles [first, end) of s (divergence theorem). */
-static double enclosed_volume(const piola_fracture_surface *s, int32_t first, int32_t end) {
-  double v = 0;
-  for (int32_t i = first; i < end; ++i) {
-    const double *a = s->positions + 3 * s->triangles[3 * i], *b = s->positions + 3 * s->triangles[3 * i + 1],
-                 *c = s->positions + 3 * s->triangles[3 * i + 2];
-    v += (a[0] * (b[1] * c[2] - b[2] * c[1]) - a[1] * (b[0] * c[2] - b[2] * c[0]) +
-          a[2] * (b[0] * c[1] - b[1] * c[0])) / 6.0;
-  }
-  return v;
-}
-
 /* The brittle slab breaks into 2 to 4 fragments: one crack through it (the example's
  * story), allowing for a chip where the edge hits the floor; the old rule (every tet past
  * the threshold cut, new cracks wherever none grew) cut 29% of its tets. At most 10% of the
@@ -109,12 +49,12 @@ static void brittle_slab_breaks_into_a_few_pieces(void **state) {
   if (piola_scene_load(path, &scene) != PIOLA_OK) fail_msg("%s", piola_last_error());
   piola_world *w = piola_scene_world(scene);
   const int32_t tets = piola_elastic_body_tet_count(piola_world_solid_body(w, 0));
-  const double mass = total_mass(w);
+  const double mass = fracture_total_mass(w);
   const double fps = piola_scene_fps(scene);
   /* the crack runs from about frame 4 to frame 10 (stats of the example) */
   for (int frame = 1; frame <= 14; ++frame) {
     if (piola_world_advance_to(w, frame / fps, NULL) != PIOLA_OK) fail_msg("frame %d: %s", frame, piola_last_error());
-    assert_true(fabs(total_mass(w) - mass) <= 1e-12 * mass);
+    assert_true(fabs(fracture_total_mass(w) - mass) <= 1e-12 * mass);
     const piola_elastic_body *b = piola_world_solid_body(w, 0);
     const double *x = piola_world_solid_positions(w, 0);
     for (int32_t i = 0; i < 3 * piola_elastic_body_vertex_count(b); ++i) assert_true(isfinite(x[i]));
@@ -127,8 +67,8 @@ static void brittle_slab_breaks_into_a_few_pieces(void **state) {
   assert_int_equal(piola_world_solid_fracture_surface(w, 0, &s), PIOLA_OK);
   assert_int_equal(s.fragment_count, fragments);
   for (int32_t g = 0; g < s.fragment_count; ++g) {
-    assert_int_equal(unpaired_edges(&s, s.fragment_start[g], s.fragment_start[g + 1]), 0);
-    assert_true(enclosed_volume(&s, s.fragment_start[g], s.fragment_start[g + 1]) > 0);
+    assert_int_equal(fracture_unpaired_edges(&s, s.fragment_start[g], s.fragment_start[g + 1]), 0);
+    assert_true(fracture_enclosed_volume(&s, s.fragment_start[g], s.fragment_start[g + 1]) > 0);
   }
   piola_fracture_surface_free(&s);
   piola_scene_destroy(scene);

@@ -14,6 +14,10 @@ double fracture_enclosed_volume(const piola_fracture_surface *s, int32_t first, 
 /* Directed edges of the triangles [first, end) of s without exactly as many opposite edges
  * (0: closed and consistently oriented). */
 int32_t fracture_unpaired_edges(const piola_fracture_surface *s, int32_t first, int32_t end);
+/* The area (m^2) of solid 0's cross-section at the rest plane x = x0 (on no vertex), at the
+ * current positions: per tet the polygon where that plane meets it, mapped by the tet's
+ * deformation. Only for a solid not cut yet (its tets are the rest mesh's). */
+double fracture_rest_section_area(const piola_world *w, double x0);
 /* Sum of the lumped masses of solid 0 (kg). */
 double fracture_total_mass(const piola_world *w);
 /* Per fragment of solid 0: its material volume, the sum of fraction x rest volume of its

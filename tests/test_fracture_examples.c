@@ -74,41 +74,6 @@ static void brittle_slab_breaks_into_a_few_pieces(void **state) {
   piola_scene_destroy(scene);
 }
 
-/* The bar's cross-section at the rest plane x = x0 (the cylinder's axis is x), at the
- * current positions: per tet the polygon where that plane meets it, mapped by the tet's
- * deformation. Only for a body not cut yet (its tets are the rest mesh's). */
-static double section(const piola_world *w, double x0) {
-  const piola_elastic_body *b = piola_world_solid_body(w, 0);
-  const double *rest = piola_elastic_body_rest_positions(b), *x = piola_world_solid_positions(w, 0);
-  const int32_t *tets = piola_elastic_body_tets(b);
-  double area = 0;
-  for (int32_t t = 0; t < piola_elastic_body_tet_count(b); ++t) {
-    const int32_t *c = tets + 4 * t;
-    double dist[4];
-    int pos = 0, neg = 0;
-    for (int k = 0; k < 4; ++k) {
-      dist[k] = rest[3 * c[k]] - x0; /* x0 is off the lattice: never 0 */
-      pos |= dist[k] > 0, neg |= dist[k] < 0;
-    }
-    if (!pos || !neg) continue;
-    copy_polygons poly;
-    piola__fracture_copy_polygons(dist, 1, c, &poly);
-    double p[4][3], sum[3] = {0, 0, 0};
-    for (int32_t i = 0; i < poly.crack_size; ++i)
-      for (int a = 0; a < 3; ++a) {
-        const double *lo = x + 3 * c[poly.crack[i].lo], *hi = x + 3 * c[poly.crack[i].hi];
-        p[i][a] = lo[a] + poly.crack[i].t * (hi[a] - lo[a]);
-      }
-    for (int32_t i = 1; i + 1 < poly.crack_size; ++i) {
-      double u[3], v[3];
-      for (int a = 0; a < 3; ++a) u[a] = p[i][a] - p[0][a], v[a] = p[i + 1][a] - p[0][a];
-      sum[0] += u[1] * v[2] - u[2] * v[1], sum[1] += u[2] * v[0] - u[0] * v[2], sum[2] += u[0] * v[1] - u[1] * v[0];
-    }
-    area += 0.5 * sqrt(sum[0] * sum[0] + sum[1] * sum[1] + sum[2] * sum[2]);
-  }
-  return area;
-}
-
 #define PLANES 25 /* rest planes x = -0.12 .. 0.12 m, between the grips (|x| > 0.157 m) */
 static double plane_x(int i) { return -0.12 + 0.01 * i + 1.234e-4; }
 
@@ -129,13 +94,13 @@ static void ductile_bar_necks_then_tears(void **state) {
   free(text);
   piola_world *w = piola_scene_world(scene);
   double rest[PLANES];
-  for (int i = 0; i < PLANES; ++i) rest[i] = section(w, plane_x(i));
+  for (int i = 0; i < PLANES; ++i) rest[i] = fracture_rest_section_area(w, plane_x(i));
   double neck = 1, neck_x = 0, first_cut = INFINITY, broken = INFINITY;
   const double chunk = 0.005; /* s between section measurements */
   for (int k = 1; k <= 100 && !isfinite(broken); ++k) {
     if (!isfinite(first_cut))
       for (int i = 0; i < PLANES; ++i) {
-        const double r = section(w, plane_x(i)) / rest[i];
+        const double r = fracture_rest_section_area(w, plane_x(i)) / rest[i];
         if (r < neck) neck = r, neck_x = plane_x(i);
       }
     if (piola_world_advance_to(w, k * chunk, NULL) != PIOLA_OK) fail_msg("t = %g: %s", k * chunk, piola_last_error());

@@ -1,11 +1,13 @@
 /* What the fracture tests measure on a cut solid (fracture_checks.h). */
 #include "test_support.h"
 
+#include <math.h>
 #include <stdlib.h>
 
 #include "fracture_checks.h"
 #include "piola/checkpoint.h"
 #include "piola/elastic_body.h"
+#include "sim/fracture_internal.h"
 
 double fracture_enclosed_volume(const piola_fracture_surface *s, int32_t first, int32_t end) {
   double v = 0;
@@ -55,6 +57,38 @@ int32_t fracture_unpaired_edges(const piola_fracture_surface *s, int32_t first, 
   }
   free(e);
   return unpaired;
+}
+
+double fracture_rest_section_area(const piola_world *w, double x0) {
+  const piola_elastic_body *b = piola_world_solid_body(w, 0);
+  const double *rest = piola_elastic_body_rest_positions(b), *x = piola_world_solid_positions(w, 0);
+  const int32_t *tets = piola_elastic_body_tets(b);
+  double area = 0;
+  for (int32_t t = 0; t < piola_elastic_body_tet_count(b); ++t) {
+    const int32_t *c = tets + 4 * t;
+    double dist[4];
+    int pos = 0, neg = 0;
+    for (int k = 0; k < 4; ++k) {
+      dist[k] = rest[3 * c[k]] - x0;
+      pos |= dist[k] > 0, neg |= dist[k] < 0;
+    }
+    if (!pos || !neg) continue;
+    copy_polygons poly;
+    piola__fracture_copy_polygons(dist, 1, c, &poly);
+    double p[4][3], sum[3] = {0, 0, 0};
+    for (int32_t i = 0; i < poly.crack_size; ++i)
+      for (int a = 0; a < 3; ++a) {
+        const double *lo = x + 3 * c[poly.crack[i].lo], *hi = x + 3 * c[poly.crack[i].hi];
+        p[i][a] = lo[a] + poly.crack[i].t * (hi[a] - lo[a]);
+      }
+    for (int32_t i = 1; i + 1 < poly.crack_size; ++i) {
+      double u[3], v[3];
+      for (int a = 0; a < 3; ++a) u[a] = p[i][a] - p[0][a], v[a] = p[i + 1][a] - p[0][a];
+      sum[0] += u[1] * v[2] - u[2] * v[1], sum[1] += u[2] * v[0] - u[0] * v[2], sum[2] += u[0] * v[1] - u[1] * v[0];
+    }
+    area += 0.5 * sqrt(sum[0] * sum[0] + sum[1] * sum[1] + sum[2] * sum[2]);
+  }
+  return area;
 }
 
 double fracture_total_mass(const piola_world *w) {

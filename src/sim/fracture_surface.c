@@ -25,12 +25,17 @@ typedef struct surface_point {
   int32_t order;                 /* position in the emitted list */
 } surface_point;
 
+/* Compares names: fragment, first node, second node (a corner's own node again), first
+ * cut, then the rest, so a solid whose tets are cut once numbers its vertices as by
+ * (fragment, a, b, cut). */
 static int same_name(const surface_point *p, const surface_point *q) {
   if (p->fragment != q->fragment) return p->fragment < q->fragment ? -1 : 1;
-  for (int k = 0; k < 4; ++k)
-    if (p->node[k] != q->node[k]) return p->node[k] < q->node[k] ? -1 : 1;
-  for (int j = 0; j < FRACTURE_MAX_CUTS; ++j)
-    if (p->event[j] != q->event[j]) return p->event[j] < q->event[j] ? -1 : 1;
+  const int32_t pk[7] = {p->node[0], p->node[1] >= 0 ? p->node[1] : p->node[0], p->event[0], p->node[2],
+                         p->node[3], p->event[1], p->event[2]};
+  const int32_t qk[7] = {q->node[0], q->node[1] >= 0 ? q->node[1] : q->node[0], q->event[0], q->node[2],
+                         q->node[3], q->event[1], q->event[2]};
+  for (int k = 0; k < 7; ++k)
+    if (pk[k] != qk[k]) return pk[k] < qk[k] ? -1 : 1;
   return 0;
 }
 

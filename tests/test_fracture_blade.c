@@ -8,6 +8,7 @@
  * checkpointed in the middle of the sweep resumes bit for bit. Bad motions are refused by the
  * C API and by the scene parser, naming the key path. */
 #include "test_support.h"
+#include "fracture_checks.h"
 
 #include <math.h>
 #include <stdlib.h>
@@ -94,34 +95,6 @@ static piola_fracture_def blade_def(piola_fracture_cut *cut, const piola_tri_mes
   return def;
 }
 
-static double enclosed_volume(const piola_fracture_surface *s, int32_t first, int32_t end) {
-  double v = 0;
-  for (int32_t i = first; i < end; ++i) {
-    const double *a = s->positions + 3 * s->triangles[3 * i], *b = s->positions + 3 * s->triangles[3 * i + 1],
-                 *c = s->positions + 3 * s->triangles[3 * i + 2];
-    v += (a[0] * (b[1] * c[2] - b[2] * c[1]) - a[1] * (b[0] * c[2] - b[2] * c[0]) +
-          a[2] * (b[0] * c[1] - b[1] * c[0])) / 6.0;
-  }
-  return v;
-}
-
-/* Directed edges of triangles [first, end) without their opposite (0: closed, oriented). */
-static int32_t unpaired_edges(const piola_fracture_surface *s, int32_t first, int32_t end) {
-  int32_t unpaired = 0;
-  for (int32_t i = first; i < end; ++i)
-    for (int k = 0; k < 3; ++k) {
-      const int32_t a = s->triangles[3 * i + k], b = s->triangles[3 * i + (k + 1) % 3];
-      int32_t same = 0, opposite = 0;
-      for (int32_t j = first; j < end; ++j)
-        for (int q = 0; q < 3; ++q) {
-          const int32_t c = s->triangles[3 * j + q], d = s->triangles[3 * j + (q + 1) % 3];
-          same += c == a && d == b, opposite += c == b && d == a;
-        }
-      unpaired += same != opposite;
-    }
-  return unpaired;
-}
-
 static void blade_cuts_a_flying_bar_step_by_step(void **state) {
   (void)state;
   piola_tet_mesh mesh;
@@ -188,8 +161,8 @@ static void blade_cuts_a_flying_bar_step_by_step(void **state) {
   const double behind = 0.12 * (0.12 * plane_c - 0.15 * 0.0072), whole = 0.4 * 0.12 * 0.12;
   double v[2];
   for (int g = 0; g < 2; ++g) {
-    v[g] = enclosed_volume(&s, s.fragment_start[g], s.fragment_start[g + 1]);
-    assert_int_equal(unpaired_edges(&s, s.fragment_start[g], s.fragment_start[g + 1]), 0);
+    v[g] = fracture_enclosed_volume(&s, s.fragment_start[g], s.fragment_start[g + 1]);
+    assert_int_equal(fracture_unpaired_edges(&s, s.fragment_start[g], s.fragment_start[g + 1]), 0);
   }
   const double small = fmin(v[0], v[1]), large = fmax(v[0], v[1]);
   assert_true(fabs(small - (whole - behind)) <= 1e-4 * (whole - behind)); /* within the snap */
@@ -207,13 +180,6 @@ static double current_volume(const piola_world *w, int32_t t) {
   for (int k = 0; k < 3; ++k)
     a[k] = x[3 * c[1] + k] - x[3 * c[0] + k], b[k] = x[3 * c[2] + k] - x[3 * c[0] + k], d[k] = x[3 * c[3] + k] - x[3 * c[0] + k];
   return (a[0] * (b[1] * d[2] - b[2] * d[1]) - a[1] * (b[0] * d[2] - b[2] * d[0]) + a[2] * (b[0] * d[1] - b[1] * d[0])) / 6.0;
-}
-
-static double total_mass(const piola_world *w) {
-  const piola_elastic_body *b = piola_world_solid_body(w, 0);
-  double sum = 0;
-  for (int32_t i = 0; i < piola_elastic_body_vertex_count(b); ++i) sum += piola_elastic_body_masses(b)[i];
-  return sum;
 }
 
 /* Random moving blades through a random mesh that flies, spins and is stretched while it is
@@ -283,7 +249,7 @@ static void random_moving_blades_mesh(const piola_tet_mesh *mesh, test_rng *rng,
     def.cuts = &cut, def.cut_count = 1;
     assert_int_equal(piola_world_solid_set_fracture(w, 0, &def), PIOLA_OK);
     piola_tri_mesh_free(&blade);
-    const double mass = total_mass(w);
+    const double mass = fracture_total_mass(w);
     while (piola_world_time(w) < 0.104) {
       double pa[3], la[3], pb[3], lb[3];
       momenta(w, pa, la);
@@ -295,7 +261,7 @@ static void random_moving_blades_mesh(const piola_tet_mesh *mesh, test_rng *rng,
         assert_close(pb[k], pa[k], 1e-11 * ps);
         assert_close(lb[k], la[k], 1e-9 * ls);
       }
-      assert_close(total_mass(w), mass, 1e-12 * mass);
+      assert_close(fracture_total_mass(w), mass, 1e-12 * mass);
     }
     *cut_total += piola_world_solid_cut_tet_count(w, 0);
     const piola_elastic_body *body = piola_world_solid_body(w, 0);
@@ -315,9 +281,9 @@ static void random_moving_blades_mesh(const piola_tet_mesh *mesh, test_rng *rng,
     piola_fracture_surface s;
     assert_int_equal(piola_world_solid_fracture_surface(w, 0, &s), PIOLA_OK);
     for (int32_t g = 0; g < s.fragment_count; ++g) {
-      const int32_t open = unpaired_edges(&s, s.fragment_start[g], s.fragment_start[g + 1]);
+      const int32_t open = fracture_unpaired_edges(&s, s.fragment_start[g], s.fragment_start[g + 1]);
       if (open) fail_msg("trial %d: fragment %d has %d edges without their opposite", trial, (int)g, (int)open);
-      const double enclosed = enclosed_volume(&s, s.fragment_start[g], s.fragment_start[g + 1]);
+      const double enclosed = fracture_enclosed_volume(&s, s.fragment_start[g], s.fragment_start[g + 1]);
       /* exact to rounding, but where the body crossed the blade between two cuts the
        * neighbouring copies' crossings can differ and the surface takes one of them */
       if (!(fabs(enclosed - material[g]) <= 1e-4 * fabs(material[g])))
@@ -350,19 +316,6 @@ static void random_moving_blades_keep_every_invariant(void **state) {
   assert_true(cut_total > 0); /* the blades did cut */
 }
 
-static void same_state(const piola_world *a, const piola_world *b) {
-  const piola_elastic_body *ea = piola_world_solid_body(a, 0), *eb = piola_world_solid_body(b, 0);
-  const int32_t n = piola_elastic_body_vertex_count(ea), nt = piola_elastic_body_tet_count(ea);
-  assert_int_equal(piola_elastic_body_vertex_count(eb), n);
-  assert_int_equal(piola_elastic_body_tet_count(eb), nt);
-  assert_memory_equal(piola_elastic_body_tets(ea), piola_elastic_body_tets(eb), 4 * sizeof(int32_t) * (size_t)nt);
-  assert_memory_equal(piola_world_solid_positions(a, 0), piola_world_solid_positions(b, 0), 3 * sizeof(double) * (size_t)n);
-  assert_memory_equal(piola_world_solid_velocities(a, 0), piola_world_solid_velocities(b, 0), 3 * sizeof(double) * (size_t)n);
-  assert_memory_equal(piola_world_solid_material_fractions(a, 0), piola_world_solid_material_fractions(b, 0),
-                      sizeof(double) * (size_t)nt);
-  assert_int_equal(piola_world_solid_fragment_count(a, 0), piola_world_solid_fragment_count(b, 0));
-}
-
 /* Checkpointed halfway down the bar, a fresh world resumes the sweep bit for bit. */
 static void moving_blade_resumes_bit_for_bit(void **state) {
   (void)state;
@@ -382,15 +335,12 @@ static void moving_blade_resumes_bit_for_bit(void **state) {
   int fd = mkstemp(path);
   assert_true(fd >= 0);
   close(fd);
-  const uint64_t key = piola_world_scene_key(b, NULL, 0);
-  assert_int_equal(piola_world_checkpoint_write(a, path, key, 3), PIOLA_OK);
-  int32_t frame = -1;
-  assert_int_equal(piola_world_checkpoint_read(b, path, key, &frame), PIOLA_OK);
+  fracture_checkpoint_round_trip(a, b, path, 3);
   unlink(path);
-  same_state(a, b);
+  fracture_same_state(a, b);
   assert_int_equal(piola_world_advance_to(a, 0.22, NULL), PIOLA_OK);
   assert_int_equal(piola_world_advance_to(b, 0.22, NULL), PIOLA_OK);
-  same_state(a, b);
+  fracture_same_state(a, b);
   assert_true(piola_world_solid_cut_tet_count(b, 0) > halfway);
   assert_int_equal(piola_world_solid_fragment_count(b, 0), 2);
   piola_world_destroy(a), piola_world_destroy(b), piola_tet_mesh_free(&mesh), piola_tet_mesh_free(&again);

@@ -7,6 +7,7 @@
  *   shared machine): the plastic bar first necks (its smallest cross-section down by >= 30%
  *   before the first tet is cut), then tears into pieces that separate its two driven ends. */
 #include "test_support.h"
+#include "fracture_checks.h"
 
 #include <math.h>
 #include <omp.h>
@@ -34,67 +35,6 @@ static char *read_text(const char *path) {
   return s;
 }
 
-static double total_mass(const piola_world *w) {
-  const piola_elastic_body *b = piola_world_solid_body(w, 0);
-  const double *m = piola_elastic_body_masses(b);
-  double sum = 0;
-  for (int32_t i = 0; i < piola_elastic_body_vertex_count(b); ++i) sum += m[i];
-  return sum;
-}
-
-typedef struct edge {
-  int32_t a, b;
-} edge;
-
-static int by_edge(const void *pa, const void *pb) {
-  const edge *p = pa, *q = pb;
-  if (p->a != q->a) return p->a < q->a ? -1 : 1;
-  return p->b < q->b ? -1 : p->b > q->b;
-}
-
-/* Directed edges of triangles [first, end) of s without exactly as many opposite edges (0:
- * closed and consistently oriented). */
-static int32_t unpaired_edges(const piola_fracture_surface *s, int32_t first, int32_t end) {
-  const size_t n = 3 * (size_t)(end - first);
-  edge *e = malloc(sizeof *e * (n ? n : 1));
-  assert_non_null(e);
-  for (int32_t i = first; i < end; ++i)
-    for (int k = 0; k < 3; ++k)
-      e[3 * (size_t)(i - first) + (size_t)k] = (edge){s->triangles[3 * i + k], s->triangles[3 * i + (k + 1) % 3]};
-  qsort(e, n, sizeof *e, by_edge);
-  int32_t unpaired = 0;
-  for (size_t i = 0; i < n;) {
-    size_t j = i;
-    while (j < n && !by_edge(&e[j], &e[i])) ++j;
-    const edge r = {e[i].b, e[i].a};
-    /* count the opposite edges: the run of r in the sorted list */
-    size_t lo = 0, hi = n;
-    while (lo < hi) {
-      const size_t mid = (lo + hi) / 2;
-      if (by_edge(&e[mid], &r) < 0) lo = mid + 1;
-      else hi = mid;
-    }
-    size_t opposite = 0;
-    while (lo + opposite < n && !by_edge(&e[lo + opposite], &r)) ++opposite;
-    if (opposite != j - i) unpaired += (int32_t)(j - i);
-    i = j;
-  }
-  free(e);
-  return unpaired;
-}
-
-/* Enclosed volume of the triangles [first, end) of s (divergence theorem). */
-static double enclosed_volume(const piola_fracture_surface *s, int32_t first, int32_t end) {
-  double v = 0;
-  for (int32_t i = first; i < end; ++i) {
-    const double *a = s->positions + 3 * s->triangles[3 * i], *b = s->positions + 3 * s->triangles[3 * i + 1],
-                 *c = s->positions + 3 * s->triangles[3 * i + 2];
-    v += (a[0] * (b[1] * c[2] - b[2] * c[1]) - a[1] * (b[0] * c[2] - b[2] * c[0]) +
-          a[2] * (b[0] * c[1] - b[1] * c[0])) / 6.0;
-  }
-  return v;
-}
-
 /* The brittle slab breaks into 2 to 4 fragments: one crack through it (the example's
  * story), allowing for a chip where the edge hits the floor; the old rule (every tet past
  * the threshold cut, new cracks wherever none grew) cut 29% of its tets. At most 10% of the
@@ -109,12 +49,12 @@ static void brittle_slab_breaks_into_a_few_pieces(void **state) {
   if (piola_scene_load(path, &scene) != PIOLA_OK) fail_msg("%s", piola_last_error());
   piola_world *w = piola_scene_world(scene);
   const int32_t tets = piola_elastic_body_tet_count(piola_world_solid_body(w, 0));
-  const double mass = total_mass(w);
+  const double mass = fracture_total_mass(w);
   const double fps = piola_scene_fps(scene);
   /* the crack runs from about frame 4 to frame 10 (stats of the example) */
   for (int frame = 1; frame <= 14; ++frame) {
     if (piola_world_advance_to(w, frame / fps, NULL) != PIOLA_OK) fail_msg("frame %d: %s", frame, piola_last_error());
-    assert_true(fabs(total_mass(w) - mass) <= 1e-12 * mass);
+    assert_true(fabs(fracture_total_mass(w) - mass) <= 1e-12 * mass);
     const piola_elastic_body *b = piola_world_solid_body(w, 0);
     const double *x = piola_world_solid_positions(w, 0);
     for (int32_t i = 0; i < 3 * piola_elastic_body_vertex_count(b); ++i) assert_true(isfinite(x[i]));
@@ -127,46 +67,11 @@ static void brittle_slab_breaks_into_a_few_pieces(void **state) {
   assert_int_equal(piola_world_solid_fracture_surface(w, 0, &s), PIOLA_OK);
   assert_int_equal(s.fragment_count, fragments);
   for (int32_t g = 0; g < s.fragment_count; ++g) {
-    assert_int_equal(unpaired_edges(&s, s.fragment_start[g], s.fragment_start[g + 1]), 0);
-    assert_true(enclosed_volume(&s, s.fragment_start[g], s.fragment_start[g + 1]) > 0);
+    assert_int_equal(fracture_unpaired_edges(&s, s.fragment_start[g], s.fragment_start[g + 1]), 0);
+    assert_true(fracture_enclosed_volume(&s, s.fragment_start[g], s.fragment_start[g + 1]) > 0);
   }
   piola_fracture_surface_free(&s);
   piola_scene_destroy(scene);
-}
-
-/* The bar's cross-section at the rest plane x = x0 (the cylinder's axis is x), at the
- * current positions: per tet the polygon where that plane meets it, mapped by the tet's
- * deformation. Only for a body not cut yet (its tets are the rest mesh's). */
-static double section(const piola_world *w, double x0) {
-  const piola_elastic_body *b = piola_world_solid_body(w, 0);
-  const double *rest = piola_elastic_body_rest_positions(b), *x = piola_world_solid_positions(w, 0);
-  const int32_t *tets = piola_elastic_body_tets(b);
-  double area = 0;
-  for (int32_t t = 0; t < piola_elastic_body_tet_count(b); ++t) {
-    const int32_t *c = tets + 4 * t;
-    double dist[4];
-    int pos = 0, neg = 0;
-    for (int k = 0; k < 4; ++k) {
-      dist[k] = rest[3 * c[k]] - x0; /* x0 is off the lattice: never 0 */
-      pos |= dist[k] > 0, neg |= dist[k] < 0;
-    }
-    if (!pos || !neg) continue;
-    copy_polygons poly;
-    piola__fracture_copy_polygons(dist, 1, c, &poly);
-    double p[4][3], sum[3] = {0, 0, 0};
-    for (int32_t i = 0; i < poly.crack_size; ++i)
-      for (int a = 0; a < 3; ++a) {
-        const double *lo = x + 3 * c[poly.crack[i].lo], *hi = x + 3 * c[poly.crack[i].hi];
-        p[i][a] = lo[a] + poly.crack[i].t * (hi[a] - lo[a]);
-      }
-    for (int32_t i = 1; i + 1 < poly.crack_size; ++i) {
-      double u[3], v[3];
-      for (int a = 0; a < 3; ++a) u[a] = p[i][a] - p[0][a], v[a] = p[i + 1][a] - p[0][a];
-      sum[0] += u[1] * v[2] - u[2] * v[1], sum[1] += u[2] * v[0] - u[0] * v[2], sum[2] += u[0] * v[1] - u[1] * v[0];
-    }
-    area += 0.5 * sqrt(sum[0] * sum[0] + sum[1] * sum[1] + sum[2] * sum[2]);
-  }
-  return area;
 }
 
 #define PLANES 25 /* rest planes x = -0.12 .. 0.12 m, between the grips (|x| > 0.157 m) */
@@ -189,13 +94,13 @@ static void ductile_bar_necks_then_tears(void **state) {
   free(text);
   piola_world *w = piola_scene_world(scene);
   double rest[PLANES];
-  for (int i = 0; i < PLANES; ++i) rest[i] = section(w, plane_x(i));
+  for (int i = 0; i < PLANES; ++i) rest[i] = fracture_rest_section_area(w, plane_x(i));
   double neck = 1, neck_x = 0, first_cut = INFINITY, broken = INFINITY;
   const double chunk = 0.005; /* s between section measurements */
   for (int k = 1; k <= 100 && !isfinite(broken); ++k) {
     if (!isfinite(first_cut))
       for (int i = 0; i < PLANES; ++i) {
-        const double r = section(w, plane_x(i)) / rest[i];
+        const double r = fracture_rest_section_area(w, plane_x(i)) / rest[i];
         if (r < neck) neck = r, neck_x = plane_x(i);
       }
     if (piola_world_advance_to(w, k * chunk, NULL) != PIOLA_OK) fail_msg("t = %g: %s", k * chunk, piola_last_error());

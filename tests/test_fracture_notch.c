@@ -3,6 +3,7 @@
  * per end; with the ductile (plastic strain) criterion its ligament first necks (cross-section
  * down by at least 30%) and it breaks later than the brittle bar. */
 #include "test_support.h"
+#include "fracture_checks.h"
 
 #include <math.h>
 #include <stdlib.h>
@@ -50,36 +51,6 @@ static void notched_bar_mesh(piola_tet_mesh *out) {
   for (int32_t i = 0; i < 4 * nt; ++i) tets[i] = keep[tets[i]];
   free(keep), free(box.positions), free(box.tets);
   *out = (piola_tet_mesh){.vertex_count = nv, .positions = x, .tet_count = nt, .tets = tets};
-}
-
-/* The area of the bar's cross-section at the rest plane x = NOTCH_X, at the current
- * positions: per tet, the polygon where that plane meets it, mapped by the tet's
- * deformation. Only for a body not cut yet. */
-static double notch_section(const piola_world *w) {
-  const piola_elastic_body *b = piola_world_solid_body(w, 0);
-  const double *rest = piola_elastic_body_rest_positions(b), *x = piola_world_solid_positions(w, 0);
-  const int32_t *tets = piola_elastic_body_tets(b);
-  double area = 0;
-  for (int32_t t = 0; t < piola_elastic_body_tet_count(b); ++t) {
-    const int32_t *c = tets + 4 * t;
-    double dist[4];
-    for (int k = 0; k < 4; ++k) dist[k] = rest[3 * c[k]] - NOTCH_X; /* no vertex on the plane */
-    copy_polygons poly;
-    piola__fracture_copy_polygons(dist, 1, c, &poly);
-    double p[4][3], sum[3] = {0, 0, 0};
-    for (int32_t i = 0; i < poly.crack_size; ++i)
-      for (int a = 0; a < 3; ++a) {
-        const double *lo = x + 3 * c[poly.crack[i].lo], *hi = x + 3 * c[poly.crack[i].hi];
-        p[i][a] = lo[a] + poly.crack[i].t * (hi[a] - lo[a]);
-      }
-    for (int32_t i = 1; i + 1 < poly.crack_size; ++i) {
-      double u[3], v[3];
-      for (int a = 0; a < 3; ++a) u[a] = p[i][a] - p[0][a], v[a] = p[i + 1][a] - p[0][a];
-      sum[0] += u[1] * v[2] - u[2] * v[1], sum[1] += u[2] * v[0] - u[0] * v[2], sum[2] += u[0] * v[1] - u[1] * v[0];
-    }
-    area += 0.5 * sqrt(sum[0] * sum[0] + sum[1] * sum[1] + sum[2] * sum[2]);
-  }
-  return area;
 }
 
 typedef struct pull_result {
@@ -133,11 +104,11 @@ static pull_result pull_notched_bar(int plastic, piola_fracture_criterion criter
   def.criterion = criterion, def.threshold = threshold;
   assert_int_equal(piola_world_solid_set_fracture(w, 0, &def), PIOLA_OK);
   pull_result r = {.first_cut = INFINITY, .broken = INFINITY};
-  const double rest_section = notch_section(w);
+  const double rest_section = fracture_rest_section_area(w, NOTCH_X);
   assert_close(rest_section, 2 * CELL * 4 * CELL, 1e-12);
   r.section_ratio = 1;
   while (piola_world_time(w) < t_end && !isfinite(r.broken)) {
-    if (!isfinite(r.first_cut)) r.section_ratio = notch_section(w) / rest_section;
+    if (!isfinite(r.first_cut)) r.section_ratio = fracture_rest_section_area(w, NOTCH_X) / rest_section;
     assert_int_equal(piola_world_step(w, 0, NULL), PIOLA_OK);
     if (piola_world_solid_cut_tet_count(w, 0) > 0 && !isfinite(r.first_cut)) r.first_cut = piola_world_time(w);
     if (piola_world_solid_fragment_count(w, 0) >= 2) r.broken = piola_world_time(w);

@@ -26,8 +26,9 @@
 extern "C" {
 #endif
 
-/* The checkpoint format this piola writes and reads (docs/file-formats.md). */
-#define PIOLA_CHECKPOINT_VERSION 4
+/* The checkpoint format this piola writes (docs/file-formats.md); it reads this one and
+ * format 4 (whose cut solids have no tet cut twice). */
+#define PIOLA_CHECKPOINT_VERSION 5
 
 /* 1 when checkpoints cover every part of the world's state; 0 with a reason in *why (a
  * static string) otherwise. */

@@ -33,6 +33,9 @@
 #define SNAP_SHARE 1e-4
 /* shared face areas below this share of the face are no material contact */
 #define OVERLAP_SHARE 1e-12
+/* a cut through a copy cut before splits it only where each side keeps more than this
+ * share of the tet's material (below it the fraction is rounding) */
+#define MIN_PIECE 1e-13
 
 static void free_blades(piola_tri_mesh *blades, int32_t count);
 
@@ -42,6 +45,7 @@ void piola__fracture_free(solid_fracture *f) {
   free(f->cuts), free(f->tets), free(f->neighbor), free(f->parent), free(f->event), free(f->dist);
   free(f->side), free(f->fraction), free(f->fragment), free(f->copies), free(f->vertex_crack), free(f->last_strain);
   free(f->vertex_value), free(f->vertex_time), free(f->sweep_crack), free(f->swept_to);
+  free(f->more_event), free(f->more_dist), free(f->more_side);
   free(f);
 }
 
@@ -85,7 +89,10 @@ static piola_status fracture_create(const world_body *b, solid_fracture **out) {
     f->side = calloc((size_t)nt, 1);
     f->fraction = malloc(sizeof(double) * (size_t)nt);
     f->fragment = calloc((size_t)nt, sizeof(int32_t));
-    f->copies = malloc(2 * sizeof(int32_t) * (size_t)nt);
+    f->copies = malloc(FRACTURE_MAX_COPIES * sizeof(int32_t) * (size_t)nt);
+    f->more_event = malloc((FRACTURE_MAX_CUTS - 1) * sizeof(int32_t) * (size_t)nt);
+    f->more_dist = calloc(4 * (FRACTURE_MAX_CUTS - 1) * (size_t)nt, sizeof(double));
+    f->more_side = calloc((FRACTURE_MAX_CUTS - 1) * (size_t)nt, 1);
     f->vertex_count = b->n;
     f->vertex_crack = malloc(sizeof(int32_t) * (size_t)b->n);
     f->vertex_value = calloc((size_t)b->n, sizeof(double));
@@ -93,7 +100,7 @@ static piola_status fracture_create(const world_body *b, solid_fracture **out) {
   }
   if (!f || !keys || !f->tets || !f->neighbor || !f->parent || !f->event || !f->dist || !f->side ||
       !f->fraction || !f->fragment || !f->copies || !f->vertex_crack || !f->vertex_value ||
-      !f->vertex_time) {
+      !f->vertex_time || !f->more_event || !f->more_dist || !f->more_side) {
     free(keys);
     piola__fracture_free(f);
     return PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "fracture of '%s': out of memory", b->name);
@@ -103,7 +110,8 @@ static piola_status fracture_create(const world_body *b, solid_fracture **out) {
   f->grown_crack = -1;
   for (int32_t t = 0; t < nt; ++t) {
     f->parent[t] = t, f->event[t] = -1, f->side[t] = 1, f->fraction[t] = 1.0;
-    f->copies[2 * t] = t, f->copies[2 * t + 1] = -1;
+    for (int j = 0; j < FRACTURE_MAX_COPIES; ++j) f->copies[FRACTURE_MAX_COPIES * t + j] = j == 0 ? t : -1;
+    for (int j = 0; j < FRACTURE_MAX_CUTS - 1; ++j) f->more_event[(FRACTURE_MAX_CUTS - 1) * t + j] = -1;
     for (int k = 0; k < 4; ++k) {
       face_key *key = &keys[4 * t + k];
       for (int i = 0; i < 3; ++i) key->v[i] = f->tets[4 * t + piola__cut_tet_face[k][i]];
@@ -137,10 +145,10 @@ static piola_status fracture_create(const world_body *b, solid_fracture **out) {
 /* Area (times a constant) of the part of triangle (e0, e1, e2) in barycentric coordinates
  * where each of the n linear functions (values at the three corners) is positive. */
 static double clipped_face_area(double value[][3], int n) {
-  double poly[8][3] = {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
+  double poly[16][3] = {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
   int size = 3;
   for (int c = 0; c < n && size > 0; ++c) {
-    double next[8][3], g[8];
+    double next[16][3], g[16];
     int m = 0;
     for (int i = 0; i < size; ++i)
       g[i] = value[c][0] * poly[i][0] + value[c][1] * poly[i][1] + value[c][2] * poly[i][2];
@@ -174,22 +182,48 @@ static int local_corner(const int32_t *tet, int32_t vertex) {
 }
 
 /* Whether copies c (of tet t, face k) and d (of the neighbour u) hold material on a
- * common part of their shared face of positive area. */
-static int faces_overlap(const solid_fracture *f, const int32_t *event, const double *dist,
-                         const int8_t *side, int32_t c, int32_t t, int k, int32_t d, int32_t u) {
-  double value[2][3];
+ * common part of their shared face of positive area (f: the copies' cuts). */
+static int faces_overlap(const solid_fracture *f, int32_t c, int32_t t, int k, int32_t d, int32_t u) {
+  double value[2 * FRACTURE_MAX_CUTS][3];
   int n = 0;
   const int32_t copy[2] = {c, d}, tet[2] = {t, u};
   for (int s = 0; s < 2; ++s) {
-    if (event[copy[s]] < 0) continue;
-    for (int i = 0; i < 3; ++i) {
-      int32_t vertex = f->tets[4 * t + piola__cut_tet_face[k][i]];
-      int corner = local_corner(f->tets + 4 * tet[s], vertex);
-      value[n][i] = side[copy[s]] * dist[4 * copy[s] + corner];
-    }
-    ++n;
+    copy_cut cuts[FRACTURE_MAX_CUTS];
+    const int32_t count = piola__fracture_copy_cuts(f, copy[s], cuts);
+    for (int32_t j = 0; j < count; ++j, ++n)
+      for (int i = 0; i < 3; ++i) {
+        int32_t vertex = f->tets[4 * t + piola__cut_tet_face[k][i]];
+        int corner = local_corner(f->tets + 4 * tet[s], vertex);
+        value[n][i] = cuts[j].side * cuts[j].dist[corner];
+      }
   }
   return clipped_face_area(value, n) > OVERLAP_SHARE * sqrt(3.0);
+}
+
+/* Whether a cut of crack `crack` with corner distances dist splits copy c: the tet's
+ * corners are on both sides of it, c has room for one more cut and none of its cuts is of
+ * this crack, and (for a copy cut before) each side holds more than MIN_PIECE of the
+ * tet's material. */
+static int cut_splits(const solid_fracture *f, int32_t c, int32_t crack, const double dist[4]) {
+  int pos = 0, neg = 0;
+  for (int k = 0; k < 4; ++k) {
+    if (dist[k] > 0) pos = 1;
+    else neg = 1;
+  }
+  if (!(pos && neg)) return 0;
+  copy_cut cuts[FRACTURE_MAX_CUTS];
+  const int32_t n = piola__fracture_copy_cuts(f, c, cuts);
+  if (n == 0) return 1;
+  if (n >= FRACTURE_MAX_CUTS) return 0;
+  for (int32_t j = 0; j < n; ++j)
+    if (cuts[j].event == crack) return 0;
+  for (int side = -1; side <= 1; side += 2) {
+    cuts[n] = (copy_cut){crack, (int8_t)side, {dist[0], dist[1], dist[2], dist[3]}};
+    cell_polygons poly;
+    piola__fracture_cell_polygons(cuts, n + 1, f->tets + 4 * f->parent[c], &poly);
+    if (!(poly.fraction > MIN_PIECE)) return 0;
+  }
+  return 1;
 }
 
 /* ------------------------------------------------------------------ the cut event */
@@ -213,14 +247,15 @@ typedef struct tet_cut {
 
 typedef struct new_mesh {
   int32_t copies, nodes;
-  int32_t *parent, *event, *element_parent, *node_of, *node_parent, *up, *fragment;
-  int8_t *side, *fresh;
-  double *dist, *fraction;
+  int32_t *parent, *event, *element_parent, *node_of, *node_parent, *up, *fragment, *more_event;
+  int8_t *side, *fresh, *more_side;
+  double *dist, *fraction, *more_dist;
 } new_mesh;
 
 static void new_mesh_free(new_mesh *m) {
   free(m->parent), free(m->event), free(m->element_parent), free(m->node_of), free(m->node_parent);
   free(m->up), free(m->fragment), free(m->side), free(m->fresh), free(m->dist), free(m->fraction);
+  free(m->more_event), free(m->more_side), free(m->more_dist);
 }
 
 /* Numbers fragments: copies joined through nodes, in order of first copy. */
@@ -246,14 +281,14 @@ static void number_fragments(int32_t copies, const int32_t *node_of, int32_t nod
   *count = n;
 }
 
-/* Splits the uncut copies cuts[i].copy (each once, corner distances of both signs, none
- * zero) into two copies each, rebuilding nodes, body and fragments (steps 2 to 5 above). */
+/* Splits the copies cuts[i].copy (each once, where cut_splits says so: corner distances
+ * none zero) into two copies each, rebuilding nodes, body and fragments (steps 2 to 5
+ * above). */
 static piola_status split_copies(piola_world *w, world_body *b, const tet_cut *cuts, int32_t count) {
   solid_fracture *f = b->fracture;
   const piola_elastic_body *old = b->solid;
   const int32_t *old_tets = piola_elastic_body_tets(old);
   if (count == 0) return PIOLA_OK;
-  const int32_t split = count;
   /* the cracks' values at the vertices they reach first (continued_crack reads them) */
   for (int32_t i = 0; i < count; ++i)
     for (int k = 0; k < 4; ++k) {
@@ -267,7 +302,7 @@ static piola_status split_copies(piola_world *w, world_body *b, const tet_cut *c
   for (int32_t c = 0; c < f->copy_count; ++c) plan[c] = -1;
   for (int32_t i = 0; i < count; ++i) plan[cuts[i].copy] = i;
   new_mesh m = {0};
-  const int32_t nc = f->copy_count + split;
+  const int32_t nc = f->copy_count + count;
   m.copies = nc;
   m.parent = malloc(sizeof(int32_t) * (size_t)nc);
   m.event = malloc(sizeof(int32_t) * (size_t)nc);
@@ -280,39 +315,71 @@ static piola_status split_copies(piola_world *w, world_body *b, const tet_cut *c
   m.fresh = calloc((size_t)b->n, 1);
   m.dist = malloc(4 * sizeof(double) * (size_t)nc);
   m.fraction = malloc(sizeof(double) * (size_t)nc);
-  int32_t *copies = malloc(2 * sizeof(int32_t) * (size_t)f->tet_count);
+  m.more_event = malloc((FRACTURE_MAX_CUTS - 1) * sizeof(int32_t) * (size_t)nc);
+  m.more_side = malloc((FRACTURE_MAX_CUTS - 1) * (size_t)nc);
+  m.more_dist = malloc(4 * (FRACTURE_MAX_CUTS - 1) * sizeof(double) * (size_t)nc);
+  int32_t *copies = malloc(FRACTURE_MAX_COPIES * sizeof(int32_t) * (size_t)f->tet_count);
   double *x = malloc(3 * sizeof(double) * 4 * (size_t)nc), *v = malloc(3 * sizeof(double) * 4 * (size_t)nc);
   double *rest = malloc(3 * sizeof(double) * 4 * (size_t)nc);
   piola_status st = PIOLA_OK;
   if (!m.parent || !m.event || !m.element_parent || !m.node_of || !m.node_parent || !m.up ||
-      !m.fragment || !m.side || !m.fresh || !m.dist || !m.fraction || !copies || !x || !v || !rest)
+      !m.fragment || !m.side || !m.fresh || !m.dist || !m.fraction || !m.more_event || !m.more_side ||
+      !m.more_dist || !copies || !x || !v || !rest)
     st = PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "cut of '%s': out of memory", b->name);
-  int32_t n = 0;
+  int32_t n = 0, newly_cut = 0;
+  enum { MORE = FRACTURE_MAX_CUTS - 1 };
   for (int32_t c = 0; c < f->copy_count && st == PIOLA_OK; ++c) {
     const int32_t *corners = old_tets + 4 * c;
     const tet_cut *cut = plan[c] >= 0 ? &cuts[plan[c]] : NULL;
+    copy_cut have[FRACTURE_MAX_CUTS];
+    const int32_t had = piola__fracture_copy_cuts(f, c, have);
+    newly_cut += cut && had == 0;
     for (int copy = 0; copy < (cut ? 2 : 1); ++copy) {
+      const int8_t side = copy == 0 ? 1 : -1;
       m.parent[n] = f->parent[c];
       m.element_parent[n] = c;
-      m.event[n] = cut ? cut->crack : f->event[c];
-      m.side[n] = cut ? (copy == 0 ? 1 : -1) : f->side[c];
+      m.event[n] = cut && had == 0 ? cut->crack : f->event[c];
+      m.side[n] = cut && had == 0 ? side : f->side[c];
       m.fraction[n] = f->fraction[c];
       memcpy(m.dist + 4 * n, f->dist + 4 * c, 4 * sizeof(double));
+      memcpy(m.more_event + MORE * n, f->more_event + MORE * c, MORE * sizeof(int32_t));
+      memcpy(m.more_side + MORE * n, f->more_side + MORE * c, MORE);
+      memcpy(m.more_dist + 4 * MORE * n, f->more_dist + 4 * MORE * c, 4 * MORE * sizeof(double));
       if (cut) {
-        for (int k = 0; k < 4; ++k) m.dist[4 * n + k] = cut->dist[k], m.fresh[corners[k]] = 1;
-        copy_polygons poly;
-        piola__fracture_copy_polygons(m.dist + 4 * n, m.side[n], f->tets + 4 * m.parent[n], &poly);
-        m.fraction[n] = poly.fraction;
+        for (int k = 0; k < 4; ++k) m.fresh[corners[k]] = 1;
+        if (had == 0) {
+          memcpy(m.dist + 4 * n, cut->dist, 4 * sizeof(double));
+          copy_polygons poly;
+          piola__fracture_copy_polygons(m.dist + 4 * n, m.side[n], f->tets + 4 * m.parent[n], &poly);
+          m.fraction[n] = poly.fraction;
+        } else {
+          /* one more cut: the copy's cell clipped by it */
+          const size_t slot = (size_t)(MORE * n + had - 1);
+          m.more_event[slot] = cut->crack, m.more_side[slot] = side;
+          memcpy(m.more_dist + 4 * slot, cut->dist, 4 * sizeof(double));
+          have[had] = (copy_cut){cut->crack, side, {cut->dist[0], cut->dist[1], cut->dist[2], cut->dist[3]}};
+          cell_polygons poly;
+          piola__fracture_cell_polygons(have, had + 1, f->tets + 4 * m.parent[n], &poly);
+          m.fraction[n] = poly.fraction;
+        }
       }
       for (int k = 0; k < 4; ++k) m.node_parent[4 * n + k] = corners[k];
       ++n;
     }
   }
   free(plan);
+  /* the new copies' cuts, for faces_overlap */
+  solid_fracture cut_view = *f;
+  cut_view.event = m.event, cut_view.dist = m.dist, cut_view.side = m.side;
+  cut_view.more_event = m.more_event, cut_view.more_dist = m.more_dist, cut_view.more_side = m.more_side;
   /* 3: nodes. Items of nodes no new copy touches stay together; elsewhere MBF04's rule */
   if (st == PIOLA_OK) {
-    for (int32_t t = 0; t < f->tet_count; ++t) copies[2 * t] = copies[2 * t + 1] = -1;
-    for (int32_t c = 0; c < nc; ++c) copies[2 * m.parent[c] + (copies[2 * m.parent[c]] >= 0)] = c;
+    for (int32_t i = 0; i < FRACTURE_MAX_COPIES * f->tet_count; ++i) copies[i] = -1;
+    for (int32_t c = 0; c < nc; ++c) {
+      int32_t *slot = copies + FRACTURE_MAX_COPIES * m.parent[c];
+      while (*slot >= 0) ++slot; /* at most FRACTURE_MAX_COPIES: three cuts deep */
+      *slot = c;
+    }
     int32_t *first = malloc(sizeof(int32_t) * (size_t)b->n);
     if (!first) st = PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "cut of '%s': out of memory", b->name);
     for (int32_t i = 0; i < 4 * nc; ++i) m.up[i] = i;
@@ -329,9 +396,9 @@ static piola_status split_copies(piola_world *w, world_body *b, const tet_cut *c
       for (int k = 0; k < 4; ++k) {
         const int32_t u = f->neighbor[4 * t + k];
         if (u < t) continue; /* each face once (and none on the boundary) */
-        for (int j = 0; j < 2; ++j) {
-          const int32_t d = copies[2 * u + j];
-          if (d < 0 || !faces_overlap(f, m.event, m.dist, m.side, c, t, k, d, u)) continue;
+        for (int j = 0; j < FRACTURE_MAX_COPIES; ++j) {
+          const int32_t d = copies[FRACTURE_MAX_COPIES * u + j];
+          if (d < 0 || !faces_overlap(&cut_view, c, t, k, d, u)) continue;
           for (int i = 0; i < 3; ++i) {
             int32_t vertex = f->tets[4 * t + piola__cut_tet_face[k][i]];
             int32_t a = 4 * c + local_corner(f->tets + 4 * t, vertex);
@@ -371,10 +438,12 @@ static piola_status split_copies(piola_world *w, world_body *b, const tet_cut *c
     /* 5: the new per-copy state */
     f = b->fracture;
     free(f->parent), free(f->event), free(f->dist), free(f->side), free(f->fraction), free(f->fragment);
-    free(f->copies);
+    free(f->copies), free(f->more_event), free(f->more_side), free(f->more_dist);
     f->parent = m.parent, f->event = m.event, f->dist = m.dist, f->side = m.side;
     f->fraction = m.fraction, f->fragment = m.fragment, f->copies = copies;
-    m.parent = m.event = m.fragment = NULL, m.dist = m.fraction = NULL, m.side = NULL, copies = NULL;
+    f->more_event = m.more_event, f->more_side = m.more_side, f->more_dist = m.more_dist;
+    m.parent = m.event = m.fragment = m.more_event = NULL, m.dist = m.fraction = m.more_dist = NULL;
+    m.side = m.more_side = NULL, copies = NULL;
     if (f->last_strain) {
       double *last = malloc(sizeof(double) * (size_t)nc);
       if (!last) st = PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "cut of '%s': out of memory", b->name);
@@ -383,7 +452,7 @@ static piola_status split_copies(piola_world *w, world_body *b, const tet_cut *c
       f->last_strain = last;
     }
     f->copy_count = nc;
-    f->cut_tets += split;
+    f->cut_tets += newly_cut;
     number_fragments(nc, piola_elastic_body_tets(b->solid), m.nodes, m.up, f->fragment,
                      &f->fragment_count);
   }
@@ -415,16 +484,9 @@ static piola_status cut_event(piola_world *w, world_body *b, const double point[
   }
   int32_t count = 0;
   for (int32_t c = 0; c < f->copy_count; ++c) {
-    if (f->event[c] >= 0) continue;
-    int pos = 0, neg = 0;
-    for (int k = 0; k < 4; ++k) {
-      if (s[tets[4 * c + k]] > 0) pos = 1;
-      else neg = 1;
-    }
-    if (!(pos && neg)) continue;
     cuts[count].copy = c, cuts[count].crack = f->events;
     for (int k = 0; k < 4; ++k) cuts[count].dist[k] = s[tets[4 * c + k]];
-    ++count;
+    count += cut_splits(f, c, f->events, cuts[count].dist);
   }
   piola_status st = split_copies(w, b, cuts, count);
   if (st == PIOLA_OK) b->fracture->events++;
@@ -554,7 +616,6 @@ piola_status piola__fracture_surface_cut(piola_world *w, world_body *b, const pi
   for (int32_t i = 0; i < b->n; ++i) s[i] = NAN; /* computed on demand */
   int32_t count = 0;
   for (int32_t c = 0; c < f->copy_count; ++c) {
-    if (f->event[c] >= 0) continue;
     const int32_t *corner = tets + 4 * c;
     int apart = 0; /* the copy's box misses the surface's */
     for (int k = 0; k < 3 && !apart; ++k) {
@@ -590,7 +651,7 @@ piola_status piola__fracture_surface_cut(piola_world *w, world_body *b, const pi
     }
     for (int k = 0; k < 4 && !(kept_pos && kept_neg); ++k)
       if ((cuts[count].dist[k] > 0) != (s[corner[k]] > 0)) cuts[count].dist[k] = s[corner[k]];
-    ++count;
+    count += cut_splits(f, c, cuts[count].crack, cuts[count].dist);
   }
   piola_status st = split_copies(w, b, cuts, count);
   if (st == PIOLA_OK && crack < 0) b->fracture->events++;
@@ -735,7 +796,7 @@ static double front_reached(const solid_fracture *f, int32_t t) {
   double when = INFINITY;
   for (int k = 0; k < 4; ++k) {
     const int32_t nb = f->neighbor[4 * t + k];
-    if (nb < 0 || f->copies[2 * nb + 1] < 0) continue;
+    if (nb < 0 || f->copies[FRACTURE_MAX_COPIES * nb + 1] < 0) continue;
     for (int e = 0; e < 3; ++e) {
       const int32_t a = ids[piola__cut_tet_face[k][e]], c = ids[piola__cut_tet_face[k][(e + 1) % 3]];
       if (f->vertex_crack[a] < 0 || f->vertex_crack[a] != f->vertex_crack[c] ||
@@ -832,8 +893,8 @@ static int neighbour_crack_normal(const solid_fracture *f, const double *x, cons
   normal[0] = normal[1] = normal[2] = 0;
   for (int k = 0; k < 4; ++k) {
     const int32_t nb = f->neighbor[4 * t + k];
-    if (nb < 0 || f->copies[2 * nb + 1] < 0) continue;
-    const int32_t c = f->copies[2 * nb];
+    if (nb < 0 || f->copies[FRACTURE_MAX_COPIES * nb + 1] < 0) continue;
+    const int32_t c = f->copies[FRACTURE_MAX_COPIES * nb];
     double g[4][3], n[3] = {0, 0, 0};
     if (!barycentric_gradients(x, nodes + 4 * c, g)) continue;
     for (int i = 0; i < 4; ++i)

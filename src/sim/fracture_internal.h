@@ -7,7 +7,15 @@
  * from zero) of the copy's four corners: inside the tet the crack is the zero set of their
  * linear interpolant, a polygon in barycentric coordinates. The copy's corners are in the
  * order of its original tet (positively oriented), so corner k of a copy and of its
- * original tet are the same material point. */
+ * original tet are the same material point.
+ *
+ * A tet can be cut again: a copy's material is then the part of its tet on its side of
+ * each of up to three cuts, a convex cell (a cell of the planes' arrangement). Unlike
+ * MBF04, whose pieces each keep the material near one of the tet's corners, a cell need
+ * not hold a corner: where two cracks cross inside a tet, the wedge between them is a copy
+ * of its own whose nodes are all virtual, joined to its neighbours through the faces it
+ * touches like any copy. So a tet has at most 8 copies (three cuts deep). The first cut is
+ * in event, dist and side; the others in more_event, more_dist and more_side. */
 #ifndef PIOLA_SIM_FRACTURE_INTERNAL_H
 #define PIOLA_SIM_FRACTURE_INTERNAL_H
 
@@ -15,6 +23,13 @@
 
 #include "piola/mesh.h"
 #include "piola/world_fracture.h"
+
+enum {
+  FRACTURE_MAX_CUTS = 3,   /* cuts through one copy */
+  FRACTURE_MAX_COPIES = 8, /* copies of one original tet: two per cut, three deep */
+  CELL_POLYGON_MAX = 12    /* points of one clipped polygon (a triangle or quadrilateral
+                              clipped by up to three planes) */
+};
 
 typedef struct solid_fracture {
   /* scripted cuts, sorted by time, and the next one to apply */
@@ -50,7 +65,12 @@ typedef struct solid_fracture {
   int32_t *fragment;          /* connected piece of material */
   int32_t fragment_count;
   int32_t cut_tets;           /* original tets split so far */
-  int32_t *copies;            /* 2 per original tet: its copies (the second -1 when whole) */
+  int32_t *copies;            /* FRACTURE_MAX_COPIES per original tet: its copies (-1 after
+                                 the last) */
+  /* per copy, its second and third cuts (FRACTURE_MAX_CUTS - 1 slots; event -1: none) */
+  int32_t *more_event;
+  double *more_dist;          /* 4 per slot */
+  int8_t *more_side;
   double *last_strain;        /* per copy, plastic_strain criterion only (else NULL): its
                                  accumulated plastic strain at the last criterion pass */
   /* per original vertex: the crack that reached it first (-1: none) and that crack's value
@@ -86,13 +106,50 @@ void piola__fracture_copy_polygons(const double dist[4], int side, const int32_t
 /* The outward faces of a positively oriented tet: face k is opposite corner k. */
 extern const int8_t piola__cut_tet_face[4][3];
 
+/* One cut through a copy: its crack (event id), the copy's side of it (+1 or -1) and the
+ * corner distances (m, none zero). */
+typedef struct copy_cut {
+  int32_t event;
+  int8_t side;
+  double dist[4];
+} copy_cut;
+
+/* The cuts through copy c (first one first); returns their count (0: whole). */
+int32_t piola__fracture_copy_cuts(const solid_fracture *f, int32_t c, copy_cut out[FRACTURE_MAX_CUTS]);
+
+/* A point of a copy cut by several planes: on the face (edge, corner) of its tet spanned by
+ * the corners in mask `corners`, and on the copy's cuts in mask `cuts` (bit j: cut j), one
+ * cut fewer than corners; w: its barycentric weights (0 outside `corners`). Its weights
+ * are computed from the corners' distances alone, corners in order of original vertex id
+ * and cuts in order of event id, so every copy that names the point alike gets the same
+ * bits. */
+typedef struct cell_point {
+  uint8_t corners, cuts;
+  double w[4];
+} cell_point;
+
+/* The polygons of a copy cut by n cuts (1 to FRACTURE_MAX_CUTS): each face (k opposite
+ * corner k, outward) clipped to the copy's material, each cut's crack polygon clipped by
+ * the other cuts (outward from the material), and the material fraction they enclose. */
+typedef struct cell_polygons {
+  cell_point face[4][CELL_POLYGON_MAX];
+  int32_t face_size[4];
+  cell_point crack[FRACTURE_MAX_CUTS][CELL_POLYGON_MAX];
+  int32_t crack_size[FRACTURE_MAX_CUTS];
+  double fraction;
+} cell_polygons;
+
+void piola__fracture_cell_polygons(const copy_cut *cuts, int32_t n, const int32_t ids[4],
+                                   cell_polygons *out);
+
 void piola__fracture_free(solid_fracture *f);
 
-/* A vertex of a fragment surface: the point a + t (b - a) between nodes a and b (a == b and
- * t = 0 for a corner). */
+/* A vertex of a fragment surface: sum w[k] x[node[k]] over its nodes (a corner: one node,
+ * a crack's crossing of an edge: two, where two cracks meet on a face: three, where three
+ * meet inside a tet: four; unused slots node -1, weight 0; the weights sum to 1). */
 typedef struct fracture_surface_point {
-  int32_t a, b;
-  double t;
+  int32_t node[4];
+  double w[4];
 } fracture_surface_point;
 
 struct world_body;

@@ -9,13 +9,14 @@
 
 /* A solid's cut state as a checkpoint holds it: per copy (element of the cut mesh) its
  * original tet, the cut that made it (-1: whole), its corner distances (4, m), side (+1 or
- * -1), material fraction, fragment and nodes (4), and per original tet its copies (2, the
- * second -1 when whole); node_count nodes. */
+ * -1), material fraction, fragment and nodes (4), its further cuts (FRACTURE_MAX_CUTS - 1
+ * slots of event, side and 4 distances; event -1: none), and per original tet its copies
+ * (FRACTURE_MAX_COPIES, -1 after the last); node_count nodes. */
 typedef struct fracture_saved {
   int32_t copy_count, node_count, events, fragment_count;
-  const int32_t *parent, *event, *fragment, *tets, *copies;
-  const int8_t *side;
-  const double *dist, *fraction;
+  const int32_t *parent, *event, *fragment, *tets, *copies, *more_event;
+  const int8_t *side, *more_side;
+  const double *dist, *fraction, *more_dist;
 } fracture_saved;
 
 /* Checks saved against solid b's original mesh (ranges; every node used, and by copies of

@@ -88,6 +88,7 @@ typedef struct stream {
   unsigned char *data;
   size_t length, capacity, pos;
   int reading, store, failed;
+  uint32_t version; /* the format read (reading; writing writes the newest) */
   char what[160]; /* the first mismatch, for the message */
 } stream;
 
@@ -217,7 +218,10 @@ static void fracture_state(stream *s, piola_world *w, world_body *b) {
   }
   if (s->failed) return;
   const int32_t nc = counts[0];
-  if (s->reading && (nc < f->tet_count || nc > 2 * f->tet_count || counts[1] < 1 ||
+  /* format 4 cut a tet once: 2 copies per tet, no further cuts */
+  const int old_format = s->reading && s->version == 4;
+  const int32_t per_tet = old_format ? 2 : FRACTURE_MAX_COPIES, more = FRACTURE_MAX_CUTS - 1;
+  if (s->reading && (nc < f->tet_count || nc > per_tet * f->tet_count || counts[1] < 1 ||
                      counts[1] > 4 * nc || /* every node is a corner of a copy */
                      counts[4] < 0 || counts[4] > f->cut_count || counts[5] < 0 ||
                      counts[5] > f->tet_count)) {
@@ -227,8 +231,10 @@ static void fracture_state(stream *s, piola_world *w, world_body *b) {
   }
   void *parent = f->parent, *event = f->event, *fragment = f->fragment, *copies = f->copies;
   void *tets = (void *)piola_elastic_body_tets(b->solid), *side = f->side, *dist = f->dist;
-  void *fraction = f->fraction;
+  void *fraction = f->fraction, *more_event = f->more_event, *more_side = f->more_side;
+  void *more_dist = f->more_dist;
   if (s->reading) parent = event = fragment = copies = tets = side = dist = fraction = NULL;
+  if (s->reading) more_event = more_side = more_dist = NULL;
   local_array(s, &parent, (uint64_t)nc, sizeof(int32_t), "copy tets");
   local_array(s, &event, (uint64_t)nc, sizeof(int32_t), "copy cuts");
   local_array(s, &side, (uint64_t)nc, 1, "copy sides");
@@ -236,7 +242,30 @@ static void fracture_state(stream *s, piola_world *w, world_body *b) {
   local_array(s, &fraction, (uint64_t)nc, sizeof(double), "material fractions");
   local_array(s, &fragment, (uint64_t)nc, sizeof(int32_t), "fragments");
   local_array(s, &tets, 4 * (uint64_t)nc, sizeof(int32_t), "copy nodes");
-  local_array(s, &copies, 2 * (uint64_t)f->tet_count, sizeof(int32_t), "copies of tets");
+  local_array(s, &copies, (uint64_t)per_tet * (uint64_t)f->tet_count, sizeof(int32_t), "copies of tets");
+  if (!old_format) {
+    local_array(s, &more_event, (uint64_t)more * (uint64_t)nc, sizeof(int32_t), "copy further cuts");
+    local_array(s, &more_side, (uint64_t)more * (uint64_t)nc, 1, "copy further sides");
+    local_array(s, &more_dist, 4 * (uint64_t)more * (uint64_t)nc, sizeof(double), "copy further distances");
+  } else if (!s->failed) {
+    /* a format-4 state in this format's layout: copies padded to FRACTURE_MAX_COPIES per
+     * tet, no further cuts */
+    int32_t *wide = malloc(FRACTURE_MAX_COPIES * sizeof(int32_t) * (size_t)(f->tet_count > 0 ? f->tet_count : 1));
+    more_event = malloc(sizeof(int32_t) * (size_t)(more * nc > 0 ? more * nc : 1));
+    more_side = calloc((size_t)(more * nc > 0 ? more * nc : 1), 1);
+    more_dist = calloc((size_t)(4 * more * nc > 0 ? 4 * more * nc : 1), sizeof(double));
+    if (!wide || !more_event || !more_side || !more_dist) {
+      s->failed = 1;
+      snprintf(s->what, sizeof s->what, "out of memory");
+    } else {
+      for (int32_t t = 0; t < f->tet_count; ++t)
+        for (int j = 0; j < FRACTURE_MAX_COPIES; ++j)
+          wide[FRACTURE_MAX_COPIES * t + j] = j < 2 ? ((int32_t *)copies)[2 * t + j] : -1;
+      for (int32_t i = 0; i < more * nc; ++i) ((int32_t *)more_event)[i] = -1;
+    }
+    free(copies);
+    copies = wide;
+  }
   /* the criterion's state: the plastic strain per copy at its last pass (plastic_strain
    * criterion, once it ran), the crack all its cracks share, and per original vertex the
    * crack that reached it first, that crack's value there and when it got there */
@@ -256,7 +285,8 @@ static void fracture_state(stream *s, piola_world *w, world_body *b) {
       fracture_saved saved = {.copy_count = nc, .node_count = counts[1], .events = counts[2],
                               .fragment_count = counts[3], .parent = parent, .event = event,
                               .fragment = fragment, .tets = tets, .copies = copies, .side = side,
-                              .dist = dist, .fraction = fraction};
+                              .dist = dist, .fraction = fraction, .more_event = more_event,
+                              .more_side = more_side, .more_dist = more_dist};
       if (piola__fracture_restore(w, b, &saved) != PIOLA_OK) {
         s->failed = 1;
         snprintf(s->what, sizeof s->what, "%s", piola_last_error());
@@ -270,7 +300,7 @@ static void fracture_state(stream *s, piola_world *w, world_body *b) {
     }
     free(last);
     free(parent), free(event), free(fragment), free(copies), free(tets), free(side), free(dist);
-    free(fraction);
+    free(fraction), free(more_event), free(more_side), free(more_dist);
   }
 }
 
@@ -575,6 +605,9 @@ piola_status piola_world_checkpoint_write(const piola_world *world, const char *
   return st;
 }
 
+/* Format 4 (tets cut once) differs from 5 only in the cut state (fracture_state). */
+#define OLDEST_READ_VERSION 4
+
 static int has_fracture(const piola_world *w) {
   for (int32_t i = 0; i < w->body_count; ++i)
     if (w->bodies[i].fracture) return 1;
@@ -623,10 +656,10 @@ piola_status piola_world_checkpoint_read(piola_world *world, const char *path, u
   const unsigned char *h = s.data;
   if (s.length < HEADER_BYTES + 8 || memcmp(h, magic, 8) != 0)
     st = PIOLA_FAIL(PIOLA_ERROR_PARSE, "%s: not a piola checkpoint", path);
-  else if (get_u32(h + 8) != PIOLA_CHECKPOINT_VERSION)
+  else if (get_u32(h + 8) != PIOLA_CHECKPOINT_VERSION && get_u32(h + 8) != OLDEST_READ_VERSION)
     st = PIOLA_FAIL(PIOLA_ERROR_UNSUPPORTED,
-                    "%s: checkpoint format version %u, this piola reads version %d only", path,
-                    (unsigned)get_u32(h + 8), PIOLA_CHECKPOINT_VERSION);
+                    "%s: checkpoint format version %u, this piola reads versions %d and %d only", path,
+                    (unsigned)get_u32(h + 8), OLDEST_READ_VERSION, PIOLA_CHECKPOINT_VERSION);
   else if (get_u32(h + 12) != byte_order_mark)
     st =
         PIOLA_FAIL(PIOLA_ERROR_UNSUPPORTED, "%s: written on a machine of another byte order", path);
@@ -652,7 +685,8 @@ piola_status piola_world_checkpoint_read(piola_world *world, const char *path, u
                     path);
   /* A cut solid takes the file's cut state on the checking pass (fracture_state): the world
    * as it is now is kept in memory first, and put back when the file turns out not to fit. */
-  stream before = {0};
+  s.version = s.length >= HEADER_BYTES ? get_u32(h + 8) : 0;
+  stream before = {.version = PIOLA_CHECKPOINT_VERSION};
   if (st == PIOLA_OK && has_fracture(world)) {
     unsigned char header[HEADER_BYTES] = {0};
     put(&before, header, sizeof header);

@@ -160,10 +160,17 @@ static piola_status build(piola_world *w) {
         if (!bs->where) {
           node[0] = c->offset[i] + k, weight[0] = 1;
         } else {
+          /* its nodes with positive weight (the first of them, a corner's or an edge
+           * crossing's first node, taking the rest of 1, as a single cut always had) */
           const fracture_surface_point *p = &bs->where[k];
-          node[0] = c->offset[i] + p->a, weight[0] = 1 - p->t;
-          if (p->b != p->a && p->t > 0) node[1] = c->offset[i] + p->b, weight[1] = p->t;
-          if (node[1] >= 0) weight[0] = 1 - weight[1];
+          double rest = 1;
+          int used = 0;
+          for (int j = 0; j < 4 && p->node[j] >= 0; ++j) {
+            if (!(p->w[j] > 0)) continue; /* the weights sum to 1: one at least is positive */
+            node[used] = c->offset[i] + p->node[j], weight[used] = fmin(p->w[j], 1);
+            if (used++ > 0) rest -= weight[used - 1];
+          }
+          weight[0] = rest;
         }
       }
       defs[b] = piola_default_collision_body_def();

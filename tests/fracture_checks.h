@@ -1,0 +1,33 @@
+/* What the fracture tests measure on a cut solid (test_fracture*.c): its fragment
+ * surfaces' enclosed volumes and closure, its material per fragment and its mass, and a
+ * checkpoint round trip between two worlds. */
+#ifndef PIOLA_TEST_FRACTURE_CHECKS_H
+#define PIOLA_TEST_FRACTURE_CHECKS_H
+
+#include <stdint.h>
+
+#include "piola/world.h"
+#include "piola/world_fracture.h"
+
+/* Volume enclosed by the triangles [first, end) of s (m^3, divergence theorem). */
+double fracture_enclosed_volume(const piola_fracture_surface *s, int32_t first, int32_t end);
+/* Directed edges of the triangles [first, end) of s without exactly as many opposite edges
+ * (0: closed and consistently oriented). */
+int32_t fracture_unpaired_edges(const piola_fracture_surface *s, int32_t first, int32_t end);
+/* The area (m^2) of solid 0's cross-section at the rest plane x = x0 (on no vertex), at the
+ * current positions: per tet the polygon where that plane meets it, mapped by the tet's
+ * deformation. Only for a solid not cut yet (its tets are the rest mesh's). */
+double fracture_rest_section_area(const piola_world *w, double x0);
+/* Sum of the lumped masses of solid 0 (kg). */
+double fracture_total_mass(const piola_world *w);
+/* Per fragment of solid 0: its material volume, the sum of fraction x rest volume of its
+ * copies (m^3; calloc'ed, the caller frees). */
+double *fracture_material_volumes(const piola_world *w);
+/* Writes a's checkpoint (frame `frame`, the key of b's scene without a scene file) to path
+ * and reads it into b, which must accept it and take that frame. */
+void fracture_checkpoint_round_trip(const piola_world *a, piola_world *b, const char *path, int32_t frame);
+/* Solid 0 of a and b is in the same state, bit for bit: mesh, positions, velocities,
+ * masses, fractions, fragments, cut tets and time. */
+void fracture_same_state(const piola_world *a, const piola_world *b);
+
+#endif

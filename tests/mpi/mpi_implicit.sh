@@ -66,7 +66,7 @@ for kind in backward_euler; do
            >/dev/null 2>"$work/log"; then
         cat "$work/log"; echo "FAIL $kind $pc -np $np: mpirun"; fail=1; continue
       fi
-      if ! result=$(/usr/bin/python3 "$here/compare_frames.py" "$single" "$out" 1e-7); then
+      if ! result=$(/usr/bin/python3 "$here/compare_frames.py" "$single" "$out" 1e-7 "$np"); then
         echo "FAIL $kind $pc -np $np: $result"; fail=1; continue
       fi
       a=$(newton "$single") b=$(newton "$out")

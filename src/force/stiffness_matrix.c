@@ -44,8 +44,8 @@ void piola__tet_diagonal_stiffness(const piola_elastic_body *body, int32_t t,
   const piola_material *material = &body->materials[body->tet_material[t]];
   const double *fhat = body->fhat + 3 * (size_t)t;
   double phat[3];
-  piola_material_stress(material, fhat, phat);
-  piola__diagonal_stiffness_eval(material, fhat, phat, 1, k);
+  piola__material_stress_and_derivative(material, fhat, phat, k->block);
+  piola__diagonal_stiffness_from(fhat, phat, 1, k);
 }
 
 void piola__tet_stiffness_blocks(const piola_elastic_body *body, int32_t t, double out[54]) {

@@ -69,9 +69,7 @@ void piola__project_symmetric3(double a[3][3]) {
       a[i][j] = q[i][0] * lam[0] * q[j][0] + q[i][1] * lam[1] * q[j][1] + q[i][2] * lam[2] * q[j][2];
 }
 
-/* The models whose stress kernel evaluates the parts of the model itself (HGO's and the
- * muscle's matrix is evaluated as neo-Hookean, Mooney-Rivlin's as Ogden's terms). */
-static int parts_are_the_model(piola_material_model model) {
+int piola__stress_evaluates_own_parts(piola_material_model model) {
   switch (model) {
     case PIOLA_MODEL_ROTATED_LINEAR:
     case PIOLA_MODEL_COROTATED:
@@ -89,7 +87,7 @@ static int parts_are_the_model(piola_material_model model) {
 void piola__material_stress_and_derivative(const piola_material *material, const double fhat[3],
                                            double phat[3], double dphat[3][3]) {
   const double c = material->threshold;
-  if (fhat[0] >= c && fhat[1] >= c && fhat[2] >= c && parts_are_the_model(material->model)) {
+  if (fhat[0] >= c && fhat[1] >= c && fhat[2] >= c && piola__stress_evaluates_own_parts(material->model)) {
     /* no entry clamped: every extension term is an exact zero, the parts are the answer */
     material_parts parts;
     material_model_parts(material->model, material, KERNEL_EXACT_DIVIDE, fhat[0], fhat[1],

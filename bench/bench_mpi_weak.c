@@ -12,7 +12,9 @@
  * memory (the largest over the run: setup, partition and steps) per tet of the box, and
  * its thread's CPU time per step, less what the exchanges took of it (their polling
  * included): the process's own work, which on a loaded machine scales where the wall time,
- * waiting for the other process's time slice, does not.
+ * waiting for the other process's time slice, does not; and its thread CPU time per step
+ * by phase of the step (the world's step profile, src/sim/step_profile.h, the exchanges'
+ * CPU included, since they are timed as a whole): where one process works more than another.
  * Efficiency of weak scaling is the 1-process s/step over the P-process one. The box is
  * generated in memory (piola_tet_mesh_box_grid), no mesh file, and each process builds only
  * its part of it (piola_mpi_split_planner): the peak memory is the split's. Only built with

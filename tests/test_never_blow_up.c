@@ -9,10 +9,10 @@
  *    so do corotated and neo-Hookean on armadillo_4k (backward Euler, the recommended
  *    viscosity: its own test below). StVK is left out of the point and line collapses: its
  *    compressive stress vanishes at F = 0, and what brings it back is the extension's floor
- *    slope alone (the same section). Mooney-Rivlin is left out of the point and line
- *    collapses (it stayed at 17.5% and 12.6% of the diagonal at the predicted 3.1 s on the
- *    unit ball's line and the octahedron's point), HGO out of the octahedron (too slow for
- *    a test): docs/time-stepping.md "Recovery".
+ *    slope alone (the same section). HGO is left out of the octahedron (too slow for a
+ *    test): docs/time-stepping.md "Recovery". (Mooney-Rivlin's point and line collapses,
+ *    once left out, stopped short in a tangle held by its former default extension, LINEAR
+ *    at 0.3; with its default CLAMP at 0.4 they recover: the same section.)
  * The scrambles are tests/test_scrambles_every_model.c's (every model, three real meshes with
  * slivers; it replaced the scramble runs that were here, on the unit ball, the octahedron and
  * octopus-low's first 0.05 s).
@@ -131,7 +131,6 @@ static void collapses_settle_in_the_predicted_time(void **state) {
       for (int k = 0; k < COLLAPSE_MODELS; ++k, ++index) {
         const piola_material_model model = collapse_models[k];
         if (model == PIOLA_MODEL_STVK && si < 2) continue;
-        if (model == PIOLA_MODEL_MOONEY_RIVLIN && si < 2) continue;
         if (model == PIOLA_MODEL_HGO && mi == 1) continue;
         if (index % stride) continue;
         piola_world *w = make_world(&mesh, model, starts[si], 0);

@@ -195,6 +195,12 @@ typedef struct piola_material {
   double lambda;              /* Pa, Lame's first parameter */
   double threshold;           /* dimensionless compression threshold c */
   piola_inversion_mode inversion_mode;
+  double threshold_compressed; /* CLAMP: the threshold where J <= threshold_volume[0]; it rises
+                                  from threshold smoothly as J falls from threshold_volume[1]
+                                  (material_threshold_at). Equal to threshold (off) unless the
+                                  model's default sets it (Mooney-Rivlin, Ogden:
+                                  docs/materials.md, "Defaults that recover") */
+  double threshold_volume[2];  /* J (low, high) of that rise */
   double spline_coefficients[16]; /* precomputed spline pieces, model-internal */
   double model_constants[24]; /* precomputed constants, model-internal (Stable Neo-Hookean's
                                  mu', lambda', alpha; the energy extension's slope; the

@@ -53,7 +53,7 @@ enum { STEP_EXTENSION_CLAMP = 0, STEP_EXTENSION_ENERGY = 1, STEP_EXTENSION_LINEA
 /* Increment of the LINEAR extension over the unextended stress, E(parts, d) - p, entry by entry. */
 STABLE_STEP_KERNEL void linear_increment(const piola_material *m, const material_parts *pa, double d0,
                                          double d1, double d2, double e[3]) {
-  material_extend(m, KERNEL_FAST_RECIPROCAL, pa, d0, d1, d2, &e[0], &e[1], &e[2]);
+  material_extend(m, KERNEL_FAST_RECIPROCAL, m->threshold, pa, d0, d1, d2, &e[0], &e[1], &e[2]);
   for (int i = 0; i < 3; ++i) e[i] -= pa->p[i];
 }
 
@@ -107,7 +107,7 @@ STABLE_STEP_KERNEL void linear_extension_slopes(piola_material_model model, cons
 STABLE_STEP_KERNEL double model_modulus_from(piola_material_model model, int energy,
                                              const piola_material *m, double f0, double f1,
                                              double f2, const material_parts *given) {
-  const double c = m->threshold;
+  const double c = MATERIAL_THRESHOLD(model, m, f0, f1, f2);
   const double fc0 = kernel_max(f0, c), fc1 = kernel_max(f1, c), fc2 = kernel_max(f2, c);
   const double d0 = f0 - fc0, d1 = f1 - fc1, d2 = f2 - fc2;
   material_parts pa;
@@ -141,7 +141,7 @@ STABLE_STEP_KERNEL double model_modulus_from(piola_material_model model, int ene
     k02 = 0.25 * ((a2 - b2) / h0 + (q0 - r0) / h2);
     k12 = 0.25 * ((e2 - g2) / h1 + (q1 - r1) / h2);
   } else {
-    material_extend(m, KERNEL_FAST_RECIPROCAL, &pa, d0, d1, d2, &p0, &p1, &p2);
+    material_extend(m, KERNEL_FAST_RECIPROCAL, c, &pa, d0, d1, d2, &p0, &p1, &p2);
     /* a clamped entry's diagonal slope is at most the extension's threshold slope */
     const double floor_slope = m->mu;
     k0 = d0 < 0.0 ? kernel_max(pa.k[0][0], floor_slope + kernel_max(pa.p[0], 0.0) / c) : pa.k[0][0];
@@ -149,6 +149,18 @@ STABLE_STEP_KERNEL double model_modulus_from(piola_material_model model, int ene
     k2 = d2 < 0.0 ? kernel_max(pa.k[2][2], floor_slope + kernel_max(pa.p[2], 0.0) / c) : pa.k[2][2];
     if (energy == STEP_EXTENSION_LINEAR)
       linear_extension_slopes(model, m, &pa, fc0, fc1, fc2, d0, d1, d2, &k0, &k1, &k2, &k01, &k02, &k12);
+    if (MATERIAL_IS_OGDEN(model) && energy == STEP_EXTENSION_CLAMP) {
+      /* the threshold's rise with J (material_threshold_at) adds g_i dc/dJ dJ/df_j to the
+       * 3x3 block (g = dPhat/dc): its diagonal and its symmetric part off it */
+      double g[3];
+      clamp_threshold_sensitivity(m, c, &pa, d0, d1, d2, g);
+      const double s = material_threshold_volume_slope(m, f0, f1, f2);
+      const double j0 = f1 * f2, j1 = f0 * f2, j2 = f0 * f1;
+      k0 += s * g[0] * j0, k1 += s * g[1] * j1, k2 += s * g[2] * j2;
+      k01 += 0.5 * s * (g[0] * j1 + g[1] * j0);
+      k02 += 0.5 * s * (g[0] * j2 + g[2] * j0);
+      k12 += 0.5 * s * (g[1] * j2 + g[2] * j1);
+    }
   }
   double k = kernel_max(k0, kernel_max(k1, k2));
   k = kernel_max(k, pair_modulus(c, p0, p1, f0, f1, k0, k1, k01));
@@ -335,7 +347,7 @@ static double neohookean_range(piola_material_model model, int energy, const pio
  * again), one with none the CLAMP numbers, as linear_range. */
 static double ogden_range(const piola_elastic_body *body, int energy, const piola_material *m,
                           const double *f, const double *w, int32_t begin, int32_t end) {
-  const double *cache = body->ogden_cache, c = m->threshold;
+  const double *cache = body->ogden_cache;
   const long stride = body->padded_tet_count;
   double best = 0;
   int32_t t = begin;
@@ -352,8 +364,9 @@ static double ogden_range(const piola_elastic_body *body, int energy, const piol
       for (int l = 0; l < PIOLA_TET_BLOCK; ++l) {
         const double *fl = f + 3 * (t + l);
         material_parts pa;
-        ogden_cached_parts(m, cache + t + l, stride, kernel_max(fl[0], c), kernel_max(fl[1], c),
-                           kernel_max(fl[2], c), &pa);
+        const double cl = material_threshold_at(m, fl[0], fl[1], fl[2]);
+        ogden_cached_parts(m, cache + t + l, stride, kernel_max(fl[0], cl), kernel_max(fl[1], cl),
+                           kernel_max(fl[2], cl), &pa);
         const double r = w[t + l] * model_modulus_from(PIOLA_MODEL_OGDEN, ext, m, fl[0], fl[1], fl[2], &pa);
         best = r > best ? r : best;
       }

@@ -75,6 +75,7 @@ struct implicit_state {
   piola__multigrid multigrid; /* a solid's multigrid hierarchy, when that is the preconditioner */
   int multigrid_ready;        /* multigrid serves the current Newton system */
   int multigrid_fresh;        /* the hierarchy was set up in this step (else: set it up) */
+  int32_t split_systems;      /* Newton systems of this step solved by the split's solver */
   double *prediction; /* 3n: x^n + dt v^n (backward Euler) */
   double *residual;   /* 3n: g, unfiltered */
   double *step;       /* 3n: the Newton direction */
@@ -439,7 +440,7 @@ static int32_t solve_newton_system(newton_problem *pb, double eta) {
   /* a split solid: the split's solver (PETSc, docs/mpi.md) instead of the loop below */
   const int split = piola__implicit_split_of(s) != NULL;
   int32_t it = split ? piola__implicit_split_solve(s, &st->matrix, st->residual, eta, &pb->w->def,
-                                                   st->cg[0], d)
+                                                   st->split_systems++, st->cg[0], d)
                      : 0;
   if (it < 0) it = 0; /* a failed solve leaves its best d; the line search judges it */
   double rz = split ? 0.0 : cg_pass(&c, cg_start_range);
@@ -597,6 +598,7 @@ static piola_status newton_body(piola_world *w, world_body *s, double t, double 
   PIOLA_TRY(implicit_state_make(s, w->def.preconditioner));
   struct implicit_state *st = s->implicit;
   st->multigrid_fresh = 0; /* a new step: the hierarchy is set up again */
+  st->split_systems = 0;   /* likewise the split solver's preconditioner */
   const int32_t n = s->n;
   const int64_t m = 3 * (int64_t)n;
   newton_problem pb = problem_of(w, s, t, dt);

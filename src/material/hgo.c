@@ -60,7 +60,7 @@ piola_status piola__hgo_init(const piola_material_def *def, piola_material *out)
   out->model_constants[HGO_COS_ANGLE] = cos(angle);
   out->model_constants[HGO_SIN_ANGLE] = h->fiber_angle_degrees == 0.0 ? 0.0 : sin(angle);
   const double q = 1.0 - 2.0 * h->kappa;
-  out->fiber_modulus = 8.0 * h->k1 * q * q; /* hgo_fiber_modulus_bound at rest */
+  out->fiber_modulus = 8.0 * h->k1 * q * q; /* both families' largest plane wave at rest */
   return PIOLA_OK;
 }
 

@@ -615,6 +615,12 @@ static void invalid_parameters_are_rejected_by_name(void **state) {
   assert_int_equal(piola_material_init(&base, &m), PIOLA_OK);
   assert_close(m.mu, base.hgo.mu, 0);
   assert_close(m.fiber_modulus, 8 * base.hgo.k1, 1e-9);
+  assert_true(m.hgo.fiber_stretch_limit == 1.7); /* the default, in force */
+  /* GOH 2006's k2: the limit in force is lowered to where k2 E^2 = 12, exp stays finite */
+  base.hgo.k2 = 524.6;
+  assert_int_equal(piola_material_init(&base, &m), PIOLA_OK);
+  assert_close(m.hgo.fiber_stretch_limit, sqrt(1 + sqrt(12 / 524.6)), 1e-12);
+  base.hgo.k2 = 0.8393;
   piola_material_model model;
   assert_true(piola_material_model_from_name("hgo", &model) && model == PIOLA_MODEL_HGO);
   assert_string_equal(piola_material_model_name(PIOLA_MODEL_HGO), "hgo");

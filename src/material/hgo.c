@@ -52,6 +52,8 @@ piola_status piola__hgo_init(const piola_material_def *def, piola_material *out)
     return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "hgo.axis must be a nonzero vector");
   out->hgo = *h;
   for (int i = 0; i < 3; ++i) out->hgo.axis[i] = h->axis[i] / n;
+  /* the limit in force: lowered to where k2 E^2 = HGO_EXP_CAP (hgo_kernels.h) */
+  out->hgo.fiber_stretch_limit = fmin(h->fiber_stretch_limit, sqrt(1.0 + sqrt(HGO_EXP_CAP / h->k2)));
   /* the matrix: neo-Hookean with shear modulus hgo.mu, lambda from poisson_ratio */
   const double nu = def->poisson_ratio;
   out->mu = h->mu;

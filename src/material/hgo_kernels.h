@@ -27,7 +27,7 @@
  * (1 - 2 kappa) b per family for a unit rank-one dF (hgo_fiber_modulus_bound). In E the
  * continuation reads psi'(E) = psi_s / (2 s), psi''(E) = (b s_l - a) / (4 s^3) > 0, so the
  * formulas of the stress and dP/dF below are unchanged. The limit is lowered, if needed, to
- * where k2 E^2 = HGO_EXP_CAP (exp would overflow at 709; at 12 the fibre stress is already
+ * where k2 E^2 = HGO_EXP_CAP (by piola__hgo_init, in the material's hgo) (exp would overflow at 709; at 12 the fibre stress is already
  * ~1.6e5 k1 E, far past collagen's rupture). */
 #ifndef PIOLA_MATERIAL_HGO_KERNELS_H
 #define PIOLA_MATERIAL_HGO_KERNELS_H
@@ -39,11 +39,11 @@
 
 #define HGO_EXP_CAP 12.0
 
-/* The fibre strain E where the continuation starts: the stretch limit's, or lower where the
- * exponential would grow past e^HGO_EXP_CAP. */
+/* The fibre strain E where the continuation starts, from the limit in force (piola__hgo_init
+ * lowers the scene's to where k2 E^2 = HGO_EXP_CAP). */
 MATERIAL_KERNEL double hgo_limit_strain(const piola_hgo_def *h) {
   const double l = h->fiber_stretch_limit;
-  return kernel_min(l * l - 1.0, sqrt(HGO_EXP_CAP / h->k2));
+  return l * l - 1.0;
 }
 
 /* psi_f(E) (J/m^3), its slope psi' (Pa) and curvature psi'' (Pa) for one family. */
@@ -56,7 +56,7 @@ MATERIAL_KERNEL void hgo_fiber_curve(const piola_hgo_def *h, double e, double *p
   const double p0 = 0.5 * k1 / k2 * (ex - 1.0), s0 = k1 * x * ex,
                c0 = e > 0.0 ? k1 * (1.0 + 2.0 * k2 * x * x) * ex : 0.0;
   /* past the limit: the quadratic in s = sqrt(1 + E) with a = dpsi/ds, b = d2psi/ds2 at s_l */
-  const double sl = sqrt(1.0 + el), s = sqrt(1.0 + ep), y = s - sl;
+  const double sl = h->fiber_stretch_limit, s = sqrt(1.0 + ep), y = s - sl;
   const double a = 2.0 * sl * s0, b = 2.0 * s0 + 4.0 * sl * sl * c0;
   const int past = ep > el;
   *psi = past ? p0 + y * (a + 0.5 * b * y) : p0;

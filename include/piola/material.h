@@ -152,6 +152,10 @@ typedef struct piola_hgo_def {
                                  fibre direction. Default 29 */
   double axis[3];             /* nonzero (normalised): the fibre plane's second direction, in
                                  rest (scene) coordinates. Default (0, 0, 1) */
+  double fiber_stretch_limit; /* dimensionless, > 1: the fibre stretch sqrt(1 + E) past which
+                                 the fibre energy is continued as a spring of constant
+                                 stiffness instead of the exponential (docs/materials.md).
+                                 Default 1.7 */
 } piola_hgo_def;
 
 typedef struct piola_material_def {

@@ -77,6 +77,31 @@ static piola_mat3 random_f(test_rng *rng, long k) {
   return f_with_singular_values(rng, s);
 }
 
+/* The fibre stress p at f9 equals the central differences (step h) of the fibre energy, and
+ * its derivative d those of the stress: to 1e-5 and to dtol_rel of the largest entries (plus
+ * k1). sample and limit (0 for none) name the case in a failure. */
+static void fiber_differences_match(const piola_material *m, const double *fam, const double *f9, const double *p,
+                                    const double *d, double h, double dtol_rel, long sample, double limit) {
+  const double ptol = 1e-5 * (max_abs9(p, 9) + m->hgo.k1), dtol = dtol_rel * (max_abs9(d, 81) + m->hgo.k1);
+  for (int e = 0; e < 9; ++e) {
+    double fp[9], fm[9], pp[9], pm[9];
+    memcpy(fp, f9, sizeof fp), memcpy(fm, f9, sizeof fm);
+    fp[e] += h, fm[e] -= h;
+    const double dpsi = (piola_material_hgo_fiber_energy_density(m, fp, fam) -
+                         piola_material_hgo_fiber_energy_density(m, fm, fam)) / (2 * h);
+    if (!(fabs(dpsi - p[e]) <= ptol))
+      fail_msg("sample %ld (limit %g): dpsi/dF[%d] = %.9g but P = %.9g", sample, limit, e, dpsi, p[e]);
+    piola_material_hgo_fiber_stress(m, fp, fam, pp);
+    piola_material_hgo_fiber_stress(m, fm, fam, pm);
+    for (int r = 0; r < 9; ++r) {
+      const double dp = (pp[r] - pm[r]) / (2 * h);
+      if (!(fabs(dp - d[9 * r + e]) <= dtol))
+        fail_msg("sample %ld (limit %g): dP[%d]/dF[%d] = %.9g by differences, %.9g returned", sample, limit, r,
+                 e, dp, d[9 * r + e]);
+    }
+  }
+}
+
 static void fiber_stress_is_the_energy_gradient_and_its_derivative_exact(void **state) {
   (void)state;
   test_rng rng = test_rng_seeded(19);
@@ -90,26 +115,7 @@ static void fiber_stress_is_the_energy_gradient_and_its_derivative_exact(void **
     flat9(random_f(&rng, k), f9);
     piola_material_hgo_fiber_stress(&m, f9, fam, p);
     piola_material_hgo_fiber_stress_derivative(&m, f9, fam, d);
-    const double h = 1e-6 * (1.0 + max_abs9(f9, 9));
-    const double ptol = 1e-5 * (max_abs9(p, 9) + m.hgo.k1);
-    const double dtol = 1e-5 * (max_abs9(d, 81) + m.hgo.k1);
-    for (int e = 0; e < 9; ++e) {
-      double fp[9], fm[9], pp[9], pm[9];
-      memcpy(fp, f9, sizeof fp), memcpy(fm, f9, sizeof fm);
-      fp[e] += h, fm[e] -= h;
-      const double dpsi = (piola_material_hgo_fiber_energy_density(&m, fp, fam) -
-                           piola_material_hgo_fiber_energy_density(&m, fm, fam)) / (2 * h);
-      if (!(fabs(dpsi - p[e]) <= ptol))
-        fail_msg("sample %ld: dpsi/dF[%d] = %.9g but P = %.9g", k, e, dpsi, p[e]);
-      piola_material_hgo_fiber_stress(&m, fp, fam, pp);
-      piola_material_hgo_fiber_stress(&m, fm, fam, pm);
-      for (int r = 0; r < 9; ++r) {
-        const double dp = (pp[r] - pm[r]) / (2 * h);
-        if (!(fabs(dp - d[9 * r + e]) <= dtol))
-          fail_msg("sample %ld: dP[%d]/dF[%d] = %.9g by differences, %.9g returned", k, r, e, dp,
-                   d[9 * r + e]);
-      }
-    }
+    fiber_differences_match(&m, fam, f9, p, d, 1e-6 * (1.0 + max_abs9(f9, 9)), 1e-5, k, 0);
     /* symmetric and positive semi-definite (no projection needed) */
     for (int r = 0; r < 9; ++r)
       for (int c = 0; c < 9; ++c) assert_close(d[9 * r + c], d[9 * c + r], 1e-9 * (max_abs9(d, 81) + 1));
@@ -159,25 +165,7 @@ static void the_stretch_limit_is_crossed_smoothly(void **state) {
     f_at_fiber_stretch(&m, fam, sl * (1.0 + test_rng_uniform(&rng, -3e-6, 3e-6)), f9);
     piola_material_hgo_fiber_stress(&m, f9, fam, p);
     piola_material_hgo_fiber_stress_derivative(&m, f9, fam, d);
-    const double h = 1e-6;
-    const double ptol = 1e-5 * (max_abs9(p, 9) + m.hgo.k1), dtol = 1e-4 * (max_abs9(d, 81) + m.hgo.k1);
-    for (int e = 0; e < 9; ++e) {
-      double fp[9], fm[9], pp[9], pm[9];
-      memcpy(fp, f9, sizeof fp), memcpy(fm, f9, sizeof fm);
-      fp[e] += h, fm[e] -= h;
-      const double dpsi = (piola_material_hgo_fiber_energy_density(&m, fp, fam) -
-                           piola_material_hgo_fiber_energy_density(&m, fm, fam)) / (2 * h);
-      if (!(fabs(dpsi - p[e]) <= ptol))
-        fail_msg("sample %ld at the limit %g: dpsi/dF[%d] = %.9g but P = %.9g", k, sl, e, dpsi, p[e]);
-      piola_material_hgo_fiber_stress(&m, fp, fam, pp);
-      piola_material_hgo_fiber_stress(&m, fm, fam, pm);
-      for (int r = 0; r < 9; ++r) {
-        const double dp = (pp[r] - pm[r]) / (2 * h);
-        if (!(fabs(dp - d[9 * r + e]) <= dtol))
-          fail_msg("sample %ld at the limit %g: dP[%d]/dF[%d] = %.9g by differences, %.9g returned",
-                   k, sl, r, e, dp, d[9 * r + e]);
-      }
-    }
+    fiber_differences_match(&m, fam, f9, p, d, 1e-6, 1e-4, k, sl);
     /* the one-sided values meet: energy, stress and dP/dF just below and just above agree */
     double fb[9], fa[9], pb[9], pa[9], db[81], da[81];
     f_at_fiber_stretch(&m, fam, sl * (1 - 1e-9), fb);

@@ -145,19 +145,6 @@ void fracture_same_state(const piola_world *a, const piola_world *b) {
   assert_true(piola_world_time(a) == piola_world_time(b));
 }
 
-void fracture_momenta(const piola_world *w, double p[3], double l[3]) {
-  const piola_elastic_body *b = piola_world_solid_body(w, 0);
-  const double *m = piola_elastic_body_masses(b);
-  const double *x = piola_world_solid_positions(w, 0), *v = piola_world_solid_velocities(w, 0);
-  for (int k = 0; k < 3; ++k) p[k] = l[k] = 0;
-  for (int32_t i = 0; i < piola_elastic_body_vertex_count(b); ++i) {
-    const double *xi = x + 3 * i, *vi = v + 3 * i;
-    for (int k = 0; k < 3; ++k) p[k] += m[i] * vi[k];
-    l[0] += m[i] * (xi[1] * vi[2] - xi[2] * vi[1]);
-    l[1] += m[i] * (xi[2] * vi[0] - xi[0] * vi[2]);
-    l[2] += m[i] * (xi[0] * vi[1] - xi[1] * vi[0]);
-  }
-}
 
 int32_t fracture_recut_tets(const piola_world *w) {
   const piola_elastic_body *b = piola_world_solid_body(w, 0);

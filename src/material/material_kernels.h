@@ -351,6 +351,11 @@ MATERIAL_KERNEL double material_threshold_at(const piola_material *m, double f0,
   const double u = material_threshold_ramp(m, f0 * f1 * f2);
   return m->threshold + (m->threshold_compressed - m->threshold) * (u * u * (3.0 - 2.0 * u));
 }
+/* The largest threshold material_threshold_at can return: an Fhat with every entry at or
+ * above it has no entry clamped, whatever its J. */
+MATERIAL_KERNEL double material_threshold_largest(const piola_material *m) {
+  return kernel_max(m->threshold, m->threshold_compressed);
+}
 /* dc/dJ of material_threshold_at (zero outside the rise). */
 MATERIAL_KERNEL double material_threshold_volume_slope(const piola_material *m, double f0,
                                                        double f1, double f2) {

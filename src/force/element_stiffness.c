@@ -86,7 +86,9 @@ int piola__stress_evaluates_own_parts(piola_material_model model) {
 
 void piola__material_stress_and_derivative(const piola_material *material, const double fhat[3],
                                            double phat[3], double dphat[3][3]) {
-  const double c = material->threshold;
+  /* the largest threshold in force: the default's rise with J (material_threshold_at) can
+   * clamp entries above material->threshold */
+  const double c = fmax(material->threshold, material->threshold_compressed);
   if (fhat[0] >= c && fhat[1] >= c && fhat[2] >= c && piola__stress_evaluates_own_parts(material->model)) {
     /* no entry clamped: every extension term is an exact zero, the parts are the answer */
     material_parts parts;

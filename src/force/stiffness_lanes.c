@@ -42,7 +42,9 @@ static int material_parts_lanes(const piola_elastic_body *body, int32_t base, do
   if (body->uniform_material < 0) return 0;
   const piola_material *m = &body->materials[body->uniform_material];
   if (!piola__stress_evaluates_own_parts(m->model)) return 0;
-  const double *fhat = body->fhat + 3 * (size_t)base, c = m->threshold;
+  /* the largest threshold in force (the default's rise with J, material_threshold_at) */
+  const double *fhat = body->fhat + 3 * (size_t)base;
+  const double c = fmax(m->threshold, m->threshold_compressed);
   int unclamped = 1;
   for (int e = 0; e < 3 * B; ++e) unclamped &= fhat[e] >= c;
   if (!unclamped) return 0;

@@ -2,9 +2,7 @@
  * "Defaults that recover") is what a def left at its defaults gets, and it recovers:
  *   - from a sample of the scrambles of bench/bench_scramble_recovery's grid (the seeds the
  *     measured table says the default recovers: `stuck_seeds` lists its misses), with the
- *     bench's own protocol (tests/support/recovery_runs.c;
- *     HGO is not in the scramble sample: under the protocol's step, half the state-aware bound,
- *     its scrambles diverge, docs/materials.md "Defaults that recover");
+ *     bench's own protocol (tests/support/recovery_runs.c);
  *   - from collapse to a point, a line and a plane of a real mesh (gmsh/msh_tetra.msh of
  *     ../shared/data, 127 tets).
  * And the test can fail: neo-Hookean with the old default (LINEAR at 0.3) stays tangled on a
@@ -91,7 +89,6 @@ static void defaults_recover_from_scrambles(void **state) {
     /* under the sanitizers the sample still includes neo-Hookean (the model that changed most) */
     const piola_material_model model =
         models < PIOLA_MODEL_COUNT && k == 0 ? PIOLA_MODEL_NEOHOOKEAN : (piola_material_model)k;
-    if (model == PIOLA_MODEL_HGO) continue;
     const piola_material m = default_material(model);
     for (int i = 0; i < per_model; ++i) {
       const int seed = sample_seed(model, i);
@@ -112,7 +109,7 @@ static void defaults_recover_from_scrambles(void **state) {
 /* The old defaults stay tangled on seeds the new ones recover (docs/materials.md): neo-Hookean
  * LINEAR 0.3 on seed 2 ("Tangled equilibria"), Mooney-Rivlin LINEAR 0.3 (1 of 160) on seed 50
  * (every entry above the threshold there: a state of the model that CLAMP at 0.4 reaches no
- * more), which is in the sample above. */
+ * more), which is in the sample above, and HGO LINEAR 0.3 (133 of 160) on seed 7. */
 static void old_defaults_stay_tangled(void **state) {
   (void)state;
   piola_tet_mesh grid;
@@ -120,7 +117,7 @@ static void old_defaults_stay_tangled(void **state) {
   const struct {
     piola_material_model model;
     int seed;
-  } cases[] = {{PIOLA_MODEL_NEOHOOKEAN, 2}, {PIOLA_MODEL_MOONEY_RIVLIN, 50}};
+  } cases[] = {{PIOLA_MODEL_NEOHOOKEAN, 2}, {PIOLA_MODEL_MOONEY_RIVLIN, 50}, {PIOLA_MODEL_HGO, 7}};
   for (size_t k = 0; k < sizeof cases / sizeof cases[0]; ++k) {
     piola_material_def def = recovery_material_def(cases[k].model);
     def.inversion_mode = PIOLA_INVERSION_LINEAR;
@@ -135,11 +132,12 @@ static void old_defaults_stay_tangled(void **state) {
   piola_tet_mesh_free(&grid);
 }
 
-/* The rubber models' default threshold rises in compressed elements (docs/materials.md
- * "Defaults that recover"): the seeds their fixed default thresholds (CLAMP 0.4 and 0.37, the
- * defaults before the rise) leave tangled, Mooney-Rivlin 12 and 56, Ogden 8 and 159, stay
- * tangled with that threshold set explicitly (no rise) and recover with the default. */
-static void rubber_threshold_rise_untangles(void **state) {
+/* The rubber models' and HGO's default threshold rises in compressed elements
+ * (docs/materials.md "Defaults that recover"): the seeds their fixed default thresholds (CLAMP
+ * 0.4, 0.37 and 0.3, the rubber defaults before the rise and HGO's CLAMP without it) leave
+ * tangled, Mooney-Rivlin 12 and 56, Ogden 8 and 159, HGO 66, stay tangled with that threshold
+ * set explicitly (no rise) and recover with the default. */
+static void threshold_rise_untangles(void **state) {
   (void)state;
   piola_tet_mesh grid;
   assert_int_equal(recovery_grid(&grid), 0);
@@ -149,8 +147,9 @@ static void rubber_threshold_rise_untangles(void **state) {
   } cases[] = {{PIOLA_MODEL_MOONEY_RIVLIN, 12},
                {PIOLA_MODEL_OGDEN, 159},
                {PIOLA_MODEL_MOONEY_RIVLIN, 56},
-               {PIOLA_MODEL_OGDEN, 8}};
-  const int count = (int)test_samples(4, 1);
+               {PIOLA_MODEL_OGDEN, 8},
+               {PIOLA_MODEL_HGO, 66}};
+  const int count = (int)test_samples(5, 1);
   for (int k = 0; k < count; ++k) {
     const piola_material m = default_material(cases[k].model);
     assert_true(m.threshold_compressed > m.threshold);
@@ -236,7 +235,7 @@ int main(void) {
       cmocka_unit_test(defaults_resolve_per_model),
       cmocka_unit_test(defaults_recover_from_scrambles),
       cmocka_unit_test(old_defaults_stay_tangled),
-      cmocka_unit_test(rubber_threshold_rise_untangles),
+      cmocka_unit_test(threshold_rise_untangles),
       cmocka_unit_test(defaults_recover_from_collapse_on_a_real_mesh),
       cmocka_unit_test(collapse_protocol_is_stable_on_a_slender_beam),
   };

@@ -42,6 +42,53 @@ static double *random_fibers(test_rng *rng, int32_t tets) {
   return a;
 }
 
+/* HGO's default threshold rises as J falls from 0.96 to 0.94 (CLAMP 0.3 to 0.5,
+ * docs/materials.md "Defaults that recover"): the force loop's lanes and the body's energy
+ * follow it as the public stress and energy do. A unit tet (Dm = I, V = 1/6) stretched by
+ * F = diag(f), f decreasing, so that vertex v's force is -V P e_(v-1) and P = diag(Phat);
+ * states with an entry between 0.3 and the risen threshold (clamped only by the rise) and J
+ * in and below the rise. The fibres are off (k1 = 0): the matrix alone. */
+static void matrix_forces_follow_the_threshold_rise(void **state) {
+  (void)state;
+  piola_material_def def = piola_default_material_def();
+  def.model = PIOLA_MODEL_HGO;
+  def.hgo.k1 = 0.0;
+  piola_material m, fixed;
+  assert_int_equal(piola_material_init(&def, &m), PIOLA_OK);
+  def.inversion_mode = PIOLA_INVERSION_CLAMP, def.inversion_threshold = m.threshold;
+  assert_int_equal(piola_material_init(&def, &fixed), PIOLA_OK);
+  assert_true(m.threshold_compressed > m.threshold && fixed.threshold_compressed == fixed.threshold);
+  piola_tet_mesh mesh = fixture_single_tet(1.0);
+  piola_elastic_body *body = fixture_body(&mesh, &m);
+  test_rng rng = test_rng_seeded(1904);
+  int differs = 0;
+  const long cases = test_samples(40, 10);
+  for (long c = 0; c < cases; ++c) {
+    double f[3];
+    f[2] = test_rng_uniform(&rng, 0.31, 0.48);
+    f[1] = c % 2 ? test_rng_uniform(&rng, f[2] + 0.01, 0.49) : test_rng_uniform(&rng, 0.8, 1.6);
+    f[0] = test_rng_uniform(&rng, 0.9, 0.965) / (f[1] * f[2]);
+    double x[12] = {0}, forces[12], p[3], p_fixed[3];
+    for (int v = 1; v < 4; ++v) x[3 * v + v - 1] = f[v - 1];
+    assert_int_equal(piola_elastic_body_update(body, x, 1.0, forces, NULL), PIOLA_OK);
+    piola_material_stress(&m, f, p);
+    piola_material_stress(&fixed, f, p_fixed);
+    const double scale = m.mu + fabs(p[0]) + fabs(p[1]) + fabs(p[2]);
+    for (int i = 0; i < 3; ++i) {
+      const double from_force = -6.0 * forces[3 * (i + 1) + i];
+      if (!(fabs(from_force - p[i]) <= 1e-9 * scale))
+        fail_msg("fhat (%g, %g, %g): force loop's Phat_%d %.12g, piola_material_stress %.12g", f[0],
+                 f[1], f[2], i, from_force, p[i]);
+    }
+    const double psi = piola_elastic_body_energy_density(body)[0];
+    assert_close(psi, piola_material_energy_density(&m, f), 1e-9 * scale);
+    differs += fabs(p[2] - p_fixed[2]) > 1e-6 * scale; /* the rise clamped f2 */
+  }
+  assert_true(differs > cases / 4);
+  piola_elastic_body_destroy(body);
+  fixture_mesh_free(&mesh);
+}
+
 static void forces_are_minus_the_energy_gradient(void **state) {
   (void)state;
   test_rng rng = test_rng_seeded(191);
@@ -238,6 +285,7 @@ static void around_fibres_are_circumferential(void **state) {
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(forces_are_minus_the_energy_gradient),
+      cmocka_unit_test(matrix_forces_follow_the_threshold_rise),
       cmocka_unit_test(inverted_tet_with_stiff_fibres_is_pushed_back),
       cmocka_unit_test(step_modulus_bounds_the_fibre_stiffness),
       cmocka_unit_test(scene_keys_reach_the_material),

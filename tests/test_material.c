@@ -672,7 +672,7 @@ static void names_and_lame_parameters_round_trip(void **state) {
   assert_int_equal(piola_youngs_poisson_from_lame(NAN, 1.0, &e, &nu), PIOLA_ERROR_NOT_FINITE);
 }
 
-/* The rubber models' default (CLAMP, threshold left unset): the threshold rises from c to
+/* The rubber models' and HGO's default (CLAMP, threshold left unset): the threshold rises from c to
  * threshold_compressed as J falls through threshold_volume (docs/materials.md "Defaults that
  * recover"). Its dPhat/dFhat, the rise's term dPhat/dc dc/dJ dJ/df included, equals the central
  * difference of the stress in and around the rise, away from the kinks (an entry at the
@@ -680,10 +680,11 @@ static void names_and_lame_parameters_round_trip(void **state) {
  * own states keep the model); and a threshold set explicitly has no rise. */
 static void threshold_rise_derivative_is_the_stress_difference(void **state) {
   (void)state;
-  const piola_material_model models[2] = {PIOLA_MODEL_MOONEY_RIVLIN, PIOLA_MODEL_OGDEN};
+  const piola_material_model models[3] = {PIOLA_MODEL_MOONEY_RIVLIN, PIOLA_MODEL_OGDEN,
+                                          PIOLA_MODEL_HGO};
   test_rng rng = test_rng_seeded(1919);
   const long cases = test_samples(400, 40);
-  for (int mi = 0; mi < 2; ++mi) {
+  for (int mi = 0; mi < 3; ++mi) {
     const piola_material m = material_of(models[mi], PIOLA_INVERSION_MODEL_DEFAULT, youngs, 0.3, 0);
     const piola_material fixed = make(models[mi], PIOLA_INVERSION_CLAMP, 0.3);
     assert_int_equal(m.inversion_mode, PIOLA_INVERSION_CLAMP);

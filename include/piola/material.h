@@ -202,7 +202,7 @@ typedef struct piola_material {
   double threshold_compressed; /* CLAMP: the threshold where J <= threshold_volume[0]; it rises
                                   from threshold smoothly as J falls from threshold_volume[1]
                                   (material_threshold_at). Equal to threshold (off) unless the
-                                  model's default sets it (Mooney-Rivlin, Ogden:
+                                  model's default sets it (Mooney-Rivlin, Ogden, HGO:
                                   docs/materials.md, "Defaults that recover") */
   double threshold_volume[2];  /* J (low, high) of that rise */
   double spline_coefficients[16]; /* precomputed spline pieces, model-internal */

@@ -91,10 +91,13 @@
       case PIOLA_MODEL_COROTATED: PIOLA_MATERIAL_LANE_LOOP(corotated_stress_lanes, lanes); return; \
       case PIOLA_MODEL_STVK: PIOLA_MATERIAL_LANE_LOOP(stvk_stress_lanes, lanes); return;          \
       case PIOLA_MODEL_NEOHOOKEAN:                                                         \
-      case PIOLA_MODEL_HGO:                                                                \
       case PIOLA_MODEL_MUSCLE:                                                             \
         PIOLA_SPLIT_BY_BLOCK(neohookean_lane_unclamped, neohookean_stress_lanes_unclamped, \
                              neohookean_stress_lanes, lanes);                              \
+        return;                                                                            \
+      case PIOLA_MODEL_HGO: /* neo-Hookean with the threshold's rise with J */             \
+        PIOLA_SPLIT_BY_BLOCK(hgo_lane_unclamped, neohookean_stress_lanes_unclamped,        \
+                             hgo_stress_lanes, lanes);                                     \
         return;                                                                            \
       case PIOLA_MODEL_STABLE_NEOHOOKEAN:                                                  \
         PIOLA_SPLIT_BY_BLOCK(lane_unclamped, stable_neohookean_stress_lanes_unclamped,     \

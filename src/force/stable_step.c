@@ -149,7 +149,7 @@ STABLE_STEP_KERNEL double model_modulus_from(piola_material_model model, int ene
     k2 = d2 < 0.0 ? kernel_max(pa.k[2][2], floor_slope + kernel_max(pa.p[2], 0.0) / c) : pa.k[2][2];
     if (energy == STEP_EXTENSION_LINEAR)
       linear_extension_slopes(model, m, &pa, fc0, fc1, fc2, d0, d1, d2, &k0, &k1, &k2, &k01, &k02, &k12);
-    if (MATERIAL_IS_OGDEN(model) && energy == STEP_EXTENSION_CLAMP) {
+    if (MATERIAL_THRESHOLD_RISES(model) && energy == STEP_EXTENSION_CLAMP) {
       /* the threshold's rise with J (material_threshold_at) adds g_i dc/dJ dJ/df_j to the
        * 3x3 block (g = dPhat/dc): its diagonal and its symmetric part off it */
       double g[3];

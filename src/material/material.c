@@ -44,8 +44,9 @@ piola_material_def piola_default_material_def(void) {
  * threshold below the lateral stretch of rubber in their uniaxial tests (0.447 at stretch 5,
  * 0.377 at Treloar's 7.05; tests/test_material_rubber.c), 158 of 160 each, and with the
  * threshold left unset it rises in elements compressed in volume (to 0.55 and 0.5 below
- * J = 0.94, piola_material_init): 160 of 160 each, rubber's own states (J ~ 1) untouched. HGO (an inflated artery's wall reaches radial stretches of 0.33-0.45,
- * tests/test_material_hgo.c) stays at LINEAR 0.3, not measured on the scrambles. Every default
+ * J = 0.94, piola_material_init): 160 of 160 each, rubber's own states (J ~ 1) untouched. HGO
+ * (an inflated artery's wall reaches radial stretches of 0.33-0.45, tests/test_material_hgo.c,
+ * nearly incompressible) takes CLAMP 0.3, rising the same way to 0.5. Every default
  * recovers from point, line and plane collapse (tests/test_default_inversion.c). */
 static const struct {
   piola_inversion_mode mode;
@@ -60,7 +61,7 @@ static const struct {
     [PIOLA_MODEL_STABLE_NEOHOOKEAN] = {PIOLA_INVERSION_CLAMP, 0.3},
     [PIOLA_MODEL_MOONEY_RIVLIN] = {PIOLA_INVERSION_CLAMP, 0.4},
     [PIOLA_MODEL_OGDEN] = {PIOLA_INVERSION_CLAMP, 0.37},
-    [PIOLA_MODEL_HGO] = {PIOLA_INVERSION_LINEAR, 0.3},
+    [PIOLA_MODEL_HGO] = {PIOLA_INVERSION_CLAMP, 0.3},
 };
 
 void piola_material_default_inversion(piola_material_model model, piola_inversion_mode *mode,
@@ -180,8 +181,9 @@ piola_status piola_material_init(const piola_material_def *def, piola_material *
   m.lambda = e * nu / ((1.0 + nu) * (1.0 - 2.0 * nu));
   m.threshold = c;
   m.inversion_mode = mode;
-  /* The rubber models' default threshold rises in elements compressed in volume: rubber's own
-   * states (uniaxial tension, J ~ 1) keep c, the tangles of scrambled bodies (J well below 1)
+  /* The rubber models' and HGO's default threshold rises in elements compressed in volume:
+   * their own states (uniaxial tension of rubber, an inflated artery: J ~ 1) keep c, the
+   * tangles of scrambled bodies (J well below 1)
    * get the larger threshold that untangles them (docs/materials.md, "Defaults that recover").
    * Only with the model's own threshold in CLAMP (the measured setting). */
   m.threshold_compressed = c;
@@ -189,6 +191,7 @@ piola_status piola_material_init(const piola_material_def *def, piola_material *
   if (def->inversion_threshold == 0.0 && mode == PIOLA_INVERSION_CLAMP)
     m.threshold_compressed = def->model == PIOLA_MODEL_MOONEY_RIVLIN ? 0.55
                              : def->model == PIOLA_MODEL_OGDEN       ? 0.5
+                             : def->model == PIOLA_MODEL_HGO         ? 0.5
                                                                      : c;
 
   if (def->model == PIOLA_MODEL_SPLINE) {
@@ -289,7 +292,7 @@ typedef struct extension_point {
 
 static extension_point extension_point_at(const piola_material *m, const double f[3]) {
   extension_point e;
-  e.c = MATERIAL_IS_OGDEN(m->model) ? material_threshold_at(m, f[0], f[1], f[2]) : m->threshold;
+  e.c = MATERIAL_THRESHOLD_RISES(m->model) ? material_threshold_at(m, f[0], f[1], f[2]) : m->threshold;
   for (int i = 0; i < 3; ++i) {
     e.fc[i] = kernel_max(f[i], e.c);
     e.d[i] = f[i] - e.fc[i];
@@ -480,7 +483,7 @@ void piola_material_stress_derivative(const piola_material *material, const doub
     }
   }
   /* The threshold's rise with J (CLAMP, material_threshold_at): dPhat_i/dc dc/dJ dJ/df_j. */
-  const double slope = MATERIAL_IS_OGDEN(m->model) ? material_threshold_volume_slope(m, fhat[0], fhat[1], fhat[2]) : 0.0;
+  const double slope = MATERIAL_THRESHOLD_RISES(m->model) ? material_threshold_volume_slope(m, fhat[0], fhat[1], fhat[2]) : 0.0;
   if (slope != 0.0 && !linear && any_clamped) {
     double g[3];
     clamp_threshold_sensitivity(m, c, pa, e.d[0], e.d[1], e.d[2], g);

@@ -363,10 +363,13 @@ MATERIAL_KERNEL double material_threshold_volume_slope(const piola_material *m, 
   const double lo = m->threshold_volume[0], hi = m->threshold_volume[1];
   return -(m->threshold_compressed - m->threshold) * 6.0 * u * (1.0 - u) / (hi - lo);
 }
-/* The threshold a kernel of MODEL uses at f: only the Ogden models have the rise (a
+/* The models whose default threshold can rise with J: the Ogden models and HGO (whose
+ * kernels are instantiated with PIOLA_MODEL_HGO for that; its matrix is neo-Hookean). */
+#define MATERIAL_THRESHOLD_RISES(model) (MATERIAL_IS_OGDEN(model) || (model) == PIOLA_MODEL_HGO)
+/* The threshold a kernel of MODEL uses at f: only those models have the rise (a
  * compile-time choice in the per-model kernels). */
 #define MATERIAL_THRESHOLD(model, m, f0, f1, f2) \
-  (MATERIAL_IS_OGDEN(model) ? material_threshold_at((m), (f0), (f1), (f2)) : (m)->threshold)
+  (MATERIAL_THRESHOLD_RISES(model) ? material_threshold_at((m), (f0), (f1), (f2)) : (m)->threshold)
 
 /* Diagonal slope at the threshold for a clamped entry i whose value at the clamped point is p
  * and whose Taylor slope is kii. LINEAR: the Taylor slope, raised where needed so that the
@@ -733,6 +736,11 @@ MATERIAL_KERNEL void neohookean_stress(const piola_material *m, double f0, doubl
                                        double *p0, double *p1, double *p2) {
   material_extended_stress(PIOLA_MODEL_NEOHOOKEAN, m, KERNEL_EXACT_DIVIDE, f0, f1, f2, p0, p1, p2);
 }
+/* HGO's matrix: neo-Hookean's formulas, with HGO's threshold rise (MATERIAL_THRESHOLD). */
+MATERIAL_KERNEL void hgo_stress(const piola_material *m, double f0, double f1, double f2,
+                                double *p0, double *p1, double *p2) {
+  material_extended_stress(PIOLA_MODEL_HGO, m, KERNEL_EXACT_DIVIDE, f0, f1, f2, p0, p1, p2);
+}
 MATERIAL_KERNEL void spline_stress(const piola_material *m, double f0, double f1, double f2,
                                    double *p0, double *p1, double *p2) {
   material_extended_stress(PIOLA_MODEL_SPLINE, m, KERNEL_EXACT_DIVIDE, f0, f1, f2, p0, p1, p2);
@@ -787,6 +795,16 @@ MATERIAL_KERNEL void neohookean_stress_lanes_unclamped(const piola_material *m, 
 MATERIAL_KERNEL int neohookean_lane_unclamped(const piola_material *m, double f0, double f1,
                                               double f2) {
   const double c = m->threshold, j = f0 * f1 * f2;
+  return (f0 >= c) & (f1 >= c) & (f2 >= c) & (j >= 1e-300) & (j <= 1e300);
+}
+/* HGO's matrix for the force loop's lanes, and when neohookean_stress_lanes_unclamped
+ * applies to a lane of it: every entry at or above the threshold in force there. */
+MATERIAL_KERNEL void hgo_stress_lanes(const piola_material *m, double f0, double f1, double f2,
+                                      double *p0, double *p1, double *p2) {
+  material_extended_stress(PIOLA_MODEL_HGO, m, KERNEL_FAST_RECIPROCAL, f0, f1, f2, p0, p1, p2);
+}
+MATERIAL_KERNEL int hgo_lane_unclamped(const piola_material *m, double f0, double f1, double f2) {
+  const double c = material_threshold_at(m, f0, f1, f2), j = f0 * f1 * f2;
   return (f0 >= c) & (f1 >= c) & (f2 >= c) & (j >= 1e-300) & (j <= 1e300);
 }
 MATERIAL_KERNEL void spline_stress_lanes(const piola_material *m, double f0, double f1, double f2,
@@ -947,9 +965,11 @@ MATERIAL_KERNEL void material_stress_kernel(const piola_material *m, double f0, 
       stvk_stress(m, f0, f1, f2, p0, p1, p2);
       return;
     case PIOLA_MODEL_NEOHOOKEAN:
-    case PIOLA_MODEL_HGO: /* its matrix is neo-Hookean too */
     case PIOLA_MODEL_MUSCLE:
       neohookean_stress(m, f0, f1, f2, p0, p1, p2);
+      return;
+    case PIOLA_MODEL_HGO: /* its matrix is neo-Hookean, with its threshold's rise */
+      hgo_stress(m, f0, f1, f2, p0, p1, p2);
       return;
     case PIOLA_MODEL_SPLINE:
       spline_stress(m, f0, f1, f2, p0, p1, p2);
@@ -986,6 +1006,10 @@ MATERIAL_KERNEL void neohookean_stress_energy(const piola_material *m, double f0
                                               double f2, double *p0, double *p1, double *p2,
                                               double *psi) {
   material_extended_stress_energy(PIOLA_MODEL_NEOHOOKEAN, m, f0, f1, f2, p0, p1, p2, psi);
+}
+MATERIAL_KERNEL void hgo_stress_energy(const piola_material *m, double f0, double f1, double f2,
+                                       double *p0, double *p1, double *p2, double *psi) {
+  material_extended_stress_energy(PIOLA_MODEL_HGO, m, f0, f1, f2, p0, p1, p2, psi);
 }
 MATERIAL_KERNEL void spline_stress_energy(const piola_material *m, double f0, double f1, double f2,
                                           double *p0, double *p1, double *p2, double *psi) {
@@ -1044,9 +1068,11 @@ MATERIAL_KERNEL void material_stress_energy_kernel(const piola_material *m, doub
       stvk_stress_energy(m, f0, f1, f2, p0, p1, p2, psi);
       return;
     case PIOLA_MODEL_NEOHOOKEAN:
-    case PIOLA_MODEL_HGO: /* its matrix is neo-Hookean too */
     case PIOLA_MODEL_MUSCLE:
       neohookean_stress_energy(m, f0, f1, f2, p0, p1, p2, psi);
+      return;
+    case PIOLA_MODEL_HGO: /* its matrix is neo-Hookean, with its threshold's rise */
+      hgo_stress_energy(m, f0, f1, f2, p0, p1, p2, psi);
       return;
     case PIOLA_MODEL_SPLINE:
       spline_stress_energy(m, f0, f1, f2, p0, p1, p2, psi);

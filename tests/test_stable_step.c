@@ -344,12 +344,11 @@ static piola_elastic_body *deformed_grid(const piola_material *materials, int32_
   return body;
 }
 
-/* Largest w_e k_e over the tets, each tet's modulus taken alone. */
+/* Largest w_e k_e over the tets, each tet's term taken alone (its direction weights included). */
 static double per_tet_rate2(const piola_elastic_body *body) {
-  const double *fhat = piola_elastic_body_fhat(body), *w = body->step_weight;
   double best = 0;
   for (int32_t t = 0; t < piola_elastic_body_tet_count(body); ++t)
-    best = fmax(best, w[t] * piola__elastic_body_tet_modulus(body, t, fhat + 3 * t));
+    best = fmax(best, piola__elastic_body_tet_state_rate2(body, t));
   return best;
 }
 

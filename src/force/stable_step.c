@@ -60,6 +60,11 @@ STABLE_STEP_KERNEL double weighted_pair_modulus(double c, double pi, double pj, 
   return step_weighted_pair(a, b + kij, wi, wj);
 }
 
+/* The direction weights apply to a tet whose modulus is above this many times its rest
+ * modulus lambda + 2 mu: where the state, not the mesh, sets the step (scrambles, strong
+ * stretch). Below it the bound is the unweighted one and costs what it did. */
+#define STIFF_FACTOR 4.0
+
 /* The models whose bound takes the direction weights: those that stiffen under stretch where
  * the sliver is wide (docs/time-stepping.md, "Slivers stretched along their thin direction").
  * Neo-Hookean, the muscle, Ogden, Mooney-Rivlin and HGO keep the unweighted bound. */
@@ -182,7 +187,7 @@ STABLE_STEP_KERNEL double model_modulus_weighted(piola_material_model model, int
     kw = kernel_max(kw, weighted_pair_modulus(c, p0, p1, f0, f1, k0, k1, k01, wgt[0], wgt[1]));
     kw = kernel_max(kw, weighted_pair_modulus(c, p0, p2, f0, f2, k0, k2, k02, wgt[0], wgt[2]));
     kw = kernel_max(kw, weighted_pair_modulus(c, p1, p2, f1, f2, k1, k2, k12, wgt[1], wgt[2]));
-    k = kernel_min(k, kw);
+    k = k > STIFF_FACTOR * (m->lambda + 2.0 * m->mu) ? kernel_min(k, kw) : k;
   }
   /* muscle fibres: their tangent stiffness bound, as in the rest bound; HGO's exponential
    * fibres depend on their direction: hgo_tet_fiber_modulus, added by the callers */
@@ -206,14 +211,42 @@ static const double *direction_gram(const piola_elastic_body *body) {
   return body->has_state ? body->step_gram : NULL;
 }
 
-/* k of tet t of a DIRECTION_WEIGHTED model with its direction weights when GRAM is not NULL. */
-STABLE_STEP_KERNEL double lane_modulus(piola_material_model model, int energy, const piola_material *m,
-                                       const piola_elastic_body *body, const double *gram, int32_t t,
-                                       const double *f) {
-  if (!DIRECTION_WEIGHTED(model) || !gram) return model_modulus(model, energy, m, f[0], f[1], f[2]);
+/* k of tet t of a DIRECTION_WEIGHTED model with its direction weights (GRAM not NULL; the
+ * callers choose outside their lane loops, so that these vectorize). */
+STABLE_STEP_KERNEL double weighted_lane_modulus(piola_material_model model, int energy,
+                                                const piola_material *m, const piola_elastic_body *body,
+                                                const double *gram, int32_t t, const double *f) {
   double wgt[3];
   step_direction_weights(gram + t, body->tet_count, body->v[0] + t, body->padded_tet_count, wgt);
   return model_modulus_weighted(model, energy, m, f[0], f[1], f[2], NULL, wgt);
+}
+
+/* max(best, max over tets [t0, t1) of w_e k_e with the direction weights), t1 - t0 at most a
+ * block. The weighted term is at most the unweighted one (min(k, k_w)), so a range with no tet
+ * above STIFF_FACTOR, or whose unweighted maximum is not above BEST, needs no weights: they
+ * cost only where they can lower the result, and the maximum is exact. */
+STABLE_STEP_KERNEL double weighted_range(piola_material_model model, int energy, const piola_material *m,
+                                         const piola_elastic_body *body, const double *gram,
+                                         const double *f, const double *w, int32_t t0, int32_t t1,
+                                         double best) {
+  const double stiff = STIFF_FACTOR * (m->lambda + 2.0 * m->mu);
+  double plain = 0;
+  int any = 0;
+#pragma omp simd reduction(max:plain) reduction(|:any)
+  for (int32_t t = t0; t < t1; ++t) {
+    const double k = model_modulus(model, energy, m, f[3 * t], f[3 * t + 1], f[3 * t + 2]);
+    const double r = w[t] * k;
+    plain = r > plain ? r : plain;
+    any |= k > stiff;
+  }
+  if (!any) return plain > best ? plain : best;
+  if (!(plain > best)) return best;
+#pragma omp simd reduction(max:best)
+  for (int32_t t = t0; t < t1; ++t) {
+    const double r = w[t] * weighted_lane_modulus(model, energy, m, body, gram, t, f + 3 * t);
+    best = r > best ? r : best;
+  }
+  return best;
 }
 
 /* HGO's fibre stiffness for a plane wave at Fhat f with the two families' unit directions
@@ -466,6 +499,7 @@ STABLE_STEP_KERNEL double linear_range(piola_material_model model, const piola_e
                                        const piola_material *m, const double *f, const double *w,
                                        int32_t begin, int32_t end) {
   const double *gram = direction_gram(body);
+  const int weighted = DIRECTION_WEIGHTED(model) && gram;
   double best = 0;
   int32_t t = begin;
   for (; t + PIOLA_TET_BLOCK <= end; t += PIOLA_TET_BLOCK) {
@@ -473,23 +507,28 @@ STABLE_STEP_KERNEL double linear_range(piola_material_model model, const piola_e
 #pragma omp simd reduction(&:plain)
     for (int l = 0; l < PIOLA_TET_BLOCK; ++l)
       plain &= lane_unclamped(m, f[3 * (t + l)], f[3 * (t + l) + 1], f[3 * (t + l) + 2]);
-    if (plain) {
+    if (plain && weighted) {
+      best = weighted_range(model, STEP_EXTENSION_CLAMP, m, body, gram, f, w, t, t + PIOLA_TET_BLOCK, best);
+    } else if (plain) {
 #pragma omp simd reduction(max:best)
       for (int l = 0; l < PIOLA_TET_BLOCK; ++l) {
         const double *fl = f + 3 * (t + l);
-        const double r = w[t + l] * lane_modulus(model, STEP_EXTENSION_CLAMP, m, body, gram, t + l, fl);
+        const double r = w[t + l] * model_modulus(model, STEP_EXTENSION_CLAMP, m, fl[0], fl[1], fl[2]);
         best = r > best ? r : best;
       }
     } else {
       for (int l = 0; l < PIOLA_TET_BLOCK; ++l) {
         const double *fl = f + 3 * (t + l);
-        const double r = w[t + l] * lane_modulus(model, STEP_EXTENSION_LINEAR, m, body, gram, t + l, fl);
+        const double r = w[t + l] * (weighted ? weighted_lane_modulus(model, STEP_EXTENSION_LINEAR, m, body, gram, t + l, fl)
+                                              : model_modulus(model, STEP_EXTENSION_LINEAR, m, fl[0], fl[1], fl[2]));
         best = r > best ? r : best;
       }
     }
   }
   for (; t < end; ++t) {
-    const double r = w[t] * lane_modulus(model, STEP_EXTENSION_LINEAR, m, body, gram, t, f + 3 * t);
+    const double *ft = f + 3 * t;
+    const double r = w[t] * (weighted ? weighted_lane_modulus(model, STEP_EXTENSION_LINEAR, m, body, gram, t, ft)
+                                      : model_modulus(model, STEP_EXTENSION_LINEAR, m, ft[0], ft[1], ft[2]));
     best = r > best ? r : best;
   }
   return best;
@@ -497,8 +536,14 @@ STABLE_STEP_KERNEL double linear_range(piola_material_model model, const piola_e
 
 #define MODEL_LANE_LOOP(model)                                                                  \
   if (energy == STEP_EXTENSION_LINEAR) return linear_range(model, body, m, f, w, begin, end);   \
+  if (DIRECTION_WEIGHTED(model) && gram) {                                                      \
+    for (int32_t t = begin; t < end; t += PIOLA_TET_BLOCK)                                      \
+      best = weighted_range(model, energy, m, body, gram, f, w, t,                              \
+                            end - t < PIOLA_TET_BLOCK ? end : t + PIOLA_TET_BLOCK, best);       \
+    break;                                                                                      \
+  }                                                                                             \
   _Pragma("omp simd reduction(max:best)") for (int32_t t = begin; t < end; ++t) {               \
-    const double r = w[t] * lane_modulus(model, energy, m, body, gram, t, f + 3 * t);           \
+    const double r = w[t] * model_modulus(model, energy, m, f[3 * t], f[3 * t + 1], f[3 * t + 2]); \
     best = r > best ? r : best;                                                                 \
   }                                                                                             \
   break;

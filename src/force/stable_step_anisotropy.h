@@ -14,7 +14,8 @@
  *     k_w = max(max_i w_i K_ii, max_{i<j} lambda_max([[a w_j, c s], [c s, a w_i]])),
  * s = sqrt(w_i w_j), c = b_ij + K_ij: the same modes, each scaled by the gradient its columns
  * meet. With all weights 1 it is k_e; at rest (isotropic tangent) it is lambda + 2 mu whatever
- * the weights, so the rest bound is unchanged. The bound takes min(k_w, k_e).
+ * the weights, so the rest bound is unchanged. The bound takes min(k_w, k_e) for tets whose k_e
+ * is above 4 (lambda + 2 mu) (STIFF_FACTOR in stable_step.c), k_e for the others.
  *
  * Everything here is plain arithmetic with selects (no fused multiply-adds: stable_step.c's
  * bits do not depend on the instruction set). */

@@ -12,7 +12,9 @@
  * memory (the largest over the run: setup, partition and steps) per tet of the box, and
  * its thread's CPU time per step, less what the exchanges took of it (their polling
  * included): the process's own work, which on a loaded machine scales where the wall time,
- * waiting for the other process's time slice, does not.
+ * waiting for the other process's time slice, does not; and its thread CPU time per step
+ * by phase of the step (the world's step profile, src/sim/step_profile.h, the exchanges'
+ * CPU included, since they are timed as a whole): where one process works more than another.
  * Efficiency of weak scaling is the 1-process s/step over the P-process one. The box is
  * generated in memory (piola_tet_mesh_box_grid), no mesh file, and each process builds only
  * its part of it (piola_mpi_split_planner): the peak memory is the split's. Only built with
@@ -30,6 +32,7 @@
 #include "support/bench_support.h"
 #include "piola/mpi.h"
 #include "piola/world.h"
+#include "sim/world_internal.h"
 
 static piola_world *jelly_box(int n, int stack, const piola_work_split_planner *planner) {
   piola_tet_mesh mesh;
@@ -87,6 +90,7 @@ int main(int argc, char **argv) {
   piola_mpi_split_stats before = piola_mpi_split_stats_of(split);
   (void)piola_world_step(w, 0, NULL); /* warm-up */
   before = piola_mpi_split_stats_of(split);
+  piola__step_profile_reset(&w->profile, 1); /* where each process's CPU time goes */
   double cpu = 0; /* the steps' CPU time, not the barriers' */
   for (int r = 0; r < repeats; ++r) {
     MPI_Barrier(MPI_COMM_WORLD);
@@ -118,6 +122,12 @@ int main(int argc, char **argv) {
                     (after.exchange_cpu_seconds - before.exchange_cpu_seconds) / total_steps};
   double *all = malloc(sizeof mine * (size_t)size);
   MPI_Gather(mine, 9, MPI_DOUBLE, all, 9, MPI_DOUBLE, 0, MPI_COMM_WORLD);
+  /* per phase: the thread CPU time per step (exchanges included), then the applies' */
+  enum { PHASES = STEP_PHASE_COUNT + 1 };
+  double phases[PHASES], *all_phases = malloc(sizeof phases * (size_t)size);
+  for (int ph = 0; ph < STEP_PHASE_COUNT; ++ph) phases[ph] = w->profile.thread_cpu[ph] / total_steps;
+  phases[STEP_PHASE_COUNT] = w->profile.apply_thread_cpu / total_steps;
+  MPI_Gather(phases, PHASES, MPI_DOUBLE, all_phases, PHASES, MPI_DOUBLE, 0, MPI_COMM_WORLD);
   if (rank == 0) {
     const piola_elastic_body *b = piola_world_solid_body(w, 0);
     printf("bench_mpi_weak: %d processes, %d tets (%ld per process asked), %d nodes, %d steps x %d\n",
@@ -134,9 +144,15 @@ int main(int argc, char **argv) {
              a[6] / 1e6, a[6] / tets);
       printf("  rank %d: CPU %.5f s/step, of which exchanges %.5f: own work %.5f s/step\n", q,
              a[7], a[8], a[7] - a[8]);
+      printf("  rank %d: CPU ms/step by phase (exchanges included):", q);
+      for (int ph = 0; ph < STEP_PHASE_COUNT; ++ph)
+        if (all_phases[PHASES * q + ph] > 0)
+          printf(" %s %.2f", piola__step_phase_names[ph], 1e3 * all_phases[PHASES * q + ph]);
+      printf(" (applies in solves %.2f)\n", 1e3 * all_phases[PHASES * q + STEP_PHASE_COUNT]);
     }
   }
   free(all);
+  free(all_phases);
   free(per_step);
   piola_mpi_split_destroy(split, w);
   piola_world_destroy(w);

@@ -31,5 +31,7 @@ void fracture_checkpoint_round_trip(const piola_world *a, piola_world *b, const 
 void fracture_same_state(const piola_world *a, const piola_world *b);
 /* Linear momentum p (kg m/s) and angular momentum about the origin l (kg m^2/s) of solid 0. */
 void fracture_momenta(const piola_world *w, double p[3], double l[3]);
+/* Original tets of solid 0 with more than two copies: cut twice or more. */
+int32_t fracture_recut_tets(const piola_world *w);
 
 #endif

@@ -6,7 +6,9 @@
  *    and the projection leaves a positive definite dP/dF unchanged;
  *  - the assembled matrix equals the dense sum of element matrices built from the 9 x 9
  *    projected dP/dF (an independent path), is symmetric, and maps a rigid translation to
- *    the mass term only. */
+ *    the mass term only;
+ *  - the assembly's one-evaluation stress and derivative give the public functions' values
+ *    for every model and inversion mode, above the threshold (its shortcut) and below. */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -229,6 +231,45 @@ static void test_projection_keeps_definite(void **state) {
   }
 }
 
+/* piola__material_stress_and_derivative against piola_material_stress and
+ * piola_material_stress_derivative, value for value (== : the shortcut drops only terms
+ * that are exact zeros), on random Fhat with no entry below the threshold (the shortcut),
+ * entries exactly at it, and entries below it, inverted ones included (the public path). */
+static void test_stress_and_derivative_shortcut(void **state) {
+  (void)state;
+  static const piola_inversion_mode MODES[3] = {PIOLA_INVERSION_LINEAR, PIOLA_INVERSION_CLAMP,
+                                                PIOLA_INVERSION_ENERGY};
+  test_rng rng = test_rng_seeded(23);
+  for (int model = 0; model < PIOLA_MODEL_COUNT; ++model)
+    for (int mode = 0; mode < 3; ++mode) {
+      piola_material_def def = piola_default_material_def();
+      def.model = (piola_material_model)model;
+      def.youngs_modulus = 1e5;
+      def.poisson_ratio = 0.45;
+      def.inversion_mode = MODES[mode];
+      def.inversion_threshold = 0.3;
+      piola_material m;
+      assert_int_equal(piola_material_init(&def, &m), PIOLA_OK);
+      for (int rep = 0; rep < 200; ++rep) {
+        double fhat[3];
+        for (int k = 0; k < 3; ++k) {
+          fhat[k] = test_rng_uniform(&rng, 0.3, 2.5);
+          if (rep % 4 == 1 && k == 0) fhat[k] = 0.3; /* at the threshold */
+          if (rep % 4 == 2 && k == rep % 3) fhat[k] = test_rng_uniform(&rng, -1.5, 0.29);
+          if (rep % 4 == 3) fhat[k] = test_rng_uniform(&rng, -1.5, 2.5); /* any, inverted too */
+        }
+        double p[3], d[3][3], pref[3], dref[3][3];
+        piola__material_stress_and_derivative(&m, fhat, p, d);
+        piola_material_stress(&m, fhat, pref);
+        piola_material_stress_derivative(&m, fhat, dref);
+        for (int i = 0; i < 3; ++i) {
+          assert_true(p[i] == pref[i]);
+          for (int j = 0; j < 3; ++j) assert_true(d[i][j] == dref[i][j]);
+        }
+      }
+    }
+}
+
 /* 12 x 12 element stiffness -dF/dx of one tet from the 9 x 9 projected dP/dF. */
 static void dense_element(const piola_elastic_body *body, int32_t t, double k[144]) {
   piola_mat3 f;
@@ -439,6 +480,7 @@ int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_dpdf_every_model),
       cmocka_unit_test(test_projection_keeps_definite),
+      cmocka_unit_test(test_stress_and_derivative_shortcut),
       cmocka_unit_test(test_assembled_matrix),
       cmocka_unit_test(test_matrix_is_force_derivative),
   };

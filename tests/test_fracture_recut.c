@@ -165,18 +165,6 @@ static int32_t check_cut_solid(const piola_world *w) {
   return open;
 }
 
-/* Original tets with more than two copies: cut twice or more. */
-static int32_t recut_tets(const piola_world *w) {
-  const piola_elastic_body *b = piola_world_solid_body(w, 0);
-  const int32_t nt = piola_elastic_body_tet_count(b), *parent = piola_world_solid_parent_tets(w, 0);
-  int32_t original = 0, recut = 0;
-  for (int32_t t = 0; t < nt; ++t) original = parent[t] + 1 > original ? parent[t] + 1 : original;
-  int32_t *count = calloc((size_t)original, sizeof(int32_t));
-  for (int32_t t = 0; t < nt; ++t) recut += ++count[parent[t]] == 3;
-  free(count);
-  return recut;
-}
-
 /* The unit box of 5 x 5 x 5 cubes cut by x = 0.5 and then y = 0.5 (both through tets, on
  * no vertex): four quarters of 0.25 m^3, the second plane splitting the copies the first
  * one made in the middle column of cubes. The inner vertices are moved a little within the
@@ -198,7 +186,7 @@ static void crossing_planes_quarter_a_box(void **state) {
   def.cuts = cuts, def.cut_count = 2;
   assert_int_equal(piola_world_solid_set_fracture(w, 0, &def), PIOLA_OK);
   assert_int_equal(piola_world_solid_fragment_count(w, 0), 4);
-  assert_true(recut_tets(w) > 0);
+  assert_true(fracture_recut_tets(w) > 0);
   assert_close(fracture_total_mass(w), mass, 1e-13 * mass);
   assert_int_equal(check_cut_solid(w), 0);
   piola_fracture_surface s;
@@ -272,7 +260,7 @@ static void random_planes_keep_every_invariant_mesh(const piola_tet_mesh *mesh, 
       assert_close(fracture_total_mass(w), mass, 1e-12 * mass);
       *open_surfaces += check_cut_solid(w) > 0;
     }
-    *recut += recut_tets(w);
+    *recut += fracture_recut_tets(w);
     assert_int_equal(piola_world_advance_to(w, 0.01, NULL), PIOLA_OK);
     check_cut_solid(w);
     piola_world_destroy(w);
@@ -327,12 +315,12 @@ static void second_cut_in_free_flight_keeps_momentum(void **state) {
   assert_int_equal(piola_world_advance_to(w, 0.06, NULL), PIOLA_OK);
   const int32_t once = piola_world_solid_cut_tet_count(w, 0);
   assert_true(once > 0);
-  assert_int_equal(recut_tets(w), 0);
+  assert_int_equal(fracture_recut_tets(w), 0);
   double p0[3], l0[3], p1[3], l1[3];
   fracture_momenta(w, p0, l0);
   const double mass = fracture_total_mass(w);
   assert_int_equal(piola_world_step(w, 0, NULL), PIOLA_OK);
-  assert_true(recut_tets(w) > 0);
+  assert_true(fracture_recut_tets(w) > 0);
   assert_int_equal(piola_world_solid_fragment_count(w, 0), 4);
   assert_close(fracture_total_mass(w), mass, 1e-13 * mass);
   fracture_momenta(w, p1, l1);
@@ -445,9 +433,9 @@ static void twice_cut_solid_resumes_bit_for_bit(void **state) {
   assert_int_equal(piola_tet_mesh_box_grid(4, 4, 4, (piola_vec3){0.05, 0.05, 0.05}, &mesh), PIOLA_OK);
   piola_world *a = twice_cut_box(&mesh, 1), *b = twice_cut_box(&mesh, 1);
   assert_int_equal(piola_world_advance_to(a, 0.02, NULL), PIOLA_OK);
-  assert_true(recut_tets(a) > 0);
+  assert_true(fracture_recut_tets(a) > 0);
   assert_int_equal(piola_world_solid_fragment_count(a, 0), 4);
-  assert_int_equal(recut_tets(b), 0);
+  assert_int_equal(fracture_recut_tets(b), 0);
   char path[] = "/tmp/piola_recut_checkpoint_XXXXXX";
   int fd = mkstemp(path);
   assert_true(fd >= 0);

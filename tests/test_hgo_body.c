@@ -152,14 +152,14 @@ static void scene_keys_reach_the_material(void **state) {
   const char *json =
       "{\"solids\": [{\"mesh\": \"a.veg\", \"material\": {\"model\": \"hgo\", \"poisson_ratio\": 0.49, "
       "\"hgo\": {\"mu\": 7640, \"k1\": 996600, \"k2\": 524.6, \"kappa\": 0.226, "
-      "\"fiber_angle_degrees\": 49.98, \"axis\": [0, 2, 0]}}, "
+      "\"fiber_angle_degrees\": 49.98, \"axis\": [0, 2, 0], \"fiber_stretch_limit\": 1.4}}, "
       "\"fibers\": {\"around\": {\"axis\": [0, 3, 0], \"point\": [1, 0, 2]}}}]}";
   assert_int_equal(piola__scene_parse(json, ".", "t", &d), PIOLA_OK);
   const scene_solid_desc *s = &d.solids[0];
   const piola_hgo_def *h = &s->def.material.hgo;
   assert_int_equal(s->def.material.model, PIOLA_MODEL_HGO);
   assert_true(h->mu == 7640 && h->k1 == 996600 && h->k2 == 524.6 && h->kappa == 0.226);
-  assert_true(h->fiber_angle_degrees == 49.98);
+  assert_true(h->fiber_angle_degrees == 49.98 && h->fiber_stretch_limit == 1.4);
   assert_true(h->axis[0] == 0 && h->axis[1] == 1 && h->axis[2] == 0);
   assert_int_equal(s->fibers.kind, SCENE_FIBERS_AROUND);
   assert_true(s->fibers.axis.y == 1 && s->fibers.point.x == 1 && s->fibers.point.z == 2);
@@ -177,6 +177,7 @@ static const bad_case BAD[] = {
     {HGO_SOLID(", \"hgo\": {\"k2\": 0}}"), "solids[0].material.hgo.k2: must be > 0"},
     {HGO_SOLID(", \"hgo\": {\"mu\": 0}}"), "solids[0].material.hgo.mu: must be > 0"},
     {HGO_SOLID(", \"hgo\": {\"fiber_angle_degrees\": 95}}"), "solids[0].material.hgo.fiber_angle_degrees: must be in [0, 90]"},
+    {HGO_SOLID(", \"hgo\": {\"fiber_stretch_limit\": 1}}"), "solids[0].material.hgo.fiber_stretch_limit: must be > 1"},
     {HGO_SOLID(", \"hgo\": {\"axis\": [0, 0, 0]}}"), "solids[0].material.hgo.axis: must be a nonzero vector"},
     {HGO_SOLID(", \"hgo\": {\"beta\": 30}}"), "solids[0].material.hgo.beta: unknown key"},
     {HGO_SOLID("}, \"fibers\": {\"around\": {\"point\": [0, 0, 0]}}"), "solids[0].fibers.around.axis"},

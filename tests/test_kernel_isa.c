@@ -291,32 +291,45 @@ static void force_damping_and_step_variants_agree(void **state) {
 }
 
 /* The projected stiffness lanes give the scalar piola__tet_stiffness_blocks's bits in every
- * variant (they fuse no multiply-adds), on stretched, compressed and inverted tets of two
- * materials. */
-static void stiffness_lanes_give_the_scalar_bits(void **state) {
-  (void)state;
+ * variant (they fuse no multiply-adds), on stretched, compressed and inverted tets: of two
+ * materials (every tet's material part through the public functions), or of one material
+ * `model` (blocks with no entry of Fhat below the threshold take the lane loop over the
+ * model's parts; at least one does here, and at least one does not). */
+static void check_stiffness_lanes(int uniform, piola_material_model model) {
   test_rng rng = test_rng_seeded(78);
   piola_tet_mesh mesh = fixture_grid(3, 0.1);
-  piola_material mats[2] = {fixture_material(PIOLA_MODEL_NEOHOOKEAN),
+  piola_material mats[2] = {fixture_material(uniform ? model : PIOLA_MODEL_NEOHOOKEAN),
                             fixture_material(PIOLA_MODEL_STVK)};
   int32_t *which = malloc(sizeof(int32_t) * (size_t)mesh.tet_count);
   for (int32_t t = 0; t < mesh.tet_count; ++t) which[t] = t % 5 == 2;
   piola_elastic_body_def def = piola_default_elastic_body_def();
   def.rest_mesh = &mesh;
   def.materials = mats;
-  def.material_count = 2;
-  def.tet_materials = which;
+  def.material_count = uniform ? 1 : 2;
+  def.tet_materials = uniform ? NULL : which;
   piola_elastic_body *body = NULL;
   assert_int_equal(piola_elastic_body_create(&def, &body), PIOLA_OK);
   const int n = 3 * mesh.vertex_count;
   double *x = malloc(sizeof(double) * (size_t)n), *f = malloc(sizeof(double) * (size_t)n);
-  for (int i = 0; i < n; ++i) x[i] = mesh.positions[i] * 1.1 + test_rng_uniform(&rng, -0.05, 0.05);
+  const double noise = uniform ? 0.005 : 0.05;
+  for (int i = 0; i < n; ++i)
+    x[i] = mesh.positions[i] * 1.1 + test_rng_uniform(&rng, -noise, noise);
   for (int v = 0; v < 6; ++v) x[3 * (5 * v + 3) + 2] += 0.15; /* inverts some tets */
   piola_elastic_stats st;
   assert_int_equal(piola_elastic_body_update(body, x, 0.7, f, &st), PIOLA_OK);
   assert_true(st.inverted_count > 0);
   const int32_t blocks = mesh.tet_count / PIOLA_TET_BLOCK;
   assert_true(blocks > 0);
+  if (uniform) { /* both paths of the lanes' material part are taken */
+    int32_t unclamped_blocks = 0;
+    for (int32_t b = 0; b < blocks; ++b) {
+      int unclamped = 1;
+      for (int e = 0; e < 3 * PIOLA_TET_BLOCK; ++e)
+        unclamped &= body->fhat[3 * (size_t)b * PIOLA_TET_BLOCK + e] >= mats[0].threshold;
+      unclamped_blocks += unclamped;
+    }
+    assert_true(unclamped_blocks > 0 && unclamped_blocks < blocks);
+  }
   for (int isa = 0; isa <= VARIANTS; ++isa) {
     if (isa < VARIANTS && (!STIFFNESS[isa] || !runs(isa))) continue;
     for (int32_t b = 0; b < blocks; ++b) {
@@ -340,6 +353,14 @@ static void stiffness_lanes_give_the_scalar_bits(void **state) {
   free(which);
   piola_elastic_body_destroy(body);
   fixture_mesh_free(&mesh);
+}
+
+static void stiffness_lanes_give_the_scalar_bits(void **state) {
+  (void)state;
+  check_stiffness_lanes(0, PIOLA_MODEL_NEOHOOKEAN);
+  for (int model = 0; model < PIOLA_MODEL_COUNT; ++model)
+    if (model != PIOLA_MODEL_MUSCLE && model != PIOLA_MODEL_HGO) /* fibres: no lanes */
+      check_stiffness_lanes(1, (piola_material_model)model);
 }
 
 int main(void) {

@@ -15,8 +15,13 @@
 static const piola_inversion_mode modes[N_MODES] = {PIOLA_INVERSION_LINEAR, PIOLA_INVERSION_CLAMP};
 static const double youngs = 1e5;
 
+/* The model's default threshold, set explicitly: the extension with a fixed threshold, whose
+ * properties the tests below check (the rubber models' default rise of the threshold with
+ * compression, which a threshold left unset gets, has its own test at the end). */
 static piola_material make(piola_material_model model, piola_inversion_mode mode, double nu) {
-  return material_of(model, mode, youngs, nu, 0);
+  double threshold;
+  piola_material_default_inversion(model, NULL, &threshold);
+  return material_of(model, mode, youngs, nu, threshold);
 }
 
 static double energy(const piola_material *m, double f0, double f1, double f2) {
@@ -667,8 +672,56 @@ static void names_and_lame_parameters_round_trip(void **state) {
   assert_int_equal(piola_youngs_poisson_from_lame(NAN, 1.0, &e, &nu), PIOLA_ERROR_NOT_FINITE);
 }
 
+/* The rubber models' default (CLAMP, threshold left unset): the threshold rises from c to
+ * threshold_compressed as J falls through threshold_volume (docs/materials.md "Defaults that
+ * recover"). Its dPhat/dFhat, the rise's term dPhat/dc dc/dJ dJ/df included, equals the central
+ * difference of the stress in and around the rise, away from the kinks (an entry at the
+ * threshold in force); at J above the rise the stress is that of the fixed threshold c (rubber's
+ * own states keep the model); and a threshold set explicitly has no rise. */
+static void threshold_rise_derivative_is_the_stress_difference(void **state) {
+  (void)state;
+  const piola_material_model models[2] = {PIOLA_MODEL_MOONEY_RIVLIN, PIOLA_MODEL_OGDEN};
+  test_rng rng = test_rng_seeded(1919);
+  const long cases = test_samples(400, 40);
+  for (int mi = 0; mi < 2; ++mi) {
+    const piola_material m = material_of(models[mi], PIOLA_INVERSION_MODEL_DEFAULT, youngs, 0.3, 0);
+    const piola_material fixed = make(models[mi], PIOLA_INVERSION_CLAMP, 0.3);
+    assert_int_equal(m.inversion_mode, PIOLA_INVERSION_CLAMP);
+    assert_true(m.threshold_compressed > m.threshold);
+    assert_true(fixed.threshold_compressed == fixed.threshold);
+    int checked = 0, in_rise = 0;
+    for (long c = 0; c < cases; ++c) {
+      /* one or two entries around the thresholds, J in and around the rise */
+      double f[3];
+      f[0] = test_rng_uniform(&rng, 0.25, 0.7);
+      f[1] = c % 2 ? test_rng_uniform(&rng, 0.25, 0.7) : test_rng_uniform(&rng, 1.0, 2.5);
+      const double j = test_rng_uniform(&rng, 0.92, 0.98);
+      f[2] = j / (f[0] * f[1]);
+      const double cf = material_threshold_at(&m, f[0], f[1], f[2]);
+      if (fabs(f[0] - cf) < 2e-3 || fabs(f[1] - cf) < 2e-3 || fabs(f[2] - cf) < 2e-3) continue;
+      double k[3][3], col[3], p[3], pf[3];
+      piola_material_stress_derivative(&m, f, k);
+      for (int jj = 0; jj < 3; ++jj) {
+        stress_fd(&m, f, jj, 1e-7, col);
+        for (int i = 0; i < 3; ++i) assert_close(k[i][jj], col[i], 1e-5 * stress_scale(&m, f));
+      }
+      ++checked;
+      in_rise += cf > m.threshold && cf < m.threshold_compressed &&
+                 (f[0] < cf || f[1] < cf || f[2] < cf);
+      if (j >= m.threshold_volume[1] + 1e-9) { /* above the rise: the fixed threshold's stress */
+        piola_material_stress(&m, f, p);
+        piola_material_stress(&fixed, f, pf);
+        for (int i = 0; i < 3; ++i) assert_true(p[i] == pf[i]);
+      }
+    }
+    assert_true(checked > cases / 2);
+    assert_true(in_rise > cases / 20); /* the rise's own term was exercised */
+  }
+}
+
 int main(void) {
   const struct CMUnitTest tests[] = {
+      cmocka_unit_test(threshold_rise_derivative_is_the_stress_difference),
       cmocka_unit_test(rest_state_is_stress_free_with_linear_elastic_tangent),
       cmocka_unit_test(uniaxial_small_strain_gives_youngs_modulus_and_poisson_ratio),
       cmocka_unit_test(stress_is_energy_gradient_above_threshold),

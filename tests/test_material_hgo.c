@@ -1,6 +1,6 @@
 /* The Holzapfel-Gasser-Ogden model (PIOLA_MODEL_HGO) at the material level: the fibre stress
  * is the gradient of the fibre energy and its dP/dF the derivative of the stress for every F
- * (flat, collapsed, inverted and far past the exponential's cap included), both are zero at
+ * (flat, collapsed, inverted and far past the fibre stretch limit included), both are zero at
  * rest, the families follow the tet's fibre and the axis, the whole stress rotates with world
  * and material, every flat or inverted entry is pushed back, and a two-layer artery inflated
  * with Holzapfel, Gasser and Ogden's (2000) published parameters follows the pressure-radius
@@ -10,6 +10,7 @@
 
 #include "piola/diagonalize.h"
 #include "piola/material.h"
+#include "material/hgo_kernels.h"
 #include "material_checks.h"
 #include "test_support.h"
 
@@ -62,7 +63,7 @@ static double max_abs9(const double *a, int n) {
 }
 
 /* Random F of every kind: moderate, flat, nearly a line, inverted, and stretched far past the
- * exponential's cap (k2 E^2 = 12). */
+ * fibre stretch limit (1.7 by default). */
 static piola_mat3 random_f(test_rng *rng, long k) {
   double s[3];
   for (int i = 0; i < 3; ++i) s[i] = test_rng_uniform(rng, 0.3, 1.9);
@@ -70,10 +71,35 @@ static piola_mat3 random_f(test_rng *rng, long k) {
     case 1: s[0] = -test_rng_uniform(rng, 0.0, 0.8); break;          /* inverted */
     case 2: s[1] = test_rng_uniform(rng, -1e-3, 1e-3); break;        /* flat */
     case 3: s[2] = 0.0, s[1] = test_rng_uniform(rng, 0, 0.05); break; /* nearly a line */
-    case 4: s[0] = test_rng_uniform(rng, 3.5, 6.0); break;           /* past the cap */
+    case 4: s[0] = test_rng_uniform(rng, 3.5, 6.0); break;           /* past the limit */
     default: break;
   }
   return f_with_singular_values(rng, s);
+}
+
+/* The fibre stress p at f9 equals the central differences (step h) of the fibre energy, and
+ * its derivative d those of the stress: to 1e-5 and to dtol_rel of the largest entries (plus
+ * k1). sample and limit (0 for none) name the case in a failure. */
+static void fiber_differences_match(const piola_material *m, const double *fam, const double *f9, const double *p,
+                                    const double *d, double h, double dtol_rel, long sample, double limit) {
+  const double ptol = 1e-5 * (max_abs9(p, 9) + m->hgo.k1), dtol = dtol_rel * (max_abs9(d, 81) + m->hgo.k1);
+  for (int e = 0; e < 9; ++e) {
+    double fp[9], fm[9], pp[9], pm[9];
+    memcpy(fp, f9, sizeof fp), memcpy(fm, f9, sizeof fm);
+    fp[e] += h, fm[e] -= h;
+    const double dpsi = (piola_material_hgo_fiber_energy_density(m, fp, fam) -
+                         piola_material_hgo_fiber_energy_density(m, fm, fam)) / (2 * h);
+    if (!(fabs(dpsi - p[e]) <= ptol))
+      fail_msg("sample %ld (limit %g): dpsi/dF[%d] = %.9g but P = %.9g", sample, limit, e, dpsi, p[e]);
+    piola_material_hgo_fiber_stress(m, fp, fam, pp);
+    piola_material_hgo_fiber_stress(m, fm, fam, pm);
+    for (int r = 0; r < 9; ++r) {
+      const double dp = (pp[r] - pm[r]) / (2 * h);
+      if (!(fabs(dp - d[9 * r + e]) <= dtol))
+        fail_msg("sample %ld (limit %g): dP[%d]/dF[%d] = %.9g by differences, %.9g returned", sample, limit, r,
+                 e, dp, d[9 * r + e]);
+    }
+  }
 }
 
 static void fiber_stress_is_the_energy_gradient_and_its_derivative_exact(void **state) {
@@ -89,26 +115,7 @@ static void fiber_stress_is_the_energy_gradient_and_its_derivative_exact(void **
     flat9(random_f(&rng, k), f9);
     piola_material_hgo_fiber_stress(&m, f9, fam, p);
     piola_material_hgo_fiber_stress_derivative(&m, f9, fam, d);
-    const double h = 1e-6 * (1.0 + max_abs9(f9, 9));
-    const double ptol = 1e-5 * (max_abs9(p, 9) + m.hgo.k1);
-    const double dtol = 1e-5 * (max_abs9(d, 81) + m.hgo.k1);
-    for (int e = 0; e < 9; ++e) {
-      double fp[9], fm[9], pp[9], pm[9];
-      memcpy(fp, f9, sizeof fp), memcpy(fm, f9, sizeof fm);
-      fp[e] += h, fm[e] -= h;
-      const double dpsi = (piola_material_hgo_fiber_energy_density(&m, fp, fam) -
-                           piola_material_hgo_fiber_energy_density(&m, fm, fam)) / (2 * h);
-      if (!(fabs(dpsi - p[e]) <= ptol))
-        fail_msg("sample %ld: dpsi/dF[%d] = %.9g but P = %.9g", k, e, dpsi, p[e]);
-      piola_material_hgo_fiber_stress(&m, fp, fam, pp);
-      piola_material_hgo_fiber_stress(&m, fm, fam, pm);
-      for (int r = 0; r < 9; ++r) {
-        const double dp = (pp[r] - pm[r]) / (2 * h);
-        if (!(fabs(dp - d[9 * r + e]) <= dtol))
-          fail_msg("sample %ld: dP[%d]/dF[%d] = %.9g by differences, %.9g returned", k, r, e, dp,
-                   d[9 * r + e]);
-      }
-    }
+    fiber_differences_match(&m, fam, f9, p, d, 1e-6 * (1.0 + max_abs9(f9, 9)), 1e-5, k, 0);
     /* symmetric and positive semi-definite (no projection needed) */
     for (int r = 0; r < 9; ++r)
       for (int c = 0; c < 9; ++c) assert_close(d[9 * r + c], d[9 * c + r], 1e-9 * (max_abs9(d, 81) + 1));
@@ -118,6 +125,102 @@ static void fiber_stress_is_the_energy_gradient_and_its_derivative_exact(void **
       for (int r = 0; r < 9; ++r)
         for (int c = 0; c < 9; ++c) q += x[r] * d[9 * r + c] * x[c];
       assert_true(q >= -1e-9 * max_abs9(d, 81));
+    }
+  }
+}
+
+/* The F whose family 0 has generalized fibre stretch s = sqrt(1 + E) exactly: a stretch t
+ * along the family (the other entries 1), solved for t by bisection (E grows with t). */
+static void f_at_fiber_stretch(const piola_material *m, const double fam[6], double s, double f9[9]) {
+  double lo = 1.0, hi = 1e4, w[3];
+  for (int it = 0; it < 200; ++it) {
+    const double t = 0.5 * (lo + hi);
+    for (int i = 0; i < 3; ++i)
+      for (int j = 0; j < 3; ++j) f9[3 * i + j] = (i == j) + (t - 1.0) * fam[i] * fam[j];
+    if (sqrt(1.0 + hgo_invariant(&m->hgo, f9, fam, w)) < s) lo = t; else hi = t;
+  }
+}
+
+/* Across the fibre stretch limit (materials.md): the energy's gradient is the stress and the
+ * stress's derivative dP/dF on both sides and straddling it (it is C2 in the fibre stretch),
+ * with and without dispersion, at the default and at other limits. */
+static void the_stretch_limit_is_crossed_smoothly(void **state) {
+  (void)state;
+  test_rng rng = test_rng_seeded(25);
+  const double kappas[2] = {0.0, 0.226}, limits[3] = {1.7, 1.2, 2.1};
+  for (long k = 0; k < test_samples(600, 60); ++k) {
+    piola_material_def def = piola_default_material_def();
+    def.model = PIOLA_MODEL_HGO;
+    def.poisson_ratio = 0.45;
+    def.hgo.kappa = kappas[k % 2];
+    def.hgo.fiber_stretch_limit = limits[(k / 2) % 3];
+    def.hgo.fiber_angle_degrees = test_rng_uniform(&rng, 0, 90);
+    piola_material m;
+    assert_int_equal(piola_material_init(&def, &m), PIOLA_OK);
+    double fiber[3], fam[6], f9[9], p[9], d[81];
+    random_unit(&rng, fiber);
+    if (piola_material_hgo_families(&m, fiber, fam) != PIOLA_OK) continue;
+    const double sl = sqrt(1.0 + hgo_limit_strain(&m.hgo));
+    /* within a few differencing steps of the limit, both sides */
+    f_at_fiber_stretch(&m, fam, sl * (1.0 + test_rng_uniform(&rng, -3e-6, 3e-6)), f9);
+    piola_material_hgo_fiber_stress(&m, f9, fam, p);
+    piola_material_hgo_fiber_stress_derivative(&m, f9, fam, d);
+    fiber_differences_match(&m, fam, f9, p, d, 1e-6, 1e-4, k, sl);
+    /* the one-sided values meet: energy, stress and dP/dF just below and just above agree */
+    double fb[9], fa[9], pb[9], pa[9], db[81], da[81];
+    f_at_fiber_stretch(&m, fam, sl * (1 - 1e-9), fb);
+    f_at_fiber_stretch(&m, fam, sl * (1 + 1e-9), fa);
+    piola_material_hgo_fiber_stress(&m, fb, fam, pb);
+    piola_material_hgo_fiber_stress(&m, fa, fam, pa);
+    piola_material_hgo_fiber_stress_derivative(&m, fb, fam, db);
+    piola_material_hgo_fiber_stress_derivative(&m, fa, fam, da);
+    for (int e = 0; e < 9; ++e) assert_close(pa[e], pb[e], 1e-6 * (max_abs9(pb, 9) + 1));
+    for (int e = 0; e < 81; ++e) assert_close(da[e], db[e], 1e-6 * (max_abs9(db, 81) + 1));
+  }
+}
+
+/* Past the limit the fibres are a spring of constant stiffness in the fibre stretch: their
+ * plane-wave stiffness stays below the step bound's hgo_fiber_modulus_bound, which stops
+ * growing at the limit, however far the fibres are stretched (a scramble stretches tets
+ * hundreds of times); the exponential's stiffness would be e^(k2 E^2) larger. */
+static void stiffness_stays_bounded_past_the_limit(void **state) {
+  (void)state;
+  test_rng rng = test_rng_seeded(26);
+  for (int kk = 0; kk < 2; ++kk) {
+    const piola_material m = hgo_material(kk ? 0.226 : 0.0, 29.0, 0.45);
+    const double fiber[3] = {1, 0, 0};
+    double fam[6];
+    assert_int_equal(piola_material_hgo_families(&m, fiber, fam), PIOLA_OK);
+    const double sl = sqrt(1.0 + hgo_limit_strain(&m.hgo));
+    double at_limit = 0;
+    const double stretches[5] = {1.0, 1.001, 10.0, 100.0, 1000.0}; /* times the limit */
+    for (int c = 0; c < 5; ++c) {
+      double f9[9], d[81];
+      f_at_fiber_stretch(&m, fam, sl * stretches[c], f9);
+      piola_material_hgo_fiber_stress_derivative(&m, f9, fam, d);
+      /* in the diagonal frame of F, as the step bound sees it */
+      piola_mat3 f, u, v;
+      piola_vec3 fh;
+      for (int e = 0; e < 9; ++e) f.m[e / 3][e % 3] = f9[e];
+      assert_int_equal(piola_diagonalize3(&f, &u, &fh, &v), PIOLA_OK);
+      const double bound = hgo_fiber_modulus_bound(&m.hgo, fh.x, fh.y, fh.z);
+      if (c == 0) at_limit = bound;
+      assert_close(bound, at_limit, 1e-9 * at_limit); /* constant past the limit */
+      double wave = 0;
+      for (int t = 0; t < 400; ++t) { /* unit rank-one dF = x y^T */
+        double x[3], y[3], q = 0;
+        random_unit(&rng, x);
+        random_unit(&rng, y);
+        if (t == 0) memcpy(x, fam, sizeof x), memcpy(y, fam, sizeof y); /* along the family */
+        for (int r = 0; r < 9; ++r)
+          for (int e = 0; e < 9; ++e) q += x[r / 3] * y[r % 3] * d[9 * r + e] * x[e / 3] * y[e % 3];
+        wave = fmax(wave, q);
+      }
+      if (!(wave <= bound * (1 + 1e-9)))
+        fail_msg("kappa %g, %g times the limit: plane wave %g above the bound %g", m.hgo.kappa,
+                 stretches[c], wave, bound);
+      if (c > 1 && !(wave > 0.25 * bound)) /* the fibres still carry: the bound is not loose */
+        fail_msg("kappa %g, %g times the limit: plane wave %g, bound %g", m.hgo.kappa, stretches[c], wave, bound);
     }
   }
 }
@@ -229,7 +332,7 @@ static void stress_rotates_with_world_and_material(void **state) {
     double fam[6], rfam[6];
     if (piola_material_hgo_families(&m, fiber, fam) != PIOLA_OK) continue;
     assert_int_equal(piola_material_hgo_families(&mr, rfiber, rfam), PIOLA_OK);
-    const piola_mat3 f = random_f(&rng, k % 4); /* not past the cap: moderate magnitudes */
+    const piola_mat3 f = random_f(&rng, k); /* every kind, far past the stretch limit included */
     piola_mat3 p, pr;
     const double e0 = whole_stress(&m, f, fam, &p);
     const double e1 = whole_stress(&mr, mat3_mul(mat3_mul(q, f), mat3_transpose(r)), rfam, &pr);
@@ -444,6 +547,22 @@ static void artery_follows_the_published_inflation_curve(void **state) {
     }
     prev_radius = ri;
   }
+  /* The curve lies below the default fibre stretch limit (so the limit leaves it unchanged):
+   * the largest fibre stretch, at each layer's inner surface at 160 mmHg, ... */
+  const double k = 2 * M_PI / (2 * M_PI - 160.0 * M_PI / 180.0), ri = prev_radius;
+  for (int a = 0; a < 2; ++a) {
+    const double rr = ARTERY[a].r_in, r0 = ARTERY[0].r_in;
+    const double lt = k * sqrt(ri * ri + (rr * rr - r0 * r0) / (k * lz)) / rr;
+    const double b = ARTERY[a].beta_degrees * M_PI / 180;
+    const double stretch = sqrt(lt * lt * cos(b) * cos(b) + lz * lz * sin(b) * sin(b));
+    print_message("layer %d: largest fibre stretch %.3f at 160 mmHg\n", a, stretch);
+    assert_true(stretch < piola_default_material_def().hgo.fiber_stretch_limit);
+  }
+  /* ... and a limit inside the curve would change it: the test sees the limit. */
+  piola_material low[2] = {layers[0], layers[1]};
+  for (int a = 0; a < 2; ++a) low[a].hgo.fiber_stretch_limit = 1.5;
+  const double p_ref = artery_pressure(layers, 0, ri, lz);
+  assert_true(fabs(artery_pressure(low, 1, ri, lz) - p_ref) > 0.01 * p_ref);
 }
 
 static void invalid_parameters_are_rejected_by_name(void **state) {
@@ -463,6 +582,8 @@ static void invalid_parameters_are_rejected_by_name(void **state) {
       {&base.hgo.fiber_angle_degrees, 91.0, "hgo.fiber_angle_degrees"},
       {&base.hgo.fiber_angle_degrees, NAN, "hgo.fiber_angle_degrees"},
       {&base.hgo.axis[1], INFINITY, "hgo.axis"},
+      {&base.hgo.fiber_stretch_limit, 1.0, "hgo.fiber_stretch_limit"},
+      {&base.hgo.fiber_stretch_limit, NAN, "hgo.fiber_stretch_limit"},
   };
   for (size_t i = 0; i < sizeof cases / sizeof cases[0]; ++i) {
     const double old = *cases[i].field;
@@ -482,6 +603,12 @@ static void invalid_parameters_are_rejected_by_name(void **state) {
   assert_int_equal(piola_material_init(&base, &m), PIOLA_OK);
   assert_close(m.mu, base.hgo.mu, 0);
   assert_close(m.fiber_modulus, 8 * base.hgo.k1, 1e-9);
+  assert_true(m.hgo.fiber_stretch_limit == 1.7); /* the default, in force */
+  /* GOH 2006's k2: the limit in force is lowered to where k2 E^2 = 12, exp stays finite */
+  base.hgo.k2 = 524.6;
+  assert_int_equal(piola_material_init(&base, &m), PIOLA_OK);
+  assert_close(m.hgo.fiber_stretch_limit, sqrt(1 + sqrt(12 / 524.6)), 1e-12);
+  base.hgo.k2 = 0.8393;
   piola_material_model model;
   assert_true(piola_material_model_from_name("hgo", &model) && model == PIOLA_MODEL_HGO);
   assert_string_equal(piola_material_model_name(PIOLA_MODEL_HGO), "hgo");
@@ -493,6 +620,8 @@ static void invalid_parameters_are_rejected_by_name(void **state) {
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(fiber_stress_is_the_energy_gradient_and_its_derivative_exact),
+      cmocka_unit_test(the_stretch_limit_is_crossed_smoothly),
+      cmocka_unit_test(stiffness_stays_bounded_past_the_limit),
       cmocka_unit_test(the_whole_stress_is_the_energy_gradient),
       cmocka_unit_test(rest_has_zero_stress_and_energy),
       cmocka_unit_test(families_and_tension_only),

@@ -11,16 +11,19 @@
  *  - in the local mode (part 0 holds its own blocks and the ghost blocks part 1 sends), its
  *    own tets' state and the damping forces of every node are the same bits (the ghosts
  *    matter: without them part 0's rows differ), and the body, once its split is taken off,
- *    refuses to step alone or to be split again;
+ *    refuses to step alone or to be split again; both parts, stepping their step bound
+ *    together (two threads), get the whole body's largest rate and the tet that sets it;
  *  - splits with parts out of range or missing operations are refused;
  *  - a split planned before the solid is built (piola_world_set_work_split_planner) writes
  *    its own tets' state with the whole solid's bits and never the tets it does not hold. */
 #include "test_support.h"
 
 #include <math.h>
+#include <pthread.h>
 #include <stdlib.h>
 #include <string.h>
 
+#include "force/stable_step.h"
 #include "piola/elastic_body.h"
 #include "piola/work_split.h"
 #include "piola/world.h"
@@ -118,6 +121,61 @@ static void noop_blocks(void *context, double *values, int32_t width) {
   (void)context, (void)values, (void)width;
 }
 
+/* The step bound in the local mode (stable_step.c): the two parts run in two threads whose
+ * reduce is an all-gather behind a barrier, as MPI_Allgather makes it; each part must get
+ * the whole body's largest rate and the tet that sets it (the first one near it), found by
+ * the part that holds it while the other skips its search. */
+typedef struct lockstep {
+  pthread_barrier_t barrier;
+  double slots[2][8];
+} lockstep;
+static lockstep *the_lockstep;
+
+static void lockstep_reduce(void *context, double *values, int32_t count, piola_work_split_reduction op) {
+  const fake_part *p = context;
+  lockstep *l = the_lockstep;
+  memcpy(l->slots[p->split.part], values, sizeof(double) * (size_t)count);
+  pthread_barrier_wait(&l->barrier);
+  for (int32_t i = 0; i < count; ++i) {
+    const double a = l->slots[0][i], b = l->slots[1][i];
+    values[i] = op == PIOLA_WORK_SPLIT_SUM ? a + b : op == PIOLA_WORK_SPLIT_MAX ? fmax(a, b) : fmin(a, b);
+  }
+  pthread_barrier_wait(&l->barrier); /* both have read the slots before the next call */
+}
+
+typedef struct rate_job {
+  fake_part *part;
+  double rate2;
+  int32_t worst;
+} rate_job;
+
+static void *part_rate(void *arg) { /* no assertion here: cmocka's belong to the main thread */
+  rate_job *j = arg;
+  j->rate2 = piola__elastic_body_state_rate2(j->part->body, &j->worst);
+  return NULL;
+}
+
+static void check_local_step_bound(piola_elastic_body *whole, fake_part *p0, fake_part *p1) {
+  int32_t worst = -1;
+  const double rate2 = piola__elastic_body_state_rate2(whole, &worst);
+  assert_true(rate2 > 0 && worst >= 0);
+  lockstep l;
+  the_lockstep = &l;
+  assert_int_equal(pthread_barrier_init(&l.barrier, NULL, 2), 0);
+  p0->split.reduce = p1->split.reduce = lockstep_reduce;
+  rate_job jobs[2] = {{p0, 0, -1}, {p1, 0, -1}};
+  pthread_t thread;
+  assert_int_equal(pthread_create(&thread, NULL, part_rate, &jobs[1]), 0);
+  part_rate(&jobs[0]);
+  assert_int_equal(pthread_join(thread, NULL), 0);
+  pthread_barrier_destroy(&l.barrier);
+  p0->split.reduce = p1->split.reduce = unused_reduce;
+  for (int k = 0; k < 2; ++k) {
+    assert_memory_equal(&jobs[k].rate2, &rate2, sizeof(double));
+    assert_int_equal(jobs[k].worst, worst);
+  }
+}
+
 /* x: the rest positions stretched, sheared and jittered; v: a random velocity field. */
 static void deformed_state(const piola_tet_mesh *mesh, double *x, double *v) {
   test_rng rng = test_rng_seeded(20);
@@ -209,6 +267,7 @@ static void check_split(int n, int alternate, int local) {
   piola_elastic_body_damping_forces(p0.body, v, 0.7, 0.3, d0);
   assert_memory_equal(d0, d, sizeof(double) * 3 * (size_t)nv);
   if (local) {
+    check_local_step_bound(whole, &p0, &p1);
     /* a local split keeps only its part: the body cannot step alone again, nor be split anew */
     assert_int_equal(piola_elastic_body_set_work_split(p0.body, NULL), PIOLA_OK);
     assert_int_equal(piola_elastic_body_update(p0.body, x, 1.0, f0, NULL), PIOLA_ERROR_INVALID_ARGUMENT);

@@ -152,6 +152,10 @@ typedef struct piola_hgo_def {
                                  fibre direction. Default 29 */
   double axis[3];             /* nonzero (normalised): the fibre plane's second direction, in
                                  rest (scene) coordinates. Default (0, 0, 1) */
+  double fiber_stretch_limit; /* dimensionless, > 1: the fibre stretch sqrt(1 + E) past which
+                                 the fibre energy is continued as a spring of constant
+                                 stiffness instead of the exponential (docs/materials.md).
+                                 Default 1.7 */
 } piola_hgo_def;
 
 typedef struct piola_material_def {
@@ -195,6 +199,12 @@ typedef struct piola_material {
   double lambda;              /* Pa, Lame's first parameter */
   double threshold;           /* dimensionless compression threshold c */
   piola_inversion_mode inversion_mode;
+  double threshold_compressed; /* CLAMP: the threshold where J <= threshold_volume[0]; it rises
+                                  from threshold smoothly as J falls from threshold_volume[1]
+                                  (material_threshold_at). Equal to threshold (off) unless the
+                                  model's default sets it (Mooney-Rivlin, Ogden:
+                                  docs/materials.md, "Defaults that recover") */
+  double threshold_volume[2];  /* J (low, high) of that rise */
   double spline_coefficients[16]; /* precomputed spline pieces, model-internal */
   double model_constants[24]; /* precomputed constants, model-internal (Stable Neo-Hookean's
                                  mu', lambda', alpha; the energy extension's slope; the

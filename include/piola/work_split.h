@@ -75,6 +75,9 @@ typedef struct piola_split_newton_system {
   double tolerance;       /* stop at this fraction of the initial residual (preconditioner norm) */
   int32_t max_iterations; /* iterations at most */
   piola_mpi_preconditioner preconditioner;
+  /* 0 for the first Newton system of a step (or of a retried step), then 1, 2, ...: a solver
+   * may reuse for a later system what it set up for an earlier one of the same step */
+  int32_t step_system;
 } piola_split_newton_system;
 
 typedef struct piola_work_split {

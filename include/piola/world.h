@@ -126,14 +126,16 @@ typedef struct piola_world_def {
   int32_t newton_max_iterations; /* >= 1: past this the step counts as failed and is
                                   retried at half its size. Default 30 */
   double linear_tolerance;     /* dimensionless, in (0, 1): each Newton system is solved by
-                                  preconditioned CG to this fraction of its initial residual.
-                                  Default 1e-3 */
+                                  preconditioned CG to this fraction of its initial residual
+                                  (with PIOLA_FORCING_FIXED; the smallest fraction with
+                                  PIOLA_FORCING_EISENSTAT_WALKER). Default 1e-3 */
   int32_t linear_max_iterations; /* >= 1: CG iterations per Newton system. Default 1000 */
   piola_preconditioner_type preconditioner; /* the CG's preconditioner. Default
                                   PIOLA_PRECONDITIONER_BLOCK_JACOBI */
-  piola_linear_forcing linear_forcing; /* each Newton system's CG tolerance: adapted
-                                  (Eisenstat-Walker, never tighter than linear_tolerance) or
-                                  fixed at linear_tolerance (quasistatic steps: always fixed). Default
+  piola_linear_forcing linear_forcing; /* each Newton system's CG tolerance, backward Euler
+                                  and quasistatics alike: adapted (Eisenstat-Walker, within
+                                  [linear_tolerance, 0.5], at most 0.1 after a step the line
+                                  search shortened) or fixed at linear_tolerance. Default
                                   PIOLA_FORCING_EISENSTAT_WALKER */
   piola_mpi_preconditioner mpi_preconditioner; /* the preconditioner of PETSc's CG when
                                   the run is split over MPI processes. Default

@@ -27,15 +27,17 @@ def _ogden(values):
 
 
 def _hgo(values):
-    """{"mu", "k1", "k2", "kappa", "fiber_angle_degrees", "axis"} (the scene keys)."""
+    """{"mu", "k1", "k2", "kappa", "fiber_angle_degrees", "axis", "fiber_stretch_limit"}
+    (the scene keys)."""
     if values is None:
         return _DEFAULT[9]
-    check_keys(values, _HGO_KEYS + ("axis",), "hgo")
+    check_keys(values, _HGO_KEYS + ("axis", "fiber_stretch_limit"), "hgo")
     scalars = tuple(number(values.get(k, d), f"hgo.{k}") for k, d in zip(_HGO_KEYS, _DEFAULT[9]))
     axis = values.get("axis", _DEFAULT[9][5])
     if isinstance(axis, (str, bytes)) or not hasattr(axis, "__len__") or len(axis) != 3:
         raise ValueError("hgo.axis must be 3 numbers")
-    return scalars + (tuple(number(a, "hgo.axis") for a in axis),)
+    limit = number(values.get("fiber_stretch_limit", _DEFAULT[9][6]), "hgo.fiber_stretch_limit")
+    return scalars + (tuple(number(a, "hgo.axis") for a in axis), limit)
 
 
 def _sub(values, keys, defaults, what):

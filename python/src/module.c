@@ -125,7 +125,8 @@ static int ogden_terms(PyObject *seq, const char *what, double *out) {
 }
 
 /* (model, E, nu, threshold, mode, (spline 3), (muscle 5), ((ogden mu...), (ogden alpha...)),
- * (mooney_rivlin c10, c01), (hgo mu, k1, k2, kappa, fiber_angle_degrees, (axis 3))) */
+ * (mooney_rivlin c10, c01), (hgo mu, k1, k2, kappa, fiber_angle_degrees, (axis 3),
+ * fiber_stretch_limit)) */
 int pypiola_material_converter(PyObject *obj, void *out) {
   piola_material_def *def = out;
   *def = piola_default_material_def();
@@ -134,13 +135,14 @@ int pypiola_material_converter(PyObject *obj, void *out) {
   piola_muscle_def *mu = &def->muscle;
   piola_hgo_def *h = &def->hgo;
   PyObject *omu = NULL, *oalpha = NULL;
-  if (!PyArg_ParseTuple(obj, "sddds(ddd)(ddddd)(OO)(dd)(ddddd(ddd));bad material tuple", &model,
+  if (!PyArg_ParseTuple(obj, "sddds(ddd)(ddddd)(OO)(dd)(ddddd(ddd)d);bad material tuple", &model,
                         &def->youngs_modulus, &def->poisson_ratio, &def->inversion_threshold, &mode,
                         &sp->compression_stretch, &sp->elongation_stretch, &sp->stiffening,
                         &mu->passive_stiffness, &mu->passive_toe_stretch, &mu->max_active_stress,
                         &mu->optimal_stretch, &mu->active_width, &omu, &oalpha,
                         &def->mooney_rivlin.c10, &def->mooney_rivlin.c01, &h->mu, &h->k1, &h->k2,
-                        &h->kappa, &h->fiber_angle_degrees, &h->axis[0], &h->axis[1], &h->axis[2]))
+                        &h->kappa, &h->fiber_angle_degrees, &h->axis[0], &h->axis[1], &h->axis[2],
+                        &h->fiber_stretch_limit))
     return 0;
   const int nm = ogden_terms(omu, "mu", def->ogden.mu), na = ogden_terms(oalpha, "alpha", def->ogden.alpha);
   if (nm < 0 || na < 0) return 0;
@@ -210,7 +212,7 @@ static PyObject *defaults(PyObject *self, PyObject *unused) {
     PyTuple_SET_ITEM(oalpha, i, PyFloat_FromDouble(m.ogden.alpha[i]));
   }
   return Py_BuildValue(
-      "{s:(sddds(ddd)(ddddd)(NN)(dd)(ddddd(ddd))),s:{s:(ddd),s:d,s:d,s:d,s:i,s:d},s:{s:d,s:d,s:d,s:d,"
+      "{s:(sddds(ddd)(ddddd)(NN)(dd)(ddddd(ddd)d)),s:{s:(ddd),s:d,s:d,s:d,s:i,s:d},s:{s:d,s:d,s:d,s:d,"
       "s:K,s:(idd)},s:{s:i}}",
       "material", piola_material_model_name(m.model), m.youngs_modulus, m.poisson_ratio,
       m.inversion_threshold, piola_inversion_mode_name(m.inversion_mode),
@@ -218,7 +220,7 @@ static PyObject *defaults(PyObject *self, PyObject *unused) {
       m.muscle.passive_stiffness, m.muscle.passive_toe_stretch, m.muscle.max_active_stress,
       m.muscle.optimal_stretch, m.muscle.active_width, omu, oalpha, m.mooney_rivlin.c10,
       m.mooney_rivlin.c01, m.hgo.mu, m.hgo.k1, m.hgo.k2, m.hgo.kappa, m.hgo.fiber_angle_degrees,
-      m.hgo.axis[0], m.hgo.axis[1], m.hgo.axis[2], "world", "gravity", w.gravity[0].value,
+      m.hgo.axis[0], m.hgo.axis[1], m.hgo.axis[2], m.hgo.fiber_stretch_limit, "world", "gravity", w.gravity[0].value,
       w.gravity[1].value, w.gravity[2].value, "max_dt", w.max_dt, "cfl", w.cfl, "cg_tolerance",
       w.cg_tolerance, "cg_max_iterations", (int)w.cg_max_iterations, "collision_interval",
       w.collision_interval, "solid", "density", s.density, "stiffness_scale",

@@ -166,6 +166,14 @@ def test_rubber_and_artery_parameters_reach_the_model():
         piola.Material("hgo", hgo={"kappa": 0.5})
     with pytest.raises(ValueError, match="unknown key 'beta'"):
         piola.Material("hgo", hgo={"beta": 30})
+    with pytest.raises(ValueError, match="hgo.fiber_stretch_limit"):
+        piola.Material("hgo", hgo={"fiber_stretch_limit": 1.0})
+    # past the fibre stretch limit the fibres are a spring of constant stiffness: a lower
+    # limit gives less stress at a stretch beyond both
+    along = np.diag([2.5, 1.0, 1.0])[None]
+    fibre = np.array([[1.0, 0, 0]])
+    assert (piola.Material("hgo", hgo={"fiber_stretch_limit": 1.2}).stress(along, fibers=fibre)[0, 0, 0]
+            < piola.Material("hgo").stress(along, fibers=fibre)[0, 0, 0])
     with pytest.raises(ValueError, match="ogden.alpha"):
         piola.Material("ogden", ogden={"mu": [1e5, 2e3], "alpha": [2]})
     with pytest.raises(ValueError, match="c10 \\+ c01"):

@@ -229,9 +229,9 @@ static void apply_relative_change(piola_collision_surface *s, const piola__conta
   vec3 impulse = vec3_scale(change, 1.0 / denom); /* kg m/s per unit weight */
   if (s->node_count > 0) {
     int32_t node[16];
-    double weight[16];
-    const int n = piola__pair_nodes(s, c->v, c->w, node, weight);
-    piola__embedding_apply(s, n, node, weight, impulse);
+    double weight[16], inverse_mass[16];
+    const int n = piola__pair_nodes(s, c->v, c->w, node, weight, inverse_mass);
+    piola__embedding_apply(s, n, node, weight, inverse_mass, impulse);
     return;
   }
   for (int k = 0; k < 4; ++k) {
@@ -247,9 +247,9 @@ static double weight_denominator(const piola_collision_surface *s, const piola__
   double denom = 0.0;
   if (s->node_count > 0) {
     int32_t node[16];
-    double weight[16];
-    const int n = piola__pair_nodes(s, c->v, c->w, node, weight);
-    for (int j = 0; j < n; ++j) denom += weight[j] * weight[j] * s->node_inverse_mass[node[j]];
+    double weight[16], inverse_mass[16];
+    const int n = piola__pair_nodes(s, c->v, c->w, node, weight, inverse_mass);
+    for (int j = 0; j < n; ++j) denom += weight[j] * weight[j] * inverse_mass[j];
     return denom;
   }
   for (int k = 0; k < 4; ++k) denom += c->w[k] * c->w[k] * s->inverse_mass[c->v[k]];
@@ -355,7 +355,7 @@ piola_status piola_collision_surface_process(piola_collision_surface *s, const d
   }
   if (embedded) {
     /* the stages below work on the vertices; impulses reach the nodes (embedding.c) */
-    piola__embedding_gather(s, x0, v);
+    piola__embedding_gather(s, x0, v, mass);
     x0 = s->vertex_x0, v = s->vertex_v;
   }
   piola_collision_stats st = {0};

@@ -141,6 +141,8 @@ struct piola_collision_surface {
   double *node_v;            /* the caller's velocities, during a call */
   const double *node_x0;     /* the caller's positions, during a call */
   double *node_inverse_mass;
+  double *vertex_inverse_node_mass; /* per vertex, 1 / sum_j e_j m_j over its unpinned nodes
+                                       (0: all pinned), during a call */
   int32_t *node_zone_parent, *node_zone_order;
   uint8_t *node_in_zone, *node_dirty;
 };
@@ -153,15 +155,17 @@ int piola__embedding_create(piola_collision_surface *s, const piola_collision_su
 void piola__embedding_free(piola_collision_surface *s);
 /* The vertices' x0 and v (and vertex inverse masses: sum of weight^2 / node mass, 0 when
  * every node is pinned) from the nodes'. */
-void piola__embedding_gather(piola_collision_surface *s, const double *node_x0, double *node_v);
-/* The pair's nodes and their weights in its relative position (nodes of several of its
- * vertices merged); returns how many (<= 16). */
+void piola__embedding_gather(piola_collision_surface *s, const double *node_x0, double *node_v,
+                             const double *node_mass);
+/* The pair's nodes, their weights in its relative position (nodes of several of its
+ * vertices merged) and their effective inverse masses in it (1 / the mass of the vertex
+ * they belong to, embedding.c); returns how many (<= 16). */
 int piola__pair_nodes(const piola_collision_surface *s, const int32_t v[4], const double w[4],
-                      int32_t node[16], double weight[16]);
-/* Adds the velocity change weight * inverse mass * impulse to each node of the pair and
+                      int32_t node[16], double weight[16], double inverse_mass[16]);
+/* Adds the velocity change weight * inverse_mass * impulse to each node of the pair and
  * brings the velocities of their vertices (vertex_v) up to date, marking them dirty. */
 void piola__embedding_apply(piola_collision_surface *s, int n, const int32_t node[16],
-                            const double weight[16], vec3 impulse);
+                            const double weight[16], const double inverse_mass[16], vec3 impulse);
 /* 1 when a vertex of one side of the pair (the point, or the first edge) shares a node with
  * one of the other side (the pair takes no part, as a vertex and a triangle that contains it
  * do not). */

@@ -6,6 +6,7 @@
 #include <string.h>
 
 #include "force/element_stiffness.h"
+#include "material/material_kernels.h"
 #include "material/muscle_kernels.h"
 #include "piola/diagonalize.h"
 
@@ -68,10 +69,46 @@ void piola__project_symmetric3(double a[3][3]) {
       a[i][j] = q[i][0] * lam[0] * q[j][0] + q[i][1] * lam[1] * q[j][1] + q[i][2] * lam[2] * q[j][2];
 }
 
+int piola__stress_evaluates_own_parts(piola_material_model model) {
+  switch (model) {
+    case PIOLA_MODEL_ROTATED_LINEAR:
+    case PIOLA_MODEL_COROTATED:
+    case PIOLA_MODEL_STVK:
+    case PIOLA_MODEL_NEOHOOKEAN:
+    case PIOLA_MODEL_SPLINE:
+    case PIOLA_MODEL_STABLE_NEOHOOKEAN:
+    case PIOLA_MODEL_OGDEN:
+      return 1;
+    default:
+      return 0;
+  }
+}
+
+void piola__material_stress_and_derivative(const piola_material *material, const double fhat[3],
+                                           double phat[3], double dphat[3][3]) {
+  const double c = material->threshold;
+  if (fhat[0] >= c && fhat[1] >= c && fhat[2] >= c && piola__stress_evaluates_own_parts(material->model)) {
+    /* no entry clamped: every extension term is an exact zero, the parts are the answer */
+    material_parts parts;
+    material_model_parts(material->model, material, KERNEL_EXACT_DIVIDE, fhat[0], fhat[1],
+                         fhat[2], &parts);
+    memcpy(phat, parts.p, sizeof parts.p);
+    memcpy(dphat, parts.k, sizeof parts.k);
+    return;
+  }
+  piola_material_stress(material, fhat, phat);
+  piola_material_stress_derivative(material, fhat, dphat);
+}
+
 void piola__diagonal_stiffness_eval(const piola_material *material, const double fhat[3],
                                     const double phat[3], int project,
                                     piola__diagonal_stiffness *out) {
   piola_material_stress_derivative(material, fhat, out->block);
+  piola__diagonal_stiffness_from(fhat, phat, project, out);
+}
+
+void piola__diagonal_stiffness_from(const double fhat[3], const double phat[3], int project,
+                                    piola__diagonal_stiffness *out) {
   double(*d)[3] = out->block;
   for (int k = 0; k < 3; ++k) {
     const int p = PAIR_P[k], q = PAIR_Q[k];

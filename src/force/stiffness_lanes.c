@@ -1,7 +1,11 @@
 /* The projected stiffness blocks of PIOLA_TET_BLOCK tets at once (stiffness_lanes.h).
  *
- * The material's part, dPhat/dFhat made semi-definite, goes through the public material
- * functions tet by tet (piola__tet_diagonal_stiffness: any model, no copy of them here); the six corner-pair blocks
+ * The material's part, dPhat/dFhat made semi-definite, goes tet by tet through
+ * piola__tet_diagonal_stiffness (any model, no copy of the models here), except that for a
+ * body of one material whose block has no entry of Fhat below the threshold, the model's
+ * Phat and dPhat/dFhat (material_kernels.h's parts, what piola__material_stress_and_derivative
+ * takes there) run in a lane loop with the model a constant, which vectorizes; the
+ * projection then stays per tet. The six corner-pair blocks
  * -V0 U M_ab U^T, most of the arithmetic, run in one loop over the lanes that vectorizes.
  * The loop repeats piola__tet_stiffness_blocks's operations in its order and this file
  * fuses no multiply-adds, so each lane gives that function's bits. */
@@ -11,18 +15,64 @@
 #include "force/stiffness_lanes.h"
 #include "force/stiffness_matrix.h"
 #include "force/svd_kernel.h"
+#include "material/material_kernels.h"
 
 #define B PIOLA_TET_BLOCK
 
 static const int PAIR_A[6] = {0, 0, 0, 1, 1, 2}, PAIR_B[6] = {1, 2, 3, 2, 3, 3};
 
+/* The parts of MODEL (a constant) at the lanes' Fhat: phat[i][l], dphat[3 i + j][l]. */
+#define PARTS_LANES(MODEL)                                                                     \
+  do {                                                                                         \
+    _Pragma("omp simd") for (int l = 0; l < B; ++l) {                                          \
+      material_parts pa;                                                                       \
+      material_model_parts(MODEL, m, KERNEL_EXACT_DIVIDE, fhat[3 * l], fhat[3 * l + 1],        \
+                           fhat[3 * l + 2], &pa);                                              \
+      PIOLA_UNROLL for (int i = 0; i < 3; ++i) phat[i][l] = pa.p[i];                           \
+      PIOLA_UNROLL for (int e = 0; e < 9; ++e) dphat[e][l] = pa.k[e / 3][e % 3];               \
+    }                                                                                          \
+  } while (0)
+
+/* Phat and dPhat/dFhat of the block's tets from one lane loop, the values (and bits) of
+ * piola__material_stress_and_derivative; 0 (nothing written) where that takes the public
+ * path for some lane: a body of several materials, a model whose stress evaluates another
+ * model's parts, an entry below the threshold. */
+static int material_parts_lanes(const piola_elastic_body *body, int32_t base, double phat[3][B],
+                                double dphat[9][B]) {
+  if (body->uniform_material < 0) return 0;
+  const piola_material *m = &body->materials[body->uniform_material];
+  if (!piola__stress_evaluates_own_parts(m->model)) return 0;
+  const double *fhat = body->fhat + 3 * (size_t)base, c = m->threshold;
+  int unclamped = 1;
+  for (int e = 0; e < 3 * B; ++e) unclamped &= fhat[e] >= c;
+  if (!unclamped) return 0;
+  switch (m->model) {
+    case PIOLA_MODEL_ROTATED_LINEAR: PARTS_LANES(PIOLA_MODEL_ROTATED_LINEAR); return 1;
+    case PIOLA_MODEL_COROTATED: PARTS_LANES(PIOLA_MODEL_COROTATED); return 1;
+    case PIOLA_MODEL_STVK: PARTS_LANES(PIOLA_MODEL_STVK); return 1;
+    case PIOLA_MODEL_NEOHOOKEAN: PARTS_LANES(PIOLA_MODEL_NEOHOOKEAN); return 1;
+    case PIOLA_MODEL_SPLINE: PARTS_LANES(PIOLA_MODEL_SPLINE); return 1;
+    case PIOLA_MODEL_STABLE_NEOHOOKEAN: PARTS_LANES(PIOLA_MODEL_STABLE_NEOHOOKEAN); return 1;
+    case PIOLA_MODEL_OGDEN: PARTS_LANES(PIOLA_MODEL_OGDEN); return 1;
+    default: return 0;
+  }
+}
+
 PIOLA_WIDE_VECTORS void PIOLA_ISA_NAME(piola__stiffness_block_lanes)(const piola_elastic_body *body, int32_t block,
                                                   double out[54][B]) {
   const int32_t base = block * B;
-  double kd[9][B], ka[3][B], kb[3][B];
+  double kd[9][B], ka[3][B], kb[3][B], phat[3][B], dphat[9][B];
+  const int parts = material_parts_lanes(body, base, phat, dphat);
   for (int l = 0; l < B; ++l) {
     piola__diagonal_stiffness k;
-    piola__tet_diagonal_stiffness(body, base + l, &k);
+    if (parts) {
+      const double *fhat = body->fhat + 3 * (size_t)(base + l);
+      const double p[3] = {phat[0][l], phat[1][l], phat[2][l]};
+      for (int e = 0; e < 9; ++e) k.block[e / 3][e % 3] = dphat[e][l];
+      piola__diagonal_stiffness_from(fhat, p, 1, &k);
+    } else {
+      piola__tet_diagonal_stiffness(body, base + l, &k);
+    }
     for (int e = 0; e < 9; ++e) kd[e][l] = k.block[e / 3][e % 3];
     for (int p = 0; p < 3; ++p) ka[p][l] = k.pair_a[p], kb[p][l] = k.pair_b[p];
   }

@@ -44,8 +44,8 @@ void piola__tet_diagonal_stiffness(const piola_elastic_body *body, int32_t t,
   const piola_material *material = &body->materials[body->tet_material[t]];
   const double *fhat = body->fhat + 3 * (size_t)t;
   double phat[3];
-  piola_material_stress(material, fhat, phat);
-  piola__diagonal_stiffness_eval(material, fhat, phat, 1, k);
+  piola__material_stress_and_derivative(material, fhat, phat, k->block);
+  piola__diagonal_stiffness_from(fhat, phat, 1, k);
 }
 
 void piola__tet_stiffness_blocks(const piola_elastic_body *body, int32_t t, double out[54]) {
@@ -132,19 +132,27 @@ void piola__tet_stiffness_blocks(const piola_elastic_body *body, int32_t t, doub
 
 /* Adds (or, for a slot's first writer, stores) weight times tet t's six blocks out[9 p + e]
  * (entry e of pair p, at stride `stride` in out) into their slots, transposed where the edge
- * is stored the other way round. */
-static void scatter_tet(piola__stiffness_matrix *m, const piola__damping_matrix *d, int32_t t,
-                        const double *out, size_t stride, double weight) {
-  static const int TRANSPOSE[2][9] = {{0, 1, 2, 3, 4, 5, 6, 7, 8}, {0, 3, 6, 1, 4, 7, 2, 5, 8}};
+ * is stored the other way round. Inlined, with the four cases written out and constant
+ * indices, so each call site gets straight-line code for its stride (the same operations
+ * on every entry as a table-driven loop: the same bits). */
+static inline __attribute__((always_inline)) void scatter_tet(piola__stiffness_matrix *m,
+                                                              const piola__damping_matrix *d,
+                                                              int32_t t, const double *out,
+                                                              size_t stride, double weight) {
   const int32_t *slots = d->tet_slot + 6 * (size_t)t;
   const unsigned flags = d->tet_flags[t];
   for (int p = 0; p < 6; ++p) {
     double *dst = m->blocks + 9 * (size_t)slots[p];
-    const int *order = TRANSPOSE[(flags >> p) & 1];
-    if ((flags >> (6 + p)) & 1)
-      for (int e = 0; e < 9; ++e) dst[e] = weight * out[stride * (size_t)(9 * p + order[e])];
+    const double *src = out + stride * (size_t)(9 * p);
+    const int transposed = (flags >> p) & 1, first = (flags >> (6 + p)) & 1;
+    if (first && !transposed)
+      for (int e = 0; e < 9; ++e) dst[e] = weight * src[stride * (size_t)e];
+    else if (first)
+      for (int e = 0; e < 9; ++e) dst[e] = weight * src[stride * (size_t)(3 * (e % 3) + e / 3)];
+    else if (!transposed)
+      for (int e = 0; e < 9; ++e) dst[e] += weight * src[stride * (size_t)e];
     else
-      for (int e = 0; e < 9; ++e) dst[e] += weight * out[stride * (size_t)(9 * p + order[e])];
+      for (int e = 0; e < 9; ++e) dst[e] += weight * src[stride * (size_t)(3 * (e % 3) + e / 3)];
   }
 }
 

@@ -18,16 +18,18 @@ piola_hgo_def piola__default_hgo_def(void) {
   h.kappa = 0.0;
   h.fiber_angle_degrees = 29.0;
   h.axis[2] = 1.0;
+  h.fiber_stretch_limit = 1.7; /* past arterial layers' rupture (docs/materials.md) */
   return h;
 }
 
 piola_status piola__hgo_init(const piola_material_def *def, piola_material *out) {
   const piola_hgo_def *h = &def->hgo;
-  const double values[8] = {h->mu, h->k1, h->k2, h->kappa, h->fiber_angle_degrees,
-                            h->axis[0], h->axis[1], h->axis[2]};
-  static const char *const keys[8] = {"hgo.mu", "hgo.k1", "hgo.k2", "hgo.kappa",
-                                      "hgo.fiber_angle_degrees", "hgo.axis", "hgo.axis", "hgo.axis"};
-  for (int i = 0; i < 8; ++i)
+  const double values[9] = {h->mu, h->k1, h->k2, h->kappa, h->fiber_angle_degrees,
+                            h->axis[0], h->axis[1], h->axis[2], h->fiber_stretch_limit};
+  static const char *const keys[9] = {"hgo.mu", "hgo.k1", "hgo.k2", "hgo.kappa",
+                                      "hgo.fiber_angle_degrees", "hgo.axis", "hgo.axis", "hgo.axis",
+                                      "hgo.fiber_stretch_limit"};
+  for (int i = 0; i < 9; ++i)
     if (!isfinite(values[i]))
       return PIOLA_FAIL(PIOLA_ERROR_NOT_FINITE, "%s must be finite, got %g", keys[i], values[i]);
   if (!(h->mu > 0.0))
@@ -39,6 +41,9 @@ piola_status piola__hgo_init(const piola_material_def *def, piola_material *out)
   if (!(h->kappa >= 0.0 && h->kappa <= 1.0 / 3.0))
     return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "hgo.kappa must be in [0, 1/3], got %g",
                       h->kappa);
+  if (!(h->fiber_stretch_limit > 1.0))
+    return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "hgo.fiber_stretch_limit must be > 1, got %g",
+                      h->fiber_stretch_limit);
   if (!(h->fiber_angle_degrees >= 0.0 && h->fiber_angle_degrees <= 90.0))
     return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT,
                       "hgo.fiber_angle_degrees must be in [0, 90], got %g", h->fiber_angle_degrees);
@@ -47,6 +52,8 @@ piola_status piola__hgo_init(const piola_material_def *def, piola_material *out)
     return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "hgo.axis must be a nonzero vector");
   out->hgo = *h;
   for (int i = 0; i < 3; ++i) out->hgo.axis[i] = h->axis[i] / n;
+  /* the limit in force: lowered to where k2 E^2 = HGO_EXP_CAP (hgo_kernels.h) */
+  out->hgo.fiber_stretch_limit = fmin(h->fiber_stretch_limit, sqrt(1.0 + sqrt(HGO_EXP_CAP / h->k2)));
   /* the matrix: neo-Hookean with shear modulus hgo.mu, lambda from poisson_ratio */
   const double nu = def->poisson_ratio;
   out->mu = h->mu;
@@ -55,7 +62,7 @@ piola_status piola__hgo_init(const piola_material_def *def, piola_material *out)
   out->model_constants[HGO_COS_ANGLE] = cos(angle);
   out->model_constants[HGO_SIN_ANGLE] = h->fiber_angle_degrees == 0.0 ? 0.0 : sin(angle);
   const double q = 1.0 - 2.0 * h->kappa;
-  out->fiber_modulus = 8.0 * h->k1 * q * q; /* hgo_fiber_modulus_bound at rest */
+  out->fiber_modulus = 8.0 * h->k1 * q * q; /* both families' largest plane wave at rest */
   return PIOLA_OK;
 }
 

@@ -17,11 +17,18 @@
  *
  * The Macaulay bracket <E> = max(E, 0) is HGO 2000's "fibres bear no compression" (for kappa = 0
  * it is their I4 > 1 switch); psi' = k1 E exp(k2 E^2) is 0 at E = 0, so the stress is C1.
- * The exponential overflows at k2 E^2 = 709 (fibre stretch ~29 for k2 = 0.84); beyond
- * k2 E^2 = HGO_EXP_CAP the energy is continued by its second-order Taylor expansion in E,
- * which keeps energy, stress and stiffness finite and C2 for every F. At the cap the fibre
- * stress is k1 E e^12 ~ 1.6e5 k1 E: far past collagen's rupture, so no physical state sees
- * the continuation. */
+ * Past the fibre stretch limit (hgo.fiber_stretch_limit, materials.md) the exponential is not
+ * followed further: with the generalized fibre stretch s = sqrt(1 + E) (for kappa = 0 the
+ * fibre's stretch |F a|; in general the norm |F H^(1/2)|, H = kappa I + (1 - 3 kappa) a a^T,
+ * since 1 + E = kappa I1 + (1 - 3 kappa) I4), the energy is continued by its second-order
+ * Taylor expansion in s at the limit s_l: psi = psi_l + a (s - s_l) + b/2 (s - s_l)^2, a linear
+ * spring in s. So energy, stress (its gradient) and dP/dF are continuous (C2 in s) and the
+ * stiffness stays bounded however far a scramble stretches the tet: dF : C : dF <=
+ * (1 - 2 kappa) b per family for a unit rank-one dF (hgo_fiber_modulus_bound). In E the
+ * continuation reads psi'(E) = psi_s / (2 s), psi''(E) = (b s_l - a) / (4 s^3) > 0, so the
+ * formulas of the stress and dP/dF below are unchanged. The limit is lowered, if needed, to
+ * where k2 E^2 = HGO_EXP_CAP (by piola__hgo_init, in the material's hgo) (exp would overflow at 709; at 12 the fibre stress is already
+ * ~1.6e5 k1 E, far past collagen's rupture). */
 #ifndef PIOLA_MATERIAL_HGO_KERNELS_H
 #define PIOLA_MATERIAL_HGO_KERNELS_H
 
@@ -32,19 +39,38 @@
 
 #define HGO_EXP_CAP 12.0
 
+/* The fibre strain E where the continuation starts, from the limit in force (piola__hgo_init
+ * lowers the scene's to where k2 E^2 = HGO_EXP_CAP). */
+MATERIAL_KERNEL double hgo_limit_strain(const piola_hgo_def *h) {
+  const double l = h->fiber_stretch_limit;
+  return l * l - 1.0;
+}
+
 /* psi_f(E) (J/m^3), its slope psi' (Pa) and curvature psi'' (Pa) for one family. */
 MATERIAL_KERNEL void hgo_fiber_curve(const piola_hgo_def *h, double e, double *psi, double *slope,
                                      double *curvature) {
   const double k1 = h->k1, k2 = h->k2;
-  const double ep = kernel_max(e, 0.0);
-  const double cap = sqrt(HGO_EXP_CAP / k2);
-  const double x = kernel_min(ep, cap), y = ep - x;
+  const double ep = kernel_max(e, 0.0), el = hgo_limit_strain(h);
+  const double x = kernel_min(ep, el);
   const double ex = exp(k2 * x * x);
   const double p0 = 0.5 * k1 / k2 * (ex - 1.0), s0 = k1 * x * ex,
                c0 = e > 0.0 ? k1 * (1.0 + 2.0 * k2 * x * x) * ex : 0.0;
-  *psi = p0 + y * (s0 + 0.5 * c0 * y);
-  *slope = s0 + c0 * y;
-  *curvature = c0;
+  /* past the limit: the quadratic in s = sqrt(1 + E) with a = dpsi/ds, b = d2psi/ds2 at s_l */
+  const double sl = h->fiber_stretch_limit, s = sqrt(1.0 + ep), y = s - sl;
+  const double a = 2.0 * sl * s0, b = 2.0 * s0 + 4.0 * sl * sl * c0;
+  const int past = ep > el;
+  *psi = past ? p0 + y * (a + 0.5 * b * y) : p0;
+  *slope = past ? (a + b * y) / (2.0 * s) : s0;
+  *curvature = past ? (b * sl - a) / (4.0 * s * s * s) : c0;
+}
+
+/* d2psi/ds2 of one family at E (the generalized fibre stretch s = sqrt(1 + E)): 2 psi' +
+ * 4 s^2 psi''; nondecreasing in E, constant past the limit. */
+MATERIAL_KERNEL double hgo_stretch_stiffness(const piola_hgo_def *h, double e) {
+  const double el = hgo_limit_strain(h), x = kernel_min(kernel_max(e, 0.0), el);
+  double psi, slope, curvature;
+  hgo_fiber_curve(h, kernel_max(x, 1e-300), &psi, &slope, &curvature);
+  return 2.0 * slope + 4.0 * (1.0 + x) * curvature;
 }
 
 /* E of one unit family a at a 3x3 f (row-major), with w = f a. */
@@ -99,19 +125,17 @@ MATERIAL_KERNEL int hgo_families_from_fiber(const piola_material *material, cons
 }
 
 /* A bound on the fibres' tangent stiffness for a plane wave (Pa) at a state with diagonal
- * entries f: for a unit rank-one dF, dF : C_f : dF = sum_a 4 psi''(E_a) (G_a : dF)^2
- * + 2 psi'(E_a) (kappa |dF|^2 + (1 - 3 kappa) |dF a|^2) with |G_a : dF| <= |G_a|_2 <=
- * (1 - 2 kappa) max|f_i|, and psi', psi'' grow with E, which is at most
- * kappa (I1 - 3) + (1 - 3 kappa) (max f_i^2 - 1) whatever the direction a. 8 k1 (1 - 2 kappa)^2
- * at rest. */
+ * entries f, whatever the families' directions: per family, for a unit rank-one dF,
+ * dF : C_a : dF = 4 psi''(E_a) (G_a : dF)^2 + 2 psi'(E_a) (kappa |dF|^2 + (1 - 3 kappa) |dF a|^2)
+ * with G_a = F H_a, |G_a|_2 <= |F H_a^(1/2)|_F |H_a^(1/2)|_2 = s_a sqrt(1 - 2 kappa), so it is at
+ * most (1 - 2 kappa) (4 s_a^2 psi'' + 2 psi') = (1 - 2 kappa) psi_ss(s_a), which grows with E_a,
+ * and E_a <= kappa (I1 - 3) + (1 - 3 kappa) (max f_i^2 - 1). 8 k1 (1 - 2 kappa) at rest;
+ * bounded past the stretch limit. */
 MATERIAL_KERNEL double hgo_fiber_modulus_bound(const piola_hgo_def *h, double f0, double f1,
                                                double f2) {
   const double big = kernel_max(f0 * f0, kernel_max(f1 * f1, f2 * f2));
   const double e = h->kappa * (f0 * f0 + f1 * f1 + f2 * f2 - 3.0) + (1.0 - 3.0 * h->kappa) * (big - 1.0);
-  double psi, slope, curvature;
-  hgo_fiber_curve(h, kernel_max(e, 1e-300), &psi, &slope, &curvature);
-  const double q = 1.0 - 2.0 * h->kappa;
-  return 2.0 * (4.0 * curvature * q * q * kernel_max(big, 1.0) + 2.0 * slope);
+  return 2.0 * (1.0 - 2.0 * h->kappa) * hgo_stretch_stiffness(h, e);
 }
 
 #endif

@@ -42,8 +42,9 @@ piola_material_def piola_default_material_def(void) {
  * recovers in 24 s), then the smaller threshold, then LINEAR over CLAMP; below the stretches
  * of the model's own published-curve test. Mooney-Rivlin and Ogden take the best CLAMP
  * threshold below the lateral stretch of rubber in their uniaxial tests (0.447 at stretch 5,
- * 0.377 at Treloar's 7.05; tests/test_material_rubber.c): 158 of 160 each, where 0.5 would
- * recover all. HGO (an inflated artery's wall reaches radial stretches of 0.33-0.45,
+ * 0.377 at Treloar's 7.05; tests/test_material_rubber.c), 158 of 160 each, and with the
+ * threshold left unset it rises in elements compressed in volume (to 0.55 and 0.5 below
+ * J = 0.94, piola_material_init): 160 of 160 each, rubber's own states (J ~ 1) untouched. HGO (an inflated artery's wall reaches radial stretches of 0.33-0.45,
  * tests/test_material_hgo.c) stays at LINEAR 0.3, not measured on the scrambles. Every default
  * recovers from point, line and plane collapse (tests/test_default_inversion.c). */
 static const struct {
@@ -179,6 +180,16 @@ piola_status piola_material_init(const piola_material_def *def, piola_material *
   m.lambda = e * nu / ((1.0 + nu) * (1.0 - 2.0 * nu));
   m.threshold = c;
   m.inversion_mode = mode;
+  /* The rubber models' default threshold rises in elements compressed in volume: rubber's own
+   * states (uniaxial tension, J ~ 1) keep c, the tangles of scrambled bodies (J well below 1)
+   * get the larger threshold that untangles them (docs/materials.md, "Defaults that recover").
+   * Only with the model's own threshold in CLAMP (the measured setting). */
+  m.threshold_compressed = c;
+  m.threshold_volume[0] = 0.94, m.threshold_volume[1] = 0.96;
+  if (def->inversion_threshold == 0.0 && mode == PIOLA_INVERSION_CLAMP)
+    m.threshold_compressed = def->model == PIOLA_MODEL_MOONEY_RIVLIN ? 0.55
+                             : def->model == PIOLA_MODEL_OGDEN       ? 0.5
+                                                                     : c;
 
   if (def->model == PIOLA_MODEL_SPLINE) {
     const double a = def->spline.compression_stretch, b = def->spline.elongation_stretch;
@@ -269,6 +280,7 @@ void piola_material_stress(const piola_material *material, const double fhat[3],
 
 /* Clamped point, offsets and the model's parts there. */
 typedef struct extension_point {
+  double c; /* the threshold in force (material_threshold_at) */
   double fc[3];
   double d[3]; /* f - fc <= 0 */
   int clamped[3];
@@ -277,8 +289,9 @@ typedef struct extension_point {
 
 static extension_point extension_point_at(const piola_material *m, const double f[3]) {
   extension_point e;
+  e.c = MATERIAL_IS_OGDEN(m->model) ? material_threshold_at(m, f[0], f[1], f[2]) : m->threshold;
   for (int i = 0; i < 3; ++i) {
-    e.fc[i] = kernel_max(f[i], m->threshold);
+    e.fc[i] = kernel_max(f[i], e.c);
     e.d[i] = f[i] - e.fc[i];
     e.clamped[i] = e.d[i] < 0.0;
   }
@@ -418,19 +431,19 @@ void piola_material_stress_derivative(const piola_material *material, const doub
   const int any_clamped = e.clamped[0] || e.clamped[1] || e.clamped[2];
   double t[3][3][3] = {{{0}}};
   if (any_clamped) model_third_derivative(m, e.fc, t);
-  const double c = m->threshold, floor_slope = m->mu;
+  const double c = e.c, floor_slope = m->mu;
   const double w = 0.25 * c, cap = fmax(2.0 * m->mu + m->lambda, floor_slope);
   double q[3], dq[3]; /* saturated offsets and their derivatives, 1 / (1 - d / w)^2 */
   for (int k = 0; k < 3; ++k) {
-    q[k] = extension_saturation(m, KERNEL_EXACT_DIVIDE, e.d[k]);
+    q[k] = extension_saturation(KERNEL_EXACT_DIVIDE, c, e.d[k]);
     const double r = w / (w - e.d[k]);
     dq[k] = r * r;
   }
 
   for (int i = 0; i < 3; ++i) {
     const double kii = pa->k[i][i], p = pa->p[i];
-    const double s = extension_diagonal_slope(m, KERNEL_EXACT_DIVIDE, p, kii);
-    const double s_far = extension_far_slope(m, KERNEL_EXACT_DIVIDE, p, kii);
+    const double s = extension_diagonal_slope(m, KERNEL_EXACT_DIVIDE, c, p, kii);
+    const double s_far = extension_far_slope(m, KERNEL_EXACT_DIVIDE, c, p, kii);
     const double raised = floor_slope + fmax(p, 0.0) / c;
     for (int j = 0; j < 3; ++j) {
       double v;
@@ -465,6 +478,15 @@ void piola_material_stress_derivative(const piola_material *material, const doub
       }
       dphat[i][j] = v;
     }
+  }
+  /* The threshold's rise with J (CLAMP, material_threshold_at): dPhat_i/dc dc/dJ dJ/df_j. */
+  const double slope = MATERIAL_IS_OGDEN(m->model) ? material_threshold_volume_slope(m, fhat[0], fhat[1], fhat[2]) : 0.0;
+  if (slope != 0.0 && !linear && any_clamped) {
+    double g[3];
+    clamp_threshold_sensitivity(m, c, pa, e.d[0], e.d[1], e.d[2], g);
+    const double dj[3] = {fhat[1] * fhat[2], fhat[0] * fhat[2], fhat[0] * fhat[1]};
+    for (int i = 0; i < 3; ++i)
+      for (int j = 0; j < 3; ++j) dphat[i][j] += g[i] * slope * dj[j];
   }
 }
 
@@ -530,7 +552,8 @@ piola_status piola_material_projected_hessian_eigensystem(const piola_material *
     return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT,
                       "projected_hessian_eigensystem: the %s model's fibres are not isotropic",
                       piola_material_model_name(m->model));
-  const double c = m->threshold;
+  const double c = MATERIAL_IS_OGDEN(m->model) ? material_threshold_at(m, fhat[0], fhat[1], fhat[2])
+                                               : m->threshold;
   const int clamped = !(fhat[0] >= c && fhat[1] >= c && fhat[2] >= c);
   if (clamped && m->inversion_mode != PIOLA_INVERSION_ENERGY)
     return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT,

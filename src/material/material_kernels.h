@@ -336,14 +336,41 @@ MATERIAL_KERNEL void material_model_parts(piola_material_model model, const piol
 
 /* --------------------------------------------------------------- the extension */
 
+/* The threshold in force at Fhat f (CLAMP, docs/materials.md "Defaults that recover"):
+ * threshold while J = f0 f1 f2 >= threshold_volume[1], threshold_compressed once
+ * J <= threshold_volume[0], between them the smoothstep 3u^2 - 2u^3 of
+ * u = (J_high - J) / (J_high - J_low) (C1 in J, so the stress stays continuous and its
+ * derivative finite). Exactly threshold when the rise is off (threshold_compressed ==
+ * threshold). */
+MATERIAL_KERNEL double material_threshold_ramp(const piola_material *m, double j) {
+  const double lo = m->threshold_volume[0], hi = m->threshold_volume[1];
+  return kernel_min(kernel_max((hi - j) / (hi - lo), 0.0), 1.0);
+}
+MATERIAL_KERNEL double material_threshold_at(const piola_material *m, double f0, double f1,
+                                             double f2) {
+  const double u = material_threshold_ramp(m, f0 * f1 * f2);
+  return m->threshold + (m->threshold_compressed - m->threshold) * (u * u * (3.0 - 2.0 * u));
+}
+/* dc/dJ of material_threshold_at (zero outside the rise). */
+MATERIAL_KERNEL double material_threshold_volume_slope(const piola_material *m, double f0,
+                                                       double f1, double f2) {
+  const double u = material_threshold_ramp(m, f0 * f1 * f2);
+  const double lo = m->threshold_volume[0], hi = m->threshold_volume[1];
+  return -(m->threshold_compressed - m->threshold) * 6.0 * u * (1.0 - u) / (hi - lo);
+}
+/* The threshold a kernel of MODEL uses at f: only the Ogden models have the rise (a
+ * compile-time choice in the per-model kernels). */
+#define MATERIAL_THRESHOLD(model, m, f0, f1, f2) \
+  (MATERIAL_IS_OGDEN(model) ? material_threshold_at((m), (f0), (f1), (f2)) : (m)->threshold)
+
 /* Diagonal slope at the threshold for a clamped entry i whose value at the clamped point is p
  * and whose Taylor slope is kii. LINEAR: the Taylor slope, raised where needed so that the
  * stress is at most -mu c at f_i = 0 (restoring) and at least mu (never softening past the
  * threshold). CLAMP: zero (constant stress), unless the clamped stress is not already
  * compressive enough, in which case the ramp that reaches -mu c at zero. */
 MATERIAL_KERNEL double extension_diagonal_slope(const piola_material *m, kernel_division dv,
-                                                double p, double kii) {
-  const double c = m->threshold, floor_slope = m->mu;
+                                                double c, double p, double kii) {
+  const double floor_slope = m->mu;
   /* Both variants are computed and blended by a 0/1 factor: a select on a loop-invariant
    * integer between doubles is one of the statements GCC's vectorizer rejects. */
   const double linear = (double)(m->inversion_mode != PIOLA_INVERSION_CLAMP);
@@ -358,9 +385,9 @@ MATERIAL_KERNEL double extension_diagonal_slope(const piola_material *m, kernel_
  * models whose slope there is already moderate; neo-Hookean's is ~14x its rest stiffness, and
  * continued linearly that steep slope makes tangled meshes stable (docs/materials.md). CLAMP:
  * the ramp itself. */
-MATERIAL_KERNEL double extension_far_slope(const piola_material *m, kernel_division dv, double p,
-                                           double kii) {
-  const double c = m->threshold, floor_slope = m->mu;
+MATERIAL_KERNEL double extension_far_slope(const piola_material *m, kernel_division dv, double c,
+                                           double p, double kii) {
+  const double floor_slope = m->mu;
   const double linear = (double)(m->inversion_mode != PIOLA_INVERSION_CLAMP);
   const double cap = kernel_max(2.0 * m->mu + m->lambda, floor_slope);
   const double far = kernel_max(kernel_min(kii, cap), floor_slope + kernel_div(kernel_max(p, 0.0), c, dv));
@@ -371,8 +398,8 @@ MATERIAL_KERNEL double extension_far_slope(const piola_material *m, kernel_divis
 /* The saturating offset q(d) = d / (1 - d / w), w = c / 4, for d = f - fc <= 0: q(0) = 0,
  * q'(0) = 1 (so the extension keeps the Taylor value and slope at the threshold: C1), and
  * -w < q <= 0 (so what is multiplied by q stays bounded however deep the inversion). */
-MATERIAL_KERNEL double extension_saturation(const piola_material *m, kernel_division dv, double d) {
-  const double w = 0.25 * m->threshold;
+MATERIAL_KERNEL double extension_saturation(kernel_division dv, double c, double d) {
+  const double w = 0.25 * c;
   return kernel_div(d * w, w - d, dv);
 }
 
@@ -387,11 +414,11 @@ MATERIAL_KERNEL double extension_saturation(const piola_material *m, kernel_divi
  * stress turns compressive past f_k < c/2 and grows with the lateral stretch, a feedback
  * that expands a body without bound). Clamped rows never take a negative coupling to other
  * clamped entries (it could pull an inverted entry further). CLAMP: p + ramp di. */
-MATERIAL_KERNEL double extended_entry(const piola_material *m, kernel_division dv, double p, double kii, double kij,
+MATERIAL_KERNEL double extended_entry(const piola_material *m, kernel_division dv, double c, double p, double kii, double kij,
                                       double kik, double di, double dj, double dk, double qi,
                                       double qj, double qk) {
-  const double s = extension_diagonal_slope(m, dv, p, kii);
-  const double s_far = extension_far_slope(m, dv, p, kii);
+  const double s = extension_diagonal_slope(m, dv, c, p, kii);
+  const double s_far = extension_far_slope(m, dv, c, p, kii);
   const double clamped_row = kernel_max(kij, 0.0) * dj + kernel_max(kik, 0.0) * dk;
   const double free_row = kij * qj + kik * qk;
   const double coupling = di < 0.0 ? clamped_row : free_row;
@@ -400,20 +427,38 @@ MATERIAL_KERNEL double extended_entry(const piola_material *m, kernel_division d
 }
 
 /* Extended stress from the parts at the clamped point and the offsets d = f - fc. */
-MATERIAL_KERNEL void material_extend(const piola_material *m, kernel_division dv,
+MATERIAL_KERNEL void material_extend(const piola_material *m, kernel_division dv, double c,
                                      const material_parts *pa, double d0,
                                      double d1, double d2, double *p0, double *p1, double *p2) {
-  const double q0 = extension_saturation(m, dv, d0), q1 = extension_saturation(m, dv, d1),
-               q2 = extension_saturation(m, dv, d2);
-  *p0 = extended_entry(m, dv, pa->p[0], pa->k[0][0], pa->k[0][1], pa->k[0][2], d0, d1, d2, q0, q1, q2);
-  *p1 = extended_entry(m, dv, pa->p[1], pa->k[1][1], pa->k[1][0], pa->k[1][2], d1, d0, d2, q1, q0, q2);
-  *p2 = extended_entry(m, dv, pa->p[2], pa->k[2][2], pa->k[2][0], pa->k[2][1], d2, d0, d1, q2, q0, q1);
+  const double q0 = extension_saturation(dv, c, d0), q1 = extension_saturation(dv, c, d1),
+               q2 = extension_saturation(dv, c, d2);
+  *p0 = extended_entry(m, dv, c, pa->p[0], pa->k[0][0], pa->k[0][1], pa->k[0][2], d0, d1, d2, q0, q1, q2);
+  *p1 = extended_entry(m, dv, c, pa->p[1], pa->k[1][1], pa->k[1][0], pa->k[1][2], d1, d0, d2, q1, q0, q2);
+  *p2 = extended_entry(m, dv, c, pa->p[2], pa->k[2][2], pa->k[2][0], pa->k[2][1], d2, d0, d1, q2, q0, q1);
+}
+
+/* CLAMP: g_i = dPhat_i/dc at fixed Fhat, the stress's change with the threshold itself (its
+ * rise with J, material_threshold_at), from the parts at the clamped point and the offsets
+ * d = f - fc. A clamped entry k moves with c (dfc_k/dc = 1, dd_k/dc = -1): p_i changes by
+ * sum over clamped k of K_ik, and a clamped row's ramp term r_i d_i, r_i = max(0, p_i/c + mu),
+ * by dr_i/dc d_i - r_i. */
+MATERIAL_KERNEL void clamp_threshold_sensitivity(const piola_material *m, double c,
+                                                 const material_parts *pa, double d0, double d1,
+                                                 double d2, double g[3]) {
+  const double d[3] = {d0, d1, d2};
+  for (int i = 0; i < 3; ++i) {
+    double dp = 0.0;
+    for (int k = 0; k < 3; ++k) dp += d[k] < 0.0 ? pa->k[i][k] : 0.0;
+    const double ramp = pa->p[i] / c + m->mu;
+    const double r = kernel_max(ramp, 0.0), dr = ramp > 0.0 ? dp / c - pa->p[i] / (c * c) : 0.0;
+    g[i] = dp + (d[i] < 0.0 ? dr * d[i] - r : 0.0);
+  }
 }
 
 /* Integral from 0 to d of the saturating offset: -w d - w^2 ln(1 - d / w) (d <= 0, so the
  * logarithm's argument is >= 1). */
-MATERIAL_KERNEL double extension_saturation_integral(const piola_material *m, double d) {
-  const double w = 0.25 * m->threshold;
+MATERIAL_KERNEL double extension_saturation_integral(double c, double d) {
+  const double w = 0.25 * c;
   return -w * d - w * w * kernel_log(1.0 - d / w);
 }
 
@@ -421,11 +466,11 @@ MATERIAL_KERNEL double extension_saturation_integral(const piola_material *m, do
 MATERIAL_KERNEL void material_extended_stress(piola_material_model model, const piola_material *m,
                                               kernel_division dv, double f0, double f1, double f2, double *p0,
                                               double *p1, double *p2) {
-  const double c = m->threshold;
+  const double c = MATERIAL_THRESHOLD(model, m, f0, f1, f2);
   const double fc0 = kernel_max(f0, c), fc1 = kernel_max(f1, c), fc2 = kernel_max(f2, c);
   material_parts parts;
   material_model_parts(model, m, dv, fc0, fc1, fc2, &parts);
-  material_extend(m, dv, &parts, f0 - fc0, f1 - fc1, f2 - fc2, p0, p1, p2);
+  material_extend(m, dv, c, &parts, f0 - fc0, f1 - fc1, f2 - fc2, p0, p1, p2);
 }
 
 /* --------------------------------------------------------------- the energy extension
@@ -623,25 +668,25 @@ MATERIAL_KERNEL void material_extended_stress_energy(piola_material_model model,
                                                      const piola_material *m, double f0, double f1,
                                                      double f2, double *p0, double *p1, double *p2,
                                                      double *psi) {
-  const double c = m->threshold;
+  const double c = MATERIAL_THRESHOLD(model, m, f0, f1, f2);
   const double fc0 = kernel_max(f0, c), fc1 = kernel_max(f1, c), fc2 = kernel_max(f2, c);
   const double d0 = f0 - fc0, d1 = f1 - fc1, d2 = f2 - fc2;
   material_parts pa;
   material_model_parts(model, m, KERNEL_EXACT_DIVIDE, fc0, fc1, fc2, &pa);
-  material_extend(m, KERNEL_EXACT_DIVIDE, &pa, d0, d1, d2, p0, p1, p2);
+  material_extend(m, KERNEL_EXACT_DIVIDE, c, &pa, d0, d1, d2, p0, p1, p2);
   const double linear = (double)(m->inversion_mode != PIOLA_INVERSION_CLAMP);
-  const double s0 = extension_diagonal_slope(m, KERNEL_EXACT_DIVIDE, pa.p[0], pa.k[0][0]);
-  const double s1 = extension_diagonal_slope(m, KERNEL_EXACT_DIVIDE, pa.p[1], pa.k[1][1]);
-  const double s2 = extension_diagonal_slope(m, KERNEL_EXACT_DIVIDE, pa.p[2], pa.k[2][2]);
-  const double r0 = extension_far_slope(m, KERNEL_EXACT_DIVIDE, pa.p[0], pa.k[0][0]);
-  const double r1 = extension_far_slope(m, KERNEL_EXACT_DIVIDE, pa.p[1], pa.k[1][1]);
-  const double r2 = extension_far_slope(m, KERNEL_EXACT_DIVIDE, pa.p[2], pa.k[2][2]);
+  const double s0 = extension_diagonal_slope(m, KERNEL_EXACT_DIVIDE, c, pa.p[0], pa.k[0][0]);
+  const double s1 = extension_diagonal_slope(m, KERNEL_EXACT_DIVIDE, c, pa.p[1], pa.k[1][1]);
+  const double s2 = extension_diagonal_slope(m, KERNEL_EXACT_DIVIDE, c, pa.p[2], pa.k[2][2]);
+  const double r0 = extension_far_slope(m, KERNEL_EXACT_DIVIDE, c, pa.p[0], pa.k[0][0]);
+  const double r1 = extension_far_slope(m, KERNEL_EXACT_DIVIDE, c, pa.p[1], pa.k[1][1]);
+  const double r2 = extension_far_slope(m, KERNEL_EXACT_DIVIDE, c, pa.p[2], pa.k[2][2]);
   const double first = pa.p[0] * d0 + pa.p[1] * d1 + pa.p[2] * d2;
   const double second =
       0.5 * (r0 * d0 * d0 + r1 * d1 * d1 + r2 * d2 * d2) +
-      linear * ((s0 - r0) * extension_saturation_integral(m, d0) +
-                (s1 - r1) * extension_saturation_integral(m, d1) +
-                (s2 - r2) * extension_saturation_integral(m, d2)) +
+      linear * ((s0 - r0) * extension_saturation_integral(c, d0) +
+                (s1 - r1) * extension_saturation_integral(c, d1) +
+                (s2 - r2) * extension_saturation_integral(c, d2)) +
       linear * (kernel_max(pa.k[0][1], 0.0) * d0 * d1 + kernel_max(pa.k[0][2], 0.0) * d0 * d2 +
                 kernel_max(pa.k[1][2], 0.0) * d1 * d2);
   *psi = material_model_energy(model, m, fc0, fc1, fc2) + first + second;
@@ -765,11 +810,11 @@ enum {
 MATERIAL_KERNEL void ogden_stress_cached_lanes(const piola_material *m, double f0, double f1,
                                                double f2, double *p0, double *p1, double *p2,
                                                double *cache, long stride) {
-  const double c = m->threshold;
+  const double c = material_threshold_at(m, f0, f1, f2);
   const double fc0 = kernel_max(f0, c), fc1 = kernel_max(f1, c), fc2 = kernel_max(f2, c);
   material_parts parts;
   material_model_parts(PIOLA_MODEL_OGDEN, m, KERNEL_FAST_RECIPROCAL, fc0, fc1, fc2, &parts);
-  material_extend(m, KERNEL_FAST_RECIPROCAL, &parts, f0 - fc0, f1 - fc1, f2 - fc2, p0, p1, p2);
+  material_extend(m, KERNEL_FAST_RECIPROCAL, c, &parts, f0 - fc0, f1 - fc1, f2 - fc2, p0, p1, p2);
   cache[(OGDEN_CACHE_KEY + 0) * stride] = f0;
   cache[(OGDEN_CACHE_KEY + 1) * stride] = f1;
   cache[(OGDEN_CACHE_KEY + 2) * stride] = f2;

@@ -9,11 +9,22 @@
  * MATMPIBAIJ: "No method creategraph for Mat of type mpibaij"), filled by 3x3 blocks
  * (MatSetValuesBlocked), preallocated once from the mesh edges of the
  * owned rows (row(), which the core fills from the rows it assembled complete: no entry
- * belongs to another process) and refilled in place for every system. KSPCG runs to the
+ * belongs to another process) and refilled in place for every system: every system writes
+ * every entry of the pattern (row() gives every edge block, zero or not), so no
+ * MatZeroEntries, and no assembly message (MAT_NO_OFF_PROC_ENTRIES). KSPCG runs to the
  * system's relative tolerance in the preconditioned norm (the single process's criterion),
  * from zero, preconditioned by GAMG told the six rigid body modes of the current positions
  * (MatNullSpaceCreateRigidBody), or by block Jacobi with one block per process, each an
- * IC(0). The solution goes to every process (VecScatterCreateToAll) and back to node order. */
+ * IC(0). The solution goes to every process (VecScatterCreateToAll) and back to node order.
+ *
+ * Reuse. GAMG is set up for the first system of a step only; the later systems of the
+ * step (the next Newton iterations, whose matrix moved a little) are solved with it as it
+ * is (KSPSetReusePreconditioner). Should CG fail with the reused one (any diverged reason,
+ * running out of iterations included), the system is solved again from zero with GAMG set
+ * up for it, which the next systems then reuse. Measured in BENCHMARKS.md, "MPI: implicit
+ * Newton systems on PETSc": GAMG's setup, redone for every system, cost more than the
+ * iterations it saved. Block Jacobi + IC(0) is factored for every system (cheap; a stale
+ * factor only added iterations). */
 #include "mpi/mpi_petsc.h"
 
 #include <petscksp.h>
@@ -40,6 +51,7 @@ struct piola__petsc_solver {
   double *blocks;
   PetscScalar *values;     /* the row's blocks as 3 rows of 3 x count values */
   int32_t widest;
+  int prepared; /* the preconditioner was set up for a system of the current step */
 };
 
 /* Did this library start PETSc (so it ends it)? */
@@ -96,6 +108,7 @@ static PetscErrorCode create(piola__petsc_solver *s, const piola_split_newton_sy
   PetscCall(MatSetBlockSize(s->matrix, bs));
   PetscCall(PetscFree2(d_nnz, o_nnz));
   PetscCall(MatSetOption(s->matrix, MAT_SYMMETRIC, PETSC_TRUE));
+  PetscCall(MatSetOption(s->matrix, MAT_NO_OFF_PROC_ENTRIES, PETSC_TRUE)); /* own rows only */
   PetscCall(MatCreateVecs(s->matrix, &s->solution, &s->rhs));
   PetscCall(VecDuplicate(s->rhs, &s->coordinates));
   PetscCall(VecSetBlockSize(s->coordinates, bs));
@@ -133,28 +146,32 @@ static PetscErrorCode fill(piola__petsc_solver *s, const piola_split_newton_syst
   PetscCall(VecRestoreArray(s->coordinates, &x));
   PetscCall(MatAssemblyBegin(s->matrix, MAT_FINAL_ASSEMBLY));
   PetscCall(MatAssemblyEnd(s->matrix, MAT_FINAL_ASSEMBLY));
+  /* the first fill made the pattern; later ones only overwrite it */
+  PetscCall(MatSetOption(s->matrix, MAT_NEW_NONZERO_LOCATION_ERR, PETSC_TRUE));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
+/* The solver for the system just filled: its preconditioner set up for it (fresh), or the
+ * one of an earlier system as it is. */
 static PetscErrorCode set_preconditioner(piola__petsc_solver *s,
-                                         const piola_split_newton_system *system) {
+                                         const piola_split_newton_system *system, int fresh) {
   PetscFunctionBeginUser;
   PC pc;
   PetscCall(KSPGetPC(s->ksp, &pc));
-  if (system->preconditioner == PIOLA_MPI_PRECONDITIONER_GAMG) {
+  PetscCall(KSPSetReusePreconditioner(s->ksp, fresh ? PETSC_FALSE : PETSC_TRUE));
+  const int gamg = system->preconditioner == PIOLA_MPI_PRECONDITIONER_GAMG;
+  if (fresh && gamg) {
     MatNullSpace rigid;
     PetscCall(MatNullSpaceCreateRigidBody(s->coordinates, &rigid));
     PetscCall(MatSetNearNullSpace(s->matrix, rigid));
     PetscCall(MatNullSpaceDestroy(&rigid));
-    PetscCall(PCSetType(pc, PCGAMG));
-  } else {
-    PetscCall(PCSetType(pc, PCBJACOBI));
   }
+  PetscCall(PCSetType(pc, gamg ? PCGAMG : PCBJACOBI));
   PetscCall(KSPSetOperators(s->ksp, s->matrix, s->matrix));
   PetscCall(KSPSetTolerances(s->ksp, system->tolerance, 0.0, PETSC_DEFAULT,
                              system->max_iterations));
   PetscCall(KSPSetUp(s->ksp));
-  if (system->preconditioner == PIOLA_MPI_PRECONDITIONER_BLOCK_JACOBI_ICC) {
+  if (fresh && !gamg) {
     KSP *local;
     PetscInt count;
     PetscCall(PCBJacobiGetSubKSP(pc, &count, NULL, &local));
@@ -172,10 +189,25 @@ static PetscErrorCode solve(piola__petsc_solver *s, const piola_split_newton_sys
   PetscFunctionBeginUser;
   if (!s->matrix) PetscCall(create(s, system));
   PetscCall(fill(s, system));
-  PetscCall(set_preconditioner(s, system));
+  /* GAMG only: IC(0)'s factorization costs little, and a stale one added CG iterations */
+  const int reuse = s->prepared && system->step_system > 0 &&
+                    system->preconditioner == PIOLA_MPI_PRECONDITIONER_GAMG;
+  PetscCall(set_preconditioner(s, system, !reuse));
   PetscCall(KSPSolve(s->ksp, s->rhs, s->solution));
   PetscCall(KSPGetIterationNumber(s->ksp, iterations));
   PetscCall(KSPGetConvergedReason(s->ksp, why));
+  if (reuse && *why < 0) { /* the earlier system's preconditioner does not serve this one */
+    PetscInt more = 0;
+    PC pc; /* forgotten: PCSetUp would skip a matrix whose state it has seen */
+    PetscCall(KSPGetPC(s->ksp, &pc));
+    PetscCall(PCReset(pc));
+    PetscCall(set_preconditioner(s, system, 1));
+    PetscCall(KSPSolve(s->ksp, s->rhs, s->solution));
+    PetscCall(KSPGetIterationNumber(s->ksp, &more));
+    PetscCall(KSPGetConvergedReason(s->ksp, why));
+    *iterations += more;
+  }
+  s->prepared = 1;
   PetscCall(VecScatterBegin(s->to_all, s->solution, s->everything, INSERT_VALUES, SCATTER_FORWARD));
   PetscCall(VecScatterEnd(s->to_all, s->solution, s->everything, INSERT_VALUES, SCATTER_FORWARD));
   const PetscScalar *all;

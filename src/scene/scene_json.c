@@ -80,8 +80,8 @@ piola_status piola__json_check_range(scene_parser *p, double v, json_range r) {
   if (!isfinite(v)) return piola__json_fail(p, BAD_VALUE, "must be finite, got %g", v);
   int ok = (r.lo_open ? v > r.lo : v >= r.lo) && (r.hi_open ? v < r.hi : v <= r.hi);
   if (ok) return PIOLA_OK;
-  if (isinf(r.hi) && r.lo == 0)
-    return piola__json_fail(p, BAD_VALUE, "must be %s 0, got %g", r.lo_open ? ">" : ">=", v);
+  if (isinf(r.hi) && isfinite(r.lo))
+    return piola__json_fail(p, BAD_VALUE, "must be %s %g, got %g", r.lo_open ? ">" : ">=", r.lo, v);
   return piola__json_fail(p, BAD_VALUE, "must be in %c%g, %g%c, got %g", r.lo_open ? '(' : '[',
                           r.lo, r.hi, r.hi_open ? ')' : ']', v);
 }

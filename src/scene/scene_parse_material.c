@@ -48,13 +48,15 @@ static piola_status parse_ogden(scene_parser *p, const cJSON *obj, piola_materia
   return PIOLA_OK;
 }
 
-/* `hgo`: {"mu", "k1", "k2", "kappa", "fiber_angle_degrees", "axis"} (materials.md). */
+/* `hgo`: {"mu", "k1", "k2", "kappa", "fiber_angle_degrees", "axis", "fiber_stretch_limit"}
+ * (materials.md). */
 static piola_status parse_hgo(scene_parser *p, const cJSON *obj, piola_material_def *m) {
   const cJSON *h = piola__json_get(obj, "hgo");
   if (!h) return PIOLA_OK;
   size_t old = piola__json_push_key(p, "hgo");
   if (m->model != PIOLA_MODEL_HGO) return piola__json_fail(p, BAD_VALUE, "needs \"model\": \"hgo\"");
-  static const char *const keys[] = {"mu", "k1", "k2", "kappa", "fiber_angle_degrees", "axis", NULL};
+  static const char *const keys[] = {"mu", "k1", "k2", "kappa", "fiber_angle_degrees", "axis",
+                                     "fiber_stretch_limit", NULL};
   PIOLA_TRY(piola__json_check_keys(p, h, keys));
   piola_hgo_def *hd = &m->hgo;
   PIOLA_TRY(piola__json_opt_number(p, h, "mu", POSITIVE, &hd->mu));
@@ -63,6 +65,8 @@ static piola_status parse_hgo(scene_parser *p, const cJSON *obj, piola_material_
   PIOLA_TRY(piola__json_opt_number(p, h, "kappa", (json_range){0, 1.0 / 3.0, 0, 0}, &hd->kappa));
   PIOLA_TRY(piola__json_opt_number(p, h, "fiber_angle_degrees", (json_range){0, 90, 0, 0},
                                    &hd->fiber_angle_degrees));
+  PIOLA_TRY(piola__json_opt_number(p, h, "fiber_stretch_limit", (json_range){1, INFINITY, 1, 0},
+                                   &hd->fiber_stretch_limit));
   if (piola__json_get(h, "axis")) {
     piola_vec3 a;
     PIOLA_TRY(piola__json_opt_direction(p, h, "axis", &a));

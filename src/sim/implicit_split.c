@@ -85,7 +85,8 @@ const piola_work_split *piola__implicit_split_of(const world_body *s) {
 
 int32_t piola__implicit_split_solve(const world_body *s, const piola__stiffness_matrix *matrix,
                                     const double *residual, double tolerance,
-                                    const piola_world_def *def, double *rhs, double *step) {
+                                    const piola_world_def *def, int32_t step_system, double *rhs,
+                                    double *step) {
   const piola_work_split *split = piola__implicit_split_of(s);
   const piola__damping_matrix *d = &s->solid->damping;
   for (int32_t i = 0; i < s->n; ++i) {
@@ -109,7 +110,8 @@ int32_t piola__implicit_split_solve(const world_body *s, const piola__stiffness_
                                             .owner = &rows,
                                             .tolerance = tolerance,
                                             .max_iterations = def->linear_max_iterations,
-                                            .preconditioner = def->mpi_preconditioner};
+                                            .preconditioner = def->mpi_preconditioner,
+                                            .step_system = step_system};
   const int32_t iterations = split->solve_newton(split->context, &system, step);
   /* an iterative solve leaves the filtered components near zero, not at it (with GAMG
    * they were ~1e-5 of the step): filtered to zero, as the serial CG's are, so that held

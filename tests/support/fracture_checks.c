@@ -158,3 +158,15 @@ void fracture_momenta(const piola_world *w, double p[3], double l[3]) {
     l[2] += m[i] * (xi[0] * vi[1] - xi[1] * vi[0]);
   }
 }
+
+int32_t fracture_recut_tets(const piola_world *w) {
+  const piola_elastic_body *b = piola_world_solid_body(w, 0);
+  const int32_t nt = piola_elastic_body_tet_count(b), *parent = piola_world_solid_parent_tets(w, 0);
+  int32_t original = 0, recut = 0;
+  for (int32_t t = 0; t < nt; ++t) original = parent[t] + 1 > original ? parent[t] + 1 : original;
+  int32_t *count = calloc((size_t)original, sizeof(int32_t));
+  assert_non_null(count);
+  for (int32_t t = 0; t < nt; ++t) recut += ++count[parent[t]] == 3;
+  free(count);
+  return recut;
+}

@@ -64,6 +64,7 @@ static piola_elastic_body *make_body(const piola_tet_mesh *mesh, const piola_mat
     for (int k = 0; k < vt->levels; ++k) {
       steps[k] = *material;
       steps[k].threshold = material->threshold + (vt->high - material->threshold) * k / (vt->levels - 1);
+      steps[k].threshold_compressed = steps[k].threshold; /* each level a fixed threshold */
     }
     bd.materials = steps;
     bd.material_count = vt->levels;

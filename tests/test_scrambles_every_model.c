@@ -14,11 +14,13 @@
  * fibres (its passive fibre modulus in the bound), HGO with fibres along x.
  *
  * Every run is 2 s, except on the two sliver meshes, where corotated, the spline and Stable
- * Neo-Hookean run from half a diagonal only: from one and two diagonals their runs take
- * minutes of CPU each, and corotated on bar-186 from two diagonals
- * gained energy (2.8e11 J to 5.3e11 J in its first 0.001 s, 254,258 steps): mostly the CLAMP
- * extension's work without a potential, which the energy check counts as work, plus a part
- * that follows the step (docs/time-stepping.md, "What the test affords"; not fixed).
+ * Neo-Hookean run from half a diagonal only here; test_scrambles_slivers.c runs corotated and
+ * the spline on bar-186 from one diagonal. The rest take minutes of CPU each (torus.msh,
+ * corotated, two diagonals: 187,502 steps for the first 1 s, 47 s of CPU, with the step bound's
+ * direction weights), and corotated on bar-186 from two diagonals gained energy (2.8e11 J to
+ * 5.3e11 J in its first 0.001 s, 254,258 steps): mostly the CLAMP extension's work without a
+ * potential, which the energy check counts as work, plus a part that follows the step
+ * (docs/time-stepping.md, "What the test affords"; not fixed).
  *
  * HGO runs every scramble since its fibres' energy past hgo.fiber_stretch_limit is a spring of
  * constant stiffness (docs/materials.md): before, their exponential made the step bound grow
@@ -32,7 +34,6 @@
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
-#include <time.h>
 
 #include "piola/mesh_io.h"
 #include "piola/threads.h"
@@ -40,15 +41,6 @@
 #include "real_mesh_scenes.h"
 
 #define DIAGONAL 2.0
-#define YOUNGS 2e4
-#define POISSON 0.3
-#define DENSITY 1000.0
-#define VISCOSITY 1000.0
-
-static double total_energy(const piola_world *w) {
-  const piola_solid_stats s = piola_world_solid_stats(w, 0);
-  return s.kinetic_energy + s.elastic_energy;
-}
 
 static const piola_material_model models[] = {
     PIOLA_MODEL_ROTATED_LINEAR, PIOLA_MODEL_COROTATED, PIOLA_MODEL_STVK, PIOLA_MODEL_NEOHOOKEAN,
@@ -74,48 +66,14 @@ static void every_model_runs_every_scramble(void **state) {
         if (only && strcmp(only, piola_material_model_name(model))) continue;
         const double radius = (r == 0 ? 0.5 : r == 1 ? 1.0 : 2.0) * DIAGONAL;
         /* On the sliver meshes the models that stiffen without limit under stretch (corotated,
-         * the spline and Stable Neo-Hookean with their J terms) take 1e5 steps per 0.1 s from
-         * one and two diagonals (torus.msh, corotated, 2 D: 106,869 steps, 18 s of CPU): there
-         * they run from half a diagonal only (docs/time-stepping.md "What the test affords"). */
+         * the spline and Stable Neo-Hookean with their J terms) take 1e4-1e5 steps per 0.1 s
+         * from one and two diagonals: here they run from half a diagonal only
+         * (test_scrambles_slivers.c runs corotated and the spline on bar-186 from one;
+         * docs/time-stepping.md "What the test affords"). */
         const int stiffening = model == PIOLA_MODEL_COROTATED || model == PIOLA_MODEL_SPLINE ||
                                model == PIOLA_MODEL_STABLE_NEOHOOKEAN;
         if (mi > 0 && stiffening && r > 0) continue;
-        const double run = seconds;
-        piola_world_def wd = piola_default_world_def();
-        for (int i = 0; i < 3; ++i) wd.gravity[i] = piola_track_constant(0);
-        piola_world *w = NULL;
-        assert_int_equal(piola_world_create(&wd, &w), PIOLA_OK);
-        piola_solid_def sd = piola_default_solid_def();
-        sd.mesh = &mesh;
-        sd.material = real_mesh_material_def(model, YOUNGS, POISSON);
-        sd.density = DENSITY;
-        sd.shear_viscosity = sd.bulk_viscosity = piola_track_constant(VISCOSITY);
-        sd.scramble_radius = radius;
-        if (model == PIOLA_MODEL_HGO) sd.fiber_directions = fibers;
-        if (piola_world_add_solid(w, &sd, NULL) != PIOLA_OK)
-          fail_msg("%s %s: %s", meshes[mi], piola_material_model_name(model), piola_last_error());
-        const double e0 = total_energy(w);
-        double highest = e0;
-        piola_step_stats st = {0};
-        const clock_t c0 = clock();
-        for (int frame = 1; frame <= 20; ++frame) {
-          piola_step_stats fs = {0};
-          if (piola_world_advance_to(w, run * frame / 20, &fs) != PIOLA_OK || !real_mesh_solid_finite(w))
-            fail_msg("%s, %s, scramble %g m, at %g s: %s", meshes[mi], piola_material_model_name(model),
-                     radius, run * frame / 20, piola_last_error());
-          st.substeps += fs.substeps, st.energy_redos += fs.energy_redos, st.step_retries += fs.step_retries;
-          highest = fmax(highest, total_energy(w));
-        }
-        if (getenv("PIOLA_TEST_VERBOSE"))
-          print_message("%-22s %-17s %4.1f D, %4.2f s: %8d steps, %3d redos, %d retries, energy %.3g -> %.3g J "
-                        "(highest %.3g), %.2f s CPU\n",
-                        meshes[mi], piola_material_model_name(model), radius / DIAGONAL, run, (int)st.substeps,
-                        (int)st.energy_redos, (int)st.step_retries, e0, total_energy(w), highest,
-                        (double)(clock() - c0) / CLOCKS_PER_SEC);
-        if (!(highest <= 1.05 * e0))
-          fail_msg("%s, %s, scramble %g m: total energy rose from %g J to %g J", meshes[mi],
-                   piola_material_model_name(model), radius, e0, highest);
-        piola_world_destroy(w);
+        real_mesh_scramble_run(&mesh, meshes[mi], model, radius, seconds, fibers);
       }
     free(fibers);
     piola_tet_mesh_free(&mesh);

@@ -98,6 +98,8 @@ struct piola_elastic_body {
 
   double *step_weight;      /* per tet 1 / (rho h_e^2), m/kg: the step bound's geometric factor
                                (stable_step.c), built on first use */
+  double *step_gram;        /* 6 * tet_count: per tet the rest sum_c g_c g_c^T (m^-2) the bound's
+                               direction weights read (stable_step_anisotropy.h), built with it */
   double *ogden_cache;      /* Ogden and Mooney-Rivlin bodies of one material: the step bound's
                                slots, OGDEN_CACHE_SLOTS * padded_tet_count (material_kernels.h),
                                written by the force loop; NULL for the other bodies */

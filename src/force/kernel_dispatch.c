@@ -51,6 +51,10 @@ double piola__elastic_body_tet_modulus(const piola_elastic_body *body, int32_t t
   return PIOLA_ISA_SELECT(piola__elastic_body_tet_modulus)(body, tet, fhat);
 }
 
+double piola__elastic_body_tet_state_rate2(const piola_elastic_body *body, int32_t tet) {
+  return PIOLA_ISA_SELECT(piola__elastic_body_tet_state_rate2)(body, tet);
+}
+
 double piola__elastic_body_tet_rest_altitude(const piola_elastic_body *body, int32_t tet) {
   return PIOLA_ISA_SELECT(piola__elastic_body_tet_rest_altitude)(body, tet);
 }

@@ -44,6 +44,7 @@ void piola__elastic_body_free_arrays(piola_elastic_body *body) {
   free(body->chunk_forces);
   piola__elastic_body_split_free(body);
   free(body->step_weight);
+  free(body->step_gram);
   free(body->ogden_cache);
   piola__damping_matrix_free(&body->damping);
   for (int k = 0; k < 3; ++k) free(body->fiber[k]);

@@ -29,6 +29,7 @@
 #include "common/status_report.h"
 #include "force/elastic_body_internal.h"
 #include "force/stable_step.h"
+#include "force/stable_step_anisotropy.h"
 #include "material/hgo_kernels.h"
 #include "material/material_kernels.h"
 
@@ -46,6 +47,31 @@ STABLE_STEP_KERNEL double pair_modulus(double c, double pi, double pj, double fi
   const double a = 0.5 * (minus + plus), b = 0.5 * (minus - plus);
   return a + fabs(b + kij);
 }
+
+/* The same pair weighted by the direction weights wi, wj (stable_step_anisotropy.h). */
+STABLE_STEP_KERNEL double weighted_pair_modulus(double c, double pi, double pj, double fi, double fj,
+                                                double kii, double kjj, double kij, double wi, double wj) {
+  const double df = fi - fj, sum = fi + fj;
+  const int close = fabs(df) <= 1e-6 * (fabs(fi) + fabs(fj));
+  const double minus = close ? 0.5 * (kii + kjj) - kij : (pi - pj) / (close ? 1.0 : df);
+  const double den = sum >= 0.0 ? kernel_max(sum, c) : kernel_min(sum, -c);
+  const double plus = (pi + pj) / den;
+  const double a = 0.5 * (minus + plus), b = 0.5 * (minus - plus);
+  return step_weighted_pair(a, b + kij, wi, wj);
+}
+
+/* The direction weights apply to a tet whose modulus is above this many times its rest
+ * modulus lambda + 2 mu: where the state, not the mesh, sets the step (scrambles, strong
+ * stretch). Below it the bound is the unweighted one and costs what it did. */
+#define STIFF_FACTOR 4.0
+
+/* The models whose bound takes the direction weights: those that stiffen under stretch where
+ * the sliver is wide (docs/time-stepping.md, "Slivers stretched along their thin direction").
+ * Neo-Hookean, the muscle, Ogden, Mooney-Rivlin and HGO keep the unweighted bound. */
+#define DIRECTION_WEIGHTED(model)                                                            \
+  ((model) == PIOLA_MODEL_COROTATED || (model) == PIOLA_MODEL_STVK ||                        \
+   (model) == PIOLA_MODEL_SPLINE || (model) == PIOLA_MODEL_STABLE_NEOHOOKEAN ||              \
+   (model) == PIOLA_MODEL_ROTATED_LINEAR)
 
 /* The extension a lane loop is compiled for (a compile-time constant there, like the model). */
 enum { STEP_EXTENSION_CLAMP = 0, STEP_EXTENSION_ENERGY = 1, STEP_EXTENSION_LINEAR = 2 };
@@ -103,10 +129,12 @@ STABLE_STEP_KERNEL void linear_extension_slopes(piola_material_model model, cons
 
 /* k of one tet of model MODEL with the stress extension of mode ENERGY (both compile-time
  * constants in the lane loops: STEP_EXTENSION_CLAMP, _ENERGY or _LINEAR); the model's parts at
- * the clamped point are GIVEN (the Ogden models' cache) or, when it is NULL, computed. */
-STABLE_STEP_KERNEL double model_modulus_from(piola_material_model model, int energy,
-                                             const piola_material *m, double f0, double f1,
-                                             double f2, const material_parts *given) {
+ * the clamped point are GIVEN (the Ogden models' cache) or, when it is NULL, computed. With
+ * direction weights WGT (NULL: none), min(k, k_w) (stable_step_anisotropy.h). */
+STABLE_STEP_KERNEL double model_modulus_weighted(piola_material_model model, int energy,
+                                                 const piola_material *m, double f0, double f1,
+                                                 double f2, const material_parts *given,
+                                                 const double *wgt) {
   const double c = MATERIAL_THRESHOLD(model, m, f0, f1, f2);
   const double fc0 = kernel_max(f0, c), fc1 = kernel_max(f1, c), fc2 = kernel_max(f2, c);
   const double d0 = f0 - fc0, d1 = f1 - fc1, d2 = f2 - fc2;
@@ -166,14 +194,43 @@ STABLE_STEP_KERNEL double model_modulus_from(piola_material_model model, int ene
   k = kernel_max(k, pair_modulus(c, p0, p1, f0, f1, k0, k1, k01));
   k = kernel_max(k, pair_modulus(c, p0, p2, f0, f2, k0, k2, k02));
   k = kernel_max(k, pair_modulus(c, p1, p2, f1, f2, k1, k2, k12));
+  if (wgt) {
+    double kw = kernel_max(wgt[0] * k0, kernel_max(wgt[1] * k1, wgt[2] * k2));
+    kw = kernel_max(kw, weighted_pair_modulus(c, p0, p1, f0, f1, k0, k1, k01, wgt[0], wgt[1]));
+    kw = kernel_max(kw, weighted_pair_modulus(c, p0, p2, f0, f2, k0, k2, k02, wgt[0], wgt[2]));
+    kw = kernel_max(kw, weighted_pair_modulus(c, p1, p2, f1, f2, k1, k2, k12, wgt[1], wgt[2]));
+    k = k > STIFF_FACTOR * (m->lambda + 2.0 * m->mu) ? kernel_min(k, kw) : k;
+  }
   /* muscle fibres: their tangent stiffness bound, as in the rest bound; HGO's exponential
    * fibres depend on their direction: hgo_tet_fiber_modulus, added by the callers */
   return k + (model == PIOLA_MODEL_HGO ? 0.0 : m->fiber_modulus);
 }
 
+STABLE_STEP_KERNEL double model_modulus_from(piola_material_model model, int energy,
+                                             const piola_material *m, double f0, double f1,
+                                             double f2, const material_parts *given) {
+  return model_modulus_weighted(model, energy, m, f0, f1, f2, given, NULL);
+}
+
 STABLE_STEP_KERNEL double model_modulus(piola_material_model model, int energy,
                                         const piola_material *m, double f0, double f1, double f2) {
-  return model_modulus_from(model, energy, m, f0, f1, f2, NULL);
+  return model_modulus_weighted(model, energy, m, f0, f1, f2, NULL, NULL);
+}
+
+/* Where the body has direction weights (stable_step_anisotropy.h): its Gram arrays once an
+ * update has set V, else NULL. */
+static const double *direction_gram(const piola_elastic_body *body) {
+  return body->has_state ? body->step_gram : NULL;
+}
+
+/* k of tet t of a DIRECTION_WEIGHTED model with its direction weights (GRAM not NULL; the
+ * callers choose outside their lane loops, so that these vectorize). */
+STABLE_STEP_KERNEL double weighted_lane_modulus(piola_material_model model, int energy,
+                                                const piola_material *m, const piola_elastic_body *body,
+                                                const double *gram, int32_t t, const double *f) {
+  double wgt[3];
+  step_direction_weights(gram + t, body->tet_count, body->v[0] + t, body->padded_tet_count, wgt);
+  return model_modulus_weighted(model, energy, m, f[0], f[1], f[2], NULL, wgt);
 }
 
 /* HGO's fibre stiffness for a plane wave at Fhat f with the two families' unit directions
@@ -240,31 +297,41 @@ STABLE_STEP_KERNEL double neohookean_plain_modulus(const piola_material *m, doub
 }
 
 /* Per tet: the model and the extension mode chosen at run time. */
-static double mode_modulus(int energy, const piola_material *m, double f0, double f1, double f2) {
+static double mode_modulus(int energy, const piola_material *m, double f0, double f1, double f2,
+                           const double *wgt) {
   switch (m->model) {
-    case PIOLA_MODEL_COROTATED: return model_modulus(PIOLA_MODEL_COROTATED, energy, m, f0, f1, f2);
-    case PIOLA_MODEL_STVK: return model_modulus(PIOLA_MODEL_STVK, energy, m, f0, f1, f2);
-    case PIOLA_MODEL_NEOHOOKEAN: return model_modulus(PIOLA_MODEL_NEOHOOKEAN, energy, m, f0, f1, f2);
-    case PIOLA_MODEL_MUSCLE: return model_modulus(PIOLA_MODEL_MUSCLE, energy, m, f0, f1, f2);
-    case PIOLA_MODEL_HGO: return model_modulus(PIOLA_MODEL_HGO, energy, m, f0, f1, f2);
-    case PIOLA_MODEL_SPLINE: return model_modulus(PIOLA_MODEL_SPLINE, energy, m, f0, f1, f2);
+    case PIOLA_MODEL_COROTATED: return model_modulus_weighted(PIOLA_MODEL_COROTATED, energy, m, f0, f1, f2, NULL,
+                                    DIRECTION_WEIGHTED(PIOLA_MODEL_COROTATED) ? wgt : NULL);
+    case PIOLA_MODEL_STVK: return model_modulus_weighted(PIOLA_MODEL_STVK, energy, m, f0, f1, f2, NULL,
+                                    DIRECTION_WEIGHTED(PIOLA_MODEL_STVK) ? wgt : NULL);
+    case PIOLA_MODEL_NEOHOOKEAN: return model_modulus_weighted(PIOLA_MODEL_NEOHOOKEAN, energy, m, f0, f1, f2, NULL,
+                                    DIRECTION_WEIGHTED(PIOLA_MODEL_NEOHOOKEAN) ? wgt : NULL);
+    case PIOLA_MODEL_MUSCLE: return model_modulus_weighted(PIOLA_MODEL_MUSCLE, energy, m, f0, f1, f2, NULL,
+                                    DIRECTION_WEIGHTED(PIOLA_MODEL_MUSCLE) ? wgt : NULL);
+    case PIOLA_MODEL_HGO: return model_modulus_weighted(PIOLA_MODEL_HGO, energy, m, f0, f1, f2, NULL,
+                                    DIRECTION_WEIGHTED(PIOLA_MODEL_HGO) ? wgt : NULL);
+    case PIOLA_MODEL_SPLINE: return model_modulus_weighted(PIOLA_MODEL_SPLINE, energy, m, f0, f1, f2, NULL,
+                                    DIRECTION_WEIGHTED(PIOLA_MODEL_SPLINE) ? wgt : NULL);
     case PIOLA_MODEL_STABLE_NEOHOOKEAN:
-      return model_modulus(PIOLA_MODEL_STABLE_NEOHOOKEAN, energy, m, f0, f1, f2);
+      return model_modulus_weighted(PIOLA_MODEL_STABLE_NEOHOOKEAN, energy, m, f0, f1, f2, NULL,
+                                    DIRECTION_WEIGHTED(PIOLA_MODEL_STABLE_NEOHOOKEAN) ? wgt : NULL);
     case PIOLA_MODEL_MOONEY_RIVLIN: /* stored as two Ogden terms: the same code path */
-    case PIOLA_MODEL_OGDEN: return model_modulus(PIOLA_MODEL_OGDEN, energy, m, f0, f1, f2);
+    case PIOLA_MODEL_OGDEN: return model_modulus_weighted(PIOLA_MODEL_OGDEN, energy, m, f0, f1, f2, NULL,
+                                    DIRECTION_WEIGHTED(PIOLA_MODEL_OGDEN) ? wgt : NULL);
     case PIOLA_MODEL_ROTATED_LINEAR:
-      return model_modulus(PIOLA_MODEL_ROTATED_LINEAR, energy, m, f0, f1, f2);
+      return model_modulus_weighted(PIOLA_MODEL_ROTATED_LINEAR, energy, m, f0, f1, f2, NULL,
+                                    DIRECTION_WEIGHTED(PIOLA_MODEL_ROTATED_LINEAR) ? wgt : NULL);
     default: abort(); /* every model has its case: a new one must get its modulus */
   }
 }
 
-static double material_modulus(const piola_material *m, double f0, double f1, double f2) {
+static double material_modulus(const piola_material *m, double f0, double f1, double f2, const double *wgt) {
   switch (m->inversion_mode) {
-    case PIOLA_INVERSION_ENERGY: return mode_modulus(STEP_EXTENSION_ENERGY, m, f0, f1, f2);
+    case PIOLA_INVERSION_ENERGY: return mode_modulus(STEP_EXTENSION_ENERGY, m, f0, f1, f2, wgt);
     case PIOLA_INVERSION_LINEAR: /* with no entry clamped, the CLAMP numbers (linear_range) */
       return mode_modulus(lane_unclamped(m, f0, f1, f2) ? STEP_EXTENSION_CLAMP : STEP_EXTENSION_LINEAR,
-                          m, f0, f1, f2);
-    default: return mode_modulus(STEP_EXTENSION_CLAMP, m, f0, f1, f2);
+                          m, f0, f1, f2, wgt);
+    default: return mode_modulus(STEP_EXTENSION_CLAMP, m, f0, f1, f2, wgt);
   }
 }
 
@@ -287,20 +354,42 @@ double PIOLA_ISA_NAME(piola__elastic_body_tet_rest_altitude)(const piola_elastic
 double PIOLA_ISA_NAME(piola__elastic_body_tet_modulus)(const piola_elastic_body *body, int32_t tet,
                                                       const double fhat[3]) {
   const piola_material *m = &body->materials[body->tet_material[tet]];
-  const double k = material_modulus(m, fhat[0], fhat[1], fhat[2]);
+  const double k = material_modulus(m, fhat[0], fhat[1], fhat[2], NULL);
   return m->model == PIOLA_MODEL_HGO ? k + hgo_tet_fiber_modulus(body, m, tet, fhat) : k;
 }
 
-/* 1 / (rho h_e^2) per tet, from the rest Dm^-1 (before plasticity changes it): built once. */
+double PIOLA_ISA_NAME(piola__elastic_body_tet_state_rate2)(const piola_elastic_body *body, int32_t tet) {
+  const piola_material *m = &body->materials[body->tet_material[tet]];
+  const double *f = body->fhat + 3 * tet, *gram = direction_gram(body);
+  if (!gram || !DIRECTION_WEIGHTED(m->model))
+    return body->step_weight[tet] * PIOLA_ISA_NAME(piola__elastic_body_tet_modulus)(body, tet, f);
+  double wgt[3];
+  step_direction_weights(gram + tet, body->tet_count, body->v[0] + tet, body->padded_tet_count, wgt);
+  return body->step_weight[tet] * material_modulus(m, f[0], f[1], f[2], wgt);
+}
+
+/* 1 / (rho h_e^2) per tet and the Gram arrays of the direction weights, from the rest Dm^-1
+ * (before plasticity changes it): built once. */
 static const double *rate_weights(piola_elastic_body *body) {
   if (!body->step_weight) {
     double *w = malloc((size_t)(body->tet_count > 0 ? body->tet_count : 1) * sizeof *w);
     if (!w) return NULL;
+    double *gram = malloc(6 * (size_t)(body->tet_count > 0 ? body->tet_count : 1) * sizeof *gram);
+    if (!gram) {
+      free(w);
+      return NULL;
+    }
     for (int32_t t = 0; t < body->tet_count; ++t) {
       const double h = PIOLA_ISA_NAME(piola__elastic_body_tet_rest_altitude)(body, t);
       w[t] = 1.0 / (body->density * h * h);
+      double g[3][3], e[6];
+      for (int r = 0; r < 3; ++r)
+        for (int k = 0; k < 3; ++k) g[r][k] = body->dm_inv[3 * r + k][t];
+      step_gram_of(g, e);
+      for (int k = 0; k < 6; ++k) gram[(size_t)k * (size_t)body->tet_count + (size_t)t] = e[k];
     }
     body->step_weight = w;
+    body->step_gram = gram;
   }
   return body->step_weight;
 }
@@ -388,19 +477,113 @@ static double ogden_range(const piola_elastic_body *body, int energy, const piol
   return best;
 }
 
+/* max(best, w_t k_t) with the LINEAR extension, the direction weights where GRAM is not NULL
+ * and they can matter (a stiff tet whose unweighted term is above BEST, as in weighted_range). */
+STABLE_STEP_KERNEL double linear_tet_rate(piola_material_model model, const piola_elastic_body *body,
+                                          const piola_material *m, const double *gram, const double *f,
+                                          const double *w, int32_t t, double best) {
+  const double *ft = f + 3 * t;
+  const double k = model_modulus(model, STEP_EXTENSION_LINEAR, m, ft[0], ft[1], ft[2]);
+  double r = w[t] * k;
+  if (gram && DIRECTION_WEIGHTED(model) && r > best && k > STIFF_FACTOR * (m->lambda + 2.0 * m->mu))
+    r = w[t] * weighted_lane_modulus(model, STEP_EXTENSION_LINEAR, m, body, gram, t, ft);
+  return r > best ? r : best;
+}
+
+/* Whether no entry of the block of tets from t is below the threshold (the LINEAR extension
+ * then gives the CLAMP numbers). */
+STABLE_STEP_KERNEL int block_unclamped(const piola_material *m, const double *f, int32_t t) {
+  int plain = 1;
+#pragma omp simd reduction(&:plain)
+  for (int l = 0; l < PIOLA_TET_BLOCK; ++l)
+    plain &= lane_unclamped(m, f[3 * (t + l)], f[3 * (t + l) + 1], f[3 * (t + l) + 2]);
+  return plain;
+}
+
+/* One block [t, e) of weighted_range: max(best, its terms with the direction weights). LINEAR
+ * blocks with a clamped entry (or a short one) go tet by tet (linear_tet_rate). */
+STABLE_STEP_KERNEL double weighted_block(piola_material_model model, int energy, const piola_material *m,
+                                         const piola_elastic_body *body, const double *gram,
+                                         const double *f, const double *w, int32_t t, int32_t e,
+                                         double best) {
+  if (energy == STEP_EXTENSION_LINEAR && !(e - t == PIOLA_TET_BLOCK && block_unclamped(m, f, t))) {
+    for (int32_t u = t; u < e; ++u) best = linear_tet_rate(model, body, m, gram, f, w, u, best);
+    return best;
+  }
+  const int ext = energy == STEP_EXTENSION_LINEAR ? STEP_EXTENSION_CLAMP : energy;
+#pragma omp simd reduction(max:best)
+  for (int32_t u = t; u < e; ++u) {
+    const double r = w[u] * weighted_lane_modulus(model, ext, m, body, gram, u, f + 3 * u);
+    best = r > best ? r : best;
+  }
+  return best;
+}
+
+/* Blocks a chunk of weighted_range holds: their stiff maxima stay on the stack. */
+enum { WEIGHTED_CHUNK = 64 };
+
+/* max over tets [t0, t1) of w_e k_e with the direction weights (GRAM not NULL), exact. The
+ * weighted term is at most the unweighted one (min(k, k_w)) and differs from it only above
+ * STIFF_FACTOR. So the unweighted lane loop runs first, block by block, and splits the
+ * unweighted maximum into the exact terms of the tets not above it (BEST) and, per block, an
+ * upper bound of the stiff ones' (HIGH); a chunk's blocks whose HIGH is above the BEST so far
+ * then take the weights (weighted_block). Near rest no tet is stiff and the bound costs the
+ * unweighted loop alone; in a stretched state only the blocks that beat the running maximum
+ * pay. LINEAR blocks with no clamped entry take the CLAMP numbers (linear_range). */
+STABLE_STEP_KERNEL double weighted_range(piola_material_model model, int energy, const piola_material *m,
+                                         const piola_elastic_body *body, const double *gram,
+                                         const double *f, const double *w, int32_t t0, int32_t t1) {
+  const double stiff = STIFF_FACTOR * (m->lambda + 2.0 * m->mu);
+  const int ext = energy == STEP_EXTENSION_LINEAR ? STEP_EXTENSION_CLAMP : energy;
+  double best = 0;
+  for (int32_t c0 = t0; c0 < t1; c0 += WEIGHTED_CHUNK * PIOLA_TET_BLOCK) {
+    const int32_t c1 = t1 - c0 < WEIGHTED_CHUNK * PIOLA_TET_BLOCK ? t1 : c0 + WEIGHTED_CHUNK * PIOLA_TET_BLOCK;
+    double high[WEIGHTED_CHUNK], chunk_high = 0;
+    for (int32_t t = c0; t < c1; t += PIOLA_TET_BLOCK) {
+      const int32_t e = c1 - t < PIOLA_TET_BLOCK ? c1 : t + PIOLA_TET_BLOCK;
+      double h = 0;
+      if (energy == STEP_EXTENSION_LINEAR && !(e - t == PIOLA_TET_BLOCK && block_unclamped(m, f, t))) {
+        for (int32_t u = t; u < e; ++u) {
+          const double *fu = f + 3 * u;
+          const double k = model_modulus(model, STEP_EXTENSION_LINEAR, m, fu[0], fu[1], fu[2]);
+          const double r = w[u] * k;
+          if (k > stiff) h = r > h ? r : h;
+          else best = r > best ? r : best;
+        }
+      } else {
+#pragma omp simd reduction(max:best) reduction(max:h)
+        for (int32_t u = t; u < e; ++u) {
+          const double k = model_modulus(model, ext, m, f[3 * u], f[3 * u + 1], f[3 * u + 2]);
+          const double r = w[u] * k;
+          const int above = k > stiff;
+          best = !above && r > best ? r : best;
+          h = above && r > h ? r : h;
+        }
+      }
+      high[(t - c0) / PIOLA_TET_BLOCK] = h;
+      chunk_high = h > chunk_high ? h : chunk_high;
+    }
+    if (!(chunk_high > best)) continue;
+    for (int32_t t = c0; t < c1; t += PIOLA_TET_BLOCK)
+      if (high[(t - c0) / PIOLA_TET_BLOCK] > best)
+        best = weighted_block(model, energy, m, body, gram, f, w, t, c1 - t < PIOLA_TET_BLOCK ? c1 : t + PIOLA_TET_BLOCK, best);
+  }
+  return best;
+}
+
 /* LINEAR by blocks of PIOLA_TET_BLOCK: a block with no entry below the threshold takes the
  * CLAMP instantiation, the same numbers there (the extension's terms vanish) without the
  * LINEAR slopes' three extra evaluations of the clamped point (linear_extension_slopes). */
-STABLE_STEP_KERNEL double linear_range(piola_material_model model, const piola_material *m,
-                                       const double *f, const double *w, int32_t begin, int32_t end) {
+STABLE_STEP_KERNEL double linear_range(piola_material_model model, const piola_elastic_body *body,
+                                       const piola_material *m, const double *f, const double *w,
+                                       int32_t begin, int32_t end) {
+  const double *gram = direction_gram(body);
+  if (DIRECTION_WEIGHTED(model) && gram)
+    return weighted_range(model, STEP_EXTENSION_LINEAR, m, body, gram, f, w, begin, end);
   double best = 0;
   int32_t t = begin;
   for (; t + PIOLA_TET_BLOCK <= end; t += PIOLA_TET_BLOCK) {
-    int plain = 1;
-#pragma omp simd reduction(&:plain)
-    for (int l = 0; l < PIOLA_TET_BLOCK; ++l)
-      plain &= lane_unclamped(m, f[3 * (t + l)], f[3 * (t + l) + 1], f[3 * (t + l) + 2]);
-    if (plain) {
+    if (block_unclamped(m, f, t)) {
 #pragma omp simd reduction(max:best)
       for (int l = 0; l < PIOLA_TET_BLOCK; ++l) {
         const double *fl = f + 3 * (t + l);
@@ -423,7 +606,8 @@ STABLE_STEP_KERNEL double linear_range(piola_material_model model, const piola_m
 }
 
 #define MODEL_LANE_LOOP(model)                                                                  \
-  if (energy == STEP_EXTENSION_LINEAR) return linear_range(model, m, f, w, begin, end);         \
+  if (energy == STEP_EXTENSION_LINEAR) return linear_range(model, body, m, f, w, begin, end);   \
+  if (DIRECTION_WEIGHTED(model) && gram) return weighted_range(model, energy, m, body, gram, f, w, begin, end); \
   _Pragma("omp simd reduction(max:best)") for (int32_t t = begin; t < end; ++t) {               \
     const double r = w[t] * model_modulus(model, energy, m, f[3 * t], f[3 * t + 1], f[3 * t + 2]); \
     best = r > best ? r : best;                                                                 \
@@ -435,6 +619,7 @@ STABLE_STEP_KERNEL double linear_range(piola_material_model model, const piola_m
 STABLE_STEP_KERNEL double uniform_range_rate2(const piola_elastic_body *body, int energy,
                                               const piola_material *m, const double *f,
                                               const double *w, int32_t begin, int32_t end) {
+  const double *gram = direction_gram(body);
   double best = 0;
   switch (m->model) {
     case PIOLA_MODEL_COROTATED: MODEL_LANE_LOOP(PIOLA_MODEL_COROTATED)
@@ -479,7 +664,7 @@ static double range_rate2(const piola_elastic_body *body, const double *w, int32
     }
   } else {
     for (int32_t t = begin; t < end; ++t) {
-      const double r = w[t] * PIOLA_ISA_NAME(piola__elastic_body_tet_modulus)(body, t, f + 3 * t);
+      const double r = PIOLA_ISA_NAME(piola__elastic_body_tet_state_rate2)(body, t);
       best = r > best ? r : best;
     }
   }
@@ -495,7 +680,7 @@ static int32_t near_tet_in(const piola_elastic_body *body, const double *w, int3
                            int32_t end, double best) {
   if (!(range_rate2(body, w, begin, end) >= best * (1 - 1e-10))) return -1;
   for (int32_t t = begin; t < end; ++t)
-    if (w[t] * PIOLA_ISA_NAME(piola__elastic_body_tet_modulus)(body, t, body->fhat + 3 * t) >= best * (1 - 1e-12))
+    if (PIOLA_ISA_NAME(piola__elastic_body_tet_state_rate2)(body, t) >= best * (1 - 1e-12))
       return t;
   return -1;
 }

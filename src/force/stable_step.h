@@ -21,6 +21,8 @@ PIOLA_ISA_DECLARE(double, piola__elastic_body_state_rate2,
                   (piola_elastic_body * body, int32_t *worst_tet));
 PIOLA_ISA_DECLARE(double, piola__elastic_body_tet_modulus,
                   (const piola_elastic_body *body, int32_t tet, const double fhat[3]));
+PIOLA_ISA_DECLARE(double, piola__elastic_body_tet_state_rate2,
+                  (const piola_elastic_body *body, int32_t tet));
 PIOLA_ISA_DECLARE(double, piola__elastic_body_tet_rest_altitude,
                   (const piola_elastic_body *body, int32_t tet));
 
@@ -32,6 +34,11 @@ double piola__elastic_body_state_rate2(piola_elastic_body *body, int32_t *worst_
 /* The modulus k_e (Pa) of one tet at Fhat fhat (the per-tet term of the bound), scale 1. */
 double piola__elastic_body_tet_modulus(const piola_elastic_body *body, int32_t tet,
                                        const double fhat[3]);
+
+/* The term of tet `tet` in piola__elastic_body_state_rate2 (1/s^2, scale 1): its weight
+ * 1 / (rho h_e^2) times its modulus at its stored Fhat, with the direction weights of its
+ * model (stable_step_anisotropy.h). Valid after a state_rate2 call has built the weights. */
+double piola__elastic_body_tet_state_rate2(const piola_elastic_body *body, int32_t tet);
 
 /* Rest altitude of tet t, 1 / max_c |grad N_c| (m), from its rest Dm^-1. */
 double piola__elastic_body_tet_rest_altitude(const piola_elastic_body *body, int32_t tet);

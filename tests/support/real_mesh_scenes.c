@@ -2,7 +2,9 @@
 #include "test_support.h"
 
 #include <math.h>
+#include <stdlib.h>
 #include <string.h>
+#include <time.h>
 
 #include "piola/elastic_body.h"
 #include "piola/mesh_io.h"
@@ -45,4 +47,48 @@ int real_mesh_solid_finite(const piola_world *w) {
   for (int64_t j = 0; j < 3 * (int64_t)n; ++j)
     if (!isfinite(x[j]) || !isfinite(v[j])) return 0;
   return 1;
+}
+
+static double total_energy(const piola_world *w) {
+  const piola_solid_stats s = piola_world_solid_stats(w, 0);
+  return s.kinetic_energy + s.elastic_energy;
+}
+
+void real_mesh_scramble_run(const piola_tet_mesh *mesh, const char *name, piola_material_model model,
+                            double radius, double seconds, const double *fibers) {
+  piola_world_def wd = piola_default_world_def();
+  for (int i = 0; i < 3; ++i) wd.gravity[i] = piola_track_constant(0);
+  piola_world *w = NULL;
+  assert_int_equal(piola_world_create(&wd, &w), PIOLA_OK);
+  piola_solid_def sd = piola_default_solid_def();
+  sd.mesh = mesh;
+  sd.material = real_mesh_material_def(model, 2e4, 0.3);
+  sd.density = 1000;
+  sd.shear_viscosity = sd.bulk_viscosity = piola_track_constant(1000);
+  sd.scramble_radius = radius;
+  if (model == PIOLA_MODEL_HGO) sd.fiber_directions = fibers;
+  if (piola_world_add_solid(w, &sd, NULL) != PIOLA_OK)
+    fail_msg("%s %s: %s", name, piola_material_model_name(model), piola_last_error());
+  const double e0 = total_energy(w);
+  double highest = e0;
+  piola_step_stats st = {0};
+  const clock_t c0 = clock();
+  for (int frame = 1; frame <= 20; ++frame) {
+    piola_step_stats fs = {0};
+    if (piola_world_advance_to(w, seconds * frame / 20, &fs) != PIOLA_OK || !real_mesh_solid_finite(w))
+      fail_msg("%s, %s, scramble %g m, at %g s: %s", name, piola_material_model_name(model), radius,
+               seconds * frame / 20, piola_last_error());
+    st.substeps += fs.substeps, st.energy_redos += fs.energy_redos, st.step_retries += fs.step_retries;
+    highest = fmax(highest, total_energy(w));
+  }
+  if (getenv("PIOLA_TEST_VERBOSE"))
+    print_message("%-22s %-17s %4.2f m, %4.2f s: %8d steps, %3d redos, %d retries, energy %.3g -> %.3g J "
+                  "(highest %.3g), %.2f s CPU\n",
+                  name, piola_material_model_name(model), radius, seconds, (int)st.substeps,
+                  (int)st.energy_redos, (int)st.step_retries, e0, total_energy(w), highest,
+                  (double)(clock() - c0) / CLOCKS_PER_SEC);
+  if (!(highest <= 1.05 * e0))
+    fail_msg("%s, %s, scramble %g m: total energy rose from %g J to %g J", name,
+             piola_material_model_name(model), radius, e0, highest);
+  piola_world_destroy(w);
 }

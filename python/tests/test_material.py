@@ -190,7 +190,9 @@ def test_hgo_fibre_stress_is_energy_gradient(kappa):
     mat = piola.Material("hgo", poisson_ratio=0.45,
                          hgo={"k1": 2e4, "k2": 2.0, "kappa": kappa, "fiber_angle_degrees": 35})
     F = random_f(rng, 80, 0.2)
-    F = F[np.linalg.svd(F, compute_uv=False).min(axis=1) > 0.45]
+    # above HGO's default threshold at its highest (0.5 once J has fallen, materials.md), where
+    # no entry is clamped and the stress is the energy's gradient
+    F = F[np.linalg.svd(F, compute_uv=False).min(axis=1) > 0.55]
     fibers = rng.standard_normal((len(F), 3))
     fibers[:, 0] += 0.5  # never along the axis z
     P = mat.stress(F, fibers=fibers)

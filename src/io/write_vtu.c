@@ -21,18 +21,38 @@ static piola_status check_field(const char *path, const piola_vtu_field *f, cons
   return PIOLA_OK;
 }
 
-static void write_array_header(FILE *o, const char *type, const char *name, int components, uint64_t *offset,
-                               uint64_t bytes) {
-  fprintf(o, "        <DataArray type=\"%s\"", type);
-  if (name) fprintf(o, " Name=\"%s\"", name);
-  fprintf(o, " NumberOfComponents=\"%d\" format=\"appended\" offset=\"%llu\"/>\n", components,
-          (unsigned long long)*offset);
-  *offset += 8 + bytes;
+/* One appended DataArray: its header's attributes and the block it points to. */
+typedef struct {
+  const char *type, *name;
+  int components;
+  const void *data;
+  uint64_t bytes, offset;
+} vtu_array;
+
+static void write_array_header(FILE *o, const vtu_array *a) {
+  fprintf(o, "        <DataArray type=\"%s\" Name=\"%s\"", a->type, a->name);
+  fprintf(o, " NumberOfComponents=\"%d\" format=\"appended\" offset=\"%llu\"/>\n", a->components,
+          (unsigned long long)a->offset);
 }
 
-static void write_block(FILE *o, const void *data, uint64_t bytes) {
-  fwrite(&bytes, 8, 1, o);
-  if (bytes) fwrite(data, 1, (size_t)bytes, o);
+static void write_block(FILE *o, const vtu_array *a) {
+  fwrite(&a->bytes, 8, 1, o);
+  if (a->bytes) fwrite(a->data, 1, (size_t)a->bytes, o);
+}
+
+/* The blocks go into the appended section in the reverse of the headers' order, the last
+ * header's block at offset 0. VTK reads each block at its offset in any order; meshio 5
+ * rewrites raw blocks to base64 in offset order and hands each block to the first header
+ * (document order) whose offset attribute equals the block's raw offset, so with blocks in
+ * header order a header already moved to its base64 offset can take a later block's data
+ * (docs/file-formats.md). In reverse order every header still unmoved comes before every
+ * moved one, and the match is always the block's own header. */
+static void place_blocks_last_first(vtu_array *arrays, int count) {
+  uint64_t offset = 0;
+  for (int i = count - 1; i >= 0; --i) {
+    arrays[i].offset = offset;
+    offset += 8 + arrays[i].bytes;
+  }
 }
 
 piola_status piola_vtu_write(const char *path, const piola_vtu_frame *frame) {
@@ -79,48 +99,56 @@ piola_status piola_vtu_write(const char *path, const piola_vtu_frame *frame) {
     types[nt + t] = 5;
   }
 
+  /* headers in the order the schema asks: point data, cell data, points, cells */
+  int count = 0, field_count = frame->point_field_count + frame->cell_field_count;
+  vtu_array *arrays = malloc((size_t)(field_count + 4) * sizeof *arrays);
+  if (!arrays) {
+    free(points);
+    free(connectivity);
+    free(offsets);
+    free(types);
+    return PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "%s: out of memory", path);
+  }
+  for (int i = 0; i < frame->point_field_count; ++i) {
+    const piola_vtu_field *fd = &frame->point_fields[i];
+    arrays[count++] = (vtu_array){"Float64", fd->name, fd->components, fd->values,
+                                  np * (uint64_t)fd->components * 8, 0};
+  }
+  for (int i = 0; i < frame->cell_field_count; ++i) {
+    const piola_vtu_field *fd = &frame->cell_fields[i];
+    arrays[count++] = (vtu_array){"Float64", fd->name, fd->components, fd->values,
+                                  nc * (uint64_t)fd->components * 8, 0};
+  }
+  const int points_at = count;
+  arrays[count++] = (vtu_array){"Float64", "Points", 3, points, 3 * np * 8, 0};
+  arrays[count++] = (vtu_array){"Int64", "connectivity", 1, connectivity, c * 8, 0};
+  arrays[count++] = (vtu_array){"Int64", "offsets", 1, offsets, nc * 8, 0};
+  arrays[count++] = (vtu_array){"UInt8", "types", 1, types, nc, 0};
+  place_blocks_last_first(arrays, count);
+
   piola_atomic_file f;
   piola_status s = piola_atomic_file_open(&f, path);
   if (s == PIOLA_OK) {
     FILE *o = f.stream;
-    uint64_t offset = 0;
     fprintf(o, "<?xml version=\"1.0\"?>\n"
                "<VTKFile type=\"UnstructuredGrid\" version=\"1.0\" byte_order=\"LittleEndian\" "
                "header_type=\"UInt64\">\n  <UnstructuredGrid>\n");
     fprintf(o, "    <Piece NumberOfPoints=\"%llu\" NumberOfCells=\"%llu\">\n", (unsigned long long)np,
             (unsigned long long)nc);
     fprintf(o, "      <PointData>\n");
-    for (int i = 0; i < frame->point_field_count; ++i) {
-      const piola_vtu_field *fd = &frame->point_fields[i];
-      write_array_header(o, "Float64", fd->name, fd->components, &offset, np * (uint64_t)fd->components * 8);
-    }
+    for (int i = 0; i < frame->point_field_count; ++i) write_array_header(o, &arrays[i]);
     fprintf(o, "      </PointData>\n      <CellData>\n");
-    for (int i = 0; i < frame->cell_field_count; ++i) {
-      const piola_vtu_field *fd = &frame->cell_fields[i];
-      write_array_header(o, "Float64", fd->name, fd->components, &offset, nc * (uint64_t)fd->components * 8);
-    }
+    for (int i = frame->point_field_count; i < points_at; ++i) write_array_header(o, &arrays[i]);
     fprintf(o, "      </CellData>\n      <Points>\n");
-    write_array_header(o, "Float64", "Points", 3, &offset, 3 * np * 8);
+    write_array_header(o, &arrays[points_at]);
     fprintf(o, "      </Points>\n      <Cells>\n");
-    write_array_header(o, "Int64", "connectivity", 1, &offset, c * 8);
-    write_array_header(o, "Int64", "offsets", 1, &offset, nc * 8);
-    write_array_header(o, "UInt8", "types", 1, &offset, nc);
+    for (int i = points_at + 1; i < count; ++i) write_array_header(o, &arrays[i]);
     fprintf(o, "      </Cells>\n    </Piece>\n  </UnstructuredGrid>\n  <AppendedData encoding=\"raw\">\n   _");
-    for (int i = 0; i < frame->point_field_count; ++i) {
-      const piola_vtu_field *fd = &frame->point_fields[i];
-      write_block(o, fd->values, np * (uint64_t)fd->components * 8);
-    }
-    for (int i = 0; i < frame->cell_field_count; ++i) {
-      const piola_vtu_field *fd = &frame->cell_fields[i];
-      write_block(o, fd->values, nc * (uint64_t)fd->components * 8);
-    }
-    write_block(o, points, 3 * np * 8);
-    write_block(o, connectivity, c * 8);
-    write_block(o, offsets, nc * 8);
-    write_block(o, types, nc);
+    for (int i = count - 1; i >= 0; --i) write_block(o, &arrays[i]);
     fprintf(o, "\n  </AppendedData>\n</VTKFile>\n");
     s = piola_atomic_file_commit(&f);
   }
+  free(arrays);
   free(points);
   free(connectivity);
   free(offsets);

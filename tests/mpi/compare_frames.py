@@ -8,8 +8,7 @@ the same frame files. With PIECES (a split run of that many processes), DIR_B mu
 per frame of A, frames/frame_NNNN.pvtu and its pieces frames/frame_NNNN_pK.vtu for
 K < PIECES and no frame_NNNN.vtu, and sim.pvd must list the .pvtu files with A's times.
 Each .pvtu is read with VTK (vtkXMLPUnstructuredGridReader merges the pieces) and its pieces
-with meshio, which must agree (but where meshio 5 would misread a piece, see
-meshio_misreads: such frames are counted and checked through VTK only); the merged dataset, put in the whole frame's order by its
+with meshio, which must agree array for array; the merged dataset, put in the whole frame's order by its
 cell_id and point_id fields, must be A's frame: the same cells (count, vertices), every
 point of a cell present, and a node on the border of pieces the same in each.
 
@@ -34,9 +33,6 @@ class Mismatch(Exception):
     pass
 
 
-MESHIO_SKIPPED = []  # frames with a piece meshio 5 would misread (meshio_misreads)
-
-
 def read_pvtu_vtk(path):
     """The merged dataset of a .pvtu as numpy arrays, read by VTK."""
     from vtkmodules.util.numpy_support import vtk_to_numpy
@@ -56,37 +52,12 @@ def read_pvtu_vtk(path):
     return points, conn, point_data, cell_data
 
 
-def meshio_misreads(path):
-    """Whether meshio 5 would give a DataArray of this raw-appended VTU another's data: it
-    walks the appended blocks in order, finds the first DataArray (document order) whose
-    offset attribute is the block's raw offset and sets it to the block's offset in its
-    base64 rewrite, so an array already rewritten to a later block's raw offset takes that
-    block (a meshio defect, not one of the file; VTK reads such files right)."""
-    raw = open(path, "rb").read()
-    start = raw.index(b'<AppendedData encoding="raw">')
-    header = raw[:start].decode()
-    data = raw[raw.index(b"_", start) + 1:]
-    tags = [int(o) for o in re.findall(r'<DataArray[^>]*offset="(\d+)"', header)]
-    current, rewritten = list(tags), 0
-    for raw_offset in sorted(tags):
-        first = current.index(raw_offset)
-        if tags[first] != raw_offset:
-            return True
-        size = int(np.frombuffer(data[raw_offset:raw_offset + 8], "<u8")[0])
-        current[first] = rewritten
-        rewritten += 4 * ((size + 8 + 2) // 3)
-    return False
-
-
 def read_pieces_meshio(pvtu):
-    """The pieces a .pvtu names, read by meshio and concatenated; None for a piece meshio 5
-    would misread (meshio_misreads)."""
+    """The pieces a .pvtu names, read by meshio and concatenated."""
     folder = os.path.dirname(pvtu)
     sources = re.findall(r'<Piece Source="([^"]+)"', open(pvtu).read())
     points, conn, point_data, cell_data, offset = [], [], {}, {}, 0
     for src in sources:
-        if meshio_misreads(os.path.join(folder, src)):
-            return None, None, None, None, sources
         m = meshio.read(os.path.join(folder, src))
         points.append(m.points)
         tets = [c.data for c in m.cells if c.type == "tetra"]
@@ -107,14 +78,12 @@ def whole_frame(pvtu, pieces, ma):
     name = os.path.basename(pvtu)
     if len(sources) != pieces:
         raise Mismatch(f"{name}: {len(sources)} pieces, expected {pieces}")
-    if m_points is None:
-        MESHIO_SKIPPED.append(name)
-    elif not (np.array_equal(points, m_points) and np.array_equal(conn, m_conn)):
+    if not (np.array_equal(points, m_points) and np.array_equal(conn, m_conn)):
         raise Mismatch(f"{name}: VTK and meshio read different datasets")
-    for key in pdata if m_points is not None else ():
+    for key in pdata:
         if not np.array_equal(np.asarray(pdata[key]).reshape(m_pdata[key].shape), m_pdata[key]):
             raise Mismatch(f"{name}: VTK and meshio differ in point field {key}")
-    for key in cdata if m_points is not None else ():
+    for key in cdata:
         if not np.array_equal(np.asarray(cdata[key]).reshape(-1), m_cdata[key]):
             raise Mismatch(f"{name}: VTK and meshio differ in cell field {key}")
     a_tets = np.concatenate([c.data for c in ma.cells if c.type == "tetra"])
@@ -147,8 +116,6 @@ def whole_frame(pvtu, pieces, ma):
 
 
 def compare_frame(a, b, name, tol, pieces):
-    if meshio_misreads(os.path.join(a, "frames", name)):
-        raise Mismatch(f"{name}: meshio 5 would misread this frame of {a} (meshio_misreads)")
     ma = meshio.read(os.path.join(a, "frames", name))
     if pieces:
         pvtu = os.path.join(b, "frames", name[:-4] + ".pvtu")
@@ -246,8 +213,7 @@ def main():
                 return 1
     print(f"{len(names)} frames{f' of {pieces} pieces' if pieces else ''}, largest relative "
           f"difference {worst:.3g}, {identical} bit-identical; stats.csv agrees (self-collision "
-          f"contacts {contacts[0]} and {contacts[1]})"
-          + (f"; meshio skipped for {len(MESHIO_SKIPPED)} frames (its offset defect)" if MESHIO_SKIPPED else ""))
+          f"contacts {contacts[0]} and {contacts[1]})")
     return 0
 
 

@@ -14,7 +14,8 @@
  * steps (4.6 s).
  *
  * PIOLA_TEST_SCALE scales the 2 s (at least 0.02 s; the stiff start is much of the cost, so a
- * twentieth of the time still costs a third: 61,293 steps on bar-186); PIOLA_TEST_VERBOSE prints steps and CPU time. */
+ * twentieth of the time still costs a third: 61,293 steps on bar-186); PIOLA_TEST_VERBOSE
+ * prints steps and CPU time. */
 #include "test_support.h"
 
 #include "piola/threads.h"

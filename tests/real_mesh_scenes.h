@@ -1,7 +1,7 @@
-/* Real meshes of ../shared/data as the issue 21 acceptance tests use them
- * (test_never_blow_up.c, test_scrambles_every_model.c, test_scrambles_slivers.c): a mesh moved and scaled to a given
- * bounding-box diagonal, one material for every model at the same rest shear modulus, the
- * finiteness of a solid's state, and one scramble run. */
+/* Real meshes of ../shared/data as the issue 21 acceptance tests use them (test_never_blow_up.c,
+ * test_scrambles_every_model.c, test_scrambles_slivers.c, test_scrambles_stable_neohookean.c): a
+ * mesh moved and scaled to a given bounding-box diagonal, one material for every model at the
+ * same rest shear modulus, the finiteness of a solid's state, and one scramble run. */
 #ifndef PIOLA_TEST_REAL_MESH_SCENES_H
 #define PIOLA_TEST_REAL_MESH_SCENES_H
 
@@ -22,14 +22,21 @@ piola_material_def real_mesh_material_def(piola_material_model model, double you
 int real_mesh_solid_finite(const piola_world *w);
 
 /* One scramble run of the issue 21 done-when (test_scrambles_every_model.c,
- * test_scrambles_slivers.c): `mesh` (as real_mesh_scaled gives it, named `name` in messages),
- * E = 20 kPa, nu = 0.3, 1000 kg/m^3, shear and bulk viscosity 1000 Pa s, no gravity, the
- * model's default inversion, scrambled by `radius` (m), `fibers` (3 per tet, HGO only, may be
- * NULL), run for `seconds` with piola's explicit integrator in 20 frames. Fails the test unless
- * every frame succeeds with a finite state and the total energy never rises above 1.05 times
- * the start's (nothing adds work; 5% for the LINEAR extension's work without a potential,
- * docs/time-stepping.md "What is not physics"). PIOLA_TEST_VERBOSE prints steps and CPU time. */
+ * test_scrambles_slivers.c, test_scrambles_stable_neohookean.c): `mesh` (as real_mesh_scaled
+ * gives it, named `name` in messages), E = 20 kPa, nu = 0.3, 1000 kg/m^3, shear and bulk
+ * viscosity 1000 Pa s, no gravity, the model's default inversion, scrambled by `radius` (m),
+ * `fibers` (3 per tet, HGO only, may be NULL), run for `seconds` with piola's explicit integrator
+ * in 20 frames. Fails the test unless every frame succeeds with a finite state and the total
+ * energy never rises above 1.05 times the start's (nothing adds work; 5% for the LINEAR
+ * extension's work without a potential, docs/time-stepping.md "What is not physics").
+ * PIOLA_TEST_VERBOSE prints steps and CPU time. */
 void real_mesh_scramble_run(const piola_tet_mesh *mesh, const char *name, piola_material_model model,
                             double radius, double seconds, const double *fibers);
+
+/* real_mesh_scramble_run for each of `count` models (no fibres) on the mesh at `relative`
+ * scaled to `diagonal` (m), scrambled by `radius` (m), for 2 s scaled by PIOLA_TEST_SCALE (at
+ * least 0.02 s); PIOLA_TEST_MODEL (a model's name) selects one. */
+void real_mesh_scramble_models(const char *relative, double diagonal,
+                               const piola_material_model *models, int count, double radius);
 
 #endif

@@ -14,13 +14,13 @@
  * fibres (its passive fibre modulus in the bound), HGO with fibres along x.
  *
  * Every run is 2 s, except on the two sliver meshes, where corotated, the spline and Stable
- * Neo-Hookean run from half a diagonal only here; test_scrambles_slivers.c runs corotated and
- * the spline on bar-186 from one diagonal. The rest take minutes of CPU each (torus.msh,
- * corotated, two diagonals: 187,502 steps for the first 1 s, 47 s of CPU, with the step bound's
- * direction weights), and corotated on bar-186 from two diagonals gained energy (2.8e11 J to
- * 5.3e11 J in its first 0.001 s, 254,258 steps): mostly the CLAMP extension's work without a
- * potential, which the energy check counts as work, plus a part that follows the step
- * (docs/time-stepping.md, "What the test affords"; not fixed).
+ * Neo-Hookean run from half a diagonal only here; test_scrambles_slivers.c and
+ * test_scrambles_stable_neohookean.c run all three from one diagonal. From two diagonals they
+ * take minutes of CPU each (torus.msh, corotated, two diagonals: 187,502 steps for the first 1 s,
+ * 47 s of CPU, with the step bound's direction weights), and corotated on bar-186 from two
+ * diagonals gained energy (2.8e11 J to 5.3e11 J in its first 0.001 s, 254,258 steps): mostly the
+ * CLAMP extension's work without a potential, which the energy check counts as work, plus a part
+ * that follows the step (docs/time-stepping.md, "What the test affords"; not fixed).
  *
  * HGO runs every scramble since its fibres' energy past hgo.fiber_stretch_limit is a spring of
  * constant stiffness (docs/materials.md): before, their exponential made the step bound grow
@@ -67,9 +67,9 @@ static void every_model_runs_every_scramble(void **state) {
         const double radius = (r == 0 ? 0.5 : r == 1 ? 1.0 : 2.0) * DIAGONAL;
         /* On the sliver meshes the models that stiffen without limit under stretch (corotated,
          * the spline and Stable Neo-Hookean with their J terms) take 1e4-1e5 steps per 0.1 s
-         * from one and two diagonals: here they run from half a diagonal only
-         * (test_scrambles_slivers.c runs corotated and the spline on bar-186 from one;
-         * docs/time-stepping.md "What the test affords"). */
+         * from two diagonals (on bar-186 from one as well): here they run from half a diagonal
+         * only (test_scrambles_slivers.c and test_scrambles_stable_neohookean.c run them from
+         * one; docs/time-stepping.md "What the test affords"). */
         const int stiffening = model == PIOLA_MODEL_COROTATED || model == PIOLA_MODEL_SPLINE ||
                                model == PIOLA_MODEL_STABLE_NEOHOOKEAN;
         if (mi > 0 && stiffening && r > 0) continue;

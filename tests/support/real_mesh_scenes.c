@@ -92,3 +92,15 @@ void real_mesh_scramble_run(const piola_tet_mesh *mesh, const char *name, piola_
              piola_material_model_name(model), radius, e0, highest);
   piola_world_destroy(w);
 }
+
+void real_mesh_scramble_models(const char *relative, double diagonal,
+                               const piola_material_model *models, int count, double radius) {
+  const double seconds = fmax(0.02, 2.0 * fmin(test_scale(), 1.0));
+  const char *only = getenv("PIOLA_TEST_MODEL");
+  piola_tet_mesh mesh = real_mesh_scaled(relative, diagonal);
+  for (int k = 0; k < count; ++k) {
+    if (only && strcmp(only, piola_material_model_name(models[k]))) continue;
+    real_mesh_scramble_run(&mesh, relative, models[k], radius, seconds, NULL);
+  }
+  piola_tet_mesh_free(&mesh);
+}

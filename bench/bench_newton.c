@@ -10,7 +10,9 @@
  * setup/refresh) plus the preconditioned CG (to 1e-3 with fixed forcing) (the world's
  * step profile, src/sim/step_profile.h; the line search's force evaluations are not in it),
  * in wall time and in process CPU time (all threads: on a loaded machine the steadier
- * figure). Newmark: the CFL step of the same scene and the median wall time of a step over
+ * figure); per frame also the steps taken and the process CPU split into the profile's
+ * update phase (force evaluations of the line search, residuals, contact passes), assembly,
+ * linear solve and the rest. Newmark: the CFL step of the same scene and the median wall time of a step over
  * `newmark_steps` steps, so the time of one frame is steps per frame times that.
  *
  * With reference = 1 (issue 14's "speed-up at equal visual result"), Newmark instead runs

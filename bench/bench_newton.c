@@ -10,7 +10,9 @@
  * setup/refresh) plus the preconditioned CG (to 1e-3 with fixed forcing) (the world's
  * step profile, src/sim/step_profile.h; the line search's force evaluations are not in it),
  * in wall time and in process CPU time (all threads: on a loaded machine the steadier
- * figure). Newmark: the CFL step of the same scene and the median wall time of a step over
+ * figure); per frame also the steps taken and the process CPU split into the profile's
+ * update phase (force evaluations of the line search, residuals, contact passes), assembly,
+ * linear solve and the rest. Newmark: the CFL step of the same scene and the median wall time of a step over
  * `newmark_steps` steps, so the time of one frame is steps per frame times that.
  *
  * With reference = 1 (issue 14's "speed-up at equal visual result"), Newmark instead runs
@@ -131,10 +133,19 @@ int main(int argc, char **argv) {
     iter_cpu_ms[f - 1] =
         per * (w->profile.cpu[STEP_PHASE_ASSEMBLE] + w->profile.cpu[STEP_PHASE_LINEAR]);
     newton += st.newton_iterations, linear += st.linear_iterations, failures += st.newton_failures;
-    printf("  backward Euler frame %d: %.1f ms (%.1f ms process CPU), %d Newton, %d CG, %d failures; per Newton iteration "
+    printf("  backward Euler frame %d: %.1f ms (%.1f ms process CPU), %d steps, %d Newton, %d CG, %d failures; per Newton iteration "
            "%.1f ms assembly + %.1f ms linear solve\n",
-           f, frame_ms[f - 1], frame_cpu_ms[f - 1], (int)st.newton_iterations, (int)st.linear_iterations,
-           (int)st.newton_failures, assemble_ms[f - 1], solve_ms[f - 1]);
+           f, frame_ms[f - 1], frame_cpu_ms[f - 1], (int)st.substeps, (int)st.newton_iterations,
+           (int)st.linear_iterations, (int)st.newton_failures, assemble_ms[f - 1], solve_ms[f - 1]);
+    /* where the frame's CPU goes: "forces" is the profile's update phase, which in the
+     * implicit step holds the line search's force evaluations and residuals and the
+     * contact passes; "other" is the rest of the frame (set-up, first guess, world phases) */
+    const double *pc = w->profile.cpu;
+    printf("    process CPU: %.1f ms forces and line search, %.1f ms assembly, %.1f ms linear solve, "
+           "%.1f ms other\n",
+           1e3 * pc[STEP_PHASE_UPDATE], 1e3 * pc[STEP_PHASE_ASSEMBLE], 1e3 * pc[STEP_PHASE_LINEAR],
+           frame_cpu_ms[f - 1] -
+               1e3 * (pc[STEP_PHASE_UPDATE] + pc[STEP_PHASE_ASSEMBLE] + pc[STEP_PHASE_LINEAR]));
   }
   double be_frame = bench_median(frame_ms, frames), be_iter = bench_median(iter_ms, frames);
   double be_assemble = bench_median(assemble_ms, frames), be_solve = bench_median(solve_ms, frames);

@@ -540,7 +540,8 @@ static void ogden_bound_reuses_the_force_loop(void **state) {
  * rising from 0.3 to 0.5 as J falls from 0.96 to 0.94) and LINEAR at 0.3; the grid near rest,
  * stretched 2x and 3x (past the fibre stretch limit, 1.7), compressed into the threshold's rise,
  * or scrambled (flat and inverted tets). The update fills the cache for every tet; the bound
- * equals the one computed tet by tet with the cache detached (hgo_bound_follows_the_fibres
+ * (and that of the same body without fibres, all matrix) equals the one computed tet by tet
+ * with the cache detached (hgo_bound_follows_the_fibres
  * checks that term against the dense dP/dF); a tet whose Fhat changes after the update (a
  * state moved in from another process) is not read from its stale slots. */
 static double hgo_rate2_without_cache(piola_elastic_body *body) {
@@ -569,7 +570,9 @@ static void hgo_bound_reuses_the_force_loop(void **state) {
     double *fibers = malloc(sizeof *fibers * 3 * (size_t)nt);
     for (int32_t k = 0; k < 3 * nt; ++k) fibers[k] = test_rng_normal(&rng);
     piola_elastic_body *body = fixture_body_with_fibers(&mesh, &m, 1, NULL, fibers);
+    piola_elastic_body *matrix = fixture_body_with_fibers(&mesh, &m, 1, NULL, NULL); /* no fibres */
     assert_non_null(body->hgo_cache);
+    assert_null(matrix->hgo_cache);
     double *x = malloc(sizeof *x * 3 * (size_t)nv), *f = malloc(sizeof *f * 3 * (size_t)nv);
     for (long start = 0; start < starts; ++start) {
       const int kind = (int)(start % KINDS);
@@ -579,6 +582,12 @@ static void hgo_bound_reuses_the_force_loop(void **state) {
         x[v] = kind == 4 ? test_rng_uniform(&rng, 0, 0.4)
                          : (v % 3 ? across : along) * mesh.positions[v] + 0.002 * test_rng_normal(&rng);
       assert_int_equal(piola_elastic_body_update(body, x, 1.0, f, NULL), PIOLA_OK);
+      /* without fibres: the closed form in the lanes, the general modulus tet by tet */
+      assert_int_equal(piola_elastic_body_update(matrix, x, 1.0, f, NULL), PIOLA_OK);
+      const double lanes = piola__elastic_body_state_rate2(matrix, NULL), tets = per_tet_rate2(matrix);
+      if (!(fabs(lanes - tets) <= 1e-9 * tets))
+        fail_msg("HGO without fibres (%s), start %ld: bound %.17g, per tet %.17g",
+                 piola_inversion_mode_name(m.inversion_mode), start, lanes, tets);
       const double *fhat = piola_elastic_body_fhat(body);
       int below = 0, rising = 0;
       for (int32_t t = 0; t < nt; ++t) {
@@ -601,6 +610,7 @@ static void hgo_bound_reuses_the_force_loop(void **state) {
     }
     free(x), free(f), free(fibers);
     piola_elastic_body_destroy(body);
+    piola_elastic_body_destroy(matrix);
     fixture_mesh_free(&mesh);
   }
 }

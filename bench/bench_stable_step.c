@@ -11,7 +11,9 @@
  * reads the Fhat the update stored, so each pass follows an update as in a step. Medians of
  * wall time and of process CPU time (the latter less disturbed on a loaded machine). Ogden
  * and Mooney-Rivlin run two bodies, interleaved: with the force loop's cache of their powers
- * (what the simulator does) and without it (the bound computing them again). */
+ * (what the simulator does) and without it (the bound computing them again). HGO runs three:
+ * without fibres, with fibres (one direction, across hgo.axis) and the force loop's cache of
+ * their term, and with fibres and no cache (the term computed again tet by tet). */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -24,13 +26,16 @@
 
 /* For the Ogden models a second body without the force loop's cache (its update writes no
  * slots and its bound computes the powers again: the cost before the cache), timed
- * interleaved with the first, one update and one bound of each per repeat. */
-static piola_elastic_body *make_body(const piola_tet_mesh *mesh, const piola_material *material) {
+ * interleaved with the first, one update and one bound of each per repeat; for HGO two more
+ * with fibres FIBERS (3 per tet; NULL: none), with and without the cache. */
+static piola_elastic_body *make_body(const piola_tet_mesh *mesh, const piola_material *material,
+                                     const double *fibers) {
   piola_elastic_body *body = NULL;
   piola_elastic_body_def def = piola_default_elastic_body_def();
   def.rest_mesh = mesh;
   def.materials = material;
   def.material_count = 1;
+  def.fiber_directions = fibers;
   if (piola_elastic_body_create(&def, &body) != PIOLA_OK) {
     fprintf(stderr, "bench_stable_step: %s\n", piola_last_error());
     exit(1);
@@ -50,12 +55,24 @@ static void bench_model(const char *name, const piola_tet_mesh *mesh, piola_mate
     fprintf(stderr, "bench_stable_step: %s\n", piola_last_error());
     exit(1);
   }
-  piola_elastic_body *bodies[2] = {make_body(mesh, &material), NULL};
-  const int variants = bodies[0]->ogden_cache ? 2 : 1;
-  if (variants == 2) {
-    bodies[1] = make_body(mesh, &material);
+  enum { MAX_VARIANTS = 3 };
+  piola_elastic_body *bodies[MAX_VARIANTS] = {make_body(mesh, &material, NULL), NULL, NULL};
+  const char *labels[MAX_VARIANTS] = {"", "", ""};
+  double *fibers = NULL;
+  int variants = 1;
+  if (bodies[0]->ogden_cache) {
+    bodies[1] = make_body(mesh, &material, NULL);
     free(bodies[1]->ogden_cache);
     bodies[1]->ogden_cache = NULL;
+    labels[0] = " (cache)", labels[1] = " (no cache)", variants = 2;
+  } else if (model == PIOLA_MODEL_HGO) {
+    fibers = malloc(sizeof(double) * 3 * (size_t)mesh->tet_count);
+    for (int32_t e = 0; e < mesh->tet_count; ++e) fibers[3 * e] = 1.0, fibers[3 * e + 1] = 0.3, fibers[3 * e + 2] = 0.2;
+    bodies[1] = make_body(mesh, &material, fibers);
+    bodies[2] = make_body(mesh, &material, fibers);
+    free(bodies[2]->hgo_cache);
+    bodies[2]->hgo_cache = NULL;
+    labels[0] = " no fibres", labels[1] = " fibres, cache", labels[2] = " fibres, none", variants = 3;
   }
   const int32_t nv = mesh->vertex_count;
   double *x = malloc(sizeof(double) * 3 * (size_t)nv), *f = malloc(sizeof(double) * 3 * (size_t)nv);
@@ -63,8 +80,8 @@ static void bench_model(const char *name, const piola_tet_mesh *mesh, piola_mate
   const double noise = 0.05 * piola_elastic_body_min_rest_altitude(bodies[0]) * 3;
   for (int32_t i = 0; i < nv; ++i)
     for (int k = 0; k < 3; ++k) x[3 * i + k] = a[k] * mesh->positions[3 * i + k] + noise * bench_uniform(-1, 1);
-  double *t[2][4]; /* per variant: update wall, bound wall, update CPU, bound CPU */
-  for (int b = 0; b < 2; ++b)
+  double *t[MAX_VARIANTS][4]; /* per variant: update wall, bound wall, update CPU, bound CPU */
+  for (int b = 0; b < MAX_VARIANTS; ++b)
     for (int k = 0; k < 4; ++k) t[b][k] = malloc(sizeof(double) * (size_t)repeats);
   for (int threads = 1; threads <= 2; ++threads) {
     piola_set_thread_count(threads);
@@ -82,15 +99,15 @@ static void bench_model(const char *name, const piola_tet_mesh *mesh, piola_mate
       double m[4];
       for (int k = 0; k < 4; ++k) m[k] = bench_median(t[b][k], repeats);
       printf("| %-16s | %-17s%s | %7d | %d | %8.3f | %8.3f | %5.1f%% | %5.1f%% | (%g)\n", name,
-             piola_material_model_name(model), b ? " (no cache)" : variants == 2 ? " (cache)" : "",
+             piola_material_model_name(model), labels[b],
              (int)mesh->tet_count, threads, 1e3 * m[0], 1e3 * m[1], 100 * m[1] / m[0],
              100 * m[3] / m[2], sink > 0 ? 1.0 : 0.0);
     }
   }
   piola_set_thread_count(0);
-  for (int b = 0; b < 2; ++b)
+  for (int b = 0; b < MAX_VARIANTS; ++b)
     for (int k = 0; k < 4; ++k) free(t[b][k]);
-  free(x), free(f);
+  free(x), free(f), free(fibers);
   for (int b = 0; b < variants; ++b) piola_elastic_body_destroy(bodies[b]);
 }
 

@@ -536,6 +536,88 @@ static void ogden_bound_reuses_the_force_loop(void **state) {
   }
 }
 
+/* HGO's bound reads each tet's fibre term from the force loop and takes neo-Hookean's closed
+ * form for the matrix in blocks with no entry clamped (issue 21: computing the term again from
+ * each tet's V and fibre, two exponentials, and the matrix through the general modulus cost
+ * 143% of an update). Fibres in random directions; the default extension (CLAMP, threshold
+ * rising from 0.3 to 0.5 as J falls from 0.96 to 0.94) and LINEAR at 0.3; the grid near rest,
+ * stretched 2x and 3x (past the fibre stretch limit, 1.7), compressed into the threshold's rise,
+ * or scrambled (flat and inverted tets). The update fills the cache for every tet; the bound
+ * (and that of the same body without fibres, all matrix) equals the one computed tet by tet
+ * with the cache detached (hgo_bound_follows_the_fibres
+ * checks that term against the dense dP/dF); a tet whose Fhat changes after the update (a
+ * state moved in from another process) is not read from its stale slots. */
+static double hgo_rate2_without_cache(piola_elastic_body *body) {
+  double *cache = body->hgo_cache;
+  body->hgo_cache = NULL;
+  const double uniform = piola__elastic_body_state_rate2(body, NULL), per_tet = per_tet_rate2(body);
+  body->hgo_cache = cache;
+  assert_close(uniform, per_tet, 1e-9 * per_tet);
+  return per_tet;
+}
+
+static void hgo_bound_reuses_the_force_loop(void **state) {
+  (void)state;
+  test_rng rng = test_rng_seeded(24);
+  enum { KINDS = 5 }; /* near rest, stretched 2x, 3x, compressed to J = 0.95, scrambled */
+  const long starts = test_samples(2 * KINDS, KINDS);
+  for (int mode = 0; mode < 2; ++mode) {
+    piola_material_def def = piola_default_material_def();
+    def.model = PIOLA_MODEL_HGO;
+    def.poisson_ratio = 0.3;
+    if (mode) def.inversion_mode = PIOLA_INVERSION_LINEAR, def.inversion_threshold = 0.3;
+    piola_material m;
+    assert_int_equal(piola_material_init(&def, &m), PIOLA_OK);
+    piola_tet_mesh mesh = fixture_grid(4, 0.1);
+    const int32_t nv = mesh.vertex_count, nt = mesh.tet_count;
+    double *fibers = malloc(sizeof *fibers * 3 * (size_t)nt);
+    for (int32_t k = 0; k < 3 * nt; ++k) fibers[k] = test_rng_normal(&rng);
+    piola_elastic_body *body = fixture_body_with_fibers(&mesh, &m, 1, NULL, fibers);
+    piola_elastic_body *matrix = fixture_body_with_fibers(&mesh, &m, 1, NULL, NULL); /* no fibres */
+    assert_non_null(body->hgo_cache);
+    assert_null(matrix->hgo_cache);
+    double *x = malloc(sizeof *x * 3 * (size_t)nv), *f = malloc(sizeof *f * 3 * (size_t)nv);
+    for (long start = 0; start < starts; ++start) {
+      const int kind = (int)(start % KINDS);
+      const double along = kind == 1 ? 2.0 : kind == 2 ? 3.0 : kind == 3 ? cbrt(0.95) : 1.0;
+      const double across = kind == 3 ? cbrt(0.95) : 1.0;
+      for (int32_t v = 0; v < 3 * nv; ++v)
+        x[v] = kind == 4 ? test_rng_uniform(&rng, 0, 0.4)
+                         : (v % 3 ? across : along) * mesh.positions[v] + 0.002 * test_rng_normal(&rng);
+      assert_int_equal(piola_elastic_body_update(body, x, 1.0, f, NULL), PIOLA_OK);
+      /* without fibres: the closed form in the lanes, the general modulus tet by tet */
+      assert_int_equal(piola_elastic_body_update(matrix, x, 1.0, f, NULL), PIOLA_OK);
+      const double lanes = piola__elastic_body_state_rate2(matrix, NULL), tets = per_tet_rate2(matrix);
+      if (!(fabs(lanes - tets) <= 1e-9 * tets))
+        fail_msg("HGO without fibres (%s), start %ld: bound %.17g, per tet %.17g",
+                 piola_inversion_mode_name(m.inversion_mode), start, lanes, tets);
+      const double *fhat = piola_elastic_body_fhat(body);
+      int below = 0, rising = 0;
+      for (int32_t t = 0; t < nt; ++t) {
+        const double *ft = fhat + 3 * t;
+        assert_true(hgo_cache_holds(body->hgo_cache + t, body->padded_tet_count, ft[0], ft[1], ft[2]));
+        below |= ft[0] < m.threshold || ft[1] < m.threshold || ft[2] < m.threshold;
+        rising |= material_threshold_volume_slope(&m, ft[0], ft[1], ft[2]) != 0.0;
+      }
+      if (kind == 4) assert_true(below); /* the scramble reaches the extension */
+      if (kind == 3 && mode == 0) assert_true(rising); /* inside the threshold's rise */
+      const double cached = piola__elastic_body_state_rate2(body, NULL), direct = hgo_rate2_without_cache(body);
+      if (!(fabs(cached - direct) <= 1e-9 * direct))
+        fail_msg("HGO (%s), start %ld: bound from the cache %.17g, computed %.17g",
+                 piola_inversion_mode_name(m.inversion_mode), start, cached, direct);
+      /* a changed Fhat: the bound computes that tet instead of reading its old slots */
+      double *own = body->fhat + 3 * 5;
+      own[0] *= 3.0, own[1] *= 0.5;
+      const double moved = piola__elastic_body_state_rate2(body, NULL);
+      assert_close(moved, hgo_rate2_without_cache(body), 1e-9 * moved);
+    }
+    free(x), free(f), free(fibers);
+    piola_elastic_body_destroy(body);
+    piola_elastic_body_destroy(matrix);
+    fixture_mesh_free(&mesh);
+  }
+}
+
 /* LINEAR bodies with inverted tets: the lane loops take the LINEAR slopes only in blocks with
  * an entry below the threshold (linear_range) and agree with the per-tet path. */
 static void linear_lanes_agree_past_the_threshold(void **state) {
@@ -818,6 +900,7 @@ int main(void) {
       cmocka_unit_test(linear_lanes_agree_past_the_threshold),
       cmocka_unit_test(hgo_bound_follows_the_fibres),
       cmocka_unit_test(ogden_bound_reuses_the_force_loop),
+      cmocka_unit_test(hgo_bound_reuses_the_force_loop),
       cmocka_unit_test(cfl_limit_of_a_block),
       cmocka_unit_test(weights_keep_sliver_steps_stable),
       cmocka_unit_test(step_follows_the_state),

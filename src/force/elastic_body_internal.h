@@ -103,6 +103,9 @@ struct piola_elastic_body {
   double *ogden_cache;      /* Ogden and Mooney-Rivlin bodies of one material: the step bound's
                                slots, OGDEN_CACHE_SLOTS * padded_tet_count (material_kernels.h),
                                written by the force loop; NULL for the other bodies */
+  double *hgo_cache;        /* HGO bodies of one material with fibres: the step bound's fibre
+                               term, HGO_CACHE_SLOTS * padded_tet_count (hgo_kernels.h), written
+                               by the force loop; NULL for the other bodies */
 
   double *chunk_forces; /* PIOLA_FORCE_CHUNKS * 3 * vertex_count partial sums of the force loop */
 

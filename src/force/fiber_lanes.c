@@ -70,8 +70,13 @@ static double hgo_lane(const piola_elastic_body *body, const piola_material *mat
       ahat[a][k] = v[k * stride + l] * fam[a][0] + v[(3 + k) * stride + l] * fam[a][1] +
                    v[(6 + k) * stride + l] * fam[a][2];
   const double f[3] = {fhat[0][l], fhat[1][l], fhat[2][l]};
-  double g, r[2];
-  const double energy = hgo_fiber_terms_diagonal(h, f[0], f[1], f[2], ahat, &g, r);
+  double g, r[2], modulus;
+  const double energy = hgo_fiber_terms_modulus(h, f[0], f[1], f[2], ahat, &g, r, &modulus);
+  if (body->hgo_cache) { /* the step bound's fibre term (hgo_kernels.h) */
+    const long slot = base + l;
+    for (int k = 0; k < 3; ++k) body->hgo_cache[slot + (HGO_CACHE_KEY + k) * stride] = f[k];
+    body->hgo_cache[slot + HGO_CACHE_MODULUS * stride] = modulus;
+  }
   /* P = U [g Fhat + sum_a r_a (Fhat ahat_a) ahat_a^T] V^T */
   double ph[3][3];
   for (int i = 0; i < 3; ++i)

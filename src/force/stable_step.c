@@ -233,37 +233,18 @@ STABLE_STEP_KERNEL double weighted_lane_modulus(piola_material_model model, int 
   return model_modulus_weighted(model, energy, m, f[0], f[1], f[2], NULL, wgt);
 }
 
-/* HGO's fibre stiffness for a plane wave at Fhat f with the two families' unit directions
- * ahat in the diagonal frame (docs/time-stepping.md, "The modulus"): per family a,
- *   dF : C_a : dF = 4 psi''(E_a) (G_a : dF)^2 + 2 psi'(E_a) (kappa |dF|^2 + (1 - 3 kappa) |dF a|^2)
- * with G_a = kappa Fhat + (1 - 3 kappa) (Fhat ahat) ahat^T. For a unit rank-one dF,
- * |G_a : dF| <= |G_a|_2 <= kappa max|f_i| + (1 - 3 kappa) |Fhat ahat| (kappa <= 1/3), and the
- * last factor is at most 1 - 2 kappa. psi'' jumps from 0 to k1 at E = 0: the larger side is
- * taken. Exact along the largest stretch, 8 k1 (1 - 2 kappa)^2 at rest. */
-STABLE_STEP_KERNEL double hgo_directed_fiber_modulus(const piola_hgo_def *h, double f0, double f1,
-                                                    double f2, double ahat[2][3]) {
-  const double big = kernel_max(fabs(f0), kernel_max(fabs(f1), fabs(f2)));
-  const double i1 = f0 * f0 + f1 * f1 + f2 * f2, kappa = h->kappa;
-  double sum = 0.0;
-  for (int a = 0; a < 2; ++a) {
-    const double x0 = f0 * ahat[a][0], x1 = f1 * ahat[a][1], x2 = f2 * ahat[a][2];
-    const double i4 = x0 * x0 + x1 * x1 + x2 * x2;
-    const double e = kappa * (i1 - 3.0) + (1.0 - 3.0 * kappa) * (i4 - 1.0);
-    double psi, slope, curvature;
-    hgo_fiber_curve(h, kernel_max(e, 1e-300), &psi, &slope, &curvature);
-    const double g = kappa * big + (1.0 - 3.0 * kappa) * sqrt(i4);
-    sum += 4.0 * curvature * g * g + 2.0 * slope * (1.0 - 2.0 * kappa);
-  }
-  return sum;
-}
-
-/* The fibre term of HGO tet t at Fhat f: its families' directions in the diagonal frame of
- * the last update (V^T a, as the force loop forms them). A body without fibres has no fibre
- * force, so no term; before any update only the direction-free bound of hgo_kernels.h. */
+/* The fibre term of HGO tet t at Fhat f (hgo_directed_fiber_modulus): its families'
+ * directions in the diagonal frame of the last update (V^T a, as the force loop forms them),
+ * or the term that update cached when it evaluated this f (hgo_cache_holds). A body without
+ * fibres has no fibre force, so no term; before any update only the direction-free bound of
+ * hgo_kernels.h. */
 static double hgo_tet_fiber_modulus(const piola_elastic_body *body, const piola_material *m,
                                     int32_t t, const double f[3]) {
   if (!body->fiber[0]) return 0.0;
   if (!body->has_state) return hgo_fiber_modulus_bound(&m->hgo, f[0], f[1], f[2]);
+  const double *cache = body->hgo_cache;
+  if (cache && hgo_cache_holds(cache + t, body->padded_tet_count, f[0], f[1], f[2]))
+    return cache[t + HGO_CACHE_MODULUS * body->padded_tet_count];
   const long stride = body->padded_tet_count;
   const double *v = body->v[0] + t;
   const double dir[3] = {body->fiber[0][t], body->fiber[1][t], body->fiber[2][t]};
@@ -281,8 +262,8 @@ static double hgo_tet_fiber_modulus(const piola_elastic_body *body, const piola_
  * (a + b = mu (1 + i_i i_j) - L i_i i_j, a - b = mu (1 - i_i i_j) + L i_i i_j,
  * K_ij = lambda i_i i_j). The same numbers as model_modulus up to rounding, at a fraction of
  * the cost (three logarithms and the extension's selects are what make it dear). */
-STABLE_STEP_KERNEL double neohookean_plain_modulus(const piola_material *m, double f0, double f1,
-                                                   double f2) {
+STABLE_STEP_KERNEL double neohookean_matrix_modulus(const piola_material *m, double f0, double f1,
+                                                    double f2) {
   const double mu = m->mu, lambda = m->lambda;
   const double i0 = kernel_recip_fast(f0), i1 = kernel_recip_fast(f1), i2 = kernel_recip_fast(f2);
   const double l = lambda * kernel_log_div(f0 * f1 * f2, KERNEL_FAST_RECIPROCAL);
@@ -293,7 +274,13 @@ STABLE_STEP_KERNEL double neohookean_plain_modulus(const piola_material *m, doub
   double k = kernel_max(k0, kernel_max(k1, k2));
   k = kernel_max(k, mu + i0 * kernel_max(i1, i2) * cross);
   k = kernel_max(k, mu + i1 * i2 * cross);
-  return k + m->fiber_modulus;
+  return k;
+}
+
+/* The same with the muscle's fibre bound (zero for neo-Hookean). */
+STABLE_STEP_KERNEL double neohookean_plain_modulus(const piola_material *m, double f0, double f1,
+                                                   double f2) {
+  return neohookean_matrix_modulus(m, f0, f1, f2) + m->fiber_modulus;
 }
 
 /* Per tet: the model and the extension mode chosen at run time. */
@@ -477,6 +464,73 @@ static double ogden_range(const piola_elastic_body *body, int energy, const piol
   return best;
 }
 
+/* max(best, w_t k_t) over HGO tets [t, end), tet by tet: the matrix's general modulus (the
+ * CLAMP numbers for a LINEAR tet with no entry clamped, as linear_range) plus the fibre term. */
+static double hgo_tets_rate(const piola_elastic_body *body, int energy, const piola_material *m,
+                            const double *f, const double *w, int32_t t, int32_t end, double best) {
+  for (; t < end; ++t) {
+    const double *ft = f + 3 * t;
+    const double k = energy == STEP_EXTENSION_LINEAR && lane_unclamped(m, ft[0], ft[1], ft[2])
+                         ? model_modulus(PIOLA_MODEL_HGO, STEP_EXTENSION_CLAMP, m, ft[0], ft[1], ft[2])
+                         : model_modulus(PIOLA_MODEL_HGO, energy, m, ft[0], ft[1], ft[2]);
+    const double r = w[t] * (k + hgo_tet_fiber_modulus(body, m, t, ft));
+    best = r > best ? r : best;
+  }
+  return best;
+}
+
+/* HGO (LINEAR or CLAMP) by blocks of PIOLA_TET_BLOCK (issue 21: tet by tet it cost 143% of an
+ * update). Its matrix is neo-Hookean's: where every lane of a block is at or above the
+ * threshold in force there (hgo_lane_unclamped, as the force loop splits it; with no entry
+ * clamped the threshold's rise adds nothing) it takes neo-Hookean's closed form, and its
+ * fibre term is the one the force loop cached at each lane's Fhat (hgo_cache_holds; none
+ * without fibres). Such a block is a lane loop over Fhat, the weight and one cached number;
+ * the others go tet by tet. The energy extension keeps the tet-by-tet path, whose slopes are
+ * differences (model_modulus), so that the lanes and the per-tet terms agree. */
+static double hgo_range(const piola_elastic_body *body, int energy, const piola_material *m,
+                        const double *f, const double *w, int32_t begin, int32_t end) {
+  const int fibers = body->fiber[0] != NULL;
+  const long stride = body->padded_tet_count;
+  const double *cache = body->hgo_cache;
+  double best = 0;
+  int32_t t = begin;
+  if (energy != STEP_EXTENSION_ENERGY && (!fibers || cache))
+    for (; t + PIOLA_TET_BLOCK <= end; t += PIOLA_TET_BLOCK) {
+      int plain = 1;
+#pragma omp simd reduction(&:plain)
+      for (int l = 0; l < PIOLA_TET_BLOCK; ++l) {
+        const double *fl = f + 3 * (t + l);
+        plain &= hgo_lane_unclamped(m, fl[0], fl[1], fl[2]);
+      }
+      if (fibers) {
+#pragma omp simd reduction(&:plain)
+        for (int l = 0; l < PIOLA_TET_BLOCK; ++l) {
+          const double *fl = f + 3 * (t + l);
+          plain &= hgo_cache_holds(cache + t + l, stride, fl[0], fl[1], fl[2]);
+        }
+      }
+      if (!plain) {
+        best = hgo_tets_rate(body, energy, m, f, w, t, t + PIOLA_TET_BLOCK, best);
+      } else if (fibers) {
+        const double *fiber_term = cache + HGO_CACHE_MODULUS * stride + t;
+#pragma omp simd reduction(max:best)
+        for (int l = 0; l < PIOLA_TET_BLOCK; ++l) {
+          const double *fl = f + 3 * (t + l);
+          const double r = w[t + l] * (neohookean_matrix_modulus(m, fl[0], fl[1], fl[2]) + fiber_term[l]);
+          best = r > best ? r : best;
+        }
+      } else {
+#pragma omp simd reduction(max:best)
+        for (int l = 0; l < PIOLA_TET_BLOCK; ++l) {
+          const double *fl = f + 3 * (t + l);
+          const double r = w[t + l] * neohookean_matrix_modulus(m, fl[0], fl[1], fl[2]);
+          best = r > best ? r : best;
+        }
+      }
+    }
+  return hgo_tets_rate(body, energy, m, f, w, t, end, best);
+}
+
 /* max(best, w_t k_t) with the LINEAR extension, the direction weights where GRAM is not NULL
  * and they can matter (a stiff tet whose unweighted term is above BEST, as in weighted_range). */
 STABLE_STEP_KERNEL double linear_tet_rate(piola_material_model model, const piola_elastic_body *body,
@@ -627,16 +681,7 @@ STABLE_STEP_KERNEL double uniform_range_rate2(const piola_elastic_body *body, in
     case PIOLA_MODEL_NEOHOOKEAN:
       return neohookean_range(PIOLA_MODEL_NEOHOOKEAN, energy, m, f, w, begin, end);
     case PIOLA_MODEL_MUSCLE: return neohookean_range(PIOLA_MODEL_MUSCLE, energy, m, f, w, begin, end);
-    case PIOLA_MODEL_HGO: /* the fibre term reads each tet's V and fibre: not a lane loop */
-      for (int32_t t = begin; t < end; ++t) {
-        const double *ft = f + 3 * t;
-        const double k = energy == STEP_EXTENSION_LINEAR && lane_unclamped(m, ft[0], ft[1], ft[2])
-                             ? model_modulus(PIOLA_MODEL_HGO, STEP_EXTENSION_CLAMP, m, ft[0], ft[1], ft[2])
-                             : model_modulus(PIOLA_MODEL_HGO, energy, m, ft[0], ft[1], ft[2]);
-        const double r = w[t] * (k + hgo_tet_fiber_modulus(body, m, t, ft));
-        best = r > best ? r : best;
-      }
-      break;
+    case PIOLA_MODEL_HGO: return hgo_range(body, energy, m, f, w, begin, end);
     case PIOLA_MODEL_SPLINE: MODEL_LANE_LOOP(PIOLA_MODEL_SPLINE)
     case PIOLA_MODEL_STABLE_NEOHOOKEAN: MODEL_LANE_LOOP(PIOLA_MODEL_STABLE_NEOHOOKEAN)
     case PIOLA_MODEL_MOONEY_RIVLIN: /* stored as two Ogden terms */

@@ -14,6 +14,7 @@
 
 #include "common/status_report.h"
 #include "force/elastic_body_internal.h"
+#include "material/hgo_kernels.h"
 #include "material/material_kernels.h"
 
 #define B PIOLA_TET_BLOCK
@@ -87,6 +88,10 @@ static int localize_state(piola_elastic_body *body) {
   if (body->ogden_cache) { /* fresh too: only the held blocks' slots get written */
     free(body->ogden_cache);
     body->ogden_cache = calloc(OGDEN_CACHE_SLOTS * np, sizeof(double)); /* NULL: no cache */
+  }
+  if (body->hgo_cache) {
+    free(body->hgo_cache);
+    body->hgo_cache = calloc(HGO_CACHE_SLOTS * np, sizeof(double));
   }
   for (int k = 0; k < 9; ++k) {
     body->u[k] = u + (size_t)k * np;

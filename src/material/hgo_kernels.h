@@ -83,15 +83,31 @@ MATERIAL_KERNEL double hgo_invariant(const piola_hgo_def *h, const double f[9], 
   return h->kappa * (i1 - 3.0) + (1.0 - 3.0 * h->kappa) * (i4 - 1.0);
 }
 
+/* One family's share of the fibres' plane-wave stiffness bound (Pa) at a state whose largest
+ * |f_i| is BIG, with I4 = |Fhat ahat|^2, slope psi' and curvature psi'' at its E: per family,
+ *   dF : C_a : dF = 4 psi''(E_a) (G_a : dF)^2 + 2 psi'(E_a) (kappa |dF|^2 + (1 - 3 kappa) |dF a|^2)
+ * with G_a = kappa Fhat + (1 - 3 kappa) (Fhat ahat) ahat^T. For a unit rank-one dF,
+ * |G_a : dF| <= |G_a|_2 <= kappa max|f_i| + (1 - 3 kappa) |Fhat ahat| (kappa <= 1/3), and the
+ * last factor is at most 1 - 2 kappa. psi'' jumps from 0 to k1 at E = 0: the caller passes the
+ * larger side (k1 for E <= 0). Exact along the largest stretch, 8 k1 (1 - 2 kappa)^2 at rest. */
+MATERIAL_KERNEL double hgo_family_wave_modulus(const piola_hgo_def *h, double big, double i4,
+                                               double slope, double curvature) {
+  const double g = h->kappa * big + (1.0 - 3.0 * h->kappa) * sqrt(i4);
+  return 4.0 * curvature * g * g + 2.0 * slope * (1.0 - 2.0 * h->kappa);
+}
+
 /* The diagonal-frame fibre stress of both families: with Fhat = diag(f) and unit ahat_a,
  * Phat_f = Fhat S, S = sum_a 2 psi'_a (kappa I + (1 - 3 kappa) ahat_a ahat_a^T). Writes
- * g = sum_a 2 psi'_a kappa (the isotropic coefficient), r_a = 2 psi'_a (1 - 3 kappa) and
- * returns the energy. (The force loop uses these; P_f = g F + sum_a r_a (F a)(a)^T.) */
-MATERIAL_KERNEL double hgo_fiber_terms_diagonal(const piola_hgo_def *h, double f0, double f1,
-                                                double f2, double ahat[2][3], double *g,
-                                                double r[2]) {
+ * g = sum_a 2 psi'_a kappa (the isotropic coefficient), r_a = 2 psi'_a (1 - 3 kappa),
+ * *modulus = both families' hgo_family_wave_modulus (the step bound's fibre term, from the
+ * same exponentials: the force loop caches it, fiber_lanes.c) and returns the energy. (The
+ * force loop uses these; P_f = g F + sum_a r_a (F a)(a)^T.) */
+MATERIAL_KERNEL double hgo_fiber_terms_modulus(const piola_hgo_def *h, double f0, double f1,
+                                               double f2, double ahat[2][3], double *g,
+                                               double r[2], double *modulus) {
   const double i1 = f0 * f0 + f1 * f1 + f2 * f2;
-  double energy = 0.0, iso = 0.0;
+  const double big = kernel_max(fabs(f0), kernel_max(fabs(f1), fabs(f2)));
+  double energy = 0.0, iso = 0.0, wave = 0.0;
   for (int a = 0; a < 2; ++a) {
     const double x0 = f0 * ahat[a][0], x1 = f1 * ahat[a][1], x2 = f2 * ahat[a][2];
     const double i4 = x0 * x0 + x1 * x1 + x2 * x2;
@@ -101,9 +117,47 @@ MATERIAL_KERNEL double hgo_fiber_terms_diagonal(const piola_hgo_def *h, double f
     energy += psi;
     iso += 2.0 * slope * h->kappa;
     r[a] = 2.0 * slope * (1.0 - 3.0 * h->kappa);
+    wave += hgo_family_wave_modulus(h, big, i4, slope, e > 0.0 ? curvature : h->k1);
   }
   *g = iso;
+  *modulus = wave;
   return energy;
+}
+
+/* hgo_fiber_terms_modulus without the modulus (the public functions and the energy). */
+MATERIAL_KERNEL double hgo_fiber_terms_diagonal(const piola_hgo_def *h, double f0, double f1,
+                                                double f2, double ahat[2][3], double *g,
+                                                double r[2]) {
+  double modulus;
+  return hgo_fiber_terms_modulus(h, f0, f1, f2, ahat, g, r, &modulus);
+}
+
+/* HGO's fibre stiffness for a plane wave at Fhat f with the two families' unit directions
+ * ahat in the diagonal frame (docs/time-stepping.md, "The modulus"): the sum of
+ * hgo_family_wave_modulus over the families. */
+MATERIAL_KERNEL double hgo_directed_fiber_modulus(const piola_hgo_def *h, double f0, double f1,
+                                                  double f2, double ahat[2][3]) {
+  double g, r[2], modulus;
+  (void)hgo_fiber_terms_modulus(h, f0, f1, f2, ahat, &g, r, &modulus);
+  return modulus;
+}
+
+/* The step bound's cache of an HGO body with fibres (one material): the force loop keeps,
+ * per tet, the Fhat it evaluated and the fibre term hgo_fiber_terms_modulus gave there, so
+ * that the bound reads one number instead of the tet's V, its fibre and two exponentials.
+ * Structure of arrays, slot s of a tet at s * stride from its first. */
+enum {
+  HGO_CACHE_KEY = 0,     /* Fhat of the update that wrote the slots */
+  HGO_CACHE_MODULUS = 3, /* Pa: the fibres' plane-wave term there */
+  HGO_CACHE_SLOTS = 4
+};
+
+/* 1 when the cache holds the fibre term of Fhat f (as ogden_cache_holds: a zero key never
+ * matches). */
+MATERIAL_KERNEL int hgo_cache_holds(const double *cache, long stride, double f0, double f1,
+                                    double f2) {
+  return (cache[HGO_CACHE_KEY * stride] == f0) & (cache[(HGO_CACHE_KEY + 1) * stride] == f1) &
+         (cache[(HGO_CACHE_KEY + 2) * stride] == f2) & ((f0 != 0.0) | (f1 != 0.0) | (f2 != 0.0));
 }
 
 /* The two unit family directions from a unit fibre direction m and the unit axis of an HGO

@@ -15,7 +15,12 @@
  *    it is reached in one step or in four load increments (gravity keyed linearly from 0),
  *    to 1e-6 of the deflection: the answer is the equilibrium, not the path; and whether its
  *    Newton systems are solved with Eisenstat and Walker's forcing or to the fixed
- *    linear_tolerance, to the same 1e-6. */
+ *    linear_tolerance, to the same 1e-6;
+ *  - a soft bar swung by a turning gravity (the quasistatic bar of
+ *    tests/scripts/run_resume_examples.py) reaches the equilibrium of its first load
+ *    increment without a failed Newton step. On the residual norm alone the line search
+ *    accepted 1/1024 of the first Newton steps and failed 12 times in that increment: the
+ *    direction of the projected Hessian decreases the potential, not |g| (implicit_step.c). */
 #include "test_support.h"
 
 #include <math.h>
@@ -185,6 +190,56 @@ static void large_load_independent_of_forcing(void **state) {
   piola_world_destroy(fixed);
 }
 
+/* The quasistatic bar of run_resume_examples.py: 0.5 m x 0.08 m x 0.08 m, neo-Hookean
+ * E = 20 kPa, nu = 0.3, clamped at x = 0, gravity (0, 0 -> 15, -5 -> -40) m/s^2 over 0.4 s;
+ * one increment of 1/30 s, the run's first frame. */
+static void soft_bar_increment_without_failed_newton(void **state) {
+  (void)state;
+  piola_world_def wd = piola_default_world_def();
+  const double times[2] = {0, 0.4}, gy[2] = {0, 15}, gz[2] = {-5, -40};
+  assert_int_equal(piola_track_from_keys(times, gy, 2, &wd.gravity[1]), PIOLA_OK);
+  assert_int_equal(piola_track_from_keys(times, gz, 2, &wd.gravity[2]), PIOLA_OK);
+  wd.integrator = PIOLA_INTEGRATOR_QUASISTATIC;
+  wd.implicit_dt = 1.0 / 30.0;
+  piola_world *w = NULL;
+  assert_int_equal(piola_world_create(&wd, &w), PIOLA_OK);
+  piola_tet_mesh mesh;
+  assert_int_equal(piola_tet_mesh_box_grid(13, 2, 2, (piola_vec3){0.5 / 13, 0.04, 0.04}, &mesh),
+                   PIOLA_OK);
+  piola_solid_def sd = piola_default_solid_def();
+  sd.mesh = &mesh;
+  sd.material.model = PIOLA_MODEL_NEOHOOKEAN;
+  sd.material.youngs_modulus = 2e4;
+  sd.material.poisson_ratio = 0.3;
+  sd.density = 1000;
+  piola_constraint_def clamp;
+  memset(&clamp, 0, sizeof clamp);
+  clamp.selector.type = PIOLA_SELECT_BOX;
+  clamp.selector.box_min = (piola_vec3){-1, -1, -1};
+  clamp.selector.box_max = (piola_vec3){1e-9, 1, 1};
+  sd.constraints = &clamp;
+  sd.constraint_count = 1;
+  assert_int_equal(piola_world_add_solid(w, &sd, NULL), PIOLA_OK);
+  free(mesh.positions);
+  free(mesh.tets);
+  piola_step_stats st;
+  memset(&st, 0, sizeof st);
+  assert_int_equal(piola_world_advance_to(w, 1.0 / 30.0, &st), PIOLA_OK);
+  const piola_elastic_body *body = piola_world_solid_body(w, 0);
+  const double *x = piola_world_solid_positions(w, 0);
+  const double *x0 = piola_elastic_body_rest_positions(body);
+  double tip = 0;
+  for (int32_t i = 0; i < piola_elastic_body_vertex_count(body); ++i)
+    if (x0[3 * i] > 0.5 - 1e-9) tip = fmax(tip, x0[3 * i + 2] - x[3 * i + 2]);
+  print_message("soft bar: first increment in %d step(s), %d Newton iterations, %d failed, "
+                "tip down %.4g m\n",
+                (int)st.substeps, (int)st.newton_iterations, (int)st.newton_failures, tip);
+  assert_true(tip > 0.1); /* a large deflection: the bar hangs */
+  assert_int_equal(st.newton_failures, 0);
+  assert_int_equal(st.substeps, 1); /* no halved increment */
+  piola_world_destroy(w);
+}
+
 int main(void) {
   /* results do not depend on the thread count; one thread spares the thousands of CG
    * iterations a barrier each, which on a loaded machine can wait a scheduler slice */
@@ -193,6 +248,7 @@ int main(void) {
       cmocka_unit_test(large_load_independent_of_increments),
       cmocka_unit_test(large_load_independent_of_forcing),
       cmocka_unit_test(small_load_matches_euler_bernoulli),
+      cmocka_unit_test(soft_bar_increment_without_failed_newton),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -21,7 +21,7 @@
 # Newton step may fail (each failure halves an increment, whose velocity then differs), the
 # positions must agree to the same 1e-7, and the Newton iterations of the whole run may be
 # at most 1.5 times the single process's. Measured: 114 and 91, 1.1e-9 relative; before the
-# line search also took the potential (time-stepping.md) 539 and 220, with 4 failed steps
+# line search also took the potential (time-stepping.md) about 540 and 220, with 4 failed steps
 # on 2 processes.
 set -euo pipefail
 piola=$1

@@ -100,6 +100,24 @@ const double *piola_elastic_body_energy_density(const piola_elastic_body *body) 
 }
 const double *piola_elastic_body_fhat(const piola_elastic_body *body) { return body->fhat; }
 
+/* The sum of V0 psi over the tets (J), from the energy densities above; on a split in the
+ * local mode each process sums its own blocks and the sums are added in process order, so
+ * every process gets the same bits (collective there). */
+double piola__elastic_body_total_energy(const piola_elastic_body *body) {
+  const double *psi = piola_elastic_body_energy_density(body);
+  const piola_work_split *local = piola__local_split(body);
+  double energy = 0;
+  for (int32_t t = 0; t < body->tet_count; ++t) {
+    if (local && local->block_part[t / B] != local->part) {
+      t = (t / B + 1) * B - 1;
+      continue;
+    }
+    energy += body->rest_volume[t] * psi[t];
+  }
+  if (local) local->reduce(local->context, &energy, 1, PIOLA_WORK_SPLIT_SUM);
+  return energy;
+}
+
 static int positions_are_finite(const double *x, int32_t n) {
   int finite = 1;
   for (int32_t i = 0; i < n; ++i) finite &= isfinite(x[i]);

@@ -132,6 +132,10 @@ static inline const piola_work_split *piola__local_split(const piola_elastic_bod
   return body->split && body->split_local && body->split->part_count > 1 ? body->split : NULL;
 }
 
+/* The body's elastic energy at its last update, sum of V0 psi (J) (elastic_body.c).
+ * Collective on a split in the local mode. */
+double piola__elastic_body_total_energy(const piola_elastic_body *body);
+
 /* piola_elastic_body_set_work_split, with the local mode allowed or not (the world forbids
  * it for solids with plasticity). */
 piola_status piola__elastic_body_set_work_split(piola_elastic_body *body,

@@ -422,12 +422,8 @@ static piola_status smooth_prolongator(piola__multigrid_level *l, const piola__b
 /* The next level's operator P^T A P, symmetrized; unknowns no mode reached (zero rows and
  * columns) get a unit diagonal. */
 static piola_status galerkin(piola__multigrid_level *l, piola__block_sparse *coarse) {
-  piola__block_sparse ap;
   PIOLA_TRY(piola__block_sparse_transpose(&l->p, &l->pt));
-  PIOLA_TRY(piola__block_sparse_product(&l->a, &l->p, &ap));
-  piola_status status = piola__block_sparse_product(&l->pt, &ap, coarse);
-  piola__block_sparse_free(&ap);
-  if (status != PIOLA_OK) return status;
+  PIOLA_TRY(piola__block_sparse_galerkin(&l->pt, &l->a, &l->p, coarse));
   piola__block_sparse_symmetrize(coarse);
   const int b = coarse->rb;
   for (int32_t r = 0; r < coarse->rows; ++r) {

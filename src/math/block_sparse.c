@@ -118,17 +118,17 @@ static int compare_int32(const void *a, const void *b) {
   return (x > y) - (x < y);
 }
 
-/* The distinct columns of row r of a b into list (marker[c] == r marks them), sorted;
- * returns how many. */
+/* The distinct columns of row r of a b into list (marker[c] == r marks them), sorted when
+ * `sorted` (the counting pass needs no order); returns how many. */
 static int32_t product_row_columns(const piola__block_sparse *a, const piola__block_sparse *b,
-                                   int32_t r, int32_t *marker, int32_t *list) {
+                                   int32_t r, int32_t *marker, int32_t *list, int sorted) {
   int32_t count = 0;
   for (int32_t k = a->row_start[r]; k < a->row_start[r + 1]; ++k) {
     const int32_t m = a->col[k];
     for (int32_t l = b->row_start[m]; l < b->row_start[m + 1]; ++l)
       if (marker[b->col[l]] != r) marker[b->col[l]] = r, list[count++] = b->col[l];
   }
-  qsort(list, (size_t)count, sizeof(int32_t), compare_int32);
+  if (sorted) qsort(list, (size_t)count, sizeof(int32_t), compare_int32);
   return count;
 }
 
@@ -180,7 +180,7 @@ piola_status piola__block_sparse_product(const piola__block_sparse *a, const pio
   }
   for (int32_t j = 0; j < cols; ++j) marker[j] = -1;
   int64_t entries = 0;
-  for (int32_t r = 0; r < a->rows; ++r) entries += product_row_columns(a, b, r, marker, list);
+  for (int32_t r = 0; r < a->rows; ++r) entries += product_row_columns(a, b, r, marker, list, 0);
   piola_status status = piola__block_sparse_alloc(c, a->rows, b->cols, a->rb, b->cb, entries);
   if (status != PIOLA_OK) {
     free(marker), free(list), free(position);
@@ -192,7 +192,7 @@ piola_status piola__block_sparse_product(const piola__block_sparse *a, const pio
   block_multiply_add *multiply_add = multiply_add_for(ra, inner, cb);
   int64_t at = 0;
   for (int32_t r = 0; r < a->rows; ++r) {
-    const int32_t count = product_row_columns(a, b, r, marker, list);
+    const int32_t count = product_row_columns(a, b, r, marker, list, 1);
     for (int32_t q = 0; q < count; ++q) position[list[q]] = (int32_t)(at + q);
     memcpy(c->col + at, list, sizeof(int32_t) * (size_t)count);
     memset(c->values + cbs * (size_t)at, 0, sizeof(double) * cbs * (size_t)count);
@@ -209,6 +209,123 @@ piola_status piola__block_sparse_product(const piola__block_sparse *a, const pio
   }
   free(marker), free(list), free(position);
   return PIOLA_OK;
+}
+
+/* The entry of column col in row r of c (present: c's pattern was built to hold it). */
+static int32_t entry_of(const piola__block_sparse *c, int32_t r, int32_t col) {
+  int32_t lo = c->row_start[r], hi = c->row_start[r + 1];
+  while (lo < hi) {
+    const int32_t mid = lo + (hi - lo) / 2;
+    if (c->col[mid] < col)
+      lo = mid + 1;
+    else
+      hi = mid;
+  }
+  return lo;
+}
+
+/* The pattern of c = pt (a p) from ap's (ap_start, ap_col: row r of a p, unsorted): row g
+ * the union of the rows of a p that row g of pt names, sorted. */
+static piola_status galerkin_pattern(const piola__block_sparse *pt, const int32_t *ap_start,
+                                     const int32_t *ap_col, int cb, piola__block_sparse *c,
+                                     int32_t *marker, int32_t *list) {
+  const int32_t rows = pt->rows, cols = c->cols;
+  for (int32_t j = 0; j < cols; ++j) marker[j] = -1;
+  int64_t entries = 0;
+  for (int pass = 0; pass < 2; ++pass) {
+    if (pass == 1) {
+      const int32_t columns = c->cols;
+      PIOLA_TRY(piola__block_sparse_alloc(c, rows, columns, pt->rb, cb, entries));
+      for (int32_t j = 0; j < cols; ++j) marker[j] = -1;
+    }
+    int64_t at = 0;
+    for (int32_t g = 0; g < rows; ++g) {
+      int32_t count = 0;
+      for (int32_t k = pt->row_start[g]; k < pt->row_start[g + 1]; ++k) {
+        const int32_t r = pt->col[k];
+        for (int32_t q = ap_start[r]; q < ap_start[r + 1]; ++q)
+          if (marker[ap_col[q]] != g) marker[ap_col[q]] = g, list[count++] = ap_col[q];
+      }
+      if (pass == 1) {
+        qsort(list, (size_t)count, sizeof(int32_t), compare_int32);
+        memcpy(c->col + at, list, sizeof(int32_t) * (size_t)count);
+        c->row_start[g + 1] = (int32_t)(at + count);
+      }
+      at += count;
+    }
+    entries = at;
+  }
+  return PIOLA_OK;
+}
+
+piola_status piola__block_sparse_galerkin(const piola__block_sparse *pt,
+                                          const piola__block_sparse *a,
+                                          const piola__block_sparse *p, piola__block_sparse *c) {
+  memset(c, 0, sizeof *c);
+  const int32_t n = a->rows, cols = p->cols > 0 ? p->cols : 1;
+  int32_t *marker = malloc(sizeof(int32_t) * (size_t)cols);
+  int32_t *list = malloc(sizeof(int32_t) * (size_t)cols);
+  int32_t *position = malloc(sizeof(int32_t) * (size_t)cols);
+  int32_t *ap_start = malloc(sizeof(int32_t) * ((size_t)n + 1));
+  int32_t *cursor = malloc(sizeof(int32_t) * (size_t)(pt->rows > 0 ? pt->rows : 1));
+  int32_t *ap_col = NULL;
+  double *row = NULL;
+  piola_status status = PIOLA_OK;
+  if (!marker || !list || !position || !ap_start || !cursor) goto out_of_memory;
+  /* the pattern of a p, row by row (unsorted: each (g, h) of c gets one term per row r) */
+  for (int32_t j = 0; j < cols; ++j) marker[j] = -1;
+  ap_start[0] = 0;
+  int32_t longest = 1;
+  for (int32_t r = 0; r < n; ++r) {
+    const int32_t count = product_row_columns(a, p, r, marker, list, 0);
+    if (count > longest) longest = count;
+    ap_start[r + 1] = ap_start[r] + count;
+  }
+  ap_col = malloc(sizeof(int32_t) * (size_t)(ap_start[n] > 0 ? ap_start[n] : 1));
+  const int ra = a->rb, inner = a->cb, cb = p->cb, rc = pt->rb;
+  const size_t abs = (size_t)(ra * inner), pbs = (size_t)(inner * cb), apbs = (size_t)(ra * cb);
+  const size_t ptbs = (size_t)(rc * ra), cbs = (size_t)(rc * cb);
+  row = malloc(sizeof(double) * apbs * (size_t)longest);
+  if (!ap_col || !row) goto out_of_memory;
+  for (int32_t j = 0; j < cols; ++j) marker[j] = -1;
+  for (int32_t r = 0; r < n; ++r) product_row_columns(a, p, r, marker, ap_col + ap_start[r], 0);
+  c->cols = p->cols;
+  status = galerkin_pattern(pt, ap_start, ap_col, cb, c, marker, list);
+  if (status != PIOLA_OK) goto done;
+  memset(c->values, 0,
+         sizeof(double) * cbs * (size_t)(c->row_start[c->rows] > 0 ? c->row_start[c->rows] : 1));
+  for (int32_t g = 0; g < pt->rows; ++g) cursor[g] = pt->row_start[g];
+  /* row r of a p into `row`, then its terms pt(g, r) (a p)(r, h) into every row g of c that
+   * names r: rows r in increasing order, as pt's rows list them, so every entry of c sums
+   * its terms in the order the two separate products would */
+  block_multiply_add *ap_multiply_add = multiply_add_for(ra, inner, cb);
+  block_multiply_add *c_multiply_add = multiply_add_for(rc, ra, cb);
+  for (int32_t r = 0; r < n; ++r) {
+    const int32_t first = ap_start[r], count = ap_start[r + 1] - first;
+    for (int32_t q = 0; q < count; ++q) position[ap_col[first + q]] = q;
+    memset(row, 0, sizeof(double) * apbs * (size_t)count);
+    for (int32_t k = a->row_start[r]; k < a->row_start[r + 1]; ++k) {
+      const double *ak = a->values + abs * (size_t)k;
+      const int32_t m = a->col[k];
+      for (int32_t l = p->row_start[m]; l < p->row_start[m + 1]; ++l)
+        ap_multiply_add(ak, p->values + pbs * (size_t)l, row + apbs * (size_t)position[p->col[l]],
+                        ra, inner, cb);
+    }
+    for (int32_t j = p->row_start[r]; j < p->row_start[r + 1]; ++j) {
+      const int32_t g = p->col[j];
+      const double *ptb = pt->values + ptbs * (size_t)cursor[g]++;
+      for (int32_t q = 0; q < count; ++q)
+        c_multiply_add(ptb, row + apbs * (size_t)q,
+                       c->values + cbs * (size_t)entry_of(c, g, ap_col[first + q]), rc, ra, cb);
+    }
+  }
+  goto done;
+out_of_memory:
+  status = PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "sparse product: out of memory");
+done:
+  if (status != PIOLA_OK) piola__block_sparse_free(c);
+  free(marker), free(list), free(position), free(ap_start), free(cursor), free(ap_col), free(row);
+  return status;
 }
 
 piola_status piola__block_sparse_transpose(const piola__block_sparse *a, piola__block_sparse *t) {

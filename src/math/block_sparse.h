@@ -40,6 +40,14 @@ void piola__block_sparse_apply(const piola__block_sparse *a, const double *x, do
 piola_status piola__block_sparse_product(const piola__block_sparse *a, const piola__block_sparse *b,
                                          piola__block_sparse *c);
 
+/* c = pt (a p), pt = p^T as piola__block_sparse_transpose gives it: the Galerkin product,
+ * bit-identical to piola__block_sparse_product(pt, a p) but without forming a p (on the
+ * Figure 2 torus a 48 MB matrix written, and its pages faulted in, at every setup): each row
+ * of a p is formed once in a row buffer and scattered into the rows of c that need it. */
+piola_status piola__block_sparse_galerkin(const piola__block_sparse *pt,
+                                          const piola__block_sparse *a,
+                                          const piola__block_sparse *p, piola__block_sparse *c);
+
 /* t = a^T. */
 piola_status piola__block_sparse_transpose(const piola__block_sparse *a, piola__block_sparse *t);
 

@@ -2,7 +2,8 @@
  * ball of ../shared/data, 1110 tets, scaled to 0.2 m): collapsed to a point, to a line, to a
  * plane, or scrambled (every node moved by up to 40% of the radius), for every model (the
  * muscle with passive fibres along x), in zero gravity with light damping. After 2 s
- * (60 frames; with PIOLA_TEST_SCALE < 1 only 5 frames, checked for finiteness) no tet is
+ * (60 frames; with PIOLA_TEST_SCALE < 1, the sanitizer pass, only 5 frames, checked for
+ * finiteness, and each model from one start, rotating through the four) no tet is
  * inverted and the elastic energy is below 1e-4 of its value at the start: the shape is back up to a rigid motion. Every frame
  * is one step unless Newton failed (then stats.csv says so); the state is finite throughout. */
 #include "test_support.h"
@@ -79,8 +80,11 @@ static void every_model_every_start(void **state) {
   const char *path = test_data_path("medit/unit_ball.mesh");
   if (piola_tet_mesh_read(path, &mesh) != PIOLA_OK) fail_msg("%s: %s", path, piola_last_error());
   for (int32_t i = 0; i < 3 * mesh.vertex_count; ++i) mesh.positions[i] *= 0.2;
+  const int every_start = test_scale() >= 1.0;
   for (int model = 0; model < PIOLA_MODEL_COUNT; ++model)
-    for (int kind = POINT; kind <= SCRAMBLE; ++kind) recover(&mesh, (piola_material_model)model, (start_kind)kind);
+    for (int kind = POINT; kind <= SCRAMBLE; ++kind)
+      if (every_start || kind == model % (SCRAMBLE + 1))
+        recover(&mesh, (piola_material_model)model, (start_kind)kind);
   free(mesh.positions);
   free(mesh.tets);
   free(mesh.tet_regions);

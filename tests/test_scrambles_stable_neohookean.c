@@ -26,7 +26,9 @@
 static void stable_neohookean_runs_one_diagonal_on_slivers(void **state) {
   (void)state;
   static const piola_material_model models[] = {PIOLA_MODEL_STABLE_NEOHOOKEAN};
-  real_mesh_scramble_models("gmsh/bar-186.msh", DIAGONAL, models, 1, DIAGONAL);
+  /* the bar's stiff start costs about the same at any PIOLA_TEST_SCALE: the sanitizer pass
+   * (scale below 0.5) runs the torus only, the Release pass both */
+  if (test_scale() >= 0.5) real_mesh_scramble_models("gmsh/bar-186.msh", DIAGONAL, models, 1, DIAGONAL);
   real_mesh_scramble_models("gmsh/torus.msh", DIAGONAL, models, 1, DIAGONAL);
 }
 

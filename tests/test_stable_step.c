@@ -146,6 +146,34 @@ static void modulus_bounds_every_plane_wave(void **state) {
  * (matrix and fibres, acoustic tensor's top eigenvalue over many directions n), stay within
  * a small factor of it, and never exceed the direction-free bound; with the fibres across
  * the stretch it is far below that bound. */
+/* The largest plane-wave modulus df : dP/dF : df at fm, by central differences of the stress:
+ * over the 9 principal directions and `random` unit rank-one directions a n^T. */
+static double sampled_wave_modulus(const piola_material *m, const double fm[9], int random, test_rng *rng) {
+  double sampled = -INFINITY;
+  for (int sample = 0; sample < 9 + random; ++sample) {
+    double df[9] = {0}, fp[9], fmn[9], pp[9], pm[9];
+    if (sample < 9) { /* the principal directions */
+      df[3 * (sample / 3) + sample % 3] = 1;
+    } else { /* a unit rank-one a n^T */
+      double a[3], n[3], na = 0, nn = 0;
+      for (int i = 0; i < 3; ++i) {
+        a[i] = test_rng_uniform(rng, -1, 1), n[i] = test_rng_uniform(rng, -1, 1);
+        na += a[i] * a[i], nn += n[i] * n[i];
+      }
+      for (int i = 0; i < 3; ++i)
+        for (int j = 0; j < 3; ++j) df[3 * i + j] = a[i] * n[j] / sqrt(na * nn);
+    }
+    const double h = 1e-7;
+    for (int e = 0; e < 9; ++e) fp[e] = fm[e] + h * df[e], fmn[e] = fm[e] - h * df[e];
+    stress_of(m, fp, pp);
+    stress_of(m, fmn, pm);
+    double q = 0;
+    for (int e = 0; e < 9; ++e) q += df[e] * (pp[e] - pm[e]) / (2 * h);
+    sampled = fmax(sampled, q);
+  }
+  return sampled;
+}
+
 static piola_mat3 random_rotation(test_rng *rng) {
   double q[4], n = 0;
   for (int i = 0; i < 4; ++i) q[i] = test_rng_normal(rng), n += q[i] * q[i];
@@ -278,28 +306,7 @@ static void modulus_bounds_the_extensions(void **state) {
         continue;
       const double fm[9] = {f[0], 0, 0, 0, f[1], 0, 0, 0, f[2]};
       const double k = piola__elastic_body_tet_modulus(body, 0, f);
-      double sampled = -INFINITY;
-      for (int sample = 0; sample < 9 + RANDOM_WAVES; ++sample) {
-        double df[9] = {0}, fp[9], fmn[9], pp[9], pm[9];
-        if (sample < 9) { /* the principal directions */
-          df[3 * (sample / 3) + sample % 3] = 1;
-        } else { /* a unit rank-one a n^T */
-          double a[3], n[3], na = 0, nn = 0;
-          for (int i = 0; i < 3; ++i) {
-            a[i] = test_rng_uniform(&rng, -1, 1), n[i] = test_rng_uniform(&rng, -1, 1);
-            na += a[i] * a[i], nn += n[i] * n[i];
-          }
-          for (int i = 0; i < 3; ++i)
-            for (int j = 0; j < 3; ++j) df[3 * i + j] = a[i] * n[j] / sqrt(na * nn);
-        }
-        const double h = 1e-7;
-        for (int e = 0; e < 9; ++e) fp[e] = fm[e] + h * df[e], fmn[e] = fm[e] - h * df[e];
-        stress_of(&m, fp, pp);
-        stress_of(&m, fmn, pm);
-        double q = 0;
-        for (int e = 0; e < 9; ++e) q += df[e] * (pp[e] - pm[e]) / (2 * h);
-        sampled = fmax(sampled, q);
-      }
+      const double sampled = sampled_wave_modulus(&m, fm, RANDOM_WAVES, &rng);
       if (!(k >= sampled - 1e-4 * fabs(sampled) - 1e-9 * m.mu))
         fail_msg("%s (%s extension, threshold %g) at fhat (%g, %g, %g): bound %g below a plane wave's %g",
                  piola_material_model_name(def.model), piola_inversion_mode_name(def.inversion_mode),
@@ -360,28 +367,7 @@ static void modulus_bounds_the_threshold_rise(void **state) {
       in_rise += cf > m.threshold && cf < m.threshold_compressed && (f[0] < cf || f[1] < cf);
       const double fm[9] = {f[0], 0, 0, 0, f[1], 0, 0, 0, f[2]};
       const double k = piola__elastic_body_tet_modulus(body, 0, f);
-      double sampled = -INFINITY;
-      for (int sample = 0; sample < 9 + 24; ++sample) {
-        double df[9] = {0}, fp[9], fmn[9], pp[9], pm[9];
-        if (sample < 9) {
-          df[3 * (sample / 3) + sample % 3] = 1;
-        } else {
-          double a[3], n[3], na = 0, nn = 0;
-          for (int i = 0; i < 3; ++i) {
-            a[i] = test_rng_uniform(&rng, -1, 1), n[i] = test_rng_uniform(&rng, -1, 1);
-            na += a[i] * a[i], nn += n[i] * n[i];
-          }
-          for (int i = 0; i < 3; ++i)
-            for (int j = 0; j < 3; ++j) df[3 * i + j] = a[i] * n[j] / sqrt(na * nn);
-        }
-        const double h = 1e-7;
-        for (int e = 0; e < 9; ++e) fp[e] = fm[e] + h * df[e], fmn[e] = fm[e] - h * df[e];
-        stress_of(&m, fp, pp);
-        stress_of(&m, fmn, pm);
-        double q = 0;
-        for (int e = 0; e < 9; ++e) q += df[e] * (pp[e] - pm[e]) / (2 * h);
-        sampled = fmax(sampled, q);
-      }
+      const double sampled = sampled_wave_modulus(&m, fm, 24, &rng);
       if (!(k >= sampled - 1e-4 * fabs(sampled) - 1e-9 * m.mu))
         fail_msg("%s (default, threshold %g rising to %g: %g here) at fhat (%g, %g, %g): bound %g "
                  "below a plane wave's %g",

@@ -35,28 +35,31 @@
 
 #define STABLE_STEP_KERNEL static inline __attribute__((always_inline))
 
-/* Largest eigenvalue of the pair block plus the K_ij coupling (see above). Selects, no
- * branches, so that the lane loop vectorizes. */
-STABLE_STEP_KERNEL double pair_modulus(double c, double pi, double pj, double fi, double fj,
-                                       double kii, double kjj, double kij) {
+/* The pair block's two eigenvalues as a +- b (see above), without the K_ij coupling. Selects,
+ * no branches, so that the lane loop vectorizes. */
+STABLE_STEP_KERNEL void pair_block(double c, double pi, double pj, double fi, double fj, double kii,
+                                   double kjj, double kij, double *a, double *b) {
   const double df = fi - fj, sum = fi + fj;
   const int close = fabs(df) <= 1e-6 * (fabs(fi) + fabs(fj));
   const double minus = close ? 0.5 * (kii + kjj) - kij : (pi - pj) / (close ? 1.0 : df);
   const double den = sum >= 0.0 ? kernel_max(sum, c) : kernel_min(sum, -c);
   const double plus = (pi + pj) / den;
-  const double a = 0.5 * (minus + plus), b = 0.5 * (minus - plus);
+  *a = 0.5 * (minus + plus), *b = 0.5 * (minus - plus);
+}
+
+/* Largest eigenvalue of the pair block plus the K_ij coupling. */
+STABLE_STEP_KERNEL double pair_modulus(double c, double pi, double pj, double fi, double fj,
+                                       double kii, double kjj, double kij) {
+  double a, b;
+  pair_block(c, pi, pj, fi, fj, kii, kjj, kij, &a, &b);
   return a + fabs(b + kij);
 }
 
 /* The same pair weighted by the direction weights wi, wj (stable_step_anisotropy.h). */
 STABLE_STEP_KERNEL double weighted_pair_modulus(double c, double pi, double pj, double fi, double fj,
                                                 double kii, double kjj, double kij, double wi, double wj) {
-  const double df = fi - fj, sum = fi + fj;
-  const int close = fabs(df) <= 1e-6 * (fabs(fi) + fabs(fj));
-  const double minus = close ? 0.5 * (kii + kjj) - kij : (pi - pj) / (close ? 1.0 : df);
-  const double den = sum >= 0.0 ? kernel_max(sum, c) : kernel_min(sum, -c);
-  const double plus = (pi + pj) / den;
-  const double a = 0.5 * (minus + plus), b = 0.5 * (minus - plus);
+  double a, b;
+  pair_block(c, pi, pj, fi, fj, kii, kjj, kij, &a, &b);
   return step_weighted_pair(a, b + kij, wi, wj);
 }
 

@@ -43,6 +43,32 @@ typedef struct beam {
   double length, side;
 } beam;
 
+/* A neo-Hookean bar of b's grid along x (1000 kg/m^3), its end at x = 0 held. */
+static void add_clamped_bar(piola_world *w, const beam *b, double youngs_modulus, double poisson_ratio) {
+  piola_tet_mesh mesh;
+  assert_int_equal(piola_tet_mesh_box_grid(b->nx, b->ny, b->ny,
+                                           (piola_vec3){b->length / b->nx, b->side / b->ny,
+                                                        b->side / b->ny},
+                                           &mesh),
+                   PIOLA_OK);
+  piola_solid_def sd = piola_default_solid_def();
+  sd.mesh = &mesh;
+  sd.material.model = PIOLA_MODEL_NEOHOOKEAN;
+  sd.material.youngs_modulus = youngs_modulus;
+  sd.material.poisson_ratio = poisson_ratio;
+  sd.density = 1000;
+  piola_constraint_def clamp;
+  memset(&clamp, 0, sizeof clamp);
+  clamp.selector.type = PIOLA_SELECT_BOX;
+  clamp.selector.box_min = (piola_vec3){-1, -1, -1};
+  clamp.selector.box_max = (piola_vec3){1e-9, 1, 1};
+  sd.constraints = &clamp;
+  sd.constraint_count = 1;
+  assert_int_equal(piola_world_add_solid(w, &sd, NULL), PIOLA_OK);
+  free(mesh.positions);
+  free(mesh.tets);
+}
+
 static piola_world *cantilever(const beam *b, piola_track gz, double dt, double tolerance,
                                piola_linear_forcing forcing) {
   piola_world_def wd = piola_default_world_def();
@@ -55,28 +81,7 @@ static piola_world *cantilever(const beam *b, piola_track gz, double dt, double 
   wd.linear_max_iterations = 20000;
   piola_world *w = NULL;
   assert_int_equal(piola_world_create(&wd, &w), PIOLA_OK);
-  piola_tet_mesh mesh;
-  assert_int_equal(piola_tet_mesh_box_grid(b->nx, b->ny, b->ny,
-                                           (piola_vec3){b->length / b->nx, b->side / b->ny,
-                                                        b->side / b->ny},
-                                           &mesh),
-                   PIOLA_OK);
-  piola_solid_def sd = piola_default_solid_def();
-  sd.mesh = &mesh;
-  sd.material.model = PIOLA_MODEL_NEOHOOKEAN;
-  sd.material.youngs_modulus = 1e6;
-  sd.material.poisson_ratio = 0.0;
-  sd.density = 1000;
-  piola_constraint_def clamp;
-  memset(&clamp, 0, sizeof clamp);
-  clamp.selector.type = PIOLA_SELECT_BOX;
-  clamp.selector.box_min = (piola_vec3){-1, -1, -1};
-  clamp.selector.box_max = (piola_vec3){1e-9, 1, 1};
-  sd.constraints = &clamp;
-  sd.constraint_count = 1;
-  assert_int_equal(piola_world_add_solid(w, &sd, NULL), PIOLA_OK);
-  free(mesh.positions);
-  free(mesh.tets);
+  add_clamped_bar(w, b, 1e6, 0.0);
   return w;
 }
 
@@ -210,25 +215,7 @@ static void soft_bar_increment_without_failed_newton(void **state) {
   wd.implicit_dt = 1.0 / 30.0;
   piola_world *w = NULL;
   assert_int_equal(piola_world_create(&wd, &w), PIOLA_OK);
-  piola_tet_mesh mesh;
-  assert_int_equal(piola_tet_mesh_box_grid(13, 2, 2, (piola_vec3){0.5 / 13, 0.04, 0.04}, &mesh),
-                   PIOLA_OK);
-  piola_solid_def sd = piola_default_solid_def();
-  sd.mesh = &mesh;
-  sd.material.model = PIOLA_MODEL_NEOHOOKEAN;
-  sd.material.youngs_modulus = 2e4;
-  sd.material.poisson_ratio = 0.3;
-  sd.density = 1000;
-  piola_constraint_def clamp;
-  memset(&clamp, 0, sizeof clamp);
-  clamp.selector.type = PIOLA_SELECT_BOX;
-  clamp.selector.box_min = (piola_vec3){-1, -1, -1};
-  clamp.selector.box_max = (piola_vec3){1e-9, 1, 1};
-  sd.constraints = &clamp;
-  sd.constraint_count = 1;
-  assert_int_equal(piola_world_add_solid(w, &sd, NULL), PIOLA_OK);
-  free(mesh.positions);
-  free(mesh.tets);
+  add_clamped_bar(w, &(beam){.nx = 13, .ny = 2, .length = 0.5, .side = 0.08}, 2e4, 0.3);
   piola_step_stats st;
   memset(&st, 0, sizeof st);
   assert_int_equal(piola_world_advance_to(w, 1.0 / 30.0, &st), PIOLA_OK);

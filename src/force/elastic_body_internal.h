@@ -159,6 +159,9 @@ void piola__elastic_body_split_update(piola_elastic_body *body, const double *x,
 void piola__elastic_body_split_free(piola_elastic_body *body);
 /* Local mode: every block's Fhat, det F and energy density onto process 0 (collective). */
 void piola__elastic_body_split_collect(piola_elastic_body *body);
+/* Local mode: the ghost blocks' Fhat from their owners (collective), which the stiffness
+ * assembly reads with the U and V the update shares; nothing otherwise. */
+void piola__elastic_body_split_share_fhat(piola_elastic_body *body);
 /* One or two consecutive blocks of the force loop from first, forces added into out in tet
  * order (force_lanes.c, a kernel built once per instruction set, common/isa.h; the plain
  * name runs the chosen variant). */

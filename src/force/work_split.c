@@ -260,6 +260,27 @@ static void unpack_rotations(void *owner, int32_t b, const double *o) {
   for (int k = 0; k < 9; ++k) memcpy(body->v[0] + k * stride + base, o + (9 + k) * B, B * sizeof(double));
 }
 
+/* Local mode: a ghost block's Fhat. The update does not share it (the force loop and the
+ * damping rows read only U and V of a ghost block), but the stiffness assembly does: with
+ * the Fhat a ghost block had when last collected, a node's row on its owner differed from
+ * the neighbouring rows on the other process, so the split Newton matrix was not symmetric
+ * (2-4% in the Frobenius norm on the quasistatic bar of docs/mpi.md) and its CG could
+ * return a direction that ascends (docs/mpi.md). */
+#define FHAT_WIDTH (B * 3)
+static void pack_fhat(void *owner, int32_t b, double *o) {
+  const piola_elastic_body *body = owner;
+  memcpy(o, body->fhat + 3 * (size_t)b * B, 3 * B * sizeof(double));
+}
+static void unpack_fhat(void *owner, int32_t b, const double *o) {
+  piola_elastic_body *body = owner;
+  memcpy(body->fhat + 3 * (size_t)b * B, o, 3 * B * sizeof(double));
+}
+
+void piola__elastic_body_split_share_fhat(piola_elastic_body *body) {
+  const piola_work_split *split = piola__local_split(body);
+  if (split) split->share_ghosts(split->context, body, pack_fhat, unpack_fhat, FHAT_WIDTH);
+}
+
 /* For the frames: a block's Fhat, det F and energy density. */
 #define FRAME_WIDTH (B * 5)
 static void pack_frame(void *owner, int32_t b, double *o) {

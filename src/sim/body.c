@@ -166,6 +166,8 @@ void piola__body_stiffness_assemble(const world_body *b, piola__stiffness_matrix
                                     double alpha, double mass_weight) {
   switch (b->kind) {
     case PIOLA_BODY_SOLID:
+      /* a split's ghost tets at this update (collective: every process assembles) */
+      piola__elastic_body_split_share_fhat(b->solid);
       piola__stiffness_matrix_assemble(matrix, b->solid, stiffness_weight, damping_weight, b->mass,
                                        mass_weight);
       return;

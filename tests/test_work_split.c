@@ -11,8 +11,10 @@
  *  - in the local mode (part 0 holds its own blocks and the ghost blocks part 1 sends), its
  *    own tets' state and the damping forces of every node are the same bits (the ghosts
  *    matter: without them part 0's rows differ), and the body, once its split is taken off,
- *    refuses to step alone or to be split again; both parts, stepping their step bound
- *    together (two threads), get the whole body's largest rate and the tet that sets it;
+ *    refuses to step alone or to be split again; its stiffness rows (the Newton matrix's)
+ *    are the same bits once its ghost blocks' Fhat is shared, and differ before; both
+ *    parts, stepping their step bound together (two threads), get the whole body's largest
+ *    rate and the tet that sets it;
  *  - splits with parts out of range or missing operations are refused;
  *  - a split planned before the solid is built (piola_world_set_work_split_planner) writes
  *    its own tets' state with the whole solid's bits and never the tets it does not hold. */
@@ -23,7 +25,9 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "force/elastic_body_internal.h"
 #include "force/stable_step.h"
+#include "force/stiffness_matrix.h"
 #include "piola/elastic_body.h"
 #include "piola/work_split.h"
 #include "piola/world.h"
@@ -176,6 +180,43 @@ static void check_local_step_bound(piola_elastic_body *whole, fake_part *p0, fak
   }
 }
 
+/* The stiffness assembly in the local mode (the implicit integrators' Newton matrix): part
+ * 0's rows, the rows of the nodes it owns, times a random field are the same bits as the
+ * whole body's, once the ghost blocks' Fhat is shared (part 1 records what it sends, then
+ * part 0 receives it). Before that part 0 holds its ghost blocks' Fhat at rest, and its
+ * rows differ: on MPI the rows of two processes then disagreed, and the matrix was not
+ * symmetric (docs/mpi.md). */
+static double owned_rows_difference(piola_elastic_body *whole, piola_elastic_body *part0,
+                                    const int32_t *node_part, int32_t nv) {
+  piola__stiffness_matrix mw, m0;
+  assert_int_equal(piola__stiffness_matrix_init(&mw, whole), PIOLA_OK);
+  assert_int_equal(piola__stiffness_matrix_init(&m0, part0), PIOLA_OK);
+  double *mass = malloc(sizeof(double) * (size_t)nv), *p = malloc(sizeof(double) * 3 * (size_t)nv);
+  double *aw = malloc(sizeof(double) * 3 * (size_t)nv), *a0 = malloc(sizeof(double) * 3 * (size_t)nv);
+  test_rng rng = test_rng_seeded(21);
+  for (int32_t i = 0; i < nv; ++i) mass[i] = 0.01;
+  for (int32_t j = 0; j < 3 * nv; ++j) p[j] = test_rng_uniform(&rng, -1, 1);
+  piola__stiffness_matrix_assemble(&mw, whole, -1.0, 0.0, mass, 1.0);
+  piola__stiffness_matrix_assemble(&m0, part0, -1.0, 0.0, mass, 1.0);
+  piola__stiffness_matrix_apply(&mw, whole, mass, 1.0, p, aw);
+  piola__stiffness_matrix_apply(&m0, part0, mass, 1.0, p, a0);
+  double worst = 0;
+  for (int32_t i = 0; i < nv; ++i)
+    if (node_part[i] == 0)
+      for (int c = 0; c < 3; ++c) worst = fmax(worst, fabs(a0[3 * i + c] - aw[3 * i + c]));
+  free(mass), free(p), free(aw), free(a0);
+  piola__stiffness_matrix_free(&mw);
+  piola__stiffness_matrix_free(&m0);
+  return worst;
+}
+
+static void check_local_stiffness(piola_elastic_body *whole, fake_part *p0, fake_part *p1) {
+  assert_true(owned_rows_difference(whole, p0->body, p0->node_part, p0->node_count) > 0);
+  piola__elastic_body_split_share_fhat(p1->body);
+  piola__elastic_body_split_share_fhat(p0->body);
+  assert_true(owned_rows_difference(whole, p0->body, p0->node_part, p0->node_count) == 0);
+}
+
 /* x: the rest positions stretched, sheared and jittered; v: a random velocity field. */
 static void deformed_state(const piola_tet_mesh *mesh, double *x, double *v) {
   test_rng rng = test_rng_seeded(20);
@@ -267,6 +308,7 @@ static void check_split(int n, int alternate, int local) {
   piola_elastic_body_damping_forces(p0.body, v, 0.7, 0.3, d0);
   assert_memory_equal(d0, d, sizeof(double) * 3 * (size_t)nv);
   if (local) {
+    check_local_stiffness(whole, &p0, &p1);
     check_local_step_bound(whole, &p0, &p1);
     /* a local split keeps only its part: the body cannot step alone again, nor be split anew */
     assert_int_equal(piola_elastic_body_set_work_split(p0.body, NULL), PIOLA_OK);

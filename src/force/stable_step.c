@@ -733,35 +733,82 @@ static int32_t near_tet_in(const piola_elastic_body *body, const double *w, int3
   return -1;
 }
 
+/* Blocks per chunk of the rate pass whose maximum is kept for the worst tet's search. */
+enum { SEARCH_CHUNK_BLOCKS = 32 };
+
+/* The first tet near best (near_tet_in) in tets [begin, end), which start at a block, given
+ * the largest rate `chunk_max` of each run of SEARCH_CHUNK_BLOCKS blocks from begin: only
+ * the blocks of the chunks near best are screened. Searching block by block from the start
+ * cost up to a second rate pass, paid by the process holding the worst tet alone (the
+ * imbalance of docs/scaling.md). The same tet: a chunk holding a tet within 1e-12 of best
+ * passes the 1e-10 screen. */
+static int32_t near_tet_by_chunks(const piola_elastic_body *body, const double *w, int32_t begin,
+                                  int32_t end, const double *chunk_max, double best) {
+  const int32_t chunk = SEARCH_CHUNK_BLOCKS * PIOLA_TET_BLOCK;
+  for (int32_t c = 0; begin + (int64_t)c * chunk < end; ++c) {
+    if (!(chunk_max[c] >= best * (1 - 1e-10))) continue;
+    const int32_t c1 = begin + (c + 1) * chunk < end ? begin + (c + 1) * chunk : end;
+    for (int32_t t0 = begin + c * chunk; t0 < c1; t0 += PIOLA_TET_BLOCK) {
+      const int32_t t = near_tet_in(body, w, t0, t0 + PIOLA_TET_BLOCK < c1 ? t0 + PIOLA_TET_BLOCK : c1, best);
+      if (t >= 0) return t;
+    }
+  }
+  return -1;
+}
+
 /* A split in the local mode: the largest rate over this process's blocks (runs of consecutive
- * blocks), then over the processes; the worst tet is the first one near it over all
- * processes, and its Fhat is sent to every process (the warning quotes it). The maximum is
- * exact, so every process gets the single process's bits. */
+ * blocks, in chunks whose maxima the search reads), then over the processes; the worst tet is
+ * the first one near it over all processes, and its Fhat is sent to every process (the
+ * warning quotes it). The maximum is exact, so every process gets the single process's bits. */
 static double local_rate2(piola_elastic_body *body, const double *w, const piola_work_split *split,
                           int32_t *worst_tet) {
   const int32_t nt = body->tet_count, *list = body->split_blocks, count = body->split_block_count;
+  /* chunks start a run or follow a full chunk: at most count / SEARCH_CHUNK_BLOCKS + runs */
+  double *chunk_max = worst_tet ? malloc(sizeof(double) * (size_t)(count + 1)) : NULL;
+  int32_t chunks = 0;
   double best = 0;
   for (int32_t k = 0; k < count;) {
     int32_t end = k + 1;
     while (end < count && list[end] == list[end - 1] + 1) ++end;
     const int32_t t0 = list[k] * PIOLA_TET_BLOCK;
     const int32_t t1 = (list[end - 1] + 1) * PIOLA_TET_BLOCK < nt ? (list[end - 1] + 1) * PIOLA_TET_BLOCK : nt;
-    const double r = t1 > t0 ? range_rate2(body, w, t0, t1) : 0;
-    best = r > best ? r : best;
+    for (int32_t c0 = t0; c0 < t1; c0 += SEARCH_CHUNK_BLOCKS * PIOLA_TET_BLOCK) {
+      const int32_t c1 = c0 + SEARCH_CHUNK_BLOCKS * PIOLA_TET_BLOCK < t1 ? c0 + SEARCH_CHUNK_BLOCKS * PIOLA_TET_BLOCK : t1;
+      const double r = range_rate2(body, w, c0, c1);
+      if (chunk_max) chunk_max[chunks++] = r;
+      best = r > best ? r : best;
+    }
     k = end;
   }
   const double mine = best;
   split->reduce(split->context, &best, 1, PIOLA_WORK_SPLIT_MAX);
-  if (!worst_tet || !(best > 0)) return best;
+  if (!worst_tet || !(best > 0)) {
+    free(chunk_max);
+    return best;
+  }
   double first = (double)nt;
   /* a process whose own largest rate is not near the largest of all holds no tet near it
-   * (near_tet_in's margin): it skips the search */
+   * (near_tet_in's margin): it skips the search. Without chunk_max (out of memory) every
+   * block is screened. */
   if (mine >= best * (1 - 1e-10))
-    for (int32_t k = 0; k < count && first == nt; ++k) {
+    for (int32_t k = 0, c = 0; k < count && first == nt;) {
+      int32_t end = k + 1;
+      while (end < count && list[end] == list[end - 1] + 1) ++end;
       const int32_t t0 = list[k] * PIOLA_TET_BLOCK;
-      const int32_t t = near_tet_in(body, w, t0, t0 + PIOLA_TET_BLOCK < nt ? t0 + PIOLA_TET_BLOCK : nt, best);
+      const int32_t t1 = (list[end - 1] + 1) * PIOLA_TET_BLOCK < nt ? (list[end - 1] + 1) * PIOLA_TET_BLOCK : nt;
+      const int32_t run_chunks = (t1 - t0 + SEARCH_CHUNK_BLOCKS * PIOLA_TET_BLOCK - 1) / (SEARCH_CHUNK_BLOCKS * PIOLA_TET_BLOCK);
+      int32_t t = -1;
+      if (chunk_max) {
+        t = near_tet_by_chunks(body, w, t0, t1, chunk_max + c, best);
+      } else {
+        for (int32_t b0 = t0; b0 < t1 && t < 0; b0 += PIOLA_TET_BLOCK)
+          t = near_tet_in(body, w, b0, b0 + PIOLA_TET_BLOCK < t1 ? b0 + PIOLA_TET_BLOCK : t1, best);
+      }
       if (t >= 0) first = t;
+      c += run_chunks;
+      k = end;
     }
+  free(chunk_max);
   split->reduce(split->context, &first, 1, PIOLA_WORK_SPLIT_MIN);
   const int32_t t = (int32_t)first;
   if (t >= nt) return best;
@@ -790,8 +837,14 @@ double PIOLA_ISA_NAME(piola__elastic_body_state_rate2)(piola_elastic_body *body,
                           (int32_t)((int64_t)nt * (r + 1) / RANGES));
   double best = 0;
   for (int r = 0; r < RANGES; ++r) best = part[r] > best ? part[r] : best;
+  /* the search screens the ranges by their maxima first (near_tet_by_chunks' reason) */
   if (worst_tet && best > 0)
-    for (int32_t t0 = 0; t0 < nt && *worst_tet < 0; t0 += PIOLA_TET_BLOCK)
-      *worst_tet = near_tet_in(body, w, t0, t0 + PIOLA_TET_BLOCK < nt ? t0 + PIOLA_TET_BLOCK : nt, best);
+    for (int r = 0; r < RANGES && *worst_tet < 0; ++r) {
+      if (!(part[r] >= best * (1 - 1e-10))) continue;
+      const int32_t r1 = (int32_t)((int64_t)nt * (r + 1) / RANGES);
+      for (int32_t t0 = (int32_t)((int64_t)nt * r / RANGES) / PIOLA_TET_BLOCK * PIOLA_TET_BLOCK;
+           t0 < r1 && *worst_tet < 0; t0 += PIOLA_TET_BLOCK)
+        *worst_tet = near_tet_in(body, w, t0, t0 + PIOLA_TET_BLOCK < nt ? t0 + PIOLA_TET_BLOCK : nt, best);
+    }
   return best;
 }

@@ -4,14 +4,16 @@
  * loop's unit of work) are the vertices of a graph: the tets' dual graph (METIS_MeshToDual,
  * tets sharing a face) collapsed onto blocks, each edge weighted by the faces it stands for,
  * each block weighted by its real tets. METIS_PartGraphKway cuts it into one part per process
- * on rank 0, which broadcasts it, so every process holds the same partition. A node is owned
- * by the lowest process whose blocks touch it (process 0 for a node no tet touches).
+ * on rank 0, which broadcasts it, so every process holds the same partition. A node only one
+ * process's blocks touch is that process's (process 0's if no tet touches it); the nodes
+ * several processes touch are shared out between them (choose_owners).
  *
  * Exchanges (the three operations of piola/work_split.h):
- *   sum_nodes    halo: each process sends its partial forces on the nodes it shares with a
- *                lower-numbered owner to that owner (MPI_Isend / MPI_Irecv, one message per
- *                neighbour pair); the owner adds them to its own in process order, so the
- *                sum has one fixed order. Then share_nodes.
+ *   sum_nodes    halo: each process sends its partial forces on the nodes it shares with
+ *                another owner to that owner (MPI_Isend / MPI_Irecv, one message per
+ *                neighbour pair and direction); the owner adds the partials in process
+ *                order, its own at its place, so the sum has one fixed order whoever owns
+ *                the node. Then share_nodes.
  *   share_nodes  replication: MPI_Allgatherv of the owned nodes' values (3 per node).
  *   share_blocks replication: MPI_Allgatherv of each process's blocks' per-tet state (only
  *                for solids with plasticity, which keep the replicated mode).
@@ -45,7 +47,13 @@ typedef struct solid_plan {
    * sends (owned by the neighbour) and those whose partial it receives (owned here) */
   int32_t neighbor_count;
   int32_t *neighbors, *send_start, *send_nodes, *recv_start, *recv_nodes;
-  double *send_values, *recv_values, *gather;
+  /* nodes owned here that a lower process touches too (their sum starts with the lowest
+   * process's partial, not with this one's), and per received partial whether it is the
+   * lowest process's; the own partials wait in late_values */
+  int32_t late_count;
+  int32_t *late_nodes;
+  uint8_t *recv_first;
+  double *send_values, *recv_values, *late_values, *gather;
   size_t gather_capacity;
   /* ghost blocks: per neighbour (ghost_neighbors) the blocks this process sends and those it
    * receives, increasing; the message buffer */
@@ -84,7 +92,8 @@ static void plan_free(solid_plan *p) {
   free(p->block_part), free(p->node_part), free(p->node_order), free(p->node_start);
   free(p->block_order), free(p->block_start), free(p->neighbors), free(p->send_start);
   free(p->send_nodes), free(p->recv_start), free(p->recv_nodes), free(p->send_values);
-  free(p->recv_values), free(p->gather), free(p->counts), free(p->displs), free(p->requests);
+  free(p->recv_values), free(p->late_nodes), free(p->recv_first), free(p->late_values);
+  free(p->gather), free(p->counts), free(p->displs), free(p->requests);
   free(p->ghost_neighbors), free(p->ghost_send_start), free(p->ghost_send);
   free(p->ghost_recv_start), free(p->ghost_recv), free(p->ghost_buffer), free(p->reduce_buffer);
 }
@@ -160,9 +169,20 @@ static void sum_nodes(void *context, double *values) {
     s->stats.halo_bytes += 24 * (int64_t)(n1 - n0);
   }
   MPI_Waitall(r, p->requests, MPI_STATUSES_IGNORE);
-  /* the owner is the lowest process touching a node, so its own partial comes first and
-   * the neighbours' follow in process order */
-  for (int32_t k = 0; k < p->neighbor_count; ++k)
+  /* the partials in process order: the lower neighbours' (the lowest one's copied, not
+   * added: 0 + x is not x's bits for x = -0), this process's, the higher neighbours' */
+  for (int32_t k = 0; k < p->late_count; ++k)
+    memcpy(p->late_values + 3 * (size_t)k, values + 3 * (size_t)p->late_nodes[k], 3 * sizeof(double));
+  int32_t k = 0;
+  for (; k < p->neighbor_count && p->neighbors[k] < s->rank; ++k)
+    for (int32_t j = p->recv_start[k]; j < p->recv_start[k + 1]; ++j)
+      for (int c = 0; c < 3; ++c) {
+        double *v = values + 3 * (size_t)p->recv_nodes[j] + c;
+        *v = p->recv_first[j] ? p->recv_values[3 * (size_t)j + c] : *v + p->recv_values[3 * (size_t)j + c];
+      }
+  for (int32_t l = 0; l < p->late_count; ++l)
+    for (int c = 0; c < 3; ++c) values[3 * (size_t)p->late_nodes[l] + c] += p->late_values[3 * (size_t)l + c];
+  for (; k < p->neighbor_count; ++k)
     for (int32_t j = p->recv_start[k]; j < p->recv_start[k + 1]; ++j)
       for (int c = 0; c < 3; ++c) values[3 * (size_t)p->recv_nodes[j] + c] += p->recv_values[3 * (size_t)j + c];
   s->stats.halo_seconds += MPI_Wtime() - t0;
@@ -434,6 +454,71 @@ static int order_by_part(const int32_t *part_of, int32_t n, int parts, int32_t *
   return 1;
 }
 
+/* lowest and highest process touching node i (touch: node x process), -1 if none */
+static void touch_range(const uint8_t *touch, int32_t i, int parts, int *lo, int *hi) {
+  *lo = *hi = -1;
+  for (int q = 0; q < parts; ++q)
+    if (touch[(size_t)i * parts + q]) {
+      if (*lo < 0) *lo = q;
+      *hi = q;
+    }
+}
+
+/* Owners. A node one process touches is its own (process 0's if none touches it). The nodes
+ * several processes touch (the parts' interfaces) are shared out: of those with the same
+ * lowest and highest process, taken in node order, the first half goes to the lowest and
+ * the rest to the highest. Giving all to the lowest (until 2026-12-02) gave process 0 of 2
+ * every interface row of the damping products and every block of the other process on the
+ * interface as a ghost to assemble: the work that made it the busier one (docs/scaling.md).
+ * Halves in node order keep each owner's interface nodes together on a spatially ordered
+ * mesh, so each process holds about half of the other's interface blocks as ghosts. */
+static int choose_owners(const uint8_t *touch, int32_t nodes, int parts, int32_t *owner) {
+  const size_t groups = (size_t)parts * (size_t)parts; /* by (lowest, highest) process */
+  int32_t *size = calloc(2 * groups, sizeof(int32_t)), *taken = size + groups;
+  if (!size) return 0;
+  for (int pass = 0; pass < 2; ++pass)
+    for (int32_t i = 0; i < nodes; ++i) {
+      int lo, hi;
+      touch_range(touch, i, parts, &lo, &hi);
+      if (lo == hi) { /* one process, or none */
+        owner[i] = lo < 0 ? 0 : lo;
+        continue;
+      }
+      const size_t g = (size_t)lo * (size_t)parts + (size_t)hi;
+      if (pass == 0) size[g]++;
+      else owner[i] = taken[g]++ < (size[g] + 1) / 2 ? lo : hi;
+    }
+  free(size);
+  return 1;
+}
+
+/* The lists sum_nodes needs to add the partials in process order when this process owns a
+ * node that a lower process touches too. */
+static int plan_late_sums(solid_plan *p, const uint8_t *touch, int parts, int me) {
+  const int32_t recvs = p->recv_start[p->neighbor_count];
+  p->recv_first = calloc((size_t)(recvs > 0 ? recvs : 1), 1);
+  if (!p->recv_first) return 0;
+  p->late_count = 0;
+  for (int32_t k = 0; k < p->neighbor_count; ++k)
+    for (int32_t j = p->recv_start[k]; j < p->recv_start[k + 1]; ++j) {
+      int lo, hi;
+      touch_range(touch, p->recv_nodes[j], parts, &lo, &hi);
+      p->recv_first[j] = p->neighbors[k] == lo;
+      p->late_count += p->recv_first[j]; /* once per late node: its lowest process sends it */
+    }
+  p->late_nodes = malloc(sizeof(int32_t) * (size_t)(p->late_count > 0 ? p->late_count : 1));
+  p->late_values = malloc(3 * sizeof(double) * (size_t)(p->late_count > 0 ? p->late_count : 1));
+  if (!p->late_nodes || !p->late_values) return 0;
+  int32_t n = 0;
+  for (int32_t i = 0; i < p->node_count; ++i) {
+    if (p->node_part[i] != me) continue;
+    int lo, hi;
+    touch_range(touch, i, parts, &lo, &hi);
+    if (lo >= 0 && lo < me) p->late_nodes[n++] = i;
+  }
+  return n == p->late_count;
+}
+
 /* The plan and split of one solid from its tets (collective). */
 static piola_status plan_solid(piola_mpi_split *s, const plan_mesh *mesh, solid_plan *p) {
   const int32_t tets = mesh->tet_count;
@@ -463,18 +548,11 @@ static piola_status plan_solid(piola_mpi_split *s, const plan_mesh *mesh, solid_
                    : PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "MPI split: rank 0 could not partition");
   }
   MPI_Bcast(p->block_part, p->block_count, MPI_INT32_T, 0, MPI_COMM_WORLD);
-  /* which processes touch each node; its owner is the lowest */
+  /* which processes touch each node, and its owner */
   for (int32_t t = 0; t < tets; ++t)
     for (int c = 0; c < 4; ++c)
       touch[(size_t)tv[4 * t + c] * parts + p->block_part[t / PIOLA_WORK_SPLIT_BLOCK]] = 1;
-  for (int32_t i = 0; i < p->node_count; ++i) {
-    p->node_part[i] = 0;
-    for (int q = 0; q < parts; ++q)
-      if (touch[(size_t)i * parts + q]) {
-        p->node_part[i] = q;
-        break;
-      }
-  }
+  if (!choose_owners(touch, p->node_count, parts, p->node_part)) goto oom;
   /* halo plan: nodes this process touches together with another, by neighbour */
   p->neighbors = malloc(sizeof(int32_t) * (size_t)parts);
   p->send_start = calloc((size_t)parts + 1, sizeof(int32_t));
@@ -507,6 +585,7 @@ static piola_status plan_solid(piola_mpi_split *s, const plan_mesh *mesh, solid_
   }
   p->send_values = malloc(3 * sizeof(double) * (size_t)(sends > 0 ? sends : 1));
   p->recv_values = malloc(3 * sizeof(double) * (size_t)(recvs > 0 ? recvs : 1));
+  if (!plan_late_sums(p, touch, parts, me)) goto oom;
   p->requests = malloc(sizeof(MPI_Request) * 2 * (size_t)parts);
   p->reduce_buffer = malloc(sizeof(double) * REDUCE_MAX * (size_t)parts);
   if (!p->send_values || !p->recv_values || !p->requests || !p->reduce_buffer) goto oom;

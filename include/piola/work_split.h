@@ -147,6 +147,18 @@ typedef struct piola_work_split_planner {
 PIOLA_API void piola_world_set_work_split_planner(piola_world *world,
                                                   const piola_work_split_planner *planner);
 
+/* Sets (or with NULL clears) the planner of the split solids whose mesh changes (a cut:
+ * world_fracture.h): after such a solid's body is rebuilt for its new mesh, the world asks
+ * it (plan, with the solid's index and its new mesh: the tets of the new body, rest
+ * positions) for the new body's split, and sets it in the replicated mode (a solid that can
+ * break holds every tet's state on every process, so every process takes the same fracture
+ * decisions). The split the solid had before may be freed by plan: no body refers to it any
+ * more. NULL from plan, or no replanner: the rebuilt body is whole on every process
+ * (correct, every process computing everything). Collective like the cut itself: every
+ * process cuts the same tets at the same step. The planner is copied. */
+PIOLA_API void piola_world_set_work_split_replanner(piola_world *world,
+                                                    const piola_work_split_planner *planner);
+
 /* piola_scene_build with planner set on the scene's world before its solids are added. */
 PIOLA_API piola_status piola_scene_build_split(const piola_scene_desc *desc,
                                                const piola_work_split_planner *planner,

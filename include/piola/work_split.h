@@ -165,7 +165,7 @@ PIOLA_API piola_status piola_scene_build_split(const piola_scene_desc *desc,
                                                piola_scene **out);
 
 /* NULL when every solid of world can be split by splits without solve_newton, else why not
- * (shells, fracture and the implicit integrators run on one process only). */
+ * (shells and, without solve_newton, the implicit integrators run on one process only). */
 PIOLA_API const char *piola_world_split_unsupported(const piola_world *world);
 
 /* The same for splits with solve_newton: the implicit integrators can be split. */

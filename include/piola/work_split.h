@@ -15,7 +15,8 @@
  * (written by the node's owner). What happens to the per-tet state (U, V, Fhat, det F) of
  * the force loop depends on the mode:
  *   - replicated (a split without the local operations, or a solid with plasticity, whose
- *     return mapping runs on every tet of every process): share_blocks gives every process
+ *     return mapping runs on every tet of every process, or with fracture, whose criteria
+ *     read every tet's state on every process): share_blocks gives every process
  *     every block's state, written by the block's process;
  *   - local (share_ghosts, reduce and collect_blocks given, no plasticity): a process holds
  *     the state of its own blocks and of its ghost blocks, the other processes' blocks with

@@ -17,7 +17,9 @@
  *    rate and the tet that sets it;
  *  - splits with parts out of range or missing operations are refused;
  *  - a split planned before the solid is built (piola_world_set_work_split_planner) writes
- *    its own tets' state with the whole solid's bits and never the tets it does not hold. */
+ *    its own tets' state with the whole solid's bits and never the tets it does not hold;
+ *  - a split solid that a cut rebuilds gets the replanner's split for its new mesh
+ *    (piola_world_set_work_split_replanner), in the replicated mode, and steps with it. */
 #include "test_support.h"
 
 #include <math.h>
@@ -31,6 +33,7 @@
 #include "piola/elastic_body.h"
 #include "piola/work_split.h"
 #include "piola/world.h"
+#include "piola/world_fracture.h"
 #include "test_elastic_body_fixtures.h"
 
 typedef struct fake_part {
@@ -419,6 +422,80 @@ static piola_world *planned_world(const piola_tet_mesh *mesh, const piola_work_s
  * owns nor ghosts were never written (zero, where the state at rest is det F = 1); a
  * planner that leaves the solid whole changes no bit; a solid with plasticity is not
  * offered to the planner. */
+/* ---- a split solid that a cut rebuilds (piola_world_set_work_split_replanner) */
+
+typedef struct replan_part {
+  int calls;
+  int32_t tet_count;            /* of the last mesh offered */
+  int32_t *block_part, *node_part;
+  piola_work_split split;
+} replan_part;
+
+/* Part 0 of 2 holding every block: its partial sums are the totals, so the split steps with
+ * the whole loop's bits (work_split.c) and no exchange is needed. */
+static piola_work_split all_on_part_zero(void *context, int32_t *block_part, int32_t *node_part) {
+  return (piola_work_split){0, 2, block_part, node_part, context, noop_nodes, noop_nodes,
+                            noop_blocks, NULL, NULL, NULL, NULL};
+}
+
+static piola_status replan_part_zero(void *context, int32_t solid, const piola_tet_mesh *mesh,
+                                     const piola_work_split **out) {
+  replan_part *p = context;
+  assert_int_equal(solid, 0);
+  const int32_t blocks = (mesh->tet_count + PIOLA_WORK_SPLIT_BLOCK - 1) / PIOLA_WORK_SPLIT_BLOCK;
+  free(p->block_part), free(p->node_part); /* no body refers to the old split any more */
+  p->block_part = calloc((size_t)blocks, sizeof(int32_t));
+  p->node_part = calloc((size_t)mesh->vertex_count, sizeof(int32_t));
+  assert_non_null(p->block_part);
+  assert_non_null(p->node_part);
+  p->split = all_on_part_zero(p, p->block_part, p->node_part);
+  p->calls++;
+  p->tet_count = mesh->tet_count;
+  *out = &p->split;
+  return PIOLA_OK;
+}
+
+/* A plane cut of a split solid: the rebuilt body takes the replanner's split for its new mesh
+ * (replicated), and the world steps with it as the unsplit world does, bit for bit. */
+static void cut_solid_is_split_again(void **state) {
+  (void)state;
+  piola_tet_mesh mesh = fixture_grid(6, 0.1);
+  piola_world *whole = planned_world(&mesh, NULL, 0), *w = planned_world(&mesh, NULL, 0);
+  const piola_elastic_body *b = piola_world_solid_body(w, 0);
+  replan_part p = {0};
+  const int32_t blocks = piola_elastic_body_block_count(b);
+  p.block_part = calloc((size_t)blocks, sizeof(int32_t));
+  p.node_part = calloc((size_t)mesh.vertex_count, sizeof(int32_t));
+  p.split = all_on_part_zero(&p, p.block_part, p.node_part);
+  assert_int_equal(piola_world_solid_set_work_split(w, 0, &p.split), PIOLA_OK);
+  const piola_work_split_planner replanner = {replan_part_zero, &p};
+  piola_world_set_work_split_replanner(w, &replanner);
+  piola_fracture_cut cut = {.time = 0, .point = {0.3, 0.3, 0.3}, .normal = {1, 0.2, 0.1}};
+  piola_fracture_def def = piola_default_fracture_def();
+  def.cuts = &cut, def.cut_count = 1;
+  assert_int_equal(piola_world_solid_set_fracture(whole, 0, &def), PIOLA_OK);
+  assert_int_equal(piola_world_solid_set_fracture(w, 0, &def), PIOLA_OK); /* cuts now */
+  b = piola_world_solid_body(w, 0);
+  assert_int_equal(piola_world_solid_fragment_count(w, 0), 2);
+  assert_int_equal(p.calls, 1);
+  assert_int_equal(p.tet_count, piola_elastic_body_tet_count(b));
+  assert_true(p.tet_count > mesh.tet_count);
+  assert_ptr_equal(piola_elastic_body_work_split(b), &p.split);
+  assert_false(piola_elastic_body_split_is_local(b));
+  for (int k = 0; k < 3; ++k) {
+    assert_int_equal(piola_world_step(whole, 0, NULL), PIOLA_OK);
+    assert_int_equal(piola_world_step(w, 0, NULL), PIOLA_OK);
+  }
+  const int32_t nv = piola_elastic_body_vertex_count(b);
+  assert_int_equal(nv, piola_elastic_body_vertex_count(piola_world_solid_body(whole, 0)));
+  assert_memory_equal(piola_world_solid_positions(w, 0), piola_world_solid_positions(whole, 0),
+                      3 * sizeof(double) * (size_t)nv);
+  piola_world_destroy(w);
+  piola_world_destroy(whole);
+  free(p.block_part), free(p.node_part);
+  free(mesh.positions), free(mesh.tets);
+}
+
 static void planned_solid_holds_its_part_only(void **state) {
   (void)state;
   piola_tet_mesh mesh = fixture_grid(12, 0.1);
@@ -492,6 +569,7 @@ static void planned_solid_holds_its_part_only(void **state) {
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(planned_solid_holds_its_part_only),
+      cmocka_unit_test(cut_solid_is_split_again),
       cmocka_unit_test(small_body_halves),
       cmocka_unit_test(small_body_alternating_blocks),
       cmocka_unit_test(chunked_body_halves),

@@ -46,10 +46,12 @@ typedef struct piola_mpi_split_stats {
   double exchange_cpu_seconds; /* s of CPU time of the calling thread in all the exchanges
                                   (halo, ghosts, gathers, reductions) so far: the rest of a
                                   step's CPU time is its own work */
+  int64_t replans;         /* partitions made again for a solid a cut changed, so far */
+  double replan_seconds;   /* s spent in them (METIS on process 0, the broadcast, the plan) */
 } piola_mpi_split_stats;
 
 /* Splits every solid of world among the processes of MPI_COMM_WORLD (MPI initialized).
- * Worlds with shells, fracture or an implicit integrator are refused
+ * Worlds with shells or an implicit integrator (without PETSc) are refused
  * (PIOLA_ERROR_UNSUPPORTED, naming what). Collective: every process calls it. Each process
  * has built the whole world first; to build only each process's part, use the planner
  * below instead. */

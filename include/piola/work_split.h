@@ -15,7 +15,8 @@
  * (written by the node's owner). What happens to the per-tet state (U, V, Fhat, det F) of
  * the force loop depends on the mode:
  *   - replicated (a split without the local operations, or a solid with plasticity, whose
- *     return mapping runs on every tet of every process): share_blocks gives every process
+ *     return mapping runs on every tet of every process, or with fracture, whose criteria
+ *     read every tet's state on every process): share_blocks gives every process
  *     every block's state, written by the block's process;
  *   - local (share_ghosts, reduce and collect_blocks given, no plasticity): a process holds
  *     the state of its own blocks and of its ghost blocks, the other processes' blocks with
@@ -147,13 +148,25 @@ typedef struct piola_work_split_planner {
 PIOLA_API void piola_world_set_work_split_planner(piola_world *world,
                                                   const piola_work_split_planner *planner);
 
+/* Sets (or with NULL clears) the planner of the split solids whose mesh changes (a cut:
+ * world_fracture.h): after such a solid's body is rebuilt for its new mesh, the world asks
+ * it (plan, with the solid's index and its new mesh: the tets of the new body, rest
+ * positions) for the new body's split, and sets it in the replicated mode (a solid that can
+ * break holds every tet's state on every process, so every process takes the same fracture
+ * decisions). The split the solid had before may be freed by plan: no body refers to it any
+ * more. NULL from plan, or no replanner: the rebuilt body is whole on every process
+ * (correct, every process computing everything). Collective like the cut itself: every
+ * process cuts the same tets at the same step. The planner is copied. */
+PIOLA_API void piola_world_set_work_split_replanner(piola_world *world,
+                                                    const piola_work_split_planner *planner);
+
 /* piola_scene_build with planner set on the scene's world before its solids are added. */
 PIOLA_API piola_status piola_scene_build_split(const piola_scene_desc *desc,
                                                const piola_work_split_planner *planner,
                                                piola_scene **out);
 
 /* NULL when every solid of world can be split by splits without solve_newton, else why not
- * (shells, fracture and the implicit integrators run on one process only). */
+ * (shells and, without solve_newton, the implicit integrators run on one process only). */
 PIOLA_API const char *piola_world_split_unsupported(const piola_world *world);
 
 /* The same for splits with solve_newton: the implicit integrators can be split. */

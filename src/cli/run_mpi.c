@@ -78,18 +78,21 @@ void run_mpi_collect(run_mpi *m, piola_world *world) {
 void run_mpi_report(run_mpi *m) {
   if (!m->split) return;
   piola_mpi_split_stats st = piola_mpi_split_stats_of(m->split);
-  double mine[7] = {(double)st.tets, (double)st.owned_nodes, (double)st.shared_nodes,
+  double mine[9] = {(double)st.tets, (double)st.owned_nodes, (double)st.shared_nodes,
                     (double)st.halo_bytes, st.halo_seconds, (double)st.gather_bytes,
-                    st.gather_seconds};
+                    st.gather_seconds, (double)st.replans, st.replan_seconds};
   double *all = m->rank == 0 ? malloc(sizeof mine * (size_t)m->size) : NULL;
-  MPI_Gather(mine, 7, MPI_DOUBLE, all, 7, MPI_DOUBLE, 0, MPI_COMM_WORLD);
+  MPI_Gather(mine, 9, MPI_DOUBLE, all, 9, MPI_DOUBLE, 0, MPI_COMM_WORLD);
   if (m->rank != 0 || !all) return;
   for (int r = 0; r < m->size; ++r) {
-    const double *a = all + 7 * r;
+    const double *a = all + 9 * r;
     fprintf(stderr,
             "piola run: MPI rank %d/%d: %.0f tets, %.0f owned nodes, %.0f shared nodes; halo "
-            "sent %.3f MB in %.3f s, gathers received %.3f MB in %.3f s\n",
+            "sent %.3f MB in %.3f s, gathers received %.3f MB in %.3f s",
             r, m->size, a[0], a[1], a[2], a[3] / 1e6, a[4], a[5] / 1e6, a[6]);
+    if (a[7] > 0) /* cuts changed a solid's mesh */
+      fprintf(stderr, "; %.0f partitions made again after cuts in %.3f s", a[7], a[8]);
+    fputc('\n', stderr);
   }
   free(all);
 }

@@ -18,6 +18,7 @@
 #include "piola/checkpoint.h"
 #include "piola/files.h"
 #include "piola/work_split.h"
+#include "piola/world_fracture.h"
 
 static void manifest_path(char *out, size_t size, const char *dir, int32_t frame) {
   snprintf(out, size, "%s/checkpoint_%04d.manifest", dir, (int)frame);
@@ -141,6 +142,13 @@ int run_split_checkpoint_save(run_mpi *m, const char *dir, const piola_world *wo
   return 1;
 }
 
+/* Whether a solid of world can be cut (its mesh and partition then change). */
+static bool cut_world(const piola_world *world) {
+  for (int32_t s = 0; s < piola_world_solid_count(world); ++s)
+    if (piola_world_solid_has_fracture(world, s)) return true;
+  return false;
+}
+
 /* Process 0: whether the manifest of frame fits this run: 0 yes, 1 damaged (skip it),
  * 2 refused (printed). */
 static int check_manifest(run_mpi *m, const char *dir, const piola_world *world, uint64_t key,
@@ -161,6 +169,13 @@ static int check_manifest(run_mpi *m, const char *dir, const piola_world *world,
   } else if (!line_of(text, "scene_key") || strtoull(line_of(text, "scene_key"), NULL, 16) != key) {
     fprintf(stderr, "piola run: cannot resume: %s was written for another scene (its scene file "
                     "or meshes differ); use --force to start over\n", path);
+    verdict = 2;
+  } else if (strcmp(text, expected) != 0 && cut_world(world)) {
+    /* a cut changed a solid's mesh and partition; the read would rebuild and partition it
+     * again, a collective step a process with a damaged file would not take */
+    fprintf(stderr, "piola run: cannot resume: %s was written after a cut (fracture); a run on "
+                    "several MPI processes resumes only from a checkpoint before its first cut "
+                    "(docs/mpi.md); use --force to start over\n", path);
     verdict = 2;
   } else if (strcmp(text, expected) != 0) {
     fprintf(stderr, "piola run: cannot resume: %s holds another partition of the solids than "

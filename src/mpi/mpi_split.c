@@ -67,6 +67,7 @@ typedef struct solid_plan {
 #ifdef PIOLA_PETSC
   piola__petsc_solver *newton; /* the implicit step's systems, made on first use */
 #endif
+  int64_t stat_tets, stat_owned, stat_shared; /* its share of the process's statistics */
   piola_work_split split;
 } solid_plan;
 
@@ -596,10 +597,13 @@ static piola_status plan_solid(piola_mpi_split *s, const plan_mesh *mesh, solid_
   free(touch);
   for (int32_t b = 0; b < p->block_count; ++b)
     if (p->block_part[b] == me)
-      s->stats.tets += (b + 1) * PIOLA_WORK_SPLIT_BLOCK <= tets ? PIOLA_WORK_SPLIT_BLOCK
-                                                               : tets - b * PIOLA_WORK_SPLIT_BLOCK;
-  s->stats.owned_nodes += p->node_start[me + 1] - p->node_start[me];
-  s->stats.shared_nodes += shared;
+      p->stat_tets += (b + 1) * PIOLA_WORK_SPLIT_BLOCK <= tets ? PIOLA_WORK_SPLIT_BLOCK
+                                                              : tets - b * PIOLA_WORK_SPLIT_BLOCK;
+  p->stat_owned = p->node_start[me + 1] - p->node_start[me];
+  p->stat_shared = shared;
+  s->stats.tets += p->stat_tets;
+  s->stats.owned_nodes += p->stat_owned;
+  s->stats.shared_nodes += p->stat_shared;
   p->split = (piola_work_split){.part = me,
                                 .part_count = parts,
                                 .block_part = p->block_part,
@@ -667,6 +671,33 @@ static piola_status plan_added_solid(void *context, int32_t solid, const piola_t
   return PIOLA_OK;
 }
 
+/* A split solid whose mesh a cut changed (piola_world_set_work_split_replanner): its old
+ * plan, which no body refers to any more, gives way to one for the new mesh, partitioned
+ * afresh (METIS on process 0, broadcast), as when the solid was added. */
+static piola_status replan_solid(void *context, int32_t solid, const piola_tet_mesh *mesh,
+                                 const piola_work_split **out) {
+  piola_mpi_split *s = context;
+  *out = NULL;
+  if (s->size == 1) return PIOLA_OK;
+  if (solid < s->solid_count && s->plans[solid]) {
+    solid_plan *old = s->plans[solid];
+    s->stats.tets -= old->stat_tets;
+    s->stats.owned_nodes -= old->stat_owned;
+    s->stats.shared_nodes -= old->stat_shared;
+    plan_free(old);
+    free(old);
+    s->plans[solid] = NULL;
+  }
+  const double t0 = MPI_Wtime();
+  plan_mesh m = {mesh->tets, mesh->tet_count, mesh->vertex_count};
+  solid_plan *p;
+  PIOLA_TRY(plan_agreed(s, solid, &m, &p));
+  s->stats.replans++;
+  s->stats.replan_seconds += MPI_Wtime() - t0;
+  *out = &p->split;
+  return PIOLA_OK;
+}
+
 piola_status piola_mpi_split_create(piola_mpi_split **out) {
   if (!out) return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "MPI split: NULL argument");
   piola_mpi_split *s = calloc(1, sizeof *s);
@@ -705,6 +736,8 @@ piola_status piola_mpi_split_finish(piola_mpi_split *s, piola_world *world) {
     MPI_Allreduce(&bad, &any, 1, MPI_INT, MPI_MAX, MPI_COMM_WORLD);
     if (any) return bad ? st : PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "MPI split: another process failed");
   }
+  const piola_work_split_planner replanner = {replan_solid, s};
+  piola_world_set_work_split_replanner(world, &replanner);
   return PIOLA_OK;
 }
 
@@ -729,6 +762,7 @@ piola_mpi_split_stats piola_mpi_split_stats_of(const piola_mpi_split *split) {
 
 void piola_mpi_split_destroy(piola_mpi_split *split, piola_world *world) {
   if (!split) return;
+  if (world) piola_world_set_work_split_replanner(world, NULL);
   for (int32_t i = 0; i < split->solid_count; ++i) {
     if (!split->plans[i]) continue;
     if (world) (void)piola_world_solid_set_work_split(world, i, NULL);

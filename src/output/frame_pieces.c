@@ -8,7 +8,9 @@
  * and point fields are those of a single-process frame plus cell_id and point_id, each
  * cell's and point's index in the whole frame, so a reader can merge the pieces into the
  * single-process frame exactly. A process reads only its own blocks' per-tet state, which
- * it computed itself. */
+ * it computed itself. With fracture the cuts change the meshes (and their split) between
+ * frames, so the layout is built again for every frame, and the cells also get fragment and
+ * material_fraction, as in a single-process frame. */
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -22,12 +24,14 @@
 #include "piola/mesh_io.h"
 #include "piola/work_split.h"
 #include "piola/world_bodies.h"
+#include "piola/world_fracture.h"
 #include "piola/world_shells.h"
 
 void piola__piece_layout_free(piece_layout *l) {
   free(l->points), free(l->cells), free(l->tets.tets), free(l->tets.positions);
   free(l->velocity), free(l->displacement), free(l->point_id);
   free(l->det_f), free(l->inverted), free(l->energy), free(l->solid), free(l->cell_id);
+  free(l->fragment), free(l->fraction);
   memset(l, 0, sizeof *l);
 }
 
@@ -47,6 +51,8 @@ piola_status piola__piece_layout_build(piece_layout *l, const piola_world *world
   memset(l, 0, sizeof *l);
   l->piece = piece;
   l->piece_count = piece_count;
+  for (int32_t s = 0; s < piola_world_solid_count(world); ++s)
+    if (piola_world_solid_has_fracture(world, s)) l->fractures = 1;
   if (piola_world_shell_count(world) > 0)
     return PIOLA_FAIL(PIOLA_ERROR_UNSUPPORTED, "output: shells are not written as pieces");
   const int32_t nb = piola_world_body_count(world);
@@ -75,6 +81,8 @@ piola_status piola__piece_layout_build(piece_layout *l, const piola_world *world
       const piola_work_split *split = piola_elastic_body_work_split(b);
       const int32_t nt = piola_elastic_body_tet_count(b);
       const int32_t *tv = piola_elastic_body_tets(b);
+      const int32_t *frag = l->fractures ? piola_world_solid_fragments(world, s) : NULL;
+      const double *fraction = l->fractures ? piola_world_solid_material_fractions(world, s) : NULL;
       for (int32_t t = 0; t < nt; ++t) {
         if (!in_piece(split, t, piece)) continue;
         if (pass == 0) {
@@ -84,6 +92,7 @@ piola_status piola__piece_layout_build(piece_layout *l, const piola_world *world
         }
         l->cells[c] = cell0 + t;
         l->solid[c] = s;
+        if (l->fractures) l->fragment[c] = frag ? frag[t] : 0, l->fraction[c] = fraction ? fraction[t] : 1;
         for (int k = 0; k < 4; ++k) l->tets.tets[4 * (size_t)c + (size_t)k] = local[point0 + tv[4 * t + k]];
         c++;
       }
@@ -102,9 +111,10 @@ piola_status piola__piece_layout_build(piece_layout *l, const piola_world *world
     l->det_f = malloc(nc * sizeof(double)), l->inverted = malloc(nc * sizeof(double));
     l->energy = malloc(nc * sizeof(double)), l->solid = malloc(nc * sizeof(double));
     l->cell_id = malloc(nc * sizeof(double));
+    if (l->fractures) l->fragment = malloc(nc * sizeof(double)), l->fraction = malloc(nc * sizeof(double));
     if (!l->points || !l->cells || !l->tets.tets || !l->tets.positions || !l->velocity ||
         !l->displacement || !l->point_id || !l->det_f || !l->inverted || !l->energy ||
-        !l->solid || !l->cell_id) {
+        !l->solid || !l->cell_id || (l->fractures && (!l->fragment || !l->fraction))) {
       free(local);
       piola__piece_layout_free(l);
       return PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "output: out of memory");
@@ -159,18 +169,25 @@ void piola__piece_name(char *out, size_t size, const char *dir, int32_t frame, i
 
 piola_status piola__piece_write(piece_layout *l, const piola_world *world, const char *dir,
                                 int32_t frame) {
+  if (l->fractures) { /* cuts change the meshes and their split between frames */
+    const int32_t piece = l->piece, piece_count = l->piece_count;
+    piola__piece_layout_free(l);
+    PIOLA_TRY(piola__piece_layout_build(l, world, piece, piece_count));
+  }
   fill_piece(l, world);
   piola_vtu_field points[3] = {{"velocity", 3, l->velocity},
                                {"displacement", 3, l->displacement},
                                {"point_id", 1, l->point_id}};
-  piola_vtu_field cells[5] = {{"det_f", 1, l->det_f},
+  piola_vtu_field cells[7] = {{"det_f", 1, l->det_f},
                               {"inverted", 1, l->inverted},
                               {"energy_density", 1, l->energy},
                               {"solid", 1, l->solid},
-                              {"cell_id", 1, l->cell_id}};
+                              {"cell_id", 1, l->cell_id},
+                              {"fragment", 1, l->fragment},
+                              {"material_fraction", 1, l->fraction}};
   piola_vtu_frame vtu = {.tets = l->tets.tet_count > 0 ? &l->tets : NULL,
                          .point_fields = points, .point_field_count = 3,
-                         .cell_fields = cells, .cell_field_count = 5,
+                         .cell_fields = cells, .cell_field_count = l->fractures ? 7 : 5,
                          .positions = l->tets.positions};
   char path[4200], pending[4200];
   piola__piece_name(path, sizeof path, dir, frame, l->piece);
@@ -184,7 +201,8 @@ piola_status piola__piece_write(piece_layout *l, const piola_world *world, const
   return piola__frame_commit_publish(&commit);
 }
 
-piola_status piola__pvtu_stage(frame_commit *c, const char *dir, int32_t frame, int32_t piece_count) {
+piola_status piola__pvtu_stage(frame_commit *c, const char *dir, int32_t frame, int32_t piece_count,
+                               int fractures) {
   char path[4200];
   struct stat st;
   for (int32_t k = 0; k < piece_count; ++k) { /* never tie a frame whose pieces are missing */
@@ -200,12 +218,13 @@ piola_status piola__pvtu_stage(frame_commit *c, const char *dir, int32_t frame, 
              "<VTKFile type=\"PUnstructuredGrid\" version=\"1.0\" byte_order=\"LittleEndian\" "
              "header_type=\"UInt64\">\n  <PUnstructuredGrid GhostLevel=\"0\">\n    <PPointData>\n");
   static const char *const point_fields[][2] = {{"velocity", "3"}, {"displacement", "3"}, {"point_id", "1"}};
-  static const char *const cell_fields[] = {"det_f", "inverted", "energy_density", "solid", "cell_id"};
+  static const char *const cell_fields[] = {"det_f", "inverted", "energy_density", "solid", "cell_id",
+                                            "fragment", "material_fraction"};
   for (int i = 0; i < 3; ++i)
     fprintf(o, "      <PDataArray type=\"Float64\" Name=\"%s\" NumberOfComponents=\"%s\"/>\n",
             point_fields[i][0], point_fields[i][1]);
   fprintf(o, "    </PPointData>\n    <PCellData>\n");
-  for (int i = 0; i < 5; ++i)
+  for (int i = 0; i < (fractures ? 7 : 5); ++i)
     fprintf(o, "      <PDataArray type=\"Float64\" Name=\"%s\" NumberOfComponents=\"1\"/>\n",
             cell_fields[i]);
   fprintf(o, "    </PCellData>\n    <PPoints>\n"

@@ -258,9 +258,7 @@ static piola_status open_output(const char *dir, bool force, int32_t resume_fram
   o->piece_count = piece_count;
   o->lead = piece == 0;
   piola_status st = PIOLA_OK;
-  if (piece_count > 0 && o->fractures)
-    st = PIOLA_FAIL(PIOLA_ERROR_UNSUPPORTED, "output: fracture is not written as pieces");
-  if (st == PIOLA_OK && piece_count > 0) st = piola__piece_layout_build(&o->piece, world, piece, piece_count);
+  if (piece_count > 0) st = piola__piece_layout_build(&o->piece, world, piece, piece_count);
   if (st == PIOLA_OK && !o->lead) { /* the folder and the indexes are piece 0's */
     *out = o;
     return PIOLA_OK;
@@ -329,7 +327,7 @@ static piola_status commit_frame(piola_output *o, const piola_vtu_frame *frame, 
   frame_commit commit = {0};
   char path[4200], pending[4200];
   if (o->piece_count > 0) { /* the pieces are in place (piola_output_write_piece) */
-    PIOLA_TRY(piola__pvtu_stage(&commit, o->dir, number, o->piece_count));
+    PIOLA_TRY(piola__pvtu_stage(&commit, o->dir, number, o->piece_count, o->fractures));
   } else {
     snprintf(path, sizeof path, "%s/frames/frame_%04d.vtu", o->dir, (int)number);
     if (!piola__frame_pending_name(path, pending, sizeof pending))

@@ -56,6 +56,9 @@ typedef struct piece_layout {
   int32_t *points, *cells;
   piola_tet_mesh tets; /* the piece's numbering; positions refreshed per frame */
   double *velocity, *displacement, *point_id, *det_f, *inverted, *energy, *solid, *cell_id;
+  int fractures;               /* a solid has fracture state: the layout is built again for
+                                  every frame, cells get fragment and material_fraction */
+  double *fragment, *fraction; /* per cell, when fractures */
 } piece_layout;
 
 piola_status piola__piece_layout_build(piece_layout *layout, const piola_world *world,
@@ -71,7 +74,7 @@ struct frame_commit;
 /* Checks that every piece of frame is in place and queues the frame's .pvtu (a data file of
  * the frame's commit, written under a temporary name). */
 piola_status piola__pvtu_stage(struct frame_commit *commit, const char *dir, int32_t frame,
-                               int32_t piece_count);
+                               int32_t piece_count, int fractures);
 /* The frame number of a file of DIR/frames piola writes (frame_NNNN.vtu, frame_NNNN.pvtu,
  * frame_NNNN_pK.vtu), or -1. */
 long piola__frame_file_number(const char *name);

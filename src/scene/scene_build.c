@@ -203,6 +203,9 @@ piola_status piola__scene_build(const scene_desc *desc, const char *label,
       return PIOLA_FAIL(st, "%s: solids[%d].%s", label, (int)i, piola_last_error());
     }
     def.fiber_directions = fibers;
+    /* a solid that can break is split after it is added, in the replicated mode: every
+     * process takes the fracture decisions from every tet's state (docs/mpi.md) */
+    piola_world_set_work_split_planner(world, d->fractures ? NULL : planner);
     st = piola_world_add_solid(world, &def, NULL);
     free(fibers);
     piola_tet_mesh_free(&mesh);
@@ -212,6 +215,7 @@ piola_status piola__scene_build(const scene_desc *desc, const char *label,
       return PIOLA_FAIL(st, "%s: solids[%d]: %s", label, (int)i, piola_last_error());
     }
   }
+  piola_world_set_work_split_planner(world, planner);
   for (int32_t i = 0; i < desc->shell_count; ++i) {
     piola_status st = build_shell(world, &desc->shells[i]);
     if (st != PIOLA_OK) {

@@ -156,8 +156,25 @@ static piola_status build_new(piola_world *w, const world_body *b, const body_ch
   return piola__body_update_forces(nb, w->time);
 }
 
+/* The split of rebuilt solid b for its new mesh (work_split.h,
+ * piola_world_set_work_split_replanner): its old body, split, is gone. */
+static piola_status resplit(piola_world *w, world_body *b) {
+  if (!w->split_replanner.plan) return PIOLA_OK; /* whole on every process */
+  int32_t solid = 0;
+  while (piola__world_body_of(w, PIOLA_BODY_SOLID, solid) != b) solid++;
+  piola_tet_mesh mesh = {.vertex_count = piola_elastic_body_vertex_count(b->solid),
+                         .positions = (double *)piola_elastic_body_rest_positions(b->solid),
+                         .tet_count = piola_elastic_body_tet_count(b->solid),
+                         .tets = (int32_t *)piola_elastic_body_tets(b->solid)};
+  const piola_work_split *split = NULL;
+  PIOLA_TRY(w->split_replanner.plan(w->split_replanner.context, solid, &mesh, &split));
+  b->product_valid = 0;
+  return split ? piola__elastic_body_set_work_split(b->solid, split, 0) : PIOLA_OK;
+}
+
 piola_status piola__body_rebuild(piola_world *w, world_body *b, const body_change *change) {
   if (!w || !b || !change) return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "rebuild: NULL argument");
+  const int was_split = b->kind == PIOLA_BODY_SOLID && b->solid->split && b->solid->split->part_count > 1;
   world_body nb;
   memset(&nb, 0, sizeof nb);
   nb.kind = b->kind;
@@ -173,5 +190,5 @@ piola_status piola__body_rebuild(piola_world *w, world_body *b, const body_chang
   *b = nb;
   w->bodies_version++;           /* the world's collision surface is rebuilt on next use */
   piola__world_collision_reset(w); /* an open interval's start positions are of the old mesh */
-  return PIOLA_OK;
+  return was_split ? resplit(w, b) : PIOLA_OK;
 }

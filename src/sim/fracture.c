@@ -1056,6 +1056,11 @@ piola_status piola_world_solid_set_fracture(piola_world *w, int32_t solid, const
   if (!b || !def) return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "set_fracture: no solid %d", (int)solid);
   if (def->cut_count < 0 || (def->cut_count > 0 && !def->cuts) || def->max_cuts_per_step < 0)
     return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "fracture of '%s': bad cut list", b->name);
+  if (piola__local_split(b->solid)) /* its criteria read every tet's state */
+    return PIOLA_FAIL(PIOLA_ERROR_UNSUPPORTED,
+                      "fracture of '%s': the solid is split in the local mode (it holds only its "
+                      "part of the tets' state); set fracture before splitting it",
+                      b->name);
   if (def->criterion != PIOLA_FRACTURE_SCRIPTED && def->criterion != PIOLA_FRACTURE_STRESS &&
       def->criterion != PIOLA_FRACTURE_PLASTIC_STRAIN)
     return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "fracture of '%s': unknown criterion %d", b->name,

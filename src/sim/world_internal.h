@@ -50,6 +50,7 @@ struct piola_world {
   step_profile profile;       /* per-phase step timers, off unless a benchmark turns them on */
   char *warnings[PIOLA_WARNING_KIND_COUNT]; /* first message of each kind, or NULL */
   piola_work_split_planner split_planner; /* splits of solids added (plan NULL: none) */
+  piola_work_split_planner split_replanner; /* splits of split solids a cut rebuilt */
 };
 
 /* Warnings (world_warnings.c). warn records the message of kind unless one is recorded

@@ -292,6 +292,7 @@ piola_status piola_world_solid_set_work_split(piola_world *world, int32_t solid,
     return PIOLA_FAIL(PIOLA_ERROR_UNSUPPORTED,
                       "work split: the implicit integrators need a split with solve_newton "
                       "(libpiola_mpi built with PETSc)");
-  /* plasticity's return mapping reads every tet's Fhat on every process: replicated mode */
-  return piola__elastic_body_set_work_split(s->solid, split, s->plastic == NULL);
+  /* plasticity's return mapping and fracture's criteria read every tet's Fhat (and U) on
+   * every process: replicated mode */
+  return piola__elastic_body_set_work_split(s->solid, split, s->plastic == NULL && s->fracture == NULL);
 }

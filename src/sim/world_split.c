@@ -21,7 +21,6 @@ const char *piola_world_split_unsupported_solving(const piola_world *world) {
   for (int32_t i = 0; i < world->body_count; ++i) {
     const world_body *b = &world->bodies[i];
     if (b->kind == PIOLA_BODY_SHELL) return "shells run on one process only";
-    if (b->fracture) return "fracture runs on one process only";
   }
   return NULL;
 }
@@ -35,6 +34,11 @@ piola_status piola_world_split_collect(piola_world *world) {
     b->elastic_stale = 1; /* process 0's statistics now see every tet */
   }
   return PIOLA_OK;
+}
+
+void piola_world_set_work_split_replanner(piola_world *world, const piola_work_split_planner *planner) {
+  if (!world) return;
+  world->split_replanner = planner ? *planner : (piola_work_split_planner){NULL, NULL};
 }
 
 void piola_world_set_work_split_planner(piola_world *world, const piola_work_split_planner *planner) {

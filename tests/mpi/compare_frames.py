@@ -15,9 +15,10 @@ point of a cell present, and a node on the border of pieces the same in each.
 For every frame the positions of B must equal A's to TOLERANCE relative: max |x_B - x_A|
 <= TOLERANCE * max |x_A| (the largest coordinate of the frame sets the scale), the point
 fields velocity and displacement and the cell fields det_f and energy_density to 1e-6
-relative to their largest magnitude, and the cell fields solid and inverted exactly.
+relative to their largest magnitude, and the cell fields solid and inverted exactly (with
+fracture also fragment exactly and material_fraction to 1e-6).
 Prints the largest relative difference and how many frames were bit-identical. stats.csv
-must have the same rows (frame, time, substeps) and the same kinetic and elastic energies
+must have the same rows (frame, time, substeps, fragments, cut_tets) and the same kinetic and elastic energies
 and smallest det F to 1e-6 relative; the self-collision contacts of both are printed.
 Exits 1 on a difference or a missing frame."""
 import csv
@@ -108,7 +109,11 @@ def whole_frame(pvtu, pieces, ma):
         v[point_id] = np.asarray(pdata[key]).reshape(-1, 3)
         out_p[key] = v[used]
     out_c = {}
-    for key in ("det_f", "energy_density", "solid", "inverted"):
+    # with fracture (cuts: docs/fracture.md) also each cell's fragment and material fraction
+    cut = tuple(k for k in ("fragment", "material_fraction") if k in ma.cell_data)
+    for key in ("det_f", "energy_density", "solid", "inverted") + cut:
+        if key not in cdata:
+            raise Mismatch(f"{name}: the pieces have no cell field {key}")
         c = np.empty(len(a_tets))
         c[cell_id] = cdata[key]
         out_c[key] = c
@@ -139,7 +144,7 @@ def compare_frame(a, b, name, tol, pieces):
     for key, va, vb in fields:
         if vb is None or va.shape != vb.shape:
             raise Mismatch(f"{name}: field {key} missing or of another shape")
-        exact = key in ("solid", "inverted")
+        exact = key in ("solid", "inverted", "fragment")
         fscale = max(np.abs(va).max(), 1e-12)
         if not (np.array_equal(va, vb) if exact else np.abs(vb - va).max() <= max(1e-6, 1000 * tol) * fscale):
             raise Mismatch(f"{name}: field {key} differs")
@@ -198,7 +203,8 @@ def main():
         return 1
     contacts = [0, 0]
     for ra, rb in zip(rows_a, rows_b):
-        for key in ("frame", "time", "substeps"):
+        # the cuts: every process takes the single process's decisions (docs/mpi.md)
+        for key in ("frame", "time", "substeps", "fragments", "cut_tets"):
             if ra[key] != rb[key]:
                 print(f"stats.csv frame {ra['frame']}: {key} {ra[key]} against {rb[key]}")
                 return 1
@@ -211,9 +217,14 @@ def main():
             if abs(va - vb) > max(1e-6, 1000 * tol) * max(abs(va), 1e-12):
                 print(f"stats.csv frame {ra['frame']}: {key} {va!r} against {vb!r}")
                 return 1
+    cuts = ""
+    if rows_a and int(rows_a[-1].get("cut_tets") or 0) > 0:
+        first = next(r["frame"] for r in rows_a if int(r["cut_tets"]) > 0)
+        cuts = (f"; cuts from frame {first} on, {rows_a[-1]['cut_tets']} cut tets and "
+                f"{rows_a[-1]['fragments']} fragments at the end, the same in both")
     print(f"{len(names)} frames{f' of {pieces} pieces' if pieces else ''}, largest relative "
           f"difference {worst:.3g}, {identical} bit-identical; stats.csv agrees (self-collision "
-          f"contacts {contacts[0]} and {contacts[1]})")
+          f"contacts {contacts[0]} and {contacts[1]}){cuts}")
     return 0
 
 

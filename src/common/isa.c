@@ -16,6 +16,18 @@
 
 static const char *const ISA_NAMES[] = {"baseline", "avx2", "avx512"};
 
+/* Whether this build has the variant (CMakeLists.txt, PIOLA_KERNEL_VARIANTS). */
+static int built(piola__isa isa) {
+#if defined(PIOLA_KERNEL_WITHOUT_AVX2)
+  if (isa == PIOLA__ISA_AVX2) return 0;
+#endif
+#if defined(PIOLA_KERNEL_WITHOUT_AVX512)
+  if (isa == PIOLA__ISA_AVX512) return 0;
+#endif
+  (void)isa;
+  return 1;
+}
+
 /* What each variant is compiled for (CMakeLists.txt, PIOLA_KERNEL_FLAGS_*): AVX2 with FMA,
  * and AVX-512 F, CD, BW, DQ and VL on top. __builtin_cpu_supports also asks whether the
  * operating system saves the wide registers. */
@@ -28,26 +40,29 @@ static int cpu_runs(piola__isa isa) {
   return isa == PIOLA__ISA_AVX512 ? avx512 : isa == PIOLA__ISA_AVX2 ? avx2 : 1;
 }
 
-static piola__isa best_supported(void) {
-  if (cpu_runs(PIOLA__ISA_AVX512)) return PIOLA__ISA_AVX512;
-  if (cpu_runs(PIOLA__ISA_AVX2)) return PIOLA__ISA_AVX2;
+int piola__isa_supported(piola__isa isa) { return built(isa) && cpu_runs(isa); }
+
+/* the best variant this build has and the CPU runs, not above `ceiling` */
+static piola__isa best_up_to(piola__isa ceiling) {
+  for (int i = ceiling; i > PIOLA__ISA_BASELINE; --i)
+    if (piola__isa_supported((piola__isa)i)) return (piola__isa)i;
   return PIOLA__ISA_BASELINE;
 }
-
-int piola__isa_supported(piola__isa isa) { return cpu_runs(isa); }
 
 const char *piola__isa_name(piola__isa isa) { return ISA_NAMES[isa]; }
 
 static piola__isa choose(void) {
-  piola__isa best = best_supported();
+  piola__isa best = best_up_to(PIOLA__ISA_AVX512);
   const char *asked = getenv("PIOLA_ISA");
   if (!asked || !*asked) return best;
   for (int i = 0; i <= PIOLA__ISA_AVX512; ++i)
     if (strcmp(asked, ISA_NAMES[i]) == 0) {
-      if ((piola__isa)i <= best) return (piola__isa)i;
-      fprintf(stderr, "piola: PIOLA_ISA=%s: this CPU does not support it, using %s\n", asked,
-              ISA_NAMES[best]);
-      return best;
+      piola__isa got = best_up_to((piola__isa)i);
+      if (got != (piola__isa)i)
+        fprintf(stderr, "piola: PIOLA_ISA=%s: %s, using %s\n", asked,
+                built((piola__isa)i) ? "this CPU does not support it" : "not built in this build",
+                ISA_NAMES[got]);
+      return got;
     }
   fprintf(stderr, "piola: PIOLA_ISA=%s is not one of baseline, avx2, avx512; using %s\n", asked,
           ISA_NAMES[best]);

@@ -9,13 +9,14 @@
  *
  * Its cost is that arithmetic, not the stream (measured, bench_stable_step's "warm" column):
  * a second pass run at once after the first, its Fhat and weights in cache, costs the same
- * CPU as the first (neo-Hookean 6.4-8.7% of the update both ways, corotated 11%, the spline
- * 14%, under load). So computing these same numbers inside the force loop would save the
- * 4 doubles per tet it reads, not the 7-34% of an update it costs on a quiet machine; one
- * long lane loop over a run of plain blocks instead of one per block saved at most a tenth
- * (throughput, not latency). What would is fewer operations per lane: the force loop already
- * forms 1/f_i, ln J and the model's parts at the clamped point for its stress, and handing
- * those over (as the Ogden and HGO caches do) is the way to the 5% of issue 21.
+ * CPU as the first (under load, 1 thread: neo-Hookean 8-10% of the update both ways,
+ * corotated 9-11%, the spline 28-33%). So computing these same numbers inside the force loop
+ * would save the 4 doubles per tet it reads, not the 7-34% of an update it costs on a quiet
+ * machine; one long lane loop over a run of plain blocks instead of one per block saved at
+ * most a tenth (throughput, not latency). What would is fewer operations per lane: the
+ * force loop already forms 1/f_i, ln J and the model's parts at the clamped point for its
+ * stress, and handing those over (as the Ogden and HGO caches do) is the way to the 5% of
+ * issue 21.
  *
  * The modulus. In the frame of the diagonalization dP/dF splits into the 3x3 block
  * K = dPhat/dFhat on the diagonal entries and one 2x2 block per pair (i, j) on (F_ij, F_ji),

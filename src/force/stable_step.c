@@ -5,7 +5,18 @@
  * geometric factor) gives it without touching the force kernels. The model switch is
  * hoisted out of an `omp simd` loop as in the force loop, and the per-lane work is the
  * model's value and slope at the clamped point (material_model_parts), its extension
- * (material_extend) and three 2x2 blocks: a few percent of an update.
+ * (material_extend) and three 2x2 blocks.
+ *
+ * Its cost is that arithmetic, not the stream (measured, bench_stable_step's "warm" column):
+ * a second pass run at once after the first, its Fhat and weights in cache, costs the same
+ * CPU as the first (under load, 1 thread: neo-Hookean 8-10% of the update both ways,
+ * corotated 9-11%, the spline 28-33%). So computing these same numbers inside the force loop
+ * would save the 4 doubles per tet it reads, not the 7-34% of an update it costs on a quiet
+ * machine; one long lane loop over a run of plain blocks instead of one per block saved at
+ * most a tenth (throughput, not latency). What would is fewer operations per lane: the
+ * force loop already forms 1/f_i, ln J and the model's parts at the clamped point for its
+ * stress, and handing those over (as the Ogden and HGO caches do) is the way to the 5% of
+ * issue 21.
  *
  * The modulus. In the frame of the diagonalization dP/dF splits into the 3x3 block
  * K = dPhat/dFhat on the diagonal entries and one 2x2 block per pair (i, j) on (F_ij, F_ji),
@@ -286,34 +297,31 @@ STABLE_STEP_KERNEL double neohookean_plain_modulus(const piola_material *m, doub
   return neohookean_matrix_modulus(m, f0, f1, f2) + m->fiber_modulus;
 }
 
+/* One case of mode_modulus: MODEL's kernel inlined with its own constant, the direction
+ * weights passed on only to the models that take them. */
+#define MODE_MODULUS_CASE(model)                                                               \
+  case model:                                                                                  \
+    return model_modulus_weighted(model, energy, m, f0, f1, f2, NULL, DIRECTION_WEIGHTED(model) ? wgt : NULL);
+
 /* Per tet: the model and the extension mode chosen at run time. */
 static double mode_modulus(int energy, const piola_material *m, double f0, double f1, double f2,
                            const double *wgt) {
   switch (m->model) {
-    case PIOLA_MODEL_COROTATED: return model_modulus_weighted(PIOLA_MODEL_COROTATED, energy, m, f0, f1, f2, NULL,
-                                    DIRECTION_WEIGHTED(PIOLA_MODEL_COROTATED) ? wgt : NULL);
-    case PIOLA_MODEL_STVK: return model_modulus_weighted(PIOLA_MODEL_STVK, energy, m, f0, f1, f2, NULL,
-                                    DIRECTION_WEIGHTED(PIOLA_MODEL_STVK) ? wgt : NULL);
-    case PIOLA_MODEL_NEOHOOKEAN: return model_modulus_weighted(PIOLA_MODEL_NEOHOOKEAN, energy, m, f0, f1, f2, NULL,
-                                    DIRECTION_WEIGHTED(PIOLA_MODEL_NEOHOOKEAN) ? wgt : NULL);
-    case PIOLA_MODEL_MUSCLE: return model_modulus_weighted(PIOLA_MODEL_MUSCLE, energy, m, f0, f1, f2, NULL,
-                                    DIRECTION_WEIGHTED(PIOLA_MODEL_MUSCLE) ? wgt : NULL);
-    case PIOLA_MODEL_HGO: return model_modulus_weighted(PIOLA_MODEL_HGO, energy, m, f0, f1, f2, NULL,
-                                    DIRECTION_WEIGHTED(PIOLA_MODEL_HGO) ? wgt : NULL);
-    case PIOLA_MODEL_SPLINE: return model_modulus_weighted(PIOLA_MODEL_SPLINE, energy, m, f0, f1, f2, NULL,
-                                    DIRECTION_WEIGHTED(PIOLA_MODEL_SPLINE) ? wgt : NULL);
-    case PIOLA_MODEL_STABLE_NEOHOOKEAN:
-      return model_modulus_weighted(PIOLA_MODEL_STABLE_NEOHOOKEAN, energy, m, f0, f1, f2, NULL,
-                                    DIRECTION_WEIGHTED(PIOLA_MODEL_STABLE_NEOHOOKEAN) ? wgt : NULL);
+    MODE_MODULUS_CASE(PIOLA_MODEL_COROTATED)
+    MODE_MODULUS_CASE(PIOLA_MODEL_STVK)
+    MODE_MODULUS_CASE(PIOLA_MODEL_NEOHOOKEAN)
+    MODE_MODULUS_CASE(PIOLA_MODEL_MUSCLE)
+    MODE_MODULUS_CASE(PIOLA_MODEL_HGO)
+    MODE_MODULUS_CASE(PIOLA_MODEL_SPLINE)
+    MODE_MODULUS_CASE(PIOLA_MODEL_STABLE_NEOHOOKEAN)
     case PIOLA_MODEL_MOONEY_RIVLIN: /* stored as two Ogden terms: the same code path */
-    case PIOLA_MODEL_OGDEN: return model_modulus_weighted(PIOLA_MODEL_OGDEN, energy, m, f0, f1, f2, NULL,
-                                    DIRECTION_WEIGHTED(PIOLA_MODEL_OGDEN) ? wgt : NULL);
-    case PIOLA_MODEL_ROTATED_LINEAR:
-      return model_modulus_weighted(PIOLA_MODEL_ROTATED_LINEAR, energy, m, f0, f1, f2, NULL,
-                                    DIRECTION_WEIGHTED(PIOLA_MODEL_ROTATED_LINEAR) ? wgt : NULL);
+    MODE_MODULUS_CASE(PIOLA_MODEL_OGDEN)
+    MODE_MODULUS_CASE(PIOLA_MODEL_ROTATED_LINEAR)
     default: abort(); /* every model has its case: a new one must get its modulus */
   }
 }
+
+#undef MODE_MODULUS_CASE
 
 static double material_modulus(const piola_material *m, double f0, double f1, double f2, const double *wgt) {
   switch (m->inversion_mode) {

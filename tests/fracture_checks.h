@@ -9,8 +9,6 @@
 #include "piola/world.h"
 #include "piola/world_fracture.h"
 
-/* A world without gravity whose steps are at most max_dt (s). */
-piola_world *fracture_world(double max_dt);
 /* Adds `mesh` as solid 0's default model, E = 20 kPa, nu = 0.3, shear and bulk viscosity
  * `viscosity` Pa s. */
 void fracture_add_solid(piola_world *w, const piola_tet_mesh *mesh, double viscosity);

@@ -102,7 +102,7 @@ static void box_splits_into_the_analytic_volumes(void **state) {
   (void)state;
   piola_tet_mesh mesh;
   assert_int_equal(piola_tet_mesh_box_grid(5, 5, 5, (piola_vec3){0.2, 0.2, 0.2}, &mesh), PIOLA_OK);
-  piola_world *w = fracture_world(1e-3);
+  piola_world *w = weightless_world(1e-3);
   fracture_add_solid(w, &mesh, 0);
   const double mass = fracture_total_mass(w);
   assert_int_equal(piola_world_solid_fragment_count(w, 0), 1);
@@ -239,7 +239,7 @@ static void random_cuts_keep_every_invariant_mesh(const piola_tet_mesh *mesh, te
   double lo[3], hi[3];
   fracture_mesh_bounds(mesh, lo, hi);
   for (int trial = 0; trial < trials; ++trial) {
-    piola_world *w = fracture_world(1e-3);
+    piola_world *w = weightless_world(1e-3);
     fracture_add_solid(w, mesh, 1);
     const double mass = fracture_total_mass(w);
     for (int plane = 0; plane < 2; ++plane) {
@@ -315,7 +315,7 @@ static void blade_cuts_like_its_plane_and_only_where_it_reaches(void **state) {
   const double un = sqrt(u[0] * u[0] + u[1] * u[1]);
   u[0] /= un, u[1] /= un;
   v[0] = n[1] * u[2] - n[2] * u[1], v[1] = n[2] * u[0] - n[0] * u[2], v[2] = n[0] * u[1] - n[1] * u[0];
-  piola_world *plane = fracture_world(1e-3), *blade = fracture_world(1e-3);
+  piola_world *plane = weightless_world(1e-3), *blade = weightless_world(1e-3);
   fracture_add_solid(plane, &mesh, 0), fracture_add_solid(blade, &mesh, 0);
   int32_t by_plane = 0, by_blade = 0;
   assert_int_equal(piola_world_solid_cut(plane, 0, center, normal, &by_plane), PIOLA_OK);
@@ -334,7 +334,7 @@ static void blade_cuts_like_its_plane_and_only_where_it_reaches(void **state) {
   piola_tri_mesh_free(&big);
   /* half a blade: a square of half-size 0.6 centred 0.6 m from the plane's point along u
    * (mostly +y) reaches into the box only for y > ~0.5 */
-  blade = fracture_world(1e-3);
+  blade = weightless_world(1e-3);
   fracture_add_solid(blade, &mesh, 0);
   double c2[3];
   if (u[1] < 0)
@@ -357,7 +357,7 @@ static void blade_cuts_like_its_plane_and_only_where_it_reaches(void **state) {
   piola_world_destroy(blade);
   piola_tri_mesh_free(&half);
   /* bad blades are refused */
-  blade = fracture_world(1e-3);
+  blade = weightless_world(1e-3);
   fracture_add_solid(blade, &mesh, 0);
   piola_tri_mesh bad = sheet(center, u, v, 1, 0, 2);
   bad.triangles[1] = 7;
@@ -380,7 +380,7 @@ static void grown_and_blade_cuts_keep_every_invariant_mesh(const piola_tet_mesh 
   double size = 0;
   for (int k = 0; k < 3; ++k) size = fmax(size, hi[k] - lo[k]);
   for (int trial = 0; trial < trials; ++trial) {
-    piola_world *w = fracture_world(1e-3);
+    piola_world *w = weightless_world(1e-3);
     fracture_add_solid(w, mesh, 1);
     const double mass = fracture_total_mass(w);
     piola_fracture_def def = piola_default_fracture_def();
@@ -465,7 +465,7 @@ static void cut_body_recovers_from_collapse(void **state) {
   (void)state;
   piola_tet_mesh mesh;
   assert_int_equal(piola_tet_mesh_box_grid(3, 3, 3, (piola_vec3){0.1, 0.1, 0.1}, &mesh), PIOLA_OK);
-  piola_world *w = fracture_world(1e-3);
+  piola_world *w = weightless_world(1e-3);
   fracture_add_solid(w, &mesh, 20);
   /* both fragments at least one and a half tets thick (docs/fracture.md: a fragment about
    * one tet thick, mostly virtual, can stay tangled after a collapse to a point) */
@@ -492,7 +492,7 @@ static void cut_keeps_plastic_state_and_energy(void **state) {
   (void)state;
   piola_tet_mesh mesh;
   assert_int_equal(piola_tet_mesh_box_grid(3, 3, 3, (piola_vec3){0.05, 0.05, 0.05}, &mesh), PIOLA_OK);
-  piola_world *w = fracture_world(1e-3);
+  piola_world *w = weightless_world(1e-3);
   piola_solid_def sd = piola_default_solid_def();
   sd.mesh = &mesh;
   sd.material.youngs_modulus = 1e5;
@@ -538,7 +538,7 @@ static void cut_keeps_plastic_state_and_energy(void **state) {
 static int32_t pulled_bar(double threshold, double t_end, double *first_cut_time, piola_world **out) {
   piola_tet_mesh mesh;
   assert_int_equal(piola_tet_mesh_box_grid(12, 2, 2, (piola_vec3){0.025, 0.025, 0.025}, &mesh), PIOLA_OK);
-  piola_world *w = fracture_world(1e-3);
+  piola_world *w = weightless_world(1e-3);
   piola_solid_def sd = piola_default_solid_def();
   sd.mesh = &mesh;
   sd.material.youngs_modulus = 1e5;
@@ -601,7 +601,7 @@ static void max_cuts_per_step_spreads_cuts(void **state) {
   (void)state;
   piola_tet_mesh mesh;
   assert_int_equal(piola_tet_mesh_box_grid(5, 5, 5, (piola_vec3){0.2, 0.2, 0.2}, &mesh), PIOLA_OK);
-  piola_world *w = fracture_world(1e-3);
+  piola_world *w = weightless_world(1e-3);
   fracture_add_solid(w, &mesh, 0);
   piola_fracture_cut cuts[2] = {{.time = 0, .point = {0.33, 0.5, 0.5}, .normal = {1, 0.1, 0}},
                                 {.time = 0, .point = {0.67, 0.5, 0.5}, .normal = {1, 0.1, 0}}};
@@ -625,7 +625,7 @@ static void bad_cuts_are_refused(void **state) {
   (void)state;
   piola_tet_mesh mesh;
   assert_int_equal(piola_tet_mesh_box_grid(2, 2, 2, (piola_vec3){0.1, 0.1, 0.1}, &mesh), PIOLA_OK);
-  piola_world *w = fracture_world(1e-3);
+  piola_world *w = weightless_world(1e-3);
   fracture_add_solid(w, &mesh, 0);
   const double point[3] = {0.1, 0.1, 0.1}, zero[3] = {0, 0, 0}, nan_normal[3] = {NAN, 0, 1};
   assert_int_equal(piola_world_solid_cut(w, 0, point, zero, NULL), PIOLA_ERROR_INVALID_ARGUMENT);

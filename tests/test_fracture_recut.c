@@ -159,7 +159,7 @@ static void crossing_planes_quarter_a_box(void **state) {
   test_rng rng = test_rng_seeded(4);
   for (int32_t i = 0; i < 3 * mesh.vertex_count; ++i)
     if (mesh.positions[i] > 1e-9 && mesh.positions[i] < 1 - 1e-9) mesh.positions[i] += test_rng_uniform(&rng, -0.03, 0.03);
-  piola_world *w = fracture_world(1e-3);
+  piola_world *w = weightless_world(1e-3);
   fracture_add_solid(w, &mesh, 0);
   const double mass = fracture_total_mass(w);
   piola_fracture_cut cuts[2] = {{.time = 0, .point = {0.5, 0.5, 0.5}, .normal = {1, 0, 0}},
@@ -227,7 +227,7 @@ static void random_planes_keep_every_invariant_mesh(const piola_tet_mesh *mesh, 
   double lo[3], hi[3];
   fracture_mesh_bounds(mesh, lo, hi);
   for (int trial = 0; trial < trials; ++trial) {
-    piola_world *w = fracture_world(1e-3);
+    piola_world *w = weightless_world(1e-3);
     fracture_add_solid(w, mesh, 1);
     const double mass = fracture_total_mass(w);
     const int planes = 2 + trial % 2;
@@ -316,7 +316,7 @@ static void second_cut_in_free_flight_keeps_momentum(void **state) {
 
 /* A stretched, drifting box cut at t = 0 by x = 0.1 and at 0.01 s by y = 0.1, crossing it. */
 static piola_world *twice_cut_box(const piola_tet_mesh *mesh, int second) {
-  piola_world *w = fracture_world(5e-4);
+  piola_world *w = weightless_world(5e-4);
   fracture_add_solid(w, mesh, 1);
   const int32_t n = mesh->vertex_count;
   double *v = malloc(3 * sizeof(double) * (size_t)n);

@@ -4,19 +4,11 @@
 #include <math.h>
 #include <stdlib.h>
 
+#include "block_scenes.h"
 #include "fracture_checks.h"
 #include "piola/checkpoint.h"
 #include "piola/elastic_body.h"
 #include "sim/fracture_internal.h"
-
-piola_world *fracture_world(double max_dt) {
-  piola_world_def wd = piola_default_world_def();
-  for (int k = 0; k < 3; ++k) wd.gravity[k] = piola_track_constant(0);
-  wd.max_dt = max_dt;
-  piola_world *w = NULL;
-  assert_int_equal(piola_world_create(&wd, &w), PIOLA_OK);
-  return w;
-}
 
 void fracture_add_solid(piola_world *w, const piola_tet_mesh *mesh, double viscosity) {
   piola_solid_def sd = piola_default_solid_def();
@@ -29,7 +21,7 @@ void fracture_add_solid(piola_world *w, const piola_tet_mesh *mesh, double visco
 }
 
 piola_world *fracture_spinning_bar(const piola_tet_mesh *mesh, double stretch, double y_centre) {
-  piola_world *w = fracture_world(5e-4);
+  piola_world *w = weightless_world(5e-4);
   fracture_add_solid(w, mesh, 0);
   const int32_t n = mesh->vertex_count;
   double *x = malloc(3 * sizeof(double) * (size_t)n), *v = malloc(3 * sizeof(double) * (size_t)n);

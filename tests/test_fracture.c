@@ -107,9 +107,7 @@ static void box_splits_into_the_analytic_volumes(void **state) {
   const double mass = fracture_total_mass(w);
   assert_int_equal(piola_world_solid_fragment_count(w, 0), 1);
   piola_fracture_cut cut = {.time = 0, .point = {0.4, 0.5, 0.5}, .normal = {1, 0.2, 0.1}};
-  piola_fracture_def def = piola_default_fracture_def();
-  def.cuts = &cut, def.cut_count = 1;
-  assert_int_equal(piola_world_solid_set_fracture(w, 0, &def), PIOLA_OK); /* due at t = 0 */
+  fracture_set_cuts(w, &cut, 1); /* due at t = 0 */
   assert_int_equal(piola_world_solid_fragment_count(w, 0), 2);
   assert_true(piola_world_solid_cut_tet_count(w, 0) > 0);
   assert_close(fracture_total_mass(w), mass, 1e-13 * mass);
@@ -166,9 +164,7 @@ static void cut_in_free_flight_keeps_momentum(void **state) {
   piola_world *w = fracture_spinning_bar(&mesh, 1.2, 0.05);
   piola_fracture_cut cuts[2] = {{.time = 0.05, .point = {0.17, 0.05, 0.05}, .normal = {1, 0.3, -0.2}},
                                 {.time = 0.05, .point = {0.0, 0.05, 0.05}, .normal = {0.1, 1, 0.3}}};
-  piola_fracture_def def = piola_default_fracture_def();
-  def.cuts = cuts, def.cut_count = 2;
-  assert_int_equal(piola_world_solid_set_fracture(w, 0, &def), PIOLA_OK);
+  fracture_set_cuts(w, cuts, 2);
   assert_int_equal(piola_world_advance_to(w, 0.05, NULL), PIOLA_OK);
   assert_int_equal(piola_world_solid_cut_tet_count(w, 0), 0); /* not yet: due at the next step */
   double p0[3], l0[3], p1[3], l1[3];

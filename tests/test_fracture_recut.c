@@ -164,9 +164,7 @@ static void crossing_planes_quarter_a_box(void **state) {
   const double mass = fracture_total_mass(w);
   piola_fracture_cut cuts[2] = {{.time = 0, .point = {0.5, 0.5, 0.5}, .normal = {1, 0, 0}},
                                 {.time = 0, .point = {0.5, 0.5, 0.5}, .normal = {0, 1, 0}}};
-  piola_fracture_def def = piola_default_fracture_def();
-  def.cuts = cuts, def.cut_count = 2;
-  assert_int_equal(piola_world_solid_set_fracture(w, 0, &def), PIOLA_OK);
+  fracture_set_cuts(w, cuts, 2);
   assert_int_equal(piola_world_solid_fragment_count(w, 0), 4);
   assert_true(fracture_recut_tets(w) > 0);
   assert_close(fracture_total_mass(w), mass, 1e-13 * mass);
@@ -280,9 +278,7 @@ static void second_cut_in_free_flight_keeps_momentum(void **state) {
   /* planes through the bar's centre as it will be then (it drifts by (0.5, -0.2, 0.1) m/s) */
   piola_fracture_cut cuts[2] = {{.time = 0.03, .point = {0.2, 0.06, 0.09}, .normal = {1, 0.3, -0.2}},
                                 {.time = 0.06, .point = {0.21, 0.05, 0.09}, .normal = {0.1, 1, 0.3}}};
-  piola_fracture_def def = piola_default_fracture_def();
-  def.cuts = cuts, def.cut_count = 2;
-  assert_int_equal(piola_world_solid_set_fracture(w, 0, &def), PIOLA_OK);
+  fracture_set_cuts(w, cuts, 2);
   assert_int_equal(piola_world_advance_to(w, 0.06, NULL), PIOLA_OK);
   const int32_t once = piola_world_solid_cut_tet_count(w, 0);
   assert_true(once > 0);
@@ -326,9 +322,7 @@ static piola_world *twice_cut_box(const piola_tet_mesh *mesh, int second) {
   free(v);
   const piola_fracture_cut cuts[2] = {{.time = 0, .point = {0.1, 0.1, 0.1}, .normal = {1, 0.1, 0.05}},
                                       {.time = 0.01, .point = {0.1, 0.1, 0.1}, .normal = {0.05, 1, 0.1}}};
-  piola_fracture_def def = piola_default_fracture_def();
-  def.cuts = cuts, def.cut_count = second ? 2 : 1;
-  assert_int_equal(piola_world_solid_set_fracture(w, 0, &def), PIOLA_OK);
+  fracture_set_cuts(w, cuts, second ? 2 : 1);
   return w;
 }
 

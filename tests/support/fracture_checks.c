@@ -35,6 +35,12 @@ piola_world *fracture_spinning_bar(const piola_tet_mesh *mesh, double stretch, d
   return w;
 }
 
+void fracture_set_cuts(piola_world *w, const piola_fracture_cut *cuts, int32_t count) {
+  piola_fracture_def def = piola_default_fracture_def();
+  def.cuts = cuts, def.cut_count = count;
+  assert_int_equal(piola_world_solid_set_fracture(w, 0, &def), PIOLA_OK);
+}
+
 void fracture_mesh_bounds(const piola_tet_mesh *mesh, double lo[3], double hi[3]) {
   for (int k = 0; k < 3; ++k) lo[k] = INFINITY, hi[k] = -INFINITY;
   for (int32_t i = 0; i < mesh->vertex_count; ++i)

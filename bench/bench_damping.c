@@ -33,11 +33,7 @@ int main(int argc, char **argv) {
     fprintf(stderr, "bench_damping: %s\n", piola_last_error());
     return 1;
   }
-  piola_material_def mdef = piola_default_material_def();
-  mdef.model = PIOLA_MODEL_NEOHOOKEAN;
-  /* the setting of BENCHMARKS.md's rows (LINEAR at 0.3, the default before issue 19 item 4) */
-  mdef.inversion_mode = PIOLA_INVERSION_LINEAR;
-  mdef.inversion_threshold = 0.3;
+  piola_material_def mdef = bench_rows_material_def(PIOLA_MODEL_NEOHOOKEAN);
   piola_material material;
   piola_elastic_body_def def = piola_default_elastic_body_def();
   def.rest_mesh = &mesh;

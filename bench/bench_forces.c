@@ -39,11 +39,7 @@ static void bench_mesh(const char *name, const piola_tet_mesh *mesh, int repeats
                                                 PIOLA_MODEL_ROTATED_LINEAR, PIOLA_MODEL_STVK,
                                                 PIOLA_MODEL_SPLINE};
   for (size_t m = 0; m < sizeof models / sizeof models[0]; ++m) {
-    piola_material_def mdef = piola_default_material_def();
-    mdef.model = models[m];
-    /* the setting of BENCHMARKS.md's rows (LINEAR at 0.3, the default before issue 19 item 4) */
-    mdef.inversion_mode = PIOLA_INVERSION_LINEAR;
-    mdef.inversion_threshold = 0.3;
+    piola_material_def mdef = bench_rows_material_def(models[m]);
     piola_material material;
     if (piola_material_init(&mdef, &material) != PIOLA_OK) return;
     piola_elastic_body_def def = piola_default_elastic_body_def();

@@ -88,11 +88,7 @@ int main(int argc, char **argv) {
   printf("|---|---|---|---|---|\n");
   double sink = 0;
   for (int model = 0; model < PIOLA_MODEL_COUNT; ++model) {
-    piola_material_def def = piola_default_material_def();
-    def.model = (piola_material_model)model;
-    /* the setting of BENCHMARKS.md's rows (LINEAR at 0.3, the default before issue 19 item 4) */
-    def.inversion_mode = PIOLA_INVERSION_LINEAR;
-    def.inversion_threshold = 0.3;
+    piola_material_def def = bench_rows_material_def((piola_material_model)model);
     piola_material m;
     if (piola_material_init(&def, &m) != PIOLA_OK) return 1;
     double t_pub[RUNS], t_simd[RUNS], t_pub_e[RUNS], t_simd_e[RUNS];

@@ -39,12 +39,8 @@ int main(int argc, char **argv) {
     return 1;
   }
   piola_set_thread_count(1);
-  piola_material_def mdef = piola_default_material_def();
-  mdef.model = PIOLA_MODEL_MUSCLE;
+  piola_material_def mdef = bench_rows_material_def(PIOLA_MODEL_MUSCLE);
   mdef.poisson_ratio = 0.45;
-  /* the setting of BENCHMARKS.md's rows (LINEAR at 0.3, the default before issue 19 item 4) */
-  mdef.inversion_mode = PIOLA_INVERSION_LINEAR;
-  mdef.inversion_threshold = 0.3;
   piola_material material;
   if (piola_material_init(&mdef, &material) != PIOLA_OK) return 1;
   double *fibers = malloc(sizeof(double) * 3 * (size_t)mesh.tet_count);

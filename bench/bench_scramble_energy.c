@@ -18,7 +18,7 @@
 
 #include "piola/threads.h"
 #include "piola/world.h"
-#include "support/recovery_runs.h"
+#include "support/bench_scenes.h"
 
 int main(int argc, char **argv) {
   if (argc < 5) {
@@ -33,16 +33,10 @@ int main(int argc, char **argv) {
   }
   const double radius = atof(argv[3]), seconds = atof(argv[4]);
   piola_tet_mesh mesh;
-  if (recovery_read_unit_mesh(PIOLA_DATA_DIR, argv[1], &mesh) != 0) {
+  if (bench_read_mesh_with_diagonal(argv[1], 2.0, &mesh) != 0) {
     fprintf(stderr, "bench_scramble_energy: %s: %s\n", argv[1], piola_last_error());
     return 1;
   }
-  double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
-  for (int32_t v = 0; v < 3 * mesh.vertex_count; ++v)
-    lo[v % 3] = fmin(lo[v % 3], mesh.positions[v]), hi[v % 3] = fmax(hi[v % 3], mesh.positions[v]);
-  const double diagonal = sqrt((hi[0] - lo[0]) * (hi[0] - lo[0]) + (hi[1] - lo[1]) * (hi[1] - lo[1]) +
-                               (hi[2] - lo[2]) * (hi[2] - lo[2]));
-  for (int32_t v = 0; v < 3 * mesh.vertex_count; ++v) mesh.positions[v] *= 2.0 / diagonal;
   piola_world_def wd = piola_default_world_def();
   for (int i = 0; i < 3; ++i) wd.gravity[i] = piola_track_constant(0);
   if (argc > 7) wd.cfl = atof(argv[7]);
@@ -51,19 +45,12 @@ int main(int argc, char **argv) {
     fprintf(stderr, "bench_scramble_energy: %s\n", piola_last_error());
     return 1;
   }
-  piola_solid_def sd = piola_default_solid_def();
-  sd.mesh = &mesh;
-  sd.material.model = model;
-  sd.material.youngs_modulus = 2e4;
-  sd.material.poisson_ratio = 0.3;
+  piola_solid_def sd = bench_scramble_solid_def(&mesh, model, radius);
   if (argc > 5 && strcmp(argv[5], "default") && !piola_inversion_mode_from_name(argv[5], &sd.material.inversion_mode)) {
     fprintf(stderr, "bench_scramble_energy: unknown inversion mode '%s'\n", argv[5]);
     return 1;
   }
   if (argc > 6 && strcmp(argv[6], "default")) sd.material.inversion_threshold = atof(argv[6]);
-  sd.density = 1000;
-  sd.shear_viscosity = sd.bulk_viscosity = piola_track_constant(1000);
-  sd.scramble_radius = radius;
   if (piola_world_add_solid(w, &sd, NULL) != PIOLA_OK) {
     fprintf(stderr, "bench_scramble_energy: %s\n", piola_last_error());
     return 1;

@@ -47,11 +47,7 @@ static piola_elastic_body *make_body(const piola_tet_mesh *mesh, const piola_mat
 
 static void bench_model(const char *name, const piola_tet_mesh *mesh, piola_material_model model,
                         int repeats) {
-  piola_material_def md = piola_default_material_def();
-  md.model = model;
-  /* the setting of BENCHMARKS.md's rows (LINEAR at 0.3, the default before issue 19 item 4) */
-  md.inversion_mode = PIOLA_INVERSION_LINEAR;
-  md.inversion_threshold = 0.3;
+  piola_material_def md = bench_rows_material_def(model);
   piola_material material;
   if (piola_material_init(&md, &material) != PIOLA_OK) {
     fprintf(stderr, "bench_stable_step: %s\n", piola_last_error());

@@ -1,7 +1,8 @@
 /* Blocks of tets and what the world dynamics tests measure on them (test_dynamics.c,
  * test_backward_euler.c, test_plasticity_world.c, test_stable_step.c,
- * test_energy_check.c): the mesh, a world holding a deformed block, the momenta of solid 0,
- * and the spinning, drifting start of the free-flight tests. */
+ * test_energy_check.c, test_fracture*.c): the mesh, a world without gravity, a world
+ * holding a deformed block, the momenta of solid 0, and the spinning, drifting start of the
+ * free-flight tests. */
 #ifndef PIOLA_TEST_BLOCK_SCENES_H
 #define PIOLA_TEST_BLOCK_SCENES_H
 
@@ -11,6 +12,9 @@
 /* The box [0,a]x[0,b]x[0,c] (m) of nx*ny*nz cubes, 6 tets each (piola_tet_mesh_box_grid). */
 piola_tet_mesh block_mesh(int nx, int ny, int nz, double a, double b, double c);
 void block_mesh_free(piola_tet_mesh *m);
+
+/* A world without gravity, its default settings otherwise, whose steps are at most max_dt (s). */
+piola_world *weightless_world(double max_dt);
 
 /* A world without gravity (max_dt 1 s, the given cfl; cg_max_iterations > 0 replaces the
  * default) holding one solid: n x n x n cubes of edge 0.1 m (E = 10 kPa, nu = 0.3,

@@ -9,6 +9,17 @@
 #include "piola/world.h"
 #include "piola/world_fracture.h"
 
+/* Adds `mesh` as solid 0's default model, E = 20 kPa, nu = 0.3, shear and bulk viscosity
+ * `viscosity` Pa s. */
+void fracture_add_solid(piola_world *w, const piola_tet_mesh *mesh, double viscosity);
+/* The spinning, stretched bar of the free-flight tests: `mesh` (a box grid) undamped in a
+ * world of steps <= 5e-4 s, each rest point p at (stretch p0 + 0.1 p1, 0.9 p1, p2 + 0.05 p0)
+ * with velocity (0.5 - 3 (p1 - y_centre), -0.2 + 3 (p0 - 0.15), 0.1 + p1) m/s. */
+piola_world *fracture_spinning_bar(const piola_tet_mesh *mesh, double stretch, double y_centre);
+/* Gives solid 0 of w the default fracture definition with the `count` scripted cuts `cuts`. */
+void fracture_set_cuts(piola_world *w, const piola_fracture_cut *cuts, int32_t count);
+/* The bounding box of `mesh`'s vertices (m). */
+void fracture_mesh_bounds(const piola_tet_mesh *mesh, double lo[3], double hi[3]);
 /* Volume enclosed by the triangles [first, end) of s (m^3, divergence theorem). */
 double fracture_enclosed_volume(const piola_fracture_surface *s, int32_t first, int32_t end);
 /* Directed edges of the triangles [first, end) of s without exactly as many opposite edges

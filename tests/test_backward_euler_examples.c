@@ -130,6 +130,21 @@ static void check_outside_solid(const char *file, int frame, const piola_world *
   piola_tri_mesh_free(&surface);
 }
 
+/* Fails unless vertex i of solid or shell s (kind), at xi, is outside (or within 1e-6 m of)
+ * each analytic obstacle of the scene at time t (NULL entries: mesh obstacles, not measured). */
+static void check_outside_obstacles(const char *file, int f, const char *kind, int32_t s, int32_t i,
+                                    const double *xi, piola_obstacle *const *obstacles, int32_t no,
+                                    double t) {
+  piola_vec3 q = {xi[0], xi[1], xi[2]};
+  for (int32_t o = 0; o < no; ++o) {
+    if (!obstacles[o]) continue;
+    double phi = piola_obstacle_signed_distance(obstacles[o], t, q, NULL, NULL);
+    if (!(phi >= -1e-6))
+      fail_msg("%s frame %d: %s %d vertex %d is %g m inside obstacle %d", file, f, kind, (int)s,
+               (int)i, -phi, (int)o);
+  }
+}
+
 static void run_checked(const char *file, int frames, int free_momentum, double max_inverted_fraction,
                         int coupled_shells) {
   char path[1024], dir[1024];
@@ -183,14 +198,7 @@ static void run_checked(const char *file, int frames, int free_momentum, double 
           scale += m[i] * fabs(v[3 * i + k]);
         }
         if (flags && flags[i]) continue;
-        piola_vec3 q = {x[3 * i], x[3 * i + 1], x[3 * i + 2]};
-        for (int32_t o = 0; o < no; ++o) {
-          if (!obstacles[o]) continue;
-          double phi = piola_obstacle_signed_distance(obstacles[o], t, q, NULL, NULL);
-          if (!(phi >= -1e-6))
-            fail_msg("%s frame %d: solid %d vertex %d is %g m inside obstacle %d", file, f, (int)s,
-                     (int)i, -phi, (int)o);
-        }
+        check_outside_obstacles(file, f, "solid", s, i, x + 3 * i, obstacles, no, t);
       }
       if (free_momentum)
         for (int k = 0; k < 3; ++k)
@@ -207,14 +215,7 @@ static void run_checked(const char *file, int frames, int free_momentum, double 
           if (!isfinite(x[3 * i + k]) || !isfinite(v[3 * i + k]))
             fail_msg("%s frame %d: shell %d vertex %d not finite", file, f, (int)s, (int)i);
         if (flags && flags[i]) continue;
-        piola_vec3 q = {x[3 * i], x[3 * i + 1], x[3 * i + 2]};
-        for (int32_t o = 0; o < no; ++o) {
-          if (!obstacles[o]) continue;
-          double phi = piola_obstacle_signed_distance(obstacles[o], t, q, NULL, NULL);
-          if (!(phi >= -1e-6))
-            fail_msg("%s frame %d: shell %d vertex %d is %g m inside obstacle %d", file, f, (int)s,
-                     (int)i, -phi, (int)o);
-        }
+        check_outside_obstacles(file, f, "shell", s, i, x + 3 * i, obstacles, no, t);
       }
       if (coupled_shells)
         for (int32_t k = 0; k < piola_world_solid_count(w); ++k)

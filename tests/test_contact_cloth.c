@@ -11,6 +11,7 @@
 
 #include "contact/triangle_intersection.h"
 #include "piola/collision_surface.h"
+#include "triangle_referee.h"
 
 typedef struct cloth_scene {
   int32_t nv, nt, ns;
@@ -90,21 +91,7 @@ static void cloth_free(cloth_scene *s) {
 }
 
 static long count_intersections(const cloth_scene *s) {
-  long hits = 0;
-  for (int32_t a = 0; a < s->nt; ++a)
-    for (int32_t b = a + 1; b < s->nt; ++b) {
-      const int32_t *ta = s->tris + 3 * a, *tb = s->tris + 3 * b;
-      int shared = 0;
-      for (int i = 0; i < 3; ++i)
-        for (int j = 0; j < 3; ++j) shared |= ta[i] == tb[j];
-      if (shared) continue;
-      const double *p[3] = {s->x + 3 * ta[0], s->x + 3 * ta[1], s->x + 3 * ta[2]};
-      const double *q[3] = {s->x + 3 * tb[0], s->x + 3 * tb[1], s->x + 3 * tb[2]};
-      int r = piola__triangles_intersect(p, q);
-      assert_true(r >= 0);
-      hits += r;
-    }
-  return hits;
+  return referee_count_intersections_every_pair((judged){s->x, s->tris, s->nt});
 }
 
 static void cloth_falls_onto_itself_in_folds(void **state) {

@@ -12,6 +12,7 @@
 #include "piola/collision_surface.h"
 #include "piola/mesh.h"
 #include "piola/mesh_io.h"
+#include "triangle_referee.h"
 
 typedef struct solids {
   int32_t nv, nt;
@@ -62,21 +63,7 @@ static void add_solid(solids *s, const char *path, const double offset[3], int32
 }
 
 static long count_intersections(const solids *s) {
-  long hits = 0;
-  for (int32_t a = 0; a < s->nt; ++a)
-    for (int32_t b = a + 1; b < s->nt; ++b) {
-      const int32_t *ta = s->tris + 3 * a, *tb = s->tris + 3 * b;
-      int shared = 0;
-      for (int i = 0; i < 3; ++i)
-        for (int j = 0; j < 3; ++j) shared |= ta[i] == tb[j];
-      if (shared) continue;
-      const double *p[3] = {s->x + 3 * ta[0], s->x + 3 * ta[1], s->x + 3 * ta[2]};
-      const double *q[3] = {s->x + 3 * tb[0], s->x + 3 * tb[1], s->x + 3 * tb[2]};
-      int r = piola__triangles_intersect(p, q);
-      assert_true(r >= 0);
-      hits += r;
-    }
-  return hits;
+  return referee_count_intersections_every_pair((judged){s->x, s->tris, s->nt});
 }
 
 static piola_collision_surface *make_surface(const solids *s, int bodies) {

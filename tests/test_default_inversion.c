@@ -106,6 +106,18 @@ static void defaults_recover_from_scrambles(void **state) {
   piola_tet_mesh_free(&grid);
 }
 
+/* The protocols' material of `model` (recovery_material_def) with this inversion mode and
+ * threshold set explicitly. */
+static piola_material protocol_material_with(piola_material_model model, piola_inversion_mode mode,
+                                             double threshold) {
+  piola_material_def def = recovery_material_def(model);
+  def.inversion_mode = mode;
+  def.inversion_threshold = threshold;
+  piola_material m;
+  assert_int_equal(piola_material_init(&def, &m), PIOLA_OK);
+  return m;
+}
+
 /* The old defaults stay tangled on seeds the new ones recover (docs/materials.md): neo-Hookean
  * LINEAR 0.3 on seed 2 ("Tangled equilibria"), Mooney-Rivlin LINEAR 0.3 (1 of 160) on seed 50
  * (every entry above the threshold there: a state of the model that CLAMP at 0.4 reaches no
@@ -119,11 +131,7 @@ static void old_defaults_stay_tangled(void **state) {
     int seed;
   } cases[] = {{PIOLA_MODEL_NEOHOOKEAN, 2}, {PIOLA_MODEL_MOONEY_RIVLIN, 50}, {PIOLA_MODEL_HGO, 7}};
   for (size_t k = 0; k < sizeof cases / sizeof cases[0]; ++k) {
-    piola_material_def def = recovery_material_def(cases[k].model);
-    def.inversion_mode = PIOLA_INVERSION_LINEAR;
-    def.inversion_threshold = 0.3;
-    piola_material old;
-    assert_int_equal(piola_material_init(&def, &old), PIOLA_OK);
+    const piola_material old = protocol_material_with(cases[k].model, PIOLA_INVERSION_LINEAR, 0.3);
     const recovery_result r = recovery_scramble_run(&grid, &old, cases[k].seed);
     assert_true(r == RECOVERY_STUCK_MODEL || r == RECOVERY_STUCK_EXTENSION);
     const piola_material m = default_material(cases[k].model);
@@ -153,11 +161,7 @@ static void threshold_rise_untangles(void **state) {
   for (int k = 0; k < count; ++k) {
     const piola_material m = default_material(cases[k].model);
     assert_true(m.threshold_compressed > m.threshold);
-    piola_material_def def = recovery_material_def(cases[k].model);
-    def.inversion_mode = PIOLA_INVERSION_CLAMP;
-    def.inversion_threshold = m.threshold;
-    piola_material fixed;
-    assert_int_equal(piola_material_init(&def, &fixed), PIOLA_OK);
+    const piola_material fixed = protocol_material_with(cases[k].model, PIOLA_INVERSION_CLAMP, m.threshold);
     assert_true(fixed.threshold_compressed == fixed.threshold);
     const recovery_result old = recovery_scramble_run(&grid, &fixed, cases[k].seed);
     const recovery_result now = recovery_scramble_run(&grid, &m, cases[k].seed);

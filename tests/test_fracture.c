@@ -22,25 +22,6 @@
 #include "piola/world_fracture.h"
 #include "sim/fracture_internal.h"
 
-static piola_world *make_world(double max_dt) {
-  piola_world_def wd = piola_default_world_def();
-  for (int k = 0; k < 3; ++k) wd.gravity[k] = piola_track_constant(0);
-  wd.max_dt = max_dt;
-  piola_world *w = NULL;
-  assert_int_equal(piola_world_create(&wd, &w), PIOLA_OK);
-  return w;
-}
-
-static void add_solid(piola_world *w, const piola_tet_mesh *mesh, double viscosity) {
-  piola_solid_def sd = piola_default_solid_def();
-  sd.mesh = mesh;
-  sd.material.youngs_modulus = 2e4;
-  sd.material.poisson_ratio = 0.3;
-  sd.shear_viscosity = piola_track_constant(viscosity);
-  sd.bulk_viscosity = piola_track_constant(viscosity);
-  assert_int_equal(piola_world_add_solid(w, &sd, NULL), PIOLA_OK);
-}
-
 /* Every invariant of a cut solid at rest: fractions, their sum per original tet, masses,
  * finite state, and each fragment's surface closed and enclosing exactly its material.
  * strict: also every edge paired (no T-junctions: a single cut plane). */
@@ -121,14 +102,12 @@ static void box_splits_into_the_analytic_volumes(void **state) {
   (void)state;
   piola_tet_mesh mesh;
   assert_int_equal(piola_tet_mesh_box_grid(5, 5, 5, (piola_vec3){0.2, 0.2, 0.2}, &mesh), PIOLA_OK);
-  piola_world *w = make_world(1e-3);
-  add_solid(w, &mesh, 0);
+  piola_world *w = weightless_world(1e-3);
+  fracture_add_solid(w, &mesh, 0);
   const double mass = fracture_total_mass(w);
   assert_int_equal(piola_world_solid_fragment_count(w, 0), 1);
   piola_fracture_cut cut = {.time = 0, .point = {0.4, 0.5, 0.5}, .normal = {1, 0.2, 0.1}};
-  piola_fracture_def def = piola_default_fracture_def();
-  def.cuts = &cut, def.cut_count = 1;
-  assert_int_equal(piola_world_solid_set_fracture(w, 0, &def), PIOLA_OK); /* due at t = 0 */
+  fracture_set_cuts(w, &cut, 1); /* due at t = 0 */
   assert_int_equal(piola_world_solid_fragment_count(w, 0), 2);
   assert_true(piola_world_solid_cut_tet_count(w, 0) > 0);
   assert_close(fracture_total_mass(w), mass, 1e-13 * mass);
@@ -182,21 +161,10 @@ static void cut_in_free_flight_keeps_momentum(void **state) {
   (void)state;
   piola_tet_mesh mesh;
   assert_int_equal(piola_tet_mesh_box_grid(6, 2, 2, (piola_vec3){0.05, 0.05, 0.05}, &mesh), PIOLA_OK);
-  piola_world *w = make_world(5e-4);
-  add_solid(w, &mesh, 0);
-  int32_t n = mesh.vertex_count;
-  double *x = malloc(3 * sizeof(double) * (size_t)n), *v = malloc(3 * sizeof(double) * (size_t)n);
-  for (int32_t i = 0; i < n; ++i) {
-    const double *p = mesh.positions + 3 * i;
-    x[3 * i] = 1.2 * p[0] + 0.1 * p[1], x[3 * i + 1] = 0.9 * p[1], x[3 * i + 2] = p[2] + 0.05 * p[0];
-    v[3 * i] = 0.5 - 3.0 * (p[1] - 0.05), v[3 * i + 1] = -0.2 + 3.0 * (p[0] - 0.15), v[3 * i + 2] = 0.1 + p[1];
-  }
-  assert_int_equal(piola_world_solid_set_state(w, 0, x, v), PIOLA_OK);
+  piola_world *w = fracture_spinning_bar(&mesh, 1.2, 0.05);
   piola_fracture_cut cuts[2] = {{.time = 0.05, .point = {0.17, 0.05, 0.05}, .normal = {1, 0.3, -0.2}},
                                 {.time = 0.05, .point = {0.0, 0.05, 0.05}, .normal = {0.1, 1, 0.3}}};
-  piola_fracture_def def = piola_default_fracture_def();
-  def.cuts = cuts, def.cut_count = 2;
-  assert_int_equal(piola_world_solid_set_fracture(w, 0, &def), PIOLA_OK);
+  fracture_set_cuts(w, cuts, 2);
   assert_int_equal(piola_world_advance_to(w, 0.05, NULL), PIOLA_OK);
   assert_int_equal(piola_world_solid_cut_tet_count(w, 0), 0); /* not yet: due at the next step */
   double p0[3], l0[3], p1[3], l1[3];
@@ -220,7 +188,7 @@ static void cut_in_free_flight_keeps_momentum(void **state) {
     assert_close(p1[k], p0[k], 1e-12 * ps);
     assert_close(l1[k], l0[k], 1e-6 * ls);
   }
-  free(x), free(v), free(mesh.positions), free(mesh.tets);
+  free(mesh.positions), free(mesh.tets);
   piola_world_destroy(w);
 }
 
@@ -231,16 +199,7 @@ static void grown_cracks_in_free_flight_keep_momentum(void **state) {
   (void)state;
   piola_tet_mesh mesh;
   assert_int_equal(piola_tet_mesh_box_grid(6, 2, 2, (piola_vec3){0.05, 0.05, 0.05}, &mesh), PIOLA_OK);
-  piola_world *w = make_world(5e-4);
-  add_solid(w, &mesh, 0);
-  int32_t n = mesh.vertex_count;
-  double *x = malloc(3 * sizeof(double) * (size_t)n), *v = malloc(3 * sizeof(double) * (size_t)n);
-  for (int32_t i = 0; i < n; ++i) {
-    const double *p = mesh.positions + 3 * i;
-    x[3 * i] = 1.3 * p[0] + 0.1 * p[1], x[3 * i + 1] = 0.9 * p[1], x[3 * i + 2] = p[2] + 0.05 * p[0];
-    v[3 * i] = 0.5 - 3.0 * (p[1] - 0.05), v[3 * i + 1] = -0.2 + 3.0 * (p[0] - 0.15), v[3 * i + 2] = 0.1 + p[1];
-  }
-  assert_int_equal(piola_world_solid_set_state(w, 0, x, v), PIOLA_OK);
+  piola_world *w = fracture_spinning_bar(&mesh, 1.3, 0.05);
   piola_fracture_def def = piola_default_fracture_def();
   def.criterion = PIOLA_FRACTURE_STRESS, def.threshold = 3e3;
   assert_int_equal(piola_world_solid_set_fracture(w, 0, &def), PIOLA_OK);
@@ -265,7 +224,7 @@ static void grown_cracks_in_free_flight_keep_momentum(void **state) {
   }
   assert_true(cutting_steps >= 2); /* a crack started and grew */
   check_cut_solid_positions_finite(w);
-  free(x), free(v), free(mesh.positions), free(mesh.tets);
+  free(mesh.positions), free(mesh.tets);
   piola_world_destroy(w);
 }
 
@@ -273,13 +232,11 @@ static void grown_cracks_in_free_flight_keep_momentum(void **state) {
  * plane and after a second, which cuts again the tets the first one cut that it crosses
  * (strictly closed surfaces both times), and the cut body steps without NaN. */
 static void random_cuts_keep_every_invariant_mesh(const piola_tet_mesh *mesh, test_rng *rng, int trials) {
-  double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
-  for (int32_t i = 0; i < mesh->vertex_count; ++i)
-    for (int k = 0; k < 3; ++k)
-      lo[k] = fmin(lo[k], mesh->positions[3 * i + k]), hi[k] = fmax(hi[k], mesh->positions[3 * i + k]);
+  double lo[3], hi[3];
+  fracture_mesh_bounds(mesh, lo, hi);
   for (int trial = 0; trial < trials; ++trial) {
-    piola_world *w = make_world(1e-3);
-    add_solid(w, mesh, 1);
+    piola_world *w = weightless_world(1e-3);
+    fracture_add_solid(w, mesh, 1);
     const double mass = fracture_total_mass(w);
     for (int plane = 0; plane < 2; ++plane) {
       double point[3], normal[3];
@@ -354,8 +311,8 @@ static void blade_cuts_like_its_plane_and_only_where_it_reaches(void **state) {
   const double un = sqrt(u[0] * u[0] + u[1] * u[1]);
   u[0] /= un, u[1] /= un;
   v[0] = n[1] * u[2] - n[2] * u[1], v[1] = n[2] * u[0] - n[0] * u[2], v[2] = n[0] * u[1] - n[1] * u[0];
-  piola_world *plane = make_world(1e-3), *blade = make_world(1e-3);
-  add_solid(plane, &mesh, 0), add_solid(blade, &mesh, 0);
+  piola_world *plane = weightless_world(1e-3), *blade = weightless_world(1e-3);
+  fracture_add_solid(plane, &mesh, 0), fracture_add_solid(blade, &mesh, 0);
   int32_t by_plane = 0, by_blade = 0;
   assert_int_equal(piola_world_solid_cut(plane, 0, center, normal, &by_plane), PIOLA_OK);
   piola_tri_mesh big = sheet(center, u, v, 2.0, 0, 3);
@@ -373,8 +330,8 @@ static void blade_cuts_like_its_plane_and_only_where_it_reaches(void **state) {
   piola_tri_mesh_free(&big);
   /* half a blade: a square of half-size 0.6 centred 0.6 m from the plane's point along u
    * (mostly +y) reaches into the box only for y > ~0.5 */
-  blade = make_world(1e-3);
-  add_solid(blade, &mesh, 0);
+  blade = weightless_world(1e-3);
+  fracture_add_solid(blade, &mesh, 0);
   double c2[3];
   if (u[1] < 0)
     for (int k = 0; k < 3; ++k) u[k] = -u[k], v[k] = -v[k];
@@ -396,8 +353,8 @@ static void blade_cuts_like_its_plane_and_only_where_it_reaches(void **state) {
   piola_world_destroy(blade);
   piola_tri_mesh_free(&half);
   /* bad blades are refused */
-  blade = make_world(1e-3);
-  add_solid(blade, &mesh, 0);
+  blade = weightless_world(1e-3);
+  fracture_add_solid(blade, &mesh, 0);
   piola_tri_mesh bad = sheet(center, u, v, 1, 0, 2);
   bad.triangles[1] = 7;
   assert_int_equal(piola_world_solid_cut_by_surface(blade, 0, &bad, NULL), PIOLA_ERROR_INVALID_ARGUMENT);
@@ -414,15 +371,13 @@ static void blade_cuts_like_its_plane_and_only_where_it_reaches(void **state) {
  * cracks cut the body: they meet edge to edge), and the body steps on. */
 static void grown_and_blade_cuts_keep_every_invariant_mesh(const piola_tet_mesh *mesh, test_rng *rng, int trials,
                                                            int32_t *grown_tets, int32_t *blade_tets) {
-  double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
-  for (int32_t i = 0; i < mesh->vertex_count; ++i)
-    for (int k = 0; k < 3; ++k)
-      lo[k] = fmin(lo[k], mesh->positions[3 * i + k]), hi[k] = fmax(hi[k], mesh->positions[3 * i + k]);
+  double lo[3], hi[3];
+  fracture_mesh_bounds(mesh, lo, hi);
   double size = 0;
   for (int k = 0; k < 3; ++k) size = fmax(size, hi[k] - lo[k]);
   for (int trial = 0; trial < trials; ++trial) {
-    piola_world *w = make_world(1e-3);
-    add_solid(w, mesh, 1);
+    piola_world *w = weightless_world(1e-3);
+    fracture_add_solid(w, mesh, 1);
     const double mass = fracture_total_mass(w);
     piola_fracture_def def = piola_default_fracture_def();
     def.criterion = PIOLA_FRACTURE_STRESS;
@@ -506,8 +461,8 @@ static void cut_body_recovers_from_collapse(void **state) {
   (void)state;
   piola_tet_mesh mesh;
   assert_int_equal(piola_tet_mesh_box_grid(3, 3, 3, (piola_vec3){0.1, 0.1, 0.1}, &mesh), PIOLA_OK);
-  piola_world *w = make_world(1e-3);
-  add_solid(w, &mesh, 20);
+  piola_world *w = weightless_world(1e-3);
+  fracture_add_solid(w, &mesh, 20);
   /* both fragments at least one and a half tets thick (docs/fracture.md: a fragment about
    * one tet thick, mostly virtual, can stay tangled after a collapse to a point) */
   const double point[3] = {0.16, 0.15, 0.15}, normal[3] = {1, 0.1, 0.05};
@@ -533,7 +488,7 @@ static void cut_keeps_plastic_state_and_energy(void **state) {
   (void)state;
   piola_tet_mesh mesh;
   assert_int_equal(piola_tet_mesh_box_grid(3, 3, 3, (piola_vec3){0.05, 0.05, 0.05}, &mesh), PIOLA_OK);
-  piola_world *w = make_world(1e-3);
+  piola_world *w = weightless_world(1e-3);
   piola_solid_def sd = piola_default_solid_def();
   sd.mesh = &mesh;
   sd.material.youngs_modulus = 1e5;
@@ -579,7 +534,7 @@ static void cut_keeps_plastic_state_and_energy(void **state) {
 static int32_t pulled_bar(double threshold, double t_end, double *first_cut_time, piola_world **out) {
   piola_tet_mesh mesh;
   assert_int_equal(piola_tet_mesh_box_grid(12, 2, 2, (piola_vec3){0.025, 0.025, 0.025}, &mesh), PIOLA_OK);
-  piola_world *w = make_world(1e-3);
+  piola_world *w = weightless_world(1e-3);
   piola_solid_def sd = piola_default_solid_def();
   sd.mesh = &mesh;
   sd.material.youngs_modulus = 1e5;
@@ -642,8 +597,8 @@ static void max_cuts_per_step_spreads_cuts(void **state) {
   (void)state;
   piola_tet_mesh mesh;
   assert_int_equal(piola_tet_mesh_box_grid(5, 5, 5, (piola_vec3){0.2, 0.2, 0.2}, &mesh), PIOLA_OK);
-  piola_world *w = make_world(1e-3);
-  add_solid(w, &mesh, 0);
+  piola_world *w = weightless_world(1e-3);
+  fracture_add_solid(w, &mesh, 0);
   piola_fracture_cut cuts[2] = {{.time = 0, .point = {0.33, 0.5, 0.5}, .normal = {1, 0.1, 0}},
                                 {.time = 0, .point = {0.67, 0.5, 0.5}, .normal = {1, 0.1, 0}}};
   piola_fracture_def def = piola_default_fracture_def();
@@ -667,8 +622,8 @@ static void bad_cuts_are_refused(void **state) {
   (void)state;
   piola_tet_mesh mesh;
   assert_int_equal(piola_tet_mesh_box_grid(2, 2, 2, (piola_vec3){0.1, 0.1, 0.1}, &mesh), PIOLA_OK);
-  piola_world *w = make_world(1e-3);
-  add_solid(w, &mesh, 0);
+  piola_world *w = weightless_world(1e-3);
+  fracture_add_solid(w, &mesh, 0);
   const double point[3] = {0.1, 0.1, 0.1}, zero[3] = {0, 0, 0}, nan_normal[3] = {NAN, 0, 1};
   assert_int_equal(piola_world_solid_cut(w, 0, point, zero, NULL), PIOLA_ERROR_INVALID_ARGUMENT);
   assert_int_equal(piola_world_solid_cut(w, 0, point, nan_normal, NULL), PIOLA_ERROR_INVALID_ARGUMENT);

@@ -232,9 +232,7 @@ static void random_moving_blades_mesh(const piola_tet_mesh *mesh, test_rng *rng,
     piola_fracture_cut cut = {.time = 0, .blade = &blade, .end_time = 0.1,
                               .velocity = {(2 * size * u[0] + across * nrm[0]) / 0.1, (2 * size * u[1] + across * nrm[1]) / 0.1,
                                            (2 * size * u[2] + across * nrm[2]) / 0.1}};
-    piola_fracture_def def = piola_default_fracture_def();
-    def.cuts = &cut, def.cut_count = 1;
-    assert_int_equal(piola_world_solid_set_fracture(w, 0, &def), PIOLA_OK);
+    fracture_set_cuts(w, &cut, 1);
     piola_tri_mesh_free(&blade);
     const double mass = fracture_total_mass(w);
     while (piola_world_time(w) < 0.104) {

@@ -50,9 +50,7 @@ static piola_world *make_world(const piola_tet_mesh *mesh, double gravity, int s
   sd.self_collision.thickness = thickness;
   sd.self_collision.friction = 0.3;
   assert_int_equal(piola_world_add_solid(w, &sd, NULL), PIOLA_OK);
-  piola_fracture_def def = piola_default_fracture_def();
-  def.cuts = cuts, def.cut_count = cut_count;
-  assert_int_equal(piola_world_solid_set_fracture(w, 0, &def), PIOLA_OK); /* due at t = 0 */
+  fracture_set_cuts(w, cuts, cut_count); /* due at t = 0 */
   return w;
 }
 

@@ -23,25 +23,6 @@
 #include "piola/world_fracture.h"
 #include "sim/fracture_internal.h"
 
-static piola_world *make_world(double max_dt) {
-  piola_world_def wd = piola_default_world_def();
-  for (int k = 0; k < 3; ++k) wd.gravity[k] = piola_track_constant(0);
-  wd.max_dt = max_dt;
-  piola_world *w = NULL;
-  assert_int_equal(piola_world_create(&wd, &w), PIOLA_OK);
-  return w;
-}
-
-static void add_solid(piola_world *w, const piola_tet_mesh *mesh, double viscosity) {
-  piola_solid_def sd = piola_default_solid_def();
-  sd.mesh = mesh;
-  sd.material.youngs_modulus = 2e4;
-  sd.material.poisson_ratio = 0.3;
-  sd.shear_viscosity = piola_track_constant(viscosity);
-  sd.bulk_viscosity = piola_track_constant(viscosity);
-  assert_int_equal(piola_world_add_solid(w, &sd, NULL), PIOLA_OK);
-}
-
 /* The vector area of a cell's polygons in barycentric coordinates (0 when they close). */
 static void add_vector_area(const cell_point *poly, int32_t n, double sum[3]) {
   for (int32_t i = 1; i + 1 < n; ++i) {
@@ -178,14 +159,12 @@ static void crossing_planes_quarter_a_box(void **state) {
   test_rng rng = test_rng_seeded(4);
   for (int32_t i = 0; i < 3 * mesh.vertex_count; ++i)
     if (mesh.positions[i] > 1e-9 && mesh.positions[i] < 1 - 1e-9) mesh.positions[i] += test_rng_uniform(&rng, -0.03, 0.03);
-  piola_world *w = make_world(1e-3);
-  add_solid(w, &mesh, 0);
+  piola_world *w = weightless_world(1e-3);
+  fracture_add_solid(w, &mesh, 0);
   const double mass = fracture_total_mass(w);
   piola_fracture_cut cuts[2] = {{.time = 0, .point = {0.5, 0.5, 0.5}, .normal = {1, 0, 0}},
                                 {.time = 0, .point = {0.5, 0.5, 0.5}, .normal = {0, 1, 0}}};
-  piola_fracture_def def = piola_default_fracture_def();
-  def.cuts = cuts, def.cut_count = 2;
-  assert_int_equal(piola_world_solid_set_fracture(w, 0, &def), PIOLA_OK);
+  fracture_set_cuts(w, cuts, 2);
   assert_int_equal(piola_world_solid_fragment_count(w, 0), 4);
   assert_true(fracture_recut_tets(w) > 0);
   assert_close(fracture_total_mass(w), mass, 1e-13 * mass);
@@ -243,13 +222,11 @@ static void crossing_planes_quarter_a_box(void **state) {
  * without NaN. */
 static void random_planes_keep_every_invariant_mesh(const piola_tet_mesh *mesh, test_rng *rng, int trials,
                                                     int32_t *recut, int32_t *open_surfaces) {
-  double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
-  for (int32_t i = 0; i < mesh->vertex_count; ++i)
-    for (int k = 0; k < 3; ++k)
-      lo[k] = fmin(lo[k], mesh->positions[3 * i + k]), hi[k] = fmax(hi[k], mesh->positions[3 * i + k]);
+  double lo[3], hi[3];
+  fracture_mesh_bounds(mesh, lo, hi);
   for (int trial = 0; trial < trials; ++trial) {
-    piola_world *w = make_world(1e-3);
-    add_solid(w, mesh, 1);
+    piola_world *w = weightless_world(1e-3);
+    fracture_add_solid(w, mesh, 1);
     const double mass = fracture_total_mass(w);
     const int planes = 2 + trial % 2;
     for (int plane = 0; plane < planes; ++plane) {
@@ -297,22 +274,11 @@ static void second_cut_in_free_flight_keeps_momentum(void **state) {
   (void)state;
   piola_tet_mesh mesh;
   assert_int_equal(piola_tet_mesh_box_grid(6, 3, 3, (piola_vec3){0.05, 0.05, 0.05}, &mesh), PIOLA_OK);
-  piola_world *w = make_world(5e-4);
-  add_solid(w, &mesh, 0);
-  const int32_t n = mesh.vertex_count;
-  double *x = malloc(3 * sizeof(double) * (size_t)n), *v = malloc(3 * sizeof(double) * (size_t)n);
-  for (int32_t i = 0; i < n; ++i) {
-    const double *p = mesh.positions + 3 * i;
-    x[3 * i] = 1.2 * p[0] + 0.1 * p[1], x[3 * i + 1] = 0.9 * p[1], x[3 * i + 2] = p[2] + 0.05 * p[0];
-    v[3 * i] = 0.5 - 3.0 * (p[1] - 0.075), v[3 * i + 1] = -0.2 + 3.0 * (p[0] - 0.15), v[3 * i + 2] = 0.1 + p[1];
-  }
-  assert_int_equal(piola_world_solid_set_state(w, 0, x, v), PIOLA_OK);
+  piola_world *w = fracture_spinning_bar(&mesh, 1.2, 0.075);
   /* planes through the bar's centre as it will be then (it drifts by (0.5, -0.2, 0.1) m/s) */
   piola_fracture_cut cuts[2] = {{.time = 0.03, .point = {0.2, 0.06, 0.09}, .normal = {1, 0.3, -0.2}},
                                 {.time = 0.06, .point = {0.21, 0.05, 0.09}, .normal = {0.1, 1, 0.3}}};
-  piola_fracture_def def = piola_default_fracture_def();
-  def.cuts = cuts, def.cut_count = 2;
-  assert_int_equal(piola_world_solid_set_fracture(w, 0, &def), PIOLA_OK);
+  fracture_set_cuts(w, cuts, 2);
   assert_int_equal(piola_world_advance_to(w, 0.06, NULL), PIOLA_OK);
   const int32_t once = piola_world_solid_cut_tet_count(w, 0);
   assert_true(once > 0);
@@ -340,14 +306,14 @@ static void second_cut_in_free_flight_keeps_momentum(void **state) {
   const double *xs = piola_world_solid_positions(w, 0);
   for (int32_t i = 0; i < 3 * piola_elastic_body_vertex_count(piola_world_solid_body(w, 0)); ++i)
     assert_true(isfinite(xs[i]));
-  free(x), free(v), free(mesh.positions), free(mesh.tets);
+  free(mesh.positions), free(mesh.tets);
   piola_world_destroy(w);
 }
 
 /* A stretched, drifting box cut at t = 0 by x = 0.1 and at 0.01 s by y = 0.1, crossing it. */
 static piola_world *twice_cut_box(const piola_tet_mesh *mesh, int second) {
-  piola_world *w = make_world(5e-4);
-  add_solid(w, mesh, 1);
+  piola_world *w = weightless_world(5e-4);
+  fracture_add_solid(w, mesh, 1);
   const int32_t n = mesh->vertex_count;
   double *v = malloc(3 * sizeof(double) * (size_t)n);
   for (int32_t i = 0; i < n; ++i)
@@ -356,9 +322,7 @@ static piola_world *twice_cut_box(const piola_tet_mesh *mesh, int second) {
   free(v);
   const piola_fracture_cut cuts[2] = {{.time = 0, .point = {0.1, 0.1, 0.1}, .normal = {1, 0.1, 0.05}},
                                       {.time = 0.01, .point = {0.1, 0.1, 0.1}, .normal = {0.05, 1, 0.1}}};
-  piola_fracture_def def = piola_default_fracture_def();
-  def.cuts = cuts, def.cut_count = second ? 2 : 1;
-  assert_int_equal(piola_world_solid_set_fracture(w, 0, &def), PIOLA_OK);
+  fracture_set_cuts(w, cuts, second ? 2 : 1);
   return w;
 }
 

@@ -24,6 +24,12 @@ static piola_material make(piola_material_model model, piola_inversion_mode mode
   return material_of(model, mode, youngs, nu, threshold);
 }
 
+/* Variant v of 2 N_MODES of `model`: every inversion mode (v % N_MODES), with a positive
+ * lambda (nu = 0.4) and then a negative one (auxetic, nu = -0.3). */
+static piola_material variant_material(int model, int variant) {
+  return make((piola_material_model)model, modes[variant % N_MODES], variant < N_MODES ? 0.4 : -0.3);
+}
+
 static double energy(const piola_material *m, double f0, double f1, double f2) {
   const double f[3] = {f0, f1, f2};
   return piola_material_energy_density(m, f);
@@ -112,10 +118,7 @@ static void stress_is_energy_gradient_above_threshold(void **state) {
   const long samples = test_samples(400, 20);
   for (int model = 0; model < PIOLA_MODEL_COUNT; ++model)
     for (int variant = 0; variant < 2 * N_MODES; ++variant) {
-      /* Both modes, with a positive and a negative lambda (auxetic, nu < 0). */
-      const int mode = variant % N_MODES;
-      const piola_material m =
-          make((piola_material_model)model, modes[mode], variant < N_MODES ? 0.4 : -0.3);
+      const piola_material m = variant_material(model, variant);
       for (long s = 0; s < samples; ++s) {
         double f[3], p[3];
         random_point(&rng, m.threshold + 0.01, 2.5, f);
@@ -136,10 +139,7 @@ static void stress_is_energy_gradient_along_clamped_entries(void **state) {
   const long samples = test_samples(400, 20);
   for (int model = 0; model < PIOLA_MODEL_COUNT; ++model)
     for (int variant = 0; variant < 2 * N_MODES; ++variant) {
-      /* Both modes, with a positive and a negative lambda (auxetic, nu < 0). */
-      const int mode = variant % N_MODES;
-      const piola_material m =
-          make((piola_material_model)model, modes[mode], variant < N_MODES ? 0.4 : -0.3);
+      const piola_material m = variant_material(model, variant);
       for (long s = 0; s < samples; ++s) {
         double f[3], p[3];
         random_point(&rng, -3.0, 2.5, f);
@@ -159,10 +159,7 @@ static void derivative_matches_finite_differences_everywhere(void **state) {
   const long samples = test_samples(600, 30);
   for (int model = 0; model < PIOLA_MODEL_COUNT; ++model)
     for (int variant = 0; variant < 2 * N_MODES; ++variant) {
-      /* Both modes, with a positive and a negative lambda (auxetic, nu < 0). */
-      const int mode = variant % N_MODES;
-      const piola_material m =
-          make((piola_material_model)model, modes[mode], variant < N_MODES ? 0.4 : -0.3);
+      const piola_material m = variant_material(model, variant);
       long checked = 0;
       for (long s = 0; s < samples; ++s) {
         double f[3], k[3][3], col[3];

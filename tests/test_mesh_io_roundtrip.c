@@ -19,15 +19,12 @@ static char tmpdir[256];
 
 static int setup(void **state) {
   (void)state;
-  snprintf(tmpdir, sizeof tmpdir, "/tmp/piola_mesh_io_XXXXXX");
-  return mkdtemp(tmpdir) ? 0 : -1;
+  return test_make_scratch_folder(tmpdir, sizeof tmpdir, "piola_mesh_io");
 }
 
 static int teardown(void **state) {
   (void)state;
-  char cmd[512];
-  snprintf(cmd, sizeof cmd, "rm -rf '%s'", tmpdir);
-  return system(cmd) == 0 ? 0 : -1;
+  return test_remove_scratch_folder(tmpdir);
 }
 
 static const char *tmp(const char *name) {

@@ -17,15 +17,12 @@ static char tmpdir[256];
 
 static int setup(void **state) {
   (void)state;
-  snprintf(tmpdir, sizeof tmpdir, "/tmp/piola_mesher_cli_XXXXXX");
-  return mkdtemp(tmpdir) ? 0 : -1;
+  return test_make_scratch_folder(tmpdir, sizeof tmpdir, "piola_mesher_cli");
 }
 
 static int teardown(void **state) {
   (void)state;
-  char cmd[512];
-  snprintf(cmd, sizeof cmd, "rm -rf '%s'", tmpdir);
-  return system(cmd) == 0 ? 0 : -1;
+  return test_remove_scratch_folder(tmpdir);
 }
 
 /* Runs the CLI with arguments; stderr goes to tmpdir/err.txt. Returns the exit code. */

@@ -14,15 +14,6 @@
 #include "piola/world.h"
 #include "test_elastic_body_fixtures.h"
 
-static piola_world *weightless_world(double max_dt) {
-  piola_world_def wd = piola_default_world_def();
-  for (int k = 0; k < 3; ++k) wd.gravity[k] = piola_track_constant(0);
-  wd.max_dt = max_dt;
-  piola_world *w = NULL;
-  assert_int_equal(piola_world_create(&wd, &w), PIOLA_OK);
-  return w;
-}
-
 /* Distance between vertices a and b now (the bodies may turn, so no axis extents). */
 static double span(const piola_world *w, int32_t a, int32_t b) {
   const double *x = piola_world_solid_positions(w, 0);

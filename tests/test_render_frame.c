@@ -17,15 +17,12 @@ static char folder[256];
 
 static int make_folder(void **state) {
   (void)state;
-  snprintf(folder, sizeof folder, "/tmp/piola_test_render_frame_XXXXXX");
-  return mkdtemp(folder) ? 0 : -1;
+  return test_make_scratch_folder(folder, sizeof folder, "piola_test_render_frame");
 }
 
 static int remove_folder(void **state) {
   (void)state;
-  char cmd[512];
-  snprintf(cmd, sizeof cmd, "rm -rf '%s'", folder);
-  return system(cmd) == 0 ? 0 : -1;
+  return test_remove_scratch_folder(folder);
 }
 
 /* An n x n x n grid of unit cubes of size h, each cut into 6 tets around its main

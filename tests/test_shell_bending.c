@@ -255,10 +255,7 @@ static void bending_damping_opposes_angle_rate(void **state) {
   (void)state;
   piola_tri_mesh mesh = shell_sheet(1.0, 1.0, 1, 1); /* two triangles, one hinge */
   piola_material material = shell_material(PIOLA_MODEL_COROTATED, 1e-6);
-  piola_shell_body_def def = piola_default_shell_body_def();
-  def.rest_mesh = &mesh;
-  def.materials = &material;
-  def.material_count = 1;
+  piola_shell_body_def def = shell_def_of(&mesh, &material);
   def.bending.stiffness = 1.0;
   def.bending.damping = 0.25;
   piola_shell_body *body;
@@ -287,10 +284,7 @@ static void plastic_bending_flows_past_yield(void **state) {
   (void)state;
   piola_tri_mesh mesh = shell_sheet(1.0, 1.0, 1, 1);
   piola_material material = shell_material(PIOLA_MODEL_COROTATED, 1e5);
-  piola_shell_body_def def = piola_default_shell_body_def();
-  def.rest_mesh = &mesh;
-  def.materials = &material;
-  def.material_count = 1;
+  piola_shell_body_def def = shell_def_of(&mesh, &material);
   def.bending.stiffness = 1.0;
   def.bending.yield_angle = 0.2;
   piola_shell_body *body;

@@ -341,10 +341,7 @@ static void triangles_inverted_against_reference_are_pushed_back(void **state) {
   piola_tri_mesh mesh = shell_single_triangle(1.0);
   for (int m = 0; m < SHELL_MODEL_COUNT; ++m) {
     piola_material material = shell_material(shell_all_models[m], 1e5);
-    piola_shell_body_def def = piola_default_shell_body_def();
-    def.rest_mesh = &mesh;
-    def.materials = &material;
-    def.material_count = 1;
+    piola_shell_body_def def = shell_def_of(&mesh, &material);
     def.thickness = 0.01;
     def.use_reference_normals = true;
     piola_shell_body *body;
@@ -382,10 +379,7 @@ static void triangles_inverted_against_reference_are_pushed_back(void **state) {
   /* reference normals given explicitly: +z reference, triangle wound clockwise at rest is
    * inverted from the start */
   piola_material material = shell_material(PIOLA_MODEL_COROTATED, 1e5);
-  piola_shell_body_def def = piola_default_shell_body_def();
-  def.rest_mesh = &mesh;
-  def.materials = &material;
-  def.material_count = 1;
+  piola_shell_body_def def = shell_def_of(&mesh, &material);
   def.use_reference_normals = true;
   double down[3] = {0, 0, -1};
   def.reference_normals = down;
@@ -442,10 +436,7 @@ static void damping_is_symmetric_dissipative_and_rigid_free(void **state) {
   double *g = malloc(sizeof(double) * 3 * n);
   test_rng rng = test_rng_seeded(21);
   piola_material material = shell_material(PIOLA_MODEL_COROTATED, 1e5);
-  piola_shell_body_def def = piola_default_shell_body_def();
-  def.rest_mesh = &mesh;
-  def.materials = &material;
-  def.material_count = 1;
+  piola_shell_body_def def = shell_def_of(&mesh, &material);
   def.bending.stiffness = 0.1;
   def.bending.damping = 0.02;
   piola_shell_body *body;
@@ -489,10 +480,7 @@ static void bad_input_is_reported(void **state) {
   (void)state;
   piola_tri_mesh mesh = shell_single_triangle(1.0);
   piola_material material = shell_material(PIOLA_MODEL_COROTATED, 1e5);
-  piola_shell_body_def def = piola_default_shell_body_def();
-  def.rest_mesh = &mesh;
-  def.materials = &material;
-  def.material_count = 1;
+  piola_shell_body_def def = shell_def_of(&mesh, &material);
   piola_shell_body *body = (piola_shell_body *)&def;
   def.thickness = 0;
   assert_int_equal(piola_shell_body_create(&def, &body), PIOLA_ERROR_INVALID_ARGUMENT);

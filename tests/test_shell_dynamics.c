@@ -149,10 +149,7 @@ static void inplane_plasticity_keeps_a_stretch(void **state) {
   (void)state;
   piola_tri_mesh mesh = shell_single_triangle(1.0);
   piola_material material = shell_material(PIOLA_MODEL_COROTATED, 1e5);
-  piola_shell_body_def def = piola_default_shell_body_def();
-  def.rest_mesh = &mesh;
-  def.materials = &material;
-  def.material_count = 1;
+  piola_shell_body_def def = shell_def_of(&mesh, &material);
   def.plasticity.yield_strain = 0.1;
   def.plasticity.max_plastic_stretch = 2.0;
   piola_shell_body *body;

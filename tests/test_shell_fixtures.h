@@ -47,13 +47,19 @@ static inline piola_tri_mesh shell_single_triangle(double h) {
   return mesh;
 }
 
-static inline piola_shell_body *shell_body_from(const piola_tri_mesh *mesh,
-                                                const piola_material *material,
-                                                double bending_stiffness) {
+/* The default shell body definition of `mesh` in the one material `material`. */
+static inline piola_shell_body_def shell_def_of(const piola_tri_mesh *mesh, const piola_material *material) {
   piola_shell_body_def def = piola_default_shell_body_def();
   def.rest_mesh = mesh;
   def.materials = material;
   def.material_count = 1;
+  return def;
+}
+
+static inline piola_shell_body *shell_body_from(const piola_tri_mesh *mesh,
+                                                const piola_material *material,
+                                                double bending_stiffness) {
+  piola_shell_body_def def = shell_def_of(mesh, material);
   def.thickness = 0.01;
   def.density = 500;
   def.bending.stiffness = bending_stiffness;

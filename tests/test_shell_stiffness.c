@@ -283,10 +283,7 @@ static void damping_derivatives(void **state) {
   test_rng rng = test_rng_seeded(17);
   piola_tri_mesh mesh = hinge_mesh();
   piola_material material = shell_material(PIOLA_MODEL_NEOHOOKEAN, 1e4);
-  piola_shell_body_def def = piola_default_shell_body_def();
-  def.rest_mesh = &mesh;
-  def.materials = &material;
-  def.material_count = 1;
+  piola_shell_body_def def = shell_def_of(&mesh, &material);
   def.thickness = 0.01;
   def.bending.stiffness = 1.0;
   def.bending.damping = 0.3;
@@ -332,10 +329,7 @@ static void assembled_matrix(void **state) {
   test_rng rng = test_rng_seeded(18);
   piola_tri_mesh mesh = shell_sheet(1.0, 0.8, 4, 3);
   piola_material material = shell_material(PIOLA_MODEL_STVK, 1e4);
-  piola_shell_body_def def = piola_default_shell_body_def();
-  def.rest_mesh = &mesh;
-  def.materials = &material;
-  def.material_count = 1;
+  piola_shell_body_def def = shell_def_of(&mesh, &material);
   def.thickness = 0.01;
   def.bending.stiffness = 0.5;
   def.bending.damping = 0.05;

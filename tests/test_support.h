@@ -41,6 +41,14 @@ void test_symmetric_eigenvalues(double *a, int n, double *lambda);
 /* Path of a file in ../shared/data (static buffer, valid until the next call). */
 const char *test_data_path(const char *relative);
 
+/* A group setup's scratch folder: makes a fresh /tmp/<prefix>_XXXXXX (its name in dir, of
+ * `size` bytes). Returns 0, or -1 if it cannot (a cmocka group setup's convention). */
+int test_make_scratch_folder(char *dir, size_t size, const char *prefix);
+
+/* Removes folder dir and everything in it (rm -rf). Returns 0, or -1 (a group teardown's
+ * convention). */
+int test_remove_scratch_folder(const char *dir);
+
 /* The whole text file at path, NUL-terminated (free it); fails the test if it cannot be read. */
 char *test_read_text(const char *path);
 

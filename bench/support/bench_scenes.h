@@ -12,4 +12,15 @@
  * Returns NULL (message printed) on failure. */
 piola_world *bench_torus_step_world(const piola_tet_mesh *mesh, double cg_tolerance);
 
+/* A file of ../shared/data (path relative to it) centred and scaled to a bounding-box diagonal
+ * of `diagonal` m (by way of recovery_read_unit_mesh's unit mesh). Returns 0 on success (else
+ * the message is piola_last_error()). */
+int bench_read_mesh_with_diagonal(const char *relative, double diagonal, piola_tet_mesh *mesh);
+
+/* The body of tests/test_scrambles_every_model.c as the scramble benchmarks build it: `mesh`
+ * as `model` with its default parameters, E = 20 kPa, nu = 0.3, 1000 kg/m^3, shear and bulk
+ * viscosity 1000 Pa s, scrambled within `radius` m. */
+piola_solid_def bench_scramble_solid_def(const piola_tet_mesh *mesh, piola_material_model model,
+                                         double radius);
+
 #endif

@@ -34,3 +34,11 @@ double bench_uniform(double lo, double hi) {
   rng_state ^= rng_state << 17;
   return lo + (hi - lo) * (double)(rng_state >> 11) * 0x1.0p-53;
 }
+
+piola_material_def bench_rows_material_def(piola_material_model model) {
+  piola_material_def def = piola_default_material_def();
+  def.model = model;
+  def.inversion_mode = PIOLA_INVERSION_LINEAR;
+  def.inversion_threshold = 0.3;
+  return def;
+}

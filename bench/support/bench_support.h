@@ -3,6 +3,8 @@
 #ifndef PIOLA_BENCH_SUPPORT_H
 #define PIOLA_BENCH_SUPPORT_H
 
+#include "piola/material.h"
+
 /* Monotonic wall-clock time, s. */
 double bench_wall_seconds(void);
 
@@ -20,5 +22,9 @@ double bench_median(double *v, int n);
 
 /* Uniform in [lo, hi) from one xorshift sequence with a fixed seed, so runs are repeatable. */
 double bench_uniform(double lo, double hi);
+
+/* The default material definition of `model` at the setting of BENCHMARKS.md's rows: LINEAR
+ * inversion at threshold 0.3 (the default before issue 19 item 4). */
+piola_material_def bench_rows_material_def(piola_material_model model);
 
 #endif

@@ -18,6 +18,15 @@ void block_mesh_free(piola_tet_mesh *m) {
   free(m->tets);
 }
 
+piola_world *weightless_world(double max_dt) {
+  piola_world_def wd = piola_default_world_def();
+  for (int k = 0; k < 3; ++k) wd.gravity[k] = piola_track_constant(0);
+  wd.max_dt = max_dt;
+  piola_world *w = NULL;
+  assert_int_equal(piola_world_create(&wd, &w), PIOLA_OK);
+  return w;
+}
+
 piola_world *deformed_block_world(piola_material_model model, int n, piola_mat3 initial,
                                   double viscosity, double cfl, int32_t cg_max_iterations) {
   return deformed_block_world_inverting(model, PIOLA_INVERSION_MODEL_DEFAULT, 0, n, initial,

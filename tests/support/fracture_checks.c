@@ -4,10 +4,49 @@
 #include <math.h>
 #include <stdlib.h>
 
+#include "block_scenes.h"
 #include "fracture_checks.h"
 #include "piola/checkpoint.h"
 #include "piola/elastic_body.h"
 #include "sim/fracture_internal.h"
+
+void fracture_add_solid(piola_world *w, const piola_tet_mesh *mesh, double viscosity) {
+  piola_solid_def sd = piola_default_solid_def();
+  sd.mesh = mesh;
+  sd.material.youngs_modulus = 2e4;
+  sd.material.poisson_ratio = 0.3;
+  sd.shear_viscosity = piola_track_constant(viscosity);
+  sd.bulk_viscosity = piola_track_constant(viscosity);
+  assert_int_equal(piola_world_add_solid(w, &sd, NULL), PIOLA_OK);
+}
+
+piola_world *fracture_spinning_bar(const piola_tet_mesh *mesh, double stretch, double y_centre) {
+  piola_world *w = weightless_world(5e-4);
+  fracture_add_solid(w, mesh, 0);
+  const int32_t n = mesh->vertex_count;
+  double *x = malloc(3 * sizeof(double) * (size_t)n), *v = malloc(3 * sizeof(double) * (size_t)n);
+  for (int32_t i = 0; i < n; ++i) {
+    const double *p = mesh->positions + 3 * i;
+    x[3 * i] = stretch * p[0] + 0.1 * p[1], x[3 * i + 1] = 0.9 * p[1], x[3 * i + 2] = p[2] + 0.05 * p[0];
+    v[3 * i] = 0.5 - 3.0 * (p[1] - y_centre), v[3 * i + 1] = -0.2 + 3.0 * (p[0] - 0.15), v[3 * i + 2] = 0.1 + p[1];
+  }
+  assert_int_equal(piola_world_solid_set_state(w, 0, x, v), PIOLA_OK);
+  free(x), free(v);
+  return w;
+}
+
+void fracture_set_cuts(piola_world *w, const piola_fracture_cut *cuts, int32_t count) {
+  piola_fracture_def def = piola_default_fracture_def();
+  def.cuts = cuts, def.cut_count = count;
+  assert_int_equal(piola_world_solid_set_fracture(w, 0, &def), PIOLA_OK);
+}
+
+void fracture_mesh_bounds(const piola_tet_mesh *mesh, double lo[3], double hi[3]) {
+  for (int k = 0; k < 3; ++k) lo[k] = INFINITY, hi[k] = -INFINITY;
+  for (int32_t i = 0; i < mesh->vertex_count; ++i)
+    for (int k = 0; k < 3; ++k)
+      lo[k] = fmin(lo[k], mesh->positions[3 * i + k]), hi[k] = fmax(hi[k], mesh->positions[3 * i + k]);
+}
 
 double fracture_enclosed_volume(const piola_fracture_surface *s, int32_t first, int32_t end) {
   double v = 0;

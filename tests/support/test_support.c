@@ -42,6 +42,17 @@ double test_rng_normal(test_rng *rng) {
   return sqrt(-2.0 * log(u1)) * cos(6.283185307179586 * u2);
 }
 
+int test_make_scratch_folder(char *dir, size_t size, const char *prefix) {
+  snprintf(dir, size, "/tmp/%s_XXXXXX", prefix);
+  return mkdtemp(dir) ? 0 : -1;
+}
+
+int test_remove_scratch_folder(const char *dir) {
+  char cmd[512];
+  snprintf(cmd, sizeof cmd, "rm -rf '%s'", dir);
+  return system(cmd) == 0 ? 0 : -1;
+}
+
 const char *test_data_path(const char *relative) {
   static char path[4096];
   snprintf(path, sizeof path, "%s/%s", PIOLA_DATA_DIR, relative);

@@ -20,6 +20,23 @@ static int by_lo_x(const void *a, const void *b) {
   return (u > v) - (u < v);
 }
 
+/* Whether triangles ta of xa and tb of xb intersect (0 or 1; the test fails on the exact
+ * test's error); 0 for two triangles of one set that share a vertex. */
+static int pair_intersects(const double *xa, const int32_t *ta, const double *xb, const int32_t *tb,
+                           int same_set) {
+  if (same_set) {
+    int shared = 0;
+    for (int p = 0; p < 3; ++p)
+      for (int q = 0; q < 3; ++q) shared |= ta[p] == tb[q];
+    if (shared) return 0;
+  }
+  const double *p[3] = {xa + 3 * ta[0], xa + 3 * ta[1], xa + 3 * ta[2]};
+  const double *q[3] = {xb + 3 * tb[0], xb + 3 * tb[1], xb + 3 * tb[2]};
+  int r = piola__triangles_intersect(p, q);
+  assert_true(r >= 0);
+  return r;
+}
+
 /* Intersecting triangle pairs over all sets (within and across), except pairs of one set
  * that share a vertex. Pairs whose closed boxes are disjoint cannot share a point. */
 long referee_count_intersections(const judged *sets, int set_count) {
@@ -46,21 +63,18 @@ long referee_count_intersections(const judged *sets, int set_count) {
       const tri_box *a = &boxes[i], *b = &boxes[j];
       if (a->lo[1] > b->hi[1] || b->lo[1] > a->hi[1] || a->lo[2] > b->hi[2] || b->lo[2] > a->hi[2])
         continue;
-      const int32_t *ta = sets[a->set].tris + 3 * a->tri, *tb = sets[b->set].tris + 3 * b->tri;
-      if (a->set == b->set) {
-        int shared = 0;
-        for (int p = 0; p < 3; ++p)
-          for (int q = 0; q < 3; ++q) shared |= ta[p] == tb[q];
-        if (shared) continue;
-      }
-      const double *xa = sets[a->set].x, *xb = sets[b->set].x;
-      const double *p[3] = {xa + 3 * ta[0], xa + 3 * ta[1], xa + 3 * ta[2]};
-      const double *q[3] = {xb + 3 * tb[0], xb + 3 * tb[1], xb + 3 * tb[2]};
-      int r = piola__triangles_intersect(p, q);
-      assert_true(r >= 0);
-      hits += r;
+      hits += pair_intersects(sets[a->set].x, sets[a->set].tris + 3 * a->tri, sets[b->set].x,
+                              sets[b->set].tris + 3 * b->tri, a->set == b->set);
     }
   free(boxes);
+  return hits;
+}
+
+long referee_count_intersections_every_pair(judged set) {
+  long hits = 0;
+  for (int32_t a = 0; a < set.count; ++a)
+    for (int32_t b = a + 1; b < set.count; ++b)
+      hits += pair_intersects(set.x, set.tris + 3 * a, set.x, set.tris + 3 * b, 1);
   return hits;
 }
 

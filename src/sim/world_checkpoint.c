@@ -538,10 +538,12 @@ static void world_state(stream *s, piola_world *w) {
 /* ------------------------------------------------------------------ files */
 
 /* Header word 44: 0 for a single process's checkpoint; for a process of a split run
- * (docs/mpi.md) its process count << 16 | its process, from the first split solid. */
+ * (docs/mpi.md) its process count << 16 | its process, from the first split solid (or one
+ * whose split waits for its replan: work_split.h). */
 static uint32_t split_tag(const piola_world *w) {
   for (int32_t i = 0; i < w->body_count; ++i) {
     const world_body *b = &w->bodies[i];
+    if (b->kind == PIOLA_BODY_SOLID && b->split_pending) return b->split_pending;
     if (b->kind != PIOLA_BODY_SOLID || !b->solid->split || b->solid->split->part_count < 2) continue;
     return (uint32_t)b->solid->split->part_count << 16 | (uint32_t)b->solid->split->part;
   }

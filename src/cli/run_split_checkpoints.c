@@ -7,7 +7,8 @@
  * the process count, the scene key and each solid's partition (the process of each block
  * of PIOLA_WORK_SPLIT_BLOCK tets, as runs "process*blocks"). A resume takes the newest
  * manifest whose process count, scene and partition are this run's and whose files every
- * process reads intact. */
+ * process reads intact; in a scene with fracture the partition is the cut mesh's, made
+ * again and compared once every process has read its file. */
 #include "cli/run_split_checkpoints.h"
 
 #include <stdio.h>

@@ -28,10 +28,11 @@ static const piola_fracture_cut cuts[4] = {
     {.time = 0.02, .point = {0.1, 0.1, 0.13}, .normal = {0.2, 0.1, 1}},
     {.time = 0.04, .point = {0.05, 0.1, 0.1}, .normal = {1, -0.3, 0.2}}};
 
-static piola_world *build(const piola_tet_mesh *mesh, const piola_plasticity_def *plasticity) {
+static piola_world *build_with(const piola_tet_mesh *mesh, const piola_plasticity_def *plasticity,
+                               double max_dt) {
   piola_world_def wd = piola_default_world_def();
   wd.gravity[2] = piola_track_constant(-9.81);
-  wd.max_dt = 5e-4;
+  wd.max_dt = max_dt;
   piola_world *w = NULL;
   assert_int_equal(piola_world_create(&wd, &w), PIOLA_OK);
   piola_solid_def sd = piola_default_solid_def();
@@ -47,6 +48,10 @@ static piola_world *build(const piola_tet_mesh *mesh, const piola_plasticity_def
   def.cuts = cuts, def.cut_count = 4, def.max_cuts_per_step = 1;
   assert_int_equal(piola_world_solid_set_fracture(w, 0, &def), PIOLA_OK);
   return w;
+}
+
+static piola_world *build(const piola_tet_mesh *mesh, const piola_plasticity_def *plasticity) {
+  return build_with(mesh, plasticity, 5e-4);
 }
 
 static void resumed_cut_solid_runs_on_bit_for_bit(void **state) {
@@ -108,9 +113,46 @@ static void resumed_cut_solid_runs_on_bit_for_bit(void **state) {
   piola_tet_mesh_free(&mesh);
 }
 
+/* A plastic solid whose steps the stable step bound sets (max_dt far above it): the cuts at
+ * 0.01 and 0.02 s rebuild it after it has yielded, so the bound's weights, built at its first
+ * step after a cut from the effective Dm^-1 of then, are state the checkpoint carries
+ * (format 6): the reader takes the writer's step sizes and runs on bit for bit through the
+ * cut at 0.04 s. Without them it steps by another dt from its first step on. */
+static void resumed_yielded_cut_solid_takes_the_writers_steps(void **state) {
+  (void)state;
+  piola_tet_mesh mesh;
+  assert_int_equal(piola_tet_mesh_box_grid(5, 5, 5, (piola_vec3){0.05, 0.05, 0.05}, &mesh), PIOLA_OK);
+  piola_plasticity_def plasticity = piola_default_plasticity_def();
+  plasticity.yield = 0.02;
+  piola_world *a = build_with(&mesh, &plasticity, 1.0), *b = build_with(&mesh, &plasticity, 1.0);
+  assert_int_equal(piola_world_advance_to(a, 0.03, NULL), PIOLA_OK);
+  assert_true(piola_world_solid_plastic_stats(a, 0).max_fp_stretch > 1); /* it has yielded */
+  char path[] = "/tmp/piola_fracture_checkpoint_XXXXXX";
+  int fd = mkstemp(path);
+  assert_true(fd >= 0);
+  close(fd);
+  fracture_checkpoint_round_trip(a, b, path, 3);
+  unlink(path);
+  fracture_same_state(a, b);
+  const int32_t cut = piola_world_solid_cut_tet_count(a, 0);
+  piola_step_stats sa, sb;
+  assert_int_equal(piola_world_step(a, 0, &sa), PIOLA_OK);
+  assert_int_equal(piola_world_step(b, 0, &sb), PIOLA_OK);
+  assert_true(sa.last_dt < 1e-2); /* the bound sets it */
+  assert_true(sa.last_dt == sb.last_dt);
+  assert_int_equal(piola_world_advance_to(a, 0.045, NULL), PIOLA_OK);
+  assert_int_equal(piola_world_advance_to(b, 0.045, NULL), PIOLA_OK);
+  assert_true(piola_world_solid_cut_tet_count(a, 0) > cut); /* through the fourth cut */
+  fracture_same_state(a, b);
+  piola_world_destroy(a);
+  piola_world_destroy(b);
+  piola_tet_mesh_free(&mesh);
+}
+
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(resumed_cut_solid_runs_on_bit_for_bit),
+      cmocka_unit_test(resumed_yielded_cut_solid_takes_the_writers_steps),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
 }

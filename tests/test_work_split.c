@@ -19,7 +19,11 @@
  *  - a split planned before the solid is built (piola_world_set_work_split_planner) writes
  *    its own tets' state with the whole solid's bits and never the tets it does not hold;
  *  - a split solid that a cut rebuilds gets the replanner's split for its new mesh
- *    (piola_world_set_work_split_replanner), in the replicated mode, and steps with it. */
+ *    (piola_world_set_work_split_replanner), in the replicated mode, and steps with it;
+ *  - while replans are deferred (piola_world_defer_work_split_replans, a checkpoint read's
+ *    cut state) the rebuilt solid stays whole and pending, the replanner is not asked, and
+ *    piola_world_solid_replan_work_split later gives it the replanner's split (pending or
+ *    still split) with which it steps as the unsplit world does. */
 #include "test_support.h"
 
 #include <math.h>
@@ -496,6 +500,60 @@ static void cut_solid_is_split_again(void **state) {
   free(mesh.positions), free(mesh.tets);
 }
 
+/* Replans deferred: the cut leaves the solid whole and pending without asking the
+ * replanner; the later replan splits it (and replans a solid still split, taking its old
+ * split off first), and the world steps with the unsplit world's bits. */
+static void deferred_replan_waits_for_the_call(void **state) {
+  (void)state;
+  piola_tet_mesh mesh = fixture_grid(6, 0.1);
+  piola_world *whole = planned_world(&mesh, NULL, 0), *w = planned_world(&mesh, NULL, 0);
+  replan_part p = {0};
+  const int32_t blocks = piola_elastic_body_block_count(piola_world_solid_body(w, 0));
+  p.block_part = calloc((size_t)blocks, sizeof(int32_t));
+  p.node_part = calloc((size_t)mesh.vertex_count, sizeof(int32_t));
+  p.split = all_on_part_zero(&p, p.block_part, p.node_part);
+  assert_int_equal(piola_world_solid_set_work_split(w, 0, &p.split), PIOLA_OK);
+  const piola_work_split_planner replanner = {replan_part_zero, &p};
+  piola_world_set_work_split_replanner(w, &replanner);
+  assert_false(piola_world_solid_split_pending(w, 0));
+  piola_world_defer_work_split_replans(w, 1);
+  piola_fracture_cut cut = {.time = 0, .point = {0.3, 0.3, 0.3}, .normal = {1, 0.2, 0.1}};
+  piola_fracture_def def = piola_default_fracture_def();
+  def.cuts = &cut, def.cut_count = 1;
+  assert_int_equal(piola_world_solid_set_fracture(whole, 0, &def), PIOLA_OK);
+  assert_int_equal(piola_world_solid_set_fracture(w, 0, &def), PIOLA_OK); /* cuts now */
+  assert_int_equal(piola_world_solid_fragment_count(w, 0), 2);
+  assert_int_equal(p.calls, 0);
+  assert_null(piola_elastic_body_work_split(piola_world_solid_body(w, 0)));
+  assert_true(piola_world_solid_split_pending(w, 0));
+  piola_world_defer_work_split_replans(w, 0);
+  assert_true(piola_world_solid_split_pending(w, 0)); /* the mark outlives the deferral */
+  assert_int_equal(piola_world_solid_replan_work_split(w, 0), PIOLA_OK);
+  const piola_elastic_body *b = piola_world_solid_body(w, 0);
+  assert_int_equal(p.calls, 1);
+  assert_int_equal(p.tet_count, piola_elastic_body_tet_count(b));
+  assert_true(p.tet_count > mesh.tet_count);
+  assert_ptr_equal(piola_elastic_body_work_split(b), &p.split);
+  assert_false(piola_world_solid_split_pending(w, 0));
+  /* a solid still split is replanned too (the replanner frees the split it had) */
+  assert_int_equal(piola_world_solid_replan_work_split(w, 0), PIOLA_OK);
+  assert_int_equal(p.calls, 2);
+  assert_ptr_equal(piola_elastic_body_work_split(b), &p.split);
+  assert_false(piola_elastic_body_split_is_local(b));
+  for (int k = 0; k < 3; ++k) {
+    assert_int_equal(piola_world_step(whole, 0, NULL), PIOLA_OK);
+    assert_int_equal(piola_world_step(w, 0, NULL), PIOLA_OK);
+  }
+  const int32_t nv = piola_elastic_body_vertex_count(b);
+  assert_int_equal(nv, piola_elastic_body_vertex_count(piola_world_solid_body(whole, 0)));
+  assert_memory_equal(piola_world_solid_positions(w, 0), piola_world_solid_positions(whole, 0),
+                      3 * sizeof(double) * (size_t)nv);
+  piola_world_destroy(w);
+  piola_world_destroy(whole);
+  free(p.block_part), free(p.node_part);
+  free(mesh.positions), free(mesh.tets);
+}
+
 static void planned_solid_holds_its_part_only(void **state) {
   (void)state;
   piola_tet_mesh mesh = fixture_grid(12, 0.1);
@@ -570,6 +628,7 @@ int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(planned_solid_holds_its_part_only),
       cmocka_unit_test(cut_solid_is_split_again),
+      cmocka_unit_test(deferred_replan_waits_for_the_call),
       cmocka_unit_test(small_body_halves),
       cmocka_unit_test(small_body_alternating_blocks),
       cmocka_unit_test(chunked_body_halves),

@@ -160,6 +160,25 @@ PIOLA_API void piola_world_set_work_split_planner(piola_world *world,
 PIOLA_API void piola_world_set_work_split_replanner(piola_world *world,
                                                     const piola_work_split_planner *planner);
 
+/* While defer is on, a split solid whose mesh changes (a checkpoint read giving a solid a
+ * cut state: docs/mpi.md, "Checkpoints") is left whole on this process and marked pending
+ * instead of asking the replanner, so that the change takes no collective step and a
+ * process whose read fails cannot leave the others waiting. Turning it off keeps the marks:
+ * once every process has read its state, piola_world_solid_replan_work_split splits each
+ * solid pending on any of them. */
+PIOLA_API void piola_world_defer_work_split_replans(piola_world *world, int defer);
+
+/* Whether solid `solid` (its index among the solids) is pending as above. */
+PIOLA_API int piola_world_solid_split_pending(const piola_world *world, int32_t solid);
+
+/* Asks the replanner for the split of solid `solid`'s current mesh and sets it in the
+ * replicated mode, whether the solid is whole (pending) or split (the old split is taken
+ * off first: the replanner may free it), and clears the mark. It changes no state but the
+ * split's own (the damping operator and the next solve's start are made afresh, as after a
+ * cut: read the state again afterwards to restore them). Collective: every process replans
+ * the same solids in the same order. */
+PIOLA_API piola_status piola_world_solid_replan_work_split(piola_world *world, int32_t solid);
+
 /* piola_scene_build with planner set on the scene's world before its solids are added. */
 PIOLA_API piola_status piola_scene_build_split(const piola_scene_desc *desc,
                                                const piola_work_split_planner *planner,

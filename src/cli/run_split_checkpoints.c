@@ -7,7 +7,8 @@
  * the process count, the scene key and each solid's partition (the process of each block
  * of PIOLA_WORK_SPLIT_BLOCK tets, as runs "process*blocks"). A resume takes the newest
  * manifest whose process count, scene and partition are this run's and whose files every
- * process reads intact. */
+ * process reads intact; in a scene with fracture the partition is the cut mesh's, made
+ * again and compared once every process has read its file. */
 #include "cli/run_split_checkpoints.h"
 
 #include <stdio.h>
@@ -150,9 +151,10 @@ static bool cut_world(const piola_world *world) {
 }
 
 /* Process 0: whether the manifest of frame fits this run: 0 yes, 1 damaged (skip it),
- * 2 refused (printed). */
+ * 2 refused (printed). Without partition, the solids' partitions are not compared: a cut
+ * world's are known only once its state is read (run_split_checkpoint_resume). */
 static int check_manifest(run_mpi *m, const char *dir, const piola_world *world, uint64_t key,
-                          int32_t frame) {
+                          int32_t frame, bool partition) {
   char path[4200];
   manifest_path(path, sizeof path, dir, frame);
   char *text = read_text(path), *expected = manifest_text(world, key, frame, m->size);
@@ -170,20 +172,58 @@ static int check_manifest(run_mpi *m, const char *dir, const piola_world *world,
     fprintf(stderr, "piola run: cannot resume: %s was written for another scene (its scene file "
                     "or meshes differ); use --force to start over\n", path);
     verdict = 2;
-  } else if (strcmp(text, expected) != 0 && cut_world(world)) {
-    /* a cut changed a solid's mesh and partition; the read would rebuild and partition it
-     * again, a collective step a process with a damaged file would not take */
-    fprintf(stderr, "piola run: cannot resume: %s was written after a cut (fracture); a run on "
-                    "several MPI processes resumes only from a checkpoint before its first cut "
-                    "(docs/mpi.md); use --force to start over\n", path);
-    verdict = 2;
-  } else if (strcmp(text, expected) != 0) {
+  } else if (partition ? strcmp(text, expected) != 0
+                       : line_value(text, "solids") != line_value(expected, "solids")) {
     fprintf(stderr, "piola run: cannot resume: %s holds another partition of the solids than "
                     "this run's (docs/mpi.md); use --force to start over\n", path);
     verdict = 2;
   }
   free(text), free(expected);
   return verdict;
+}
+
+/* Every process reads its file of frame: 0 when all read it intact, 1 when one found it
+ * damaged, 2 when one refused it (printed where it happened). Collective. */
+static int read_set(run_mpi *m, const char *dir, piola_world *world, uint64_t key, int32_t frame) {
+  char path[4200];
+  part_path(path, sizeof path, dir, frame, m->rank);
+  int32_t read_frame = -1;
+  const piola_status st = piola_world_checkpoint_read(world, path, key, &read_frame);
+  const int mine = st == PIOLA_OK && read_frame == frame ? 0 : st == PIOLA_ERROR_UNSUPPORTED ? 2 : 1;
+  if (mine == 2)
+    fprintf(stderr, "piola run: MPI process %d: cannot resume: %s; use --force to start over\n",
+            m->rank, piola_last_error());
+  else if (mine == 1)
+    fprintf(stderr, "piola run: MPI process %d: skipping a damaged checkpoint: %s\n", m->rank,
+            st == PIOLA_OK ? "another frame than its manifest's" : piola_last_error());
+  return run_mpi_max(m, mine);
+}
+
+/* After every process has read the set of frame of a world that can be cut: the solids a
+ * cut rebuilt on any process (left whole by the deferred read) are partitioned again
+ * together, the files read once more into the split solids (the split's own state, the
+ * damping operator and the next solve's start, as the run that wrote them had it), and
+ * the manifest's partitions compared with the world's. 0, or 2 (printed). Collective. */
+static int split_cut_solids(run_mpi *m, const char *dir, piola_world *world, uint64_t key,
+                            int32_t frame) {
+  bool replanned = false, ok = true;
+  for (int32_t s = 0; s < piola_world_solid_count(world) && ok; ++s) {
+    if (!run_mpi_max(m, piola_world_solid_split_pending(world, s))) continue;
+    const piola_status st = piola_world_solid_replan_work_split(world, s);
+    if (st != PIOLA_OK)
+      fprintf(stderr, "piola run: MPI process %d: cannot resume: %s\n", m->rank, piola_last_error());
+    ok = run_mpi_all(m, st == PIOLA_OK);
+    replanned = true;
+  }
+  if (ok && replanned && read_set(m, dir, world, key, frame) != 0) {
+    if (m->rank == 0)
+      fprintf(stderr, "piola run: cannot resume: the checkpoint of frame %d could not be read again "
+                      "after its cut solids were partitioned; use --force to start over\n", (int)frame);
+    ok = false;
+  }
+  if (!ok) return 2;
+  const int verdict = m->rank == 0 ? check_manifest(m, dir, world, key, frame, true) : 0;
+  return run_mpi_from_lead(m, verdict) == 0 ? 0 : 2;
 }
 
 int run_split_checkpoint_resume(run_mpi *m, const char *dir, piola_world *world, uint64_t key,
@@ -204,11 +244,16 @@ int run_split_checkpoint_resume(run_mpi *m, const char *dir, piola_world *world,
     free(frames);
     return found;
   }
+  /* a cut state's read rebuilds the solid; its partition, a collective step, waits until
+   * every process has read its file, so that a set one of them cannot read is skipped by
+   * all without anyone left waiting */
+  const bool cut = cut_world(world);
+  piola_world_defer_work_split_replans(world, cut);
   int rc = 2, next = 0;
   for (;;) {
     int candidate = -1; /* -1: none left, -2: refused */
     while (lead && next < count) {
-      const int verdict = check_manifest(m, dir, world, key, frames[next++]);
+      const int verdict = check_manifest(m, dir, world, key, frames[next++], !cut);
       if (verdict == 0) candidate = frames[next - 1];
       if (verdict == 2) candidate = -2;
       if (verdict != 1) break;
@@ -221,18 +266,7 @@ int run_split_checkpoint_resume(run_mpi *m, const char *dir, piola_world *world,
                         "start over\n", dir);
       break;
     }
-    char path[4200];
-    part_path(path, sizeof path, dir, candidate, m->rank);
-    int32_t read_frame = -1;
-    const piola_status st = piola_world_checkpoint_read(world, path, key, &read_frame);
-    const int mine = st == PIOLA_OK && read_frame == candidate ? 0 : st == PIOLA_ERROR_UNSUPPORTED ? 2 : 1;
-    if (mine == 2)
-      fprintf(stderr, "piola run: MPI process %d: cannot resume: %s; use --force to start over\n",
-              m->rank, piola_last_error());
-    else if (mine == 1)
-      fprintf(stderr, "piola run: MPI process %d: skipping a damaged checkpoint: %s\n", m->rank,
-              st == PIOLA_OK ? "another frame than its manifest's" : piola_last_error());
-    const int worst = run_mpi_max(m, mine);
+    const int worst = read_set(m, dir, world, key, candidate);
     if (worst == 0) {
       *frame = candidate;
       rc = 0;
@@ -240,6 +274,8 @@ int run_split_checkpoint_resume(run_mpi *m, const char *dir, piola_world *world,
     }
     if (worst == 2) break;
   }
+  piola_world_defer_work_split_replans(world, 0);
+  if (rc == 0 && cut) rc = split_cut_solids(m, dir, world, key, *frame);
   free(frames);
   return rc;
 }

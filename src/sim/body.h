@@ -85,6 +85,10 @@ typedef struct world_body {
   double state_rate2;
   int32_t state_worst_tet;
   int state_rate_valid;
+  uint32_t split_pending; /* solids: split before a rebuild whose replan is deferred
+                             (work_split.h, piola_world_defer_work_split_replans), whole on
+                             this process until piola_world_solid_replan_work_split: the
+                             split's process count << 16 | process; 0: not pending */
   struct solid_fracture *fracture; /* solids: the virtual node state, NULL until the solid
                                       is first cut or given a fracture def (fracture.c) */
   struct implicit_state *implicit; /* the implicit integrators' matrix and vectors, made on
@@ -196,6 +200,10 @@ typedef struct body_change {
  * force. b keeps its id, name and parameters. On error b and w are unchanged. Solids only
  * for now (a shell answers PIOLA_ERROR_UNSUPPORTED). */
 piola_status piola__body_rebuild(piola_world *w, world_body *b, const body_change *change);
+
+/* Asks the world's replanner for split solid b's split of its current mesh and sets it in
+ * the replicated mode (work_split.h). Collective. */
+piola_status piola__body_resplit(piola_world *w, world_body *b);
 
 /* ---- the kinds' own code */
 

@@ -157,8 +157,8 @@ static piola_status build_new(piola_world *w, const world_body *b, const body_ch
 }
 
 /* The split of rebuilt solid b for its new mesh (work_split.h,
- * piola_world_set_work_split_replanner): its old body, split, is gone. */
-static piola_status resplit(piola_world *w, world_body *b) {
+ * piola_world_set_work_split_replanner): its old body, split, is gone, or b is whole. */
+piola_status piola__body_resplit(piola_world *w, world_body *b) {
   if (!w->split_replanner.plan) return PIOLA_OK; /* whole on every process */
   int32_t solid = 0;
   while (piola__world_body_of(w, PIOLA_BODY_SOLID, solid) != b) solid++;
@@ -174,7 +174,11 @@ static piola_status resplit(piola_world *w, world_body *b) {
 
 piola_status piola__body_rebuild(piola_world *w, world_body *b, const body_change *change) {
   if (!w || !b || !change) return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "rebuild: NULL argument");
-  const int was_split = b->kind == PIOLA_BODY_SOLID && b->solid->split && b->solid->split->part_count > 1;
+  const piola_work_split *split = b->kind == PIOLA_BODY_SOLID ? b->solid->split : NULL;
+  const int was_split = b->split_pending || (split && split->part_count > 1);
+  /* the process and process count the body was split for, kept while its replan waits */
+  const uint32_t pending = b->split_pending ? b->split_pending
+                           : was_split ? (uint32_t)split->part_count << 16 | (uint32_t)split->part : 0;
   world_body nb;
   memset(&nb, 0, sizeof nb);
   nb.kind = b->kind;
@@ -190,5 +194,10 @@ piola_status piola__body_rebuild(piola_world *w, world_body *b, const body_chang
   *b = nb;
   w->bodies_version++;           /* the world's collision surface is rebuilt on next use */
   piola__world_collision_reset(w); /* an open interval's start positions are of the old mesh */
-  return was_split ? resplit(w, b) : PIOLA_OK;
+  if (!was_split) return PIOLA_OK;
+  if (w->split_replans_deferred) { /* whole on this process for now, no collective step */
+    b->split_pending = pending;
+    return PIOLA_OK;
+  }
+  return piola__body_resplit(w, b);
 }

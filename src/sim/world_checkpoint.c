@@ -320,6 +320,41 @@ static void held_doubles(stream *s, const uint8_t *held, double *base, uint64_t 
   }
 }
 
+/* The step bound's weights (stable_step.c), built once from the Dm^-1 the body has at its
+ * first step bound: for a plastic solid a cut rebuilt, the effective Dm^-1 of then, which
+ * the rest of the state does not give back. Only solids with fracture and plasticity have
+ * them in the file (format 6; older files leave them to be built on the next step bound),
+ * after the plastic state, so that a file whose plasticity differs is refused for that. */
+static void step_weights(stream *s, world_body *b) {
+  piola_elastic_body *e = b->solid;
+  if (!b->fracture || !b->plastic) return;
+  int32_t present = e->step_weight != NULL;
+  local_int(s, &present, "step weights present");
+  if (s->failed || !present) return;
+  const uint64_t nt = (uint64_t)e->tet_count;
+  double *w = e->step_weight, *g = e->step_gram;
+  if (s->reading && s->store) { /* into memory of their own, swapped in once read */
+    w = malloc((size_t)(nt > 0 ? nt : 1) * sizeof(double));
+    g = malloc(6 * (size_t)(nt > 0 ? nt : 1) * sizeof(double));
+    if (!w || !g) {
+      free(w), free(g);
+      s->failed = 1;
+      snprintf(s->what, sizeof s->what, "out of memory");
+      return;
+    }
+  }
+  doubles(s, w, nt, "step weights");
+  doubles(s, g, 6 * nt, "step direction weights");
+  if (s->reading && s->store) {
+    if (s->failed) {
+      free(w), free(g);
+      return;
+    }
+    free(e->step_weight), free(e->step_gram);
+    e->step_weight = w, e->step_gram = g;
+  }
+}
+
 static void elastic_state(stream *s, world_body *b) {
   piola_elastic_body *e = b->solid;
   const uint64_t np = (uint64_t)e->padded_tet_count, n3 = 3 * (uint64_t)b->n;
@@ -524,6 +559,7 @@ static void world_state(stream *s, piola_world *w) {
       case PIOLA_BODY_SOLID:
         elastic_state(s, b);
         plastic_state(s, b);
+        if (!s->reading || s->version >= 6) step_weights(s, b);
         break;
       case PIOLA_BODY_SHELL:
         shell_state(s, b);
@@ -538,10 +574,12 @@ static void world_state(stream *s, piola_world *w) {
 /* ------------------------------------------------------------------ files */
 
 /* Header word 44: 0 for a single process's checkpoint; for a process of a split run
- * (docs/mpi.md) its process count << 16 | its process, from the first split solid. */
+ * (docs/mpi.md) its process count << 16 | its process, from the first split solid (or one
+ * whose split waits for its replan: work_split.h). */
 static uint32_t split_tag(const piola_world *w) {
   for (int32_t i = 0; i < w->body_count; ++i) {
     const world_body *b = &w->bodies[i];
+    if (b->kind == PIOLA_BODY_SOLID && b->split_pending) return b->split_pending;
     if (b->kind != PIOLA_BODY_SOLID || !b->solid->split || b->solid->split->part_count < 2) continue;
     return (uint32_t)b->solid->split->part_count << 16 | (uint32_t)b->solid->split->part;
   }
@@ -605,7 +643,8 @@ piola_status piola_world_checkpoint_write(const piola_world *world, const char *
   return st;
 }
 
-/* Format 4 (tets cut once) differs from 5 only in the cut state (fracture_state). */
+/* Format 4 (tets cut once) differs from 5 only in the cut state (fracture_state), 5 from 6
+ * only in the step weights of cut plastic solids (step_weights). */
 #define OLDEST_READ_VERSION 4
 
 static int has_fracture(const piola_world *w) {
@@ -656,9 +695,9 @@ piola_status piola_world_checkpoint_read(piola_world *world, const char *path, u
   const unsigned char *h = s.data;
   if (s.length < HEADER_BYTES + 8 || memcmp(h, magic, 8) != 0)
     st = PIOLA_FAIL(PIOLA_ERROR_PARSE, "%s: not a piola checkpoint", path);
-  else if (get_u32(h + 8) != PIOLA_CHECKPOINT_VERSION && get_u32(h + 8) != OLDEST_READ_VERSION)
+  else if (get_u32(h + 8) > PIOLA_CHECKPOINT_VERSION || get_u32(h + 8) < OLDEST_READ_VERSION)
     st = PIOLA_FAIL(PIOLA_ERROR_UNSUPPORTED,
-                    "%s: checkpoint format version %u, this piola reads versions %d and %d only", path,
+                    "%s: checkpoint format version %u, this piola reads versions %d to %d only", path,
                     (unsigned)get_u32(h + 8), OLDEST_READ_VERSION, PIOLA_CHECKPOINT_VERSION);
   else if (get_u32(h + 12) != byte_order_mark)
     st =

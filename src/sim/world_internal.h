@@ -51,6 +51,7 @@ struct piola_world {
   char *warnings[PIOLA_WARNING_KIND_COUNT]; /* first message of each kind, or NULL */
   piola_work_split_planner split_planner; /* splits of solids added (plan NULL: none) */
   piola_work_split_planner split_replanner; /* splits of split solids a cut rebuilt */
+  int split_replans_deferred; /* a rebuilt split solid stays whole, marked split_pending */
 };
 
 /* Warnings (world_warnings.c). warn records the message of kind unless one is recorded

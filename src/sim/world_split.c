@@ -7,6 +7,7 @@
 #include "common/status_report.h"
 #include "force/elastic_body_internal.h"
 #include "piola/work_split.h"
+#include "sim/body.h"
 #include "sim/world_internal.h"
 
 const char *piola_world_split_unsupported(const piola_world *world) {
@@ -39,6 +40,24 @@ piola_status piola_world_split_collect(piola_world *world) {
 void piola_world_set_work_split_replanner(piola_world *world, const piola_work_split_planner *planner) {
   if (!world) return;
   world->split_replanner = planner ? *planner : (piola_work_split_planner){NULL, NULL};
+}
+
+void piola_world_defer_work_split_replans(piola_world *world, int defer) {
+  if (world) world->split_replans_deferred = defer != 0;
+}
+
+int piola_world_solid_split_pending(const piola_world *world, int32_t solid) {
+  const world_body *b = world ? piola__world_body_of(world, PIOLA_BODY_SOLID, solid) : NULL;
+  return b && b->split_pending;
+}
+
+piola_status piola_world_solid_replan_work_split(piola_world *world, int32_t solid) {
+  world_body *b = world ? piola__world_body_of(world, PIOLA_BODY_SOLID, solid) : NULL;
+  if (!b) return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "work split: no solid %d", (int)solid);
+  /* the replanner frees the solid's old split: no body may refer to it then */
+  PIOLA_TRY(piola__elastic_body_set_work_split(b->solid, NULL, 0));
+  b->split_pending = 0;
+  return piola__body_resplit(world, b);
 }
 
 void piola_world_set_work_split_planner(piola_world *world, const piola_work_split_planner *planner) {

@@ -18,11 +18,12 @@
  *     return mapping runs on every tet of every process, or with fracture, whose criteria
  *     read every tet's state on every process): share_blocks gives every process
  *     every block's state, written by the block's process;
- *   - local (share_ghosts, reduce and collect_blocks given, no plasticity): a process holds
- *     the state of its own blocks and of its ghost blocks, the other processes' blocks with
- *     a tet on one of its nodes (the damping rows of its nodes need their rotations), which
- *     share_ghosts brings (U and V); the step bound and the statistics of
- *     piola_elastic_body_update are reduced over the processes. The state of the other
+ *   - local (share_ghosts, reduce and collect_blocks given, no plasticity or fracture): a
+ *     process holds the state of its own blocks and of its ghost blocks, the other processes'
+ *     blocks with a tet on one of its nodes (the damping rows of its nodes need their
+ *     rotations), which share_ghosts brings (U and V; Fhat too before each Newton assembly);
+ *     the step bound and the statistics of piola_elastic_body_update are reduced over the
+ *     processes. The state of the other
  *     blocks is never written here: its memory stays untouched (allocated, not resident),
  *     and the getters (det F, Fhat, energy density) hold it only on process 0 after
  *     piola_world_split_collect.

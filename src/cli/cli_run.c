@@ -44,7 +44,8 @@ static void usage(FILE *out) {
           "  --checkpoint-every N  a checkpoint every N frames (0: none; default: every 10\n"
           "                     frames or 5 minutes of wall time, whichever comes first)\n"
           "  --render           also render every frame to DIR/render/frame_NNNN.png\n"
-          "                     (DIR/preview.png of the last frame is always written)\n"
+          "                     (DIR/preview.png of the last frame is written by every\n"
+          "                     run but one split under mpirun)\n"
           "  -h, --help         this text\n"
           "\n"
           "`piola check SCENE.json` validates a scene and estimates its run without writing.\n");

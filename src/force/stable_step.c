@@ -366,8 +366,10 @@ double PIOLA_ISA_NAME(piola__elastic_body_tet_state_rate2)(const piola_elastic_b
   return body->step_weight[tet] * material_modulus(m, f[0], f[1], f[2], wgt);
 }
 
-/* 1 / (rho h_e^2) per tet and the Gram arrays of the direction weights, from the rest Dm^-1
- * (before plasticity changes it): built once. */
+/* 1 / (rho h_e^2) per tet and the Gram arrays of the direction weights, from the Dm^-1 the
+ * body has when first asked: built once. That is the rest Dm^-1, except for a body a cut
+ * rebuilt after plasticity changed it (the effective Dm^-1 then; checkpoints store these
+ * weights for such solids, docs/file-formats.md). */
 static const double *rate_weights(piola_elastic_body *body) {
   if (!body->step_weight) {
     double *w = malloc((size_t)(body->tet_count > 0 ? body->tet_count : 1) * sizeof *w);

@@ -15,9 +15,10 @@
  *
  * Every run is 2 s, except on the two sliver meshes, where corotated, the spline and Stable
  * Neo-Hookean run from half a diagonal only here; test_scrambles_slivers.c and
- * test_scrambles_stable_neohookean.c run all three from one diagonal. From two diagonals they
- * take minutes of CPU each (torus.msh, corotated, two diagonals: 187,502 steps for the first 1 s,
- * 47 s of CPU, with the step bound's direction weights), and corotated on bar-186 from two
+ * test_scrambles_stable_neohookean.c run all three from one diagonal, and
+ * test_scrambles_two_diagonals.c from two on torus.msh (and from every radius on a third real
+ * mesh, medit/cylinder.mesh). From two diagonals on the torus they take 14-75 s of CPU each
+ * (corotated 235,613 steps for 2 s, 47 s, measured 2026-12-03), and corotated on bar-186 from two
  * diagonals gained energy (2.8e11 J to 5.3e11 J in its first 0.001 s, 254,258 steps): mostly the
  * CLAMP extension's work without a potential, which the energy check counts as work, plus a part
  * that follows the step (docs/time-stepping.md, "What the test affords"; not fixed).
@@ -69,7 +70,8 @@ static void every_model_runs_every_scramble(void **state) {
          * the spline and Stable Neo-Hookean with their J terms) take 1e4-1e5 steps per 0.1 s
          * from two diagonals (on bar-186 from one as well): here they run from half a diagonal
          * only (test_scrambles_slivers.c and test_scrambles_stable_neohookean.c run them from
-         * one; docs/time-stepping.md "What the test affords"). */
+         * one, test_scrambles_two_diagonals.c from two on the torus; docs/time-stepping.md "What
+         * the test affords"). */
         const int stiffening = model == PIOLA_MODEL_COROTATED || model == PIOLA_MODEL_SPLINE ||
                                model == PIOLA_MODEL_STABLE_NEOHOOKEAN;
         if (mi > 0 && stiffening && r > 0) continue;

@@ -37,6 +37,10 @@ double *fracture_material_volumes(const piola_world *w);
 /* Writes a's checkpoint (frame `frame`, the key of b's scene without a scene file) to path
  * and reads it into b, which must accept it and take that frame. */
 void fracture_checkpoint_round_trip(const piola_world *a, piola_world *b, const char *path, int32_t frame);
+/* fracture_checkpoint_round_trip through a fresh file in the temporary folder ($TMPDIR, else
+ * /tmp), removed afterwards. */
+void fracture_checkpoint_round_trip_via_temp_file(const piola_world *a, piola_world *b,
+                                                  int32_t frame);
 /* Solid 0 of a and b is in the same state, bit for bit: mesh, positions, velocities,
  * masses, fractions, fragments, cut tets and time. */
 void fracture_same_state(const piola_world *a, const piola_world *b);

@@ -459,41 +459,57 @@ static piola_status replan_part_zero(void *context, int32_t solid, const piola_t
   return PIOLA_OK;
 }
 
+/* Splits solid 0 of w on part 0 alone (p holds the arrays) and gives w the replanner that
+ * splits every rebuilt body the same way. */
+static void split_on_part_zero_with_replanner(piola_world *w, replan_part *p,
+                                              int32_t vertex_count) {
+  const int32_t blocks = piola_elastic_body_block_count(piola_world_solid_body(w, 0));
+  p->block_part = calloc((size_t)blocks, sizeof(int32_t));
+  p->node_part = calloc((size_t)vertex_count, sizeof(int32_t));
+  p->split = all_on_part_zero(p, p->block_part, p->node_part);
+  assert_int_equal(piola_world_solid_set_work_split(w, 0, &p->split), PIOLA_OK);
+  const piola_work_split_planner replanner = {replan_part_zero, p}; /* the world copies it */
+  piola_world_set_work_split_replanner(w, &replanner);
+}
+
+/* The same plane cut of solid 0, now, in both worlds. */
+static void cut_both_now(piola_world *whole, piola_world *w) {
+  piola_fracture_cut cut = {.time = 0, .point = {0.3, 0.3, 0.3}, .normal = {1, 0.2, 0.1}};
+  piola_fracture_def def = piola_default_fracture_def();
+  def.cuts = &cut, def.cut_count = 1;
+  assert_int_equal(piola_world_solid_set_fracture(whole, 0, &def), PIOLA_OK);
+  assert_int_equal(piola_world_solid_set_fracture(w, 0, &def), PIOLA_OK);
+}
+
+/* Three steps of each world leave solid 0 at the same positions, bit for bit. */
+static void steps_as_the_whole_does(piola_world *whole, piola_world *w) {
+  for (int k = 0; k < 3; ++k) {
+    assert_int_equal(piola_world_step(whole, 0, NULL), PIOLA_OK);
+    assert_int_equal(piola_world_step(w, 0, NULL), PIOLA_OK);
+  }
+  const int32_t nv = piola_elastic_body_vertex_count(piola_world_solid_body(w, 0));
+  assert_int_equal(nv, piola_elastic_body_vertex_count(piola_world_solid_body(whole, 0)));
+  assert_memory_equal(piola_world_solid_positions(w, 0), piola_world_solid_positions(whole, 0),
+                      3 * sizeof(double) * (size_t)nv);
+}
+
 /* A plane cut of a split solid: the rebuilt body takes the replanner's split for its new mesh
  * (replicated), and the world steps with it as the unsplit world does, bit for bit. */
 static void cut_solid_is_split_again(void **state) {
   (void)state;
   piola_tet_mesh mesh = fixture_grid(6, 0.1);
   piola_world *whole = planned_world(&mesh, NULL, 0), *w = planned_world(&mesh, NULL, 0);
-  const piola_elastic_body *b = piola_world_solid_body(w, 0);
   replan_part p = {0};
-  const int32_t blocks = piola_elastic_body_block_count(b);
-  p.block_part = calloc((size_t)blocks, sizeof(int32_t));
-  p.node_part = calloc((size_t)mesh.vertex_count, sizeof(int32_t));
-  p.split = all_on_part_zero(&p, p.block_part, p.node_part);
-  assert_int_equal(piola_world_solid_set_work_split(w, 0, &p.split), PIOLA_OK);
-  const piola_work_split_planner replanner = {replan_part_zero, &p};
-  piola_world_set_work_split_replanner(w, &replanner);
-  piola_fracture_cut cut = {.time = 0, .point = {0.3, 0.3, 0.3}, .normal = {1, 0.2, 0.1}};
-  piola_fracture_def def = piola_default_fracture_def();
-  def.cuts = &cut, def.cut_count = 1;
-  assert_int_equal(piola_world_solid_set_fracture(whole, 0, &def), PIOLA_OK);
-  assert_int_equal(piola_world_solid_set_fracture(w, 0, &def), PIOLA_OK); /* cuts now */
-  b = piola_world_solid_body(w, 0);
+  split_on_part_zero_with_replanner(w, &p, mesh.vertex_count);
+  cut_both_now(whole, w);
+  const piola_elastic_body *b = piola_world_solid_body(w, 0);
   assert_int_equal(piola_world_solid_fragment_count(w, 0), 2);
   assert_int_equal(p.calls, 1);
   assert_int_equal(p.tet_count, piola_elastic_body_tet_count(b));
   assert_true(p.tet_count > mesh.tet_count);
   assert_ptr_equal(piola_elastic_body_work_split(b), &p.split);
   assert_false(piola_elastic_body_split_is_local(b));
-  for (int k = 0; k < 3; ++k) {
-    assert_int_equal(piola_world_step(whole, 0, NULL), PIOLA_OK);
-    assert_int_equal(piola_world_step(w, 0, NULL), PIOLA_OK);
-  }
-  const int32_t nv = piola_elastic_body_vertex_count(b);
-  assert_int_equal(nv, piola_elastic_body_vertex_count(piola_world_solid_body(whole, 0)));
-  assert_memory_equal(piola_world_solid_positions(w, 0), piola_world_solid_positions(whole, 0),
-                      3 * sizeof(double) * (size_t)nv);
+  steps_as_the_whole_does(whole, w);
   piola_world_destroy(w);
   piola_world_destroy(whole);
   free(p.block_part), free(p.node_part);
@@ -508,20 +524,10 @@ static void deferred_replan_waits_for_the_call(void **state) {
   piola_tet_mesh mesh = fixture_grid(6, 0.1);
   piola_world *whole = planned_world(&mesh, NULL, 0), *w = planned_world(&mesh, NULL, 0);
   replan_part p = {0};
-  const int32_t blocks = piola_elastic_body_block_count(piola_world_solid_body(w, 0));
-  p.block_part = calloc((size_t)blocks, sizeof(int32_t));
-  p.node_part = calloc((size_t)mesh.vertex_count, sizeof(int32_t));
-  p.split = all_on_part_zero(&p, p.block_part, p.node_part);
-  assert_int_equal(piola_world_solid_set_work_split(w, 0, &p.split), PIOLA_OK);
-  const piola_work_split_planner replanner = {replan_part_zero, &p};
-  piola_world_set_work_split_replanner(w, &replanner);
+  split_on_part_zero_with_replanner(w, &p, mesh.vertex_count);
   assert_false(piola_world_solid_split_pending(w, 0));
   piola_world_defer_work_split_replans(w, 1);
-  piola_fracture_cut cut = {.time = 0, .point = {0.3, 0.3, 0.3}, .normal = {1, 0.2, 0.1}};
-  piola_fracture_def def = piola_default_fracture_def();
-  def.cuts = &cut, def.cut_count = 1;
-  assert_int_equal(piola_world_solid_set_fracture(whole, 0, &def), PIOLA_OK);
-  assert_int_equal(piola_world_solid_set_fracture(w, 0, &def), PIOLA_OK); /* cuts now */
+  cut_both_now(whole, w);
   assert_int_equal(piola_world_solid_fragment_count(w, 0), 2);
   assert_int_equal(p.calls, 0);
   assert_null(piola_elastic_body_work_split(piola_world_solid_body(w, 0)));
@@ -540,14 +546,7 @@ static void deferred_replan_waits_for_the_call(void **state) {
   assert_int_equal(p.calls, 2);
   assert_ptr_equal(piola_elastic_body_work_split(b), &p.split);
   assert_false(piola_elastic_body_split_is_local(b));
-  for (int k = 0; k < 3; ++k) {
-    assert_int_equal(piola_world_step(whole, 0, NULL), PIOLA_OK);
-    assert_int_equal(piola_world_step(w, 0, NULL), PIOLA_OK);
-  }
-  const int32_t nv = piola_elastic_body_vertex_count(b);
-  assert_int_equal(nv, piola_elastic_body_vertex_count(piola_world_solid_body(whole, 0)));
-  assert_memory_equal(piola_world_solid_positions(w, 0), piola_world_solid_positions(whole, 0),
-                      3 * sizeof(double) * (size_t)nv);
+  steps_as_the_whole_does(whole, w);
   piola_world_destroy(w);
   piola_world_destroy(whole);
   free(p.block_part), free(p.node_part);

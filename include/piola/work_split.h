@@ -23,10 +23,9 @@
  *     blocks with a tet on one of its nodes (the damping rows of its nodes need their
  *     rotations), which share_ghosts brings (U and V; Fhat too before each Newton assembly);
  *     the step bound and the statistics of piola_elastic_body_update are reduced over the
- *     processes. The state of the other
- *     blocks is never written here: its memory stays untouched (allocated, not resident),
- *     and the getters (det F, Fhat, energy density) hold it only on process 0 after
- *     piola_world_split_collect.
+ *     processes. The state of the other blocks is never written here: its memory stays
+ *     untouched (allocated, not resident), and the getters (det F, Fhat, energy density)
+ *     hold it only on process 0 after piola_world_split_collect.
  * All processes must make the same calls in the same order (they do: their node states are
  * bit-identical). */
 #ifndef PIOLA_WORK_SPLIT_H

@@ -18,9 +18,10 @@ int run_split_checkpoint_save(run_mpi *m, const char *dir, const piola_world *wo
 
 /* Loads the newest checkpoint set of dir that fits this run and that every process reads
  * intact (a cut state included: its solids are partitioned again once every process has
- * read its file, docs/mpi.md "Checkpoints"). Collective. Returns 0 with *frame set; 1 when dir holds no checkpoint at all; 2
- * (message printed) when refused: another process count (the message names the one to
- * use), scene or partition, a single process's checkpoints, or none intact. */
+ * read its file, docs/mpi.md "Checkpoints"). Collective. Returns 0 with *frame set; 1 when
+ * dir holds no checkpoint at all; 2 (message printed) when refused: another process count
+ * (the message names the one to use), scene or partition, a single process's checkpoints,
+ * or none intact. */
 int run_split_checkpoint_resume(run_mpi *m, const char *dir, piola_world *world, uint64_t key,
                                 int32_t *frame);
 

@@ -2,7 +2,9 @@
 #include "test_support.h"
 
 #include <math.h>
+#include <stdio.h>
 #include <stdlib.h>
+#include <unistd.h>
 
 #include "block_scenes.h"
 #include "fracture_checks.h"
@@ -165,6 +167,18 @@ void fracture_checkpoint_round_trip(const piola_world *a, piola_world *b, const 
   int32_t read_frame = -1;
   assert_int_equal(piola_world_checkpoint_read(b, path, key, &read_frame), PIOLA_OK);
   assert_int_equal(read_frame, frame);
+}
+
+void fracture_checkpoint_round_trip_via_temp_file(const piola_world *a, piola_world *b,
+                                                  int32_t frame) {
+  const char *tmp = getenv("TMPDIR");
+  char path[4096];
+  snprintf(path, sizeof path, "%s/piola_fracture_checkpoint_XXXXXX", tmp && *tmp ? tmp : "/tmp");
+  const int fd = mkstemp(path); /* a fresh file of our own: the Xs become its unique name */
+  assert_true(fd >= 0);
+  close(fd);
+  fracture_checkpoint_round_trip(a, b, path, frame);
+  unlink(path);
 }
 
 void fracture_same_state(const piola_world *a, const piola_world *b) {

@@ -669,7 +669,7 @@ static piola_status newton_iterate(const newton_problem *problem, int accept_unc
   double phi_last = -1, eta = w->def.linear_tolerance;
   double last_alpha = 1.0; /* the last line search's step (the forcing term reads it) */
   int converged = 0;
-  for (int32_t iter = 0; iter < w->def.newton_max_iterations; ++iter) {
+for (int32_t iter = 0; iter < w->def.newton_max_iterations; ++iter) {
     if (!isfinite(phi)) break;
     if (phi <= target2) {
       if (release_contacts(&pb) == 0) {
@@ -887,7 +887,17 @@ piola_status piola__implicit_world_step(piola_world *w, double dt_limit, piola_s
   piola__step_profile_start(&w->profile);
   double left;
   PIOLA_TRY(piola__world_collision_open(w, &left));
+  /* the last try is never shorter than the user's step halved MAX_HALVINGS times (or what
+   * is left of the target, when that is less): halving what is left of a frame each time
+   * instead made a frame whose steps all fail take steps shrinking geometrically, and it
+   * never ended once they fell below the rounding of the time */
+  const double shortest = fmin(dt, ldexp(w->def.implicit_dt, -MAX_HALVINGS));
   for (int halvings = 0;; ++halvings) {
+    if (halvings == MAX_HALVINGS) {
+      dt = fmax(dt, shortest);
+      /* and a remainder a rounding error long is not left for a step of its own */
+      if (dt_limit > 0 && dt_limit > dt && dt_limit <= dt * (1 + 1e-9)) dt = dt_limit;
+    }
     piola_status st = PIOLA_OK;
     int32_t done = 0;
     for (; done < w->body_count && st == PIOLA_OK; ++done)

@@ -9,7 +9,8 @@
  *    below it;
  *  - on a 0.5 rad incline a block with mu = 0.2 slides at g (sin - mu cos) within 10%, and one
  *    with mu = 0.8 > tan(0.5) stays put;
- *  - a frame whose every step fails Newton ends, in at most 8 steps. */
+ *  - a frame whose every step fails Newton ends, in at most 8 steps; a step whose Newton
+ *    converges at its last allowed iteration is converged, not failed. */
 #include "test_support.h"
 
 #include <math.h>
@@ -255,6 +256,29 @@ static void failing_steps_finish_the_frame(void **state) {
   block_mesh_free(&mesh);
 }
 
+/* An iterate that converges at the last allowed Newton iteration is a converged step: the
+ * test runs once more after the last iteration (before, the step counted as failed, was
+ * undone and redone at half the size). */
+static void newton_may_converge_at_its_last_iteration(void **state) {
+  (void)state;
+  piola_tet_mesh mesh = block_mesh(3, 2, 2, 0.3, 0.2, 0.2);
+  piola_step_stats free_st, capped_st;
+  piola_world *free_run = collapsed_block_frame(&mesh, 30, &free_st);
+  assert_int_equal(free_st.substeps, 1);
+  assert_int_equal(free_st.newton_failures, 0);
+  assert_true(free_st.newton_iterations >= 2);
+  piola_world *capped = collapsed_block_frame(&mesh, free_st.newton_iterations, &capped_st);
+  assert_int_equal(capped_st.substeps, 1);
+  assert_int_equal(capped_st.newton_failures, 0);
+  assert_int_equal(capped_st.newton_iterations, free_st.newton_iterations);
+  const double *a = piola_world_solid_positions(free_run, 0), *b = piola_world_solid_positions(capped, 0);
+  for (int32_t j = 0; j < 3 * piola_elastic_body_vertex_count(piola_world_solid_body(capped, 0)); ++j)
+    assert_true(a[j] == b[j]);
+  piola_world_destroy(free_run);
+  piola_world_destroy(capped);
+  block_mesh_free(&mesh);
+}
+
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(newmark_default),
@@ -263,6 +287,7 @@ int main(void) {
       cmocka_unit_test(drop_on_ground),
       cmocka_unit_test(incline_friction),
       cmocka_unit_test(failing_steps_finish_the_frame),
+      cmocka_unit_test(newton_may_converge_at_its_last_iteration),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -669,7 +669,9 @@ static piola_status newton_iterate(const newton_problem *problem, int accept_unc
   double phi_last = -1, eta = w->def.linear_tolerance;
   double last_alpha = 1.0; /* the last line search's step (the forcing term reads it) */
   int converged = 0;
-for (int32_t iter = 0; iter < w->def.newton_max_iterations; ++iter) {
+  /* the test runs once more after the last iteration: an iterate that converges there is
+   * a converged step, not a failed one */
+  for (int32_t iter = 0;; ++iter) {
     if (!isfinite(phi)) break;
     if (phi <= target2) {
       if (release_contacts(&pb) == 0) {
@@ -682,6 +684,7 @@ for (int32_t iter = 0; iter < w->def.newton_max_iterations; ++iter) {
         break;
       }
     }
+    if (iter == w->def.newton_max_iterations) break;
     /* contacts whose force pulls are released at every iteration after the first (whose
      * residual reflects the first guess more than the contact): releasing them only once
      * converged costs a whole Newton solve per round of releases (measured on a torus

@@ -176,7 +176,8 @@ int cli_check(int argc, char **argv) {
   double dt = piola_world_stable_dt(world);
   double frame_dt = 1.0 / fps;
   double steps_per_frame = ceil(frame_dt / dt - 1e-9);
-  printf("step:      %.4g s (the smaller of integrator.max_dt and the CFL bound at the start)\n",
+  printf("step:      %.4g s (\"newmark\": the smaller of integrator.max_dt and the CFL bound at "
+         "the start; \"backward_euler\", \"quasistatic\": integrator.dt)\n",
          dt);
   printf("estimate:  %.0f steps per frame, %.0f steps in all (at the starting step; contact and "
          "keyframed stiffness can change it)\n",

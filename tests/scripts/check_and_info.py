@@ -106,6 +106,16 @@ def main():
               "timing: the time per frame is the time per step times the steps per frame")
         quiet = subprocess.run([PIOLA, "check", path, "--timing-seconds", "0"], capture_output=True, text=True)
         check(quiet.returncode == 0 and "timing:" not in quiet.stdout, "--timing-seconds 0 times nothing")
+        # an implicit integrator steps integrator.dt, whatever the mesh's CFL bound
+        implicit = dict(scene, integrator={"type": "backward_euler", "dt": 0.007})
+        with open(path, "w") as f:
+            json.dump(implicit, f)
+        t = subprocess.run([PIOLA, "check", path, "--timing-seconds", "0"], capture_output=True, text=True).stdout
+        step = re.search(r"step: +([\d.e+-]+) s \((.*)\)", t)
+        check(step is not None and close(float(step.group(1)), 0.007, 1e-3) and "integrator.dt" in step.group(2),
+              f"backward_euler: the step is integrator.dt and says so ({step and step.group(0)})")
+        spf = int(re.search(r"estimate: +(\d+) steps per frame", t).group(1))
+        check(spf == math.ceil((1 / fps) / 0.007 - 1e-9), f"backward_euler: {spf} steps per frame of integrator.dt")
 
         scene["solids"][0]["material"]["poisson_ratio"] = 0.7
         with open(path, "w") as f:

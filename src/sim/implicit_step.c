@@ -876,7 +876,7 @@ static piola_status obstacles_after_contact(piola_world *w, double t1, double dt
 }
 
 /* A step whose Newton does not converge is undone and retried at half the size up to this
- * many times; the last try keeps its best iterate (a force field that jumps, as the
+ * many times; the last try keeps its last iterate (a force field that jumps, as the
  * extended stress of an element passing through a reflection does, may have no exact
  * root) and the step goes on, counted in newton_failures. */
 #define MAX_HALVINGS 3

@@ -105,14 +105,16 @@ static void progress(bool tty, int frame, int frames, double t, double elapsed, 
   fflush(stderr);
 }
 
-/* The time-budget guard: a scene whose simulated time (frames / fps) would take more than
- * max_steps steps of the first stable step is refused before anything is written, as a
- * mistyped fps (1e-300) or frame count would otherwise run for ever. The estimate uses the
- * step at t = 0; steps shrink under stiffening and contact, so it is a lower bound. */
+/* The time-budget guard: a scene whose frames would take more than max_steps steps of the
+ * first stable step is refused before anything is written, as a mistyped fps (1e-300) or
+ * frame count would otherwise run for ever. The estimate uses the step at t = 0; steps
+ * shrink under stiffening and contact, and every frame ends a step (so a step longer than
+ * a frame, an implicit integrator's integrator.dt, still takes one per frame): frames times
+ * ceil(frame time / step), as `piola check` estimates, is a lower bound. */
 static bool budget_ok(const char *scene_path, const piola_world *world, int frames, double fps,
                       double max_steps, bool quiet) {
   double simulated = frames / fps, dt = piola_world_stable_dt(world);
-  double steps = simulated / dt;
+  double steps = frames * ceil(1.0 / fps / dt - 1e-9);
   if (isfinite(steps) && steps <= max_steps) return true;
   if (quiet) return false; /* MPI processes other than 0 */
   fprintf(stderr,

@@ -73,6 +73,10 @@ echo "{\"fps\": 0.5, \"frames\": 1, \"integrator\": {\"max_dt\": 0.01}, \"solids
 expect 2 "more than the limit of 10 steps" -- "$PIOLA" run two_seconds.json -o out_two --max-steps 10
 expect 0 "done" -- "$PIOLA" run two_seconds.json -o out_two --max-steps 1e4
 expect 2 "--max-steps needs a number" -- "$PIOLA" run two_seconds.json -o out_x --max-steps 0
+# a step longer than a frame still takes one per frame: 300 frames are 300 steps, not 10
+echo "{\"fps\": 30, \"frames\": 300, \"integrator\": {\"type\": \"backward_euler\", \"dt\": 1}, \"solids\": [{\"mesh\": $box}]}" >long_dt.json
+expect 2 "about 300 steps of 1 s: more than the limit of 100 steps" -- "$PIOLA" run long_dt.json -o out_long --max-steps 100
+[[ -e out_long ]] && fail "the refused implicit run created its output folder"
 
 # refinement levels: 0..6 as documented
 echo "{\"fps\": 10, \"frames\": 0, \"solids\": [{\"mesh\": {\"generate\": \"sphere\", \"radius\": 0.1, \"cell_size\": 0.05, \"refinement_levels\": 7}}]}" >refine.json

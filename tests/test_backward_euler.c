@@ -1,7 +1,8 @@
 /* The implicit integrators (src/sim/implicit_step.c) through the public world API:
  *  - the defaults (Newmark stays the default), the names, and invalid parameters refused;
  *  - the scene keys: integrator.type, integrator.dt defaulting to the frame time, a bad type
- *    refused by its key path, free fall in one step;
+ *    refused by its key path, free fall in one step; the iteration caps accept their
+ *    documented range [1, 1000000] and refuse one more, naming the key;
  *  - backward Euler, free flight: a stretched, spinning block keeps its linear momentum to
  *    1e-10 (damped or not, every isotropic model) at one step per 1/30 s frame, and its total
  *    energy never grows (backward Euler only dissipates);
@@ -14,6 +15,7 @@
 #include "test_support.h"
 
 #include <math.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -213,6 +215,24 @@ static void scene_keys(void **state) {
   if (piola_scene_load_string(with_dt, NULL, NULL, &scene) != PIOLA_OK) fail_msg("%s", piola_last_error());
   assert_close(piola_world_stable_dt(piola_scene_world(scene)), 0.01, 1e-15);
   piola_scene_destroy(scene);
+  /* the iteration caps take the documented range [1, 1000000] (scene-format.md) */
+  const char *caps[] = {"newton_max_iterations", "linear_max_iterations", "cg_max_iterations"};
+  for (int c = 0; c < 3; ++c)
+    for (int over = 0; over <= 1; ++over) {
+      char json[512];
+      snprintf(json, sizeof json,
+               "{\"frames\": 0, \"integrator\": {\"type\": \"backward_euler\", \"%s\": %d},"
+               " \"solids\": [{\"mesh\": {\"generate\": \"box\", \"half_extents\": [0.1, 0.1, 0.1], \"cell_size\": 0.1}}]}",
+               caps[c], 1000000 + over);
+      piola_status loaded = piola_scene_load_string(json, NULL, NULL, &scene);
+      if (!over) {
+        if (loaded != PIOLA_OK) fail_msg("%s = 1000000 refused: %s", caps[c], piola_last_error());
+        piola_scene_destroy(scene);
+      } else {
+        assert_int_equal(loaded, PIOLA_ERROR_INVALID_ARGUMENT);
+        assert_non_null(strstr(piola_last_error(), caps[c]));
+      }
+    }
   const char *bad = "{\"integrator\": {\"type\": \"implicit\"}, \"solids\": []}";
   assert_int_equal(piola_scene_load_string(bad, NULL, NULL, &scene), PIOLA_ERROR_INVALID_ARGUMENT);
   assert_non_null(strstr(piola_last_error(), "integrator.type"));

@@ -11,7 +11,8 @@
  *  - on a 0.5 rad incline a block with mu = 0.2 slides at g (sin - mu cos) within 10%, and one
  *    with mu = 0.8 > tan(0.5) stays put;
  *  - a frame whose every step fails Newton ends, in at most 8 steps; a step whose Newton
- *    converges at its last allowed iteration is converged, not failed. */
+ *    converges at its last allowed iteration is converged, not failed; a non-finite
+ *    residual ends the step with PIOLA_ERROR_NOT_FINITE. */
 #include "test_support.h"
 
 #include <math.h>
@@ -276,6 +277,27 @@ static void failing_steps_finish_the_frame(void **state) {
   block_mesh_free(&mesh);
 }
 
+/* A state whose forces overflow (a block stretched by 1e200) ends the step with
+ * PIOLA_ERROR_NOT_FINITE, the world left at its last good state: before, the last try
+ * failed on its non-finite residual and the step was halved for ever (a scene scrambled by
+ * 1e300 m ran until killed). */
+static void non_finite_residual_fails_the_step(void **state) {
+  (void)state;
+  piola_world *w = make_world(PIOLA_INTEGRATOR_BACKWARD_EULER, 0, 1.0 / 30);
+  piola_tet_mesh mesh = block_mesh(2, 2, 2, 0.2, 0.2, 0.2);
+  piola_solid_def sd = piola_default_solid_def();
+  sd.mesh = &mesh;
+  sd.initial_matrix = (piola_mat3){{{1e200, 0, 0}, {0, 1, 0}, {0, 0, 1}}};
+  assert_int_equal(piola_world_add_solid(w, &sd, NULL), PIOLA_OK);
+  piola_step_stats st;
+  memset(&st, 0, sizeof st);
+  assert_int_equal(piola_world_advance_to(w, 1.0 / 30, &st), PIOLA_ERROR_NOT_FINITE);
+  assert_non_null(strstr(piola_last_error(), "non-finite"));
+  assert_true(piola_world_time(w) == 0);
+  piola_world_destroy(w);
+  block_mesh_free(&mesh);
+}
+
 /* An iterate that converges at the last allowed Newton iteration is a converged step: the
  * test runs once more after the last iteration (before, the step counted as failed, was
  * undone and redone at half the size). */
@@ -308,6 +330,7 @@ int main(void) {
       cmocka_unit_test(incline_friction),
       cmocka_unit_test(failing_steps_finish_the_frame),
       cmocka_unit_test(newton_may_converge_at_its_last_iteration),
+      cmocka_unit_test(non_finite_residual_fails_the_step),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
 }

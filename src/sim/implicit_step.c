@@ -912,6 +912,16 @@ piola_status piola__implicit_world_step(piola_world *w, double dt_limit, piola_s
       return st;
     }
     local.newton_failures++;
+    if (halvings == MAX_HALVINGS) {
+      /* the last try keeps any finite iterate, so its failure is a non-finite residual:
+       * halving on would loop for ever (a scene scrambled by 1e300 m did) */
+      if (stats) *stats = local;
+      const world_body *s = &w->bodies[done - 1];
+      return PIOLA_FAIL(PIOLA_ERROR_NOT_FINITE,
+                        "%s '%s': the implicit step's residual became non-finite at t = %g s "
+                        "(after %d halvings of the step, to %g s)",
+                        piola__body_kind_name(s->kind), s->name, w->time + dt, MAX_HALVINGS, dt);
+    }
     dt *= 0.5;
   }
   const int closes = dt >= left || dt == w->collision_deadline - w->time;

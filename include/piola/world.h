@@ -268,6 +268,8 @@ typedef enum piola_warning_kind {
                                           estimate of the rest state */
   PIOLA_WARNING_SLIVER,                /* a tet's rest altitude forces a step far below the
                                           others (found when the solid is added) */
+  PIOLA_WARNING_NEWTON_FAILED,         /* an implicit step's last try did not converge and
+                                          its last accepted iterate was kept */
   PIOLA_WARNING_KIND_COUNT
 } piola_warning_kind;
 

@@ -68,6 +68,11 @@
 
 #define STANDARD_GRAVITY 9.81
 #define RANGES 16
+/* A step whose Newton does not converge is undone and retried at half the size up to this
+ * many times; the last try keeps its last accepted iterate (a force field that jumps, as the
+ * extended stress of an element passing through a reflection does, may have no exact
+ * root), the step goes on, counted in newton_failures, and the user is warned once. */
+#define MAX_HALVINGS 3
 
 /* Values of world_body.colliding during an implicit step: a node held along its normal by
  * an obstacle, along the push of the self-collision pass (see self_collide_and_resolve), or
@@ -743,7 +748,16 @@ static piola_status newton_iterate(const newton_problem *problem, int accept_unc
       alpha *= 0.5;
     }
     if (!accepted) {
-      if (!(best_alpha > 0)) break; /* no decrease at all: Newton failed */
+      if (!(best_alpha > 0)) {
+        /* no decrease at all: Newton failed, at the iterate the search started from (the
+         * last trial, 1/2048 of a step that may be huge where the matrix is nearly
+         * singular, is no result; a last try kept it: armadillo_4k on a frictionless
+         * plane ended 1e9 m away) */
+        memcpy(s->x, st->base, sizeof(double) * (size_t)m);
+        PIOLA_TRY(update(&pb));
+        phi = residual(&pb);
+        break;
+      }
       alpha = best_alpha;
       for (int64_t j = 0; j < m; ++j) s->x[j] = st->base[j] + alpha * st->step[j];
       PIOLA_TRY(update(&pb));
@@ -772,8 +786,20 @@ static piola_status newton_iterate(const newton_problem *problem, int accept_unc
     }
   }
   if (!converged) {
+    /* the regularization a failed Newton shrank or grew is no start for the retry (a
+     * quasistatic retry that began at the failed try's mu of 1e-22 took a first step of
+     * 1e38 m): it starts again from the first one */
+    if (pb.quasistatic) s->quasistatic_mu = 0;
     if (!accept_unconverged || !isfinite(phi)) return PIOLA_ERROR_NOT_CONVERGED;
     stats->newton_failures++;
+    piola__world_warn(w, PIOLA_WARNING_NEWTON_FAILED,
+                      "%s '%s': the %s step to t = %g s did not converge (Newton, after %d "
+                      "halvings of the step); its last accepted iterate was kept and the run goes "
+                      "on (stats.csv newton_failures counts such steps). A quasistatic body "
+                      "held by obstacle contacts alone has no equilibrium: fix or drive a "
+                      "node, or use \"backward_euler\" (time-stepping.md)",
+                      piola__body_kind_name(s->kind), s->name,
+                      pb.quasistatic ? "quasistatic" : "backward Euler", pb.t1, MAX_HALVINGS);
   }
   /* velocities; friction; prescribed velocities */
   const double inv_dt = 1.0 / dt;
@@ -875,11 +901,6 @@ static piola_status obstacles_after_contact(piola_world *w, double t1, double dt
   return PIOLA_OK;
 }
 
-/* A step whose Newton does not converge is undone and retried at half the size up to this
- * many times; the last try keeps its last iterate (a force field that jumps, as the
- * extended stress of an element passing through a reflection does, may have no exact
- * root) and the step goes on, counted in newton_failures. */
-#define MAX_HALVINGS 3
 
 piola_status piola__implicit_world_step(piola_world *w, double dt_limit, piola_step_stats *stats) {
   piola_step_stats local = {0};

@@ -1,0 +1,92 @@
+/* A quasistatic body with no equilibrium (docs/time-stepping.md, "Quasistatics"):
+ * tetgen/armadillo_4k (1.37 m diagonal, corotated, E = 100 kPa) released 0.3 m above a
+ * frictionless plane. Held by contacts alone it may slide and topple, so its Newton steps
+ * fail. A failed step's last try keeps its last accepted iterate, and every accepted iterate
+ * lowers the residual norm or the potential (elastic energy minus gravity's work), so after
+ * the frame the potential is below the start's, the body did not leave the region above
+ * the plane it started over, and the NEWTON_FAILED warning names it. Before, a line search
+ * that found no decrease left the last rejected trial in place (1/2048 of a Newton step
+ * that the vanishing regularization made 1e38 m long) and the last try kept it: the body
+ * ended 1e10 m away, no warning. */
+#include "test_support.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "piola/elastic_body.h"
+#include "piola/threads.h"
+#include "piola/world.h"
+#include "real_mesh_scenes.h"
+
+#define DIAGONAL 1.37
+
+static void armadillo_on_frictionless_plane(void **state) {
+  (void)state;
+  piola_world_def wd = piola_default_world_def();
+  wd.gravity[1] = piola_track_constant(-9.81);
+  wd.gravity[2] = piola_track_constant(0);
+  wd.integrator = PIOLA_INTEGRATOR_QUASISTATIC;
+  wd.implicit_dt = 1.0 / 30;
+  piola_world *w = NULL;
+  assert_int_equal(piola_world_create(&wd, &w), PIOLA_OK);
+  piola_tet_mesh mesh = real_mesh_scaled("tetgen/armadillo_4k.node", DIAGONAL);
+  double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+  for (int32_t v = 0; v < mesh.vertex_count; ++v)
+    for (int k = 0; k < 3; ++k)
+      lo[k] = fmin(lo[k], mesh.positions[3 * v + k]), hi[k] = fmax(hi[k], mesh.positions[3 * v + k]);
+  piola_solid_def sd = piola_default_solid_def();
+  sd.name = "armadillo";
+  sd.mesh = &mesh;
+  sd.material = real_mesh_material_def(PIOLA_MODEL_COROTATED, 1e5, 0.3);
+  assert_int_equal(piola_world_add_solid(w, &sd, NULL), PIOLA_OK);
+  piola_obstacle_def g = piola_default_obstacle_def();
+  g.type = PIOLA_OBSTACLE_PLANE;
+  g.center = (piola_vec3){0, lo[1] - 0.3, 0};
+  g.axis = (piola_vec3){0, 1, 0};
+  g.friction = 0;
+  assert_int_equal(piola_world_add_obstacle(w, &g, NULL), PIOLA_OK);
+
+  const int32_t n = mesh.vertex_count;
+  const piola_elastic_body *body = piola_world_solid_body(w, 0);
+  const double *mass = piola_elastic_body_masses(body);
+  /* the potential at the start: no elastic energy, and gravity's work counted from there */
+  const double *x = piola_world_solid_positions(w, 0);
+  double height0 = 0;
+  for (int32_t i = 0; i < n; ++i) height0 += mass[i] * x[3 * i + 1];
+
+  piola_step_stats st = {0};
+  assert_int_equal(piola_world_advance_to(w, 1.0 / 30, &st), PIOLA_OK);
+  assert_true(real_mesh_solid_finite(w));
+  x = piola_world_solid_positions(w, 0);
+  double height = 0;
+  for (int32_t i = 0; i < n; ++i) {
+    height += mass[i] * x[3 * i + 1];
+    /* over the plane it started above, and not beyond its start's extent on it */
+    assert_true(x[3 * i + 1] >= g.center.y - 1e-9);
+    for (int k = 0; k < 3; k += 2)
+      if (!(x[3 * i + k] >= lo[k] - DIAGONAL && x[3 * i + k] <= hi[k] + DIAGONAL))
+        fail_msg("vertex %d at %g along axis %d, started within [%g, %g]", (int)i, x[3 * i + k], k,
+                 lo[k], hi[k]);
+  }
+  const double elastic = piola_world_solid_stats(w, 0).elastic_energy;
+  const double potential = elastic + 9.81 * (height - height0);
+  if (!(potential <= 1e-9))
+    fail_msg("potential %g J (elastic %g J) above the start's 0 after %d Newton failures", potential,
+             elastic, (int)st.newton_failures);
+  /* the scene has no equilibrium in its first frame: the run says so, naming the solid */
+  assert_true(st.newton_failures > 0);
+  const char *text = piola_world_warning(w, PIOLA_WARNING_NEWTON_FAILED);
+  assert_non_null(text);
+  assert_non_null(strstr(text, "'armadillo'"));
+  piola_tet_mesh_free(&mesh);
+  piola_world_destroy(w);
+}
+
+int main(void) {
+  piola_set_thread_count(1);
+  const struct CMUnitTest tests[] = {
+      cmocka_unit_test(armadillo_on_frictionless_plane),
+  };
+  return cmocka_run_group_tests(tests, NULL, NULL);
+}

@@ -8,6 +8,8 @@
 #include <string.h>
 
 #include "piola/keyframes.h"
+#include "piola/scene.h"
+#include "piola/world.h"
 #include "scene/scene_desc.h"
 #include "scene_cases.h"
 
@@ -223,11 +225,53 @@ static void bad_input_names_its_key_path(void **state) {
   assert_bad_scenes_refused(BAD, sizeof BAD / sizeof BAD[0]);
 }
 
+
+/* A fixed or driven selector that picks no node is accepted (a coarse mesh may have none
+ * in a small box) with a warning naming the solid and the scene key; the first empty one
+ * is named, and a scene whose selectors all pick nodes raises none. */
+static const char *empty_selection_warning(const char *constraints, char *text, size_t size) {
+  char json[2048];
+  snprintf(json, sizeof json,
+           "{\"solids\": [{\"name\": \"oct\", \"mesh\": \"%s\", %s}]}",
+           test_data_path("tetgen/octahedron.node"), constraints);
+  piola_scene *scene = NULL;
+  if (piola_scene_load_string(json, ".", NULL, &scene) != PIOLA_OK) fail_msg("%s", piola_last_error());
+  const char *w = piola_world_warning(piola_scene_world(scene), PIOLA_WARNING_EMPTY_SELECTION);
+  snprintf(text, size, "%s", w ? w : "");
+  piola_scene_destroy(scene);
+  return text;
+}
+
+static void empty_selection_is_a_warning_naming_its_key(void **state) {
+  (void)state;
+  char text[1024];
+  const char *far = "{\"sphere\": {\"center\": [50, 50, 50], \"radius\": 0.1}}";
+  const char *all = "{\"box\": [[-100, -100, -100], [100, 100, 100]]}";
+  char constraints[512];
+  snprintf(constraints, sizeof constraints, "\"fixed\": [%s, %s]", all, far);
+  assert_non_null(strstr(empty_selection_warning(constraints, text, sizeof text),
+                         "solid 'oct': solids[0].fixed[1] selects no node"));
+  snprintf(constraints, sizeof constraints,
+           "\"fixed\": [%s], \"driven\": [{\"box\": [[40, 40, 40], [41, 41, 41]], "
+           "\"motion\": {\"velocity\": [0, 0, 1]}}]", far);
+  /* the first empty selector is named: fixed before driven, as the keys come */
+  assert_non_null(strstr(empty_selection_warning(constraints, text, sizeof text), "solids[0].fixed[0] "));
+  snprintf(constraints, sizeof constraints,
+           "\"fixed\": [{\"indices\": [0]}], \"driven\": [{\"box\": [[40, 40, 40], [41, 41, 41]], "
+           "\"motion\": {\"velocity\": [0, 0, 1]}}]");
+  assert_non_null(strstr(empty_selection_warning(constraints, text, sizeof text), "solids[0].driven[0] "));
+  snprintf(constraints, sizeof constraints,
+           "\"fixed\": [{\"indices\": [0]}, %s], \"driven\": [{\"indices\": [1], "
+           "\"motion\": {\"velocity\": [0, 0, 1]}}]", all);
+  assert_string_equal(empty_selection_warning(constraints, text, sizeof text), "");
+}
+
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(defaults_hold_when_keys_are_left_out),
       cmocka_unit_test(every_key_reaches_its_definition),
       cmocka_unit_test(bad_input_names_its_key_path),
+      cmocka_unit_test(empty_selection_is_a_warning_naming_its_key),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -270,6 +270,8 @@ typedef enum piola_warning_kind {
                                           others (found when the solid is added) */
   PIOLA_WARNING_NEWTON_FAILED,         /* an implicit step's last try did not converge and
                                           its last accepted iterate was kept */
+  PIOLA_WARNING_EMPTY_SELECTION,       /* a fixed or driven constraint's selector picks no
+                                          node (found when the body is added) */
   PIOLA_WARNING_KIND_COUNT
 } piola_warning_kind;
 

@@ -66,6 +66,28 @@ piola_status piola__body_apply_constraints(world_body *s, const double *rest,
   return PIOLA_OK;
 }
 
+void piola__world_check_selections(piola_world *w, const world_body *s, const double *rest,
+                                   const piola_constraint_def *constraints, int32_t count,
+                                   int32_t index) {
+  int32_t of_kind[2] = {0, 0}; /* fixed, driven: the scene keys number each list from 0 */
+  for (int32_t c = 0; c < count; ++c) {
+    const piola_selector *sel = &constraints[c].selector;
+    const int driven = constraints[c].driven ? 1 : 0;
+    const int32_t k = of_kind[driven]++;
+    int32_t selected = sel->type == PIOLA_SELECT_INDICES ? sel->index_count : 0;
+    for (int32_t i = 0; i < s->n && sel->type != PIOLA_SELECT_INDICES && !selected; ++i)
+      selected = piola__selector_contains(sel, rest + 3 * i);
+    if (selected) continue;
+    const char *kind = piola__body_kind_name(s->kind);
+    piola__world_warn(w, PIOLA_WARNING_EMPTY_SELECTION,
+                      "%s '%s': %ss[%d].%s[%d] selects no node (no rest position, after "
+                      "transform, lies in its %s): it constrains nothing",
+                      kind, s->name, kind, (int)index, driven ? "driven" : "fixed", (int)k,
+                      sel->type == PIOLA_SELECT_BOX ? "box" : sel->type == PIOLA_SELECT_SPHERE ? "sphere" : "index list");
+    return; /* the warning names the first one */
+  }
+}
+
 void piola__body_constrained_state(const world_body *s, int32_t i, double t, double x[3],
                                    double v[3]) {
   const double *p0 = s->start + 3 * i;

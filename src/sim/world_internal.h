@@ -93,6 +93,12 @@ int piola__selector_contains(const piola_selector *sel, const double *p);
 piola_status piola__body_apply_constraints(world_body *b, const double *rest,
                                            const piola_constraint_def *constraints,
                                            int32_t count);
+/* Raises PIOLA_WARNING_EMPTY_SELECTION for the first of body b's constraints (index: b's
+ * number among the bodies of its kind) whose selector picks no node, naming it as the scene
+ * keys do: fixed[k] and driven[k] count the non-driven and the driven constraints apart. */
+void piola__world_check_selections(piola_world *w, const world_body *b, const double *rest,
+                                   const piola_constraint_def *constraints, int32_t count,
+                                   int32_t index);
 /* Prescribed position (m) and velocity (m/s) of constrained node i at time t. */
 void piola__body_constrained_state(const world_body *b, int32_t i, double t, double x[3],
                                    double v[3]);

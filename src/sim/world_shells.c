@@ -99,6 +99,7 @@ static piola_status fill_shell(piola_world *world, world_body *s, const piola_sh
   s->solid_friction = def->solid_friction;
   s->self_collision = def->self_collision;
   PIOLA_TRY(piola__body_apply_constraints(s, rest, def->constraints, def->constraint_count));
+  piola__world_check_selections(world, s, rest, def->constraints, def->constraint_count, id);
   piola__body_finish_masses(s);
   for (int32_t i = 0; i < n; ++i) {
     if (s->flags[i] != NODE_FREE) {

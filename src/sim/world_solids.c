@@ -185,6 +185,7 @@ static piola_status fill_solid(piola_world *world, world_body *s, const piola_so
   s->activation = def->activation;
   s->self_collision = def->self_collision;
   PIOLA_TRY(piola__body_apply_constraints(s, rest, def->constraints, def->constraint_count));
+  piola__world_check_selections(world, s, rest, def->constraints, def->constraint_count, id);
   PIOLA_TRY(piola__solid_plastic_create(s, def));
   piola__body_finish_masses(s);
   /* initial state: free nodes deformed about the rest centroid, constrained ones at rest */

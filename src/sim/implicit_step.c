@@ -799,7 +799,7 @@ static piola_status newton_iterate(const newton_problem *problem, int accept_unc
     stats->newton_failures++;
     piola__world_warn(w, PIOLA_WARNING_NEWTON_FAILED,
                       "%s '%s': the %s step to t = %g s did not converge (Newton, after %d "
-                      "halvings of the step); its last accepted iterate was kept and the run goes "
+                      "halvings of the step); its last iterate was kept and the run goes "
                       "on (stats.csv newton_failures counts such steps). A quasistatic body "
                       "held by obstacle contacts alone has no equilibrium: fix or drive a "
                       "node, or use \"backward_euler\" (time-stepping.md)",

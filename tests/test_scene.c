@@ -209,6 +209,11 @@ static const bad_scene_case BAD[] = {
     {"{\"integrator\": {\"cfl\": 0}, \"solids\": [{\"mesh\": \"a.veg\"}]}", "integrator.cfl: must be in (0, 2]"},
     {"{\"integrator\": {\"max_dt\": -1}, \"solids\": [{\"mesh\": \"a.veg\"}]}", "integrator.max_dt"},
     {"{\"integrator\": {\"cg_max_iterations\": 0}, \"solids\": [{\"mesh\": \"a.veg\"}]}", "integrator.cg_max_iterations"},
+    /* the bounds and the refused value in full: %g printed "[1, 1e+06], got 1e+06" */
+    {"{\"integrator\": {\"newton_max_iterations\": 1000001}, \"solids\": [{\"mesh\": \"a.veg\"}]}",
+     "integrator.newton_max_iterations: must be in [1, 1000000], got 1000001"},
+    {"{\"integrator\": {\"newton_tolerance\": 1.0000001}, \"solids\": [{\"mesh\": \"a.veg\"}]}",
+     "integrator.newton_tolerance: must be in (0, 1), got 1.0000001"},
     {"{\"solids\": [{\"mesh\": \"a.veg\"}], \"obstacles\": [{\"type\": \"cone\"}]}", "obstacles[0].type: must be one of"},
     {"{\"solids\": [{\"mesh\": \"a.veg\"}], \"obstacles\": [{\"type\": \"plane\", \"point\": [0, 0, 0]}]}", "obstacles[0].normal: is required"},
     {"{\"solids\": [{\"mesh\": \"a.veg\"}], \"obstacles\": [{\"type\": \"plane\", \"point\": [0, 0, 0], \"normal\": [0, 0, 0]}]}", "obstacles[0].normal: must be a nonzero vector"},

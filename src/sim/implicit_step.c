@@ -798,13 +798,13 @@ static piola_status newton_iterate(const newton_problem *problem, int accept_unc
     if (!accept_unconverged || !isfinite(phi)) return PIOLA_ERROR_NOT_CONVERGED;
     stats->newton_failures++;
     piola__world_warn(w, PIOLA_WARNING_NEWTON_FAILED,
-                      "%s '%s': the %s step to t = %g s did not converge (Newton, after %d "
-                      "halvings of the step); its last iterate was kept and the run goes "
-                      "on (stats.csv newton_failures counts such steps). A quasistatic body "
-                      "held by obstacle contacts alone has no equilibrium: fix or drive a "
-                      "node, or use \"backward_euler\" (time-stepping.md)",
+                      "%s '%s': the %s step to t = %g s did not converge (Newton, on its "
+                      "last try); its last iterate was kept and the run goes on (stats.csv "
+                      "newton_failures counts failed tries). A quasistatic body held by "
+                      "obstacle contacts alone has no equilibrium: fix or drive a node, or "
+                      "use \"backward_euler\" (time-stepping.md)",
                       piola__body_kind_name(s->kind), s->name,
-                      pb.quasistatic ? "quasistatic" : "backward Euler", pb.t1, MAX_HALVINGS);
+                      pb.quasistatic ? "quasistatic" : "backward Euler", pb.t1);
   }
   /* velocities; friction; prescribed velocities */
   const double inv_dt = 1.0 / dt;

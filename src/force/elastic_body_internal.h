@@ -103,6 +103,10 @@ struct piola_elastic_body {
   double *ogden_cache;      /* Ogden and Mooney-Rivlin bodies of one material: the step bound's
                                slots, OGDEN_CACHE_SLOTS * padded_tet_count (material_kernels.h),
                                written by the force loop; NULL for the other bodies */
+  double *step_cache;       /* bodies of one material whose model forms the step bound's k in
+                               the force loop (STEP_CACHE_MODEL, not the energy extension):
+                               STEP_CACHE_SLOTS * padded_tet_count (stable_step_modulus.h),
+                               written by the force loop; NULL for the other bodies */
   double *hgo_cache;        /* HGO bodies of one material with fibres: the step bound's fibre
                                term, HGO_CACHE_SLOTS * padded_tet_count (hgo_kernels.h), written
                                by the force loop; NULL for the other bodies */

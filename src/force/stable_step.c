@@ -41,36 +41,17 @@
 #include "force/elastic_body_internal.h"
 #include "force/stable_step.h"
 #include "force/stable_step_anisotropy.h"
+#include "force/stable_step_modulus.h"
 #include "material/hgo_kernels.h"
 #include "material/material_kernels.h"
 
 #define STABLE_STEP_KERNEL static inline __attribute__((always_inline))
 
-/* The pair block's two eigenvalues as a +- b (see above), without the K_ij coupling. Selects,
- * no branches, so that the lane loop vectorizes. */
-STABLE_STEP_KERNEL void pair_block(double c, double pi, double pj, double fi, double fj, double kii,
-                                   double kjj, double kij, double *a, double *b) {
-  const double df = fi - fj, sum = fi + fj;
-  const int close = fabs(df) <= 1e-6 * (fabs(fi) + fabs(fj));
-  const double minus = close ? 0.5 * (kii + kjj) - kij : (pi - pj) / (close ? 1.0 : df);
-  const double den = sum >= 0.0 ? kernel_max(sum, c) : kernel_min(sum, -c);
-  const double plus = (pi + pj) / den;
-  *a = 0.5 * (minus + plus), *b = 0.5 * (minus - plus);
-}
-
-/* Largest eigenvalue of the pair block plus the K_ij coupling. */
-STABLE_STEP_KERNEL double pair_modulus(double c, double pi, double pj, double fi, double fj,
-                                       double kii, double kjj, double kij) {
-  double a, b;
-  pair_block(c, pi, pj, fi, fj, kii, kjj, kij, &a, &b);
-  return a + fabs(b + kij);
-}
-
 /* The same pair weighted by the direction weights wi, wj (stable_step_anisotropy.h). */
 STABLE_STEP_KERNEL double weighted_pair_modulus(double c, double pi, double pj, double fi, double fj,
                                                 double kii, double kjj, double kij, double wi, double wj) {
   double a, b;
-  pair_block(c, pi, pj, fi, fj, kii, kjj, kij, &a, &b);
+  step_pair_block(c, pi, pj, fi, fj, kii, kjj, kij, &a, &b);
   return step_weighted_pair(a, b + kij, wi, wj);
 }
 
@@ -204,10 +185,7 @@ STABLE_STEP_KERNEL double model_modulus_weighted(piola_material_model model, int
       k12 += 0.5 * s * (g[1] * j2 + g[2] * j1);
     }
   }
-  double k = kernel_max(k0, kernel_max(k1, k2));
-  k = kernel_max(k, pair_modulus(c, p0, p1, f0, f1, k0, k1, k01));
-  k = kernel_max(k, pair_modulus(c, p0, p2, f0, f2, k0, k2, k02));
-  k = kernel_max(k, pair_modulus(c, p1, p2, f1, f2, k1, k2, k12));
+  double k = step_modulus_of_slopes(c, p0, p1, p2, f0, f1, f2, k0, k1, k2, k01, k02, k12);
   if (wgt) {
     double kw = kernel_max(wgt[0] * k0, kernel_max(wgt[1] * k1, wgt[2] * k2));
     kw = kernel_max(kw, weighted_pair_modulus(c, p0, p1, f0, f1, k0, k1, k01, wgt[0], wgt[1]));
@@ -271,24 +249,13 @@ static double hgo_tet_fiber_modulus(const piola_elastic_body *body, const piola_
 }
 
 /* Neo-Hookean (and the muscle's matrix) with every entry at or above the threshold: the
- * closed forms of the terms above with one logarithm of J, L = lambda ln J, i_k = 1 / f_k:
- *   K_ii = mu (1 + i_i^2) + (lambda - L) i_i^2,  pair_ij = mu + i_i i_j |mu + lambda - L|
- * (a + b = mu (1 + i_i i_j) - L i_i i_j, a - b = mu (1 - i_i i_j) + L i_i i_j,
- * K_ij = lambda i_i i_j). The same numbers as model_modulus up to rounding, at a fraction of
- * the cost (three logarithms and the extension's selects are what make it dear). */
+ * closed form of step_neohookean_modulus with one logarithm of J. The same numbers as
+ * model_modulus up to rounding, at a fraction of the cost (three logarithms and the
+ * extension's selects are what make it dear). */
 STABLE_STEP_KERNEL double neohookean_matrix_modulus(const piola_material *m, double f0, double f1,
                                                     double f2) {
-  const double mu = m->mu, lambda = m->lambda;
   const double i0 = kernel_recip_fast(f0), i1 = kernel_recip_fast(f1), i2 = kernel_recip_fast(f2);
-  const double l = lambda * kernel_log_div(f0 * f1 * f2, KERNEL_FAST_RECIPROCAL);
-  const double soft = lambda - l, cross = fabs(mu + lambda - l);
-  const double k0 = mu * (1.0 + i0 * i0) + soft * i0 * i0;
-  const double k1 = mu * (1.0 + i1 * i1) + soft * i1 * i1;
-  const double k2 = mu * (1.0 + i2 * i2) + soft * i2 * i2;
-  double k = kernel_max(k0, kernel_max(k1, k2));
-  k = kernel_max(k, mu + i0 * kernel_max(i1, i2) * cross);
-  k = kernel_max(k, mu + i1 * i2 * cross);
-  return k;
+  return step_neohookean_modulus(m, i0, i1, i2, m->lambda * kernel_log_div(f0 * f1 * f2, KERNEL_FAST_RECIPROCAL));
 }
 
 /* The same with the muscle's fibre bound (zero for neo-Hookean). */
@@ -567,6 +534,16 @@ STABLE_STEP_KERNEL int block_unclamped(const piola_material *m, const double *f,
   return plain;
 }
 
+/* Whether the force loop's cache holds k for every tet of the block from t
+ * (stable_step_modulus.h). */
+STABLE_STEP_KERNEL int block_cached(const double *cache, long stride, const double *f, int32_t t) {
+  int held = 1;
+#pragma omp simd reduction(&:held)
+  for (int l = 0; l < PIOLA_TET_BLOCK; ++l)
+    held &= step_cache_holds(cache + t + l, stride, f[3 * (t + l)], f[3 * (t + l) + 1], f[3 * (t + l) + 2]);
+  return held;
+}
+
 /* One block [t, e) of weighted_range: max(best, its terms with the direction weights). LINEAR
  * blocks with a clamped entry (or a short one) go tet by tet (linear_tet_rate). */
 STABLE_STEP_KERNEL double weighted_block(piola_material_model model, int energy, const piola_material *m,
@@ -596,12 +573,15 @@ enum { WEIGHTED_CHUNK = 64 };
  * upper bound of the stiff ones' (HIGH); a chunk's blocks whose HIGH is above the BEST so far
  * then take the weights (weighted_block). Near rest no tet is stiff and the bound costs the
  * unweighted loop alone; in a stretched state only the blocks that beat the running maximum
- * pay. LINEAR blocks with no clamped entry take the CLAMP numbers (linear_range). */
+ * pay. LINEAR blocks with no clamped entry take the CLAMP numbers (linear_range). A block
+ * whose k the force loop cached (block_cached) reads the unweighted terms from there. */
 STABLE_STEP_KERNEL double weighted_range(piola_material_model model, int energy, const piola_material *m,
                                          const piola_elastic_body *body, const double *gram,
                                          const double *f, const double *w, int32_t t0, int32_t t1) {
   const double stiff = STIFF_FACTOR * (m->lambda + 2.0 * m->mu);
   const int ext = energy == STEP_EXTENSION_LINEAR ? STEP_EXTENSION_CLAMP : energy;
+  const double *cache = body->step_cache;
+  const long stride = body->padded_tet_count;
   double best = 0;
   for (int32_t c0 = t0; c0 < t1; c0 += WEIGHTED_CHUNK * PIOLA_TET_BLOCK) {
     const int32_t c1 = t1 - c0 < WEIGHTED_CHUNK * PIOLA_TET_BLOCK ? t1 : c0 + WEIGHTED_CHUNK * PIOLA_TET_BLOCK;
@@ -609,7 +589,16 @@ STABLE_STEP_KERNEL double weighted_range(piola_material_model model, int energy,
     for (int32_t t = c0; t < c1; t += PIOLA_TET_BLOCK) {
       const int32_t e = c1 - t < PIOLA_TET_BLOCK ? c1 : t + PIOLA_TET_BLOCK;
       double h = 0;
-      if (energy == STEP_EXTENSION_LINEAR && !(e - t == PIOLA_TET_BLOCK && block_unclamped(m, f, t))) {
+      if (cache && e - t == PIOLA_TET_BLOCK && block_cached(cache, stride, f, t)) {
+        const double *kc = cache + STEP_CACHE_MODULUS * stride;
+#pragma omp simd reduction(max:best) reduction(max:h)
+        for (int32_t u = t; u < e; ++u) {
+          const double r = w[u] * kc[u];
+          const int above = kc[u] > stiff;
+          best = !above && r > best ? r : best;
+          h = above && r > h ? r : h;
+        }
+      } else if (energy == STEP_EXTENSION_LINEAR && !(e - t == PIOLA_TET_BLOCK && block_unclamped(m, f, t))) {
         for (int32_t u = t; u < e; ++u) {
           const double *fu = f + 3 * u;
           const double k = model_modulus(model, STEP_EXTENSION_LINEAR, m, fu[0], fu[1], fu[2]);
@@ -708,9 +697,9 @@ STABLE_STEP_KERNEL double uniform_range_rate2(const piola_elastic_body *body, in
   return best;
 }
 
-/* max over tets [begin, end) of w_e k_e */
-static double range_rate2(const piola_elastic_body *body, const double *w, int32_t begin,
-                          int32_t end) {
+/* max over tets [begin, end) of w_e k_e, every k computed here */
+static double computed_range_rate2(const piola_elastic_body *body, const double *w, int32_t begin,
+                                   int32_t end) {
   const double *f = body->fhat;
   double best = 0;
   if (body->uniform_material >= 0) {
@@ -725,6 +714,37 @@ static double range_rate2(const piola_elastic_body *body, const double *w, int32
       const double r = PIOLA_ISA_NAME(piola__elastic_body_tet_state_rate2)(body, t);
       best = r > best ? r : best;
     }
+  }
+  return best;
+}
+
+/* max over tets [begin, end) of w_e k_e: k from the force loop's cache in the blocks where it
+ * holds every tet's (block_cached), computed in the others. The direction-weighted models read
+ * it inside weighted_range, which weighs only the blocks that can raise the maximum. */
+static double range_rate2(const piola_elastic_body *body, const double *w, int32_t begin,
+                          int32_t end) {
+  const double *cache = body->step_cache;
+  if (!cache || (direction_gram(body) && DIRECTION_WEIGHTED(body->materials[body->uniform_material].model)))
+    return computed_range_rate2(body, w, begin, end);
+  const long stride = body->padded_tet_count;
+  const double *f = body->fhat, *kc = cache + STEP_CACHE_MODULUS * stride;
+  double best = 0;
+  int32_t t = begin;
+  for (; t + PIOLA_TET_BLOCK <= end; t += PIOLA_TET_BLOCK) {
+    if (!block_cached(cache, stride, f, t)) {
+      const double r = computed_range_rate2(body, w, t, t + PIOLA_TET_BLOCK);
+      best = r > best ? r : best;
+      continue;
+    }
+#pragma omp simd reduction(max:best)
+    for (int32_t u = t; u < t + PIOLA_TET_BLOCK; ++u) {
+      const double r = w[u] * kc[u];
+      best = r > best ? r : best;
+    }
+  }
+  if (t < end) {
+    const double r = computed_range_rate2(body, w, t, end);
+    best = r > best ? r : best;
   }
   return best;
 }

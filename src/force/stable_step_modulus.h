@@ -129,8 +129,45 @@ MATERIAL_KERNEL void step_cache_skip(double *cache, long stride) {
   cache[STEP_CACHE_KEY * stride] = (double)NAN;
 }
 
+/* k with no entry clamped, from the parts there, for the force loop. For three models the
+ * pairs' divisions cancel (P_i = A'(f_i) + kappa q g_i, the pair ij's a +- b are the divided
+ * differences of P_i -+ P_j):
+ *   corotated (g_i = J / f_i, K_ii = 2 mu + lambda g_i^2): a = 2 mu (1 - s), b + K_ij =
+ *     2 mu s + lambda g_i g_j with s = 1 / (f_i + f_j), so pair_ij = 2 mu + lambda g_i g_j, at
+ *     most max(K_ii, K_jj): k = max_i K_ii;
+ *   StVK (A' = mu f (f^2 - 1), kappa q g_i = Q f_i with Q = lambda / 2 (|f|^2 - 3), K_ij =
+ *     lambda f_i f_j): a = mu (f_i^2 + f_j^2 - 1) + Q, b = mu f_i f_j, so
+ *     pair_ij = mu (f_i^2 + f_j^2 - 1) + Q + (mu + lambda) f_i f_j;
+ *   rotated linear (A' = 2 mu (f - 1), kappa q g_i = T = lambda (tr Fhat - 3), K_ij = lambda):
+ *     a = 2 mu + (T - 2 mu) s, b = (2 mu - T) s, one division per pair instead of two.
+ * The others take the pair blocks as the pass does. The pass's divided differences agree with
+ * these closed forms up to its rounding (tests/test_stable_step.c, to 1e-12). */
+MATERIAL_KERNEL double step_model_unclamped_modulus(piola_material_model model, const piola_material *m,
+                                                    double c, const material_parts *pa, double f0,
+                                                    double f1, double f2) {
+  const double mu = m->mu, lambda = m->lambda;
+  const double diagonal = kernel_max(pa->k[0][0], kernel_max(pa->k[1][1], pa->k[2][2]));
+  switch (model) {
+    case PIOLA_MODEL_COROTATED: return diagonal + m->fiber_modulus;
+    case PIOLA_MODEL_STVK: {
+      const double q = 0.5 * lambda * (f0 * f0 + f1 * f1 + f2 * f2 - 3.0) - mu, cross = mu + lambda;
+      double k = kernel_max(diagonal, mu * (f0 * f0 + f1 * f1) + q + cross * f0 * f1);
+      k = kernel_max(k, mu * (f0 * f0 + f2 * f2) + q + cross * f0 * f2);
+      return kernel_max(k, mu * (f1 * f1 + f2 * f2) + q + cross * f1 * f2) + m->fiber_modulus;
+    }
+    case PIOLA_MODEL_ROTATED_LINEAR: {
+      const double t = lambda * (f0 + f1 + f2 - 3.0) - 2.0 * mu;
+      const double s01 = 1.0 / (f0 + f1), s02 = 1.0 / (f0 + f2), s12 = 1.0 / (f1 + f2);
+      double k = kernel_max(diagonal, 2.0 * mu + t * s01 + fabs(lambda - t * s01));
+      k = kernel_max(k, 2.0 * mu + t * s02 + fabs(lambda - t * s02));
+      return kernel_max(k, 2.0 * mu + t * s12 + fabs(lambda - t * s12)) + m->fiber_modulus;
+    }
+    default: return step_unclamped_modulus(m, c, pa, f0, f1, f2);
+  }
+}
+
 /* material_extended_stress of MODEL (no threshold rise) with k from the same parts where no
- * entry is clamped: the pairs' six divisions and the maxima more, not the model again. */
+ * entry is clamped (step_model_unclamped_modulus), not the model again. */
 MATERIAL_KERNEL void material_stress_modulus_lanes(piola_material_model model, const piola_material *m,
                                                    double f0, double f1, double f2, double *p0,
                                                    double *p1, double *p2, double *cache, long stride) {
@@ -140,7 +177,7 @@ MATERIAL_KERNEL void material_stress_modulus_lanes(piola_material_model model, c
   material_model_parts(model, m, KERNEL_FAST_RECIPROCAL, fc0, fc1, fc2, &parts);
   material_extend(m, KERNEL_FAST_RECIPROCAL, c, &parts, f0 - fc0, f1 - fc1, f2 - fc2, p0, p1, p2);
   const int held = (f0 >= c) & (f1 >= c) & (f2 >= c);
-  step_cache_store(cache, stride, held, f0, f1, f2, step_unclamped_modulus(m, c, &parts, f0, f1, f2));
+  step_cache_store(cache, stride, held, f0, f1, f2, step_model_unclamped_modulus(model, m, c, &parts, f0, f1, f2));
 }
 
 /* One per model, so that the force loop's lane loops name a kernel with the model constant. */

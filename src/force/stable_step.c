@@ -1,22 +1,19 @@
 /* The state-aware explicit step bound (see stable_step.h and docs/time-stepping.md).
  *
- * Why a separate pass and not the force loop: the bound needs only Fhat, which the update
- * stores per tet, so one streaming pass over 3 doubles per tet (plus one cached per-tet
- * geometric factor) gives it without touching the force kernels. The model switch is
- * hoisted out of an `omp simd` loop as in the force loop, and the per-lane work is the
- * model's value and slope at the clamped point (material_model_parts), its extension
- * (material_extend) and three 2x2 blocks.
- *
- * Its cost is that arithmetic, not the stream (measured, bench_stable_step's "warm" column):
- * a second pass run at once after the first, its Fhat and weights in cache, costs the same
- * CPU as the first (under load, 1 thread: neo-Hookean 8-10% of the update both ways,
- * corotated 9-11%, the spline 28-33%). So computing these same numbers inside the force loop
- * would save the 4 doubles per tet it reads, not the 7-34% of an update it costs on a quiet
- * machine; one long lane loop over a run of plain blocks instead of one per block saved at
- * most a tenth (throughput, not latency). What would is fewer operations per lane: the
- * force loop already forms 1/f_i, ln J and the model's parts at the clamped point for its
- * stress, and handing those over (as the Ogden and HGO caches do) is the way to the 5% of
- * issue 21.
+ * Why the force loop forms most of it: the pass is bound by its arithmetic, not by the
+ * stream (bench_stable_step's "warm" column: a second pass run at once after the first costs
+ * the same CPU), and that arithmetic repeats the force loop's (the model's value and slopes
+ * at Fhat, 1/f_i, ln J). So for neo-Hookean, the muscle, corotated, StVK, rotated linear and
+ * the spline the force loop's lane kernels form each tet's k (before the weight 1/(rho h_e^2)
+ * and the direction weights) where no entry is clamped and keep it with its Fhat as key
+ * (stable_step_modulus.h; corotated, StVK and rotated linear in closed form); the pass reads
+ * it for every block whose stored Fhat matches, and the weighted models' stiff blocks still
+ * take their weights here. Blocks with a clamped entry, a stale key (a state moved in from
+ * another process, a body changed since), the energy extension, mixed materials and the other
+ * models go through the lane loops below: the model switch hoisted out of an `omp simd` loop
+ * as in the force loop, per lane the model's value and slope at the clamped point
+ * (material_model_parts), its extension (material_extend) and three 2x2 blocks. The Ogden
+ * models and HGO hand over their dearest parts the same way (their own caches).
  *
  * The modulus. In the frame of the diagonalization dP/dF splits into the 3x3 block
  * K = dPhat/dFhat on the diagonal entries and one 2x2 block per pair (i, j) on (F_ij, F_ji),
@@ -33,7 +30,9 @@
  *
  * A kernel, compiled once per instruction set (common/isa.h): its lane loops are a few
  * percent of a step, and at baseline x86-64 four times that. Without fused multiply-adds
- * and with only max reductions, every variant computes the same bits. */
+ * and with only max reductions, every variant computes the same bits here; a k cached by
+ * the force loop carries that kernel's fused multiply-adds, so where the cache holds, the
+ * bound's last bits follow the variant as Fhat's do (tests/test_kernel_isa.c). */
 #include <math.h>
 #include <stdlib.h>
 

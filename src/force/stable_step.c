@@ -562,6 +562,31 @@ STABLE_STEP_KERNEL double weighted_block(piola_material_model model, int energy,
   return best;
 }
 
+/* The unweighted split of weighted_range for a full block from t whose k the force loop
+ * cached (KC): raises *BEST by the terms not above STIFF and returns the largest of the
+ * others. Not inlined: inside weighted_range's loop this second lane loop cost the computed
+ * path 3-4 times its time (the AVX-512 build, measured), whatever the block took. */
+__attribute__((noinline)) static double cached_block_split(const double *kc, const double *w, int32_t t,
+                                                           double stiff, double *best) {
+  double low = *best, h = 0;
+#pragma omp simd reduction(max:low) reduction(max:h)
+  for (int32_t u = t; u < t + PIOLA_TET_BLOCK; ++u) {
+    const double r = w[u] * kc[u];
+    const int above = kc[u] > stiff;
+    low = !above && r > low ? r : low;
+    h = above && r > h ? r : h;
+  }
+  *best = low;
+  return h;
+}
+
+/* weighted_range with the body's cache (stable_step_modulus.h) or none. Two instances, the
+ * second with a constant NULL: with the cache's branch in it, the computed lane loop (a body
+ * without the cache, the energy extension) took 3-4 times its time in the AVX-512 build. */
+#define WEIGHTED_RANGE(model, energy, m, body, gram, f, w, t0, t1)                                   \
+  ((body)->step_cache ? weighted_range(model, energy, m, body, gram, (body)->step_cache, f, w, t0, t1) \
+                      : weighted_range(model, energy, m, body, gram, NULL, f, w, t0, t1))
+
 /* Blocks a chunk of weighted_range holds: their stiff maxima stay on the stack. */
 enum { WEIGHTED_CHUNK = 64 };
 
@@ -576,10 +601,10 @@ enum { WEIGHTED_CHUNK = 64 };
  * whose k the force loop cached (block_cached) reads the unweighted terms from there. */
 STABLE_STEP_KERNEL double weighted_range(piola_material_model model, int energy, const piola_material *m,
                                          const piola_elastic_body *body, const double *gram,
-                                         const double *f, const double *w, int32_t t0, int32_t t1) {
+                                         const double *cache, const double *f, const double *w,
+                                         int32_t t0, int32_t t1) {
   const double stiff = STIFF_FACTOR * (m->lambda + 2.0 * m->mu);
   const int ext = energy == STEP_EXTENSION_LINEAR ? STEP_EXTENSION_CLAMP : energy;
-  const double *cache = body->step_cache;
   const long stride = body->padded_tet_count;
   double best = 0;
   for (int32_t c0 = t0; c0 < t1; c0 += WEIGHTED_CHUNK * PIOLA_TET_BLOCK) {
@@ -589,14 +614,7 @@ STABLE_STEP_KERNEL double weighted_range(piola_material_model model, int energy,
       const int32_t e = c1 - t < PIOLA_TET_BLOCK ? c1 : t + PIOLA_TET_BLOCK;
       double h = 0;
       if (cache && e - t == PIOLA_TET_BLOCK && block_cached(cache, stride, f, t)) {
-        const double *kc = cache + STEP_CACHE_MODULUS * stride;
-#pragma omp simd reduction(max:best) reduction(max:h)
-        for (int32_t u = t; u < e; ++u) {
-          const double r = w[u] * kc[u];
-          const int above = kc[u] > stiff;
-          best = !above && r > best ? r : best;
-          h = above && r > h ? r : h;
-        }
+        h = cached_block_split(cache + STEP_CACHE_MODULUS * stride, w, t, stiff, &best);
       } else if (energy == STEP_EXTENSION_LINEAR && !(e - t == PIOLA_TET_BLOCK && block_unclamped(m, f, t))) {
         for (int32_t u = t; u < e; ++u) {
           const double *fu = f + 3 * u;
@@ -634,7 +652,7 @@ STABLE_STEP_KERNEL double linear_range(piola_material_model model, const piola_e
                                        int32_t begin, int32_t end) {
   const double *gram = direction_gram(body);
   if (DIRECTION_WEIGHTED(model) && gram)
-    return weighted_range(model, STEP_EXTENSION_LINEAR, m, body, gram, f, w, begin, end);
+    return WEIGHTED_RANGE(model, STEP_EXTENSION_LINEAR, m, body, gram, f, w, begin, end);
   double best = 0;
   int32_t t = begin;
   for (; t + PIOLA_TET_BLOCK <= end; t += PIOLA_TET_BLOCK) {
@@ -662,7 +680,7 @@ STABLE_STEP_KERNEL double linear_range(piola_material_model model, const piola_e
 
 #define MODEL_LANE_LOOP(model)                                                                  \
   if (energy == STEP_EXTENSION_LINEAR) return linear_range(model, body, m, f, w, begin, end);   \
-  if (DIRECTION_WEIGHTED(model) && gram) return weighted_range(model, energy, m, body, gram, f, w, begin, end); \
+  if (DIRECTION_WEIGHTED(model) && gram) return WEIGHTED_RANGE(model, energy, m, body, gram, f, w, begin, end); \
   _Pragma("omp simd reduction(max:best)") for (int32_t t = begin; t < end; ++t) {               \
     const double r = w[t] * model_modulus(model, energy, m, f[3 * t], f[3 * t + 1], f[3 * t + 2]); \
     best = r > best ? r : best;                                                                 \

@@ -208,6 +208,16 @@ STABLE_STEP_KERNEL double model_modulus(piola_material_model model, int energy,
   return model_modulus_weighted(model, energy, m, f0, f1, f2, NULL, NULL);
 }
 
+/* The force loop's k cache (stable_step_modulus.h) where the pass may read it, else NULL. Not
+ * in the replicated mode of a work split: there every process takes the bound over every tet
+ * and must get the same bits, but only its own blocks' k come from its force loop (with fused
+ * multiply-adds), the gathered ones would be computed here (without): the processes' steps
+ * would part in their last bits and their collectives with them (mpi_frames.sh's
+ * plastic_control hung on 2 processes). The local mode takes each process's own blocks only. */
+static const double *readable_step_cache(const piola_elastic_body *body) {
+  return body->split && !body->split_local ? NULL : body->step_cache;
+}
+
 /* Where the body has direction weights (stable_step_anisotropy.h): its Gram arrays once an
  * update has set V, else NULL. */
 static const double *direction_gram(const piola_elastic_body *body) {
@@ -584,8 +594,9 @@ __attribute__((noinline)) static double cached_block_split(const double *kc, con
  * second with a constant NULL: with the cache's branch in it, the computed lane loop (a body
  * without the cache, the energy extension) took 3-4 times its time in the AVX-512 build. */
 #define WEIGHTED_RANGE(model, energy, m, body, gram, f, w, t0, t1)                                   \
-  ((body)->step_cache ? weighted_range(model, energy, m, body, gram, (body)->step_cache, f, w, t0, t1) \
-                      : weighted_range(model, energy, m, body, gram, NULL, f, w, t0, t1))
+  (readable_step_cache(body) ? weighted_range(model, energy, m, body, gram, readable_step_cache(body), \
+                                              f, w, t0, t1)                                            \
+                             : weighted_range(model, energy, m, body, gram, NULL, f, w, t0, t1))
 
 /* Blocks a chunk of weighted_range holds: their stiff maxima stay on the stack. */
 enum { WEIGHTED_CHUNK = 64 };
@@ -740,7 +751,7 @@ static double computed_range_rate2(const piola_elastic_body *body, const double 
  * it inside weighted_range, which weighs only the blocks that can raise the maximum. */
 static double range_rate2(const piola_elastic_body *body, const double *w, int32_t begin,
                           int32_t end) {
-  const double *cache = body->step_cache;
+  const double *cache = readable_step_cache(body);
   if (!cache || (direction_gram(body) && DIRECTION_WEIGHTED(body->materials[body->uniform_material].model)))
     return computed_range_rate2(body, w, begin, end);
   const long stride = body->padded_tet_count;

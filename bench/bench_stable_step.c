@@ -15,7 +15,15 @@
  * and Mooney-Rivlin run two bodies, interleaved: with the force loop's cache of their powers
  * (what the simulator does) and without it (the bound computing them again). HGO runs three:
  * without fibres, with fibres (one direction, across hgo.axis) and the force loop's cache of
- * their term, and with fibres and no cache (the term computed again tet by tet). */
+ * their term, and with fibres and no cache (the term computed again tet by tet). The models
+ * whose force loop forms the bound's k (stable_step_modulus.h: neo-Hookean, the muscle,
+ * corotated, StVK, rotated linear, the spline) run two bodies too, with that cache and without
+ * it (the force loop forms no k, the pass computes every one: the cost before the cache), and
+ * a line "added" with what the bound adds to a step, the medians of (update with k + pass) /
+ * (update without k) - 1 over the interleaved repeats, wall and process CPU.
+ * PIOLA_BENCH_VARIANT=i (0: with the cache, 1: without) runs body i alone, for instruction
+ * counts (valgrind --tool=callgrind; the inclusive counts of piola_elastic_body_update and of
+ * the bound's piola__elastic_body_state_rate2 per call). */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -58,7 +66,12 @@ static void bench_model(const char *name, const piola_tet_mesh *mesh, piola_mate
   const char *labels[MAX_VARIANTS] = {"", "", ""};
   double *fibers = NULL;
   int variants = 1;
-  if (bodies[0]->ogden_cache) {
+  if (bodies[0]->step_cache) {
+    bodies[1] = make_body(mesh, &material, NULL);
+    free(bodies[1]->step_cache);
+    bodies[1]->step_cache = NULL;
+    labels[0] = " (k cache)", labels[1] = " (no k cache)", variants = 2;
+  } else if (bodies[0]->ogden_cache) {
     bodies[1] = make_body(mesh, &material, NULL);
     free(bodies[1]->ogden_cache);
     bodies[1]->ogden_cache = NULL;
@@ -72,6 +85,8 @@ static void bench_model(const char *name, const piola_tet_mesh *mesh, piola_mate
     bodies[2]->hgo_cache = NULL;
     labels[0] = " no fibres", labels[1] = " fibres, cache", labels[2] = " fibres, none", variants = 3;
   }
+  const char *only = getenv("PIOLA_BENCH_VARIANT");
+  const int alone = only && *only ? atoi(only) : -1;
   const int32_t nv = mesh->vertex_count;
   double *x = malloc(sizeof(double) * 3 * (size_t)nv), *f = malloc(sizeof(double) * 3 * (size_t)nv);
   double a[3] = {1 + bench_uniform(-0.3, 0.3), 1 + bench_uniform(-0.3, 0.3), 1 + bench_uniform(-0.3, 0.3)};
@@ -88,6 +103,7 @@ static void bench_model(const char *name, const piola_tet_mesh *mesh, piola_mate
     double sink = 0;
     for (int r = -1; r < repeats; ++r) /* r = -1 warms up (and builds the weights) */
       for (int b = 0; b < variants; ++b) {
+        if (alone >= 0 && b != alone) continue;
         double c0 = bench_cpu_seconds(), t0 = bench_wall_seconds();
         piola_elastic_body_update(bodies[b], x, 1.0, f, NULL);
         double c1 = bench_cpu_seconds(), t1 = bench_wall_seconds();
@@ -100,7 +116,18 @@ static void bench_model(const char *name, const piola_tet_mesh *mesh, piola_mate
           t[b][4][r] = t3 - t2, t[b][5][r] = c3 - c2;
         }
       }
+    /* per repeat, before the medians sort the timings: (update + pass with the cache) over
+     * the update without it, wall then CPU */
+    double added_wall = 0, added_cpu = 0;
+    if (bodies[0]->step_cache && alone < 0) {
+      double added[2][repeats];
+      for (int r = 0; r < repeats; ++r)
+        for (int k = 0; k < 2; ++k)
+          added[k][r] = (t[0][2 * k][r] + t[0][2 * k + 1][r]) / t[1][2 * k][r] - 1.0;
+      added_wall = bench_median(added[0], repeats), added_cpu = bench_median(added[1], repeats);
+    }
     for (int b = 0; b < variants; ++b) {
+      if (alone >= 0 && b != alone) continue;
       double m[6];
       for (int k = 0; k < 6; ++k) m[k] = bench_median(t[b][k], repeats);
       printf("| %-16s | %-17s%s | %7d | %d | %8.3f | %8.3f | %5.1f%% | %5.1f%% | %8.3f | %5.1f%% | (%g)\n",
@@ -108,6 +135,10 @@ static void bench_model(const char *name, const piola_tet_mesh *mesh, piola_mate
              1e3 * m[0], 1e3 * m[1], 100 * m[1] / m[0], 100 * m[3] / m[2], 1e3 * m[4],
              100 * m[5] / m[2], sink > 0 ? 1.0 : 0.0);
     }
+    if (bodies[0]->step_cache && alone < 0)
+      printf("| %-16s | %-17s added | %7d | %d | added by the bound to the update without k: %5.1f%% (wall), %5.1f%% (process CPU) |\n",
+             name, piola_material_model_name(model), (int)mesh->tet_count, threads, 100 * added_wall,
+             100 * added_cpu);
   }
   piola_set_thread_count(0);
   for (int b = 0; b < MAX_VARIANTS; ++b)

@@ -14,6 +14,7 @@
 #include "force/element_stiffness.h"
 #include "force/force_lanes.h"
 #include "force/stable_step.h"
+#include "force/stable_step_modulus.h"
 #include "force/stiffness_lanes.h"
 #include "force/stiffness_matrix.h"
 #include "force/svd_kernel.h"
@@ -228,7 +229,9 @@ static void force_damping_and_step_variants_agree(void **state) {
   piola_elastic_body_damping_forces(body, v, 2.0, 0.5, fd);
   memcpy(damp[VARIANTS], body->damping.blocks, sizeof(double) * edge_values);
 
-  /* the step bound: no fused multiply-adds, only max reductions, so the same bits */
+  /* the step bound: no fused multiply-adds, only max reductions, so the same bits (a body of
+   * mixed materials has no cache of k from the force loop; cached_step_bound_variants_agree
+   * checks the bodies that do) */
   int32_t worst_chosen = -2;
   const double rate2_chosen = piola__elastic_body_state_rate2(body, &worst_chosen);
   assert_true(rate2_chosen > 0 && worst_chosen >= 0);
@@ -288,6 +291,67 @@ static void force_damping_and_step_variants_agree(void **state) {
   free(fibers);
   piola_elastic_body_destroy(body);
   fixture_mesh_free(&mesh);
+}
+
+/* Bodies of one material whose force loop forms the step bound's k (stable_step_modulus.h):
+ * each variant's force loop and then its bound, on the grid randomly deformed with some tets
+ * inverted (those blocks computed by the pass, the others read from the cache). Not the same
+ * bits: the cached k is the force loop's arithmetic, with fused multiply-adds where the
+ * variant has them, from that variant's Fhat, whose last bits differ too (the forces above
+ * agree to 1e-13 of their largest entry, not to the bit). A few roundings of k, so the bound
+ * agrees to 1e-13 relative, and the worst tet is the same. */
+static void cached_step_bound_variants_agree(void **state) {
+  (void)state;
+  const piola_material_model models[] = {PIOLA_MODEL_NEOHOOKEAN, PIOLA_MODEL_COROTATED, PIOLA_MODEL_STVK};
+  for (int mi = 0; mi < 3; ++mi) {
+    test_rng rng = test_rng_seeded(79);
+    piola_tet_mesh mesh = fixture_grid(4, 0.1);
+    piola_material m = fixture_material(models[mi]);
+    piola_elastic_body_def def = piola_default_elastic_body_def();
+    def.rest_mesh = &mesh;
+    def.materials = &m;
+    def.material_count = 1;
+    piola_elastic_body *body = NULL;
+    assert_int_equal(piola_elastic_body_create(&def, &body), PIOLA_OK);
+    assert_non_null(body->step_cache);
+    const int n = 3 * mesh.vertex_count;
+    double *x = malloc(sizeof(double) * (size_t)n), *f = calloc((size_t)n, sizeof(double));
+    for (int i = 0; i < n; ++i) x[i] = mesh.positions[i] * 1.1 + test_rng_uniform(&rng, -0.04, 0.04);
+    for (int i = 0; i < n; i += 37) x[i] -= 0.15; /* inverted tets */
+    const int32_t blocks = body->padded_tet_count / PIOLA_TET_BLOCK;
+    assert_int_equal(piola_elastic_body_update(body, x, 1.0, f, NULL), PIOLA_OK);
+    int32_t held = 0;
+    for (int32_t t = 0; t < mesh.tet_count; ++t) {
+      const double *ft = body->fhat + 3 * t;
+      held += step_cache_holds(body->step_cache + t, body->padded_tet_count, ft[0], ft[1], ft[2]);
+    }
+    assert_true(held > 0 && held < mesh.tet_count); /* both paths of the pass */
+    double first_rate2 = -1;
+    int32_t first_worst = -2;
+    int first = -1;
+    for (int isa = 0; isa < VARIANTS; ++isa) {
+      if (!FORCES[isa] || !RATE2[isa] || !runs(isa)) continue;
+      FORCES[isa](body, x, 1.0, 0, 0, blocks, f);
+      int32_t worst = -2;
+      const double rate2 = RATE2[isa](body, &worst);
+      assert_true(rate2 > 0 && worst >= 0);
+      if (first < 0) {
+        first = isa, first_rate2 = rate2, first_worst = worst;
+        continue;
+      }
+      print_message("%s: step bound rate^2 %s vs %s differ by %.2g relative\n", piola_material_model_name(m.model),
+                    piola__isa_name((piola__isa)isa), piola__isa_name((piola__isa)first),
+                    fabs(rate2 - first_rate2) / first_rate2);
+      if (!(fabs(rate2 - first_rate2) <= 1e-13 * first_rate2) || worst != first_worst)
+        fail_msg("%s: step bound rate^2 %.17g (tet %d) under %s, %.17g (tet %d) under %s",
+                 piola_material_model_name(m.model), rate2, (int)worst, piola__isa_name((piola__isa)isa),
+                 first_rate2, (int)first_worst, piola__isa_name((piola__isa)first));
+    }
+    assert_true(first >= 0);
+    free(x), free(f);
+    piola_elastic_body_destroy(body);
+    fixture_mesh_free(&mesh);
+  }
 }
 
 /* The projected stiffness lanes give the scalar piola__tet_stiffness_blocks's bits in every
@@ -368,6 +432,7 @@ int main(void) {
       cmocka_unit_test(chosen_variant_follows_cpu_and_environment),
       cmocka_unit_test(svd_variants_agree),
       cmocka_unit_test(force_damping_and_step_variants_agree),
+      cmocka_unit_test(cached_step_bound_variants_agree),
       cmocka_unit_test(stiffness_lanes_give_the_scalar_bits),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);

@@ -29,6 +29,7 @@
 #include "force/elastic_body_internal.h"
 #include "force/element_stiffness.h"
 #include "force/stable_step.h"
+#include "force/stable_step_modulus.h"
 #include "material/hgo_kernels.h"
 #include "material/material_kernels.h"
 #include "piola/diagonalize.h"
@@ -652,6 +653,111 @@ static void hgo_bound_reuses_the_force_loop(void **state) {
   }
 }
 
+/* The models whose force loop forms k (stable_step_modulus.h; issue 21: computing it again in
+ * the pass cost 7-32% of an update). Each with its default extension and with LINEAR at 0.3,
+ * on a grid near rest, stretched 2x and 3x, flattened to 0.6 (every entry still above the
+ * threshold) and scrambled (flat and inverted tets): every cached k equals the one computed
+ * for that tet to 1e-12 relative (the force loop forms it with fused multiply-adds where its
+ * instruction set has them: rounding, not a different formula); every tet with no entry
+ * clamped is cached and none with one is; the bound equals the one computed tet by tet and
+ * the one of the same body with its cache detached; a tet whose Fhat changes after the update
+ * (a state moved in from another process) is not read from its stale slot. */
+static const piola_material_model step_cached_models[] = {
+    PIOLA_MODEL_NEOHOOKEAN, PIOLA_MODEL_MUSCLE, PIOLA_MODEL_COROTATED,
+    PIOLA_MODEL_STVK,       PIOLA_MODEL_ROTATED_LINEAR, PIOLA_MODEL_SPLINE};
+
+static double rate2_without_step_cache(piola_elastic_body *body) {
+  double *cache = body->step_cache;
+  body->step_cache = NULL;
+  const double computed = piola__elastic_body_state_rate2(body, NULL);
+  body->step_cache = cache;
+  return computed;
+}
+
+static void step_bound_reuses_the_force_loop(void **state) {
+  (void)state;
+  test_rng rng = test_rng_seeded(25);
+  enum { KINDS = 5 }; /* near rest, stretched 2x, 3x, flattened to 0.6, scrambled */
+  const long starts = test_samples(2 * KINDS, KINDS);
+  const int models = (int)(sizeof step_cached_models / sizeof step_cached_models[0]);
+  for (int mi = 0; mi < 2 * models; ++mi) {
+    piola_material_def def = piola_default_material_def();
+    def.model = step_cached_models[mi / 2];
+    def.poisson_ratio = 0.3;
+    if (mi % 2) def.inversion_mode = PIOLA_INVERSION_LINEAR, def.inversion_threshold = 0.3;
+    piola_material m;
+    assert_int_equal(piola_material_init(&def, &m), PIOLA_OK);
+    piola_tet_mesh mesh = fixture_grid(4, 0.1);
+    piola_elastic_body *body = fixture_body(&mesh, &m);
+    assert_non_null(body->step_cache);
+    const int32_t nv = mesh.vertex_count, nt = mesh.tet_count;
+    const long stride = body->padded_tet_count;
+    /* neo-Hookean and the muscle cache whole blocks with no entry clamped only */
+    const int block_wise = m.model == PIOLA_MODEL_NEOHOOKEAN || m.model == PIOLA_MODEL_MUSCLE;
+    double *x = malloc(sizeof *x * 3 * (size_t)nv), *f = malloc(sizeof *f * 3 * (size_t)nv);
+    for (long start = 0; start < starts; ++start) {
+      const int kind = (int)(start % KINDS);
+      const double along = kind == 1 ? 2.0 : kind == 2 ? 3.0 : 1.0, across = kind == 3 ? 0.6 : 1.0;
+      for (int32_t v = 0; v < 3 * nv; ++v)
+        x[v] = kind == 4 ? test_rng_uniform(&rng, 0, 0.4)
+                         : (v % 3 == 0 ? along : v % 3 == 2 ? across : 1.0) * mesh.positions[v] +
+                               0.002 * test_rng_normal(&rng);
+      assert_int_equal(piola_elastic_body_update(body, x, 1.0, f, NULL), PIOLA_OK);
+      const double *fhat = piola_elastic_body_fhat(body);
+      int32_t held = 0, clamped = 0;
+      for (int32_t t = 0; t < nt; ++t) {
+        const double *ft = fhat + 3 * t;
+        const int below = ft[0] < m.threshold || ft[1] < m.threshold || ft[2] < m.threshold;
+        const int holds = step_cache_holds(body->step_cache + t, stride, ft[0], ft[1], ft[2]);
+        clamped += below;
+        if (below) assert_false(holds);
+        if (!below && !block_wise) assert_true(holds);
+        if (!holds) continue;
+        ++held;
+        const double cached = body->step_cache[t + STEP_CACHE_MODULUS * stride];
+        const double direct = piola__elastic_body_tet_modulus(body, t, ft);
+        if (!(fabs(cached - direct) <= 1e-12 * direct))
+          fail_msg("%s (%s), start %ld, tet %d at (%.17g, %.17g, %.17g): cached k %.17g, computed %.17g",
+                   piola_material_model_name(m.model), piola_inversion_mode_name(m.inversion_mode), start,
+                   (int)t, ft[0], ft[1], ft[2], cached, direct);
+      }
+      /* the block-wise models: every full block with no entry clamped is cached (the last
+       * block holds padding tets at Fhat = 0) */
+      for (int32_t b = 0; block_wise && (b + 1) * PIOLA_TET_BLOCK <= nt; ++b) {
+        int plain = 1, all = 1;
+        for (int32_t t = b * PIOLA_TET_BLOCK; t < (b + 1) * PIOLA_TET_BLOCK; ++t) {
+          const double *ft = fhat + 3 * t;
+          plain &= neohookean_lane_unclamped(&m, ft[0], ft[1], ft[2]);
+          all &= step_cache_holds(body->step_cache + t, stride, ft[0], ft[1], ft[2]);
+        }
+        if (plain) assert_true(all);
+      }
+      if (kind < 4 && !(held > nt / 2))
+        fail_msg("%s (%s), start %ld: %d of %d tets cached, %d clamped", piola_material_model_name(m.model),
+                 piola_inversion_mode_name(m.inversion_mode), start, (int)held, (int)nt, (int)clamped);
+      if (kind == 4 && !(clamped > 0)) /* the scramble reaches the extension */
+        fail_msg("%s (%s), start %ld: no tet clamped, %d cached", piola_material_model_name(m.model),
+                 piola_inversion_mode_name(m.inversion_mode), start, (int)held);
+      const double bound = piola__elastic_body_state_rate2(body, NULL), per_tet = per_tet_rate2(body);
+      const double computed = rate2_without_step_cache(body);
+      if (!(fabs(bound - per_tet) <= 1e-12 * per_tet) || !(fabs(bound - computed) <= 1e-12 * computed))
+        fail_msg("%s (%s), start %ld: bound from the cache %.17g, per tet %.17g, without the cache %.17g",
+                 piola_material_model_name(m.model), piola_inversion_mode_name(m.inversion_mode), start,
+                 bound, per_tet, computed);
+      /* a changed Fhat: the bound computes that tet instead of reading its old slot */
+      double *own = body->fhat + 3 * 5;
+      own[0] *= 3.0, own[1] *= 0.5;
+      assert_false(step_cache_holds(body->step_cache + 5, stride, own[0], own[1], own[2]));
+      const double moved = piola__elastic_body_state_rate2(body, NULL);
+      assert_close(moved, per_tet_rate2(body), 1e-12 * moved);
+      assert_close(moved, rate2_without_step_cache(body), 1e-12 * moved);
+    }
+    free(x), free(f);
+    piola_elastic_body_destroy(body);
+    fixture_mesh_free(&mesh);
+  }
+}
+
 /* LINEAR bodies with inverted tets: the lane loops take the LINEAR slopes only in blocks with
  * an entry below the threshold (linear_range) and agree with the per-tet path. */
 static void linear_lanes_agree_past_the_threshold(void **state) {
@@ -923,6 +1029,7 @@ int main(void) {
       cmocka_unit_test(hgo_bound_follows_the_fibres),
       cmocka_unit_test(ogden_bound_reuses_the_force_loop),
       cmocka_unit_test(hgo_bound_reuses_the_force_loop),
+      cmocka_unit_test(step_bound_reuses_the_force_loop),
       cmocka_unit_test(cfl_limit_of_a_block),
       cmocka_unit_test(weights_keep_sliver_steps_stable),
       cmocka_unit_test(step_follows_the_state),

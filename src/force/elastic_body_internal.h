@@ -103,6 +103,10 @@ struct piola_elastic_body {
   double *ogden_cache;      /* Ogden and Mooney-Rivlin bodies of one material: the step bound's
                                slots, OGDEN_CACHE_SLOTS * padded_tet_count (material_kernels.h),
                                written by the force loop; NULL for the other bodies */
+  double *step_cache;       /* bodies of one material whose model forms the step bound's k in
+                               the force loop (STEP_CACHE_MODEL, not the energy extension):
+                               STEP_CACHE_SLOTS * padded_tet_count (stable_step_modulus.h),
+                               written by the force loop; NULL for the other bodies */
   double *hgo_cache;        /* HGO bodies of one material with fibres: the step bound's fibre
                                term, HGO_CACHE_SLOTS * padded_tet_count (hgo_kernels.h), written
                                by the force loop; NULL for the other bodies */
@@ -170,6 +174,14 @@ void piola__elastic_body_split_share_fhat(piola_elastic_body *body);
    int32_t first, int count, double *out)
 PIOLA_ISA_DECLARE(void, piola__elastic_body_update_block_pair, PIOLA_UPDATE_BLOCK_PAIR_PARAMS);
 void piola__elastic_body_update_block_pair PIOLA_UPDATE_BLOCK_PAIR_PARAMS;
+
+/* Refills the step bound's k cache (stable_step_modulus.h) from the stored Fhat with the
+ * force loop's own kernels, blocks in the force loop's pairs: after a checkpoint restores Fhat
+ * without an update, the bound then reads the bits the uninterrupted run's force loop stored
+ * (force_lanes.c; the plain name runs the chosen variant). No-op without the cache. */
+#define PIOLA_REFILL_STEP_CACHE_PARAMS (piola_elastic_body * body)
+PIOLA_ISA_DECLARE(void, piola__elastic_body_refill_step_cache, PIOLA_REFILL_STEP_CACHE_PARAMS);
+void piola__elastic_body_refill_step_cache PIOLA_REFILL_STEP_CACHE_PARAMS;
 
 /* Bodies of at least PIOLA_PARALLEL_MIN_BLOCKS blocks sum their elastic forces in this many
  * fixed tet ranges (each its own partial sum), whatever the thread count. */

@@ -232,6 +232,34 @@ void PIOLA_ISA_NAME(piola__elastic_body_update_block_pair)(piola_elastic_body *b
   update_blocks(body, x, stiffness_scale, want_energy, first, count, out);
 }
 
+/* The stress lane kernels of the blocks from first (count 1 or 2, as update_blocks pairs
+ * them) on the stored Fhat, for what they write into the step bound's cache. */
+PIOLA_WIDE_VECTORS static void refill_blocks(piola_elastic_body *body, int32_t first, int count) {
+  double fhat[3][2 * B], phat[3][2 * B];
+  const int32_t base = first * B;
+  for (int l = 0; l < count * B; ++l)
+    for (int i = 0; i < 3; ++i) fhat[i][l] = body->fhat[3 * (size_t)(base + l) + i];
+  if (count == 2) {
+    piola__material_stress_lanes2(body, base, fhat, phat);
+  } else {
+    double fh1[3][B], ph1[3][B];
+    for (int i = 0; i < 3; ++i)
+      for (int l = 0; l < B; ++l) fh1[i][l] = fhat[i][l];
+    piola__material_stress_lanes(body, base, fh1, ph1);
+  }
+}
+
+void PIOLA_ISA_NAME(piola__elastic_body_refill_step_cache)(piola_elastic_body *body) {
+  if (!body->step_cache) return;
+  const int32_t blocks = body->padded_tet_count / B;
+  if (body->split_held) { /* a local split: the blocks this process holds, one by one */
+    for (int32_t b = 0; b < blocks; ++b)
+      if (body->split_held[b]) refill_blocks(body, b, 1);
+    return;
+  }
+  for (int32_t b = 0; b < blocks; b += 2) refill_blocks(body, b, blocks - b >= 2 ? 2 : 1);
+}
+
 /* Blocks [b0, b1) in pairs (the pairing depends only on b0 and b1, not on threads). */
 void PIOLA_ISA_NAME(piola__force_block_range)(piola_elastic_body *body, const double *x,
                                               double stiffness_scale, int want_energy, int32_t b0,

@@ -20,6 +20,10 @@ void piola__elastic_body_update_block_pair(piola_elastic_body *body, const doubl
                                                           first, count, out);
 }
 
+void piola__elastic_body_refill_step_cache(piola_elastic_body *body) {
+  PIOLA_ISA_SELECT(piola__elastic_body_refill_step_cache)(body);
+}
+
 double piola__fiber_energy_density(const piola_elastic_body *body, int32_t t) {
   return PIOLA_ISA_SELECT(piola__fiber_energy_density)(body, t);
 }

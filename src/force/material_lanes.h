@@ -13,6 +13,7 @@
 #define PIOLA_FORCE_MATERIAL_LANES_H
 
 #include "force/elastic_body_internal.h"
+#include "force/stable_step_modulus.h"
 #include "force/svd_kernel.h"
 #include "material/material_kernels.h"
 #include "piola/material.h"
@@ -23,6 +24,16 @@
     _Pragma("omp simd") for (int l = 0; l < (count); ++l)                                  \
         kernel(m, fhat[0][(first) + l], fhat[1][(first) + l], fhat[2][(first) + l],        \
                &phat[0][(first) + l], &phat[1][(first) + l], &phat[2][(first) + l]);       \
+  } while (0)
+
+/* The same, KERNEL also writing the step bound's cache slots of each lane (stable_step_modulus.h;
+ * cache_ and stride_ in scope). */
+#define PIOLA_STEP_CACHED_RUN(kernel, first, count)                                        \
+  do {                                                                                     \
+    _Pragma("omp simd") for (int l = 0; l < (count); ++l)                                  \
+        kernel(m, fhat[0][(first) + l], fhat[1][(first) + l], fhat[2][(first) + l],        \
+               &phat[0][(first) + l], &phat[1][(first) + l], &phat[2][(first) + l],        \
+               cache_ + (first) + l, stride_);                                             \
   } while (0)
 
 /* 1 when every lane of the PIOLA_TET_BLOCK lanes from lane FIRST passes PREDICATE (no entry
@@ -37,23 +48,48 @@
     (flag) = all_;                                                                         \
   } while (0)
 
-/* Blocks whose lanes are all unclamped take PLAIN, the others EXTENDED; per block of
- * PIOLA_TET_BLOCK, and a pair that agrees stays one interleaved loop. */
-#define PIOLA_SPLIT_BY_BLOCK(predicate, plain, extended, lanes)                            \
+/* Blocks whose lanes are all unclamped take PLAIN, the others EXTENDED, each lane loop run by
+ * RUN; per block of PIOLA_TET_BLOCK, and a pair that agrees stays one interleaved loop. */
+#define PIOLA_SPLIT_BY_BLOCK_WITH(run, predicate, plain, extended, lanes)                  \
   do {                                                                                     \
     int u0, u1 = 1;                                                                        \
     PIOLA_BLOCK_UNCLAMPED(predicate, 0, u0);                                               \
     if ((lanes) > PIOLA_TET_BLOCK) PIOLA_BLOCK_UNCLAMPED(predicate, PIOLA_TET_BLOCK, u1);  \
     if ((lanes) == PIOLA_TET_BLOCK || u0 == u1) {                                          \
-      if (u0) PIOLA_NEOHOOKEAN_RUN(plain, 0, (lanes));                                     \
-      else PIOLA_NEOHOOKEAN_RUN(extended, 0, (lanes));                                     \
+      if (u0) run(plain, 0, (lanes));                                                      \
+      else run(extended, 0, (lanes));                                                      \
     } else {                                                                               \
-      if (u0) PIOLA_NEOHOOKEAN_RUN(plain, 0, PIOLA_TET_BLOCK);                             \
-      else PIOLA_NEOHOOKEAN_RUN(extended, 0, PIOLA_TET_BLOCK);                             \
-      if (u1) PIOLA_NEOHOOKEAN_RUN(plain, PIOLA_TET_BLOCK, PIOLA_TET_BLOCK);               \
-      else PIOLA_NEOHOOKEAN_RUN(extended, PIOLA_TET_BLOCK, PIOLA_TET_BLOCK);               \
+      if (u0) run(plain, 0, PIOLA_TET_BLOCK);                                              \
+      else run(extended, 0, PIOLA_TET_BLOCK);                                              \
+      if (u1) run(plain, PIOLA_TET_BLOCK, PIOLA_TET_BLOCK);                                \
+      else run(extended, PIOLA_TET_BLOCK, PIOLA_TET_BLOCK);                                \
     }                                                                                      \
   } while (0)
+#define PIOLA_SPLIT_BY_BLOCK(predicate, plain, extended, lanes)                            \
+  PIOLA_SPLIT_BY_BLOCK_WITH(PIOLA_NEOHOOKEAN_RUN, predicate, plain, extended, lanes)
+
+/* The models whose force loop forms the step bound's k (body->step_cache, stable_step_modulus.h):
+ * returns from the stress body when it took the case. */
+#define PIOLA_STEP_CACHED_STRESS(lanes)                                                    \
+  if (body->step_cache) {                                                                  \
+    double *cache_ = body->step_cache + base;                                              \
+    const long stride_ = body->padded_tet_count;                                           \
+    switch (m->model) {                                                                    \
+      case PIOLA_MODEL_NEOHOOKEAN:                                                         \
+      case PIOLA_MODEL_MUSCLE:                                                             \
+        PIOLA_SPLIT_BY_BLOCK_WITH(PIOLA_STEP_CACHED_RUN, neohookean_lane_unclamped,        \
+                                  neohookean_stress_modulus_unclamped,                     \
+                                  neohookean_stress_lanes_uncached, lanes);                \
+        return;                                                                            \
+      case PIOLA_MODEL_COROTATED: PIOLA_STEP_CACHED_RUN(corotated_stress_modulus_lanes, 0, (lanes)); return; \
+      case PIOLA_MODEL_STVK: PIOLA_STEP_CACHED_RUN(stvk_stress_modulus_lanes, 0, (lanes)); return; \
+      case PIOLA_MODEL_SPLINE: PIOLA_STEP_CACHED_RUN(spline_stress_modulus_lanes, 0, (lanes)); return; \
+      case PIOLA_MODEL_ROTATED_LINEAR:                                                     \
+        PIOLA_STEP_CACHED_RUN(rotated_linear_stress_modulus_lanes, 0, (lanes));            \
+        return;                                                                            \
+      default: break;                                                                      \
+    }                                                                                      \
+  }
 
 #define PIOLA_MATERIAL_LANE_LOOP(kernel, lanes)                                            \
   do {                                                                                     \
@@ -87,6 +123,7 @@
         default: PIOLA_MATERIAL_LANE_LOOP(rotated_linear_stress_energy_mode_lanes, lanes); return; \
       }                                                                                    \
     }                                                                                      \
+    PIOLA_STEP_CACHED_STRESS(lanes)                                                        \
     switch (m->model) {                                                                    \
       case PIOLA_MODEL_COROTATED: PIOLA_MATERIAL_LANE_LOOP(corotated_stress_lanes, lanes); return; \
       case PIOLA_MODEL_STVK: PIOLA_MATERIAL_LANE_LOOP(stvk_stress_lanes, lanes); return;          \
@@ -145,5 +182,8 @@ PIOLA_KERNEL_INLINE void piola__material_stress_lanes2(const piola_elastic_body 
 #undef PIOLA_NEOHOOKEAN_RUN
 #undef PIOLA_BLOCK_UNCLAMPED
 #undef PIOLA_SPLIT_BY_BLOCK
+#undef PIOLA_SPLIT_BY_BLOCK_WITH
+#undef PIOLA_STEP_CACHED_RUN
+#undef PIOLA_STEP_CACHED_STRESS
 
 #endif

@@ -8,6 +8,7 @@
 #include "common/status_report.h"
 #include "force/elastic_body_internal.h"
 #include "force/fiber_lanes.h"
+#include "force/stable_step_modulus.h"
 #include "material/hgo_kernels.h"
 #include "material/material_kernels.h"
 #include "math/mat3.h"
@@ -48,6 +49,7 @@ void piola__elastic_body_free_arrays(piola_elastic_body *body) {
   free(body->step_gram);
   free(body->ogden_cache);
   free(body->hgo_cache);
+  free(body->step_cache);
   piola__damping_matrix_free(&body->damping);
   for (int k = 0; k < 3; ++k) free(body->fiber[k]);
   free(body->fiber_aos);
@@ -192,6 +194,9 @@ piola_status piola__elastic_body_build_rest_state(piola_elastic_body *body,
     /* calloc: pages stay unmapped until the force loop writes them (a local split's) */
     if (MATERIAL_IS_OGDEN(um->model) && um->inversion_mode != PIOLA_INVERSION_ENERGY &&
         !(body->ogden_cache = calloc(OGDEN_CACHE_SLOTS * (size_t)np, sizeof(double))))
+      return PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "elastic body with %d tets: out of memory", (int)nt);
+    if (STEP_CACHE_MODEL(um->model) && um->inversion_mode != PIOLA_INVERSION_ENERGY &&
+        !(body->step_cache = calloc(STEP_CACHE_SLOTS * (size_t)np, sizeof(double))))
       return PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "elastic body with %d tets: out of memory", (int)nt);
     if (um->model == PIOLA_MODEL_HGO && def->fiber_directions &&
         !(body->hgo_cache = calloc(HGO_CACHE_SLOTS * (size_t)np, sizeof(double))))

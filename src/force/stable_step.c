@@ -1,22 +1,19 @@
 /* The state-aware explicit step bound (see stable_step.h and docs/time-stepping.md).
  *
- * Why a separate pass and not the force loop: the bound needs only Fhat, which the update
- * stores per tet, so one streaming pass over 3 doubles per tet (plus one cached per-tet
- * geometric factor) gives it without touching the force kernels. The model switch is
- * hoisted out of an `omp simd` loop as in the force loop, and the per-lane work is the
- * model's value and slope at the clamped point (material_model_parts), its extension
- * (material_extend) and three 2x2 blocks.
- *
- * Its cost is that arithmetic, not the stream (measured, bench_stable_step's "warm" column):
- * a second pass run at once after the first, its Fhat and weights in cache, costs the same
- * CPU as the first (under load, 1 thread: neo-Hookean 8-10% of the update both ways,
- * corotated 9-11%, the spline 28-33%). So computing these same numbers inside the force loop
- * would save the 4 doubles per tet it reads, not the 7-34% of an update it costs on a quiet
- * machine; one long lane loop over a run of plain blocks instead of one per block saved at
- * most a tenth (throughput, not latency). What would is fewer operations per lane: the
- * force loop already forms 1/f_i, ln J and the model's parts at the clamped point for its
- * stress, and handing those over (as the Ogden and HGO caches do) is the way to the 5% of
- * issue 21.
+ * Why the force loop forms most of it: the pass is bound by its arithmetic, not by the
+ * stream (bench_stable_step's "warm" column: a second pass run at once after the first costs
+ * the same CPU), and that arithmetic repeats the force loop's (the model's value and slopes
+ * at Fhat, 1/f_i, ln J). So for neo-Hookean, the muscle, corotated, StVK, rotated linear and
+ * the spline the force loop's lane kernels form each tet's k (before the weight 1/(rho h_e^2)
+ * and the direction weights) where no entry is clamped and keep it with its Fhat as key
+ * (stable_step_modulus.h; corotated, StVK and rotated linear in closed form); the pass reads
+ * it for every block whose stored Fhat matches, and the weighted models' stiff blocks still
+ * take their weights here. Blocks with a clamped entry, a stale key (a state moved in from
+ * another process, a body changed since), the energy extension, mixed materials and the other
+ * models go through the lane loops below: the model switch hoisted out of an `omp simd` loop
+ * as in the force loop, per lane the model's value and slope at the clamped point
+ * (material_model_parts), its extension (material_extend) and three 2x2 blocks. The Ogden
+ * models and HGO hand over their dearest parts the same way (their own caches).
  *
  * The modulus. In the frame of the diagonalization dP/dF splits into the 3x3 block
  * K = dPhat/dFhat on the diagonal entries and one 2x2 block per pair (i, j) on (F_ij, F_ji),
@@ -33,7 +30,9 @@
  *
  * A kernel, compiled once per instruction set (common/isa.h): its lane loops are a few
  * percent of a step, and at baseline x86-64 four times that. Without fused multiply-adds
- * and with only max reductions, every variant computes the same bits. */
+ * and with only max reductions, every variant computes the same bits here; a k cached by
+ * the force loop carries that kernel's fused multiply-adds, so where the cache holds, the
+ * bound's last bits follow the variant as Fhat's do (tests/test_kernel_isa.c). */
 #include <math.h>
 #include <stdlib.h>
 
@@ -41,36 +40,17 @@
 #include "force/elastic_body_internal.h"
 #include "force/stable_step.h"
 #include "force/stable_step_anisotropy.h"
+#include "force/stable_step_modulus.h"
 #include "material/hgo_kernels.h"
 #include "material/material_kernels.h"
 
 #define STABLE_STEP_KERNEL static inline __attribute__((always_inline))
 
-/* The pair block's two eigenvalues as a +- b (see above), without the K_ij coupling. Selects,
- * no branches, so that the lane loop vectorizes. */
-STABLE_STEP_KERNEL void pair_block(double c, double pi, double pj, double fi, double fj, double kii,
-                                   double kjj, double kij, double *a, double *b) {
-  const double df = fi - fj, sum = fi + fj;
-  const int close = fabs(df) <= 1e-6 * (fabs(fi) + fabs(fj));
-  const double minus = close ? 0.5 * (kii + kjj) - kij : (pi - pj) / (close ? 1.0 : df);
-  const double den = sum >= 0.0 ? kernel_max(sum, c) : kernel_min(sum, -c);
-  const double plus = (pi + pj) / den;
-  *a = 0.5 * (minus + plus), *b = 0.5 * (minus - plus);
-}
-
-/* Largest eigenvalue of the pair block plus the K_ij coupling. */
-STABLE_STEP_KERNEL double pair_modulus(double c, double pi, double pj, double fi, double fj,
-                                       double kii, double kjj, double kij) {
-  double a, b;
-  pair_block(c, pi, pj, fi, fj, kii, kjj, kij, &a, &b);
-  return a + fabs(b + kij);
-}
-
 /* The same pair weighted by the direction weights wi, wj (stable_step_anisotropy.h). */
 STABLE_STEP_KERNEL double weighted_pair_modulus(double c, double pi, double pj, double fi, double fj,
                                                 double kii, double kjj, double kij, double wi, double wj) {
   double a, b;
-  pair_block(c, pi, pj, fi, fj, kii, kjj, kij, &a, &b);
+  step_pair_block(c, pi, pj, fi, fj, kii, kjj, kij, &a, &b);
   return step_weighted_pair(a, b + kij, wi, wj);
 }
 
@@ -204,10 +184,7 @@ STABLE_STEP_KERNEL double model_modulus_weighted(piola_material_model model, int
       k12 += 0.5 * s * (g[1] * j2 + g[2] * j1);
     }
   }
-  double k = kernel_max(k0, kernel_max(k1, k2));
-  k = kernel_max(k, pair_modulus(c, p0, p1, f0, f1, k0, k1, k01));
-  k = kernel_max(k, pair_modulus(c, p0, p2, f0, f2, k0, k2, k02));
-  k = kernel_max(k, pair_modulus(c, p1, p2, f1, f2, k1, k2, k12));
+  double k = step_modulus_of_slopes(c, p0, p1, p2, f0, f1, f2, k0, k1, k2, k01, k02, k12);
   if (wgt) {
     double kw = kernel_max(wgt[0] * k0, kernel_max(wgt[1] * k1, wgt[2] * k2));
     kw = kernel_max(kw, weighted_pair_modulus(c, p0, p1, f0, f1, k0, k1, k01, wgt[0], wgt[1]));
@@ -229,6 +206,16 @@ STABLE_STEP_KERNEL double model_modulus_from(piola_material_model model, int ene
 STABLE_STEP_KERNEL double model_modulus(piola_material_model model, int energy,
                                         const piola_material *m, double f0, double f1, double f2) {
   return model_modulus_weighted(model, energy, m, f0, f1, f2, NULL, NULL);
+}
+
+/* The force loop's k cache (stable_step_modulus.h) where the pass may read it, else NULL. Not
+ * in the replicated mode of a work split: there every process takes the bound over every tet
+ * and must get the same bits, but only its own blocks' k come from its force loop (with fused
+ * multiply-adds), the gathered ones would be computed here (without): the processes' steps
+ * would part in their last bits and their collectives with them (mpi_frames.sh's
+ * plastic_control hung on 2 processes). The local mode takes each process's own blocks only. */
+static const double *readable_step_cache(const piola_elastic_body *body) {
+  return body->split && !body->split_local ? NULL : body->step_cache;
 }
 
 /* Where the body has direction weights (stable_step_anisotropy.h): its Gram arrays once an
@@ -271,24 +258,13 @@ static double hgo_tet_fiber_modulus(const piola_elastic_body *body, const piola_
 }
 
 /* Neo-Hookean (and the muscle's matrix) with every entry at or above the threshold: the
- * closed forms of the terms above with one logarithm of J, L = lambda ln J, i_k = 1 / f_k:
- *   K_ii = mu (1 + i_i^2) + (lambda - L) i_i^2,  pair_ij = mu + i_i i_j |mu + lambda - L|
- * (a + b = mu (1 + i_i i_j) - L i_i i_j, a - b = mu (1 - i_i i_j) + L i_i i_j,
- * K_ij = lambda i_i i_j). The same numbers as model_modulus up to rounding, at a fraction of
- * the cost (three logarithms and the extension's selects are what make it dear). */
+ * closed form of step_neohookean_modulus with one logarithm of J. The same numbers as
+ * model_modulus up to rounding, at a fraction of the cost (three logarithms and the
+ * extension's selects are what make it dear). */
 STABLE_STEP_KERNEL double neohookean_matrix_modulus(const piola_material *m, double f0, double f1,
                                                     double f2) {
-  const double mu = m->mu, lambda = m->lambda;
   const double i0 = kernel_recip_fast(f0), i1 = kernel_recip_fast(f1), i2 = kernel_recip_fast(f2);
-  const double l = lambda * kernel_log_div(f0 * f1 * f2, KERNEL_FAST_RECIPROCAL);
-  const double soft = lambda - l, cross = fabs(mu + lambda - l);
-  const double k0 = mu * (1.0 + i0 * i0) + soft * i0 * i0;
-  const double k1 = mu * (1.0 + i1 * i1) + soft * i1 * i1;
-  const double k2 = mu * (1.0 + i2 * i2) + soft * i2 * i2;
-  double k = kernel_max(k0, kernel_max(k1, k2));
-  k = kernel_max(k, mu + i0 * kernel_max(i1, i2) * cross);
-  k = kernel_max(k, mu + i1 * i2 * cross);
-  return k;
+  return step_neohookean_modulus(m, i0, i1, i2, m->lambda * kernel_log_div(f0 * f1 * f2, KERNEL_FAST_RECIPROCAL));
 }
 
 /* The same with the muscle's fibre bound (zero for neo-Hookean). */
@@ -567,6 +543,16 @@ STABLE_STEP_KERNEL int block_unclamped(const piola_material *m, const double *f,
   return plain;
 }
 
+/* Whether the force loop's cache holds k for every tet of the block from t
+ * (stable_step_modulus.h). */
+STABLE_STEP_KERNEL int block_cached(const double *cache, long stride, const double *f, int32_t t) {
+  int held = 1;
+#pragma omp simd reduction(&:held)
+  for (int l = 0; l < PIOLA_TET_BLOCK; ++l)
+    held &= step_cache_holds(cache + t + l, stride, f[3 * (t + l)], f[3 * (t + l) + 1], f[3 * (t + l) + 2]);
+  return held;
+}
+
 /* One block [t, e) of weighted_range: max(best, its terms with the direction weights). LINEAR
  * blocks with a clamped entry (or a short one) go tet by tet (linear_tet_rate). */
 STABLE_STEP_KERNEL double weighted_block(piola_material_model model, int energy, const piola_material *m,
@@ -586,6 +572,32 @@ STABLE_STEP_KERNEL double weighted_block(piola_material_model model, int energy,
   return best;
 }
 
+/* The unweighted split of weighted_range for a full block from t whose k the force loop
+ * cached (KC): raises *BEST by the terms not above STIFF and returns the largest of the
+ * others. Not inlined: inside weighted_range's loop this second lane loop cost the computed
+ * path 3-4 times its time (the AVX-512 build, measured), whatever the block took. */
+__attribute__((noinline)) static double cached_block_split(const double *kc, const double *w, int32_t t,
+                                                           double stiff, double *best) {
+  double low = *best, h = 0;
+#pragma omp simd reduction(max:low) reduction(max:h)
+  for (int32_t u = t; u < t + PIOLA_TET_BLOCK; ++u) {
+    const double r = w[u] * kc[u];
+    const int above = kc[u] > stiff;
+    low = !above && r > low ? r : low;
+    h = above && r > h ? r : h;
+  }
+  *best = low;
+  return h;
+}
+
+/* weighted_range with the body's cache (stable_step_modulus.h) or none. Two instances, the
+ * second with a constant NULL: with the cache's branch in it, the computed lane loop (a body
+ * without the cache, the energy extension) took 3-4 times its time in the AVX-512 build. */
+#define WEIGHTED_RANGE(model, energy, m, body, gram, f, w, t0, t1)                                   \
+  (readable_step_cache(body) ? weighted_range(model, energy, m, body, gram, readable_step_cache(body), \
+                                              f, w, t0, t1)                                            \
+                             : weighted_range(model, energy, m, body, gram, NULL, f, w, t0, t1))
+
 /* Blocks a chunk of weighted_range holds: their stiff maxima stay on the stack. */
 enum { WEIGHTED_CHUNK = 64 };
 
@@ -596,12 +608,15 @@ enum { WEIGHTED_CHUNK = 64 };
  * upper bound of the stiff ones' (HIGH); a chunk's blocks whose HIGH is above the BEST so far
  * then take the weights (weighted_block). Near rest no tet is stiff and the bound costs the
  * unweighted loop alone; in a stretched state only the blocks that beat the running maximum
- * pay. LINEAR blocks with no clamped entry take the CLAMP numbers (linear_range). */
+ * pay. LINEAR blocks with no clamped entry take the CLAMP numbers (linear_range). A block
+ * whose k the force loop cached (block_cached) reads the unweighted terms from there. */
 STABLE_STEP_KERNEL double weighted_range(piola_material_model model, int energy, const piola_material *m,
                                          const piola_elastic_body *body, const double *gram,
-                                         const double *f, const double *w, int32_t t0, int32_t t1) {
+                                         const double *cache, const double *f, const double *w,
+                                         int32_t t0, int32_t t1) {
   const double stiff = STIFF_FACTOR * (m->lambda + 2.0 * m->mu);
   const int ext = energy == STEP_EXTENSION_LINEAR ? STEP_EXTENSION_CLAMP : energy;
+  const long stride = body->padded_tet_count;
   double best = 0;
   for (int32_t c0 = t0; c0 < t1; c0 += WEIGHTED_CHUNK * PIOLA_TET_BLOCK) {
     const int32_t c1 = t1 - c0 < WEIGHTED_CHUNK * PIOLA_TET_BLOCK ? t1 : c0 + WEIGHTED_CHUNK * PIOLA_TET_BLOCK;
@@ -609,7 +624,9 @@ STABLE_STEP_KERNEL double weighted_range(piola_material_model model, int energy,
     for (int32_t t = c0; t < c1; t += PIOLA_TET_BLOCK) {
       const int32_t e = c1 - t < PIOLA_TET_BLOCK ? c1 : t + PIOLA_TET_BLOCK;
       double h = 0;
-      if (energy == STEP_EXTENSION_LINEAR && !(e - t == PIOLA_TET_BLOCK && block_unclamped(m, f, t))) {
+      if (cache && e - t == PIOLA_TET_BLOCK && block_cached(cache, stride, f, t)) {
+        h = cached_block_split(cache + STEP_CACHE_MODULUS * stride, w, t, stiff, &best);
+      } else if (energy == STEP_EXTENSION_LINEAR && !(e - t == PIOLA_TET_BLOCK && block_unclamped(m, f, t))) {
         for (int32_t u = t; u < e; ++u) {
           const double *fu = f + 3 * u;
           const double k = model_modulus(model, STEP_EXTENSION_LINEAR, m, fu[0], fu[1], fu[2]);
@@ -646,7 +663,7 @@ STABLE_STEP_KERNEL double linear_range(piola_material_model model, const piola_e
                                        int32_t begin, int32_t end) {
   const double *gram = direction_gram(body);
   if (DIRECTION_WEIGHTED(model) && gram)
-    return weighted_range(model, STEP_EXTENSION_LINEAR, m, body, gram, f, w, begin, end);
+    return WEIGHTED_RANGE(model, STEP_EXTENSION_LINEAR, m, body, gram, f, w, begin, end);
   double best = 0;
   int32_t t = begin;
   for (; t + PIOLA_TET_BLOCK <= end; t += PIOLA_TET_BLOCK) {
@@ -674,7 +691,7 @@ STABLE_STEP_KERNEL double linear_range(piola_material_model model, const piola_e
 
 #define MODEL_LANE_LOOP(model)                                                                  \
   if (energy == STEP_EXTENSION_LINEAR) return linear_range(model, body, m, f, w, begin, end);   \
-  if (DIRECTION_WEIGHTED(model) && gram) return weighted_range(model, energy, m, body, gram, f, w, begin, end); \
+  if (DIRECTION_WEIGHTED(model) && gram) return WEIGHTED_RANGE(model, energy, m, body, gram, f, w, begin, end); \
   _Pragma("omp simd reduction(max:best)") for (int32_t t = begin; t < end; ++t) {               \
     const double r = w[t] * model_modulus(model, energy, m, f[3 * t], f[3 * t + 1], f[3 * t + 2]); \
     best = r > best ? r : best;                                                                 \
@@ -708,9 +725,9 @@ STABLE_STEP_KERNEL double uniform_range_rate2(const piola_elastic_body *body, in
   return best;
 }
 
-/* max over tets [begin, end) of w_e k_e */
-static double range_rate2(const piola_elastic_body *body, const double *w, int32_t begin,
-                          int32_t end) {
+/* max over tets [begin, end) of w_e k_e, every k computed here */
+static double computed_range_rate2(const piola_elastic_body *body, const double *w, int32_t begin,
+                                   int32_t end) {
   const double *f = body->fhat;
   double best = 0;
   if (body->uniform_material >= 0) {
@@ -725,6 +742,37 @@ static double range_rate2(const piola_elastic_body *body, const double *w, int32
       const double r = PIOLA_ISA_NAME(piola__elastic_body_tet_state_rate2)(body, t);
       best = r > best ? r : best;
     }
+  }
+  return best;
+}
+
+/* max over tets [begin, end) of w_e k_e: k from the force loop's cache in the blocks where it
+ * holds every tet's (block_cached), computed in the others. The direction-weighted models read
+ * it inside weighted_range, which weighs only the blocks that can raise the maximum. */
+static double range_rate2(const piola_elastic_body *body, const double *w, int32_t begin,
+                          int32_t end) {
+  const double *cache = readable_step_cache(body);
+  if (!cache || (direction_gram(body) && DIRECTION_WEIGHTED(body->materials[body->uniform_material].model)))
+    return computed_range_rate2(body, w, begin, end);
+  const long stride = body->padded_tet_count;
+  const double *f = body->fhat, *kc = cache + STEP_CACHE_MODULUS * stride;
+  double best = 0;
+  int32_t t = begin;
+  for (; t + PIOLA_TET_BLOCK <= end; t += PIOLA_TET_BLOCK) {
+    if (!block_cached(cache, stride, f, t)) {
+      const double r = computed_range_rate2(body, w, t, t + PIOLA_TET_BLOCK);
+      best = r > best ? r : best;
+      continue;
+    }
+#pragma omp simd reduction(max:best)
+    for (int32_t u = t; u < t + PIOLA_TET_BLOCK; ++u) {
+      const double r = w[u] * kc[u];
+      best = r > best ? r : best;
+    }
+  }
+  if (t < end) {
+    const double r = computed_range_rate2(body, w, t, end);
+    best = r > best ? r : best;
   }
   return best;
 }

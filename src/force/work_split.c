@@ -14,6 +14,7 @@
 
 #include "common/status_report.h"
 #include "force/elastic_body_internal.h"
+#include "force/stable_step_modulus.h"
 #include "material/hgo_kernels.h"
 #include "material/material_kernels.h"
 
@@ -92,6 +93,10 @@ static int localize_state(piola_elastic_body *body) {
   if (body->hgo_cache) {
     free(body->hgo_cache);
     body->hgo_cache = calloc(HGO_CACHE_SLOTS * np, sizeof(double));
+  }
+  if (body->step_cache) {
+    free(body->step_cache);
+    body->step_cache = calloc(STEP_CACHE_SLOTS * np, sizeof(double));
   }
   for (int k = 0; k < 9; ++k) {
     body->u[k] = u + (size_t)k * np;

@@ -406,6 +406,7 @@ static void elastic_state(stream *s, world_body *b) {
     e->energy_valid = 0; /* recomputed from Fhat when asked */
     b->elastic_stale = 1;
     b->state_rate_valid = 0; /* the step bound: recomputed from the restored Fhat */
+    if (has_state) piola__elastic_body_refill_step_cache(e); /* with the force loop's bits */
     m->ready = 0;
     if (ready) {
       /* allocate and assemble (the structure), then put back the saved blocks */

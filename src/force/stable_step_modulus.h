@@ -1,0 +1,211 @@
+/* The per-tet modulus k of the state-aware step bound where no entry of Fhat is clamped, and
+ * the force loop's cache of it (docs/time-stepping.md, "Cost").
+ *
+ * Why a cache: the bound's pass (stable_step.c) is bound by its arithmetic, not by the Fhat it
+ * reads, and most of that arithmetic repeats the force loop's: the model's value and slopes at
+ * Fhat, 1/f_i and ln J. So the force loop's lane kernels form k from the intermediates they
+ * already have and store it per tet with the Fhat it belongs to as key (as the Ogden and HGO
+ * caches do); the pass reads it for every block whose stored Fhat matches and computes the
+ * rest (a clamped entry, a state moved in from another process, a body changed since, the
+ * energy extension) as before. Only lanes with no entry clamped are cached: there every
+ * extension except the energy one adds exactly zero, so k is the same for CLAMP and LINEAR
+ * and needs neither the LINEAR slopes' extra evaluations nor the threshold's rise. A clamped
+ * lane writes a NaN key, which never matches.
+ *
+ * The formulas live here once, for both the pass and the force loop. The force loop compiles
+ * them with fused multiply-adds (force_lanes.c), so a cached k's last bits follow the kernel's
+ * instruction set variant, as Fhat's own do; the pass computes without them. */
+#ifndef PIOLA_FORCE_STABLE_STEP_MODULUS_H
+#define PIOLA_FORCE_STABLE_STEP_MODULUS_H
+
+#include <math.h>
+
+#include "material/material_kernels.h"
+
+/* The pair block's two eigenvalues as a +- b (stable_step.c's header), without the K_ij
+ * coupling. Selects, no branches, so that the lane loop vectorizes. */
+MATERIAL_KERNEL void step_pair_block(double c, double pi, double pj, double fi, double fj, double kii,
+                                     double kjj, double kij, double *a, double *b) {
+  const double df = fi - fj, sum = fi + fj;
+  const int close = fabs(df) <= 1e-6 * (fabs(fi) + fabs(fj));
+  const double minus = close ? 0.5 * (kii + kjj) - kij : (pi - pj) / (close ? 1.0 : df);
+  const double den = sum >= 0.0 ? kernel_max(sum, c) : kernel_min(sum, -c);
+  const double plus = (pi + pj) / den;
+  *a = 0.5 * (minus + plus), *b = 0.5 * (minus - plus);
+}
+
+/* Largest eigenvalue of the pair block plus the K_ij coupling. */
+MATERIAL_KERNEL double step_pair_modulus(double c, double pi, double pj, double fi, double fj,
+                                         double kii, double kjj, double kij) {
+  double a, b;
+  step_pair_block(c, pi, pj, fi, fj, kii, kjj, kij, &a, &b);
+  return a + fabs(b + kij);
+}
+
+/* k = max(max_i K_ii, max_{i<j} pair_ij) from the stress P and the 3x3 block K at Fhat f
+ * (threshold c, which keeps the pairs' f_i + f_j away from 0). */
+MATERIAL_KERNEL double step_modulus_of_slopes(double c, double p0, double p1, double p2, double f0,
+                                              double f1, double f2, double k0, double k1, double k2,
+                                              double k01, double k02, double k12) {
+  double k = kernel_max(k0, kernel_max(k1, k2));
+  k = kernel_max(k, step_pair_modulus(c, p0, p1, f0, f1, k0, k1, k01));
+  k = kernel_max(k, step_pair_modulus(c, p0, p2, f0, f2, k0, k2, k02));
+  return kernel_max(k, step_pair_modulus(c, p1, p2, f1, f2, k1, k2, k12));
+}
+
+/* k of a lane with no entry clamped from the model's parts there (fc = f), muscle fibres'
+ * bound included (HGO's directed fibre term is not: it has its own cache). */
+MATERIAL_KERNEL double step_unclamped_modulus(const piola_material *m, double c, const material_parts *pa,
+                                              double f0, double f1, double f2) {
+  return step_modulus_of_slopes(c, pa->p[0], pa->p[1], pa->p[2], f0, f1, f2, pa->k[0][0], pa->k[1][1],
+                                pa->k[2][2], pa->k[0][1], pa->k[0][2], pa->k[1][2]) +
+         m->fiber_modulus;
+}
+
+/* Neo-Hookean's matrix with every entry at or above the threshold, from i_k = 1 / f_k and
+ * L = lambda ln J:
+ *   K_ii = mu (1 + i_i^2) + (lambda - L) i_i^2,  pair_ij = mu + i_i i_j |mu + lambda - L|
+ * (a + b = mu (1 + i_i i_j) - L i_i i_j, a - b = mu (1 - i_i i_j) + L i_i i_j,
+ * K_ij = lambda i_i i_j). */
+MATERIAL_KERNEL double step_neohookean_modulus(const piola_material *m, double i0, double i1, double i2,
+                                               double l) {
+  const double mu = m->mu, lambda = m->lambda;
+  const double soft = lambda - l, cross = fabs(mu + lambda - l);
+  const double k0 = mu * (1.0 + i0 * i0) + soft * i0 * i0;
+  const double k1 = mu * (1.0 + i1 * i1) + soft * i1 * i1;
+  const double k2 = mu * (1.0 + i2 * i2) + soft * i2 * i2;
+  double k = kernel_max(k0, kernel_max(k1, k2));
+  k = kernel_max(k, mu + i0 * kernel_max(i1, i2) * cross);
+  return kernel_max(k, mu + i1 * i2 * cross);
+}
+
+/* The cache: per tet the Fhat of the update that wrote it and k there, structure of arrays,
+ * slot s of a tet at s * stride from its first. */
+enum {
+  STEP_CACHE_KEY = 0,     /* Fhat of the update that wrote the slot; NaN: a clamped lane */
+  STEP_CACHE_MODULUS = 3, /* Pa: k at that Fhat, muscle fibres included */
+  STEP_CACHE_SLOTS = 4
+};
+
+/* The bodies whose force loop fills the cache: one material, one of these models, and an
+ * extension other than the energy one (whose slopes are differences of the extended stress
+ * everywhere, stable_step.c). */
+#define STEP_CACHE_MODEL(model)                                                              \
+  ((model) == PIOLA_MODEL_NEOHOOKEAN || (model) == PIOLA_MODEL_MUSCLE ||                     \
+   (model) == PIOLA_MODEL_COROTATED || (model) == PIOLA_MODEL_STVK ||                        \
+   (model) == PIOLA_MODEL_ROTATED_LINEAR || (model) == PIOLA_MODEL_SPLINE)
+
+/* 1 when the cache holds k of Fhat f (the zero key of a never-written slot never matches, nor
+ * does a NaN one). */
+MATERIAL_KERNEL int step_cache_holds(const double *cache, long stride, double f0, double f1, double f2) {
+  return (cache[STEP_CACHE_KEY * stride] == f0) & (cache[(STEP_CACHE_KEY + 1) * stride] == f1) &
+         (cache[(STEP_CACHE_KEY + 2) * stride] == f2) & ((f0 != 0.0) | (f1 != 0.0) | (f2 != 0.0));
+}
+
+MATERIAL_KERNEL void step_cache_store(double *cache, long stride, int held, double f0, double f1, double f2,
+                                      double k) {
+  cache[(STEP_CACHE_KEY + 0) * stride] = held ? f0 : (double)NAN;
+  cache[(STEP_CACHE_KEY + 1) * stride] = f1;
+  cache[(STEP_CACHE_KEY + 2) * stride] = f2;
+  cache[STEP_CACHE_MODULUS * stride] = k;
+}
+
+/* The force loop's kernels. neohookean_stress_lanes_unclamped (the muscle's matrix too) with
+ * k from its reciprocals and logarithm: a few multiply-adds more. */
+MATERIAL_KERNEL void neohookean_stress_modulus_unclamped(const piola_material *m, double f0, double f1,
+                                                         double f2, double *p0, double *p1, double *p2,
+                                                         double *cache, long stride) {
+  const double mu = m->mu;
+  const double i0 = kernel_recip_fast(f0), i1 = kernel_recip_fast(f1), i2 = kernel_recip_fast(f2);
+  const double lq = m->lambda * kernel_log_div(f0 * f1 * f2, KERNEL_FAST_RECIPROCAL);
+  *p0 = mu * (f0 - i0) + lq * i0;
+  *p1 = mu * (f1 - i1) + lq * i1;
+  *p2 = mu * (f2 - i2) + lq * i2;
+  step_cache_store(cache, stride, 1, f0, f1, f2, step_neohookean_modulus(m, i0, i1, i2, lq) + m->fiber_modulus);
+}
+
+/* A lane the kernel above does not take (an entry clamped): its key never matches. */
+MATERIAL_KERNEL void step_cache_skip(double *cache, long stride) {
+  cache[STEP_CACHE_KEY * stride] = (double)NAN;
+}
+
+/* k with no entry clamped, from the parts there, for the force loop. For three models the
+ * pairs' divisions cancel (P_i = A'(f_i) + kappa q g_i, the pair ij's a +- b are the divided
+ * differences of P_i -+ P_j):
+ *   corotated (g_i = J / f_i, K_ii = 2 mu + lambda g_i^2): a = 2 mu (1 - s), b + K_ij =
+ *     2 mu s + lambda g_i g_j with s = 1 / (f_i + f_j), so pair_ij = 2 mu + lambda g_i g_j, at
+ *     most max(K_ii, K_jj): k = max_i K_ii;
+ *   StVK (A' = mu f (f^2 - 1), kappa q g_i = Q f_i with Q = lambda / 2 (|f|^2 - 3), K_ij =
+ *     lambda f_i f_j): a = mu (f_i^2 + f_j^2 - 1) + Q, b = mu f_i f_j, so
+ *     pair_ij = mu (f_i^2 + f_j^2 - 1) + Q + (mu + lambda) f_i f_j, largest for the two
+ *     largest entries;
+ *   rotated linear (A' = 2 mu (f - 1), kappa q g_i = T = lambda (tr Fhat - 3), K_ij = lambda,
+ *     K_ii = 2 mu + lambda): a = 2 mu + t s, b + K_ij = lambda - t s with t = T - 2 mu, so
+ *     pair_ij = 2 mu + max(lambda, 2 t s - lambda), largest for the smallest f_i + f_j when
+ *     t > 0 and at most K_ii when t <= 0: one division per tet instead of six.
+ * The others take the pair blocks as the pass does. The pass's divided differences agree with
+ * these closed forms up to its rounding (tests/test_stable_step.c, to 1e-12; on a million
+ * random Fhat in [c, c + 5]^3 corotated and StVK to the bit, rotated linear to 4e-11, where
+ * two entries lie within ~1e-5 of each other and the pass's (P_i - P_j) / (f_i - f_j) loses
+ * digits that the closed form keeps). */
+MATERIAL_KERNEL double step_model_unclamped_modulus(piola_material_model model, const piola_material *m,
+                                                    double c, const material_parts *pa, double f0,
+                                                    double f1, double f2) {
+  const double mu = m->mu, lambda = m->lambda;
+  const double diagonal = kernel_max(pa->k[0][0], kernel_max(pa->k[1][1], pa->k[2][2]));
+  switch (model) {
+    case PIOLA_MODEL_COROTATED: return diagonal + m->fiber_modulus;
+    case PIOLA_MODEL_STVK: {
+      /* the two largest entries: a b = the product of the pair without the smallest */
+      const double least = kernel_min(f0, kernel_min(f1, f2));
+      const double ab = least == f0 ? f1 * f2 : least == f1 ? f0 * f2 : f0 * f1;
+      const double q = 0.5 * lambda * (f0 * f0 + f1 * f1 + f2 * f2 - 3.0) - mu;
+      const double pair = mu * (f0 * f0 + f1 * f1 + f2 * f2 - least * least) + q + (mu + lambda) * ab;
+      return kernel_max(diagonal, pair) + m->fiber_modulus;
+    }
+    case PIOLA_MODEL_ROTATED_LINEAR: {
+      const double t = lambda * (f0 + f1 + f2 - 3.0) - 2.0 * mu;
+      const double most = kernel_max(f0, kernel_max(f1, f2));
+      const double pair = 2.0 * mu + kernel_max(lambda, 2.0 * t / (f0 + f1 + f2 - most) - lambda);
+      return kernel_max(diagonal, pair) + m->fiber_modulus;
+    }
+    default: return step_unclamped_modulus(m, c, pa, f0, f1, f2);
+  }
+}
+
+/* material_extended_stress of MODEL (no threshold rise) with k from the same parts where no
+ * entry is clamped (step_model_unclamped_modulus), not the model again. */
+MATERIAL_KERNEL void material_stress_modulus_lanes(piola_material_model model, const piola_material *m,
+                                                   double f0, double f1, double f2, double *p0,
+                                                   double *p1, double *p2, double *cache, long stride) {
+  const double c = m->threshold;
+  const double fc0 = kernel_max(f0, c), fc1 = kernel_max(f1, c), fc2 = kernel_max(f2, c);
+  material_parts parts;
+  material_model_parts(model, m, KERNEL_FAST_RECIPROCAL, fc0, fc1, fc2, &parts);
+  material_extend(m, KERNEL_FAST_RECIPROCAL, c, &parts, f0 - fc0, f1 - fc1, f2 - fc2, p0, p1, p2);
+  const int held = (f0 >= c) & (f1 >= c) & (f2 >= c);
+  step_cache_store(cache, stride, held, f0, f1, f2, step_model_unclamped_modulus(model, m, c, &parts, f0, f1, f2));
+}
+
+/* One per model, so that the force loop's lane loops name a kernel with the model constant. */
+#define STEP_STRESS_MODULUS_KERNEL(name, model)                                                        \
+  MATERIAL_KERNEL void name##_stress_modulus_lanes(const piola_material *m, double f0, double f1,       \
+                                                   double f2, double *p0, double *p1, double *p2,      \
+                                                   double *cache, long stride) {                       \
+    material_stress_modulus_lanes(model, m, f0, f1, f2, p0, p1, p2, cache, stride);                    \
+  }
+STEP_STRESS_MODULUS_KERNEL(corotated, PIOLA_MODEL_COROTATED)
+STEP_STRESS_MODULUS_KERNEL(stvk, PIOLA_MODEL_STVK)
+STEP_STRESS_MODULUS_KERNEL(spline, PIOLA_MODEL_SPLINE)
+STEP_STRESS_MODULUS_KERNEL(rotated_linear, PIOLA_MODEL_ROTATED_LINEAR)
+#undef STEP_STRESS_MODULUS_KERNEL
+
+/* neohookean_stress_lanes for a block with a clamped lane: no k formed, every key left stale. */
+MATERIAL_KERNEL void neohookean_stress_lanes_uncached(const piola_material *m, double f0, double f1,
+                                                      double f2, double *p0, double *p1, double *p2,
+                                                      double *cache, long stride) {
+  neohookean_stress_lanes(m, f0, f1, f2, p0, p1, p2);
+  step_cache_skip(cache, stride);
+}
+
+#endif

@@ -158,7 +158,8 @@ static inline int pcg(const system_t *sys, const held *h, test_preconditioner *p
     double rz_new = 0, rr = 0;
     for (int32_t j = 0; j < m; ++j) rz_new += r[j] * z[j], rr += r[j] * r[j];
     if (rr <= tol * tol * r0) break;
-    for (int32_t j = 0; j < m; ++j) p[j] = z[j] + (it > 0 ? rz_new / rz : 0.0) * p[j];
+    /* the first direction is z itself: p is not yet set (0 times garbage can be NaN) */
+    for (int32_t j = 0; j < m; ++j) p[j] = it > 0 ? z[j] + rz_new / rz * p[j] : z[j];
     rz = rz_new;
     filtered_apply(sys, h, p, q);
     double pq = 0;

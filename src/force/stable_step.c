@@ -208,14 +208,18 @@ STABLE_STEP_KERNEL double model_modulus(piola_material_model model, int energy,
   return model_modulus_weighted(model, energy, m, f0, f1, f2, NULL, NULL);
 }
 
-/* The force loop's k cache (stable_step_modulus.h) where the pass may read it, else NULL. Not
+/* The force loop's k cache (stable_step_modulus.h), or the Ogden and HGO caches of
+ * material_kernels.h and hgo_kernels.h, where the pass may read it, else NULL. Not
  * in the replicated mode of a work split: there every process takes the bound over every tet
  * and must get the same bits, but only its own blocks' k come from its force loop (with fused
  * multiply-adds), the gathered ones would be computed here (without): the processes' steps
  * would part in their last bits and their collectives with them (mpi_frames.sh's
  * plastic_control hung on 2 processes). The local mode takes each process's own blocks only. */
+static const double *readable_force_loop_cache(const piola_elastic_body *body, const double *cache) {
+  return body->split && !body->split_local ? NULL : cache;
+}
 static const double *readable_step_cache(const piola_elastic_body *body) {
-  return body->split && !body->split_local ? NULL : body->step_cache;
+  return readable_force_loop_cache(body, body->step_cache);
 }
 
 /* Where the body has direction weights (stable_step_anisotropy.h): its Gram arrays once an
@@ -243,7 +247,7 @@ static double hgo_tet_fiber_modulus(const piola_elastic_body *body, const piola_
                                     int32_t t, const double f[3]) {
   if (!body->fiber[0]) return 0.0;
   if (!body->has_state) return hgo_fiber_modulus_bound(&m->hgo, f[0], f[1], f[2]);
-  const double *cache = body->hgo_cache;
+  const double *cache = readable_force_loop_cache(body, body->hgo_cache);
   if (cache && hgo_cache_holds(cache + t, body->padded_tet_count, f[0], f[1], f[2]))
     return cache[t + HGO_CACHE_MODULUS * body->padded_tet_count];
   const long stride = body->padded_tet_count;
@@ -480,7 +484,7 @@ static double hgo_range(const piola_elastic_body *body, int energy, const piola_
                         const double *f, const double *w, int32_t begin, int32_t end) {
   const int fibers = body->fiber[0] != NULL;
   const long stride = body->padded_tet_count;
-  const double *cache = body->hgo_cache;
+  const double *cache = readable_force_loop_cache(body, body->hgo_cache);
   double best = 0;
   int32_t t = begin;
   if (energy != STEP_EXTENSION_ENERGY && (!fibers || cache))
@@ -716,7 +720,7 @@ STABLE_STEP_KERNEL double uniform_range_rate2(const piola_elastic_body *body, in
     case PIOLA_MODEL_STABLE_NEOHOOKEAN: MODEL_LANE_LOOP(PIOLA_MODEL_STABLE_NEOHOOKEAN)
     case PIOLA_MODEL_MOONEY_RIVLIN: /* stored as two Ogden terms */
     case PIOLA_MODEL_OGDEN:
-      if (energy != STEP_EXTENSION_ENERGY && body->ogden_cache)
+      if (energy != STEP_EXTENSION_ENERGY && readable_force_loop_cache(body, body->ogden_cache))
         return ogden_range(body, energy, m, f, w, begin, end);
       MODEL_LANE_LOOP(PIOLA_MODEL_OGDEN)
     case PIOLA_MODEL_ROTATED_LINEAR: MODEL_LANE_LOOP(PIOLA_MODEL_ROTATED_LINEAR)

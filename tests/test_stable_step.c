@@ -383,6 +383,18 @@ static void modulus_bounds_the_threshold_rise(void **state) {
 }
 
 /* A grid body of one material per tet (materials[tet % count]) deformed by the matrix a. */
+/* MODEL at nu = 0.3 with its default extension, or with LINEAR at 0.3 where LINEAR is set:
+ * the materials of the force-loop cache tests below. */
+static piola_material cache_test_material(piola_material_model model, int linear) {
+  piola_material_def def = piola_default_material_def();
+  def.model = model;
+  def.poisson_ratio = 0.3;
+  if (linear) def.inversion_mode = PIOLA_INVERSION_LINEAR, def.inversion_threshold = 0.3;
+  piola_material m;
+  assert_int_equal(piola_material_init(&def, &m), PIOLA_OK);
+  return m;
+}
+
 static piola_elastic_body *deformed_grid(const piola_material *materials, int32_t count,
                                          const double a[9]) {
   piola_tet_mesh mesh = fixture_grid(3, 0.1);
@@ -513,12 +525,7 @@ static void ogden_bound_reuses_the_force_loop(void **state) {
   const piola_material_model models[] = {PIOLA_MODEL_MOONEY_RIVLIN, PIOLA_MODEL_OGDEN};
   const long starts = test_samples(6, 2);
   for (int mi = 0; mi < 4; ++mi) {
-    piola_material_def def = piola_default_material_def();
-    def.model = models[mi % 2];
-    def.poisson_ratio = 0.3;
-    if (mi >= 2) def.inversion_mode = PIOLA_INVERSION_LINEAR, def.inversion_threshold = 0.3;
-    piola_material m;
-    assert_int_equal(piola_material_init(&def, &m), PIOLA_OK);
+    piola_material m = cache_test_material(models[mi % 2], mi >= 2);
     piola_tet_mesh mesh = fixture_grid(4, 0.1);
     piola_elastic_body *body = fixture_body(&mesh, &m);
     assert_non_null(body->ogden_cache);
@@ -597,12 +604,7 @@ static void hgo_bound_reuses_the_force_loop(void **state) {
   enum { KINDS = 5 }; /* near rest, stretched 2x, 3x, compressed to J = 0.95, scrambled */
   const long starts = test_samples(2 * KINDS, KINDS);
   for (int mode = 0; mode < 2; ++mode) {
-    piola_material_def def = piola_default_material_def();
-    def.model = PIOLA_MODEL_HGO;
-    def.poisson_ratio = 0.3;
-    if (mode) def.inversion_mode = PIOLA_INVERSION_LINEAR, def.inversion_threshold = 0.3;
-    piola_material m;
-    assert_int_equal(piola_material_init(&def, &m), PIOLA_OK);
+    piola_material m = cache_test_material(PIOLA_MODEL_HGO, mode);
     piola_tet_mesh mesh = fixture_grid(4, 0.1);
     const int32_t nv = mesh.vertex_count, nt = mesh.tet_count;
     double *fibers = malloc(sizeof *fibers * 3 * (size_t)nt);
@@ -681,12 +683,7 @@ static void step_bound_reuses_the_force_loop(void **state) {
   const long starts = test_samples(2 * KINDS, KINDS);
   const int models = (int)(sizeof step_cached_models / sizeof step_cached_models[0]);
   for (int mi = 0; mi < 2 * models; ++mi) {
-    piola_material_def def = piola_default_material_def();
-    def.model = step_cached_models[mi / 2];
-    def.poisson_ratio = 0.3;
-    if (mi % 2) def.inversion_mode = PIOLA_INVERSION_LINEAR, def.inversion_threshold = 0.3;
-    piola_material m;
-    assert_int_equal(piola_material_init(&def, &m), PIOLA_OK);
+    piola_material m = cache_test_material(step_cached_models[mi / 2], mi % 2);
     piola_tet_mesh mesh = fixture_grid(4, 0.1);
     piola_elastic_body *body = fixture_body(&mesh, &m);
     assert_non_null(body->step_cache);

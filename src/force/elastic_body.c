@@ -9,6 +9,7 @@
 #include "force/elastic_body_internal.h"
 #include "force/fiber_lanes.h"
 #include "force/force_lanes.h"
+#include "force/stable_step.h"
 #include "material/muscle_kernels.h"
 
 #define B PIOLA_TET_BLOCK
@@ -176,6 +177,10 @@ piola_status piola_elastic_body_update(piola_elastic_body *body, const double *x
                       "elastic body update: the body was split among processes (local mode) and "
                       "holds only its part; it cannot step without that split");
   int32_t blocks = body->padded_tet_count / B;
+  if (body->step_cache) { /* the blocks this update forms carry its generation as their key */
+    ++body->step_generation;
+    (void)piola__elastic_body_step_weights(body); /* NULL (out of memory): no block is cached */
+  }
   if (body->split) {
     piola__elastic_body_split_update(body, x, stiffness_scale, stats != NULL, forces);
   } else {

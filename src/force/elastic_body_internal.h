@@ -105,8 +105,10 @@ struct piola_elastic_body {
                                written by the force loop; NULL for the other bodies */
   double *step_cache;       /* bodies of one material whose model forms the step bound's k in
                                the force loop (STEP_CACHE_MODEL, not the energy extension):
-                               STEP_CACHE_SLOTS * padded_tet_count (stable_step_modulus.h),
-                               written by the force loop; NULL for the other bodies */
+                               STEP_CACHE_SLOTS per block (stable_step_modulus.h), written by
+                               the force loop; NULL for the other bodies */
+  uint64_t step_generation; /* raised by each update and refill of a body with step_cache: the
+                               key of the blocks that update formed */
   double *hgo_cache;        /* HGO bodies of one material with fibres: the step bound's fibre
                                term, HGO_CACHE_SLOTS * padded_tet_count (hgo_kernels.h), written
                                by the force loop; NULL for the other bodies */

@@ -15,6 +15,7 @@
 #include "force/fiber_lanes.h"
 #include "force/force_lanes.h"
 #include "force/material_lanes.h"
+#include "force/stable_step.h"
 #include "force/svd_kernel.h"
 
 #define B PIOLA_TET_BLOCK
@@ -251,6 +252,9 @@ PIOLA_WIDE_VECTORS static void refill_blocks(piola_elastic_body *body, int32_t f
 
 void PIOLA_ISA_NAME(piola__elastic_body_refill_step_cache)(piola_elastic_body *body) {
   if (!body->step_cache) return;
+  ++body->step_generation; /* no block of an earlier update holds */
+  if (!body->has_state) return;
+  (void)PIOLA_ISA_NAME(piola__elastic_body_step_weights)(body);
   const int32_t blocks = body->padded_tet_count / B;
   if (body->split_held) { /* a local split: the blocks this process holds, one by one */
     for (int32_t b = 0; b < blocks; ++b)

@@ -59,6 +59,10 @@ double piola__elastic_body_tet_state_rate2(const piola_elastic_body *body, int32
   return PIOLA_ISA_SELECT(piola__elastic_body_tet_state_rate2)(body, tet);
 }
 
+const double *piola__elastic_body_step_weights(piola_elastic_body *body) {
+  return PIOLA_ISA_SELECT(piola__elastic_body_step_weights)(body);
+}
+
 double piola__elastic_body_tet_rest_altitude(const piola_elastic_body *body, int32_t tet) {
   return PIOLA_ISA_SELECT(piola__elastic_body_tet_rest_altitude)(body, tet);
 }

@@ -26,15 +26,46 @@
                &phat[0][(first) + l], &phat[1][(first) + l], &phat[2][(first) + l]);       \
   } while (0)
 
-/* The same, KERNEL also writing the step bound's cache slots of each lane (stable_step_modulus.h;
- * cache_ and stride_ in scope). */
+/* The same, KERNEL also writing each lane's step-bound modulus k into k_ (in scope). */
 #define PIOLA_STEP_CACHED_RUN(kernel, first, count)                                        \
   do {                                                                                     \
     _Pragma("omp simd") for (int l = 0; l < (count); ++l)                                  \
         kernel(m, fhat[0][(first) + l], fhat[1][(first) + l], fhat[2][(first) + l],        \
                &phat[0][(first) + l], &phat[1][(first) + l], &phat[2][(first) + l],        \
-               cache_ + (first) + l, stride_);                                             \
+               k_ + (first) + l);                                                          \
   } while (0)
+
+/* The step bound's cache (stable_step_modulus.h) of the LANES / PIOLA_TET_BLOCK blocks from
+ * tet BASE, from their lanes' k (NaN where an entry is clamped): per block the maxima of
+ * w_e k_e below and above the stiff modulus, under the update's generation. A block with a
+ * clamped lane or a padding tet, or a body without its weights yet, is marked not formed. */
+PIOLA_KERNEL_INLINE void piola__step_cache_blocks(const piola_elastic_body *body, const piola_material *m,
+                                                  int32_t base, const double *k, int lanes) {
+  const double *w = body->step_weight;
+  const double stiff = STEP_CACHE_STIFF * (m->lambda + 2.0 * m->mu);
+  for (int j = 0; j < lanes / PIOLA_TET_BLOCK; ++j) {
+    const int32_t first = base + j * PIOLA_TET_BLOCK;
+    double *slot = body->step_cache + (size_t)(first / PIOLA_TET_BLOCK) * STEP_CACHE_SLOTS;
+    if (!w || first + PIOLA_TET_BLOCK > body->tet_count) {
+      slot[STEP_CACHE_KEY] = 0.0;
+      continue;
+    }
+    const double *kj = k + j * PIOLA_TET_BLOCK, *wj = w + first;
+    double low = 0, high = 0;
+    int formed = 1;
+#pragma omp simd reduction(max:low) reduction(max:high) reduction(&:formed)
+    for (int l = 0; l < PIOLA_TET_BLOCK; ++l) {
+      const double r = wj[l] * kj[l];
+      const int above = kj[l] > stiff;
+      formed &= kj[l] == kj[l];
+      low = !above && r > low ? r : low;
+      high = above && r > high ? r : high;
+    }
+    slot[STEP_CACHE_KEY] = formed ? (double)body->step_generation : 0.0;
+    slot[STEP_CACHE_LOW] = low;
+    slot[STEP_CACHE_HIGH] = high;
+  }
+}
 
 /* 1 when every lane of the PIOLA_TET_BLOCK lanes from lane FIRST passes PREDICATE (no entry
  * below the threshold): the block then takes the plain formula (every extension adds exactly
@@ -71,24 +102,25 @@
 /* The models whose force loop forms the step bound's k (body->step_cache, stable_step_modulus.h):
  * returns from the stress body when it took the case. */
 #define PIOLA_STEP_CACHED_STRESS(lanes)                                                    \
-  if (body->step_cache) {                                                                  \
-    double *cache_ = body->step_cache + base;                                              \
-    const long stride_ = body->padded_tet_count;                                           \
+  if (body->step_cache && STEP_CACHE_MODEL(m->model)) {                                    \
+    double k_[2 * PIOLA_TET_BLOCK];                                                        \
     switch (m->model) {                                                                    \
       case PIOLA_MODEL_NEOHOOKEAN:                                                         \
       case PIOLA_MODEL_MUSCLE:                                                             \
         PIOLA_SPLIT_BY_BLOCK_WITH(PIOLA_STEP_CACHED_RUN, neohookean_lane_unclamped,        \
                                   neohookean_stress_modulus_unclamped,                     \
                                   neohookean_stress_lanes_uncached, lanes);                \
-        return;                                                                            \
-      case PIOLA_MODEL_COROTATED: PIOLA_STEP_CACHED_RUN(corotated_stress_modulus_lanes, 0, (lanes)); return; \
-      case PIOLA_MODEL_STVK: PIOLA_STEP_CACHED_RUN(stvk_stress_modulus_lanes, 0, (lanes)); return; \
-      case PIOLA_MODEL_SPLINE: PIOLA_STEP_CACHED_RUN(spline_stress_modulus_lanes, 0, (lanes)); return; \
+        break;                                                                             \
+      case PIOLA_MODEL_COROTATED: PIOLA_STEP_CACHED_RUN(corotated_stress_modulus_lanes, 0, (lanes)); break; \
+      case PIOLA_MODEL_STVK: PIOLA_STEP_CACHED_RUN(stvk_stress_modulus_lanes, 0, (lanes)); break; \
+      case PIOLA_MODEL_SPLINE: PIOLA_STEP_CACHED_RUN(spline_stress_modulus_lanes, 0, (lanes)); break; \
       case PIOLA_MODEL_ROTATED_LINEAR:                                                     \
         PIOLA_STEP_CACHED_RUN(rotated_linear_stress_modulus_lanes, 0, (lanes));            \
-        return;                                                                            \
-      default: break;                                                                      \
+        break;                                                                             \
+      default: break; /* not a STEP_CACHE_MODEL */                                        \
     }                                                                                      \
+    piola__step_cache_blocks(body, m, base, k_, (lanes));                                  \
+    return;                                                                                \
   }
 
 #define PIOLA_MATERIAL_LANE_LOOP(kernel, lanes)                                            \

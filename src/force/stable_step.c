@@ -54,11 +54,6 @@ STABLE_STEP_KERNEL double weighted_pair_modulus(double c, double pi, double pj, 
   return step_weighted_pair(a, b + kij, wi, wj);
 }
 
-/* The direction weights apply to a tet whose modulus is above this many times its rest
- * modulus lambda + 2 mu: where the state, not the mesh, sets the step (scrambles, strong
- * stretch). Below it the bound is the unweighted one and costs what it did. */
-#define STIFF_FACTOR 4.0
-
 /* The models whose bound takes the direction weights: those that stiffen under stretch where
  * the sliver is wide (docs/time-stepping.md, "Slivers stretched along their thin direction").
  * Neo-Hookean, the muscle, Ogden, Mooney-Rivlin and HGO keep the unweighted bound. */
@@ -190,7 +185,7 @@ STABLE_STEP_KERNEL double model_modulus_weighted(piola_material_model model, int
     kw = kernel_max(kw, weighted_pair_modulus(c, p0, p1, f0, f1, k0, k1, k01, wgt[0], wgt[1]));
     kw = kernel_max(kw, weighted_pair_modulus(c, p0, p2, f0, f2, k0, k2, k02, wgt[0], wgt[2]));
     kw = kernel_max(kw, weighted_pair_modulus(c, p1, p2, f1, f2, k1, k2, k12, wgt[1], wgt[2]));
-    k = k > STIFF_FACTOR * (m->lambda + 2.0 * m->mu) ? kernel_min(k, kw) : k;
+    k = k > STEP_CACHE_STIFF * (m->lambda + 2.0 * m->mu) ? kernel_min(k, kw) : k;
   }
   /* muscle fibres: their tangent stiffness bound, as in the rest bound; HGO's exponential
    * fibres depend on their direction: hgo_tet_fiber_modulus, added by the callers */
@@ -374,6 +369,10 @@ static const double *rate_weights(piola_elastic_body *body) {
   return body->step_weight;
 }
 
+const double *PIOLA_ISA_NAME(piola__elastic_body_step_weights)(piola_elastic_body *body) {
+  return rate_weights(body);
+}
+
 /* Neo-Hookean by blocks of PIOLA_TET_BLOCK: the plain closed form when no lane of the block
  * is below the threshold (neohookean_lane_unclamped, as the force loop decides), else the
  * general one. */
@@ -532,7 +531,7 @@ STABLE_STEP_KERNEL double linear_tet_rate(piola_material_model model, const piol
   const double *ft = f + 3 * t;
   const double k = model_modulus(model, STEP_EXTENSION_LINEAR, m, ft[0], ft[1], ft[2]);
   double r = w[t] * k;
-  if (gram && DIRECTION_WEIGHTED(model) && r > best && k > STIFF_FACTOR * (m->lambda + 2.0 * m->mu))
+  if (gram && DIRECTION_WEIGHTED(model) && r > best && k > STEP_CACHE_STIFF * (m->lambda + 2.0 * m->mu))
     r = w[t] * weighted_lane_modulus(model, STEP_EXTENSION_LINEAR, m, body, gram, t, ft);
   return r > best ? r : best;
 }
@@ -547,14 +546,13 @@ STABLE_STEP_KERNEL int block_unclamped(const piola_material *m, const double *f,
   return plain;
 }
 
-/* Whether the force loop's cache holds k for every tet of the block from t
- * (stable_step_modulus.h). */
-STABLE_STEP_KERNEL int block_cached(const double *cache, long stride, const double *f, int32_t t) {
-  int held = 1;
-#pragma omp simd reduction(&:held)
-  for (int l = 0; l < PIOLA_TET_BLOCK; ++l)
-    held &= step_cache_holds(cache + t + l, stride, f[3 * (t + l)], f[3 * (t + l) + 1], f[3 * (t + l) + 2]);
-  return held;
+/* The force loop's slots of the block from t (stable_step_modulus.h) when that block was
+ * formed by the update whose Fhat the body holds (its key is the body's generation), else
+ * NULL. T starts a block: the callers' ranges do. */
+STABLE_STEP_KERNEL const double *cached_block(const piola_elastic_body *body, const double *cache, int32_t t) {
+  const double *slot = cache + (size_t)(t / PIOLA_TET_BLOCK) * STEP_CACHE_SLOTS;
+  const double key = slot[STEP_CACHE_KEY];
+  return t % PIOLA_TET_BLOCK == 0 && key != 0.0 && key == (double)body->step_generation ? slot : NULL;
 }
 
 /* One block [t, e) of weighted_range: max(best, its terms with the direction weights). LINEAR
@@ -576,24 +574,6 @@ STABLE_STEP_KERNEL double weighted_block(piola_material_model model, int energy,
   return best;
 }
 
-/* The unweighted split of weighted_range for a full block from t whose k the force loop
- * cached (KC): raises *BEST by the terms not above STIFF and returns the largest of the
- * others. Not inlined: inside weighted_range's loop this second lane loop cost the computed
- * path 3-4 times its time (the AVX-512 build, measured), whatever the block took. */
-__attribute__((noinline)) static double cached_block_split(const double *kc, const double *w, int32_t t,
-                                                           double stiff, double *best) {
-  double low = *best, h = 0;
-#pragma omp simd reduction(max:low) reduction(max:h)
-  for (int32_t u = t; u < t + PIOLA_TET_BLOCK; ++u) {
-    const double r = w[u] * kc[u];
-    const int above = kc[u] > stiff;
-    low = !above && r > low ? r : low;
-    h = above && r > h ? r : h;
-  }
-  *best = low;
-  return h;
-}
-
 /* weighted_range with the body's cache (stable_step_modulus.h) or none. Two instances, the
  * second with a constant NULL: with the cache's branch in it, the computed lane loop (a body
  * without the cache, the energy extension) took 3-4 times its time in the AVX-512 build. */
@@ -607,7 +587,7 @@ enum { WEIGHTED_CHUNK = 64 };
 
 /* max over tets [t0, t1) of w_e k_e with the direction weights (GRAM not NULL), exact. The
  * weighted term is at most the unweighted one (min(k, k_w)) and differs from it only above
- * STIFF_FACTOR. So the unweighted lane loop runs first, block by block, and splits the
+ * STEP_CACHE_STIFF. So the unweighted lane loop runs first, block by block, and splits the
  * unweighted maximum into the exact terms of the tets not above it (BEST) and, per block, an
  * upper bound of the stiff ones' (HIGH); a chunk's blocks whose HIGH is above the BEST so far
  * then take the weights (weighted_block). Near rest no tet is stiff and the bound costs the
@@ -618,9 +598,8 @@ STABLE_STEP_KERNEL double weighted_range(piola_material_model model, int energy,
                                          const piola_elastic_body *body, const double *gram,
                                          const double *cache, const double *f, const double *w,
                                          int32_t t0, int32_t t1) {
-  const double stiff = STIFF_FACTOR * (m->lambda + 2.0 * m->mu);
+  const double stiff = STEP_CACHE_STIFF * (m->lambda + 2.0 * m->mu);
   const int ext = energy == STEP_EXTENSION_LINEAR ? STEP_EXTENSION_CLAMP : energy;
-  const long stride = body->padded_tet_count;
   double best = 0;
   for (int32_t c0 = t0; c0 < t1; c0 += WEIGHTED_CHUNK * PIOLA_TET_BLOCK) {
     const int32_t c1 = t1 - c0 < WEIGHTED_CHUNK * PIOLA_TET_BLOCK ? t1 : c0 + WEIGHTED_CHUNK * PIOLA_TET_BLOCK;
@@ -628,8 +607,10 @@ STABLE_STEP_KERNEL double weighted_range(piola_material_model model, int energy,
     for (int32_t t = c0; t < c1; t += PIOLA_TET_BLOCK) {
       const int32_t e = c1 - t < PIOLA_TET_BLOCK ? c1 : t + PIOLA_TET_BLOCK;
       double h = 0;
-      if (cache && e - t == PIOLA_TET_BLOCK && block_cached(cache, stride, f, t)) {
-        h = cached_block_split(cache + STEP_CACHE_MODULUS * stride, w, t, stiff, &best);
+      const double *slot = cache && e - t == PIOLA_TET_BLOCK ? cached_block(body, cache, t) : NULL;
+      if (slot) {
+        best = slot[STEP_CACHE_LOW] > best ? slot[STEP_CACHE_LOW] : best;
+        h = slot[STEP_CACHE_HIGH];
       } else if (energy == STEP_EXTENSION_LINEAR && !(e - t == PIOLA_TET_BLOCK && block_unclamped(m, f, t))) {
         for (int32_t u = t; u < e; ++u) {
           const double *fu = f + 3 * u;
@@ -758,21 +739,13 @@ static double range_rate2(const piola_elastic_body *body, const double *w, int32
   const double *cache = readable_step_cache(body);
   if (!cache || (direction_gram(body) && DIRECTION_WEIGHTED(body->materials[body->uniform_material].model)))
     return computed_range_rate2(body, w, begin, end);
-  const long stride = body->padded_tet_count;
-  const double *f = body->fhat, *kc = cache + STEP_CACHE_MODULUS * stride;
   double best = 0;
   int32_t t = begin;
   for (; t + PIOLA_TET_BLOCK <= end; t += PIOLA_TET_BLOCK) {
-    if (!block_cached(cache, stride, f, t)) {
-      const double r = computed_range_rate2(body, w, t, t + PIOLA_TET_BLOCK);
-      best = r > best ? r : best;
-      continue;
-    }
-#pragma omp simd reduction(max:best)
-    for (int32_t u = t; u < t + PIOLA_TET_BLOCK; ++u) {
-      const double r = w[u] * kc[u];
-      best = r > best ? r : best;
-    }
+    const double *slot = cached_block(body, cache, t);
+    const double r = slot ? (slot[STEP_CACHE_LOW] > slot[STEP_CACHE_HIGH] ? slot[STEP_CACHE_LOW] : slot[STEP_CACHE_HIGH])
+                          : computed_range_rate2(body, w, t, t + PIOLA_TET_BLOCK);
+    best = r > best ? r : best;
   }
   if (t < end) {
     const double r = computed_range_rate2(body, w, t, end);
@@ -890,23 +863,24 @@ double PIOLA_ISA_NAME(piola__elastic_body_state_rate2)(piola_elastic_body *body,
   if (!w || nt <= 0) return 0;
   const piola_work_split *local = piola__local_split(body);
   if (local) return local_rate2(body, w, local, worst_tet);
+  /* RANGES ranges of whole blocks (the force loop's, whose cached maxima they read) */
   enum { RANGES = 16 };
+  const int64_t blocks = ((int64_t)nt + PIOLA_TET_BLOCK - 1) / PIOLA_TET_BLOCK;
+#define RANGE_EDGE(r) ((int32_t)(blocks * (r) / RANGES * PIOLA_TET_BLOCK < nt ? blocks * (r) / RANGES * PIOLA_TET_BLOCK : nt))
   double part[RANGES];
   const int parallel = nt >= PIOLA_PARALLEL_MIN_BLOCKS * PIOLA_TET_BLOCK;
 #pragma omp parallel for schedule(static) num_threads(piola_thread_count()) if (parallel)
-  for (int r = 0; r < RANGES; ++r)
-    part[r] = range_rate2(body, w, (int32_t)((int64_t)nt * r / RANGES),
-                          (int32_t)((int64_t)nt * (r + 1) / RANGES));
+  for (int r = 0; r < RANGES; ++r) part[r] = range_rate2(body, w, RANGE_EDGE(r), RANGE_EDGE(r + 1));
   double best = 0;
   for (int r = 0; r < RANGES; ++r) best = part[r] > best ? part[r] : best;
   /* the search screens the ranges by their maxima first (near_tet_by_chunks' reason) */
   if (worst_tet && best > 0)
     for (int r = 0; r < RANGES && *worst_tet < 0; ++r) {
       if (!(part[r] >= best * (1 - 1e-10))) continue;
-      const int32_t r1 = (int32_t)((int64_t)nt * (r + 1) / RANGES);
-      for (int32_t t0 = (int32_t)((int64_t)nt * r / RANGES) / PIOLA_TET_BLOCK * PIOLA_TET_BLOCK;
-           t0 < r1 && *worst_tet < 0; t0 += PIOLA_TET_BLOCK)
+      const int32_t r1 = RANGE_EDGE(r + 1);
+      for (int32_t t0 = RANGE_EDGE(r); t0 < r1 && *worst_tet < 0; t0 += PIOLA_TET_BLOCK)
         *worst_tet = near_tet_in(body, w, t0, t0 + PIOLA_TET_BLOCK < nt ? t0 + PIOLA_TET_BLOCK : nt, best);
     }
+#undef RANGE_EDGE
   return best;
 }

@@ -25,6 +25,7 @@ PIOLA_ISA_DECLARE(double, piola__elastic_body_tet_state_rate2,
                   (const piola_elastic_body *body, int32_t tet));
 PIOLA_ISA_DECLARE(double, piola__elastic_body_tet_rest_altitude,
                   (const piola_elastic_body *body, int32_t tet));
+PIOLA_ISA_DECLARE(const double *, piola__elastic_body_step_weights, (piola_elastic_body * body));
 
 /* max over tets of k_e / (rho h_e^2) at the body's last update (1/s^2, stiffness scale 1),
  * the plastic stiffening left out (the caller multiplies by its square). *worst_tet (may be
@@ -39,6 +40,11 @@ double piola__elastic_body_tet_modulus(const piola_elastic_body *body, int32_t t
  * 1 / (rho h_e^2) times its modulus at its stored Fhat, with the direction weights of its
  * model (stable_step_anisotropy.h). Valid after a state_rate2 call has built the weights. */
 double piola__elastic_body_tet_state_rate2(const piola_elastic_body *body, int32_t tet);
+
+/* The bound's per-tet weights 1 / (rho h_e^2) (m/kg) and the Gram arrays of its direction
+ * weights, built on the first call from the Dm^-1 the body has then; NULL when out of memory.
+ * The force loop of a body with the step cache calls it so that it can weigh its k. */
+const double *piola__elastic_body_step_weights(piola_elastic_body *body);
 
 /* Rest altitude of tet t, 1 / max_c |grad N_c| (m), from its rest Dm^-1. */
 double piola__elastic_body_tet_rest_altitude(const piola_elastic_body *body, int32_t tet);

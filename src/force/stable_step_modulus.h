@@ -79,13 +79,23 @@ MATERIAL_KERNEL double step_neohookean_modulus(const piola_material *m, double i
   return kernel_max(k, mu + i1 * i2 * cross);
 }
 
-/* The cache: per tet the Fhat of the update that wrote it and k there, structure of arrays,
- * slot s of a tet at s * stride from its first. */
+/* The cache: per block of PIOLA_TET_BLOCK tets, the step bound's two partial maxima of
+ * w_e k_e (w_e = 1 / (rho h_e^2), stable_step.c) and the update that formed them. LOW is the
+ * largest over the block's tets whose k is at most STEP_CACHE_STIFF times the rest modulus,
+ * HIGH over the others (0 where there is none): the direction-weighted models weigh only the
+ * stiff ones (stable_step.c, weighted_range), the others take the larger of the two. */
 enum {
-  STEP_CACHE_KEY = 0,     /* Fhat of the update that wrote the slot; NaN: a clamped lane */
-  STEP_CACHE_MODULUS = 3, /* Pa: k at that Fhat, muscle fibres included */
-  STEP_CACHE_SLOTS = 4
+  STEP_CACHE_KEY = 0,  /* the body's step_generation when the force loop formed the block;
+                          0 (never a generation): not formed, a lane clamped, no weights */
+  STEP_CACHE_LOW = 1,  /* 1/s^2 */
+  STEP_CACHE_HIGH = 2, /* 1/s^2 */
+  STEP_CACHE_SLOTS = 3
 };
+
+/* The direction weights apply to a tet whose modulus is above this many times its rest
+ * modulus lambda + 2 mu: where the state, not the mesh, sets the step (scrambles, strong
+ * stretch). Below it the bound is the unweighted one. */
+#define STEP_CACHE_STIFF 4.0
 
 /* The bodies whose force loop fills the cache: one material, one of these models, and an
  * extension other than the energy one (whose slopes are differences of the extended stress
@@ -95,39 +105,26 @@ enum {
    (model) == PIOLA_MODEL_COROTATED || (model) == PIOLA_MODEL_STVK ||                        \
    (model) == PIOLA_MODEL_ROTATED_LINEAR || (model) == PIOLA_MODEL_SPLINE)
 
-/* 1 when the cache holds k of Fhat f (the zero key of a never-written slot never matches, nor
- * does a NaN one). */
-MATERIAL_KERNEL int step_cache_holds(const double *cache, long stride, double f0, double f1, double f2) {
-  return (cache[STEP_CACHE_KEY * stride] == f0) & (cache[(STEP_CACHE_KEY + 1) * stride] == f1) &
-         (cache[(STEP_CACHE_KEY + 2) * stride] == f2) & ((f0 != 0.0) | (f1 != 0.0) | (f2 != 0.0));
-}
-
-MATERIAL_KERNEL void step_cache_store(double *cache, long stride, int held, double f0, double f1, double f2,
-                                      double k) {
-  cache[(STEP_CACHE_KEY + 0) * stride] = held ? f0 : (double)NAN;
-  cache[(STEP_CACHE_KEY + 1) * stride] = f1;
-  cache[(STEP_CACHE_KEY + 2) * stride] = f2;
-  cache[STEP_CACHE_MODULUS * stride] = k;
-}
+/* A lane's k for the block's maxima: NaN where an entry is clamped (the block is then not
+ * cached). */
+MATERIAL_KERNEL void step_cache_store(double *k_out, int held, double k) { *k_out = held ? k : (double)NAN; }
 
 /* The force loop's kernels. neohookean_stress_lanes_unclamped (the muscle's matrix too) with
  * k from its reciprocals and logarithm: a few multiply-adds more. */
 MATERIAL_KERNEL void neohookean_stress_modulus_unclamped(const piola_material *m, double f0, double f1,
                                                          double f2, double *p0, double *p1, double *p2,
-                                                         double *cache, long stride) {
+                                                         double *k_out) {
   const double mu = m->mu;
   const double i0 = kernel_recip_fast(f0), i1 = kernel_recip_fast(f1), i2 = kernel_recip_fast(f2);
   const double lq = m->lambda * kernel_log_div(f0 * f1 * f2, KERNEL_FAST_RECIPROCAL);
   *p0 = mu * (f0 - i0) + lq * i0;
   *p1 = mu * (f1 - i1) + lq * i1;
   *p2 = mu * (f2 - i2) + lq * i2;
-  step_cache_store(cache, stride, 1, f0, f1, f2, step_neohookean_modulus(m, i0, i1, i2, lq) + m->fiber_modulus);
+  step_cache_store(k_out, 1, step_neohookean_modulus(m, i0, i1, i2, lq) + m->fiber_modulus);
 }
 
-/* A lane the kernel above does not take (an entry clamped): its key never matches. */
-MATERIAL_KERNEL void step_cache_skip(double *cache, long stride) {
-  cache[STEP_CACHE_KEY * stride] = (double)NAN;
-}
+/* A lane the kernel above does not take (an entry clamped): no k, so no cached block. */
+MATERIAL_KERNEL void step_cache_skip(double *k_out) { *k_out = (double)NAN; }
 
 /* k with no entry clamped, from the parts there, for the force loop. For three models the
  * pairs' divisions cancel (P_i = A'(f_i) + kappa q g_i, the pair ij's a +- b are the divided
@@ -177,22 +174,22 @@ MATERIAL_KERNEL double step_model_unclamped_modulus(piola_material_model model, 
  * entry is clamped (step_model_unclamped_modulus), not the model again. */
 MATERIAL_KERNEL void material_stress_modulus_lanes(piola_material_model model, const piola_material *m,
                                                    double f0, double f1, double f2, double *p0,
-                                                   double *p1, double *p2, double *cache, long stride) {
+                                                   double *p1, double *p2, double *k_out) {
   const double c = m->threshold;
   const double fc0 = kernel_max(f0, c), fc1 = kernel_max(f1, c), fc2 = kernel_max(f2, c);
   material_parts parts;
   material_model_parts(model, m, KERNEL_FAST_RECIPROCAL, fc0, fc1, fc2, &parts);
   material_extend(m, KERNEL_FAST_RECIPROCAL, c, &parts, f0 - fc0, f1 - fc1, f2 - fc2, p0, p1, p2);
   const int held = (f0 >= c) & (f1 >= c) & (f2 >= c);
-  step_cache_store(cache, stride, held, f0, f1, f2, step_model_unclamped_modulus(model, m, c, &parts, f0, f1, f2));
+  step_cache_store(k_out, held, step_model_unclamped_modulus(model, m, c, &parts, f0, f1, f2));
 }
 
 /* One per model, so that the force loop's lane loops name a kernel with the model constant. */
 #define STEP_STRESS_MODULUS_KERNEL(name, model)                                                        \
   MATERIAL_KERNEL void name##_stress_modulus_lanes(const piola_material *m, double f0, double f1,       \
                                                    double f2, double *p0, double *p1, double *p2,      \
-                                                   double *cache, long stride) {                       \
-    material_stress_modulus_lanes(model, m, f0, f1, f2, p0, p1, p2, cache, stride);                    \
+                                                   double *k_out) {                                    \
+    material_stress_modulus_lanes(model, m, f0, f1, f2, p0, p1, p2, k_out);                            \
   }
 STEP_STRESS_MODULUS_KERNEL(corotated, PIOLA_MODEL_COROTATED)
 STEP_STRESS_MODULUS_KERNEL(stvk, PIOLA_MODEL_STVK)
@@ -203,9 +200,9 @@ STEP_STRESS_MODULUS_KERNEL(rotated_linear, PIOLA_MODEL_ROTATED_LINEAR)
 /* neohookean_stress_lanes for a block with a clamped lane: no k formed, every key left stale. */
 MATERIAL_KERNEL void neohookean_stress_lanes_uncached(const piola_material *m, double f0, double f1,
                                                       double f2, double *p0, double *p1, double *p2,
-                                                      double *cache, long stride) {
+                                                      double *k_out) {
   neohookean_stress_lanes(m, f0, f1, f2, p0, p1, p2);
-  step_cache_skip(cache, stride);
+  step_cache_skip(k_out);
 }
 
 #endif

@@ -96,7 +96,7 @@ static int localize_state(piola_elastic_body *body) {
   }
   if (body->step_cache) {
     free(body->step_cache);
-    body->step_cache = calloc(STEP_CACHE_SLOTS * np, sizeof(double));
+    body->step_cache = calloc(STEP_CACHE_SLOTS * (np / B), sizeof(double));
   }
   for (int k = 0; k < 9; ++k) {
     body->u[k] = u + (size_t)k * np;

@@ -406,7 +406,6 @@ static void elastic_state(stream *s, world_body *b) {
     e->energy_valid = 0; /* recomputed from Fhat when asked */
     b->elastic_stale = 1;
     b->state_rate_valid = 0; /* the step bound: recomputed from the restored Fhat */
-    if (has_state) piola__elastic_body_refill_step_cache(e); /* with the force loop's bits */
     m->ready = 0;
     if (ready) {
       /* allocate and assemble (the structure), then put back the saved blocks */
@@ -561,6 +560,9 @@ static void world_state(stream *s, piola_world *w) {
         elastic_state(s, b);
         plastic_state(s, b);
         if (!s->reading || s->version >= 6) step_weights(s, b);
+        /* the step bound's cache from the restored Fhat and weights, with the force loop's
+         * bits (stable_step_modulus.h; none without a state) */
+        if (s->reading && s->store && !s->failed) piola__elastic_body_refill_step_cache(b->solid);
         break;
       case PIOLA_BODY_SHELL:
         shell_state(s, b);

@@ -180,7 +180,9 @@ void piola__elastic_body_update_block_pair PIOLA_UPDATE_BLOCK_PAIR_PARAMS;
 /* Refills the step bound's k cache (stable_step_modulus.h) from the stored Fhat with the
  * force loop's own kernels, blocks in the force loop's pairs: after a checkpoint restores Fhat
  * without an update, the bound then reads the bits the uninterrupted run's force loop stored
- * (force_lanes.c; the plain name runs the chosen variant). No-op without the cache. */
+ * (force_lanes.c; the plain name runs the chosen variant). It raises step_generation first,
+ * so that no block of an earlier state is read, and without a state refills nothing. Call it
+ * after the step weights are restored. No-op without the cache. */
 #define PIOLA_REFILL_STEP_CACHE_PARAMS (piola_elastic_body * body)
 PIOLA_ISA_DECLARE(void, piola__elastic_body_refill_step_cache, PIOLA_REFILL_STEP_CACHE_PARAMS);
 void piola__elastic_body_refill_step_cache PIOLA_REFILL_STEP_CACHE_PARAMS;

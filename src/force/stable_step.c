@@ -5,12 +5,12 @@
  * the same CPU), and that arithmetic repeats the force loop's (the model's value and slopes
  * at Fhat, 1/f_i, ln J). So for neo-Hookean, the muscle, corotated, StVK, rotated linear and
  * the spline the force loop's lane kernels form each tet's k (before the weight 1/(rho h_e^2)
- * and the direction weights) where no entry is clamped and keep it with its Fhat as key
+ * and the direction weights) where no entry is clamped, and the force loop keeps per block
+ * the maxima of w_e k_e below and above the stiff modulus under the update's generation
  * (stable_step_modulus.h; corotated, StVK and rotated linear in closed form); the pass reads
- * it for every block whose stored Fhat matches, and the weighted models' stiff blocks still
- * take their weights here. Blocks with a clamped entry, a stale key (a state moved in from
- * another process, a body changed since), the energy extension, mixed materials and the other
- * models go through the lane loops below: the model switch hoisted out of an `omp simd` loop
+ * them for every block the last update formed, and the weighted models' stiff blocks still
+ * take their weights here. Blocks with a clamped entry, a stale key (formed by an earlier
+ * update), the energy extension, mixed materials and the other models go through the lane loops below: the model switch hoisted out of an `omp simd` loop
  * as in the force loop, per lane the model's value and slope at the clamped point
  * (material_model_parts), its extension (material_extend) and three 2x2 blocks. The Ogden
  * models and HGO hand over their dearest parts the same way (their own caches).

@@ -4,13 +4,16 @@
  * Why a cache: the bound's pass (stable_step.c) is bound by its arithmetic, not by the Fhat it
  * reads, and most of that arithmetic repeats the force loop's: the model's value and slopes at
  * Fhat, 1/f_i and ln J. So the force loop's lane kernels form k from the intermediates they
- * already have and store it per tet with the Fhat it belongs to as key (as the Ogden and HGO
- * caches do); the pass reads it for every block whose stored Fhat matches and computes the
- * rest (a clamped entry, a state moved in from another process, a body changed since, the
- * energy extension) as before. Only lanes with no entry clamped are cached: there every
- * extension except the energy one adds exactly zero, so k is the same for CLAMP and LINEAR
- * and needs neither the LINEAR slopes' extra evaluations nor the threshold's rise. A clamped
- * lane writes a NaN key, which never matches.
+ * already have, and the force loop keeps per block of PIOLA_TET_BLOCK tets the maxima of
+ * w_e k_e the pass needs, keyed by the update that formed them (material_lanes.h,
+ * piola__step_cache_blocks); the pass reads them for every block the last update formed and
+ * computes the rest (a clamped entry, the energy extension, a body without its weights) as
+ * before. Kept per tet with the Fhat as key, as the Ogden and HGO caches are, the cache was a
+ * memory stream of its own (4 doubles written and 8 read per tet) that took back most of what
+ * it saved. Only blocks with no entry clamped are cached: there every extension except the
+ * energy one adds exactly zero, so k is the same for CLAMP and LINEAR and needs neither the
+ * LINEAR slopes' extra evaluations nor the threshold's rise. A clamped lane's k is NaN, which
+ * marks its block not formed.
  *
  * The formulas live here once, for both the pass and the force loop. The force loop compiles
  * them with fused multiply-adds (force_lanes.c), so a cached k's last bits follow the kernel's
@@ -197,7 +200,7 @@ STEP_STRESS_MODULUS_KERNEL(spline, PIOLA_MODEL_SPLINE)
 STEP_STRESS_MODULUS_KERNEL(rotated_linear, PIOLA_MODEL_ROTATED_LINEAR)
 #undef STEP_STRESS_MODULUS_KERNEL
 
-/* neohookean_stress_lanes for a block with a clamped lane: no k formed, every key left stale. */
+/* neohookean_stress_lanes for a block with a clamped lane: no k formed (NaN), so the block is not cached. */
 MATERIAL_KERNEL void neohookean_stress_lanes_uncached(const piola_material *m, double f0, double f1,
                                                       double f2, double *p0, double *p1, double *p2,
                                                       double *k_out) {

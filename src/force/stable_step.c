@@ -856,6 +856,15 @@ static double local_rate2(piola_elastic_body *body, const double *w, const piola
   return best;
 }
 
+/* The pass over a whole body takes RATE_RANGES ranges of whole blocks (the force loop's, whose
+ * cached maxima it reads); range r starts at tet range_edge(nt, r) of nt. */
+enum { RATE_RANGES = 16 };
+static int32_t range_edge(int32_t nt, int r) {
+  const int64_t blocks = ((int64_t)nt + PIOLA_TET_BLOCK - 1) / PIOLA_TET_BLOCK;
+  const int64_t t = blocks * r / RATE_RANGES * PIOLA_TET_BLOCK;
+  return (int32_t)(t < nt ? t : nt);
+}
+
 double PIOLA_ISA_NAME(piola__elastic_body_state_rate2)(piola_elastic_body *body, int32_t *worst_tet) {
   const double *w = rate_weights(body);
   const int32_t nt = body->tet_count;
@@ -863,24 +872,19 @@ double PIOLA_ISA_NAME(piola__elastic_body_state_rate2)(piola_elastic_body *body,
   if (!w || nt <= 0) return 0;
   const piola_work_split *local = piola__local_split(body);
   if (local) return local_rate2(body, w, local, worst_tet);
-  /* RANGES ranges of whole blocks (the force loop's, whose cached maxima they read) */
-  enum { RANGES = 16 };
-  const int64_t blocks = ((int64_t)nt + PIOLA_TET_BLOCK - 1) / PIOLA_TET_BLOCK;
-#define RANGE_EDGE(r) ((int32_t)(blocks * (r) / RANGES * PIOLA_TET_BLOCK < nt ? blocks * (r) / RANGES * PIOLA_TET_BLOCK : nt))
-  double part[RANGES];
+  double part[RATE_RANGES];
   const int parallel = nt >= PIOLA_PARALLEL_MIN_BLOCKS * PIOLA_TET_BLOCK;
 #pragma omp parallel for schedule(static) num_threads(piola_thread_count()) if (parallel)
-  for (int r = 0; r < RANGES; ++r) part[r] = range_rate2(body, w, RANGE_EDGE(r), RANGE_EDGE(r + 1));
+  for (int r = 0; r < RATE_RANGES; ++r) part[r] = range_rate2(body, w, range_edge(nt, r), range_edge(nt, r + 1));
   double best = 0;
-  for (int r = 0; r < RANGES; ++r) best = part[r] > best ? part[r] : best;
+  for (int r = 0; r < RATE_RANGES; ++r) best = part[r] > best ? part[r] : best;
   /* the search screens the ranges by their maxima first (near_tet_by_chunks' reason) */
   if (worst_tet && best > 0)
-    for (int r = 0; r < RANGES && *worst_tet < 0; ++r) {
+    for (int r = 0; r < RATE_RANGES && *worst_tet < 0; ++r) {
       if (!(part[r] >= best * (1 - 1e-10))) continue;
-      const int32_t r1 = RANGE_EDGE(r + 1);
-      for (int32_t t0 = RANGE_EDGE(r); t0 < r1 && *worst_tet < 0; t0 += PIOLA_TET_BLOCK)
+      const int32_t r1 = range_edge(nt, r + 1);
+      for (int32_t t0 = range_edge(nt, r); t0 < r1 && *worst_tet < 0; t0 += PIOLA_TET_BLOCK)
         *worst_tet = near_tet_in(body, w, t0, t0 + PIOLA_TET_BLOCK < nt ? t0 + PIOLA_TET_BLOCK : nt, best);
     }
-#undef RANGE_EDGE
   return best;
 }

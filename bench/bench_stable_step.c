@@ -11,15 +11,13 @@
  * reads the Fhat the update stored, so each pass follows an update as in a step. Medians of
  * wall time and of process CPU time (the latter less disturbed on a loaded machine). A second
  * bound pass follows the first at once ("warm"): its Fhat and weights are then in cache, so
- * warm against cold tells whether the pass waits on memory or on its arithmetic. Ogden
- * and Mooney-Rivlin run two bodies, interleaved: with the force loop's cache of their powers
- * (what the simulator does) and without it (the bound computing them again). HGO runs three:
- * without fibres, with fibres (one direction, across hgo.axis) and the force loop's cache of
- * their term, and with fibres and no cache (the term computed again tet by tet). The models
- * whose force loop forms the bound's k (stable_step_modulus.h: neo-Hookean, the muscle,
- * corotated, StVK, rotated linear, the spline) run one body two ways, with that cache and with
- * it detached (the force loop forms no k, the pass computes every one: the cost before the
- * cache; one body, so that both read the same memory), and
+ * warm against cold tells whether the pass waits on memory or on its arithmetic. HGO also
+ * runs with fibres (one direction, across hgo.axis), with the force loop's cache of their
+ * term and without it (the term computed again tet by tet). The models whose force loop
+ * forms the bound's k (stable_step_modulus.h: every model, HGO without fibres) run
+ * one body two ways, with that cache and with it detached (the force loop forms no k, the pass
+ * computes every one: the cost before the cache; one body, so that both read the same memory;
+ * the Ogden models' per-tet cache of their parts is detached with it), and
  * a line "added" with what the bound adds to a step, the medians of (update with k + pass) /
  * (update without k) - 1 over the interleaved repeats, wall and process CPU.
  * PIOLA_BENCH_VARIANT=i (0: with the cache, 1: without) runs body i alone, for instruction
@@ -35,10 +33,8 @@
 #include "piola/mesh_io.h"
 #include "support/bench_support.h"
 
-/* For the Ogden models a second body without the force loop's cache (its update writes no
- * slots and its bound computes the powers again: the cost before the cache), timed
- * interleaved with the first, one update and one bound of each per repeat; for HGO two more
- * with fibres FIBERS (3 per tet; NULL: none), with and without the cache. */
+/* A body of the mesh and material; HGO's second and third have fibres FIBERS (3 per tet;
+ * NULL: none), with and without their cache. */
 static piola_elastic_body *make_body(const piola_tet_mesh *mesh, const piola_material *material,
                                      const double *fibers) {
   piola_elastic_body *body = NULL;
@@ -62,31 +58,30 @@ static void bench_model(const char *name, const piola_tet_mesh *mesh, piola_mate
     fprintf(stderr, "bench_stable_step: %s\n", piola_last_error());
     exit(1);
   }
-  enum { MAX_VARIANTS = 3 };
-  piola_elastic_body *bodies[MAX_VARIANTS] = {make_body(mesh, &material, NULL), NULL, NULL};
-  const char *labels[MAX_VARIANTS] = {"", "", ""};
+  enum { MAX_VARIANTS = 4 };
+  piola_elastic_body *bodies[MAX_VARIANTS] = {make_body(mesh, &material, NULL), NULL, NULL, NULL};
+  const char *labels[MAX_VARIANTS] = {"", "", "", ""};
   double *fibers = NULL;
   int variants = 1;
   /* the k cache's two variants are one body, its cache detached for the second: the same
    * memory, so that the difference is the cache's and not where each body's arrays lie */
-  double *detached = NULL;
+  double *detached = NULL, *detached_ogden = NULL;
   if (bodies[0]->step_cache) {
     bodies[1] = bodies[0];
     detached = bodies[0]->step_cache;
+    /* the Ogden models' per-tet cache goes too: an update without the bound writes neither */
+    detached_ogden = bodies[0]->ogden_cache;
     labels[0] = " (k cache)", labels[1] = " (no k cache)", variants = 2;
-  } else if (bodies[0]->ogden_cache) {
-    bodies[1] = make_body(mesh, &material, NULL);
-    free(bodies[1]->ogden_cache);
-    bodies[1]->ogden_cache = NULL;
-    labels[0] = " (cache)", labels[1] = " (no cache)", variants = 2;
-  } else if (model == PIOLA_MODEL_HGO) {
+  }
+  if (model == PIOLA_MODEL_HGO) { /* the first two without fibres */
     fibers = malloc(sizeof(double) * 3 * (size_t)mesh->tet_count);
     for (int32_t e = 0; e < mesh->tet_count; ++e) fibers[3 * e] = 1.0, fibers[3 * e + 1] = 0.3, fibers[3 * e + 2] = 0.2;
-    bodies[1] = make_body(mesh, &material, fibers);
-    bodies[2] = make_body(mesh, &material, fibers);
-    free(bodies[2]->hgo_cache);
-    bodies[2]->hgo_cache = NULL;
-    labels[0] = " no fibres", labels[1] = " fibres, cache", labels[2] = " fibres, none", variants = 3;
+    bodies[variants] = make_body(mesh, &material, fibers);
+    bodies[variants + 1] = make_body(mesh, &material, fibers);
+    free(bodies[variants + 1]->hgo_cache);
+    bodies[variants + 1]->hgo_cache = NULL;
+    labels[variants] = " fibres, cache", labels[variants + 1] = " fibres, none";
+    variants += 2;
   }
   const char *only = getenv("PIOLA_BENCH_VARIANT");
   const int alone = only && *only ? atoi(only) : -1;
@@ -107,7 +102,10 @@ static void bench_model(const char *name, const piola_tet_mesh *mesh, piola_mate
     for (int r = -1; r < repeats; ++r) /* r = -1 warms up (and builds the weights) */
       for (int b = 0; b < variants; ++b) {
         if (alone >= 0 && b != alone) continue;
-        if (detached) bodies[0]->step_cache = b == 1 ? NULL : detached;
+        if (detached) {
+          bodies[0]->step_cache = b == 1 ? NULL : detached;
+          bodies[0]->ogden_cache = b == 1 ? NULL : detached_ogden;
+        }
         double c0 = bench_cpu_seconds(), t0 = bench_wall_seconds();
         piola_elastic_body_update(bodies[b], x, 1.0, f, NULL);
         double c1 = bench_cpu_seconds(), t1 = bench_wall_seconds();
@@ -122,7 +120,7 @@ static void bench_model(const char *name, const piola_tet_mesh *mesh, piola_mate
       }
     /* per repeat, before the medians sort the timings: (update + pass with the cache) over
      * the update without it, wall then CPU */
-    if (detached) bodies[0]->step_cache = detached;
+    if (detached) bodies[0]->step_cache = detached, bodies[0]->ogden_cache = detached_ogden;
     double added_wall = 0, added_cpu = 0;
     if (bodies[0]->step_cache && alone < 0) {
       double added[2][repeats];

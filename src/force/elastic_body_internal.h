@@ -102,7 +102,8 @@ struct piola_elastic_body {
                                direction weights read (stable_step_anisotropy.h), built with it */
   double *ogden_cache;      /* Ogden and Mooney-Rivlin bodies of one material: the step bound's
                                slots, OGDEN_CACHE_SLOTS * padded_tet_count (material_kernels.h),
-                               written by the force loop; NULL for the other bodies */
+                               written by the force loop for the blocks step_cache does not
+                               hold (material_lanes.h); NULL for the other bodies */
   double *step_cache;       /* bodies of one material whose model forms the step bound's k in
                                the force loop (STEP_CACHE_MODEL, not the energy extension):
                                STEP_CACHE_SLOTS per block (stable_step_modulus.h), written by

@@ -67,6 +67,24 @@ PIOLA_KERNEL_INLINE void piola__step_cache_blocks(const piola_elastic_body *body
   }
 }
 
+/* The Ogden models' per-tet cache (material_kernels.h) for the blocks of LANES tets from
+ * BASE that the step bound's cache does not hold (piola__step_cache_blocks marked them: a
+ * lane clamped, a padding tet): the pass computes those blocks and takes their powers from
+ * there. SLOTS holds the lanes' slots, slot s of lane l at s LANES + l. The blocks it holds
+ * need no per-tet slots: writing every tet's (9 doubles) was a memory stream of a third of
+ * the bound's cost. */
+PIOLA_KERNEL_INLINE void piola__ogden_cache_unformed(const piola_elastic_body *body, int32_t base,
+                                                     const double *slots, int lanes) {
+  if (!body->ogden_cache) return;
+  for (int j = 0; j < lanes / PIOLA_TET_BLOCK; ++j) {
+    const double *slot = body->step_cache + (size_t)(base / PIOLA_TET_BLOCK + j) * STEP_CACHE_SLOTS;
+    if (slot[STEP_CACHE_KEY] != 0.0) continue; /* formed by this update */
+    for (int s = 0; s < OGDEN_CACHE_SLOTS; ++s)
+      for (int l = j * PIOLA_TET_BLOCK; l < (j + 1) * PIOLA_TET_BLOCK; ++l)
+        body->ogden_cache[(size_t)s * (size_t)body->padded_tet_count + (size_t)(base + l)] = slots[s * lanes + l];
+  }
+}
+
 /* 1 when every lane of the PIOLA_TET_BLOCK lanes from lane FIRST passes PREDICATE (no entry
  * below the threshold): the block then takes the plain formula (every extension adds exactly
  * zero there). */
@@ -103,7 +121,8 @@ PIOLA_KERNEL_INLINE void piola__step_cache_blocks(const piola_elastic_body *body
  * returns from the stress body when it took the case. */
 #define PIOLA_STEP_CACHED_STRESS(lanes)                                                    \
   if (body->step_cache && STEP_CACHE_MODEL(m->model)) {                                    \
-    double k_[2 * PIOLA_TET_BLOCK];                                                        \
+    double k_[2 * PIOLA_TET_BLOCK], slots_[OGDEN_CACHE_SLOTS * 2 * PIOLA_TET_BLOCK];       \
+    const double *ogden_slots_ = NULL;                                                     \
     switch (m->model) {                                                                    \
       case PIOLA_MODEL_NEOHOOKEAN:                                                         \
       case PIOLA_MODEL_MUSCLE:                                                             \
@@ -117,9 +136,30 @@ PIOLA_KERNEL_INLINE void piola__step_cache_blocks(const piola_elastic_body *body
       case PIOLA_MODEL_ROTATED_LINEAR:                                                     \
         PIOLA_STEP_CACHED_RUN(rotated_linear_stress_modulus_lanes, 0, (lanes));            \
         break;                                                                             \
+      case PIOLA_MODEL_HGO: /* a body without fibres (STEP_CACHE_MODEL) */                 \
+        PIOLA_SPLIT_BY_BLOCK_WITH(PIOLA_STEP_CACHED_RUN, hgo_lane_unclamped,               \
+                                  hgo_matrix_stress_modulus_unclamped,                     \
+                                  hgo_stress_lanes_uncached, lanes);                       \
+        break;                                                                             \
+      case PIOLA_MODEL_STABLE_NEOHOOKEAN:                                                  \
+        PIOLA_SPLIT_BY_BLOCK_WITH(PIOLA_STEP_CACHED_RUN, lane_unclamped,                   \
+                                  stable_neohookean_stress_modulus_unclamped,              \
+                                  stable_neohookean_stress_lanes_uncached, lanes);         \
+        break;                                                                             \
+      case PIOLA_MODEL_MOONEY_RIVLIN:                                                      \
+      case PIOLA_MODEL_OGDEN: {                                                            \
+        _Pragma("omp simd") for (int l = 0; l < (lanes); ++l)                              \
+            ogden_stress_cached_lanes(m, fhat[0][l], fhat[1][l], fhat[2][l], &phat[0][l],   \
+                                      &phat[1][l], &phat[2][l], slots_ + l, (lanes));      \
+        _Pragma("omp simd") for (int l = 0; l < (lanes); ++l)                              \
+            ogden_modulus_from_slots(m, slots_ + l, (lanes), k_ + l);                      \
+        ogden_slots_ = slots_;                                                             \
+        break;                                                                             \
+      }                                                                                    \
       default: break; /* not a STEP_CACHE_MODEL */                                        \
     }                                                                                      \
     piola__step_cache_blocks(body, m, base, k_, (lanes));                                  \
+    if (ogden_slots_) piola__ogden_cache_unformed(body, base, ogden_slots_, (lanes));      \
     return;                                                                                \
   }
 

@@ -196,6 +196,7 @@ piola_status piola__elastic_body_build_rest_state(piola_elastic_body *body,
         !(body->ogden_cache = calloc(OGDEN_CACHE_SLOTS * (size_t)np, sizeof(double))))
       return PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "elastic body with %d tets: out of memory", (int)nt);
     if (STEP_CACHE_MODEL(um->model) && um->inversion_mode != PIOLA_INVERSION_ENERGY &&
+        !(um->model == PIOLA_MODEL_HGO && def->fiber_directions) &&
         !(body->step_cache = calloc(STEP_CACHE_SLOTS * (size_t)(np / PIOLA_TET_BLOCK), sizeof(double))))
       return PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "elastic body with %d tets: out of memory", (int)nt);
     if (um->model == PIOLA_MODEL_HGO && def->fiber_directions &&

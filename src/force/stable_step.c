@@ -3,17 +3,18 @@
  * Why the force loop forms most of it: the pass is bound by its arithmetic, not by the
  * stream (bench_stable_step's "warm" column: a second pass run at once after the first costs
  * the same CPU), and that arithmetic repeats the force loop's (the model's value and slopes
- * at Fhat, 1/f_i, ln J). So for neo-Hookean, the muscle, corotated, StVK, rotated linear and
- * the spline the force loop's lane kernels form each tet's k (before the weight 1/(rho h_e^2)
- * and the direction weights) where no entry is clamped, and the force loop keeps per block
- * the maxima of w_e k_e below and above the stiff modulus under the update's generation
- * (stable_step_modulus.h; corotated, StVK and rotated linear in closed form); the pass reads
- * them for every block the last update formed, and the weighted models' stiff blocks still
- * take their weights here. Blocks with a clamped entry, a stale key (formed by an earlier
- * update), the energy extension, mixed materials and the other models go through the lane loops below: the model switch hoisted out of an `omp simd` loop
- * as in the force loop, per lane the model's value and slope at the clamped point
- * (material_model_parts), its extension (material_extend) and three 2x2 blocks. The Ogden
- * models and HGO hand over their dearest parts the same way (their own caches).
+ * at Fhat, 1/f_i, ln J). So for every model but HGO (STEP_CACHE_MODEL) the force loop's lane
+ * kernels form each tet's k (before the weight 1/(rho h_e^2) and the direction weights) where
+ * no entry is clamped, and the force loop keeps per block the maxima of w_e k_e below and
+ * above the stiff modulus under the update's generation (stable_step_modulus.h; corotated,
+ * StVK, rotated linear and Stable Neo-Hookean in closed form); the pass reads them for every
+ * block the last update formed, and the weighted models' stiff blocks still take their
+ * weights here. Blocks with a clamped entry, a stale key (formed by an earlier update), the
+ * energy extension, mixed materials and HGO go through the lane loops below: the model switch
+ * hoisted out of an `omp simd` loop as in the force loop, per lane the model's value and
+ * slope at the clamped point (material_model_parts), its extension (material_extend) and
+ * three 2x2 blocks. The Ogden models' blocks with a clamped entry and HGO take their dearest
+ * parts from caches of their own (their powers; the fibre term).
  *
  * The modulus. In the frame of the diagonalization dP/dF splits into the 3x3 block
  * K = dPhat/dFhat on the diagonal entries and one 2x2 block per pair (i, j) on (F_ij, F_ji),
@@ -409,8 +410,10 @@ static double neohookean_range(piola_material_model model, int energy, const pio
 }
 
 /* Ogden and Mooney-Rivlin (LINEAR or CLAMP: ENERGY is STEP_EXTENSION_LINEAR or _CLAMP) by
- * blocks of PIOLA_TET_BLOCK: the parts at the clamped point from the force loop's cache when it
- * holds every lane's Fhat (no pow here), else computed; a LINEAR block with an entry past the
+ * blocks of PIOLA_TET_BLOCK, for the blocks the step cache does not hold (the force loop
+ * writes the per-tet slots of those only, piola__ogden_cache_unformed): the parts at the
+ * clamped point from the force loop's cache when it holds every lane's Fhat (no pow here),
+ * else computed; a LINEAR block with an entry past the
  * threshold takes the LINEAR slopes (linear_extension_slopes, which evaluate the clamped point
  * again), one with none the CLAMP numbers, as linear_range. */
 static double ogden_range(const piola_elastic_body *body, int energy, const piola_material *m,

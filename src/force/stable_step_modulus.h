@@ -102,28 +102,47 @@ enum {
 
 /* The bodies whose force loop fills the cache: one material, one of these models, and an
  * extension other than the energy one (whose slopes are differences of the extended stress
- * everywhere, stable_step.c). */
+ * everywhere, stable_step.c); HGO without fibres only (the fibre term has a cache of its own,
+ * which its force loop forms after the matrix: rest_state.c). */
 #define STEP_CACHE_MODEL(model)                                                              \
   ((model) == PIOLA_MODEL_NEOHOOKEAN || (model) == PIOLA_MODEL_MUSCLE ||                     \
    (model) == PIOLA_MODEL_COROTATED || (model) == PIOLA_MODEL_STVK ||                        \
-   (model) == PIOLA_MODEL_ROTATED_LINEAR || (model) == PIOLA_MODEL_SPLINE)
+   (model) == PIOLA_MODEL_ROTATED_LINEAR || (model) == PIOLA_MODEL_SPLINE ||                 \
+   (model) == PIOLA_MODEL_STABLE_NEOHOOKEAN || (model) == PIOLA_MODEL_OGDEN ||               \
+   (model) == PIOLA_MODEL_MOONEY_RIVLIN || (model) == PIOLA_MODEL_HGO)
 
 /* A lane's k for the block's maxima: NaN where an entry is clamped (the block is then not
  * cached). */
 MATERIAL_KERNEL void step_cache_store(double *k_out, int held, double k) { *k_out = held ? k : (double)NAN; }
 
-/* The force loop's kernels. neohookean_stress_lanes_unclamped (the muscle's matrix too) with
- * k from its reciprocals and logarithm: a few multiply-adds more. */
-MATERIAL_KERNEL void neohookean_stress_modulus_unclamped(const piola_material *m, double f0, double f1,
-                                                         double f2, double *p0, double *p1, double *p2,
-                                                         double *k_out) {
+/* The force loop's kernels. neohookean_stress_lanes_unclamped with k from its reciprocals and
+ * logarithm (a few multiply-adds more), plus FIBER (Pa): the muscle's fibre bound. */
+MATERIAL_KERNEL void neohookean_stress_modulus_plus(const piola_material *m, double fiber, double f0,
+                                                    double f1, double f2, double *p0, double *p1,
+                                                    double *p2, double *k_out) {
   const double mu = m->mu;
   const double i0 = kernel_recip_fast(f0), i1 = kernel_recip_fast(f1), i2 = kernel_recip_fast(f2);
   const double lq = m->lambda * kernel_log_div(f0 * f1 * f2, KERNEL_FAST_RECIPROCAL);
   *p0 = mu * (f0 - i0) + lq * i0;
   *p1 = mu * (f1 - i1) + lq * i1;
   *p2 = mu * (f2 - i2) + lq * i2;
-  step_cache_store(k_out, 1, step_neohookean_modulus(m, i0, i1, i2, lq) + m->fiber_modulus);
+  step_cache_store(k_out, 1, step_neohookean_modulus(m, i0, i1, i2, lq) + fiber);
+}
+
+/* Neo-Hookean and the muscle's matrix. */
+MATERIAL_KERNEL void neohookean_stress_modulus_unclamped(const piola_material *m, double f0, double f1,
+                                                         double f2, double *p0, double *p1, double *p2,
+                                                         double *k_out) {
+  neohookean_stress_modulus_plus(m, m->fiber_modulus, f0, f1, f2, p0, p1, p2, k_out);
+}
+
+/* HGO's matrix, neo-Hookean's, for a body without fibres: no fibre term (stable_step.c,
+ * hgo_tet_fiber_modulus; HGO's m->fiber_modulus is its fibres' rest bound, which the
+ * model's own modulus does not add). */
+MATERIAL_KERNEL void hgo_matrix_stress_modulus_unclamped(const piola_material *m, double f0, double f1,
+                                                         double f2, double *p0, double *p1, double *p2,
+                                                         double *k_out) {
+  neohookean_stress_modulus_plus(m, 0.0, f0, f1, f2, p0, p1, p2, k_out);
 }
 
 /* A lane the kernel above does not take (an entry clamped): no k, so no cached block. */
@@ -178,7 +197,7 @@ MATERIAL_KERNEL double step_model_unclamped_modulus(piola_material_model model, 
 MATERIAL_KERNEL void material_stress_modulus_lanes(piola_material_model model, const piola_material *m,
                                                    double f0, double f1, double f2, double *p0,
                                                    double *p1, double *p2, double *k_out) {
-  const double c = m->threshold;
+  const double c = MATERIAL_THRESHOLD(model, m, f0, f1, f2);
   const double fc0 = kernel_max(f0, c), fc1 = kernel_max(f1, c), fc2 = kernel_max(f2, c);
   material_parts parts;
   material_model_parts(model, m, KERNEL_FAST_RECIPROCAL, fc0, fc1, fc2, &parts);
@@ -199,6 +218,57 @@ STEP_STRESS_MODULUS_KERNEL(stvk, PIOLA_MODEL_STVK)
 STEP_STRESS_MODULUS_KERNEL(spline, PIOLA_MODEL_SPLINE)
 STEP_STRESS_MODULUS_KERNEL(rotated_linear, PIOLA_MODEL_ROTATED_LINEAR)
 #undef STEP_STRESS_MODULUS_KERNEL
+
+/* The Ogden models' k (Mooney-Rivlin is two Ogden terms) from the slots their stress kernel
+ * wrote for a lane (ogden_stress_cached_lanes, stride STRIDE): the Fhat, and Phat and the
+ * diagonal slopes at the clamped point, whose powers f^(alpha_p - 1) are most of an update.
+ * Their stress loop calls libm's pow and runs lane by lane; this one has no call, so it
+ * vectorizes, and its six divisions with it. */
+MATERIAL_KERNEL void ogden_modulus_from_slots(const piola_material *m, const double *slots, long stride,
+                                              double *k_out) {
+  const double f0 = slots[OGDEN_CACHE_KEY * stride], f1 = slots[(OGDEN_CACHE_KEY + 1) * stride],
+               f2 = slots[(OGDEN_CACHE_KEY + 2) * stride];
+  const double c = material_threshold_at(m, f0, f1, f2);
+  material_parts parts;
+  ogden_cached_parts(m, slots, stride, kernel_max(f0, c), kernel_max(f1, c), kernel_max(f2, c), &parts);
+  const int held = (f0 >= c) & (f1 >= c) & (f2 >= c);
+  step_cache_store(k_out, held, step_unclamped_modulus(m, c, &parts, f0, f1, f2));
+}
+
+/* Stable Neo-Hookean with no entry clamped (stable_neohookean_stress_lanes_unclamped) and its
+ * k in closed form. With A = mu' I_C / (I_C + 1), g_i = J / f_i, v = lambda' (J - alpha) and
+ * B = 2 mu' / (I_C + 1)^2: P_i = A f_i + v g_i, K_ii = A + lambda' g_i^2 + B f_i^2, and the
+ * pair ij's divided differences are A -+ v f_k, so a = A, b = -v f_k and
+ * pair_ij = A + lambda' g_i g_j + B f_i f_j, at most (K_ii + K_jj) / 2 (2 x y <= x^2 + y^2):
+ * k = max_i K_ii, no division. */
+MATERIAL_KERNEL void stable_neohookean_stress_modulus_unclamped(const piola_material *m, double f0,
+                                                                double f1, double f2, double *p0,
+                                                                double *p1, double *p2, double *k_out) {
+  stable_neohookean_stress_lanes_unclamped(m, f0, f1, f2, p0, p1, p2);
+  const double mu_s = m->model_constants[SNH_MU], lambda_s = m->model_constants[SNH_LAMBDA];
+  const double ic = f0 * f0 + f1 * f1 + f2 * f2, r = kernel_recip_fast(ic + 1.0);
+  const double a = mu_s * ic * r, b = 2.0 * mu_s * r * r;
+  const double g0 = f1 * f2, g1 = f0 * f2, g2 = f0 * f1;
+  const double k0 = a + lambda_s * g0 * g0 + b * f0 * f0;
+  const double k1 = a + lambda_s * g1 * g1 + b * f1 * f1;
+  const double k2 = a + lambda_s * g2 * g2 + b * f2 * f2;
+  step_cache_store(k_out, 1, kernel_max(k0, kernel_max(k1, k2)) + m->fiber_modulus);
+}
+
+/* stable_neohookean_stress_lanes for a block with a clamped lane: no k, so no cached block. */
+MATERIAL_KERNEL void stable_neohookean_stress_lanes_uncached(const piola_material *m, double f0,
+                                                             double f1, double f2, double *p0,
+                                                             double *p1, double *p2, double *k_out) {
+  stable_neohookean_stress_lanes(m, f0, f1, f2, p0, p1, p2);
+  step_cache_skip(k_out);
+}
+
+/* hgo_stress_lanes for a block with a lane clamped at the threshold in force: no k. */
+MATERIAL_KERNEL void hgo_stress_lanes_uncached(const piola_material *m, double f0, double f1, double f2,
+                                               double *p0, double *p1, double *p2, double *k_out) {
+  hgo_stress_lanes(m, f0, f1, f2, p0, p1, p2);
+  step_cache_skip(k_out);
+}
 
 /* neohookean_stress_lanes for a block with a clamped lane: no k formed (NaN), so the block is not cached. */
 MATERIAL_KERNEL void neohookean_stress_lanes_uncached(const piola_material *m, double f0, double f1,

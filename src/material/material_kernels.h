@@ -819,7 +819,9 @@ MATERIAL_KERNEL void ogden_stress_lanes(const piola_material *m, double f0, doub
  * most of an update, and the state-aware step bound (force/stable_step.c) needs the same
  * ones: the force loop keeps, per tet, the Fhat it evaluated and the model's Phat and
  * diagonal slopes at the clamped point, and the bound takes them from there instead of
- * calling pow again. The couplings are lambda / (fc_i fc_j) (the ln J term; the separable
+ * calling pow again. Where the force loop forms k itself (a block with no entry clamped,
+ * force/stable_step_modulus.h) it takes them from a block's slots on its stack and writes
+ * the body's only for the other blocks. The couplings are lambda / (fc_i fc_j) (the ln J term; the separable
  * part has none): three reciprocals, formed again. Structure of arrays, slot s of a tet at
  * s * stride from its first. */
 enum {

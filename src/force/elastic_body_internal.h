@@ -178,6 +178,11 @@ void piola__elastic_body_split_share_fhat(piola_elastic_body *body);
 PIOLA_ISA_DECLARE(void, piola__elastic_body_update_block_pair, PIOLA_UPDATE_BLOCK_PAIR_PARAMS);
 void piola__elastic_body_update_block_pair PIOLA_UPDATE_BLOCK_PAIR_PARAMS;
 
+/* Frees the caches only the explicit step bound reads (step_cache, ogden_cache, hgo_cache):
+ * a world with an implicit integrator never computes that bound (piola_world_stable_dt), so
+ * its force evaluations need not form them. The stress is the same without them. */
+void piola__elastic_body_drop_step_caches(piola_elastic_body *body);
+
 /* Refills the step bound's k cache (stable_step_modulus.h) from the stored Fhat with the
  * force loop's own kernels, blocks in the force loop's pairs: after a checkpoint restores Fhat
  * without an update, the bound then reads the bits the uninterrupted run's force loop stored

@@ -218,3 +218,9 @@ piola_status piola__elastic_body_build_rest_state(piola_elastic_body *body,
   body->last_stiffness_scale = 1.0;
   return piola__damping_matrix_init(&body->damping, body);
 }
+
+void piola__elastic_body_drop_step_caches(piola_elastic_body *body) {
+  free(body->step_cache), body->step_cache = NULL;
+  free(body->ogden_cache), body->ogden_cache = NULL;
+  free(body->hgo_cache), body->hgo_cache = NULL;
+}

@@ -116,6 +116,7 @@ static piola_status build_new(piola_world *w, const world_body *b, const body_ch
       PIOLA_TRY(check_change(b, c, c->solid_rest->vertex_count, c->solid_rest->tet_count,
                              piola__body_element_count(b)));
       PIOLA_TRY(rebuild_solid_object(b, c, nb));
+      if (w->def.integrator != PIOLA_INTEGRATOR_NEWMARK) piola__elastic_body_drop_step_caches(nb->solid);
       n = piola_elastic_body_vertex_count(nb->solid);
       rest = piola_elastic_body_rest_positions(nb->solid);
       mass = piola_elastic_body_masses(nb->solid);

@@ -176,6 +176,7 @@ static piola_status fill_solid(piola_world *world, world_body *s, const piola_so
     s->solid = NULL;
     return st;
   }
+  if (world->def.integrator != PIOLA_INTEGRATOR_NEWMARK) piola__elastic_body_drop_step_caches(s->solid);
   int32_t n = piola_elastic_body_vertex_count(s->solid);
   const double *rest = piola_elastic_body_rest_positions(s->solid);
   PIOLA_TRY(piola__body_allocate(s, n, def->name, id, rest, piola_elastic_body_masses(s->solid)));

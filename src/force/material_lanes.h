@@ -12,6 +12,8 @@
 #ifndef PIOLA_FORCE_MATERIAL_LANES_H
 #define PIOLA_FORCE_MATERIAL_LANES_H
 
+#include <stdlib.h>
+
 #include "force/elastic_body_internal.h"
 #include "force/stable_step_modulus.h"
 #include "force/svd_kernel.h"
@@ -156,7 +158,7 @@ PIOLA_KERNEL_INLINE void piola__ogden_cache_unformed(const piola_elastic_body *b
         ogden_slots_ = slots_;                                                             \
         break;                                                                             \
       }                                                                                    \
-      default: break; /* not a STEP_CACHE_MODEL */                                        \
+      default: abort(); /* every STEP_CACHE_MODEL has its case: a new one must get its k */ \
     }                                                                                      \
     piola__step_cache_blocks(body, m, base, k_, (lanes));                                  \
     if (ogden_slots_) piola__ogden_cache_unformed(body, base, ogden_slots_, (lanes));      \

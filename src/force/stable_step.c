@@ -210,7 +210,9 @@ STABLE_STEP_KERNEL double model_modulus(piola_material_model model, int energy,
  * and must get the same bits, but only its own blocks' k come from its force loop (with fused
  * multiply-adds), the gathered ones would be computed here (without): the processes' steps
  * would part in their last bits and their collectives with them (mpi_frames.sh's
- * plastic_control hung on 2 processes). The local mode takes each process's own blocks only. */
+ * plastic_control hung on 2 processes). The local mode takes each process's own blocks only.
+ * (The replicated mode's bodies also drop the caches when the split is set up, work_split.c,
+ * so that their force loops do not form them.) */
 static const double *readable_force_loop_cache(const piola_elastic_body *body, const double *cache) {
   return body->split && !body->split_local ? NULL : cache;
 }

@@ -200,8 +200,12 @@ piola_status piola__elastic_body_set_work_split(piola_elastic_body *body,
       piola__elastic_body_split_free(body);
       return PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "work split: out of memory");
     }
-  } else if (body->state_unwritten) {
-    piola__elastic_body_rest_rotations(body, NULL);
+  } else {
+    if (body->state_unwritten) piola__elastic_body_rest_rotations(body, NULL);
+    /* the replicated mode's bound reads no force-loop cache (stable_step.c,
+     * readable_force_loop_cache): its force loop need not form them. The forces are the
+     * same bits without them (implicit_worlds_form_no_bound_caches). */
+    piola__elastic_body_drop_step_caches(body);
   }
   body->state_unwritten = 0;
   for (int32_t b = 0; b < blocks; ++b)

@@ -124,7 +124,6 @@ PIOLA_KERNEL_INLINE void piola__ogden_cache_unformed(const piola_elastic_body *b
 #define PIOLA_STEP_CACHED_STRESS(lanes)                                                    \
   if (body->step_cache && STEP_CACHE_MODEL(m->model)) {                                    \
     double k_[2 * PIOLA_TET_BLOCK], slots_[OGDEN_CACHE_SLOTS * 2 * PIOLA_TET_BLOCK];       \
-    const double *ogden_slots_ = NULL;                                                     \
     switch (m->model) {                                                                    \
       case PIOLA_MODEL_NEOHOOKEAN:                                                         \
       case PIOLA_MODEL_MUSCLE:                                                             \
@@ -155,13 +154,12 @@ PIOLA_KERNEL_INLINE void piola__ogden_cache_unformed(const piola_elastic_body *b
                                       &phat[1][l], &phat[2][l], slots_ + l, (lanes));      \
         _Pragma("omp simd") for (int l = 0; l < (lanes); ++l)                              \
             ogden_modulus_from_slots(m, slots_ + l, (lanes), k_ + l);                      \
-        ogden_slots_ = slots_;                                                             \
         break;                                                                             \
       }                                                                                    \
       default: abort(); /* every STEP_CACHE_MODEL has its case: a new one must get its k */ \
     }                                                                                      \
     piola__step_cache_blocks(body, m, base, k_, (lanes));                                  \
-    if (ogden_slots_) piola__ogden_cache_unformed(body, base, ogden_slots_, (lanes));      \
+    if (MATERIAL_IS_OGDEN(m->model)) piola__ogden_cache_unformed(body, base, slots_, (lanes)); \
     return;                                                                                \
   }
 

@@ -141,6 +141,51 @@ static void modulus_bounds_every_plane_wave(void **state) {
   fixture_mesh_free(&mesh);
 }
 
+/* The spline's k where no entry is clamped is step_spline_modulus, a division-free bound on
+ * its pairs (stable_step_modulus.h): never below the pair blocks' exact k, above it by at most
+ * max_ij |A''(f_i) - A''(f_j)| / 2 (the exact k is at least the mean of two diagonal entries),
+ * and equal to it where the entries share a segment of the 1D curve (A'' equal). On random
+ * Fhat above the threshold, across the knees and on their stiff side. */
+static void spline_bound_brackets_the_exact_pairs(void **state) {
+  (void)state;
+  test_rng rng = test_rng_seeded(25);
+  const piola_material m = fixture_material(PIOLA_MODEL_SPLINE);
+  const double *s = m.spline_coefficients, c = m.threshold;
+  const long cases = test_samples(20000, 2000);
+  double worst_excess = 0;
+  for (long n = 0; n < cases; ++n) {
+    double f[3];
+    const int stiff_side = n % 3 == 0; /* every entry past the elongation knee */
+    for (int i = 0; i < 3; ++i)
+      f[i] = stiff_side ? 1.0 + s[SPLINE_WE] * test_rng_uniform(&rng, 1.01, 4.0)
+                        : exp(test_rng_uniform(&rng, log(fmax(c, 0.2)), log(3.0)));
+    material_parts pa;
+    material_model_parts(PIOLA_MODEL_SPLINE, &m, KERNEL_EXACT_DIVIDE, f[0], f[1], f[2], &pa);
+    const double exact = step_modulus_of_slopes(KERNEL_EXACT_DIVIDE, c, pa.p[0], pa.p[1], pa.p[2], f[0], f[1],
+                                                f[2], pa.k[0][0], pa.k[1][1], pa.k[2][2], pa.k[0][1],
+                                                pa.k[0][2], pa.k[1][2]);
+    const double bound = step_spline_modulus(m.lambda, f[0], f[1], f[2], pa.k[0][0], pa.k[1][1], pa.k[2][2]);
+    double curvature[3], slope, spread = 0;
+    for (int i = 0; i < 3; ++i) entry_slope_curvature(PIOLA_MODEL_SPLINE, &m, KERNEL_EXACT_DIVIDE, f[i], &slope, &curvature[i]);
+    for (int i = 0; i < 3; ++i)
+      for (int j = i + 1; j < 3; ++j) spread = fmax(spread, 0.5 * fabs(curvature[i] - curvature[j]));
+    const double tol = 1e-10 * exact;
+    if (!(bound >= exact - tol))
+      fail_msg("fhat (%.17g, %.17g, %.17g): bound %.17g below the exact pairs' %.17g", f[0], f[1], f[2], bound, exact);
+    if (!(bound <= exact + spread + tol))
+      fail_msg("fhat (%.17g, %.17g, %.17g): bound %.17g above exact %.17g + spread %.17g", f[0], f[1], f[2],
+               bound, exact, spread);
+    if (stiff_side && !(fabs(bound - exact) <= tol))
+      fail_msg("fhat (%.17g, %.17g, %.17g) on the stiff side: bound %.17g, exact %.17g", f[0], f[1], f[2],
+               bound, exact);
+    worst_excess = fmax(worst_excess, bound / exact - 1);
+  }
+  /* the spread is at most half the largest A''(f_i), which the exact k (at least max_i K_ii)
+   * exceeds: the bound is at most 1.5 times the exact k */
+  print_message("spline: bound at most %.1f%% above the exact pairs\n", 100 * worst_excess);
+  assert_true(worst_excess <= 0.5);
+}
+
 /* HGO's fibre term follows each tet's actual fibre directions (issue 21: the bound assumed
  * the fibres along the largest stretch, and a unit ball scrambled by half a diagonal stepped
  * at 9.5e-8 s). A single tet with a fibre is deformed to random F = R1 diag(s) R2 and
@@ -1153,6 +1198,7 @@ int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(modulus_at_rest_is_the_rest_wave_modulus),
       cmocka_unit_test(modulus_bounds_every_plane_wave),
+      cmocka_unit_test(spline_bound_brackets_the_exact_pairs),
       cmocka_unit_test(every_model_takes_its_own_modulus),
       cmocka_unit_test(worst_tet_is_the_first_near_the_bound),
       cmocka_unit_test(modulus_bounds_the_extensions),

@@ -7,9 +7,10 @@
  * kernels form each tet's k (before the weight 1/(rho h_e^2) and the direction weights) where
  * no entry is clamped, and the force loop keeps per block the maxima of w_e k_e below and
  * above the stiff modulus under the update's generation (stable_step_modulus.h; corotated,
- * StVK, rotated linear and Stable Neo-Hookean in closed form); the pass reads them for every
+ * StVK, rotated linear and Stable Neo-Hookean in closed form, the spline's pairs by a bound
+ * without division); the pass reads them for every
  * block the last update formed, and the weighted models' stiff blocks still take their
- * weights here. Blocks with a clamped entry, a stale key (formed by an earlier update), the
+ * weights here (a cached block's lanes known unclamped: STEP_EXTENSION_NONE). Blocks with a clamped entry, a stale key (formed by an earlier update), the
  * energy extension, mixed materials and HGO go through the lane loops below: the model switch
  * hoisted out of an `omp simd` loop as in the force loop, per lane the model's value and
  * slope at the clamped point (material_model_parts), its extension (material_extend) and
@@ -48,10 +49,11 @@
 #define STABLE_STEP_KERNEL static inline __attribute__((always_inline))
 
 /* The same pair weighted by the direction weights wi, wj (stable_step_anisotropy.h). */
-STABLE_STEP_KERNEL double weighted_pair_modulus(double c, double pi, double pj, double fi, double fj,
-                                                double kii, double kjj, double kij, double wi, double wj) {
+STABLE_STEP_KERNEL double weighted_pair_modulus(kernel_division dv, double c, double pi, double pj,
+                                                double fi, double fj, double kii, double kjj, double kij,
+                                                double wi, double wj) {
   double a, b;
-  step_pair_block(c, pi, pj, fi, fj, kii, kjj, kij, &a, &b);
+  step_pair_block(dv, c, pi, pj, fi, fj, kii, kjj, kij, &a, &b);
   return step_weighted_pair(a, b + kij, wi, wj);
 }
 
@@ -63,8 +65,12 @@ STABLE_STEP_KERNEL double weighted_pair_modulus(double c, double pi, double pj, 
    (model) == PIOLA_MODEL_SPLINE || (model) == PIOLA_MODEL_STABLE_NEOHOOKEAN ||              \
    (model) == PIOLA_MODEL_ROTATED_LINEAR)
 
-/* The extension a lane loop is compiled for (a compile-time constant there, like the model). */
-enum { STEP_EXTENSION_CLAMP = 0, STEP_EXTENSION_ENERGY = 1, STEP_EXTENSION_LINEAR = 2 };
+/* The extension a lane loop is compiled for (a compile-time constant there, like the model).
+ * NONE: no entry is clamped, which the caller knows (a block the force loop cached): every
+ * extension but the energy one adds exactly zero there, and the pairs' f_i + f_j >= 2 c > 0
+ * and |f_i - f_j| are normal, so their divisions are fast reciprocals (multiply-adds only,
+ * without fusing: the same bits in every variant). */
+enum { STEP_EXTENSION_CLAMP = 0, STEP_EXTENSION_ENERGY = 1, STEP_EXTENSION_LINEAR = 2, STEP_EXTENSION_NONE = 3 };
 
 /* Increment of the LINEAR extension over the unextended stress, E(parts, d) - p, entry by entry. */
 STABLE_STEP_KERNEL void linear_increment(const piola_material *m, const material_parts *pa, double d0,
@@ -133,7 +139,10 @@ STABLE_STEP_KERNEL double model_modulus_weighted(piola_material_model model, int
   else material_model_parts(model, m, KERNEL_FAST_RECIPROCAL, fc0, fc1, fc2, &pa);
   double p0, p1, p2, k0, k1, k2;
   double k01 = pa.k[0][1], k02 = pa.k[0][2], k12 = pa.k[1][2];
-  if (energy == STEP_EXTENSION_ENERGY) {
+  if (energy == STEP_EXTENSION_NONE) {
+    p0 = pa.p[0], p1 = pa.p[1], p2 = pa.p[2];
+    k0 = pa.k[0][0], k1 = pa.k[1][1], k2 = pa.k[2][2];
+  } else if (energy == STEP_EXTENSION_ENERGY) {
     /* The energy extension (material_kernels.h) has no closed-form slopes worth writing out:
      * a clamped entry's diagonal is the extension's k, which grows with the other entries'
      * stretch (as its fourth power for the J models), and the unclamped entries' slopes and
@@ -180,12 +189,17 @@ STABLE_STEP_KERNEL double model_modulus_weighted(piola_material_model model, int
       k12 += 0.5 * s * (g[1] * j2 + g[2] * j1);
     }
   }
-  double k = step_modulus_of_slopes(c, p0, p1, p2, f0, f1, f2, k0, k1, k2, k01, k02, k12);
+  const kernel_division dv = energy == STEP_EXTENSION_NONE ? KERNEL_FAST_RECIPROCAL : KERNEL_EXACT_DIVIDE;
+  /* the spline's plain lanes: the force loop's bound without divisions (step_spline_modulus) */
+  const int spline_plain = model == PIOLA_MODEL_SPLINE && energy != STEP_EXTENSION_ENERGY &&
+                           (energy == STEP_EXTENSION_NONE || (d0 == 0.0 && d1 == 0.0 && d2 == 0.0));
+  double k = spline_plain ? step_spline_modulus(m->lambda, f0, f1, f2, k0, k1, k2)
+                          : step_modulus_of_slopes(dv, c, p0, p1, p2, f0, f1, f2, k0, k1, k2, k01, k02, k12);
   if (wgt) {
     double kw = kernel_max(wgt[0] * k0, kernel_max(wgt[1] * k1, wgt[2] * k2));
-    kw = kernel_max(kw, weighted_pair_modulus(c, p0, p1, f0, f1, k0, k1, k01, wgt[0], wgt[1]));
-    kw = kernel_max(kw, weighted_pair_modulus(c, p0, p2, f0, f2, k0, k2, k02, wgt[0], wgt[2]));
-    kw = kernel_max(kw, weighted_pair_modulus(c, p1, p2, f1, f2, k1, k2, k12, wgt[1], wgt[2]));
+    kw = kernel_max(kw, weighted_pair_modulus(dv, c, p0, p1, f0, f1, k0, k1, k01, wgt[0], wgt[1]));
+    kw = kernel_max(kw, weighted_pair_modulus(dv, c, p0, p2, f0, f2, k0, k2, k02, wgt[0], wgt[2]));
+    kw = kernel_max(kw, weighted_pair_modulus(dv, c, p1, p2, f1, f2, k1, k2, k12, wgt[1], wgt[2]));
     k = k > STEP_CACHE_STIFF * (m->lambda + 2.0 * m->mu) ? kernel_min(k, kw) : k;
   }
   /* muscle fibres: their tangent stiffness bound, as in the rest bound; HGO's exponential
@@ -560,18 +574,35 @@ STABLE_STEP_KERNEL const double *cached_block(const piola_elastic_body *body, co
   return t % PIOLA_TET_BLOCK == 0 && key != 0.0 && key == (double)body->step_generation ? slot : NULL;
 }
 
+/* max(best, w_u k_u) with the direction weights over the whole block from t, its lanes' extension
+ * EXT a compile-time constant: a trip count the compiler knows, so the loop is one pass of
+ * vector code (with a run-time count of 8 it ran the scalar remainder loop). */
+STABLE_STEP_KERNEL double weighted_whole_block(piola_material_model model, int ext, const piola_material *m,
+                                               const piola_elastic_body *body, const double *gram,
+                                               const double *f, const double *w, int32_t t, double best) {
+#pragma omp simd reduction(max:best)
+  for (int l = 0; l < PIOLA_TET_BLOCK; ++l) {
+    const double r = w[t + l] * weighted_lane_modulus(model, ext, m, body, gram, t + l, f + 3 * (t + l));
+    best = r > best ? r : best;
+  }
+  return best;
+}
+
 /* One block [t, e) of weighted_range: max(best, its terms with the direction weights). LINEAR
- * blocks with a clamped entry (or a short one) go tet by tet (linear_tet_rate). */
+ * blocks with a clamped entry (or a short one) go tet by tet (linear_tet_rate); a block the
+ * force loop cached (CACHED: no entry clamped) takes STEP_EXTENSION_NONE. */
 STABLE_STEP_KERNEL double weighted_block(piola_material_model model, int energy, const piola_material *m,
                                          const piola_elastic_body *body, const double *gram,
                                          const double *f, const double *w, int32_t t, int32_t e,
-                                         double best) {
+                                         int cached, double best) {
+  if (e - t == PIOLA_TET_BLOCK && cached && energy != STEP_EXTENSION_ENERGY)
+    return weighted_whole_block(model, STEP_EXTENSION_NONE, m, body, gram, f, w, t, best);
   if (energy == STEP_EXTENSION_LINEAR && !(e - t == PIOLA_TET_BLOCK && block_unclamped(m, f, t))) {
     for (int32_t u = t; u < e; ++u) best = linear_tet_rate(model, body, m, gram, f, w, u, best);
     return best;
   }
   const int ext = energy == STEP_EXTENSION_LINEAR ? STEP_EXTENSION_CLAMP : energy;
-#pragma omp simd reduction(max:best)
+  if (e - t == PIOLA_TET_BLOCK) return weighted_whole_block(model, ext, m, body, gram, f, w, t, best);
   for (int32_t u = t; u < e; ++u) {
     const double r = w[u] * weighted_lane_modulus(model, ext, m, body, gram, u, f + 3 * u);
     best = r > best ? r : best;
@@ -640,7 +671,8 @@ STABLE_STEP_KERNEL double weighted_range(piola_material_model model, int energy,
     if (!(chunk_high > best)) continue;
     for (int32_t t = c0; t < c1; t += PIOLA_TET_BLOCK)
       if (high[(t - c0) / PIOLA_TET_BLOCK] > best)
-        best = weighted_block(model, energy, m, body, gram, f, w, t, c1 - t < PIOLA_TET_BLOCK ? c1 : t + PIOLA_TET_BLOCK, best);
+        best = weighted_block(model, energy, m, body, gram, f, w, t, c1 - t < PIOLA_TET_BLOCK ? c1 : t + PIOLA_TET_BLOCK,
+                              cache && cached_block(body, cache, t) != NULL, best);
   }
   return best;
 }

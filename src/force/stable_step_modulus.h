@@ -25,44 +25,78 @@
 
 #include "material/material_kernels.h"
 
+/* num / den for a den of either sign, |den| normal (DV as in material_kernels.h): the fast
+ * reciprocal takes positive arguments, so the sign moves to the numerator (an exact negation). */
+MATERIAL_KERNEL double step_signed_div(double num, double den, kernel_division dv) {
+  return dv == KERNEL_FAST_RECIPROCAL ? (den < 0.0 ? -num : num) * kernel_recip_fast(fabs(den)) : num / den;
+}
+
 /* The pair block's two eigenvalues as a +- b (stable_step.c's header), without the K_ij
- * coupling. Selects, no branches, so that the lane loop vectorizes. */
-MATERIAL_KERNEL void step_pair_block(double c, double pi, double pj, double fi, double fj, double kii,
-                                     double kjj, double kij, double *a, double *b) {
+ * coupling. Selects, no branches, so that the lane loop vectorizes. Its two divisions are
+ * most of a pair's cost (a vector division takes several times a multiply-add's slot): the
+ * force loop takes them as fast reciprocals (DV), the pass exactly. */
+MATERIAL_KERNEL void step_pair_block(kernel_division dv, double c, double pi, double pj, double fi,
+                                     double fj, double kii, double kjj, double kij, double *a, double *b) {
   const double df = fi - fj, sum = fi + fj;
   const int close = fabs(df) <= 1e-6 * (fabs(fi) + fabs(fj));
-  const double minus = close ? 0.5 * (kii + kjj) - kij : (pi - pj) / (close ? 1.0 : df);
+  const double minus = close ? 0.5 * (kii + kjj) - kij : step_signed_div(pi - pj, close ? 1.0 : df, dv);
   const double den = sum >= 0.0 ? kernel_max(sum, c) : kernel_min(sum, -c);
-  const double plus = (pi + pj) / den;
+  const double plus = step_signed_div(pi + pj, den, dv);
   *a = 0.5 * (minus + plus), *b = 0.5 * (minus - plus);
 }
 
 /* Largest eigenvalue of the pair block plus the K_ij coupling. */
-MATERIAL_KERNEL double step_pair_modulus(double c, double pi, double pj, double fi, double fj,
-                                         double kii, double kjj, double kij) {
+MATERIAL_KERNEL double step_pair_modulus(kernel_division dv, double c, double pi, double pj, double fi,
+                                         double fj, double kii, double kjj, double kij) {
   double a, b;
-  step_pair_block(c, pi, pj, fi, fj, kii, kjj, kij, &a, &b);
+  step_pair_block(dv, c, pi, pj, fi, fj, kii, kjj, kij, &a, &b);
   return a + fabs(b + kij);
 }
 
 /* k = max(max_i K_ii, max_{i<j} pair_ij) from the stress P and the 3x3 block K at Fhat f
  * (threshold c, which keeps the pairs' f_i + f_j away from 0). */
-MATERIAL_KERNEL double step_modulus_of_slopes(double c, double p0, double p1, double p2, double f0,
-                                              double f1, double f2, double k0, double k1, double k2,
-                                              double k01, double k02, double k12) {
+MATERIAL_KERNEL double step_modulus_of_slopes(kernel_division dv, double c, double p0, double p1,
+                                              double p2, double f0, double f1, double f2, double k0,
+                                              double k1, double k2, double k01, double k02, double k12) {
   double k = kernel_max(k0, kernel_max(k1, k2));
-  k = kernel_max(k, step_pair_modulus(c, p0, p1, f0, f1, k0, k1, k01));
-  k = kernel_max(k, step_pair_modulus(c, p0, p2, f0, f2, k0, k2, k02));
-  return kernel_max(k, step_pair_modulus(c, p1, p2, f1, f2, k1, k2, k12));
+  k = kernel_max(k, step_pair_modulus(dv, c, p0, p1, f0, f1, k0, k1, k01));
+  k = kernel_max(k, step_pair_modulus(dv, c, p0, p2, f0, f2, k0, k2, k02));
+  return kernel_max(k, step_pair_modulus(dv, c, p1, p2, f1, f2, k1, k2, k12));
 }
 
 /* k of a lane with no entry clamped from the model's parts there (fc = f), muscle fibres'
- * bound included (HGO's directed fibre term is not: it has its own cache). */
+ * bound included (HGO's directed fibre term is not: it has its own cache). The force loop's:
+ * fast reciprocals. */
 MATERIAL_KERNEL double step_unclamped_modulus(const piola_material *m, double c, const material_parts *pa,
                                               double f0, double f1, double f2) {
-  return step_modulus_of_slopes(c, pa->p[0], pa->p[1], pa->p[2], f0, f1, f2, pa->k[0][0], pa->k[1][1],
-                                pa->k[2][2], pa->k[0][1], pa->k[0][2], pa->k[1][2]) +
+  return step_modulus_of_slopes(KERNEL_FAST_RECIPROCAL, c, pa->p[0], pa->p[1], pa->p[2], f0, f1, f2,
+                                pa->k[0][0], pa->k[1][1], pa->k[2][2], pa->k[0][1], pa->k[0][2],
+                                pa->k[1][2]) +
          m->fiber_modulus;
+}
+
+/* The spline's k with no entry clamped, without a division: max_i K_ii and, for each pair,
+ * max(A''(f_i), A''(f_j)) + lambda g_i g_j, an upper bound of the pair's mode (its two
+ * divisions cost more than the rest of k, and a tenth of an update in the force loop). The
+ * spline's stress is corotated's with the 1D curve A' for 2 mu (f - 1): P_i = A'(f_i) +
+ * lambda (J - 1) g_i, g_i = J / f_i, K_ii = A''(f_i) + lambda g_i^2, and the pair ij's divided
+ * differences are D -+ lambda (J - 1) f_k with D = (A'(f_i) - A'(f_j)) / (f_i - f_j) and
+ * S = (A'(f_i) + A'(f_j)) / (f_i + f_j) in place of D: a = (D + S) / 2 and b + K_ij =
+ * (D - S) / 2 + lambda g_i g_j, so the mode a + |b + K_ij| is D + lambda g_i g_j or
+ * S - lambda g_i g_j. A'' is smallest at f = 1 and grows with |f - 1| on either side, so with
+ * M = max(A''(f_i), A''(f_j)): D <= M (the mean value theorem), and S <= M (A'(f) <= (f - 1)
+ * A''(f) above 1, A'(f) < 0 below). Hence mode <= M + lambda g_i g_j: equal where the two
+ * entries share a segment of the curve (at rest it is 2 mu + lambda), above the mode by at
+ * most (A''(f_i) - A''(f_j)) / 2 plus lambda |g_i^2 - g_j^2| / 2 where they straddle the
+ * curve's knee. K holds the parts at f; A''(f_i) = K_ii - lambda g_i^2. */
+MATERIAL_KERNEL double step_spline_modulus(double lambda, double f0, double f1, double f2, double k0,
+                                           double k1, double k2) {
+  const double g0 = f1 * f2, g1 = f0 * f2, g2 = f0 * f1;
+  const double c0 = k0 - lambda * g0 * g0, c1 = k1 - lambda * g1 * g1, c2 = k2 - lambda * g2 * g2;
+  double k = kernel_max(k0, kernel_max(k1, k2));
+  k = kernel_max(k, kernel_max(c0, c1) + lambda * g0 * g1);
+  k = kernel_max(k, kernel_max(c0, c2) + lambda * g0 * g2);
+  return kernel_max(k, kernel_max(c1, c2) + lambda * g1 * g2);
 }
 
 /* Neo-Hookean's matrix with every entry at or above the threshold, from i_k = 1 / f_k and
@@ -162,7 +196,9 @@ MATERIAL_KERNEL void step_cache_skip(double *k_out) { *k_out = (double)NAN; }
  *     K_ii = 2 mu + lambda): a = 2 mu + t s, b + K_ij = lambda - t s with t = T - 2 mu, so
  *     pair_ij = 2 mu + max(lambda, 2 t s - lambda), largest for the smallest f_i + f_j when
  *     t > 0 and at most K_ii when t <= 0: one division per tet instead of six.
- * The others take the pair blocks as the pass does. The pass's divided differences agree with
+ * The spline takes step_spline_modulus, a bound without division that the pass takes for its
+ * unclamped lanes too; the others take the pair blocks as the pass does, with fast
+ * reciprocals for their divisions. The pass's divided differences agree with
  * these closed forms up to its rounding (tests/test_stable_step.c, to 1e-12; on a million
  * random Fhat in [c, c + 5]^3 corotated and StVK to the bit, rotated linear to 4e-11, where
  * two entries lie within ~1e-5 of each other and the pass's (P_i - P_j) / (f_i - f_j) loses
@@ -188,6 +224,8 @@ MATERIAL_KERNEL double step_model_unclamped_modulus(piola_material_model model, 
       const double pair = 2.0 * mu + kernel_max(lambda, 2.0 * t / (f0 + f1 + f2 - most) - lambda);
       return kernel_max(diagonal, pair) + m->fiber_modulus;
     }
+    case PIOLA_MODEL_SPLINE:
+      return step_spline_modulus(lambda, f0, f1, f2, pa->k[0][0], pa->k[1][1], pa->k[2][2]) + m->fiber_modulus;
     default: return step_unclamped_modulus(m, c, pa, f0, f1, f2);
   }
 }

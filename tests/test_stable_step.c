@@ -166,12 +166,14 @@ static void spline_bound_brackets_the_exact_pairs(void **state) {
                                                 pa.k[0][2], pa.k[1][2]);
     const double bound = step_spline_modulus(m.lambda, f[0], f[1], f[2], pa.k[0][0], pa.k[1][1], pa.k[2][2]);
     double curvature[3], slope, spread = 0;
-    for (int i = 0; i < 3; ++i) entry_slope_curvature(PIOLA_MODEL_SPLINE, &m, KERNEL_EXACT_DIVIDE, f[i], &slope, &curvature[i]);
+    for (int i = 0; i < 3; ++i)
+      entry_slope_curvature(PIOLA_MODEL_SPLINE, &m, KERNEL_EXACT_DIVIDE, f[i], &slope, &curvature[i]);
     for (int i = 0; i < 3; ++i)
       for (int j = i + 1; j < 3; ++j) spread = fmax(spread, 0.5 * fabs(curvature[i] - curvature[j]));
     const double tol = 1e-10 * exact;
     if (!(bound >= exact - tol))
-      fail_msg("fhat (%.17g, %.17g, %.17g): bound %.17g below the exact pairs' %.17g", f[0], f[1], f[2], bound, exact);
+      fail_msg("fhat (%.17g, %.17g, %.17g): bound %.17g below the exact pairs' %.17g", f[0], f[1],
+               f[2], bound, exact);
     if (!(bound <= exact + spread + tol))
       fail_msg("fhat (%.17g, %.17g, %.17g): bound %.17g above exact %.17g + spread %.17g", f[0], f[1], f[2],
                bound, exact, spread);

@@ -8,10 +8,11 @@
  * no entry is clamped, and the force loop keeps per block the maxima of w_e k_e below and
  * above the stiff modulus under the update's generation (stable_step_modulus.h; corotated,
  * StVK, rotated linear and Stable Neo-Hookean in closed form, the spline's pairs by a bound
- * without division); the pass reads them for every
- * block the last update formed, and the weighted models' stiff blocks still take their
- * weights here (a cached block's lanes known unclamped: STEP_EXTENSION_NONE). Blocks with a clamped entry, a stale key (formed by an earlier update), the
- * energy extension, mixed materials and HGO go through the lane loops below: the model switch
+ * without division); the pass reads them for every block the last update formed, and the
+ * weighted models' stiff blocks still take their weights here (a cached block's lanes are
+ * known unclamped: STEP_EXTENSION_NONE). Blocks with a clamped entry, a stale key (formed by
+ * an earlier update), the energy extension, mixed materials and HGO go through the lane
+ * loops below: the model switch
  * hoisted out of an `omp simd` loop as in the force loop, per lane the model's value and
  * slope at the clamped point (material_model_parts), its extension (material_extend) and
  * three 2x2 blocks. The Ogden models' blocks with a clamped entry and HGO take their dearest
@@ -70,7 +71,12 @@ STABLE_STEP_KERNEL double weighted_pair_modulus(kernel_division dv, double c, do
  * extension but the energy one adds exactly zero there, and the pairs' f_i + f_j >= 2 c > 0
  * and |f_i - f_j| are normal, so their divisions are fast reciprocals (multiply-adds only,
  * without fusing: the same bits in every variant). */
-enum { STEP_EXTENSION_CLAMP = 0, STEP_EXTENSION_ENERGY = 1, STEP_EXTENSION_LINEAR = 2, STEP_EXTENSION_NONE = 3 };
+enum {
+  STEP_EXTENSION_CLAMP = 0,
+  STEP_EXTENSION_ENERGY = 1,
+  STEP_EXTENSION_LINEAR = 2,
+  STEP_EXTENSION_NONE = 3
+};
 
 /* Increment of the LINEAR extension over the unextended stress, E(parts, d) - p, entry by entry. */
 STABLE_STEP_KERNEL void linear_increment(const piola_material *m, const material_parts *pa, double d0,
@@ -670,9 +676,11 @@ STABLE_STEP_KERNEL double weighted_range(piola_material_model model, int energy,
     }
     if (!(chunk_high > best)) continue;
     for (int32_t t = c0; t < c1; t += PIOLA_TET_BLOCK)
-      if (high[(t - c0) / PIOLA_TET_BLOCK] > best)
-        best = weighted_block(model, energy, m, body, gram, f, w, t, c1 - t < PIOLA_TET_BLOCK ? c1 : t + PIOLA_TET_BLOCK,
-                              cache && cached_block(body, cache, t) != NULL, best);
+      if (high[(t - c0) / PIOLA_TET_BLOCK] > best) {
+        const int32_t e = c1 - t < PIOLA_TET_BLOCK ? c1 : t + PIOLA_TET_BLOCK;
+        const int cached = cache && cached_block(body, cache, t) != NULL;
+        best = weighted_block(model, energy, m, body, gram, f, w, t, e, cached, best);
+      }
   }
   return best;
 }

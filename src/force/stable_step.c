@@ -196,7 +196,8 @@ STABLE_STEP_KERNEL double model_modulus_weighted(piola_material_model model, int
     }
   }
   const kernel_division dv = energy == STEP_EXTENSION_NONE ? KERNEL_FAST_RECIPROCAL : KERNEL_EXACT_DIVIDE;
-  /* the spline's plain lanes: the force loop's bound without divisions (step_spline_modulus) */
+  /* the spline's plain lanes: the force loop's bound without divisions (step_spline_modulus);
+   * NONE is named so that its loops, where d is zero but not known to be, drop the pairs */
   const int spline_plain = model == PIOLA_MODEL_SPLINE && energy != STEP_EXTENSION_ENERGY &&
                            (energy == STEP_EXTENSION_NONE || (d0 == 0.0 && d1 == 0.0 && d2 == 0.0));
   double k = spline_plain ? step_spline_modulus(m->lambda, f0, f1, f2, k0, k1, k2)
@@ -646,6 +647,7 @@ STABLE_STEP_KERNEL double weighted_range(piola_material_model model, int energy,
   for (int32_t c0 = t0; c0 < t1; c0 += WEIGHTED_CHUNK * PIOLA_TET_BLOCK) {
     const int32_t c1 = t1 - c0 < WEIGHTED_CHUNK * PIOLA_TET_BLOCK ? t1 : c0 + WEIGHTED_CHUNK * PIOLA_TET_BLOCK;
     double high[WEIGHTED_CHUNK], chunk_high = 0;
+    int cached[WEIGHTED_CHUNK];
     for (int32_t t = c0; t < c1; t += PIOLA_TET_BLOCK) {
       const int32_t e = c1 - t < PIOLA_TET_BLOCK ? c1 : t + PIOLA_TET_BLOCK;
       double h = 0;
@@ -672,14 +674,14 @@ STABLE_STEP_KERNEL double weighted_range(piola_material_model model, int energy,
         }
       }
       high[(t - c0) / PIOLA_TET_BLOCK] = h;
+      cached[(t - c0) / PIOLA_TET_BLOCK] = slot != NULL;
       chunk_high = h > chunk_high ? h : chunk_high;
     }
     if (!(chunk_high > best)) continue;
     for (int32_t t = c0; t < c1; t += PIOLA_TET_BLOCK)
       if (high[(t - c0) / PIOLA_TET_BLOCK] > best) {
         const int32_t e = c1 - t < PIOLA_TET_BLOCK ? c1 : t + PIOLA_TET_BLOCK;
-        const int cached = cache && cached_block(body, cache, t) != NULL;
-        best = weighted_block(model, energy, m, body, gram, f, w, t, e, cached, best);
+        best = weighted_block(model, energy, m, body, gram, f, w, t, e, cached[(t - c0) / PIOLA_TET_BLOCK], best);
       }
   }
   return best;

@@ -76,8 +76,9 @@ MATERIAL_KERNEL double step_unclamped_modulus(const piola_material *m, double c,
 }
 
 /* The spline's k with no entry clamped, without a division: max_i K_ii and, for each pair,
- * max(A''(f_i), A''(f_j)) + lambda g_i g_j, an upper bound of the pair's mode (its two
- * divisions cost more than the rest of k, and a tenth of an update in the force loop). The
+ * max(A''(f_i), A''(f_j)) + lambda g_i g_j, an upper bound of the pair's mode (the exact
+ * pairs' six divisions took k in the force loop from 1.5% to 3.9% of an update's
+ * instructions, BENCHMARKS.md). The
  * spline's stress is corotated's with the 1D curve A' for 2 mu (f - 1): P_i = A'(f_i) +
  * lambda (J - 1) g_i, g_i = J / f_i, K_ii = A''(f_i) + lambda g_i^2, and the pair ij's divided
  * differences are D -+ lambda (J - 1) f_k with D = (A'(f_i) - A'(f_j)) / (f_i - f_j) and
@@ -85,10 +86,11 @@ MATERIAL_KERNEL double step_unclamped_modulus(const piola_material *m, double c,
  * (D - S) / 2 + lambda g_i g_j, so the mode a + |b + K_ij| is D + lambda g_i g_j or
  * S - lambda g_i g_j. A'' is smallest at f = 1 and grows with |f - 1| on either side, so with
  * M = max(A''(f_i), A''(f_j)): D <= M (the mean value theorem), and S <= M (A'(f) <= (f - 1)
- * A''(f) above 1, A'(f) < 0 below). Hence mode <= M + lambda g_i g_j: equal where the two
- * entries share a segment of the curve (at rest it is 2 mu + lambda), above the mode by at
- * most (A''(f_i) - A''(f_j)) / 2 plus lambda |g_i^2 - g_j^2| / 2 where they straddle the
- * curve's knee. K holds the parts at f; A''(f_i) = K_ii - lambda g_i^2. */
+ * A''(f) above 1, A'(f) < 0 below). Hence mode <= M + lambda g_i g_j <= M + lambda (g_i^2 +
+ * g_j^2) / 2, and since the exact k is at least (K_ii + K_jj) / 2 the bound exceeds it by at
+ * most |A''(f_i) - A''(f_j)| / 2: nothing where the two entries share a segment of the curve
+ * (at rest it is 2 mu + lambda), at most 1.5 times it anywhere. K holds the parts at f;
+ * A''(f_i) = K_ii - lambda g_i^2. */
 MATERIAL_KERNEL double step_spline_modulus(double lambda, double f0, double f1, double f2, double k0,
                                            double k1, double k2) {
   const double g0 = f1 * f2, g1 = f0 * f2, g2 = f0 * f1;

@@ -105,6 +105,37 @@ static void progress(bool tty, int frame, int frames, double t, double elapsed, 
   fflush(stderr);
 }
 
+/* The time it takes the fastest wave of the rest state to cross the smallest tet, over the
+ * world's solids (s; INFINITY without solids): the rest CFL step at cfl = 1. */
+static double rest_crossing_time(const piola_world *world) {
+  double t = INFINITY;
+  for (int32_t i = 0; i < piola_world_solid_count(world); ++i) {
+    const piola_elastic_body *body = piola_world_solid_body(world, i);
+    const double h = piola_elastic_body_min_rest_altitude(body);
+    const double c = piola_elastic_body_max_wave_speed(body);
+    if (h > 0 && c > 0) t = fmin(t, h / c);
+  }
+  return t;
+}
+
+/* Why the budget guard may have refused, where the first step is far below the rest state's:
+ * a body that starts deformed (a scramble, a collapse) is stiff where it is stretched, and
+ * the explicit step stays that short until it recovers, which the estimate cannot foresee;
+ * the implicit integrator takes such starts in frame-sized steps. A hint, worded as one: a
+ * tiny max_dt or stiffness_scale shortens the step too. */
+static void deformed_start_hint(const piola_world *world, double dt) {
+  const double rest = rest_crossing_time(world);
+  if (!(dt < 0.01 * rest)) return;
+  fprintf(stderr,
+          "piola run: the first step is %.0f times shorter than the time the rest state's "
+          "fastest wave takes to cross the smallest tet (%.3g s). If a solid starts deformed "
+          "(initial.scramble, initial.matrix), it is far stiffer where it is stretched, and "
+          "the explicit step stays that short until it recovers: \"integrator\": {\"type\": "
+          "\"backward_euler\"} takes frame-sized steps through it (docs/time-stepping.md, "
+          "\"Implicit integrators\")\n",
+          rest / dt, rest);
+}
+
 /* The time-budget guard: a scene whose frames would take more than max_steps steps of the
  * first stable step is refused before anything is written, as a mistyped fps (1e-300) or
  * frame count would otherwise run for ever. The estimate uses the step at t = 0; steps
@@ -122,6 +153,7 @@ static bool budget_ok(const char *scene_path, const piola_world *world, int fram
           "%.3g s: more than the limit of %.3g steps. Check fps and frames, or raise the limit "
           "with --max-steps N\n",
           scene_path, frames, fps, simulated, steps, dt, max_steps);
+  deformed_start_hint(world, dt);
   return false;
 }
 

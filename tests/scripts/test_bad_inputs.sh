@@ -69,6 +69,12 @@ LC_ALL=C grep -q $'[\x01-\x08\x0b-\x1f\x7f]' stderr && fail "esc.json: control b
 echo "{\"fps\": 1e-300, \"frames\": 1, \"solids\": [{\"mesh\": $box}]}" >slow.json
 expect 2 "raise the limit with --max-steps" -- "$PIOLA" run slow.json -o out_slow
 [[ -e out_slow ]] && fail "the refused run created its output folder"
+grep -q "backward_euler" stderr && fail "slow.json: the deformed-start hint for a step at max_dt: $(cat stderr)"
+# a start scrambled far past its rest size: the first step is far below the rest state's, and
+# the refusal says why and names the implicit integrator
+echo "{\"fps\": 30, \"frames\": 1, \"gravity\": [0, 0, 0], \"solids\": [{\"mesh\": $box, \"material\": {\"model\": \"stvk\"}, \"initial\": {\"scramble\": 5}}]}" >scrambled.json
+expect 2 'If a solid starts deformed (initial.scramble, initial.matrix), it is far stiffer where it is stretched, and the explicit step stays that short until it recovers: "integrator": {"type": "backward_euler"}' -- "$PIOLA" run scrambled.json -o out_scrambled --max-steps 10
+[[ -e out_scrambled ]] && fail "the refused scrambled run created its output folder"
 echo "{\"fps\": 0.5, \"frames\": 1, \"integrator\": {\"max_dt\": 0.01}, \"solids\": [{\"mesh\": $box}]}" >two_seconds.json
 expect 2 "more than the limit of 10 steps" -- "$PIOLA" run two_seconds.json -o out_two --max-steps 10
 expect 0 "done" -- "$PIOLA" run two_seconds.json -o out_two --max-steps 1e4

@@ -147,7 +147,11 @@ PIOLA_KERNEL_INLINE void piola__ogden_cache_unformed(const piola_elastic_body *b
                                   stable_neohookean_stress_modulus_unclamped,              \
                                   stable_neohookean_stress_lanes_uncached, lanes);         \
         break;                                                                             \
-      case PIOLA_MODEL_MOONEY_RIVLIN:                                                      \
+      case PIOLA_MODEL_MOONEY_RIVLIN: /* its powers in closed form: vector loops */        \
+        PIOLA_SPLIT_BY_BLOCK_WITH(PIOLA_STEP_CACHED_RUN, mooney_rivlin_lane_unclamped,     \
+                                  mooney_rivlin_stress_modulus_unclamped,                  \
+                                  mooney_rivlin_stress_lanes_uncached, lanes);             \
+        break;                                                                             \
       case PIOLA_MODEL_OGDEN: {                                                            \
         _Pragma("omp simd") for (int l = 0; l < (lanes); ++l)                              \
             ogden_stress_cached_lanes(m, fhat[0][l], fhat[1][l], fhat[2][l], &phat[0][l],   \
@@ -159,7 +163,7 @@ PIOLA_KERNEL_INLINE void piola__ogden_cache_unformed(const piola_elastic_body *b
       default: abort(); /* every STEP_CACHE_MODEL has its case: a new one must get its k */ \
     }                                                                                      \
     piola__step_cache_blocks(body, m, base, k_, (lanes));                                  \
-    if (MATERIAL_IS_OGDEN(m->model)) piola__ogden_cache_unformed(body, base, slots_, (lanes)); \
+    if (m->model == PIOLA_MODEL_OGDEN) piola__ogden_cache_unformed(body, base, slots_, (lanes)); \
     return;                                                                                \
   }
 
@@ -214,6 +218,9 @@ PIOLA_KERNEL_INLINE void piola__ogden_cache_unformed(const piola_elastic_body *b
         return;                                                                            \
       case PIOLA_MODEL_SPLINE: PIOLA_MATERIAL_LANE_LOOP(spline_stress_lanes, lanes); return;      \
       case PIOLA_MODEL_MOONEY_RIVLIN:                                                      \
+        PIOLA_SPLIT_BY_BLOCK(mooney_rivlin_lane_unclamped, mooney_rivlin_stress_lanes_unclamped, \
+                             mooney_rivlin_stress_lanes, lanes);                           \
+        return;                                                                            \
       case PIOLA_MODEL_OGDEN:                                                              \
         if (body->ogden_cache) { /* the step bound's powers (material_kernels.h) */        \
           double *cache_ = body->ogden_cache + base;                                       \

@@ -192,7 +192,9 @@ piola_status piola__elastic_body_build_rest_state(piola_elastic_body *body,
   if (body->uniform_material >= 0) {
     const piola_material *um = &body->materials[body->uniform_material];
     /* calloc: pages stay unmapped until the force loop writes them (a local split's) */
-    if (MATERIAL_IS_OGDEN(um->model) && um->inversion_mode != PIOLA_INVERSION_ENERGY &&
+    /* Ogden's powers (Mooney-Rivlin's are closed forms, which its force loop and the pass
+     * evaluate without a cache) */
+    if (um->model == PIOLA_MODEL_OGDEN && um->inversion_mode != PIOLA_INVERSION_ENERGY &&
         !(body->ogden_cache = calloc(OGDEN_CACHE_SLOTS * (size_t)np, sizeof(double))))
       return PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "elastic body with %d tets: out of memory", (int)nt);
     if (STEP_CACHE_MODEL(um->model) && um->inversion_mode != PIOLA_INVERSION_ENERGY &&

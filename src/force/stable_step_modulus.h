@@ -101,6 +101,31 @@ MATERIAL_KERNEL double step_spline_modulus(double lambda, double f0, double f1, 
   return kernel_max(k, kernel_max(c1, c2) + lambda * g1 * g2);
 }
 
+/* Mooney-Rivlin with every entry at or above the threshold, from i_k = 1 / f_k and
+ * L = lambda ln J, without a division. Its stress is P_i = A'(f_i) + L i_i with
+ * A'(f) = mu_1 f + mu_2 / f^3 - M / f (the Ogden terms (mu_1, 2) and (mu_2, -2), M = mu_1 + mu_2),
+ * so K_ii = mu_1 - 3 mu_2 i_i^4 + (M + lambda - L) i_i^2 and K_ij = lambda i_i i_j. The pair ij's
+ * divided differences of A' are D = mu_1 + M p - mu_2 p (i_i^2 + i_i i_j + i_j^2) and
+ * S = mu_1 - M p + mu_2 p (i_i^2 - i_i i_j + i_j^2) with p = i_i i_j (f^-3's differences
+ * factor exactly), and those of L i_k are -+ L p. So a = mu_1 - mu_2 p^2, b + K_ij =
+ * p (M + lambda - L - mu_2 (i_i^2 + i_j^2)) and
+ *   pair_ij = mu_1 - mu_2 p^2 + p |M + lambda - L - mu_2 (i_i^2 + i_j^2)|:
+ * the exact pairs of the divided differences, without their divisions. */
+MATERIAL_KERNEL double step_mooney_rivlin_modulus(const piola_material *m, double i0, double i1,
+                                                  double i2, double l) {
+  const double *o = m->model_constants;
+  const double mu_1 = o[OGDEN_TERMS], mu_2 = o[OGDEN_TERMS + 2], soft = o[OGDEN_MU_SUM] + m->lambda - l;
+  const double s0 = i0 * i0, s1 = i1 * i1, s2 = i2 * i2;
+  const double k0 = mu_1 + (soft - 3.0 * mu_2 * s0) * s0;
+  const double k1 = mu_1 + (soft - 3.0 * mu_2 * s1) * s1;
+  const double k2 = mu_1 + (soft - 3.0 * mu_2 * s2) * s2;
+  const double p01 = i0 * i1, p02 = i0 * i2, p12 = i1 * i2;
+  double k = kernel_max(k0, kernel_max(k1, k2));
+  k = kernel_max(k, mu_1 - mu_2 * p01 * p01 + p01 * fabs(soft - mu_2 * (s0 + s1)));
+  k = kernel_max(k, mu_1 - mu_2 * p02 * p02 + p02 * fabs(soft - mu_2 * (s0 + s2)));
+  return kernel_max(k, mu_1 - mu_2 * p12 * p12 + p12 * fabs(soft - mu_2 * (s1 + s2)));
+}
+
 /* Neo-Hookean's matrix with every entry at or above the threshold, from i_k = 1 / f_k and
  * L = lambda ln J:
  *   K_ii = mu (1 + i_i^2) + (lambda - L) i_i^2,  pair_ij = mu + i_i i_j |mu + lambda - L|
@@ -183,6 +208,25 @@ MATERIAL_KERNEL void hgo_matrix_stress_modulus_unclamped(const piola_material *m
 
 /* A lane the kernel above does not take (an entry clamped): no k, so no cached block. */
 MATERIAL_KERNEL void step_cache_skip(double *k_out) { *k_out = (double)NAN; }
+
+/* mooney_rivlin_stress_lanes_unclamped with k in closed form (step_mooney_rivlin_modulus):
+ * the reciprocals and the logarithm are the stress's (the compiler forms them once). */
+MATERIAL_KERNEL void mooney_rivlin_stress_modulus_unclamped(const piola_material *m, double f0, double f1,
+                                                            double f2, double *p0, double *p1, double *p2,
+                                                            double *k_out) {
+  mooney_rivlin_stress_lanes_unclamped(m, f0, f1, f2, p0, p1, p2);
+  const double i0 = kernel_recip_fast(f0), i1 = kernel_recip_fast(f1), i2 = kernel_recip_fast(f2);
+  const double lq = m->lambda * kernel_log_div(f0 * f1 * f2, KERNEL_FAST_RECIPROCAL);
+  step_cache_store(k_out, 1, step_mooney_rivlin_modulus(m, i0, i1, i2, lq) + m->fiber_modulus);
+}
+
+/* mooney_rivlin_stress_lanes for a block with a clamped lane: no k, so no cached block. */
+MATERIAL_KERNEL void mooney_rivlin_stress_lanes_uncached(const piola_material *m, double f0, double f1,
+                                                         double f2, double *p0, double *p1, double *p2,
+                                                         double *k_out) {
+  mooney_rivlin_stress_lanes(m, f0, f1, f2, p0, p1, p2);
+  step_cache_skip(k_out);
+}
 
 /* k with no entry clamped, from the parts there, for the force loop. For three models the
  * pairs' divisions cancel (P_i = A'(f_i) + kappa q g_i, the pair ij's a +- b are the divided

@@ -226,7 +226,16 @@ MATERIAL_KERNEL void entry_slope_curvature(piola_material_model model, const pio
       *a1 = m->model_constants[SNH_MU] * f;
       *a2 = m->model_constants[SNH_MU];
       return;
-    case PIOLA_MODEL_MOONEY_RIVLIN:
+    case PIOLA_MODEL_MOONEY_RIVLIN: {
+      /* the Ogden terms (mu_1, 2) and (mu_2, -2): their powers f^(alpha - 1) are f and 1/f^3,
+       * in closed form (no pow), so that its lanes vectorize */
+      const double *o = m->model_constants;
+      const double inv = kernel_recip(f, dv), cube = inv * inv * inv, msum = o[OGDEN_MU_SUM];
+      const double mu_1 = o[OGDEN_TERMS], mu_2 = o[OGDEN_TERMS + 2];
+      *a1 = mu_1 * f + mu_2 * cube - msum * inv;
+      *a2 = mu_1 - 3.0 * mu_2 * cube * inv + msum * inv * inv;
+      return;
+    }
     case PIOLA_MODEL_OGDEN: { /* A = sum_p mu_p / alpha_p (f^alpha_p - 1) - M ln f */
       const double *o = m->model_constants;
       const double inv = kernel_recip(f, dv), msum = o[OGDEN_MU_SUM];
@@ -636,7 +645,11 @@ MATERIAL_KERNEL double entry_energy(piola_material_model model, const piola_mate
     }
     case PIOLA_MODEL_STABLE_NEOHOOKEAN:
       return 0.5 * m->model_constants[SNH_MU] * (f * f - 1.0);
-    case PIOLA_MODEL_MOONEY_RIVLIN:
+    case PIOLA_MODEL_MOONEY_RIVLIN: { /* the Ogden terms with alpha = 2 and -2 */
+      const double *o = m->model_constants, inv = 1.0 / f;
+      return 0.5 * o[OGDEN_TERMS] * (f * f - 1.0) - 0.5 * o[OGDEN_TERMS + 2] * (inv * inv - 1.0) -
+             o[OGDEN_MU_SUM] * kernel_log(f);
+    }
     case PIOLA_MODEL_OGDEN: {
       const double *o = m->model_constants;
       double a = -o[OGDEN_MU_SUM] * kernel_log(f);
@@ -814,6 +827,38 @@ MATERIAL_KERNEL void spline_stress_lanes(const piola_material *m, double f0, dou
 MATERIAL_KERNEL void ogden_stress_lanes(const piola_material *m, double f0, double f1, double f2,
                                         double *p0, double *p1, double *p2) {
   material_extended_stress(PIOLA_MODEL_OGDEN, m, KERNEL_FAST_RECIPROCAL, f0, f1, f2, p0, p1, p2);
+}
+/* Mooney-Rivlin for lanes whose entries all lie at or above the threshold in force
+ * (mooney_rivlin_lane_unclamped; the force loop takes it for a block only when every lane
+ * qualifies): there the extension adds exactly zero, so this is the plain formula
+ * P_i = mu_1 f_i + mu_2 / f_i^3 - M / f_i + lambda ln J / f_i (the Ogden terms (mu_1, 2) and
+ * (mu_2, -2), M = mu_1 + mu_2) with one logarithm of J instead of three. Differs from
+ * mooney_rivlin_stress_lanes by a few ulp of lambda. */
+MATERIAL_KERNEL void mooney_rivlin_stress_lanes_unclamped(const piola_material *m, double f0, double f1,
+                                                          double f2, double *p0, double *p1, double *p2) {
+  const double *o = m->model_constants;
+  const double mu_1 = o[OGDEN_TERMS], mu_2 = o[OGDEN_TERMS + 2], msum = o[OGDEN_MU_SUM];
+  const double i0 = kernel_recip_fast(f0), i1 = kernel_recip_fast(f1), i2 = kernel_recip_fast(f2);
+  const double lq = m->lambda * kernel_log_div(f0 * f1 * f2, KERNEL_FAST_RECIPROCAL);
+  *p0 = mu_1 * f0 + (mu_2 * i0 * i0 - msum + lq) * i0;
+  *p1 = mu_1 * f1 + (mu_2 * i1 * i1 - msum + lq) * i1;
+  *p2 = mu_1 * f2 + (mu_2 * i2 * i2 - msum + lq) * i2;
+}
+/* 1 when mooney_rivlin_stress_lanes_unclamped applies to this lane: every entry at or above
+ * the threshold in force (which rises as J falls) and J in the range its logarithm takes. */
+MATERIAL_KERNEL int mooney_rivlin_lane_unclamped(const piola_material *m, double f0, double f1,
+                                                 double f2) {
+  const double c = material_threshold_at(m, f0, f1, f2), j = f0 * f1 * f2;
+  return (f0 >= c) & (f1 >= c) & (f2 >= c) & (j >= 1e-300) & (j <= 1e300);
+}
+
+/* Mooney-Rivlin with its own model constant: its two powers in closed form (f and 1/f^3,
+ * material_model_parts), so its lane loop vectorizes where the Ogden one calls pow per entry
+ * and term. The public functions take it as two Ogden terms: the same numbers within a few
+ * ulp. */
+MATERIAL_KERNEL void mooney_rivlin_stress_lanes(const piola_material *m, double f0, double f1,
+                                                double f2, double *p0, double *p1, double *p2) {
+  material_extended_stress(PIOLA_MODEL_MOONEY_RIVLIN, m, KERNEL_FAST_RECIPROCAL, f0, f1, f2, p0, p1, p2);
 }
 /* The Ogden models' step-bound cache (LINEAR and CLAMP). Their powers f^(alpha_p - 1) are
  * most of an update, and the state-aware step bound (force/stable_step.c) needs the same

@@ -200,17 +200,13 @@ STABLE_STEP_KERNEL double model_modulus_weighted(piola_material_model model, int
    * NONE is named so that its loops, where d is zero but not known to be, drop the pairs */
   const int spline_plain = model == PIOLA_MODEL_SPLINE && energy != STEP_EXTENSION_ENERGY &&
                            (energy == STEP_EXTENSION_NONE || (d0 == 0.0 && d1 == 0.0 && d2 == 0.0));
-  /* Mooney-Rivlin's likewise (step_mooney_rivlin_modulus: its exact pairs in closed form, from
-   * the reciprocals and the one logarithm of J the force loop takes, for the J that takes) */
-  const double j = f0 * f1 * f2;
+  /* Mooney-Rivlin's likewise where the force loop takes its plain stress (its exact pairs in
+   * closed form, step_mooney_rivlin_modulus_at) */
   const int mooney_rivlin_plain = model == PIOLA_MODEL_MOONEY_RIVLIN && energy != STEP_EXTENSION_ENERGY &&
-                                  (energy == STEP_EXTENSION_NONE ||
-                                   (d0 == 0.0 && d1 == 0.0 && d2 == 0.0 && j >= 1e-300 && j <= 1e300));
-  const double i0 = kernel_recip_fast(f0), i1 = kernel_recip_fast(f1), i2 = kernel_recip_fast(f2);
-  double k = spline_plain ? step_spline_modulus(m->lambda, f0, f1, f2, k0, k1, k2)
-             : mooney_rivlin_plain
-                 ? step_mooney_rivlin_modulus(m, i0, i1, i2, m->lambda * kernel_log_div(j, KERNEL_FAST_RECIPROCAL))
-                 : step_modulus_of_slopes(dv, c, p0, p1, p2, f0, f1, f2, k0, k1, k2, k01, k02, k12);
+                                  (energy == STEP_EXTENSION_NONE || mooney_rivlin_lane_unclamped(m, f0, f1, f2));
+  double k = spline_plain          ? step_spline_modulus(m->lambda, f0, f1, f2, k0, k1, k2)
+             : mooney_rivlin_plain ? step_mooney_rivlin_modulus_at(m, f0, f1, f2)
+                                   : step_modulus_of_slopes(dv, c, p0, p1, p2, f0, f1, f2, k0, k1, k2, k01, k02, k12);
   if (wgt) {
     double kw = kernel_max(wgt[0] * k0, kernel_max(wgt[1] * k1, wgt[2] * k2));
     kw = kernel_max(kw, weighted_pair_modulus(dv, c, p0, p1, f0, f1, k0, k1, k01, wgt[0], wgt[1]));

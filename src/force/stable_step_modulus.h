@@ -126,6 +126,14 @@ MATERIAL_KERNEL double step_mooney_rivlin_modulus(const piola_material *m, doubl
   return kernel_max(k, mu_1 - mu_2 * p12 * p12 + p12 * fabs(soft - mu_2 * (s1 + s2)));
 }
 
+/* The same at Fhat f, from the reciprocals and the one logarithm of J that
+ * mooney_rivlin_stress_lanes_unclamped takes (J within its range). */
+MATERIAL_KERNEL double step_mooney_rivlin_modulus_at(const piola_material *m, double f0, double f1,
+                                                     double f2) {
+  return step_mooney_rivlin_modulus(m, kernel_recip_fast(f0), kernel_recip_fast(f1), kernel_recip_fast(f2),
+                                    m->lambda * kernel_log_div(f0 * f1 * f2, KERNEL_FAST_RECIPROCAL));
+}
+
 /* Neo-Hookean's matrix with every entry at or above the threshold, from i_k = 1 / f_k and
  * L = lambda ln J:
  *   K_ii = mu (1 + i_i^2) + (lambda - L) i_i^2,  pair_ij = mu + i_i i_j |mu + lambda - L|
@@ -209,15 +217,13 @@ MATERIAL_KERNEL void hgo_matrix_stress_modulus_unclamped(const piola_material *m
 /* A lane the kernel above does not take (an entry clamped): no k, so no cached block. */
 MATERIAL_KERNEL void step_cache_skip(double *k_out) { *k_out = (double)NAN; }
 
-/* mooney_rivlin_stress_lanes_unclamped with k in closed form (step_mooney_rivlin_modulus):
+/* mooney_rivlin_stress_lanes_unclamped with k in closed form (step_mooney_rivlin_modulus_at):
  * the reciprocals and the logarithm are the stress's (the compiler forms them once). */
 MATERIAL_KERNEL void mooney_rivlin_stress_modulus_unclamped(const piola_material *m, double f0, double f1,
                                                             double f2, double *p0, double *p1, double *p2,
                                                             double *k_out) {
   mooney_rivlin_stress_lanes_unclamped(m, f0, f1, f2, p0, p1, p2);
-  const double i0 = kernel_recip_fast(f0), i1 = kernel_recip_fast(f1), i2 = kernel_recip_fast(f2);
-  const double lq = m->lambda * kernel_log_div(f0 * f1 * f2, KERNEL_FAST_RECIPROCAL);
-  step_cache_store(k_out, 1, step_mooney_rivlin_modulus(m, i0, i1, i2, lq) + m->fiber_modulus);
+  step_cache_store(k_out, 1, step_mooney_rivlin_modulus_at(m, f0, f1, f2) + m->fiber_modulus);
 }
 
 /* mooney_rivlin_stress_lanes for a block with a clamped lane: no k, so no cached block. */

@@ -848,8 +848,7 @@ MATERIAL_KERNEL void mooney_rivlin_stress_lanes_unclamped(const piola_material *
  * the threshold in force (which rises as J falls) and J in the range its logarithm takes. */
 MATERIAL_KERNEL int mooney_rivlin_lane_unclamped(const piola_material *m, double f0, double f1,
                                                  double f2) {
-  const double c = material_threshold_at(m, f0, f1, f2), j = f0 * f1 * f2;
-  return (f0 >= c) & (f1 >= c) & (f2 >= c) & (j >= 1e-300) & (j <= 1e300);
+  return hgo_lane_unclamped(m, f0, f1, f2); /* the same rising threshold and range of J */
 }
 
 /* Mooney-Rivlin with its own model constant: its two powers in closed form (f and 1/f^3,

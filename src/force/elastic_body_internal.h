@@ -95,6 +95,9 @@ struct piola_elastic_body {
   int energy_valid;         /* energy_density matches the last update (it is computed only
                                when stats are requested, or lazily by the getter) */
   double last_stiffness_scale;
+  int signed_twist;         /* 1: the implicit assembly keeps the sign of the rotation
+                               eigenvalues (PIOLA_STIFFNESS_SIGNED_TWIST, element_stiffness.h;
+                               implicit_step.c sets it for Newton's tail), 0: projected */
 
   double *step_weight;      /* per tet 1 / (rho h_e^2), m/kg: the step bound's geometric factor
                                (stable_step.c), built on first use */

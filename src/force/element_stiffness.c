@@ -126,19 +126,20 @@ void piola__diagonal_stiffness_from(const double fhat[3], const double phat[3], 
       twist = (phat[p] + phat[q]) / (fp + fq);
     else
       twist = 0.5 * (d[p][p] + d[p][q] + d[q][p] + d[q][q]);
-    if (project) {
+    if (project != PIOLA_STIFFNESS_EXACT) {
       shear = fmax(shear, 0.0);
       /* near f_p = -f_q (an inverted element close to a reflection) the stress is not
        * continuous unless P_p + P_q vanishes there, and the quotient grows without bound;
        * such a stiff rotation mode only stalls Newton, so it is capped at the element's
-       * other stiffnesses */
+       * other stiffnesses (from below too where it keeps its sign) */
       const double cap = fmax(shear, fmax(fabs(d[p][p]), fabs(d[q][q])));
-      twist = fmin(fmax(twist, 0.0), cap);
+      const double least = project == PIOLA_STIFFNESS_SIGNED_TWIST ? -cap : 0.0;
+      twist = fmin(fmax(twist, least), cap);
     }
     out->pair_a[k] = 0.5 * (shear + twist);
     out->pair_b[k] = 0.5 * (shear - twist);
   }
-  if (project) piola__project_symmetric3(out->block);
+  if (project != PIOLA_STIFFNESS_EXACT) piola__project_symmetric3(out->block);
 }
 
 void piola__fiber_stiffness_terms(const piola_material *material, double stretch,

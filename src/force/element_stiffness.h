@@ -39,14 +39,31 @@ typedef struct piola__diagonal_stiffness {
   double pair_a[3], pair_b[3]; /* the pair blocks [[a, b], [b, a]] */
 } piola__diagonal_stiffness;
 
-/* Fills out at fhat (the diagonalization's signed entries) and Phat = phat. With project,
- * the blocks are made symmetric positive semi-definite. */
+/* How far the blocks are made definite: the `project` argument below.
+ * - PIOLA_STIFFNESS_EXACT: not at all, dP/dF itself.
+ * - PIOLA_STIFFNESS_PROJECTED: the definiteness fix, positive semi-definite for every F.
+ * - PIOLA_STIFFNESS_SIGNED_TWIST: the same except that the rotation eigenvalues
+ *   (P_p + P_q) / (f_p + f_q) keep their sign (capped at plus and minus the element's other
+ *   stiffnesses). That quotient is the stress over the stretch, negative wherever the element
+ *   is compressed, and clamping it at zero is what keeps a Newton iteration on a compressed
+ *   solid from converging quadratically (docs/time-stepping.md, "The Newton tail"); the
+ *   shear quotients and the 3x3 block stay projected. Not definite: for the implicit step's
+ *   tail only, which falls back to the projected matrix when the CG meets negative
+ *   curvature. */
+enum {
+  PIOLA_STIFFNESS_EXACT = 0,
+  PIOLA_STIFFNESS_PROJECTED = 1,
+  PIOLA_STIFFNESS_SIGNED_TWIST = 2
+};
+
+/* Fills out at fhat (the diagonalization's signed entries) and Phat = phat, made definite as
+ * project says (PIOLA_STIFFNESS_*). */
 void piola__diagonal_stiffness_eval(const piola_material *material, const double fhat[3],
                                     const double phat[3], int project,
                                     piola__diagonal_stiffness *out);
 
-/* The same with out->block = dPhat/dFhat at fhat given (unprojected; projected here with
- * project). */
+/* The same with out->block = dPhat/dFhat at fhat given (unprojected; made definite here as
+ * project says). */
 void piola__diagonal_stiffness_from(const double fhat[3], const double phat[3], int project,
                                     piola__diagonal_stiffness *out);
 
@@ -66,8 +83,9 @@ void piola__material_stress_and_derivative(const piola_material *material, const
 int piola__stress_evaluates_own_parts(piola_material_model model);
 
 /* The fibre term's two coefficients at fibre stretch lambda (see above), Pa: s and c with
- * dP_f/dF = s (I (x) a a^T) + c (w (x) a)(w (x) a)^T for a unit a. With project, T' is
- * replaced by max(T', 0). Zero for non-muscle materials and near lambda = 0 (where T = 0). */
+ * dP_f/dF = s (I (x) a a^T) + c (w (x) a)(w (x) a)^T for a unit a. With project (any but
+ * PIOLA_STIFFNESS_EXACT), T' is replaced by max(T', 0). Zero for non-muscle materials and
+ * near lambda = 0 (where T = 0). */
 void piola__fiber_stiffness_terms(const piola_material *material, double stretch,
                                   double activation, int project, double *s, double *c);
 

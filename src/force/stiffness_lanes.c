@@ -63,13 +63,14 @@ PIOLA_WIDE_VECTORS void PIOLA_ISA_NAME(piola__stiffness_block_lanes)(const piola
   const int32_t base = block * B;
   double kd[9][B], ka[3][B], kb[3][B], phat[3][B], dphat[9][B];
   const int parts = material_parts_lanes(body, base, phat, dphat);
+  const int project = piola__stiffness_projection(body);
   for (int l = 0; l < B; ++l) {
     piola__diagonal_stiffness k;
     if (parts) {
       const double *fhat = body->fhat + 3 * (size_t)(base + l);
       const double p[3] = {phat[0][l], phat[1][l], phat[2][l]};
       for (int e = 0; e < 9; ++e) k.block[e / 3][e % 3] = dphat[e][l];
-      piola__diagonal_stiffness_from(fhat, p, 1, &k);
+      piola__diagonal_stiffness_from(fhat, p, project, &k);
     } else {
       piola__tet_diagonal_stiffness(body, base + l, &k);
     }

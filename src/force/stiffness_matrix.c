@@ -39,13 +39,17 @@ void piola__stiffness_matrix_free(piola__stiffness_matrix *m) {
   memset(m, 0, sizeof *m);
 }
 
+int piola__stiffness_projection(const piola_elastic_body *body) {
+  return body->signed_twist ? PIOLA_STIFFNESS_SIGNED_TWIST : PIOLA_STIFFNESS_PROJECTED;
+}
+
 void piola__tet_diagonal_stiffness(const piola_elastic_body *body, int32_t t,
                                    piola__diagonal_stiffness *k) {
   const piola_material *material = &body->materials[body->tet_material[t]];
   const double *fhat = body->fhat + 3 * (size_t)t;
   double phat[3];
   piola__material_stress_and_derivative(material, fhat, phat, k->block);
-  piola__diagonal_stiffness_from(fhat, phat, 1, k);
+  piola__diagonal_stiffness_from(fhat, phat, piola__stiffness_projection(body), k);
 }
 
 void piola__tet_stiffness_blocks(const piola_elastic_body *body, int32_t t, double out[54]) {
@@ -79,7 +83,7 @@ void piola__tet_stiffness_blocks(const piola_elastic_body *body, int32_t t, doub
     for (int i = 0; i < 3; ++i)
       w[i] = u[i][0] * fhat[0] * ah[0] + u[i][1] * fhat[1] * ah[1] + u[i][2] * fhat[2] * ah[2];
     piola__fiber_stiffness_terms(material, sqrt(w[0] * w[0] + w[1] * w[1] + w[2] * w[2]),
-                                 body->activation, 1, &fs, &fc);
+                                 body->activation, PIOLA_STIFFNESS_PROJECTED, &fs, &fc);
   }
   /* HGO's fibres: dP_f/dF at F = U Fhat V^T, positive semi-definite as it is (material.h) */
   double hgo_dpdf[81];

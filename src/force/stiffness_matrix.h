@@ -3,8 +3,9 @@
  * Newton's method for a backward Euler step solves
  *   (m_w M - dt^2 K - dt D) dx = -g,
  * with K = df/dx the elastic force's derivative, made negative semi-definite per element
- * (element_stiffness.h: the projected dP/dF), D the damping matrix and m_w 1 (0 in
- * quasistatics, where a small multiple of M regularizes). K and D are both translation
+ * (element_stiffness.h: the projected dP/dF; in Newton's tail the rotation eigenvalues keep
+ * their sign), D the damping matrix and m_w 1 (0 in quasistatics, where a small multiple of
+ * M regularizes). K and D are both translation
  * invariant (their block rows sum to zero) and symmetric, and they live on the same pairs of
  * vertices: the mesh edges. So the matrix is stored like the damping matrix
  * (damping_matrix.h), reusing its pattern, its row order and its per-tet slots: one 3x3 block
@@ -61,14 +62,18 @@ void piola__stiffness_matrix_apply(const piola__stiffness_matrix *matrix,
                                    const piola_elastic_body *body, const double *mass,
                                    double mass_weight, const double *p, double *out);
 
+/* How the body's assembly makes dP/dF definite: PIOLA_STIFFNESS_PROJECTED, or
+ * PIOLA_STIFFNESS_SIGNED_TWIST while body->signed_twist is set (element_stiffness.h). */
+int piola__stiffness_projection(const piola_elastic_body *body);
+
 /* The material's part of tet t's stiffness at the body's last update: dPhat/dFhat in the
- * diagonal frame, projected (element_stiffness.h). */
+ * diagonal frame, made definite as piola__stiffness_projection says (element_stiffness.h). */
 void piola__tet_diagonal_stiffness(const piola_elastic_body *body, int32_t t,
                                    piola__diagonal_stiffness *k);
 
 /* The 6 corner-pair blocks df_a/dx_b (a < b in the order 01 02 03 12 13 23, row-major) of
- * tet t of body at its last update, projected, times the body's stiffness scale. For tests
- * and the assembly. */
+ * tet t of body at its last update, made definite as above, times the body's stiffness
+ * scale. For tests and the assembly. */
 void piola__tet_stiffness_blocks(const piola_elastic_body *body, int32_t t, double out[54]);
 
 #endif

@@ -28,6 +28,15 @@
  * quasistatic bar of run_resume_examples.py were cut to 1/1024, and its first increment
  * failed 12 times; docs/time-stepping.md).
  *
+ * The tail. The projected matrix is not the Jacobian where elements are compressed (the
+ * fix clamps their negative rotation eigenvalues), and Newton on it converges only
+ * linearly. So after an iteration that took the full step with no contact change and no
+ * Levenberg-Marquardt shift, the next systems keep those eigenvalues' sign
+ * (PIOLA_STIFFNESS_SIGNED_TWIST, element_stiffness.h), with the last projected system's
+ * preconditioner; a CG that meets non-positive curvature there is solved again on the
+ * projected matrix, and a backtracking line search ends the tail for the step
+ * (newton_direction; docs/time-stepping.md, "The Newton tail").
+ *
  * Constraints. Fixed, driven and bone nodes sit at their positions of t^n+1 before the
  * first iteration and are filtered out of every residual and search direction. Obstacle
  * contacts are an active set: nodes found inside an obstacle (at the prediction and after
@@ -203,6 +212,8 @@ typedef struct newton_problem {
   double force_weight; /* dt^2, or 1 in quasistatics */
   double mass_weight;  /* 1, or 0 in quasistatics */
   double total_mass;
+  int signed_twist; /* this Newton system keeps the rotation eigenvalues' sign (the tail) */
+  int indefinite;   /* the last CG met non-positive curvature or an indefinite preconditioner */
 } newton_problem;
 
 /* Nodes i0 .. i1 - 1 of the residual; returns their part of |S g|^2_{M^-1}. */
@@ -374,6 +385,7 @@ static int vertex_constraint(const void *context, int32_t i, double normal[3]) {
  * than the iterations it saves). */
 static piola_status factor_newton_system(const newton_problem *pb) {
   struct implicit_state *st = pb->st;
+  if (pb->signed_twist) return PIOLA_OK; /* the tail keeps the last projected one */
   st->factored = pb->w->def.preconditioner == PIOLA_PRECONDITIONER_INCOMPLETE_CHOLESKY &&
                  pb->s->kind == PIOLA_BODY_SOLID && st->factor.pair_start &&
                  !piola__implicit_split_of(pb->s);
@@ -454,6 +466,7 @@ static int32_t solve_newton_system(newton_problem *pb, double eta) {
                                                    st->split_systems++, st->cg[0], d)
                      : 0;
   if (it < 0) it = 0; /* a failed solve leaves its best d; the line search judges it */
+  pb->indefinite = 0;
   double rz = split ? 0.0 : cg_pass(&c, cg_start_range);
   double merit = rz; /* |r|^2_{M^-1} with the multigrid */
   if (!split && (c.factor || c.multigrid)) {
@@ -465,7 +478,10 @@ static int32_t solve_newton_system(newton_problem *pb, double eta) {
          it < pb->w->def.linear_max_iterations) {
     piola__body_stiffness_apply(s, c.mx, mass_weight, c.p, c.q);
     const double pq = cg_pass(&c, cg_curvature_range);
-    if (!(pq > 0)) break;
+    if (!(pq > 0)) {
+      pb->indefinite = 1;
+      break;
+    }
     c.alpha = rz / pq;
     double rz_new = cg_pass(&c, cg_update_range);
     if (c.multigrid) merit = rz_new;
@@ -474,6 +490,7 @@ static int32_t solve_newton_system(newton_problem *pb, double eta) {
     rz = rz_new;
     ++it;
   }
+  if (!(rz >= 0)) pb->indefinite = 1; /* an indefinite preconditioner (block Jacobi's) */
   /* a free body: move d by the uniform displacement that makes sum M d = -sum g (K and D
    * ignore uniform fields, so the net residual after a full step is then zero whatever the
    * CG's accuracy or the regularization), so the linear momentum comes out exact */
@@ -659,6 +676,45 @@ static piola_status newton_body(piola_world *w, world_body *s, double t, double 
 
 /* Newton's iterations from the body's current state (its forces up to date), then the
  * velocities, friction and prescribed nodes. */
+/* Assembles, factors and solves the Newton system at the current iterate into st->step.
+ * The tail's matrix (pb->signed_twist) is not definite everywhere: where its CG meets
+ * non-positive curvature, or block Jacobi's diagonal turns out indefinite, the system is
+ * assembled projected and solved again, and the tail stays off for the rest of the step
+ * (*tail_allowed = 0). */
+static piola_status newton_direction(newton_problem *pb, double eta, int *tail_allowed,
+                                     piola_step_stats *stats) {
+  piola_world *w = pb->w;
+  world_body *s = pb->s;
+  struct implicit_state *st = pb->st;
+  const double dt = pb->dt;
+  for (;;) {
+    if (s->kind == PIOLA_BODY_SOLID) s->solid->signed_twist = pb->signed_twist;
+    if (pb->damped) piola__body_damping_prepare(s, pb->beta, pb->alpha);
+    piola__body_stiffness_assemble(s, &st->matrix, pb->force_weight, pb->damped ? dt : 0.0,
+                                   pb->beta, pb->alpha, pb->mass_weight);
+    if (pb->quasistatic) {
+      if (!(s->quasistatic_mu > 0)) {
+        /* the first regularization: a small fraction of the mean stiffness per mass */
+        const double trace = piola__implicit_matrix_trace(s, &st->matrix);
+        s->quasistatic_mu = 1e-6 * trace / (3.0 * pb->total_mass);
+        if (!(s->quasistatic_mu > 0)) s->quasistatic_mu = 1.0;
+      }
+      piola__body_stiffness_set_mass_weight(s, &st->matrix, pb->force_weight, 0.0, pb->beta,
+                                            pb->alpha, s->quasistatic_mu);
+    } else if (s->quasistatic_mu > 0) {
+      piola__body_stiffness_set_mass_weight(s, &st->matrix, pb->force_weight,
+                                            pb->damped ? dt : 0.0, pb->beta, pb->alpha,
+                                            pb->mass_weight + s->quasistatic_mu);
+    }
+    PIOLA_TRY(factor_newton_system(pb));
+    piola__step_profile_mark(&w->profile, STEP_PHASE_ASSEMBLE);
+    stats->linear_iterations += solve_newton_system(pb, eta);
+    piola__step_profile_mark(&w->profile, STEP_PHASE_LINEAR);
+    if (!(pb->signed_twist && pb->indefinite)) return PIOLA_OK;
+    pb->signed_twist = 0, *tail_allowed = 0;
+  }
+}
+
 static piola_status newton_iterate(const newton_problem *problem, int accept_unconverged,
                                    piola_step_stats *stats) {
   newton_problem pb = *problem;
@@ -673,6 +729,10 @@ static piola_status newton_iterate(const newton_problem *problem, int accept_unc
   double phi = residual(&pb);
   double phi_last = -1, eta = w->def.linear_tolerance;
   double last_alpha = 1.0; /* the last line search's step (the forcing term reads it) */
+  /* the tail's matrix (see the head of this file): solids of backward Euler on one process;
+   * once it has failed, not again in this step */
+  int tail_allowed = s->kind == PIOLA_BODY_SOLID && !pb.quasistatic && !piola__implicit_split_of(s);
+  pb.signed_twist = 0;
   int converged = 0;
   /* the test runs once more after the last iteration: an iterate that converges there is
    * a converged step, not a failed one */
@@ -694,32 +754,14 @@ static piola_status newton_iterate(const newton_problem *problem, int accept_unc
      * residual reflects the first guess more than the contact): releasing them only once
      * converged costs a whole Newton solve per round of releases (measured on a torus
      * landing on a plane: 22-24 iterations per frame, 10-13 this way) */
-    if (iter > 0 && release_contacts(&pb) > 0) phi = residual(&pb);
+    const int32_t released = iter > 0 ? release_contacts(&pb) : 0;
+    if (released > 0) phi = residual(&pb);
     stats->newton_iterations++;
     piola__step_profile_mark(&w->profile, STEP_PHASE_UPDATE);
-    if (pb.damped) piola__body_damping_prepare(s, pb.beta, pb.alpha);
-    piola__body_stiffness_assemble(s, &st->matrix, pb.force_weight, pb.damped ? dt : 0.0,
-                                   pb.beta, pb.alpha, pb.mass_weight);
-    if (pb.quasistatic) {
-      if (!(s->quasistatic_mu > 0)) {
-        /* the first regularization: a small fraction of the mean stiffness per mass */
-        const double trace = piola__implicit_matrix_trace(s, &st->matrix);
-        s->quasistatic_mu = 1e-6 * trace / (3.0 * pb.total_mass);
-        if (!(s->quasistatic_mu > 0)) s->quasistatic_mu = 1.0;
-      }
-      piola__body_stiffness_set_mass_weight(s, &st->matrix, pb.force_weight, 0.0, pb.beta,
-                                            pb.alpha, s->quasistatic_mu);
-    } else if (s->quasistatic_mu > 0) {
-      piola__body_stiffness_set_mass_weight(s, &st->matrix, pb.force_weight,
-                                            pb.damped ? dt : 0.0, pb.beta, pb.alpha,
-                                            pb.mass_weight + s->quasistatic_mu);
-    }
-    PIOLA_TRY(factor_newton_system(&pb));
-    piola__step_profile_mark(&w->profile, STEP_PHASE_ASSEMBLE);
+    if (released > 0) pb.signed_twist = 0;
     eta = forcing_term(&w->def, phi, phi_last, eta, target2, last_alpha < 1.0);
     phi_last = phi;
-    stats->linear_iterations += solve_newton_system(&pb, eta);
-    piola__step_profile_mark(&w->profile, STEP_PHASE_LINEAR);
+    PIOLA_TRY(newton_direction(&pb, eta, &tail_allowed, stats));
     /* backtracking line search on |S g|^2, and for a quasistatic solid also on its
      * potential: a step is accepted when either decreases by the Armijo fraction (see the
      * head of this file) */
@@ -785,11 +827,15 @@ static piola_status newton_iterate(const newton_problem *problem, int accept_unc
     }
     int32_t added = contacts(&pb);
     if (added < 0) return PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "implicit step: out of memory");
+    if (pb.signed_twist && alpha < 1.0) tail_allowed = 0;
+    pb.signed_twist = tail_allowed && alpha == 1.0 && added == 0 && released == 0 &&
+                      !(s->quasistatic_mu > 0);
     if (added > 0) {
       PIOLA_TRY(update(&pb));
       phi = residual(&pb);
     }
   }
+  if (s->kind == PIOLA_BODY_SOLID) s->solid->signed_twist = 0;
   if (!converged) {
     /* the regularization a failed Newton shrank or grew is no start for the retry (a
      * quasistatic retry that began at the failed try's mu of 1e-22 took a first step of

@@ -674,8 +674,6 @@ static piola_status newton_body(piola_world *w, world_body *s, double t, double 
   return newton_iterate(&pb, accept_unconverged, stats);
 }
 
-/* Newton's iterations from the body's current state (its forces up to date), then the
- * velocities, friction and prescribed nodes. */
 /* Assembles, factors and solves the Newton system at the current iterate into st->step.
  * The tail's matrix (pb->signed_twist) is not definite everywhere: where its CG meets
  * non-positive curvature, or block Jacobi's diagonal turns out indefinite, the system is
@@ -715,6 +713,8 @@ static piola_status newton_direction(newton_problem *pb, double eta, int *tail_a
   }
 }
 
+/* Newton's iterations from the body's current state (its forces up to date), then the
+ * velocities, friction and prescribed nodes. */
 static piola_status newton_iterate(const newton_problem *problem, int accept_unconverged,
                                    piola_step_stats *stats) {
   newton_problem pb = *problem;
@@ -731,7 +731,8 @@ static piola_status newton_iterate(const newton_problem *problem, int accept_unc
   double last_alpha = 1.0; /* the last line search's step (the forcing term reads it) */
   /* the tail's matrix (see the head of this file): solids of backward Euler on one process;
    * once it has failed, not again in this step */
-  int tail_allowed = s->kind == PIOLA_BODY_SOLID && !pb.quasistatic && !piola__implicit_split_of(s);
+  int tail_allowed =
+      s->kind == PIOLA_BODY_SOLID && !pb.quasistatic && !piola__implicit_split_of(s);
   pb.signed_twist = 0;
   int converged = 0;
   /* the test runs once more after the last iteration: an iterate that converges there is

@@ -391,16 +391,14 @@ static piola_status rigid_modes(const piola__multigrid *mg, const piola_elastic_
   return PIOLA_OK;
 }
 
-/* P = (I - omega D^-1 A) T on level l (t: the tentative prolongator). */
-static piola_status smooth_prolongator(piola__multigrid_level *l, const piola__block_sparse *t) {
-  piola__block_sparse at;
-  PIOLA_TRY(piola__block_sparse_product(&l->a, t, &at));
+/* Rows r0 .. r1 - 1 of P = T - omega D^-1 (A T), in place of A T's blocks. */
+static void smooth_rows(const piola__multigrid_level *l, const piola__block_sparse *t,
+                        piola__block_sparse *at, double omega, int32_t r0, int32_t r1) {
   const int b = l->a.rb, nm = PIOLA_MULTIGRID_MODES;
-  const double omega = 4.0 / (3.0 * l->rho);
-  for (int32_t r = 0; r < at.rows; ++r) {
+  for (int32_t r = r0; r < r1; ++r) {
     const double *dinv = l->inverse_diagonal + (size_t)(b * b) * (size_t)r;
-    for (int32_t k = at.row_start[r]; k < at.row_start[r + 1]; ++k) {
-      double *blk = at.values + (size_t)(b * nm) * (size_t)k, w[36];
+    for (int32_t k = at->row_start[r]; k < at->row_start[r + 1]; ++k) {
+      double *blk = at->values + (size_t)(b * nm) * (size_t)k, w[36];
       for (int i = 0; i < b; ++i)
         for (int j = 0; j < nm; ++j) {
           double s = 0;
@@ -408,13 +406,26 @@ static piola_status smooth_prolongator(piola__multigrid_level *l, const piola__b
           w[nm * i + j] = -omega * s;
         }
       /* T's block of row r, if it is in this column */
-      if (t->row_start[r + 1] > t->row_start[r] && t->col[t->row_start[r]] == at.col[k]) {
+      if (t->row_start[r + 1] > t->row_start[r] && t->col[t->row_start[r]] == at->col[k]) {
         const double *tb = t->values + (size_t)(b * nm) * (size_t)t->row_start[r];
         for (int e = 0; e < b * nm; ++e) w[e] += tb[e];
       }
       memcpy(blk, w, sizeof(double) * (size_t)(b * nm));
     }
   }
+}
+
+/* P = (I - omega D^-1 A) T on level l (t: the tentative prolongator). */
+static piola_status smooth_prolongator(piola__multigrid_level *l, const piola__block_sparse *t) {
+  piola__block_sparse at;
+  PIOLA_TRY(piola__block_sparse_product(&l->a, t, &at));
+  const double omega = 4.0 / (3.0 * l->rho);
+  const int32_t n = at.rows;
+#pragma omp parallel for schedule(static) \
+    num_threads(piola_thread_count()) if (n >= MULTIGRID_PARALLEL_MIN_ROWS)
+  for (int k = 0; k < RANGES; ++k)
+    smooth_rows(l, t, &at, omega, (int32_t)((int64_t)n * k / RANGES),
+                (int32_t)((int64_t)n * (k + 1) / RANGES));
   l->p = at;
   return PIOLA_OK;
 }

@@ -7,8 +7,10 @@
 #include "common/status_report.h"
 #include "piola/threads.h"
 
-/* below this many rows a product runs on one thread (the parallel region costs more) */
+/* below this many rows a product with a vector runs on one thread (the parallel region
+ * costs more), and a sparse product below this many values of its left factor */
 #define BLOCK_SPARSE_PARALLEL_MIN_ROWS 4096
+#define BLOCK_SPARSE_PARALLEL_MIN_VALUES (1 << 19)
 enum { RANGES = 16 };
 
 piola_status piola__block_sparse_alloc(piola__block_sparse *m, int32_t rows, int32_t cols, int rb,
@@ -167,31 +169,23 @@ static block_multiply_add *multiply_add_for(int r, int k, int c) {
   return multiply_add_any;
 }
 
-piola_status piola__block_sparse_product(const piola__block_sparse *a, const piola__block_sparse *b,
-                                         piola__block_sparse *c) {
-  memset(c, 0, sizeof *c);
-  const int32_t cols = b->cols > 0 ? b->cols : 1;
-  int32_t *marker = malloc(sizeof(int32_t) * (size_t)cols);
-  int32_t *list = malloc(sizeof(int32_t) * (size_t)cols);
-  int32_t *position = malloc(sizeof(int32_t) * (size_t)cols);
-  if (!marker || !list || !position) {
-    free(marker), free(list), free(position);
-    return PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "sparse product: out of memory");
-  }
-  for (int32_t j = 0; j < cols; ++j) marker[j] = -1;
-  int64_t entries = 0;
-  for (int32_t r = 0; r < a->rows; ++r) entries += product_row_columns(a, b, r, marker, list, 0);
-  piola_status status = piola__block_sparse_alloc(c, a->rows, b->cols, a->rb, b->cb, entries);
-  if (status != PIOLA_OK) {
-    free(marker), free(list), free(position);
-    return status;
-  }
-  for (int32_t j = 0; j < cols; ++j) marker[j] = -1;
+/* Whether a sparse product with left factor a runs in parallel: by its values, since a
+ * coarse level's 6x6 blocks make a row 16 times the work of a 3x3 one. */
+static int parallel_product(const piola__block_sparse *a) {
+  return (int64_t)a->row_start[a->rows] * a->rb * a->cb >= BLOCK_SPARSE_PARALLEL_MIN_VALUES;
+}
+
+/* Rows r0 .. r1 - 1 of c = a b, its row_start known: each row's columns sorted, its blocks
+ * summed over a's row in order (marker, list and position: this range's own, marker[j] not
+ * a row of the range on entry). */
+static void product_rows(const piola__block_sparse *a, const piola__block_sparse *b,
+                         piola__block_sparse *c, int32_t r0, int32_t r1, int32_t *marker,
+                         int32_t *list, int32_t *position) {
   const int ra = a->rb, inner = a->cb, cb = b->cb;
   const size_t abs = (size_t)(ra * inner), bbs = (size_t)(inner * cb), cbs = (size_t)(ra * cb);
   block_multiply_add *multiply_add = multiply_add_for(ra, inner, cb);
-  int64_t at = 0;
-  for (int32_t r = 0; r < a->rows; ++r) {
+  for (int32_t r = r0; r < r1; ++r) {
+    const int64_t at = c->row_start[r];
     const int32_t count = product_row_columns(a, b, r, marker, list, 1);
     for (int32_t q = 0; q < count; ++q) position[list[q]] = (int32_t)(at + q);
     memcpy(c->col + at, list, sizeof(int32_t) * (size_t)count);
@@ -199,16 +193,49 @@ piola_status piola__block_sparse_product(const piola__block_sparse *a, const pio
     for (int32_t k = a->row_start[r]; k < a->row_start[r + 1]; ++k) {
       const double *ak = a->values + abs * (size_t)k;
       const int32_t m = a->col[k];
-      for (int32_t l = b->row_start[m]; l < b->row_start[m + 1]; ++l) {
+      for (int32_t l = b->row_start[m]; l < b->row_start[m + 1]; ++l)
         multiply_add(ak, b->values + bbs * (size_t)l, c->values + cbs * (size_t)position[b->col[l]],
                      ra, inner, cb);
-      }
     }
-    at += count;
-    c->row_start[r + 1] = (int32_t)at;
   }
-  free(marker), free(list), free(position);
-  return PIOLA_OK;
+}
+
+piola_status piola__block_sparse_product(const piola__block_sparse *a, const piola__block_sparse *b,
+                                         piola__block_sparse *c) {
+  memset(c, 0, sizeof *c);
+  const int32_t rows = a->rows, cols = b->cols > 0 ? b->cols : 1;
+  /* row ranges in parallel from this many rows on, each with its own work arrays */
+  const int ranges = parallel_product(a) ? RANGES : 1;
+  const size_t work = (size_t)cols * (size_t)ranges;
+  int32_t *marker = malloc(sizeof(int32_t) * work);
+  int32_t *list = malloc(sizeof(int32_t) * work);
+  int32_t *position = malloc(sizeof(int32_t) * work);
+  int32_t *counts = malloc(sizeof(int32_t) * ((size_t)rows + 1));
+  piola_status status = PIOLA_OK;
+  if (!marker || !list || !position || !counts) {
+    status = PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "sparse product: out of memory");
+    goto done;
+  }
+  for (int32_t j = 0; j < cols; ++j) marker[j] = -1;
+  int64_t entries = 0;
+  for (int32_t r = 0; r < rows; ++r) {
+    counts[r] = product_row_columns(a, b, r, marker, list, 0);
+    entries += counts[r];
+  }
+  status = piola__block_sparse_alloc(c, rows, b->cols, a->rb, b->cb, entries);
+  if (status != PIOLA_OK) goto done;
+  for (int32_t r = 0; r < rows; ++r) c->row_start[r + 1] = c->row_start[r] + counts[r];
+  for (size_t j = 0; j < work; ++j) marker[j] = -1;
+#pragma omp parallel for schedule(static) \
+    num_threads(piola_thread_count()) if (ranges > 1)
+  for (int k = 0; k < ranges; ++k) {
+    const size_t w = (size_t)cols * (size_t)k;
+    product_rows(a, b, c, (int32_t)((int64_t)rows * k / ranges),
+                 (int32_t)((int64_t)rows * (k + 1) / ranges), marker + w, list + w, position + w);
+  }
+done:
+  free(marker), free(list), free(position), free(counts);
+  return status;
 }
 
 /* The entry of column col in row r of c (present: c's pattern was built to hold it). */
@@ -258,14 +285,74 @@ static piola_status galerkin_pattern(const piola__block_sparse *pt, const int32_
   return PIOLA_OK;
 }
 
+/* The numeric part of the Galerkin product for the rows [g0, g1) of c (pattern built, values
+ * zeroed): row r of a p into `row`, then its terms pt(g, r) (a p)(r, h) into every row g of c
+ * in the range that names r. Rows r in increasing order, as pt's rows list them, so every
+ * entry of c sums its terms in the order the two separate products would, whichever range
+ * it falls in; a row r whose p row names rows of two ranges is formed by both. */
+typedef struct galerkin_pass {
+  const piola__block_sparse *pt, *a, *p;
+  piola__block_sparse *c;
+  const int32_t *ap_start, *ap_col;
+  int32_t *cursor; /* per row g of c: its next entry of pt (rows of one range only) */
+} galerkin_pass;
+
+static void galerkin_rows(const galerkin_pass *gp, int32_t g0, int32_t g1, int32_t *position,
+                          double *row) {
+  const piola__block_sparse *pt = gp->pt, *a = gp->a, *p = gp->p;
+  piola__block_sparse *c = gp->c;
+  const int ra = a->rb, inner = a->cb, cb = p->cb, rc = pt->rb;
+  const size_t abs = (size_t)(ra * inner), pbs = (size_t)(inner * cb), apbs = (size_t)(ra * cb);
+  const size_t ptbs = (size_t)(rc * ra), cbs = (size_t)(rc * cb);
+  block_multiply_add *ap_multiply_add = multiply_add_for(ra, inner, cb);
+  block_multiply_add *c_multiply_add = multiply_add_for(rc, ra, cb);
+  for (int32_t r = 0; r < a->rows; ++r) {
+    int names = 0;
+    for (int32_t j = p->row_start[r]; j < p->row_start[r + 1]; ++j)
+      names |= p->col[j] >= g0 && p->col[j] < g1;
+    if (!names) continue;
+    const int32_t first = gp->ap_start[r], count = gp->ap_start[r + 1] - first;
+    for (int32_t q = 0; q < count; ++q) position[gp->ap_col[first + q]] = q;
+    memset(row, 0, sizeof(double) * apbs * (size_t)count);
+    for (int32_t k = a->row_start[r]; k < a->row_start[r + 1]; ++k) {
+      const double *ak = a->values + abs * (size_t)k;
+      const int32_t m = a->col[k];
+      for (int32_t l = p->row_start[m]; l < p->row_start[m + 1]; ++l)
+        ap_multiply_add(ak, p->values + pbs * (size_t)l, row + apbs * (size_t)position[p->col[l]],
+                        ra, inner, cb);
+    }
+    for (int32_t j = p->row_start[r]; j < p->row_start[r + 1]; ++j) {
+      const int32_t g = p->col[j];
+      if (g < g0 || g >= g1) continue;
+      const double *ptb = pt->values + ptbs * (size_t)gp->cursor[g]++;
+      for (int32_t q = 0; q < count; ++q)
+        c_multiply_add(ptb, row + apbs * (size_t)q,
+                       c->values + cbs * (size_t)entry_of(c, g, gp->ap_col[first + q]), rc, ra,
+                       cb);
+    }
+  }
+}
+
+/* The first row of range k of `ranges` over pt's rows: the ranges split pt's entries (the
+ * rows of a p each range forms) evenly. */
+static int32_t range_row(const piola__block_sparse *pt, int k, int ranges) {
+  if (k >= ranges) return pt->rows;
+  const int64_t share = (int64_t)pt->row_start[pt->rows] * k;
+  int32_t g = 0;
+  while (g < pt->rows && (int64_t)pt->row_start[g] * ranges < share) ++g;
+  return g;
+}
+
 piola_status piola__block_sparse_galerkin(const piola__block_sparse *pt,
                                           const piola__block_sparse *a,
                                           const piola__block_sparse *p, piola__block_sparse *c) {
   memset(c, 0, sizeof *c);
   const int32_t n = a->rows, cols = p->cols > 0 ? p->cols : 1;
+  /* one range of c's rows per thread (each thread forms the rows of a p its range needs) */
+  const int ranges = parallel_product(a) ? piola_thread_count() : 1;
   int32_t *marker = malloc(sizeof(int32_t) * (size_t)cols);
   int32_t *list = malloc(sizeof(int32_t) * (size_t)cols);
-  int32_t *position = malloc(sizeof(int32_t) * (size_t)cols);
+  int32_t *position = malloc(sizeof(int32_t) * (size_t)cols * (size_t)ranges);
   int32_t *ap_start = malloc(sizeof(int32_t) * ((size_t)n + 1));
   int32_t *cursor = malloc(sizeof(int32_t) * (size_t)(pt->rows > 0 ? pt->rows : 1));
   int32_t *ap_col = NULL;
@@ -282,43 +369,22 @@ piola_status piola__block_sparse_galerkin(const piola__block_sparse *pt,
     ap_start[r + 1] = ap_start[r] + count;
   }
   ap_col = malloc(sizeof(int32_t) * (size_t)(ap_start[n] > 0 ? ap_start[n] : 1));
-  const int ra = a->rb, inner = a->cb, cb = p->cb, rc = pt->rb;
-  const size_t abs = (size_t)(ra * inner), pbs = (size_t)(inner * cb), apbs = (size_t)(ra * cb);
-  const size_t ptbs = (size_t)(rc * ra), cbs = (size_t)(rc * cb);
-  row = malloc(sizeof(double) * apbs * (size_t)longest);
+  const size_t apbs = (size_t)(a->rb * p->cb), cbs = (size_t)(pt->rb * p->cb);
+  row = malloc(sizeof(double) * apbs * (size_t)longest * (size_t)ranges);
   if (!ap_col || !row) goto out_of_memory;
   for (int32_t j = 0; j < cols; ++j) marker[j] = -1;
   for (int32_t r = 0; r < n; ++r) product_row_columns(a, p, r, marker, ap_col + ap_start[r], 0);
   c->cols = p->cols;
-  status = galerkin_pattern(pt, ap_start, ap_col, cb, c, marker, list);
+  status = galerkin_pattern(pt, ap_start, ap_col, p->cb, c, marker, list);
   if (status != PIOLA_OK) goto done;
   memset(c->values, 0,
          sizeof(double) * cbs * (size_t)(c->row_start[c->rows] > 0 ? c->row_start[c->rows] : 1));
   for (int32_t g = 0; g < pt->rows; ++g) cursor[g] = pt->row_start[g];
-  /* row r of a p into `row`, then its terms pt(g, r) (a p)(r, h) into every row g of c that
-   * names r: rows r in increasing order, as pt's rows list them, so every entry of c sums
-   * its terms in the order the two separate products would */
-  block_multiply_add *ap_multiply_add = multiply_add_for(ra, inner, cb);
-  block_multiply_add *c_multiply_add = multiply_add_for(rc, ra, cb);
-  for (int32_t r = 0; r < n; ++r) {
-    const int32_t first = ap_start[r], count = ap_start[r + 1] - first;
-    for (int32_t q = 0; q < count; ++q) position[ap_col[first + q]] = q;
-    memset(row, 0, sizeof(double) * apbs * (size_t)count);
-    for (int32_t k = a->row_start[r]; k < a->row_start[r + 1]; ++k) {
-      const double *ak = a->values + abs * (size_t)k;
-      const int32_t m = a->col[k];
-      for (int32_t l = p->row_start[m]; l < p->row_start[m + 1]; ++l)
-        ap_multiply_add(ak, p->values + pbs * (size_t)l, row + apbs * (size_t)position[p->col[l]],
-                        ra, inner, cb);
-    }
-    for (int32_t j = p->row_start[r]; j < p->row_start[r + 1]; ++j) {
-      const int32_t g = p->col[j];
-      const double *ptb = pt->values + ptbs * (size_t)cursor[g]++;
-      for (int32_t q = 0; q < count; ++q)
-        c_multiply_add(ptb, row + apbs * (size_t)q,
-                       c->values + cbs * (size_t)entry_of(c, g, ap_col[first + q]), rc, ra, cb);
-    }
-  }
+  const galerkin_pass gp = {pt, a, p, c, ap_start, ap_col, cursor};
+#pragma omp parallel for schedule(static, 1) num_threads(ranges) if (ranges > 1)
+  for (int k = 0; k < ranges; ++k)
+    galerkin_rows(&gp, range_row(pt, k, ranges), range_row(pt, k + 1, ranges),
+                  position + (size_t)cols * (size_t)k, row + apbs * (size_t)longest * (size_t)k);
   goto done;
 out_of_memory:
   status = PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "sparse product: out of memory");

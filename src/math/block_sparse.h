@@ -6,8 +6,9 @@
  * their block columns col[k] increasing, their blocks values[rb cb k ..] row-major. Both
  * triangles of a symmetric matrix are stored, so a product row needs no transposed access
  * and every row is summed by one thread in a fixed order: products are bit-identical for
- * any thread count. The sparse products (Galerkin's P^T A P) are for the hierarchy's setup
- * and run on one thread. */
+ * any thread count. The sparse products (A T, Galerkin's P^T A P) are for the hierarchy's
+ * setup; their numbers are formed in parallel ranges of rows (of c for the Galerkin product),
+ * each entry summed in the same order whatever the ranges, their patterns on one thread. */
 #ifndef PIOLA_MATH_BLOCK_SPARSE_H
 #define PIOLA_MATH_BLOCK_SPARSE_H
 
@@ -43,7 +44,9 @@ piola_status piola__block_sparse_product(const piola__block_sparse *a, const pio
 /* c = pt (a p), pt = p^T as piola__block_sparse_transpose gives it: the Galerkin product,
  * bit-identical to piola__block_sparse_product(pt, a p) but without forming a p (on the
  * Figure 2 torus a 48 MB matrix written, and its pages faulted in, at every setup): each row
- * of a p is formed once in a row buffer and scattered into the rows of c that need it. */
+ * of a p is formed once in a row buffer and scattered into the rows of c that need it (with
+ * several threads, once per range of c's rows that needs it: the ranges split c's rows so
+ * that few rows of a p feed two). */
 piola_status piola__block_sparse_galerkin(const piola__block_sparse *pt,
                                           const piola__block_sparse *a,
                                           const piola__block_sparse *p, piola__block_sparse *c);

@@ -204,7 +204,7 @@ piola_status piola__block_sparse_product(const piola__block_sparse *a, const pio
                                          piola__block_sparse *c) {
   memset(c, 0, sizeof *c);
   const int32_t rows = a->rows, cols = b->cols > 0 ? b->cols : 1;
-  /* row ranges in parallel from this many rows on, each with its own work arrays */
+  /* row ranges in parallel (parallel_product), each with its own work arrays */
   const int ranges = parallel_product(a) ? RANGES : 1;
   const size_t work = (size_t)cols * (size_t)ranges;
   int32_t *marker = malloc(sizeof(int32_t) * work);
@@ -285,11 +285,7 @@ static piola_status galerkin_pattern(const piola__block_sparse *pt, const int32_
   return PIOLA_OK;
 }
 
-/* The numeric part of the Galerkin product for the rows [g0, g1) of c (pattern built, values
- * zeroed): row r of a p into `row`, then its terms pt(g, r) (a p)(r, h) into every row g of c
- * in the range that names r. Rows r in increasing order, as pt's rows list them, so every
- * entry of c sums its terms in the order the two separate products would, whichever range
- * it falls in; a row r whose p row names rows of two ranges is formed by both. */
+/* The operands of the Galerkin product's numbers, shared by its ranges. */
 typedef struct galerkin_pass {
   const piola__block_sparse *pt, *a, *p;
   piola__block_sparse *c;
@@ -297,6 +293,11 @@ typedef struct galerkin_pass {
   int32_t *cursor; /* per row g of c: its next entry of pt (rows of one range only) */
 } galerkin_pass;
 
+/* The numbers of the rows [g0, g1) of c (pattern built, values zeroed): row r of a p into
+ * `row`, then its terms pt(g, r) (a p)(r, h) into every row g of c in the range that names r.
+ * Rows r in increasing order, as pt's rows list them, so every entry of c sums its terms in
+ * the order the two separate products would, whichever range it falls in; a row r whose p
+ * row names rows of two ranges is formed by both. */
 static void galerkin_rows(const galerkin_pass *gp, int32_t g0, int32_t g1, int32_t *position,
                           double *row) {
   const piola__block_sparse *pt = gp->pt, *a = gp->a, *p = gp->p;

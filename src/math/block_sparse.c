@@ -169,6 +169,22 @@ static block_multiply_add *multiply_add_for(int r, int k, int c) {
   return multiply_add_any;
 }
 
+/* Adds row r of a b into out: the block of column j at out + (a->rb b->cb) position[j],
+ * summed over a's row in order. */
+static void add_product_row(const piola__block_sparse *a, const piola__block_sparse *b,
+                            int32_t r, const int32_t *position, double *out,
+                            block_multiply_add *multiply_add) {
+  const int ra = a->rb, inner = a->cb, cb = b->cb;
+  const size_t abs = (size_t)(ra * inner), bbs = (size_t)(inner * cb), obs = (size_t)(ra * cb);
+  for (int32_t k = a->row_start[r]; k < a->row_start[r + 1]; ++k) {
+    const double *ak = a->values + abs * (size_t)k;
+    const int32_t m = a->col[k];
+    for (int32_t l = b->row_start[m]; l < b->row_start[m + 1]; ++l)
+      multiply_add(ak, b->values + bbs * (size_t)l, out + obs * (size_t)position[b->col[l]], ra,
+                   inner, cb);
+  }
+}
+
 /* Whether a sparse product with left factor a runs in parallel: by its values, since a
  * coarse level's 6x6 blocks make a row 16 times the work of a 3x3 one. */
 static int parallel_product(const piola__block_sparse *a) {
@@ -182,7 +198,7 @@ static void product_rows(const piola__block_sparse *a, const piola__block_sparse
                          piola__block_sparse *c, int32_t r0, int32_t r1, int32_t *marker,
                          int32_t *list, int32_t *position) {
   const int ra = a->rb, inner = a->cb, cb = b->cb;
-  const size_t abs = (size_t)(ra * inner), bbs = (size_t)(inner * cb), cbs = (size_t)(ra * cb);
+  const size_t cbs = (size_t)(ra * cb);
   block_multiply_add *multiply_add = multiply_add_for(ra, inner, cb);
   for (int32_t r = r0; r < r1; ++r) {
     const int64_t at = c->row_start[r];
@@ -190,13 +206,7 @@ static void product_rows(const piola__block_sparse *a, const piola__block_sparse
     for (int32_t q = 0; q < count; ++q) position[list[q]] = (int32_t)(at + q);
     memcpy(c->col + at, list, sizeof(int32_t) * (size_t)count);
     memset(c->values + cbs * (size_t)at, 0, sizeof(double) * cbs * (size_t)count);
-    for (int32_t k = a->row_start[r]; k < a->row_start[r + 1]; ++k) {
-      const double *ak = a->values + abs * (size_t)k;
-      const int32_t m = a->col[k];
-      for (int32_t l = b->row_start[m]; l < b->row_start[m + 1]; ++l)
-        multiply_add(ak, b->values + bbs * (size_t)l, c->values + cbs * (size_t)position[b->col[l]],
-                     ra, inner, cb);
-    }
+    add_product_row(a, b, r, position, c->values, multiply_add);
   }
 }
 
@@ -303,8 +313,7 @@ static void galerkin_rows(const galerkin_pass *gp, int32_t g0, int32_t g1, int32
   const piola__block_sparse *pt = gp->pt, *a = gp->a, *p = gp->p;
   piola__block_sparse *c = gp->c;
   const int ra = a->rb, inner = a->cb, cb = p->cb, rc = pt->rb;
-  const size_t abs = (size_t)(ra * inner), pbs = (size_t)(inner * cb), apbs = (size_t)(ra * cb);
-  const size_t ptbs = (size_t)(rc * ra), cbs = (size_t)(rc * cb);
+  const size_t apbs = (size_t)(ra * cb), ptbs = (size_t)(rc * ra), cbs = (size_t)(rc * cb);
   block_multiply_add *ap_multiply_add = multiply_add_for(ra, inner, cb);
   block_multiply_add *c_multiply_add = multiply_add_for(rc, ra, cb);
   for (int32_t r = 0; r < a->rows; ++r) {
@@ -315,13 +324,7 @@ static void galerkin_rows(const galerkin_pass *gp, int32_t g0, int32_t g1, int32
     const int32_t first = gp->ap_start[r], count = gp->ap_start[r + 1] - first;
     for (int32_t q = 0; q < count; ++q) position[gp->ap_col[first + q]] = q;
     memset(row, 0, sizeof(double) * apbs * (size_t)count);
-    for (int32_t k = a->row_start[r]; k < a->row_start[r + 1]; ++k) {
-      const double *ak = a->values + abs * (size_t)k;
-      const int32_t m = a->col[k];
-      for (int32_t l = p->row_start[m]; l < p->row_start[m + 1]; ++l)
-        ap_multiply_add(ak, p->values + pbs * (size_t)l, row + apbs * (size_t)position[p->col[l]],
-                        ra, inner, cb);
-    }
+    add_product_row(a, p, r, position, row, ap_multiply_add);
     for (int32_t j = p->row_start[r]; j < p->row_start[r + 1]; ++j) {
       const int32_t g = p->col[j];
       if (g < g0 || g >= g1) continue;

@@ -685,9 +685,11 @@ static piola_status newton_direction(newton_problem *pb, double eta, int *tail_a
   world_body *s = pb->s;
   struct implicit_state *st = pb->st;
   const double dt = pb->dt;
+  /* the damping matrix does not depend on the stiffness's projection: once, before a
+   * fallback's second assembly */
+  if (pb->damped) piola__body_damping_prepare(s, pb->beta, pb->alpha);
   for (;;) {
     if (s->kind == PIOLA_BODY_SOLID) s->solid->signed_twist = pb->signed_twist;
-    if (pb->damped) piola__body_damping_prepare(s, pb->beta, pb->alpha);
     piola__body_stiffness_assemble(s, &st->matrix, pb->force_weight, pb->damped ? dt : 0.0,
                                    pb->beta, pb->alpha, pb->mass_weight);
     if (pb->quasistatic) {

@@ -226,14 +226,6 @@ MATERIAL_KERNEL void mooney_rivlin_stress_modulus_unclamped(const piola_material
   step_cache_store(k_out, 1, step_mooney_rivlin_modulus_at(m, f0, f1, f2) + m->fiber_modulus);
 }
 
-/* mooney_rivlin_stress_lanes for a block with a clamped lane: no k, so no cached block. */
-MATERIAL_KERNEL void mooney_rivlin_stress_lanes_uncached(const piola_material *m, double f0, double f1,
-                                                         double f2, double *p0, double *p1, double *p2,
-                                                         double *k_out) {
-  mooney_rivlin_stress_lanes(m, f0, f1, f2, p0, p1, p2);
-  step_cache_skip(k_out);
-}
-
 /* k with no entry clamped, from the parts there, for the force loop. For three models the
  * pairs' divisions cancel (P_i = A'(f_i) + kappa q g_i, the pair ij's a +- b are the divided
  * differences of P_i -+ P_j):
@@ -345,27 +337,20 @@ MATERIAL_KERNEL void stable_neohookean_stress_modulus_unclamped(const piola_mate
   step_cache_store(k_out, 1, kernel_max(k0, kernel_max(k1, k2)) + m->fiber_modulus);
 }
 
-/* stable_neohookean_stress_lanes for a block with a clamped lane: no k, so no cached block. */
-MATERIAL_KERNEL void stable_neohookean_stress_lanes_uncached(const piola_material *m, double f0,
-                                                             double f1, double f2, double *p0,
-                                                             double *p1, double *p2, double *k_out) {
-  stable_neohookean_stress_lanes(m, f0, f1, f2, p0, p1, p2);
-  step_cache_skip(k_out);
-}
-
-/* hgo_stress_lanes for a block with a lane clamped at the threshold in force: no k. */
-MATERIAL_KERNEL void hgo_stress_lanes_uncached(const piola_material *m, double f0, double f1, double f2,
-                                               double *p0, double *p1, double *p2, double *k_out) {
-  hgo_stress_lanes(m, f0, f1, f2, p0, p1, p2);
-  step_cache_skip(k_out);
-}
-
-/* neohookean_stress_lanes for a block with a clamped lane: no k formed (NaN), so the block is not cached. */
-MATERIAL_KERNEL void neohookean_stress_lanes_uncached(const piola_material *m, double f0, double f1,
-                                                      double f2, double *p0, double *p1, double *p2,
-                                                      double *k_out) {
-  neohookean_stress_lanes(m, f0, f1, f2, p0, p1, p2);
-  step_cache_skip(k_out);
-}
+/* NAME_stress_lanes for a block with a lane clamped at the threshold in force: the stress with
+ * no k formed (step_cache_skip's NaN), so the block is not cached. One per model that splits
+ * its blocks (PIOLA_SPLIT_BY_BLOCK_WITH in material_lanes.h), for the lane loops to name. */
+#define STEP_UNCACHED_STRESS_KERNEL(name)                                                           \
+  MATERIAL_KERNEL void name##_stress_lanes_uncached(const piola_material *m, double f0, double f1,   \
+                                                    double f2, double *p0, double *p1, double *p2,  \
+                                                    double *k_out) {                                \
+    name##_stress_lanes(m, f0, f1, f2, p0, p1, p2);                                                 \
+    step_cache_skip(k_out);                                                                         \
+  }
+STEP_UNCACHED_STRESS_KERNEL(neohookean)
+STEP_UNCACHED_STRESS_KERNEL(hgo)
+STEP_UNCACHED_STRESS_KERNEL(stable_neohookean)
+STEP_UNCACHED_STRESS_KERNEL(mooney_rivlin)
+#undef STEP_UNCACHED_STRESS_KERNEL
 
 #endif

@@ -8,7 +8,9 @@
  *    projected dP/dF (an independent path), is symmetric, and maps a rigid translation to
  *    the mass term only;
  *  - the assembly's one-evaluation stress and derivative give the public functions' values
- *    for every model and inversion mode, above the threshold (its shortcut) and below. */
+ *    for every model and inversion mode, above the threshold (its shortcut) and below;
+ *  - the Newton tail's matrix is the force derivative on a compressed body and the projected
+ *    matrix in every pair near collapse or inverted. */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -522,6 +524,46 @@ static void test_signed_twist_is_force_derivative_compressed(void **state) {
   }
 }
 
+/* Near collapse or inverted (a pair's f_p + f_q below 1) the tail's matrix is the projected
+ * one, pair by pair: there the rotation quotient changes sign through the reflection and an
+ * indefinite matrix would aim Newton at a collapsed state's saddle. A compressed pair above
+ * the cutoff keeps its negative rotation eigenvalue. */
+static void test_signed_twist_only_where_compressed(void **state) {
+  (void)state;
+  static const double SHAPES_NEAR_COLLAPSE[][3] = {
+      {0.0, 0.0, 0.0}, {1.0, 0.0, 0.0}, {1.0, 1.0, 0.0},  {0.8, 0.3, -0.2},
+      {0.6, 0.3, 0.2}, {1.2, 0.45, 0.5}, {0.9, -0.4, 0.4}, {-0.3, -0.3, 1.1}};
+  for (int model = 0; model < PIOLA_MODEL_COUNT; ++model) {
+    piola_material m = fixture_material((piola_material_model)model);
+    for (size_t n = 0; n < sizeof SHAPES_NEAR_COLLAPSE / sizeof SHAPES_NEAR_COLLAPSE[0]; ++n) {
+      const double *f = SHAPES_NEAR_COLLAPSE[n];
+      double phat[3];
+      piola_material_stress(&m, f, phat);
+      piola__diagonal_stiffness projected, tail;
+      piola__diagonal_stiffness_eval(&m, f, phat, PIOLA_STIFFNESS_PROJECTED, &projected);
+      piola__diagonal_stiffness_eval(&m, f, phat, PIOLA_STIFFNESS_SIGNED_TWIST, &tail);
+      for (int k = 0; k < 3; ++k) {
+        const int p = k == 2 ? 1 : 0, q = k == 0 ? 1 : 2; /* pairs (0,1), (0,2), (1,2) */
+        const double a = tail.pair_a[k], b = tail.pair_b[k];
+        if (f[p] + f[q] < 1.0) {
+          if (a != projected.pair_a[k] || b != projected.pair_b[k])
+            fail_msg("%s at (%g, %g, %g), pair %d: the tail's block differs from the projected one",
+                     piola_material_model_name((piola_material_model)model), f[0], f[1], f[2], k);
+        }
+        assert_true(isfinite(a) && isfinite(b));
+      }
+    }
+    /* compressed above the cutoff: the rotation eigenvalue a - b keeps its negative sign */
+    const double squeezed[3] = {0.8, 0.8, 0.8};
+    double phat[3];
+    piola_material_stress(&m, squeezed, phat);
+    if (!(phat[0] + phat[1] < 0)) continue; /* a model whose stress is not compressive here */
+    piola__diagonal_stiffness tail;
+    piola__diagonal_stiffness_eval(&m, squeezed, phat, PIOLA_STIFFNESS_SIGNED_TWIST, &tail);
+    assert_true(tail.pair_a[0] - tail.pair_b[0] < 0);
+  }
+}
+
 static void test_assembled_matrix(void **state) {
   (void)state;
   for (int model = 0; model < PIOLA_MODEL_COUNT; ++model) {
@@ -539,6 +581,7 @@ int main(void) {
       cmocka_unit_test(test_assembled_matrix),
       cmocka_unit_test(test_matrix_is_force_derivative),
       cmocka_unit_test(test_signed_twist_is_force_derivative_compressed),
+      cmocka_unit_test(test_signed_twist_only_where_compressed),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -44,7 +44,7 @@ typedef struct piola__diagonal_stiffness {
  * - PIOLA_STIFFNESS_PROJECTED: the definiteness fix, positive semi-definite for every F.
  * - PIOLA_STIFFNESS_SIGNED_TWIST: the same except that the rotation eigenvalues
  *   (P_p + P_q) / (f_p + f_q) keep their sign (capped at plus and minus the element's other
- *   stiffnesses). That quotient is the stress over the stretch, negative wherever the element
+ *   stiffnesses) where f_p + f_q >= 1, a pair compressed but not near collapse. That quotient is the stress over the stretch, negative wherever the element
  *   is compressed, and clamping it at zero is what keeps a Newton iteration on a compressed
  *   solid from converging quadratically (docs/time-stepping.md, "The Newton tail"); the
  *   shear quotients and the 3x3 block stay projected. Not definite: for the implicit step's

@@ -543,9 +543,9 @@ static void test_signed_twist_only_where_compressed(void **state) {
       piola__diagonal_stiffness_eval(&m, f, phat, PIOLA_STIFFNESS_PROJECTED, &projected);
       piola__diagonal_stiffness_eval(&m, f, phat, PIOLA_STIFFNESS_SIGNED_TWIST, &tail);
       for (int k = 0; k < 3; ++k) {
-        const int p = k == 2 ? 1 : 0, q = k == 0 ? 1 : 2; /* pairs (0,1), (0,2), (1,2) */
+        const int p = PIOLA__PAIR_P[k], q = PIOLA__PAIR_Q[k];
         const double a = tail.pair_a[k], b = tail.pair_b[k];
-        if (f[p] + f[q] < 1.0) {
+        if (f[p] + f[q] < PIOLA__SIGNED_TWIST_LEAST_STRETCH_SUM) {
           if (a != projected.pair_a[k] || b != projected.pair_b[k])
             fail_msg("%s at (%g, %g, %g), pair %d: the tail's block differs from the projected one",
                      piola_material_model_name((piola_material_model)model), f[0], f[1], f[2], k);
@@ -555,6 +555,7 @@ static void test_signed_twist_only_where_compressed(void **state) {
     }
     /* compressed above the cutoff: the rotation eigenvalue a - b keeps its negative sign */
     const double squeezed[3] = {0.8, 0.8, 0.8};
+    assert_true(squeezed[0] + squeezed[1] >= PIOLA__SIGNED_TWIST_LEAST_STRETCH_SUM);
     double phat[3];
     piola_material_stress(&m, squeezed, phat);
     if (!(phat[0] + phat[1] < 0)) continue; /* a model whose stress is not compressive here */

@@ -10,8 +10,6 @@
 #include "material/muscle_kernels.h"
 #include "piola/diagonalize.h"
 
-static const int PAIR_P[3] = {0, 0, 1}, PAIR_Q[3] = {1, 2, 2};
-
 /* Eigen-decomposition of a symmetric 3x3 by cyclic Jacobi rotations: a becomes diagonal
  * (the eigenvalues), q collects the rotations (columns are eigenvectors). A dozen sweeps
  * reach rounding for any input; the loop stops earlier once the off-diagonal part is below
@@ -24,7 +22,7 @@ static void jacobi_eigen3(double a[3][3], double q[3][3]) {
     double diag = a[0][0] * a[0][0] + a[1][1] * a[1][1] + a[2][2] * a[2][2];
     if (!(off > 1e-32 * diag)) break;
     for (int k = 0; k < 3; ++k) {
-      const int p = PAIR_P[k], r = PAIR_Q[k];
+      const int p = PIOLA__PAIR_P[k], r = PIOLA__PAIR_Q[k];
       if (a[p][r] == 0.0) continue;
       /* the rotation in plane (p, r) that zeroes a[p][r] */
       double theta = (a[r][r] - a[p][p]) / (2.0 * a[p][r]);
@@ -109,18 +107,11 @@ void piola__diagonal_stiffness_eval(const piola_material *material, const double
   piola__diagonal_stiffness_from(fhat, phat, project, out);
 }
 
-/* The tail keeps a rotation eigenvalue's sign only where the pair's mean stretch is at least
- * one half: a compressed element, not one near collapse or inverted. There the quotient is
- * large and changes sign through the reflection, and an indefinite Newton matrix aims at the
- * collapsed state's saddles: a line collapse of armadillo_4k then unfolded into a shape 58%
- * of the diagonal from rest and took 7.5 s to settle instead of 5.3 s. */
-#define SIGNED_TWIST_LEAST_STRETCH_SUM 1.0
-
 void piola__diagonal_stiffness_from(const double fhat[3], const double phat[3], int project,
                                     piola__diagonal_stiffness *out) {
   double(*d)[3] = out->block;
   for (int k = 0; k < 3; ++k) {
-    const int p = PAIR_P[k], q = PAIR_Q[k];
+    const int p = PIOLA__PAIR_P[k], q = PIOLA__PAIR_Q[k];
     const double fp = fhat[p], fq = fhat[q];
     /* below this gap the quotient loses most of its digits: take its limit instead */
     const double gap = 1e-6 * fmax(fmax(fabs(fp), fabs(fq)), 1e-3);
@@ -140,8 +131,8 @@ void piola__diagonal_stiffness_from(const double fhat[3], const double phat[3], 
        * such a stiff rotation mode only stalls Newton, so it is capped at the element's
        * other stiffnesses (from below too where it keeps its sign) */
       const double cap = fmax(shear, fmax(fabs(d[p][p]), fabs(d[q][q])));
-      const int signed_twist =
-          project == PIOLA_STIFFNESS_SIGNED_TWIST && fp + fq >= SIGNED_TWIST_LEAST_STRETCH_SUM;
+      const int signed_twist = project == PIOLA_STIFFNESS_SIGNED_TWIST &&
+                               fp + fq >= PIOLA__SIGNED_TWIST_LEAST_STRETCH_SUM;
       const double least = signed_twist ? -cap : 0.0;
       twist = fmin(fmax(twist, least), cap);
     }
@@ -178,7 +169,7 @@ void piola__element_dpdf(const piola_material *material, const piola_mat3 *f,
   for (int i = 0; i < 3; ++i)
     for (int j = 0; j < 3; ++j) c[9 * (4 * i) + 4 * j] = k.block[i][j];
   for (int n = 0; n < 3; ++n) {
-    const int pq = 3 * PAIR_P[n] + PAIR_Q[n], qp = 3 * PAIR_Q[n] + PAIR_P[n];
+    const int p = PIOLA__PAIR_P[n], q = PIOLA__PAIR_Q[n], pq = 3 * p + q, qp = 3 * q + p;
     c[9 * pq + pq] = c[9 * qp + qp] = k.pair_a[n];
     c[9 * pq + qp] = c[9 * qp + pq] = k.pair_b[n];
   }

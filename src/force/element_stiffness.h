@@ -32,8 +32,11 @@
 #include "piola/material.h"
 #include "piola/math_types.h"
 
-/* dPhat/dFhat of the isotropic part in the diagonal frame (Pa). Pair k is (0, 1), (0, 2),
- * (1, 2) for k = 0, 1, 2; its block acts on (dFhat_pq, dFhat_qp). */
+/* Pair k of the diagonal frame's entries: (0, 1), (0, 2), (1, 2) for k = 0, 1, 2. */
+static const int PIOLA__PAIR_P[3] = {0, 0, 1}, PIOLA__PAIR_Q[3] = {1, 2, 2};
+
+/* dPhat/dFhat of the isotropic part in the diagonal frame (Pa). Pair k's block acts on
+ * (dFhat_pq, dFhat_qp), p = PIOLA__PAIR_P[k] and q = PIOLA__PAIR_Q[k]. */
 typedef struct piola__diagonal_stiffness {
   double block[3][3];          /* dPhat_i / dFhat_j */
   double pair_a[3], pair_b[3]; /* the pair blocks [[a, b], [b, a]] */
@@ -44,12 +47,20 @@ typedef struct piola__diagonal_stiffness {
  * - PIOLA_STIFFNESS_PROJECTED: the definiteness fix, positive semi-definite for every F.
  * - PIOLA_STIFFNESS_SIGNED_TWIST: the same except that the rotation eigenvalues
  *   (P_p + P_q) / (f_p + f_q) keep their sign (capped at plus and minus the element's other
- *   stiffnesses) where f_p + f_q >= 1, a pair compressed but not near collapse. That quotient is the stress over the stretch, negative wherever the element
- *   is compressed, and clamping it at zero is what keeps a Newton iteration on a compressed
- *   solid from converging quadratically (docs/time-stepping.md, "The Newton tail"); the
- *   shear quotients and the 3x3 block stay projected. Not definite: for the implicit step's
+ *   stiffnesses) in a pair compressed but not near collapse (below). That quotient is the
+ *   stress over the stretch, negative wherever the element is compressed, and clamping it at
+ *   zero is what keeps a Newton iteration on a compressed solid from converging
+ *   quadratically (docs/time-stepping.md, "The Newton tail"); the shear quotients and the
+ *   3x3 block stay projected. Not definite: for the implicit step's
  *   tail only, which falls back to the projected matrix when the CG meets negative
  *   curvature. */
+/* The signed twist's cutoff: a pair keeps its sign only where f_p + f_q is at least this (a
+ * mean stretch of 1/2). Nearer collapse, or inverted, the quotient is large and changes sign
+ * through the reflection, and an indefinite Newton matrix there aims at the collapsed state's
+ * saddles: armadillo_4k's line collapse unfolded into a shape 58% of its diagonal from rest
+ * and settled in 7.5 s instead of 5.3 s (docs/time-stepping.md, "The Newton tail"). */
+#define PIOLA__SIGNED_TWIST_LEAST_STRETCH_SUM 1.0
+
 enum {
   PIOLA_STIFFNESS_EXACT = 0,
   PIOLA_STIFFNESS_PROJECTED = 1,

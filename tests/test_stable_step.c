@@ -597,6 +597,42 @@ static void every_model_takes_its_own_modulus(void **state) {
   }
 }
 
+/* The force loop's Ogden k (ogden_modulus_from_slots) takes its nine quotients from one
+ * reciprocal of their product: on random unclamped Fhat, two entries equal or within 1e-7
+ * in a third of them, and stretches to 50x, it equals the pair blocks formed quotient by
+ * quotient (step_unclamped_modulus on the same parts) to 1e-12; a lane whose product leaves
+ * the representable range (entries 1e-3 and 1e100 apart) stores no k, as a clamped one. */
+static void ogden_k_from_one_reciprocal(void **state) {
+  (void)state;
+  test_rng rng = test_rng_seeded(31);
+  for (int mi = 0; mi < 2; ++mi) {
+    piola_material m = cache_test_material(mi ? PIOLA_MODEL_OGDEN : PIOLA_MODEL_MOONEY_RIVLIN, 0);
+    m.model = PIOLA_MODEL_OGDEN; /* Mooney-Rivlin's constants as two Ogden terms */
+    for (long s = 0; s < test_samples(20000, 2000); ++s) {
+      const double top = s % 4 == 0 ? 50.0 : 3.0;
+      double f[3];
+      for (int i = 0; i < 3; ++i) f[i] = test_rng_uniform(&rng, 1.0, top);
+      if (s % 3 == 1) f[2] = f[0];
+      if (s % 3 == 2) f[1] = f[0] * (1 + 1e-7);
+      double slots[OGDEN_CACHE_SLOTS], p[3], k;
+      ogden_stress_cached_lanes(&m, f[0], f[1], f[2], &p[0], &p[1], &p[2], slots, 1);
+      ogden_modulus_from_slots(&m, slots, 1, &k);
+      material_parts parts;
+      material_model_parts(PIOLA_MODEL_OGDEN, &m, KERNEL_FAST_RECIPROCAL, f[0], f[1], f[2], &parts);
+      const double c = material_threshold_at(&m, f[0], f[1], f[2]);
+      const double each = step_unclamped_modulus(&m, c, &parts, f[0], f[1], f[2]);
+      if (!(fabs(k - each) <= 1e-12 * each))
+        fail_msg(
+            "Fhat (%.17g, %.17g, %.17g): k %.17g from one reciprocal, %.17g quotient by quotient",
+            f[0], f[1], f[2], k, each);
+    }
+    double slots[OGDEN_CACHE_SLOTS], p[3], k = 0;
+    ogden_stress_cached_lanes(&m, 1e-3 + 0.5, 1e100, 1e100 * 3, &p[0], &p[1], &p[2], slots, 1);
+    ogden_modulus_from_slots(&m, slots, 1, &k);
+    assert_true(isnan(k));
+  }
+}
+
 /* Ogden's bound takes the powers from the force loop (issue 21: evaluating them again cost
  * 52-83% of an update; Mooney-Rivlin's are closed forms and have no cache). With its default
  * extension and with LINEAR at 0.3, a grid whose nodes are scrambled (random, flat and inverted Fhat)
@@ -1245,6 +1281,7 @@ int main(void) {
       cmocka_unit_test(modulus_bounds_the_threshold_rise),
       cmocka_unit_test(linear_lanes_agree_past_the_threshold),
       cmocka_unit_test(hgo_bound_follows_the_fibres),
+      cmocka_unit_test(ogden_k_from_one_reciprocal),
       cmocka_unit_test(ogden_bound_reuses_the_force_loop),
       cmocka_unit_test(hgo_bound_reuses_the_force_loop),
       cmocka_unit_test(step_bound_reuses_the_force_loop),

@@ -301,20 +301,69 @@ STEP_STRESS_MODULUS_KERNEL(spline, PIOLA_MODEL_SPLINE)
 STEP_STRESS_MODULUS_KERNEL(rotated_linear, PIOLA_MODEL_ROTATED_LINEAR)
 #undef STEP_STRESS_MODULUS_KERNEL
 
+/* 1/x_0, 1/x_1, 1/x_2 from R = 1/(x_0 x_1 x_2): six multiplies instead of three reciprocals. */
+MATERIAL_KERNEL void step_reciprocals_of_three(double x0, double x1, double x2, double r,
+                                               double *i0, double *i1, double *i2) {
+  *i0 = x1 * x2 * r, *i1 = x0 * x2 * r, *i2 = x0 * x1 * r;
+}
+
+/* The pair block's mode a + |b + K_ij| (step_pair_modulus) of an unclamped lane whose
+ * reciprocals are given: SUM_INV = 1 / (f_i + f_j), DIFF_INV = 1 / (f_i - f_j), CLOSE where the
+ * two entries agree to 1e-6 (the divided difference is then the mean diagonal slope). */
+MATERIAL_KERNEL double step_pair_modulus_given(double pi, double pj, double kii, double kjj,
+                                               double kij, int close, double sum_inv,
+                                               double diff_inv) {
+  const double minus = close ? 0.5 * (kii + kjj) - kij : (pi - pj) * diff_inv;
+  const double plus = (pi + pj) * sum_inv;
+  const double a = 0.5 * (minus + plus), b = 0.5 * (minus - plus);
+  return a + fabs(b + kij);
+}
+
 /* The Ogden models' k (Mooney-Rivlin is two Ogden terms) from the slots their stress kernel
  * wrote for a lane (ogden_stress_cached_lanes, stride STRIDE): the Fhat, and Phat and the
  * diagonal slopes at the clamped point, whose powers f^(alpha_p - 1) are most of an update.
  * Their stress loop calls libm's pow and runs lane by lane; this one has no call, so it
- * vectorizes, and its six divisions with it. */
+ * vectorizes. Its nine quotients (1/f_i for K_ij, and each pair's 1/(f_i + f_j) and
+ * 1/(f_i - f_j)) come from one reciprocal of their product: a reciprocal is about eleven
+ * multiply-adds, and nine of them were most of what k added to an update on an AVX2 machine
+ * (BENCHMARKS.md). A lane whose product leaves [1e-280, 1e280] (entries far apart in scale)
+ * is left to the pass, as a clamped one is. */
 MATERIAL_KERNEL void ogden_modulus_from_slots(const piola_material *m, const double *slots, long stride,
                                               double *k_out) {
   const double f0 = slots[OGDEN_CACHE_KEY * stride], f1 = slots[(OGDEN_CACHE_KEY + 1) * stride],
                f2 = slots[(OGDEN_CACHE_KEY + 2) * stride];
   const double c = material_threshold_at(m, f0, f1, f2);
-  material_parts parts;
-  ogden_cached_parts(m, slots, stride, kernel_max(f0, c), kernel_max(f1, c), kernel_max(f2, c), &parts);
-  const int held = (f0 >= c) & (f1 >= c) & (f2 >= c);
-  step_cache_store(k_out, held, step_unclamped_modulus(m, c, &parts, f0, f1, f2));
+  const int unclamped = (f0 >= c) & (f1 >= c) & (f2 >= c);
+  /* clamped lanes store no k; their entries are raised to c so that every product is finite */
+  const double e0 = kernel_max(f0, c), e1 = kernel_max(f1, c), e2 = kernel_max(f2, c);
+  const double p0 = slots[OGDEN_CACHE_P * stride], p1 = slots[(OGDEN_CACHE_P + 1) * stride],
+               p2 = slots[(OGDEN_CACHE_P + 2) * stride];
+  const double k0 = slots[OGDEN_CACHE_K * stride], k1 = slots[(OGDEN_CACHE_K + 1) * stride],
+               k2 = slots[(OGDEN_CACHE_K + 2) * stride];
+  const double d01 = e0 - e1, d02 = e0 - e2, d12 = e1 - e2;
+  const int close01 = fabs(d01) <= 1e-6 * (e0 + e1), close02 = fabs(d02) <= 1e-6 * (e0 + e2),
+            close12 = fabs(d12) <= 1e-6 * (e1 + e2);
+  /* differences as magnitudes, their signs put back below; 1 where close (not used there) */
+  const double a01 = close01 ? 1.0 : fabs(d01), a02 = close02 ? 1.0 : fabs(d02),
+               a12 = close12 ? 1.0 : fabs(d12);
+  const double s01 = e0 + e1, s02 = e0 + e2, s12 = e1 + e2;
+  const double volume = e0 * e1 * e2, sums = s01 * s02 * s12, diffs = a01 * a02 * a12;
+  const double product = volume * sums * diffs;
+  const int representable = (product >= 1e-280) & (product <= 1e280);
+  const double r = kernel_recip_fast(representable ? product : 1.0);
+  double i0, i1, i2, si01, si02, si12, di01, di02, di12;
+  step_reciprocals_of_three(e0, e1, e2, sums * diffs * r, &i0, &i1, &i2);
+  step_reciprocals_of_three(s01, s02, s12, volume * diffs * r, &si01, &si02, &si12);
+  step_reciprocals_of_three(a01, a02, a12, volume * sums * r, &di01, &di02, &di12);
+  const double lambda = m->lambda;
+  double k = kernel_max(k0, kernel_max(k1, k2));
+  k = kernel_max(k, step_pair_modulus_given(p0, p1, k0, k1, lambda * i0 * i1, close01, si01,
+                                            d01 < 0.0 ? -di01 : di01));
+  k = kernel_max(k, step_pair_modulus_given(p0, p2, k0, k2, lambda * i0 * i2, close02, si02,
+                                            d02 < 0.0 ? -di02 : di02));
+  k = kernel_max(k, step_pair_modulus_given(p1, p2, k1, k2, lambda * i1 * i2, close12, si12,
+                                            d12 < 0.0 ? -di12 : di12));
+  step_cache_store(k_out, unclamped & representable, k + m->fiber_modulus);
 }
 
 /* Stable Neo-Hookean with no entry clamped (stable_neohookean_stress_lanes_unclamped) and its

@@ -4,13 +4,14 @@
  *   build/<dir>/bench_stable_step [repeats [model ...]]
  *
  * Vega's torus-easy.veg (97,878 tets) when the data folder is there, else a generated
- * 105,456-tet grid, deformed by a random stretch of up to 30% plus noise of 5% of an edge,
- * for the models named (default: neohookean, corotated, stable_neohookean, ogden). Per model and thread count (1, 2) the update
- * (piola_elastic_body_update, forces only) and the bound pass are timed interleaved, one of
- * each per repeat; the medians (default 15 repeats) and their ratio are printed. The bound
- * reads the Fhat the update stored, so each pass follows an update as in a step. Medians of
- * wall time and of process CPU time (the latter less disturbed on a loaded machine). A second
- * bound pass follows the first at once ("warm"): its Fhat and weights are then in cache, so
+ * 105,456-tet grid, deformed by a random stretch of up to 30% plus noise of 5% of an edge
+ * (the same state for every model; PIOLA_BENCH_STATE=n draws the n-th other one), for the
+ * models named (default: neohookean, corotated, stable_neohookean, ogden). Per model and thread
+ * count (1, 2) the update (piola_elastic_body_update, forces only) and the bound pass are timed
+ * interleaved, one of each per repeat; the medians (default 15 repeats) and their ratio are
+ * printed. The bound reads the Fhat the update stored, so each pass follows an update as in a step.
+ * Medians of wall time and of process CPU time (the latter less disturbed on a loaded machine). A
+ * second bound pass follows the first at once ("warm"): its Fhat and weights are then in cache, so
  * warm against cold tells whether the pass waits on memory or on its arithmetic. HGO also
  * runs with fibres (one direction, across hgo.axis), with the force loop's cache of their
  * term and without it (the term computed again tet by tet). The models whose force loop
@@ -87,6 +88,8 @@ static void bench_model(const char *name, const piola_tet_mesh *mesh, piola_mate
   const int alone = only && *only ? atoi(only) : -1;
   const int32_t nv = mesh->vertex_count;
   double *x = malloc(sizeof(double) * 3 * (size_t)nv), *f = malloc(sizeof(double) * 3 * (size_t)nv);
+  const char *state = getenv("PIOLA_BENCH_STATE");
+  bench_seed(state && *state ? (uint64_t)strtoull(state, NULL, 10) : 0);
   double a[3] = {1 + bench_uniform(-0.3, 0.3), 1 + bench_uniform(-0.3, 0.3), 1 + bench_uniform(-0.3, 0.3)};
   const double noise = 0.05 * piola_elastic_body_min_rest_altitude(bodies[0]) * 3;
   for (int32_t i = 0; i < nv; ++i)

@@ -926,6 +926,54 @@ static void step_bound_reuses_the_force_loop(void **state) {
   }
 }
 
+/* The whole-body pass weighs the cached stiff blocks in decreasing order, shared between the
+ * threads (ordered_start in stable_step.c). On a grid large enough for the threads (3,072
+ * tets), stretched 1.3-2.5x along x with noise, so that most blocks are stiff and the weights
+ * matter, for the five direction-weighted models: the bound is the same bits on 1 and 2
+ * threads, equals the bound computed tet by tet and the one without the cache to 1e-12, and
+ * the state has stiff blocks above the bound (ones the order may skip). */
+static void ordered_weighing_matches_every_tet(void **state) {
+  (void)state;
+  test_rng rng = test_rng_seeded(37);
+  static const piola_material_model weighted[] = {PIOLA_MODEL_SPLINE, PIOLA_MODEL_COROTATED,
+                                                  PIOLA_MODEL_STVK, PIOLA_MODEL_STABLE_NEOHOOKEAN,
+                                                  PIOLA_MODEL_ROTATED_LINEAR};
+  for (int mi = 0; mi < 5; ++mi) {
+    piola_material m = cache_test_material(weighted[mi], 1);
+    piola_tet_mesh mesh = fixture_grid(8, 0.05);
+    piola_elastic_body *body = fixture_body(&mesh, &m);
+    assert_non_null(body->step_cache);
+    const int32_t nv = mesh.vertex_count, full_blocks = mesh.tet_count / PIOLA_TET_BLOCK;
+    double *x = malloc(sizeof *x * 3 * (size_t)nv), *f = malloc(sizeof *f * 3 * (size_t)nv);
+    int above_somewhere = 0;
+    for (int start = 0; start < 3; ++start) {
+      const double along = 1.3 + 0.6 * start;
+      for (int32_t v = 0; v < 3 * nv; ++v)
+        x[v] = (v % 3 == 0 ? along : 1.0) * mesh.positions[v] + 0.004 * test_rng_normal(&rng);
+      assert_int_equal(piola_elastic_body_update(body, x, 1.0, f, NULL), PIOLA_OK);
+      piola_set_thread_count(1);
+      const double one = piola__elastic_body_state_rate2(body, NULL);
+      piola_set_thread_count(2);
+      const double two = piola__elastic_body_state_rate2(body, NULL);
+      piola_set_thread_count(0);
+      const double per_tet = per_tet_rate2(body), computed = rate2_without_step_cache(body);
+      if (!(one == two) || !(fabs(one - per_tet) <= 1e-12 * per_tet) ||
+          !(fabs(one - computed) <= 1e-12 * computed))
+        fail_msg(
+            "%s, stretch %g: bound %.17g (1 thread), %.17g (2), per tet %.17g, without the cache "
+            "%.17g",
+            piola_material_model_name(m.model), along, one, two, per_tet, computed);
+      for (int32_t b = 0; b < full_blocks; ++b)
+        above_somewhere |= step_block_cached(body, b * PIOLA_TET_BLOCK) &&
+                           body->step_cache[(size_t)b * STEP_CACHE_SLOTS + STEP_CACHE_HIGH] > one;
+    }
+    if (m.model == PIOLA_MODEL_SPLINE) assert_true(above_somewhere);
+    free(x), free(f);
+    piola_elastic_body_destroy(body);
+    fixture_mesh_free(&mesh);
+  }
+}
+
 /* LINEAR bodies with inverted tets: the lane loops take the LINEAR slopes only in blocks with
  * an entry below the threshold (linear_range) and agree with the per-tet path. */
 static void linear_lanes_agree_past_the_threshold(void **state) {
@@ -1282,6 +1330,7 @@ int main(void) {
       cmocka_unit_test(linear_lanes_agree_past_the_threshold),
       cmocka_unit_test(hgo_bound_follows_the_fibres),
       cmocka_unit_test(ogden_k_from_one_reciprocal),
+      cmocka_unit_test(ordered_weighing_matches_every_tet),
       cmocka_unit_test(ogden_bound_reuses_the_force_loop),
       cmocka_unit_test(hgo_bound_reuses_the_force_loop),
       cmocka_unit_test(step_bound_reuses_the_force_loop),

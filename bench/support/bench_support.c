@@ -28,6 +28,12 @@ double bench_median(double *v, int n) {
 
 static uint64_t rng_state = 0x9E3779B97F4A7C15ull;
 
+void bench_seed(uint64_t seed) {
+  /* xorshift's zero state is a fixed point: every seed maps to a non-zero one */
+  rng_state = 0x9E3779B97F4A7C15ull ^ (seed * 0xD1B54A32D192ED03ull);
+  if (!rng_state) rng_state = 0x9E3779B97F4A7C15ull;
+}
+
 double bench_uniform(double lo, double hi) {
   rng_state ^= rng_state << 13;
   rng_state ^= rng_state >> 7;

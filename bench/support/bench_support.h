@@ -3,6 +3,8 @@
 #ifndef PIOLA_BENCH_SUPPORT_H
 #define PIOLA_BENCH_SUPPORT_H
 
+#include <stdint.h>
+
 #include "piola/material.h"
 
 /* Monotonic wall-clock time, s. */
@@ -22,6 +24,9 @@ double bench_median(double *v, int n);
 
 /* Uniform in [lo, hi) from one xorshift sequence with a fixed seed, so runs are repeatable. */
 double bench_uniform(double lo, double hi);
+
+/* Restarts bench_uniform's sequence; seed 0 is the sequence a process starts with. */
+void bench_seed(uint64_t seed);
 
 /* The default material definition of `model` at the setting of BENCHMARKS.md's rows: LINEAR
  * inversion at threshold 0.3 (the default before issue 19 item 4). */

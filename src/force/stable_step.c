@@ -1029,7 +1029,7 @@ static rate_start ordered_start(const piola_elastic_body *body, const piola_mate
     for (int32_t i = first[k]; i < first[k + 1]; ++i)
       if (cache[(size_t)order[i] * STEP_CACHE_SLOTS + STEP_CACHE_HIGH] > local)
         local = weighed_cached_block(body, m, gram, w, order[i] * PIOLA_TET_BLOCK, local);
-#pragma omp critical(piola_ordered_start)
+#pragma omp critical
     shared = local > shared ? local : shared;
 #pragma omp barrier
   }

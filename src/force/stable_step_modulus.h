@@ -31,6 +31,15 @@ MATERIAL_KERNEL double step_signed_div(double num, double den, kernel_division d
   return dv == KERNEL_FAST_RECIPROCAL ? (den < 0.0 ? -num : num) * kernel_recip_fast(fabs(den)) : num / den;
 }
 
+/* a and b from the pair's divided differences: PLUS = (P_i + P_j) / (f_i + f_j) and
+ * MINUS = (P_i - P_j) / (f_i - f_j), or where the two entries are CLOSE (agree to 1e-6) the
+ * mean diagonal slope less K_ij instead of MINUS. */
+MATERIAL_KERNEL void step_pair_halves(int close, double kii, double kjj, double kij, double minus,
+                                      double plus, double *a, double *b) {
+  const double difference = close ? 0.5 * (kii + kjj) - kij : minus;
+  *a = 0.5 * (difference + plus), *b = 0.5 * (difference - plus);
+}
+
 /* The pair block's two eigenvalues as a +- b (stable_step.c's header), without the K_ij
  * coupling. Selects, no branches, so that the lane loop vectorizes. Its two divisions are
  * most of a pair's cost (a vector division takes several times a multiply-add's slot): the
@@ -39,10 +48,9 @@ MATERIAL_KERNEL void step_pair_block(kernel_division dv, double c, double pi, do
                                      double fj, double kii, double kjj, double kij, double *a, double *b) {
   const double df = fi - fj, sum = fi + fj;
   const int close = fabs(df) <= 1e-6 * (fabs(fi) + fabs(fj));
-  const double minus = close ? 0.5 * (kii + kjj) - kij : step_signed_div(pi - pj, close ? 1.0 : df, dv);
   const double den = sum >= 0.0 ? kernel_max(sum, c) : kernel_min(sum, -c);
-  const double plus = step_signed_div(pi + pj, den, dv);
-  *a = 0.5 * (minus + plus), *b = 0.5 * (minus - plus);
+  step_pair_halves(close, kii, kjj, kij, step_signed_div(pi - pj, close ? 1.0 : df, dv),
+                   step_signed_div(pi + pj, den, dv), a, b);
 }
 
 /* Largest eigenvalue of the pair block plus the K_ij coupling. */
@@ -313,9 +321,8 @@ MATERIAL_KERNEL void step_reciprocals_of_three(double x0, double x1, double x2, 
 MATERIAL_KERNEL double step_pair_modulus_given(double pi, double pj, double kii, double kjj,
                                                double kij, int close, double sum_inv,
                                                double diff_inv) {
-  const double minus = close ? 0.5 * (kii + kjj) - kij : (pi - pj) * diff_inv;
-  const double plus = (pi + pj) * sum_inv;
-  const double a = 0.5 * (minus + plus), b = 0.5 * (minus - plus);
+  double a, b;
+  step_pair_halves(close, kii, kjj, kij, (pi - pj) * diff_inv, (pi + pj) * sum_inv, &a, &b);
   return a + fabs(b + kij);
 }
 

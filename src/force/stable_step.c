@@ -37,6 +37,7 @@
  * the force loop carries that kernel's fused multiply-adds, so where the cache holds, the
  * bound's last bits follow the variant as Fhat's do (tests/test_kernel_isa.c). */
 #include <math.h>
+#include <stdatomic.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -972,16 +973,80 @@ static double quarter_octave_start(int64_t key) {
 /* Buckets of the ordered start: quarter octaves below the largest stiff maximum, the last
  * one holding everything smaller. */
 enum { ORDERED_BUCKETS = 128 };
+static int ordered_bucket(int64_t top_key, double stiff_maximum) {
+  const int64_t below = top_key - quarter_octave(stiff_maximum);
+  return (int)(below < ORDERED_BUCKETS - 1 ? below : ORDERED_BUCKETS - 1);
+}
+
+/* A positive double's bits, which order as it does. */
+static uint64_t magnitude_bits(double x) {
+  uint64_t bits;
+  memcpy(&bits, &x, sizeof bits);
+  return bits;
+}
+static double from_magnitude_bits(uint64_t bits) {
+  double x;
+  memcpy(&x, &bits, sizeof x);
+  return x;
+}
+
+/* max(*shared, x) stored in *shared. */
+static void raise_shared_maximum(_Atomic uint64_t *shared, double x) {
+  const uint64_t bits = magnitude_bits(x);
+  uint64_t seen = atomic_load_explicit(shared, memory_order_relaxed);
+  while (bits > seen &&
+         !atomic_compare_exchange_weak_explicit(shared, &seen, bits, memory_order_relaxed,
+                                                memory_order_relaxed)) {
+  }
+}
+
+/* Blocks a thread takes from the order at a time. */
+enum { ORDERED_CHUNK = 4 };
+
+/* max(best, the weighted terms of the COUNT cached blocks ORDER lists), ORDER sorted by
+ * ordered_bucket under TOP_KEY. The threads take chunks of the order from one counter and
+ * share their maxima through one word, with no barrier between the quarter octaves (a barrier
+ * each cost more than weighing the blocks between them on two threads); a thread stops at the
+ * first chunk whose quarter octave ends at or below the maximum it has seen. A block is
+ * skipped only when its stiff maximum is at most a maximum of terms found, so what is returned
+ * is the largest term whatever the threads' timing: the same bits on any thread count. */
+static double weigh_in_order(const piola_elastic_body *body, const piola_material *m,
+                             const double *gram, const double *cache, const double *w,
+                             const int32_t *order, int32_t count, int64_t top_key, double best,
+                             int parallel) {
+  _Atomic int32_t next = 0;
+  _Atomic uint64_t shared = magnitude_bits(best);
+#pragma omp parallel num_threads(piola_thread_count()) if (parallel)
+  {
+    double local = best;
+    for (;;) {
+      const int32_t i0 = atomic_fetch_add_explicit(&next, ORDERED_CHUNK, memory_order_relaxed);
+      if (i0 >= count) break;
+      const double seen = from_magnitude_bits(atomic_load_explicit(&shared, memory_order_relaxed));
+      local = seen > local ? seen : local;
+      const double *first_slot = cache + (size_t)order[i0] * STEP_CACHE_SLOTS;
+      /* every later block's stiff maximum lies below where this one's quarter octave ends */
+      const int bucket = ordered_bucket(top_key, first_slot[STEP_CACHE_HIGH]);
+      if (!(quarter_octave_start(top_key - bucket + 1) > local)) break;
+      const int32_t i1 = i0 + ORDERED_CHUNK < count ? i0 + ORDERED_CHUNK : count;
+      for (int32_t i = i0; i < i1; ++i)
+        if (cache[(size_t)order[i] * STEP_CACHE_SLOTS + STEP_CACHE_HIGH] > local)
+          local = weighed_cached_block(body, m, gram, w, order[i] * PIOLA_TET_BLOCK, local);
+      raise_shared_maximum(&shared, local);
+    }
+  }
+  return from_magnitude_bits(atomic_load_explicit(&shared, memory_order_relaxed));
+}
 
 /* The start of the ranges (rate_start) for a direction-weighted body whose force loop cached
  * its blocks: every cached block's terms taken here. Each range weighs the blocks
  * whose stiff maximum (an upper bound of their weighted terms) beats its running maximum, and
  * each range starts from nothing: in a stretched state (every block stiff) the ranges weighed
  * 16% of the blocks, while 0.4% had a stiff maximum above the final bound. Here the cached
- * blocks' exact maxima come first, then their stiff maxima in decreasing order, a quarter
- * octave at a time (a counting sort: no comparison sort of every block each step), each
- * weighed while it can still raise the maximum; a block whose stiff maximum is at most the
- * maximum so far holds no larger term. The ranges then take the uncached blocks only. Without
+ * blocks' exact maxima come first, then the blocks in decreasing quarter octaves of their
+ * stiff maxima (a counting sort: no comparison sort of every block each step), weighed while
+ * they can still raise the maximum (weigh_in_order); a block whose stiff maximum is at most
+ * the maximum so far holds no larger term. The ranges then take the uncached blocks only. Without
  * memory for the order: the cached blocks' exact maxima only, and the ranges weigh as before. */
 static rate_start ordered_start(const piola_elastic_body *body, const piola_material *m,
                                 const double *gram, const double *cache, const double *w) {
@@ -994,13 +1059,15 @@ static rate_start ordered_start(const piola_elastic_body *body, const piola_mate
     top = slot[STEP_CACHE_HIGH] > top ? slot[STEP_CACHE_HIGH] : top;
   }
   if (!(top > best)) return (rate_start){best, 1};
+  /* an infinite stiff maximum has no quarter octave above it to end the first one: the
+   * ranges weigh every block instead */
+  if (!(top < INFINITY)) return (rate_start){best, 0};
   const int64_t top_key = quarter_octave(top);
   int32_t first[ORDERED_BUCKETS + 1] = {0};
   for (int32_t b = 0; b < blocks; ++b) {
     const double *slot = cached_block(body, cache, b * PIOLA_TET_BLOCK);
     if (!slot || !(slot[STEP_CACHE_HIGH] > best)) continue;
-    const int64_t below = top_key - quarter_octave(slot[STEP_CACHE_HIGH]);
-    ++first[(below < ORDERED_BUCKETS - 1 ? below : ORDERED_BUCKETS - 1) + 1];
+    ++first[ordered_bucket(top_key, slot[STEP_CACHE_HIGH]) + 1];
   }
   for (int k = 0; k < ORDERED_BUCKETS; ++k) first[k + 1] += first[k];
   int32_t *order =
@@ -1011,30 +1078,12 @@ static rate_start ordered_start(const piola_elastic_body *body, const piola_mate
   for (int32_t b = 0; b < blocks; ++b) {
     const double *slot = cached_block(body, cache, b * PIOLA_TET_BLOCK);
     if (!slot || !(slot[STEP_CACHE_HIGH] > best)) continue;
-    const int64_t below = top_key - quarter_octave(slot[STEP_CACHE_HIGH]);
-    order[next[below < ORDERED_BUCKETS - 1 ? below : ORDERED_BUCKETS - 1]++] = b;
+    order[next[ordered_bucket(top_key, slot[STEP_CACHE_HIGH])]++] = b;
   }
-  /* The threads share each quarter octave's blocks and then their maxima; the maximum of the
-   * same terms whatever the order, so the same bits on any thread count. Every thread reads
-   * `shared` only between the barriers that follow the writes, and so takes the same exits. */
-  double shared = best;
-  const int parallel = blocks >= PIOLA_PARALLEL_MIN_BLOCKS;
-#pragma omp parallel num_threads(piola_thread_count()) if (parallel)
-  for (int k = 0; k < ORDERED_BUCKETS; ++k) {
-    double local = shared;
-    /* every stiff maximum from here on lies below where this quarter octave ends */
-    if (!(quarter_octave_start(top_key - k + 1) > local)) break;
-    if (first[k] == first[k + 1]) continue;
-#pragma omp for schedule(dynamic, 4)
-    for (int32_t i = first[k]; i < first[k + 1]; ++i)
-      if (cache[(size_t)order[i] * STEP_CACHE_SLOTS + STEP_CACHE_HIGH] > local)
-        local = weighed_cached_block(body, m, gram, w, order[i] * PIOLA_TET_BLOCK, local);
-#pragma omp critical
-    shared = local > shared ? local : shared;
-#pragma omp barrier
-  }
+  const double found = weigh_in_order(body, m, gram, cache, w, order, first[ORDERED_BUCKETS], top_key,
+                                      best, blocks >= PIOLA_PARALLEL_MIN_BLOCKS);
   free(order);
-  return (rate_start){shared, 1};
+  return (rate_start){found, 1};
 }
 
 /* The pass over a whole body takes RATE_RANGES ranges of whole blocks (the force loop's, whose

@@ -956,28 +956,6 @@ static double weighed_cached_block(const piola_elastic_body *body, const piola_m
   }
 }
 
-/* Quarter octaves of a positive double's magnitude: its exponent and first two mantissa
- * bits, increasing with it. */
-static int64_t quarter_octave(double x) {
-  uint64_t bits;
-  memcpy(&bits, &x, sizeof bits);
-  return (int64_t)(bits >> 50);
-}
-static double quarter_octave_start(int64_t key) {
-  const uint64_t bits = key > 0 ? (uint64_t)key << 50 : 0;
-  double x;
-  memcpy(&x, &bits, sizeof x);
-  return x;
-}
-
-/* Buckets of the ordered start: quarter octaves below the largest stiff maximum, the last
- * one holding everything smaller. */
-enum { ORDERED_BUCKETS = 128 };
-static int ordered_bucket(int64_t top_key, double stiff_maximum) {
-  const int64_t below = top_key - quarter_octave(stiff_maximum);
-  return (int)(below < ORDERED_BUCKETS - 1 ? below : ORDERED_BUCKETS - 1);
-}
-
 /* A positive double's bits, which order as it does. */
 static uint64_t magnitude_bits(double x) {
   uint64_t bits;
@@ -988,6 +966,21 @@ static double from_magnitude_bits(uint64_t bits) {
   double x;
   memcpy(&x, &bits, sizeof x);
   return x;
+}
+
+/* Quarter octaves of a positive double's magnitude: its exponent and first two mantissa
+ * bits, increasing with it. */
+static int64_t quarter_octave(double x) { return (int64_t)(magnitude_bits(x) >> 50); }
+static double quarter_octave_start(int64_t key) {
+  return from_magnitude_bits(key > 0 ? (uint64_t)key << 50 : 0);
+}
+
+/* Buckets of the ordered start: quarter octaves below the largest stiff maximum, the last
+ * one holding everything smaller. */
+enum { ORDERED_BUCKETS = 128 };
+static int ordered_bucket(int64_t top_key, double stiff_maximum) {
+  const int64_t below = top_key - quarter_octave(stiff_maximum);
+  return (int)(below < ORDERED_BUCKETS - 1 ? below : ORDERED_BUCKETS - 1);
 }
 
 /* max(*shared, x) stored in *shared. */

@@ -674,7 +674,7 @@ STABLE_STEP_KERNEL double weighted_range(piola_material_model model, int energy,
       double h = 0;
       const double *slot = cache && e - t == PIOLA_TET_BLOCK ? cached_block(body, cache, t) : NULL;
       if (slot && start.cached_blocks_within) {
-        h = 0.0;
+        /* ordered_start has taken this block's terms: h stays 0 */
       } else if (slot) {
         best = slot[STEP_CACHE_LOW] > best ? slot[STEP_CACHE_LOW] : best;
         h = slot[STEP_CACHE_HIGH];

@@ -31,6 +31,12 @@ MATERIAL_KERNEL double step_signed_div(double num, double den, kernel_division d
   return dv == KERNEL_FAST_RECIPROCAL ? (den < 0.0 ? -num : num) * kernel_recip_fast(fabs(den)) : num / den;
 }
 
+/* Whether two entries agree to 1e-6, where a pair's divided difference (P_i - P_j) /
+ * (f_i - f_j) gives way to the mean diagonal slope (step_pair_halves). */
+MATERIAL_KERNEL int step_entries_close(double fi, double fj) {
+  return fabs(fi - fj) <= 1e-6 * (fabs(fi) + fabs(fj));
+}
+
 /* a and b from the pair's divided differences: PLUS = (P_i + P_j) / (f_i + f_j) and
  * MINUS = (P_i - P_j) / (f_i - f_j), or where the two entries are CLOSE (agree to 1e-6) the
  * mean diagonal slope less K_ij instead of MINUS. */
@@ -47,7 +53,7 @@ MATERIAL_KERNEL void step_pair_halves(int close, double kii, double kjj, double 
 MATERIAL_KERNEL void step_pair_block(kernel_division dv, double c, double pi, double pj, double fi,
                                      double fj, double kii, double kjj, double kij, double *a, double *b) {
   const double df = fi - fj, sum = fi + fj;
-  const int close = fabs(df) <= 1e-6 * (fabs(fi) + fabs(fj));
+  const int close = step_entries_close(fi, fj);
   const double den = sum >= 0.0 ? kernel_max(sum, c) : kernel_min(sum, -c);
   step_pair_halves(close, kii, kjj, kij, step_signed_div(pi - pj, close ? 1.0 : df, dv),
                    step_signed_div(pi + pj, den, dv), a, b);
@@ -348,8 +354,8 @@ MATERIAL_KERNEL void ogden_modulus_from_slots(const piola_material *m, const dou
   const double k0 = slots[OGDEN_CACHE_K * stride], k1 = slots[(OGDEN_CACHE_K + 1) * stride],
                k2 = slots[(OGDEN_CACHE_K + 2) * stride];
   const double d01 = e0 - e1, d02 = e0 - e2, d12 = e1 - e2;
-  const int close01 = fabs(d01) <= 1e-6 * (e0 + e1), close02 = fabs(d02) <= 1e-6 * (e0 + e2),
-            close12 = fabs(d12) <= 1e-6 * (e1 + e2);
+  const int close01 = step_entries_close(e0, e1), close02 = step_entries_close(e0, e2),
+            close12 = step_entries_close(e1, e2);
   /* differences as magnitudes, their signs put back below; 1 where close (not used there) */
   const double a01 = close01 ? 1.0 : fabs(d01), a02 = close02 ? 1.0 : fabs(d02),
                a12 = close12 ? 1.0 : fabs(d12);

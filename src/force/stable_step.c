@@ -968,19 +968,29 @@ static double from_magnitude_bits(uint64_t bits) {
   return x;
 }
 
-/* Quarter octaves of a positive double's magnitude: its exponent and first two mantissa
- * bits, increasing with it. */
-static int64_t quarter_octave(double x) { return (int64_t)(magnitude_bits(x) >> 50); }
-static double quarter_octave_start(int64_t key) {
-  return from_magnitude_bits(key > 0 ? (uint64_t)key << 50 : 0);
+/* The order's buckets: slices of a positive double's magnitude bits, the bits above SHIFT,
+ * increasing with it (at SHIFT 50 the exponent and two mantissa bits: quarter octaves). */
+static int64_t order_key(double x, int shift) { return (int64_t)(magnitude_bits(x) >> shift); }
+static double order_key_start(int64_t key, int shift) {
+  return from_magnitude_bits(key > 0 ? (uint64_t)key << shift : 0);
 }
 
-/* Buckets of the ordered start: quarter octaves below the largest stiff maximum, the last
- * one holding everything smaller. */
-enum { ORDERED_BUCKETS = 128 };
-static int ordered_bucket(int64_t top_key, double stiff_maximum) {
-  const int64_t below = top_key - quarter_octave(stiff_maximum);
+/* Buckets of the ordered start below the key of the largest stiff maximum, the last one
+ * holding everything smaller. */
+enum { ORDERED_BUCKETS = 1024 };
+static int ordered_bucket(int64_t top_key, int shift, double stiff_maximum) {
+  const int64_t below = top_key - order_key(stiff_maximum, shift);
   return (int)(below < ORDERED_BUCKETS - 1 ? below : ORDERED_BUCKETS - 1);
+}
+
+/* The finest slices (fewest bits dropped, from 32 to 50) that fit the span from LOW to TOP in
+ * the buckets (a wider span leaves its lowest blocks in the last one, unordered): in a
+ * uniformly stretched body the blocks' stiff maxima lie close together, and quarter octaves
+ * left thousands in one unordered bucket, weighed before the maximum caught up with them. */
+static int ordered_shift(double low, double top) {
+  int shift = 32;
+  while (shift < 50 && order_key(top, shift) - order_key(low, shift) >= ORDERED_BUCKETS - 1) ++shift;
+  return shift;
 }
 
 /* max(*shared, x) stored in *shared. */
@@ -997,16 +1007,16 @@ static void raise_shared_maximum(_Atomic uint64_t *shared, double x) {
 enum { ORDERED_CHUNK = 4 };
 
 /* max(best, the weighted terms of the COUNT cached blocks ORDER lists), ORDER sorted by
- * ordered_bucket under TOP_KEY. The threads take chunks of the order from one counter and
- * share their maxima through one word, with no barrier between the quarter octaves (a barrier
- * each cost more than weighing the blocks between them on two threads); a thread stops at the
- * first chunk whose quarter octave ends at or below the maximum it has seen. A block is
+ * ordered_bucket under TOP_KEY and SHIFT. The threads take chunks of the order from one
+ * counter and share their maxima through one word, with no barrier between the slices (a
+ * barrier each cost more than weighing the blocks between them on two threads); a thread
+ * stops at the first chunk whose slice ends at or below the maximum it has seen. A block is
  * skipped only when its stiff maximum is at most a maximum of terms found, so what is returned
  * is the largest term whatever the threads' timing: the same bits on any thread count. */
 static double weigh_in_order(const piola_elastic_body *body, const piola_material *m,
                              const double *gram, const double *cache, const double *w,
-                             const int32_t *order, int32_t count, int64_t top_key, double best,
-                             int parallel) {
+                             const int32_t *order, int32_t count, int64_t top_key, int shift,
+                             double best, int parallel) {
   _Atomic int32_t next = 0;
   _Atomic uint64_t shared = magnitude_bits(best);
 #pragma omp parallel num_threads(piola_thread_count()) if (parallel)
@@ -1018,9 +1028,9 @@ static double weigh_in_order(const piola_elastic_body *body, const piola_materia
       const double seen = from_magnitude_bits(atomic_load_explicit(&shared, memory_order_relaxed));
       local = seen > local ? seen : local;
       const double *first_slot = cache + (size_t)order[i0] * STEP_CACHE_SLOTS;
-      /* every later block's stiff maximum lies below where this one's quarter octave ends */
-      const int bucket = ordered_bucket(top_key, first_slot[STEP_CACHE_HIGH]);
-      if (!(quarter_octave_start(top_key - bucket + 1) > local)) break;
+      /* every later block's stiff maximum lies below where this one's bucket ends */
+      const int bucket = ordered_bucket(top_key, shift, first_slot[STEP_CACHE_HIGH]);
+      if (!(order_key_start(top_key - bucket + 1, shift) > local)) break;
       const int32_t i1 = i0 + ORDERED_CHUNK < count ? i0 + ORDERED_CHUNK : count;
       for (int32_t i = i0; i < i1; ++i)
         if (cache[(size_t)order[i] * STEP_CACHE_SLOTS + STEP_CACHE_HIGH] > local)
@@ -1036,45 +1046,55 @@ static double weigh_in_order(const piola_elastic_body *body, const piola_materia
  * whose stiff maximum (an upper bound of their weighted terms) beats its running maximum, and
  * each range starts from nothing: in a stretched state (every block stiff) the ranges weighed
  * 16% of the blocks, while 0.4% had a stiff maximum above the final bound. Here the cached
- * blocks' exact maxima come first, then the blocks in decreasing quarter octaves of their
- * stiff maxima (a counting sort: no comparison sort of every block each step), weighed while
- * they can still raise the maximum (weigh_in_order); a block whose stiff maximum is at most
- * the maximum so far holds no larger term. The ranges then take the uncached blocks only. Without
- * memory for the order: the cached blocks' exact maxima only, and the ranges weigh as before. */
+ * blocks' exact maxima come first, then the block of the largest stiff maximum, then the
+ * blocks whose stiff maximum is above what those found, in decreasing order of it (a counting
+ * sort into slices of the span between: no comparison sort of every block each step), weighed
+ * while they can still raise the maximum (weigh_in_order); a block whose stiff maximum is at
+ * most the maximum so far holds no larger term. The ranges then take the uncached blocks
+ * only. Without memory for the order: the cached blocks' exact maxima only, and the ranges
+ * weigh as before. */
 static rate_start ordered_start(const piola_elastic_body *body, const piola_material *m,
                                 const double *gram, const double *cache, const double *w) {
   const int32_t blocks = body->tet_count / PIOLA_TET_BLOCK;
   double best = 0, top = 0;
+  int32_t top_block = -1;
   for (int32_t b = 0; b < blocks; ++b) {
     const double *slot = cached_block(body, cache, b * PIOLA_TET_BLOCK);
     if (!slot) continue;
     best = slot[STEP_CACHE_LOW] > best ? slot[STEP_CACHE_LOW] : best;
-    top = slot[STEP_CACHE_HIGH] > top ? slot[STEP_CACHE_HIGH] : top;
+    if (slot[STEP_CACHE_HIGH] > top) {
+      top = slot[STEP_CACHE_HIGH];
+      top_block = b;
+    }
   }
   if (!(top > best)) return (rate_start){best, 1};
-  /* an infinite stiff maximum has no quarter octave above it to end the first one: the
-   * ranges weigh every block instead */
+  /* an infinite stiff maximum has no slice above it to end the first one: the ranges weigh
+   * every block instead */
   if (!(top < INFINITY)) return (rate_start){best, 0};
-  const int64_t top_key = quarter_octave(top);
+  /* the top block's terms bound the final maximum from below: the blocks at or under them
+   * need no weighing, and the order's slices span only the blocks above */
+  best = weighed_cached_block(body, m, gram, w, top_block * PIOLA_TET_BLOCK, best);
+  const int shift = ordered_shift(best, top);
+  const int64_t top_key = order_key(top, shift);
   int32_t first[ORDERED_BUCKETS + 1] = {0};
   for (int32_t b = 0; b < blocks; ++b) {
     const double *slot = cached_block(body, cache, b * PIOLA_TET_BLOCK);
-    if (!slot || !(slot[STEP_CACHE_HIGH] > best)) continue;
-    ++first[ordered_bucket(top_key, slot[STEP_CACHE_HIGH]) + 1];
+    if (!slot || b == top_block || !(slot[STEP_CACHE_HIGH] > best)) continue;
+    ++first[ordered_bucket(top_key, shift, slot[STEP_CACHE_HIGH]) + 1];
   }
   for (int k = 0; k < ORDERED_BUCKETS; ++k) first[k + 1] += first[k];
-  int32_t *order =
-      malloc(sizeof(int32_t) * (size_t)(first[ORDERED_BUCKETS] > 0 ? first[ORDERED_BUCKETS] : 1));
+  if (first[ORDERED_BUCKETS] == 0) return (rate_start){best, 1};
+  int32_t *order = malloc(sizeof(int32_t) * (size_t)first[ORDERED_BUCKETS]);
   if (!order) return (rate_start){best, 0};
   int32_t next[ORDERED_BUCKETS];
   memcpy(next, first, sizeof next);
   for (int32_t b = 0; b < blocks; ++b) {
     const double *slot = cached_block(body, cache, b * PIOLA_TET_BLOCK);
-    if (!slot || !(slot[STEP_CACHE_HIGH] > best)) continue;
-    order[next[ordered_bucket(top_key, slot[STEP_CACHE_HIGH])]++] = b;
+    if (!slot || b == top_block || !(slot[STEP_CACHE_HIGH] > best)) continue;
+    order[next[ordered_bucket(top_key, shift, slot[STEP_CACHE_HIGH])]++] = b;
   }
   const double found = weigh_in_order(body, m, gram, cache, w, order, first[ORDERED_BUCKETS], top_key,
-                                      best, blocks >= PIOLA_PARALLEL_MIN_BLOCKS);
+                                      shift, best, blocks >= PIOLA_PARALLEL_MIN_BLOCKS);
   free(order);
   return (rate_start){found, 1};
 }

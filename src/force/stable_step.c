@@ -968,29 +968,35 @@ static double from_magnitude_bits(uint64_t bits) {
   return x;
 }
 
-/* The order's buckets: slices of a positive double's magnitude bits, the bits above SHIFT,
- * increasing with it (at SHIFT 50 the exponent and two mantissa bits: quarter octaves). */
-static int64_t order_key(double x, int shift) { return (int64_t)(magnitude_bits(x) >> shift); }
-static double order_key_start(int64_t key, int shift) {
-  return from_magnitude_bits(key > 0 ? (uint64_t)key << shift : 0);
-}
-
-/* Buckets of the ordered start below the key of the largest stiff maximum, the last one
- * holding everything smaller. */
+/* The order's buckets: slices of a positive double's magnitude bits (the bits above SHIFT,
+ * increasing with it; at SHIFT 50 the exponent and two mantissa bits, quarter octaves),
+ * counted down from the slice of the largest stiff maximum, the last bucket holding
+ * everything smaller. */
 enum { ORDERED_BUCKETS = 1024 };
-static int ordered_bucket(int64_t top_key, int shift, double stiff_maximum) {
-  const int64_t below = top_key - order_key(stiff_maximum, shift);
-  return (int)(below < ORDERED_BUCKETS - 1 ? below : ORDERED_BUCKETS - 1);
-}
+typedef struct ordered_slices {
+  int64_t top_key;
+  int shift;
+} ordered_slices;
+static int64_t order_key(double x, int shift) { return (int64_t)(magnitude_bits(x) >> shift); }
 
-/* The finest slices (fewest bits dropped, from 32 to 50) that fit the span from LOW to TOP in
- * the buckets (a wider span leaves its lowest blocks in the last one, unordered): in a
- * uniformly stretched body the blocks' stiff maxima lie close together, and quarter octaves
- * left thousands in one unordered bucket, weighed before the maximum caught up with them. */
-static int ordered_shift(double low, double top) {
+/* The finest slices (fewest bits dropped, from 32 to 50: the top slice's end stays finite)
+ * that fit the span from LOW to TOP in the buckets (a wider span leaves its lowest blocks in
+ * the last one, unordered): in a uniformly stretched body the blocks' stiff maxima lie close
+ * together, and quarter octaves left thousands in one unordered bucket, weighed before the
+ * maximum caught up with them. */
+static ordered_slices ordered_slices_spanning(double low, double top) {
   int shift = 32;
   while (shift < 50 && order_key(top, shift) - order_key(low, shift) >= ORDERED_BUCKETS - 1) ++shift;
-  return shift;
+  return (ordered_slices){order_key(top, shift), shift};
+}
+static int ordered_bucket(const ordered_slices *s, double stiff_maximum) {
+  const int64_t below = s->top_key - order_key(stiff_maximum, s->shift);
+  return (int)(below < ORDERED_BUCKETS - 1 ? below : ORDERED_BUCKETS - 1);
+}
+/* Where BUCKET ends: every stiff maximum in it or after it lies below. */
+static double ordered_bucket_end(const ordered_slices *s, int bucket) {
+  const int64_t key = s->top_key - bucket + 1;
+  return from_magnitude_bits(key > 0 ? (uint64_t)key << s->shift : 0);
 }
 
 /* max(*shared, x) stored in *shared. */
@@ -1007,7 +1013,7 @@ static void raise_shared_maximum(_Atomic uint64_t *shared, double x) {
 enum { ORDERED_CHUNK = 4 };
 
 /* max(best, the weighted terms of the COUNT cached blocks ORDER lists), ORDER sorted by
- * ordered_bucket under TOP_KEY and SHIFT. The threads take chunks of the order from one
+ * ordered_bucket in SLICES. The threads take chunks of the order from one
  * counter and share their maxima through one word, with no barrier between the slices (a
  * barrier each cost more than weighing the blocks between them on two threads); a thread
  * stops at the first chunk whose slice ends at or below the maximum it has seen. A block is
@@ -1015,7 +1021,7 @@ enum { ORDERED_CHUNK = 4 };
  * is the largest term whatever the threads' timing: the same bits on any thread count. */
 static double weigh_in_order(const piola_elastic_body *body, const piola_material *m,
                              const double *gram, const double *cache, const double *w,
-                             const int32_t *order, int32_t count, int64_t top_key, int shift,
+                             const int32_t *order, int32_t count, const ordered_slices *slices,
                              double best, int parallel) {
   _Atomic int32_t next = 0;
   _Atomic uint64_t shared = magnitude_bits(best);
@@ -1029,8 +1035,7 @@ static double weigh_in_order(const piola_elastic_body *body, const piola_materia
       local = seen > local ? seen : local;
       const double *first_slot = cache + (size_t)order[i0] * STEP_CACHE_SLOTS;
       /* every later block's stiff maximum lies below where this one's bucket ends */
-      const int bucket = ordered_bucket(top_key, shift, first_slot[STEP_CACHE_HIGH]);
-      if (!(order_key_start(top_key - bucket + 1, shift) > local)) break;
+      if (!(ordered_bucket_end(slices, ordered_bucket(slices, first_slot[STEP_CACHE_HIGH])) > local)) break;
       const int32_t i1 = i0 + ORDERED_CHUNK < count ? i0 + ORDERED_CHUNK : count;
       for (int32_t i = i0; i < i1; ++i)
         if (cache[(size_t)order[i] * STEP_CACHE_SLOTS + STEP_CACHE_HIGH] > local)
@@ -1039,6 +1044,14 @@ static double weigh_in_order(const piola_elastic_body *body, const piola_materia
     }
   }
   return from_magnitude_bits(atomic_load_explicit(&shared, memory_order_relaxed));
+}
+
+/* The stiff maximum of cached block B if the order holds it (above BEST, not the top block,
+ * weighed already), else 0. */
+static double ordered_candidate(const piola_elastic_body *body, const double *cache, int32_t b,
+                                int32_t top_block, double best) {
+  const double *slot = cached_block(body, cache, b * PIOLA_TET_BLOCK);
+  return slot && b != top_block && slot[STEP_CACHE_HIGH] > best ? slot[STEP_CACHE_HIGH] : 0.0;
 }
 
 /* The start of the ranges (rate_start) for a direction-weighted body whose force loop cached
@@ -1074,13 +1087,11 @@ static rate_start ordered_start(const piola_elastic_body *body, const piola_mate
   /* the top block's terms bound the final maximum from below: the blocks at or under them
    * need no weighing, and the order's slices span only the blocks above */
   best = weighed_cached_block(body, m, gram, w, top_block * PIOLA_TET_BLOCK, best);
-  const int shift = ordered_shift(best, top);
-  const int64_t top_key = order_key(top, shift);
+  const ordered_slices slices = ordered_slices_spanning(best, top);
   int32_t first[ORDERED_BUCKETS + 1] = {0};
   for (int32_t b = 0; b < blocks; ++b) {
-    const double *slot = cached_block(body, cache, b * PIOLA_TET_BLOCK);
-    if (!slot || b == top_block || !(slot[STEP_CACHE_HIGH] > best)) continue;
-    ++first[ordered_bucket(top_key, shift, slot[STEP_CACHE_HIGH]) + 1];
+    const double stiff = ordered_candidate(body, cache, b, top_block, best);
+    if (stiff > 0) ++first[ordered_bucket(&slices, stiff) + 1];
   }
   for (int k = 0; k < ORDERED_BUCKETS; ++k) first[k + 1] += first[k];
   if (first[ORDERED_BUCKETS] == 0) return (rate_start){best, 1};
@@ -1089,12 +1100,11 @@ static rate_start ordered_start(const piola_elastic_body *body, const piola_mate
   int32_t next[ORDERED_BUCKETS];
   memcpy(next, first, sizeof next);
   for (int32_t b = 0; b < blocks; ++b) {
-    const double *slot = cached_block(body, cache, b * PIOLA_TET_BLOCK);
-    if (!slot || b == top_block || !(slot[STEP_CACHE_HIGH] > best)) continue;
-    order[next[ordered_bucket(top_key, shift, slot[STEP_CACHE_HIGH])]++] = b;
+    const double stiff = ordered_candidate(body, cache, b, top_block, best);
+    if (stiff > 0) order[next[ordered_bucket(&slices, stiff)]++] = b;
   }
-  const double found = weigh_in_order(body, m, gram, cache, w, order, first[ORDERED_BUCKETS], top_key,
-                                      shift, best, blocks >= PIOLA_PARALLEL_MIN_BLOCKS);
+  const double found = weigh_in_order(body, m, gram, cache, w, order, first[ORDERED_BUCKETS], &slices,
+                                      best, blocks >= PIOLA_PARALLEL_MIN_BLOCKS);
   free(order);
   return (rate_start){found, 1};
 }

@@ -930,8 +930,9 @@ static void step_bound_reuses_the_force_loop(void **state) {
  * threads (ordered_start in stable_step.c). On a grid large enough for the threads (3,072
  * tets), stretched 1.3-2.5x along x with noise, so that most blocks are stiff and the weights
  * matter, for the five direction-weighted models: the bound is the same bits on 1 and 2
- * threads, equals the bound computed tet by tet and the one without the cache to 1e-12, and
- * the state has stiff blocks above the bound (ones the order may skip). */
+ * threads, equals the bound computed tet by tet and the one without the cache to 1e-12, names
+ * the first tet near it on both thread counts (the search skips blocks by what the order
+ * weighed), and the state has stiff blocks above the bound (ones the order may skip). */
 static void ordered_weighing_matches_every_tet(void **state) {
   (void)state;
   test_rng rng = test_rng_seeded(37);
@@ -951,10 +952,11 @@ static void ordered_weighing_matches_every_tet(void **state) {
       for (int32_t v = 0; v < 3 * nv; ++v)
         x[v] = (v % 3 == 0 ? along : 1.0) * mesh.positions[v] + 0.004 * test_rng_normal(&rng);
       assert_int_equal(piola_elastic_body_update(body, x, 1.0, f, NULL), PIOLA_OK);
+      int32_t worst_one = -2, worst_two = -2;
       piola_set_thread_count(1);
-      const double one = piola__elastic_body_state_rate2(body, NULL);
+      const double one = piola__elastic_body_state_rate2(body, &worst_one);
       piola_set_thread_count(2);
-      const double two = piola__elastic_body_state_rate2(body, NULL);
+      const double two = piola__elastic_body_state_rate2(body, &worst_two);
       piola_set_thread_count(0);
       const double per_tet = per_tet_rate2(body), computed = rate2_without_step_cache(body);
       if (!(one == two) || !(fabs(one - per_tet) <= 1e-12 * per_tet) ||
@@ -963,6 +965,14 @@ static void ordered_weighing_matches_every_tet(void **state) {
             "%s, stretch %g: bound %.17g (1 thread), %.17g (2), per tet %.17g, without the cache "
             "%.17g",
             piola_material_model_name(m.model), along, one, two, per_tet, computed);
+      /* the tet it names: the first whose own term is near the bound, the search screening
+       * the blocks by what the ordered weighing found */
+      int32_t first = -1;
+      for (int32_t t = 0; t < mesh.tet_count && first < 0; ++t)
+        if (piola__elastic_body_tet_state_rate2(body, t) >= one * (1 - 1e-12)) first = t;
+      if (first < 0 || worst_one != first || worst_two != first)
+        fail_msg("%s, stretch %g: the bound names tet %d (1 thread), %d (2); the first near it is %d",
+                 piola_material_model_name(m.model), along, (int)worst_one, (int)worst_two, (int)first);
       for (int32_t b = 0; b < full_blocks; ++b)
         above_somewhere |= step_block_cached(body, b * PIOLA_TET_BLOCK) &&
                            body->step_cache[(size_t)b * STEP_CACHE_SLOTS + STEP_CACHE_HIGH] > one;

@@ -625,13 +625,15 @@ STABLE_STEP_KERNEL double weighted_block(piola_material_model model, int energy,
 }
 
 /* What the whole-body pass found before its ranges (ordered_start): a term of the maximum
- * (0 for none), and whether every cached block's terms are at most it, so that the ranges
- * skip those blocks. */
+ * (0 for none), whether every cached block's terms are at most it, so that the ranges
+ * skip those blocks, and whether every whole block was cached (the ranges then take only the
+ * tets past the last whole block). */
 typedef struct rate_start {
   double at_least;
   int cached_blocks_within;
+  int every_block_cached;
 } rate_start;
-static const rate_start NO_START = {0.0, 0};
+static const rate_start NO_START = {0.0, 0, 0};
 
 /* weighted_range with the body's cache (stable_step_modulus.h) or none. Two instances, the
  * second with a constant NULL: with the cache's branch in it, the computed lane loop (a body
@@ -1076,45 +1078,53 @@ static rate_start ordered_start(const piola_elastic_body *body, const piola_mate
                                 double *weighed) {
   const int32_t blocks = body->tet_count / PIOLA_TET_BLOCK;
   double best = 0, top = 0;
-  int32_t top_block = -1;
+  int32_t top_block = -1, uncached = 0;
   for (int32_t b = 0; b < blocks; ++b) {
     const double *slot = cached_block(body, cache, b * PIOLA_TET_BLOCK);
-    if (!slot) continue;
+    if (!slot) {
+      ++uncached;
+      continue;
+    }
     best = slot[STEP_CACHE_LOW] > best ? slot[STEP_CACHE_LOW] : best;
     if (slot[STEP_CACHE_HIGH] > top) {
       top = slot[STEP_CACHE_HIGH];
       top_block = b;
     }
   }
-  if (!(top > best)) return (rate_start){best, 1};
+  const int every = uncached == 0;
+  if (!(top > best)) return (rate_start){best, 1, every};
   /* an infinite stiff maximum has no slice above it to end the first one: the ranges weigh
    * every block instead */
-  if (!(top < INFINITY)) return (rate_start){best, 0};
+  if (!(top < INFINITY)) return (rate_start){best, 0, 0};
   /* the top block's terms bound the final maximum from below: the blocks at or under them
    * need no weighing, and the order's slices span only the blocks above */
   const double top_terms = weighed_cached_block(body, m, gram, w, top_block * PIOLA_TET_BLOCK, 0.0);
   if (weighed) weighed[top_block] = top_terms;
   best = top_terms > best ? top_terms : best;
   const ordered_slices slices = ordered_slices_spanning(best, top);
-  int32_t first[ORDERED_BUCKETS + 1] = {0};
+  /* the blocks above them gathered in one scan, without a branch per block (in a stretched
+   * body about as many are above as not: a branch there mispredicted in the counting and
+   * the placing scans over every block), then counted and placed by slice */
+  int32_t *order = malloc(sizeof(int32_t) * 2 * (size_t)blocks);
+  if (!order) return (rate_start){best, 0, 0};
+  int32_t *above = order + blocks, count = 0;
   for (int32_t b = 0; b < blocks; ++b) {
-    const double stiff = ordered_candidate(body, cache, b, top_block, best);
-    if (stiff > 0) ++first[ordered_bucket(&slices, stiff) + 1];
+    above[count] = b;
+    count += ordered_candidate(body, cache, b, top_block, best) > 0;
   }
+  int32_t first[ORDERED_BUCKETS + 1] = {0};
+  for (int32_t i = 0; i < count; ++i)
+    ++first[ordered_bucket(&slices, cache[(size_t)above[i] * STEP_CACHE_SLOTS + STEP_CACHE_HIGH]) + 1];
   for (int k = 0; k < ORDERED_BUCKETS; ++k) first[k + 1] += first[k];
-  if (first[ORDERED_BUCKETS] == 0) return (rate_start){best, 1};
-  int32_t *order = malloc(sizeof(int32_t) * (size_t)first[ORDERED_BUCKETS]);
-  if (!order) return (rate_start){best, 0};
   int32_t next[ORDERED_BUCKETS];
   memcpy(next, first, sizeof next);
-  for (int32_t b = 0; b < blocks; ++b) {
-    const double stiff = ordered_candidate(body, cache, b, top_block, best);
-    if (stiff > 0) order[next[ordered_bucket(&slices, stiff)]++] = b;
-  }
-  const double found = weigh_in_order(body, m, gram, cache, w, order, first[ORDERED_BUCKETS], &slices,
-                                      best, weighed, blocks >= PIOLA_PARALLEL_MIN_BLOCKS);
+  for (int32_t i = 0; i < count; ++i)
+    order[next[ordered_bucket(&slices, cache[(size_t)above[i] * STEP_CACHE_SLOTS + STEP_CACHE_HIGH])]++] = above[i];
+  const double found = count > 0 ? weigh_in_order(body, m, gram, cache, w, order, count, &slices, best,
+                                                  weighed, blocks >= PIOLA_PARALLEL_MIN_BLOCKS)
+                                 : best;
   free(order);
-  return (rate_start){found, 1};
+  return (rate_start){found, 1, every};
 }
 
 /* Whether the block from T0 may hold a tet whose rate is at least NEAR, as near_tet_in's
@@ -1160,9 +1170,17 @@ double PIOLA_ISA_NAME(piola__elastic_body_state_rate2)(piola_elastic_body *body,
     start = ordered_start(body, &body->materials[body->uniform_material], gram, cache, w, weighed);
   }
   const int parallel = nt >= PIOLA_PARALLEL_MIN_BLOCKS * PIOLA_TET_BLOCK;
+  if (start.every_block_cached && start.cached_blocks_within) {
+    /* ordered_start took every whole block: the ranges hold nothing more but the tets past
+     * the last (the last range's); the others keep its maximum for the search's screen */
+    const int32_t whole = nt / PIOLA_TET_BLOCK * PIOLA_TET_BLOCK;
+    for (int r = 0; r < RATE_RANGES; ++r) part[r] = start.at_least;
+    if (whole < nt) part[RATE_RANGES - 1] = range_rate2(body, w, whole, nt, start);
+  } else {
 #pragma omp parallel for schedule(static) num_threads(piola_thread_count()) if (parallel)
-  for (int r = 0; r < RATE_RANGES; ++r)
-    part[r] = range_rate2(body, w, range_edge(nt, r), range_edge(nt, r + 1), start);
+    for (int r = 0; r < RATE_RANGES; ++r)
+      part[r] = range_rate2(body, w, range_edge(nt, r), range_edge(nt, r + 1), start);
+  }
   double best = start.at_least;
   for (int r = 0; r < RATE_RANGES; ++r) best = part[r] > best ? part[r] : best;
   /* the search screens the ranges by their maxima first (near_tet_by_chunks' reason) */

@@ -626,8 +626,8 @@ STABLE_STEP_KERNEL double weighted_block(piola_material_model model, int energy,
 
 /* What the whole-body pass found before its ranges (ordered_start): a term of the maximum
  * (0 for none), whether every cached block's terms are at most it, so that the ranges
- * skip those blocks, and whether every whole block was cached (the ranges then take only the
- * tets past the last whole block). */
+ * skip those blocks, and whether besides every whole block was cached (the ranges then take
+ * only the tets past the last whole block). */
 typedef struct rate_start {
   double at_least;
   int cached_blocks_within;
@@ -836,14 +836,33 @@ static double range_rate2(const piola_elastic_body *body, const double *w, int32
   return best;
 }
 
+/* Whether the block from T0 may hold a tet whose rate is at least NEAR: not when the force
+ * loop cached it (its unweighted terms below the stiff modulus are at most LOW) and its stiff
+ * terms are below NEAR, as weighed by ordered_start (WEIGHED, 0 where it did not; NULL: none
+ * kept) or else bounded by the stiff maximum. */
+static int cached_block_may_hold(const piola_elastic_body *body, const double *cache,
+                                 const double *weighed, int32_t t0, double near) {
+  const int32_t b = t0 / PIOLA_TET_BLOCK;
+  const double *slot = cache && b < body->tet_count / PIOLA_TET_BLOCK ? cached_block(body, cache, t0) : NULL;
+  if (!slot) return 1;
+  const double stiff = weighed && weighed[b] > 0 ? weighed[b] : slot[STEP_CACHE_HIGH];
+  return !(slot[STEP_CACHE_LOW] < near && stiff < near);
+}
+
 /* The first tet of [begin, end) (at most a block) whose rate is within 1e-12 of best, the
- * largest rate, or -1. The block's vector rate (the rate loop's) screens it first with a
+ * largest rate, or -1. A cached block is screened by its slots first (cached_block_may_hold,
+ * with WEIGHED, ordered_start's weighed maxima, where the caller has them): the block's rate
+ * weighs a direction-weighted model's stiff block, and searching the blocks before the worst
+ * tet's that way weighed each of them again (in a stretched spline body, six times the rest of
+ * the pass). The block's vector rate (the rate loop's) screens it first with a
  * margin 100 times wider, so the per-tet scalar modulus, several times dearer, runs on the
  * block that holds the tet only: searching every tet with it cost as much as the rate loop
  * itself, and in a split run made the process that searched longest the slowest one. */
 static int32_t near_tet_in(const piola_elastic_body *body, const double *w, int32_t begin,
-                           int32_t end, double best) {
-  if (!(range_rate2(body, w, begin, end, NO_START) >= best * (1 - 1e-10))) return -1;
+                           int32_t end, double best, const double *weighed) {
+  const double near = best * (1 - 1e-10);
+  if (!cached_block_may_hold(body, readable_step_cache(body), weighed, begin, near)) return -1;
+  if (!(range_rate2(body, w, begin, end, NO_START) >= near)) return -1;
   for (int32_t t = begin; t < end; ++t)
     if (PIOLA_ISA_NAME(piola__elastic_body_tet_state_rate2)(body, t) >= best * (1 - 1e-12))
       return t;
@@ -866,7 +885,7 @@ static int32_t near_tet_by_chunks(const piola_elastic_body *body, const double *
     if (!(chunk_max[c] >= best * (1 - 1e-10))) continue;
     const int32_t c1 = begin + (c + 1) * chunk < end ? begin + (c + 1) * chunk : end;
     for (int32_t t0 = begin + c * chunk; t0 < c1; t0 += PIOLA_TET_BLOCK) {
-      const int32_t t = near_tet_in(body, w, t0, t0 + PIOLA_TET_BLOCK < c1 ? t0 + PIOLA_TET_BLOCK : c1, best);
+      const int32_t t = near_tet_in(body, w, t0, t0 + PIOLA_TET_BLOCK < c1 ? t0 + PIOLA_TET_BLOCK : c1, best, NULL);
       if (t >= 0) return t;
     }
   }
@@ -919,7 +938,7 @@ static double local_rate2(piola_elastic_body *body, const double *w, const piola
         t = near_tet_by_chunks(body, w, t0, t1, chunk_max + c, best);
       } else {
         for (int32_t b0 = t0; b0 < t1 && t < 0; b0 += PIOLA_TET_BLOCK)
-          t = near_tet_in(body, w, b0, b0 + PIOLA_TET_BLOCK < t1 ? b0 + PIOLA_TET_BLOCK : t1, best);
+          t = near_tet_in(body, w, b0, b0 + PIOLA_TET_BLOCK < t1 ? b0 + PIOLA_TET_BLOCK : t1, best, NULL);
       }
       if (t >= 0) first = t;
       c += run_chunks;
@@ -1001,6 +1020,11 @@ static double ordered_bucket_end(const ordered_slices *s, int bucket) {
   return from_magnitude_bits(key > 0 ? (uint64_t)key << s->shift : 0);
 }
 
+/* The stiff maximum in the slots of block B. */
+static double block_stiff_maximum(const double *cache, int32_t b) {
+  return cache[(size_t)b * STEP_CACHE_SLOTS + STEP_CACHE_HIGH];
+}
+
 /* max(*shared, x) stored in *shared. */
 static void raise_shared_maximum(_Atomic uint64_t *shared, double x) {
   const uint64_t bits = magnitude_bits(x);
@@ -1016,12 +1040,12 @@ enum { ORDERED_CHUNK = 4 };
 
 /* max(best, the weighted terms of the COUNT cached blocks ORDER lists), ORDER sorted by
  * ordered_bucket in SLICES; WEIGHED (NULL: not kept) takes each weighed block's largest term
- * at its block's index, for the worst tet's search (cached_block_may_hold). The threads take chunks of the order from one
- * counter and share their maxima through one word, with no barrier between the slices (a
- * barrier each cost more than weighing the blocks between them on two threads); a thread
- * stops at the first chunk whose slice ends at or below the maximum it has seen. A block is
- * skipped only when its stiff maximum is at most a maximum of terms found, so what is returned
- * is the largest term whatever the threads' timing: the same bits on any thread count. */
+ * at its block's index, for the worst tet's search (near_tet_in). The threads take chunks of
+ * the order from one counter and share their maxima through one word, with no barrier between
+ * the slices (a barrier each cost more than weighing the blocks between them on two threads);
+ * a thread stops at the first chunk whose slice ends at or below the maximum it has seen. A
+ * block is skipped only when its stiff maximum is at most a maximum of terms found, so what is
+ * returned is the largest term whatever the threads' timing: the same bits on any thread count. */
 static double weigh_in_order(const piola_elastic_body *body, const piola_material *m,
                              const double *gram, const double *cache, const double *w,
                              const int32_t *order, int32_t count, const ordered_slices *slices,
@@ -1036,12 +1060,11 @@ static double weigh_in_order(const piola_elastic_body *body, const piola_materia
       if (i0 >= count) break;
       const double seen = from_magnitude_bits(atomic_load_explicit(&shared, memory_order_relaxed));
       local = seen > local ? seen : local;
-      const double *first_slot = cache + (size_t)order[i0] * STEP_CACHE_SLOTS;
       /* every later block's stiff maximum lies below where this one's bucket ends */
-      if (!(ordered_bucket_end(slices, ordered_bucket(slices, first_slot[STEP_CACHE_HIGH])) > local)) break;
+      if (!(ordered_bucket_end(slices, ordered_bucket(slices, block_stiff_maximum(cache, order[i0]))) > local)) break;
       const int32_t i1 = i0 + ORDERED_CHUNK < count ? i0 + ORDERED_CHUNK : count;
       for (int32_t i = i0; i < i1; ++i)
-        if (cache[(size_t)order[i] * STEP_CACHE_SLOTS + STEP_CACHE_HIGH] > local) {
+        if (block_stiff_maximum(cache, order[i]) > local) {
           const double own = weighed_cached_block(body, m, gram, w, order[i] * PIOLA_TET_BLOCK, 0.0);
           if (weighed) weighed[order[i]] = own;
           local = own > local ? own : local;
@@ -1114,32 +1137,17 @@ static rate_start ordered_start(const piola_elastic_body *body, const piola_mate
   }
   int32_t first[ORDERED_BUCKETS + 1] = {0};
   for (int32_t i = 0; i < count; ++i)
-    ++first[ordered_bucket(&slices, cache[(size_t)above[i] * STEP_CACHE_SLOTS + STEP_CACHE_HIGH]) + 1];
+    ++first[ordered_bucket(&slices, block_stiff_maximum(cache, above[i])) + 1];
   for (int k = 0; k < ORDERED_BUCKETS; ++k) first[k + 1] += first[k];
   int32_t next[ORDERED_BUCKETS];
   memcpy(next, first, sizeof next);
   for (int32_t i = 0; i < count; ++i)
-    order[next[ordered_bucket(&slices, cache[(size_t)above[i] * STEP_CACHE_SLOTS + STEP_CACHE_HIGH])]++] = above[i];
+    order[next[ordered_bucket(&slices, block_stiff_maximum(cache, above[i]))]++] = above[i];
   const double found = count > 0 ? weigh_in_order(body, m, gram, cache, w, order, count, &slices, best,
                                                   weighed, blocks >= PIOLA_PARALLEL_MIN_BLOCKS)
                                  : best;
   free(order);
   return (rate_start){found, 1, every};
-}
-
-/* Whether the block from T0 may hold a tet whose rate is at least NEAR, as near_tet_in's
- * screen would find: not when the force loop cached it (so its unweighted terms below the
- * stiff modulus are at most LOW) and its stiff terms are below NEAR, weighed by ordered_start
- * (WEIGHED, 0 where it did not) or bounded by the stiff maximum. Screening every block with
- * near_tet_in weighed each stiff block before the worst tet's: in a stretched spline body,
- * six times the rest of the pass. */
-static int cached_block_may_hold(const piola_elastic_body *body, const double *cache,
-                                 const double *weighed, int32_t t0, double near) {
-  const int32_t b = t0 / PIOLA_TET_BLOCK;
-  const double *slot = b < body->tet_count / PIOLA_TET_BLOCK ? cached_block(body, cache, t0) : NULL;
-  if (!slot) return 1;
-  const double stiff = weighed[b] > 0 ? weighed[b] : slot[STEP_CACHE_HIGH];
-  return !(slot[STEP_CACHE_LOW] < near && stiff < near);
 }
 
 /* The pass over a whole body takes RATE_RANGES ranges of whole blocks (the force loop's, whose
@@ -1170,7 +1178,7 @@ double PIOLA_ISA_NAME(piola__elastic_body_state_rate2)(piola_elastic_body *body,
     start = ordered_start(body, &body->materials[body->uniform_material], gram, cache, w, weighed);
   }
   const int parallel = nt >= PIOLA_PARALLEL_MIN_BLOCKS * PIOLA_TET_BLOCK;
-  if (start.every_block_cached && start.cached_blocks_within) {
+  if (start.every_block_cached) {
     /* ordered_start took every whole block: the ranges hold nothing more but the tets past
      * the last (the last range's); the others keep its maximum for the search's screen */
     const int32_t whole = nt / PIOLA_TET_BLOCK * PIOLA_TET_BLOCK;
@@ -1189,8 +1197,8 @@ double PIOLA_ISA_NAME(piola__elastic_body_state_rate2)(piola_elastic_body *body,
       if (!(part[r] >= best * (1 - 1e-10))) continue;
       const int32_t r1 = range_edge(nt, r + 1);
       for (int32_t t0 = range_edge(nt, r); t0 < r1 && *worst_tet < 0; t0 += PIOLA_TET_BLOCK)
-        if (!weighed || cached_block_may_hold(body, cache, weighed, t0, best * (1 - 1e-10)))
-          *worst_tet = near_tet_in(body, w, t0, t0 + PIOLA_TET_BLOCK < nt ? t0 + PIOLA_TET_BLOCK : nt, best);
+        *worst_tet = near_tet_in(body, w, t0, t0 + PIOLA_TET_BLOCK < nt ? t0 + PIOLA_TET_BLOCK : nt,
+                                 best, weighed);
     }
   free(weighed);
   return best;

@@ -20,7 +20,9 @@
  * one body two ways, with that cache and with it detached (the force loop forms no k, the pass
  * computes every one: the cost before the cache; one body, so that both read the same memory;
  * the Ogden models' per-tet cache of their parts is detached with it; the two swap places
- * every other repeat, so that each runs after the same work as often as the other), and
+ * every other repeat, so that each runs after the same work as often as the other: in a fixed
+ * order HGO's update with k always followed its fibre bodies' heavy passes and read 8-15% for
+ * neo-Hookean's arithmetic), and
  * a line "added" with what the bound adds to a step, the medians of (update with k + pass) /
  * (update without k) - 1 over the interleaved repeats, wall and process CPU.
  * PIOLA_BENCH_VARIANT=i (0: with the cache, 1: without) runs body i alone, for instruction
@@ -106,11 +108,7 @@ static void bench_model(const char *name, const piola_tet_mesh *mesh, piola_mate
     double sink = 0;
     for (int r = -1; r < repeats; ++r) /* r = -1 warms up (and builds the weights) */
       for (int i = 0; i < variants; ++i) {
-        /* the pair with and without k swaps places every other repeat, so that each follows
-         * the same work as often as the other: in a fixed order the update with k always ran
-         * after the fibre bodies' passes (HGO) or the other body's (the rest), with other
-         * caches, and the difference read 8-15% for HGO's k where neo-Hookean's, the same
-         * arithmetic, read 3% */
+        /* the pair swaps places every other repeat (the head of this file says why) */
         const int b = detached && i < 2 && (r & 1) ? 1 - i : i;
         if (alone >= 0 && b != alone) continue;
         if (detached) {

@@ -83,6 +83,20 @@
  * root), the step goes on, counted in newton_failures, and the user is warned once. */
 #define MAX_HALVINGS 3
 
+/* Backward Euler's first guess is the prediction x^n + dt v^n plus the step gravity alone
+ * would give (dt^2 g: 1.1 cm at 1/30 s), which is exact for a free fall. A solid that is
+ * supported (held by a constraint, or that step would take a node into an obstacle) takes
+ * only this fraction of it (11 um at 1/30 s): its nodes resting on an obstacle are pushed
+ * just inside it, so they are held from the first solve on, while nodes above it stay free.
+ * The whole step pushed every node within 1.1 cm of the obstacle into it, and all were held:
+ * a torus resting on a plane released 60-150 of them after the first solve and then added
+ * and released dozens per iteration, 15-17 Newton iterations a frame where this guess takes
+ * 5-8; a hanging muscle spindle took 50 iterations in 6 frames, 33 with it (BENCHMARKS.md,
+ * "The first guess"). With no nudge at all, resting nodes a rounding error above the surface
+ * were missed. Shells keep the whole step: on cloth folding over on the ground the fraction
+ * doubled the failed Newton steps. */
+#define GUESS_GRAVITY_FRACTION 1e-3
+
 /* Values of world_body.colliding during an implicit step: a node held along its normal by
  * an obstacle, along the push of the self-collision pass (see self_collide_and_resolve), or
  * by a solid's surface (a shell's one-way coupling, collide_with_solids). */
@@ -620,6 +634,30 @@ static int32_t contact_friction(newton_problem *pb) {
   return changed;
 }
 
+/* Whether a node with mass is fixed, driven or attached to a bone (the contacts of the
+ * last step are not read: a resumed run has none, and must take the same guess). */
+static int has_prescribed_nodes(const world_body *s) {
+  for (int32_t i = 0; i < s->n; ++i)
+    if (s->mass[i] > 0 && s->flags[i] != NODE_FREE) return 1;
+  return 0;
+}
+
+/* Whether a free node of the first guess at s->x is inside an obstacle (1, else 0; -1 on
+ * error). Moves nothing: the obstacles project a copy. */
+static int guess_enters_obstacle(newton_problem *pb) {
+  world_body *s = pb->s;
+  struct implicit_state *st = pb->st;
+  if (pb->w->obstacle_count == 0 || s->n == 0) return 0;
+  memcpy(st->base, s->x, sizeof(double) * 3 * (size_t)s->n);
+  memset(st->scratch_v, 0, sizeof(double) * 3 * (size_t)s->n);
+  if (piola_obstacles_collide(pb->w->obstacles, pb->w->obstacle_count, pb->t1, 0.0, s->n, st->base,
+                              st->scratch_v, st->hit, st->cg[0]) < 0)
+    return -1;
+  for (int32_t i = 0; i < s->n; ++i)
+    if (st->hit[i] && s->flags[i] == NODE_FREE) return 1;
+  return 0;
+}
+
 /* The step's problem for solid s over [t, t + dt]; reads no state. */
 static newton_problem problem_of(piola_world *w, world_body *s, double t, double dt) {
   newton_problem pb;
@@ -652,8 +690,10 @@ static piola_status newton_body(piola_world *w, world_body *s, double t, double 
   newton_problem pb = problem_of(w, s, t, dt);
   if (!pb.quasistatic) s->quasistatic_mu = 0;
 
-  /* the prediction, and the first guess: the prediction plus a step of gravity
-   * (backward Euler) or the last equilibrium (quasistatics); prescribed nodes at t1 */
+  /* the prediction, and the first guess: the prediction plus a step of gravity, or for a
+   * solid held by a constraint or whose step of gravity would take a node into an obstacle
+   * only GUESS_GRAVITY_FRACTION of it (backward Euler); the last equilibrium
+   * (quasistatics); prescribed nodes at t1 */
   memcpy(s->x_old, s->x, sizeof(double) * (size_t)m);
   memcpy(s->v_old, s->v, sizeof(double) * (size_t)m);
   memcpy(s->force_old, s->force, sizeof(double) * (size_t)m);
@@ -663,6 +703,16 @@ static piola_status newton_body(piola_world *w, world_body *s, double t, double 
       st->prediction[j] = s->x[j] + (pb.quasistatic ? 0.0 : dt * s->v[j]);
       if (!pb.quasistatic) s->x[j] = st->prediction[j] + dt * dt * pb.g1[k];
     }
+  if (!pb.quasistatic && s->kind == PIOLA_BODY_SOLID) {
+    const int supported = has_prescribed_nodes(s) ? 1 : guess_enters_obstacle(&pb);
+    if (supported < 0) return PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "implicit step: out of memory");
+    if (supported)
+      for (int32_t i = 0; i < n; ++i)
+        for (int k = 0; k < 3; ++k) {
+          const int64_t j = 3 * (int64_t)i + k;
+          s->x[j] = st->prediction[j] + GUESS_GRAVITY_FRACTION * dt * dt * pb.g1[k];
+        }
+  }
   if (n > 0) memset(s->colliding, 0, (size_t)n);
   for (int32_t i = 0; i < n; ++i) {
     if (s->flags[i] == NODE_FREE) continue;

@@ -634,21 +634,16 @@ static int32_t contact_friction(newton_problem *pb) {
   return changed;
 }
 
-/* Whether a node with mass is fixed, driven or attached to a bone (the contacts of the
- * last step are not read: a resumed run has none, and must take the same guess). */
-static int has_prescribed_nodes(const world_body *s) {
-  for (int32_t i = 0; i < s->n; ++i)
-    if (s->mass[i] > 0 && s->flags[i] != NODE_FREE) return 1;
-  return 0;
-}
-
-/* Whether a free node of the first guess at s->x is inside an obstacle (1, else 0; -1 on
- * error). Moves nothing: the obstacles project a copy. */
-static int guess_enters_obstacle(newton_problem *pb) {
+/* Whether the step of gravity alone, x = prediction + dt^2 g, would take a free node into an
+ * obstacle (1, else 0; -1 on error). Moves nothing: the obstacles project those positions in
+ * a scratch copy. */
+static int gravity_step_enters_obstacle(newton_problem *pb) {
   world_body *s = pb->s;
   struct implicit_state *st = pb->st;
   if (pb->w->obstacle_count == 0 || s->n == 0) return 0;
-  memcpy(st->base, s->x, sizeof(double) * 3 * (size_t)s->n);
+  const double dt2 = pb->dt * pb->dt;
+  for (int32_t i = 0; i < s->n; ++i)
+    for (int k = 0; k < 3; ++k) st->base[3 * (int64_t)i + k] = st->prediction[3 * (int64_t)i + k] + dt2 * pb->g1[k];
   memset(st->scratch_v, 0, sizeof(double) * 3 * (size_t)s->n);
   if (piola_obstacles_collide(pb->w->obstacles, pb->w->obstacle_count, pb->t1, 0.0, s->n, st->base,
                               st->scratch_v, st->hit, st->cg[0]) < 0)
@@ -693,27 +688,24 @@ static piola_status newton_body(piola_world *w, world_body *s, double t, double 
   /* the prediction, and the first guess: the prediction plus a step of gravity, or for a
    * solid held by a constraint or whose step of gravity would take a node into an obstacle
    * only GUESS_GRAVITY_FRACTION of it (backward Euler); the last equilibrium
-   * (quasistatics); prescribed nodes at t1 */
+   * (quasistatics); prescribed nodes at t1. The contacts of the last step are cleared
+   * first: a resumed run has none, and must take the same guess. */
   memcpy(s->x_old, s->x, sizeof(double) * (size_t)m);
   memcpy(s->v_old, s->v, sizeof(double) * (size_t)m);
   memcpy(s->force_old, s->force, sizeof(double) * (size_t)m);
-  for (int32_t i = 0; i < n; ++i)
-    for (int k = 0; k < 3; ++k) {
-      const int64_t j = 3 * (int64_t)i + k;
-      st->prediction[j] = s->x[j] + (pb.quasistatic ? 0.0 : dt * s->v[j]);
-      if (!pb.quasistatic) s->x[j] = st->prediction[j] + dt * dt * pb.g1[k];
-    }
-  if (!pb.quasistatic && s->kind == PIOLA_BODY_SOLID) {
-    const int supported = has_prescribed_nodes(s) ? 1 : guess_enters_obstacle(&pb);
-    if (supported < 0) return PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "implicit step: out of memory");
-    if (supported)
-      for (int32_t i = 0; i < n; ++i)
-        for (int k = 0; k < 3; ++k) {
-          const int64_t j = 3 * (int64_t)i + k;
-          s->x[j] = st->prediction[j] + GUESS_GRAVITY_FRACTION * dt * dt * pb.g1[k];
-        }
-  }
+  for (int64_t j = 0; j < m; ++j) st->prediction[j] = s->x[j] + (pb.quasistatic ? 0.0 : dt * s->v[j]);
   if (n > 0) memset(s->colliding, 0, (size_t)n);
+  if (!pb.quasistatic) {
+    double fraction = 1.0;
+    if (s->kind == PIOLA_BODY_SOLID) {
+      const int supported = has_filtered_nodes(s) ? 1 : gravity_step_enters_obstacle(&pb);
+      if (supported < 0) return PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "implicit step: out of memory");
+      if (supported) fraction = GUESS_GRAVITY_FRACTION;
+    }
+    for (int32_t i = 0; i < n; ++i)
+      for (int k = 0; k < 3; ++k)
+        s->x[3 * (int64_t)i + k] = st->prediction[3 * (int64_t)i + k] + fraction * dt * dt * pb.g1[k];
+  }
   for (int32_t i = 0; i < n; ++i) {
     if (s->flags[i] == NODE_FREE) continue;
     double vp[3];

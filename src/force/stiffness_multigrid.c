@@ -430,11 +430,12 @@ static piola_status smooth_prolongator(piola__multigrid_level *l, const piola__b
   return PIOLA_OK;
 }
 
-/* The next level's operator P^T A P, symmetrized; unknowns no mode reached (zero rows and
- * columns) get a unit diagonal. */
+/* The next level's operator P^T A P: the blocks above the diagonal formed, those below
+ * mirrored (A is symmetric), the diagonal blocks symmetrized; unknowns no mode reached (zero
+ * rows and columns) get a unit diagonal. */
 static piola_status galerkin(piola__multigrid_level *l, piola__block_sparse *coarse) {
   PIOLA_TRY(piola__block_sparse_transpose(&l->p, &l->pt));
-  PIOLA_TRY(piola__block_sparse_galerkin(&l->pt, &l->a, &l->p, coarse));
+  PIOLA_TRY(piola__block_sparse_galerkin_symmetric(&l->pt, &l->a, &l->p, coarse));
   piola__block_sparse_symmetrize(coarse);
   const int b = coarse->rb;
   for (int32_t r = 0; r < coarse->rows; ++r) {

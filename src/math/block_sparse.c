@@ -7,9 +7,12 @@
 #include "common/status_report.h"
 #include "piola/threads.h"
 
-/* below this many rows a product with a vector runs on one thread (the parallel region
- * costs more), and a sparse product below this many values of its left factor */
-#define BLOCK_SPARSE_PARALLEL_MIN_ROWS 4096
+/* below this many values a product with a vector runs on one thread (the parallel region
+ * costs more), and so does a sparse product below this many values of its left factor. By
+ * values, not rows: a coarse level's row of 6x6 blocks is 16 times a 3x3 row's work, and
+ * counted by rows the Figure 2 torus's second level (1,290 rows, 13 MB of blocks) and its
+ * restriction ran on one thread, a quarter of a V-cycle (BENCHMARKS.md, "Implicit
+ * integrators"). */
 #define BLOCK_SPARSE_PARALLEL_MIN_VALUES (1 << 19)
 enum { RANGES = 16 };
 
@@ -34,6 +37,12 @@ piola_status piola__block_sparse_alloc(piola__block_sparse *m, int32_t rows, int
 void piola__block_sparse_free(piola__block_sparse *m) {
   free(m->row_start), free(m->col), free(m->values);
   memset(m, 0, sizeof *m);
+}
+
+/* Whether a product of a with a vector, or a sparse product with left factor a, runs in
+ * parallel (BLOCK_SPARSE_PARALLEL_MIN_VALUES). */
+static int parallel_product(const piola__block_sparse *a) {
+  return (int64_t)a->row_start[a->rows] * a->rb * a->cb >= BLOCK_SPARSE_PARALLEL_MIN_VALUES;
 }
 
 typedef struct apply_pass {
@@ -110,7 +119,7 @@ void piola__block_sparse_apply(const piola__block_sparse *a, const double *x, do
   const apply_pass c = {a, x, y, accumulate};
   const int32_t n = a->rows;
 #pragma omp parallel for schedule(static) \
-    num_threads(piola_thread_count()) if (n >= BLOCK_SPARSE_PARALLEL_MIN_ROWS)
+    num_threads(piola_thread_count()) if (parallel_product(a))
   for (int r = 0; r < RANGES; ++r)
     apply_rows(&c, (int32_t)((int64_t)n * r / RANGES), (int32_t)((int64_t)n * (r + 1) / RANGES));
 }
@@ -185,11 +194,6 @@ static void add_product_row(const piola__block_sparse *a, const piola__block_spa
   }
 }
 
-/* Whether a sparse product with left factor a runs in parallel: by its values, since a
- * coarse level's 6x6 blocks make a row 16 times the work of a 3x3 one. */
-static int parallel_product(const piola__block_sparse *a) {
-  return (int64_t)a->row_start[a->rows] * a->rb * a->cb >= BLOCK_SPARSE_PARALLEL_MIN_VALUES;
-}
 
 /* Rows r0 .. r1 - 1 of c = a b, its row_start known: each row's columns sorted, its blocks
  * summed over a's row in order (marker, list and position: this range's own, marker[j] not
@@ -301,13 +305,15 @@ typedef struct galerkin_pass {
   piola__block_sparse *c;
   const int32_t *ap_start, *ap_col;
   int32_t *cursor; /* per row g of c: its next entry of pt (rows of one range only) */
+  int upper;       /* form only the blocks (g, h) with h >= g */
 } galerkin_pass;
 
 /* The numbers of the rows [g0, g1) of c (pattern built, values zeroed): row r of a p into
- * `row`, then its terms pt(g, r) (a p)(r, h) into every row g of c in the range that names r.
- * Rows r in increasing order, as pt's rows list them, so every entry of c sums its terms in
- * the order the two separate products would, whichever range it falls in; a row r whose p
- * row names rows of two ranges is formed by both. */
+ * `row`, then its terms pt(g, r) (a p)(r, h) into every row g of c in the range that names r
+ * (with gp->upper, only the blocks with h >= g). Rows r in increasing order, as pt's rows
+ * list them, so every entry of c sums its terms in the order the two separate products
+ * would, whichever range it falls in; a row r whose p row names rows of two ranges is formed
+ * by both. */
 static void galerkin_rows(const galerkin_pass *gp, int32_t g0, int32_t g1, int32_t *position,
                           double *row) {
   const piola__block_sparse *pt = gp->pt, *a = gp->a, *p = gp->p;
@@ -329,10 +335,12 @@ static void galerkin_rows(const galerkin_pass *gp, int32_t g0, int32_t g1, int32
       const int32_t g = p->col[j];
       if (g < g0 || g >= g1) continue;
       const double *ptb = pt->values + ptbs * (size_t)gp->cursor[g]++;
-      for (int32_t q = 0; q < count; ++q)
-        c_multiply_add(ptb, row + apbs * (size_t)q,
-                       c->values + cbs * (size_t)entry_of(c, g, gp->ap_col[first + q]), rc, ra,
-                       cb);
+      for (int32_t q = 0; q < count; ++q) {
+        const int32_t h = gp->ap_col[first + q];
+        if (gp->upper && h < g) continue;
+        c_multiply_add(ptb, row + apbs * (size_t)q, c->values + cbs * (size_t)entry_of(c, g, h),
+                       rc, ra, cb);
+      }
     }
   }
 }
@@ -347,9 +355,25 @@ static int32_t range_row(const piola__block_sparse *pt, int k, int ranges) {
   return g;
 }
 
-piola_status piola__block_sparse_galerkin(const piola__block_sparse *pt,
-                                          const piola__block_sparse *a,
-                                          const piola__block_sparse *p, piola__block_sparse *c) {
+/* Rows r0 .. r1 - 1 of c's blocks below the diagonal: the transposes of their mirror
+ * blocks above it. */
+static void mirror_rows(piola__block_sparse *c, int32_t r0, int32_t r1) {
+  const int b = c->rb;
+  const size_t bs = (size_t)(b * b);
+  for (int32_t g = r0; g < r1; ++g)
+    for (int32_t k = c->row_start[g]; k < c->row_start[g + 1] && c->col[k] < g; ++k) {
+      const double *upper = c->values + bs * (size_t)entry_of(c, c->col[k], g);
+      double *lower = c->values + bs * (size_t)k;
+      for (int i = 0; i < b; ++i)
+        for (int j = 0; j < b; ++j) lower[b * i + j] = upper[b * j + i];
+    }
+}
+
+/* c = pt (a p), all blocks formed (upper = 0) or those on and above the diagonal only and
+ * the others mirrored (upper = 1, for a symmetric a; c square with a symmetric pattern). */
+static piola_status galerkin_product(const piola__block_sparse *pt, const piola__block_sparse *a,
+                                     const piola__block_sparse *p, piola__block_sparse *c,
+                                     int upper) {
   memset(c, 0, sizeof *c);
   const int32_t n = a->rows, cols = p->cols > 0 ? p->cols : 1;
   /* one range of c's rows per thread (each thread forms the rows of a p its range needs) */
@@ -384,11 +408,20 @@ piola_status piola__block_sparse_galerkin(const piola__block_sparse *pt,
   memset(c->values, 0,
          sizeof(double) * cbs * (size_t)(c->row_start[c->rows] > 0 ? c->row_start[c->rows] : 1));
   for (int32_t g = 0; g < pt->rows; ++g) cursor[g] = pt->row_start[g];
-  const galerkin_pass gp = {pt, a, p, c, ap_start, ap_col, cursor};
-#pragma omp parallel for schedule(static, 1) num_threads(ranges) if (ranges > 1)
-  for (int k = 0; k < ranges; ++k)
-    galerkin_rows(&gp, range_row(pt, k, ranges), range_row(pt, k + 1, ranges),
-                  position + (size_t)cols * (size_t)k, row + apbs * (size_t)longest * (size_t)k);
+  const galerkin_pass gp = {pt, a, p, c, ap_start, ap_col, cursor, upper};
+#pragma omp parallel num_threads(ranges) if (ranges > 1)
+  {
+#pragma omp for schedule(static, 1)
+    for (int k = 0; k < ranges; ++k)
+      galerkin_rows(&gp, range_row(pt, k, ranges), range_row(pt, k + 1, ranges),
+                    position + (size_t)cols * (size_t)k, row + apbs * (size_t)longest * (size_t)k);
+    if (upper) {
+#pragma omp for schedule(static)
+      for (int k = 0; k < RANGES; ++k)
+        mirror_rows(c, (int32_t)((int64_t)c->rows * k / RANGES),
+                    (int32_t)((int64_t)c->rows * (k + 1) / RANGES));
+    }
+  }
   goto done;
 out_of_memory:
   status = PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "sparse product: out of memory");
@@ -396,6 +429,19 @@ done:
   if (status != PIOLA_OK) piola__block_sparse_free(c);
   free(marker), free(list), free(position), free(ap_start), free(cursor), free(ap_col), free(row);
   return status;
+}
+
+piola_status piola__block_sparse_galerkin(const piola__block_sparse *pt,
+                                          const piola__block_sparse *a,
+                                          const piola__block_sparse *p, piola__block_sparse *c) {
+  return galerkin_product(pt, a, p, c, 0);
+}
+
+piola_status piola__block_sparse_galerkin_symmetric(const piola__block_sparse *pt,
+                                                    const piola__block_sparse *a,
+                                                    const piola__block_sparse *p,
+                                                    piola__block_sparse *c) {
+  return galerkin_product(pt, a, p, c, 1);
 }
 
 piola_status piola__block_sparse_transpose(const piola__block_sparse *a, piola__block_sparse *t) {

@@ -51,6 +51,17 @@ piola_status piola__block_sparse_galerkin(const piola__block_sparse *pt,
                                           const piola__block_sparse *a,
                                           const piola__block_sparse *p, piola__block_sparse *c);
 
+/* The Galerkin product of a symmetric a: c's blocks on and above the diagonal as
+ * piola__block_sparse_galerkin forms them (bit-identical), those below the transposes of
+ * their mirror blocks, so c is symmetric but for its diagonal blocks. The scatter of the
+ * product's terms, most of its work, is halved: the level-0 product of the Figure 2 torus's
+ * multigrid setup takes 57-70 ms instead of 73-86 ms (BENCHMARKS.md, "Implicit
+ * integrators"). */
+piola_status piola__block_sparse_galerkin_symmetric(const piola__block_sparse *pt,
+                                                    const piola__block_sparse *a,
+                                                    const piola__block_sparse *p,
+                                                    piola__block_sparse *c);
+
 /* t = a^T. */
 piola_status piola__block_sparse_transpose(const piola__block_sparse *a, piola__block_sparse *t);
 

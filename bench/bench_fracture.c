@@ -21,7 +21,7 @@
 #include "support/bench_support.h"
 
 int main(int argc, char **argv) {
-  bench_fracture_allocator(&argc, argv);
+  bench_allocator(&argc, argv);
   const int nx = argc > 1 ? atoi(argv[1]) : 45;
   const int steps = argc > 2 ? atoi(argv[2]) : 20;
   const int samples = argc > 3 ? atoi(argv[3]) : 7;

@@ -24,7 +24,7 @@
 enum { CREATE, FIRST_UPDATE, FIRST_DAMPING, UPDATE, DAMPING, PHASES };
 
 int main(int argc, char **argv) {
-  bench_fracture_allocator(&argc, argv);
+  bench_allocator(&argc, argv);
   const int nx = argc > 1 ? atoi(argv[1]) : 30;
   const int rounds = argc > 2 ? atoi(argv[2]) : 7;
   if (nx < 3 || rounds < 2) {

@@ -2,9 +2,7 @@
 
 #include <stdio.h>
 #include <stdlib.h>
-#include <string.h>
 
-#include "cli/allocator_policy.h"
 #include "support/bench_support.h"
 
 piola_world *bench_fracture_world(const piola_tet_mesh *mesh, piola_vec3 velocity) {
@@ -41,13 +39,3 @@ double bench_fracture_time_steps(piola_world *w, int steps, double dt) {
   return (bench_thread_cpu_seconds() - t0) / steps;
 }
 
-void bench_fracture_allocator(int *argc, char **argv) {
-  int keep_defaults = 0, n = 1;
-  for (int i = 1; i < *argc; ++i)
-    if (strcmp(argv[i], "--default-allocator") == 0) keep_defaults = 1;
-    else argv[n++] = argv[i];
-  *argc = n;
-  if (!keep_defaults) piola_cli_keep_freed_memory();
-  printf("allocator: %s\n",
-         keep_defaults ? "the C library's defaults" : "freed memory kept, as piola run does");
-}

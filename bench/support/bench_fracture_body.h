@@ -13,9 +13,4 @@ piola_world *bench_fracture_world(const piola_tet_mesh *mesh, piola_vec3 velocit
 /* Thread CPU time (s) per step of `steps` steps of dt; exits with the message on failure. */
 double bench_fracture_time_steps(piola_world *w, int steps, double dt);
 
-/* With the argument "--default-allocator" (taken out of argv, *argc updated) the C library's
- * allocator keeps its defaults; otherwise freed memory is treated as `piola run` treats it
- * (src/cli/allocator_policy.h). Prints which. */
-void bench_fracture_allocator(int *argc, char **argv);
-
 #endif

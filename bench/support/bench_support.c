@@ -1,13 +1,30 @@
 #include "support/bench_support.h"
 
 #include <stdint.h>
+#include <stdio.h>
 #include <stdlib.h>
+#include <string.h>
 #include <time.h>
+
+#include "cli/allocator_policy.h"
 
 static double seconds_of(clockid_t clock) {
   struct timespec ts;
   clock_gettime(clock, &ts);
   return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+void bench_allocator(int *argc, char **argv) {
+  int keep_defaults = 0, n = 1;
+  for (int i = 1; i < *argc; ++i)
+    if (strcmp(argv[i], "--default-allocator") == 0)
+      keep_defaults = 1;
+    else
+      argv[n++] = argv[i];
+  *argc = n;
+  if (!keep_defaults) piola_cli_keep_freed_memory();
+  printf("allocator: %s\n",
+         keep_defaults ? "the C library's defaults" : "freed memory kept, as piola run does");
 }
 
 double bench_wall_seconds(void) { return seconds_of(CLOCK_MONOTONIC); }

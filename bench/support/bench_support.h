@@ -7,6 +7,11 @@
 
 #include "piola/material.h"
 
+/* With the argument "--default-allocator" (taken out of argv, *argc updated) the C library's
+ * allocator keeps its defaults; otherwise freed memory is treated as `piola run` treats it
+ * (src/cli/allocator_policy.h), so a benchmark times what the program does. Prints which. */
+void bench_allocator(int *argc, char **argv);
+
 /* Monotonic wall-clock time, s. */
 double bench_wall_seconds(void);
 

@@ -218,32 +218,30 @@ enum {
   PASS_RESIDUAL         /* r = f - q (q = A x) */
 };
 
-static void vector_rows(const vector_pass *c, int32_t r0, int32_t r1) {
+/* Rows r0 .. r1 - 1 of one of the passes but PASS_INVERT_DIAGONAL, for blocks of B: always
+ * inlined with B and KIND constants (vector_rows), so the block loops unroll and the kind's
+ * branches fold; written generically they were a quarter of a V-cycle on the rubber torus of
+ * BENCHMARKS.md. */
+static inline __attribute__((always_inline)) void pass_rows(const vector_pass *c, int32_t r0,
+                                                            int32_t r1, const int b,
+                                                            const int kind) {
   const piola__multigrid_level *l = c->l;
-  const int b = l->a.rb, bb = b * b;
+  const int bb = b * b;
   for (int32_t row = r0; row < r1; ++row) {
-    double *dinv = l->inverse_diagonal + (size_t)bb * (size_t)row;
+    const double *dinv = l->inverse_diagonal + (size_t)bb * (size_t)row;
     double *x = l->x + (size_t)b * row, *f = l->f + (size_t)b * row;
     double *r = l->r + (size_t)b * row, *d = l->d + (size_t)b * row;
     const double *q = l->q + (size_t)b * row;
-    if (c->kind == PASS_INVERT_DIAGONAL) {
-      const int32_t k = diagonal_entry(&l->a, row);
-      if (k >= 0)
-        invert_block(l->a.values + (size_t)bb * (size_t)k, b, dinv);
-      else
-        memset(dinv, 0, sizeof(double) * (size_t)bb);
-      continue;
-    }
-    if (c->kind == PASS_RESIDUAL) {
+    if (kind == PASS_RESIDUAL) {
       for (int i = 0; i < b; ++i) r[i] = f[i] - q[i];
       continue;
     }
     double v[6];
-    for (int i = 0; i < b; ++i) v[i] = c->kind == PASS_START ? f[i] - q[i] : q[i];
+    for (int i = 0; i < b; ++i) v[i] = kind == PASS_START ? f[i] - q[i] : q[i];
     for (int i = 0; i < b; ++i) {
       double s = 0;
       for (int j = 0; j < b; ++j) s += dinv[b * i + j] * v[j];
-      if (c->kind == PASS_START) {
+      if (kind == PASS_START) {
         r[i] = s;
         d[i] = c->c2 * s;
         x[i] = c->c1 != 0 ? x[i] + d[i] : d[i];
@@ -251,8 +249,48 @@ static void vector_rows(const vector_pass *c, int32_t r0, int32_t r1) {
         r[i] -= s;
       }
     }
-    if (c->kind == PASS_CHEBYSHEV)
+    if (kind == PASS_CHEBYSHEV)
       for (int i = 0; i < b; ++i) d[i] = c->c1 * d[i] + c->c2 * r[i], x[i] += d[i];
+  }
+}
+
+/* pass_rows for blocks of B, each kind its own instance */
+#define PASS_ROWS(NAME, B)                                                      \
+  static void NAME(const vector_pass *c, int32_t r0, int32_t r1) {              \
+    switch (c->kind) {                                                          \
+      case PASS_START: pass_rows(c, r0, r1, B, PASS_START); break;              \
+      case PASS_CHEBYSHEV: pass_rows(c, r0, r1, B, PASS_CHEBYSHEV); break;      \
+      default: pass_rows(c, r0, r1, B, PASS_RESIDUAL); break;                   \
+    }                                                                           \
+  }
+
+PASS_ROWS(pass_rows_3, 3)
+PASS_ROWS(pass_rows_6, 6)
+
+static void vector_rows(const vector_pass *c, int32_t r0, int32_t r1) {
+  const piola__multigrid_level *l = c->l;
+  const int b = l->a.rb, bb = b * b;
+  if (c->kind == PASS_INVERT_DIAGONAL) {
+    for (int32_t row = r0; row < r1; ++row) {
+      double *dinv = l->inverse_diagonal + (size_t)bb * (size_t)row;
+      const int32_t k = diagonal_entry(&l->a, row);
+      if (k >= 0)
+        invert_block(l->a.values + (size_t)bb * (size_t)k, b, dinv);
+      else
+        memset(dinv, 0, sizeof(double) * (size_t)bb);
+    }
+    return;
+  }
+  if (b == 3) {
+    pass_rows_3(c, r0, r1);
+  } else if (b == 6) {
+    pass_rows_6(c, r0, r1);
+  } else {
+    switch (c->kind) {
+      case PASS_START: pass_rows(c, r0, r1, b, PASS_START); break;
+      case PASS_CHEBYSHEV: pass_rows(c, r0, r1, b, PASS_CHEBYSHEV); break;
+      default: pass_rows(c, r0, r1, b, PASS_RESIDUAL); break;
+    }
   }
 }
 

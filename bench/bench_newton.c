@@ -25,7 +25,11 @@
  *                     [preconditioner=block_jacobi|incomplete_cholesky|multigrid]
  *                     [forcing=eisenstat_walker|fixed] [reference=0|1]
  *                     [newton_tolerance=1e-5 (the default of integrator.newton_tolerance)]
- *                     [--default-allocator]
+ *                     [repeats=1] [--default-allocator]
+ * With the reference, the backward Euler frames run `repeats` times (fresh worlds; every run
+ * must end on the same bits) and the speed-up divides the reference's CPU time by their
+ * median: a run of under a second varied by 30% between runs on the project's shared
+ * machine, the 30 s reference by a few percent.
  * Freed memory is kept as `piola run` keeps it (src/cli/allocator_policy.h), unless
  * --default-allocator is given: the multigrid setup of every step allocates tens of MB, and
  * with the C library's defaults their pages were faulted in afresh at every step (12% of a
@@ -95,6 +99,8 @@ int main(int argc, char **argv) {
   }
   const int reference = argc > 9 && atoi(argv[9]) != 0;
   if (argc > 10) newton_tolerance = atof(argv[10]);
+  int repeats = argc > 11 ? atoi(argv[11]) : 1;
+  if (repeats < 1) repeats = 1;
   if (frames < 1) frames = 1;
   if (newmark_steps < 1) newmark_steps = 1;
   piola_set_thread_count(threads);
@@ -163,6 +169,28 @@ int main(int argc, char **argv) {
   double *be_final = malloc(v3);
   memcpy(be_final, piola_world_solid_positions(w, 0), v3);
   piola_world_destroy(w);
+  double *be_runs_cpu = malloc(sizeof(double) * (size_t)repeats);
+  be_runs_cpu[0] = be_total_cpu;
+  for (int r = 1; r < repeats && reference; ++r) {
+    w = make_world(&mesh, PIOLA_INTEGRATOR_BACKWARD_EULER, e, nu, zmin);
+    if (!w) {
+      fprintf(stderr, "bench_newton: %s\n", piola_last_error());
+      return 1;
+    }
+    const double c0 = bench_cpu_seconds();
+    for (int f = 1; f <= frames; ++f)
+      if (piola_world_advance_to(w, f / 30.0, NULL) != PIOLA_OK) {
+        fprintf(stderr, "bench_newton: repeat %d, frame %d: %s\n", r, f, piola_last_error());
+        return 1;
+      }
+    be_runs_cpu[r] = 1e3 * (bench_cpu_seconds() - c0);
+    if (memcmp(be_final, piola_world_solid_positions(w, 0), v3) != 0) {
+      fprintf(stderr, "bench_newton: repeat %d did not end where the first run did\n", r);
+      return 1;
+    }
+    piola_world_destroy(w);
+  }
+  if (reference) be_total_cpu = bench_median(be_runs_cpu, repeats);
 
   w = make_world(&mesh, PIOLA_INTEGRATOR_NEWMARK, e, nu, zmin);
   const double dt = piola_world_stable_dt(w);
@@ -193,7 +221,10 @@ int main(int argc, char **argv) {
     const double diagonal = sqrt((hi[0] - lo[0]) * (hi[0] - lo[0]) +
                                  (hi[1] - lo[1]) * (hi[1] - lo[1]) +
                                  (hi[2] - lo[2]) * (hi[2] - lo[2]));
-    printf("backward Euler: %d frames in %.2f s process CPU\n", frames, be_total_cpu / 1e3);
+    printf("backward Euler: %d frames in %.2f s process CPU (median of %d runs", frames,
+           be_total_cpu / 1e3, repeats);
+    for (int r = 0; r < repeats; ++r) printf("%s%.2f", r ? ", " : ": ", be_runs_cpu[r] / 1e3);
+    printf(")\n");
     printf("Newmark reference: %ld steps (dt %.3g s) in %.2f s process CPU\n", steps, dt, nm_cpu);
     printf("final shapes: largest node distance %.3g m = %.3g%% of the bounding-box diagonal "
            "(%.3g m)\n",
@@ -202,7 +233,7 @@ int main(int argc, char **argv) {
            nm_cpu / (be_total_cpu / 1e3));
     piola_world_destroy(w);
     free(be_final), free(frame_ms), free(iter_ms), free(assemble_ms), free(solve_ms);
-    free(iter_cpu_ms), free(frame_cpu_ms);
+    free(iter_cpu_ms), free(frame_cpu_ms), free(be_runs_cpu);
     free(mesh.positions), free(mesh.tets), free(mesh.tet_regions);
     return 0;
   }
@@ -229,7 +260,7 @@ int main(int argc, char **argv) {
          dt, steps_per_frame, nm_step, newmark_steps, steps_per_frame * nm_step);
   printf("speed-up per frame: %.1f\n", steps_per_frame * nm_step / be_frame);
   free(frame_ms), free(iter_ms), free(assemble_ms), free(solve_ms), free(iter_cpu_ms);
-  free(frame_cpu_ms), free(be_final);
+  free(frame_cpu_ms), free(be_final), free(be_runs_cpu);
   free(step_ms);
   free(mesh.positions), free(mesh.tets), free(mesh.tet_regions);
   return 0;

@@ -262,7 +262,6 @@ static void add_product_row(const piola__block_sparse *a, const piola__block_spa
   }
 }
 
-
 /* Rows r0 .. r1 - 1 of c = a b, its row_start known: each row's columns sorted, its blocks
  * summed over a's row in order (marker, list and position: this range's own, marker[j] not
  * a row of the range on entry). */

@@ -254,7 +254,8 @@ static inline __attribute__((always_inline)) void pass_rows(const vector_pass *c
   }
 }
 
-/* pass_rows for blocks of B, each kind its own instance */
+/* pass_rows for blocks of B (a constant, or the level's block size), each kind its own
+ * instance */
 #define PASS_ROWS(NAME, B)                                                      \
   static void NAME(const vector_pass *c, int32_t r0, int32_t r1) {              \
     switch (c->kind) {                                                          \
@@ -266,6 +267,7 @@ static inline __attribute__((always_inline)) void pass_rows(const vector_pass *c
 
 PASS_ROWS(pass_rows_3, 3)
 PASS_ROWS(pass_rows_6, 6)
+PASS_ROWS(pass_rows_any, c->l->a.rb)
 
 static void vector_rows(const vector_pass *c, int32_t r0, int32_t r1) {
   const piola__multigrid_level *l = c->l;
@@ -281,17 +283,12 @@ static void vector_rows(const vector_pass *c, int32_t r0, int32_t r1) {
     }
     return;
   }
-  if (b == 3) {
+  if (b == 3)
     pass_rows_3(c, r0, r1);
-  } else if (b == 6) {
+  else if (b == 6)
     pass_rows_6(c, r0, r1);
-  } else {
-    switch (c->kind) {
-      case PASS_START: pass_rows(c, r0, r1, b, PASS_START); break;
-      case PASS_CHEBYSHEV: pass_rows(c, r0, r1, b, PASS_CHEBYSHEV); break;
-      default: pass_rows(c, r0, r1, b, PASS_RESIDUAL); break;
-    }
-  }
+  else
+    pass_rows_any(c, r0, r1);
 }
 
 static void over_rows(const piola__multigrid_level *l, int kind, double c1, double c2) {

@@ -174,7 +174,7 @@ static void incline_friction(void **state) {
 /* Friction acts after the Newton solve. On a mesh with slivers at the contact its moves are
  * many times their altitude, and before the step was solved again around them (implicit_step.c,
  * friction_moves_deform) Gmsh's bunny resting on a frictional plane kept up to 16 tets
- * inverted at its feet, 7 still after 1 s (docs/time-stepping.md, "Friction after the
+ * inverted at its feet, 5 still after 1 s (docs/time-stepping.md, "Friction after the
  * solve"). Dropped from 1 cm onto a plane with friction 0.5, no tet may invert. */
 static void friction_on_slivers_inverts_nothing(void **state) {
   (void)state;

@@ -681,8 +681,9 @@ static int32_t contact_friction(newton_problem *pb) {
 
 /* Whether friction's moves (contact_friction, just run) are large against the tets they
  * touch: a move above FRICTION_RESOLVE_MOVE times a tet's rest altitude can flatten or invert
- * it, and the solve did not see it. Solids on one process only (a split solid's ranks would
- * each decide their own; shells have no tets): there the friction stays a split step. */
+ * it, and the solve did not see it. Solids on one process only (the ranks of a split solid
+ * hold different tets, and its PETSc filter holds normals only; shells have no tets): there
+ * friction stays a move after the solve. */
 static int friction_moves_deform(const newton_problem *pb) {
   const world_body *s = pb->s;
   if (s->kind != PIOLA_BODY_SOLID || piola__implicit_split_of(s)) return 0;

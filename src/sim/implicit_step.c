@@ -632,9 +632,8 @@ static int32_t release_contacts(newton_problem *pb) {
 /* Coulomb friction with the converged contact force: the normal impulse dt (g . n) / dt^2
  * per unit mass limits the tangential velocity relative to the nearest obstacle. Changes
  * x and v of sliding nodes; returns how many. Notes for a second solve, per node: in
- * st->hit 1 where friction stopped it (no tangential velocity relative to the obstacle
- * left), 2 where it slowed it, else 0; in st->friction the force m dv / dt; in
- * st->scratch_v (n) how far it moved. */
+ * st->hit what piola__coulomb_limit did (2 stopped it, 1 slowed it, 0 nothing); in
+ * st->friction the force m dv / dt; in st->scratch_v (n) how far it moved. */
 static int32_t contact_friction(newton_problem *pb) {
   piola_world *w = pb->w;
   world_body *s = pb->s;
@@ -660,20 +659,17 @@ static int32_t contact_friction(newton_problem *pb) {
       piola__nearest_obstacle_motion(w->obstacles, w->obstacle_count, pb->t1, p, &mu, &vo);
     }
     const double before[3] = {vi[0], vi[1], vi[2]};
-    if (!piola__coulomb_limit(vi, vo, nrm, mu, dvn)) continue;
-    double move2 = 0, vt2 = 0, dv2 = 0;
-    const double rn = (vi[0] - vo.x) * nrm[0] + (vi[1] - vo.y) * nrm[1] + (vi[2] - vo.z) * nrm[2];
-    const double vok[3] = {vo.x, vo.y, vo.z};
+    const int limited = piola__coulomb_limit(vi, vo, nrm, mu, dvn);
+    if (!limited) continue;
+    double move2 = 0;
     for (int k = 0; k < 3; ++k) {
-      const double x = s->x_old[3 * i + k] + pb->dt * vi[k], dv = vi[k] - before[k];
-      const double vt = vi[k] - vok[k] - rn * nrm[k];
+      const double x = s->x_old[3 * i + k] + pb->dt * vi[k];
       move2 += (x - s->x[3 * i + k]) * (x - s->x[3 * i + k]);
-      vt2 += vt * vt, dv2 += dv * dv;
       s->x[3 * i + k] = x;
-      st->friction[3 * i + k] = s->mass[i] * dv / pb->dt;
+      st->friction[3 * i + k] = s->mass[i] * (vi[k] - before[k]) / pb->dt;
     }
     moved[i] = sqrt(move2);
-    st->hit[i] = vt2 <= 1e-24 * dv2 ? 1 : 2;
+    st->hit[i] = (uint8_t)limited;
     changed++;
   }
   return changed;
@@ -982,7 +978,7 @@ static piola_status newton_iterate(const newton_problem *problem, int accept_unc
      * (docs/time-stepping.md, "Friction after the solve") */
     if (friction_moves_deform(&pb)) {
       for (int32_t i = 0; i < n; ++i)
-        if (st->hit[i] == 1) s->colliding[i] = HELD_BY_FRICTION;
+        if (st->hit[i] == 2) s->colliding[i] = HELD_BY_FRICTION; /* stopped */
       pb.friction_held = 1, pb.contacts_moved = 1;
       return newton_iterate(&pb, accept_unconverged, stats);
     }

@@ -24,5 +24,5 @@ int piola__coulomb_limit(double v[3], piola_vec3 vo, const double n[3], double m
   if (!(vtn > 0)) return 0;
   double keep = fmax(0.0, 1.0 - mu * dvn / vtn);
   for (int k = 0; k < 3; ++k) v[k] -= (1.0 - keep) * vt[k];
-  return 1;
+  return keep > 0 ? 1 : 2;
 }

@@ -13,7 +13,8 @@ void piola__nearest_obstacle_motion(piola_obstacle *const *obstacles, int32_t co
 
 /* vT <- max(0, 1 - mu dvn / |vT|) vT for the velocity v relative to the surface velocity vo,
  * vT its part tangential to the unit normal n, dvn > 0 the normal velocity change of the
- * contact (m/s). Returns 0 (v unchanged) when mu or |vT| is zero, else 1. */
+ * contact (m/s). Returns 0 (v unchanged) when mu or |vT| is zero, 2 when friction stops the
+ * tangential motion (mu dvn >= |vT|: vT becomes 0), else 1 (slowed). */
 int piola__coulomb_limit(double v[3], piola_vec3 vo, const double n[3], double mu, double dvn);
 
 #endif

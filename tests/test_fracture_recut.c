@@ -354,6 +354,11 @@ static void rewrite_as_format_4(const char *path) {
   fclose(f);
   size_t pos = 48;
   skip_array(data, &pos, 8); /* time */
+  const size_t bounds_at = pos; /* the recent step bounds (format 7 on), not in format 4 */
+  skip_array(data, &pos, 4);
+  skip_array(data, &pos, 4);
+  skip_array(data, &pos, 8);
+  const size_t bounds_end = pos;
   skip_array(data, &pos, 4); /* body kind */
   skip_array(data, &pos, 4); /* fracture present */
   skip_array(data, &pos, 4); /* counts */
@@ -365,7 +370,8 @@ static void rewrite_as_format_4(const char *path) {
   for (int a = 0; a < 3; ++a) skip_array(data, &pos, a == 0 ? 4 : a == 1 ? 1 : 8);
   const size_t rest_at = pos;
   size_t n = 0;
-  memcpy(out, data, copies_at), n = copies_at;
+  memcpy(out, data, bounds_at), n = bounds_at;
+  memcpy(out + n, data + bounds_end, copies_at - bounds_end), n += copies_at - bounds_end;
   const uint64_t tets = slots / FRACTURE_MAX_COPIES, two = 2 * tets;
   memcpy(out + n, &two, 8), n += 8;
   for (uint64_t t = 0; t < tets; ++t) {

@@ -242,7 +242,8 @@ typedef struct piola_step_stats {
                              (docs/time-stepping.md, "Energy check") */
 } piola_step_stats;
 
-/* The step size the next step would take with no target time: min(max_dt, CFL bound), s. */
+/* The step size the next step would take with no target time: min(max_dt, CFL bound, the
+ * CFL bounds of the last 16 steps' start states), s (docs/time-stepping.md, "Step size"). */
 PIOLA_API double piola_world_stable_dt(const piola_world *world);
 
 /* One step of min(stable dt, dt_limit) seconds. stats (may be NULL) is overwritten. A step

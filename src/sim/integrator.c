@@ -191,14 +191,37 @@ static double stiffness_bound(const world_body *s, double t0, double t1) {
   return m;
 }
 
-double piola_world_stable_dt(const piola_world *w) {
-  if (w->def.integrator != PIOLA_INTEGRATOR_NEWMARK) return w->def.implicit_dt;
+/* min(max_dt, every body's CFL bound) at the current state (collective in a split run). */
+static double current_bound(const piola_world *w) {
   double dt = w->def.max_dt;
   for (int32_t i = 0; i < w->body_count; ++i) {
     const world_body *b = &w->bodies[i];
     dt = fmin(dt, piola__body_stable_dt(w, b, stiffness_bound(b, w->time, w->time + w->def.max_dt)));
   }
   return dt;
+}
+
+/* The smallest of the recent steps' bounds (INFINITY before the first step). */
+static double recent_bound_min(const piola_world *w) {
+  double dt = INFINITY;
+  for (int32_t i = 0; i < w->recent_bound_count; ++i) dt = fmin(dt, w->recent_bounds[i]);
+  return dt;
+}
+
+static void remember_bound(piola_world *w, double bound) {
+  w->recent_bounds[w->recent_bound_next] = bound;
+  w->recent_bound_next = (w->recent_bound_next + 1) % STEP_BOUND_WINDOW;
+  if (w->recent_bound_count < STEP_BOUND_WINDOW) w->recent_bound_count++;
+}
+
+/* The explicit step follows the stiffest of the recent states, not the current one alone:
+ * where the stiffest tets oscillate between soft and stiff states (a strongly stretched
+ * body), a step sized from the soft state alone carries them into the stiff one at several
+ * times its bound, and a step size that rises and falls with their oscillation pumps energy
+ * into it (docs/time-stepping.md, "The recent bounds"). */
+double piola_world_stable_dt(const piola_world *w) {
+  if (w->def.integrator != PIOLA_INTEGRATOR_NEWMARK) return w->def.implicit_dt;
+  return fmin(current_bound(w), recent_bound_min(w));
 }
 
 static void gravity_at(const piola_world *w, double t, double g[3]) {
@@ -505,7 +528,8 @@ piola_status piola_world_step(piola_world *w, double dt_limit, piola_step_stats 
     return piola__implicit_world_step(w, dt_limit, stats);
   piola_step_stats local = {0};
   piola__step_profile_start(&w->profile);
-  double dt = piola_world_stable_dt(w);
+  const double bound = current_bound(w);
+  double dt = fmin(bound, recent_bound_min(w));
   if (dt_limit > 0 && dt_limit < dt) dt = dt_limit;
   if (!(dt > 0)) return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "step: dt must be > 0, got %g", dt);
   note_small_step(w);
@@ -533,6 +557,7 @@ piola_status piola_world_step(piola_world *w, double dt_limit, piola_step_stats 
     if (stats) *stats = local;
     return st;
   }
+  remember_bound(w, bound);
   return piola__world_finish_step(w, dt, &local, stats);
 }
 

@@ -539,8 +539,28 @@ static void contact_state(stream *s, piola_world *w) {
   if (s->store) *c.open = open, *c.t_start = t_start;
 }
 
+/* The recent steps' bounds (format 7 on; an older file starts with none, as a new run). */
+static void recent_bounds(stream *s, piola_world *w) {
+  if (s->reading && s->version < 7) {
+    if (s->store) w->recent_bound_count = 0, w->recent_bound_next = 0;
+    return;
+  }
+  int32_t count = w->recent_bound_count, next = w->recent_bound_next;
+  local_int(s, &count, "recent step bounds");
+  local_int(s, &next, "next step bound");
+  if (!s->failed && (count < 0 || count > STEP_BOUND_WINDOW || next < 0 || next >= STEP_BOUND_WINDOW)) {
+    s->failed = 1;
+    snprintf(s->what, sizeof s->what, "recent step bounds: %d, next %d (at most %d)", (int)count,
+             (int)next, STEP_BOUND_WINDOW);
+    return;
+  }
+  doubles(s, w->recent_bounds, STEP_BOUND_WINDOW, "recent step bound values");
+  if (s->store && !s->failed) w->recent_bound_count = count, w->recent_bound_next = next;
+}
+
 static void world_state(stream *s, piola_world *w) {
   one_double(s, &w->time, "time");
+  recent_bounds(s, w);
   for (int32_t i = 0; i < w->body_count && !s->failed; ++i) {
     world_body *b = &w->bodies[i];
     int32_t kind = (int32_t)b->kind;

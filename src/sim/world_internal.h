@@ -33,6 +33,11 @@ typedef struct body_slot {
   uint32_t generation;
 } body_slot;
 
+/* How many steps' bounds an explicit step looks back over (docs/time-stepping.md, "The
+ * recent bounds"): at least one period of the fastest element's oscillation at the
+ * default cfl (about 2 pi / (cfl sqrt 3) steps, 7 at cfl 0.5), twice that to be safe. */
+enum { STEP_BOUND_WINDOW = 16 };
+
 struct piola_world {
   piola_world_def def;
   double time;
@@ -45,6 +50,12 @@ struct piola_world {
   piola_obstacle **obstacles;
   int32_t obstacle_count, obstacle_capacity;
   struct world_contact *contact; /* self-collision of boundary surfaces (world_contact.c) */
+  /* the CFL bounds (min(max_dt, every body's bound)) of the start states of the last
+   * STEP_BOUND_WINDOW Newmark steps, oldest overwritten first: a step is never longer than
+   * their minimum (docs/time-stepping.md, "The recent bounds") */
+  double recent_bounds[STEP_BOUND_WINDOW];
+  int32_t recent_bound_count; /* how many of them hold a bound, up to STEP_BOUND_WINDOW */
+  int32_t recent_bound_next;  /* where the next one goes */
   double collision_deadline;  /* advance_to's target, which closes a collision interval too;
                                  NAN outside advance_to */
   step_profile profile;       /* per-phase step timers, off unless a benchmark turns them on */

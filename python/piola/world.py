@@ -242,7 +242,8 @@ class World:
     # ---------------------------------------------------------------- state
     time = property(lambda self: self._core.info()["time"], doc="s")
     stable_dt = property(lambda self: self._core.info()["stable_dt"],
-                         doc="s: the next step's size without a target, min(max_dt, CFL bound)")
+                         doc="s: the next step's size without a target, min(max_dt, CFL bound, the "
+                         "CFL bounds of the last 16 steps' states)")
     closed = property(lambda self: self._core.closed)
 
     @property

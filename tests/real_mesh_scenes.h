@@ -13,6 +13,9 @@
  * scaled to the diagonal `diagonal` (m). Fails the test when it cannot be read. */
 piola_tet_mesh real_mesh_scaled(const char *relative, double diagonal);
 
+/* The diagonal of the mesh's bounding box (m). */
+double real_mesh_diagonal(const piola_tet_mesh *mesh);
+
 /* E (Pa) and nu for every model: the models with their own parameters get the same shear
  * modulus mu = E / (2 (1 + nu)) (Ogden's default terms scaled, Mooney-Rivlin with
  * C10 = 3 C01, HGO's matrix), so that what is predicted from E holds for them too. */

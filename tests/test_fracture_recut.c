@@ -14,6 +14,7 @@
 #include <unistd.h>
 
 #include "block_scenes.h"
+#include "checkpoint_files.h"
 #include "fracture_checks.h"
 #include "piola/checkpoint.h"
 #include "piola/elastic_body.h"
@@ -326,48 +327,27 @@ static piola_world *twice_cut_box(const piola_tet_mesh *mesh, int second) {
   return w;
 }
 
-/* Skips one array of the payload at *pos (u64 count, count elements of size bytes); returns
- * the count. */
-static uint64_t skip_array(const unsigned char *data, size_t *pos, size_t size) {
-  uint64_t count;
-  memcpy(&count, data + *pos, sizeof count);
-  *pos += sizeof count + (size_t)count * size;
-  return count;
-}
-
-static uint64_t fnv1a(const unsigned char *p, size_t n) {
-  uint64_t h = 0xcbf29ce484222325ull;
-  for (size_t i = 0; i < n; ++i) h = (h ^ p[i]) * 0x100000001b3ull;
-  return h;
-}
-
 /* Rewrites the checkpoint at path (one solid, its tets cut at most once) as format 4 wrote
  * it (docs/file-formats.md): two copies per tet, no further cuts. */
 static void rewrite_as_format_4(const char *path) {
-  FILE *f = fopen(path, "rb");
-  assert_non_null(f);
-  fseek(f, 0, SEEK_END);
-  const size_t length = (size_t)ftell(f);
-  fseek(f, 0, SEEK_SET);
-  unsigned char *data = malloc(length), *out = malloc(length);
-  assert_int_equal(fread(data, 1, length, f), length);
-  fclose(f);
-  size_t pos = 48;
-  skip_array(data, &pos, 8); /* time */
+  size_t length;
+  unsigned char *data = checkpoint_file_read(path, &length), *out = malloc(length);
+  assert_non_null(out);
+  size_t pos = CHECKPOINT_HEADER_BYTES;
+  checkpoint_skip_array(data, &pos, 8); /* time */
   const size_t bounds_at = pos; /* the recent step bounds (format 7 on), not in format 4 */
-  skip_array(data, &pos, 4);
-  skip_array(data, &pos, 4);
-  skip_array(data, &pos, 8);
+  checkpoint_skip_array(data, &pos, 4);
+  checkpoint_skip_array(data, &pos, 4);
+  checkpoint_skip_array(data, &pos, 8);
   const size_t bounds_end = pos;
-  skip_array(data, &pos, 4); /* body kind */
-  skip_array(data, &pos, 4); /* fracture present */
-  skip_array(data, &pos, 4); /* counts */
+  checkpoint_skip_array(data, &pos, 4); /* body kind */
+  checkpoint_skip_array(data, &pos, 4); /* fracture present */
+  checkpoint_skip_array(data, &pos, 4); /* counts */
   static const size_t per_copy[7] = {4, 4, 1, 8, 8, 4, 4}; /* parent .. nodes */
-  for (int a = 0; a < 7; ++a) skip_array(data, &pos, per_copy[a]);
+  for (int a = 0; a < 7; ++a) checkpoint_skip_array(data, &pos, per_copy[a]);
   const size_t copies_at = pos;
-  const uint64_t slots = skip_array(data, &pos, 4);
-  const size_t more_at = pos;
-  for (int a = 0; a < 3; ++a) skip_array(data, &pos, a == 0 ? 4 : a == 1 ? 1 : 8);
+  const uint64_t slots = checkpoint_skip_array(data, &pos, 4);
+  for (int a = 0; a < 3; ++a) checkpoint_skip_array(data, &pos, a == 0 ? 4 : a == 1 ? 1 : 8);
   const size_t rest_at = pos;
   size_t n = 0;
   memcpy(out, data, bounds_at), n = bounds_at;
@@ -380,18 +360,8 @@ static void rewrite_as_format_4(const char *path) {
     assert_int_equal(third, -1); /* cut once */
     memcpy(out + n, data + copies_at + 8 + 4 * FRACTURE_MAX_COPIES * t, 8), n += 8;
   }
-  (void)more_at;
   memcpy(out + n, data + rest_at, length - 8 - rest_at), n += length - 8 - rest_at;
-  const uint32_t version = 4;
-  const uint64_t payload = n - 48;
-  memcpy(out + 8, &version, 4);
-  memcpy(out + 32, &payload, 8);
-  const uint64_t sum = fnv1a(out, n);
-  memcpy(out + n, &sum, 8), n += 8;
-  f = fopen(path, "wb");
-  assert_non_null(f);
-  assert_int_equal(fwrite(out, 1, n, f), n);
-  fclose(f);
+  checkpoint_file_write(path, out, n, 4);
   free(data), free(out);
 }
 

@@ -12,6 +12,7 @@
  * it and runs on bit for bit like the writer, and the same file rewritten as format 6 (no
  * window) still reads. */
 #include "test_support.h"
+#include "checkpoint_files.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -23,6 +24,7 @@
 #include "piola/elastic_body.h"
 #include "piola/mesh_io.h"
 #include "piola/world.h"
+#include "real_mesh_scenes.h"
 
 static piola_world *scrambled_ogden_ball(const piola_tet_mesh *mesh) {
   piola_world_def wd = piola_default_world_def();
@@ -36,12 +38,7 @@ static piola_world *scrambled_ogden_ball(const piola_tet_mesh *mesh) {
   sd.material.poisson_ratio = 0.3;
   sd.density = 1000;
   sd.shear_viscosity = sd.bulk_viscosity = piola_track_constant(5);
-  double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
-  for (int32_t v = 0; v < mesh->vertex_count; ++v)
-    for (int i = 0; i < 3; ++i)
-      lo[i] = fmin(lo[i], mesh->positions[3 * v + i]), hi[i] = fmax(hi[i], mesh->positions[3 * v + i]);
-  sd.scramble_radius = 2 * sqrt((hi[0] - lo[0]) * (hi[0] - lo[0]) + (hi[1] - lo[1]) * (hi[1] - lo[1]) +
-                                (hi[2] - lo[2]) * (hi[2] - lo[2]));
+  sd.scramble_radius = 2 * real_mesh_diagonal(mesh);
   if (piola_world_add_solid(w, &sd, NULL) != PIOLA_OK) fail_msg("%s", piola_last_error());
   return w;
 }
@@ -69,47 +66,20 @@ static void same_state(const piola_world *a, const piola_world *b) {
   assert_true(piola_world_time(a) == piola_world_time(b));
 }
 
-static uint64_t fnv1a(const unsigned char *p, size_t n) {
-  uint64_t h = 0xcbf29ce484222325ull;
-  for (size_t i = 0; i < n; ++i) h = (h ^ p[i]) * 0x100000001b3ull;
-  return h;
-}
-
 /* Rewrites the checkpoint at path as format 6 wrote it (docs/file-formats.md): the same, less
  * the three arrays of the recent step bounds after the time. */
 static void rewrite_as_format_6(const char *path) {
-  FILE *f = fopen(path, "rb");
-  assert_non_null(f);
-  fseek(f, 0, SEEK_END);
-  const size_t length = (size_t)ftell(f);
-  fseek(f, 0, SEEK_SET);
-  unsigned char *data = malloc(length), *out = malloc(length);
-  assert_non_null(data), assert_non_null(out);
-  assert_int_equal(fread(data, 1, length, f), length);
-  fclose(f);
-  size_t pos = 48 + 8 + 8; /* the header, the time's count and value */
+  size_t length;
+  unsigned char *data = checkpoint_file_read(path, &length);
+  size_t pos = CHECKPOINT_HEADER_BYTES;
+  checkpoint_skip_array(data, &pos, 8); /* time */
   const size_t bounds_at = pos;
-  static const size_t sizes[3] = {4, 4, 8}; /* count, next, the values */
-  for (int a = 0; a < 3; ++a) {
-    uint64_t count;
-    memcpy(&count, data + pos, 8);
-    assert_int_equal(count, a < 2 ? 1 : 16);
-    pos += 8 + count * sizes[a];
-  }
-  size_t n = bounds_at;
-  memcpy(out, data, bounds_at);
-  memcpy(out + n, data + pos, length - 8 - pos), n += length - 8 - pos;
-  const uint32_t version = 6;
-  const uint64_t payload = n - 48;
-  memcpy(out + 8, &version, 4);
-  memcpy(out + 32, &payload, 8);
-  const uint64_t sum = fnv1a(out, n);
-  memcpy(out + n, &sum, 8), n += 8;
-  f = fopen(path, "wb");
-  assert_non_null(f);
-  assert_int_equal(fwrite(out, 1, n, f), n);
-  fclose(f);
-  free(data), free(out);
+  assert_int_equal(checkpoint_skip_array(data, &pos, 4), 1);  /* count */
+  assert_int_equal(checkpoint_skip_array(data, &pos, 4), 1);  /* next */
+  assert_int_equal(checkpoint_skip_array(data, &pos, 8), 16); /* the values */
+  memmove(data + bounds_at, data + pos, length - 8 - pos);
+  checkpoint_file_write(path, data, bounds_at + length - 8 - pos, 6);
+  free(data);
 }
 
 static void stretched_ogden_ball_loses_energy(void **state) {
@@ -134,7 +104,7 @@ static void stretched_ogden_ball_loses_energy(void **state) {
   assert_true(steps > 1000); /* the scramble is stiff: the state's bound is far below the rest one */
 
   /* the window through a checkpoint: b, built the same way, runs on like a */
-  char file[] = "/tmp/piola_recent_bounds_XXXXXX";
+  char file[] = "/tmp/piola_recent_bounds_XXXXXX"; /* mkstemp's template: it replaces the X's */
   const int fd = mkstemp(file);
   assert_true(fd >= 0);
   close(fd);

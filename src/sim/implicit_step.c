@@ -689,7 +689,7 @@ static int friction_moves_deform(const newton_problem *pb) {
   for (int32_t t = 0; t < piola_elastic_body_tet_count(b); ++t) {
     double most = 0;
     for (int c = 0; c < 4; ++c) most = fmax(most, moved[tets[4 * t + c]]);
-    if (most > 0 && most > FRICTION_RESOLVE_MOVE * piola__elastic_body_tet_rest_altitude(b, t))
+    if (most > FRICTION_RESOLVE_MOVE * piola__elastic_body_tet_rest_altitude(b, t))
       return 1;
   }
   return 0;

@@ -10,17 +10,28 @@
 #include "piola/mesh_io.h"
 #include "real_mesh_scenes.h"
 
+/* The mesh's bounding box, lo and hi; returns its diagonal. */
+static double bounds(const piola_tet_mesh *mesh, double lo[3], double hi[3]) {
+  for (int i = 0; i < 3; ++i) lo[i] = INFINITY, hi[i] = -INFINITY;
+  for (int32_t v = 0; v < mesh->vertex_count; ++v)
+    for (int i = 0; i < 3; ++i)
+      lo[i] = fmin(lo[i], mesh->positions[3 * v + i]), hi[i] = fmax(hi[i], mesh->positions[3 * v + i]);
+  return sqrt((hi[0] - lo[0]) * (hi[0] - lo[0]) + (hi[1] - lo[1]) * (hi[1] - lo[1]) +
+              (hi[2] - lo[2]) * (hi[2] - lo[2]));
+}
+
+double real_mesh_diagonal(const piola_tet_mesh *mesh) {
+  double lo[3], hi[3];
+  return bounds(mesh, lo, hi);
+}
+
 piola_tet_mesh real_mesh_scaled(const char *relative, double diagonal) {
   piola_tet_mesh mesh;
   memset(&mesh, 0, sizeof mesh);
   const char *path = test_data_path(relative);
   if (piola_tet_mesh_read(path, &mesh) != PIOLA_OK) fail_msg("%s: %s", path, piola_last_error());
-  double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
-  for (int32_t v = 0; v < mesh.vertex_count; ++v)
-    for (int i = 0; i < 3; ++i)
-      lo[i] = fmin(lo[i], mesh.positions[3 * v + i]), hi[i] = fmax(hi[i], mesh.positions[3 * v + i]);
-  const double d = sqrt((hi[0] - lo[0]) * (hi[0] - lo[0]) + (hi[1] - lo[1]) * (hi[1] - lo[1]) +
-                        (hi[2] - lo[2]) * (hi[2] - lo[2]));
+  double lo[3], hi[3];
+  const double d = bounds(&mesh, lo, hi);
   for (int32_t v = 0; v < mesh.vertex_count; ++v)
     for (int i = 0; i < 3; ++i)
       mesh.positions[3 * v + i] = (mesh.positions[3 * v + i] - 0.5 * (lo[i] + hi[i])) * diagonal / d;

@@ -1,0 +1,41 @@
+/* See checkpoint_files.h. */
+#include "checkpoint_files.h"
+
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "test_support.h"
+
+unsigned char *checkpoint_file_read(const char *path, size_t *length) {
+  FILE *f = fopen(path, "rb");
+  assert_non_null(f);
+  fseek(f, 0, SEEK_END);
+  *length = (size_t)ftell(f);
+  fseek(f, 0, SEEK_SET);
+  unsigned char *data = malloc(*length);
+  assert_non_null(data);
+  assert_int_equal(fread(data, 1, *length, f), *length);
+  fclose(f);
+  return data;
+}
+
+uint64_t checkpoint_skip_array(const unsigned char *data, size_t *pos, size_t size) {
+  uint64_t count;
+  memcpy(&count, data + *pos, sizeof count);
+  *pos += sizeof count + (size_t)count * size;
+  return count;
+}
+
+void checkpoint_file_write(const char *path, unsigned char *data, size_t length, uint32_t version) {
+  const uint64_t payload = length - CHECKPOINT_HEADER_BYTES;
+  memcpy(data + 8, &version, 4);
+  memcpy(data + 32, &payload, 8);
+  uint64_t sum = 0xcbf29ce484222325ull;
+  for (size_t i = 0; i < length; ++i) sum = (sum ^ data[i]) * 0x100000001b3ull;
+  memcpy(data + length, &sum, 8);
+  FILE *f = fopen(path, "wb");
+  assert_non_null(f);
+  assert_int_equal(fwrite(data, 1, length + 8, f), length + 8);
+  fclose(f);
+}

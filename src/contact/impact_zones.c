@@ -4,30 +4,7 @@
 
 #include "common/union_find.h"
 #include "contact/contact_internal.h"
-
-/* Solves m w = b for the symmetric positive semi-definite inertia-like matrix m; when it is
- * (nearly) singular (a zone whose points are collinear) a small multiple of the trace is added
- * so that the rotation about the degenerate axis, which moves nothing, is taken as zero. */
-static vec3 solve_inertia(mat3 m, vec3 b) {
-  double tr = mat3_trace(m);
-  if (!(tr > 0.0)) return (vec3){0, 0, 0};
-  double det = mat3_det(m);
-  if (!(fabs(det) > 1e-12 * tr * tr * tr)) {
-    for (int k = 0; k < 3; ++k) m.m[k][k] += 1e-9 * tr;
-    det = mat3_det(m);
-    if (!(fabs(det) > 0.0)) return (vec3){0, 0, 0};
-  }
-  return mat3_mul_vec(mat3_inverse(m), b);
-}
-
-static mat3 point_inertia(vec3 r, double m) {
-  double r2 = vec3_norm2(r);
-  mat3 out;
-  for (int i = 0; i < 3; ++i)
-    for (int j = 0; j < 3; ++j)
-      out.m[i][j] = m * ((i == j ? r2 : 0.0) - vec3_get(r, i) * vec3_get(r, j));
-  return out;
-}
+#include "math/inertia.h"
 
 /* The points zones are made of: the surface's vertices, or an embedded surface's nodes. */
 typedef struct zone_points {

@@ -74,6 +74,7 @@
 #include "force/stiffness_matrix.h"
 #include "force/stiffness_multigrid.h"
 #include "force/stable_step.h"
+#include "sim/failed_step_velocity.h"
 #include "sim/implicit_split.h"
 #include "sim/obstacle_friction.h"
 #include "sim/world_internal.h"
@@ -83,7 +84,9 @@
 /* A step whose Newton does not converge is undone and retried at half the size up to this
  * many times; the last try keeps its last accepted iterate (a force field that jumps, as the
  * extended stress of an element passing through a reflection does, may have no exact
- * root), the step goes on, counted in newton_failures, and the user is warned once. */
+ * root), or with backward Euler what holds no more energy than the step's start
+ * (keep_failed_step), the step goes on, counted in newton_failures, and the user is warned
+ * once. */
 #define MAX_HALVINGS 3
 
 /* Backward Euler's first guess is the prediction x^n + dt v^n plus the step gravity alone
@@ -715,6 +718,57 @@ static int gravity_step_enters_obstacle(newton_problem *pb) {
 }
 
 /* The step's problem for solid s over [t, t + dt]; reads no state. */
+/* The body's total energy (J) at positions x with velocities v: kinetic, elastic (of the last
+ * update, which must be at x) and gravity's potential at t1. */
+static double total_energy(const newton_problem *pb, const double *x, const double *v) {
+  world_body *s = pb->s;
+  double kinetic = 0, work = 0;
+  for (int32_t i = 0; i < s->n; ++i)
+    for (int k = 0; k < 3; ++k) {
+      const int64_t j = 3 * (int64_t)i + k;
+      kinetic += s->mass[i] * v[j] * v[j];
+      work += s->mass[i] * pb->g1[k] * x[j];
+    }
+  return 0.5 * kinetic + piola__body_stats(s).elastic_energy - work;
+}
+
+/* What a failed backward Euler try keeps (docs/time-stepping.md, "What a failed step keeps"):
+ * its iterate and velocity (x - x^n) / dt, turned to the start's angular momentum, when they
+ * hold no more energy than the step's start (x^n, v^n); else the iterate with the rigid velocity of the start's momentum
+ * (failed_step_velocity.h) when that holds no more; else the start's positions with that
+ * velocity. The start's energy takes an update at x^n; a failed last try costs far more. */
+static piola_status keep_failed_step(newton_problem *pb) {
+  world_body *s = pb->s;
+  struct implicit_state *st = pb->st;
+  const size_t bytes = sizeof(double) * 3 * (size_t)s->n;
+  piola__failed_step_keep_angular_momentum(s->n, s->mass, s->x_old, s->v_old, s->x, s->v);
+  const double end = total_energy(pb, s->x, s->v);
+  memcpy(st->base, s->x, bytes);
+  memcpy(s->x, s->x_old, bytes);
+  PIOLA_TRY(update(pb));
+  const double start = total_energy(pb, s->x_old, s->v_old);
+  if (end <= start) {
+    memcpy(s->x, st->base, bytes);
+    return update(pb);
+  }
+  /* the start's positions (prescribed nodes at t1), unless the iterate holds no more energy
+   * with the rigid velocity. Those hold no more than the start plus a step of gravity's work:
+   * at the start's shape the rigid motion has the least kinetic energy of any velocity with
+   * the start's momentum */
+  memcpy(s->x, st->base, bytes);
+  PIOLA_TRY(update(pb));
+  piola__failed_step_velocity(s->n, s->mass, s->x_old, s->v_old, s->x, pb->g1, pb->dt, s->v);
+  const double rigid = total_energy(pb, s->x, s->v);
+  if (rigid <= start) return PIOLA_OK;
+  memcpy(s->x, s->x_old, bytes);
+  piola__failed_step_velocity(s->n, s->mass, s->x_old, s->v_old, s->x, pb->g1, pb->dt, s->v);
+  for (int32_t i = 0; i < s->n; ++i)
+    if (s->flags[i] != NODE_FREE) piola__body_constrained_state(s, i, pb->t1, s->x + 3 * i, s->v + 3 * i);
+  PIOLA_TRY(update(pb));
+  (void)residual(pb);
+  return PIOLA_OK;
+}
+
 static newton_problem problem_of(piola_world *w, world_body *s, double t, double dt) {
   newton_problem pb;
   memset(&pb, 0, sizeof pb);
@@ -960,7 +1014,9 @@ static piola_status newton_iterate(const newton_problem *problem, int accept_unc
     stats->newton_failures++;
     piola__world_warn(w, PIOLA_WARNING_NEWTON_FAILED,
                       "%s '%s': the %s step to t = %g s did not converge (Newton, on its "
-                      "last try); its last iterate was kept and the run goes on (stats.csv "
+                      "last try); its last iterate was kept (backward Euler: unless it held more "
+                      "energy than the step's start, time-stepping.md \"What a failed step "
+                      "keeps\") and the run goes on (stats.csv "
                       "newton_failures counts failed tries). A quasistatic body held by "
                       "obstacle contacts alone has no equilibrium: fix or drive a node, or "
                       "use \"backward_euler\" (time-stepping.md)",
@@ -970,6 +1026,7 @@ static piola_status newton_iterate(const newton_problem *problem, int accept_unc
   /* velocities; friction; prescribed velocities */
   const double inv_dt = 1.0 / dt;
   for (int64_t j = 0; j < m; ++j) s->v[j] = (s->x[j] - s->x_old[j]) * inv_dt;
+  if (!converged && !pb.quasistatic) PIOLA_TRY(keep_failed_step(&pb));
   if (!pb.quasistatic && !pb.friction_held && contact_friction(&pb) > 0) {
     PIOLA_TRY(update(&pb));
     /* Friction moved nodes after the solve, and the rest of the body has not answered. Where

@@ -719,7 +719,9 @@ static int gravity_step_enters_obstacle(newton_problem *pb) {
 
 /* The step's problem for solid s over [t, t + dt]; reads no state. */
 /* The body's total energy (J) at positions x with velocities v: kinetic, elastic (of the last
- * update, which must be at x) and gravity's potential at t1. */
+ * update, which must be at x) and gravity's potential at t1. Collective on a split solid
+ * (the elastic energy's sum, the same bits on every process), so every process keeps the
+ * same thing. */
 static double total_energy(const newton_problem *pb, const double *x, const double *v) {
   world_body *s = pb->s;
   double kinetic = 0, work = 0;
@@ -729,7 +731,9 @@ static double total_energy(const newton_problem *pb, const double *x, const doub
       kinetic += s->mass[i] * v[j] * v[j];
       work += s->mass[i] * pb->g1[k] * x[j];
     }
-  return 0.5 * kinetic + piola__body_stats(s).elastic_energy - work;
+  const double elastic = s->kind == PIOLA_BODY_SOLID ? piola__elastic_body_total_energy(s->solid)
+                                                     : piola__body_stats(s).elastic_energy;
+  return 0.5 * kinetic + elastic - work;
 }
 
 /* What a failed backward Euler try keeps (docs/time-stepping.md, "What a failed step keeps"):

@@ -31,7 +31,8 @@
 
 static double uniform(unsigned *seed) { return (double)rand_r(seed) / RAND_MAX * 2.0 - 1.0; }
 
-static void momenta(const double *mass, const double *x, const double *v, double p[3], double l[3]) {
+static void momenta(const double *mass, const double *x, const double *v, double p[3],
+                    double l[3]) {
   double total = 0, c[3] = {0, 0, 0};
   for (int i = 0; i < POINTS; ++i) {
     total += mass[i];
@@ -78,7 +79,8 @@ static void random_points_keep_momentum(void **state) {
   double x_old[3 * POINTS], x[3 * POINTS], v_old[3 * POINTS], mass[POINTS];
   for (int i = 0; i < POINTS; ++i) {
     mass[i] = 0.5 + 0.5 * (uniform(&seed) + 1.0);
-    for (int k = 0; k < 3; ++k) x_old[3 * i + k] = uniform(&seed), v_old[3 * i + k] = uniform(&seed);
+    for (int k = 0; k < 3; ++k)
+      x_old[3 * i + k] = uniform(&seed), v_old[3 * i + k] = uniform(&seed);
   }
   /* the kept positions: the start turned, stretched, moved and disturbed */
   const double c = cos(0.7), s = sin(0.7);
@@ -99,11 +101,13 @@ static void collapsed_points_get_finite_velocities(void **state) {
   double x_old[3 * POINTS], x[3 * POINTS], v_old[3 * POINTS], v[3 * POINTS], mass[POINTS];
   for (int i = 0; i < POINTS; ++i) {
     mass[i] = 1.0;
-    for (int k = 0; k < 3; ++k) x_old[3 * i + k] = uniform(&seed), v_old[3 * i + k] = uniform(&seed);
+    for (int k = 0; k < 3; ++k)
+      x_old[3 * i + k] = uniform(&seed), v_old[3 * i + k] = uniform(&seed);
   }
   const double g[3] = {0, 0, -9.81}, dt = 0.01;
   for (int line = 1; line >= 0; --line) {
-    for (int i = 0; i < POINTS; ++i) x[3 * i] = line ? x_old[3 * i] : 0.2, x[3 * i + 1] = 0.2, x[3 * i + 2] = 0.2;
+    for (int i = 0; i < POINTS; ++i)
+      x[3 * i] = line ? x_old[3 * i] : 0.2, x[3 * i + 1] = 0.2, x[3 * i + 2] = 0.2;
     piola__failed_step_velocity(POINTS, mass, x_old, v_old, x, g, dt, v);
     double p0[3], l0[3], p1[3], l1[3];
     momenta(mass, x_old, v_old, p0, l0);
@@ -156,7 +160,8 @@ static void failing_steps_keep_momentum(void **state) {
       assert_close(l[k], l0[k], 1e-9 * scale);
     }
     const double energy = ke + piola_world_solid_stats(w, 0).elastic_energy;
-    if (!(energy <= last_energy * (1 + 1e-12))) fail_msg("frame %d: energy %g after %g", f, energy, last_energy);
+    if (!(energy <= last_energy * (1 + 1e-12)))
+      fail_msg("frame %d: energy %g after %g", f, energy, last_energy);
     last_energy = energy;
   }
   assert_true(failures > 0);
@@ -198,7 +203,8 @@ static void scrambled_spline_ball_recovers(void **state) {
       fail_msg("frame %d: %s", f, piola_last_error());
     failures += st.newton_failures;
     assert_true(real_mesh_solid_finite(w));
-    if (!(total_energy(w) <= start)) fail_msg("frame %d: energy %g above the start's %g", f, total_energy(w), start);
+    if (!(total_energy(w) <= start))
+      fail_msg("frame %d: energy %g above the start's %g", f, total_energy(w), start);
   }
   const piola_solid_stats end = piola_world_solid_stats(w, 0);
   print_message("scrambled spline ball: energy %.3g -> %.3g J, %d inverted, %d Newton failures\n",

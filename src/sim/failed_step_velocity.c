@@ -65,8 +65,8 @@ static double moment_scale(const body_motion *start, const body_motion *kept) {
 }
 
 void piola__failed_step_velocity(int32_t n, const double *mass, const double *x_old,
-                                 const double *v_old, const double *x, const double g[3],
-                                 double dt, double *v) {
+                                 const double *v_old, const double *x, const double g[3], double dt,
+                                 double *v) {
   const body_motion start = motion_of(n, mass, x_old, v_old);
   if (!(start.mass > 0)) return;
   const body_motion kept = motion_of(n, mass, x, v_old); /* for its centre and inertia */

@@ -13,8 +13,8 @@
  * flattened towards a line spins up as 1 / thickness^2 (the caller's energy check,
  * keep_failed_step in implicit_step.c, turns that down). */
 void piola__failed_step_velocity(int32_t n, const double *mass, const double *x_old,
-                                 const double *v_old, const double *x, const double g[3],
-                                 double dt, double *v);
+                                 const double *v_old, const double *x, const double g[3], double dt,
+                                 double *v);
 
 /* v += the rotation about the centre of mass of x that gives v the angular momentum
  * (x_old, v_old) had about theirs: a kept unconverged iterate's velocity (x - x_old) / dt

@@ -717,7 +717,6 @@ static int gravity_step_enters_obstacle(newton_problem *pb) {
   return 0;
 }
 
-/* The step's problem for solid s over [t, t + dt]; reads no state. */
 /* The body's total energy (J) at positions x with velocities v: kinetic, elastic (of the last
  * update, which must be at x) and gravity's potential at t1. Collective on a split solid
  * (the elastic energy's sum, the same bits on every process), so every process keeps the
@@ -738,9 +737,10 @@ static double total_energy(const newton_problem *pb, const double *x, const doub
 
 /* What a failed backward Euler try keeps (docs/time-stepping.md, "What a failed step keeps"):
  * its iterate and velocity (x - x^n) / dt, turned to the start's angular momentum, when they
- * hold no more energy than the step's start (x^n, v^n); else the iterate with the rigid velocity of the start's momentum
- * (failed_step_velocity.h) when that holds no more; else the start's positions with that
- * velocity. The start's energy takes an update at x^n; a failed last try costs far more. */
+ * hold no more energy than the step's start (x^n, v^n); else the iterate with the rigid
+ * velocity of the start's momentum (failed_step_velocity.h) when that holds no more; else the
+ * start's positions with that velocity. The start's energy takes an update at x^n and one
+ * back; a failed last try costs far more. */
 static piola_status keep_failed_step(newton_problem *pb) {
   world_body *s = pb->s;
   struct implicit_state *st = pb->st;
@@ -767,12 +767,14 @@ static piola_status keep_failed_step(newton_problem *pb) {
   memcpy(s->x, s->x_old, bytes);
   piola__failed_step_velocity(s->n, s->mass, s->x_old, s->v_old, s->x, pb->g1, pb->dt, s->v);
   for (int32_t i = 0; i < s->n; ++i)
-    if (s->flags[i] != NODE_FREE) piola__body_constrained_state(s, i, pb->t1, s->x + 3 * i, s->v + 3 * i);
+    if (s->flags[i] != NODE_FREE)
+      piola__body_constrained_state(s, i, pb->t1, s->x + 3 * i, s->v + 3 * i);
   PIOLA_TRY(update(pb));
   (void)residual(pb);
   return PIOLA_OK;
 }
 
+/* The step's problem for solid s over [t, t + dt]; reads no state. */
 static newton_problem problem_of(piola_world *w, world_body *s, double t, double dt) {
   newton_problem pb;
   memset(&pb, 0, sizeof pb);

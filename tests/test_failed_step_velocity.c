@@ -171,11 +171,6 @@ static void failing_steps_keep_momentum(void **state) {
   piola_world_destroy(w);
 }
 
-static double total_energy(const piola_world *w) {
-  const piola_solid_stats s = piola_world_solid_stats(w, 0);
-  return s.kinetic_energy + s.elastic_energy;
-}
-
 static piola_tet_mesh read_mesh(const char *relative) {
   piola_tet_mesh mesh;
   memset(&mesh, 0, sizeof mesh);
@@ -193,26 +188,18 @@ static void free_mesh(piola_tet_mesh *mesh) {
 /* The scenes of the head of this file: `mesh` as its file has it, scrambled by two diagonals,
  * backward Euler at one step per 1/30 s frame. */
 static piola_world *scrambled_world(const piola_tet_mesh *mesh, piola_material_model model) {
-  piola_world_def wd = piola_default_world_def();
-  for (int i = 0; i < 3; ++i) wd.gravity[i] = piola_track_constant(0);
-  wd.integrator = PIOLA_INTEGRATOR_BACKWARD_EULER;
-  wd.implicit_dt = 1.0 / 30;
-  piola_world *w = NULL;
-  assert_int_equal(piola_world_create(&wd, &w), PIOLA_OK);
-  piola_solid_def sd = piola_default_solid_def();
-  sd.mesh = mesh;
-  sd.material = real_mesh_material_def(model, 1e5, 0.3);
-  sd.density = 1000;
-  sd.shear_viscosity = sd.bulk_viscosity = piola_track_constant(5);
-  sd.scramble_radius = 2 * real_mesh_diagonal(mesh);
-  assert_int_equal(piola_world_add_solid(w, &sd, NULL), PIOLA_OK);
+  const real_mesh_scramble scene = {real_mesh_material_def(model, 1e5, 0.3), 5,
+                                    2 * real_mesh_diagonal(mesh), PIOLA_INTEGRATOR_BACKWARD_EULER,
+                                    NULL};
+  piola_world *w = real_mesh_scramble_world(mesh, &scene);
+  if (!w) fail_msg("%s", piola_last_error());
   return w;
 }
 
 /* Runs `frames` frames; fails unless every one succeeds with a finite state and a total energy
  * below the last frame's. Returns the failed Newton tries. */
 static int32_t run_losing_energy(piola_world *w, const char *name, int frames) {
-  double last = total_energy(w);
+  double last = real_mesh_total_energy(w);
   int32_t failures = 0;
   for (int f = 1; f <= frames; ++f) {
     piola_step_stats st;
@@ -221,7 +208,7 @@ static int32_t run_losing_energy(piola_world *w, const char *name, int frames) {
       fail_msg("%s, frame %d: %s", name, f, piola_last_error());
     failures += st.newton_failures;
     assert_true(real_mesh_solid_finite(w));
-    const double energy = total_energy(w);
+    const double energy = real_mesh_total_energy(w);
     if (!(energy <= last)) fail_msg("%s, frame %d: energy %g after %g", name, f, energy, last);
     last = energy;
   }
@@ -232,16 +219,16 @@ static void scrambled_spline_ball_recovers(void **state) {
   (void)state;
   piola_tet_mesh mesh = read_mesh("medit/unit_ball.mesh");
   piola_world *w = scrambled_world(&mesh, PIOLA_MODEL_SPLINE);
-  const double start = total_energy(w);
+  const double start = real_mesh_total_energy(w);
   const int frames = test_scale() >= 1.0 ? 10 : 5;
   const int32_t failures = run_losing_energy(w, "spline ball", frames);
   const piola_solid_stats end = piola_world_solid_stats(w, 0);
   print_message("scrambled spline ball: energy %.3g -> %.3g J, %d inverted, %d Newton failures\n",
-                start, total_energy(w), (int)end.inverted_count, (int)failures);
+                start, real_mesh_total_energy(w), (int)end.inverted_count, (int)failures);
   assert_true(failures > 0); /* the scene still takes the failure path */
   if (frames >= 10) {
     assert_int_equal(end.inverted_count, 0);
-    assert_true(total_energy(w) < 1e-6 * start);
+    assert_true(real_mesh_total_energy(w) < 1e-6 * start);
   }
   piola_world_destroy(w);
   free_mesh(&mesh);
@@ -256,11 +243,12 @@ static void scrambled_armadillos_lose_energy(void **state) {
                                          PIOLA_MODEL_STABLE_NEOHOOKEAN};
   for (int k = 0; k < 3; ++k) {
     piola_world *w = scrambled_world(&mesh, models[k]);
-    const double start = total_energy(w);
+    const double start = real_mesh_total_energy(w);
     const int32_t failures =
         run_losing_energy(w, piola_material_model_name(models[k]), test_scale() >= 1.0 ? 4 : 2);
     print_message("scrambled %s armadillo: energy %.3g -> %.3g J, %d Newton failures\n",
-                  piola_material_model_name(models[k]), start, total_energy(w), (int)failures);
+                  piola_material_model_name(models[k]), start, real_mesh_total_energy(w),
+                  (int)failures);
     piola_world_destroy(w);
   }
   free_mesh(&mesh);

@@ -1317,6 +1317,7 @@ static void warnings_name_what_slows_the_run(void **state) {
   text = piola_world_warning(w, PIOLA_WARNING_SMALL_STEP);
   assert_non_null(text);
   assert_non_null(strstr(text, "times below the CFL estimate"));
+  assert_non_null(strstr(text, "\"backward_euler\"} steps through such states"));
   assert_null(piola_world_warning(w, PIOLA_WARNING_CG_MAX_ITERATIONS));
   piola_world_destroy(w);
   /* a damped stretch solved with one CG iteration per solve */

@@ -16,7 +16,9 @@
  *    frames no tet is inverted and the energy is below 1e-6 of the start's (5 frames and the
  *    energy bound alone under the sanitizers);
  *  - the same scene on tetgen/armadillo_4k.node for corotated, the spline and Stable
- *    Neo-Hookean, which overflowed within 0.1 s: 4 frames, each losing energy. */
+ *    Neo-Hookean, which overflowed within 0.1 s: 4 frames, each losing energy;
+ *  - the warning of a step that kept its start's positions, on the spline in the energy
+ *    inversion mode scrambled by half a diagonal there (it freezes: materials.md). */
 #include "test_support.h"
 
 #include <math.h>
@@ -254,8 +256,40 @@ static void scrambled_armadillos_lose_energy(void **state) {
   free_mesh(&mesh);
 }
 
+/* The spline in the energy inversion mode on the armadillo scrambled by half a diagonal (a
+ * scene of materials.md, "With backward Euler, scrambles can freeze"): its failed steps keep
+ * the start's positions, and the user is told so once, with where the docs say why. */
+static void kept_start_is_reported(void **state) {
+  (void)state;
+  piola_tet_mesh mesh = read_mesh("tetgen/armadillo_4k.node");
+  real_mesh_scramble scene = {real_mesh_material_def(PIOLA_MODEL_SPLINE, 1e5, 0.3), 5,
+                              0.5 * real_mesh_diagonal(&mesh), PIOLA_INTEGRATOR_BACKWARD_EULER,
+                              NULL};
+  scene.material.inversion_mode = PIOLA_INVERSION_ENERGY;
+  piola_world *w = real_mesh_scramble_world(&mesh, &scene);
+  if (!w) fail_msg("%s", piola_last_error());
+  assert_null(piola_world_warning(w, PIOLA_WARNING_STEP_KEPT_START));
+  int steps = 0;
+  while (!piola_world_warning(w, PIOLA_WARNING_STEP_KEPT_START) && steps < 8) {
+    piola_step_stats st;
+    memset(&st, 0, sizeof st);
+    assert_int_equal(piola_world_step(w, 0, &st), PIOLA_OK);
+    assert_true(real_mesh_solid_finite(w));
+    assert_true(st.newton_failures > 0);
+    ++steps;
+  }
+  print_message("energy-mode spline armadillo: the start kept at step %d\n", steps);
+  const char *text = piola_world_warning(w, PIOLA_WARNING_STEP_KEPT_START);
+  assert_non_null(text);
+  assert_non_null(strstr(text, "kept its start's positions"));
+  assert_non_null(strstr(text, "With backward Euler, scrambles can freeze"));
+  piola_world_destroy(w);
+  free_mesh(&mesh);
+}
+
 int main(void) {
   const struct CMUnitTest tests[] = {
+      cmocka_unit_test(kept_start_is_reported),
       cmocka_unit_test(random_points_keep_momentum),
       cmocka_unit_test(collapsed_points_get_finite_velocities),
       cmocka_unit_test(failing_steps_keep_momentum),

@@ -273,6 +273,8 @@ typedef enum piola_warning_kind {
                                           its last accepted iterate was kept */
   PIOLA_WARNING_EMPTY_SELECTION,       /* a fixed or driven constraint's selector picks no
                                           node (found when the body is added) */
+  PIOLA_WARNING_STEP_KEPT_START,       /* a failed backward Euler step kept its start's
+                                          positions (its iterate held more energy) */
   PIOLA_WARNING_KIND_COUNT
 } piola_warning_kind;
 

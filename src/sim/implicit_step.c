@@ -764,6 +764,14 @@ static piola_status keep_failed_step(newton_problem *pb) {
   piola__failed_step_velocity(s->n, s->mass, s->x_old, s->v_old, s->x, pb->g1, pb->dt, s->v);
   const double rigid = total_energy(pb, s->x, s->v);
   if (rigid <= start) return PIOLA_OK;
+  piola__world_warn(pb->w, PIOLA_WARNING_STEP_KEPT_START,
+                    "%s '%s': the failed backward Euler step to t = %g s kept its start's "
+                    "positions with a rigid velocity, since its iterate held more energy than "
+                    "the start (time-stepping.md, \"What a failed step keeps\"); a body whose "
+                    "every step does this does not move. The energy inversion mode does so on "
+                    "scrambled meshes, where the model's default extension recovers "
+                    "(materials.md, \"With backward Euler, scrambles can freeze\")",
+                    piola__body_kind_name(s->kind), s->name, pb->t1);
   memcpy(s->x, s->x_old, bytes);
   piola__failed_step_velocity(s->n, s->mass, s->x_old, s->v_old, s->x, pb->g1, pb->dt, s->v);
   for (int32_t i = 0; i < s->n; ++i)

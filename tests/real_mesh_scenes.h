@@ -10,6 +10,10 @@
 #include "piola/mesh.h"
 #include "piola/world.h"
 
+/* The mesh at `relative` (under ../shared/data) as its file has it; free it with
+ * piola_tet_mesh_free. Fails the test when it cannot be read. */
+piola_tet_mesh real_mesh_read(const char *relative);
+
 /* The mesh at `relative` (under ../shared/data), its bounding box centred at the origin and
  * scaled to the diagonal `diagonal` (m). Fails the test when it cannot be read. */
 piola_tet_mesh real_mesh_scaled(const char *relative, double diagonal);

@@ -26,11 +26,16 @@ double real_mesh_diagonal(const piola_tet_mesh *mesh) {
   return bounds(mesh, lo, hi);
 }
 
-piola_tet_mesh real_mesh_scaled(const char *relative, double diagonal) {
+piola_tet_mesh real_mesh_read(const char *relative) {
   piola_tet_mesh mesh;
   memset(&mesh, 0, sizeof mesh);
   const char *path = test_data_path(relative);
   if (piola_tet_mesh_read(path, &mesh) != PIOLA_OK) fail_msg("%s: %s", path, piola_last_error());
+  return mesh;
+}
+
+piola_tet_mesh real_mesh_scaled(const char *relative, double diagonal) {
+  piola_tet_mesh mesh = real_mesh_read(relative);
   double lo[3], hi[3];
   const double d = bounds(&mesh, lo, hi);
   for (int32_t v = 0; v < mesh.vertex_count; ++v)

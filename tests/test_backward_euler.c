@@ -308,7 +308,8 @@ static piola_world *collapsed_block_frame(const piola_tet_mesh *mesh, int32_t ne
 }
 
 /* A frame whose every step fails Newton ends in at most 8 steps: each failing step is
- * halved three times and then kept at its best iterate, never shorter than dt / 8. Before,
+ * halved at least once and at most three times (until halving stops helping, or the
+ * third) and then kept at its best iterate, never shorter than dt / 8. Before,
  * the steps after the first halved what was left of the frame, shrinking geometrically, and
  * the frame never ended once they fell below the rounding of the time (found by a scene of
  * docs/scene-format.md with "newton_max_iterations": 1: a collapsed ball ran for ever). */
@@ -318,7 +319,7 @@ static void failing_steps_finish_the_frame(void **state) {
   piola_step_stats st;
   piola_world *w = collapsed_block_frame(&mesh, 1, &st);
   assert_true(st.substeps >= 2 && st.substeps <= 8);
-  assert_int_equal(st.newton_failures, 4 * st.substeps); /* three halvings and the kept try */
+  assert_true(st.newton_failures >= 2 * st.substeps && st.newton_failures <= 4 * st.substeps);
   piola_world_destroy(w);
   block_mesh_free(&mesh);
 }

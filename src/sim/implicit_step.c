@@ -89,6 +89,16 @@
  * once. */
 #define MAX_HALVINGS 3
 
+/* A failed try is retried at half the size only while halving helps: a retry that gets less
+ * than HALVING_GAIN times as far toward convergence as the try before it (try_progress) is
+ * kept as a last try is. In a tangle the elastic forces dwarf the inertia M / dt^2 that
+ * halving raises, and every try takes the same path: on Gmsh's bunny.msh scrambled by half
+ * its diagonal (corotated) the tries at dt and dt / 2 went 5.8% and 6.0% of the way, all
+ * four tries of nearly every step failed, up to 29 s a frame; with this rule the 2 s ran in
+ * 130 s instead of 551 s, 31 tets inverted at the end instead of 43 (docs/time-stepping.md,
+ * "Failure"). */
+#define HALVING_GAIN 1.5
+
 /* Backward Euler's first guess is the prediction x^n + dt v^n plus the step gravity alone
  * would give (dt^2 g: 1.1 cm at 1/30 s), which is exact for a free fall. A solid that is
  * supported (held by a constraint, or that step would take a node into an obstacle) takes
@@ -123,6 +133,7 @@ struct implicit_state {
   int multigrid_ready;        /* multigrid serves the current Newton system */
   int multigrid_fresh;        /* the hierarchy was set up in this step (else: set it up) */
   int32_t split_systems;      /* Newton systems of this step solved by the split's solver */
+  double failed_progress;     /* try_progress of this step's last failed try; -1: none yet */
   double *prediction; /* 3n: x^n + dt v^n (backward Euler) */
   double *residual;   /* 3n: g, unfiltered */
   double *step;       /* 3n: the Newton direction */
@@ -735,6 +746,14 @@ static double total_energy(const newton_problem *pb, const double *x, const doub
   return 0.5 * kinetic + elastic - work;
 }
 
+/* How far a Newton try got: the fraction of the way, on a log scale, from its first
+ * residual phi_first to the stop target2 that its last residual phi went; 0 for none (or
+ * a residual that rose), 1 at convergence. */
+static double try_progress(double phi_first, double phi, double target2) {
+  if (!(phi_first > target2) || !(phi > 0) || !(phi < phi_first)) return 0;
+  return log(phi_first / phi) / log(phi_first / target2);
+}
+
 /* What a failed backward Euler try keeps (docs/time-stepping.md, "What a failed step keeps"):
  * its iterate and velocity (x - x^n) / dt, turned to the start's angular momentum, when they
  * hold no more energy than the step's start (x^n, v^n); else the iterate with the rigid
@@ -803,12 +822,14 @@ static piola_status newton_iterate(const newton_problem *problem, int accept_unc
 
 /* Newton's method for one body over [t, t + dt]. Returns PIOLA_OK when converged,
  * PIOLA_ERROR_NOT_CONVERGED when not (the caller undoes and halves), or another error. */
-static piola_status newton_body(piola_world *w, world_body *s, double t, double dt,
-                                 int accept_unconverged, piola_step_stats *stats) {
+static piola_status newton_body(piola_world *w, world_body *s, double t, double dt, int halvings,
+                                piola_step_stats *stats) {
   PIOLA_TRY(implicit_state_make(s, w->def.preconditioner));
   struct implicit_state *st = s->implicit;
   st->multigrid_fresh = 0; /* a new step: the hierarchy is set up again */
   st->split_systems = 0;   /* likewise the split solver's preconditioner */
+  if (halvings == 0) st->failed_progress = -1;
+  const int accept_unconverged = halvings == MAX_HALVINGS;
   const int32_t n = s->n;
   const int64_t m = 3 * (int64_t)n;
   newton_problem pb = problem_of(w, s, t, dt);
@@ -900,6 +921,7 @@ static piola_status newton_iterate(const newton_problem *problem, int accept_unc
   const double target = w->def.newton_tolerance * STANDARD_GRAVITY * pb.force_weight;
   const double target2 = target * target * pb.total_mass;
   double phi = residual(&pb);
+  const double phi_first = phi;
   double phi_last = -1, eta = w->def.linear_tolerance;
   double last_alpha = 1.0; /* the last line search's step (the forcing term reads it) */
   /* the tail's matrix (see the head of this file): solids of backward Euler on one process;
@@ -1024,13 +1046,24 @@ static piola_status newton_iterate(const newton_problem *problem, int accept_unc
      * quasistatic retry that began at the failed try's mu of 1e-22 took a first step of
      * 1e38 m): it starts again from the first one */
     if (pb.quasistatic) s->quasistatic_mu = 0;
+    /* backward Euler: a retry that halving did not help is kept (HALVING_GAIN), unless it
+     * is shorter than a last try: kept halves of what is left of a frame would shrink
+     * geometrically, and the frame would never end */
+    if (!pb.quasistatic && !accept_unconverged && isfinite(phi)) {
+      const double progress = try_progress(phi_first, phi, target2);
+      accept_unconverged = st->failed_progress >= 0 &&
+                           progress <= HALVING_GAIN * st->failed_progress &&
+                           dt >= ldexp(w->def.implicit_dt, -MAX_HALVINGS);
+      st->failed_progress = progress;
+    }
     if (!accept_unconverged || !isfinite(phi)) return PIOLA_ERROR_NOT_CONVERGED;
     stats->newton_failures++;
     piola__world_warn(w, PIOLA_WARNING_NEWTON_FAILED,
                       "%s '%s': the %s step to t = %g s did not converge (Newton, on its "
-                      "last try); its last iterate was kept (backward Euler: unless it held more "
-                      "energy than the step's start, time-stepping.md \"What a failed step "
-                      "keeps\") and the run goes on (stats.csv "
+                      "last try, or a retry that halving did not help); its last iterate was "
+                      "kept (backward Euler: unless it held more energy than the step's start, "
+                      "time-stepping.md \"What a failed step keeps\") and the run goes on "
+                      "(stats.csv "
                       "newton_failures counts failed tries). A quasistatic body held by "
                       "obstacle contacts alone has no equilibrium: fix or drive a node, or "
                       "use \"backward_euler\" (time-stepping.md)",
@@ -1174,7 +1207,7 @@ piola_status piola__implicit_world_step(piola_world *w, double dt_limit, piola_s
     piola_status st = PIOLA_OK;
     int32_t done = 0;
     for (; done < w->body_count && st == PIOLA_OK; ++done)
-      st = newton_body(w, &w->bodies[done], w->time, dt, halvings == MAX_HALVINGS, &local);
+      st = newton_body(w, &w->bodies[done], w->time, dt, halvings, &local);
     if (st == PIOLA_OK) break;
     for (int32_t j = 0; j < done; ++j) piola__body_restore_step(&w->bodies[j], w->time);
     if (st != PIOLA_ERROR_NOT_CONVERGED) {

@@ -75,8 +75,8 @@ typedef struct piola_frame_info {
   int32_t newton_iterations; /* implicit integrators: Newton iterations since the previous
                                 frame (0 with Newmark) */
   int32_t linear_iterations; /* implicit integrators: CG iterations of the Newton systems */
-  int32_t newton_failures;   /* implicit integrators: steps retried at half the size because
-                                Newton did not converge */
+  int32_t newton_failures;   /* implicit integrators: tries whose Newton did not converge,
+                                retried at half the size or kept (time-stepping.md, "Failure") */
   int32_t step_retries;   /* steps redone at a smaller size since the previous frame */
   int32_t energy_redos;   /* Newmark steps redone at a smaller size since the previous frame
                              because their energy rose (docs/time-stepping.md) */

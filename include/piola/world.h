@@ -233,8 +233,8 @@ typedef struct piola_step_stats {
   int32_t newton_iterations; /* implicit integrators: Newton iterations, summed over the
                                 steps and bodies (0 with Newmark) */
   int32_t linear_iterations; /* implicit integrators: CG iterations of the Newton systems */
-  int32_t newton_failures;   /* implicit integrators: steps whose Newton did not converge,
-                                undone and retried at half the step */
+  int32_t newton_failures;   /* implicit integrators: tries whose Newton did not converge,
+                                retried at half the step or kept (time-stepping.md, "Failure") */
   int32_t step_retries;   /* steps redone at a quarter of their size because the state blew
                              up (docs/time-stepping.md, "Step retries") */
   int32_t energy_redos;   /* Newmark: steps redone at a quarter of their size because their
@@ -269,8 +269,9 @@ typedef enum piola_warning_kind {
                                           estimate of the rest state */
   PIOLA_WARNING_SLIVER,                /* a tet's rest altitude forces a step far below the
                                           others (found when the solid is added) */
-  PIOLA_WARNING_NEWTON_FAILED,         /* an implicit step's last try did not converge and
-                                          its last accepted iterate was kept */
+  PIOLA_WARNING_NEWTON_FAILED,         /* an implicit step's last try, or a retry that
+                                          halving did not help, did not converge and its last
+                                          accepted iterate was kept */
   PIOLA_WARNING_EMPTY_SELECTION,       /* a fixed or driven constraint's selector picks no
                                           node (found when the body is added) */
   PIOLA_WARNING_STEP_KEPT_START,       /* a failed backward Euler step kept its start's

@@ -89,6 +89,12 @@
  * once. */
 #define MAX_HALVINGS 3
 
+/* The length of a last try (the user's step halved MAX_HALVINGS times): no failed try is
+ * kept at a shorter one, unless the frame's remainder is shorter still. */
+static double last_try_length(const piola_world *w) {
+  return ldexp(w->def.implicit_dt, -MAX_HALVINGS);
+}
+
 /* A failed try is retried at half the size only while halving helps: a retry that gets less
  * than HALVING_GAIN times as far toward convergence as the try before it (try_progress) is
  * kept as a last try is. In a tangle the elastic forces dwarf the inertia M / dt^2 that
@@ -1053,7 +1059,7 @@ static piola_status newton_iterate(const newton_problem *problem, int accept_unc
       const double progress = try_progress(phi_first, phi, target2);
       accept_unconverged = st->failed_progress >= 0 &&
                            progress <= HALVING_GAIN * st->failed_progress &&
-                           dt >= ldexp(w->def.implicit_dt, -MAX_HALVINGS);
+                           dt >= last_try_length(w);
       st->failed_progress = progress;
     }
     if (!accept_unconverged || !isfinite(phi)) return PIOLA_ERROR_NOT_CONVERGED;
@@ -1063,8 +1069,7 @@ static piola_status newton_iterate(const newton_problem *problem, int accept_unc
                       "last try, or a retry that halving did not help); its last iterate was "
                       "kept (backward Euler: unless it held more energy than the step's start, "
                       "time-stepping.md \"What a failed step keeps\") and the run goes on "
-                      "(stats.csv "
-                      "newton_failures counts failed tries). A quasistatic body held by "
+                      "(stats.csv newton_failures counts failed tries). A quasistatic body held by "
                       "obstacle contacts alone has no equilibrium: fix or drive a node, or "
                       "use \"backward_euler\" (time-stepping.md)",
                       piola__body_kind_name(s->kind), s->name,
@@ -1197,7 +1202,7 @@ piola_status piola__implicit_world_step(piola_world *w, double dt_limit, piola_s
    * is left of the target, when that is less): halving what is left of a frame each time
    * instead made a frame whose steps all fail take steps shrinking geometrically, and it
    * never ended once they fell below the rounding of the time */
-  const double shortest = fmin(dt, ldexp(w->def.implicit_dt, -MAX_HALVINGS));
+  const double shortest = fmin(dt, last_try_length(w));
   for (int halvings = 0;; ++halvings) {
     if (halvings == MAX_HALVINGS) {
       dt = fmax(dt, shortest);

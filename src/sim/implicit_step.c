@@ -95,6 +95,23 @@ static double last_try_length(const piola_world *w) {
   return ldexp(w->def.implicit_dt, -MAX_HALVINGS);
 }
 
+/* A backward Euler try that would keep only its start's positions (keep_failed_step's last
+ * case: its iterate held more energy than the start) is no result: a body whose every step
+ * ends there never moves. Such a try is halved on instead, past the last try's length, at
+ * most this many more times (dt / 512), in at most IMPLICIT_DEEPER_STEPS steps of a frame
+ * (world_internal.h), so a frame still ends in a bounded number of steps. Gmsh's bunny.msh
+ * collapsed to a point (Stable Neo-Hookean, one step per 1/30 s frame) froze from its fourth
+ * frame on with 8,567 of 19,379 tets inverted, every try of every step failing, while a
+ * try of dt / 32 got 93% of the way to convergence (try_progress); with the deeper tries it
+ * recovers (docs/time-stepping.md, "Failure"). Halving on only while it helps
+ * (HALVING_GAIN) did not unfreeze it: near the freeze a try's progress does not grow
+ * steadily as the step shrinks. A try that got less than DEEPER_MIN_PROGRESS of the way
+ * (try_progress) keeps its start as before: the energy mode's frozen scrambles of
+ * docs/materials.md get nowhere at any length (each try ends in its first line search), and
+ * halving them on to dt / 512 took 10 times the time and moved nothing. */
+#define DEEPER_HALVINGS 6
+#define DEEPER_MIN_PROGRESS 0.1
+
 /* A failed try is retried at half the size only while halving helps: a retry that gets less
  * than HALVING_GAIN times as far toward convergence as the try before it (try_progress) is
  * kept as a last try is. In a tangle the elastic forces dwarf the inertia M / dt^2 that
@@ -140,6 +157,9 @@ struct implicit_state {
   int multigrid_fresh;        /* the hierarchy was set up in this step (else: set it up) */
   int32_t split_systems;      /* Newton systems of this step solved by the split's solver */
   double failed_progress;     /* try_progress of this step's last failed try; -1: none yet */
+  int halvings;               /* of the step's try being solved */
+  int may_go_deeper;  /* a kept try that would keep only its start is halved on (DEEPER_HALVINGS) */
+  int went_deeper;    /* ... and this try was */
   double *prediction; /* 3n: x^n + dt v^n (backward Euler) */
   double *residual;   /* 3n: g, unfiltered */
   double *step;       /* 3n: the Newton direction */
@@ -789,6 +809,10 @@ static piola_status keep_failed_step(newton_problem *pb) {
   piola__failed_step_velocity(s->n, s->mass, s->x_old, s->v_old, s->x, pb->g1, pb->dt, s->v);
   const double rigid = total_energy(pb, s->x, s->v);
   if (rigid <= start) return PIOLA_OK;
+  if (st->may_go_deeper) {
+    st->went_deeper = 1; /* the caller undoes the try and halves it */
+    return PIOLA_ERROR_NOT_CONVERGED;
+  }
   piola__world_warn(pb->w, PIOLA_WARNING_STEP_KEPT_START,
                     "%s '%s': the failed backward Euler step to t = %g s kept its start's "
                     "positions with a rigid velocity, since its iterate held more energy than "
@@ -835,7 +859,9 @@ static piola_status newton_body(piola_world *w, world_body *s, double t, double 
   st->multigrid_fresh = 0; /* a new step: the hierarchy is set up again */
   st->split_systems = 0;   /* likewise the split solver's preconditioner */
   if (halvings == 0) st->failed_progress = -1;
-  const int accept_unconverged = halvings == MAX_HALVINGS;
+  st->halvings = halvings;
+  st->may_go_deeper = 0, st->went_deeper = 0;
+  const int accept_unconverged = halvings >= MAX_HALVINGS;
   const int32_t n = s->n;
   const int64_t m = 3 * (int64_t)n;
   newton_problem pb = problem_of(w, s, t, dt);
@@ -1054,12 +1080,16 @@ static piola_status newton_iterate(const newton_problem *problem, int accept_unc
     if (pb.quasistatic) s->quasistatic_mu = 0;
     /* backward Euler: a retry that halving did not help is kept (HALVING_GAIN), unless it
      * is shorter than a last try: kept halves of what is left of a frame would shrink
-     * geometrically, and the frame would never end */
-    if (!pb.quasistatic && !accept_unconverged && isfinite(phi)) {
+     * geometrically, and the frame would never end. A kept try that would keep only its
+     * start is halved on, when it got anywhere: to the last try's length, and past it
+     * (DEEPER_HALVINGS) */
+    if (!pb.quasistatic && isfinite(phi)) {
       const double progress = try_progress(phi_first, phi, target2);
-      accept_unconverged = st->failed_progress >= 0 &&
-                           progress <= HALVING_GAIN * st->failed_progress &&
-                           dt >= last_try_length(w);
+      const int helped = st->failed_progress < 0 || progress > HALVING_GAIN * st->failed_progress;
+      if (!accept_unconverged) accept_unconverged = !helped && dt >= last_try_length(w);
+      st->may_go_deeper = progress >= DEEPER_MIN_PROGRESS &&
+                          st->halvings < MAX_HALVINGS + DEEPER_HALVINGS &&
+                          (st->halvings < MAX_HALVINGS || w->deeper_steps_left != 0);
       st->failed_progress = progress;
     }
     if (!accept_unconverged || !isfinite(phi)) return PIOLA_ERROR_NOT_CONVERGED;
@@ -1213,14 +1243,21 @@ piola_status piola__implicit_world_step(piola_world *w, double dt_limit, piola_s
     int32_t done = 0;
     for (; done < w->body_count && st == PIOLA_OK; ++done)
       st = newton_body(w, &w->bodies[done], w->time, dt, halvings, &local);
-    if (st == PIOLA_OK) break;
+    if (st == PIOLA_OK) {
+      if (halvings > MAX_HALVINGS && w->deeper_steps_left > 0) w->deeper_steps_left--;
+      break;
+    }
     for (int32_t j = 0; j < done; ++j) piola__body_restore_step(&w->bodies[j], w->time);
     if (st != PIOLA_ERROR_NOT_CONVERGED) {
       if (stats) *stats = local;
       return st;
     }
-    local.newton_failures++;
-    if (halvings == MAX_HALVINGS) {
+    /* a try halved on instead of keeping its start was counted where it was kept */
+    int went_deeper = 0;
+    for (int32_t j = 0; j < done; ++j)
+      went_deeper |= w->bodies[j].implicit && w->bodies[j].implicit->went_deeper;
+    if (!went_deeper) local.newton_failures++;
+    if (halvings >= MAX_HALVINGS && !went_deeper) {
       /* the last try keeps any finite iterate, so its failure is a non-finite residual:
        * halving on would loop for ever (a scene scrambled by 1e300 m did) */
       if (stats) *stats = local;
@@ -1228,7 +1265,7 @@ piola_status piola__implicit_world_step(piola_world *w, double dt_limit, piola_s
       return PIOLA_FAIL(PIOLA_ERROR_NOT_FINITE,
                         "%s '%s': the implicit step's residual became non-finite at t = %g s "
                         "(after %d halvings of the step, to %g s)",
-                        piola__body_kind_name(s->kind), s->name, w->time + dt, MAX_HALVINGS, dt);
+                        piola__body_kind_name(s->kind), s->name, w->time + dt, halvings, dt);
     }
     dt *= 0.5;
   }

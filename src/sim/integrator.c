@@ -578,6 +578,7 @@ piola_status piola__world_finish_step(piola_world *w, double dt, piola_step_stat
 piola_status piola_world_advance_to(piola_world *w, double t_end, piola_step_stats *stats) {
   if (!isfinite(t_end))
     return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "advance_to: t_end must be finite");
+  w->deeper_steps_left = IMPLICIT_DEEPER_STEPS;
   while (w->time < t_end) {
     double left = t_end - w->time;
     /* avoid a sliver step after a full one: split the last two evenly */
@@ -606,8 +607,12 @@ piola_status piola_world_advance_to(piola_world *w, double t_end, piola_step_sta
       stats->energy_redos += one.energy_redos;
       if (one.substeps) stats->last_dt = one.last_dt;
     }
-    if (st != PIOLA_OK) return st;
+    if (st != PIOLA_OK) {
+      w->deeper_steps_left = -1;
+      return st;
+    }
     if (one.last_dt == left) w->time = t_end; /* land exactly on the target, no rounding drift */
   }
+  w->deeper_steps_left = -1;
   return PIOLA_OK;
 }

@@ -65,6 +65,7 @@ piola_status piola_world_create(const piola_world_def *def, piola_world **out) {
   if (!w) return PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "world: out of memory");
   w->def = *def;
   w->collision_deadline = NAN;
+  w->deeper_steps_left = -1;
   *out = w;
   return PIOLA_OK;
 }

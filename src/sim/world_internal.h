@@ -58,12 +58,19 @@ struct piola_world {
   int32_t recent_bound_next;  /* where the next one goes */
   double collision_deadline;  /* advance_to's target, which closes a collision interval too;
                                  NAN outside advance_to */
+  /* implicit steps that advance_to may still halve past the last try's length in this call
+   * (implicit_step.c, DEEPER_HALVINGS): IMPLICIT_DEEPER_STEPS at its start, so a frame ends
+   * in a bounded number of steps; -1 (no limit: one step) outside advance_to */
+  int32_t deeper_steps_left;
   step_profile profile;       /* per-phase step timers, off unless a benchmark turns them on */
   char *warnings[PIOLA_WARNING_KIND_COUNT]; /* first message of each kind, or NULL */
   piola_work_split_planner split_planner; /* splits of solids added (plan NULL: none) */
   piola_work_split_planner split_replanner; /* splits of split solids a cut rebuilt */
   int split_replans_deferred; /* a rebuilt split solid stays whole, marked split_pending */
 };
+
+/* How many steps of one advance_to may be halved past the last try's length (above). */
+#define IMPLICIT_DEEPER_STEPS 8
 
 /* Warnings (world_warnings.c). warn records the message of kind unless one is recorded
  * already (printf format). check_slivers raises PIOLA_WARNING_SLIVER for solid s when its

@@ -40,6 +40,7 @@ typedef struct real_mesh_scramble {
   double radius;                    /* scramble radius, m */
   piola_integrator_type integrator; /* an implicit one takes one step per 1/30 s frame */
   const double *fibers;             /* 3 per tet (HGO, muscle), or NULL */
+  const piola_mat3 *start_matrix;   /* initial.matrix (a collapse), or NULL: the identity */
 } real_mesh_scramble;
 
 /* A world with no gravity and one solid: `mesh` at 1000 kg/m^3 as `scene` sets it. NULL, with

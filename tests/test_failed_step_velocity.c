@@ -182,7 +182,7 @@ static void failing_steps_keep_momentum(void **state) {
 static piola_world *scrambled_world(const piola_tet_mesh *mesh, piola_material_model model) {
   const real_mesh_scramble scene = {real_mesh_material_def(model, 1e5, 0.3), 5,
                                     2 * real_mesh_diagonal(mesh), PIOLA_INTEGRATOR_BACKWARD_EULER,
-                                    NULL};
+                                    NULL, NULL};
   piola_world *w = real_mesh_scramble_world(mesh, &scene);
   if (!w) fail_msg("%s", piola_last_error());
   return w;
@@ -272,7 +272,7 @@ static void kept_start_is_reported(void **state) {
   piola_tet_mesh mesh = real_mesh_read("tetgen/armadillo_4k.node");
   real_mesh_scramble scene = {real_mesh_material_def(PIOLA_MODEL_SPLINE, 1e5, 0.3), 5,
                               0.5 * real_mesh_diagonal(&mesh), PIOLA_INTEGRATOR_BACKWARD_EULER,
-                              NULL};
+                              NULL, NULL};
   scene.material.inversion_mode = PIOLA_INVERSION_ENERGY;
   piola_world *w = real_mesh_scramble_world(&mesh, &scene);
   if (!w) fail_msg("%s", piola_last_error());

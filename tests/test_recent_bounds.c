@@ -28,7 +28,7 @@
 
 static piola_world *scrambled_ogden_ball(const piola_tet_mesh *mesh) {
   real_mesh_scramble scene = {piola_default_solid_def().material, 5, 2 * real_mesh_diagonal(mesh),
-                              PIOLA_INTEGRATOR_NEWMARK, NULL};
+                              PIOLA_INTEGRATOR_NEWMARK, NULL, NULL};
   /* Ogden's default terms, as a scene naming only the model (E is not used by Ogden) */
   scene.material.model = PIOLA_MODEL_OGDEN;
   scene.material.youngs_modulus = 1e5;

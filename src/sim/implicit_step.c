@@ -1252,10 +1252,10 @@ piola_status piola__implicit_world_step(piola_world *w, double dt_limit, piola_s
       if (stats) *stats = local;
       return st;
     }
-    /* a try halved on instead of keeping its start was counted where it was kept */
-    int went_deeper = 0;
-    for (int32_t j = 0; j < done; ++j)
-      went_deeper |= w->bodies[j].implicit && w->bodies[j].implicit->went_deeper;
+    /* a try halved on instead of keeping its start (only the body that failed, the last
+     * one solved, can be one) was counted where it was kept */
+    const struct implicit_state *failed = w->bodies[done - 1].implicit;
+    const int went_deeper = failed && failed->went_deeper;
     if (!went_deeper) local.newton_failures++;
     if (halvings >= MAX_HALVINGS && !went_deeper) {
       /* the last try keeps any finite iterate, so its failure is a non-finite residual:

@@ -579,7 +579,8 @@ piola_status piola_world_advance_to(piola_world *w, double t_end, piola_step_sta
   if (!isfinite(t_end))
     return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "advance_to: t_end must be finite");
   w->deeper_steps_left = IMPLICIT_DEEPER_STEPS;
-  while (w->time < t_end) {
+  piola_status st = PIOLA_OK;
+  while (w->time < t_end && st == PIOLA_OK) {
     double left = t_end - w->time;
     /* avoid a sliver step after a full one: split the last two evenly */
     double dt = piola_world_stable_dt(w);
@@ -590,7 +591,7 @@ piola_status piola_world_advance_to(piola_world *w, double t_end, piola_step_sta
     if (w->def.integrator != PIOLA_INTEGRATOR_NEWMARK && left <= dt * (1 + 1e-9)) limit = left;
     piola_step_stats one;
     w->collision_deadline = t_end;
-    piola_status st = piola_world_step(w, limit, &one);
+    st = piola_world_step(w, limit, &one);
     w->collision_deadline = NAN;
     if (stats) {
       stats->substeps += one.substeps;
@@ -607,12 +608,9 @@ piola_status piola_world_advance_to(piola_world *w, double t_end, piola_step_sta
       stats->energy_redos += one.energy_redos;
       if (one.substeps) stats->last_dt = one.last_dt;
     }
-    if (st != PIOLA_OK) {
-      w->deeper_steps_left = -1;
-      return st;
-    }
-    if (one.last_dt == left) w->time = t_end; /* land exactly on the target, no rounding drift */
+    /* land exactly on the target, no rounding drift */
+    if (st == PIOLA_OK && one.last_dt == left) w->time = t_end;
   }
   w->deeper_steps_left = -1;
-  return PIOLA_OK;
+  return st;
 }

@@ -88,6 +88,7 @@ piola_world *real_mesh_scramble_world(const piola_tet_mesh *mesh, const real_mes
   sd.shear_viscosity = sd.bulk_viscosity = piola_track_constant(scene->viscosity);
   sd.scramble_radius = scene->radius;
   sd.fiber_directions = scene->fibers;
+  if (scene->start_matrix) sd.initial_matrix = *scene->start_matrix;
   if (piola_world_add_solid(w, &sd, NULL) != PIOLA_OK) {
     piola_world_destroy(w);
     return NULL;
@@ -100,7 +101,7 @@ void real_mesh_scramble_run(const piola_tet_mesh *mesh, const char *name,
                             const double *fibers) {
   const real_mesh_scramble scene = {real_mesh_material_def(model, 2e4, 0.3), 1000, radius,
                                     PIOLA_INTEGRATOR_NEWMARK,
-                                    model == PIOLA_MODEL_HGO ? fibers : NULL};
+                                    model == PIOLA_MODEL_HGO ? fibers : NULL, NULL};
   piola_world *w = real_mesh_scramble_world(mesh, &scene);
   if (!w) fail_msg("%s %s: %s", name, piola_material_model_name(model), piola_last_error());
   const double e0 = real_mesh_total_energy(w);

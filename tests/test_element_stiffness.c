@@ -4,6 +4,8 @@
  *    threshold kinks, muscle fibres included (fibre stretch away from its kinks too);
  *  - the projected dP/dF and the projected element stiffness have no negative eigenvalue,
  *    and the projection leaves a positive definite dP/dF unchanged;
+ *  - the 3x3 projection against the exact one, every count of negative eigenvalues,
+ *    repeated and nearly repeated ones, magnitudes from 1e-200 to 1e200;
  *  - the assembled matrix equals the dense sum of element matrices built from the 9 x 9
  *    projected dP/dF (an independent path), is symmetric, and maps a rigid translation to
  *    the mass term only;
@@ -231,6 +233,70 @@ static void test_projection_keeps_definite(void **state) {
     }
     assert_true(diff <= 1e-12 * scale);
   }
+}
+
+/* piola__project_symmetric3 on S = Q diag(lambda) Q^T against the exact projection
+ * Q diag(max(lambda, 0)) Q^T: every count of negative eigenvalues, eigenvalues repeated
+ * exactly or nearly, next to zero, and magnitudes from 1e-200 to 1e200 (the closed form's
+ * cases and the Jacobi fallback's). The projection onto the semi-definite matrices moves by at
+ * most the rounding in S, so the tolerance is a few roundings of the largest |lambda|, with
+ * room for the positive definite shortcut: it keeps S where the determinant rounds positive,
+ * so a negative eigenvalue next to zero with another near zero (-1e-12, 0, 1) stays. The
+ * result must be exactly symmetric. */
+static void check_projection3(double q[3][3], const double lambda[3]) {
+  double s[3][3], exact[3][3], scale = 0;
+  for (int i = 0; i < 3; ++i) scale = fmax(scale, fabs(lambda[i]));
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j) {
+      s[i][j] = exact[i][j] = 0;
+      for (int k = 0; k < 3; ++k) {
+        s[i][j] += q[i][k] * lambda[k] * q[j][k];
+        exact[i][j] += q[i][k] * fmax(lambda[k], 0.0) * q[j][k];
+      }
+    }
+  for (int i = 0; i < 3; ++i) /* symmetric input, as the assembly's blocks are */
+    for (int j = i + 1; j < 3; ++j) s[j][i] = s[i][j];
+  piola__project_symmetric3(s);
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j) {
+      assert_true(s[i][j] == s[j][i]);
+      if (!(fabs(s[i][j] - exact[i][j]) <= 2e-12 * scale))
+        fail_msg("eigenvalues (%g %g %g): projected entry (%d %d) %.17g, exact %.17g", lambda[0],
+                 lambda[1], lambda[2], i, j, s[i][j], exact[i][j]);
+    }
+}
+
+static void test_projection_of_symmetric3(void **state) {
+  (void)state;
+  test_rng rng = test_rng_seeded(33);
+  static const double patterns[][3] = {
+      {-1.0, 2.0, 3.0},         {-1.0, -2.0, 3.0},         {-1.0, -2.0, -3.0}, {-1.0, -1.0, 2.0},
+      {-1.0, 2.0, 2.0},         {-2.0, -1.0, -1.0},        {-1.0, 1e-9, 1.0},  {-1e-6, 1e-6, 1.0},
+      {-1.0, -1e-9, 1e-9},      {-1e-12, 0.0, 1.0},        {-1.0, 0.0, 0.0},   {0.0, 0.0, 0.0},
+      {-1.0, 1.0, 1.0 + 1e-12}, {-1.0, -1.0 - 1e-12, 1.0}, {-1e-7, 1.0, 1.0},  {1.0, 2.0, 3.0},
+      {-3.0, 1e-15, 1e-15},
+  };
+  static const double scales[] = {1.0, 1e5, 1e-200, 1e200, 3.7e9};
+  const long samples = test_samples(200, 20);
+  for (long n = 0; n < samples; ++n) {
+    double q9[9], q[3][3];
+    fixture_random_rotation(&rng, q9);
+    for (int k = 0; k < 9; ++k) q[k / 3][k % 3] = q9[k];
+    for (size_t p = 0; p < sizeof patterns / sizeof patterns[0]; ++p)
+      for (size_t c = 0; c < sizeof scales / sizeof scales[0]; ++c) {
+        const double lambda[3] = {patterns[p][0] * scales[c], patterns[p][1] * scales[c],
+                                  patterns[p][2] * scales[c]};
+        check_projection3(q, lambda);
+      }
+    /* and eigenvalues drawn at random, in any order */
+    double lambda[3];
+    for (int k = 0; k < 3; ++k) lambda[k] = test_rng_uniform(&rng, -2.0, 2.0);
+    check_projection3(q, lambda);
+  }
+  /* the axes themselves (a diagonal input: the adjugate's columns have zeros) */
+  double identity[3][3] = {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
+  for (size_t p = 0; p < sizeof patterns / sizeof patterns[0]; ++p)
+    check_projection3(identity, patterns[p]);
 }
 
 /* piola__material_stress_and_derivative against piola_material_stress and
@@ -578,6 +644,7 @@ int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_dpdf_every_model),
       cmocka_unit_test(test_projection_keeps_definite),
+      cmocka_unit_test(test_projection_of_symmetric3),
       cmocka_unit_test(test_stress_and_derivative_shortcut),
       cmocka_unit_test(test_assembled_matrix),
       cmocka_unit_test(test_matrix_is_force_derivative),

@@ -45,6 +45,130 @@ static void jacobi_eigen3(double a[3][3], double q[3][3]) {
   }
 }
 
+/* A unit eigenvector v of symmetric t for its simple eigenvalue lambda: the largest column of
+ * the adjugate of t - lambda I (the cross products of its rows), each of which is a multiple
+ * of v. 0 where that column is zero. */
+static int adjugate_eigenvector3(double t[3][3], double lambda, double v[3]) {
+  const double r[3][3] = {{t[0][0] - lambda, t[0][1], t[0][2]},
+                          {t[1][0], t[1][1] - lambda, t[1][2]},
+                          {t[2][0], t[2][1], t[2][2] - lambda}};
+  double best = 0.0;
+  for (int k = 0; k < 3; ++k) {
+    const double *x = r[PIOLA__PAIR_P[k]], *y = r[PIOLA__PAIR_Q[k]];
+    const double c[3] = {x[1] * y[2] - x[2] * y[1], x[2] * y[0] - x[0] * y[2],
+                         x[0] * y[1] - x[1] * y[0]};
+    const double n2 = c[0] * c[0] + c[1] * c[1] + c[2] * c[2];
+    if (n2 > best) {
+      best = n2;
+      memcpy(v, c, sizeof c);
+    }
+  }
+  if (!(best > 0.0)) return 0;
+  const double inv = 1.0 / sqrt(best);
+  for (int i = 0; i < 3; ++i) v[i] *= inv;
+  return 1;
+}
+
+/* x^T t y for symmetric t. */
+static double bilinear3(double t[3][3], const double x[3], const double y[3]) {
+  double sum = 0.0;
+  for (int i = 0; i < 3; ++i) sum += x[i] * (t[i][0] * y[0] + t[i][1] * y[1] + t[i][2] * y[2]);
+  return sum;
+}
+
+/* The eigen decomposition of symmetric t (entries at most 1 in magnitude) in closed form:
+ * eigenvalues lam and unit eigenvectors u[k]. The characteristic cubic of (t - q I) / p (q
+ * the mean of the diagonal) solved by its trigonometric form gives the eigenvalue farthest
+ * from the other two accurately, but the two nearer ones only to the square root of the
+ * rounding where they nearly coincide (a double root of the cubic moves that much); so only
+ * the far one is taken from it, with its vector from the adjugate, and the other two from
+ * the 2x2 block of t on the plane orthogonal to that vector, whose closed form is exact to
+ * rounding. 0 where a vector is not found. */
+static int closed_form_eigensystem3(double t[3][3], double lam[3], double u[3][3]) {
+  const double q = (t[0][0] + t[1][1] + t[2][2]) / 3.0;
+  const double off = t[0][1] * t[0][1] + t[0][2] * t[0][2] + t[1][2] * t[1][2];
+  const double d0 = t[0][0] - q, d1 = t[1][1] - q, d2 = t[2][2] - q;
+  const double p = sqrt((d0 * d0 + d1 * d1 + d2 * d2 + 2.0 * off) / 6.0);
+  if (!(p > 0.0)) { /* t = q I */
+    memset(u, 0, 9 * sizeof(double));
+    for (int k = 0; k < 3; ++k) lam[k] = q, u[k][k] = 1.0;
+    return 1;
+  }
+  const double b00 = d0 / p, b11 = d1 / p, b22 = d2 / p, b01 = t[0][1] / p, b02 = t[0][2] / p,
+               b12 = t[1][2] / p;
+  const double half_det = 0.5 * (b00 * (b11 * b22 - b12 * b12) - b01 * (b01 * b22 - b12 * b02) +
+                                 b02 * (b01 * b12 - b11 * b02));
+  const double phi = acos(fmin(fmax(half_det, -1.0), 1.0)) / 3.0;
+  /* half_det >= 0: the largest is the far one, else the smallest */
+  lam[0] = half_det >= 0.0 ? q + 2.0 * p * cos(phi) : q + 2.0 * p * cos(phi + 2.0943951023931957);
+  if (!adjugate_eigenvector3(t, lam[0], u[0])) return 0;
+  /* an orthonormal pair e, f spanning the plane orthogonal to v = u[0]: e = axis x v for the
+   * axis along v's smallest entry */
+  const double *v = u[0];
+  int k = 0;
+  for (int i = 1; i < 3; ++i)
+    if (fabs(v[i]) < fabs(v[k])) k = i;
+  double e[3] = {0, 0, 0};
+  e[(k + 1) % 3] = -v[(k + 2) % 3];
+  e[(k + 2) % 3] = v[(k + 1) % 3];
+  const double en = 1.0 / sqrt(e[0] * e[0] + e[1] * e[1] + e[2] * e[2]);
+  for (int i = 0; i < 3; ++i) e[i] *= en;
+  const double f[3] = {v[1] * e[2] - v[2] * e[1], v[2] * e[0] - v[0] * e[2],
+                       v[0] * e[1] - v[1] * e[0]};
+  /* the 2x2 block [[a, c], [c, b]] on (e, f): eigenvalues mid +- radius, the larger one's
+   * vector (h + radius, c) or (c, radius - h), whichever does not cancel */
+  const double a = bilinear3(t, e, e), b = bilinear3(t, f, f), c = bilinear3(t, e, f);
+  const double h = 0.5 * (a - b), mid = 0.5 * (a + b), radius = sqrt(h * h + c * c);
+  lam[1] = mid + radius, lam[2] = mid - radius;
+  double x = h >= 0.0 ? h + radius : c, y = h >= 0.0 ? c : radius - h;
+  const double xy = sqrt(x * x + y * y);
+  /* xy = 0: the block is a multiple of I, and any pair will do */
+  x = xy > 0.0 ? x / xy : 1.0, y = xy > 0.0 ? y / xy : 0.0;
+  for (int i = 0; i < 3; ++i) {
+    u[1][i] = x * e[i] + y * f[i];
+    u[2][i] = -y * e[i] + x * f[i];
+  }
+  return 1;
+}
+
+/* The projection of symmetric s in closed form into a, on s scaled by its largest entry
+ * (no square or product then overflows or underflows whatever s's magnitude): s less its
+ * negative eigenvalue's term, or its positive eigenvalue's term alone, or s, or zero,
+ * whichever takes fewest terms. 0 (a untouched) where an entry is not finite or a vector is
+ * not found. */
+static int closed_form_projection3(double s[3][3], double a[3][3]) {
+  double m = 0.0;
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j) m = fmax(m, fabs(s[i][j]));
+  if (!(m < INFINITY) || isnan(s[0][0] + s[0][1] + s[0][2] + s[1][1] + s[1][2] + s[2][2])) return 0;
+  if (m == 0.0) {
+    memset(a, 0, 9 * sizeof(double));
+    return 1;
+  }
+  double t[3][3], lam[3], u[3][3];
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j) t[i][j] = s[i][j] / m;
+  if (!closed_form_eigensystem3(t, lam, u)) return 0;
+  const int negative = (lam[0] < 0.0) + (lam[1] < 0.0) + (lam[2] < 0.0);
+  if (negative == 0) {
+    memcpy(a, s, 9 * sizeof(double));
+  } else if (negative == 3) {
+    memset(a, 0, 9 * sizeof(double));
+  } else {
+    /* the single eigenvalue on its side of zero */
+    int single = 0;
+    while ((lam[single] < 0.0) != (negative == 1)) ++single;
+    const double *w = u[single], l = lam[single];
+    for (int i = 0; i < 3; ++i)
+      for (int j = 0; j < 3; ++j)
+        a[i][j] = m * (negative == 1 ? t[i][j] - l * w[i] * w[j] : l * w[i] * w[j]);
+  }
+  /* the terms above are symmetric up to the order of a product's factors: made exactly so */
+  for (int i = 0; i < 3; ++i)
+    for (int j = i + 1; j < 3; ++j) a[j][i] = a[i][j];
+  return 1;
+}
+
 void piola__project_symmetric3(double a[3][3]) {
   double s[3][3];
   for (int i = 0; i < 3; ++i)
@@ -59,6 +183,11 @@ void piola__project_symmetric3(double a[3][3]) {
     memcpy(a, s, sizeof s);
     return;
   }
+  /* an indefinite block (compressed and inverted elements: every tet of a collapsed body)
+   * in closed form; Jacobi's rotations, three sweeps each, were a sixth of a backward Euler
+   * run recovering from a collapse (BENCHMARKS.md). Jacobi remains for what the closed form
+   * cannot take: numbers that are not finite, an eigenvector it cannot find. */
+  if (closed_form_projection3(s, a)) return;
   double q[3][3];
   jacobi_eigen3(s, q);
   double lam[3] = {fmax(s[0][0], 0.0), fmax(s[1][1], 0.0), fmax(s[2][2], 0.0)};

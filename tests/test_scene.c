@@ -271,12 +271,55 @@ static void empty_selection_is_a_warning_naming_its_key(void **state) {
   assert_string_equal(empty_selection_warning(constraints, text, sizeof text), "");
 }
 
+/* Free nodes that start inside an obstacle deeper than 1% of the body's size raise a warning
+ * at the first step naming the body, the obstacle and the depth (cli.md, "Warnings"); a body
+ * above the obstacle, resting on it, or inside it with every node fixed raises none. The
+ * octahedron spans [-4, 4] in each axis (diagonal 13.9 m). */
+static const char *starts_inside_warning(const char *placement, char *text, size_t size) {
+  char json[2048];
+  snprintf(json, sizeof json,
+           "{\"gravity\": [0, 0, 0], \"solids\": [{\"name\": \"oct\", \"mesh\": \"%s\"%s}], "
+           "\"obstacles\": [{\"type\": \"sphere\", \"center\": [50, 0, 0], \"radius\": 1}, "
+           "{\"type\": \"plane\", \"point\": [0, 0, 0], \"normal\": [0, 0, 1]}]}",
+           test_data_path("tetgen/octahedron.node"), placement);
+  piola_scene *scene = NULL;
+  if (piola_scene_load_string(json, ".", NULL, &scene) != PIOLA_OK)
+    fail_msg("%s", piola_last_error());
+  piola_world *world = piola_scene_world(scene);
+  assert_null(piola_world_warning(world, PIOLA_WARNING_STARTS_INSIDE)); /* not before a step */
+  piola_step_stats stats;
+  if (piola_world_step(world, 1e-4, &stats) != PIOLA_OK) fail_msg("%s", piola_last_error());
+  const char *w = piola_world_warning(world, PIOLA_WARNING_STARTS_INSIDE);
+  snprintf(text, size, "%s", w ? w : "");
+  piola_scene_destroy(scene);
+  return text;
+}
+
+static void starting_inside_an_obstacle_is_a_warning(void **state) {
+  (void)state;
+  char text[1024];
+  /* centred on the plane: the lower half is inside, the bottom vertex 4 m deep */
+  const char *w = starts_inside_warning("", text, sizeof text);
+  assert_non_null(strstr(w, "solid 'oct': "));
+  assert_non_null(strstr(w, "start inside obstacle 1 "));
+  assert_non_null(strstr(w, "deepest at 4 m"));
+  assert_string_equal(
+      starts_inside_warning(", \"transform\": {\"translate\": [0, 0, 5]}", text, sizeof text), "");
+  /* resting on it: the bottom vertex on the plane, a rounding error deep at most */
+  assert_string_equal(
+      starts_inside_warning(", \"transform\": {\"translate\": [0, 0, 4]}", text, sizeof text), "");
+  assert_string_equal(starts_inside_warning(", \"fixed\": [{\"box\": [[-9, -9, -9], [9, 9, 9]]}]",
+                                            text, sizeof text),
+                      "");
+}
+
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(defaults_hold_when_keys_are_left_out),
       cmocka_unit_test(every_key_reaches_its_definition),
       cmocka_unit_test(bad_input_names_its_key_path),
       cmocka_unit_test(empty_selection_is_a_warning_naming_its_key),
+      cmocka_unit_test(starting_inside_an_obstacle_is_a_warning),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
 }

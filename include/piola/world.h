@@ -276,6 +276,9 @@ typedef enum piola_warning_kind {
                                           node (found when the body is added) */
   PIOLA_WARNING_STEP_KEPT_START,       /* a failed backward Euler step kept its start's
                                           positions (its iterate held more energy) */
+  PIOLA_WARNING_STARTS_INSIDE,         /* at the world's first step from t = 0, free nodes lie
+                                          inside an obstacle, deeper than 1% of the body's
+                                          size: the step pushes them out at once */
   PIOLA_WARNING_KIND_COUNT
 } piola_warning_kind;
 

@@ -525,6 +525,7 @@ static piola_status try_step(piola_world *w, double dt, piola_step_stats *local,
 }
 
 piola_status piola_world_step(piola_world *w, double dt_limit, piola_step_stats *stats) {
+  piola__world_check_start_inside(w);
   PIOLA_TRY(piola__world_fracture_step(w));
   if (w->def.integrator != PIOLA_INTEGRATOR_NEWMARK)
     return piola__implicit_world_step(w, dt_limit, stats);

@@ -64,6 +64,7 @@ struct piola_world {
   int32_t deeper_steps_left;
   step_profile profile;       /* per-phase step timers, off unless a benchmark turns them on */
   char *warnings[PIOLA_WARNING_KIND_COUNT]; /* first message of each kind, or NULL */
+  int start_checked; /* the first step's check of nodes inside obstacles ran (world_warnings.c) */
   piola_work_split_planner split_planner; /* splits of solids added (plan NULL: none) */
   piola_work_split_planner split_replanner; /* splits of split solids a cut rebuilt */
   int split_replans_deferred; /* a rebuilt split solid stays whole, marked split_pending */
@@ -81,6 +82,9 @@ void piola__world_warn(piola_world *w, piola_warning_kind kind, const char *form
 #endif
     ;
 void piola__world_check_slivers(piola_world *w, const world_body *s);
+/* Before the world's first step from t = 0: warns (PIOLA_WARNING_STARTS_INSIDE) when free nodes of
+ * a body start inside an obstacle deeper than a percent of the body's size. Once per world. */
+void piola__world_check_start_inside(piola_world *w);
 void piola__world_warnings_free(piola_world *w);
 
 /* ---- the body table (body_table.c) */

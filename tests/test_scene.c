@@ -311,6 +311,13 @@ static void starting_inside_an_obstacle_is_a_warning(void **state) {
   assert_string_equal(starts_inside_warning(", \"fixed\": [{\"box\": [[-9, -9, -9], [9, 9, 9]]}]",
                                             text, sizeof text),
                       "");
+  /* collapsed to a point 1 m below the plane: every node inside, and no size to compare with */
+  w = starts_inside_warning(
+      ", \"transform\": {\"translate\": [0, 0, -1]}, \"initial\": {\"matrix\": "
+      "[[0, 0, 0], [0, 0, 0], [0, 0, 0]]}",
+      text, sizeof text);
+  assert_non_null(strstr(w, "solid 'oct': 330 of its 330 nodes start inside obstacle 1 "));
+  assert_null(strstr(w, "inf"));
 }
 
 int main(void) {

@@ -143,7 +143,7 @@ void piola__world_check_start_inside(piola_world *w) {
     piola__rigid_motion_state(&ob->motion, w->time, &pose);
     for (int32_t bi = 0; bi < w->body_count; ++bi) {
       const world_body *b = &w->bodies[bi];
-      const double limit = STARTS_INSIDE_DEPTH * body_diagonal(b);
+      const double size = body_diagonal(b), limit = STARTS_INSIDE_DEPTH * size;
       int32_t inside = 0, deepest = -1;
       double depth = 0;
       for (int32_t i = 0; i < b->n; ++i) {
@@ -156,15 +156,18 @@ void piola__world_check_start_inside(piola_world *w) {
         if (d > depth) depth = d, deepest = i;
       }
       if (inside == 0) continue;
+      /* a body collapsed to a point (initial.matrix zero) has no size to compare with */
+      char share[64] = "";
+      if (size > 0)
+        snprintf(share, sizeof share, " (%.0f%% of the %s's size)", 100.0 * depth / size,
+                 piola__body_kind_name(b->kind));
       piola__world_warn(w, PIOLA_WARNING_STARTS_INSIDE,
                         "%s '%s': %d of its %d nodes start inside obstacle %d (obstacles and "
-                        "bones counted from 0 in the order added), node %d deepest at %.3g m "
-                        "(%.0f%% of the %s's size); the first step pushes them to its surface "
-                        "at once, crushing the elements between: move the %s out (its "
-                        "transform) or the obstacle away",
+                        "bones counted from 0 in the order added), node %d deepest at %.3g m%s; "
+                        "the first step pushes them to its surface at once, crushing the "
+                        "elements between: move the %s out (its transform) or the obstacle away",
                         piola__body_kind_name(b->kind), b->name, (int)inside, (int)b->n, (int)o,
-                        (int)deepest, depth, 100.0 * depth / (limit / STARTS_INSIDE_DEPTH),
-                        piola__body_kind_name(b->kind), piola__body_kind_name(b->kind));
+                        (int)deepest, depth, share, piola__body_kind_name(b->kind));
       return;
     }
   }

@@ -230,6 +230,24 @@ static void bad_input_names_its_key_path(void **state) {
   assert_bad_scenes_refused(BAD, sizeof BAD / sizeof BAD[0]);
 }
 
+/* The message of warning KIND (or "", copied into text) of the world the scene JSON builds,
+ * after STEPS steps of 1e-4 s; with steps > 0 it must not be raised before the first. */
+static const char *scene_warning(const char *json, piola_warning_kind kind, int steps, char *text,
+                                 size_t size) {
+  piola_scene *scene = NULL;
+  if (piola_scene_load_string(json, ".", NULL, &scene) != PIOLA_OK)
+    fail_msg("%s", piola_last_error());
+  piola_world *world = piola_scene_world(scene);
+  if (steps > 0) assert_null(piola_world_warning(world, kind));
+  for (int k = 0; k < steps; ++k) {
+    piola_step_stats stats;
+    if (piola_world_step(world, 1e-4, &stats) != PIOLA_OK) fail_msg("%s", piola_last_error());
+  }
+  const char *w = piola_world_warning(world, kind);
+  snprintf(text, size, "%s", w ? w : "");
+  piola_scene_destroy(scene);
+  return text;
+}
 
 /* A fixed or driven selector that picks no node is accepted (a coarse mesh may have none
  * in a small box) with a warning naming the solid and the scene key; the first empty one
@@ -239,12 +257,7 @@ static const char *empty_selection_warning(const char *constraints, char *text, 
   snprintf(json, sizeof json,
            "{\"solids\": [{\"name\": \"oct\", \"mesh\": \"%s\", %s}]}",
            test_data_path("tetgen/octahedron.node"), constraints);
-  piola_scene *scene = NULL;
-  if (piola_scene_load_string(json, ".", NULL, &scene) != PIOLA_OK) fail_msg("%s", piola_last_error());
-  const char *w = piola_world_warning(piola_scene_world(scene), PIOLA_WARNING_EMPTY_SELECTION);
-  snprintf(text, size, "%s", w ? w : "");
-  piola_scene_destroy(scene);
-  return text;
+  return scene_warning(json, PIOLA_WARNING_EMPTY_SELECTION, 0, text, size);
 }
 
 static void empty_selection_is_a_warning_naming_its_key(void **state) {
@@ -282,17 +295,7 @@ static const char *starts_inside_warning(const char *placement, char *text, size
            "\"obstacles\": [{\"type\": \"sphere\", \"center\": [50, 0, 0], \"radius\": 1}, "
            "{\"type\": \"plane\", \"point\": [0, 0, 0], \"normal\": [0, 0, 1]}]}",
            test_data_path("tetgen/octahedron.node"), placement);
-  piola_scene *scene = NULL;
-  if (piola_scene_load_string(json, ".", NULL, &scene) != PIOLA_OK)
-    fail_msg("%s", piola_last_error());
-  piola_world *world = piola_scene_world(scene);
-  assert_null(piola_world_warning(world, PIOLA_WARNING_STARTS_INSIDE)); /* not before a step */
-  piola_step_stats stats;
-  if (piola_world_step(world, 1e-4, &stats) != PIOLA_OK) fail_msg("%s", piola_last_error());
-  const char *w = piola_world_warning(world, PIOLA_WARNING_STARTS_INSIDE);
-  snprintf(text, size, "%s", w ? w : "");
-  piola_scene_destroy(scene);
-  return text;
+  return scene_warning(json, PIOLA_WARNING_STARTS_INSIDE, 1, text, size);
 }
 
 static void starting_inside_an_obstacle_is_a_warning(void **state) {

@@ -137,13 +137,13 @@ void piola__world_check_start_inside(piola_world *w) {
   w->start_checked = 1;
   /* a resumed run continues one that was checked: its contacts are the run's own */
   if (w->time != 0.0) return;
-  for (int32_t o = 0; o < w->obstacle_count; ++o) {
-    const piola_obstacle *ob = w->obstacles[o];
-    piola__rigid_state pose;
-    piola__rigid_motion_state(&ob->motion, w->time, &pose);
-    for (int32_t bi = 0; bi < w->body_count; ++bi) {
-      const world_body *b = &w->bodies[bi];
-      const double size = body_diagonal(b), limit = STARTS_INSIDE_DEPTH * size;
+  for (int32_t bi = 0; bi < w->body_count; ++bi) {
+    const world_body *b = &w->bodies[bi];
+    const double size = body_diagonal(b), limit = STARTS_INSIDE_DEPTH * size;
+    for (int32_t o = 0; o < w->obstacle_count; ++o) {
+      const piola_obstacle *ob = w->obstacles[o];
+      piola__rigid_state pose;
+      piola__rigid_motion_state(&ob->motion, w->time, &pose);
       int32_t inside = 0, deepest = -1;
       double depth = 0;
       for (int32_t i = 0; i < b->n; ++i) {

@@ -322,10 +322,54 @@ static void chebyshev(const piola__multigrid_level *l, int degree, int zero_star
   }
 }
 
+/* Rows r0 .. r1 - 1 of a power iteration's two passes: sums[0] = v . A v and sums[1] =
+ * v . D v (av = A v), or (normalize) v = D^-1 av and sums[0] = its squared size. */
+static void power_rows(const piola__multigrid_level *l, const double *av, int32_t r0, int32_t r1,
+                       int normalize, double sums[2]) {
+  const int b = l->a.rb;
+  double *v = l->mode;
+  sums[0] = sums[1] = 0;
+  for (int32_t r = r0; r < r1; ++r) {
+    double *vr = v + (size_t)b * r;
+    const double *ar = av + (size_t)b * r;
+    if (normalize) {
+      const double *dinv = l->inverse_diagonal + (size_t)(b * b) * (size_t)r;
+      double t[6];
+      for (int i = 0; i < b; ++i) {
+        t[i] = 0;
+        for (int j = 0; j < b; ++j) t[i] += dinv[b * i + j] * ar[j];
+      }
+      for (int i = 0; i < b; ++i) vr[i] = t[i], sums[0] += t[i] * t[i];
+      continue;
+    }
+    for (int i = 0; i < b; ++i) sums[0] += vr[i] * ar[i];
+    const int32_t k = diagonal_entry(&l->a, r);
+    if (k < 0) continue;
+    const double *blk = l->a.values + (size_t)(b * b) * (size_t)k;
+    for (int i = 0; i < b; ++i)
+      for (int j = 0; j < b; ++j) sums[1] += vr[i] * blk[b * i + j] * vr[j];
+  }
+}
+
+/* sums[0 .. 1] of power_rows over the level's rows: the RANGES ranges' partial sums added in
+ * range order, so the result does not depend on the thread count. */
+static void power_pass(const piola__multigrid_level *l, const double *av, int normalize,
+                       double sums[2]) {
+  const int32_t n = l->a.rows;
+  double part[RANGES][2];
+#pragma omp parallel for schedule(static) \
+    num_threads(piola_thread_count()) if (n >= MULTIGRID_PARALLEL_MIN_ROWS)
+  for (int k = 0; k < RANGES; ++k)
+    power_rows(l, av, (int32_t)((int64_t)n * k / RANGES), (int32_t)((int64_t)n * (k + 1) / RANGES),
+               normalize, part[k]);
+  sums[0] = sums[1] = 0;
+  for (int k = 0; k < RANGES; ++k) sums[0] += part[k][0], sums[1] += part[k][1];
+}
+
 /* The largest eigenvalue of D^-1 A by `iterations` power iterations from a fixed start
  * (warm: from the last iterate, l->mode), as the Rayleigh quotient (v . A v) / (v . D v)
- * (D^-1 A is self-adjoint in the D inner product: the quotient converges from below). On
- * one thread for the sums' order. */
+ * (D^-1 A is self-adjoint in the D inner product: the quotient converges from below). The
+ * sums in fixed ranges (power_pass), so any thread count gives the same bits. */
 static double spectral_radius(const piola__multigrid_level *l, int iterations, int warm) {
   const int b = l->a.rb;
   const int64_t m = (int64_t)l->a.rows * b;
@@ -338,28 +382,13 @@ static double spectral_radius(const piola__multigrid_level *l, int iterations, i
   for (int it = 0; it < iterations; ++it) {
     piola__block_sparse_apply(&l->a, v, av, 0);
     /* v . A v and v . D v */
-    double vav = 0, vdv = 0;
-    for (int64_t j = 0; j < m; ++j) vav += v[j] * av[j];
-    for (int32_t r = 0; r < l->a.rows; ++r) {
-      const int32_t k = diagonal_entry(&l->a, r);
-      if (k < 0) continue;
-      const double *blk = l->a.values + (size_t)(b * b) * (size_t)k, *vr = v + (size_t)b * r;
-      for (int i = 0; i < b; ++i)
-        for (int j = 0; j < b; ++j) vdv += vr[i] * blk[b * i + j] * vr[j];
-    }
-    if (!(vdv > 0)) break;
-    quotient = vav / vdv;
+    double sums[2];
+    power_pass(l, av, 0, sums);
+    if (!(sums[1] > 0)) break;
+    quotient = sums[0] / sums[1];
     /* v = D^-1 A v, normalized */
-    double size = 0;
-    for (int32_t r = 0; r < l->a.rows; ++r) {
-      const double *dinv = l->inverse_diagonal + (size_t)(b * b) * (size_t)r;
-      double t[6];
-      for (int i = 0; i < b; ++i) {
-        t[i] = 0;
-        for (int j = 0; j < b; ++j) t[i] += dinv[b * i + j] * av[(size_t)b * r + j];
-      }
-      for (int i = 0; i < b; ++i) v[(size_t)b * r + i] = t[i], size += t[i] * t[i];
-    }
+    power_pass(l, av, 1, sums);
+    const double size = sums[0];
     if (!(size > 0) || !isfinite(size)) break;
     const double scale = 1.0 / sqrt(size);
     for (int64_t j = 0; j < m; ++j) v[j] *= scale;

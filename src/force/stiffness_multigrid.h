@@ -38,9 +38,10 @@
  * coarse correction; the caller sets up the whole hierarchy once per step.
  *
  * Threads. The products and the smoother's vector work run in parallel over fixed row
- * ranges, each row summed by one thread in a fixed order, and so do the numbers of the
- * setup's sparse products (math/block_sparse.h); the rest of the setup and the coarse solve
- * run on one thread: results are bit-identical for any thread count. */
+ * ranges, each row summed by one thread in a fixed order, and so do the setup's sparse
+ * products and transposes (math/block_sparse.h) and the power iterations (their sums as
+ * partial sums of fixed ranges, added in order); the aggregation, the tentative prolongator
+ * and the coarse solve run on one thread: results are bit-identical for any thread count. */
 #ifndef PIOLA_FORCE_STIFFNESS_MULTIGRID_H
 #define PIOLA_FORCE_STIFFNESS_MULTIGRID_H
 

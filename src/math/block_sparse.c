@@ -226,9 +226,28 @@ typedef void block_multiply_add(const double *a, const double *b, double *c, int
       }                                                                                 \
   }
 
-BLOCK_MULTIPLY_ADD(multiply_add_3x3x6, 3, 3, 6)
-BLOCK_MULTIPLY_ADD(multiply_add_6x3x6, 6, 3, 6)
-BLOCK_MULTIPLY_ADD(multiply_add_6x6x6, 6, 6, 6)
+/* The same sums with two adjacent numbers of a row of c at a time (C even): each lane does
+ * exactly the operations of BLOCK_MULTIPLY_ADD in its order, so the bits are the same, in
+ * half the arithmetic instructions (the Galerkin product's numbers are most of a multigrid
+ * setup, BENCHMARKS.md). */
+#define BLOCK_MULTIPLY_ADD_PAIRS(NAME, R, K, C)                                         \
+  static void NAME(const double *a, const double *b, double *c, int r, int k, int cc) { \
+    (void)r, (void)k, (void)cc;                                                         \
+    for (int i = 0; i < R; ++i)                                                         \
+      for (int j = 0; j < C; j += 2) {                                                  \
+        pair s = {0, 0};                                                                \
+        for (int p = 0; p < K; ++p) {                                                   \
+          const pair ap = {a[K * i + p], a[K * i + p]};                                 \
+          s += ap * load_pair(b + C * p + j);                                           \
+        }                                                                               \
+        const pair sum = load_pair(c + C * i + j) + s;                                  \
+        memcpy(c + C * i + j, &sum, sizeof sum);                                        \
+      }                                                                                 \
+  }
+
+BLOCK_MULTIPLY_ADD_PAIRS(multiply_add_3x3x6, 3, 3, 6)
+BLOCK_MULTIPLY_ADD_PAIRS(multiply_add_6x3x6, 6, 3, 6)
+BLOCK_MULTIPLY_ADD_PAIRS(multiply_add_6x6x6, 6, 6, 6)
 
 static void multiply_add_any(const double *a, const double *b, double *c, int r, int k, int cc) {
   for (int i = 0; i < r; ++i)
@@ -297,12 +316,16 @@ piola_status piola__block_sparse_product(const piola__block_sparse *a, const pio
     status = PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "sparse product: out of memory");
     goto done;
   }
-  for (int32_t j = 0; j < cols; ++j) marker[j] = -1;
-  int64_t entries = 0;
-  for (int32_t r = 0; r < rows; ++r) {
-    counts[r] = product_row_columns(a, b, r, marker, list, 0);
-    entries += counts[r];
+  for (size_t j = 0; j < work; ++j) marker[j] = -1;
+#pragma omp parallel for schedule(static) num_threads(piola_thread_count()) if (ranges > 1)
+  for (int k = 0; k < ranges; ++k) {
+    const size_t w = (size_t)cols * (size_t)k;
+    for (int32_t r = (int32_t)((int64_t)rows * k / ranges);
+         r < (int32_t)((int64_t)rows * (k + 1) / ranges); ++r)
+      counts[r] = product_row_columns(a, b, r, marker + w, list + w, 0);
   }
+  int64_t entries = 0;
+  for (int32_t r = 0; r < rows; ++r) entries += counts[r];
   status = piola__block_sparse_alloc(c, rows, b->cols, a->rb, b->cb, entries);
   if (status != PIOLA_OK) goto done;
   for (int32_t r = 0; r < rows; ++r) c->row_start[r + 1] = c->row_start[r] + counts[r];
@@ -330,40 +353,6 @@ static int32_t entry_of(const piola__block_sparse *c, int32_t r, int32_t col) {
       hi = mid;
   }
   return lo;
-}
-
-/* The pattern of c = pt (a p) from ap's (ap_start, ap_col: row r of a p, unsorted): row g
- * the union of the rows of a p that row g of pt names, sorted. */
-static piola_status galerkin_pattern(const piola__block_sparse *pt, const int32_t *ap_start,
-                                     const int32_t *ap_col, int cb, piola__block_sparse *c,
-                                     int32_t *marker, int32_t *list) {
-  const int32_t rows = pt->rows, cols = c->cols;
-  for (int32_t j = 0; j < cols; ++j) marker[j] = -1;
-  int64_t entries = 0;
-  for (int pass = 0; pass < 2; ++pass) {
-    if (pass == 1) {
-      const int32_t columns = c->cols;
-      PIOLA_TRY(piola__block_sparse_alloc(c, rows, columns, pt->rb, cb, entries));
-      for (int32_t j = 0; j < cols; ++j) marker[j] = -1;
-    }
-    int64_t at = 0;
-    for (int32_t g = 0; g < rows; ++g) {
-      int32_t count = 0;
-      for (int32_t k = pt->row_start[g]; k < pt->row_start[g + 1]; ++k) {
-        const int32_t r = pt->col[k];
-        for (int32_t q = ap_start[r]; q < ap_start[r + 1]; ++q)
-          if (marker[ap_col[q]] != g) marker[ap_col[q]] = g, list[count++] = ap_col[q];
-      }
-      if (pass == 1) {
-        qsort(list, (size_t)count, sizeof(int32_t), compare_int32);
-        memcpy(c->col + at, list, sizeof(int32_t) * (size_t)count);
-        c->row_start[g + 1] = (int32_t)(at + count);
-      }
-      at += count;
-    }
-    entries = at;
-  }
-  return PIOLA_OK;
 }
 
 /* The operands of the Galerkin product's numbers, shared by its ranges. */
@@ -436,52 +425,155 @@ static void mirror_rows(piola__block_sparse *c, int32_t r0, int32_t r1) {
     }
 }
 
-/* c = pt (a p), all blocks formed (upper = 0) or those on and above the diagonal only and
- * the others mirrored (upper = 1, for a symmetric a; c square with a symmetric pattern). */
-static piola_status galerkin_product(const piola__block_sparse *pt, const piola__block_sparse *a,
-                                     const piola__block_sparse *p, piola__block_sparse *c,
-                                     int upper) {
-  memset(c, 0, sizeof *c);
-  const int32_t n = a->rows, cols = p->cols > 0 ? p->cols : 1;
+/* What the Galerkin product's numbers need of its patterns besides c's: those of a p (row r's
+ * columns ap_col[ap_start[r] ..), unsorted). */
+typedef struct galerkin_plan {
+  int32_t *ap_start, *ap_col;
+  int32_t longest; /* the longest row of a p */
+} galerkin_plan;
+
+static void galerkin_plan_free(galerkin_plan *plan) {
+  free(plan->ap_start), free(plan->ap_col);
+  memset(plan, 0, sizeof *plan);
+}
+
+/* The columns of row g of c = pt (a p) into list (marker[h] == g marks them): the union of
+ * the rows of a p that row g of pt names; returns how many. */
+static int32_t galerkin_row_columns(const piola__block_sparse *pt, const galerkin_plan *plan,
+                                    int32_t g, int32_t *marker, int32_t *list) {
+  int32_t count = 0;
+  for (int32_t k = pt->row_start[g]; k < pt->row_start[g + 1]; ++k) {
+    const int32_t r = pt->col[k];
+    for (int32_t q = plan->ap_start[r]; q < plan->ap_start[r + 1]; ++q) {
+      const int32_t h = plan->ap_col[q];
+      if (marker[h] != g) marker[h] = g, list[count++] = h;
+    }
+  }
+  return count;
+}
+
+/* The four pattern passes of the plan, each over `ranges` ranges of rows with their own
+ * marker and list (width each, marker -1 on entry to each pass): a p's row lengths, its
+ * columns, c's row lengths, c's columns sorted. Each row's columns are found in the same
+ * order whatever the range, so the pattern does not depend on the ranges. */
+enum { PASS_AP_COUNT, PASS_AP_COLUMNS, PASS_C_COUNT, PASS_C_COLUMNS };
+
+static void plan_pass(const piola__block_sparse *pt, const piola__block_sparse *a,
+                      const piola__block_sparse *p, galerkin_plan *plan, piola__block_sparse *c,
+                      int pass, int ranges, int32_t *marker, int32_t *list, int32_t width) {
+  const int over_ap = pass == PASS_AP_COUNT || pass == PASS_AP_COLUMNS;
+#pragma omp parallel for schedule(static) num_threads(piola_thread_count()) if (ranges > 1)
+  for (int k = 0; k < ranges; ++k) {
+    int32_t *mk = marker + (size_t)width * (size_t)k, *lk = list + (size_t)width * (size_t)k;
+    for (int32_t j = 0; j < width; ++j) mk[j] = -1;
+    const int32_t rows = over_ap ? a->rows : pt->rows;
+    const int32_t r0 = over_ap ? (int32_t)((int64_t)rows * k / ranges) : range_row(pt, k, ranges);
+    const int32_t r1 =
+        over_ap ? (int32_t)((int64_t)rows * (k + 1) / ranges) : range_row(pt, k + 1, ranges);
+    for (int32_t r = r0; r < r1; ++r) switch (pass) {
+        case PASS_AP_COUNT:
+          plan->ap_start[r + 1] = product_row_columns(a, p, r, mk, lk, 0);
+          break;
+        case PASS_AP_COLUMNS:
+          product_row_columns(a, p, r, mk, plan->ap_col + plan->ap_start[r], 0);
+          break;
+        case PASS_C_COUNT:
+          c->row_start[r + 1] = galerkin_row_columns(pt, plan, r, mk, lk);
+          break;
+        default: {
+          const int32_t count = galerkin_row_columns(pt, plan, r, mk, lk);
+          qsort(lk, (size_t)count, sizeof(int32_t), compare_int32);
+          memcpy(c->col + c->row_start[r], lk, sizeof(int32_t) * (size_t)count);
+        }
+      }
+  }
+}
+
+/* start[0 .. n] from the lengths in start[1 .. n]: their running sums; returns the total
+ * and the longest length in *longest. */
+static int64_t running_sums(int32_t *start, int32_t n, int32_t *longest) {
+  int64_t sum = 0;
+  start[0] = 0;
+  for (int32_t r = 0; r < n; ++r) {
+    if (start[r + 1] > *longest) *longest = start[r + 1];
+    sum += start[r + 1];
+    start[r + 1] = (int32_t)(sum <= INT32_MAX ? sum : INT32_MAX);
+  }
+  return sum;
+}
+
+/* The plan and c's pattern (c allocated, its values not formed) for c = pt (a p), its
+ * pattern passes in parallel ranges (plan_pass). */
+static piola_status make_galerkin_plan(const piola__block_sparse *pt, const piola__block_sparse *a,
+                                       const piola__block_sparse *p, galerkin_plan *plan,
+                                       piola__block_sparse *c) {
+  memset(c, 0, sizeof *c), memset(plan, 0, sizeof *plan);
+  const int32_t n = a->rows, width = p->cols > 0 ? p->cols : 1;
+  const int ranges = parallel_product(a) ? RANGES : 1;
+  int32_t *marker = malloc(sizeof(int32_t) * (size_t)width * (size_t)ranges);
+  int32_t *list = malloc(sizeof(int32_t) * (size_t)width * (size_t)ranges);
+  int32_t *lengths = malloc(sizeof(int32_t) * ((size_t)pt->rows + 1));
+  plan->ap_start = malloc(sizeof(int32_t) * ((size_t)n + 1));
+  piola_status status = PIOLA_OK;
+  if (!marker || !list || !lengths || !plan->ap_start) goto out_of_memory;
+  /* the pattern of a p, row by row (unsorted: each (g, h) of c gets one term per row r) */
+  plan_pass(pt, a, p, plan, c, PASS_AP_COUNT, ranges, marker, list, width);
+  plan->longest = 1;
+  const int64_t ap_entries = running_sums(plan->ap_start, n, &plan->longest);
+  if (ap_entries > INT32_MAX) {
+    status = PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "sparse product: %lld blocks are too many",
+                        (long long)ap_entries);
+    goto done;
+  }
+  plan->ap_col = malloc(sizeof(int32_t) * (size_t)(ap_entries > 0 ? ap_entries : 1));
+  if (!plan->ap_col) goto out_of_memory;
+  plan_pass(pt, a, p, plan, c, PASS_AP_COLUMNS, ranges, marker, list, width);
+  /* c: row g the union of the rows of a p that row g of pt names, sorted */
+  piola__block_sparse counting = {.rows = pt->rows, .row_start = lengths};
+  plan_pass(pt, a, p, plan, &counting, PASS_C_COUNT, ranges, marker, list, width);
+  int32_t longest = 0;
+  const int64_t entries = running_sums(lengths, pt->rows, &longest);
+  status = piola__block_sparse_alloc(c, pt->rows, p->cols, pt->rb, p->cb, entries);
+  if (status == PIOLA_OK) {
+    memcpy(c->row_start, lengths, sizeof(int32_t) * ((size_t)pt->rows + 1));
+    plan_pass(pt, a, p, plan, c, PASS_C_COLUMNS, ranges, marker, list, width);
+  }
+  goto done;
+out_of_memory:
+  status = PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "sparse product: out of memory");
+done:
+  if (status != PIOLA_OK) piola__block_sparse_free(c), galerkin_plan_free(plan);
+  free(marker), free(list), free(lengths);
+  return status;
+}
+
+/* c's numbers from the plan: all blocks (upper = 0) or those on and above the diagonal and
+ * the others mirrored (upper = 1). */
+static piola_status galerkin_numbers(const piola__block_sparse *pt, const piola__block_sparse *a,
+                                     const piola__block_sparse *p, const galerkin_plan *plan,
+                                     piola__block_sparse *c, int upper) {
+  const int32_t cols = p->cols > 0 ? p->cols : 1;
   /* one range of c's rows per thread (each thread forms the rows of a p its range needs) */
   const int ranges = parallel_product(a) ? piola_thread_count() : 1;
-  int32_t *marker = malloc(sizeof(int32_t) * (size_t)cols);
-  int32_t *list = malloc(sizeof(int32_t) * (size_t)cols);
-  int32_t *position = malloc(sizeof(int32_t) * (size_t)cols * (size_t)ranges);
-  int32_t *ap_start = malloc(sizeof(int32_t) * ((size_t)n + 1));
-  int32_t *cursor = malloc(sizeof(int32_t) * (size_t)(pt->rows > 0 ? pt->rows : 1));
-  int32_t *ap_col = NULL;
-  double *row = NULL;
-  piola_status status = PIOLA_OK;
-  if (!marker || !list || !position || !ap_start || !cursor) goto out_of_memory;
-  /* the pattern of a p, row by row (unsorted: each (g, h) of c gets one term per row r) */
-  for (int32_t j = 0; j < cols; ++j) marker[j] = -1;
-  ap_start[0] = 0;
-  int32_t longest = 1;
-  for (int32_t r = 0; r < n; ++r) {
-    const int32_t count = product_row_columns(a, p, r, marker, list, 0);
-    if (count > longest) longest = count;
-    ap_start[r + 1] = ap_start[r] + count;
-  }
-  ap_col = malloc(sizeof(int32_t) * (size_t)(ap_start[n] > 0 ? ap_start[n] : 1));
   const size_t apbs = (size_t)(a->rb * p->cb), cbs = (size_t)(pt->rb * p->cb);
-  row = malloc(sizeof(double) * apbs * (size_t)longest * (size_t)ranges);
-  if (!ap_col || !row) goto out_of_memory;
-  for (int32_t j = 0; j < cols; ++j) marker[j] = -1;
-  for (int32_t r = 0; r < n; ++r) product_row_columns(a, p, r, marker, ap_col + ap_start[r], 0);
-  c->cols = p->cols;
-  status = galerkin_pattern(pt, ap_start, ap_col, p->cb, c, marker, list);
-  if (status != PIOLA_OK) goto done;
+  int32_t *position = malloc(sizeof(int32_t) * (size_t)cols * (size_t)ranges);
+  int32_t *cursor = malloc(sizeof(int32_t) * (size_t)(pt->rows > 0 ? pt->rows : 1));
+  double *row = malloc(sizeof(double) * apbs * (size_t)plan->longest * (size_t)ranges);
+  if (!position || !cursor || !row) {
+    free(position), free(cursor), free(row);
+    return PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "sparse product: out of memory");
+  }
   memset(c->values, 0,
          sizeof(double) * cbs * (size_t)(c->row_start[c->rows] > 0 ? c->row_start[c->rows] : 1));
   for (int32_t g = 0; g < pt->rows; ++g) cursor[g] = pt->row_start[g];
-  const galerkin_pass gp = {pt, a, p, c, ap_start, ap_col, cursor, upper};
+  const galerkin_pass gp = {pt, a, p, c, plan->ap_start, plan->ap_col, cursor, upper};
 #pragma omp parallel num_threads(ranges) if (ranges > 1)
   {
 #pragma omp for schedule(static, 1)
     for (int k = 0; k < ranges; ++k)
       galerkin_rows(&gp, range_row(pt, k, ranges), range_row(pt, k + 1, ranges),
-                    position + (size_t)cols * (size_t)k, row + apbs * (size_t)longest * (size_t)k);
+                    position + (size_t)cols * (size_t)k,
+                    row + apbs * (size_t)plan->longest * (size_t)k);
     if (upper) {
 #pragma omp for schedule(static)
       for (int k = 0; k < RANGES; ++k)
@@ -489,12 +581,20 @@ static piola_status galerkin_product(const piola__block_sparse *pt, const piola_
                     (int32_t)((int64_t)c->rows * (k + 1) / RANGES));
     }
   }
-  goto done;
-out_of_memory:
-  status = PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "sparse product: out of memory");
-done:
+  free(position), free(cursor), free(row);
+  return PIOLA_OK;
+}
+
+/* c = pt (a p), all blocks formed (upper = 0) or those on and above the diagonal only and
+ * the others mirrored (upper = 1, for a symmetric a; c square with a symmetric pattern). */
+static piola_status galerkin_product(const piola__block_sparse *pt, const piola__block_sparse *a,
+                                     const piola__block_sparse *p, piola__block_sparse *c,
+                                     int upper) {
+  galerkin_plan plan;
+  PIOLA_TRY(make_galerkin_plan(pt, a, p, &plan, c));
+  const piola_status status = galerkin_numbers(pt, a, p, &plan, c, upper);
   if (status != PIOLA_OK) piola__block_sparse_free(c);
-  free(marker), free(list), free(position), free(ap_start), free(cursor), free(ap_col), free(row);
+  galerkin_plan_free(&plan);
   return status;
 }
 
@@ -511,6 +611,30 @@ piola_status piola__block_sparse_galerkin_symmetric(const piola__block_sparse *p
   return galerkin_product(pt, a, p, c, 1);
 }
 
+/* Rows r0 .. r1 - 1 of the transpose's numbers: each block of t found in a's row by a binary
+ * search, a's rows sorted. */
+static void transpose_numbers_rows(const piola__block_sparse *a, piola__block_sparse *t, int32_t r0,
+                                   int32_t r1) {
+  const int rb = a->rb, cb = a->cb;
+  const size_t bs = (size_t)(rb * cb);
+  for (int32_t g = r0; g < r1; ++g)
+    for (int32_t k = t->row_start[g]; k < t->row_start[g + 1]; ++k) {
+      const double *src = a->values + bs * (size_t)entry_of(a, t->col[k], g);
+      double *dst = t->values + bs * (size_t)k;
+      for (int i = 0; i < rb; ++i)
+        for (int j = 0; j < cb; ++j) dst[rb * j + i] = src[cb * i + j];
+    }
+}
+
+/* t's numbers from a's, t's pattern that of a^T, in parallel ranges of t's rows. */
+static void transpose_numbers(const piola__block_sparse *a, piola__block_sparse *t) {
+  const int32_t n = t->rows;
+#pragma omp parallel for schedule(static) num_threads(piola_thread_count()) if (parallel_product(a))
+  for (int k = 0; k < RANGES; ++k)
+    transpose_numbers_rows(a, t, (int32_t)((int64_t)n * k / RANGES),
+                           (int32_t)((int64_t)n * (k + 1) / RANGES));
+}
+
 piola_status piola__block_sparse_transpose(const piola__block_sparse *a, piola__block_sparse *t) {
   const int64_t entries = piola__block_sparse_entries(a);
   PIOLA_TRY(piola__block_sparse_alloc(t, a->cols, a->rows, a->cb, a->rb, entries));
@@ -523,39 +647,24 @@ piola_status piola__block_sparse_transpose(const piola__block_sparse *a, piola__
     return PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "sparse transpose: out of memory");
   }
   memcpy(next, t->row_start, sizeof(int32_t) * (size_t)a->cols);
-  const int rb = a->rb, cb = a->cb;
-  const size_t bs = (size_t)(rb * cb);
   /* rows in order: each transposed row gets its columns increasing */
   for (int32_t r = 0; r < a->rows; ++r)
-    for (int32_t k = a->row_start[r]; k < a->row_start[r + 1]; ++k) {
-      const int32_t at = next[a->col[k]]++;
-      t->col[at] = r;
-      const double *src = a->values + bs * (size_t)k;
-      double *dst = t->values + bs * (size_t)at;
-      for (int i = 0; i < rb; ++i)
-        for (int j = 0; j < cb; ++j) dst[rb * j + i] = src[cb * i + j];
-    }
+    for (int32_t k = a->row_start[r]; k < a->row_start[r + 1]; ++k) t->col[next[a->col[k]]++] = r;
+  transpose_numbers(a, t);
   free(next);
   return PIOLA_OK;
 }
 
-void piola__block_sparse_symmetrize(piola__block_sparse *a) {
+/* Rows r0 .. r1 - 1: each pair of blocks (r, c), (c, r) with c >= r by the row r; the pairs
+ * of different rows share no block, so ranges run in parallel. */
+static void symmetrize_rows(piola__block_sparse *a, int32_t r0, int32_t r1) {
   const int b = a->rb;
   const size_t bs = (size_t)(b * b);
-  for (int32_t r = 0; r < a->rows; ++r)
+  for (int32_t r = r0; r < r1; ++r)
     for (int32_t k = a->row_start[r]; k < a->row_start[r + 1]; ++k) {
       const int32_t c = a->col[k];
       if (c < r) continue;
-      /* the entry (c, r): a binary search in row c */
-      int32_t lo = a->row_start[c], hi = a->row_start[c + 1];
-      while (lo < hi) {
-        const int32_t mid = lo + (hi - lo) / 2;
-        if (a->col[mid] < r)
-          lo = mid + 1;
-        else
-          hi = mid;
-      }
-      double *x = a->values + bs * (size_t)k, *y = a->values + bs * (size_t)lo;
+      double *x = a->values + bs * (size_t)k, *y = a->values + bs * (size_t)entry_of(a, c, r);
       for (int i = 0; i < b; ++i)
         for (int j = 0; j < b; ++j) {
           if (c == r && j <= i) continue;
@@ -563,4 +672,12 @@ void piola__block_sparse_symmetrize(piola__block_sparse *a) {
           x[b * i + j] = y[b * j + i] = mean;
         }
     }
+}
+
+void piola__block_sparse_symmetrize(piola__block_sparse *a) {
+  const int32_t n = a->rows;
+#pragma omp parallel for schedule(static) num_threads(piola_thread_count()) if (parallel_product(a))
+  for (int k = 0; k < RANGES; ++k)
+    symmetrize_rows(a, (int32_t)((int64_t)n * k / RANGES),
+                    (int32_t)((int64_t)n * (k + 1) / RANGES));
 }

@@ -8,7 +8,9 @@
  * and every row is summed by one thread in a fixed order: products are bit-identical for
  * any thread count. The sparse products (A T, Galerkin's P^T A P) are for the hierarchy's
  * setup; their numbers are formed in parallel ranges of rows (of c for the Galerkin product),
- * each entry summed in the same order whatever the ranges, their patterns on one thread. */
+ * each entry summed in the same order whatever the ranges, and so are their patterns (each
+ * range with its own marker arrays, each row's columns found in the same order whatever the
+ * range; only the running sums of the row lengths on one thread). */
 #ifndef PIOLA_MATH_BLOCK_SPARSE_H
 #define PIOLA_MATH_BLOCK_SPARSE_H
 
@@ -62,11 +64,11 @@ piola_status piola__block_sparse_galerkin_symmetric(const piola__block_sparse *p
                                                     const piola__block_sparse *p,
                                                     piola__block_sparse *c);
 
-/* t = a^T. */
+/* t = a^T: its pattern on one thread, its numbers in parallel ranges of t's rows. */
 piola_status piola__block_sparse_transpose(const piola__block_sparse *a, piola__block_sparse *t);
 
 /* a = (a + a^T) / 2 for a square matrix with a symmetric pattern (columns increasing):
- * the Galerkin products are symmetric only to rounding. */
+ * the Galerkin products are symmetric only to rounding. In parallel ranges of rows. */
 void piola__block_sparse_symmetrize(piola__block_sparse *a);
 
 #endif

@@ -135,9 +135,8 @@ PIOLA_WIDE_VECTORS void PIOLA_ISA_NAME(piola__stiffness_block_lanes)(const piola
       for (int i = 0; i < 3; ++i)
         PIOLA_UNROLL
         for (int j = 0; j < 3; ++j) {
-          double kij = um[i][0] * u[j][0] + um[i][1] * u[j][1] + um[i][2] * u[j][2];
-          kij += 0.0; /* the fibre term's place (no fibres here): keeps the sign of a zero */
-          out[9 * n + 3 * i + j][l] = scale * kij;
+          out[9 * n + 3 * i + j][l] =
+              scale * (um[i][0] * u[j][0] + um[i][1] * u[j][1] + um[i][2] * u[j][2]);
         }
     }
   }

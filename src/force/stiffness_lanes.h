@@ -10,7 +10,8 @@
 #include "force/elastic_body_internal.h"
 
 /* out[e][l] = entry e of piola__tet_stiffness_blocks(body, block * PIOLA_TET_BLOCK + l) for
- * every lane l, the same bits. Only for bodies without fibres, and blocks of real tets. */
+ * every lane l, the same bits, but for the fibre term of a muscle's or HGO's tet, which the
+ * assembly adds tet by tet (stiffness_matrix.c). Only for blocks of real tets. */
 #define PIOLA_STIFFNESS_BLOCK_LANES_PARAMS \
   (const piola_elastic_body * body, int32_t block, double out[54][PIOLA_TET_BLOCK])
 PIOLA_ISA_DECLARE(void, piola__stiffness_block_lanes, PIOLA_STIFFNESS_BLOCK_LANES_PARAMS);

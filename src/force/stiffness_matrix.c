@@ -52,31 +52,39 @@ void piola__tet_diagonal_stiffness(const piola_elastic_body *body, int32_t t,
   piola__diagonal_stiffness_from(fhat, phat, piola__stiffness_projection(body), k);
 }
 
-void piola__tet_stiffness_blocks(const piola_elastic_body *body, int32_t t, double out[54]) {
-  double u[3][3], v[3][3], dm[3][3];
+/* The rows g_a of tet t's Dm^-1 (g_0 = -(g_1 + g_2 + g_3)) and its U and V. */
+static void tet_frame(const piola_elastic_body *body, int32_t t, double g[4][3], double u[3][3],
+                      double v[3][3]) {
+  double dm[3][3];
   for (int k = 0; k < 9; ++k) {
     u[k / 3][k % 3] = body->u[k][t];
     v[k / 3][k % 3] = body->v[k][t];
     dm[k / 3][k % 3] = body->dm_inv[k][t];
   }
-  const piola_material *material = &body->materials[body->tet_material[t]];
-  const double *fhat = body->fhat + 3 * (size_t)t;
-  piola__diagonal_stiffness k;
-  piola__tet_diagonal_stiffness(body, t, &k);
-  /* rows g_a of Dm^-1 (g_0 = -(g_1 + g_2 + g_3)) in the diagonal frame: gh_a = V^T g_a */
-  double g[4][3], gh[4][3];
   for (int j = 0; j < 3; ++j) {
     g[0][j] = -(dm[0][j] + dm[1][j] + dm[2][j]);
     for (int a = 1; a < 4; ++a) g[a][j] = dm[a - 1][j];
   }
-  for (int a = 0; a < 4; ++a)
-    for (int p = 0; p < 3; ++p) gh[a][p] = v[0][p] * g[a][0] + v[1][p] * g[a][1] + v[2][p] * g[a][2];
-  /* pair (p, q) of the diagonal frame: index of its 2x2 block */
-  static const int PAIR_OF[3][3] = {{-1, 0, 1}, {0, -1, 2}, {1, 2, -1}};
+}
+
+/* Adds tet t's fibre term (a muscle's or HGO's, when the body has fibres; nothing otherwise)
+ * to its six corner-pair blocks out[stride (9 p + e)], scaled as the material's part. Kept
+ * apart from that part so that the assembly takes the material's part through the lane
+ * kernel (stiffness_lanes.h) for bodies with fibres too. */
+static void add_fiber_blocks(const piola_elastic_body *body, int32_t t, double *out,
+                             size_t stride) {
+  if (!body->fiber[0]) return;
+  const piola_material *material = &body->materials[body->tet_material[t]];
+  const int muscle = material->model == PIOLA_MODEL_MUSCLE,
+            hgo = material->model == PIOLA_MODEL_HGO;
+  if (!muscle && !hgo) return;
+  double g[4][3], u[3][3], v[3][3];
+  tet_frame(body, t, g, u, v);
+  const double *fhat = body->fhat + 3 * (size_t)t;
   const double scale = -body->rest_volume[t] * body->last_stiffness_scale;
-  /* the fibre term: w = F a = U (fhat * (V^T a)) */
+  /* the muscle's: w = F a = U (fhat * (V^T a)) */
   double fs = 0, fc = 0, fa[3] = {0, 0, 0}, w[3] = {0, 0, 0};
-  if (body->fiber[0] && material->model == PIOLA_MODEL_MUSCLE) {
+  if (muscle) {
     for (int i = 0; i < 3; ++i) fa[i] = body->fiber[i][t];
     double ah[3];
     for (int p = 0; p < 3; ++p) ah[p] = v[0][p] * fa[0] + v[1][p] * fa[1] + v[2][p] * fa[2];
@@ -84,10 +92,10 @@ void piola__tet_stiffness_blocks(const piola_elastic_body *body, int32_t t, doub
       w[i] = u[i][0] * fhat[0] * ah[0] + u[i][1] * fhat[1] * ah[1] + u[i][2] * fhat[2] * ah[2];
     piola__fiber_stiffness_terms(material, sqrt(w[0] * w[0] + w[1] * w[1] + w[2] * w[2]),
                                  body->activation, PIOLA_STIFFNESS_PROJECTED, &fs, &fc);
+    if (fs == 0 && fc == 0) return;
   }
-  /* HGO's fibres: dP_f/dF at F = U Fhat V^T, positive semi-definite as it is (material.h) */
+  /* HGO's: dP_f/dF at F = U Fhat V^T, positive semi-definite as it is (material.h) */
   double hgo_dpdf[81];
-  const int hgo = body->fiber[0] && material->model == PIOLA_MODEL_HGO;
   if (hgo) {
     double fm[9], fam[6];
     for (int i = 0; i < 3; ++i)
@@ -97,6 +105,36 @@ void piola__tet_stiffness_blocks(const piola_elastic_body *body, int32_t t, doub
     (void)piola_material_hgo_families(material, m, fam); /* checked when the body was built */
     piola_material_hgo_fiber_stress_derivative(material, fm, fam, hgo_dpdf);
   }
+  for (int n = 0; n < 6; ++n) {
+    const double *pa = g[PAIR_A[n]], *pb = g[PAIR_B[n]];
+    const double fiber_weight = muscle ? (pa[0] * fa[0] + pa[1] * fa[1] + pa[2] * fa[2]) *
+                                             (pb[0] * fa[0] + pb[1] * fa[1] + pb[2] * fa[2])
+                                       : 0.0;
+    for (int i = 0; i < 3; ++i)
+      for (int j = 0; j < 3; ++j) {
+        double kij = fiber_weight * ((i == j ? fs : 0.0) + fc * w[i] * w[j]);
+        if (hgo)
+          for (int jj = 0; jj < 3; ++jj)
+            for (int l = 0; l < 3; ++l)
+              kij += pa[jj] * hgo_dpdf[9 * (3 * i + jj) + 3 * j + l] * pb[l];
+        out[stride * (size_t)(9 * n + 3 * i + j)] += scale * kij;
+      }
+  }
+}
+
+void piola__tet_stiffness_blocks(const piola_elastic_body *body, int32_t t, double out[54]) {
+  double g[4][3], u[3][3], v[3][3];
+  tet_frame(body, t, g, u, v);
+  piola__diagonal_stiffness k;
+  piola__tet_diagonal_stiffness(body, t, &k);
+  /* the rows g_a of Dm^-1 in the diagonal frame: gh_a = V^T g_a */
+  double gh[4][3];
+  for (int a = 0; a < 4; ++a)
+    for (int p = 0; p < 3; ++p)
+      gh[a][p] = v[0][p] * g[a][0] + v[1][p] * g[a][1] + v[2][p] * g[a][2];
+  /* pair (p, q) of the diagonal frame: index of its 2x2 block */
+  static const int PAIR_OF[3][3] = {{-1, 0, 1}, {0, -1, 2}, {1, 2, -1}};
+  const double scale = -body->rest_volume[t] * body->last_stiffness_scale;
   for (int n = 0; n < 6; ++n) {
     const double *ga = gh[PAIR_A[n]], *gb = gh[PAIR_B[n]];
     double mm[3][3];
@@ -113,25 +151,14 @@ void piola__tet_stiffness_blocks(const piola_elastic_body *body, int32_t t, doub
     /* U M U^T */
     double um[3][3];
     for (int i = 0; i < 3; ++i)
-      for (int q = 0; q < 3; ++q) um[i][q] = u[i][0] * mm[0][q] + u[i][1] * mm[1][q] + u[i][2] * mm[2][q];
-    double fiber_weight = 0;
-    if (fs != 0 || fc != 0) {
-      const double *pa = g[PAIR_A[n]], *pb = g[PAIR_B[n]];
-      fiber_weight = (pa[0] * fa[0] + pa[1] * fa[1] + pa[2] * fa[2]) *
-                     (pb[0] * fa[0] + pb[1] * fa[1] + pb[2] * fa[2]);
-    }
+      for (int q = 0; q < 3; ++q)
+        um[i][q] = u[i][0] * mm[0][q] + u[i][1] * mm[1][q] + u[i][2] * mm[2][q];
     for (int i = 0; i < 3; ++i)
-      for (int j = 0; j < 3; ++j) {
-        double kij = um[i][0] * u[j][0] + um[i][1] * u[j][1] + um[i][2] * u[j][2];
-        kij += fiber_weight * ((i == j ? fs : 0.0) + fc * w[i] * w[j]);
-        if (hgo) {
-          const double *pa = g[PAIR_A[n]], *pb = g[PAIR_B[n]];
-          for (int jj = 0; jj < 3; ++jj)
-            for (int l = 0; l < 3; ++l) kij += pa[jj] * hgo_dpdf[9 * (3 * i + jj) + 3 * j + l] * pb[l];
-        }
-        out[9 * n + 3 * i + j] = scale * kij;
-      }
+      for (int j = 0; j < 3; ++j)
+        out[9 * n + 3 * i + j] =
+            scale * (um[i][0] * u[j][0] + um[i][1] * u[j][1] + um[i][2] * u[j][2]);
   }
+  add_fiber_blocks(body, t, out, 1);
 }
 
 /* Adds (or, for a slot's first writer, stores) weight times tet t's six blocks out[9 p + e]
@@ -160,9 +187,9 @@ static inline __attribute__((always_inline)) void scatter_tet(piola__stiffness_m
   }
 }
 
-/* Range k of the tets (the damping assembly's ranges), in tet order. Whole blocks of a body
- * without fibres go through the lane kernel (stiffness_lanes.h, the same bits), the rest
- * tet by tet. */
+/* Range k of the tets (the damping assembly's ranges), in tet order. Whole blocks go through
+ * the lane kernel (stiffness_lanes.h, the same bits), their fibre terms added tet by tet,
+ * the rest tet by tet. */
 static void assemble_part(piola__stiffness_matrix *m, const piola_elastic_body *body, int k,
                           double weight) {
   const piola__damping_matrix *d = &body->damping;
@@ -170,7 +197,7 @@ static void assemble_part(piola__stiffness_matrix *m, const piola_elastic_body *
   const int32_t t0 = piola__damping_part_start(blocks, k) * PIOLA_TET_BLOCK;
   int32_t t1 = piola__damping_part_start(blocks, k + 1) * PIOLA_TET_BLOCK;
   if (t1 > body->tet_count) t1 = body->tet_count;
-  const int lanes = !body->fiber[0];
+
   /* a split in the local mode assembles the blocks it holds, as the damping assembly does:
    * every tet on one of its nodes, so its nodes' rows are complete, in the same order */
   const uint8_t *held = piola__local_split(body) ? body->split_held : NULL;
@@ -180,10 +207,12 @@ static void assemble_part(piola__stiffness_matrix *m, const piola_elastic_body *
       t = (t / PIOLA_TET_BLOCK + 1) * PIOLA_TET_BLOCK;
       continue;
     }
-    if (lanes && t + PIOLA_TET_BLOCK <= t1) {
+    if (t + PIOLA_TET_BLOCK <= t1) {
       piola__stiffness_block_lanes(body, t / PIOLA_TET_BLOCK, lane_out);
-      for (int l = 0; l < PIOLA_TET_BLOCK; ++l)
+      for (int l = 0; l < PIOLA_TET_BLOCK; ++l) {
+        add_fiber_blocks(body, t + l, &lane_out[0][l], PIOLA_TET_BLOCK);
         scatter_tet(m, d, t + l, &lane_out[0][l], PIOLA_TET_BLOCK, weight);
+      }
       t += PIOLA_TET_BLOCK;
     } else {
       piola__tet_stiffness_blocks(body, t, out);

@@ -196,18 +196,14 @@ void piola__project_symmetric3(double a[3][3]) {
       a[i][j] = q[i][0] * lam[0] * q[j][0] + q[i][1] * lam[1] * q[j][1] + q[i][2] * lam[2] * q[j][2];
 }
 
-int piola__stress_evaluates_own_parts(piola_material_model model) {
+piola_material_model piola__stress_parts_model(piola_material_model model) {
   switch (model) {
-    case PIOLA_MODEL_ROTATED_LINEAR:
-    case PIOLA_MODEL_COROTATED:
-    case PIOLA_MODEL_STVK:
-    case PIOLA_MODEL_NEOHOOKEAN:
-    case PIOLA_MODEL_SPLINE:
-    case PIOLA_MODEL_STABLE_NEOHOOKEAN:
-    case PIOLA_MODEL_OGDEN:
-      return 1;
+    case PIOLA_MODEL_MUSCLE:
+      return PIOLA_MODEL_NEOHOOKEAN;
+    case PIOLA_MODEL_MOONEY_RIVLIN:
+      return PIOLA_MODEL_COUNT;
     default:
-      return 0;
+      return model;
   }
 }
 
@@ -216,11 +212,12 @@ void piola__material_stress_and_derivative(const piola_material *material, const
   /* the default's rise with J (material_threshold_at) can clamp entries above
    * material->threshold */
   const double c = material_threshold_largest(material);
-  if (fhat[0] >= c && fhat[1] >= c && fhat[2] >= c && piola__stress_evaluates_own_parts(material->model)) {
+  const piola_material_model parts_model = piola__stress_parts_model(material->model);
+  if (fhat[0] >= c && fhat[1] >= c && fhat[2] >= c && parts_model != PIOLA_MODEL_COUNT) {
     /* no entry clamped: every extension term is an exact zero, the parts are the answer */
     material_parts parts;
-    material_model_parts(material->model, material, KERNEL_EXACT_DIVIDE, fhat[0], fhat[1],
-                         fhat[2], &parts);
+    material_model_parts(parts_model, material, KERNEL_EXACT_DIVIDE, fhat[0], fhat[1], fhat[2],
+                         &parts);
     memcpy(phat, parts.p, sizeof parts.p);
     memcpy(dphat, parts.k, sizeof parts.k);
     return;

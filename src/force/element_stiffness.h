@@ -81,17 +81,19 @@ void piola__diagonal_stiffness_from(const double fhat[3], const double phat[3], 
 /* Phat and dPhat/dFhat at fhat: the values of piola_material_stress and
  * piola_material_stress_derivative. Where no entry of fhat is below the inversion threshold
  * (most elements) the extensions add exact zeros, so both are the model's own stress and
- * Hessian there, from one evaluation of the model (material_kernels.h's parts) instead of one
- * per public function; elsewhere, and for the models whose stress evaluates another model's
- * parts (HGO's and the muscle's matrix, Mooney-Rivlin), through the public functions. For
- * the implicit assembly, where the two calls were half of its time. */
+ * Hessian there, from one evaluation of the parts its stress kernel evaluates
+ * (material_kernels.h; piola__stress_parts_model) instead of one per public function;
+ * elsewhere through the public functions. For the implicit assembly, where the two calls
+ * were half of its time. */
 void piola__material_stress_and_derivative(const piola_material *material, const double fhat[3],
                                            double phat[3], double dphat[3][3]);
 
-/* 1 for the models whose stress kernel evaluates the parts of the model itself, where the
- * above takes its one-evaluation path (HGO's and the muscle's matrix is evaluated as
- * neo-Hookean, Mooney-Rivlin as Ogden's terms: 0). */
-int piola__stress_evaluates_own_parts(piola_material_model model);
+/* The model whose parts a model's stress kernel evaluates, where the above takes its
+ * one-evaluation path: the model's own (HGO's matrix has its own case among the parts, the
+ * neo-Hookean's arithmetic), the muscle's matrix neo-Hookean's; PIOLA_MODEL_COUNT for
+ * Mooney-Rivlin, whose public derivative (closed form) differs from its Ogden terms' parts in
+ * the last bit, so it takes the public functions. */
+piola_material_model piola__stress_parts_model(piola_material_model model);
 
 /* The fibre term's two coefficients at fibre stretch lambda (see above), Pa: s and c with
  * dP_f/dF = s (I (x) a a^T) + c (w (x) a)(w (x) a)^T for a unit a. With project (any but

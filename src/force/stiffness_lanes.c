@@ -35,18 +35,16 @@ static const int PAIR_A[6] = {0, 0, 0, 1, 1, 2}, PAIR_B[6] = {1, 2, 3, 2, 3, 3};
 
 /* Phat and dPhat/dFhat of the block's tets from one lane loop, the values (and bits) of
  * piola__material_stress_and_derivative; 0 (nothing written) where that takes the public
- * path for some lane: a body of several materials, a model whose stress evaluates another
- * model's parts, an entry below the threshold. */
+ * path for some lane: a body of several materials, an entry below the threshold. */
 static int material_parts_lanes(const piola_elastic_body *body, int32_t base, double phat[3][B],
                                 double dphat[9][B]) {
   if (body->uniform_material < 0) return 0;
   const piola_material *m = &body->materials[body->uniform_material];
-  if (!piola__stress_evaluates_own_parts(m->model)) return 0;
   const double *fhat = body->fhat + 3 * (size_t)base, c = material_threshold_largest(m);
   int unclamped = 1;
   for (int e = 0; e < 3 * B; ++e) unclamped &= fhat[e] >= c;
   if (!unclamped) return 0;
-  switch (m->model) {
+  switch (piola__stress_parts_model(m->model)) {
     case PIOLA_MODEL_ROTATED_LINEAR: PARTS_LANES(PIOLA_MODEL_ROTATED_LINEAR); return 1;
     case PIOLA_MODEL_COROTATED: PARTS_LANES(PIOLA_MODEL_COROTATED); return 1;
     case PIOLA_MODEL_STVK: PARTS_LANES(PIOLA_MODEL_STVK); return 1;
@@ -54,6 +52,7 @@ static int material_parts_lanes(const piola_elastic_body *body, int32_t base, do
     case PIOLA_MODEL_SPLINE: PARTS_LANES(PIOLA_MODEL_SPLINE); return 1;
     case PIOLA_MODEL_STABLE_NEOHOOKEAN: PARTS_LANES(PIOLA_MODEL_STABLE_NEOHOOKEAN); return 1;
     case PIOLA_MODEL_OGDEN: PARTS_LANES(PIOLA_MODEL_OGDEN); return 1;
+    case PIOLA_MODEL_HGO: PARTS_LANES(PIOLA_MODEL_HGO); return 1;
     default: return 0;
   }
 }

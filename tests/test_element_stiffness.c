@@ -402,10 +402,18 @@ static void dense_element(const piola_elastic_body *body, int32_t t, double k[14
         }
 }
 
-static void check_body_matrix(piola_material_model model, double squash) {
+/* hgo_kappa: HGO's fibre dispersion (0: the fixture's material, the default's 0) */
+static void check_body_matrix(piola_material_model model, double squash, double hgo_kappa) {
   piola_tet_mesh mesh = fixture_grid(2, 0.5);
   piola_elastic_body_def def = piola_default_elastic_body_def();
   piola_material mat = fixture_material(model);
+  if (hgo_kappa > 0) {
+    piola_material_def mdef = piola_default_material_def();
+    mdef.model = PIOLA_MODEL_HGO;
+    mdef.poisson_ratio = 0.3;
+    mdef.hgo.kappa = hgo_kappa;
+    assert_int_equal(piola_material_init(&mdef, &mat), PIOLA_OK);
+  }
   def.rest_mesh = &mesh;
   def.materials = &mat;
   def.material_count = 1;
@@ -634,10 +642,13 @@ static void test_signed_twist_only_where_compressed(void **state) {
 static void test_assembled_matrix(void **state) {
   (void)state;
   for (int model = 0; model < PIOLA_MODEL_COUNT; ++model) {
-    check_body_matrix((piola_material_model)model, 0.9);  /* stretched and squashed */
-    check_body_matrix((piola_material_model)model, -0.4); /* inverted through the plane */
-    check_body_matrix((piola_material_model)model, 0.0);  /* flat */
+    check_body_matrix((piola_material_model)model, 0.9, 0);  /* stretched and squashed */
+    check_body_matrix((piola_material_model)model, -0.4, 0); /* inverted through the plane */
+    check_body_matrix((piola_material_model)model, 0.0, 0);  /* flat */
   }
+  /* HGO with dispersed fibres: the isotropic part of its fibre term */
+  check_body_matrix(PIOLA_MODEL_HGO, 0.9, 0.2);
+  check_body_matrix(PIOLA_MODEL_HGO, -0.4, 0.2);
 }
 
 int main(void) {

@@ -95,12 +95,10 @@ static void add_fiber_blocks(const piola_elastic_body *body, int32_t t, double *
                                  body->activation, PIOLA_STIFFNESS_PROJECTED, &fs, &fc);
     if (fs == 0 && fc == 0) return;
   }
-  /* HGO's, dP_f/dF at F = U Fhat V^T, positive semi-definite as it is (material.h): per
-   * family n, with curve slope s and curvature c at its invariant and
-   * G = kappa F + (1 - 3 kappa) (F n) n^T,
-   *   dP_ij/dF_kl = 4 c G_ij G_kl + delta_ik 2 s (kappa delta_jl + (1 - 3 kappa) n_j n_l),
-   * so pair (a, b)'s block, the sum over j and l of g_a[j] dP_ij/dF_kl g_b[l], is
-   *   4 c (G g_a)(G g_b)^T + 2 s (kappa g_a . g_b + (1 - 3 kappa) (g_a . n)(g_b . n)) I:
+  /* HGO's, dP_f/dF at F = U Fhat V^T, positive semi-definite as it is (material.h), in the
+   * factored form of hgo_family_derivative: pair (a, b)'s block, the sum over j and l of
+   * g_a[j] dP_ij/dF_kl g_b[l], is per family
+   *   c4 (G g_a)(G g_b)^T + s2 (kappa g_a . g_b + (1 - 3 kappa) (g_a . n)(g_b . n)) I,
    * a fifth of the products of contracting the 81 numbers of dP_f/dF with g_a and g_b */
   double hgo_blocks[6][9] = {{0}};
   if (hgo) {
@@ -113,12 +111,8 @@ static void add_fiber_blocks(const piola_elastic_body *body, int32_t t, double *
     (void)piola_material_hgo_families(material, m, fam); /* checked when the body was built */
     for (int a = 0; a < 2; ++a) {
       const double *n = fam + 3 * a;
-      double fn[3], psi, slope, curvature; /* fn = F n */
-      hgo_fiber_curve(h, hgo_invariant(h, fm, n, fn), &psi, &slope, &curvature);
-      double gm[9], gg[4][3], gn[4];
-      for (int i = 0; i < 3; ++i)
-        for (int j = 0; j < 3; ++j)
-          gm[3 * i + j] = h->kappa * fm[3 * i + j] + (1.0 - 3.0 * h->kappa) * fn[i] * n[j];
+      double gm[9], c4, s2, gg[4][3], gn[4];
+      hgo_family_derivative(h, fm, n, gm, &c4, &s2);
       for (int c = 0; c < 4; ++c) {
         gn[c] = g[c][0] * n[0] + g[c][1] * n[1] + g[c][2] * n[2];
         for (int i = 0; i < 3; ++i)
@@ -127,11 +121,9 @@ static void add_fiber_blocks(const piola_elastic_body *body, int32_t t, double *
       for (int p = 0; p < 6; ++p) {
         const int ca = PAIR_A[p], cb = PAIR_B[p];
         const double dot = g[ca][0] * g[cb][0] + g[ca][1] * g[cb][1] + g[ca][2] * g[cb][2];
-        const double diagonal =
-            2.0 * slope * (h->kappa * dot + (1.0 - 3.0 * h->kappa) * gn[ca] * gn[cb]);
+        const double diagonal = s2 * (h->kappa * dot + (1.0 - 3.0 * h->kappa) * gn[ca] * gn[cb]);
         for (int i = 0; i < 3; ++i) {
-          for (int k = 0; k < 3; ++k)
-            hgo_blocks[p][3 * i + k] += 4.0 * curvature * gg[ca][i] * gg[cb][k];
+          for (int k = 0; k < 3; ++k) hgo_blocks[p][3 * i + k] += c4 * gg[ca][i] * gg[cb][k];
           hgo_blocks[p][4 * i] += diagonal;
         }
       }

@@ -121,17 +121,14 @@ void piola_material_hgo_fiber_stress_derivative(const piola_material *material, 
   const piola_hgo_def *h = &material->hgo;
   for (int a = 0; a < 2; ++a) {
     const double *n = families + 3 * a;
-    double w[3], psi, slope, curvature, g[9];
-    hgo_fiber_curve(h, hgo_invariant(h, f, n, w), &psi, &slope, &curvature);
-    for (int i = 0; i < 3; ++i)
-      for (int j = 0; j < 3; ++j) g[3 * i + j] = h->kappa * f[3 * i + j] + (1.0 - 3.0 * h->kappa) * w[i] * n[j];
+    double g[9], c4, s2;
+    hgo_family_derivative(h, f, n, g, &c4, &s2);
     for (int i = 0; i < 3; ++i)
       for (int j = 0; j < 3; ++j)
         for (int k = 0; k < 3; ++k)
           for (int l = 0; l < 3; ++l) {
-            double v = 4.0 * curvature * g[3 * i + j] * g[3 * k + l];
-            if (i == k)
-              v += 2.0 * slope * (h->kappa * (j == l) + (1.0 - 3.0 * h->kappa) * n[j] * n[l]);
+            double v = c4 * g[3 * i + j] * g[3 * k + l];
+            if (i == k) v += s2 * (h->kappa * (j == l) + (1.0 - 3.0 * h->kappa) * n[j] * n[l]);
             dpdf[9 * (3 * i + j) + 3 * k + l] += v;
           }
   }

@@ -83,6 +83,21 @@ MATERIAL_KERNEL double hgo_invariant(const piola_hgo_def *h, const double f[9], 
   return h->kappa * (i1 - 3.0) + (1.0 - 3.0 * h->kappa) * (i4 - 1.0);
 }
 
+/* One family's part of dP_f/dF at a 3x3 f (row-major) in factored form: with G = kappa f +
+ * (1 - 3 kappa) (f n) n^T (into g), c4 = 4 psi'' and s2 = 2 psi' at the family's E,
+ *   dP_ij/dF_kl = c4 G_ij G_kl + delta_ik s2 (kappa delta_jl + (1 - 3 kappa) n_j n_l).
+ * The public dP_f/dF forms its 81 numbers from it; the implicit assembly contracts it with the
+ * shape gradients without forming them (force/stiffness_matrix.c). */
+MATERIAL_KERNEL void hgo_family_derivative(const piola_hgo_def *h, const double f[9],
+                                           const double n[3], double g[9], double *c4, double *s2) {
+  double w[3], psi, slope, curvature;
+  hgo_fiber_curve(h, hgo_invariant(h, f, n, w), &psi, &slope, &curvature);
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j)
+      g[3 * i + j] = h->kappa * f[3 * i + j] + (1.0 - 3.0 * h->kappa) * w[i] * n[j];
+  *c4 = 4.0 * curvature, *s2 = 2.0 * slope;
+}
+
 /* One family's share of the fibres' plane-wave stiffness bound (Pa) at a state whose largest
  * |f_i| is BIG, with I4 = |Fhat ahat|^2, slope psi' and curvature psi'' at its E: per family,
  *   dF : C_a : dF = 4 psi''(E_a) (G_a : dF)^2 + 2 psi'(E_a) (kappa |dF|^2 + (1 - 3 kappa) |dF a|^2)

@@ -322,26 +322,20 @@ static void chebyshev(const piola__multigrid_level *l, int degree, int zero_star
   }
 }
 
-/* Rows r0 .. r1 - 1 of a power iteration's two passes: sums[0] = v . A v and sums[1] =
- * v . D v (av = A v), or (normalize) v = D^-1 av and sums[0] = its squared size. */
-static void power_rows(const piola__multigrid_level *l, const double *av, int32_t r0, int32_t r1,
-                       int normalize, double sums[2]) {
+/* A power iteration's two passes over rows r0 .. r1 - 1 (av = A v), each leaving its partial
+ * sums in sums[0 .. 1]. */
+typedef void power_rows(const piola__multigrid_level *l, const double *av, int32_t r0, int32_t r1,
+                        double sums[2]);
+
+/* The Rayleigh quotient's parts: sums[0] = v . A v, sums[1] = v . D v. */
+static void quotient_rows(const piola__multigrid_level *l, const double *av, int32_t r0, int32_t r1,
+                          double sums[2]) {
   const int b = l->a.rb;
-  double *v = l->mode;
+  const double *v = l->mode;
   sums[0] = sums[1] = 0;
   for (int32_t r = r0; r < r1; ++r) {
-    double *vr = v + (size_t)b * r;
+    const double *vr = v + (size_t)b * r;
     const double *ar = av + (size_t)b * r;
-    if (normalize) {
-      const double *dinv = l->inverse_diagonal + (size_t)(b * b) * (size_t)r;
-      double t[6];
-      for (int i = 0; i < b; ++i) {
-        t[i] = 0;
-        for (int j = 0; j < b; ++j) t[i] += dinv[b * i + j] * ar[j];
-      }
-      for (int i = 0; i < b; ++i) vr[i] = t[i], sums[0] += t[i] * t[i];
-      continue;
-    }
     for (int i = 0; i < b; ++i) sums[0] += vr[i] * ar[i];
     const int32_t k = diagonal_entry(&l->a, r);
     if (k < 0) continue;
@@ -351,17 +345,36 @@ static void power_rows(const piola__multigrid_level *l, const double *av, int32_
   }
 }
 
-/* sums[0 .. 1] of power_rows over the level's rows: the RANGES ranges' partial sums added in
+/* The next iterate before its scaling: v = D^-1 av, and sums[0] = its squared size. */
+static void next_iterate_rows(const piola__multigrid_level *l, const double *av, int32_t r0,
+                              int32_t r1, double sums[2]) {
+  const int b = l->a.rb;
+  double *v = l->mode;
+  sums[0] = sums[1] = 0;
+  for (int32_t r = r0; r < r1; ++r) {
+    double *vr = v + (size_t)b * r;
+    const double *ar = av + (size_t)b * r;
+    const double *dinv = l->inverse_diagonal + (size_t)(b * b) * (size_t)r;
+    double t[6];
+    for (int i = 0; i < b; ++i) {
+      t[i] = 0;
+      for (int j = 0; j < b; ++j) t[i] += dinv[b * i + j] * ar[j];
+    }
+    for (int i = 0; i < b; ++i) vr[i] = t[i], sums[0] += t[i] * t[i];
+  }
+}
+
+/* sums[0 .. 1] of one pass over the level's rows: the RANGES ranges' partial sums added in
  * range order, so the result does not depend on the thread count. */
-static void power_pass(const piola__multigrid_level *l, const double *av, int normalize,
+static void power_pass(const piola__multigrid_level *l, const double *av, power_rows *rows,
                        double sums[2]) {
   const int32_t n = l->a.rows;
   double part[RANGES][2];
 #pragma omp parallel for schedule(static) \
     num_threads(piola_thread_count()) if (n >= MULTIGRID_PARALLEL_MIN_ROWS)
   for (int k = 0; k < RANGES; ++k)
-    power_rows(l, av, (int32_t)((int64_t)n * k / RANGES), (int32_t)((int64_t)n * (k + 1) / RANGES),
-               normalize, part[k]);
+    rows(l, av, (int32_t)((int64_t)n * k / RANGES), (int32_t)((int64_t)n * (k + 1) / RANGES),
+         part[k]);
   sums[0] = sums[1] = 0;
   for (int k = 0; k < RANGES; ++k) sums[0] += part[k][0], sums[1] += part[k][1];
 }
@@ -383,11 +396,11 @@ static double spectral_radius(const piola__multigrid_level *l, int iterations, i
     piola__block_sparse_apply(&l->a, v, av, 0);
     /* v . A v and v . D v */
     double sums[2];
-    power_pass(l, av, 0, sums);
+    power_pass(l, av, quotient_rows, sums);
     if (!(sums[1] > 0)) break;
     quotient = sums[0] / sums[1];
     /* v = D^-1 A v, normalized */
-    power_pass(l, av, 1, sums);
+    power_pass(l, av, next_iterate_rows, sums);
     const double size = sums[0];
     if (!(size > 0) || !isfinite(size)) break;
     const double scale = 1.0 / sqrt(size);

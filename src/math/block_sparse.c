@@ -211,6 +211,22 @@ static int32_t product_row_columns(const piola__block_sparse *a, const piola__bl
   return count;
 }
 
+/* lengths[r] = the number of distinct columns of row r of a b for every row of a, over
+ * `ranges` ranges of rows, each with its own marker and list (width each). */
+static void product_row_lengths(const piola__block_sparse *a, const piola__block_sparse *b,
+                                int32_t *lengths, int ranges, int32_t *marker, int32_t *list,
+                                int32_t width) {
+  const int32_t rows = a->rows;
+#pragma omp parallel for schedule(static) num_threads(piola_thread_count()) if (ranges > 1)
+  for (int k = 0; k < ranges; ++k) {
+    int32_t *mk = marker + (size_t)width * (size_t)k, *lk = list + (size_t)width * (size_t)k;
+    for (int32_t j = 0; j < width; ++j) mk[j] = -1;
+    for (int32_t r = (int32_t)((int64_t)rows * k / ranges);
+         r < (int32_t)((int64_t)rows * (k + 1) / ranges); ++r)
+      lengths[r] = product_row_columns(a, b, r, mk, lk, 0);
+  }
+}
+
 /* c += a b for blocks R x K and K x C, fixed sizes for the products the multigrid setup
  * forms (A T and A P: 3x3 by 3x6; P^T (A P): 6x3 by 3x6; the coarse levels: 6x6 by 6x6). */
 typedef void block_multiply_add(const double *a, const double *b, double *c, int r, int k, int cc);
@@ -316,14 +332,7 @@ piola_status piola__block_sparse_product(const piola__block_sparse *a, const pio
     status = PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "sparse product: out of memory");
     goto done;
   }
-  for (size_t j = 0; j < work; ++j) marker[j] = -1;
-#pragma omp parallel for schedule(static) num_threads(piola_thread_count()) if (ranges > 1)
-  for (int k = 0; k < ranges; ++k) {
-    const size_t w = (size_t)cols * (size_t)k;
-    for (int32_t r = (int32_t)((int64_t)rows * k / ranges);
-         r < (int32_t)((int64_t)rows * (k + 1) / ranges); ++r)
-      counts[r] = product_row_columns(a, b, r, marker + w, list + w, 0);
-  }
+  product_row_lengths(a, b, counts, ranges, marker, list, cols);
   int64_t entries = 0;
   for (int32_t r = 0; r < rows; ++r) entries += counts[r];
   status = piola__block_sparse_alloc(c, rows, b->cols, a->rb, b->cb, entries);
@@ -452,16 +461,16 @@ static int32_t galerkin_row_columns(const piola__block_sparse *pt, const galerki
   return count;
 }
 
-/* The four pattern passes of the plan, each over `ranges` ranges of rows with their own
- * marker and list (width each, marker -1 on entry to each pass): a p's row lengths, its
- * columns, c's row lengths, c's columns sorted. Each row's columns are found in the same
+/* The plan's pattern passes after a p's row lengths (product_row_lengths), each over `ranges`
+ * ranges of rows with their own marker and list (width each): a p's columns, c's row lengths,
+ * c's columns sorted. Each row's columns are found in the same
  * order whatever the range, so the pattern does not depend on the ranges. */
-enum { PASS_AP_COUNT, PASS_AP_COLUMNS, PASS_C_COUNT, PASS_C_COLUMNS };
+enum { PASS_AP_COLUMNS, PASS_C_COUNT, PASS_C_COLUMNS };
 
 static void plan_pass(const piola__block_sparse *pt, const piola__block_sparse *a,
                       const piola__block_sparse *p, galerkin_plan *plan, piola__block_sparse *c,
                       int pass, int ranges, int32_t *marker, int32_t *list, int32_t width) {
-  const int over_ap = pass == PASS_AP_COUNT || pass == PASS_AP_COLUMNS;
+  const int over_ap = pass == PASS_AP_COLUMNS;
 #pragma omp parallel for schedule(static) num_threads(piola_thread_count()) if (ranges > 1)
   for (int k = 0; k < ranges; ++k) {
     int32_t *mk = marker + (size_t)width * (size_t)k, *lk = list + (size_t)width * (size_t)k;
@@ -471,9 +480,6 @@ static void plan_pass(const piola__block_sparse *pt, const piola__block_sparse *
     const int32_t r1 =
         over_ap ? (int32_t)((int64_t)rows * (k + 1) / ranges) : range_row(pt, k + 1, ranges);
     for (int32_t r = r0; r < r1; ++r) switch (pass) {
-        case PASS_AP_COUNT:
-          plan->ap_start[r + 1] = product_row_columns(a, p, r, mk, lk, 0);
-          break;
         case PASS_AP_COLUMNS:
           product_row_columns(a, p, r, mk, plan->ap_col + plan->ap_start[r], 0);
           break;
@@ -517,7 +523,7 @@ static piola_status make_galerkin_plan(const piola__block_sparse *pt, const piol
   piola_status status = PIOLA_OK;
   if (!marker || !list || !lengths || !plan->ap_start) goto out_of_memory;
   /* the pattern of a p, row by row (unsorted: each (g, h) of c gets one term per row r) */
-  plan_pass(pt, a, p, plan, c, PASS_AP_COUNT, ranges, marker, list, width);
+  product_row_lengths(a, p, plan->ap_start + 1, ranges, marker, list, width);
   plan->longest = 1;
   const int64_t ap_entries = running_sums(plan->ap_start, n, &plan->longest);
   if (ap_entries > INT32_MAX) {

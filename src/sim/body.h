@@ -79,10 +79,12 @@ typedef struct world_body {
   int product_valid;
   uint8_t *colliding;
   double *normals;
-  /* solids: the state-aware step bound of the last update (stable_step.h): max over tets of
-   * k_e / (rho h_e^2), 1/s^2, and the tet that attains it; a cache of a function of the
-   * update's per-tet state, valid until the next update (world_solids.c) */
-  double state_rate2;
+  /* the state-aware step bound of the last update, a cache of a function of the update's
+   * per-element state, valid until the next update. Solids (stable_step.h, world_solids.c):
+   * max over tets of k_e / (rho h_e^2), 1/s^2, and the tet that attains it. Shells
+   * (shell_stable_step.h, world_shells.c): the membrane's term and its triangle, and the
+   * bending term in state_bending_rate2 */
+  double state_rate2, state_bending_rate2;
   int32_t state_worst_tet;
   int state_rate_valid;
   uint32_t split_pending; /* solids: split before a rebuild whose replan is deferred

@@ -466,6 +466,7 @@ static void shell_state(stream *s, world_body *b) {
   one_double(s, &sh->last_stiffness_scale, "shell stiffness scale");
   one_double(s, &b->quasistatic_mu, "shell quasistatic regularization");
   field(s, &b->shell_stats, 1, sizeof b->shell_stats, "shell stats");
+  if (s->reading && s->store && !s->failed) b->state_rate_valid = 0; /* from the restored state */
 }
 
 /* A byte string of variable length: its length, then the bytes. Reading hands out where

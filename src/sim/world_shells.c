@@ -10,6 +10,7 @@
 
 #include "common/status_report.h"
 #include "math/mat3.h"
+#include "shell/shell_stable_step.h"
 #include "sim/world_internal.h"
 
 piola_shell_def piola_default_shell_def(void) {
@@ -29,17 +30,41 @@ piola_shell_def piola_default_shell_def(void) {
 
 piola_status piola__shell_update_forces(world_body *s, double t) {
   double scale = piola_track_eval(&s->stiffness_scale, t);
+  s->state_rate_valid = 0;
   return piola_shell_body_update(s->shell, s->x, scale, s->force, &s->shell_stats);
 }
 
+/* The state-aware terms of shell s (shell_stable_step.h), computed once per update. */
+static void shell_state_rates(const world_body *s) {
+  world_body *cache = (world_body *)s; /* a cache of a function of the const state */
+  if (cache->state_rate_valid) return;
+  cache->state_rate2 = piola__shell_body_membrane_rate2(s->shell, &cache->state_worst_tet);
+  cache->state_bending_rate2 = piola__shell_body_bending_rate2(s->shell);
+  cache->state_rate_valid = 1;
+}
+
+/* The smaller of a rest bound and a state bound cfl / sqrt(rate2), the state bound only where
+ * it is smaller by more than rounding: a shell at rest keeps the rest step's bits. */
+static double state_or_rest(double rest, double cfl, double rate2) {
+  const double state = rate2 > 0 ? cfl / sqrt(rate2) : INFINITY;
+  return state < rest * (1.0 - 1e-9) ? state : rest;
+}
+
+/* The step of shell s: its membrane and bending bounds, each the rest bound or the
+ * state-aware one where that is smaller (docs/time-stepping.md, "Step size"). */
 double piola__shell_stable_dt(const piola_world *w, const world_body *s, double scale) {
   double dt = INFINITY;
+  if (!(scale > 0)) return dt;
+  shell_state_rates(s);
   double speed = piola_shell_body_max_wave_speed(s->shell) * sqrt(scale);
   double h = piola_shell_body_min_rest_altitude(s->shell);
-  if (speed > 0 && h > 0) dt = w->def.cfl * h / speed;
+  if (speed > 0 && h > 0)
+    dt = state_or_rest(w->def.cfl * h / speed, w->def.cfl, s->state_rate2 * scale);
   /* bending: explicit, stable up to ~2 sqrt(m/k); cfl in (0, 2] scales it the same way */
   double bending = piola_shell_body_bending_time_scale(s->shell);
-  if (scale > 0 && isfinite(bending)) dt = fmin(dt, w->def.cfl * bending / sqrt(scale));
+  if (isfinite(bending))
+    dt = fmin(dt, state_or_rest(w->def.cfl * bending / sqrt(scale), w->def.cfl,
+                                s->state_bending_rate2 * scale));
   return dt;
 }
 

@@ -12,22 +12,41 @@
 #include "piola/mesher.h"
 
 static void usage(FILE *out) {
-  fprintf(out,
-          "usage: piola mesh generate SHAPE -o OUT [options]\n"
-          "\n"
-          "SHAPE is sphere, box, torus, cylinder, capsule, or a closed surface file (.obj .off .stl).\n"
-          "OUT is a tet mesh file (.msh .vtu .node .mesh, or .obj for its boundary).\n"
-          "\n"
-          "options (lengths in metres):\n"
-          "  --cell-size H          BCC lattice spacing (cube edge). Default: 1/20 of the shape's size\n"
-          "                         (for surfaces: of the largest extent, at most 1/8 of the smallest)\n"
-          "  --refine N             red-green refinement levels toward the surface (0..6, default 0)\n"
-          "  --radius R             sphere, cylinder, capsule radius; torus major radius (default 1)\n"
-          "  --minor-radius r       torus tube radius (default 0.25)\n"
-          "  --half-extents a,b,c   box half sizes (default 1,1,1)\n"
-          "  --half-length h        cylinder half height, capsule half segment (default 1)\n"
-          "  --center x,y,z         shape centre (default 0,0,0)\n"
-          "  --axis x,y,z           torus, cylinder, capsule axis (default 0,0,1)\n");
+  fprintf(
+      out,
+      "usage: piola mesh generate SHAPE -o OUT [options]\n"
+      "\n"
+      "SHAPE is sphere, box, torus, cylinder, capsule, a closed surface file (.obj .off .stl),\n"
+      "or a tet mesh file (.msh .mesh .node .veg .vtu), remeshed inside its boundary surface.\n"
+      "OUT is a tet mesh file (.msh .vtu .node .mesh, or .obj for its boundary).\n"
+      "\n"
+      "options (lengths in metres):\n"
+      "  --cell-size H          BCC lattice spacing (cube edge). Default: 1/20 of the shape's "
+      "size\n"
+      "                         (for surfaces: of the largest extent, at most 1/8 of the "
+      "smallest)\n"
+      "  --refine N             red-green refinement levels toward the surface (0..6, default 0)\n"
+      "  --radius R             sphere, cylinder, capsule radius; torus major radius (default 1)\n"
+      "  --minor-radius r       torus tube radius (default 0.25)\n"
+      "  --half-extents a,b,c   box half sizes (default 1,1,1)\n"
+      "  --half-length h        cylinder half height, capsule half segment (default 1)\n"
+      "  --center x,y,z         shape centre (default 0,0,0)\n"
+      "  --axis x,y,z           torus, cylinder, capsule axis (default 0,0,1)\n");
+}
+
+/* SHAPE as a closed surface: a surface file, or the boundary of a tet mesh file (remeshing a
+ * mesh whose slivers force tiny steps: the sliver warning suggests it, docs/cli.md). */
+static piola_status read_shape_surface(const char *path, piola_tri_mesh *surface) {
+  const char *dot = strrchr(path, '.');
+  static const char *const surfaces[] = {".obj", ".off", ".stl"};
+  for (size_t k = 0; dot && k < sizeof surfaces / sizeof surfaces[0]; ++k)
+    if (strcasecmp(dot, surfaces[k]) == 0) return piola_tri_mesh_read(path, surface);
+  piola_tet_mesh tets;
+  piola_status st = piola_tet_mesh_read(path, &tets);
+  if (st != PIOLA_OK) return st;
+  st = piola_tet_mesh_boundary(&tets, surface);
+  piola_tet_mesh_free(&tets);
+  return st;
 }
 
 static double shape_size(const piola_shape *s) {
@@ -126,9 +145,11 @@ int cli_mesh_generate(int argc, char **argv) {
       found = 1;
     }
   if (!found) {
-    piola_status st = piola_tri_mesh_read(shape_arg, &surface);
+    piola_status st = read_shape_surface(shape_arg, &surface);
     if (st != PIOLA_OK) {
-      fprintf(stderr, "piola mesh generate: SHAPE '%s' is not a primitive name and not a readable surface: %s\n",
+      fprintf(stderr,
+              "piola mesh generate: SHAPE '%s' is not a primitive name, a readable surface or a "
+              "readable tet mesh: %s\n",
               shape_arg, piola_last_error());
       return st == PIOLA_ERROR_IO ? 1 : 2;
     }

@@ -95,20 +95,23 @@ void piola__world_check_slivers(piola_world *w, const world_body *s) {
                             "%stet %d (dihedral angles %.2f to %.2f degrees) forces %.3g s",
                             q ? "; " : "", (int)worst[q], lo, hi, step[worst[q]]);
   }
-  if (w->def.integrator == PIOLA_INTEGRATOR_NEWMARK)
-    piola__world_warn(w, PIOLA_WARNING_SLIVER,
-                      "solid '%s': sliver elements set the step: %s, %.0f times below the median "
-                      "tet's %.3g s (tets numbered from 0 in file order); remesh with `piola mesh "
-                      "generate` for a step near the median",
-                      s->name, list, median / step[worst[0]], median);
-  else /* the implicit step is integrator.dt: slivers slow its linear solves instead */
+  if (w->def.integrator == PIOLA_INTEGRATOR_NEWMARK) {
+    /* at a max_dt below the slivers' step they set nothing */
+    if (step[worst[0]] < w->def.max_dt)
+      piola__world_warn(w, PIOLA_WARNING_SLIVER,
+                        "solid '%s': sliver elements set the step: %s, %.0f times below the "
+                        "median tet's %.3g s (tets numbered from 0 in file order); remesh with "
+                        "`piola mesh generate MESH_FILE -o NEW_MESH_FILE` (inside the mesh's "
+                        "boundary, mesher.md) for a step near the median",
+                        s->name, list, median / step[worst[0]], median);
+  } else /* the implicit step is integrator.dt: slivers slow its linear solves instead */
     piola__world_warn(w, PIOLA_WARNING_SLIVER,
                       "solid '%s': sliver elements would set a \"newmark\" step: %s, %.0f times "
                       "below the median tet's %.3g s (tets numbered from 0 in file order); "
                       "\"%s\" steps integrator.dt whatever they force, but its conjugate "
                       "gradient converges more slowly on them (integrator.preconditioner "
                       "\"incomplete_cholesky\" or \"multigrid\" helps); remesh with `piola mesh "
-                      "generate` to avoid both",
+                      "generate MESH_FILE -o NEW_MESH_FILE` to avoid both",
                       s->name, list, median / step[worst[0]], median,
                       piola_integrator_type_name(w->def.integrator));
   free(step);

@@ -136,6 +136,15 @@ try:
         # tetgen itself reads piola's .node (as a point set to re-mesh)
         run("tetgen", "-Q", out)
         check(os.path.exists(os.path.join(sub, "back.1.ele")), f"tetgen {label}: tetgen reads piola's .node")
+    # a sliver mesh remeshed inside its boundary (the sliver warning's suggestion, docs/cli.md)
+    bunny = os.path.join(os.environ["PIOLA_DATA_DIR"], "gmsh", "bunny.msh")
+    remeshed = os.path.join(work, "bunny_remeshed.msh")
+    run(PIOLA, "mesh", "generate", bunny, "-o", remeshed)
+    before, after = info(bunny), info(remeshed)
+    check(after["min_dihedral_degrees"] > 5 > before["min_dihedral_degrees"],
+          f"bunny.msh remeshed: smallest dihedral {before['min_dihedral_degrees']} -> {after['min_dihedral_degrees']} degrees")
+    check(abs(after["volume"] - before["volume"]) < 0.1 * before["volume"] and after["closed"],
+          f"bunny.msh remeshed: volume {before['volume']} -> {after['volume']} m^3, closed boundary")
 finally:
     shutil.rmtree(work, ignore_errors=True)
 

@@ -35,6 +35,8 @@ void piola__shell_body_free_arrays(piola_shell_body *body) {
   free(body->materials);
   free(body->rest_positions);
   free(body->masses);
+  free(body->inverse_sqrt_masses);
+  free(body->vertex_rate2);
   if (body->pattern) {
     free(body->pattern->row_start), free(body->pattern->col);
     free(body->pattern->triangle_slot), free(body->pattern->hinge_slot);
@@ -284,8 +286,15 @@ piola_status piola__shell_body_build(piola_shell_body *body, const piola_shell_b
   /* bending stability: the hinge stiffness D w/2 g g^T summed over hinges, bounded per
    * vertex a by Gershgorin on M^-1/2 K M^-1/2: omega^2 <= max_a sum_h (D w/2) |g_a| / sqrt(m_a)
    * sum_b |g_b| / sqrt(m_b). The time scale is 1 / omega. */
+  body->inverse_sqrt_masses = alloc_array((size_t)nv, sizeof(double));
+  body->vertex_rate2 = alloc_array((size_t)nv, sizeof(double));
   double *omega2 = alloc_array((size_t)nv, sizeof(double));
-  if (!omega2) return PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "shell body: out of memory");
+  if (!omega2 || !body->inverse_sqrt_masses || !body->vertex_rate2) {
+    free(omega2);
+    return PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "shell body: out of memory");
+  }
+  for (int32_t i = 0; i < nv; ++i)
+    body->inverse_sqrt_masses[i] = body->masses[i] > 0 ? 1.0 / sqrt(body->masses[i]) : 0.0;
   for (int32_t h = 0; h < nh; ++h) {
     shell_hinge *hg = &body->hinges[h];
     const double *p[4];

@@ -85,6 +85,8 @@ struct piola_shell_body {
   /* cold */
   double *rest_positions;
   double *masses;
+  double *inverse_sqrt_masses; /* 1 / sqrt(m_i), for the bending's step bound */
+  double *vertex_rate2;        /* scratch of the bending's step bound, one per vertex */
   double min_rest_altitude, max_wave_speed, bending_time_scale;
   double last_stiffness_scale;
   shell_matrix_pattern *pattern; /* built on the first implicit step, NULL before */

@@ -1321,6 +1321,21 @@ static void warnings_name_what_slows_the_run(void **state) {
   w = world_with_mesh_file("medit/unit_ball.mesh", PIOLA_INTEGRATOR_NEWMARK);
   for (int k = 0; k < PIOLA_WARNING_KIND_COUNT; ++k) assert_null(piola_world_warning(w, (piola_warning_kind)k));
   piola_world_destroy(w);
+  /* cfl above 1 is accepted, past the stability limit of well-shaped meshes: warned at once */
+  const double cfls[3] = {1.0, 1.5, 2.0};
+  for (int c = 0; c < 3; ++c) {
+    piola_world_def wd = piola_default_world_def();
+    wd.cfl = cfls[c];
+    assert_int_equal(piola_world_create(&wd, &w), PIOLA_OK);
+    text = piola_world_warning(w, PIOLA_WARNING_UNSTABLE_CFL);
+    if (cfls[c] > 1) {
+      assert_non_null(text);
+      assert_non_null(strstr(text, "integrator.cfl"));
+    } else {
+      assert_null(text);
+    }
+    piola_world_destroy(w);
+  }
   /* StVK at an 8x stretch: ~120 times stiffer, the step under a tenth of the rest CFL */
   w = world_with_block(PIOLA_MODEL_STVK, 8.0, 0, 0.5, 200);
   assert_int_equal(piola_world_step(w, 0, NULL), PIOLA_OK);

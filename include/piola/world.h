@@ -279,6 +279,9 @@ typedef enum piola_warning_kind {
   PIOLA_WARNING_STARTS_INSIDE,         /* at the world's first step from t = 0, free nodes lie
                                           inside an obstacle, deeper than 1% of the body's
                                           size: the step pushes them out at once */
+  PIOLA_WARNING_UNSTABLE_CFL,          /* the explicit step's cfl is above 1, past the
+                                          stability limit of well-shaped meshes (raised when
+                                          the world is created) */
   PIOLA_WARNING_KIND_COUNT
 } piola_warning_kind;
 

@@ -66,6 +66,15 @@ piola_status piola_world_create(const piola_world_def *def, piola_world **out) {
   w->def = *def;
   w->collision_deadline = NAN;
   w->deeper_steps_left = -1;
+  if (def->integrator == PIOLA_INTEGRATOR_NEWMARK && def->cfl > 1)
+    piola__world_warn(w, PIOLA_WARNING_UNSTABLE_CFL,
+                      "integrator.cfl %g is above 1, past the stability limit of well-shaped "
+                      "meshes (0.94-1.35 measured, time-stepping.md \"How far cfl can go\"): an "
+                      "undamped body's energy can grow by a little every step, below what the "
+                      "energy check catches (an undamped neo-Hookean block's grew 3e9 times in 5 s at cfl 2); 0.5, the "
+                      "default, is about half the limit and 0.37 (0.29 near nu = 0.5) is stable "
+                      "on any mesh",
+                      def->cfl);
   *out = w;
   return PIOLA_OK;
 }

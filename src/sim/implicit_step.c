@@ -362,10 +362,10 @@ static inline double precondition_node(const cg_vectors *c, int32_t i) {
   return x[0] * y[0] + x[1] * y[1] + x[2] * y[2];
 }
 
-/* With the multigrid: node i's part of |r|^2 in the M^-1 norm, the line search's (for the
- * CG's second stopping test, see solve_newton_system); 0 with the other preconditioners. */
-static inline double multigrid_merit_node(const cg_vectors *c, int32_t i) {
-  if (!c->multigrid) return 0;
+/* With the multigrid or IC(0): node i's part of |r|^2 in the M^-1 norm, the line search's
+ * (for the CG's second stopping test, see solve_newton_system); 0 with block Jacobi. */
+static inline double factored_merit_node(const cg_vectors *c, int32_t i) {
+  if (!c->multigrid && !c->factor) return 0;
   const double *r = c->r + 3 * i;
   return c->s->inverse_mass[i] * (r[0] * r[0] + r[1] * r[1] + r[2] * r[2]);
 }
@@ -393,7 +393,7 @@ static double precondition_factored(const cg_vectors *c) {
 }
 
 /* d = 0, r = -S g, z = S P^-1 r, p = z over nodes i0 .. i1 - 1 (g = c->g);
- * returns their part of r . z (with the multigrid: of |r|^2_{M^-1}). */
+ * returns their part of r . z (with the multigrid or IC(0): of |r|^2_{M^-1}). */
 static double cg_start_range(const void *context, int32_t i0, int32_t i1) {
   const cg_vectors *c = context;
   const double *g = c->g;
@@ -401,7 +401,7 @@ static double cg_start_range(const void *context, int32_t i0, int32_t i1) {
   for (int32_t i = i0; i < i1; ++i) {
     for (int k = 0; k < 3; ++k) c->d[3 * i + k] = 0, c->r[3 * i + k] = -g[3 * i + k];
     filter_node(c->s, i, c->r);
-    sum += precondition_node(c, i) + multigrid_merit_node(c, i);
+    sum += precondition_node(c, i) + factored_merit_node(c, i);
     for (int k = 0; k < 3; ++k) c->p[3 * i + k] = c->z[3 * i + k];
   }
   return sum;
@@ -420,7 +420,7 @@ static double cg_curvature_range(const void *context, int32_t i0, int32_t i1) {
 }
 
 /* d += a p, r -= a q, z = S P^-1 r (a in c->alpha); returns this range's part of r . z
- * (with the multigrid: of |r|^2_{M^-1}). */
+ * (with the multigrid or IC(0): of |r|^2_{M^-1}). */
 static double cg_update_range(const void *context, int32_t i0, int32_t i1) {
   const cg_vectors *c = context;
   const double a = c->alpha;
@@ -430,7 +430,7 @@ static double cg_update_range(const void *context, int32_t i0, int32_t i1) {
       c->d[3 * i + k] += a * c->p[3 * i + k];
       c->r[3 * i + k] -= a * c->q[3 * i + k];
     }
-    sum += precondition_node(c, i) + multigrid_merit_node(c, i);
+    sum += precondition_node(c, i) + factored_merit_node(c, i);
   }
   return sum;
 }
@@ -530,8 +530,10 @@ static double forcing_term(const piola_world_def *def, double phi, double phi_la
  * multigrid's V-cycle is close to A^-1, whose norm discounts exactly the rough residual
  * that dominates the M^-1 norm: after the few CG iterations a loose eta allows, |r|_{M^-1}
  * was up to 13 times |g|_{M^-1} in quasistatic steps (no mass in the matrix), no descent
- * direction, and Newton failed (docs/time-stepping.md). So with the multigrid the CG also
- * runs until |r|_{M^-1} <= eta |S g|_{M^-1}. */
+ * direction, and Newton failed (docs/time-stepping.md). IC(0) is close to A^-1 too: with
+ * Eisenstat-Walker's loose eta a clamped bar's first backward Euler step found no descent
+ * along its second direction, failed three tries and kept a step 28% off. So with either
+ * the CG also runs until |r|_{M^-1} <= eta |S g|_{M^-1}. */
 static int32_t solve_newton_system(newton_problem *pb, double eta) {
   world_body *s = pb->s;
   struct implicit_state *st = pb->st;
@@ -551,13 +553,14 @@ static int32_t solve_newton_system(newton_problem *pb, double eta) {
   if (it < 0) it = 0; /* a failed solve leaves its best d; the line search judges it */
   pb->indefinite = 0;
   double rz = split ? 0.0 : cg_pass(&c, cg_start_range);
-  double merit = rz; /* |r|^2_{M^-1} with the multigrid */
+  double merit = rz; /* |r|^2_{M^-1} with the multigrid or IC(0) */
   if (!split && (c.factor || c.multigrid)) {
     rz = precondition_factored(&c);
     memcpy(c.p, c.z, sizeof(double) * 3 * (size_t)n);
   }
   const double stop = eta * eta * rz, merit_stop = eta * eta * merit;
-  while ((rz > stop || (c.multigrid && merit > merit_stop)) && rz > 0 &&
+  const int factored = c.factor || c.multigrid;
+  while ((rz > stop || (factored && merit > merit_stop)) && rz > 0 &&
          it < pb->w->def.linear_max_iterations) {
     piola__body_stiffness_apply(s, c.mx, mass_weight, c.p, c.q);
     const double pq = cg_pass(&c, cg_curvature_range);
@@ -567,8 +570,7 @@ static int32_t solve_newton_system(newton_problem *pb, double eta) {
     }
     c.alpha = rz / pq;
     double rz_new = cg_pass(&c, cg_update_range);
-    if (c.multigrid) merit = rz_new;
-    if (c.factor || c.multigrid) rz_new = precondition_factored(&c);
+    if (factored) merit = rz_new, rz_new = precondition_factored(&c);
     cg_direction(&c, rz_new / rz);
     rz = rz_new;
     ++it;

@@ -259,6 +259,7 @@ PIOLA_API piola_status piola_world_advance_to(piola_world *world, double t_end,
                                               piola_step_stats *stats);
 
 PIOLA_API double piola_world_time(const piola_world *world); /* s */
+PIOLA_API piola_integrator_type piola_world_integrator(const piola_world *world);
 
 /* Warnings: conditions a run survives but a user should know about. Each kind is raised at
  * most once per world; its message (the first occurrence, naming the body, the element or

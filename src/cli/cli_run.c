@@ -126,8 +126,18 @@ static double rest_crossing_time(const piola_world *world) {
 static void deformed_start_hint(const piola_world *world, double dt) {
   const double rest = rest_crossing_time(world);
   if (!(dt < 0.01 * rest)) return;
+  if (piola_world_integrator(world) != PIOLA_INTEGRATOR_NEWMARK) {
+    /* the implicit step is the scene's own integrator.dt */
+    fprintf(stderr,
+            "piola run: integrator.dt (%.3g s) is %.3g times shorter than the time the rest "
+            "state's fastest wave takes to cross the smallest tet (%.3g s); \"%s\" needs no "
+            "such step: leave integrator.dt out for one step per frame (docs/time-stepping.md, "
+            "\"Implicit integrators\")\n",
+            dt, rest / dt, rest, piola_integrator_type_name(piola_world_integrator(world)));
+    return;
+  }
   fprintf(stderr,
-          "piola run: the first step is %.0f times shorter than the time the rest state's "
+          "piola run: the first step is %.3g times shorter than the time the rest state's "
           "fastest wave takes to cross the smallest tet (%.3g s). If a solid starts deformed "
           "(initial.scramble, initial.matrix), it is far stiffer where it is stretched, and "
           "the explicit step stays that short until it recovers: \"integrator\": {\"type\": "

@@ -108,4 +108,7 @@ piola_status piola_world_add_obstacle(piola_world *world, const piola_obstacle_d
 }
 
 double piola_world_time(const piola_world *world) { return world->time; }
+piola_integrator_type piola_world_integrator(const piola_world *world) {
+  return world->def.integrator;
+}
 int32_t piola_world_obstacle_count(const piola_world *world) { return world->obstacle_count; }

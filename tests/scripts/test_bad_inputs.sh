@@ -75,6 +75,12 @@ grep -q "backward_euler" stderr && fail "slow.json: the deformed-start hint for 
 echo "{\"fps\": 30, \"frames\": 1, \"gravity\": [0, 0, 0], \"solids\": [{\"mesh\": $box, \"material\": {\"model\": \"stvk\"}, \"initial\": {\"scramble\": 5}}]}" >scrambled.json
 expect 2 'If a solid starts deformed (initial.scramble, initial.matrix), it is far stiffer where it is stretched, and the explicit step stays that short until it recovers: "integrator": {"type": "backward_euler"}' -- "$PIOLA" run scrambled.json -o out_scrambled --max-steps 10
 [[ -e out_scrambled ]] && fail "the refused scrambled run created its output folder"
+# an implicit scene refused for a tiny integrator.dt: the hint is about integrator.dt, not the
+# explicit step
+echo "{\"fps\": 30, \"frames\": 1, \"integrator\": {\"type\": \"backward_euler\", \"dt\": 1e-7}, \"solids\": [{\"mesh\": $box}]}" >tiny_dt.json
+expect 2 'integrator.dt (1e-07 s) is' -- "$PIOLA" run tiny_dt.json -o out_tiny --max-steps 10
+grep -q 'the explicit step' stderr && fail "tiny_dt.json: the explicit step's hint for an implicit scene: $(cat stderr)"
+[[ -e out_tiny ]] && fail "the refused tiny-dt run created its output folder"
 echo "{\"fps\": 0.5, \"frames\": 1, \"integrator\": {\"max_dt\": 0.01}, \"solids\": [{\"mesh\": $box}]}" >two_seconds.json
 expect 2 "more than the limit of 10 steps" -- "$PIOLA" run two_seconds.json -o out_two --max-steps 10
 expect 0 "done" -- "$PIOLA" run two_seconds.json -o out_two --max-steps 1e4

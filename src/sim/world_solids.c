@@ -146,6 +146,32 @@ static piola_status check_solid_def(const piola_solid_def *def, int32_t id) {
   return PIOLA_OK;
 }
 
+/* The initial state may stretch a solid far past its rest size (a scramble of twice its
+ * diagonal is a test case), but not so far that its positions cannot hold its shape: at
+ * 1e16 times its size a node's rounding is its size. A scramble of 1e100 m froze the body (no
+ * step changed a position), 1e300 m made its energy NaN in frame 0. */
+#define INITIAL_EXTENT_LIMIT 1e6
+
+static piola_status check_initial_extent(const world_body *s, const double *rest, vec3 c,
+                                         int32_t id) {
+  double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+  double farthest = 0;
+  for (int32_t i = 0; i < s->n; ++i) {
+    for (int k = 0; k < 3; ++k)
+      lo[k] = fmin(lo[k], rest[3 * i + k]), hi[k] = fmax(hi[k], rest[3 * i + k]);
+    farthest = fmax(farthest, vec3_norm(vec3_sub(vec3_load(s->x + 3 * i), c)));
+  }
+  double size2 = 0;
+  for (int k = 0; k < 3; ++k) size2 += s->n > 0 ? (hi[k] - lo[k]) * (hi[k] - lo[k]) : 0.0;
+  const double size = sqrt(size2);
+  if (farthest <= INITIAL_EXTENT_LIMIT * size) return PIOLA_OK;
+  return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT,
+                    "solid %d: its initial state (initial.matrix, initial.scramble) puts a node "
+                    "%g m from the rest centroid, more than %g times the solid's rest size "
+                    "(bounding-box diagonal %g m), where positions cannot hold its shape",
+                    (int)id, farthest, INITIAL_EXTENT_LIMIT, size);
+}
+
 /* Everything of a new solid after its slot in the table: the elastic body, the per-node
  * state, constraints, plasticity, the initial state and its forces. */
 static piola_status fill_solid(piola_world *world, world_body *s, const piola_solid_def *def,
@@ -204,6 +230,7 @@ static piola_status fill_solid(piola_world *world, world_body *s, const piola_so
     vec3_store(s->x + 3 * i, p);
     vec3_store(s->v + 3 * i, def->velocity);
   }
+  PIOLA_TRY(check_initial_extent(s, rest, c, id));
   PIOLA_TRY(piola__body_update_forces(s, world->time));
   /* the step bound's per-tet weights come from the rest Dm^-1: built now, before plasticity
    * or a checkpoint's restored state changes Dm^-1, so a resumed run uses the same ones */

@@ -767,7 +767,8 @@ static int friction_moves_deform(const newton_problem *pb) {
  * the solve"). Solids on one process, as friction_moves_deform. */
 static int body_may_slide(const newton_problem *pb) {
   const world_body *s = pb->s;
-  if (s->kind != PIOLA_BODY_SOLID || piola__implicit_split_of(s)) return 0;
+  if (s->kind != PIOLA_BODY_SOLID || piola__implicit_split_of(s) || s->self_collision.enabled)
+    return 0;
   double capacity = 0, impulse = 0, normal[3] = {0, 0, 0}, surface_v[3] = {0, 0, 0};
   for (int32_t i = 0; i < s->n; ++i) {
     if (s->colliding[i] != HELD_BY_OBSTACLE || s->flags[i] != NODE_FREE) continue;
@@ -1377,6 +1378,22 @@ static piola_status self_collide_and_resolve(piola_world *w, double dt, int clos
   PIOLA_TRY(piola__world_self_collide(w, dt, t1, closes, stats));
   if (!per_step || stats->impacts + stats->contacts == 0) return PIOLA_OK;
   int resolved = 0;
+  /* the pass's impulses are equal and opposite between bodies; the holds of the solves
+   * below are not, and they changed the bodies' total momentum (two balls meeting head-on at
+   * 0.5 m/s came apart with 8% of one ball's momentum left over). Where every body solved
+   * again is held by the pushes alone (nothing outside them, an obstacle or a prescribed
+   * node, takes part), each gets back the momentum the pass left it, as a uniform velocity
+   * added to its velocities only: its positions stay where the holds keep the surfaces apart
+   * (moved too, they went back into the other body, and the second pass's pushes of the
+   * surface alone inverted 245 tets). Where one rests on an obstacle, the holds carry its
+   * support (a torus landing on a ball on the ground): nothing is added */
+  double *after_pass = calloc(3 * (size_t)w->body_count + 1, sizeof(double));
+  uint8_t *solved = calloc((size_t)w->body_count + 1, 1);
+  if (!after_pass || !solved) {
+    free(after_pass), free(solved);
+    return PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "implicit step: out of memory");
+  }
+  int free_group = 1;
   for (int32_t b = 0; b < w->body_count; ++b) {
     world_body *s = &w->bodies[b];
     if (!s->implicit) continue;
@@ -1396,27 +1413,30 @@ static piola_status self_collide_and_resolve(piola_world *w, double dt, int clos
       held++;
     }
     if (held == 0) continue;
-    /* the pass's impulses are equal and opposite between bodies; the holds of the solve
-     * below are not, and they changed the bodies' total momentum (two balls meeting head-on
-     * at 0.5 m/s came apart with 8% of one ball's momentum left over). A body held by the
-     * pushes alone gets back the momentum the pass left it, by a uniform velocity added to
-     * its velocities only: its positions stay where the holds keep the surfaces apart (moved
-     * too, they went back into the other body, and the second pass's pushes of the surface
-     * alone inverted 245 tets) */
-    double after_pass[3];
-    body_momentum(s, after_pass);
+    body_momentum(s, after_pass + 3 * b);
     newton_problem pb = problem_of(w, s, w->time, dt);
     const int64_t colliding = stats->colliding;
-    PIOLA_TRY(newton_iterate(&pb, 1, stats));
-    stats->colliding = colliding;
-    if (held_by_collisions_only(s) && pb.total_mass > 0) {
-      double now[3];
-      body_momentum(s, now);
-      for (int32_t i = 0; i < s->n; ++i)
-        for (int k = 0; k < 3; ++k) s->v[3 * i + k] += (after_pass[k] - now[k]) / pb.total_mass;
+    const piola_status st = newton_iterate(&pb, 1, stats);
+    if (st != PIOLA_OK) {
+      free(after_pass), free(solved);
+      return st;
     }
+    stats->colliding = colliding;
+    solved[b] = 1;
+    free_group = free_group && held_by_collisions_only(s);
     resolved = 1;
   }
+  for (int32_t b = 0; b < w->body_count && free_group; ++b) {
+    world_body *s = &w->bodies[b];
+    double now[3], mass = 0;
+    if (!solved[b]) continue;
+    body_momentum(s, now);
+    for (int32_t i = 0; i < s->n; ++i) mass += s->mass[i];
+    if (!(mass > 0)) continue;
+    for (int32_t i = 0; i < s->n; ++i)
+      for (int k = 0; k < 3; ++k) s->v[3 * i + k] += (after_pass[3 * b + k] - now[k]) / mass;
+  }
+  free(after_pass), free(solved);
   if (!resolved) return PIOLA_OK;
   /* the step's contact counts are those of the first pass */
   const piola_step_stats first = *stats;

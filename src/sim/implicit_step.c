@@ -764,7 +764,9 @@ static int friction_moves_deform(const newton_problem *pb) {
  * the next steps through the elastic forces, and friction never sees those. Measured: a block
  * on a 0.5 rad incline stuck for good at one step per 1/30 s frame for every mu from 0.1 to
  * 0.8, its contact nodes holding a tenth of its mass (docs/time-stepping.md, "Friction after
- * the solve"). Solids on one process, as friction_moves_deform. */
+ * the solve"). Solids on one process, as friction_moves_deform, without self-collision:
+ * examples/solids_stack.json as backward Euler, the ball under the landing torus, failed 2
+ * Newton tries with it (0 without) and took 9% more iterations. */
 static int body_may_slide(const newton_problem *pb) {
   const world_body *s = pb->s;
   if (s->kind != PIOLA_BODY_SOLID || piola__implicit_split_of(s) || s->self_collision.enabled)

@@ -755,9 +755,19 @@ static int friction_moves_deform(const newton_problem *pb) {
   return 0;
 }
 
+/* The tangential part of node i's velocity relative to vo, about its normal, into vt; returns
+ * its size. */
+static double relative_slip(const world_body *s, int32_t i, piola_vec3 vo, double vt[3]) {
+  const double *v = s->v + 3 * i, *nrm = s->normals + 3 * i;
+  const double rel[3] = {v[0] - vo.x, v[1] - vo.y, v[2] - vo.z};
+  const double rn = rel[0] * nrm[0] + rel[1] * nrm[1] + rel[2] * nrm[2];
+  for (int k = 0; k < 3; ++k) vt[k] = rel[k] - rn * nrm[k];
+  return sqrt(vt[0] * vt[0] + vt[1] * vt[1] + vt[2] * vt[2]);
+}
+
 /* Whether the body may slide as a whole on its contacts, after a solve without friction:
- * the tangential momentum of its free nodes relative to the obstacles, about the
- * impulse-weighted normal of its contact nodes, is above the friction impulse those contacts
+ * its mass times its contacts' mean slip (their tangential velocity relative to the nearest
+ * obstacle, weighted by their normal impulses) is above the friction impulse those contacts
  * can give, the sum of mu dt (g . n) / dt^2. Friction node by node (contact_friction)
  * misleads there at large steps: it stops a contact node whose own momentum is below its
  * share of that impulse, the rest of the body, which the solve moved on, drags it along in
@@ -771,35 +781,28 @@ static int body_may_slide(const newton_problem *pb) {
   const world_body *s = pb->s;
   if (s->kind != PIOLA_BODY_SOLID || piola__implicit_split_of(s) || s->self_collision.enabled)
     return 0;
-  double capacity = 0, impulse = 0, normal[3] = {0, 0, 0}, surface_v[3] = {0, 0, 0};
+  double capacity = 0, impulse = 0, slip[3] = {0, 0, 0};
   for (int32_t i = 0; i < s->n; ++i) {
     if (s->colliding[i] != HELD_BY_OBSTACLE || s->flags[i] != NODE_FREE) continue;
     const double *g = pb->st->residual + 3 * i, *nrm = s->normals + 3 * i;
     const double jn = (g[0] * nrm[0] + g[1] * nrm[1] + g[2] * nrm[2]) / pb->dt;
     if (!(jn > 0)) continue;
     piola_vec3 p = {s->x[3 * i], s->x[3 * i + 1], s->x[3 * i + 2]}, vo;
-    double mu;
+    double mu, vt[3];
     piola__nearest_obstacle_motion(pb->w->obstacles, pb->w->obstacle_count, pb->t1, p, &mu, &vo);
+    (void)relative_slip(s, i, vo, vt);
     capacity += mu * jn, impulse += jn;
-    const double v[3] = {vo.x, vo.y, vo.z};
-    for (int k = 0; k < 3; ++k) normal[k] += jn * nrm[k], surface_v[k] += jn * v[k];
+    for (int k = 0; k < 3; ++k) slip[k] += jn * vt[k];
   }
-  const double size = sqrt(normal[0] * normal[0] + normal[1] * normal[1] + normal[2] * normal[2]);
-  if (!(impulse > 0) || !(size > 0)) return 0;
-  double momentum[3] = {0, 0, 0};
-  for (int32_t i = 0; i < s->n; ++i) {
-    if (s->flags[i] != NODE_FREE) continue;
-    for (int k = 0; k < 3; ++k)
-      momentum[k] += s->mass[i] * (s->v[3 * i + k] - surface_v[k] / impulse);
-  }
-  double along = 0;
-  for (int k = 0; k < 3; ++k) along += momentum[k] * normal[k] / size;
-  double tangential2 = 0;
-  for (int k = 0; k < 3; ++k) {
-    const double t = momentum[k] - along * normal[k] / size;
-    tangential2 += t * t;
-  }
-  return tangential2 > capacity * capacity;
+  if (!(impulse > 0)) return 0;
+  double mass = 0;
+  for (int32_t i = 0; i < s->n; ++i) mass += s->flags[i] == NODE_FREE ? s->mass[i] : 0.0;
+  /* the body's momentum at the contacts' mean slip: a body rolling without slipping has
+   * none, whatever its speed */
+  const double scale = mass / impulse;
+  const double momentum2 =
+      scale * scale * (slip[0] * slip[0] + slip[1] * slip[1] + slip[2] * slip[2]);
+  return momentum2 > capacity * capacity;
 }
 
 /* After a solve with friction-held nodes: each held node whose holding impulse g / dt has a
@@ -827,16 +830,6 @@ static int32_t release_slipping_holds(newton_problem *pb) {
   }
   if (released > 0) pb->contacts_moved = 1;
   return released;
-}
-
-/* The tangential part of node i's velocity relative to vo, about its normal, into vt; returns
- * its size. */
-static double relative_slip(const world_body *s, int32_t i, piola_vec3 vo, double vt[3]) {
-  const double *v = s->v + 3 * i, *nrm = s->normals + 3 * i;
-  const double rel[3] = {v[0] - vo.x, v[1] - vo.y, v[2] - vo.z};
-  const double rn = rel[0] * nrm[0] + rel[1] * nrm[1] + rel[2] * nrm[2];
-  for (int k = 0; k < 3; ++k) vt[k] = rel[k] - rn * nrm[k];
-  return sqrt(vt[0] * vt[0] + vt[1] * vt[1] + vt[2] * vt[2]);
 }
 
 /* Kinetic friction on every obstacle contact of a body that may slide as a whole

@@ -663,24 +663,23 @@ static int32_t contacts(newton_problem *pb) {
 }
 
 /* Releases held nodes whose contact force would pull them into the obstacle (g . n < 0 means
- * the constraint force g / dt^2 points along -n). Nodes friction holds only with
- * `friction_held_too` (at convergence): while the iterate is far from it their residual is no
- * contact force yet, and one released there came back as a contact without friction
- * (measured: 47 of a sliding block's 57 holds released in the first iterations of a step).
- * Returns how many. */
+ * the constraint force g / dt^2 points along -n). On the kinetic-friction path (pb->kinetic)
+ * nodes friction holds only with `friction_held_too` (at convergence): while the iterate is
+ * far from it their residual is no contact force yet (47 of a sliding block's 57 holds went
+ * in the first iterations of a step). Returns how many. */
 static int32_t release_contacts(newton_problem *pb, int friction_held_too) {
   world_body *s = pb->s;
   int32_t released = 0;
   for (int32_t i = 0; i < s->n; ++i) {
     if (!s->colliding[i] || s->flags[i] != NODE_FREE) continue;
-    if (s->colliding[i] == HELD_BY_FRICTION && !friction_held_too) continue;
+    if (s->colliding[i] == HELD_BY_FRICTION && !friction_held_too && pb->kinetic) continue;
     const double *g = pb->st->residual + 3 * i, *nrm = s->normals + 3 * i;
     if (g[0] * nrm[0] + g[1] * nrm[1] + g[2] * nrm[2] < 0) {
       s->colliding[i] = 0;
       /* its friction goes with the contact, and does not come back with it in this solve:
        * a force that came and went with the contact made the contact set cycle (nodes of a
        * block sliding down an incline, lifted by the friction's moment) */
-      if (pb->friction_held)
+      if (pb->kinetic)
         for (int k = 0; k < 3; ++k) pb->st->friction[3 * i + k] = 0;
       released++;
     }
@@ -796,7 +795,12 @@ static int body_may_slide(const newton_problem *pb) {
   }
   if (!(impulse > 0)) return 0;
   double mass = 0;
-  for (int32_t i = 0; i < s->n; ++i) mass += s->flags[i] == NODE_FREE ? s->mass[i] : 0.0;
+  for (int32_t i = 0; i < s->n; ++i) {
+    /* a body held by fixed, driven or bone nodes does not slide as a whole (examples/arm_flex
+     * as backward Euler, its flesh on its bones, took 2.4 times the Newton iterations) */
+    if (s->flags[i] != NODE_FREE && s->mass[i] > 0) return 0;
+    mass += s->mass[i];
+  }
   /* the body's momentum at the contacts' mean slip: a body rolling without slipping has
    * none, whatever its speed */
   const double scale = mass / impulse;
@@ -1306,14 +1310,11 @@ static piola_status newton_iterate(const newton_problem *problem, int accept_unc
      * solve") */
     if (friction_moves_deform(&pb)) {
       for (int32_t i = 0; i < n; ++i)
-        if (st->hit[i] == 2) {
-          s->colliding[i] = HELD_BY_FRICTION; /* stopped */
-          for (int k = 0; k < 3; ++k) st->friction[3 * i + k] = 0;
-        }
-      pb.friction_held = 1, pb.contacts_moved = 1, pb.slip_rounds = 0;
+        if (st->hit[i] == 2) s->colliding[i] = HELD_BY_FRICTION; /* stopped */
+      pb.friction_held = 1, pb.contacts_moved = 1;
       return newton_iterate(&pb, accept_unconverged, stats);
     }
-  } else if (pb.friction_held && converged && pb.slip_rounds < FRICTION_SLIP_ROUNDS &&
+  } else if (pb.kinetic && converged && pb.slip_rounds < FRICTION_SLIP_ROUNDS &&
              next_friction_round(&pb)) {
     /* holds beyond Coulomb's cone slip, slips friction reverses are held, the kinetic
      * friction follows the normal forces: solved again */
@@ -1346,22 +1347,6 @@ static piola_status newton_iterate(const newton_problem *problem, int accept_unc
  * the pass runs once more on the result, which leaves the surfaces apart as before. Only
  * with the per-step collision pass (collision_interval 0), where each pass covers exactly
  * this step. */
-/* Whether body s is held only by the collision pass's pushes: no prescribed node, no
- * obstacle or friction hold (then nothing outside the bodies changes its momentum). */
-static int held_by_collisions_only(const world_body *s) {
-  for (int32_t i = 0; i < s->n; ++i)
-    if (s->mass[i] > 0 &&
-        (s->flags[i] != NODE_FREE || (s->colliding[i] && s->colliding[i] != HELD_BY_COLLISION)))
-      return 0;
-  return 1;
-}
-
-static void body_momentum(const world_body *s, double p[3]) {
-  p[0] = p[1] = p[2] = 0;
-  for (int32_t i = 0; i < s->n; ++i)
-    for (int k = 0; k < 3; ++k) p[k] += s->mass[i] * s->v[3 * i + k];
-}
-
 static piola_status self_collide_and_resolve(piola_world *w, double dt, int closes,
                                              piola_step_stats *stats) {
   const double t1 = w->time + dt;
@@ -1373,22 +1358,6 @@ static piola_status self_collide_and_resolve(piola_world *w, double dt, int clos
   PIOLA_TRY(piola__world_self_collide(w, dt, t1, closes, stats));
   if (!per_step || stats->impacts + stats->contacts == 0) return PIOLA_OK;
   int resolved = 0;
-  /* the pass's impulses are equal and opposite between bodies; the holds of the solves
-   * below are not, and they changed the bodies' total momentum (two balls meeting head-on at
-   * 0.5 m/s came apart with 8% of one ball's momentum left over). Where every body solved
-   * again is held by the pushes alone (nothing outside them, an obstacle or a prescribed
-   * node, takes part), each gets back the momentum the pass left it, as a uniform velocity
-   * added to its velocities only: its positions stay where the holds keep the surfaces apart
-   * (moved too, they went back into the other body, and the second pass's pushes of the
-   * surface alone inverted 245 tets). Where one rests on an obstacle, the holds carry its
-   * support (a torus landing on a ball on the ground): nothing is added */
-  double *after_pass = calloc(3 * (size_t)w->body_count + 1, sizeof(double));
-  uint8_t *solved = calloc((size_t)w->body_count + 1, 1);
-  if (!after_pass || !solved) {
-    free(after_pass), free(solved);
-    return PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "implicit step: out of memory");
-  }
-  int free_group = 1;
   for (int32_t b = 0; b < w->body_count; ++b) {
     world_body *s = &w->bodies[b];
     if (!s->implicit) continue;
@@ -1408,30 +1377,12 @@ static piola_status self_collide_and_resolve(piola_world *w, double dt, int clos
       held++;
     }
     if (held == 0) continue;
-    body_momentum(s, after_pass + 3 * b);
     newton_problem pb = problem_of(w, s, w->time, dt);
     const int64_t colliding = stats->colliding;
-    const piola_status st = newton_iterate(&pb, 1, stats);
-    if (st != PIOLA_OK) {
-      free(after_pass), free(solved);
-      return st;
-    }
+    PIOLA_TRY(newton_iterate(&pb, 1, stats));
     stats->colliding = colliding;
-    solved[b] = 1;
-    free_group = free_group && held_by_collisions_only(s);
     resolved = 1;
   }
-  for (int32_t b = 0; b < w->body_count && free_group; ++b) {
-    world_body *s = &w->bodies[b];
-    double now[3], mass = 0;
-    if (!solved[b]) continue;
-    body_momentum(s, now);
-    for (int32_t i = 0; i < s->n; ++i) mass += s->mass[i];
-    if (!(mass > 0)) continue;
-    for (int32_t i = 0; i < s->n; ++i)
-      for (int k = 0; k < 3; ++k) s->v[3 * i + k] += (after_pass[3 * b + k] - now[k]) / mass;
-  }
-  free(after_pass), free(solved);
   if (!resolved) return PIOLA_OK;
   /* the step's contact counts are those of the first pass */
   const piola_step_stats first = *stats;

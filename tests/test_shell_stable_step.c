@@ -21,9 +21,8 @@
 
 /* The triangle's modulus k_t (Pa) behind the body's rate: rate2 rho h_t^2. */
 static double triangle_modulus(const piola_shell_body *body) {
-  const shell_triangle *tri = &body->triangles[0];
-  const double *d = tri->dm_inv_eff;
-  const double g[3][2] = {{-(d[0] + d[2]), -(d[1] + d[3])}, {d[0], d[1]}, {d[2], d[3]}};
+  double g[3][2];
+  shell_triangle_gradients(&body->triangles[0], g);
   double most = 0;
   for (int a = 0; a < 3; ++a) most = fmax(most, g[a][0] * g[a][0] + g[a][1] * g[a][1]);
   return piola__shell_body_membrane_rate2(body, NULL) * body->density / most;

@@ -167,7 +167,7 @@ static int fail(piola_status s) {
   return (s == PIOLA_ERROR_IO || s == PIOLA_ERROR_OUT_OF_MEMORY) ? 1 : 2;
 }
 
-static int is_surface_path(const char *path) {
+int cli_is_surface_path(const char *path) {
   const char *dot = strrchr(path, '.');
   const char *slash = strrchr(path, '/');
   if (!dot || (slash && dot < slash)) return 0;
@@ -401,7 +401,7 @@ static int info_tets(const char *path, int json, const info_material *material,
 
 static int convert(const char *in, const char *out) {
   piola_status s;
-  if (is_surface_path(in)) {
+  if (cli_is_surface_path(in)) {
     piola_tri_mesh m;
     s = piola_tri_mesh_read(in, &m);
     if (s != PIOLA_OK) return fail(s);
@@ -472,13 +472,14 @@ int cli_mesh(int argc, char **argv) {
       fprintf(stderr, "piola mesh info: --viscosity needs --material E,NU,RHO\n");
       return 2;
     }
-    if (viscosity_given && is_surface_path(path)) {
+    if (viscosity_given && cli_is_surface_path(path)) {
       fprintf(stderr, "piola mesh info: --viscosity: %s is a surface, it has no tets and so no "
                       "vibration modes; fill it with `piola mesh generate` first\n", path);
       return 2;
     }
-    return is_surface_path(path) ? info_surface(path, json, &material)
-                                 : info_tets(path, json, &material, viscosity_given ? viscosity : NULL);
+    return cli_is_surface_path(path)
+               ? info_surface(path, json, &material)
+               : info_tets(path, json, &material, viscosity_given ? viscosity : NULL);
   }
   if (strcmp(sub, "convert") == 0) {
     for (int i = 2; i < argc; ++i)

@@ -37,10 +37,7 @@ static void usage(FILE *out) {
 /* SHAPE as a closed surface: a surface file, or the boundary of a tet mesh file (remeshing a
  * mesh whose slivers force tiny steps: the sliver warning suggests it, docs/cli.md). */
 static piola_status read_shape_surface(const char *path, piola_tri_mesh *surface) {
-  const char *dot = strrchr(path, '.');
-  static const char *const surfaces[] = {".obj", ".off", ".stl"};
-  for (size_t k = 0; dot && k < sizeof surfaces / sizeof surfaces[0]; ++k)
-    if (strcasecmp(dot, surfaces[k]) == 0) return piola_tri_mesh_read(path, surface);
+  if (cli_is_surface_path(path)) return piola_tri_mesh_read(path, surface);
   piola_tet_mesh tets;
   piola_status st = piola_tet_mesh_read(path, &tets);
   if (st != PIOLA_OK) return st;

@@ -21,4 +21,7 @@ int cli_check(int argc, char **argv);
 /* `piola mesh generate ...` (argv[0] is "generate"), called by the `mesh` command. */
 int cli_mesh_generate(int argc, char **argv);
 
+/* Whether path names a surface file (.obj, .off, .stl) rather than a tet mesh (cli_mesh.c). */
+int cli_is_surface_path(const char *path);
+
 #endif

@@ -10,6 +10,7 @@
 #include "math/mat3.h"
 #include "mesh/element_input.h"
 #include "shell/shell_body_internal.h"
+#include "shell/shell_stable_step.h"
 
 /* A rest triangle whose area is below this fraction of (longest edge)^2 is degenerate:
  * its Dm^-1 would be meaningless. */
@@ -283,16 +284,10 @@ piola_status piola__shell_body_build(piola_shell_body *body, const piola_shell_b
   if (!ok)
     return PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "shell body with %d hinges: out of memory",
                       (int)nh);
-  /* bending stability: the hinge stiffness D w/2 g g^T summed over hinges, bounded per
-   * vertex a by Gershgorin on M^-1/2 K M^-1/2: omega^2 <= max_a sum_h (D w/2) |g_a| / sqrt(m_a)
-   * sum_b |g_b| / sqrt(m_b). The time scale is 1 / omega. */
   body->inverse_sqrt_masses = alloc_array((size_t)nv, sizeof(double));
   body->vertex_rate2 = alloc_array((size_t)nv, sizeof(double));
-  double *omega2 = alloc_array((size_t)nv, sizeof(double));
-  if (!omega2 || !body->inverse_sqrt_masses || !body->vertex_rate2) {
-    free(omega2);
+  if (!body->inverse_sqrt_masses || !body->vertex_rate2)
     return PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "shell body: out of memory");
-  }
   for (int32_t i = 0; i < nv; ++i)
     body->inverse_sqrt_masses[i] = body->masses[i] > 0 ? 1.0 / sqrt(body->masses[i]) : 0.0;
   for (int32_t h = 0; h < nh; ++h) {
@@ -309,18 +304,10 @@ piola_status piola__shell_body_build(piola_shell_body *body, const piola_shell_b
     hg->rest_angle = piola__hinge_angle(p[0], p[1], p[2], p[3], hg->grad);
     hg->angle = hg->rest_angle;
     body->rest_angles[h] = body->angles[h] = hg->rest_angle;
-    double norms[4], sum = 0;
-    for (int k = 0; k < 4; ++k) {
-      const double *g = hg->grad + 3 * k;
-      norms[k] = sqrt(g[0] * g[0] + g[1] * g[1] + g[2] * g[2]) / sqrt(body->masses[hg->v[k]]);
-      sum += norms[k];
-    }
-    for (int k = 0; k < 4; ++k)
-      omega2[hg->v[k]] += 0.5 * def->bending.stiffness * hg->weight * norms[k] * sum;
   }
-  double largest = 0;
-  for (int32_t i = 0; i < nv; ++i) largest = fmax(largest, omega2[i]);
-  free(omega2);
+  /* bending stability: the step bound's Gershgorin estimate (shell_stable_step.h) at the
+   * rest gradients; the time scale is 1 / omega */
+  const double largest = piola__shell_body_bending_rate2(body);
   body->bending_time_scale = largest > 0 ? 1.0 / sqrt(largest) : INFINITY;
 
   PIOLA_TRY(build_incidence(nv, nt, 3, body->triangle_indices, &body->tri_start,

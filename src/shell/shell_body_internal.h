@@ -40,6 +40,15 @@ typedef struct shell_triangle {
   double energy_density; /* J/m^3 */
 } shell_triangle;
 
+/* The shape-function gradients g_a of a triangle in its rest frame, from its effective
+ * Dm^-1 (F = sum_a x_a g_a^T: g1, g2 its rows, g0 = -(g1 + g2)). */
+static inline void shell_triangle_gradients(const shell_triangle *tri, double g[3][2]) {
+  const double *d = tri->dm_inv_eff;
+  g[0][0] = -(d[0] + d[2]), g[0][1] = -(d[1] + d[3]);
+  g[1][0] = d[0], g[1][1] = d[1];
+  g[2][0] = d[2], g[2][1] = d[3];
+}
+
 /* The implicit system matrix's pattern (shell_stiffness.h): row i lists the vertices that
  * share a triangle or a hinge with vertex i, increasing, in col[row_start[i] ..
  * row_start[i + 1]); triangle_slot[6 t + k] and hinge_slot[12 h + k] are the entries of the

@@ -68,11 +68,10 @@ static double membrane_modulus(const piola_material *m, double f0, double f1) {
   return fmax(k, modulus_at(m, fmax(f0, c), fmax(f1, c)));
 }
 
-/* 1 / h_t^2 of a triangle: its largest squared shape-function gradient, from the effective
- * Dm^-1 (F = e1 g1^T + e2 g2^T, g0 = -(g1 + g2)). */
+/* 1 / h_t^2 of a triangle: its largest squared shape-function gradient. */
 static double inverse_altitude2(const shell_triangle *tri) {
-  const double *d = tri->dm_inv_eff;
-  const double g[3][2] = {{-(d[0] + d[2]), -(d[1] + d[3])}, {d[0], d[1]}, {d[2], d[3]}};
+  double g[3][2];
+  shell_triangle_gradients(tri, g);
   double most = 0;
   for (int a = 0; a < 3; ++a) most = fmax(most, g[a][0] * g[a][0] + g[a][1] * g[a][1]);
   return most;
@@ -96,8 +95,9 @@ double piola__shell_body_bending_rate2(const piola_shell_body *body) {
   if (!(stiffness > 0) || body->hinge_count == 0) return 0;
   double *omega2 = body->vertex_rate2;
   memset(omega2, 0, sizeof(double) * (size_t)body->vertex_count);
-  /* the rest bound's estimate (rest_state.c) with the current gradients: omega^2 <=
-   * max_a sum_h (D w / 2) |g_a| / sqrt(m_a) sum_b |g_b| / sqrt(m_b) */
+  /* the hinge stiffness D w/2 g g^T summed over hinges, bounded per vertex a by Gershgorin
+   * on M^-1/2 K M^-1/2: omega^2 <= max_a sum_h (D w / 2) |g_a| / sqrt(m_a) sum_b |g_b| /
+   * sqrt(m_b), with the gradients g of the last update (at rest: the rest bound) */
   for (int32_t h = 0; h < body->hinge_count; ++h) {
     const shell_hinge *hg = &body->hinges[h];
     double norms[4], sum = 0;

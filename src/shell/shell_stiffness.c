@@ -10,8 +10,9 @@
 /* The rows g_a of a triangle's effective Dm^-1 (F = sum_a x_a g_a^T), rotated by V:
  * gh_a = V^T g_a. */
 static void rotated_gradients(const shell_triangle *tri, double gh[3][2]) {
-  const double *d = tri->dm_inv_eff, *r = tri->vrot;
-  const double g[3][2] = {{-(d[0] + d[2]), -(d[1] + d[3])}, {d[0], d[1]}, {d[2], d[3]}};
+  const double *r = tri->vrot;
+  double g[3][2];
+  shell_triangle_gradients(tri, g);
   for (int a = 0; a < 3; ++a)
     for (int j = 0; j < 2; ++j) gh[a][j] = r[j] * g[a][0] + r[2 + j] * g[a][1];
 }

@@ -28,6 +28,7 @@
 #ifndef PIOLA_SIM_BODY_H
 #define PIOLA_SIM_BODY_H
 
+#include <math.h>
 #include <stdint.h>
 
 #include "piola/world.h"
@@ -208,6 +209,15 @@ piola_status piola__body_rebuild(piola_world *w, world_body *b, const body_chang
 piola_status piola__body_resplit(piola_world *w, world_body *b);
 
 /* ---- the kinds' own code */
+
+/* A body's explicit step from its rest bound (s) and its state-aware rate2 (1/s^2): the state
+ * bound cfl / sqrt(rate2) where it is smaller by more than rounding, else the rest bound (at
+ * rest the two agree up to rounding, and a state at rest keeps the rest step's bits;
+ * docs/time-stepping.md, "Step size"). */
+static inline double piola__state_or_rest_step(double rest, double cfl, double rate2) {
+  const double state = rate2 > 0 ? cfl / sqrt(rate2) : INFINITY;
+  return state < rest * (1.0 - 1e-9) ? state : rest;
+}
 
 /* world_solids.c */
 piola_status piola__solid_update_forces(world_body *b, double t);

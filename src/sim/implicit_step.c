@@ -754,6 +754,22 @@ static int friction_moves_deform(const newton_problem *pb) {
   return 0;
 }
 
+/* g . n at node i, positive where its hold pushes: the normal contact force is
+ * g . n / dt^2 (g, the residual, carries dt^2). */
+static double normal_residual(const newton_problem *pb, int32_t i) {
+  const double *g = pb->st->residual + 3 * i, *nrm = pb->s->normals + 3 * i;
+  return g[0] * nrm[0] + g[1] * nrm[1] + g[2] * nrm[2];
+}
+
+/* The obstacle nearest node i: its friction coefficient (returned) and surface velocity vo. */
+static double node_obstacle(const newton_problem *pb, int32_t i, piola_vec3 *vo) {
+  const double *x = pb->s->x + 3 * i;
+  double mu;
+  piola__nearest_obstacle_motion(pb->w->obstacles, pb->w->obstacle_count, pb->t1,
+                                 (piola_vec3){x[0], x[1], x[2]}, &mu, vo);
+  return mu;
+}
+
 /* The tangential part of node i's velocity relative to vo, about its normal, into vt; returns
  * its size. */
 static double relative_slip(const world_body *s, int32_t i, piola_vec3 vo, double vt[3]) {
@@ -783,27 +799,23 @@ static int body_may_slide(const newton_problem *pb) {
   double capacity = 0, impulse = 0, slip[3] = {0, 0, 0};
   for (int32_t i = 0; i < s->n; ++i) {
     if (s->colliding[i] != HELD_BY_OBSTACLE || s->flags[i] != NODE_FREE) continue;
-    const double *g = pb->st->residual + 3 * i, *nrm = s->normals + 3 * i;
-    const double jn = (g[0] * nrm[0] + g[1] * nrm[1] + g[2] * nrm[2]) / pb->dt;
+    const double jn = normal_residual(pb, i) / pb->dt;
     if (!(jn > 0)) continue;
-    piola_vec3 p = {s->x[3 * i], s->x[3 * i + 1], s->x[3 * i + 2]}, vo;
-    double mu, vt[3];
-    piola__nearest_obstacle_motion(pb->w->obstacles, pb->w->obstacle_count, pb->t1, p, &mu, &vo);
+    piola_vec3 vo;
+    double vt[3];
+    const double mu = node_obstacle(pb, i, &vo);
     (void)relative_slip(s, i, vo, vt);
     capacity += mu * jn, impulse += jn;
     for (int k = 0; k < 3; ++k) slip[k] += jn * vt[k];
   }
   if (!(impulse > 0)) return 0;
-  double mass = 0;
-  for (int32_t i = 0; i < s->n; ++i) {
-    /* a body held by fixed, driven or bone nodes does not slide as a whole (examples/arm_flex
-     * as backward Euler, its flesh on its bones, took 2.4 times the Newton iterations) */
+  /* a body held by fixed, driven or bone nodes does not slide as a whole (examples/arm_flex
+   * as backward Euler, its flesh on its bones, took 2.4 times the Newton iterations) */
+  for (int32_t i = 0; i < s->n; ++i)
     if (s->flags[i] != NODE_FREE && s->mass[i] > 0) return 0;
-    mass += s->mass[i];
-  }
   /* the body's momentum at the contacts' mean slip: a body rolling without slipping has
    * none, whatever its speed */
-  const double scale = mass / impulse;
+  const double scale = pb->total_mass / impulse;
   const double momentum2 =
       scale * scale * (slip[0] * slip[0] + slip[1] * slip[1] + slip[2] * slip[2]);
   return momentum2 > capacity * capacity;
@@ -820,12 +832,11 @@ static int32_t release_slipping_holds(newton_problem *pb) {
   for (int32_t i = 0; i < s->n; ++i) {
     if (s->colliding[i] != HELD_BY_FRICTION || s->flags[i] != NODE_FREE) continue;
     const double *g = st->residual + 3 * i, *nrm = s->normals + 3 * i;
-    const double gn = g[0] * nrm[0] + g[1] * nrm[1] + g[2] * nrm[2];
+    const double gn = normal_residual(pb, i);
     const double gt[3] = {g[0] - gn * nrm[0], g[1] - gn * nrm[1], g[2] - gn * nrm[2]};
     const double gt_size = sqrt(gt[0] * gt[0] + gt[1] * gt[1] + gt[2] * gt[2]);
-    piola_vec3 p = {s->x[3 * i], s->x[3 * i + 1], s->x[3 * i + 2]}, vo;
-    double mu;
-    piola__nearest_obstacle_motion(pb->w->obstacles, pb->w->obstacle_count, pb->t1, p, &mu, &vo);
+    piola_vec3 vo;
+    const double mu = node_obstacle(pb, i, &vo);
     if (!(gn > 0) || !(gt_size > mu * gn)) continue;
     s->colliding[i] = HELD_BY_OBSTACLE;
     const double scale = mu * gn / gt_size / (pb->dt * pb->dt);
@@ -849,11 +860,10 @@ static int32_t kinetic_friction(newton_problem *pb) {
     if (s->colliding[i] == HELD_BY_FRICTION) continue; /* the hold is its friction */
     for (int k = 0; k < 3; ++k) st->friction[3 * i + k] = 0;
     if (s->colliding[i] != HELD_BY_OBSTACLE || s->flags[i] != NODE_FREE) continue;
-    const double *g = st->residual + 3 * i, *nrm = s->normals + 3 * i;
-    const double gn = g[0] * nrm[0] + g[1] * nrm[1] + g[2] * nrm[2];
-    piola_vec3 p = {s->x[3 * i], s->x[3 * i + 1], s->x[3 * i + 2]}, vo;
-    double mu, vt[3];
-    piola__nearest_obstacle_motion(pb->w->obstacles, pb->w->obstacle_count, pb->t1, p, &mu, &vo);
+    const double gn = normal_residual(pb, i);
+    piola_vec3 vo;
+    double vt[3];
+    const double mu = node_obstacle(pb, i, &vo);
     const double slip = relative_slip(s, i, vo, vt);
     if (!(gn > 0) || !(mu > 0) || !(slip > 0)) continue;
     const double scale = -mu * gn / (pb->dt * pb->dt) / slip;
@@ -875,9 +885,9 @@ static int32_t hold_reversed_slips(newton_problem *pb) {
     if (s->colliding[i] != HELD_BY_OBSTACLE || s->flags[i] != NODE_FREE) continue;
     double *f = st->friction + 3 * i;
     if (f[0] == 0 && f[1] == 0 && f[2] == 0) continue;
-    piola_vec3 p = {s->x[3 * i], s->x[3 * i + 1], s->x[3 * i + 2]}, vo;
-    double mu, vt[3];
-    piola__nearest_obstacle_motion(pb->w->obstacles, pb->w->obstacle_count, pb->t1, p, &mu, &vo);
+    piola_vec3 vo;
+    double vt[3];
+    (void)node_obstacle(pb, i, &vo);
     (void)relative_slip(s, i, vo, vt);
     if (!(vt[0] * f[0] + vt[1] * f[1] + vt[2] * f[2] > 0)) continue;
     for (int k = 0; k < 3; ++k) {

@@ -85,6 +85,9 @@ void piola__world_check_slivers(piola_world *w, const world_body *s);
 /* Before the world's first step from t = 0: warns (PIOLA_WARNING_STARTS_INSIDE) when free nodes of
  * a body start inside an obstacle deeper than a percent of the body's size. Once per world. */
 void piola__world_check_start_inside(piola_world *w);
+
+/* Diagonal (m) of the bounding box of n points x (3 n numbers); 0 for none. */
+double piola__bounding_diagonal(int32_t n, const double *x);
 void piola__world_warnings_free(piola_world *w);
 
 /* ---- the body table (body_table.c) */

@@ -43,13 +43,6 @@ static void shell_state_rates(const world_body *s) {
   cache->state_rate_valid = 1;
 }
 
-/* The smaller of a rest bound and a state bound cfl / sqrt(rate2), the state bound only where
- * it is smaller by more than rounding: a shell at rest keeps the rest step's bits. */
-static double state_or_rest(double rest, double cfl, double rate2) {
-  const double state = rate2 > 0 ? cfl / sqrt(rate2) : INFINITY;
-  return state < rest * (1.0 - 1e-9) ? state : rest;
-}
-
 /* The step of shell s: its membrane and bending bounds, each the rest bound or the
  * state-aware one where that is smaller (docs/time-stepping.md, "Step size"). */
 double piola__shell_stable_dt(const piola_world *w, const world_body *s, double scale) {
@@ -59,12 +52,12 @@ double piola__shell_stable_dt(const piola_world *w, const world_body *s, double 
   double speed = piola_shell_body_max_wave_speed(s->shell) * sqrt(scale);
   double h = piola_shell_body_min_rest_altitude(s->shell);
   if (speed > 0 && h > 0)
-    dt = state_or_rest(w->def.cfl * h / speed, w->def.cfl, s->state_rate2 * scale);
+    dt = piola__state_or_rest_step(w->def.cfl * h / speed, w->def.cfl, s->state_rate2 * scale);
   /* bending: explicit, stable up to ~2 sqrt(m/k); cfl in (0, 2] scales it the same way */
   double bending = piola_shell_body_bending_time_scale(s->shell);
   if (isfinite(bending))
-    dt = fmin(dt, state_or_rest(w->def.cfl * bending / sqrt(scale), w->def.cfl,
-                                s->state_bending_rate2 * scale));
+    dt = fmin(dt, piola__state_or_rest_step(w->def.cfl * bending / sqrt(scale), w->def.cfl,
+                                            s->state_bending_rate2 * scale));
   return dt;
 }
 

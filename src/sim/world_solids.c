@@ -43,10 +43,8 @@ double piola__solid_stable_dt(const piola_world *w, const world_body *b, double 
   double speed = piola_elastic_body_max_wave_speed(b->solid) * sqrt(scale);
   double h = piola_elastic_body_min_rest_altitude(b->solid) / stiffening;
   if (!(speed > 0 && h > 0)) return INFINITY;
-  double rest = w->def.cfl * h / speed;
-  double rate2 = solid_state_rate2(b) * scale * stiffening * stiffening;
-  double state = rate2 > 0 ? w->def.cfl / sqrt(rate2) : INFINITY;
-  return state < rest * (1.0 - 1e-9) ? state : rest;
+  const double rate2 = solid_state_rate2(b) * scale * stiffening * stiffening;
+  return piola__state_or_rest_step(w->def.cfl * h / speed, w->def.cfl, rate2);
 }
 
 /* The elastic statistics of the last update, from its per-tet state (energy density lazily
@@ -154,16 +152,10 @@ static piola_status check_solid_def(const piola_solid_def *def, int32_t id) {
 
 static piola_status check_initial_extent(const world_body *s, const double *rest, vec3 c,
                                          int32_t id) {
-  double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
   double farthest = 0;
-  for (int32_t i = 0; i < s->n; ++i) {
-    for (int k = 0; k < 3; ++k)
-      lo[k] = fmin(lo[k], rest[3 * i + k]), hi[k] = fmax(hi[k], rest[3 * i + k]);
+  for (int32_t i = 0; i < s->n; ++i)
     farthest = fmax(farthest, vec3_norm(vec3_sub(vec3_load(s->x + 3 * i), c)));
-  }
-  double size2 = 0;
-  for (int k = 0; k < 3; ++k) size2 += s->n > 0 ? (hi[k] - lo[k]) * (hi[k] - lo[k]) : 0.0;
-  const double size = sqrt(size2);
+  const double size = piola__bounding_diagonal(s->n, rest);
   if (farthest <= INITIAL_EXTENT_LIMIT * size) return PIOLA_OK;
   return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT,
                     "solid %d: its initial state (initial.matrix, initial.scramble) puts a node "

@@ -124,14 +124,13 @@ void piola__world_check_slivers(piola_world *w, const world_body *s) {
  * error, is far below it. */
 #define STARTS_INSIDE_DEPTH 0.01
 
-/* Diagonal (m) of the bounding box of the body's current positions. */
-static double body_diagonal(const world_body *b) {
+double piola__bounding_diagonal(int32_t n, const double *x) {
   double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
-  for (int32_t i = 0; i < b->n; ++i)
+  for (int32_t i = 0; i < n; ++i)
     for (int k = 0; k < 3; ++k)
-      lo[k] = fmin(lo[k], b->x[3 * i + k]), hi[k] = fmax(hi[k], b->x[3 * i + k]);
+      lo[k] = fmin(lo[k], x[3 * i + k]), hi[k] = fmax(hi[k], x[3 * i + k]);
   double d2 = 0;
-  for (int k = 0; k < 3; ++k) d2 += b->n > 0 ? (hi[k] - lo[k]) * (hi[k] - lo[k]) : 0.0;
+  for (int k = 0; k < 3; ++k) d2 += n > 0 ? (hi[k] - lo[k]) * (hi[k] - lo[k]) : 0.0;
   return sqrt(d2);
 }
 
@@ -142,7 +141,7 @@ void piola__world_check_start_inside(piola_world *w) {
   if (w->time != 0.0) return;
   for (int32_t bi = 0; bi < w->body_count; ++bi) {
     const world_body *b = &w->bodies[bi];
-    const double size = body_diagonal(b), limit = STARTS_INSIDE_DEPTH * size;
+    const double size = piola__bounding_diagonal(b->n, b->x), limit = STARTS_INSIDE_DEPTH * size;
     for (int32_t o = 0; o < w->obstacle_count; ++o) {
       const piola_obstacle *ob = w->obstacles[o];
       piola__rigid_state pose;

@@ -450,10 +450,13 @@ static piola_status step_body(piola_world *w, world_body *s, double t, double dt
    * nodes to those nodes' imposed motion, work the balance does not see. Gains below the
    * energy of a uniform strain of 1e-9 at the rest modulus, (lambda + 2 mu) V 1e-18 / 2 =
    * M c^2 1e-18 / 2, are rounding (a body at rest has forces of ~1e-16 of its stresses).
-   * Solids only: shells are not checked. */
+   * Shells the same way, with the membrane's wave speed: their membrane and bending forces are
+   * in s->force and derive from energies, and their damping is in the solves. */
   *energy_rose = 0;
-  if (s->kind == PIOLA_BODY_SOLID && !driven && colliding == 0) {
-    const double tol = w->def.cg_tolerance, c = piola_elastic_body_max_wave_speed(s->solid);
+  if (s->kind != PIOLA_BODY_NONE && !driven && colliding == 0) {
+    const double tol = w->def.cg_tolerance;
+    const double c = s->kind == PIOLA_BODY_SOLID ? piola_elastic_body_max_wave_speed(s->solid)
+                                                 : piola_shell_body_max_wave_speed(s->shell);
     double total_mass = 0;
     for (int32_t i = 0; i < n; ++i) total_mass += s->mass[i];
     const double floor = 0.5e-18 * total_mass * c * c;

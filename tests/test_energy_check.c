@@ -14,7 +14,6 @@
 
 #include "block_scenes.h"
 #include "piola/world.h"
-#include "piola/world_shells.h"
 #include "sim/body.h"
 #include "sim/world_internal.h"
 #include "test_shell_fixtures.h"
@@ -90,22 +89,7 @@ static void unstable_steps_are_redone(void **state) {
  * along x and a slight sag (so bending works too), and the redos of those steps. */
 static double shell_peak_energy(piola_material_model model, double cfl, double stretch, int steps,
                                 int *redos) {
-  piola_world_def wdef = piola_default_world_def();
-  wdef.max_dt = 1.0;
-  wdef.cfl = cfl;
-  for (int k = 0; k < 3; ++k) wdef.gravity[k] = piola_track_constant(0.0);
-  piola_world *w;
-  assert_int_equal(piola_world_create(&wdef, &w), PIOLA_OK);
-  piola_tri_mesh mesh = shell_sheet(1.0, 1.0, 12, 12);
-  piola_shell_def def = piola_default_shell_def();
-  def.mesh = &mesh;
-  def.material.model = model;
-  def.material.youngs_modulus = 1e5;
-  def.material.poisson_ratio = 0.3;
-  def.thickness = 1e-3;
-  def.bending.stiffness = 1e-4;
-  assert_int_equal(piola_world_add_shell(w, &def, NULL), PIOLA_OK);
-  piola_tri_mesh_free(&mesh);
+  piola_world *w = shell_sheet_world(model, cfl, 1e-4, NULL, 0);
   world_body *b = &w->bodies[0];
   for (int32_t i = 0; i < b->n; ++i) {
     double *x = b->x + 3 * i;

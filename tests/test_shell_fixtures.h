@@ -8,6 +8,8 @@
 #include <string.h>
 
 #include "piola/shell_body.h"
+#include "piola/world.h"
+#include "piola/world_shells.h"
 #include "test_support.h"
 
 static const piola_material_model shell_all_models[] = {
@@ -30,6 +32,33 @@ static inline piola_tri_mesh shell_sheet(double width, double height, int nx, in
   piola_tri_mesh mesh;
   assert_int_equal(piola_tri_mesh_rectangle(width, height, nx, ny, &mesh), PIOLA_OK);
   return mesh;
+}
+
+/* A world without gravity (max_dt 1 s, the given cfl) holding one 1 x 1 m sheet of 12 x 12
+ * cells, 1 mm thick, E = 100 kPa, nu = 0.3, with the given bending stiffness (N m) and
+ * constraints. */
+static inline piola_world *shell_sheet_world(piola_material_model model, double cfl, double bending,
+                                             const piola_constraint_def *constraints,
+                                             int32_t constraint_count) {
+  piola_world_def wdef = piola_default_world_def();
+  wdef.max_dt = 1.0;
+  wdef.cfl = cfl;
+  for (int k = 0; k < 3; ++k) wdef.gravity[k] = piola_track_constant(0.0);
+  piola_world *world;
+  assert_int_equal(piola_world_create(&wdef, &world), PIOLA_OK);
+  piola_tri_mesh mesh = shell_sheet(1.0, 1.0, 12, 12);
+  piola_shell_def def = piola_default_shell_def();
+  def.mesh = &mesh;
+  def.material.model = model;
+  def.material.youngs_modulus = 1e5;
+  def.material.poisson_ratio = 0.3;
+  def.thickness = 1e-3;
+  def.bending.stiffness = bending;
+  def.constraints = constraints;
+  def.constraint_count = constraint_count;
+  assert_int_equal(piola_world_add_shell(world, &def, NULL), PIOLA_OK);
+  piola_tri_mesh_free(&mesh);
+  return world;
 }
 
 /* A single triangle (0,0,0), (1,0,0), (0.3,0.8,0) scaled by h. */

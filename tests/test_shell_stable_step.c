@@ -126,19 +126,6 @@ static void membrane_modulus_bounds_every_wave(void **state) {
 }
 
 static piola_world *sheet_world(piola_material_model model, double pull_speed, double bending) {
-  piola_world_def wdef = piola_default_world_def();
-  wdef.max_dt = 1.0;
-  for (int k = 0; k < 3; ++k) wdef.gravity[k] = piola_track_constant(0.0);
-  piola_world *world;
-  assert_int_equal(piola_world_create(&wdef, &world), PIOLA_OK);
-  piola_tri_mesh mesh = shell_sheet(1.0, 1.0, 12, 12);
-  piola_shell_def def = piola_default_shell_def();
-  def.mesh = &mesh;
-  def.material.model = model;
-  def.material.youngs_modulus = 1e5;
-  def.material.poisson_ratio = 0.3;
-  def.thickness = 1e-3;
-  def.bending.stiffness = bending;
   piola_constraint_def ends[2];
   memset(ends, 0, sizeof ends);
   for (int e = 0; e < 2; ++e) {
@@ -150,11 +137,7 @@ static piola_world *sheet_world(piola_material_model model, double pull_speed, d
   ends[1].driven = true;
   ends[1].motion = piola_default_rigid_motion_def();
   ends[1].motion.velocity[0] = piola_track_constant(pull_speed);
-  def.constraints = ends;
-  def.constraint_count = pull_speed > 0 ? 2 : 1;
-  assert_int_equal(piola_world_add_shell(world, &def, NULL), PIOLA_OK);
-  piola_tri_mesh_free(&mesh);
-  return world;
+  return shell_sheet_world(model, 0.5, bending, ends, pull_speed > 0 ? 2 : 1);
 }
 
 static void a_sheet_at_rest_keeps_its_rest_step(void **state) {

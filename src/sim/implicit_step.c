@@ -46,7 +46,7 @@
  * pull is released. After convergence the normal contact force (the filtered-out residual)
  * limits the tangential velocity relative to the obstacle by Coulomb's law, as the Newmark
  * step does with its normal impulse; where those moves are large against the tets around
- * them, the step is solved once more around them (friction_moves_deform). Self-collision
+ * them, the step is solved once more around them (implicit_contacts.c). Self-collision
  * runs after the step as with Newmark, and the bodies it moved are solved again behind their
  * pushed surfaces (self_collide_and_resolve); plasticity runs after the step.
  *
@@ -70,13 +70,9 @@
 
 #include "common/status_report.h"
 #include "force/elastic_body_internal.h"
-#include "force/stiffness_incomplete_cholesky.h"
-#include "force/stiffness_matrix.h"
-#include "force/stiffness_multigrid.h"
-#include "force/stable_step.h"
 #include "sim/failed_step_velocity.h"
+#include "sim/implicit_problem.h"
 #include "sim/implicit_split.h"
-#include "sim/obstacle_friction.h"
 #include "sim/world_internal.h"
 
 #define STANDARD_GRAVITY 9.81
@@ -135,47 +131,6 @@ static double last_try_length(const piola_world *w) {
  * were missed. Shells keep the whole step: on cloth folding over on the ground the fraction
  * doubled the failed Newton steps. */
 #define GUESS_GRAVITY_FRACTION 1e-3
-
-/* Values of world_body.colliding during an implicit step: a node held along its normal by
- * an obstacle, along the push of the self-collision pass (see self_collide_and_resolve), or
- * by a solid's surface (a shell's one-way coupling, collide_with_solids); or held in all
- * three directions where friction stopped it (newton_iterate's friction pass). */
-enum { HELD_BY_OBSTACLE = 1, HELD_BY_COLLISION = 2, HELD_BY_SOLID = 3, HELD_BY_FRICTION = 4 };
-
-/* Friction's move of a node after the solve, as a fraction of the rest altitude of a tet
- * around it, above which the step is solved again (friction_moves_deform). Measured on
- * bunny.msh's slivers at the contact: 1.8-12, and elements there stayed inverted; on the
- * generated tori of BENCHMARKS.md at most 0.27, where the split is harmless. */
-#define FRICTION_RESOLVE_MOVE 0.5
-/* How many times a step with friction is solved again after its first solve with it
- * (next_friction_round): the sliding block of body_may_slide settles in one to three */
-#define FRICTION_SLIP_ROUNDS 4
-/* A friction round changes less than this fraction of the total friction force: no more */
-#define FRICTION_ROUND_CHANGE 0.01
-
-struct implicit_state {
-  piola__stiffness_matrix matrix;
-  piola__incomplete_cholesky factor; /* a solid's IC(0), when that is the preconditioner */
-  int factored;                      /* factor holds the current Newton system's */
-  piola__multigrid multigrid; /* a solid's multigrid hierarchy, when that is the preconditioner */
-  int multigrid_ready;        /* multigrid serves the current Newton system */
-  int multigrid_fresh;        /* the hierarchy was set up in this step (else: set it up) */
-  int32_t split_systems;      /* Newton systems of this step solved by the split's solver */
-  double failed_progress;     /* try_progress of this step's last failed try; -1: none yet */
-  int halvings;               /* of the step's try being solved */
-  int may_go_deeper;  /* a kept try that would keep only its start is halved on (DEEPER_HALVINGS) */
-  int went_deeper;    /* ... and this try was */
-  double *prediction; /* 3n: x^n + dt v^n (backward Euler) */
-  double *residual;   /* 3n: g, unfiltered */
-  double *step;       /* 3n: the Newton direction */
-  double *base;       /* 3n: x before the line search */
-  double *damping;    /* 3n: D v */
-  double *cg[4];      /* 3n each: r, z, p, q */
-  double *scratch_v;  /* 3n: velocities handed to the obstacle projection */
-  double *surface_v;  /* 3n: velocity of the solid surface a HELD_BY_SOLID node touches */
-  double *friction;   /* 3n: the force friction applied to each node in the step, m dv / dt (N) */
-  uint8_t *hit;       /* n: nodes the obstacle projection moved */
-};
 
 void piola__implicit_state_free(struct implicit_state *st) {
   if (!st) return;
@@ -270,29 +225,6 @@ static double sum_over_ranges(int32_t n, int32_t parallel_min, range_pass *pass,
 }
 
 /* ------------------------------------------------------------------ the step's problem */
-
-typedef struct newton_problem {
-  piola_world *w;
-  world_body *s;
-  struct implicit_state *st;
-  double t1, dt;
-  int quasistatic;
-  double beta, alpha;  /* viscosities at t1, Pa s */
-  int damped;
-  double g1[3];        /* gravity at t1 */
-  double force_weight; /* dt^2, or 1 in quasistatics */
-  double mass_weight;  /* 1, or 0 in quasistatics */
-  double total_mass;
-  int signed_twist; /* this Newton system keeps the rotation eigenvalues' sign (the tail) */
-  int indefinite;   /* the last CG met non-positive curvature or an indefinite preconditioner */
-  int contacts_moved; /* contacts() or release_contacts() changed the contact set since the
-                        * preconditioner was built */
-  int friction_held;  /* solved again after friction (friction_moves_deform): the nodes it
-                       * stopped are held, the others feel its force, no friction pass */
-  int slip_rounds;    /* friction rounds solved since (next_friction_round) */
-  int kinetic;        /* the step began its friction with kinetic friction on every contact
-                       * (body_may_slide) */
-} newton_problem;
 
 /* Nodes i0 .. i1 - 1 of the residual; returns their part of |S g|^2_{M^-1}. */
 static double residual_range(const void *ctx, int32_t i0, int32_t i1) {
@@ -614,338 +546,6 @@ static double residual_dot_step(const newton_problem *pb) {
   return slope;
 }
 
-/* A shell's one-way coupling to the solids (collide_with_solids; the solids have stepped
- * already): free nodes inside a solid's surface are projected onto it and held along its
- * normal like obstacle contacts, the surface's velocity kept for friction. Returns 1 when
- * it moved a node, else 0. */
-static int32_t coupling_contacts(newton_problem *pb) {
-  world_body *s = pb->s;
-  struct implicit_state *st = pb->st;
-  if (!s->collide_with_solids) return 0;
-  const size_t v3 = sizeof(double) * 3 * (size_t)s->n;
-  memcpy(st->scratch_v, s->x, v3);
-  (void)piola__body_collide_in_step(pb->w, s, pb->t1, pb->dt, HELD_BY_SOLID, st->surface_v);
-  return memcmp(st->scratch_v, s->x, v3) != 0;
-}
-
-/* Projects free nodes that are inside an obstacle (or, for a coupled shell, a solid) onto
- * its surface and holds their normal from then on. Returns the number of nodes newly held
- * (at least 1 when any node moved; -1 on error). */
-static int32_t contacts(newton_problem *pb) {
-  piola_world *w = pb->w;
-  world_body *s = pb->s;
-  struct implicit_state *st = pb->st;
-  if (s->n == 0) return 0;
-  const int32_t coupled = coupling_contacts(pb);
-  if (w->obstacle_count == 0) return coupled;
-  memset(st->scratch_v, 0, sizeof(double) * 3 * (size_t)s->n);
-  double *normals = st->cg[0]; /* free between solves */
-  int32_t moved = piola_obstacles_collide(w->obstacles, w->obstacle_count, pb->t1, 0.0, s->n, s->x,
-                                          st->scratch_v, st->hit, normals);
-  if (moved < 0) return -1;
-  int32_t added = 0;
-  for (int32_t i = 0; i < s->n; ++i) {
-    if (!st->hit[i]) continue;
-    if (s->flags[i] != NODE_FREE) {
-      /* prescribed nodes are never projected: put them back */
-      double xp[3], vp[3];
-      piola__body_constrained_state(s, i, pb->t1, xp, vp);
-      for (int k = 0; k < 3; ++k) s->x[3 * i + k] = xp[k];
-      continue;
-    }
-    if (!s->colliding[i]) added++;
-    if (s->colliding[i] != HELD_BY_FRICTION) s->colliding[i] = HELD_BY_OBSTACLE;
-    for (int k = 0; k < 3; ++k) s->normals[3 * i + k] = normals[3 * i + k];
-  }
-  const int32_t changed = moved > 0 ? (added > 0 ? added : 1) : coupled;
-  if (changed > 0) pb->contacts_moved = 1;
-  return changed;
-}
-
-/* Releases held nodes whose contact force would pull them into the obstacle (g . n < 0 means
- * the constraint force g / dt^2 points along -n). On the kinetic-friction path (pb->kinetic)
- * nodes friction holds only with `friction_held_too` (at convergence): while the iterate is
- * far from it their residual is no contact force yet (47 of a sliding block's 57 holds went
- * in the first iterations of a step). Returns how many. */
-static int32_t release_contacts(newton_problem *pb, int friction_held_too) {
-  world_body *s = pb->s;
-  int32_t released = 0;
-  for (int32_t i = 0; i < s->n; ++i) {
-    if (!s->colliding[i] || s->flags[i] != NODE_FREE) continue;
-    if (s->colliding[i] == HELD_BY_FRICTION && !friction_held_too && pb->kinetic) continue;
-    const double *g = pb->st->residual + 3 * i, *nrm = s->normals + 3 * i;
-    if (g[0] * nrm[0] + g[1] * nrm[1] + g[2] * nrm[2] < 0) {
-      s->colliding[i] = 0;
-      /* its friction goes with the contact, and does not come back with it in this solve:
-       * a force that came and went with the contact made the contact set cycle (nodes of a
-       * block sliding down an incline, lifted by the friction's moment) */
-      if (pb->kinetic)
-        for (int k = 0; k < 3; ++k) pb->st->friction[3 * i + k] = 0;
-      released++;
-    }
-  }
-  if (released > 0) pb->contacts_moved = 1;
-  return released;
-}
-
-/* Coulomb friction with the converged contact force: the normal impulse dt (g . n) / dt^2
- * per unit mass limits the tangential velocity relative to the nearest obstacle. Changes
- * x and v of sliding nodes; returns how many. Notes for a second solve, per node: in
- * st->hit what piola__coulomb_limit did (2 stopped it, 1 slowed it, 0 nothing); in
- * st->friction the force m dv / dt; in st->scratch_v (n) how far it moved. */
-static int32_t contact_friction(newton_problem *pb) {
-  piola_world *w = pb->w;
-  world_body *s = pb->s;
-  struct implicit_state *st = pb->st;
-  double *moved = st->scratch_v;
-  memset(st->hit, 0, (size_t)s->n);
-  memset(moved, 0, sizeof(double) * (size_t)s->n);
-  memset(st->friction, 0, sizeof(double) * 3 * (size_t)s->n);
-  int32_t changed = 0;
-  for (int32_t i = 0; i < s->n; ++i) {
-    const int on_solid = s->colliding[i] == HELD_BY_SOLID;
-    if ((s->colliding[i] != HELD_BY_OBSTACLE && !on_solid) || s->flags[i] != NODE_FREE) continue;
-    const double *g = pb->st->residual + 3 * i, *nrm = s->normals + 3 * i;
-    double dvn = (g[0] * nrm[0] + g[1] * nrm[1] + g[2] * nrm[2]) / (pb->dt * s->mass[i]);
-    if (!(dvn > 0)) continue;
-    piola_vec3 p = {s->x[3 * i], s->x[3 * i + 1], s->x[3 * i + 2]}, vo;
-    double mu, *vi = s->v + 3 * i;
-    if (on_solid) {
-      /* against the solid's surface: the shell's solid_friction, the surface's velocity */
-      const double *vs = pb->st->surface_v + 3 * i;
-      mu = s->solid_friction, vo = (piola_vec3){vs[0], vs[1], vs[2]};
-    } else {
-      piola__nearest_obstacle_motion(w->obstacles, w->obstacle_count, pb->t1, p, &mu, &vo);
-    }
-    const double before[3] = {vi[0], vi[1], vi[2]};
-    const int limited = piola__coulomb_limit(vi, vo, nrm, mu, dvn);
-    if (!limited) continue;
-    double move2 = 0;
-    for (int k = 0; k < 3; ++k) {
-      const double x = s->x_old[3 * i + k] + pb->dt * vi[k];
-      move2 += (x - s->x[3 * i + k]) * (x - s->x[3 * i + k]);
-      s->x[3 * i + k] = x;
-      st->friction[3 * i + k] = s->mass[i] * (vi[k] - before[k]) / pb->dt;
-    }
-    moved[i] = sqrt(move2);
-    st->hit[i] = (uint8_t)limited;
-    changed++;
-  }
-  return changed;
-}
-
-/* Whether friction's moves (contact_friction, just run) are large against the tets they
- * touch: a move above FRICTION_RESOLVE_MOVE times a tet's rest altitude can flatten or invert
- * it, and the solve did not see it. Solids on one process only (the ranks of a split solid
- * hold different tets, and its PETSc filter holds normals only; shells have no tets): there
- * friction stays a move after the solve. */
-static int friction_moves_deform(const newton_problem *pb) {
-  const world_body *s = pb->s;
-  if (s->kind != PIOLA_BODY_SOLID || piola__implicit_split_of(s)) return 0;
-  const piola_elastic_body *b = s->solid;
-  const int32_t *tets = piola_elastic_body_tets(b);
-  const double *moved = pb->st->scratch_v;
-  for (int32_t t = 0; t < piola_elastic_body_tet_count(b); ++t) {
-    double most = 0;
-    for (int c = 0; c < 4; ++c) most = fmax(most, moved[tets[4 * t + c]]);
-    if (most > FRICTION_RESOLVE_MOVE * piola__elastic_body_tet_rest_altitude(b, t))
-      return 1;
-  }
-  return 0;
-}
-
-/* g . n at node i, positive where its hold pushes: the normal contact force is
- * g . n / dt^2 (g, the residual, carries dt^2). */
-static double normal_residual(const newton_problem *pb, int32_t i) {
-  const double *g = pb->st->residual + 3 * i, *nrm = pb->s->normals + 3 * i;
-  return g[0] * nrm[0] + g[1] * nrm[1] + g[2] * nrm[2];
-}
-
-/* The obstacle nearest node i: its friction coefficient (returned) and surface velocity vo. */
-static double node_obstacle(const newton_problem *pb, int32_t i, piola_vec3 *vo) {
-  const double *x = pb->s->x + 3 * i;
-  double mu;
-  piola__nearest_obstacle_motion(pb->w->obstacles, pb->w->obstacle_count, pb->t1,
-                                 (piola_vec3){x[0], x[1], x[2]}, &mu, vo);
-  return mu;
-}
-
-/* The tangential part of node i's velocity relative to vo, about its normal, into vt; returns
- * its size. */
-static double relative_slip(const world_body *s, int32_t i, piola_vec3 vo, double vt[3]) {
-  const double *v = s->v + 3 * i, *nrm = s->normals + 3 * i;
-  const double rel[3] = {v[0] - vo.x, v[1] - vo.y, v[2] - vo.z};
-  const double rn = rel[0] * nrm[0] + rel[1] * nrm[1] + rel[2] * nrm[2];
-  for (int k = 0; k < 3; ++k) vt[k] = rel[k] - rn * nrm[k];
-  return sqrt(vt[0] * vt[0] + vt[1] * vt[1] + vt[2] * vt[2]);
-}
-
-/* Whether the body may slide as a whole on its contacts, after a solve without friction:
- * its mass times its contacts' mean slip (their tangential velocity relative to the nearest
- * obstacle, weighted by their normal impulses) is above the friction impulse those contacts
- * can give, the sum of mu dt (g . n) / dt^2. Friction node by node (contact_friction)
- * misleads there at large steps: it stops a contact node whose own momentum is below its
- * share of that impulse, the rest of the body, which the solve moved on, drags it along in
- * the next steps through the elastic forces, and friction never sees those. Measured: a block
- * on a 0.5 rad incline stuck for good at one step per 1/30 s frame for every mu from 0.1 to
- * 0.8, its contact nodes holding a tenth of its mass (docs/time-stepping.md, "Friction after
- * the solve"). Solids on one process, as friction_moves_deform, without self-collision:
- * examples/solids_stack.json as backward Euler, the ball under the landing torus, failed 2
- * Newton tries with it (0 without) and took 9% more iterations. */
-static int body_may_slide(const newton_problem *pb) {
-  const world_body *s = pb->s;
-  if (s->kind != PIOLA_BODY_SOLID || piola__implicit_split_of(s) || s->self_collision.enabled)
-    return 0;
-  double capacity = 0, impulse = 0, slip[3] = {0, 0, 0};
-  for (int32_t i = 0; i < s->n; ++i) {
-    if (s->colliding[i] != HELD_BY_OBSTACLE || s->flags[i] != NODE_FREE) continue;
-    const double jn = normal_residual(pb, i) / pb->dt;
-    if (!(jn > 0)) continue;
-    piola_vec3 vo;
-    double vt[3];
-    const double mu = node_obstacle(pb, i, &vo);
-    (void)relative_slip(s, i, vo, vt);
-    capacity += mu * jn, impulse += jn;
-    for (int k = 0; k < 3; ++k) slip[k] += jn * vt[k];
-  }
-  if (!(impulse > 0)) return 0;
-  /* a body held by fixed, driven or bone nodes does not slide as a whole (examples/arm_flex
-   * as backward Euler, its flesh on its bones, took 2.4 times the Newton iterations) */
-  for (int32_t i = 0; i < s->n; ++i)
-    if (s->flags[i] != NODE_FREE && s->mass[i] > 0) return 0;
-  /* the body's momentum at the contacts' mean slip: a body rolling without slipping has
-   * none, whatever its speed */
-  const double scale = pb->total_mass / impulse;
-  const double momentum2 =
-      scale * scale * (slip[0] * slip[0] + slip[1] * slip[1] + slip[2] * slip[2]);
-  return momentum2 > capacity * capacity;
-}
-
-/* After a solve with friction-held nodes: each held node whose holding impulse g / dt has a
- * tangential part above mu times its normal part slips instead: it keeps its normal hold and
- * feels the kinetic friction force mu (g . n) / dt^2 along that tangential part (the way the
- * hold pushed). Returns how many. */
-static int32_t release_slipping_holds(newton_problem *pb) {
-  world_body *s = pb->s;
-  struct implicit_state *st = pb->st;
-  int32_t released = 0;
-  for (int32_t i = 0; i < s->n; ++i) {
-    if (s->colliding[i] != HELD_BY_FRICTION || s->flags[i] != NODE_FREE) continue;
-    const double *g = st->residual + 3 * i, *nrm = s->normals + 3 * i;
-    const double gn = normal_residual(pb, i);
-    const double gt[3] = {g[0] - gn * nrm[0], g[1] - gn * nrm[1], g[2] - gn * nrm[2]};
-    const double gt_size = sqrt(gt[0] * gt[0] + gt[1] * gt[1] + gt[2] * gt[2]);
-    piola_vec3 vo;
-    const double mu = node_obstacle(pb, i, &vo);
-    if (!(gn > 0) || !(gt_size > mu * gn)) continue;
-    s->colliding[i] = HELD_BY_OBSTACLE;
-    const double scale = mu * gn / gt_size / (pb->dt * pb->dt);
-    for (int k = 0; k < 3; ++k) st->friction[3 * i + k] = scale * gt[k];
-    released++;
-  }
-  if (released > 0) pb->contacts_moved = 1;
-  return released;
-}
-
-/* Kinetic friction on every obstacle contact of a body that may slide as a whole
- * (body_may_slide), from the solve just done: the force mu (g . n) / dt^2 against each
- * node's tangential velocity relative to the nearest obstacle, into st->friction for the next
- * solve (the nodes friction holds keep none: their hold is their friction). Returns how many
- * nodes feel it. */
-static int32_t kinetic_friction(newton_problem *pb) {
-  world_body *s = pb->s;
-  struct implicit_state *st = pb->st;
-  int32_t count = 0;
-  for (int32_t i = 0; i < s->n; ++i) {
-    if (s->colliding[i] == HELD_BY_FRICTION) continue; /* the hold is its friction */
-    for (int k = 0; k < 3; ++k) st->friction[3 * i + k] = 0;
-    if (s->colliding[i] != HELD_BY_OBSTACLE || s->flags[i] != NODE_FREE) continue;
-    const double gn = normal_residual(pb, i);
-    piola_vec3 vo;
-    double vt[3];
-    const double mu = node_obstacle(pb, i, &vo);
-    const double slip = relative_slip(s, i, vo, vt);
-    if (!(gn > 0) || !(mu > 0) || !(slip > 0)) continue;
-    const double scale = -mu * gn / (pb->dt * pb->dt) / slip;
-    for (int k = 0; k < 3; ++k) st->friction[3 * i + k] = scale * vt[k];
-    count++;
-  }
-  return count;
-}
-
-/* After a solve with kinetic friction: a node that its friction force now pushes along its
- * slip (the force would have stopped it within the step) is held where it stops, its
- * tangential velocity relative to the obstacle gone (x = x^n + dt v), and its friction left
- * to the hold. Returns how many. */
-static int32_t hold_reversed_slips(newton_problem *pb) {
-  world_body *s = pb->s;
-  struct implicit_state *st = pb->st;
-  int32_t held = 0;
-  for (int32_t i = 0; i < s->n; ++i) {
-    if (s->colliding[i] != HELD_BY_OBSTACLE || s->flags[i] != NODE_FREE) continue;
-    double *f = st->friction + 3 * i;
-    if (f[0] == 0 && f[1] == 0 && f[2] == 0) continue;
-    piola_vec3 vo;
-    double vt[3];
-    (void)node_obstacle(pb, i, &vo);
-    (void)relative_slip(s, i, vo, vt);
-    if (!(vt[0] * f[0] + vt[1] * f[1] + vt[2] * f[2] > 0)) continue;
-    for (int k = 0; k < 3; ++k) {
-      s->v[3 * i + k] -= vt[k];
-      s->x[3 * i + k] = s->x_old[3 * i + k] + pb->dt * s->v[3 * i + k];
-      f[k] = 0;
-    }
-    s->colliding[i] = HELD_BY_FRICTION;
-    held++;
-  }
-  if (held > 0) pb->contacts_moved = 1;
-  return held;
-}
-
-/* Sum of |friction force| over the nodes (N). */
-static double friction_total(const newton_problem *pb) {
-  const double *f = pb->st->friction;
-  double total = 0;
-  for (int32_t i = 0; i < pb->s->n; ++i)
-    total += sqrt(f[3 * i] * f[3 * i] + f[3 * i + 1] * f[3 * i + 1] + f[3 * i + 2] * f[3 * i + 2]);
-  return total;
-}
-
-/* After a converged solve with friction (pb->friction_held): holds beyond Coulomb's cone slip
- * (release_slipping_holds), and where the step began with kinetic friction
- * (pb->kinetic), slips the friction reversed are held (hold_reversed_slips) and every slip's
- * friction follows its contact's normal force at this solve, which the friction's own moment
- * shifts (kinetic_friction). Returns whether any of this moved the friction by more than
- * FRICTION_ROUND_CHANGE of its total, so that the step is to be solved again. */
-static int next_friction_round(newton_problem *pb) {
-  const double before = friction_total(pb);
-  int32_t changed = release_slipping_holds(pb);
-  if (pb->kinetic) {
-    changed += hold_reversed_slips(pb);
-    (void)kinetic_friction(pb);
-  }
-  return changed > 0 || fabs(friction_total(pb) - before) > FRICTION_ROUND_CHANGE * before;
-}
-
-/* Whether the step of gravity alone, x = prediction + dt^2 g, would take a free node into an
- * obstacle (1, else 0; -1 on error). Moves nothing: the obstacles project those positions in
- * a scratch copy. */
-static int gravity_step_enters_obstacle(newton_problem *pb) {
-  world_body *s = pb->s;
-  struct implicit_state *st = pb->st;
-  if (pb->w->obstacle_count == 0 || s->n == 0) return 0;
-  const double dt2 = pb->dt * pb->dt;
-  for (int32_t i = 0; i < s->n; ++i)
-    for (int k = 0; k < 3; ++k) st->base[3 * (int64_t)i + k] = st->prediction[3 * (int64_t)i + k] + dt2 * pb->g1[k];
-  memset(st->scratch_v, 0, sizeof(double) * 3 * (size_t)s->n);
-  if (piola_obstacles_collide(pb->w->obstacles, pb->w->obstacle_count, pb->t1, 0.0, s->n, st->base,
-                              st->scratch_v, st->hit, st->cg[0]) < 0)
-    return -1;
-  for (int32_t i = 0; i < s->n; ++i)
-    if (st->hit[i] && s->flags[i] == NODE_FREE) return 1;
-  return 0;
-}
-
 /* The body's total energy (J) at positions x with velocities v: kinetic, elastic (of the last
  * update, which must be at x) and gravity's potential at t1. Collective on a split solid
  * (the elastic energy's sum, the same bits on every process), so every process keeps the
@@ -1072,7 +672,8 @@ static piola_status newton_body(piola_world *w, world_body *s, double t, double 
   if (!pb.quasistatic) {
     double fraction = 1.0;
     if (s->kind == PIOLA_BODY_SOLID) {
-      const int supported = has_filtered_nodes(s) ? 1 : gravity_step_enters_obstacle(&pb);
+      const int supported =
+          has_filtered_nodes(s) ? 1 : piola__newton_gravity_step_enters_obstacle(&pb);
       if (supported < 0) return PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "implicit step: out of memory");
       if (supported) fraction = GUESS_GRAVITY_FRACTION;
     }
@@ -1085,7 +686,8 @@ static piola_status newton_body(piola_world *w, world_body *s, double t, double 
     double vp[3];
     piola__body_constrained_state(s, i, pb.t1, s->x + 3 * i, vp);
   }
-  if (contacts(&pb) < 0) return PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "implicit step: out of memory");
+  if (piola__newton_contacts(&pb) < 0)
+    return PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "implicit step: out of memory");
   PIOLA_TRY(update(&pb));
   return newton_iterate(&pb, accept_unconverged, stats);
 }
@@ -1167,7 +769,7 @@ static piola_status newton_iterate(const newton_problem *problem, int accept_unc
   for (int32_t iter = 0;; ++iter) {
     if (!isfinite(phi)) break;
     if (phi <= target2) {
-      if (release_contacts(&pb, 1) == 0) {
+      if (piola__newton_release_contacts(&pb, 1) == 0) {
         converged = 1;
         break;
       }
@@ -1182,7 +784,7 @@ static piola_status newton_iterate(const newton_problem *problem, int accept_unc
      * residual reflects the first guess more than the contact): releasing them only once
      * converged costs a whole Newton solve per round of releases (measured on a torus
      * landing on a plane: 22-24 iterations per frame, 10-13 this way) */
-    const int32_t released = iter > 0 ? release_contacts(&pb, 0) : 0;
+    const int32_t released = iter > 0 ? piola__newton_release_contacts(&pb, 0) : 0;
     if (released > 0) phi = residual(&pb);
     stats->newton_iterations++;
     piola__step_profile_mark(&w->profile, STEP_PHASE_UPDATE);
@@ -1253,7 +855,7 @@ static piola_status newton_iterate(const newton_problem *problem, int accept_unc
       else if (alpha == 1.0)
         s->quasistatic_mu = s->quasistatic_mu > 1e-3 ? 0.25 * s->quasistatic_mu : 0.0;
     }
-    int32_t added = contacts(&pb);
+    int32_t added = piola__newton_contacts(&pb);
     if (added < 0) return PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "implicit step: out of memory");
     if (pb.signed_twist && alpha < 1.0) tail_allowed = 0;
     pb.signed_twist = tail_allowed && alpha == 1.0 &&
@@ -1301,8 +903,9 @@ static piola_status newton_iterate(const newton_problem *problem, int accept_unc
   const double inv_dt = 1.0 / dt;
   for (int64_t j = 0; j < m; ++j) s->v[j] = (s->x[j] - s->x_old[j]) * inv_dt;
   if (!converged && !pb.quasistatic) PIOLA_TRY(keep_failed_step(&pb));
-  const int may_slide = !pb.quasistatic && !pb.friction_held && converged && body_may_slide(&pb);
-  if (may_slide && kinetic_friction(&pb) > 0) {
+  const int may_slide =
+      !pb.quasistatic && !pb.friction_held && converged && piola__newton_body_may_slide(&pb);
+  if (may_slide && piola__newton_kinetic_friction(&pb) > 0) {
     /* a body that may slide as a whole: solved again with kinetic friction on every contact,
      * then the contacts friction stops are held (hold_reversed_slips) and those whose hold
      * leaves Coulomb's cone slip again (release_slipping_holds), up to FRICTION_SLIP_ROUNDS
@@ -1310,7 +913,7 @@ static piola_status newton_iterate(const newton_problem *problem, int accept_unc
     pb.friction_held = 1, pb.kinetic = 1, pb.contacts_moved = 1, pb.slip_rounds = 0;
     return newton_iterate(&pb, accept_unconverged, stats);
   }
-  if (!pb.quasistatic && !pb.friction_held && contact_friction(&pb) > 0) {
+  if (!pb.quasistatic && !pb.friction_held && piola__newton_contact_friction(&pb) > 0) {
     PIOLA_TRY(update(&pb));
     /* Friction moved nodes after the solve, and the rest of the body has not answered. Where
      * the moves could flatten or invert tets, or where it stopped nodes of a body that may be
@@ -1318,14 +921,14 @@ static piola_status newton_iterate(const newton_problem *problem, int accept_unc
      * stopped held where it put them (the hold supplies all of their friction), the others
      * pushed by the force it applied to them (docs/time-stepping.md, "Friction after the
      * solve") */
-    if (friction_moves_deform(&pb)) {
+    if (piola__newton_friction_moves_deform(&pb)) {
       for (int32_t i = 0; i < n; ++i)
         if (st->hit[i] == 2) s->colliding[i] = HELD_BY_FRICTION; /* stopped */
       pb.friction_held = 1, pb.contacts_moved = 1;
       return newton_iterate(&pb, accept_unconverged, stats);
     }
   } else if (pb.kinetic && converged && pb.slip_rounds < FRICTION_SLIP_ROUNDS &&
-             next_friction_round(&pb)) {
+             piola__newton_next_friction_round(&pb)) {
     /* holds beyond Coulomb's cone slip, slips friction reverses are held, the kinetic
      * friction follows the normal forces: solved again */
     pb.slip_rounds++;

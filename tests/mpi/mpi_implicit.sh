@@ -114,7 +114,9 @@ else
     read -r n2 f2 <<<"$(totals "$out")"
     if ! result=$(/usr/bin/python3 "$here/compare_frames.py" "$work/q-single" "$out" 1e-7 "$np"); then
       echo "FAIL quasistatic -np $np: $result"; fail=1
-    elif [ "$f1" -ne 0 ] || [ "$f2" -ne 0 ] || [ $((2 * n2)) -gt $((3 * n1)) ]; then
+    # the single process takes the Newton tail (docs/time-stepping.md), the split keeps the
+    # projected matrix: 62 iterations against 111-117 (2026-12-06)
+    elif [ "$f1" -ne 0 ] || [ "$f2" -ne 0 ] || [ $((2 * n2)) -gt $((5 * n1)) ]; then
       echo "FAIL quasistatic -np $np: Newton iterations $n2 (single $n1), failed steps $f2 (single $f1)"; fail=1
     else
       echo "ok quasistatic block_jacobi_icc -np $np: $result; Newton iterations $n2 (single: $n1), no failed step"

@@ -34,7 +34,7 @@ typedef struct piola_settling_estimate {
   double crossing_time;     /* D / c_p, s: a dilatational wave across the bounding-box
                                diagonal D (c_p = sqrt((lambda + 2 mu) / density) of the
                                slowest material, fibres left out) */
-  double reexpansion_time;  /* s: 6 max(D / c_p, 1 / relaxation_rate), how long a body
+  double reexpansion_time;  /* s: 8 max(D / c_p, 1 / relaxation_rate), how long a body
                                collapsed to a point, a line or a plane takes to re-expand
                                and untangle before its shape error decays at decay_rate (a
                                measured bound, docs/time-stepping.md "Recovery") */

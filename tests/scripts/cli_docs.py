@@ -77,7 +77,7 @@ def main():
         lo, hi = json.loads(p.stdout)["bounding_box_min"], json.loads(p.stdout)["bounding_box_max"]
         d = math.dist(lo, hi)
         check(abs(st["crossing_time"] - d / math.sqrt((lam + 2 * mu) / 1000)) < 1e-9, "settling: D / c_p")
-        t = 6 * max(st["crossing_time"], 1 / floor) + math.log(st["point_collapse_error"] / (0.01 * d)) / r
+        t = 8 * max(st["crossing_time"], 1 / floor) + math.log(st["point_collapse_error"] / (0.01 * d)) / r
         check(abs(st["point_collapse_settling_time"] - t) < 1e-9 * t, f"settling: T {st} against {t}")
     for bad in (["--viscosity", "1000"], ["--material", "2e4,0.3,1000", "--viscosity", "-1"],
                 ["--material", "2e4,0.3,1000", "--viscosity", "1000,"]):

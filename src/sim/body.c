@@ -123,6 +123,15 @@ double piola__body_stable_dt(const piola_world *w, const world_body *b, double s
   return INFINITY;
 }
 
+double piola__body_max_wave_speed(const world_body *b) {
+  switch (b->kind) {
+    case PIOLA_BODY_SOLID: return piola_elastic_body_max_wave_speed(b->solid);
+    case PIOLA_BODY_SHELL: return piola_shell_body_max_wave_speed(b->shell);
+    case PIOLA_BODY_NONE: break;
+  }
+  return 0;
+}
+
 void piola__body_plastic_in_step(world_body *b, double dt) {
   switch (b->kind) {
     case PIOLA_BODY_SOLID: return;

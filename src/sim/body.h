@@ -128,6 +128,9 @@ void piola__body_damping_add_sparse(const world_body *b, const double *e, double
                                     double alpha, double scale, double *out);
 /* The largest stable step of b (s) with stiffness scale `scale`, before max_dt. */
 double piola__body_stable_dt(const piola_world *w, const world_body *b, double scale);
+/* The rest state's fastest wave speed of b (m/s): a solid's dilatational, a shell's
+ * membrane's; 0 for no body. */
+double piola__body_max_wave_speed(const world_body *b);
 /* Plasticity inside the step, right after the force update at the step's end (shells). */
 void piola__body_plastic_in_step(world_body *b, double dt);
 /* Plasticity once every body has stepped and contact is done (solids). */

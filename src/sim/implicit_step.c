@@ -974,12 +974,14 @@ static int held_by_bodies_only(const world_body *s) {
   return 1;
 }
 
-/* Adds body s's momentum times `sign` to p (kg m/s), its mass to *mass (kg). */
-static void add_momentum(const world_body *s, double sign, double p[3], double *mass) {
+/* Adds body s's momentum times `sign` to p (kg m/s); returns its mass (kg). */
+static double add_momentum(const world_body *s, double sign, double p[3]) {
+  double mass = 0;
   for (int32_t i = 0; i < s->n; ++i) {
-    *mass += s->mass[i];
+    mass += s->mass[i];
     for (int k = 0; k < 3; ++k) p[k] += sign * s->mass[i] * s->v[3 * i + k];
   }
+  return mass;
 }
 
 static piola_status self_collide_and_resolve(piola_world *w, double dt, int closes,
@@ -1021,8 +1023,7 @@ static piola_status self_collide_and_resolve(piola_world *w, double dt, int clos
     }
     if (held == 0) continue;
     bodies_only = bodies_only && held_by_bodies_only(s);
-    double mass = 0;
-    add_momentum(s, -1.0, added, &mass);
+    (void)add_momentum(s, -1.0, added);
     newton_problem pb = problem_of(w, s, w->time, dt);
     const int64_t colliding = stats->colliding;
     piola_status st = newton_iterate(&pb, 1, stats);
@@ -1032,7 +1033,7 @@ static piola_status self_collide_and_resolve(piola_world *w, double dt, int clos
     }
     stats->colliding = colliding;
     bodies_only = bodies_only && held_by_bodies_only(s);
-    add_momentum(s, 1.0, added, &resolved_mass);
+    resolved_mass += add_momentum(s, 1.0, added);
     was_resolved[b] = 1;
     resolved = 1;
   }

@@ -390,17 +390,19 @@ static piola_status step_body(piola_world *w, world_body *s, double t, double dt
   enum { CHECK_RANGES = 16 };
   double kinetic_part[CHECK_RANGES], force2_part[CHECK_RANGES], gain_part[CHECK_RANGES];
   double fm_part[CHECK_RANGES], mdx_part[CHECK_RANGES], mv_part[CHECK_RANGES], mdv_part[CHECK_RANGES];
+  double mass_part[CHECK_RANGES];
   int64_t bad_part[CHECK_RANGES];
   int driven_part[CHECK_RANGES];
   const double gmid[3] = {0.5 * (g0[0] + g1[0]), 0.5 * (g0[1] + g1[1]), 0.5 * (g0[2] + g1[2])};
 #pragma omp parallel for schedule(static) num_threads(piola_thread_count()) \
     if (n >= PIOLA_PARALLEL_MIN_VERTICES)
   for (int r = 0; r < CHECK_RANGES; ++r) {
-    double ke = 0, f2 = 0, gain = 0, fm = 0, mdx = 0, mv = 0, mdv = 0;
+    double ke = 0, f2 = 0, gain = 0, fm = 0, mdx = 0, mv = 0, mdv = 0, mass = 0;
     int64_t bad = -1;
     int driven = 0;
     for (int32_t i = (int32_t)((int64_t)n * r / CHECK_RANGES); i < (int32_t)((int64_t)n * (r + 1) / CHECK_RANGES); ++i) {
       const double mi = s->mass[i];
+      mass += mi;
       driven |= s->flags[i] == NODE_DRIVEN;
       const int balanced = s->flags[i] == NODE_FREE && !s->colliding[i] && mi > 0;
       for (int k = 0; k < 3; ++k) {
@@ -421,12 +423,14 @@ static piola_status step_body(piola_world *w, world_body *s, double t, double dt
     }
     kinetic_part[r] = ke, force2_part[r] = f2, bad_part[r] = bad, driven_part[r] = driven;
     gain_part[r] = gain, fm_part[r] = fm, mdx_part[r] = mdx, mv_part[r] = mv, mdv_part[r] = mdv;
+    mass_part[r] = mass;
   }
-  double kinetic = 0, force2 = 0, gain = 0, fm = 0, mdx = 0, mv = 0, mdv = 0;
+  double kinetic = 0, force2 = 0, gain = 0, fm = 0, mdx = 0, mv = 0, mdv = 0, total_mass = 0;
   int driven = 0;
   for (int r = 0; r < CHECK_RANGES; ++r) {
     driven |= driven_part[r];
     gain += gain_part[r], fm += fm_part[r], mdx += mdx_part[r], mv += mv_part[r], mdv += mdv_part[r];
+    total_mass += mass_part[r];
     if (bad_part[r] >= 0) {
       piola__body_restore_step(s, t);
       return PIOLA_FAIL(PIOLA_ERROR_NOT_FINITE,
@@ -453,12 +457,8 @@ static piola_status step_body(piola_world *w, world_body *s, double t, double dt
    * Shells the same way, with the membrane's wave speed: their membrane and bending forces are
    * in s->force and derive from energies, and their damping is in the solves. */
   *energy_rose = 0;
-  if (s->kind != PIOLA_BODY_NONE && !driven && colliding == 0) {
-    const double tol = w->def.cg_tolerance;
-    const double c = s->kind == PIOLA_BODY_SOLID ? piola_elastic_body_max_wave_speed(s->solid)
-                                                 : piola_shell_body_max_wave_speed(s->shell);
-    double total_mass = 0;
-    for (int32_t i = 0; i < n; ++i) total_mass += s->mass[i];
+  if (!driven && colliding == 0) {
+    const double tol = w->def.cg_tolerance, c = piola__body_max_wave_speed(s);
     const double floor = 0.5e-18 * total_mass * c * c;
     const double allowed = (1 + tol) * sqrt(fm * mdx) + 2 * tol * sqrt(mv * mdv);
     *energy_rose = gain > allowed * (1 + 1e-9) + floor;

@@ -134,11 +134,13 @@ STABLE_STEP_KERNEL void linear_extension_slopes(piola_material_model model, cons
 /* k of one tet of model MODEL with the stress extension of mode ENERGY (both compile-time
  * constants in the lane loops: STEP_EXTENSION_CLAMP, _ENERGY or _LINEAR); the model's parts at
  * the clamped point are GIVEN (the Ogden models' cache) or, when it is NULL, computed. With
- * direction weights WGT (NULL: none), min(k, k_w) (stable_step_anisotropy.h). */
+ * direction weights WGT (NULL: none) the tet's term instead, its weight WEIGHT = 1 / (rho
+ * h_e^2) times k, or where k is stiff times min(k, k_w) rounded up to the grid
+ * (stable_step_anisotropy.h). */
 STABLE_STEP_KERNEL double model_modulus_weighted(piola_material_model model, int energy,
                                                  const piola_material *m, double f0, double f1,
                                                  double f2, const material_parts *given,
-                                                 const double *wgt) {
+                                                 const double *wgt, double weight) {
   const double c = MATERIAL_THRESHOLD(model, m, f0, f1, f2);
   const double fc0 = kernel_max(f0, c), fc1 = kernel_max(f1, c), fc2 = kernel_max(f2, c);
   const double d0 = f0 - fc0, d1 = f1 - fc1, d2 = f2 - fc2;
@@ -214,7 +216,9 @@ STABLE_STEP_KERNEL double model_modulus_weighted(piola_material_model model, int
     kw = kernel_max(kw, weighted_pair_modulus(dv, c, p0, p1, f0, f1, k0, k1, k01, wgt[0], wgt[1]));
     kw = kernel_max(kw, weighted_pair_modulus(dv, c, p0, p2, f0, f2, k0, k2, k02, wgt[0], wgt[2]));
     kw = kernel_max(kw, weighted_pair_modulus(dv, c, p1, p2, f1, f2, k1, k2, k12, wgt[1], wgt[2]));
-    k = k > STEP_CACHE_STIFF * (m->lambda + 2.0 * m->mu) ? kernel_min(k, kw) : k;
+    const int stiff = k > STEP_CACHE_STIFF * (m->lambda + 2.0 * m->mu);
+    const double term = weight * ((stiff ? kernel_min(k, kw) : k) + m->fiber_modulus);
+    return stiff ? step_rate_grid_ceil(term) : term;
   }
   /* muscle fibres: their tangent stiffness bound, as in the rest bound; HGO's exponential
    * fibres depend on their direction: hgo_tet_fiber_modulus, added by the callers */
@@ -224,12 +228,12 @@ STABLE_STEP_KERNEL double model_modulus_weighted(piola_material_model model, int
 STABLE_STEP_KERNEL double model_modulus_from(piola_material_model model, int energy,
                                              const piola_material *m, double f0, double f1,
                                              double f2, const material_parts *given) {
-  return model_modulus_weighted(model, energy, m, f0, f1, f2, given, NULL);
+  return model_modulus_weighted(model, energy, m, f0, f1, f2, given, NULL, 1.0);
 }
 
 STABLE_STEP_KERNEL double model_modulus(piola_material_model model, int energy,
                                         const piola_material *m, double f0, double f1, double f2) {
-  return model_modulus_weighted(model, energy, m, f0, f1, f2, NULL, NULL);
+  return model_modulus_weighted(model, energy, m, f0, f1, f2, NULL, NULL, 1.0);
 }
 
 /* The force loop's k cache (stable_step_modulus.h), or the Ogden and HGO caches of
@@ -254,14 +258,15 @@ static const double *direction_gram(const piola_elastic_body *body) {
   return body->has_state ? body->step_gram : NULL;
 }
 
-/* k of tet t of a DIRECTION_WEIGHTED model with its direction weights (GRAM not NULL; the
- * callers choose outside their lane loops, so that these vectorize). */
-STABLE_STEP_KERNEL double weighted_lane_modulus(piola_material_model model, int energy,
-                                                const piola_material *m, const piola_elastic_body *body,
-                                                const double *gram, int32_t t, const double *f) {
+/* The term of tet t of a DIRECTION_WEIGHTED model with its direction weights and its weight W
+ * (GRAM not NULL; the callers choose outside their lane loops, so that these vectorize). */
+STABLE_STEP_KERNEL double weighted_lane_rate(piola_material_model model, int energy,
+                                             const piola_material *m,
+                                             const piola_elastic_body *body, const double *gram,
+                                             int32_t t, const double *f, double w) {
   double wgt[3];
   step_direction_weights(gram + t, body->tet_count, body->v[0] + t, body->padded_tet_count, wgt);
-  return model_modulus_weighted(model, energy, m, f[0], f[1], f[2], NULL, wgt);
+  return model_modulus_weighted(model, energy, m, f[0], f[1], f[2], NULL, wgt, w);
 }
 
 /* The fibre term of HGO tet t at Fhat f (hgo_directed_fiber_modulus): its families'
@@ -305,13 +310,15 @@ STABLE_STEP_KERNEL double neohookean_plain_modulus(const piola_material *m, doub
 
 /* One case of mode_modulus: MODEL's kernel inlined with its own constant, the direction
  * weights passed on only to the models that take them. */
-#define MODE_MODULUS_CASE(model)                                                               \
-  case model:                                                                                  \
-    return model_modulus_weighted(model, energy, m, f0, f1, f2, NULL, DIRECTION_WEIGHTED(model) ? wgt : NULL);
+#define MODE_MODULUS_CASE(model)                                      \
+  case model:                                                         \
+    return model_modulus_weighted(model, energy, m, f0, f1, f2, NULL, \
+                                  DIRECTION_WEIGHTED(model) ? wgt : NULL, weight);
 
-/* Per tet: the model and the extension mode chosen at run time. */
+/* Per tet: the model and the extension mode chosen at run time; with WGT (a DIRECTION_WEIGHTED
+ * model) the term of weight WEIGHT, as model_modulus_weighted. */
 static double mode_modulus(int energy, const piola_material *m, double f0, double f1, double f2,
-                           const double *wgt) {
+                           const double *wgt, double weight) {
   switch (m->model) {
     MODE_MODULUS_CASE(PIOLA_MODEL_COROTATED)
     MODE_MODULUS_CASE(PIOLA_MODEL_STVK)
@@ -329,13 +336,17 @@ static double mode_modulus(int energy, const piola_material *m, double f0, doubl
 
 #undef MODE_MODULUS_CASE
 
-static double material_modulus(const piola_material *m, double f0, double f1, double f2, const double *wgt) {
+static double material_modulus(const piola_material *m, double f0, double f1, double f2,
+                               const double *wgt, double weight) {
   switch (m->inversion_mode) {
-    case PIOLA_INVERSION_ENERGY: return mode_modulus(STEP_EXTENSION_ENERGY, m, f0, f1, f2, wgt);
+    case PIOLA_INVERSION_ENERGY:
+      return mode_modulus(STEP_EXTENSION_ENERGY, m, f0, f1, f2, wgt, weight);
     case PIOLA_INVERSION_LINEAR: /* with no entry clamped, the CLAMP numbers (linear_range) */
-      return mode_modulus(lane_unclamped(m, f0, f1, f2) ? STEP_EXTENSION_CLAMP : STEP_EXTENSION_LINEAR,
-                          m, f0, f1, f2, wgt);
-    default: return mode_modulus(STEP_EXTENSION_CLAMP, m, f0, f1, f2, wgt);
+      return mode_modulus(
+          lane_unclamped(m, f0, f1, f2) ? STEP_EXTENSION_CLAMP : STEP_EXTENSION_LINEAR, m, f0, f1,
+          f2, wgt, weight);
+    default:
+      return mode_modulus(STEP_EXTENSION_CLAMP, m, f0, f1, f2, wgt, weight);
   }
 }
 
@@ -358,7 +369,7 @@ double PIOLA_ISA_NAME(piola__elastic_body_tet_rest_altitude)(const piola_elastic
 double PIOLA_ISA_NAME(piola__elastic_body_tet_modulus)(const piola_elastic_body *body, int32_t tet,
                                                       const double fhat[3]) {
   const piola_material *m = &body->materials[body->tet_material[tet]];
-  const double k = material_modulus(m, fhat[0], fhat[1], fhat[2], NULL);
+  const double k = material_modulus(m, fhat[0], fhat[1], fhat[2], NULL, 1.0);
   return m->model == PIOLA_MODEL_HGO ? k + hgo_tet_fiber_modulus(body, m, tet, fhat) : k;
 }
 
@@ -369,7 +380,7 @@ double PIOLA_ISA_NAME(piola__elastic_body_tet_state_rate2)(const piola_elastic_b
     return body->step_weight[tet] * PIOLA_ISA_NAME(piola__elastic_body_tet_modulus)(body, tet, f);
   double wgt[3];
   step_direction_weights(gram + tet, body->tet_count, body->v[0] + tet, body->padded_tet_count, wgt);
-  return body->step_weight[tet] * material_modulus(m, f[0], f[1], f[2], wgt);
+  return material_modulus(m, f[0], f[1], f[2], wgt, body->step_weight[tet]);
 }
 
 /* 1 / (rho h_e^2) per tet and the Gram arrays of the direction weights, from the Dm^-1 the
@@ -564,8 +575,9 @@ STABLE_STEP_KERNEL double linear_tet_rate(piola_material_model model, const piol
   const double *ft = f + 3 * t;
   const double k = model_modulus(model, STEP_EXTENSION_LINEAR, m, ft[0], ft[1], ft[2]);
   double r = w[t] * k;
-  if (gram && DIRECTION_WEIGHTED(model) && r > best && k > STEP_CACHE_STIFF * (m->lambda + 2.0 * m->mu))
-    r = w[t] * weighted_lane_modulus(model, STEP_EXTENSION_LINEAR, m, body, gram, t, ft);
+  if (gram && DIRECTION_WEIGHTED(model) && step_rate_grid_ceil(r) > best &&
+      k > STEP_CACHE_STIFF * (m->lambda + 2.0 * m->mu))
+    r = weighted_lane_rate(model, STEP_EXTENSION_LINEAR, m, body, gram, t, ft, w[t]);
   return r > best ? r : best;
 }
 
@@ -596,7 +608,8 @@ STABLE_STEP_KERNEL double weighted_whole_block(piola_material_model model, int e
                                                const double *f, const double *w, int32_t t, double best) {
 #pragma omp simd reduction(max:best)
   for (int l = 0; l < PIOLA_TET_BLOCK; ++l) {
-    const double r = w[t + l] * weighted_lane_modulus(model, ext, m, body, gram, t + l, f + 3 * (t + l));
+    const double r =
+        weighted_lane_rate(model, ext, m, body, gram, t + l, f + 3 * (t + l), w[t + l]);
     best = r > best ? r : best;
   }
   return best;
@@ -618,7 +631,7 @@ STABLE_STEP_KERNEL double weighted_block(piola_material_model model, int energy,
   const int ext = energy == STEP_EXTENSION_LINEAR ? STEP_EXTENSION_CLAMP : energy;
   if (e - t == PIOLA_TET_BLOCK) return weighted_whole_block(model, ext, m, body, gram, f, w, t, best);
   for (int32_t u = t; u < e; ++u) {
-    const double r = w[u] * weighted_lane_modulus(model, ext, m, body, gram, u, f + 3 * u);
+    const double r = weighted_lane_rate(model, ext, m, body, gram, u, f + 3 * u, w[u]);
     best = r > best ? r : best;
   }
   return best;
@@ -647,16 +660,17 @@ static const rate_start NO_START = {0.0, 0, 0};
 /* Blocks a chunk of weighted_range holds: their stiff maxima stay on the stack. */
 enum { WEIGHTED_CHUNK = 64 };
 
-/* max over tets [t0, t1) of w_e k_e with the direction weights (GRAM not NULL), exact. The
- * weighted term is at most the unweighted one (min(k, k_w)) and differs from it only above
+/* max over tets [t0, t1) of w_e k_e with the direction weights (GRAM not NULL), exact (a stiff
+ * term is rounded up to the grid, step_rate_grid_ceil, on every path alike). The weighted term
+ * is at most the unweighted one rounded up (min(k, k_w)) and differs from it only above
  * STEP_CACHE_STIFF. So the unweighted lane loop runs first, block by block, and splits the
  * unweighted maximum into the exact terms of the tets not above it (BEST) and, per block, an
  * upper bound of the stiff ones' (HIGH); a chunk's blocks whose HIGH is above the BEST so far
- * then take the weights (weighted_block). Near rest no tet is stiff and the bound costs the
- * unweighted loop alone; in a stretched state only the blocks that beat the running maximum
- * pay. LINEAR blocks with no clamped entry take the CLAMP numbers (linear_range). A block
- * whose k the force loop cached (block_cached) reads the unweighted terms from there.
- * START is what the caller has already found (ordered_start; NO_START for nothing): the
+ * then take the weights (weighted_block) where it rounds up to more than BEST. Near rest no tet is
+ * stiff and the bound costs the unweighted loop alone; in a stretched state only the blocks that
+ * beat the running maximum pay. LINEAR blocks with no clamped entry take the CLAMP numbers
+ * (linear_range). A block whose k the force loop cached (block_cached) reads the unweighted terms
+ * from there. START is what the caller has already found (ordered_start; NO_START for nothing): the
  * running maximum starts at its term, so the result is max(START.at_least, every term), and
  * the cached blocks are skipped where it holds them. */
 STABLE_STEP_KERNEL double weighted_range(piola_material_model model, int energy,
@@ -703,9 +717,9 @@ STABLE_STEP_KERNEL double weighted_range(piola_material_model model, int energy,
       cached[(t - c0) / PIOLA_TET_BLOCK] = slot != NULL;
       chunk_high = h > chunk_high ? h : chunk_high;
     }
-    if (!(chunk_high > best)) continue;
+    if (!(step_rate_grid_ceil(chunk_high) > best)) continue;
     for (int32_t t = c0; t < c1; t += PIOLA_TET_BLOCK)
-      if (high[(t - c0) / PIOLA_TET_BLOCK] > best) {
+      if (step_rate_grid_ceil(high[(t - c0) / PIOLA_TET_BLOCK]) > best) {
         const int32_t e = c1 - t < PIOLA_TET_BLOCK ? c1 : t + PIOLA_TET_BLOCK;
         best = weighted_block(model, energy, m, body, gram, f, w, t, e, cached[(t - c0) / PIOLA_TET_BLOCK], best);
       }
@@ -845,7 +859,8 @@ static int cached_block_may_hold(const piola_elastic_body *body, const double *c
   const int32_t b = t0 / PIOLA_TET_BLOCK;
   const double *slot = cache && b < body->tet_count / PIOLA_TET_BLOCK ? cached_block(body, cache, t0) : NULL;
   if (!slot) return 1;
-  const double stiff = weighed && weighed[b] > 0 ? weighed[b] : slot[STEP_CACHE_HIGH];
+  const double stiff =
+      weighed && weighed[b] > 0 ? weighed[b] : step_rate_grid_ceil(slot[STEP_CACHE_HIGH]);
   return !(slot[STEP_CACHE_LOW] < near && stiff < near);
 }
 
@@ -1043,9 +1058,11 @@ enum { ORDERED_CHUNK = 4 };
  * at its block's index, for the worst tet's search (near_tet_in). The threads take chunks of
  * the order from one counter and share their maxima through one word, with no barrier between
  * the slices (a barrier each cost more than weighing the blocks between them on two threads);
- * a thread stops at the first chunk whose slice ends at or below the maximum it has seen. A
- * block is skipped only when its stiff maximum is at most a maximum of terms found, so what is
- * returned is the largest term whatever the threads' timing: the same bits on any thread count. */
+ * a thread stops at the first chunk whose slice ends, rounded up to the grid, at or below the
+ * maximum it has seen. A block is skipped only when its stiff maximum rounded up to the grid
+ * (step_rate_grid_ceil, which its weighted terms cannot exceed) is at most a maximum of terms
+ * found, so what is returned is the largest term whatever the threads' timing: the same bits
+ * on any thread count. */
 static double weigh_in_order(const piola_elastic_body *body, const piola_material *m,
                              const double *gram, const double *cache, const double *w,
                              const int32_t *order, int32_t count, const ordered_slices *slices,
@@ -1061,10 +1078,12 @@ static double weigh_in_order(const piola_elastic_body *body, const piola_materia
       const double seen = from_magnitude_bits(atomic_load_explicit(&shared, memory_order_relaxed));
       local = seen > local ? seen : local;
       /* every later block's stiff maximum lies below where this one's bucket ends */
-      if (!(ordered_bucket_end(slices, ordered_bucket(slices, block_stiff_maximum(cache, order[i0]))) > local)) break;
+      if (!(step_rate_grid_ceil(ordered_bucket_end(
+                slices, ordered_bucket(slices, block_stiff_maximum(cache, order[i0])))) > local))
+        break;
       const int32_t i1 = i0 + ORDERED_CHUNK < count ? i0 + ORDERED_CHUNK : count;
       for (int32_t i = i0; i < i1; ++i)
-        if (block_stiff_maximum(cache, order[i]) > local) {
+        if (step_rate_grid_ceil(block_stiff_maximum(cache, order[i])) > local) {
           const double own = weighed_cached_block(body, m, gram, w, order[i] * PIOLA_TET_BLOCK, 0.0);
           if (weighed) weighed[order[i]] = own;
           local = own > local ? own : local;
@@ -1075,12 +1094,14 @@ static double weigh_in_order(const piola_elastic_body *body, const piola_materia
   return from_magnitude_bits(atomic_load_explicit(&shared, memory_order_relaxed));
 }
 
-/* The stiff maximum of cached block B if the order holds it (above BEST, not the top block,
- * weighed already), else 0. */
+/* The stiff maximum of cached block B if the order holds it (rounded up to the grid above BEST,
+ * not the top block, weighed already), else 0. */
 static double ordered_candidate(const piola_elastic_body *body, const double *cache, int32_t b,
                                 int32_t top_block, double best) {
   const double *slot = cached_block(body, cache, b * PIOLA_TET_BLOCK);
-  return slot && b != top_block && slot[STEP_CACHE_HIGH] > best ? slot[STEP_CACHE_HIGH] : 0.0;
+  return slot && b != top_block && step_rate_grid_ceil(slot[STEP_CACHE_HIGH]) > best
+             ? slot[STEP_CACHE_HIGH]
+             : 0.0;
 }
 
 /* The start of the ranges (rate_start) for a direction-weighted body whose force loop cached
@@ -1115,7 +1136,7 @@ static rate_start ordered_start(const piola_elastic_body *body, const piola_mate
     }
   }
   const int every = uncached == 0;
-  if (!(top > best)) return (rate_start){best, 1, every};
+  if (!(step_rate_grid_ceil(top) > best)) return (rate_start){best, 1, every};
   /* an infinite stiff maximum has no slice above it to end the first one: the ranges weigh
    * every block instead */
   if (!(top < INFINITY)) return (rate_start){best, 0, 0};

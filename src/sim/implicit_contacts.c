@@ -14,8 +14,8 @@
 #include "sim/obstacle_friction.h"
 
 /* Friction's move of a node after the solve, as a fraction of the rest altitude of a tet
- * around it, above which the step is solved again (friction_moves_deform). Measured on
- * bunny.msh's slivers at the contact: 1.8-12, and elements there stayed inverted; on the
+ * around it, above which the step is solved again (piola__newton_friction_moves_deform). Measured
+ * on bunny.msh's slivers at the contact: 1.8-12, and elements there stayed inverted; on the
  * generated tori of BENCHMARKS.md at most 0.27, where the split is harmless. */
 #define FRICTION_RESOLVE_MOVE 0.5
 /* A friction round changes less than this fraction of the total friction force: no more */
@@ -141,8 +141,8 @@ int32_t piola__newton_contact_friction(newton_problem *pb) {
   return changed;
 }
 
-/* Whether friction's moves (contact_friction, just run) are large against the tets they
- * touch: a move above FRICTION_RESOLVE_MOVE times a tet's rest altitude can flatten or invert
+/* Whether friction's moves (piola__newton_contact_friction, just run) are large against the tets
+ * they touch: a move above FRICTION_RESOLVE_MOVE times a tet's rest altitude can flatten or invert
  * it, and the solve did not see it. Solids on one process only (the ranks of a split solid
  * hold different tets, and its PETSc filter holds normals only; shells have no tets): there
  * friction stays a move after the solve. */
@@ -189,15 +189,15 @@ static double relative_slip(const world_body *s, int32_t i, piola_vec3 vo, doubl
 /* Whether the body may slide as a whole on its contacts, after a solve without friction:
  * its mass times its contacts' mean slip (their tangential velocity relative to the nearest
  * obstacle, weighted by their normal impulses) is above the friction impulse those contacts
- * can give, the sum of mu dt (g . n) / dt^2. Friction node by node (contact_friction)
+ * can give, the sum of mu dt (g . n) / dt^2. Friction node by node (piola__newton_contact_friction)
  * misleads there at large steps: it stops a contact node whose own momentum is below its
  * share of that impulse, the rest of the body, which the solve moved on, drags it along in
  * the next steps through the elastic forces, and friction never sees those. Measured: a block
  * on a 0.5 rad incline stuck for good at one step per 1/30 s frame for every mu from 0.1 to
  * 0.8, its contact nodes holding a tenth of its mass (docs/time-stepping.md, "Friction after
- * the solve"). Solids on one process, as friction_moves_deform, without self-collision:
- * examples/solids_stack.json as backward Euler, the ball under the landing torus, failed 2
- * Newton tries with it (0 without) and took 9% more iterations. */
+ * the solve"). Solids on one process, as piola__newton_friction_moves_deform, without
+ * self-collision: examples/solids_stack.json as backward Euler, the ball under the landing torus,
+ * failed 2 Newton tries with it (0 without) and took 9% more iterations. */
 int piola__newton_body_may_slide(const newton_problem *pb) {
   const world_body *s = pb->s;
   if (s->kind != PIOLA_BODY_SOLID || piola__implicit_split_of(s) || s->self_collision.enabled)
@@ -254,8 +254,8 @@ static int32_t release_slipping_holds(newton_problem *pb) {
 }
 
 /* Kinetic friction on every obstacle contact of a body that may slide as a whole
- * (body_may_slide), from the solve just done: the force mu (g . n) / dt^2 against each
- * node's tangential velocity relative to the nearest obstacle, into st->friction for the next
+ * (piola__newton_body_may_slide), from the solve just done: the force mu (g . n) / dt^2 against
+ * each node's tangential velocity relative to the nearest obstacle, into st->friction for the next
  * solve (the nodes friction holds keep none: their hold is their friction). Returns how many
  * nodes feel it. */
 int32_t piola__newton_kinetic_friction(newton_problem *pb) {
@@ -321,8 +321,8 @@ static double friction_total(const newton_problem *pb) {
  * (release_slipping_holds), and where the step began with kinetic friction
  * (pb->kinetic), slips the friction reversed are held (hold_reversed_slips) and every slip's
  * friction follows its contact's normal force at this solve, which the friction's own moment
- * shifts (kinetic_friction). Returns whether any of this moved the friction by more than
- * FRICTION_ROUND_CHANGE of its total, so that the step is to be solved again. */
+ * shifts (piola__newton_kinetic_friction). Returns whether any of this moved the friction by more
+ * than FRICTION_ROUND_CHANGE of its total, so that the step is to be solved again. */
 int piola__newton_next_friction_round(newton_problem *pb) {
   const double before = friction_total(pb);
   int32_t changed = release_slipping_holds(pb);

@@ -17,7 +17,8 @@
 enum { HELD_BY_OBSTACLE = 1, HELD_BY_COLLISION = 2, HELD_BY_SOLID = 3, HELD_BY_FRICTION = 4 };
 
 /* How many times a step with friction is solved again after its first solve with it
- * (next_friction_round): the sliding block of body_may_slide settles in one to three */
+ * (piola__newton_next_friction_round): the sliding block of piola__newton_body_may_slide settles in
+ * one to three */
 #define FRICTION_SLIP_ROUNDS 4
 
 struct implicit_state {
@@ -58,13 +59,13 @@ typedef struct newton_problem {
   double total_mass;
   int signed_twist;   /* this Newton system keeps the rotation eigenvalues' sign (the tail) */
   int indefinite;     /* the last CG met non-positive curvature or an indefinite preconditioner */
-  int contacts_moved; /* contacts() or release_contacts() changed the contact set since the
-                       * preconditioner was built */
-  int friction_held;  /* solved again after friction (friction_moves_deform): the nodes it
-                       * stopped are held, the others feel its force, no friction pass */
-  int slip_rounds;    /* friction rounds solved since (next_friction_round) */
-  int kinetic;        /* the step began its friction with kinetic friction on every contact
-                       * (body_may_slide) */
+  int contacts_moved; /* piola__newton_contacts or _release_contacts changed the contact set since
+                       * the preconditioner was built */
+  int friction_held; /* solved again after friction (piola__newton_friction_moves_deform): the nodes
+                      * it stopped are held, the others feel its force, no friction pass */
+  int slip_rounds;   /* friction rounds solved since (piola__newton_next_friction_round) */
+  int kinetic;       /* the step began its friction with kinetic friction on every contact
+                      * (piola__newton_body_may_slide) */
 } newton_problem;
 
 /* Projects free nodes that are inside an obstacle (or, for a coupled shell, a solid) onto

@@ -921,8 +921,8 @@ static piola_status newton_iterate(const newton_problem *problem, int accept_unc
     PIOLA_TRY(update(&pb));
     /* Friction moved nodes after the solve, and the rest of the body has not answered. Where
      * the moves could flatten or invert tets, or where it stopped nodes of a body that may be
-     * sliding as a whole (body_may_slide), the step is solved once more: the nodes friction
-     * stopped held where it put them (the hold supplies all of their friction), the others
+     * sliding as a whole (piola__newton_body_may_slide), the step is solved once more: the nodes
+     * friction stopped held where it put them (the hold supplies all of their friction), the others
      * pushed by the force it applied to them (docs/time-stepping.md, "Friction after the
      * solve") */
     if (piola__newton_friction_moves_deform(&pb)) {

@@ -51,6 +51,26 @@
 
 #define STABLE_STEP_KERNEL static inline __attribute__((always_inline))
 
+/* A positive double's bits, which order as it does. */
+STABLE_STEP_KERNEL uint64_t magnitude_bits(double x) {
+  uint64_t bits;
+  memcpy(&bits, &x, sizeof bits);
+  return bits;
+}
+STABLE_STEP_KERNEL double from_magnitude_bits(uint64_t bits) {
+  double x;
+  memcpy(&x, &bits, sizeof x);
+  return x;
+}
+
+/* X rounded up to the weighted terms' grid (STEP_RATE_GRID_BITS mantissa bits; infinity past
+ * its largest value); 0, negative, infinite and NaN X unchanged. */
+STABLE_STEP_KERNEL double step_rate_grid_ceil(double x) {
+  const uint64_t mask = ((uint64_t)1 << (52 - STEP_RATE_GRID_BITS)) - 1;
+  const double up = from_magnitude_bits((magnitude_bits(x) + mask) & ~mask);
+  return x > 0.0 && x < INFINITY ? up : x;
+}
+
 /* The same pair weighted by the direction weights wi, wj (stable_step_anisotropy.h). */
 STABLE_STEP_KERNEL double weighted_pair_modulus(kernel_division dv, double c, double pi, double pj,
                                                 double fi, double fj, double kii, double kjj, double kij,
@@ -990,18 +1010,6 @@ static double weighed_cached_block(const piola_elastic_body *body, const piola_m
     default:
       abort(); /* DIRECTION_WEIGHTED lists these five */
   }
-}
-
-/* A positive double's bits, which order as it does. */
-static uint64_t magnitude_bits(double x) {
-  uint64_t bits;
-  memcpy(&bits, &x, sizeof bits);
-  return bits;
-}
-static double from_magnitude_bits(uint64_t bits) {
-  double x;
-  memcpy(&x, &bits, sizeof x);
-  return x;
 }
 
 /* The order's buckets: slices of a positive double's magnitude bits (the bits above SHIFT,

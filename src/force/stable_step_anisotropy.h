@@ -16,7 +16,7 @@
  * meet. With all weights 1 it is k_e; at rest (isotropic tangent) it is lambda + 2 mu whatever
  * the weights, so the rest bound is unchanged. The bound takes min(k_w, k_e) for tets whose k_e
  * is above 4 (lambda + 2 mu) (STEP_CACHE_STIFF), their term rounded up to a grid
- * (step_rate_grid_ceil below), k_e for the others.
+ * (STEP_RATE_GRID_BITS below), k_e for the others.
  *
  * Everything here is plain arithmetic with selects (no fused multiply-adds: stable_step.c's
  * bits do not depend on the instruction set). */
@@ -25,7 +25,6 @@
 
 #include <math.h>
 #include <stdint.h>
-#include <string.h>
 
 #include "material/material_kernels.h"
 
@@ -73,17 +72,9 @@ static inline __attribute__((always_inline)) void step_direction_weights(const d
  * stretched body's stiff maxima lie within a few percent of each other, and the exact maximum
  * weighed hundreds of blocks where the rounded one weighs tens (docs/time-stepping.md, "The
  * weighted terms' grid"). A function of the term alone, so every path (the ordered weighing,
- * the ranges, a split's processes, the per-tet search) takes the same bits. */
+ * the ranges, a split's processes, the per-tet search) takes the same bits. The rounding is
+ * step_rate_grid_ceil in stable_step.c. */
 #define STEP_RATE_GRID_BITS 5
-static inline __attribute__((always_inline)) double step_rate_grid_ceil(double x) {
-  const uint64_t mask = ((uint64_t)1 << (52 - STEP_RATE_GRID_BITS)) - 1;
-  uint64_t bits;
-  memcpy(&bits, &x, sizeof bits);
-  bits = (bits + mask) & ~mask;
-  double up;
-  memcpy(&up, &bits, sizeof up);
-  return x > 0.0 && x < INFINITY ? up : x; /* past the largest grid value: infinity */
-}
 
 /* Largest eigenvalue of [[a wj, c s], [c s, a wi]], s = sqrt(wi wj): one pair's weighted mode. */
 static inline __attribute__((always_inline)) double step_weighted_pair(double a, double c, double wi,

@@ -283,6 +283,10 @@ typedef enum piola_warning_kind {
   PIOLA_WARNING_UNSTABLE_CFL,          /* the explicit step's cfl is above 1, past the
                                           stability limit of well-shaped meshes (raised when
                                           the world is created) */
+  PIOLA_WARNING_TANGLED_START,         /* at the world's first step from t = 0, a solid with
+                                          self-collision starts tangled (an inverted or flat
+                                          tet, or its surface through itself): its
+                                          self-collision waits until it has untangled */
   PIOLA_WARNING_KIND_COUNT
 } piola_warning_kind;
 

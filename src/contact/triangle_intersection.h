@@ -2,11 +2,12 @@
  *
  * This is the referee for collision processing: tests use it to check that no two triangles
  * of a surface intersect after a step, so it must not share code or tolerances with the code
- * it judges. It uses only the signs of orientation determinants (orient3d, and orient2d in a
- * coordinate plane for coplanar pieces), evaluated exactly: a floating-point filter first, and
- * when the value is too close to zero to trust, an exact sum of products in expansion
- * arithmetic (error-free transformations: two_sum and an fma-based two_product). Touching
- * counts as intersecting. */
+ * it judges. The world asks it too, outside collision processing, whether a solid that
+ * started tangled has untangled (surface_intersection.h). It uses only the signs of orientation
+ * determinants (orient3d, and orient2d in a coordinate plane for coplanar pieces), evaluated
+ * exactly: a floating-point filter first, and when the value is too close to zero to trust, an
+ * exact sum of products in expansion arithmetic (error-free transformations: two_sum and an
+ * fma-based two_product). Touching counts as intersecting. */
 #ifndef PIOLA_CONTACT_TRIANGLE_INTERSECTION_H
 #define PIOLA_CONTACT_TRIANGLE_INTERSECTION_H
 

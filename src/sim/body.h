@@ -70,6 +70,9 @@ typedef struct world_body {
   int32_t motion_count;
   piola_track stiffness_scale, shear_viscosity, bulk_viscosity;
   piola_self_collision_def self_collision;
+  /* solids: self-collision waits for this solid to untangle, so it is not in the collision
+   * surface (world_contact.c, "A tangled start"); checkpointed */
+  int collision_waits;
   /* scratch for the step */
   double *x_old, *v_old, *force_old, *rhs, *work, *tmp;
   /* the final solve's A v (3n) and the v it was taken at (3n), with its h and the damping

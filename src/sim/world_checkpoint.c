@@ -559,6 +559,21 @@ static void recent_bounds(stream *s, piola_world *w) {
   if (s->store && !s->failed) w->recent_bound_count = count, w->recent_bound_next = next;
 }
 
+/* Whether a solid with self-collision waits for it to untangle (format 8 on; an older
+ * file's solids take part, as they did then). */
+static void collision_waits(stream *s, piola_world *w, world_body *b) {
+  if (!b->self_collision.enabled) return;
+  int32_t waits = b->collision_waits;
+  local_int(s, &waits, "self-collision waits");
+  if (s->failed) return;
+  if (waits != 0 && waits != 1) {
+    s->failed = 1;
+    snprintf(s->what, sizeof s->what, "self-collision waits: %d (0 or 1)", (int)waits);
+    return;
+  }
+  if (s->store) piola__world_set_collision_waits(w, b, waits);
+}
+
 static void world_state(stream *s, piola_world *w) {
   one_double(s, &w->time, "time");
   recent_bounds(s, w);
@@ -581,6 +596,7 @@ static void world_state(stream *s, piola_world *w) {
         elastic_state(s, b);
         plastic_state(s, b);
         if (!s->reading || s->version >= 6) step_weights(s, b);
+        if (!s->reading || s->version >= 8) collision_waits(s, w, b);
         /* the step bound's cache from the restored Fhat and weights, with the force loop's
          * bits (stable_step_modulus.h; none without a state) */
         if (s->reading && s->store && !s->failed) piola__elastic_body_refill_step_cache(b->solid);

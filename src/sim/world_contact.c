@@ -33,10 +33,13 @@
  * every interval is collision-free whatever the steps inside it did; the detection passes,
  * which dominate the cost of a cloth, run once per interval instead of once per step. */
 #include <math.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
 #include "common/status_report.h"
+#include "contact/surface_intersection.h"
+#include "force/elastic_body_internal.h"
 #include "piola/collision_surface.h"
 #include "sim/fracture_internal.h"
 #include "sim/world_internal.h"
@@ -118,7 +121,7 @@ static piola_status build(piola_world *w) {
   for (int32_t i = 0; i < count; ++i) c->offset[i] = -1;
   for (int32_t i = 0; i < count && st == PIOLA_OK; ++i) {
     const world_body *s = &w->bodies[i];
-    if (!s->self_collision.enabled) continue;
+    if (!s->self_collision.enabled || s->collision_waits) continue;
     st = body_surface_build(s, &surfaces[i]);
     embedded |= surfaces[i].where != NULL;
     c->offset[i] = nv, vertex_offset[i] = nsv;
@@ -192,10 +195,107 @@ static piola_status build(piola_world *w) {
   return st;
 }
 
+/* Bodies in the collision surface: self_collision enabled, not waiting to untangle. */
 static int any_self_collision(piola_world *w) {
   int any = 0;
-  for (int32_t i = 0; i < w->body_count; ++i) any |= w->bodies[i].self_collision.enabled;
+  for (int32_t i = 0; i < w->body_count; ++i)
+    any |= w->bodies[i].self_collision.enabled && !w->bodies[i].collision_waits;
   return any;
+}
+
+/* A tangled start. Collision processing keeps an intersection-free surface free; it cannot
+ * untangle one, and on a solid started scrambled, collapsed or mirrored its impulses and
+ * rigid zones hold the tangle in place: an octopus (1,140 tets) scrambled by a quarter of its
+ * size kept 571 tets inverted through 1 s of backward Euler, 40 times slower than without
+ * self-collision, which untangled it within 0.13 s; collapsed to a point it never left the
+ * point. So a solid that is tangled at the world's first collision pass from t = 0 stays out
+ * of the collision surface (it collides with nothing else either) until it has untangled: no
+ * tet inverted or nearly flat (det F above JOIN_MIN_DET) and its boundary free of intersections
+ * (the exact test of surface_intersection.h; a cut solid's fragment surfaces are not tested).
+ * Then it joins the surface for good. Shells do not wait. */
+#define TANGLE_MIN_DET 1e-6
+/* A waiting solid joins once every tet's det F is above this: one that joined as soon as no
+ * tet was flat (det F above TANGLE_MIN_DET) still had nearly flat tets, unfolding, and the
+ * collision pass then held one of them inverted for 0.5 s (the scrambled octopus above);
+ * at 0.1 and 0.5 alike it joined 0.07 s in and no tet was inverted after. */
+#define JOIN_MIN_DET 0.1
+
+/* det [b - a, c - a, d - a] of four points given by index into x. */
+static double corner_det(const double *x, const int32_t *c) {
+  double e[3][3];
+  for (int k = 0; k < 3; ++k)
+    for (int d = 0; d < 3; ++d) e[k][d] = x[3 * (size_t)c[k + 1] + d] - x[3 * (size_t)c[0] + d];
+  return e[0][0] * (e[1][1] * e[2][2] - e[1][2] * e[2][1]) -
+         e[0][1] * (e[1][0] * e[2][2] - e[1][2] * e[2][0]) +
+         e[0][2] * (e[1][0] * e[2][1] - e[1][1] * e[2][0]);
+}
+
+/* The first tet of solid s whose det F is at most LIMIT (its value in *det), or -1 for none.
+ * From the node positions, which every process of a split run holds whole, so every process
+ * decides alike (mpi.md, "Self-collision: replicated"). */
+static int32_t flat_or_inverted_tet(const world_body *s, double *det, double limit) {
+  const piola_elastic_body *e = s->solid;
+  for (int32_t t = 0; t < e->tet_count; ++t) {
+    const int32_t *c = e->tets + 4 * (size_t)t;
+    *det = corner_det(s->x, c) / corner_det(e->rest_positions, c);
+    if (!(*det > limit)) return t;
+  }
+  return -1;
+}
+
+/* 1 when solid s's boundary surface passes through itself (the tet test passed), 0 when it
+ * does not, -1 out of memory. */
+static int surface_tangled(const world_body *s) {
+  if (s->fracture) return 0;
+  piola_tri_mesh tris = {0};
+  int owned = 0;
+  if (piola__body_collision_triangles(s, &tris, &owned) != PIOLA_OK) return -1;
+  const int found = piola__surface_intersects(s->x, tris.triangles, tris.triangle_count);
+  if (owned) piola_tri_mesh_free(&tris);
+  return found;
+}
+
+/* Starts a tangled solid waiting at the world's first collision pass from t = 0 (a resumed
+ * run reads the waits from its checkpoint), and lets each waiting solid that has untangled
+ * join the surface (rebuilt). */
+static piola_status update_waits(piola_world *w) {
+  int changed = 0;
+  const int first = !w->tangle_checked && w->time == 0.0;
+  w->tangle_checked = 1;
+  for (int32_t i = 0; i < w->body_count; ++i) {
+    world_body *s = &w->bodies[i];
+    if (s->kind != PIOLA_BODY_SOLID || !s->self_collision.enabled ||
+        (!first && !s->collision_waits))
+      continue;
+    double det = 0;
+    const int32_t tet = flat_or_inverted_tet(s, &det, first ? TANGLE_MIN_DET : JOIN_MIN_DET);
+    const int through = tet >= 0 ? 0 : surface_tangled(s);
+    if (through < 0) return PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "self-collision: out of memory");
+    const int tangled = tet >= 0 || through;
+    if (first && tangled) {
+      char why[160];
+      if (tet >= 0)
+        snprintf(why, sizeof why, "tet %d (numbered from 0 in file order) has det F = %.3g",
+                 (int)tet, det);
+      else
+        snprintf(why, sizeof why, "its boundary surface passes through itself");
+      piola__world_warn(w, PIOLA_WARNING_TANGLED_START,
+                        "solid '%s' starts tangled (%s): collision processing cannot untangle a "
+                        "surface, so the solid's self-collision waits until it has untangled "
+                        "(det F > %g in every tet, its surface free of intersections) and it "
+                        "collides with nothing else until then (contact.md, \"A tangled start\")",
+                        s->name, why, JOIN_MIN_DET);
+    }
+    if (tangled != s->collision_waits) s->collision_waits = tangled, changed = 1;
+  }
+  if (changed) piola__world_contact_free(w);
+  return PIOLA_OK;
+}
+
+void piola__world_set_collision_waits(piola_world *w, world_body *s, int waits) {
+  if (s->collision_waits == waits) return;
+  s->collision_waits = waits;
+  piola__world_contact_free(w);
 }
 
 static piola_status ensure_built(piola_world *w) {
@@ -253,6 +353,10 @@ piola_status piola__world_collision_open(piola_world *w, double *left) {
 piola_status piola__world_self_collide(piola_world *w, double dt, double t1, int closes,
                                        piola_step_stats *stats) {
   const int32_t count = w->body_count;
+  int enabled = 0;
+  for (int32_t i = 0; i < count; ++i) enabled |= w->bodies[i].self_collision.enabled;
+  if (!enabled) return PIOLA_OK;
+  PIOLA_TRY(update_waits(w));
   if (!any_self_collision(w)) return PIOLA_OK;
   const int per_step = !(w->def.collision_interval > 0);
   if (!per_step && (!closes || !w->contact || !w->contact->open)) return PIOLA_OK;

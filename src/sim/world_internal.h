@@ -65,6 +65,7 @@ struct piola_world {
   step_profile profile;       /* per-phase step timers, off unless a benchmark turns them on */
   char *warnings[PIOLA_WARNING_KIND_COUNT]; /* first message of each kind, or NULL */
   int start_checked; /* the first step's check of nodes inside obstacles ran (world_warnings.c) */
+  int tangle_checked; /* the first collision pass's check of tangled solids ran (world_contact.c) */
   piola_work_split_planner split_planner; /* splits of solids added (plan NULL: none) */
   piola_work_split_planner split_replanner; /* splits of split solids a cut rebuilt */
   int split_replans_deferred; /* a rebuilt split solid stays whole, marked split_pending */
@@ -82,6 +83,9 @@ void piola__world_warn(piola_world *w, piola_warning_kind kind, const char *form
 #endif
     ;
 void piola__world_check_slivers(piola_world *w, const world_body *s);
+/* Sets whether solid s waits to untangle before it joins self-collision (world_contact.c,
+ * "A tangled start"; checkpoints restore it), rebuilding the collision surface if it changed. */
+void piola__world_set_collision_waits(piola_world *w, world_body *s, int waits);
 /* Before the world's first step from t = 0: warns (PIOLA_WARNING_STARTS_INSIDE) when free nodes of
  * a body start inside an obstacle deeper than a percent of the body's size. Once per world. */
 void piola__world_check_start_inside(piola_world *w);

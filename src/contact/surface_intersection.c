@@ -1,0 +1,58 @@
+/* Self-intersection of a triangle surface (surface_intersection.h). */
+#include "contact/surface_intersection.h"
+
+#include <math.h>
+#include <stdlib.h>
+
+#include "contact/bvh.h"
+#include "contact/triangle_intersection.h"
+
+static piola__box triangle_box(const double *x, const int32_t *tri) {
+  piola__box b = {{INFINITY, INFINITY, INFINITY}, {-INFINITY, -INFINITY, -INFINITY}};
+  for (int c = 0; c < 3; ++c)
+    for (int d = 0; d < 3; ++d) {
+      const double v = x[3 * (size_t)tri[c] + d];
+      b.lo[d] = fmin(b.lo[d], v), b.hi[d] = fmax(b.hi[d], v);
+    }
+  return b;
+}
+
+static int share_vertex(const int32_t *a, const int32_t *b) {
+  for (int p = 0; p < 3; ++p)
+    for (int q = 0; q < 3; ++q)
+      if (a[p] == b[q]) return 1;
+  return 0;
+}
+
+int piola__surface_intersects(const double *x, const int32_t *tris, int32_t count) {
+  if (count < 2) return 0;
+  piola__box *boxes = malloc(sizeof(piola__box) * (size_t)count);
+  piola__bvh bvh = {0};
+  piola__index_list near = {0};
+  int found = -1;
+  if (!boxes) goto done;
+  for (int32_t t = 0; t < count; ++t) boxes[t] = triangle_box(x, tris + 3 * (size_t)t);
+  if (piola__bvh_build(&bvh, boxes, count) != 0) goto done;
+  found = 0;
+  for (int32_t a = 0; a < count && found == 0; ++a) {
+    near.count = 0;
+    if (piola__bvh_query(&bvh, &boxes[a], &near) != 0) {
+      found = -1;
+      break;
+    }
+    const int32_t *ta = tris + 3 * (size_t)a;
+    const double *p[3] = {x + 3 * (size_t)ta[0], x + 3 * (size_t)ta[1], x + 3 * (size_t)ta[2]};
+    for (int64_t k = 0; k < near.count && found == 0; ++k) {
+      const int32_t b = near.items[k];
+      const int32_t *tb = tris + 3 * (size_t)b;
+      if (b <= a || share_vertex(ta, tb)) continue; /* each pair once; neighbours touch */
+      const double *q[3] = {x + 3 * (size_t)tb[0], x + 3 * (size_t)tb[1], x + 3 * (size_t)tb[2]};
+      found = piola__triangles_intersect(p, q) != 0;
+    }
+  }
+done:
+  free(boxes);
+  free(near.items);
+  piola__bvh_free(&bvh);
+  return found;
+}

@@ -1,0 +1,173 @@
+/* A solid that starts tangled waits to untangle before it takes part in self-collision
+ * (docs/contact.md, "A tangled start"; src/sim/world_contact.c).
+ *
+ * - The surface test (src/contact/surface_intersection.c) agrees with the contact tests' exact
+ *   referee, which tests every pair, on random triangle soups, and calls a surface collapsed
+ *   to a point tangled.
+ * - medit/unit_ball.mesh collapsed to a point, with self_collision, under backward Euler:
+ *   the first step raises the "tangled start" warning; while the ball waits its run is the
+ *   same, bit for bit, as the run without self_collision (it is in no collision surface);
+ *   it joins within two seconds, re-expanded, and stays joined. The same ball from rest
+ *   never waits and raises no warning.
+ * - A checkpoint written while it waits reads into a world built the same way, which waits
+ *   too and joins later, re-expanded. (Not bit for bit with the writer: a backward Euler
+ *   collapse resumed from its first frame parts from the writer with self_collision off as
+ *   well, a matter of the implicit step's own state, not of the waits.) */
+#include "test_support.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+#include "contact/surface_intersection.h"
+#include "piola/checkpoint.h"
+#include "piola/elastic_body.h"
+#include "piola/keyframes.h"
+#include "piola/world.h"
+#include "real_mesh_scenes.h"
+#include "sim/world_internal.h"
+#include "triangle_referee.h"
+
+static double uniform(uint64_t *state) {
+  *state = *state * 6364136223846793005ULL + 1442695040888963407ULL;
+  return (double)(*state >> 11) * 0x1.0p-53;
+}
+
+static void surface_test_agrees_with_the_referee(void **state) {
+  (void)state;
+  enum { TRIANGLES = 24, VERTICES = 3 * TRIANGLES };
+  uint64_t seed = 7;
+  int tangled = 0, free_ = 0;
+  for (int soup = 0; soup < 400; ++soup) {
+    double x[3 * VERTICES];
+    int32_t tris[3 * TRIANGLES];
+    /* small triangles in a box whose size varies, so that both answers occur */
+    const double box = 0.5 + 4.0 * uniform(&seed);
+    for (int v = 0; v < VERTICES; ++v) {
+      const int anchor = v / 3 * 3; /* a triangle's corners near its first: small triangles */
+      for (int d = 0; d < 3; ++d)
+        x[3 * v + d] =
+            v == anchor ? box * uniform(&seed) : x[3 * anchor + d] + 0.6 * uniform(&seed);
+    }
+    for (int t = 0; t < TRIANGLES; ++t) {
+      for (int c = 0; c < 3; ++c) tris[3 * t + c] = 3 * t + c;
+      /* some share a vertex with the one before: such pairs are exempt */
+      if (t > 0 && uniform(&seed) < 0.3) tris[3 * t] = 3 * (t - 1) + 1;
+    }
+    const long pairs = referee_count_intersections_every_pair((judged){x, tris, TRIANGLES});
+    const int found = piola__surface_intersects(x, tris, TRIANGLES);
+    assert_int_equal(found, pairs > 0);
+    tangled += found == 1, free_ += found == 0;
+  }
+  assert_true(tangled > 20 && free_ > 20); /* both answers were checked */
+  /* collapsed to a point: every triangle degenerate, and the surface counts as tangled */
+  double point[3 * 6] = {0};
+  const int32_t two[6] = {0, 1, 2, 3, 4, 5};
+  assert_int_equal(piola__surface_intersects(point, two, 2), 1);
+}
+
+/* The ball under backward Euler, no gravity, collapsed to a point (collapse) or at rest,
+ * with self_collision or without. */
+static piola_world *ball_world(const piola_tet_mesh *mesh, int collapse, int self_collision) {
+  piola_world_def wd = piola_default_world_def();
+  wd.integrator = PIOLA_INTEGRATOR_BACKWARD_EULER;
+  wd.implicit_dt = 1.0 / 30;
+  for (int k = 0; k < 3; ++k) wd.gravity[k] = piola_track_constant(0);
+  piola_world *w = NULL;
+  assert_int_equal(piola_world_create(&wd, &w), PIOLA_OK);
+  piola_solid_def sd = piola_default_solid_def();
+  sd.mesh = mesh;
+  sd.material.youngs_modulus = 1e5;
+  sd.shear_viscosity = piola_track_constant(20);
+  sd.bulk_viscosity = piola_track_constant(20);
+  if (collapse) memset(&sd.initial_matrix, 0, sizeof sd.initial_matrix);
+  sd.self_collision.enabled = self_collision;
+  sd.self_collision.thickness = 0.01;
+  if (piola_world_add_solid(w, &sd, NULL) != PIOLA_OK) fail_msg("%s", piola_last_error());
+  return w;
+}
+
+static int waits(const piola_world *w) { return w->bodies[0].collision_waits; }
+
+static void same_state(const piola_world *a, const piola_world *b) {
+  const int32_t n = piola_elastic_body_vertex_count(piola_world_solid_body(a, 0));
+  assert_memory_equal(piola_world_solid_positions(a, 0), piola_world_solid_positions(b, 0),
+                      3 * (size_t)n * sizeof(double));
+  assert_memory_equal(piola_world_solid_velocities(a, 0), piola_world_solid_velocities(b, 0),
+                      3 * (size_t)n * sizeof(double));
+  assert_true(piola_world_time(a) == piola_world_time(b));
+}
+
+static double solid_diagonal(const piola_world *w) {
+  return piola__bounding_diagonal(piola_elastic_body_vertex_count(piola_world_solid_body(w, 0)),
+                                  piola_world_solid_positions(w, 0));
+}
+
+static void collapsed_ball_waits_then_joins(void **state) {
+  (void)state;
+  piola_tet_mesh mesh = real_mesh_read("medit/unit_ball.mesh");
+  const double rest = real_mesh_diagonal(&mesh);
+  piola_world *a = ball_world(&mesh, 1, 1), *b = ball_world(&mesh, 1, 0);
+  piola_world *r = ball_world(&mesh, 0, 1);
+  char file[] = "/tmp/piola_tangled_start_XXXXXX";
+  const int fd = mkstemp(file);
+  assert_true(fd >= 0);
+  close(fd);
+  const uint64_t key = piola_world_scene_key(a, NULL, 0);
+  int joined_at = -1, saved = 0;
+  for (int frame = 1; frame <= 60 && joined_at < 0; ++frame) {
+    assert_int_equal(piola_world_advance_to(a, frame / 30.0, NULL), PIOLA_OK);
+    assert_true(real_mesh_solid_finite(a));
+    if (frame == 1) {
+      const char *text = piola_world_warning(a, PIOLA_WARNING_TANGLED_START);
+      assert_non_null(text);
+      assert_non_null(strstr(text, "starts tangled"));
+      assert_true(waits(a));
+      assert_int_equal(piola_world_checkpoint_write(a, file, key, frame), PIOLA_OK);
+      saved = frame;
+    }
+    if (waits(a)) { /* in no collision surface: the run without self_collision */
+      assert_int_equal(piola_world_advance_to(b, frame / 30.0, NULL), PIOLA_OK);
+      same_state(a, b);
+    } else {
+      joined_at = frame;
+    }
+  }
+  if (joined_at < 0) fail_msg("the collapsed ball still waits after 2 s");
+  if (getenv("PIOLA_TEST_VERBOSE"))
+    print_message("joined in frame %d, diagonal %.4g of rest %.4g\n", joined_at, solid_diagonal(a),
+                  rest);
+  assert_true(solid_diagonal(a) > 0.9 * rest); /* re-expanded */
+  assert_int_equal(piola_world_advance_to(a, (joined_at + 6) / 30.0, NULL), PIOLA_OK);
+  assert_false(waits(a)); /* joined for good */
+
+  /* the checkpoint of frame 1, read into a world built the same way: it waits too, then
+   * joins re-expanded */
+  piola_world *c = ball_world(&mesh, 1, 1);
+  int32_t frame = -1;
+  assert_int_equal(piola_world_checkpoint_read(c, file, key, &frame), PIOLA_OK);
+  assert_int_equal(frame, saved);
+  assert_true(waits(c));
+  for (int f = saved + 1; f <= 60 && waits(c); ++f)
+    assert_int_equal(piola_world_advance_to(c, f / 30.0, NULL), PIOLA_OK);
+  assert_false(waits(c));
+  assert_true(solid_diagonal(c) > 0.9 * rest);
+  unlink(file);
+
+  /* from rest: never waits, no warning */
+  assert_int_equal(piola_world_advance_to(r, 3.0 / 30, NULL), PIOLA_OK);
+  assert_false(waits(r));
+  assert_null(piola_world_warning(r, PIOLA_WARNING_TANGLED_START));
+  piola_world_destroy(a), piola_world_destroy(b), piola_world_destroy(c), piola_world_destroy(r);
+  piola_tet_mesh_free(&mesh);
+}
+
+int main(void) {
+  const struct CMUnitTest tests[] = {
+      cmocka_unit_test(surface_test_agrees_with_the_referee),
+      cmocka_unit_test(collapsed_ball_waits_then_joins),
+  };
+  return cmocka_run_group_tests(tests, NULL, NULL);
+}

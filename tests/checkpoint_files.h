@@ -1,6 +1,7 @@
 /* Checkpoint files taken apart and put back together by tests that rewrite one as an older
  * format wrote it (docs/file-formats.md: a 48-byte header, the payload as arrays of a u64
- * count and its elements, an FNV-1a 64 checksum of everything before it). */
+ * count and its elements, an FNV-1a 64 checksum of everything before it), and the check that
+ * a world read from one runs on like its writer. */
 #ifndef PIOLA_TEST_CHECKPOINT_FILES_H
 #define PIOLA_TEST_CHECKPOINT_FILES_H
 
@@ -21,5 +22,9 @@ uint64_t checkpoint_skip_array(const unsigned char *data, size_t *pos, size_t si
  * for it) to path as format `version`: the header's version and payload length set, the
  * checksum appended. Fails the test when it cannot be written. */
 void checkpoint_file_write(const char *path, unsigned char *data, size_t length, uint32_t version);
+
+struct piola_world;
+/* Solid 0 of a and b has the same positions and velocities, bit for bit, at the same time. */
+void checkpoint_same_solid_state(const struct piola_world *a, const struct piola_world *b);
 
 #endif

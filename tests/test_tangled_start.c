@@ -13,6 +13,7 @@
  *   runs on frame by frame bit for bit like the writer, waiting and joining in the same
  *   frames. */
 #include "test_support.h"
+#include "checkpoint_files.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -90,15 +91,6 @@ static piola_world *ball_world(const piola_tet_mesh *mesh, int collapse, int sel
 
 static int waits(const piola_world *w) { return w->bodies[0].collision_waits; }
 
-static void same_state(const piola_world *a, const piola_world *b) {
-  const int32_t n = piola_elastic_body_vertex_count(piola_world_solid_body(a, 0));
-  assert_memory_equal(piola_world_solid_positions(a, 0), piola_world_solid_positions(b, 0),
-                      3 * (size_t)n * sizeof(double));
-  assert_memory_equal(piola_world_solid_velocities(a, 0), piola_world_solid_velocities(b, 0),
-                      3 * (size_t)n * sizeof(double));
-  assert_true(piola_world_time(a) == piola_world_time(b));
-}
-
 static double solid_diagonal(const piola_world *w) {
   return piola__bounding_diagonal(piola_elastic_body_vertex_count(piola_world_solid_body(w, 0)),
                                   piola_world_solid_positions(w, 0));
@@ -131,7 +123,7 @@ static void collapsed_ball_waits_then_joins(void **state) {
     waited[frame] = waits(a);
     if (waits(a)) { /* in no collision surface: the run without self_collision */
       assert_int_equal(piola_world_advance_to(b, frame / 30.0, NULL), PIOLA_OK);
-      same_state(a, b);
+      checkpoint_same_solid_state(a, b);
     } else {
       joined_at = frame;
     }
@@ -157,7 +149,7 @@ static void collapsed_ball_waits_then_joins(void **state) {
     assert_int_equal(piola_world_advance_to(c, f / 30.0, NULL), PIOLA_OK);
     assert_int_equal(waits(c), waited[f]);
   }
-  same_state(a, c);
+  checkpoint_same_solid_state(a, c);
   unlink(file);
 
   /* from rest: never waits, no warning */

@@ -5,6 +5,8 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "piola/elastic_body.h"
+#include "piola/world.h"
 #include "test_support.h"
 
 unsigned char *checkpoint_file_read(const char *path, size_t *length) {
@@ -38,4 +40,14 @@ void checkpoint_file_write(const char *path, unsigned char *data, size_t length,
   assert_non_null(f);
   assert_int_equal(fwrite(data, 1, length + 8, f), length + 8);
   fclose(f);
+}
+
+void checkpoint_same_solid_state(const piola_world *a, const piola_world *b) {
+  const int32_t n = piola_elastic_body_vertex_count(piola_world_solid_body(a, 0));
+  assert_int_equal(piola_elastic_body_vertex_count(piola_world_solid_body(b, 0)), n);
+  assert_memory_equal(piola_world_solid_positions(a, 0), piola_world_solid_positions(b, 0),
+                      3 * (size_t)n * sizeof(double));
+  assert_memory_equal(piola_world_solid_velocities(a, 0), piola_world_solid_velocities(b, 0),
+                      3 * (size_t)n * sizeof(double));
+  assert_true(piola_world_time(a) == piola_world_time(b));
 }

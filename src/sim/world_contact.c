@@ -195,6 +195,13 @@ static piola_status build(piola_world *w) {
   return st;
 }
 
+/* Bodies with self_collision enabled. */
+static int any_enabled(piola_world *w) {
+  int any = 0;
+  for (int32_t i = 0; i < w->body_count; ++i) any |= w->bodies[i].self_collision.enabled;
+  return any;
+}
+
 /* Bodies in the collision surface: self_collision enabled, not waiting to untangle. */
 static int any_self_collision(piola_world *w) {
   int any = 0;
@@ -214,10 +221,11 @@ static int any_self_collision(piola_world *w) {
  * (the exact test of surface_intersection.h; a cut solid's fragment surfaces are not tested).
  * Then it joins the surface for good. Shells do not wait. */
 #define TANGLE_MIN_DET 1e-6
-/* A waiting solid joins once every tet's det F is above this: one that joined as soon as no
- * tet was flat (det F above TANGLE_MIN_DET) still had nearly flat tets, unfolding, and the
- * collision pass then held one of them inverted for 0.5 s (the scrambled octopus above);
- * at 0.1 and 0.5 alike it joined 0.07 s in and no tet was inverted after. */
+/* A waiting solid joins once every tet's det F is above this, a margin over flat: judged at
+ * the step's end instead of its start (as it was first written), a solid that joined as soon
+ * as no tet was flat still had nearly flat tets unfolding, and the collision pass held one of
+ * them inverted for 0.5 s (the scrambled octopus above), which 0.1 and 0.5 alike avoided.
+ * Judged at the step's start, 1e-6 and 0.1 both untangle these scenes cleanly. */
 #define JOIN_MIN_DET 0.1
 
 /* det [b - a, c - a, d - a] of four points given by index into x. */
@@ -230,35 +238,39 @@ static double corner_det(const double *x, const int32_t *c) {
          e[0][2] * (e[1][0] * e[2][1] - e[1][1] * e[2][0]);
 }
 
-/* The first tet of solid s whose det F is at most LIMIT (its value in *det), or -1 for none.
+/* The first tet of solid s at positions x whose det F is at most LIMIT (its value in *det), or
+ * -1 for none.
  * From the node positions, which every process of a split run holds whole, so every process
  * decides alike (mpi.md, "Self-collision: replicated"). */
-static int32_t flat_or_inverted_tet(const world_body *s, double *det, double limit) {
+static int32_t flat_or_inverted_tet(const world_body *s, const double *x, double *det,
+                                    double limit) {
   const piola_elastic_body *e = s->solid;
   for (int32_t t = 0; t < e->tet_count; ++t) {
     const int32_t *c = e->tets + 4 * (size_t)t;
-    *det = corner_det(s->x, c) / corner_det(e->rest_positions, c);
+    *det = corner_det(x, c) / corner_det(e->rest_positions, c);
     if (!(*det > limit)) return t;
   }
   return -1;
 }
 
-/* 1 when solid s's boundary surface passes through itself (the tet test passed), 0 when it
- * does not, -1 out of memory. */
-static int surface_tangled(const world_body *s) {
+/* 1 when solid s's boundary surface at positions x passes through itself (the tet test
+ * passed), 0 when it does not, -1 out of memory. */
+static int surface_tangled(const world_body *s, const double *x) {
   if (s->fracture) return 0;
   piola_tri_mesh tris = {0};
   int owned = 0;
   if (piola__body_collision_triangles(s, &tris, &owned) != PIOLA_OK) return -1;
-  const int found = piola__surface_intersects(s->x, tris.triangles, tris.triangle_count);
+  const int found = piola__surface_intersects(x, tris.triangles, tris.triangle_count);
   if (owned) piola_tri_mesh_free(&tris);
   return found;
 }
 
 /* Starts a tangled solid waiting at the world's first collision pass from t = 0 (a resumed
  * run reads the waits from its checkpoint), and lets each waiting solid that has untangled
- * join the surface (rebuilt). */
-static piola_status update_waits(piola_world *w) {
+ * join the surface (rebuilt). Judged at the positions the pass starts from, which collision
+ * processing takes to be intersection-free: the step's start (AT_STEP_START, x_old) when
+ * every step is processed, else the current positions as a collision interval opens. */
+static piola_status update_waits(piola_world *w, int at_step_start) {
   int changed = 0;
   const int first = !w->tangle_checked && w->time == 0.0;
   w->tangle_checked = 1;
@@ -267,9 +279,10 @@ static piola_status update_waits(piola_world *w) {
     if (s->kind != PIOLA_BODY_SOLID || !s->self_collision.enabled ||
         (!first && !s->collision_waits))
       continue;
+    const double *x = at_step_start ? s->x_old : s->x;
     double det = 0;
-    const int32_t tet = flat_or_inverted_tet(s, &det, first ? TANGLE_MIN_DET : JOIN_MIN_DET);
-    const int through = tet >= 0 ? 0 : surface_tangled(s);
+    const int32_t tet = flat_or_inverted_tet(s, x, &det, first ? TANGLE_MIN_DET : JOIN_MIN_DET);
+    const int through = tet >= 0 ? 0 : surface_tangled(s, x);
     if (through < 0) return PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "self-collision: out of memory");
     const int tangled = tet >= 0 || through;
     if (first && tangled) {
@@ -328,7 +341,11 @@ piola_status piola__world_contact_prepare(piola_world *w, int built) {
 
 piola_status piola__world_collision_open(piola_world *w, double *left) {
   *left = INFINITY;
-  if (!(w->def.collision_interval > 0) || !any_self_collision(w)) return PIOLA_OK;
+  if (!(w->def.collision_interval > 0) || !any_enabled(w)) return PIOLA_OK;
+  /* the waits change only as an interval opens: its start is what processing takes to be
+   * free of intersections */
+  if (!w->contact || !w->contact->open) PIOLA_TRY(update_waits(w, 0));
+  if (!any_self_collision(w)) return PIOLA_OK;
   PIOLA_TRY(ensure_built(w));
   world_contact *c = w->contact;
   if (!c->open) {
@@ -353,12 +370,10 @@ piola_status piola__world_collision_open(piola_world *w, double *left) {
 piola_status piola__world_self_collide(piola_world *w, double dt, double t1, int closes,
                                        piola_step_stats *stats) {
   const int32_t count = w->body_count;
-  int enabled = 0;
-  for (int32_t i = 0; i < count; ++i) enabled |= w->bodies[i].self_collision.enabled;
-  if (!enabled) return PIOLA_OK;
-  PIOLA_TRY(update_waits(w));
-  if (!any_self_collision(w)) return PIOLA_OK;
   const int per_step = !(w->def.collision_interval > 0);
+  if (!any_enabled(w)) return PIOLA_OK;
+  if (per_step) PIOLA_TRY(update_waits(w, 1));
+  if (!any_self_collision(w)) return PIOLA_OK;
   if (!per_step && (!closes || !w->contact || !w->contact->open)) return PIOLA_OK;
   PIOLA_TRY(ensure_built(w));
   world_contact *c = w->contact;

@@ -234,6 +234,30 @@ static void soft_bar_increment_without_failed_newton(void **state) {
   piola_world_destroy(w);
 }
 
+/* A clamped bar whose step fails (Newton allowed one iteration, far from its tolerance): the
+ * warning names the step and, the bar being held by a constrained node, advises ramping the
+ * load (time-stepping.md, "Quasistatics"), not the advice for a body with no equilibrium. */
+static void held_bar_failure_advises_a_ramp(void **state) {
+  (void)state;
+  piola_world_def wd = piola_default_world_def();
+  wd.integrator = PIOLA_INTEGRATOR_QUASISTATIC;
+  wd.implicit_dt = 1.0 / 30.0;
+  wd.newton_max_iterations = 1;
+  piola_world *w = NULL;
+  assert_int_equal(piola_world_create(&wd, &w), PIOLA_OK);
+  add_clamped_bar(w, &(beam){.nx = 13, .ny = 2, .length = 0.5, .side = 0.08}, 2e4, 0.3);
+  piola_step_stats st;
+  memset(&st, 0, sizeof st);
+  assert_int_equal(piola_world_advance_to(w, 1.0 / 30.0, &st), PIOLA_OK);
+  assert_true(st.newton_failures > 0);
+  const char *text = piola_world_warning(w, PIOLA_WARNING_NEWTON_FAILED);
+  assert_non_null(text);
+  assert_non_null(strstr(text, "quasistatic step"));
+  assert_non_null(strstr(text, "ramped: keyframe gravity up from 0"));
+  assert_null(strstr(text, "no equilibrium"));
+  piola_world_destroy(w);
+}
+
 /* Pi(x) = sum V0 psi - sum m_i g . x_i after an update at x. */
 static double potential_at(piola_elastic_body *body, const double *x, const double g[3],
                            double *forces) {
@@ -297,6 +321,7 @@ int main(void) {
       cmocka_unit_test(large_load_independent_of_forcing),
       cmocka_unit_test(small_load_matches_euler_bernoulli),
       cmocka_unit_test(soft_bar_increment_without_failed_newton),
+      cmocka_unit_test(held_bar_failure_advises_a_ramp),
       cmocka_unit_test(potential_gradient_is_the_residual),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);

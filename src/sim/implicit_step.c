@@ -736,6 +736,24 @@ static piola_status newton_direction(newton_problem *pb, double eta, int *tail_a
 
 /* Newton's iterations from the body's current state (its forces up to date), then the
  * velocities, friction and prescribed nodes. */
+/* The Newton failure warning's advice for a quasistatic body (time-stepping.md,
+ * "Quasistatics"): held by obstacle contacts alone it may have no equilibrium; held by
+ * constrained nodes, a load it cannot take in one step converges when ramped (a soft HGO
+ * elbow, medit/elbow.mesh, under the whole of gravity at once: its first step failed after
+ * three halvings, which do not shrink a quasistatic load; with gravity keyframed up from 0
+ * over 0.2 s, none failed). Backward Euler: none. */
+static const char *failure_advice(const newton_problem *pb) {
+  if (!pb->quasistatic) return "";
+  const world_body *s = pb->s;
+  for (int32_t i = 0; i < s->n; ++i)
+    if (s->flags[i] != NODE_FREE)
+      return ". A load a quasistatic body cannot take in one step (the whole of gravity at "
+             "once on a soft solid) converges when ramped: keyframe gravity up from 0 over a "
+             "few frames (time-stepping.md, \"Quasistatics\")";
+  return ". A quasistatic body held by obstacle contacts alone has no equilibrium: fix or "
+         "drive a node, or use \"backward_euler\" (time-stepping.md, \"Quasistatics\")";
+}
+
 static piola_status newton_iterate(const newton_problem *problem, int accept_unconverged,
                                    piola_step_stats *stats) {
   newton_problem pb = *problem;
@@ -897,11 +915,10 @@ static piola_status newton_iterate(const newton_problem *problem, int accept_unc
                       "last try, or a retry that halving did not help); its last iterate was "
                       "kept (backward Euler: unless it held more energy than the step's start, "
                       "time-stepping.md \"What a failed step keeps\") and the run goes on "
-                      "(stats.csv newton_failures counts failed tries). A quasistatic body held by "
-                      "obstacle contacts alone has no equilibrium: fix or drive a node, or "
-                      "use \"backward_euler\" (time-stepping.md)",
+                      "(stats.csv newton_failures counts failed tries)%s",
                       piola__body_kind_name(s->kind), s->name,
-                      pb.quasistatic ? "quasistatic" : "backward Euler", pb.t1);
+                      pb.quasistatic ? "quasistatic" : "backward Euler", pb.t1,
+                      failure_advice(&pb));
   }
   /* velocities; friction; prescribed velocities */
   const double inv_dt = 1.0 / dt;

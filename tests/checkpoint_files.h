@@ -23,6 +23,11 @@ uint64_t checkpoint_skip_array(const unsigned char *data, size_t *pos, size_t si
  * checksum appended. Fails the test when it cannot be written. */
 void checkpoint_file_write(const char *path, unsigned char *data, size_t length, uint32_t version);
 
+/* Makes a fresh empty file of the caller's own in the temporary folder ($TMPDIR, else /tmp),
+ * its name STEM followed by a unique suffix, and writes its path to PATH (SIZE bytes); the
+ * caller unlinks it. Fails the test when it cannot. */
+void checkpoint_temp_file(char *path, size_t size, const char *stem);
+
 struct piola_world;
 /* Solid 0 of a and b has the same positions and velocities, bit for bit, at the same time. */
 void checkpoint_same_solid_state(const struct piola_world *a, const struct piola_world *b);

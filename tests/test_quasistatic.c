@@ -205,20 +205,27 @@ static void large_load_independent_of_forcing(void **state) {
 /* The quasistatic bar of run_resume_examples.py: 0.5 m x 0.08 m x 0.08 m, neo-Hookean
  * E = 20 kPa, nu = 0.3, clamped at x = 0, gravity (0, 0 -> 15, -5 -> -40) m/s^2 over 0.4 s;
  * one increment of 1/30 s, the run's first frame. */
+/* The soft bar below (0.5 m, E = 20 kPa, nu = 0.3, clamped) in a quasistatic world of wd
+ * after its first increment of 1/30 s, the increment's statistics in *st. */
+static piola_world *soft_bar_first_increment(piola_world_def wd, piola_step_stats *st) {
+  wd.integrator = PIOLA_INTEGRATOR_QUASISTATIC;
+  wd.implicit_dt = 1.0 / 30.0;
+  piola_world *w = NULL;
+  assert_int_equal(piola_world_create(&wd, &w), PIOLA_OK);
+  add_clamped_bar(w, &(beam){.nx = 13, .ny = 2, .length = 0.5, .side = 0.08}, 2e4, 0.3);
+  memset(st, 0, sizeof *st);
+  assert_int_equal(piola_world_advance_to(w, 1.0 / 30.0, st), PIOLA_OK);
+  return w;
+}
+
 static void soft_bar_increment_without_failed_newton(void **state) {
   (void)state;
   piola_world_def wd = piola_default_world_def();
   const double times[2] = {0, 0.4}, gy[2] = {0, 15}, gz[2] = {-5, -40};
   assert_int_equal(piola_track_from_keys(times, gy, 2, &wd.gravity[1]), PIOLA_OK);
   assert_int_equal(piola_track_from_keys(times, gz, 2, &wd.gravity[2]), PIOLA_OK);
-  wd.integrator = PIOLA_INTEGRATOR_QUASISTATIC;
-  wd.implicit_dt = 1.0 / 30.0;
-  piola_world *w = NULL;
-  assert_int_equal(piola_world_create(&wd, &w), PIOLA_OK);
-  add_clamped_bar(w, &(beam){.nx = 13, .ny = 2, .length = 0.5, .side = 0.08}, 2e4, 0.3);
   piola_step_stats st;
-  memset(&st, 0, sizeof st);
-  assert_int_equal(piola_world_advance_to(w, 1.0 / 30.0, &st), PIOLA_OK);
+  piola_world *w = soft_bar_first_increment(wd, &st);
   const piola_elastic_body *body = piola_world_solid_body(w, 0);
   const double *x = piola_world_solid_positions(w, 0);
   const double *x0 = piola_elastic_body_rest_positions(body);
@@ -240,15 +247,9 @@ static void soft_bar_increment_without_failed_newton(void **state) {
 static void held_bar_failure_advises_a_ramp(void **state) {
   (void)state;
   piola_world_def wd = piola_default_world_def();
-  wd.integrator = PIOLA_INTEGRATOR_QUASISTATIC;
-  wd.implicit_dt = 1.0 / 30.0;
   wd.newton_max_iterations = 1;
-  piola_world *w = NULL;
-  assert_int_equal(piola_world_create(&wd, &w), PIOLA_OK);
-  add_clamped_bar(w, &(beam){.nx = 13, .ny = 2, .length = 0.5, .side = 0.08}, 2e4, 0.3);
   piola_step_stats st;
-  memset(&st, 0, sizeof st);
-  assert_int_equal(piola_world_advance_to(w, 1.0 / 30.0, &st), PIOLA_OK);
+  piola_world *w = soft_bar_first_increment(wd, &st);
   assert_true(st.newton_failures > 0);
   const char *text = piola_world_warning(w, PIOLA_WARNING_NEWTON_FAILED);
   assert_non_null(text);

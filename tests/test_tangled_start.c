@@ -102,10 +102,8 @@ static void collapsed_ball_waits_then_joins(void **state) {
   const double rest = real_mesh_diagonal(&mesh);
   piola_world *a = ball_world(&mesh, 1, 1), *b = ball_world(&mesh, 1, 0);
   piola_world *r = ball_world(&mesh, 0, 1);
-  char file[] = "/tmp/piola_tangled_start_XXXXXX";
-  const int fd = mkstemp(file);
-  assert_true(fd >= 0);
-  close(fd);
+  char file[4096];
+  checkpoint_temp_file(file, sizeof file, "piola_tangled_start");
   const uint64_t key = piola_world_scene_key(a, NULL, 0);
   enum { FRAMES = 60, AFTER = 6 };
   int joined_at = -1, saved = 0, waited[FRAMES + AFTER + 1] = {0};

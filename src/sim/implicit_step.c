@@ -734,8 +734,6 @@ static piola_status newton_direction(newton_problem *pb, double eta, int *tail_a
   }
 }
 
-/* Newton's iterations from the body's current state (its forces up to date), then the
- * velocities, friction and prescribed nodes. */
 /* The Newton failure warning's advice for a quasistatic body (time-stepping.md,
  * "Quasistatics"): held by obstacle contacts alone it may have no equilibrium; held by
  * constrained nodes, a load it cannot take in one step converges when ramped (a soft HGO
@@ -754,6 +752,8 @@ static const char *failure_advice(const newton_problem *pb) {
          "drive a node, or use \"backward_euler\" (time-stepping.md, \"Quasistatics\")";
 }
 
+/* Newton's iterations from the body's current state (its forces up to date), then the
+ * velocities, friction and prescribed nodes. */
 static piola_status newton_iterate(const newton_problem *problem, int accept_unconverged,
                                    piola_step_stats *stats) {
   newton_problem pb = *problem;

@@ -4,6 +4,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 
 #include "piola/elastic_body.h"
 #include "piola/world.h"
@@ -50,4 +51,13 @@ void checkpoint_same_solid_state(const piola_world *a, const piola_world *b) {
   assert_memory_equal(piola_world_solid_velocities(a, 0), piola_world_solid_velocities(b, 0),
                       3 * (size_t)n * sizeof(double));
   assert_true(piola_world_time(a) == piola_world_time(b));
+}
+
+void checkpoint_temp_file(char *path, size_t size, const char *stem) {
+  const char *tmp = getenv("TMPDIR");
+  const int n = snprintf(path, size, "%s/%s_XXXXXX", tmp && *tmp ? tmp : "/tmp", stem);
+  assert_true(n > 0 && (size_t)n < size);
+  const int fd = mkstemp(path); /* the X's become the file's unique name */
+  assert_true(fd >= 0);
+  close(fd);
 }

@@ -7,6 +7,7 @@
 #include <unistd.h>
 
 #include "block_scenes.h"
+#include "checkpoint_files.h"
 #include "fracture_checks.h"
 #include "piola/checkpoint.h"
 #include "piola/elastic_body.h"
@@ -171,12 +172,8 @@ void fracture_checkpoint_round_trip(const piola_world *a, piola_world *b, const 
 
 void fracture_checkpoint_round_trip_via_temp_file(const piola_world *a, piola_world *b,
                                                   int32_t frame) {
-  const char *tmp = getenv("TMPDIR");
   char path[4096];
-  snprintf(path, sizeof path, "%s/piola_fracture_checkpoint_XXXXXX", tmp && *tmp ? tmp : "/tmp");
-  const int fd = mkstemp(path); /* a fresh file of our own: the Xs become its unique name */
-  assert_true(fd >= 0);
-  close(fd);
+  checkpoint_temp_file(path, sizeof path, "piola_fracture_checkpoint");
   fracture_checkpoint_round_trip(a, b, path, frame);
   unlink(path);
 }

@@ -11,7 +11,11 @@
  *   never waits and raises no warning.
  * - A checkpoint written while it waits reads into a world built the same way, which then
  *   runs on frame by frame bit for bit like the writer, waiting and joining in the same
- *   frames. */
+ *   frames.
+ * - Bodies placed through each other: the test across bodies agrees with the referee on
+ *   random soups split in two; two balls overlapping, and a sheet through a ball, raise the
+ *   "through each other" warning naming both; balls apart, or one without self_collision,
+ *   raise none. */
 #include "test_support.h"
 #include "checkpoint_files.h"
 
@@ -22,6 +26,7 @@
 #include <unistd.h>
 
 #include "contact/surface_intersection.h"
+#include "contact/triangle_intersection.h"
 #include "piola/checkpoint.h"
 #include "piola/elastic_body.h"
 #include "piola/keyframes.h"
@@ -66,6 +71,111 @@ static void surface_test_agrees_with_the_referee(void **state) {
   double point[3 * 6] = {0};
   const int32_t two[6] = {0, 1, 2, 3, 4, 5};
   assert_int_equal(piola__surface_intersects(point, two, 2), 1);
+}
+
+static void surfaces_cross_agrees_with_the_referee(void **state) {
+  (void)state;
+  enum { TRIANGLES = 24, VERTICES = 3 * TRIANGLES, HALF = TRIANGLES / 2 };
+  uint64_t seed = 11;
+  int crossed = 0, apart = 0;
+  for (int soup = 0; soup < 400; ++soup) {
+    double x[3 * VERTICES];
+    int32_t tris[3 * TRIANGLES], group[TRIANGLES];
+    const double box = 0.5 + 4.0 * uniform(&seed);
+    for (int v = 0; v < VERTICES; ++v) {
+      const int anchor = v / 3 * 3;
+      for (int d = 0; d < 3; ++d)
+        x[3 * v + d] =
+            v == anchor ? box * uniform(&seed) : x[3 * anchor + d] + 0.6 * uniform(&seed);
+    }
+    /* two bodies, each over its own vertices; inside each, some share a vertex */
+    for (int t = 0; t < TRIANGLES; ++t) {
+      for (int c = 0; c < 3; ++c) tris[3 * t + c] = 3 * t + c;
+      if (t % HALF > 0 && uniform(&seed) < 0.3) tris[3 * t] = 3 * (t - 1) + 1;
+      group[t] = t / HALF;
+    }
+    const judged first = {x, tris, HALF}, second = {x, tris + 3 * HALF, HALF};
+    const judged both[2] = {first, second};
+    const long across = referee_count_intersections(both, 2) -
+                        referee_count_intersections(&first, 1) -
+                        referee_count_intersections(&second, 1);
+    int32_t pair[2] = {-1, -1};
+    const int found = piola__surfaces_cross(x, tris, group, TRIANGLES, pair);
+    assert_int_equal(found, across > 0);
+    if (found == 1) {
+      assert_true(pair[0] < HALF && pair[1] >= HALF);
+      const double *p[3] = {x + 3 * tris[3 * pair[0]], x + 3 * tris[3 * pair[0] + 1],
+                            x + 3 * tris[3 * pair[0] + 2]};
+      const double *q[3] = {x + 3 * tris[3 * pair[1]], x + 3 * tris[3 * pair[1] + 1],
+                            x + 3 * tris[3 * pair[1] + 2]};
+      assert_int_not_equal(piola__triangles_intersect(p, q), 0); /* the pair it names */
+    }
+    crossed += found == 1, apart += found == 0;
+  }
+  assert_true(crossed > 20 && apart > 20);
+}
+
+/* Two unit balls (radius 1 m) with their centres `gap` apart along x, the second with
+ * self_collision or without, and (sheet) a sheet through the first ball's equator. */
+static piola_world *two_bodies_world(const piola_tet_mesh *mesh, double gap, int second_collides,
+                                     int sheet) {
+  piola_world_def wd = piola_default_world_def();
+  piola_world *w = NULL;
+  assert_int_equal(piola_world_create(&wd, &w), PIOLA_OK);
+  piola_tet_mesh moved = *mesh;
+  double *x = malloc(sizeof(double) * 3 * (size_t)mesh->vertex_count);
+  assert_non_null(x);
+  for (int32_t i = 0; i < 3 * mesh->vertex_count; ++i)
+    x[i] = mesh->positions[i] + (i % 3 == 0 ? gap : 0);
+  moved.positions = x;
+  piola_solid_def sd = piola_default_solid_def();
+  sd.self_collision.enabled = 1;
+  sd.self_collision.thickness = 0.01;
+  sd.mesh = mesh, sd.name = "first";
+  assert_int_equal(piola_world_add_solid(w, &sd, NULL), PIOLA_OK);
+  sd.mesh = &moved, sd.name = "second", sd.self_collision.enabled = second_collides;
+  if (gap < 1e3) assert_int_equal(piola_world_add_solid(w, &sd, NULL), PIOLA_OK);
+  free(x);
+  if (sheet) {
+    piola_tri_mesh rectangle;
+    /* 3 m square in z = 0, centred on the origin: through the first ball's equator */
+    assert_int_equal(piola_tri_mesh_rectangle(3, 3, 4, 4, &rectangle), PIOLA_OK);
+    piola_shell_def hd = piola_default_shell_def();
+    hd.mesh = &rectangle, hd.name = "sheet";
+    hd.self_collision.enabled = 1;
+    hd.self_collision.thickness = 0.01;
+    assert_int_equal(piola_world_add_shell(w, &hd, NULL), PIOLA_OK);
+    piola_tri_mesh_free(&rectangle);
+  }
+  return w;
+}
+
+/* The warning after the first step, or NULL. */
+static char *through_each_other_after_a_step(piola_world *w) {
+  assert_int_equal(piola_world_step(w, 0, NULL), PIOLA_OK);
+  const char *text = piola_world_warning(w, PIOLA_WARNING_BODIES_CROSS);
+  char *copy = text ? strdup(text) : NULL;
+  piola_world_destroy(w);
+  return copy;
+}
+
+static void bodies_through_each_other_are_named(void **state) {
+  (void)state;
+  piola_tet_mesh mesh = real_mesh_read("medit/unit_ball.mesh");
+  char *overlap = through_each_other_after_a_step(two_bodies_world(&mesh, 1.2, 1, 0));
+  assert_non_null(overlap);
+  assert_non_null(strstr(overlap, "solid 'first' and solid 'second' start through each other"));
+  free(overlap);
+  /* apart by a tenth of a radius: nothing to report */
+  assert_null(through_each_other_after_a_step(two_bodies_world(&mesh, 2.1, 1, 0)));
+  /* overlapping, but the second is in no collision surface: nothing collides, nothing holds */
+  assert_null(through_each_other_after_a_step(two_bodies_world(&mesh, 1.2, 0, 0)));
+  /* a sheet through the one ball */
+  char *sheet = through_each_other_after_a_step(two_bodies_world(&mesh, 1e9, 1, 1));
+  assert_non_null(sheet);
+  assert_non_null(strstr(sheet, "solid 'first' and shell 'sheet'"));
+  free(sheet);
+  piola_tet_mesh_free(&mesh);
 }
 
 /* The ball under backward Euler, no gravity, collapsed to a point (collapse) or at rest,
@@ -162,6 +272,8 @@ int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(surface_test_agrees_with_the_referee),
       cmocka_unit_test(collapsed_ball_waits_then_joins),
+      cmocka_unit_test(surfaces_cross_agrees_with_the_referee),
+      cmocka_unit_test(bodies_through_each_other_are_named),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
 }

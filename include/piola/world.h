@@ -287,6 +287,10 @@ typedef enum piola_warning_kind {
                                           self-collision starts tangled (an inverted or flat
                                           tet, or its surface through itself): its
                                           self-collision waits until it has untangled */
+  PIOLA_WARNING_BODIES_CROSS,          /* at the world's first step from t = 0, the surfaces
+                                          of two bodies with self-collision intersect:
+                                          collision processing holds them hooked where they
+                                          cross */
   PIOLA_WARNING_KIND_COUNT
 } piola_warning_kind;
 

@@ -265,6 +265,66 @@ static int surface_tangled(const world_body *s, const double *x) {
   return found;
 }
 
+/* Bodies placed through each other. Their surfaces intersect from the first step, and
+ * collision processing cannot separate them: its impulses act on pairs already through each
+ * other and hold them hooked where they cross. Unlike one solid's tangle this is no state the
+ * elastic forces leave (each body is at rest in its own shape), so no body waits: the world
+ * warns, once, at its first collision pass from t = 0, naming the first two bodies found
+ * through each other (bodies in the surface only: not waiting, not cut by fracture, whose
+ * fragment surfaces are not tested). Returns -1 out of memory. */
+static int warn_bodies_through_each_other(piola_world *w, int at_step_start) {
+  int32_t nv = 0, nt = 0, bodies = 0;
+  piola_tri_mesh *surfaces =
+      calloc((size_t)(w->body_count > 0 ? w->body_count : 1), sizeof(piola_tri_mesh));
+  int *owned = calloc((size_t)(w->body_count > 0 ? w->body_count : 1), sizeof(int));
+  int found = -1;
+  double *x = NULL;
+  int32_t *tris = NULL, *group = NULL;
+  if (!surfaces || !owned) goto done;
+  for (int32_t i = 0; i < w->body_count; ++i) {
+    const world_body *b = &w->bodies[i];
+    if (!b->self_collision.enabled || b->collision_waits || b->fracture) continue;
+    if (piola__body_collision_triangles(b, &surfaces[i], &owned[i]) != PIOLA_OK) goto done;
+    nv += b->n, nt += surfaces[i].triangle_count, ++bodies;
+  }
+  found = 0;
+  if (bodies < 2) goto done;
+  found = -1;
+  x = malloc(sizeof(double) * 3 * (size_t)nv);
+  tris = malloc(sizeof(int32_t) * 3 * (size_t)(nt > 0 ? nt : 1));
+  group = malloc(sizeof(int32_t) * (size_t)(nt > 0 ? nt : 1));
+  if (!x || !tris || !group) goto done;
+  int32_t v0 = 0, t0 = 0;
+  for (int32_t i = 0; i < w->body_count; ++i) {
+    const world_body *b = &w->bodies[i];
+    if (!b->self_collision.enabled || b->collision_waits || b->fracture) continue;
+    memcpy(x + 3 * (size_t)v0, at_step_start ? b->x_old : b->x, sizeof(double) * 3 * (size_t)b->n);
+    for (int32_t t = 0; t < surfaces[i].triangle_count; ++t, ++t0) {
+      for (int c = 0; c < 3; ++c)
+        tris[3 * (size_t)t0 + c] = v0 + surfaces[i].triangles[3 * (size_t)t + c];
+      group[t0] = i;
+    }
+    v0 += b->n;
+  }
+  int32_t pair[2];
+  found = piola__surfaces_cross(x, tris, group, nt, pair);
+  if (found == 1) {
+    const world_body *a = &w->bodies[group[pair[0]]], *b = &w->bodies[group[pair[1]]];
+    piola__world_warn(w, PIOLA_WARNING_BODIES_CROSS,
+                      "%s '%s' and %s '%s' start through each other (their surfaces intersect): "
+                      "collision processing cannot separate surfaces that already pass through "
+                      "each other, and holds them hooked where they cross; move one (its "
+                      "`transform`) so that they start apart (contact.md, \"Limits\")",
+                      piola__body_kind_name(a->kind), a->name, piola__body_kind_name(b->kind),
+                      b->name);
+  }
+done:
+  for (int32_t i = 0; surfaces && owned && i < w->body_count; ++i)
+    if (owned[i]) piola_tri_mesh_free(&surfaces[i]);
+  free(surfaces), free(owned), free(x), free(tris), free(group);
+  return found;
+}
+
 /* Starts a tangled solid waiting at the world's first collision pass from t = 0 (a resumed
  * run reads the waits from its checkpoint), and lets each waiting solid that has untangled
  * join the surface (rebuilt). Judged at the positions the pass starts from, which collision
@@ -301,6 +361,8 @@ static piola_status update_waits(piola_world *w, int at_step_start) {
     }
     if (tangled != s->collision_waits) s->collision_waits = tangled, changed = 1;
   }
+  if (first && warn_bodies_through_each_other(w, at_step_start) < 0)
+    return PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "self-collision: out of memory");
   if (changed) piola__world_contact_free(w);
   return PIOLA_OK;
 }

@@ -8,7 +8,16 @@
  * held by contacts alone has no equilibrium. Before, a line search
  * that found no decrease left the last rejected trial in place (1/2048 of a Newton step
  * that the vanishing regularization made 1e38 m long) and the last try kept it: the body
- * ended 1e10 m away, no warning. */
+ * ended 1e10 m away, no warning.
+ *
+ * medit/unit_ball.mesh (radius 1 m, E = 100 kPa) resting on a frictionless plane: it may
+ * slide and turn along the plane at no cost, and its Newton steps fail. A step along those
+ * free directions is as long as the regularization is small; the full steps shrank it to
+ * 1e-22 of its first value and the ball ended its first frame 1e6 m away, its second 1e11 m.
+ * No Newton iteration may now move a node further than the body's size, and a failed step
+ * whose iterate did is not kept: after every frame each node is within the ball's bounding
+ * diagonal of where it started, over the plane. The mesh's first vertex is in no tet (held,
+ * massless): the advice is still that of a body held by contacts alone. */
 #include "test_support.h"
 
 #include <math.h>
@@ -87,10 +96,55 @@ static void armadillo_on_frictionless_plane(void **state) {
   piola_world_destroy(w);
 }
 
+static void ball_resting_on_frictionless_plane(void **state) {
+  (void)state;
+  piola_world_def wd = piola_default_world_def();
+  wd.integrator = PIOLA_INTEGRATOR_QUASISTATIC;
+  wd.implicit_dt = 1.0 / 30;
+  piola_world *w = NULL;
+  assert_int_equal(piola_world_create(&wd, &w), PIOLA_OK);
+  piola_tet_mesh mesh = real_mesh_read("medit/unit_ball.mesh");
+  piola_solid_def sd = piola_default_solid_def();
+  sd.name = "ball";
+  sd.mesh = &mesh;
+  sd.material = real_mesh_material_def(PIOLA_MODEL_NEOHOOKEAN, 1e5, 0.3);
+  assert_int_equal(piola_world_add_solid(w, &sd, NULL), PIOLA_OK);
+  double bottom = INFINITY;
+  for (int32_t v = 0; v < mesh.vertex_count; ++v) bottom = fmin(bottom, mesh.positions[3 * v + 2]);
+  piola_obstacle_def g = piola_default_obstacle_def();
+  g.type = PIOLA_OBSTACLE_PLANE;
+  g.center = (piola_vec3){0, 0, bottom};
+  g.axis = (piola_vec3){0, 0, 1};
+  g.friction = 0;
+  assert_int_equal(piola_world_add_obstacle(w, &g, NULL), PIOLA_OK);
+  const double size = 2 * sqrt(3.0); /* the bounding diagonal of a unit ball */
+  piola_step_stats st = {0};
+  for (int frame = 1; frame <= 3; ++frame) {
+    assert_int_equal(piola_world_advance_to(w, frame / 30.0, &st), PIOLA_OK);
+    assert_true(real_mesh_solid_finite(w));
+    const double *x = piola_world_solid_positions(w, 0);
+    for (int32_t i = 0; i < mesh.vertex_count; ++i) {
+      double d2 = 0;
+      for (int k = 0; k < 3; ++k) d2 += pow(x[3 * i + k] - mesh.positions[3 * i + k], 2);
+      if (!(sqrt(d2) <= size))
+        fail_msg("frame %d: vertex %d moved %g m (the ball's size %g m)", frame, (int)i, sqrt(d2),
+                 size);
+      assert_true(x[3 * i + 2] >= bottom - 1e-9);
+    }
+  }
+  assert_true(st.newton_failures > 0);
+  const char *text = piola_world_warning(w, PIOLA_WARNING_NEWTON_FAILED);
+  assert_non_null(text);
+  assert_non_null(strstr(text, "held by obstacle contacts alone has no equilibrium"));
+  piola_tet_mesh_free(&mesh);
+  piola_world_destroy(w);
+}
+
 int main(void) {
   piola_set_thread_count(1);
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(armadillo_on_frictionless_plane),
+      cmocka_unit_test(ball_resting_on_frictionless_plane),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
 }

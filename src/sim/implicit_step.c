@@ -734,6 +734,49 @@ static piola_status newton_direction(newton_problem *pb, double eta, int *tail_a
   }
 }
 
+/* Quasistatics: how far one Newton iteration may move a node, and how far a failed step's
+ * kept iterate may have moved one: the body's size (the larger bounding-box diagonal of its
+ * rest shape and of the step's start; a solid collapsed to a point still has its rest size).
+ * A body held by frictionless obstacle contacts alone slides and turns along them at no cost
+ * in potential or residual, so -K + mu M is singular there but for mu, which full steps
+ * shrink a tenfold each: a unit ball resting on a plane (medit/unit_ball.mesh, E = 100 kPa)
+ * took a step of 1.7e13 m along the plane, and its failed frames kept iterates 1e11 m away.
+ * Converged steps take far shorter steps than this. */
+static double quasistatic_reach(const world_body *s) {
+  double reach = piola__bounding_diagonal(s->n, s->x_old);
+  if (s->kind == PIOLA_BODY_SOLID)
+    reach = fmax(reach, piola__bounding_diagonal(s->n, s->solid->rest_positions));
+  return reach > 0 ? reach : INFINITY;
+}
+
+/* Scales the Newton step down so that no node moves further than reach; 1 when it did. */
+static int limit_step(newton_problem *pb, double reach) {
+  const world_body *s = pb->s;
+  double longest2 = 0;
+  for (int32_t i = 0; i < s->n; ++i) {
+    const double *d = pb->st->step + 3 * (size_t)i;
+    longest2 = fmax(longest2, d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+  }
+  if (!(longest2 > reach * reach)) return 0;
+  const double scale = reach / sqrt(longest2);
+  for (int64_t j = 0; j < 3 * (int64_t)s->n; ++j) pb->st->step[j] *= scale;
+  return 1;
+}
+
+/* 1 when a free node of s is further than reach from where the step started. */
+static int moved_beyond(const world_body *s, double reach) {
+  for (int32_t i = 0; i < s->n; ++i) {
+    if (s->flags[i] != NODE_FREE) continue;
+    double d2 = 0;
+    for (int k = 0; k < 3; ++k) {
+      const double d = s->x[3 * (size_t)i + k] - s->x_old[3 * (size_t)i + k];
+      d2 += d * d;
+    }
+    if (d2 > reach * reach) return 1;
+  }
+  return 0;
+}
+
 /* The Newton failure warning's advice for a quasistatic body (time-stepping.md,
  * "Quasistatics"): held by obstacle contacts alone it may have no equilibrium; held by
  * constrained nodes, a load it cannot take in one step converges when ramped (a soft HGO
@@ -743,8 +786,8 @@ static piola_status newton_direction(newton_problem *pb, double eta, int *tail_a
 static const char *failure_advice(const newton_problem *pb) {
   if (!pb->quasistatic) return "";
   const world_body *s = pb->s;
-  for (int32_t i = 0; i < s->n; ++i)
-    if (s->flags[i] != NODE_FREE)
+  for (int32_t i = 0; i < s->n; ++i) /* a vertex in no element is held, but holds nothing */
+    if (s->mass[i] > 0 && s->flags[i] != NODE_FREE)
       return ". A load a quasistatic body cannot take in one step (the whole of gravity at "
              "once on a soft solid) converges when ramped: keyframe gravity up from 0 over a "
              "few frames (time-stepping.md, \"Quasistatics\")";
@@ -782,6 +825,7 @@ static piola_status newton_iterate(const newton_problem *problem, int accept_unc
       w->def.preconditioner != PIOLA_PRECONDITIONER_INCOMPLETE_CHOLESKY;
   pb.signed_twist = 0;
   int converged = 0;
+  const double reach = pb.quasistatic ? quasistatic_reach(s) : INFINITY;
   /* the test runs once more after the last iteration: an iterate that converges there is
    * a converged step, not a failed one */
   for (int32_t iter = 0;; ++iter) {
@@ -810,6 +854,7 @@ static piola_status newton_iterate(const newton_problem *problem, int accept_unc
     eta = forcing_term(&w->def, phi, phi_last, eta, target2, last_alpha < 1.0);
     phi_last = phi;
     PIOLA_TRY(newton_direction(&pb, eta, &tail_allowed, stats));
+    const int limited = pb.quasistatic && limit_step(&pb, reach);
     /* backtracking line search on |S g|^2, and for a quasistatic solid also on its
      * potential: a step is accepted when either decreases by the Armijo fraction (see the
      * head of this file) */
@@ -860,7 +905,11 @@ static piola_status newton_iterate(const newton_problem *problem, int accept_unc
     }
     last_alpha = alpha;
     if (pb.quasistatic) {
-      if (alpha == 1.0)
+      /* a step the reach cut short: the regularization is too weak for the body's
+       * (nearly) free directions, as after a short step */
+      if (limited)
+        s->quasistatic_mu *= 10.0;
+      else if (alpha == 1.0)
         s->quasistatic_mu = fmax(s->quasistatic_mu / 10.0, 1e-300);
       else if (alpha < 0.25)
         s->quasistatic_mu *= 10.0;
@@ -880,7 +929,7 @@ static piola_status newton_iterate(const newton_problem *problem, int accept_unc
      * one, which a full step has just divided by 10: there the tail follows every full
      * step (examples/muscle_spindle_hanging.json as quasistatic: 30 Newton iterations in
      * 10 frames instead of 523 and 8 failed tries) */
-    pb.signed_twist = tail_allowed && alpha == 1.0 &&
+    pb.signed_twist = tail_allowed && alpha == 1.0 && !limited &&
                       (follows_contacts || (added == 0 && released == 0)) &&
                       (pb.quasistatic || !(s->quasistatic_mu > 0));
     if (added > 0) {
@@ -910,11 +959,20 @@ static piola_status newton_iterate(const newton_problem *problem, int accept_unc
     }
     if (!accept_unconverged || !isfinite(phi)) return PIOLA_ERROR_NOT_CONVERGED;
     stats->newton_failures++;
+    /* quasistatics: an iterate that took a node further than the body's size along its
+     * free directions is no result; the free nodes stay where the step started */
+    if (pb.quasistatic && moved_beyond(s, reach)) {
+      for (int32_t i = 0; i < n; ++i)
+        if (s->flags[i] == NODE_FREE) memcpy(s->x + 3 * i, s->x_old + 3 * i, sizeof(double) * 3);
+      PIOLA_TRY(update(&pb));
+    }
     piola__world_warn(w, PIOLA_WARNING_NEWTON_FAILED,
                       "%s '%s': the %s step to t = %g s did not converge (Newton, on its "
                       "last try, or a retry that halving did not help); its last iterate was "
                       "kept (backward Euler: unless it held more energy than the step's start, "
-                      "time-stepping.md \"What a failed step keeps\") and the run goes on "
+                      "time-stepping.md \"What a failed step keeps\"; quasistatic: unless it "
+                      "moved a node further than the body's size, then the step's start) and "
+                      "the run goes on "
                       "(stats.csv newton_failures counts failed tries)%s",
                       piola__body_kind_name(s->kind), s->name,
                       pb.quasistatic ? "quasistatic" : "backward Euler", pb.t1,

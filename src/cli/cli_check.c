@@ -14,7 +14,9 @@
 #include <string.h>
 #include <time.h>
 
+#include "cli/cli_numbers.h"
 #include "cli/commands.h"
+#include "cli/run_budget.h"
 #include "piola/elastic_body.h"
 #include "piola/mesh_quality.h"
 #include "piola/scene.h"
@@ -25,13 +27,14 @@
 
 static void usage(FILE *out) {
   fprintf(out,
-          "usage: piola check SCENE.json [--threads N] [--timing-seconds S]\n"
+          "usage: piola check SCENE.json [--threads N] [--timing-seconds S] [--max-steps N]\n"
           "\n"
           "Validates the scene, reads or generates its meshes and builds it as `piola run` would,\n"
           "then prints its bodies, counts, the step the CFL bound allows, the worst elements\n"
           "and an estimate of the run's steps and wall time from a short timing. Writes nothing.\n"
           "  --threads N          worker threads for the timing (default: all cores)\n"
           "  --timing-seconds S   wall time spent on timing steps, 0 for none (default 1)\n"
+          "  --max-steps N        refuse, as piola run would, past N estimated steps (1e7)\n"
           "  -h, --help           this text\n");
 }
 
@@ -108,6 +111,7 @@ int cli_check(int argc, char **argv) {
   const char *scene_path = NULL;
   long threads = 0;
   double timing_seconds = 1;
+  double max_steps = 1e7; /* piola run's default limit */
   for (int i = 1; i < argc; ++i) {
     const char *a = argv[i];
     if (strcmp(a, "-h") == 0 || strcmp(a, "--help") == 0) {
@@ -123,6 +127,10 @@ int cli_check(int argc, char **argv) {
       timing_seconds = ++i < argc ? strtod(argv[i], &end) : NAN;
       if (i >= argc || !argv[i][0] || *end || !(timing_seconds >= 0 && timing_seconds <= 3600))
         return fprintf(stderr, "piola check: --timing-seconds needs seconds in [0, 3600]\n"), 2;
+    } else if (strcmp(a, "--max-steps") == 0) {
+      if (++i >= argc || !cli_parse_double(argv[i], &max_steps) || !(max_steps >= 1) ||
+          max_steps > 1e18)
+        return fprintf(stderr, "piola check: --max-steps needs a number in [1, 1e18]\n"), 2;
     } else if (a[0] == '-' && a[1]) {
       fprintf(stderr, "piola check: unknown option '%s'\n", a);
       usage(stderr);
@@ -182,6 +190,16 @@ int cli_check(int argc, char **argv) {
   printf("estimate:  %.0f steps per frame, %.0f steps in all (at the starting step; contact and "
          "keyframed stiffness can change it)\n",
          steps_per_frame, steps_per_frame * frames);
+  /* what the world warned of while it was built (slivers, empty selections, cfl) */
+  for (int k = 0; k < PIOLA_WARNING_KIND_COUNT; ++k) {
+    const char *text = piola_world_warning(world, (piola_warning_kind)k);
+    if (text) fprintf(stderr, "piola check: warning: %s\n", text);
+  }
+  /* the run piola run would refuse is no valid run */
+  if (!run_budget_ok("piola check", scene_path, world, frames, fps, max_steps, false)) {
+    piola_scene_destroy(scene);
+    return 2;
+  }
   int rc = 0;
   if (timing_seconds > 0) {
     /* a few real steps: the first ones include one-time setup, so time after the first */

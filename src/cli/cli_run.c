@@ -15,6 +15,7 @@
 
 #include "cli/cli_numbers.h"
 #include "cli/commands.h"
+#include "cli/run_budget.h"
 #include "cli/run_checkpoints.h"
 #include "cli/run_mpi.h"
 #include "cli/run_split_checkpoints.h"
@@ -103,68 +104,6 @@ static void progress(bool tty, int frame, int frames, double t, double elapsed, 
             frames, t, substeps, inverted, el_s, eta_s);
   }
   fflush(stderr);
-}
-
-/* The time it takes the fastest wave of the rest state to cross the smallest tet, over the
- * world's solids (s; INFINITY without solids): the rest CFL step at cfl = 1. */
-static double rest_crossing_time(const piola_world *world) {
-  double t = INFINITY;
-  for (int32_t i = 0; i < piola_world_solid_count(world); ++i) {
-    const piola_elastic_body *body = piola_world_solid_body(world, i);
-    const double h = piola_elastic_body_min_rest_altitude(body);
-    const double c = piola_elastic_body_max_wave_speed(body);
-    if (h > 0 && c > 0) t = fmin(t, h / c);
-  }
-  return t;
-}
-
-/* Why the budget guard may have refused, where the first step is far below the rest state's:
- * a body that starts deformed (a scramble, a collapse) is stiff where it is stretched, and
- * the explicit step stays that short until it recovers, which the estimate cannot foresee;
- * the implicit integrator takes such starts in frame-sized steps. A hint, worded as one: a
- * tiny max_dt or stiffness_scale shortens the step too. */
-static void deformed_start_hint(const piola_world *world, double dt) {
-  const double rest = rest_crossing_time(world);
-  if (!(dt < 0.01 * rest)) return;
-  if (piola_world_integrator(world) != PIOLA_INTEGRATOR_NEWMARK) {
-    /* the implicit step is the scene's own integrator.dt */
-    fprintf(stderr,
-            "piola run: integrator.dt (%.3g s) is %.3g times shorter than the time the rest "
-            "state's fastest wave takes to cross the smallest tet (%.3g s); \"%s\" needs no "
-            "such step: leave integrator.dt out for one step per frame (docs/time-stepping.md, "
-            "\"Implicit integrators\")\n",
-            dt, rest / dt, rest, piola_integrator_type_name(piola_world_integrator(world)));
-    return;
-  }
-  fprintf(stderr,
-          "piola run: the first step is %.3g times shorter than the time the rest state's "
-          "fastest wave takes to cross the smallest tet (%.3g s). If a solid starts deformed "
-          "(initial.scramble, initial.matrix), it is far stiffer where it is stretched, and "
-          "the explicit step stays that short until it recovers: \"integrator\": {\"type\": "
-          "\"backward_euler\"} takes frame-sized steps through it (docs/time-stepping.md, "
-          "\"Implicit integrators\")\n",
-          rest / dt, rest);
-}
-
-/* The time-budget guard: a scene whose frames would take more than max_steps steps of the
- * first stable step is refused before anything is written, as a mistyped fps (1e-300) or
- * frame count would otherwise run for ever. The estimate uses the step at t = 0; steps
- * shrink under stiffening and contact, and every frame ends a step (so a step longer than
- * a frame, an implicit integrator's integrator.dt, still takes one per frame): frames times
- * ceil(frame time / step), as `piola check` estimates, is a lower bound. */
-static bool budget_ok(const char *scene_path, const piola_world *world, int frames, double fps,
-                      double max_steps, bool quiet) {
-  double simulated = frames / fps, dt = piola_world_stable_dt(world);
-  double steps = frames * ceil(1.0 / fps / dt - 1e-9);
-  if (isfinite(steps) && steps <= max_steps) return true;
-  if (quiet) return false; /* MPI processes other than 0 */
-  fprintf(stderr,
-          "piola run: %s: %d frames at %g fps are %.3g s of simulated time, about %.3g steps of "
-          "%.3g s: more than the limit of %.3g steps. Check fps and frames, or raise the limit "
-          "with --max-steps N\n",
-          scene_path, frames, fps, simulated, steps, dt, max_steps);
-  deformed_start_hint(world, dt);
-  return false;
 }
 
 /* Writes a frame: process 0's VTU, or in a split run every process's piece and then, once
@@ -264,7 +203,7 @@ static int run(int argc, char **argv, run_mpi *mpi) {
   }
   int frames = frames_override >= 0 ? (int)frames_override : (int)piola_scene_frames(scene);
   double fps = piola_scene_fps(scene);
-  if (!budget_ok(scene_path, world, frames, fps, max_steps, !lead)) {
+  if (!run_budget_ok("piola run", scene_path, world, frames, fps, max_steps, !lead)) {
     piola_scene_destroy(scene);
     return 2;
   }

@@ -91,6 +91,12 @@ echo "{\"fps\": 0.5, \"frames\": 1, \"integrator\": {\"max_dt\": 0.01}, \"solids
 expect 2 "more than the limit of 10 steps" -- "$PIOLA" run two_seconds.json -o out_two --max-steps 10
 expect 0 "done" -- "$PIOLA" run two_seconds.json -o out_two --max-steps 1e4
 expect 2 "--max-steps needs a number" -- "$PIOLA" run two_seconds.json -o out_x --max-steps 0
+# piola check refuses what piola run would, with the same limit and message
+expect 2 "piola check: slow.json: 1 frames at 1e-300 fps" -- "$PIOLA" check slow.json --timing-seconds 0
+expect 2 "more than the limit of 10 steps" -- "$PIOLA" check two_seconds.json --timing-seconds 0 --max-steps 10
+timeout 20 "$PIOLA" check two_seconds.json --timing-seconds 0 --max-steps 1e4 >stdout 2>stderr ||
+  fail "check two_seconds.json --max-steps 1e4: exit $?: $(cat stderr)"
+grep -q "^estimate:  [0-9]* steps per frame" stdout || fail "check two_seconds.json: no estimate: $(cat stdout)"
 # a step longer than a frame still takes one per frame: 300 frames are 300 steps, not 10
 echo "{\"fps\": 30, \"frames\": 300, \"integrator\": {\"type\": \"backward_euler\", \"dt\": 1}, \"solids\": [{\"mesh\": $box}]}" >long_dt.json
 expect 2 "about 300 steps of 1 s: more than the limit of 100 steps" -- "$PIOLA" run long_dt.json -o out_long --max-steps 100

@@ -27,10 +27,11 @@ extern "C" {
 #endif
 
 /* The checkpoint format this piola writes (docs/file-formats.md); it reads this one,
- * format 7 (without the solids' self-collision waits), format 6 (without the recent step
- * bounds either), format 5 (without the step weights of cut plastic solids either) and
- * format 4 (whose cut solids have no tet cut twice either). */
-#define PIOLA_CHECKPOINT_VERSION 8
+ * format 8 (without backward Euler solids' kept start), format 7 (without the solids'
+ * self-collision waits either), format 6 (without the recent step bounds either), format 5
+ * (without the step weights of cut plastic solids either) and format 4 (whose cut solids
+ * have no tet cut twice either). */
+#define PIOLA_CHECKPOINT_VERSION 9
 
 /* 1 when checkpoints cover every part of the world's state; 0 with a reason in *why (a
  * static string) otherwise. */

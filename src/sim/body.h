@@ -101,6 +101,9 @@ typedef struct world_body {
                                       their first step of a solid (implicit_step.c) */
   double quasistatic_mu; /* the implicit integrators' regularization carried from step to
                             step, 1/s^2 (0: not chosen yet; implicit_step.c); checkpointed */
+  int kept_start;        /* solids: backward Euler's last step kept its start's positions
+                            (a tangle froze it; implicit_step.c, RECOVERING_DROP);
+                            checkpointed */
 } world_body;
 
 /* ---- the kind-dependent operations (body.c) */

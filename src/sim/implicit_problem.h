@@ -29,6 +29,8 @@ struct implicit_state {
   int multigrid_ready;        /* multigrid serves the current Newton system */
   int multigrid_fresh;        /* the hierarchy was set up in this step (else: set it up) */
   int32_t split_systems;      /* Newton systems of this step solved by the split's solver */
+  int after_kept_start;       /* the step before this one kept its start */
+  double start_elastic, start_energy; /* J, at the step's start (RECOVERING_DROP) */
   double failed_progress;     /* try_progress of this step's last failed try; -1: none yet */
   int halvings;               /* of the step's try being solved */
   int may_go_deeper;  /* a kept try that would keep only its start is halved on (DEEPER_HALVINGS) */

@@ -119,6 +119,19 @@ static double last_try_length(const piola_world *w) {
  * "Failure"). */
 #define HALVING_GAIN 1.5
 
+/* After a backward Euler step that kept its start's positions (keep_failed_step's last case),
+ * a failed try from a start with a flat or inverted tet whose iterate, with its velocity
+ * (x - x^n) / dt, holds less energy than the start by at least RECOVERING_DROP of the start's
+ * elastic energy is kept as a last try is, instead of halved: it is a tangle letting go, and
+ * its halves would start again from the tangle and end where the last step did.
+ * armadillo_4k rotated z-up, scrambled by two diagonals (the spline, seed 2; a scene written
+ * from the docs): each frame's first try took the energy from 3.9e13 to 2.8e8 J in its 30
+ * Newton iterations without converging, the halves failed, and the last try kept its start,
+ * frame after frame: the body stood frozen with 1,763 tets inverted. Kept at every tangled
+ * step instead of only after a frozen one, the rule changed how the armadillo scrambles of
+ * docs/time-stepping.md recover, for better and for worse (one bunny scramble timed out). */
+#define RECOVERING_DROP 0.9
+
 /* Backward Euler's first guess is the prediction x^n + dt v^n plus the step gravity alone
  * would give (dt^2 g: 1.1 cm at 1/30 s), which is exact for a free fall. A solid that is
  * supported (held by a constraint, or that step would take a node into an obstacle) takes
@@ -610,11 +623,13 @@ static piola_status keep_failed_step(newton_problem *pb) {
                     "%s '%s': the failed backward Euler step to t = %g s kept its start's "
                     "positions with a rigid velocity, since its iterate held more energy than "
                     "the start (time-stepping.md, \"What a failed step keeps\"); a body whose "
-                    "every step does this does not move. The energy inversion mode does so on "
-                    "scrambled meshes, where the model's default extension recovers "
-                    "(materials.md, \"With backward Euler, scrambles can freeze\")",
+                    "every step does this does not move. The energy inversion mode freezes "
+                    "this way on scrambled meshes; with any extension, more damping or a "
+                    "shorter integrator.dt can help (materials.md, \"With backward Euler, "
+                    "scrambles can freeze\")",
                     piola__body_kind_name(s->kind), s->name, pb->t1);
   memcpy(s->x, s->x_old, bytes);
+  s->kept_start = 1;
   piola__failed_step_velocity(s->n, s->mass, s->x_old, s->v_old, s->x, pb->g1, pb->dt, s->v);
   for (int32_t i = 0; i < s->n; ++i)
     if (s->flags[i] != NODE_FREE)
@@ -659,6 +674,17 @@ static piola_status newton_body(piola_world *w, world_body *s, double t, double 
   const int64_t m = 3 * (int64_t)n;
   newton_problem pb = problem_of(w, s, t, dt);
   if (!pb.quasistatic) s->quasistatic_mu = 0;
+
+  /* after a step that kept its start, a tangled start's energy, for RECOVERING_DROP (the
+   * forces, and so the energy densities, are those of x^n) */
+  if (halvings == 0) st->after_kept_start = s->kept_start, s->kept_start = 0;
+  st->start_elastic = 0;
+  double det = 0;
+  if (st->after_kept_start && s->kind == PIOLA_BODY_SOLID && !pb.quasistatic &&
+      piola__solid_flat_or_inverted_tet(s, s->x, &det, 0.0) >= 0) {
+    st->start_elastic = piola__elastic_body_total_energy(s->solid);
+    st->start_energy = total_energy(&pb, s->x, s->v);
+  }
 
   /* the prediction, and the first guess: the prediction plus a step of gravity, or for a
    * solid held by a constraint or whose step of gravity would take a node into an obstacle
@@ -943,6 +969,14 @@ static piola_status newton_iterate(const newton_problem *problem, int accept_unc
      * quasistatic retry that began at the failed try's mu of 1e-22 took a first step of
      * 1e38 m): it starts again from the first one */
     if (pb.quasistatic) s->quasistatic_mu = 0;
+    /* backward Euler after a frozen step: a try that lets go of the tangle is kept whole
+     * (RECOVERING_DROP) */
+    if (!pb.quasistatic && isfinite(phi) && !accept_unconverged && s->kind == PIOLA_BODY_SOLID &&
+        st->start_elastic > 0) {
+      for (int64_t j = 0; j < m; ++j) s->v[j] = (s->x[j] - s->x_old[j]) / dt;
+      accept_unconverged =
+          total_energy(&pb, s->x, s->v) <= st->start_energy - RECOVERING_DROP * st->start_elastic;
+    }
     /* backward Euler: a retry that halving did not help is kept (HALVING_GAIN), unless it
      * is shorter than a last try: kept halves of what is left of a frame would shrink
      * geometrically, and the frame would never end. A kept try that would keep only its

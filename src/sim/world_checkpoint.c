@@ -574,6 +574,21 @@ static void collision_waits(stream *s, piola_world *w, world_body *b) {
   if (s->store) piola__world_set_collision_waits(w, b, waits);
 }
 
+/* Whether a backward Euler solid's last step kept its start's positions (format 9 on; an
+ * older file's solids did not, as none was told then). */
+static void kept_start(stream *s, piola_world *w, world_body *b) {
+  if (w->def.integrator != PIOLA_INTEGRATOR_BACKWARD_EULER) return;
+  int32_t kept = b->kept_start;
+  local_int(s, &kept, "backward Euler kept start");
+  if (s->failed) return;
+  if (kept != 0 && kept != 1) {
+    s->failed = 1;
+    snprintf(s->what, sizeof s->what, "backward Euler kept start: %d (0 or 1)", (int)kept);
+    return;
+  }
+  if (s->store) b->kept_start = kept;
+}
+
 static void world_state(stream *s, piola_world *w) {
   one_double(s, &w->time, "time");
   recent_bounds(s, w);
@@ -597,6 +612,7 @@ static void world_state(stream *s, piola_world *w) {
         plastic_state(s, b);
         if (!s->reading || s->version >= 6) step_weights(s, b);
         if (!s->reading || s->version >= 8) collision_waits(s, w, b);
+        if (!s->reading || s->version >= 9) kept_start(s, w, b);
         /* the step bound's cache from the restored Fhat and weights, with the force loop's
          * bits (stable_step_modulus.h; none without a state) */
         if (s->reading && s->store && !s->failed) piola__elastic_body_refill_step_cache(b->solid);

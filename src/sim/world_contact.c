@@ -242,8 +242,8 @@ static double corner_det(const double *x, const int32_t *c) {
  * -1 for none.
  * From the node positions, which every process of a split run holds whole, so every process
  * decides alike (mpi.md, "Self-collision: replicated"). */
-static int32_t flat_or_inverted_tet(const world_body *s, const double *x, double *det,
-                                    double limit) {
+int32_t piola__solid_flat_or_inverted_tet(const world_body *s, const double *x, double *det,
+                                          double limit) {
   const piola_elastic_body *e = s->solid;
   for (int32_t t = 0; t < e->tet_count; ++t) {
     const int32_t *c = e->tets + 4 * (size_t)t;
@@ -341,7 +341,8 @@ static piola_status update_waits(piola_world *w, int at_step_start) {
       continue;
     const double *x = at_step_start ? s->x_old : s->x;
     double det = 0;
-    const int32_t tet = flat_or_inverted_tet(s, x, &det, first ? TANGLE_MIN_DET : JOIN_MIN_DET);
+    const int32_t tet =
+        piola__solid_flat_or_inverted_tet(s, x, &det, first ? TANGLE_MIN_DET : JOIN_MIN_DET);
     const int through = tet >= 0 ? 0 : surface_tangled(s, x);
     if (through < 0) return PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "self-collision: out of memory");
     const int tangled = tet >= 0 || through;

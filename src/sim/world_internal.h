@@ -92,6 +92,10 @@ void piola__world_check_start_inside(piola_world *w);
 
 /* Diagonal (m) of the bounding box of n points x (3 n numbers); 0 for none. */
 double piola__bounding_diagonal(int32_t n, const double *x);
+/* The first tet of solid s at positions x whose det F (against the rest mesh) is at most
+ * limit, its value in *det; -1 for none (world_contact.c). */
+int32_t piola__solid_flat_or_inverted_tet(const world_body *s, const double *x, double *det,
+                                          double limit);
 void piola__world_warnings_free(piola_world *w);
 
 /* ---- the body table (body_table.c) */

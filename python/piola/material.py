@@ -115,7 +115,10 @@ class Material:
         fib = None
         if fibers is not None:
             fib = float_array(fibers, "fibers", lead + (3,)).reshape(-1, 3)
-        P, psi = _piola.material_eval(self._def, flat, fib, number(activation, "activation"))
+        activation = number(activation, "activation")
+        if not 0.0 <= activation <= 1.0:  # NaN included
+            raise ValueError(f"activation must be in [0, 1], got {activation!r}")
+        P, psi = _piola.material_eval(self._def, flat, fib, activation)
         return P.reshape(lead + (3, 3)), psi.reshape(lead)
 
     def stress(self, F, fibers=None, activation=0.0):

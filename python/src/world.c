@@ -15,6 +15,7 @@
 #include "pypiola.h"
 
 #include <math.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -224,8 +225,11 @@ static PyObject *run_steps(world_object *self, int advance, double value) {
     return NULL;
   }
   if (advance && value < piola_world_time(w)) {
-    PyErr_Format(PyExc_ValueError, "advance_to: t = %g s is before the world's time %g s", value,
-                 piola_world_time(w));
+    /* PyErr_Format has no %g */
+    char text[160];
+    snprintf(text, sizeof text, "advance_to: t = %g s is before the world's time %g s", value,
+             piola_world_time(w));
+    PyErr_SetString(PyExc_ValueError, text);
     return NULL;
   }
   piola_step_stats st = {0};

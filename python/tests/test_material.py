@@ -58,6 +58,10 @@ def test_muscle_fibre_stress_is_energy_gradient():
     iso = mat.stress(stretch)[0, 0, 0]
     active = mat.stress(stretch, fibers=along_x, activation=1.0)[0, 0, 0]
     assert active > iso
+    # activation outside [0, 1] is refused, not clamped
+    for bad in (2.0, -1.0, float("nan")):
+        with pytest.raises(ValueError, match="activation must be in"):
+            mat.stress(stretch, fibers=along_x, activation=bad)
 
 
 @pytest.mark.parametrize("model", MODELS)

@@ -76,6 +76,14 @@ def test_views_are_the_worlds_memory():
             ro[0] = 0
 
 
+def test_advance_to_the_past_is_refused_with_the_times():
+    w = piola.World()
+    w.add_solid(ball(0.04))
+    w.advance_to(0.02)
+    with pytest.raises(ValueError, match=r"t = 0.01 s is before the world's time 0.02 s"):
+        w.advance_to(0.01)
+
+
 def test_writes_through_views_reach_the_solver():
     w = piola.World(gravity=(0, 0, 0))
     b = w.add_solid(ball(0.04))

@@ -26,7 +26,7 @@ static double rest_crossing_time(const piola_world *world) {
  * tiny max_dt or stiffness_scale shortens the step too. */
 static void deformed_start_hint(const char *command, const piola_world *world, double dt) {
   const double rest = rest_crossing_time(world);
-  if (!(dt < 0.01 * rest)) return;
+  if (!isfinite(rest) || !(dt < 0.01 * rest)) return; /* no solid: no such hint */
   if (piola_world_integrator(world) != PIOLA_INTEGRATOR_NEWMARK) {
     /* the implicit step is the scene's own integrator.dt */
     fprintf(stderr,

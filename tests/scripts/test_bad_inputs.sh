@@ -91,6 +91,10 @@ echo "{\"fps\": 0.5, \"frames\": 1, \"integrator\": {\"max_dt\": 0.01}, \"solids
 expect 2 "more than the limit of 10 steps" -- "$PIOLA" run two_seconds.json -o out_two --max-steps 10
 expect 0 "done" -- "$PIOLA" run two_seconds.json -o out_two --max-steps 1e4
 expect 2 "--max-steps needs a number" -- "$PIOLA" run two_seconds.json -o out_x --max-steps 0
+# a scene without solids: the refusal gives no hint about tets it does not have
+echo "{\"fps\": 1e-300, \"frames\": 1, \"shells\": [{\"mesh\": {\"generate\": \"rectangle\", \"size\": [0.2, 0.2], \"resolution\": [2, 2]}}]}" >shell_slow.json
+expect 2 "raise the limit with --max-steps" -- "$PIOLA" run shell_slow.json -o out_shell_slow
+grep -q "times shorter" stderr && fail "shell_slow.json: a hint about the smallest tet: $(cat stderr)"
 # piola check refuses what piola run would, with the same limit and message
 expect 2 "piola check: slow.json: 1 frames at 1e-300 fps" -- "$PIOLA" check slow.json --timing-seconds 0
 expect 2 "more than the limit of 10 steps" -- "$PIOLA" check two_seconds.json --timing-seconds 0 --max-steps 10

@@ -330,6 +330,13 @@ class World:
             sc_friction = number(self_collision.get("friction", sc_friction), "self_collision.friction")
         if name is not None and not isinstance(name, str):
             raise TypeError("name must be a string")
+        # as the scene format refuses them (docs/scene-format.md)
+        if name is not None and any(b.kind == "solid" and b.name == name for b in self.bodies):
+            raise ValueError(f"a solid named {name!r} exists already (names are unique among solids)")
+        if fibers is not None and material.model not in ("muscle", "hgo"):
+            raise ValueError(f"fibers need the muscle or hgo model, not {material.model!r}")
+        if activation is not None and material.model != "muscle":
+            raise ValueError(f"activation needs the muscle model, not {material.model!r}")
         cons = [_selector(s, f"fixed[{i}]", False) for i, s in enumerate(fixed)]
         cons += [_selector(s, f"driven[{i}]", True) for i, s in enumerate(driven)]
         fib = None if fibers is None else float_array(fibers, "fibers", (len(tets), 3))

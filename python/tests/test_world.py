@@ -84,6 +84,19 @@ def test_advance_to_the_past_is_refused_with_the_times():
         w.advance_to(0.01)
 
 
+def test_add_solid_refuses_what_the_scene_format_refuses():
+    w = piola.World()
+    w.add_solid(ball(0.04), name="x")
+    with pytest.raises(ValueError, match="exists already"):
+        w.add_solid(ball(0.04), name="x")
+    with pytest.raises(ValueError, match="fibers need the muscle or hgo model"):
+        w.add_solid(ball(0.04), material={"model": "neohookean"},
+                    fibers=np.tile([1.0, 0, 0], (len(w.body("x").cells), 1)))
+    with pytest.raises(ValueError, match="activation needs the muscle model"):
+        w.add_solid(ball(0.04), material={"model": "neohookean"}, activation=0.5)
+    assert len(w.bodies) == 1  # nothing half added
+
+
 def test_writes_through_views_reach_the_solver():
     w = piola.World(gravity=(0, 0, 0))
     b = w.add_solid(ball(0.04))

@@ -74,7 +74,7 @@ piola_status piola_output_check_folder(const char *dir, bool force) {
   if (!empty)
     return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT,
                       "%s is not empty (it may hold results of an earlier run); "
-                      "use --force to write into it",
+                      "use --force (Python: force=True) to write into it",
                       dir);
   return PIOLA_OK;
 }

@@ -3,6 +3,8 @@
  * world object, which clears it when it goes, so there is only ever one. */
 #include "pypiola.h"
 
+#include <stdio.h>
+
 typedef struct {
   PyObject_HEAD piola_scene *scene;
   PyObject *world; /* borrowed: the world object, or NULL */
@@ -38,6 +40,8 @@ static int scene_init(PyObject *self_obj, PyObject *args, PyObject *kwds) {
   PyThreadState *released = PyEval_SaveThread(); /* the GIL */
   st = json ? piola_scene_load_string(json, base, label, &scene) : piola_scene_load(path, &scene);
   PyEval_RestoreThread(released);
+  char where[4096]; /* the name messages give the scene: its file's path, or a dict's label */
+  snprintf(where, sizeof where, "%s", json ? (label ? label : "scene") : path);
   Py_DECREF(path_obj);
   if (st != PIOLA_OK) {
     pypiola_raise(pypiola_scene_error, st);
@@ -48,9 +52,10 @@ static int scene_init(PyObject *self_obj, PyObject *args, PyObject *kwds) {
   const piola_world *world = piola_scene_world(scene);
   for (int32_t s = 0; s < piola_world_solid_count(world); ++s)
     if (piola_world_solid_has_fracture(world, s)) {
-      PyErr_Format(pypiola_scene_error, "solids[%d] ('%s') has fracture, which the Python package "
-                   "does not support (docs/fracture.md); run the scene with `piola run`", (int)s,
-                   piola_world_solid_name(world, s));
+      PyErr_Format(pypiola_scene_error,
+                   "%s: solids[%d] ('%s') has fracture, which the Python package "
+                   "does not support (docs/fracture.md); run the scene with `piola run`",
+                   where, (int)s, piola_world_solid_name(world, s));
       piola_scene_destroy(scene); /* after the message: it owns the name */
       return -1;
     }

@@ -131,5 +131,5 @@ def test_run_refuses_a_used_folder(tmp_path):
 def test_fracture_scenes_are_refused():
     # a cut replaces a solid's arrays, which the views over the world's memory cannot follow
     cut = {"cuts": [{"time": 0.5, "plane": {"point": [0, 0, 0], "normal": [1, 0, 0]}}]}
-    with pytest.raises(piola.SceneError, match=r"solids\[0\].*fracture.*piola run"):
+    with pytest.raises(piola.SceneError, match=r"^scene: solids\[0\].*fracture.*piola run"):
         piola.Scene(dict(SMALL, solids=[dict(SMALL["solids"][0], fracture=cut)]))

@@ -559,19 +559,25 @@ static void recent_bounds(stream *s, piola_world *w) {
   if (s->store && !s->failed) w->recent_bound_count = count, w->recent_bound_next = next;
 }
 
+/* A flag of the body's (0 or 1; anything else fails the stream, naming WHAT): 1 when read
+ * and to be stored. */
+static int local_flag(stream *s, int32_t *flag, const char *what) {
+  local_int(s, flag, what);
+  if (s->failed) return 0;
+  if (*flag != 0 && *flag != 1) {
+    s->failed = 1;
+    snprintf(s->what, sizeof s->what, "%s: %d (0 or 1)", what, (int)*flag);
+    return 0;
+  }
+  return s->store;
+}
+
 /* Whether a solid with self-collision waits for it to untangle (format 8 on; an older
  * file's solids take part, as they did then). */
 static void collision_waits(stream *s, piola_world *w, world_body *b) {
   if (!b->self_collision.enabled) return;
   int32_t waits = b->collision_waits;
-  local_int(s, &waits, "self-collision waits");
-  if (s->failed) return;
-  if (waits != 0 && waits != 1) {
-    s->failed = 1;
-    snprintf(s->what, sizeof s->what, "self-collision waits: %d (0 or 1)", (int)waits);
-    return;
-  }
-  if (s->store) piola__world_set_collision_waits(w, b, waits);
+  if (local_flag(s, &waits, "self-collision waits")) piola__world_set_collision_waits(w, b, waits);
 }
 
 /* Whether a backward Euler solid's last step kept its start's positions (format 9 on; an
@@ -579,14 +585,7 @@ static void collision_waits(stream *s, piola_world *w, world_body *b) {
 static void kept_start(stream *s, piola_world *w, world_body *b) {
   if (w->def.integrator != PIOLA_INTEGRATOR_BACKWARD_EULER) return;
   int32_t kept = b->kept_start;
-  local_int(s, &kept, "backward Euler kept start");
-  if (s->failed) return;
-  if (kept != 0 && kept != 1) {
-    s->failed = 1;
-    snprintf(s->what, sizeof s->what, "backward Euler kept start: %d (0 or 1)", (int)kept);
-    return;
-  }
-  if (s->store) b->kept_start = kept;
+  if (local_flag(s, &kept, "backward Euler kept start")) b->kept_start = kept;
 }
 
 static void world_state(stream *s, piola_world *w) {

@@ -205,7 +205,9 @@ static piola_status read_array(vtu_reader *r, const char *tag, size_t count, dou
   } else if (!strcmp(format, "binary")) {
     const char *close = find(body, r->end, "</DataArray>");
     if (!close) return error_at(r, tag, PIOLA_ERROR_PARSE, "missing </DataArray>", NULL);
-    decoded = decode_base64(body, close, &available);
+    /* the data ends at the first child element: VTK 9 follows it with <InformationKey>s */
+    const char *child = memchr(body, '<', (size_t)(close - body));
+    decoded = decode_base64(body, child ? child : close, &available);
     if (!decoded) return error_at(r, tag, PIOLA_ERROR_PARSE, "bad base64 data in DataArray ", what);
     bytes = decoded;
   } else {

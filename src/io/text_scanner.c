@@ -101,10 +101,13 @@ int piola__scan_accept(text_scanner *s, const char *word, int ignore_case) {
   return 1;
 }
 
-static void describe_token(const text_scanner *s, char *out, size_t size) {
+/* The token at the scanner, its first TOKEN_TEXT - 1 bytes as they are: piola_fail writes
+ * control bytes and bytes that are not UTF-8 as \xNN, as in every quote of file content. */
+enum { TOKEN_TEXT = 41 };
+static void describe_token(const text_scanner *s, char out[TOKEN_TEXT]) {
   size_t len = 0;
-  while (s->p + len < s->end && len + 1 < size && is_token_char(s, s->p[len])) ++len;
-  for (size_t i = 0; i < len; ++i) out[i] = (s->p[i] >= 32 && s->p[i] < 127) ? s->p[i] : '?';
+  while (s->p + len < s->end && len + 1 < TOKEN_TEXT && is_token_char(s, s->p[len])) ++len;
+  memcpy(out, s->p, len);
   out[len] = '\0';
 }
 
@@ -129,8 +132,8 @@ piola_status piola__scan_int64_full(text_scanner *s, int64_t *value, const char 
   s->p = p;
   return PIOLA_OK;
 bad:;
-  char tok[48];
-  describe_token(s, tok, sizeof tok);
+  char tok[TOKEN_TEXT];
+  describe_token(s, tok);
   return piola__scan_error(s, PIOLA_ERROR_PARSE, "expected %s (an integer), got '%s'", what, tok);
 }
 
@@ -258,8 +261,8 @@ piola_status piola__scan_double_full(text_scanner *s, double *value, const char 
   if (!piola__scan_skip(s)) return piola__scan_error(s, PIOLA_ERROR_PARSE, "unexpected end of file, expected %s", what);
   size_t n = piola__parse_double(s->p, s->end, value);
   if (n == 0 || (s->p + n < s->end && is_token_char(s, s->p[n]))) {
-    char tok[48];
-    describe_token(s, tok, sizeof tok);
+    char tok[TOKEN_TEXT];
+    describe_token(s, tok);
     return piola__scan_error(s, PIOLA_ERROR_PARSE, "expected %s (a number), got '%s'", what, tok);
   }
   if (!isfinite(*value)) return piola__scan_error(s, PIOLA_ERROR_PARSE, "%s is not finite", what);

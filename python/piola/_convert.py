@@ -32,6 +32,21 @@ def index_array(value, what, shape):
     return np.ascontiguousarray(a, dtype=np.int32)
 
 
+def int32_array(value, what, shape):
+    """A C-ordered int32 array of any values that fit (region ids: -1 marks a tet no region
+    covers, as the Vega and TetGen readers give it)."""
+    a = np.asarray(value)
+    if a.size == 0 and a.dtype.kind == "f":
+        a = a.astype(np.int64)
+    if a.dtype.kind not in "iu":
+        raise TypeError(f"{what} must be integers, got dtype {a.dtype}")
+    check_shape(a, what, shape)
+    info = np.iinfo(np.int32)
+    if a.size and (a.min() < info.min or a.max() > info.max):
+        raise ValueError(f"{what} must fit in 32-bit signed integers")
+    return np.ascontiguousarray(a, dtype=np.int32)
+
+
 def check_shape(a, what, shape):
     ok = a.ndim == len(shape) and all(s < 0 or s == d for s, d in zip(shape, a.shape))
     if not ok:

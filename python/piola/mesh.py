@@ -4,7 +4,7 @@ import os
 import numpy as np
 
 from . import _piola
-from ._convert import check_keys, float_array, index_array, integer, number, vec3
+from ._convert import check_keys, float_array, index_array, int32_array, integer, number, vec3
 
 TET_READ = (".node", ".ele", ".msh", ".mesh", ".veg", ".vtu")
 TET_WRITE = (".msh", ".vtu", ".obj", ".node", ".mesh")
@@ -27,7 +27,7 @@ class Mesh:
         self.tets = None if tets is None else _cells(tets, "tets", 4, n)
         self.triangles = None if triangles is None else _cells(triangles, "triangles", 3, n)
         m = len(self.cells)
-        self.regions = None if regions is None else index_array(regions, "regions", (m,))
+        self.regions = None if regions is None else int32_array(regions, "regions", (m,))
         self.fibers = None if fibers is None else float_array(fibers, "fibers", (m, 3))
 
     @property
@@ -86,7 +86,7 @@ def write_mesh(path, points, cells=None, regions=None, fibers=None):
     if width == 4:
         tets = _cells(cells, "tets", 4, len(points))
         if ext in TET_WRITE:
-            r = None if regions is None else index_array(regions, "regions", (len(tets),))
+            r = None if regions is None else int32_array(regions, "regions", (len(tets),))
             f = None if fibers is None else float_array(fibers, "fibers", (len(tets), 3))
             _piola.write_tet_mesh(path, points, tets, r, f)
             return
@@ -178,7 +178,7 @@ def generate_mesh(shape=None, *, cell_size, refinement_levels=0, shapes=None, **
     Shapes: sphere (radius), box (half_extents), torus (radius, minor_radius), cylinder and
     capsule (radius, half_length), surface (a closed surface: a Mesh, (points, triangles) or a
     path); all take center (m, default origin) and axis (default (0, 0, 1)). Lengths in m.
-    cell_size (m, > 0): lattice spacing; refinement_levels (0..8): grading toward the
+    cell_size (m, > 0): lattice spacing; refinement_levels (0..6): grading toward the
     surface. Raises MeshError (e.g. an open surface) or ValueError."""
     if (shape is None) == (shapes is None):
         raise TypeError("give one shape (with its parameters) or shapes=[...]")
@@ -189,8 +189,8 @@ def generate_mesh(shape=None, *, cell_size, refinement_levels=0, shapes=None, **
     if not isinstance(shapes, (list, tuple)):
         raise TypeError("shapes must be a list of dicts")
     levels = integer(refinement_levels, "refinement_levels")
-    if not 0 <= levels <= 8:
-        raise ValueError(f"refinement_levels must be in 0..8, got {levels}")
+    if not 0 <= levels <= 6:
+        raise ValueError(f"refinement_levels must be in 0..6, got {levels}")
     tuples = [_shape_tuple(s, f"shapes[{i}]") for i, s in enumerate(shapes)]
     points, tets = _piola.generate_mesh(tuples, number(cell_size, "cell_size"), levels)
     return Mesh(points, tets=tets)

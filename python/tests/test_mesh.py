@@ -101,6 +101,22 @@ def test_regions_and_fibers_survive(tmp_path, ball, ext):
         assert np.allclose(back.fibers, fibers)
 
 
+def test_uncovered_tets_keep_region_minus_one(tmp_path):
+    # Vega: a tet no *REGION covers is region -1 (file-formats.md); it reads, and adds
+    veg = tmp_path / "uncovered.veg"
+    veg.write_text("*VERTICES\n5 3 0 0\n1 0 0 0\n2 1 0 0\n3 0 1 0\n4 0 0 1\n5 1 1 1\n"
+                   "*ELEMENTS\nTET\n2 4 0\n1 1 2 3 4\n2 2 3 4 5\n"
+                   "*MATERIAL hard\nENU, 2000, 1e7, 0.45\n*SET s1\n1,\n*REGION\ns1, hard\n")
+    mesh = piola.read_mesh(str(veg))
+    assert list(mesh.regions) == [0, -1]
+    world = piola.World()
+    world.add_solid(str(veg))
+    # and a VTU with a negative region round-trips it
+    path = str(tmp_path / "back.vtu")
+    piola.write_mesh(path, mesh)
+    assert list(piola.read_mesh(path).regions) == [0, -1]
+
+
 def test_bad_files_and_arguments(tmp_path, ball):
     bad = tmp_path / "bad.msh"
     bad.write_text("$MeshFormat\n4.1 0 8\n$EndMeshFormat\n$Nodes\nnonsense\n")
@@ -125,6 +141,9 @@ def test_bad_files_and_arguments(tmp_path, ball):
         piola.generate_mesh("sphere", cell_size=0.1)
     with pytest.raises(ValueError, match="unknown key"):
         piola.generate_mesh("sphere", radius=0.1, radious=0.2, cell_size=0.1)
+    # the mesher's range (mesher.md), refused before the mesher runs
+    with pytest.raises(ValueError, match=r"refinement_levels must be in 0\.\.6, got 7"):
+        piola.generate_mesh("sphere", radius=0.1, cell_size=0.1, refinement_levels=7)
     # an open surface is refused by the mesher, naming an edge
     tris = piola.boundary_surface(ball.points, ball.tets)[1:]
     with pytest.raises(piola.MeshError):

@@ -268,6 +268,11 @@ static int run(int argc, char **argv, run_mpi *mpi) {
     fprintf(stderr, "piola run: resuming after frame %d (t = %.9g s) from %s/checkpoint_%04d.%s\n",
             (int)resume_frame, piola_world_time(world), out_dir, (int)resume_frame,
             pieces ? "manifest and one file per MPI process" : "bin");
+  if (resume_frame >= frames && lead)
+    fprintf(stderr,
+            "piola run: nothing to simulate: the run in %s already reaches frame %d, and this "
+            "one ends at frame %d (--frames or the scene's frames); its frames are kept\n",
+            out_dir, (int)resume_frame, frames);
   const double checkpoint_wall = 300; /* s: the default's time bound */
   int32_t last_checkpoint = resume_frame >= 0 ? resume_frame : 0;
   double last_checkpoint_time = now_seconds();
@@ -375,18 +380,23 @@ static int run(int argc, char **argv, run_mpi *mpi) {
   double sim_wall = now_seconds() - sim_start;
   int written = frames_written;
   run_mpi_report(mpi);
+  /* the hints name only files that are there: a run stopped by a failed write may have none */
+  char pvd[4200], png[4200];
+  snprintf(pvd, sizeof pvd, "%s/sim.pvd", out_dir);
+  snprintf(png, sizeof png, "%s/preview.png", out_dir);
   if (lead)
-  fprintf(stderr,
-          "piola run: %s. %d frames (%.3f s simulated) in %.2f s wall (%.2f frames/s), %lld steps, "
-          "%lld CG iterations, %lld Newton iterations, %lld linear iterations, %lld failed "
-          "Newton steps, at most %d inverted tets in a frame. Open %s/sim.pvd in ParaView.\n",
-          rc == 0 ? "done" : "stopped", written, written / fps, wall,
-          sim_wall > 0 ? written / sim_wall : 0.0, total_steps, total_cg, total_newton,
-          total_linear, total_failures, max_inverted, out_dir);
+    fprintf(stderr,
+            "piola run: %s. %d frames (%.3f s simulated) in %.2f s wall (%.2f frames/s), %lld "
+            "steps, %lld CG iterations, %lld Newton iterations, %lld linear iterations, %lld "
+            "failed Newton steps, at most %d inverted tets in a frame.%s%s%s\n",
+            rc == 0 ? "done" : "stopped", written, written / fps, wall,
+            sim_wall > 0 ? written / sim_wall : 0.0, total_steps, total_cg, total_newton,
+            total_linear, total_failures, max_inverted, access(pvd, F_OK) == 0 ? " Open " : "",
+            access(pvd, F_OK) == 0 ? pvd : "", access(pvd, F_OK) == 0 ? " in ParaView." : "");
   if (preview && piola_preview_close(preview) != PIOLA_OK)
     fprintf(stderr, "piola run: preview.png: %s\n", piola_last_error());
-  else if (preview)
-    fprintf(stderr, "piola run: preview of the last frame: %s/preview.png\n", out_dir);
+  else if (preview && access(png, F_OK) == 0)
+    fprintf(stderr, "piola run: preview of the last frame: %s\n", png);
   piola_output_close(out);
   piola_scene_destroy(scene);
   return rc;

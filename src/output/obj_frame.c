@@ -44,9 +44,10 @@ piola_status piola__obj_layout_build(const piola_tri_mesh *surface, const int32_
   int32_t nv_out = 0, nf_out = 0;
   for (int32_t b = 0; b < body_count; ++b) {
     snprintf(l->names[b], sizeof l->names[b], "%s", names[b]);
-    /* an OBJ name ends at whitespace */
+    /* an OBJ name ends at whitespace, a line break would start a record of its own and '#'
+     * a comment: all become '_' */
     for (char *c = l->names[b]; *c; ++c)
-      if (*c == ' ' || *c == '\t') *c = '_';
+      if ((unsigned char)*c <= ' ' || *c == 0x7f || *c == '#') *c = '_';
     l->body_vertex_start[b] = nv_out;
     l->body_face_start[b] = nf_out;
     int32_t lo = body_first_vertex[b], hi = body_first_vertex[b + 1];

@@ -9,6 +9,7 @@ import random
 import re
 import shutil
 import signal
+import struct
 import subprocess
 import tempfile
 import time
@@ -183,6 +184,9 @@ for k in (3, 10, 17, 30):
           and not differ and strays(out) == [] and (k < 10 or len(rows_listed) >= 1),
           f"write failure at write {k}: exit {r.returncode}, frames 0..{len(rows_listed) - 1} kept intact: "
           + r.stderr.strip().splitlines()[-2][:160])
+    named = re.findall(r"Open (\S+) in ParaView|preview of the last frame: (\S+)", r.stderr)
+    missing = [p for pair in named for p in pair if p and not os.path.exists(p)]
+    check(not missing, f"write failure at write {k}: the summary names only files that exist {missing}")
 
 # refusals: another scene, another format version; a damaged newest checkpoint is skipped
 other = os.path.join(work, "other.json")
@@ -205,6 +209,22 @@ open(newest, "wb").write(bytes(data))
 r = piola_run(out, "--resume")
 check(r.returncode == 0 and "damaged" in r.stderr and "after frame 6" in r.stderr and not same_frames(ref, out),
       "a damaged newest checkpoint is skipped, the older one resumes: " + r.stderr.strip()[:300])
+# a checkpoint whose header names another frame than its file name (copied, renamed or
+# forged) is skipped as damaged: resuming from it would rewrite the frames after the one it
+# holds, with that frame's state
+out = os.path.join(work, "misnamed")
+shutil.copytree(ref, out)
+data = bytearray(open(f"{out}/checkpoint_0008.bin", "rb").read())
+struct.pack_into("<I", data, 24, 5)  # the frame (file-formats.md)
+h = 0xCBF29CE484222325  # FNV-1a 64 over everything before the checksum
+for byte in data[:-8]:
+    h = ((h ^ byte) * 0x100000001B3) & 0xFFFFFFFFFFFFFFFF
+struct.pack_into("<Q", data, len(data) - 8, h)
+open(f"{out}/checkpoint_0008.bin", "wb").write(bytes(data))
+r = piola_run(out, "--resume")
+check(r.returncode == 0 and "holds frame 5, not the frame 8" in r.stderr and "after frame 6" in r.stderr
+      and not same_frames(ref, out),
+      "a checkpoint naming another frame than its file is skipped: " + r.stderr.strip()[:300])
 # a mesh file that changed under the same scene text
 mesh_dir = os.path.join(work, "mesh")
 os.mkdir(mesh_dir)

@@ -3,7 +3,9 @@
 # with one `o <name>` object per body, in the scene's order (solids, then shells), and only
 # surface vertices: every vertex is used by a face of its own object (no loose interior
 # nodes), and each closed solid's surface satisfies Euler's V - E + F = 2 with E = 3F/2;
-# the shell keeps all its vertices. The frame is also read back by `piola mesh info`.
+# the shell keeps all its vertices. The frame is also read back by `piola mesh info`. A name
+# with a line break, a control character or '#' cannot start a record or a comment of its
+# own: they become '_' as blanks do.
 set -euo pipefail
 : "${PIOLA:?path of the piola program}"
 work=$(mktemp -d)
@@ -13,7 +15,7 @@ cat >"$work/scene.json" <<'JSON'
  "solids": [
    {"name": "left box", "mesh": {"generate": "box", "center": [-0.3, 0, 0.2], "half_extents": [0.1, 0.1, 0.1], "cell_size": 0.04},
     "material": {"youngs_modulus": 1e4, "poisson_ratio": 0.3}},
-   {"name": "ball", "mesh": {"generate": "sphere", "center": [0.3, 0, 0.2], "radius": 0.1, "cell_size": 0.04},
+   {"name": "ball\nv\u000b9#x", "mesh": {"generate": "sphere", "center": [0.3, 0, 0.2], "radius": 0.1, "cell_size": 0.04},
     "material": {"youngs_modulus": 1e4, "poisson_ratio": 0.3}}],
  "shells": [{"name": "sheet", "mesh": {"generate": "rectangle", "size": [0.4, 0.4], "resolution": [4, 4]},
              "transform": {"translate": [0, 0, 0.6]}, "thickness": 0.001,
@@ -39,7 +41,7 @@ for frame in ("frame_0000.obj", "frame_0001.obj"):
             current["v"] += 1; vertex_owner.append(len(objects) - 1)
         elif w[0] == "f":
             current["faces"].append([int(x.split("/")[0]) for x in w[1:]])
-    check([o["name"] for o in objects] == ["left_box", "ball", "sheet"],
+    check([o["name"] for o in objects] == ["left_box", "ball_v_9_x", "sheet"],
           f"{frame}: objects {[o['name'] for o in objects]} are the bodies in order")
     used = set()
     for k, o in enumerate(objects):

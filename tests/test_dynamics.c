@@ -147,6 +147,33 @@ static void resting_body_stays_on_the_plane(void **state) {
   piola_world_destroy(w);
 }
 
+/* world.h: a step's limit <= 0 sets none, NaN is refused; advance_to never steps back. */
+static void time_arguments_are_checked(void **state) {
+  (void)state;
+  piola_world *w = make_world(-9.81, 1e-3);
+  piola_tet_mesh mesh = block_mesh(1, 1, 1, 0.1, 0.1, 0.1);
+  piola_solid_def sd = piola_default_solid_def();
+  sd.mesh = &mesh;
+  assert_int_equal(piola_world_add_solid(w, &sd, NULL), PIOLA_OK);
+  const double dt = piola_world_stable_dt(w);
+  piola_step_stats st;
+  assert_int_equal(piola_world_step(w, NAN, &st), PIOLA_ERROR_INVALID_ARGUMENT);
+  assert_non_null(strstr(piola_last_error(), "dt_limit"));
+  assert_true(piola_world_time(w) == 0);
+  assert_int_equal(piola_world_step(w, 0, &st), PIOLA_OK);
+  assert_true(piola_world_time(w) == dt);
+  assert_int_equal(piola_world_step(w, -1, &st), PIOLA_OK);
+  assert_true(piola_world_time(w) == 2 * dt);
+  const double now = piola_world_time(w);
+  assert_int_equal(piola_world_advance_to(w, now / 2, NULL), PIOLA_ERROR_INVALID_ARGUMENT);
+  assert_non_null(strstr(piola_last_error(), "before the world's time"));
+  assert_true(piola_world_time(w) == now);
+  assert_int_equal(piola_world_advance_to(w, now, &st), PIOLA_OK); /* no step */
+  assert_true(piola_world_time(w) == now);
+  block_mesh_free(&mesh);
+  piola_world_destroy(w);
+}
+
 /* Mean x velocity of the block. */
 static double mean_vx(const piola_world *w) {
   const piola_elastic_body *b = piola_world_solid_body(w, 0);
@@ -310,6 +337,7 @@ int main(void) {
       cmocka_unit_test(free_flight_conserves_momentum),
       cmocka_unit_test(undamped_bounce_gains_no_energy),
       cmocka_unit_test(resting_body_stays_on_the_plane),
+      cmocka_unit_test(time_arguments_are_checked),
       cmocka_unit_test(incline_sticks_or_slides_as_coulomb_says),
       cmocka_unit_test(constraints_hold_and_drive_nodes_exactly),
       cmocka_unit_test(initial_state_is_deformed_as_asked),

@@ -78,8 +78,14 @@ static void resumed_cut_solid_runs_on_bit_for_bit(void **state) {
   assert_int_equal(piola_world_advance_to(b, 0.05, NULL), PIOLA_OK);
   fracture_same_state(a, b);
   const int32_t four = piola_world_solid_cut_tet_count(a, 0);
-  /* a world reading its own older checkpoint goes back to that cut state */
+  /* a world reading its own older checkpoint goes back to that cut state (frame may be
+   * NULL; a missing file is reported as missing with it too) */
+  assert_int_not_equal(piola_world_checkpoint_read(a, "/nonexistent/checkpoint.bin", key, NULL),
+                       PIOLA_OK);
+  assert_non_null(strstr(piola_last_error(), "/nonexistent/checkpoint.bin"));
+  assert_int_equal(piola_world_checkpoint_read(a, path, key, NULL), PIOLA_OK);
   assert_int_equal(piola_world_checkpoint_read(a, path, key, &frame), PIOLA_OK);
+  assert_int_equal(frame, 7);
   assert_true(piola_world_solid_cut_tet_count(a, 0) < four);
   assert_int_equal(piola_world_advance_to(a, 0.05, NULL), PIOLA_OK);
   fracture_same_state(a, b);

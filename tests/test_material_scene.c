@@ -65,6 +65,8 @@ static const bad_scene_case BAD[] = {
      "solids[0].material.mooney_rivlin.c20: unknown key"},
     {SOLID("{\"model\": \"neohookean\", \"mooney_rivlin\": {\"c10\": 1}}"),
      "solids[0].material.mooney_rivlin: needs \"model\": \"mooney_rivlin\""},
+    {SOLID("{\"model\": \"neohookean\", \"spline\": {\"stiffening\": 5}}"),
+     "solids[0].material.spline: needs \"model\": \"spline\""},
 };
 
 static void bad_keys_name_their_path(void **state) {

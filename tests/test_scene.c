@@ -49,7 +49,7 @@ static const char *FULL =
     " \"solids\": [{\"name\": \"blob\", \"mesh\": {\"generate\": \"torus\", \"center\": [0, 0, 1], \"axis\": [0, 2, 0],\n"
     "    \"radius\": 0.5, \"minor_radius\": 0.2, \"cell_size\": 0.1, \"refinement_levels\": 1},\n"
     "   \"transform\": {\"translate\": [1, 2, 3], \"rotate_degrees\": [90, 0, 45], \"scale\": [1, 2, 3]},\n"
-    "   \"density\": 1100, \"material\": {\"model\": \"neohookean\", \"youngs_modulus\": 2e5, \"poisson_ratio\": 0.45,\n"
+    "   \"density\": 1100, \"material\": {\"model\": \"spline\", \"youngs_modulus\": 2e5, \"poisson_ratio\": 0.45,\n"
     "     \"stiffness_scale\": {\"keys\": [[0, 1], [1, 0], [2, 1]]}, \"inversion\": {\"threshold\": 0.2, \"mode\": \"clamp\"},\n"
     "     \"spline\": {\"compression_stretch\": 0.7, \"elongation_stretch\": 1.3, \"stiffening\": 5}},\n"
     "   \"damping\": {\"shear\": 2, \"bulk\": {\"keys\": [[0, 1], [1, 3]]}}, \"velocity\": [0, 0, -1],\n"
@@ -95,7 +95,7 @@ static void every_key_reaches_its_definition(void **state) {
   assert_close(s->rotate_degrees.z, 45, 0);
   assert_close(s->scale.z, 3, 0);
   assert_close(s->def.density, 1100, 0);
-  assert_int_equal(s->def.material.model, PIOLA_MODEL_NEOHOOKEAN);
+  assert_int_equal(s->def.material.model, PIOLA_MODEL_SPLINE);
   assert_close(s->def.material.youngs_modulus, 2e5, 0);
   assert_close(s->def.material.poisson_ratio, 0.45, 0);
   assert_close(s->def.material.inversion_threshold, 0.2, 0);

@@ -53,7 +53,7 @@ PIOLA_API piola_status piola_world_checkpoint_write(const piola_world *world, co
  * checksum), PIOLA_ERROR_UNSUPPORTED for another format version or another scene, each
  * with a message. The world is changed only when the whole file was checked (a cut solid
  * takes the file's cut state while the rest is checked, and is put back as it was when the
- * file does not fit). *frame receives the frame it was written at. */
+ * file does not fit). *frame (frame may be NULL) receives the frame it was written at. */
 PIOLA_API piola_status piola_world_checkpoint_read(piola_world *world, const char *path,
                                                    uint64_t scene_key, int32_t *frame);
 

@@ -246,7 +246,10 @@ typedef struct piola_step_stats {
  * CFL bounds of the last 16 steps' start states), s (docs/time-stepping.md, "Step size"). */
 PIOLA_API double piola_world_stable_dt(const piola_world *world);
 
-/* One step of min(stable dt, dt_limit) seconds. stats (may be NULL) is overwritten. A step
+/* One step of min(stable dt, dt_limit) seconds; a dt_limit <= 0 (or INFINITY) sets no limit,
+ * NaN is refused (PIOLA_ERROR_INVALID_ARGUMENT). With "backward_euler" and "quasistatic" the
+ * step is integrator.dt's (the implicit_dt of the definition) instead of the stable dt. stats
+ * (may be NULL) is overwritten. A step
  * whose state blows up (NaN, Inf, overflowing energy) is redone from the state before it at
  * a quarter of its size, up to PIOLA_STEP_MAX_RETRIES times; if the last try blows up too,
  * returns PIOLA_ERROR_NOT_FINITE and restores the state before the step. */
@@ -254,7 +257,9 @@ PIOLA_API double piola_world_stable_dt(const piola_world *world);
 PIOLA_API piola_status piola_world_step(piola_world *world, double dt_limit,
                                         piola_step_stats *stats);
 
-/* Steps until the world time equals t_end (s) exactly. stats (may be NULL) accumulates. */
+/* Steps until the world time equals t_end (s) exactly. stats (may be NULL) accumulates. A t_end
+ * before the world's time is refused (PIOLA_ERROR_INVALID_ARGUMENT); one equal to it takes no
+ * step. */
 PIOLA_API piola_status piola_world_advance_to(piola_world *world, double t_end,
                                               piola_step_stats *stats);
 

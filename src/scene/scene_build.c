@@ -206,6 +206,16 @@ piola_status piola__scene_build(const scene_desc *desc, const char *label,
     /* a solid that can break is split after it is added, in the replicated mode: every
      * process takes the fracture decisions from every tet's state (docs/mpi.md) */
     piola_world_set_work_split_planner(world, d->fractures ? NULL : planner);
+    /* the material's own checks, under its key path */
+    piola_material checked;
+    st = piola_material_init(&def.material, &checked);
+    if (st != PIOLA_OK) {
+      free(fibers);
+      piola_tet_mesh_free(&mesh);
+      piola_tet_mesh_free(&goal);
+      piola_world_destroy(world);
+      return PIOLA_FAIL(st, "%s: solids[%d].material.%s", label, (int)i, piola_last_error());
+    }
     st = piola_world_add_solid(world, &def, NULL);
     free(fibers);
     piola_tet_mesh_free(&mesh);

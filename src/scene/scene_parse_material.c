@@ -121,6 +121,8 @@ piola_status piola__scene_parse_material(scene_parser *p, const cJSON *obj, scen
   const cJSON *sp = piola__json_get(obj, "spline");
   if (sp) {
     size_t old = piola__json_push_key(p, "spline");
+    if (m->model != PIOLA_MODEL_SPLINE)
+      return piola__json_fail(p, BAD_VALUE, "needs \"model\": \"spline\"");
     static const char *const keys[] = {"compression_stretch", "elongation_stretch", "stiffening",
                                        NULL};
     PIOLA_TRY(piola__json_check_keys(p, sp, keys));

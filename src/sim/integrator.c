@@ -528,6 +528,9 @@ static piola_status try_step(piola_world *w, double dt, piola_step_stats *local,
 }
 
 piola_status piola_world_step(piola_world *w, double dt_limit, piola_step_stats *stats) {
+  if (isnan(dt_limit))
+    return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT,
+                      "step: dt_limit is NaN (a limit in s, or <= 0 for none)");
   piola__world_check_start_inside(w);
   PIOLA_TRY(piola__world_fracture_step(w));
   if (w->def.integrator != PIOLA_INTEGRATOR_NEWMARK)
@@ -582,6 +585,11 @@ piola_status piola__world_finish_step(piola_world *w, double dt, piola_step_stat
 piola_status piola_world_advance_to(piola_world *w, double t_end, piola_step_stats *stats) {
   if (!isfinite(t_end))
     return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "advance_to: t_end must be finite");
+  if (t_end < w->time)
+    return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT,
+                      "advance_to: t_end = %.17g s is before the world's time %.17g s (a world "
+                      "does not step back)",
+                      t_end, w->time);
   w->deeper_steps_left = IMPLICIT_DEEPER_STEPS;
   piola_status st = PIOLA_OK;
   while (w->time < t_end && st == PIOLA_OK) {

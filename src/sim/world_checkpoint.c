@@ -739,8 +739,8 @@ static piola_status read_file(const char *path, stream *s) {
 
 piola_status piola_world_checkpoint_read(piola_world *world, const char *path, uint64_t scene_key,
                                          int32_t *frame) {
-  if (!world || !path || !frame)
-    return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "checkpoint: NULL argument");
+  if (!world || !path)
+    return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "checkpoint: NULL world or path");
   stream s = {0};
   piola_status st = read_file(path, &s);
   if (st != PIOLA_OK) {
@@ -795,7 +795,7 @@ piola_status piola_world_checkpoint_read(piola_world *world, const char *path, u
         st = PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "%s: does not fit, and the world could not be put "
                         "back (%s)", path, before.what);
     } else {
-      *frame = (int32_t)get_u32(h + 24);
+      if (frame) *frame = (int32_t)get_u32(h + 24);
     }
   }
   free(before.data);

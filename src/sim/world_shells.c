@@ -92,7 +92,9 @@ static piola_status fill_shell(piola_world *world, world_body *s, const piola_sh
   if (mdef.inversion_mode == PIOLA_INVERSION_MODEL_DEFAULT) mdef.inversion_mode = PIOLA_INVERSION_LINEAR;
   if (mdef.inversion_threshold == 0.0) mdef.inversion_threshold = 0.3;
   piola_material material;
-  PIOLA_TRY(piola_material_init(&mdef, &material));
+  if (piola_material_init(&mdef, &material) != PIOLA_OK)
+    return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "shell %d: material: %s", (int)id,
+                      piola_last_error());
   piola_shell_body_def bdef = piola_default_shell_body_def();
   bdef.rest_mesh = def->mesh;
   bdef.materials = &material;

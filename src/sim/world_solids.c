@@ -169,7 +169,9 @@ static piola_status check_initial_extent(const world_body *s, const double *rest
 static piola_status fill_solid(piola_world *world, world_body *s, const piola_solid_def *def,
                                int32_t id) {
   piola_material material;
-  PIOLA_TRY(piola_material_init(&def->material, &material));
+  if (piola_material_init(&def->material, &material) != PIOLA_OK)
+    return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "solid %d: material: %s", (int)id,
+                      piola_last_error());
   piola_elastic_body_def bdef = piola_default_elastic_body_def();
   bdef.rest_mesh = def->mesh;
   bdef.materials = &material;

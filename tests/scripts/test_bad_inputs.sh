@@ -55,6 +55,11 @@ expect 2 "Not a directory" -- "$PIOLA" run good.json -o good.json/sub
 expect 2 "exists and is not a folder" -- "$PIOLA" run good.json -o good.json
 expect 2 "cannot write in /proc" -- "$PIOLA" run pipe.json -o /proc/forbidden  # the folder first
 
+# a material out of range is named by its key path (the C library checks it, under
+# solids[i].material)
+echo "{\"solids\": [{\"mesh\": $box, \"material\": {\"model\": \"spline\", \"spline\": {\"compression_stretch\": 0.2}}}]}" >spline.json
+expect 2 "solids[0].material.spline.compression_stretch must be in (inversion.threshold = 0.3, 1), got 0.2" -- "$PIOLA" check spline.json
+
 # control bytes of a file never reach the terminal
 printf '1 3 0 0\n1 0 0 \033[2J\033]0;title\007\n' >esc.node
 printf '1 4 0\n1 1 1 1 1\n' >esc.ele

@@ -69,6 +69,7 @@ typedef struct render_options {
   piola_vec3 pos, target;
   const char *hidden[MAX_HIDDEN];
   int hidden_count;
+  const char *first_named_hidden; /* the first --hide-obstacle NAME, if any */
 } render_options;
 
 static bool parse_range(const char *v, render_options *o) {
@@ -144,6 +145,7 @@ static int parse_options(int argc, char **argv, render_options *o) {
     } else if (strcmp(a, "--hide-obstacle") == 0) {
       NEEDS(v[0] && o->hidden_count < MAX_HIDDEN, "a name, a type, obstacles[i] or bones[i] "
                                                    "(at most 64 of them)");
+      if (!o->first_named_hidden) o->first_named_hidden = v;
       o->hidden[o->hidden_count++] = v;
     } else if (strcmp(a, "--every") == 0) {
       NEEDS(cli_parse_long(v, 1, 1000000, &o->every), "an integer >= 1");
@@ -372,6 +374,13 @@ static int plan_view(render_options *o, render_plan *p) {
  * whatever the flags set replacing its parts. */
 static int make_renderer(render_options *o, render_plan *p, piola_renderer **out) {
   piola_renderer *r = NULL;
+  if (!p->use_scene && o->first_named_hidden) {
+    fprintf(stderr,
+            "piola render: --hide-obstacle %s names nothing: there is no scene to take obstacles "
+            "from (no scene.json in the folder and no --scene)\n",
+            o->first_named_hidden);
+    return 2;
+  }
   for (int pass = 0; pass < 2; ++pass) {
     if (piola_renderer_create(&o->def, &r) != PIOLA_OK) {
       fprintf(stderr, "piola render: %s\n", piola_last_error());
@@ -453,7 +462,17 @@ int cli_render(int argc, char **argv) {
     o.def.up = (piola_vec3){0, 0, 1}; /* an unreadable scene is reported with its obstacles */
 
   /* colour mode and field */
-  if (strcmp(o.color, "inverted") == 0) o.def.color = PIOLA_RENDER_COLOR_INVERTED;
+  if (strcmp(o.color, "inverted") == 0) {
+    /* which tets are inverted is in the VTU frames only */
+    if (!p.vtu) {
+      fprintf(stderr,
+              "piola render: --color inverted needs the VTU frames in %s/frames (the "
+              "OBJ surfaces draw in plain colours only)\n",
+              o.dir);
+      return free(p.frames), 2;
+    }
+    o.def.color = PIOLA_RENDER_COLOR_INVERTED;
+  }
   p.value_field = o.field;
   if (!p.value_field && strcmp(o.color, "energy") == 0) {
     p.value_field = "energy_density";

@@ -241,6 +241,10 @@ piola_status piola__scene_build(const scene_desc *desc, const char *label,
     piola_status st = PIOLA_OK;
     if (def.type == PIOLA_OBSTACLE_MESH) {
       st = piola_tri_mesh_read(d->mesh_path, &surface);
+      if (st != PIOLA_OK) {
+        piola_world_destroy(world);
+        return PIOLA_FAIL(st, "%s: obstacles[%d].path: %s", label, (int)i, piola_last_error());
+      }
       def.mesh = &surface;
     }
     if (st == PIOLA_OK) st = piola_world_add_obstacle(world, &def, NULL);

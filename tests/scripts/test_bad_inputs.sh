@@ -60,6 +60,9 @@ expect 2 "cannot write in /proc" -- "$PIOLA" run pipe.json -o /proc/forbidden  #
 echo "{\"solids\": [{\"mesh\": $box, \"material\": {\"model\": \"spline\", \"spline\": {\"compression_stretch\": 0.2}}}]}" >spline.json
 expect 2 "solids[0].material.spline.compression_stretch must be in (inversion.threshold = 0.3, 1), got 0.2" -- "$PIOLA" check spline.json
 
+echo '{"solids": [{"mesh": '"$box"'}], "obstacles": [{"type": "mesh", "path": "missing.obj"}]}' >obstacle.json
+expect 2 "obstacles[0].path: " -- "$PIOLA" check obstacle.json
+
 # control bytes of a file never reach the terminal
 printf '1 3 0 0\n1 0 0 \033[2J\033]0;title\007\n' >esc.node
 printf '1 4 0\n1 1 1 1 1\n' >esc.ele

@@ -86,6 +86,23 @@ set +e
 rc=$?
 set -e
 [[ $rc -eq 2 ]] && grep -q "ball (sphere)" "$work/log" || { cat "$work/log"; fail "--hide-obstacle bal: exit $rc, expected 2 naming ball"; }
+# ... and so is any name where there is no scene to take obstacles from
+mkdir "$work/noscene"
+cp -r "$out/frames" "$out/sim.pvd" "$work/noscene/"
+set +e
+"$PIOLA" render "$work/noscene" --no-movie --width 160 --height 120 --hide-obstacle ball >"$work/log" 2>&1
+rc=$?
+set -e
+[[ $rc -eq 2 ]] && grep -q "names nothing" "$work/log" || { cat "$work/log"; fail "--hide-obstacle without a scene: exit $rc, expected 2"; }
+# a folder of OBJ surfaces draws in plain colours, and refuses the inverted colouring
+mkdir "$work/objonly"
+cp -r "$out/surface" "$work/objonly/"
+"$PIOLA" render "$work/objonly" --no-movie --width 160 --height 120 >"$work/log" 2>&1 || { cat "$work/log"; fail "render of OBJ surfaces"; }
+set +e
+"$PIOLA" render "$work/objonly" --no-movie --width 160 --height 120 --color inverted >"$work/log" 2>&1
+rc=$?
+set -e
+[[ $rc -eq 2 ]] && grep -q "needs the VTU frames" "$work/log" || { cat "$work/log"; fail "--color inverted on OBJ surfaces: exit $rc, expected 2"; }
 
 # up from gravity: a scene whose gravity points along -y renders as with --up 0,1,0
 python3 -c "import json,sys; d=json.load(open(sys.argv[1])); d['gravity']=[0, -9.81, 0]; json.dump(d, open(sys.argv[2], 'w'))" "$work/named.json" "$work/yup.json"

@@ -349,6 +349,11 @@ static void world_checks_activation_and_fibres(void **state) {
   assert_int_equal(piola_world_add_solid(world, &sdef, NULL), PIOLA_ERROR_INVALID_ARGUMENT);
   assert_non_null(strstr(piola_last_error(), "activation"));
   sdef.activation = piola_track_constant(0.5);
+  /* a material out of range names the solid it was meant for, as the other checks do */
+  sdef.material.poisson_ratio = 0.5;
+  assert_int_equal(piola_world_add_solid(world, &sdef, NULL), PIOLA_ERROR_INVALID_ARGUMENT);
+  assert_non_null(strstr(piola_last_error(), "solid 0: material: poisson_ratio must be in"));
+  sdef.material.poisson_ratio = 0.3;
   double *fibers = calloc(3 * (size_t)mesh.tet_count, sizeof(double)); /* all zero */
   sdef.fiber_directions = fibers;
   assert_int_equal(piola_world_add_solid(world, &sdef, NULL), PIOLA_ERROR_INVALID_ARGUMENT);

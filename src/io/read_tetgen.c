@@ -55,7 +55,9 @@ static piola_status read_tets(text_scanner *s, piola_tet_mesh *out, int64_t base
   if (npe != 4 && npe != 10)
     return piola__scan_error(s, PIOLA_ERROR_UNSUPPORTED, "%lld nodes per tet, expected 4 or 10", (long long)npe);
   if (nattr < 0 || nattr > 1000) return piola__scan_error(s, PIOLA_ERROR_PARSE, "bad attribute count %lld", (long long)nattr);
-  if (n <= 0 || n > INT32_MAX || (uint64_t)n > (uint64_t)(s->end - s->p) / 10)
+  if (n == 0)
+    return piola__scan_error(s, PIOLA_ERROR_PARSE, "tet count 0: the mesh has no tetrahedra");
+  if (n < 0 || n > INT32_MAX || (uint64_t)n > (uint64_t)(s->end - s->p) / 10)
     return piola__scan_error(s, PIOLA_ERROR_PARSE, "tet count %lld does not fit the file", (long long)n);
   out->tets = malloc((size_t)n * 4 * sizeof(int32_t));
   *lines = malloc((size_t)n * sizeof(int32_t));

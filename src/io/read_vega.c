@@ -94,7 +94,9 @@ static piola_status read_elements(vega_reader *r, piola_tet_mesh *out) {
   PIOLA_TRY(piola__scan_int64(s, &npe, "nodes per element"));
   PIOLA_TRY(piola__scan_int64(s, &zero, "element header value"));
   if (npe != 4) return piola__scan_error(s, PIOLA_ERROR_PARSE, "TET elements with %lld nodes, expected 4", (long long)npe);
-  if (n <= 0 || n > INT32_MAX || (uint64_t)n > (uint64_t)(s->end - s->p) / 10)
+  if (n == 0)
+    return piola__scan_error(s, PIOLA_ERROR_PARSE, "element count 0: the mesh has no tetrahedra");
+  if (n < 0 || n > INT32_MAX || (uint64_t)n > (uint64_t)(s->end - s->p) / 10)
     return piola__scan_error(s, PIOLA_ERROR_PARSE, "element count %lld does not fit the file", (long long)n);
   out->tets = malloc((size_t)n * 4 * sizeof(int32_t));
   r->lines = malloc((size_t)n * sizeof(int32_t));

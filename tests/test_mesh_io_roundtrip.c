@@ -95,6 +95,21 @@ static void vtu_variants_read_like_the_original(void **state) {
   piola_tet_mesh_free(&original);
 }
 
+/* A text mesh that starts with a UTF-8 byte order mark (as editors on Windows save it)
+ * reads as without one: Medit and Gmsh 2.2, two tets each. */
+static void byte_order_mark_is_skipped(void **state) {
+  (void)state;
+  const char *files[] = {"bom_two_tets.mesh", "bom_two_tets.msh"};
+  for (int i = 0; i < 2; ++i) {
+    char path[1024];
+    snprintf(path, sizeof path, "%s/tests/data/%s", PIOLA_SOURCE_DIR, files[i]);
+    piola_tet_mesh m;
+    if (piola_tet_mesh_read(path, &m) != PIOLA_OK) fail_msg("%s", piola_last_error());
+    assert_int_equal(m.tet_count, 2);
+    piola_tet_mesh_free(&m);
+  }
+}
+
 static void boundary_obj_is_the_closed_boundary(void **state) {
   (void)state;
   piola_tet_mesh a;
@@ -513,6 +528,7 @@ int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(tet_writers_round_trip_exactly),
       cmocka_unit_test(vtu_variants_read_like_the_original),
+      cmocka_unit_test(byte_order_mark_is_skipped),
       cmocka_unit_test(boundary_obj_is_the_closed_boundary),
       cmocka_unit_test(surface_writers_round_trip),
       cmocka_unit_test(writers_never_leave_partial_files),

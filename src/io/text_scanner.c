@@ -14,6 +14,8 @@ void piola__scanner_init(text_scanner *s, const char *name, const char *data, si
   s->begin = data;
   s->p = data;
   s->end = data + size;
+  /* a UTF-8 byte order mark (editors on Windows write one) is not part of the text */
+  if (size >= 3 && memcmp(data, "\xEF\xBB\xBF", 3) == 0) s->p += 3;
   s->line = 1;
   s->comment = comment;
 }

@@ -139,8 +139,9 @@ typedef struct piola_mooney_rivlin_def {
  * extension), <E> = max(E, 0) (fibres bear no compression). The two unit family directions
  * a_+- = cos(angle) m +- sin(angle) n lie in the plane of the tet's fibre direction m (the
  * solid's fibre field, e.g. circumferential in an artery) and axis (n = the part of axis
- * perpendicular to m, normalised), at +-fiber_angle_degrees from m. Beyond k2 E^2 = 12 the
- * exponential is continued by its second-order Taylor expansion (finite for every F). */
+ * perpendicular to m, normalised), at +-fiber_angle_degrees from m. Past the fibre stretch
+ * fiber_stretch_limit the fibre energy continues as a spring of constant stiffness instead of
+ * the exponential (finite for every F; docs/materials.md). */
 typedef struct piola_hgo_def {
   double mu;                  /* Pa, > 0: shear modulus of the neo-Hookean matrix (HGO's c).
                                  Default 3000 (HGO 2000, rabbit carotid media) */

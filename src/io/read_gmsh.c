@@ -598,6 +598,16 @@ static piola_status map_fibers(gmsh_reader *g, piola_tet_mesh *out) {
   return PIOLA_OK;
 }
 
+/* A tet naming a node tag $Nodes lacks: at the tet's line in an ASCII file. */
+static piola_status missing_tag(const gmsh_reader *g, size_t tet, uint64_t tag) {
+  if (!g->binary)
+    return PIOLA_FAIL(PIOLA_ERROR_PARSE,
+                      "%s:%d: tet %zu uses node tag %llu, which is not in $Nodes", g->s.name,
+                      (int)g->tet_lines[tet], tet, (unsigned long long)tag);
+  return PIOLA_FAIL(PIOLA_ERROR_PARSE, "%s: tet %zu uses node tag %llu, which is not in $Nodes",
+                    g->s.name, tet, (unsigned long long)tag);
+}
+
 /* Tag -> index: a dense table when tags are compact, else a sorted list. */
 
 static piola_status map_tags(gmsh_reader *g, piola_tet_mesh *out) {
@@ -626,8 +636,7 @@ static piola_status map_tags(gmsh_reader *g, piola_tet_mesh *out) {
       int32_t v = tag <= max_tag ? dense[tag] : -1;
       if (v < 0) {
         free(dense);
-        return PIOLA_FAIL(PIOLA_ERROR_PARSE, "%s: tet %zu uses node tag %llu, which is not in $Nodes", g->s.name, k / 4,
-                          (unsigned long long)tag);
+        return missing_tag(g, k / 4, tag);
       }
       out->tets[k] = v;
     }
@@ -657,8 +666,7 @@ static piola_status map_tags(gmsh_reader *g, piola_tet_mesh *out) {
     }
     if (lo >= n || pairs[2 * lo] != tag) {
       free(pairs);
-      return PIOLA_FAIL(PIOLA_ERROR_PARSE, "%s: tet %zu uses node tag %llu, which is not in $Nodes", g->s.name, k / 4,
-                        (unsigned long long)tag);
+      return missing_tag(g, k / 4, tag);
     }
     out->tets[k] = (int32_t)pairs[2 * lo + 1];
   }

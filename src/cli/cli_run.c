@@ -314,13 +314,16 @@ static int run(int argc, char **argv, run_mpi *mpi) {
   for (frame = first; rc == 0 && frame <= frames; ++frame) {
     double t0 = now_seconds();
     piola_step_stats st = {0};
-    if (piola_world_advance_to(world, frame / fps, &st) != PIOLA_OK) {
+    const piola_status advanced = piola_world_advance_to(world, frame / fps, &st);
+    if (advanced != PIOLA_OK) {
       /* every MPI process fails the same step: their node states are the same bits */
       rc = 1;
       run_mpi_collect(mpi, world); /* for the failure report */
       if (!lead) break;
       char message[1024];
-      snprintf(message, sizeof message, "%s", piola_last_error());
+      /* a failure the library left without a message still says what it was */
+      snprintf(message, sizeof message, "%s",
+               piola_last_error()[0] ? piola_last_error() : piola_status_name(advanced));
       if (tty) fputc('\n', stderr);
       report_warnings(lead ? out : NULL, world, warned, false);
       fprintf(stderr, "piola run: stopped at frame %d: %s\n", frame, message);

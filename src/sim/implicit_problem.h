@@ -68,6 +68,8 @@ typedef struct newton_problem {
   int slip_rounds;   /* friction rounds solved since (piola__newton_next_friction_round) */
   int kinetic;       /* the step began its friction with kinetic friction on every contact
                       * (piola__newton_body_may_slide) */
+  int resolving;     /* solved again after the collision pass: no halving loop around it, so a
+                      * failed try is kept, never handed back to be halved */
 } newton_problem;
 
 /* Projects free nodes that are inside an obstacle (or, for a coupled shell, a solid) onto

@@ -1013,7 +1013,7 @@ static piola_status newton_iterate(const newton_problem *problem, int accept_unc
       const double progress = try_progress(phi_first, phi, target2);
       const int helped = st->failed_progress < 0 || progress > HALVING_GAIN * st->failed_progress;
       if (!accept_unconverged) accept_unconverged = !helped && dt >= last_try_length(w);
-      st->may_go_deeper = progress >= DEEPER_MIN_PROGRESS &&
+      st->may_go_deeper = !pb.resolving && progress >= DEEPER_MIN_PROGRESS &&
                           st->halvings < MAX_HALVINGS + DEEPER_HALVINGS &&
                           (st->halvings < MAX_HALVINGS || w->deeper_steps_left != 0);
       st->failed_progress = progress;
@@ -1161,8 +1161,14 @@ static piola_status self_collide_and_resolve(piola_world *w, double dt, int clos
     bodies_only = bodies_only && held_by_bodies_only(s);
     (void)add_momentum(s, -1.0, added);
     newton_problem pb = problem_of(w, s, w->time, dt);
+    pb.resolving = 1;
     const int64_t colliding = stats->colliding;
     piola_status st = newton_iterate(&pb, 1, stats);
+    if (st == PIOLA_ERROR_NOT_CONVERGED) /* a kept try that is not finite */
+      st = PIOLA_FAIL(PIOLA_ERROR_NOT_FINITE,
+                      "%s '%s': the backward Euler step to t = %g s, solved again after the "
+                      "collision pass, became non-finite",
+                      piola__body_kind_name(s->kind), s->name, pb.t1);
     if (st != PIOLA_OK) {
       free(was_resolved);
       return st;

@@ -254,7 +254,7 @@ static void held_bar_failure_advises_a_ramp(void **state) {
   const char *text = piola_world_warning(w, PIOLA_WARNING_NEWTON_FAILED);
   assert_non_null(text);
   assert_non_null(strstr(text, "quasistatic step"));
-  assert_non_null(strstr(text, "ramped: keyframe gravity up from 0"));
+  assert_non_null(strstr(text, "ramped: keyframe gravity (or the activation"));
   assert_null(strstr(text, "no equilibrium"));
   piola_world_destroy(w);
 }

@@ -842,8 +842,9 @@ static const char *failure_advice(const newton_problem *pb) {
   for (int32_t i = 0; i < s->n; ++i) /* a vertex in no element is held, but holds nothing */
     if (s->mass[i] > 0 && s->flags[i] != NODE_FREE)
       return ". A load a quasistatic body cannot take in one step (the whole of gravity at "
-             "once on a soft solid) converges when ramped: keyframe gravity up from 0 over a "
-             "few frames (time-stepping.md, \"Quasistatics\")";
+             "once on a soft solid, a muscle's activation switched on at once, a large jump "
+             "of a driven node) converges when ramped: keyframe gravity (or the activation, "
+             "or the motion) up from 0 over a few frames (time-stepping.md, \"Quasistatics\")";
   return ". A quasistatic body held by obstacle contacts alone has no equilibrium: fix or "
          "drive a node, or use \"backward_euler\" (time-stepping.md, \"Quasistatics\")";
 }

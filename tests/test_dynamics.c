@@ -192,27 +192,36 @@ static double mean_x(const piola_world *w) {
   return p / mt;
 }
 
-/* A block on a plane z = 0 under gravity tilted by theta: the same as a block on an
- * incline, with the slope along +x. Returns the x acceleration measured between t1 and t2
- * and the distance slid. */
-static void incline(double theta, double mu, double *accel, double *slid) {
+/* A world whose gravity is tilted by theta about y (the same as an incline with its slope
+ * along +x), holding `mesh` (E = 100 kPa, damping 20 Pa s) on the plane z = 0 with friction
+ * mu. max_dt 0 keeps the default. */
+static piola_world *incline_world(double theta, double mu, double max_dt,
+                                  const piola_tet_mesh *mesh) {
   const double g = 9.81;
   piola_world_def wd = piola_default_world_def();
   wd.gravity[0] = piola_track_constant(g * sin(theta));
   wd.gravity[1] = piola_track_constant(0);
   wd.gravity[2] = piola_track_constant(-g * cos(theta));
-  wd.max_dt = 5e-4;
+  if (max_dt > 0) wd.max_dt = max_dt;
   piola_world *w = NULL;
   assert_int_equal(piola_world_create(&wd, &w), PIOLA_OK);
-  piola_tet_mesh mesh = block_mesh(2, 2, 1, 0.2, 0.2, 0.1);
   piola_solid_def sd = piola_default_solid_def();
-  sd.mesh = &mesh;
+  sd.mesh = mesh;
   sd.material.youngs_modulus = 1e5;
   sd.shear_viscosity = piola_track_constant(20);
   sd.bulk_viscosity = piola_track_constant(20);
   assert_int_equal(piola_world_add_solid(w, &sd, NULL), PIOLA_OK);
   piola_obstacle_def pl = ground(mu);
   assert_int_equal(piola_world_add_obstacle(w, &pl, NULL), PIOLA_OK);
+  return w;
+}
+
+/* A block on a plane z = 0 under gravity tilted by theta: the same as a block on an
+ * incline, with the slope along +x. Returns the x acceleration measured between t1 and t2
+ * and the distance slid. */
+static void incline(double theta, double mu, double *accel, double *slid) {
+  piola_tet_mesh mesh = block_mesh(2, 2, 1, 0.2, 0.2, 0.1);
+  piola_world *w = incline_world(theta, mu, 5e-4, &mesh);
   double x0 = mean_x(w);
   assert_int_equal(piola_world_advance_to(w, 0.2, NULL), PIOLA_OK);
   double v1 = mean_vx(w);
@@ -231,27 +240,13 @@ static void incline(double theta, double mu, double *accel, double *slid) {
  * impulse"): 9.2 mm between 0.1 s and 0.5 s. */
 static void real_mesh_block_sticks_on_an_incline(void **state) {
   (void)state;
-  const double g = 9.81, theta = 0.5;
-  piola_world_def wd = piola_default_world_def();
-  wd.gravity[0] = piola_track_constant(g * sin(theta));
-  wd.gravity[1] = piola_track_constant(0);
-  wd.gravity[2] = piola_track_constant(-g * cos(theta));
-  piola_world *w = NULL;
-  assert_int_equal(piola_world_create(&wd, &w), PIOLA_OK);
   piola_tet_mesh mesh;
   if (piola_tet_mesh_read(test_data_path("medit/cube_medium_tetra.mesh"), &mesh) != PIOLA_OK)
     fail_msg("%s", piola_last_error());
   for (int32_t i = 0; i < mesh.vertex_count; ++i) /* [-0.5, 0.5]^3 to a 0.1 m cube on z = 0 */
     for (int k = 0; k < 3; ++k)
       mesh.positions[3 * i + k] = 0.1 * mesh.positions[3 * i + k] + (k == 2 ? 0.05 : 0.0);
-  piola_solid_def sd = piola_default_solid_def();
-  sd.mesh = &mesh;
-  sd.material.youngs_modulus = 1e5;
-  sd.shear_viscosity = piola_track_constant(20);
-  sd.bulk_viscosity = piola_track_constant(20);
-  assert_int_equal(piola_world_add_solid(w, &sd, NULL), PIOLA_OK);
-  piola_obstacle_def pl = ground(0.8);
-  assert_int_equal(piola_world_add_obstacle(w, &pl, NULL), PIOLA_OK);
+  piola_world *w = incline_world(0.5, 0.8, 0, &mesh);
   assert_int_equal(piola_world_advance_to(w, 0.1, NULL), PIOLA_OK);
   const double settled = mean_x(w);
   assert_int_equal(piola_world_advance_to(w, 0.5, NULL), PIOLA_OK);

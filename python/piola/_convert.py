@@ -19,14 +19,21 @@ def float_array(value, what, shape):
     return a
 
 
-def index_array(value, what, shape):
-    """A C-ordered int32 array of non-negative indices below 2**31."""
+def integer_array(value, what, shape):
+    """value as an integer array of the given shape (an empty float array counts as integers);
+    TypeError for any other kind of number."""
     a = np.asarray(value)
     if a.size == 0 and a.dtype.kind == "f":
         a = a.astype(np.int64)
     if a.dtype.kind not in "iu":
         raise TypeError(f"{what} must be integers, got dtype {a.dtype}")
     check_shape(a, what, shape)
+    return a
+
+
+def index_array(value, what, shape):
+    """A C-ordered int32 array of non-negative indices below 2**31."""
+    a = integer_array(value, what, shape)
     if a.size and (a.min() < 0 or a.max() > np.iinfo(np.int32).max):
         raise ValueError(f"{what} must be indices in [0, 2**31)")
     return np.ascontiguousarray(a, dtype=np.int32)
@@ -35,12 +42,7 @@ def index_array(value, what, shape):
 def int32_array(value, what, shape):
     """A C-ordered int32 array of any values that fit (region ids: -1 marks a tet no region
     covers, as the Vega and TetGen readers give it)."""
-    a = np.asarray(value)
-    if a.size == 0 and a.dtype.kind == "f":
-        a = a.astype(np.int64)
-    if a.dtype.kind not in "iu":
-        raise TypeError(f"{what} must be integers, got dtype {a.dtype}")
-    check_shape(a, what, shape)
+    a = integer_array(value, what, shape)
     info = np.iinfo(np.int32)
     if a.size and (a.min() < info.min or a.max() > info.max):
         raise ValueError(f"{what} must fit in 32-bit signed integers")

@@ -387,6 +387,7 @@ static int run(int argc, char **argv, run_mpi *mpi) {
   char pvd[4200], png[4200];
   snprintf(pvd, sizeof pvd, "%s/sim.pvd", out_dir);
   snprintf(png, sizeof png, "%s/preview.png", out_dir);
+  const bool have_pvd = access(pvd, F_OK) == 0;
   if (lead)
     fprintf(stderr,
             "piola run: %s. %d frames (%.3f s simulated) in %.2f s wall (%.2f frames/s), %lld "
@@ -394,8 +395,8 @@ static int run(int argc, char **argv, run_mpi *mpi) {
             "failed Newton steps, at most %d inverted tets in a frame.%s%s%s\n",
             rc == 0 ? "done" : "stopped", written, written / fps, wall,
             sim_wall > 0 ? written / sim_wall : 0.0, total_steps, total_cg, total_newton,
-            total_linear, total_failures, max_inverted, access(pvd, F_OK) == 0 ? " Open " : "",
-            access(pvd, F_OK) == 0 ? pvd : "", access(pvd, F_OK) == 0 ? " in ParaView." : "");
+            total_linear, total_failures, max_inverted, have_pvd ? " Open " : "",
+            have_pvd ? pvd : "", have_pvd ? " in ParaView." : "");
   if (preview && piola_preview_close(preview) != PIOLA_OK)
     fprintf(stderr, "piola run: preview.png: %s\n", piola_last_error());
   else if (preview && access(png, F_OK) == 0)

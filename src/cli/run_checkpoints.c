@@ -92,22 +92,14 @@ int run_checkpoint_resume(const char *dir, piola_world *world, uint64_t key, int
     char path[4200];
     snprintf(path, sizeof path, "%s/checkpoint_%04d.bin", dir, (int)frames[i]);
     piola_status st = piola_world_checkpoint_read(world, path, key, frame);
-    if (st == PIOLA_OK && *frame == frames[i]) {
+    /* one holding another frame than its name says is damaged: resuming from it would
+     * rewrite the frames after the one it holds */
+    if (st == PIOLA_OK && *frame != frames[i])
+      st = piola_fail(PIOLA_ERROR_PARSE, "%s holds frame %d, not the frame %d its name says", path,
+                      (int)*frame, (int)frames[i]);
+    if (st == PIOLA_OK) {
       rc = 0;
       break;
-    }
-    if (st == PIOLA_OK) {
-      /* resuming from it would rewrite the frames after the one it holds */
-      fprintf(stderr,
-              "piola run: skipping a damaged checkpoint: %s holds frame %d, not the frame %d "
-              "its name says\n",
-              path, (int)*frame, (int)frames[i]);
-      if (i == count - 1)
-        fprintf(stderr,
-                "piola run: cannot resume: no intact checkpoint in %s; use --force to start "
-                "over\n",
-                dir);
-      continue;
     }
     if (st == PIOLA_ERROR_UNSUPPORTED) { /* another scene or version: never silently older */
       fprintf(stderr, "piola run: cannot resume: %s; use --force to start over\n",

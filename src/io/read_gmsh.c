@@ -32,6 +32,7 @@ typedef struct gmsh_reader {
   int have_entities;
   /* nodes */
   uint64_t *node_tags;
+  int32_t *node_lines; /* ASCII files: line of each node's tag */
   double *positions;
   size_t node_count, node_capacity;
   /* tets, with node tags until mapped */
@@ -157,7 +158,12 @@ static piola_status reserve_nodes(gmsh_reader *g, size_t more) {
   size_t cap2 = g->node_capacity;
   if (piola__grow((void **)&g->positions, &cap2, g->node_count + more, 3 * sizeof(double)) != 0)
     return PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "%s: out of memory", g->s.name);
+  size_t cap3 = g->node_capacity;
+  if (!g->binary &&
+      piola__grow((void **)&g->node_lines, &cap3, g->node_count + more, sizeof(int32_t)) != 0)
+    return PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "%s: out of memory", g->s.name);
   g->node_capacity = cap < cap2 ? cap : cap2;
+  if (!g->binary && cap3 < g->node_capacity) g->node_capacity = cap3;
   return PIOLA_OK;
 }
 
@@ -304,6 +310,7 @@ static piola_status read_nodes_v4(gmsh_reader *g) {
       uint64_t tag = 0;
       PIOLA_TRY(get_size(g, &tag, "node tag"));
       g->node_tags[first + i] = tag;
+      if (!g->binary) g->node_lines[first + i] = (int32_t)g->s.line;
     }
     int extra = parametric ? dim : 0;
     for (uint64_t i = 0; i < n; ++i) {
@@ -389,6 +396,7 @@ static piola_status read_nodes_v2(gmsh_reader *g) {
     }
     if (tag < 0) return piola__scan_error(&g->s, PIOLA_ERROR_PARSE, "negative node tag %lld", (long long)tag);
     g->node_tags[g->node_count] = (uint64_t)tag;
+    if (!g->binary) g->node_lines[g->node_count] = (int32_t)g->s.line;
     for (int k = 0; k < 3; ++k) PIOLA_TRY(get_double(g, &g->positions[3 * g->node_count + k], "coordinate"));
     ++g->node_count;
   }
@@ -608,6 +616,15 @@ static piola_status missing_tag(const gmsh_reader *g, size_t tet, uint64_t tag) 
                     g->s.name, tet, (unsigned long long)tag);
 }
 
+/* Node `second` repeats the tag of node `first` (first < second): at its line in an ASCII file. */
+static piola_status duplicate_tag(const gmsh_reader *g, size_t first, size_t second) {
+  unsigned long long tag = (unsigned long long)g->node_tags[second];
+  if (!g->binary)
+    return PIOLA_FAIL(PIOLA_ERROR_PARSE, "%s:%d: node tag %llu appears twice (first at line %d)",
+                      g->s.name, (int)g->node_lines[second], tag, (int)g->node_lines[first]);
+  return PIOLA_FAIL(PIOLA_ERROR_PARSE, "%s: node tag %llu appears twice", g->s.name, tag);
+}
+
 /* Tag -> index: a dense table when tags are compact, else a sorted list. */
 
 static piola_status map_tags(gmsh_reader *g, piola_tet_mesh *out) {
@@ -625,9 +642,9 @@ static piola_status map_tags(gmsh_reader *g, piola_tet_mesh *out) {
     for (size_t i = 0; i <= max_tag; ++i) dense[i] = -1;
     for (size_t i = 0; i < n; ++i) {
       if (dense[g->node_tags[i]] >= 0) {
+        size_t first = (size_t)dense[g->node_tags[i]];
         free(dense);
-        return PIOLA_FAIL(PIOLA_ERROR_PARSE, "%s: node tag %llu appears twice", g->s.name,
-                          (unsigned long long)g->node_tags[i]);
+        return duplicate_tag(g, first, i);
       }
       dense[g->node_tags[i]] = (int32_t)i;
     }
@@ -652,9 +669,9 @@ static piola_status map_tags(gmsh_reader *g, piola_tet_mesh *out) {
   qsort(pairs, n, 2 * sizeof(uint64_t), cmp_pair);
   for (size_t i = 1; i < n; ++i)
     if (pairs[2 * i] == pairs[2 * i - 2]) {
-      unsigned long long dup = pairs[2 * i];
+      size_t a = (size_t)pairs[2 * i - 1], b = (size_t)pairs[2 * i + 1];
       free(pairs);
-      return PIOLA_FAIL(PIOLA_ERROR_PARSE, "%s: node tag %llu appears twice", g->s.name, dup);
+      return duplicate_tag(g, a < b ? a : b, a < b ? b : a);
     }
   for (size_t k = 0; k < 4 * nt; ++k) {
     uint64_t tag = g->tet_nodes[k];
@@ -732,6 +749,7 @@ piola_status piola__read_gmsh_mem(const char *name, const char *data, size_t siz
   free(g.volume_tags);
   free(g.volume_physical);
   free(g.node_tags);
+  free(g.node_lines);
   free(g.positions);
   free(g.tet_nodes);
   free(g.tet_regions);

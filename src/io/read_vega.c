@@ -19,7 +19,8 @@
 typedef struct vega_set {
   char name[64];
   int32_t *ids;
-  size_t count, capacity;
+  int32_t *id_lines; /* line of each id, to report one out of range there */
+  size_t count, capacity, line_capacity;
 } vega_set;
 
 typedef struct vega_region {
@@ -153,8 +154,10 @@ static piola_status read_set(vega_reader *r) {
   while (piola__scan_skip(s) && *s->p != '*') {
     int32_t id;
     PIOLA_TRY(piola__scan_int32(s, &id, "set element id"));
-    if (piola__grow((void **)&set->ids, &set->capacity, set->count + 1, sizeof(int32_t)))
+    if (piola__grow((void **)&set->ids, &set->capacity, set->count + 1, sizeof(int32_t)) ||
+        piola__grow((void **)&set->id_lines, &set->line_capacity, set->count + 1, sizeof(int32_t)))
       return PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "%s: out of memory", s->name);
+    set->id_lines[set->count] = (int32_t)s->line;
     set->ids[set->count++] = id;
   }
   return PIOLA_OK;
@@ -195,8 +198,9 @@ static piola_status resolve_regions(vega_reader *r, piola_tet_mesh *out) {
     for (size_t k = 0; k < set->count; ++k) {
       int32_t id = set->ids[k];
       if (id < 1 || id > out->tet_count)
-        return PIOLA_FAIL(PIOLA_ERROR_PARSE, "%s: set '%s' lists element %d, out of range [1, %d]", r->s.name, set->name,
-                          (int)id, (int)out->tet_count);
+        return PIOLA_FAIL(PIOLA_ERROR_PARSE,
+                          "%s:%d: set '%s' lists element %d, out of range [1, %d]", r->s.name,
+                          (int)set->id_lines[k], set->name, (int)id, (int)out->tet_count);
       out->tet_regions[id - 1] = material;
     }
   }
@@ -235,7 +239,10 @@ piola_status piola__read_vega_mem(const char *name, const char *data, size_t siz
   piola__scanner_init(&r.s, name, data, size, '#');
   r.s.comma_is_space = 1;
   piola_status status = parse(&r, out);
-  for (size_t i = 0; i < r.set_count; ++i) free(r.sets[i].ids);
+  for (size_t i = 0; i < r.set_count; ++i) {
+    free(r.sets[i].ids);
+    free(r.sets[i].id_lines);
+  }
   free(r.sets);
   free(r.regions);
   free(r.lines);

@@ -510,8 +510,28 @@ static void friction_is_reported(void **state) {
   piola_obstacle_destroy(o);
 }
 
+/* A query at a non-finite point or time has no distance: a box's clamps put a NaN point on
+ * its surface (distance 0) before. */
+static void non_finite_queries_give_nan(void **state) {
+  (void)state;
+  piola_obstacle_def d = piola_default_obstacle_def();
+  d.type = PIOLA_OBSTACLE_BOX;
+  d.half_extents = vec3_make(1, 2, 3);
+  piola_obstacle *o = make(&d);
+  vec3 n, v;
+  assert_true(isnan(piola_obstacle_signed_distance(o, 0, vec3_make(NAN, 0, 0), &n, &v)));
+  assert_true(isnan(n.x) && isnan(v.x));
+  assert_true(isnan(piola_obstacle_signed_distance(o, INFINITY, vec3_make(0, 0, 5), NULL, NULL)));
+  const piola_obstacle_pose pose = piola_obstacle_pose_at(o, 0);
+  assert_true(isnan(piola_obstacle_posed_distance(o, &pose, vec3_make(0, INFINITY, 0), &n)));
+  assert_true(isnan(n.z));
+  assert_close(piola_obstacle_signed_distance(o, 0, vec3_make(0, 0, 5), &n, &v), 2, 1e-15);
+  piola_obstacle_destroy(o);
+}
+
 int main(void) {
   const struct CMUnitTest tests[] = {
+      cmocka_unit_test(non_finite_queries_give_nan),
       cmocka_unit_test(plane_distances),
       cmocka_unit_test(sphere_distances),
       cmocka_unit_test(box_distances),

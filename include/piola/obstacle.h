@@ -61,7 +61,8 @@ PIOLA_API piola_obstacle_def piola_default_obstacle_def(void);
 PIOLA_API piola_status piola_obstacle_create(const piola_obstacle_def *def, piola_obstacle **out);
 
 /* Signed distance (m, negative inside) at world point p and time t (s); the outward unit
- * normal and the obstacle's velocity (m/s) there are written when not NULL. */
+ * normal and the obstacle's velocity (m/s) there are written when not NULL. A non-finite p
+ * or t gives NaN, and NaN normal and velocity. */
 PIOLA_API double piola_obstacle_signed_distance(const piola_obstacle *obstacle, double t,
                                                 piola_vec3 p, piola_vec3 *normal,
                                                 piola_vec3 *velocity);
@@ -81,7 +82,8 @@ typedef struct piola_obstacle_pose {
 PIOLA_API piola_obstacle_pose piola_obstacle_pose_at(const piola_obstacle *obstacle, double t);
 
 /* piola_obstacle_signed_distance (m, negative inside) for the obstacle at pose: the same
- * value and outward unit normal (written when not NULL) as at the pose's time. */
+ * value and outward unit normal (written when not NULL) as at the pose's time; NaN for a
+ * non-finite p. */
 PIOLA_API double piola_obstacle_posed_distance(const piola_obstacle *obstacle,
                                                const piola_obstacle_pose *pose, piola_vec3 p,
                                                piola_vec3 *normal);

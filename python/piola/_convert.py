@@ -62,6 +62,20 @@ def number(value, what):
     return float(value)
 
 
+def finite_number(value, what):
+    x = number(value, what)
+    if not math.isfinite(x):
+        raise ValueError(f"{what} must be finite, got {x}")
+    return x
+
+
+def finite_array(value, what, shape):
+    a = float_array(value, what, shape)
+    if not np.all(np.isfinite(a)):
+        raise ValueError(f"{what} must be finite")
+    return a
+
+
 def integer(value, what):
     if isinstance(value, bool) or not isinstance(value, numbers.Integral):
         raise TypeError(f"{what} must be an integer, got {type(value).__name__}")

@@ -11,8 +11,8 @@ import numbers
 import numpy as np
 
 from . import _piola
-from ._convert import (check_keys, float_array, index_array, integer, number, track, tracks3,
-                       vec3)
+from ._convert import (check_keys, finite_array, finite_number, float_array, index_array, integer,
+                       number, track, tracks3, vec3)
 from .material import Material
 from .mesh import Mesh, read_mesh
 
@@ -115,12 +115,12 @@ class Obstacle:
     def signed_distance(self, points, t=0.0):
         """(distance (n,) m, outward normal (n, 3), obstacle velocity (n, 3) m/s) at points
         (n, 3) m and time t (s)."""
-        return self._core.signed_distance(float_array(points, "points", (-1, 3)),
-                                          number(t, "t"))
+        return self._core.signed_distance(finite_array(points, "points", (-1, 3)),
+                                          finite_number(t, "t"))
 
     def pose(self, t):
         """(R (3, 3), translation (3,) m): the obstacle's points move as x(t) = R x0 + translation."""
-        return self._core.pose(number(t, "t"))
+        return self._core.pose(finite_number(t, "t"))
 
     def __repr__(self):
         return f"Obstacle({self.type!r}, index={self.index})"
@@ -330,9 +330,12 @@ class World:
             sc_friction = number(self_collision.get("friction", sc_friction), "self_collision.friction")
         if name is not None and not isinstance(name, str):
             raise TypeError("name must be a string")
-        # as the scene format refuses them (docs/scene-format.md)
-        if name is not None and any(b.kind == "solid" and b.name == name for b in self.bodies):
-            raise ValueError(f"a solid named {name!r} exists already (names are unique among solids)")
+        # as the scene format refuses them (docs/scene-format.md); an unnamed solid is named
+        # "solid<index>" by the library, which may be a name given earlier
+        given = name if name is not None else f"solid{len(self.solids)}"
+        if any(b.name == given for b in self.solids):
+            what = "" if name is not None else f" (the name an unnamed solid {len(self.solids)} gets)"
+            raise ValueError(f"a solid named {given!r} exists already{what}; names are unique among solids")
         if fibers is not None and material.model not in ("muscle", "hgo"):
             raise ValueError(f"fibers need the muscle or hgo model, not {material.model!r}")
         if activation is not None and material.model != "muscle":

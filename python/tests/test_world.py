@@ -95,6 +95,11 @@ def test_add_solid_refuses_what_the_scene_format_refuses():
     with pytest.raises(ValueError, match="activation needs the muscle model"):
         w.add_solid(ball(0.04), material={"model": "neohookean"}, activation=0.5)
     assert len(w.bodies) == 1  # nothing half added
+    # an unnamed solid takes "solid<index>", which a named one may already hold
+    w.add_solid(ball(0.04), name="solid2")
+    with pytest.raises(ValueError, match="'solid2' exists already"):
+        w.add_solid(ball(0.04))
+    assert [b.name for b in w.solids] == ["x", "solid2"]
 
 
 def test_writes_through_views_reach_the_solver():
@@ -159,6 +164,19 @@ def test_mesh_obstacle_matches_the_sphere_it_samples(tmp_path):
         assert np.allclose(n[0], [0, 0, 1], atol=0.05)
     with pytest.raises(ValueError, match="not both"):
         piola.Obstacle("mesh")
+
+
+def test_obstacle_queries_refuse_non_finite_input():
+    # a box's clamps put a NaN point on its surface (distance 0) before this was refused
+    box = piola.Obstacle("box", center=[0, 0, 0], half_extents=[1, 1, 1])
+    with pytest.raises(ValueError, match="points must be finite"):
+        box.signed_distance([[np.nan, 0, 0]])
+    with pytest.raises(ValueError, match="t must be finite"):
+        box.signed_distance([[0, 0, 2]], t=np.inf)
+    with pytest.raises(ValueError, match="t must be finite"):
+        box.pose(np.nan)
+    d, _, _ = box.signed_distance([[0, 0, 2]])
+    assert d[0] == pytest.approx(1.0)
 
 
 def test_driven_and_fixed_nodes():

@@ -247,9 +247,19 @@ double piola__obstacle_distance_posed(const piola_obstacle *obstacle,
   return d;
 }
 
+/* A query at a non-finite point or time has no answer: NaN everywhere (a box's clamps
+ * turned a NaN point into distance 0, on its surface). */
+static int query_not_finite(double t, piola_vec3 p, piola_vec3 *normal, piola_vec3 *velocity) {
+  if (isfinite(t) && isfinite(p.x) && isfinite(p.y) && isfinite(p.z)) return 0;
+  if (normal) *normal = vec3_make(NAN, NAN, NAN);
+  if (velocity) *velocity = vec3_make(NAN, NAN, NAN);
+  return 1;
+}
+
 double piola_obstacle_posed_distance(const piola_obstacle *obstacle,
                                      const piola_obstacle_pose *pose, piola_vec3 p,
                                      piola_vec3 *normal) {
+  if (query_not_finite(0.0, p, normal, NULL)) return NAN;
   piola__rigid_state state = {.rotation = pose->rotation, .translation = pose->translation};
   return piola__obstacle_distance_posed(obstacle, &state, p, normal, NULL);
 }
@@ -261,6 +271,7 @@ double piola_obstacle_signed_distance(const piola_obstacle *obstacle, double t, 
     if (velocity) *velocity = vec3_make(0, 0, 0);
     return INFINITY;
   }
+  if (query_not_finite(t, p, normal, velocity)) return NAN;
   piola__rigid_state state;
   piola__rigid_motion_state(&obstacle->motion, t, &state);
   return piola__obstacle_distance_posed(obstacle, &state, p, normal, velocity);

@@ -253,6 +253,13 @@ static void plastic_control(void **state) { (void)state; run("plastic_control.js
 static void plastic_bar_bend(void **state) { (void)state; run("plastic_bar_bend.json", frames_heavy(), 0); }
 static void arm_flex(void **state) { (void)state; run("arm_flex.json", frames_heavy(), 0); }
 static void gears(void **state) { (void)state; run("gears.json", frames_heavy(), 0); }
+/* Through the nip (18 frames): friction's move after the solve, along an obstacle's tangent
+ * plane, left a ball node 0.4 mm inside a gear tooth at frame 17 before every step's end
+ * projected the nodes out of the obstacles (docs/time-stepping.md, "The step's end"). */
+static void gears_through_the_nip(void **state) {
+  (void)state;
+  run("gears.json", test_scale() >= 1.0 ? 18 : 0, 0);
+}
 static void armadillo_incline(void **state) { (void)state; run("armadillo_incline.json", frames_heavy(), 0); }
 static void plastic_sphere_gears(void **state) {
   (void)state;
@@ -272,15 +279,24 @@ int main(void) {
   piola_set_thread_count(1);
   omp_set_num_threads(1);
   const struct CMUnitTest tests[] = {
-      cmocka_unit_test(ball_recovers),     cmocka_unit_test(squeezed_solid),
-      cmocka_unit_test(torus_puddle),      cmocka_unit_test(solids_stack),
+      cmocka_unit_test(ball_recovers),
+      cmocka_unit_test(squeezed_solid),
+      cmocka_unit_test(torus_puddle),
+      cmocka_unit_test(solids_stack),
       cmocka_unit_test(solids_stack_impact),
-      cmocka_unit_test(muscle_spindle),    cmocka_unit_test(muscle_spindle_hanging),
-      cmocka_unit_test(plastic_control),   cmocka_unit_test(plastic_bar_bend),
-      cmocka_unit_test(arm_flex),          cmocka_unit_test(gears),
-      cmocka_unit_test(armadillo_incline), cmocka_unit_test(plastic_sphere_gears),
-      cmocka_unit_test(cloth_on_sphere),   cmocka_unit_test(dented_torus_shell),
-      cmocka_unit_test(cloth_cape_on_body), cmocka_unit_test(cloth_folds),
+      cmocka_unit_test(muscle_spindle),
+      cmocka_unit_test(muscle_spindle_hanging),
+      cmocka_unit_test(plastic_control),
+      cmocka_unit_test(plastic_bar_bend),
+      cmocka_unit_test(arm_flex),
+      cmocka_unit_test(gears),
+      cmocka_unit_test(gears_through_the_nip),
+      cmocka_unit_test(armadillo_incline),
+      cmocka_unit_test(plastic_sphere_gears),
+      cmocka_unit_test(cloth_on_sphere),
+      cmocka_unit_test(dented_torus_shell),
+      cmocka_unit_test(cloth_cape_on_body),
+      cmocka_unit_test(cloth_folds),
       cmocka_unit_test(cloth_on_jelly),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);

@@ -1210,12 +1210,15 @@ static piola_status self_collide_and_resolve(piola_world *w, double dt, int clos
   return PIOLA_OK;
 }
 
-/* The collision pass between bodies can push a node into an obstacle (a layer of cloth
- * pressed onto the ground by the layer landing on it). A Newmark step's next collision
- * processing puts it back; a frame-sized step must not end there. So after the pass every
- * free node inside an obstacle is put back on its surface with the obstacle's normal
- * velocity, as collisions do (piola_obstacles_collide), and its body's forces are updated. */
-static piola_status obstacles_after_contact(piola_world *w, double t1, double dt) {
+/* Every free node still inside an obstacle when all bodies have stepped is put back on its
+ * surface with the obstacle's normal velocity, as collisions do (piola_obstacles_collide),
+ * and its body's forces are updated: the collision pass between bodies can push a node into
+ * an obstacle (a layer of cloth pressed onto the ground by the layer landing on it), and
+ * friction's move after the solve, along the tangent plane of the obstacle at the node, can
+ * end inside a curved or cornered one (a gear's tooth). A Newmark step's next collision
+ * processing puts such a node back; a frame-sized step must not end there
+ * (docs/time-stepping.md, "The step's end: out of every obstacle"). */
+static piola_status obstacles_at_step_end(piola_world *w, double t1, double dt) {
   for (int32_t b = 0; b < w->body_count && w->obstacle_count > 0; ++b) {
     world_body *s = &w->bodies[b];
     struct implicit_state *st = s->implicit;
@@ -1234,7 +1237,6 @@ static piola_status obstacles_after_contact(piola_world *w, double t1, double dt
   }
   return PIOLA_OK;
 }
-
 
 piola_status piola__implicit_world_step(piola_world *w, double dt_limit, piola_step_stats *stats) {
   piola_step_stats local = {0};
@@ -1293,7 +1295,7 @@ piola_status piola__implicit_world_step(piola_world *w, double dt_limit, piola_s
     if (stats) *stats = local;
     return contact;
   }
-  if (local.impacts + local.contacts > 0) PIOLA_TRY(obstacles_after_contact(w, w->time + dt, dt));
+  PIOLA_TRY(obstacles_at_step_end(w, w->time + dt, dt));
   /* shells' plastic flow, from the update at the step's end (solids': in finish_step) */
   for (int32_t i = 0; i < w->body_count; ++i) piola__body_plastic_in_step(&w->bodies[i], dt);
   return piola__world_finish_step(w, dt, &local, stats);

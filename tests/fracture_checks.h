@@ -22,8 +22,9 @@ void fracture_set_cuts(piola_world *w, const piola_fracture_cut *cuts, int32_t c
 void fracture_mesh_bounds(const piola_tet_mesh *mesh, double lo[3], double hi[3]);
 /* Volume enclosed by the triangles [first, end) of s (m^3, divergence theorem). */
 double fracture_enclosed_volume(const piola_fracture_surface *s, int32_t first, int32_t end);
-/* Directed edges of the triangles [first, end) of s without exactly as many opposite edges
- * (0: closed and consistently oriented). */
+/* Directed edges of the triangles [first, end) of s that are not one of exactly two
+ * triangles on their edge, running it opposite ways (0: closed, consistently oriented and
+ * every edge shared by exactly two triangles, as docs/fracture.md promises). */
 int32_t fracture_unpaired_edges(const piola_fracture_surface *s, int32_t first, int32_t end);
 /* The area (m^2) of solid 0's cross-section at the rest plane x = x0 (on no vertex), at the
  * current positions: per tet the polygon where that plane meets it, mapped by the tet's

@@ -591,6 +591,66 @@ static void stress_criterion_breaks_a_pulled_bar(void **state) {
   piola_world_destroy(w);
 }
 
+/* A crack the stress criterion starts and grows slowly (growth_threshold, max_crack_speed) in
+ * Medit's cylinder, scaled to 0.3 m and pulled: while its front has not separated the nodes
+ * around it, the two copies of its tets share their nodes. Every edge of every fragment's
+ * surface has exactly two triangles after every step that cut: before, the crack's first tet
+ * (and later the tets along its front) left its edge on the cylinder's surface with four
+ * triangles, each side's boundary piece and crack polygon on the same two vertices. */
+static void growing_crack_surfaces_are_manifold(void **state) {
+  (void)state;
+  piola_tet_mesh mesh;
+  assert_int_equal(piola_tet_mesh_read(test_data_path("medit/cylinder.mesh"), &mesh), PIOLA_OK);
+  const piola_mat3 scale = {{{3, 0, 0}, {0, 3, 0}, {0, 0, 3}}};
+  assert_int_equal(piola_tet_mesh_transform(&mesh, scale, (piola_vec3){0, 0, 0}), PIOLA_OK);
+  piola_world *w = weightless_world(1e-3);
+  piola_solid_def sd = piola_default_solid_def();
+  sd.mesh = &mesh;
+  sd.material.youngs_modulus = 1e5;
+  sd.material.poisson_ratio = 0.3;
+  sd.shear_viscosity = piola_track_constant(5);
+  sd.bulk_viscosity = piola_track_constant(5);
+  piola_constraint_def ends[2];
+  memset(ends, 0, sizeof ends);
+  for (int k = 0; k < 2; ++k) {
+    ends[k].selector.type = PIOLA_SELECT_BOX;
+    ends[k].selector.box_min = (piola_vec3){k ? 0.295 : -1, -1, -1};
+    ends[k].selector.box_max = (piola_vec3){k ? 1 : 0.005, 1, 1};
+  }
+  ends[1].driven = true;
+  ends[1].motion = piola_default_rigid_motion_def();
+  ends[1].motion.velocity[0] = piola_track_constant(0.5);
+  sd.constraints = ends, sd.constraint_count = 2;
+  assert_int_equal(piola_world_add_solid(w, &sd, NULL), PIOLA_OK);
+  piola_fracture_def def = piola_default_fracture_def();
+  def.criterion = PIOLA_FRACTURE_STRESS, def.threshold = 1.2e4;
+  def.growth_threshold = 6e3, def.max_crack_speed = 5;
+  assert_int_equal(piola_world_solid_set_fracture(w, 0, &def), PIOLA_OK);
+  const double t_end = test_scale() >= 1.0 ? 0.3 : 0.08;
+  int32_t cut = 0, checks = 0;
+  while (piola_world_time(w) < t_end) {
+    assert_int_equal(piola_world_step(w, 0, NULL), PIOLA_OK);
+    const int32_t now = piola_world_solid_cut_tet_count(w, 0);
+    if (now == cut) continue;
+    cut = now, ++checks;
+    piola_fracture_surface s;
+    assert_int_equal(piola_world_solid_fracture_surface(w, 0, &s), PIOLA_OK);
+    for (int32_t g = 0; g < s.fragment_count; ++g) {
+      const int32_t bad = fracture_unpaired_edges(&s, s.fragment_start[g], s.fragment_start[g + 1]);
+      if (bad)
+        fail_msg(
+            "t = %g s, %d tets cut: fragment %d has %d edges not shared by exactly two triangles",
+            piola_world_time(w), (int)now, (int)g, (int)bad);
+    }
+    piola_fracture_surface_free(&s);
+  }
+  print_message("%d steps that cut checked, %d tets cut, %d fragments\n", (int)checks, (int)cut,
+                (int)piola_world_solid_fragment_count(w, 0));
+  assert_true(checks > 0);
+  piola_tet_mesh_free(&mesh);
+  piola_world_destroy(w);
+}
+
 /* Two cuts due at once with max_cuts_per_step 1: the first is applied when the def is set
  * (time 0), the second before the next step; parallel planes, 3 fragments. */
 static void max_cuts_per_step_spreads_cuts(void **state) {
@@ -652,6 +712,7 @@ int main(void) {
       cmocka_unit_test(cut_keeps_plastic_state_and_energy),
       cmocka_unit_test(max_cuts_per_step_spreads_cuts),
       cmocka_unit_test(stress_criterion_breaks_a_pulled_bar),
+      cmocka_unit_test(growing_crack_surfaces_are_manifold),
       cmocka_unit_test(bad_cuts_are_refused),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);

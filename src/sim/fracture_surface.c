@@ -10,6 +10,7 @@
  * point where two cracks meet on a face by the face's nodes and both cuts, one where three
  * meet inside a tet by its four nodes and the three cuts. So each fragment's surface is
  * closed wherever its cuts meet the body's surface through tets cut by the same plane. */
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -23,6 +24,9 @@ typedef struct surface_point {
   int32_t fragment, node[4], event[FRACTURE_MAX_CUTS];
   double w[4];
   int32_t order;                 /* position in the emitted list */
+  int32_t side;                  /* a crossing inside the criterion's crack sheet: 1 + the
+                                    original id of the edge's end on the copy's side, so the
+                                    crack's two sides do not share it; else 0 */
 } surface_point;
 
 /* Compares names: fragment, first node, second node (a corner's own node again), first
@@ -36,7 +40,7 @@ static int same_name(const surface_point *p, const surface_point *q) {
                          q->node[3], q->event[1], q->event[2]};
   for (int k = 0; k < 7; ++k)
     if (pk[k] != qk[k]) return pk[k] < qk[k] ? -1 : 1;
-  return 0;
+  return p->side < q->side ? -1 : p->side > q->side;
 }
 
 static int by_name(const void *pa, const void *pb) {
@@ -56,13 +60,59 @@ void piola_fracture_surface_free(piola_fracture_surface *s) {
   memset(s, 0, sizeof *s);
 }
 
+/* Whether crack `event` cut every copy of original tet t (a copy it did not cut, one that
+ * had three cuts already or one of a moving blade's earlier steps, is where it stops). */
+static int tet_cut_by(const solid_fracture *f, int32_t t, int32_t event) {
+  int any = 0;
+  for (int i = 0; i < FRACTURE_MAX_COPIES; ++i) {
+    const int32_t c = f->copies[FRACTURE_MAX_COPIES * (size_t)t + i];
+    if (c < 0) break;
+    copy_cut cuts[FRACTURE_MAX_CUTS];
+    const int32_t n = piola__fracture_copy_cuts(f, c, cuts);
+    int cut = 0;
+    for (int32_t j = 0; j < n; ++j) cut |= cuts[j].event == event;
+    if (!cut) return 0;
+    any = 1;
+  }
+  return any;
+}
+
+/* Whether the crossing of original edge (u, v) by crack `event` lies inside the crack's sheet:
+ * every tet around the edge (from tet t, across the faces that hold the edge, both ways on
+ * the solid's surface) is cut by that crack. Elsewhere the crossing is on the crack's front,
+ * where its two sides meet, or on its end on the solid's surface. */
+static int inside_sheet(const solid_fracture *f, int32_t t, int32_t u, int32_t v, int32_t event) {
+  if (!tet_cut_by(f, t, event)) return 0;
+  /* the faces of a tet that hold the edge are those opposite its two other corners */
+  int32_t first[2] = {-1, -1}, ways = 0;
+  for (int k = 0; k < 4; ++k) {
+    const int32_t id = f->tets[4 * (size_t)t + k];
+    if (id != u && id != v && ways < 2) first[ways++] = f->neighbor[4 * (size_t)t + k];
+  }
+  for (int way = 0; way < 2; ++way) {
+    int32_t prev = t, at = first[way];
+    for (int steps = 0; steps < 256 && at >= 0; ++steps) { /* a ring of 256: no real mesh */
+      if (at == t) return 1;                               /* round the ring */
+      if (!tet_cut_by(f, at, event)) return 0;
+      int32_t next = -1;
+      for (int k = 0; k < 4; ++k) {
+        const int32_t id = f->tets[4 * (size_t)at + k];
+        const int32_t across = f->neighbor[4 * (size_t)at + k];
+        if (id != u && id != v && across != prev) next = across;
+      }
+      prev = at, at = next;
+    }
+  }
+  return 1;
+}
+
 /* Appends polygon poly of copy c (its points, named, and a record of it); cuts: the
  * copy's cuts, ids: its original tet's vertex ids. */
 static void emit(const solid_fracture *f, const int32_t *nodes, int32_t c, const copy_cut *cuts,
                  const int32_t ids[4], const cell_point *poly, int32_t size, surface_point *points,
                  int32_t *np, int32_t *polygon, int32_t *npoly) {
   if (size < 3) return;
-  polygon[2 * *npoly] = *np, polygon[2 * *npoly + 1] = size, ++*npoly;
+  polygon[3 * *npoly] = *np, polygon[3 * *npoly + 1] = size, polygon[3 * *npoly + 2] = c, ++*npoly;
   for (int32_t i = 0; i < size; ++i) {
     surface_point *p = &points[(*np)++];
     p->fragment = f->fragment[c];
@@ -85,6 +135,18 @@ static void emit(const solid_fracture *f, const int32_t *nodes, int32_t c, const
         p->event[b] = cuts[j].event;
       }
     for (int j = m; j < FRACTURE_MAX_CUTS; ++j) p->event[j] = -1;
+    p->side = 0;
+    if (n == 2 && m == 1) {
+      int32_t j = 0;
+      while (!(poly[i].cuts >> j & 1)) ++j;
+      /* the side: the end of the edge that holds this copy's material, which every tet
+       * around the edge names alike. Scripted cuts separate the nodes they pass (a moving
+       * blade's slit too: its earlier copies, cut at other positions, close it) */
+      if (cuts[j].event == f->grown_crack &&
+          inside_sheet(f, f->parent[c], ids[corner[0]], ids[corner[1]], cuts[j].event))
+        p->side =
+            1 + (cuts[j].dist[corner[0]] * cuts[j].side > 0 ? ids[corner[0]] : ids[corner[1]]);
+    }
   }
 }
 
@@ -96,6 +158,171 @@ static int by_edge_name(const void *pa, const void *pb) {
   int32_t ql = q->node[0] < q->node[1] ? q->node[0] : q->node[1], qh = q->node[0] < q->node[1] ? q->node[1] : q->node[0];
   if (pl != ql) return pl < ql ? -1 : 1;
   return ph < qh ? -1 : ph > qh;
+}
+
+/* One use of an edge by a triangle: its ends in order, the sheet the triangle is on (below),
+ * and whether the triangle runs from lo to hi. */
+typedef struct edge_use {
+  int32_t lo, hi, sheet, triangle, forward;
+} edge_use;
+
+/* The sheet of a triangle of copy c at an edge: where both ends cross one crack, the copy's
+ * side of that crack (-2 or -4, apart from copy numbers), else the copy itself. */
+static int32_t sheet_of(const solid_fracture *f, int32_t c, int32_t event) {
+  if (event < 0) return c;
+  copy_cut cuts[FRACTURE_MAX_CUTS];
+  const int32_t n = piola__fracture_copy_cuts(f, c, cuts);
+  for (int32_t j = 0; j < n; ++j)
+    if (cuts[j].event == event) return cuts[j].side > 0 ? -2 : -4;
+  return c;
+}
+
+static int by_edge_then_copy(const void *pa, const void *pb) {
+  const edge_use *p = pa, *q = pb;
+  if (p->lo != q->lo) return p->lo < q->lo ? -1 : 1;
+  if (p->hi != q->hi) return p->hi < q->hi ? -1 : 1;
+  if (p->sheet != q->sheet) return p->sheet < q->sheet ? -1 : 1;
+  return p->triangle < q->triangle ? -1 : p->triangle > q->triangle;
+}
+
+/* Whether triangle t has the edge {u, v}; if so *at is the corner it starts from. */
+static int has_edge(const int32_t *t, int32_t u, int32_t v, int *at) {
+  for (int k = 0; k < 3; ++k) {
+    const int32_t a = t[k], b = t[(k + 1) % 3];
+    if ((a == u && b == v) || (a == v && b == u)) {
+      *at = k;
+      return 1;
+    }
+  }
+  return 0;
+}
+
+/* Where a crack has not separated the nodes around it (the first tet a crack cuts, the tets
+ * along its front), the two copies of a cut tet have the same nodes. Inside the crack's
+ * sheet its crossings are told apart by side (surface_point.side); on its front the two
+ * sides meet and share them. An edge between two such shared points carries four triangles,
+ * two on each side of the crack: where the crack ends on the solid's surface between two
+ * front points (each side's boundary piece and crack polygon), and where the sheet spans a
+ * face between them. Each side's pair is made an edge of its own: for every sheet but the
+ * first, the edge's midpoint becomes a new vertex of the fragment and the sheet's two
+ * triangles are split there, so every edge has exactly two triangles (docs/fracture.md,
+ * "Output"). An edge whose triangles do not pair up sheet by sheet, one each way, is left as
+ * it is. copy_of: each triangle's copy; crack_of: each vertex's crack where it is a shared
+ * crossing, else -1. */
+static piola_status split_shared_edges(const solid_fracture *f, piola_fracture_surface *out,
+                                       const int32_t *copy_of, const int32_t *crack_of) {
+  const int32_t nt = out->triangle_count, nv = out->vertex_count;
+  edge_use *uses = malloc(sizeof *uses * 3 * (size_t)(nt > 0 ? nt : 1));
+  if (!uses) return PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "fracture surface: out of memory");
+  for (int32_t t = 0; t < nt; ++t)
+    for (int k = 0; k < 3; ++k) {
+      const int32_t a = out->triangles[3 * (size_t)t + k],
+                    b = out->triangles[3 * (size_t)t + (k + 1) % 3];
+      const int32_t crack = crack_of[a] == crack_of[b] ? crack_of[a] : -1;
+      uses[3 * (size_t)t + k] =
+          (edge_use){a < b ? a : b, a < b ? b : a, sheet_of(f, copy_of[t], crack), t, a < b};
+    }
+  const size_t nu = 3 * (size_t)nt;
+  qsort(uses, nu, sizeof *uses, by_edge_then_copy);
+  /* the splits, in place of the uses: the edge, and the two triangles of a copy */
+  size_t nsplit = 0;
+  for (size_t i = 0; i < nu;) {
+    size_t j = i;
+    while (j < nu && uses[j].lo == uses[i].lo && uses[j].hi == uses[i].hi) ++j;
+    int pairs = j - i > 2 && (j - i) % 2 == 0;
+    for (size_t k = i; k < j && pairs; k += 2)
+      pairs = uses[k + 1].sheet == uses[k].sheet && uses[k + 1].forward != uses[k].forward &&
+              (k + 2 == j || uses[k + 2].sheet != uses[k].sheet);
+    if (j - i > 2 && !pairs && getenv("PIOLA_DBG")) {
+      fprintf(stderr, "DBG edge %d-%d (cracks %d %d):", uses[i].lo, uses[i].hi,
+              crack_of[uses[i].lo], crack_of[uses[i].hi]);
+      for (size_t k = i; k < j; ++k)
+        fprintf(stderr, " (s%d c%d t%d f%d)", uses[k].sheet, copy_of[uses[k].triangle],
+                uses[k].triangle, uses[k].forward);
+      fprintf(stderr, "\n");
+    }
+    for (size_t k = i + 2; k < j && pairs; k += 2)
+      uses[nsplit++] = uses[k], uses[nsplit++] = uses[k + 1];
+    i = j;
+  }
+  nsplit /= 2;
+  if (nsplit == 0) {
+    free(uses);
+    return PIOLA_OK;
+  }
+  const size_t mt = (size_t)nt + 2 * nsplit, mv = (size_t)nv + nsplit;
+  int32_t *tris = malloc(3 * sizeof(int32_t) * mt), *next = malloc(sizeof(int32_t) * mt);
+  int32_t *fragment = malloc(sizeof(int32_t) * mt), *vertex_fragment = malloc(sizeof(int32_t) * mv);
+  int32_t *renumber = malloc(sizeof(int32_t) * mv),
+          *start = calloc((size_t)out->fragment_count + 1, sizeof(int32_t));
+  double *positions = malloc(3 * sizeof(double) * mv);
+  int32_t *triangles = malloc(3 * sizeof(int32_t) * mt);
+  piola_status st = PIOLA_OK;
+  if (!tris || !next || !fragment || !vertex_fragment || !renumber || !start || !positions ||
+      !triangles) {
+    st = PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "fracture surface: out of memory");
+    goto done;
+  }
+  for (size_t i = 0; i < mv; ++i) vertex_fragment[i] = -1;
+  memcpy(tris, out->triangles, 3 * sizeof(int32_t) * (size_t)nt);
+  memcpy(positions, out->positions, 3 * sizeof(double) * (size_t)nv);
+  for (int32_t g = 0; g < out->fragment_count; ++g)
+    for (int32_t t = out->fragment_start[g]; t < out->fragment_start[g + 1]; ++t) {
+      fragment[t] = g, next[t] = -1;
+      for (int k = 0; k < 3; ++k) vertex_fragment[tris[3 * (size_t)t + k]] = g;
+    }
+  for (int32_t i = 1; i < nv; ++i) /* a vertex no triangle uses (none expected): its neighbour's */
+    if (vertex_fragment[i] < 0) vertex_fragment[i] = vertex_fragment[i - 1];
+  if (nv > 0 && vertex_fragment[0] < 0) vertex_fragment[0] = 0;
+  /* split: a triangle split before along another edge is followed to the piece that has
+   * this one (next[] chains each triangle's pieces) */
+  size_t count = (size_t)nt;
+  for (size_t s = 0; s < nsplit; ++s) {
+    const int32_t u = uses[2 * s].lo, v = uses[2 * s].hi, m = nv + (int32_t)s;
+    for (int k = 0; k < 3; ++k)
+      positions[3 * (size_t)m + k] =
+          0.5 * (positions[3 * (size_t)u + k] + positions[3 * (size_t)v + k]);
+    vertex_fragment[m] = fragment[uses[2 * s].triangle];
+    for (int side = 0; side < 2; ++side) {
+      int32_t t = uses[2 * s + side].triangle;
+      int at = 0;
+      while (t >= 0 && !has_edge(tris + 3 * (size_t)t, u, v, &at)) t = next[t];
+      if (t < 0) continue; /* cannot happen: a piece keeps every edge but the one split */
+      int32_t *a = tris + 3 * (size_t)t, *b = tris + 3 * count;
+      const int32_t p = a[at], q = a[(at + 1) % 3], r = a[(at + 2) % 3];
+      a[0] = p, a[1] = m, a[2] = r; /* (p, q, r) -> (p, m, r) and (m, q, r) */
+      b[0] = m, b[1] = q, b[2] = r;
+      fragment[count] = fragment[t], next[count] = next[t], next[t] = (int32_t)count;
+      ++count;
+    }
+  }
+  /* vertices and triangles grouped by fragment again, in their order within each */
+  int32_t nvn = 0;
+  for (int32_t g = 0; g < out->fragment_count; ++g)
+    for (size_t i = 0; i < mv; ++i)
+      if (vertex_fragment[i] == g) renumber[i] = nvn++;
+  double *moved = malloc(3 * sizeof(double) * mv);
+  if (!moved) {
+    st = PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "fracture surface: out of memory");
+    goto done;
+  }
+  for (size_t i = 0; i < mv; ++i)
+    for (int k = 0; k < 3; ++k) moved[3 * (size_t)renumber[i] + k] = positions[3 * i + k];
+  for (size_t t = 0; t < count; ++t) start[fragment[t] + 1]++;
+  for (int32_t g = 0; g < out->fragment_count; ++g) start[g + 1] += start[g];
+  memcpy(out->fragment_start, start, sizeof(int32_t) * ((size_t)out->fragment_count + 1));
+  for (size_t t = 0; t < count; ++t) {
+    const int32_t slot = start[fragment[t]]++;
+    for (int k = 0; k < 3; ++k) triangles[3 * (size_t)slot + k] = renumber[tris[3 * t + k]];
+  }
+  free(out->positions), free(out->triangles);
+  out->positions = moved, out->triangles = triangles, triangles = NULL;
+  out->vertex_count = nvn, out->triangle_count = (int32_t)count;
+done:
+  free(uses), free(tris), free(next), free(fragment), free(vertex_fragment), free(renumber),
+      free(start);
+  free(positions), free(triangles);
+  return st;
 }
 
 piola_status piola_world_solid_fracture_surface(const piola_world *w, int32_t solid,
@@ -119,11 +346,14 @@ piola_status piola__fracture_surface_build(const world_body *b, double inset, pi
   const size_t cap = (4 + FRACTURE_MAX_CUTS) * CELL_POLYGON_MAX * (size_t)f->copy_count + 1;
   surface_point *raw = malloc(sizeof *raw * cap), *points = malloc(2 * sizeof *points * cap);
   surface_point *crossings = malloc(sizeof *crossings * cap);
-  int32_t *polygon = malloc(2 * sizeof(int32_t) * cap);
+  int32_t *polygon = malloc(3 * sizeof(int32_t) * cap); /* first point, size, copy */
   int32_t *tri = malloc(3 * sizeof(int32_t) * 2 * cap), *index = malloc(2 * sizeof(int32_t) * cap);
   int32_t *triangle_fragment = malloc(2 * sizeof(int32_t) * cap);
-  if (!raw || !points || !crossings || !polygon || !tri || !index || !triangle_fragment) {
+  int32_t *triangle_copy = malloc(2 * sizeof(int32_t) * cap);
+  if (!raw || !points || !crossings || !polygon || !tri || !index || !triangle_fragment ||
+      !triangle_copy) {
     free(raw), free(points), free(crossings), free(polygon), free(tri), free(index), free(triangle_fragment);
+    free(triangle_copy);
     return PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "fracture surface: out of memory");
   }
   int32_t nraw = 0, npoly = 0;
@@ -164,13 +394,14 @@ piola_status piola__fracture_surface_build(const world_body *b, double inset, pi
   qsort(crossings, (size_t)ncross, sizeof *crossings, by_edge_name);
   int32_t np = 0, nt = 0;
   for (int32_t g = 0; g < npoly; ++g) {
-    const int32_t first = polygon[2 * g], size = polygon[2 * g + 1], base = np;
+    const int32_t first = polygon[3 * g], size = polygon[3 * g + 1], base = np;
     int32_t apex = 0;
     for (int32_t i = 0; i < size; ++i) {
       const surface_point *p = &raw[first + i], *q = &raw[first + (i + 1) % size];
       points[np] = *p, points[np].order = np, ++np;
       if (!is_corner(p) || !is_corner(q) || ncross == 0) continue;
-      const surface_point key = {p->fragment, {p->node[0], q->node[0], -1, -1}, {-1, -1, -1}, {0, 0, 0, 0}, 0};
+      const surface_point key = {
+          p->fragment, {p->node[0], q->node[0], -1, -1}, {-1, -1, -1}, {0, 0, 0, 0}, 0, 0};
       const surface_point *hit = bsearch(&key, crossings, (size_t)ncross, sizeof *crossings, by_edge_name);
       if (!hit) continue;
       if (apex == 0) apex = np - base;
@@ -180,6 +411,7 @@ piola_status piola__fracture_surface_build(const world_body *b, double inset, pi
     for (int32_t i = 1; i + 1 < n; ++i) {
       int32_t *t3 = tri + 3 * (size_t)nt;
       t3[0] = base + apex, t3[1] = base + (apex + i) % n, t3[2] = base + (apex + i + 1) % n;
+      triangle_copy[nt] = polygon[3 * g + 2];
       triangle_fragment[nt++] = raw[first].fragment;
     }
   }
@@ -191,9 +423,13 @@ piola_status piola__fracture_surface_build(const world_body *b, double inset, pi
   out->triangles = malloc(3 * sizeof(int32_t) * (size_t)(nt > 0 ? nt : 1));
   out->fragment_start = calloc((size_t)f->fragment_count + 1, sizeof(int32_t));
   int32_t *fill = calloc((size_t)f->fragment_count + 1, sizeof(int32_t));
+  int32_t *crack_of = malloc(sizeof(int32_t) * (size_t)(np > 0 ? np : 1));
   fracture_surface_point *at = where ? malloc(sizeof *at * (size_t)(np > 0 ? np : 1)) : NULL;
-  if (!out->positions || !out->triangles || !out->fragment_start || !fill || (where && !at)) {
-    free(points), free(tri), free(index), free(triangle_fragment), free(fill), free(at);
+  if (!out->positions || !out->triangles || !out->fragment_start || !fill || !crack_of ||
+      (where && !at)) {
+    free(points), free(tri), free(index), free(triangle_fragment), free(triangle_copy), free(fill),
+        free(at);
+    free(crack_of);
     piola_fracture_surface_free(out);
     return PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "fracture surface: out of memory");
   }
@@ -210,6 +446,7 @@ piola_status piola__fracture_surface_build(const world_body *b, double inset, pi
           out->positions[3 * (size_t)nv + k] = sum;
         }
       }
+      crack_of[nv] = is_edge_crossing(p) && p->side == 0 ? p->event[0] : -1;
       if (at) {
         fracture_surface_point *q = &at[nv];
         for (int j = 0; j < 4; ++j) q->node[j] = p->node[j], q->w[j] = p->w[j];
@@ -225,11 +462,20 @@ piola_status piola__fracture_surface_build(const world_body *b, double inset, pi
     int32_t g = triangle_fragment[i];
     int32_t slot = out->fragment_start[g] + fill[g]++;
     for (int k = 0; k < 3; ++k) out->triangles[3 * (size_t)slot + k] = index[tri[3 * (size_t)i + k]];
+    triangle_fragment[i] = slot; /* now: where triangle i went */
   }
+  for (int32_t i = 0; i < nt; ++i) index[triangle_fragment[i]] = triangle_copy[i]; /* per slot */
   out->fragment_count = f->fragment_count;
   out->vertex_count = nv;
   out->triangle_count = nt;
-  free(points), free(tri), free(index), free(triangle_fragment), free(fill);
+  piola_status st = PIOLA_OK;
+  if (!where) st = split_shared_edges(f, out, index, crack_of);
+  free(points), free(tri), free(index), free(triangle_fragment), free(triangle_copy), free(fill);
+  free(crack_of);
+  if (st != PIOLA_OK) {
+    piola_fracture_surface_free(out);
+    return st;
+  }
   if (where) *where = at;
   return PIOLA_OK;
 }

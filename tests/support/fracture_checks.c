@@ -94,7 +94,7 @@ int32_t fracture_unpaired_edges(const piola_fracture_surface *s, int32_t first, 
     }
     size_t opposite = 0;
     while (lo + opposite < n && !by_edge(&e[lo + opposite], &r)) ++opposite;
-    if (opposite != j - i) unpaired += (int32_t)(j - i);
+    if (j - i != 1 || opposite != 1) unpaired += (int32_t)(j - i);
     i = j;
   }
   free(e);

@@ -83,6 +83,16 @@ static void transform_turns_fibers_and_keeps_their_length(void **state) {
   double x0 = a.positions[3];
   assert_int_equal(piola_tet_mesh_transform(&a, mirror, (piola_vec3){0, 0, 0}), PIOLA_ERROR_INVALID_ARGUMENT);
   assert_true(a.positions[3] == x0);
+  /* a non-finite map is a NOT_FINITE input, and the message says which part */
+  piola_mat3 id = {{{1, 0, 0}, {0, 1, 0}, {0, 0, 1}}}, bad = id;
+  bad.m[1][2] = INFINITY;
+  assert_int_equal(piola_tet_mesh_transform(&a, bad, (piola_vec3){0, 0, 0}),
+                   PIOLA_ERROR_NOT_FINITE);
+  assert_non_null(strstr(piola_last_error(), "the matrix has a non-finite entry"));
+  assert_int_equal(piola_tet_mesh_transform(&a, id, (piola_vec3){0, NAN, 0}),
+                   PIOLA_ERROR_NOT_FINITE);
+  assert_non_null(strstr(piola_last_error(), "the translation has a non-finite entry"));
+  assert_true(a.positions[3] == x0);
   piola_tet_mesh_free(&a);
   piola_tet_mesh_free(&before);
 }

@@ -45,7 +45,8 @@ PIOLA_API piola_status piola_tet_mesh_copy(const piola_tet_mesh *source, piola_t
 /* Maps the mesh by x' = linear x + translation (positions in m) and carries its fibres
  * along as material directions: d' = linear d, rescaled to the length of d (unit fibres stay
  * unit; a zero fibre stays zero). det(linear) must be > 0 so tets keep their orientation;
- * a singular or mirroring map or non-finite entries are refused and leave the mesh as it
+ * a singular or mirroring map (PIOLA_ERROR_INVALID_ARGUMENT) or a non-finite entry of
+ * linear or translation (PIOLA_ERROR_NOT_FINITE) is refused and leaves the mesh as it
  * was. With linear = R S (a rotation times a scale) this is the scene's `transform`. */
 PIOLA_API piola_status piola_tet_mesh_transform(piola_tet_mesh *mesh, piola_mat3 linear,
                                                 piola_vec3 translation);

@@ -73,12 +73,17 @@ piola_status piola_tet_mesh_validate(const piola_tet_mesh *mesh) {
 
 piola_status piola_tet_mesh_transform(piola_tet_mesh *mesh, piola_mat3 linear, piola_vec3 translation) {
   if (!mesh) return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "tet mesh transform: NULL mesh");
+  if (!mat3_is_finite(linear))
+    return PIOLA_FAIL(PIOLA_ERROR_NOT_FINITE,
+                      "tet mesh transform: the matrix has a non-finite entry");
+  if (!isfinite(translation.x) || !isfinite(translation.y) || !isfinite(translation.z))
+    return PIOLA_FAIL(PIOLA_ERROR_NOT_FINITE,
+                      "tet mesh transform: the translation has a non-finite entry");
   double det = mat3_det(linear);
-  if (!mat3_is_finite(linear) || !isfinite(translation.x) || !isfinite(translation.y) ||
-      !isfinite(translation.z) || !(det > 0) || !isfinite(det))
-    return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT,
-                      "tet mesh transform: the map must be finite with a positive determinant, got "
-                      "det %g", det);
+  if (!(det > 0) || !isfinite(det))
+    return PIOLA_FAIL(
+        PIOLA_ERROR_INVALID_ARGUMENT,
+        "tet mesh transform: the matrix must have a finite positive determinant, got det %g", det);
   for (int32_t i = 0; i < mesh->vertex_count; ++i) {
     double *p = mesh->positions + 3 * (size_t)i;
     vec3_store(p, vec3_add(mat3_mul_vec(linear, vec3_load(p)), translation));

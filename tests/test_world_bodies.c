@@ -1,11 +1,14 @@
 /* The world's body table (piola/world_bodies.h): one id per body whatever its kind, ids
  * that survive insertions and refuse what names no body, accessors and stats that agree with
  * the kind-specific ones and with sums over the nodes, and a result that does not depend on
- * the order in which solids and shells were added. */
+ * the order in which solids and shells were added. A NULL world is refused, never read. */
 #include <math.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 
+#include "piola/checkpoint.h"
 #include "piola/world_bodies.h"
 #include "piola/world_shells.h"
 #include "test_shell_fixtures.h"
@@ -170,6 +173,46 @@ static void ids_that_name_no_body_are_refused(void **state) {
   free_tets(&flat);
 }
 
+/* A NULL world: the status functions say so, the getters give their neutral values; and the
+ * checkpoint calls take a NULL why and refuse a negative frame before writing anything. */
+static void a_null_world_is_refused(void **state) {
+  (void)state;
+  piola_step_stats stats;
+  assert_int_equal(piola_world_step(NULL, 0, &stats), PIOLA_ERROR_INVALID_ARGUMENT);
+  assert_non_null(strstr(piola_last_error(), "NULL world"));
+  assert_int_equal(piola_world_advance_to(NULL, 1, &stats), PIOLA_ERROR_INVALID_ARGUMENT);
+  assert_non_null(strstr(piola_last_error(), "NULL world"));
+  assert_int_equal(piola_world_solid_set_state(NULL, 0, NULL, NULL), PIOLA_ERROR_INVALID_ARGUMENT);
+  piola_tet_mesh cube = block(1, 0.2, 0.0);
+  piola_solid_def bd = solid_def(&cube, "cube");
+  assert_int_equal(piola_world_add_solid(NULL, &bd, NULL), PIOLA_ERROR_INVALID_ARGUMENT);
+  piola_obstacle_def ground = piola_default_obstacle_def();
+  assert_int_equal(piola_world_add_obstacle(NULL, &ground, NULL), PIOLA_ERROR_INVALID_ARGUMENT);
+  assert_true(isnan(piola_world_time(NULL)));
+  assert_true(isnan(piola_world_stable_dt(NULL)));
+  assert_int_equal(piola_world_integrator(NULL), PIOLA_INTEGRATOR_COUNT);
+  assert_int_equal(piola_world_solid_count(NULL), 0);
+  assert_int_equal(piola_world_obstacle_count(NULL), 0);
+  piola_world *w = make_world();
+  assert_int_equal(piola_world_add_solid(w, &bd, NULL), PIOLA_OK);
+  assert_int_equal(piola_world_checkpoint_supported(w, NULL), 1);
+  char dir[] = "/tmp/piola_null_world_XXXXXX", path[64];
+  assert_non_null(mkdtemp(dir));
+  snprintf(path, sizeof path, "%s/c.bin", dir);
+  uint64_t key = piola_world_scene_key(w, NULL, 0);
+  assert_int_equal(piola_world_checkpoint_write(w, path, key, -1), PIOLA_ERROR_INVALID_ARGUMENT);
+  assert_non_null(strstr(piola_last_error(), "frame must be >= 0, got -1"));
+  assert_int_equal(access(path, F_OK), -1);
+  assert_int_equal(piola_world_checkpoint_write(w, path, key, 0), PIOLA_OK);
+  int32_t frame = -1;
+  assert_int_equal(piola_world_checkpoint_read(w, path, key, &frame), PIOLA_OK);
+  assert_int_equal(frame, 0);
+  assert_int_equal(remove(path), 0);
+  assert_int_equal(rmdir(dir), 0);
+  piola_world_destroy(w);
+  free_tets(&cube);
+}
+
 /* Body stats: the kinetic energy and momentum are the sums over the nodes, and the energies
  * are those of the kind-specific stats. */
 static void stats_agree_with_the_nodes_and_the_kinds(void **state) {
@@ -284,6 +327,7 @@ int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(ids_survive_insertions),
       cmocka_unit_test(ids_that_name_no_body_are_refused),
+      cmocka_unit_test(a_null_world_is_refused),
       cmocka_unit_test(stats_agree_with_the_nodes_and_the_kinds),
       cmocka_unit_test(result_does_not_depend_on_the_order_of_adds),
   };

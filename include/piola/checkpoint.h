@@ -34,7 +34,7 @@ extern "C" {
 #define PIOLA_CHECKPOINT_VERSION 9
 
 /* 1 when checkpoints cover every part of the world's state; 0 with a reason in *why (a
- * static string) otherwise. */
+ * static string) otherwise. why may be NULL. */
 PIOLA_API int piola_world_checkpoint_supported(const piola_world *world, const char **why);
 
 /* A 64-bit key (FNV-1a) naming the scene a world was built from: the scene file's bytes
@@ -43,8 +43,10 @@ PIOLA_API int piola_world_checkpoint_supported(const piola_world *world, const c
 PIOLA_API uint64_t piola_world_scene_key(const piola_world *world, const void *scene,
                                          size_t length);
 
-/* Writes the world's state at frame `frame` to path, whole or not at all (a temporary
- * renamed into place). */
+/* Writes the world's state at frame `frame` (>= 0: the frame whose end state it is, as
+ * piola_world_checkpoint_read gives back; a negative one is refused with
+ * PIOLA_ERROR_INVALID_ARGUMENT) to path, whole or not at all (a temporary renamed into
+ * place). */
 PIOLA_API piola_status piola_world_checkpoint_write(const piola_world *world, const char *path,
                                                     uint64_t scene_key, int32_t frame);
 

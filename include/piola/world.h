@@ -266,6 +266,10 @@ PIOLA_API piola_status piola_world_advance_to(piola_world *world, double t_end,
 PIOLA_API double piola_world_time(const piola_world *world); /* s */
 PIOLA_API piola_integrator_type piola_world_integrator(const piola_world *world);
 
+/* A NULL world: the functions of this header that take it and return a status give
+ * PIOLA_ERROR_INVALID_ARGUMENT; piola_world_time and _stable_dt NAN, _integrator
+ * PIOLA_INTEGRATOR_COUNT, _solid_count and _obstacle_count 0. */
+
 /* Warnings: conditions a run survives but a user should know about. Each kind is raised at
  * most once per world; its message (the first occurrence, naming the body, the element or
  * the numbers) stays until the world is destroyed. docs/cli.md lists them. */

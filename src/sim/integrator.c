@@ -263,6 +263,7 @@ static void remember_bound(piola_world *w, double bound) {
  * times its bound, and a step size that rises and falls with their oscillation pumps energy
  * into it (docs/time-stepping.md, "The recent bounds"). */
 double piola_world_stable_dt(const piola_world *w) {
+  if (!w) return NAN;
   if (w->def.integrator != PIOLA_INTEGRATOR_NEWMARK) return w->def.implicit_dt;
   return fmin(current_bound(w), recent_bound_min(w));
 }
@@ -575,6 +576,7 @@ static piola_status try_step(piola_world *w, double dt, piola_step_stats *local,
 }
 
 piola_status piola_world_step(piola_world *w, double dt_limit, piola_step_stats *stats) {
+  if (!w) return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "step: NULL world");
   if (isnan(dt_limit))
     return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT,
                       "step: dt_limit is NaN (a limit in s, or <= 0 for none)");
@@ -630,6 +632,7 @@ piola_status piola__world_finish_step(piola_world *w, double dt, piola_step_stat
 }
 
 piola_status piola_world_advance_to(piola_world *w, double t_end, piola_step_stats *stats) {
+  if (!w) return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "advance_to: NULL world");
   if (!isfinite(t_end))
     return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "advance_to: t_end must be finite");
   if (t_end < w->time)

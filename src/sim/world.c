@@ -107,8 +107,10 @@ piola_status piola_world_add_obstacle(piola_world *world, const piola_obstacle_d
   return PIOLA_OK;
 }
 
-double piola_world_time(const piola_world *world) { return world->time; }
+double piola_world_time(const piola_world *world) { return world ? world->time : NAN; }
 piola_integrator_type piola_world_integrator(const piola_world *world) {
-  return world->def.integrator;
+  return world ? world->def.integrator : PIOLA_INTEGRATOR_COUNT;
 }
-int32_t piola_world_obstacle_count(const piola_world *world) { return world->obstacle_count; }
+int32_t piola_world_obstacle_count(const piola_world *world) {
+  return world ? world->obstacle_count : 0;
+}

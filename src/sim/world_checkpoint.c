@@ -46,7 +46,7 @@ static uint64_t fnv1a(uint64_t h, const void *data, size_t n) {
 
 int piola_world_checkpoint_supported(const piola_world *w, const char **why) {
   (void)w; /* every part of a world is covered */
-  *why = NULL;
+  if (why) *why = NULL;
   return 1;
 }
 
@@ -657,6 +657,9 @@ static uint64_t get_u64(const unsigned char *p) {
 piola_status piola_world_checkpoint_write(const piola_world *world, const char *path,
                                           uint64_t scene_key, int32_t frame) {
   if (!world || !path) return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "checkpoint: NULL argument");
+  if (frame < 0) /* the header stores it unsigned, and read gives back an int32_t */
+    return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "%s: checkpoint frame must be >= 0, got %d",
+                      path, (int)frame);
   const char *why;
   if (!piola_world_checkpoint_supported(world, &why))
     return PIOLA_FAIL(PIOLA_ERROR_UNSUPPORTED, "%s: %s", path, why);

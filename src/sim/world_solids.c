@@ -257,7 +257,7 @@ piola_status piola_world_add_solid(piola_world *world, const piola_solid_def *de
 /* ------------------------------------------------------------------ accessors */
 
 int32_t piola_world_solid_count(const piola_world *world) {
-  return world->kind_count[PIOLA_BODY_SOLID];
+  return world ? world->kind_count[PIOLA_BODY_SOLID] : 0;
 }
 
 static const world_body *solid_at(const piola_world *w, int32_t i) {
@@ -287,6 +287,7 @@ const uint8_t *piola_world_solid_constraint_flags(const piola_world *world, int3
 
 piola_status piola_world_solid_set_state(piola_world *world, int32_t solid, const double *positions,
                                          const double *velocities) {
+  if (!world) return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "set_state: NULL world");
   if (!solid_at(world, solid))
     return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "set_state: no solid %d", (int)solid);
   return piola_world_body_set_state(world, piola_world_body_of(world, PIOLA_BODY_SOLID, solid),

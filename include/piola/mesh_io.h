@@ -24,8 +24,8 @@ extern "C" {
 PIOLA_API piola_status piola_tet_mesh_read(const char *path, piola_tet_mesh *out);
 PIOLA_API piola_status piola_tri_mesh_read(const char *path, piola_tri_mesh *out);
 
-/* .msh (Gmsh 4.1 ASCII), .vtu, .obj (the boundary surface), .node (writes .node and .ele),
- * .mesh (Medit). */
+/* .msh (Gmsh 4.1 ASCII), .vtu, .node or .ele (writes both), .mesh (Medit), and the boundary
+ * surface as .obj, .off or .stl (binary); others are PIOLA_ERROR_UNSUPPORTED. */
 PIOLA_API piola_status piola_tet_mesh_write(const char *path, const piola_tet_mesh *mesh);
 /* .obj, .off, .stl (binary) */
 PIOLA_API piola_status piola_tri_mesh_write(const char *path, const piola_tri_mesh *mesh);

@@ -216,10 +216,18 @@ piola_status piola__json_opt_track(scene_parser *p, const cJSON *obj, const char
   return v ? popped(p, old, piola__json_track(p, v, r, out)) : PIOLA_OK;
 }
 
+/* v's type, and an array's length with it: "got an array" alone hides what is wrong. */
+static const char *type_and_length(const cJSON *v, char *buf, size_t size) {
+  if (!cJSON_IsArray(v)) return piola__json_type_name(v);
+  snprintf(buf, size, "an array of %d", cJSON_GetArraySize(v));
+  return buf;
+}
+
 piola_status piola__json_vec3(scene_parser *p, const cJSON *v, json_range r, piola_vec3 *out) {
+  char got[32];
   if (!cJSON_IsArray(v) || cJSON_GetArraySize(v) != 3)
     return piola__json_fail(p, PIOLA_ERROR_PARSE, "must be an array of 3 numbers, got %s",
-                            piola__json_type_name(v));
+                            type_and_length(v, got, sizeof got));
   double c[3];
   int i = 0;
   for (const cJSON *e = v->child; e; e = e->next, ++i) {
@@ -255,10 +263,11 @@ piola_status piola__json_opt_direction(scene_parser *p, const cJSON *obj, const 
 }
 
 static piola_status vec3_tracks(scene_parser *p, const cJSON *v, piola_track out[3]) {
+  char got[32];
   if (!cJSON_IsArray(v) || cJSON_GetArraySize(v) != 3)
     return piola__json_fail(p, PIOLA_ERROR_PARSE,
                             "must be an array of 3 numbers (or keyframes), got %s",
-                            piola__json_type_name(v));
+                            type_and_length(v, got, sizeof got));
   int i = 0;
   for (const cJSON *e = v->child; e; e = e->next, ++i) {
     size_t old = piola__json_push_index(p, i);

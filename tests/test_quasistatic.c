@@ -22,6 +22,8 @@
  *    accepted 1/1024 of the first Newton steps and that increment failed 12 times in the
  *    scene's run (52,164 times, in 13,042 halved steps, on this test's mesh): the direction
  *    of the projected Hessian decreases the potential, not always |g| (implicit_step.c);
+ *  - a failed step's warning gives its own integrator's rule for what it keeps, and its
+ *    advice tells a held bar (ramp the load) from a free block (nothing holds it);
  *  - that potential, elastic energy (piola__elastic_body_total_energy) minus gravity's
  *    work, is the function the quasistatic residual is the gradient of: its central
  *    difference along a random direction at a bent, stretched state equals -(f + M g) . d
@@ -256,7 +258,66 @@ static void held_bar_failure_advises_a_ramp(void **state) {
   assert_non_null(strstr(text, "quasistatic step"));
   assert_non_null(strstr(text, "ramped: keyframe gravity (or the activation"));
   assert_null(strstr(text, "no equilibrium"));
+  /* what a failed step keeps: the quasistatic rule only */
+  assert_non_null(strstr(text, "(unless it moved a node further than the body's size"));
+  assert_null(strstr(text, "backward Euler"));
+  assert_null(strstr(text, "held more energy"));
   piola_world_destroy(w);
+}
+
+/* The same bar and failure under backward Euler: the warning gives backward Euler's rule
+ * for what a failed step keeps, not the quasistatic one, and no quasistatic advice. */
+static void backward_euler_failure_names_its_own_rule(void **state) {
+  (void)state;
+  piola_world_def wd = piola_default_world_def();
+  wd.integrator = PIOLA_INTEGRATOR_BACKWARD_EULER;
+  wd.implicit_dt = 1.0 / 30.0;
+  wd.newton_max_iterations = 1;
+  piola_world *w = NULL;
+  assert_int_equal(piola_world_create(&wd, &w), PIOLA_OK);
+  add_clamped_bar(w, &(beam){.nx = 13, .ny = 2, .length = 0.5, .side = 0.08}, 2e4, 0.3);
+  piola_step_stats st = {0};
+  assert_int_equal(piola_world_advance_to(w, 1.0 / 30.0, &st), PIOLA_OK);
+  assert_true(st.newton_failures > 0);
+  const char *text = piola_world_warning(w, PIOLA_WARNING_NEWTON_FAILED);
+  assert_non_null(text);
+  assert_non_null(strstr(text, "backward Euler step"));
+  assert_non_null(strstr(text, "(unless it held more energy than the step's start"));
+  assert_null(strstr(text, "quasistatic"));
+  assert_null(strstr(text, "moved a node further"));
+  piola_world_destroy(w);
+}
+
+/* A free block in gravity (no constrained node, no obstacle) has no equilibrium: the advice
+ * says nothing holds it, not that obstacle contacts alone do. */
+static void free_block_failure_says_nothing_holds_it(void **state) {
+  (void)state;
+  piola_world_def wd = piola_default_world_def();
+  wd.integrator = PIOLA_INTEGRATOR_QUASISTATIC;
+  wd.implicit_dt = 1.0 / 30.0;
+  piola_world *w = NULL;
+  assert_int_equal(piola_world_create(&wd, &w), PIOLA_OK);
+  piola_tet_mesh mesh;
+  assert_int_equal(piola_tet_mesh_box_grid(2, 2, 2, (piola_vec3){0.05, 0.05, 0.05}, &mesh),
+                   PIOLA_OK);
+  piola_solid_def sd = piola_default_solid_def();
+  sd.name = "block";
+  sd.mesh = &mesh;
+  sd.material.youngs_modulus = 1e5;
+  assert_int_equal(piola_world_add_solid(w, &sd, NULL), PIOLA_OK);
+  piola_step_stats st = {0};
+  assert_int_equal(piola_world_advance_to(w, 1.0 / 30.0, &st), PIOLA_OK);
+  assert_true(st.newton_failures > 0);
+  const char *text = piola_world_warning(w, PIOLA_WARNING_NEWTON_FAILED);
+  assert_non_null(text);
+  assert_non_null(strstr(text, "'block'"));
+  assert_non_null(strstr(text,
+                         "A quasistatic body with nothing holding it (no fixed, driven or bone "
+                         "node, no obstacle contact) has no equilibrium under gravity"));
+  assert_null(strstr(text, "obstacle contacts alone"));
+  piola_world_destroy(w);
+  free(mesh.positions);
+  free(mesh.tets);
 }
 
 /* Pi(x) = sum V0 psi - sum m_i g . x_i after an update at x. */
@@ -323,6 +384,8 @@ int main(void) {
       cmocka_unit_test(small_load_matches_euler_bernoulli),
       cmocka_unit_test(soft_bar_increment_without_failed_newton),
       cmocka_unit_test(held_bar_failure_advises_a_ramp),
+      cmocka_unit_test(backward_euler_failure_names_its_own_rule),
+      cmocka_unit_test(free_block_failure_says_nothing_holds_it),
       cmocka_unit_test(potential_gradient_is_the_residual),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);

@@ -831,20 +831,28 @@ static int moved_beyond(const world_body *s, double reach) {
 }
 
 /* The Newton failure warning's advice for a quasistatic body (time-stepping.md,
- * "Quasistatics"): held by obstacle contacts alone it may have no equilibrium; held by
- * constrained nodes, a load it cannot take in one step converges when ramped (a soft HGO
- * elbow, medit/elbow.mesh, under the whole of gravity at once: its first step failed after
- * three halvings, which do not shrink a quasistatic load; with gravity keyframed up from 0
- * over 0.2 s, none failed). Backward Euler: none. */
+ * "Quasistatics"): held by nothing, or by obstacle contacts alone, it may have no
+ * equilibrium; held by constrained nodes, a load it cannot take in one step converges when
+ * ramped (a soft HGO elbow, medit/elbow.mesh, under the whole of gravity at once: its first
+ * step failed after three halvings, which do not shrink a quasistatic load; with gravity
+ * keyframed up from 0 over 0.2 s, none failed). The contacts are those of the failed try
+ * (colliding is cleared at each step's start). Backward Euler: none. */
 static const char *failure_advice(const newton_problem *pb) {
   if (!pb->quasistatic) return "";
   const world_body *s = pb->s;
-  for (int32_t i = 0; i < s->n; ++i) /* a vertex in no element is held, but holds nothing */
+  int touching = 0;
+  for (int32_t i = 0; i < s->n; ++i) { /* a vertex in no element is held, but holds nothing */
     if (s->mass[i] > 0 && s->flags[i] != NODE_FREE)
       return ". A load a quasistatic body cannot take in one step (the whole of gravity at "
              "once on a soft solid, a muscle's activation switched on at once, a large jump "
              "of a driven node) converges when ramped: keyframe gravity (or the activation, "
              "or the motion) up from 0 over a few frames (time-stepping.md, \"Quasistatics\")";
+    if (s->mass[i] > 0 && s->colliding[i]) touching = 1;
+  }
+  if (!touching)
+    return ". A quasistatic body with nothing holding it (no fixed, driven or bone node, no "
+           "obstacle contact) has no equilibrium under gravity: fix or drive a node, or use "
+           "\"backward_euler\" (time-stepping.md, \"Quasistatics\")";
   return ". A quasistatic body held by obstacle contacts alone has no equilibrium: fix or "
          "drive a node, or use \"backward_euler\" (time-stepping.md, \"Quasistatics\")";
 }
@@ -1028,16 +1036,18 @@ static piola_status newton_iterate(const newton_problem *problem, int accept_unc
         if (s->flags[i] == NODE_FREE) memcpy(s->x + 3 * i, s->x_old + 3 * i, sizeof(double) * 3);
       PIOLA_TRY(update(&pb));
     }
+    /* only the clause of the body's own integrator: the other's would mislead */
     piola__world_warn(w, PIOLA_WARNING_NEWTON_FAILED,
                       "%s '%s': the %s step to t = %g s did not converge (Newton, on its "
                       "last try, or a retry that halving did not help); its last iterate was "
-                      "kept (backward Euler: unless it held more energy than the step's start, "
-                      "time-stepping.md \"What a failed step keeps\"; quasistatic: unless it "
-                      "moved a node further than the body's size, then the step's start) and "
-                      "the run goes on "
+                      "kept (%s) and the run goes on "
                       "(stats.csv newton_failures counts failed tries)%s",
                       piola__body_kind_name(s->kind), s->name,
                       pb.quasistatic ? "quasistatic" : "backward Euler", pb.t1,
+                      pb.quasistatic ? "unless it moved a node further than the body's size, "
+                                       "then the step's start"
+                                     : "unless it held more energy than the step's start, "
+                                       "time-stepping.md \"What a failed step keeps\"",
                       failure_advice(&pb));
   }
   /* velocities; friction; prescribed velocities */

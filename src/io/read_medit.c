@@ -80,8 +80,10 @@ static piola_status parse(text_scanner *s, piola_tet_mesh *out, int32_t **lines)
           int64_t v;
           PIOLA_TRY(piola__scan_int64(s, &v, "vertex index"));
           if (v < 1 || v > out->vertex_count)
-            return piola__scan_error(s, PIOLA_ERROR_PARSE, "tet %lld: vertex %lld out of range [1, %d]", (long long)(t + 1),
-                                     (long long)v, (int)out->vertex_count);
+            /* numbered as the checks after reading number tets: from 0, with the file's */
+            return piola__scan_error(s, PIOLA_ERROR_PARSE,
+                                     "tet %lld (element %lld in the file): vertex %lld out of range [1, %d]",
+                                     (long long)t, (long long)(t + 1), (long long)v, (int)out->vertex_count);
           out->tets[4 * t + k] = (int32_t)(v - 1);
         }
         PIOLA_TRY(piola__scan_int32(s, &out->tet_regions[t], "tet reference"));

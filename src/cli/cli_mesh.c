@@ -343,7 +343,7 @@ static int info_tets(const char *path, int json, const info_material *material,
       cJSON_AddItemToArray(worst, w);
     }
     cJSON *regions = cJSON_AddArrayToObject(o, "regions");
-    for (int32_t i = 0; i < m.tet_count;) {
+    for (int32_t i = 0; i < m.tet_count && m.tet_regions;) {
       int32_t j = i + 1;
       while (j < m.tet_count && ids[j] == ids[i]) ++j;
       cJSON *r = cJSON_CreateObject();
@@ -362,8 +362,8 @@ static int info_tets(const char *path, int json, const info_material *material,
     printf("fibres:           %s\n", m.tet_fibers ? "one direction per tet" : "none");
     print_bounds(lo, hi);
     printf("volume:           %.9g m^3 (tets from %.3g to %.3g m^3)\n", q.volume, q.min_volume, q.max_volume);
-    printf("regions:         ");
-    for (int32_t i = 0; i < m.tet_count;) {
+    printf("regions:         %s", m.tet_regions ? "" : " none (the file has no region ids)");
+    for (int32_t i = 0; i < m.tet_count && m.tet_regions;) {
       int32_t j = i + 1;
       while (j < m.tet_count && ids[j] == ids[i]) ++j;
       printf(" %d: %d tets%s", (int)ids[i], (int)(j - i), j < m.tet_count ? "," : "");

@@ -59,6 +59,17 @@ def main():
         text = subprocess.run([PIOLA, "mesh", "info", mesh], check=True, capture_output=True, text=True).stdout
         check("bounding box:" in text and "size:" in text and "min altitude:" in text,
               "the text form prints the bounding box, size and smallest altitude")
+        # a TetGen pair without attributes has no region ids: "none", not a region 0
+        with open(os.path.join(work, "one.node"), "w") as f:
+            f.write("4 3 0 0\n1 0 0 0\n2 1 0 0\n3 0 1 0\n4 0 0 1\n")
+        with open(os.path.join(work, "one.ele"), "w") as f:
+            f.write("1 4 0\n1 1 2 3 4\n")
+        one = os.path.join(work, "one.ele")
+        plain = subprocess.run([PIOLA, "mesh", "info", one], check=True, capture_output=True, text=True).stdout
+        check("regions:          none" in plain, "a mesh without region ids lists none")
+        one_json = json.loads(subprocess.run([PIOLA, "mesh", "info", one, "--json"], check=True,
+                                             capture_output=True, text=True).stdout)
+        check(one_json["regions"] == [], f"--json regions {one_json['regions']} is empty")
         surface = os.path.join(work, "box.obj")
         subprocess.run([PIOLA, "mesh", "convert", mesh, surface], check=True, capture_output=True)
         s = json.loads(subprocess.run([PIOLA, "mesh", "info", surface, "--json"], check=True,

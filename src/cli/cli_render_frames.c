@@ -87,11 +87,15 @@ int render_cli_load_frame(const char *dir, bool vtu, int f, const char *field, d
   memset(lf, 0, sizeof *lf);
   if (vtu) {
     snprintf(path, sizeof path, "%s/frames/frame_%04d.vtu", dir, f);
-    if (piola_render_frame_read(path, &lf->vtu) != PIOLA_OK ||
-        (stress && stress->count > 0 &&
+    if (piola_render_frame_read(path, &lf->vtu) != PIOLA_OK) { /* its message names the file */
+      fprintf(stderr, "piola render: %s\n", piola_last_error());
+      render_cli_frame_free(lf);
+      return -1;
+    }
+    if ((stress && stress->count > 0 &&
          piola_render_frame_add_stress(lf->vtu, stress->materials, stress->count) != PIOLA_OK) ||
         piola_render_frame_mesh(lf->vtu, field, time, &lf->mesh) != PIOLA_OK) {
-      fprintf(stderr, "piola render: %s\n", piola_last_error());
+      fprintf(stderr, "piola render: %s: %s\n", path, piola_last_error());
       render_cli_frame_free(lf);
       return -1;
     }

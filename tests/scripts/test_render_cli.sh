@@ -81,6 +81,15 @@ cmp -s "$work/shown.png" "$work/by_name.png" && fail "--hide-obstacle ball chang
 render0 --frame-obstacles --hide-obstacle sphere; cmp -s "$work/hide.png" "$work/by_name.png" || fail "by type differs from by name"
 render0 --frame-obstacles --hide-obstacle 'obstacles[1]'; cmp -s "$work/hide.png" "$work/by_name.png" || fail "by index differs from by name"
 render0 --frame-obstacles --hide-obstacles; cmp -s "$work/hide.png" "$work/by_name.png" && fail "--hide-obstacles kept the plane"
+cp "$work/hide.png" "$work/none.png"
+render0 --frame-obstacles --hide-obstacle all; cmp -s "$work/hide.png" "$work/none.png" || fail "--hide-obstacle all differs from --hide-obstacles"
+# a field the frames lack is named with the frame that lacks it
+set +e
+"$PIOLA" render "$out" --no-movie --width 160 --height 120 --field bogus >"$work/log" 2>&1
+rc=$?
+set -e
+[[ $rc -eq 2 ]] && grep -q "frame_0000.vtu: frame has no cell field 'bogus'" "$work/log" ||
+  { cat "$work/log"; fail "--field bogus: exit $rc, expected 2 naming the frame"; }
 set +e
 "$PIOLA" render "$out" --no-movie --scene "$work/named.json" --hide-obstacle bal >"$work/log" 2>&1
 rc=$?

@@ -9,6 +9,7 @@
 
 #include "force/elastic_body_internal.h"
 #include "force/stable_step.h"
+#include "piola/shell_body.h"
 #include "sim/implicit_problem.h"
 #include "sim/implicit_split.h"
 #include "sim/obstacle_friction.h"
@@ -141,14 +142,42 @@ int32_t piola__newton_contact_friction(newton_problem *pb) {
   return changed;
 }
 
-/* Whether friction's moves (piola__newton_contact_friction, just run) are large against the tets
- * they touch: a move above FRICTION_RESOLVE_MOVE times a tet's rest altitude can flatten or invert
- * it, and the solve did not see it. Solids on one process only (the ranks of a split solid
- * hold different tets, and its PETSc filter holds normals only; shells have no tets): there
- * friction stays a move after the solve. */
+/* A shell triangle's rest altitude: twice its area over its longest edge (m). */
+static double triangle_rest_altitude(const double *rest, const int32_t *t) {
+  const double *a = rest + 3 * (size_t)t[0], *b = rest + 3 * (size_t)t[1],
+               *c = rest + 3 * (size_t)t[2];
+  double ab[3], ac[3], bc[3];
+  for (int k = 0; k < 3; ++k) ab[k] = b[k] - a[k], ac[k] = c[k] - a[k], bc[k] = c[k] - b[k];
+  const double n[3] = {ab[1] * ac[2] - ab[2] * ac[1], ab[2] * ac[0] - ab[0] * ac[2],
+                       ab[0] * ac[1] - ab[1] * ac[0]};
+  const double twice_area = sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+  const double longest = sqrt(fmax(ab[0] * ab[0] + ab[1] * ab[1] + ab[2] * ab[2],
+                                   fmax(ac[0] * ac[0] + ac[1] * ac[1] + ac[2] * ac[2],
+                                        bc[0] * bc[0] + bc[1] * bc[1] + bc[2] * bc[2])));
+  return longest > 0 ? twice_area / longest : 0;
+}
+
+/* Whether friction's moves (piola__newton_contact_friction, just run) are large against the
+ * elements they touch: a move above FRICTION_RESOLVE_MOVE times a tet's (a shell triangle's)
+ * rest altitude can flatten or invert it, or lock a strain the solve never saw (a cloth on a
+ * sphere with friction kept 0.14 J of stretch with the move alone, 0.07 J solved again, where
+ * Newmark settles at 0.02 J). Not a split solid (its ranks hold different tets, and its PETSc
+ * filter holds normals only): there friction stays a move after the solve. */
 int piola__newton_friction_moves_deform(const newton_problem *pb) {
   const world_body *s = pb->s;
-  if (s->kind != PIOLA_BODY_SOLID || piola__implicit_split_of(s)) return 0;
+  if (piola__implicit_split_of(s)) return 0;
+  if (s->kind == PIOLA_BODY_SHELL) {
+    const int32_t *tris = piola_shell_body_triangles(s->shell);
+    const double *rest = piola_shell_body_rest_positions(s->shell);
+    const double *moved = pb->st->scratch_v;
+    for (int32_t t = 0; t < piola_shell_body_triangle_count(s->shell); ++t) {
+      double most = 0;
+      for (int c = 0; c < 3; ++c) most = fmax(most, moved[tris[3 * t + c]]);
+      if (most > FRICTION_RESOLVE_MOVE * triangle_rest_altitude(rest, tris + 3 * t)) return 1;
+    }
+    return 0;
+  }
+  if (s->kind != PIOLA_BODY_SOLID) return 0;
   const piola_elastic_body *b = s->solid;
   const int32_t *tets = piola_elastic_body_tets(b);
   const double *moved = pb->st->scratch_v;

@@ -83,7 +83,7 @@ int32_t piola__newton_release_contacts(newton_problem *pb, int friction_held_too
  * changed (what it did to each is left in pb->st for a second solve). */
 int32_t piola__newton_contact_friction(newton_problem *pb);
 /* Whether friction's moves (piola__newton_contact_friction, just run) can flatten or invert
- * the tets they touch. */
+ * the tets (a shell's triangles) they touch. */
 int piola__newton_friction_moves_deform(const newton_problem *pb);
 /* Whether the body may slide as a whole on its contacts, after a solve without friction. */
 int piola__newton_body_may_slide(const newton_problem *pb);

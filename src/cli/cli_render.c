@@ -418,7 +418,7 @@ static double now_seconds(void) {
 }
 
 static int write_sheet(const render_options *o, const char *render_dir, piola_image *images,
-                       char (*labels)[48], int count) {
+                       char (*labels)[96], int count) {
   const char *label_ptrs[100];
   for (int i = 0; i < count; ++i) label_ptrs[i] = labels[i];
   int columns = count <= 4 ? count : count <= 9 ? 3 : 4;
@@ -510,7 +510,7 @@ int cli_render(int argc, char **argv) {
   int sheet_count = o.sheet ? (count < o.sheet_frames ? count : (int)o.sheet_frames) : 0;
   piola_image *sheet_images =
       calloc((size_t)(sheet_count > 0 ? sheet_count : 1), sizeof *sheet_images);
-  char(*sheet_labels)[48] =
+  char(*sheet_labels)[96] =
       calloc((size_t)(sheet_count > 0 ? sheet_count : 1), sizeof *sheet_labels);
   if (!sheet_images || !sheet_labels) rc = 1;
   fprintf(stderr, "piola render: %d frames of %s -> %s (%d x %d, %s%s%s)\n", count, o.dir,
@@ -544,6 +544,26 @@ int cli_render(int argc, char **argv) {
       snprintf(text, sizeof text, "FRAME %d  T = %.3f S  INVERTED %d", f, t, inverted);
     else
       snprintf(text, sizeof text, "FRAME %d  T = %.3f S", f, t);
+    /* evenly spaced frames for the contact sheet, kept without the frame's own label: the
+     * sheet draws one of its own size, and a frame scaled up to the tile showed its label
+     * out from under the sheet's */
+    if (next_sheet < sheet_count) {
+      int want = sheet_count > 1 ? (int)((long)next_sheet * (count - 1) / (sheet_count - 1)) : 0;
+      if (i == want) {
+        const size_t bytes = 3 * (size_t)img.width * (size_t)img.height;
+        piola_image *copy = &sheet_images[next_sheet];
+        copy->rgb = malloc(bytes);
+        if (!copy->rgb) {
+          fprintf(stderr, "piola render: out of memory\n");
+          rc = 1;
+          break;
+        }
+        memcpy(copy->rgb, img.rgb, bytes);
+        copy->width = img.width, copy->height = img.height;
+        snprintf(sheet_labels[next_sheet], sizeof sheet_labels[0], "%s", text);
+        ++next_sheet;
+      }
+    }
     piola_image_draw_label(&img, 8 * label_scale, 8 * label_scale, label_scale, text);
     char path[4400];
     snprintf(path, sizeof path, "%s/frame_%04d.png", render_dir, f);
@@ -551,16 +571,6 @@ int cli_render(int argc, char **argv) {
       fprintf(stderr, "piola render: %s\n", piola_last_error());
       rc = 1;
       break;
-    }
-    /* evenly spaced frames for the contact sheet */
-    if (next_sheet < sheet_count) {
-      int want = sheet_count > 1 ? (int)((long)next_sheet * (count - 1) / (sheet_count - 1)) : 0;
-      if (i == want) {
-        sheet_images[next_sheet] = img;
-        img = (piola_image){0};
-        snprintf(sheet_labels[next_sheet], sizeof sheet_labels[0], "FRAME %d  T = %.3f S", f, t);
-        ++next_sheet;
-      }
     }
   }
   double per_frame = count > 0 ? (now_seconds() - t_start) / count : 0;

@@ -18,7 +18,7 @@ static void usage(FILE *out) {
       "\n"
       "SHAPE is sphere, box, torus, cylinder, capsule, a closed surface file (.obj .off .stl),\n"
       "or a tet mesh file (.msh .mesh .node .veg .vtu), remeshed inside its boundary surface.\n"
-      "OUT is a tet mesh file (.msh .vtu .node .mesh, or .obj for its boundary).\n"
+      "OUT is a tet mesh file (.msh .vtu .node .mesh, or .obj .off .stl for its boundary).\n"
       "\n"
       "options (lengths in metres):\n"
       "  --cell-size H          BCC lattice spacing (cube edge). Default: 1/20 of the shape's "

@@ -156,7 +156,7 @@ int pypiola_material_converter(PyObject *obj, void *out) {
     return 0;
   }
   if (!piola_inversion_mode_from_name(mode, &def->inversion_mode)) {
-    PyErr_Format(PyExc_ValueError, "unknown inversion mode '%s' (linear, clamp or energy)", mode);
+    PyErr_Format(PyExc_ValueError, "unknown inversion mode '%s' (default, linear, clamp or energy)", mode);
     return 0;
   }
   return 1;

@@ -200,6 +200,9 @@ static void a_null_world_is_refused(void **state) {
   assert_non_null(mkdtemp(dir));
   snprintf(path, sizeof path, "%s/c.bin", dir);
   uint64_t key = piola_world_scene_key(w, NULL, 0);
+  /* a NULL world adds no body to the scene's key */
+  assert_true(piola_world_scene_key(NULL, "{}", 2) != piola_world_scene_key(w, "{}", 2));
+  assert_true(piola_world_scene_key(NULL, "{}", 2) == piola_world_scene_key(NULL, "{}", 2));
   assert_int_equal(piola_world_checkpoint_write(w, path, key, -1), PIOLA_ERROR_INVALID_ARGUMENT);
   assert_non_null(strstr(piola_last_error(), "frame must be >= 0, got -1"));
   assert_int_equal(access(path, F_OK), -1);

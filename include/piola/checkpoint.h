@@ -39,7 +39,7 @@ PIOLA_API int piola_world_checkpoint_supported(const piola_world *world, const c
 
 /* A 64-bit key (FNV-1a) naming the scene a world was built from: the scene file's bytes
  * (scene, length; NULL and 0 for none) and the rest state of every body (rest positions,
- * elements and masses, so a changed mesh file changes the key). */
+ * elements and masses, so a changed mesh file changes the key); a NULL world adds none. */
 PIOLA_API uint64_t piola_world_scene_key(const piola_world *world, const void *scene,
                                          size_t length);
 

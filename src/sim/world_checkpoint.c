@@ -53,7 +53,7 @@ int piola_world_checkpoint_supported(const piola_world *w, const char **why) {
 uint64_t piola_world_scene_key(const piola_world *w, const void *scene, size_t length) {
   uint64_t h = FNV_OFFSET;
   if (scene) h = fnv1a(h, scene, length);
-  for (int32_t i = 0; i < w->body_count; ++i) {
+  for (int32_t i = 0; w && i < w->body_count; ++i) {
     const world_body *b = &w->bodies[i];
     int32_t kind = (int32_t)b->kind;
     h = fnv1a(h, &kind, sizeof kind);
@@ -76,7 +76,7 @@ uint64_t piola_world_scene_key(const piola_world *w, const void *scene, size_t l
         break;
     }
   }
-  int32_t counts[2] = {w->body_count, w->obstacle_count};
+  int32_t counts[2] = {w ? w->body_count : 0, w ? w->obstacle_count : 0};
   return fnv1a(h, counts, sizeof counts);
 }
 

@@ -9,8 +9,10 @@
  * (copies sharing both nodes were cut together, so they computed the same crossing), a
  * point where two cracks meet on a face by the face's nodes and both cuts, one where three
  * meet inside a tet by its four nodes and the three cuts. So each fragment's surface is
- * closed wherever its cuts meet the body's surface through tets cut by the same plane. */
-#include <stdio.h>
+ * closed wherever its cuts meet the body's surface through tets cut by the same plane.
+ * Where a crack has not separated the nodes around it, both sides of the crack would name
+ * their points alike: there a crossing also carries its side (surface_point.side), and the
+ * edges left between two shared points are split (split_shared_edges). */
 #include <stdlib.h>
 #include <string.h>
 
@@ -177,7 +179,7 @@ static int32_t sheet_of(const solid_fracture *f, int32_t c, int32_t event) {
   return c;
 }
 
-static int by_edge_then_copy(const void *pa, const void *pb) {
+static int by_edge_then_sheet(const void *pa, const void *pb) {
   const edge_use *p = pa, *q = pb;
   if (p->lo != q->lo) return p->lo < q->lo ? -1 : 1;
   if (p->hi != q->hi) return p->hi < q->hi ? -1 : 1;
@@ -223,7 +225,7 @@ static piola_status split_shared_edges(const solid_fracture *f, piola_fracture_s
           (edge_use){a < b ? a : b, a < b ? b : a, sheet_of(f, copy_of[t], crack), t, a < b};
     }
   const size_t nu = 3 * (size_t)nt;
-  qsort(uses, nu, sizeof *uses, by_edge_then_copy);
+  qsort(uses, nu, sizeof *uses, by_edge_then_sheet);
   /* the splits, in place of the uses: the edge, and the two triangles of a copy */
   size_t nsplit = 0;
   for (size_t i = 0; i < nu;) {
@@ -233,14 +235,6 @@ static piola_status split_shared_edges(const solid_fracture *f, piola_fracture_s
     for (size_t k = i; k < j && pairs; k += 2)
       pairs = uses[k + 1].sheet == uses[k].sheet && uses[k + 1].forward != uses[k].forward &&
               (k + 2 == j || uses[k + 2].sheet != uses[k].sheet);
-    if (j - i > 2 && !pairs && getenv("PIOLA_DBG")) {
-      fprintf(stderr, "DBG edge %d-%d (cracks %d %d):", uses[i].lo, uses[i].hi,
-              crack_of[uses[i].lo], crack_of[uses[i].hi]);
-      for (size_t k = i; k < j; ++k)
-        fprintf(stderr, " (s%d c%d t%d f%d)", uses[k].sheet, copy_of[uses[k].triangle],
-                uses[k].triangle, uses[k].forward);
-      fprintf(stderr, "\n");
-    }
     for (size_t k = i + 2; k < j && pairs; k += 2)
       uses[nsplit++] = uses[k], uses[nsplit++] = uses[k + 1];
     i = j;

@@ -190,8 +190,18 @@ static PetscErrorCode solve(piola__petsc_solver *s, const piola_split_newton_sys
   if (!s->matrix) PetscCall(create(s, system));
   PetscCall(fill(s, system));
   /* GAMG only: IC(0)'s factorization costs little, and a stale one added CG iterations */
-  const int reuse = s->prepared && system->step_system > 0 &&
-                    system->preconditioner == PIOLA_MPI_PRECONDITIONER_GAMG;
+  const int gamg = system->preconditioner == PIOLA_MPI_PRECONDITIONER_GAMG;
+  const int reuse = s->prepared && system->step_system > 0 && gamg;
+  if (s->prepared && gamg && !reuse) {
+    /* a step's GAMG starts from a new solver, as a resumed run's first one does: set up again
+     * in the last step's, it kept state a checkpoint does not hold (PCReset alone did not
+     * clear it), and a split run resumed from a checkpoint differed from the run that never
+     * stopped by about 1e-11 from its first step */
+    PetscCall(KSPDestroy(&s->ksp));
+    PetscCall(KSPCreate(PETSC_COMM_WORLD, &s->ksp));
+    PetscCall(KSPSetType(s->ksp, KSPCG));
+    PetscCall(KSPSetNormType(s->ksp, KSP_NORM_PRECONDITIONED));
+  }
   PetscCall(set_preconditioner(s, system, !reuse));
   PetscCall(KSPSolve(s->ksp, s->rhs, s->solution));
   PetscCall(KSPGetIterationNumber(s->ksp, iterations));

@@ -196,8 +196,8 @@ static void a_null_world_is_refused(void **state) {
   piola_world *w = make_world();
   assert_int_equal(piola_world_add_solid(w, &bd, NULL), PIOLA_OK);
   assert_int_equal(piola_world_checkpoint_supported(w, NULL), 1);
-  char dir[] = "/tmp/piola_null_world_XXXXXX", path[64];
-  assert_non_null(mkdtemp(dir));
+  char dir[64], path[96];
+  assert_int_equal(test_make_scratch_folder(dir, sizeof dir, "piola_null_world"), 0);
   snprintf(path, sizeof path, "%s/c.bin", dir);
   uint64_t key = piola_world_scene_key(w, NULL, 0);
   /* a NULL world adds no body to the scene's key */
@@ -210,8 +210,7 @@ static void a_null_world_is_refused(void **state) {
   int32_t frame = -1;
   assert_int_equal(piola_world_checkpoint_read(w, path, key, &frame), PIOLA_OK);
   assert_int_equal(frame, 0);
-  assert_int_equal(remove(path), 0);
-  assert_int_equal(rmdir(dir), 0);
+  assert_int_equal(test_remove_scratch_folder(dir), 0);
   piola_world_destroy(w);
   free_tets(&cube);
 }

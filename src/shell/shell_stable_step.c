@@ -77,6 +77,10 @@ static double inverse_altitude2(const shell_triangle *tri) {
   return most;
 }
 
+double piola__shell_body_triangle_altitude(const piola_shell_body *body, int32_t t) {
+  return 1.0 / sqrt(inverse_altitude2(&body->triangles[t]));
+}
+
 double piola__shell_body_membrane_rate2(const piola_shell_body *body, int32_t *worst) {
   double rate2 = 0;
   int32_t at = -1;

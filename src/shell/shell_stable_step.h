@@ -21,6 +21,9 @@
  * the bound is the rest bound. *worst (may be NULL) receives the triangle that sets it. */
 double piola__shell_body_membrane_rate2(const piola_shell_body *body, int32_t *worst);
 
+/* Triangle t's effective rest altitude h_t (m), as the bound above takes it. */
+double piola__shell_body_triangle_altitude(const piola_shell_body *body, int32_t t);
+
 /* The bending term: a Gershgorin estimate of the hinges' omega^2 (1/s^2,
  * stiffness scale 1) with the hinge-angle gradients of the last update (at the rest build:
  * the rest bound, rest_state.c); 0 without bending

@@ -10,6 +10,7 @@
 #include "force/elastic_body_internal.h"
 #include "force/stable_step.h"
 #include "piola/shell_body.h"
+#include "shell/shell_stable_step.h"
 #include "sim/implicit_problem.h"
 #include "sim/implicit_split.h"
 #include "sim/obstacle_friction.h"
@@ -142,21 +143,6 @@ int32_t piola__newton_contact_friction(newton_problem *pb) {
   return changed;
 }
 
-/* A shell triangle's rest altitude: twice its area over its longest edge (m). */
-static double triangle_rest_altitude(const double *rest, const int32_t *t) {
-  const double *a = rest + 3 * (size_t)t[0], *b = rest + 3 * (size_t)t[1],
-               *c = rest + 3 * (size_t)t[2];
-  double ab[3], ac[3], bc[3];
-  for (int k = 0; k < 3; ++k) ab[k] = b[k] - a[k], ac[k] = c[k] - a[k], bc[k] = c[k] - b[k];
-  const double n[3] = {ab[1] * ac[2] - ab[2] * ac[1], ab[2] * ac[0] - ab[0] * ac[2],
-                       ab[0] * ac[1] - ab[1] * ac[0]};
-  const double twice_area = sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
-  const double longest = sqrt(fmax(ab[0] * ab[0] + ab[1] * ab[1] + ab[2] * ab[2],
-                                   fmax(ac[0] * ac[0] + ac[1] * ac[1] + ac[2] * ac[2],
-                                        bc[0] * bc[0] + bc[1] * bc[1] + bc[2] * bc[2])));
-  return longest > 0 ? twice_area / longest : 0;
-}
-
 /* Whether friction's moves (piola__newton_contact_friction, just run) are large against the
  * elements they touch: a move above FRICTION_RESOLVE_MOVE times a tet's (a shell triangle's)
  * rest altitude can flatten or invert it, or lock a strain the solve never saw (a cloth on a
@@ -168,12 +154,11 @@ int piola__newton_friction_moves_deform(const newton_problem *pb) {
   if (piola__implicit_split_of(s)) return 0;
   if (s->kind == PIOLA_BODY_SHELL) {
     const int32_t *tris = piola_shell_body_triangles(s->shell);
-    const double *rest = piola_shell_body_rest_positions(s->shell);
     const double *moved = pb->st->scratch_v;
     for (int32_t t = 0; t < piola_shell_body_triangle_count(s->shell); ++t) {
       double most = 0;
       for (int c = 0; c < 3; ++c) most = fmax(most, moved[tris[3 * t + c]]);
-      if (most > FRICTION_RESOLVE_MOVE * triangle_rest_altitude(rest, tris + 3 * t)) return 1;
+      if (most > FRICTION_RESOLVE_MOVE * piola__shell_body_triangle_altitude(s->shell, t)) return 1;
     }
     return 0;
   }

@@ -283,11 +283,13 @@ piola_status piola__body_allocate(world_body *b, int32_t n, const char *name, in
   b->x_old = malloc(v3), b->v_old = malloc(v3), b->force_old = malloc(v3), b->rhs = malloc(v3);
   b->tmp = malloc(v3), b->work = malloc(4 * v3) /* CG's 3 vectors + the first solve's A x0 */;
   b->normals = malloc(v3);
+  b->friction_spent = malloc((size_t)n * sizeof(double));
   b->av_product = malloc(v3), b->v_product = malloc(v3);
   b->colliding = calloc((size_t)n, 1);
   if (!b->av_product || !b->v_product || !b->name || !b->x || !b->v || !b->force || !b->start ||
       !b->mass || !b->inverse_mass || !b->flags || !b->motion_of || !b->x_old || !b->v_old ||
-      !b->force_old || !b->rhs || !b->tmp || !b->work || !b->normals || !b->colliding)
+      !b->force_old || !b->rhs || !b->tmp || !b->work || !b->normals || !b->colliding ||
+      !b->friction_spent)
     return PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "%s %d: out of memory", kind, (int)index);
   strcpy(b->name, name);
   memcpy(b->mass, mass, (size_t)n * sizeof(double));
@@ -319,7 +321,7 @@ void piola__body_free(world_body *b) {
   free(b->flags), free(b->motion_of), free(b->motions);
   free(b->x_old), free(b->v_old), free(b->force_old), free(b->rhs), free(b->work), free(b->tmp);
   free(b->av_product), free(b->v_product);
-  free(b->colliding), free(b->normals);
+  free(b->colliding), free(b->normals), free(b->friction_spent);
   piola__implicit_state_free(b->implicit);
   memset(b, 0, sizeof *b);
 }

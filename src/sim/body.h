@@ -83,6 +83,10 @@ typedef struct world_body {
   int product_valid;
   uint8_t *colliding;
   double *normals;
+  /* n: the normal impulse per unit mass (m/s) whose friction the explicit step's collision
+   * processing applied to each obstacle contact's motion, NAN for the other nodes; the
+   * friction after the final solve makes up the rest of the step's (integrator.c) */
+  double *friction_spent;
   /* the state-aware step bound of the last update, a cache of a function of the update's
    * per-element state, valid until the next update. Solids (stable_step.h, world_solids.c):
    * max over tets of k_e / (rho h_e^2), 1/s^2, and the tet that attains it. Shells

@@ -169,12 +169,14 @@ static int32_t damping_solve(piola_world *w, world_body *s, double h, double t,
 static void friction_on_step_motion(const piola_world *w, world_body *s, double t1, double dt,
                                     const double *x_tilde) {
   for (int32_t i = 0; i < s->n; ++i) {
+    s->friction_spent[i] = NAN;
     if (!s->colliding[i] || s->flags[i] != NODE_FREE || !(s->mass[i] > 0)) continue;
     const double *nrm = s->normals + 3 * i;
     double *xi = s->x + 3 * i, *vi = s->v + 3 * i;
     const double *xo = s->x_old + 3 * i, *xt = x_tilde + 3 * i;
     const double dxn =
         (xi[0] - xt[0]) * nrm[0] + (xi[1] - xt[1]) * nrm[1] + (xi[2] - xt[2]) * nrm[2];
+    s->friction_spent[i] = dxn > 0 ? dxn / dt : 0.0;
     if (!(dxn > 0)) continue;
     piola_vec3 p = {xi[0], xi[1], xi[2]}, vo;
     double mu;
@@ -194,27 +196,41 @@ static void friction_on_step_motion(const piola_world *w, world_body *s, double 
   }
 }
 
-/* Friction for the second half of the step's contact impulse.
+/* Friction for the rest of the step's contact impulse.
  *
  * Collision processing (step 3) applies friction with the normal velocity change it causes,
  * dvN + dxN/dt; in resting contact that is the half-step of normal acceleration that
  * carried the node into the obstacle through v~. The final solve then holds the normal
- * velocity, which removes the normal impulse of the other half, dt/2 a^n+1 . n; without
- * friction for it a block on an incline would feel half its Coulomb friction. Here that
- * impulse, dt/2 (f^n+1 + f_ext + D v^n+1) . n / m when it presses into the obstacle, limits
- * the relative tangential velocity the same way: vT <- max(0, 1 - mu dvN / |vT|) vT. */
+ * velocity, which removes the normal impulse of both halves, dt/2 (a^n + a^n+1) . n; without
+ * friction for the second a block on an incline would feel half its Coulomb friction. Here
+ * that impulse, dt/2 (f^n+1 + f_ext + D v^n+1) . n / m when it presses into the obstacle,
+ * limits the relative tangential velocity the same way: vT <- max(0, 1 - mu dvN / |vT|) vT.
+ *
+ * The first half's impulse as the solve held it, dt/2 (f^n + f_ext + D v') . n / m, is not
+ * the dxN/dt step 3 spent: v~ carried the node in with its damping solved implicitly, which
+ * pulls a pressed node back towards the nodes above it, so dxN/dt fell short by about h c / m
+ * (c the node's damping coefficient) and a damped block on an incline slid as if mu were
+ * 3.5% smaller (docs/time-stepping.md, "Friction of the held normal impulse"). On an
+ * obstacle contact of step 3 (friction_spent known) the difference joins this half's
+ * impulse, so the velocity gets the friction of the whole held impulse. */
 static void contact_friction(const piola_world *w, world_body *s, double t1, double h,
-                             const double *g1, const double *av) {
+                             const double *g1, const double *av, int spent_known) {
   for (int32_t i = 0; i < s->n; ++i) {
     if (!s->colliding[i] || s->flags[i] != NODE_FREE) continue;
     const double *nrm = s->normals + 3 * i;
     double *vi = s->v + 3 * i;
     /* normal impulse per unit mass of the n+1 half: h (f + m g).n + (h D v).n, where
-     * h D v = M v - A v */
-    double push = 0;
-    for (int k = 0; k < 3; ++k)
-      push += nrm[k] * (h * (s->force[3 * i + k] + s->mass[i] * g1[k]) + s->mass[i] * vi[k] - av[3 * i + k]);
-    double dvn = -push / s->mass[i];
+     * h D v = M v - A v; and of the first half, from the right-hand side M v' + h (f^n +
+     * D v' + m g0) + h (f + m g1), whose normal part of M v' the hold kept in v */
+    double push = 0, first = 0;
+    for (int k = 0; k < 3; ++k) {
+      const double second = h * (s->force[3 * i + k] + s->mass[i] * g1[k]);
+      push += nrm[k] * (second + s->mass[i] * vi[k] - av[3 * i + k]);
+      first += nrm[k] * (s->rhs[3 * i + k] - s->mass[i] * vi[k] - second);
+    }
+    double dvn = fmax(-push / s->mass[i], 0.0);
+    if (spent_known && isfinite(s->friction_spent[i]))
+      dvn += fmax(-first / s->mass[i], 0.0) - s->friction_spent[i];
     if (!(dvn > 0)) continue;
     /* the obstacle the node touches: the one nearest to it */
     piola_vec3 p = {s->x[3 * i], s->x[3 * i + 1], s->x[3 * i + 2]}, vo;
@@ -340,6 +356,7 @@ static piola_status step_body(piola_world *w, world_body *s, double t, double dt
                                         s->colliding, s->normals);
     if (colliding > 0) friction_on_step_motion(w, s, t1, dt, x_tilde);
   }
+  const int obstacle_contacts = colliding > 0;
   colliding += piola__body_collide_in_step(w, s, t1, dt, 1, NULL);
   for (int32_t i = 0; i < n; ++i) {
     if (s->flags[i] == NODE_FREE) continue;
@@ -426,7 +443,7 @@ static piola_status step_body(piola_world *w, world_body *s, double t, double dt
     s->product_valid = 1;
   }
   piola__step_profile_mark(&w->profile, STEP_PHASE_SOLVE2);
-  if (colliding > 0) contact_friction(w, s, t1, h, g1, av);
+  if (colliding > 0) contact_friction(w, s, t1, h, g1, av, obstacle_contacts);
   piola__step_profile_mark(&w->profile, STEP_PHASE_FRICTION);
   /* a state whose energies overflow has blown up even if each coordinate is still finite.
    * The elastic energy is not computed per step (world.c); the squared norm of the elastic

@@ -73,6 +73,9 @@ typedef struct world_body {
   /* solids: self-collision waits for this solid to untangle, so it is not in the collision
    * surface (world_contact.c, "A tangled start"); checkpointed */
   int collision_waits;
+  /* solids, in an implicit step: holds between this solid and another's surface, of either's
+   * nodes (solid_contacts.c), counted since the step's try began */
+  int32_t solid_contacts;
   /* scratch for the step */
   double *x_old, *v_old, *force_old, *rhs, *work, *tmp;
   /* the final solve's A v (3n) and the v it was taken at (3n), with its h and the damping
@@ -236,6 +239,9 @@ static inline double piola__state_or_rest_step(double rest, double cfl, double r
 piola_status piola__solid_update_forces(world_body *b, double t);
 double piola__solid_stable_dt(const piola_world *w, const world_body *b, double scale);
 piola_body_stats piola__solid_stats(world_body *b);
+/* The boundary surface of solid b in b->boundary (its longest rest edge in boundary_reach),
+ * built on the first call from the rest topology; positions are b->x. */
+piola_status piola__solid_boundary(world_body *b);
 /* world_shells.c */
 piola_status piola__shell_update_forces(world_body *b, double t);
 double piola__shell_stable_dt(const piola_world *w, const world_body *b, double scale);

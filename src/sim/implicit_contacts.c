@@ -14,6 +14,7 @@
 #include "sim/implicit_problem.h"
 #include "sim/implicit_split.h"
 #include "sim/obstacle_friction.h"
+#include "sim/solid_contacts.h"
 
 /* Friction's move of a node after the solve, as a fraction of the rest altitude of a tet
  * around it, above which the step is solved again (piola__newton_friction_moves_deform). Measured
@@ -25,15 +26,20 @@
 
 /* A shell's one-way coupling to the solids (collide_with_solids; the solids have stepped
  * already): free nodes inside a solid's surface are projected onto it and held along its
- * normal like obstacle contacts, the surface's velocity kept for friction. Returns 1 when
- * it moved a node, else 0. */
+ * normal like obstacle contacts, the surface's velocity kept for friction. A solid with
+ * self_collision: the same against the other such solids' surfaces, kept the pair's
+ * thickness apart (solid_contacts.c). Returns 1 when it moved a node, else 0. */
 static int32_t coupling_contacts(newton_problem *pb) {
   world_body *s = pb->s;
   struct implicit_state *st = pb->st;
-  if (!s->collide_with_solids) return 0;
+  const int solid = s->kind == PIOLA_BODY_SOLID;
+  if (!s->collide_with_solids && !solid) return 0;
   const size_t v3 = sizeof(double) * 3 * (size_t)s->n;
   memcpy(st->scratch_v, s->x, v3);
-  (void)piola__body_collide_in_step(pb->w, s, pb->t1, pb->dt, HELD_BY_SOLID, st->surface_v);
+  if (solid)
+    (void)piola__solid_contacts_with_solids(pb->w, s, HELD_BY_SOLID, st->surface_v, st->surface_mu);
+  else
+    (void)piola__body_collide_in_step(pb->w, s, pb->t1, pb->dt, HELD_BY_SOLID, st->surface_v);
   return memcmp(st->scratch_v, s->x, v3) != 0;
 }
 
@@ -64,6 +70,7 @@ int32_t piola__newton_contacts(newton_problem *pb) {
     }
     if (!s->colliding[i]) added++;
     if (s->colliding[i] != HELD_BY_FRICTION) s->colliding[i] = HELD_BY_OBSTACLE;
+    st->surface_mu[i] = NAN; /* an obstacle's contact now */
     for (int k = 0; k < 3; ++k) s->normals[3 * i + k] = normals[3 * i + k];
   }
   const int32_t changed = moved > 0 ? (added > 0 ? added : 1) : coupled;
@@ -120,9 +127,11 @@ int32_t piola__newton_contact_friction(newton_problem *pb) {
     piola_vec3 p = {s->x[3 * i], s->x[3 * i + 1], s->x[3 * i + 2]}, vo;
     double mu, *vi = s->v + 3 * i;
     if (on_solid) {
-      /* against the solid's surface: the shell's solid_friction, the surface's velocity */
+      /* against a solid's surface: a shell's solid_friction or a solid pair's, the
+       * surface's velocity */
       const double *vs = pb->st->surface_v + 3 * i;
-      mu = s->solid_friction, vo = (piola_vec3){vs[0], vs[1], vs[2]};
+      mu = s->kind == PIOLA_BODY_SOLID ? pb->st->surface_mu[i] : s->solid_friction;
+      vo = (piola_vec3){vs[0], vs[1], vs[2]};
     } else {
       piola__nearest_obstacle_motion(w->obstacles, w->obstacle_count, pb->t1, p, &mu, &vo);
     }
@@ -188,6 +197,16 @@ static double node_obstacle(const newton_problem *pb, int32_t i, piola_vec3 *vo)
   piola__nearest_obstacle_motion(pb->w->obstacles, pb->w->obstacle_count, pb->t1,
                                  (piola_vec3){x[0], x[1], x[2]}, &mu, vo);
   return mu;
+}
+
+/* Where friction stopped a solid's node on another solid's surface (solid_contacts.c set its
+ * surface_mu): that pair's coefficient and the surface's velocity, as for node_obstacle; -1
+ * for a node on an obstacle. */
+static double node_solid_surface(const newton_problem *pb, int32_t i, piola_vec3 *vo) {
+  if (pb->s->kind != PIOLA_BODY_SOLID || !isfinite(pb->st->surface_mu[i])) return -1;
+  const double *vs = pb->st->surface_v + 3 * i;
+  *vo = (piola_vec3){vs[0], vs[1], vs[2]};
+  return pb->st->surface_mu[i];
 }
 
 /* The tangential part of node i's velocity relative to vo, about its normal, into vt; returns
@@ -256,9 +275,10 @@ static int32_t release_slipping_holds(newton_problem *pb) {
     const double gt[3] = {g[0] - gn * nrm[0], g[1] - gn * nrm[1], g[2] - gn * nrm[2]};
     const double gt_size = sqrt(gt[0] * gt[0] + gt[1] * gt[1] + gt[2] * gt[2]);
     piola_vec3 vo;
-    const double mu = node_obstacle(pb, i, &vo);
+    const double on_solid = node_solid_surface(pb, i, &vo);
+    const double mu = on_solid >= 0 ? on_solid : node_obstacle(pb, i, &vo);
     if (!(gn > 0) || !(gt_size > mu * gn)) continue;
-    s->colliding[i] = HELD_BY_OBSTACLE;
+    s->colliding[i] = on_solid >= 0 ? HELD_BY_SOLID : HELD_BY_OBSTACLE;
     const double scale = mu * gn / gt_size / (pb->dt * pb->dt);
     for (int k = 0; k < 3; ++k) st->friction[3 * i + k] = scale * gt[k];
     released++;

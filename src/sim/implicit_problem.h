@@ -43,6 +43,7 @@ struct implicit_state {
   double *cg[4];      /* 3n each: r, z, p, q */
   double *scratch_v;  /* 3n: velocities handed to the obstacle projection */
   double *surface_v;  /* 3n: velocity of the solid surface a HELD_BY_SOLID node touches */
+  double *surface_mu; /* n: a solid's HELD_BY_SOLID node: the pair's friction coefficient */
   double *friction;   /* 3n: the force friction applied to each node in the step, m dv / dt (N) */
   uint8_t *hit;       /* n: nodes the obstacle projection moved */
 };

@@ -153,7 +153,8 @@ void piola__implicit_state_free(struct implicit_state *st) {
   piola__multigrid_free(&st->multigrid);
   free(st->prediction), free(st->residual), free(st->step), free(st->base), free(st->damping);
   for (int k = 0; k < 4; ++k) free(st->cg[k]);
-  free(st->scratch_v), free(st->surface_v), free(st->friction), free(st->hit);
+  free(st->scratch_v), free(st->surface_v), free(st->surface_mu), free(st->friction);
+  free(st->hit);
   free(st);
 }
 
@@ -167,11 +168,12 @@ static piola_status implicit_state_make(world_body *s, piola_preconditioner_type
   st->prediction = malloc(v3), st->residual = malloc(v3), st->step = malloc(v3);
   st->base = malloc(v3), st->damping = malloc(v3), st->scratch_v = malloc(v3);
   st->surface_v = malloc(v3);
+  st->surface_mu = malloc(sizeof(double) * (size_t)(s->n > 0 ? s->n : 1));
   st->friction = malloc(v3);
   for (int k = 0; k < 4; ++k) st->cg[k] = malloc(v3);
   st->hit = malloc((size_t)(s->n > 0 ? s->n : 1));
-  int ok = st->prediction && st->residual && st->step && st->base && st->damping &&
-           st->scratch_v && st->surface_v && st->friction && st->hit && st->cg[0] && st->cg[1] &&
+  int ok = st->prediction && st->residual && st->step && st->base && st->damping && st->scratch_v &&
+           st->surface_v && st->surface_mu && st->friction && st->hit && st->cg[0] && st->cg[1] &&
            st->cg[2] && st->cg[3];
   if (ok && piola__body_stiffness_init(s, &st->matrix) != PIOLA_OK) ok = 0;
   if (ok && preconditioner == PIOLA_PRECONDITIONER_INCOMPLETE_CHOLESKY &&
@@ -723,6 +725,7 @@ static piola_status newton_body(piola_world *w, world_body *s, double t, double 
   memcpy(s->force_old, s->force, sizeof(double) * (size_t)m);
   for (int64_t j = 0; j < m; ++j) st->prediction[j] = s->x[j] + (pb.quasistatic ? 0.0 : dt * s->v[j]);
   if (n > 0) memset(s->colliding, 0, (size_t)n);
+  for (int32_t i = 0; i < n; ++i) st->surface_mu[i] = NAN; /* no solid contact yet */
   if (!pb.quasistatic) {
     double fraction = 1.0;
     if (s->kind == PIOLA_BODY_SOLID) {
@@ -1114,11 +1117,61 @@ static piola_status newton_iterate(const newton_problem *problem, int accept_unc
 /* Whether nothing outside the bodies held body s in this step: no prescribed node with mass,
  * no node held by an obstacle, by friction or (a coupled shell) by a solid. */
 static int held_by_bodies_only(const world_body *s) {
-  for (int32_t i = 0; i < s->n; ++i)
-    if (s->mass[i] > 0 &&
-        (s->flags[i] != NODE_FREE || (s->colliding[i] && s->colliding[i] != HELD_BY_COLLISION)))
-      return 0;
+  /* a solid's HELD_BY_SOLID is another solid's surface; a shell's, a solid that does not
+   * feel it */
+  const int solid = s->kind == PIOLA_BODY_SOLID && s->implicit;
+  for (int32_t i = 0; i < s->n; ++i) {
+    if (!(s->mass[i] > 0)) continue;
+    if (s->flags[i] != NODE_FREE) return 0;
+    const uint8_t held = s->colliding[i];
+    if (!held || held == HELD_BY_COLLISION) continue;
+    /* where friction stopped a solid's node on another solid (surface_mu is set) */
+    if (solid && (held == HELD_BY_SOLID ||
+                  (held == HELD_BY_FRICTION && isfinite(s->implicit->surface_mu[i]))))
+      continue;
+    return 0;
+  }
   return 1;
+}
+
+/* Whether solid s met another solid inside its solve, or another solid met it, in this
+ * step's try (solid_contacts.c); a hold released before convergence counts too, since a try
+ * kept unconverged keeps what it did. */
+static int in_solid_contact(const world_body *s) {
+  return s->kind == PIOLA_BODY_SOLID && s->implicit && s->solid_contacts > 0;
+}
+
+/* Solids that met inside their solves each took the other as fixed where it was, so the
+ * forces of their holds are not equal and opposite. Where nothing outside the bodies held
+ * any of them, their momentum is made the start's plus dt M g, by one uniform velocity of
+ * all of them, positions moved with it (x = x^n + dt v): their relative motion is
+ * unchanged (as after the collision pass's solves, self_collide_and_resolve). */
+static void keep_solid_contact_momentum(piola_world *w, double t1, double dt) {
+  if (w->def.integrator != PIOLA_INTEGRATOR_BACKWARD_EULER) return;
+  double excess[3] = {0, 0, 0}, mass = 0, g1[3];
+  for (int k = 0; k < 3; ++k) g1[k] = piola_track_eval(&w->def.gravity[k], t1);
+  int any = 0;
+  for (int32_t b = 0; b < w->body_count; ++b) {
+    const world_body *s = &w->bodies[b];
+    if (!in_solid_contact(s)) continue;
+    if (!held_by_bodies_only(s)) return;
+    any = 1;
+    for (int32_t i = 0; i < s->n; ++i) {
+      mass += s->mass[i];
+      for (int k = 0; k < 3; ++k)
+        excess[k] += s->mass[i] * (s->v[3 * i + k] - s->v_old[3 * i + k] - dt * g1[k]);
+    }
+  }
+  if (!any || !(mass > 0)) return;
+  for (int32_t b = 0; b < w->body_count; ++b) {
+    world_body *s = &w->bodies[b];
+    if (!in_solid_contact(s)) continue;
+    for (int32_t i = 0; i < s->n; ++i)
+      for (int k = 0; k < 3; ++k) {
+        s->v[3 * i + k] -= excess[k] / mass;
+        s->x[3 * i + k] -= dt * excess[k] / mass;
+      }
+  }
 }
 
 /* Adds body s's momentum times `sign` to p (kg m/s); returns its mass (kg). */
@@ -1270,6 +1323,7 @@ piola_status piola__implicit_world_step(piola_world *w, double dt_limit, piola_s
     }
     piola_status st = PIOLA_OK;
     int32_t done = 0;
+    for (int32_t b = 0; b < w->body_count; ++b) w->bodies[b].solid_contacts = 0;
     for (; done < w->body_count && st == PIOLA_OK; ++done)
       st = newton_body(w, &w->bodies[done], w->time, dt, halvings, &local);
     if (st == PIOLA_OK) {
@@ -1298,6 +1352,7 @@ piola_status piola__implicit_world_step(piola_world *w, double dt_limit, piola_s
     }
     dt *= 0.5;
   }
+  keep_solid_contact_momentum(w, w->time + dt, dt);
   const int closes = dt >= left || dt == w->collision_deadline - w->time;
   piola_status contact = self_collide_and_resolve(w, dt, closes, &local);
   if (contact != PIOLA_OK) {

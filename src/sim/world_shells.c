@@ -241,32 +241,6 @@ static vec3 closest_on_triangle(vec3 p, vec3 a, vec3 b, vec3 c, double w[3]) {
   return vec3_add(a, vec3_add(vec3_scale(ab, v), vec3_scale(ac, u)));
 }
 
-/* The boundary surface of a solid, built once (rest topology; positions are read live). */
-static piola_status solid_boundary(world_body *solid) {
-  if (solid->boundary) return PIOLA_OK;
-  const piola_elastic_body *b = solid->solid;
-  piola_tet_mesh tets = {piola_elastic_body_vertex_count(b),
-                         (double *)piola_elastic_body_rest_positions(b),
-                         piola_elastic_body_tet_count(b), (int32_t *)piola_elastic_body_tets(b), NULL, NULL};
-  piola_tri_mesh *surface = calloc(1, sizeof *surface);
-  if (!surface) return PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "solid boundary: out of memory");
-  piola_status st = piola_tet_mesh_boundary(&tets, surface);
-  if (st != PIOLA_OK) {
-    free(surface);
-    return st;
-  }
-  double reach = 0;
-  for (int32_t t = 0; t < surface->triangle_count; ++t)
-    for (int k = 0; k < 3; ++k) {
-      vec3 p = vec3_load(tets.positions + 3 * surface->triangles[3 * t + k]);
-      vec3 q = vec3_load(tets.positions + 3 * surface->triangles[3 * t + (k + 1) % 3]);
-      reach = fmax(reach, vec3_norm(vec3_sub(p, q)));
-    }
-  solid->boundary = surface;
-  solid->boundary_reach = reach;
-  return PIOLA_OK;
-}
-
 int32_t piola__shell_collide_with_solids(piola_world *w, world_body *s, double t1, double dt,
                                          uint8_t mark, double *surface_velocity) {
   (void)t1;
@@ -275,7 +249,7 @@ int32_t piola__shell_collide_with_solids(piola_world *w, world_body *s, double t
     world_body *solid = piola__world_body_of(w, PIOLA_BODY_SOLID, k);
     /* both in the collision surface: the two-way contact after the step handles the pair */
     if (s->self_collision.enabled && solid->self_collision.enabled) continue;
-    if (solid_boundary(solid) != PIOLA_OK) return moved;
+    if (piola__solid_boundary(solid) != PIOLA_OK) return moved;
     const piola_tri_mesh *surface = solid->boundary;
     const double *sx = solid->x, *sv = solid->v;
     /* the solid's current bounding box, grown by the search reach */

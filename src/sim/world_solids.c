@@ -320,3 +320,32 @@ piola_status piola_world_solid_set_work_split(piola_world *world, int32_t solid,
    * every process: replicated mode */
   return piola__elastic_body_set_work_split(s->solid, split, s->plastic == NULL && s->fracture == NULL);
 }
+
+/* The boundary surface of a solid, built once (rest topology; positions are read live). */
+piola_status piola__solid_boundary(world_body *solid) {
+  if (solid->boundary) return PIOLA_OK;
+  const piola_elastic_body *b = solid->solid;
+  piola_tet_mesh tets = {piola_elastic_body_vertex_count(b),
+                         (double *)piola_elastic_body_rest_positions(b),
+                         piola_elastic_body_tet_count(b),
+                         (int32_t *)piola_elastic_body_tets(b),
+                         NULL,
+                         NULL};
+  piola_tri_mesh *surface = calloc(1, sizeof *surface);
+  if (!surface) return PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "solid boundary: out of memory");
+  piola_status st = piola_tet_mesh_boundary(&tets, surface);
+  if (st != PIOLA_OK) {
+    free(surface);
+    return st;
+  }
+  double reach = 0;
+  for (int32_t t = 0; t < surface->triangle_count; ++t)
+    for (int k = 0; k < 3; ++k) {
+      vec3 p = vec3_load(tets.positions + 3 * surface->triangles[3 * t + k]);
+      vec3 q = vec3_load(tets.positions + 3 * surface->triangles[3 * t + (k + 1) % 3]);
+      reach = fmax(reach, vec3_norm(vec3_sub(p, q)));
+    }
+  solid->boundary = surface;
+  solid->boundary_reach = reach;
+  return PIOLA_OK;
+}

@@ -172,7 +172,7 @@ typedef struct piola_constraint_def {
  * with itself and with every other solid or shell that has it enabled (Bridson, Fedkiw and
  * Anderson 2002; docs/contact.md), processed after every step, outside it (paper section 9),
  * or once per piola_world_def.collision_interval. Contact between two bodies is two-way:
- * impulses act on both. With the implicit integrators, solids with it also meet each other's
+ * impulses act on both. With backward Euler, solids with it also meet each other's
  * surfaces inside each step's solve (docs/time-stepping.md, "Solids against each other
  * inside the solve"). */
 typedef struct piola_self_collision_def {

@@ -11,7 +11,8 @@
  *  - on a 0.5 rad incline a block with mu = 0.2 slides at g (sin - mu cos) within 10%, and one
  *    with mu = 0.8 > tan(0.5) stays put, at 1/120 s and (mu = 0.2, 0.4, 0.8) at 1/30 s;
  *  - two balls meeting with self-collision, equal and head-on or unequal and off-centre,
- *    keep their total momentum;
+ *    keep their total momentum; a box dropped on or sliding on a box, both with
+ *    self-collision, gains no energy and comes to rest;
  *  - a frame whose every step fails Newton ends, in at most 8 steps; a step whose Newton
  *    converges at its last allowed iteration is converged, not failed; a non-finite
  *    residual ends the step with PIOLA_ERROR_NOT_FINITE. */

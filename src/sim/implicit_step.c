@@ -1134,6 +1134,16 @@ static int held_by_bodies_only(const world_body *s) {
   return 1;
 }
 
+/* Adds the velocity dv (m/s) to every node of s, moving it by dt dv with it (x = x^n + dt v):
+ * a momentum taken back without changing the bodies' relative motion. */
+static void add_uniform_velocity(world_body *s, const double dv[3], double dt) {
+  for (int32_t i = 0; i < s->n; ++i)
+    for (int k = 0; k < 3; ++k) {
+      s->v[3 * i + k] += dv[k];
+      s->x[3 * i + k] += dt * dv[k];
+    }
+}
+
 /* Whether solid s met another solid inside its solve, or another solid met it, in this
  * step's try (solid_contacts.c); a hold released before convergence counts too, since a try
  * kept unconverged keeps what it did. */
@@ -1163,15 +1173,9 @@ static void keep_solid_contact_momentum(piola_world *w, double t1, double dt) {
     }
   }
   if (!any || !(mass > 0)) return;
-  for (int32_t b = 0; b < w->body_count; ++b) {
-    world_body *s = &w->bodies[b];
-    if (!in_solid_contact(s)) continue;
-    for (int32_t i = 0; i < s->n; ++i)
-      for (int k = 0; k < 3; ++k) {
-        s->v[3 * i + k] -= excess[k] / mass;
-        s->x[3 * i + k] -= dt * excess[k] / mass;
-      }
-  }
+  const double dv[3] = {-excess[0] / mass, -excess[1] / mass, -excess[2] / mass};
+  for (int32_t b = 0; b < w->body_count; ++b)
+    if (in_solid_contact(&w->bodies[b])) add_uniform_velocity(&w->bodies[b], dv, dt);
 }
 
 /* Adds body s's momentum times `sign` to p (kg m/s); returns its mass (kg). */
@@ -1254,12 +1258,7 @@ static piola_status self_collide_and_resolve(piola_world *w, double dt, int clos
                           -added[2] / resolved_mass};
     for (int32_t b = 0; b < w->body_count; ++b) {
       if (!was_resolved[b]) continue;
-      world_body *s = &w->bodies[b];
-      for (int32_t i = 0; i < s->n; ++i)
-        for (int k = 0; k < 3; ++k) {
-          s->v[3 * i + k] += dv[k];
-          s->x[3 * i + k] += dt * dv[k];
-        }
+      add_uniform_velocity(&w->bodies[b], dv, dt);
     }
   }
   free(was_resolved);

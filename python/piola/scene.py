@@ -82,7 +82,7 @@ class Scene:
         steps = cg = written = 0
         try:
             self._write_copy(os.path.join(os.fspath(out_dir), "scene.json"))
-            out.write_frame(0, 0, 0, 0.0, 0, 0, 0)
+            out.write_frame(0, 0.0, None)
             for frame in range(1, n + 1):
                 t0 = _time.perf_counter()
                 try:
@@ -90,9 +90,7 @@ class Scene:
                 except _piola.SimulationError as e:
                     out.write_failure_report(str(e))
                     raise
-                out.write_frame(frame, st["substeps"], st["cg_iterations"],
-                                _time.perf_counter() - t0, st["contacts"], st["impacts"],
-                                st["impact_zones"])
+                out.write_frame(frame, _time.perf_counter() - t0, st)
                 written = frame
                 steps += st["substeps"]
                 cg += st["cg_iterations"]

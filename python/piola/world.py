@@ -277,7 +277,8 @@ class World:
     def advance_to(self, t):
         """Steps until the world time is t (s) exactly, with the GIL released. Returns the
         summed step stats: substeps, cg_iterations, colliding (last step), last_dt (s),
-        contacts, impacts, impact_zones, collision_steps. A non-finite state raises
+        contacts, impacts, impact_zones, collision_steps, newton_iterations,
+        linear_iterations, newton_failures, step_retries, energy_redos. A non-finite state raises
         SimulationError and leaves the state before the failing step."""
         return self._core.advance_to(number(t, "t"))
 

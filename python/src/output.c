@@ -51,19 +51,46 @@ static piola_world *output_world(output_object *self) {
   return pypiola_world_get(self->world);
 }
 
-/* write_frame(frame, substeps, cg_iterations, wall_seconds, contacts, impacts, impact_zones) */
+/* One entry of a step-stats dict (world.c's stats_dict) as an integer; 0 when absent (frame 0
+ * has no steps). Returns -1 with a Python error set. */
+static int stats_entry(PyObject *stats, const char *key, long long *value) {
+  *value = 0;
+  if (stats == Py_None) return 0;
+  PyObject *item = PyDict_GetItemString(stats, key); /* borrowed */
+  if (!item) return 0;
+  *value = PyLong_AsLongLong(item);
+  return *value == -1 && PyErr_Occurred() ? -1 : 0;
+}
+
+/* write_frame(frame, wall_seconds, stats): stats is the dict advance_to returned for the
+ * frame (None for frame 0); its counters become the frame's stats.csv row, as piola run
+ * writes them. */
 static PyObject *output_write_frame(PyObject *self_obj, PyObject *args) {
   output_object *self = (output_object *)self_obj;
   piola_frame_info info = {0};
-  long long contacts = 0, impacts = 0;
-  int frame, substeps, cg, zones;
-  if (!PyArg_ParseTuple(args, "iiidLLi", &frame, &substeps, &cg, &info.wall_seconds, &contacts,
-                        &impacts, &zones))
+  int frame;
+  PyObject *stats;
+  if (!PyArg_ParseTuple(args, "idO", &frame, &info.wall_seconds, &stats)) return NULL;
+  if (stats != Py_None && !PyDict_Check(stats)) {
+    PyErr_SetString(PyExc_TypeError, "write_frame: stats must be a dict or None");
+    return NULL;
+  }
+  long long substeps, cg, contacts, impacts, zones, newton, linear, failures, retries, redos;
+  if (stats_entry(stats, "substeps", &substeps) || stats_entry(stats, "cg_iterations", &cg) ||
+      stats_entry(stats, "contacts", &contacts) || stats_entry(stats, "impacts", &impacts) ||
+      stats_entry(stats, "impact_zones", &zones) ||
+      stats_entry(stats, "newton_iterations", &newton) ||
+      stats_entry(stats, "linear_iterations", &linear) ||
+      stats_entry(stats, "newton_failures", &failures) ||
+      stats_entry(stats, "step_retries", &retries) || stats_entry(stats, "energy_redos", &redos))
     return NULL;
   piola_world *w = output_world(self);
   if (!w) return NULL;
-  info.frame = frame, info.substeps = substeps, info.cg_iterations = cg, info.impact_zones = zones;
-  info.contacts = contacts, info.impacts = impacts;
+  info.frame = frame, info.substeps = (int32_t)substeps, info.cg_iterations = (int32_t)cg;
+  info.contacts = contacts, info.impacts = impacts, info.impact_zones = (int32_t)zones;
+  info.newton_iterations = (int32_t)newton, info.linear_iterations = (int32_t)linear;
+  info.newton_failures = (int32_t)failures, info.step_retries = (int32_t)retries;
+  info.energy_redos = (int32_t)redos;
   /* with the GIL held: no other thread can step the world while its frame is written */
   piola_status st = piola_output_write_frame(self->output, w, &info);
   if (st != PIOLA_OK) return pypiola_raise(pypiola_error, st);
@@ -90,8 +117,7 @@ static PyObject *output_close(PyObject *self_obj, PyObject *unused) {
 }
 
 static PyMethodDef output_methods[] = {
-    {"write_frame", output_write_frame, METH_VARARGS,
-     "write_frame(frame, substeps, cg, wall, contacts, impacts, zones)"},
+    {"write_frame", output_write_frame, METH_VARARGS, "write_frame(frame, wall_seconds, stats)"},
     {"write_failure_report", output_write_failure_report, METH_VARARGS,
      "write_failure_report(message)"},
     {"close", output_close, METH_NOARGS, "close()"},

@@ -209,11 +209,14 @@ static PyObject *world_get_closed(PyObject *self_obj, void *unused) {
 }
 
 static PyObject *stats_dict(const piola_step_stats *st) {
-  return Py_BuildValue("{s:i,s:i,s:i,s:d,s:L,s:L,s:i,s:i}", "substeps", (int)st->substeps,
-                       "cg_iterations", (int)st->cg_iterations, "colliding", (int)st->colliding,
-                       "last_dt", st->last_dt, "contacts", (long long)st->contacts, "impacts",
-                       (long long)st->impacts, "impact_zones", (int)st->impact_zones,
-                       "collision_steps", (int)st->collision_steps);
+  return Py_BuildValue(
+      "{s:i,s:i,s:i,s:d,s:L,s:L,s:i,s:i,s:i,s:i,s:i,s:i,s:i}", "substeps", (int)st->substeps,
+      "cg_iterations", (int)st->cg_iterations, "colliding", (int)st->colliding, "last_dt",
+      st->last_dt, "contacts", (long long)st->contacts, "impacts", (long long)st->impacts,
+      "impact_zones", (int)st->impact_zones, "collision_steps", (int)st->collision_steps,
+      "newton_iterations", (int)st->newton_iterations, "linear_iterations",
+      (int)st->linear_iterations, "newton_failures", (int)st->newton_failures, "step_retries",
+      (int)st->step_retries, "energy_redos", (int)st->energy_redos);
 }
 
 /* Runs advance_to (target >= 0) or one step (dt_limit) without the GIL. */

@@ -47,6 +47,27 @@ def test_run_writes_what_the_cli_writes(tmp_path):
     assert os.path.exists(tmp_path / "py" / "render" / "frame_0002.png")
 
 
+def test_run_writes_the_cli_stats_rows(tmp_path):
+    """Every stats.csv column but the wall time as piola run writes it, the implicit
+    integrator's Newton counters included."""
+    if not CLI:
+        pytest.skip("PIOLA (the CLI) not given; ctest sets it")
+    scene_path = tmp_path / "implicit.json"
+    scene_path.write_text(json.dumps(dict(SMALL, frames=8, integrator={"type": "backward_euler"})))
+    piola.Scene.from_file(scene_path).run(tmp_path / "py")
+    subprocess.run([CLI, "run", str(scene_path), "-o", str(tmp_path / "cli")], check=True,
+                   capture_output=True)
+    rows = {}
+    for side in ["py", "cli"]:
+        with open(tmp_path / side / "stats.csv") as f:
+            rows[side] = [{k: v for k, v in r.items() if k != "wall_seconds"}
+                          for r in csv.DictReader(f)]
+    assert rows["py"] == rows["cli"]
+    # the ball lands in these frames: Newton and its linear solves have work to count
+    assert sum(int(r["newton_iterations"]) for r in rows["py"]) > 0
+    assert sum(int(r["linear_iterations"]) for r in rows["py"]) > 0
+
+
 def test_dict_scene_and_progress_stop(tmp_path):
     scene = piola.Scene(SMALL)
     seen = []

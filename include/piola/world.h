@@ -102,12 +102,13 @@ PIOLA_API bool piola_linear_forcing_from_name(const char *name, piola_linear_for
 
 typedef struct piola_world_def {
   piola_track gravity[3];    /* m/s^2, keyframable. Default (0, 0, -9.81): z is up */
-  double max_dt;             /* s, > 0: the user's cap on the step size. Default 1e-3 */
+  double max_dt;             /* s, in (0, 1]: the user's cap on the step size. Default 1e-3 */
   double cfl;                /* dimensionless, in (0, 2]: dt <= cfl * min altitude / wave
                                 speed. Default 0.5 */
-  double cg_tolerance;       /* damping solves stop at this fraction of the initial residual (the step's velocity change), > 0. Default 1e-4 */
-  int32_t cg_max_iterations; /* >= 1. Default 200 */
-  /* s, >= 0: the collision step of Bridson, Fedkiw and Anderson 2002 (docs/contact.md).
+  double cg_tolerance; /* damping solves stop at this fraction of the initial residual (the step's
+                          velocity change), in (0, 1). Default 1e-4 */
+  int32_t cg_max_iterations; /* in [1, 1000000]. Default 200 */
+  /* s, in [0, 1]: the collision step of Bridson, Fedkiw and Anderson 2002 (docs/contact.md).
    * Self-collision processing (piola_self_collision_def) runs once per interval of this
    * length, from the positions at its start to those after the steps inside it, instead of
    * after every step; an interval ends with the first step that reaches its end, and
@@ -120,16 +121,17 @@ typedef struct piola_world_def {
   piola_integrator_type integrator;
   double implicit_dt;          /* s, > 0: the step of the implicit integrators; halved only
                                   when Newton fails to converge. Default 1/30 */
-  double newton_tolerance;     /* dimensionless, > 0: Newton stops when the mass-weighted RMS
+  double newton_tolerance;     /* dimensionless, in (0, 1): Newton stops when the mass-weighted RMS
                                   of the unbalanced force per mass is below this times
                                   9.81 m/s^2. Default 1e-5 */
-  int32_t newton_max_iterations; /* >= 1: past this the step counts as failed and is
+  int32_t newton_max_iterations; /* in [1, 1000000]: past this the step counts as failed and is
                                   retried at half its size. Default 30 */
   double linear_tolerance;     /* dimensionless, in (0, 1): each Newton system is solved by
                                   preconditioned CG to this fraction of its initial residual
                                   (with PIOLA_FORCING_FIXED; the smallest fraction with
                                   PIOLA_FORCING_EISENSTAT_WALKER). Default 1e-3 */
-  int32_t linear_max_iterations; /* >= 1: CG iterations per Newton system. Default 1000 */
+  int32_t
+      linear_max_iterations; /* in [1, 1000000]: CG iterations per Newton system. Default 1000 */
   piola_preconditioner_type preconditioner; /* the CG's preconditioner. Default
                                   PIOLA_PRECONDITIONER_BLOCK_JACOBI */
   piola_linear_forcing linear_forcing; /* each Newton system's CG tolerance, backward Euler

@@ -76,6 +76,15 @@ def test_views_are_the_worlds_memory():
             ro[0] = 0
 
 
+def test_world_keys_take_the_scene_ranges():
+    """World's keys are refused outside scene-format.md's ranges, as in a scene file."""
+    for key, bad in [("max_dt", 2.0), ("cg_tolerance", 1.0), ("collision_interval", 2.0),
+                     ("cg_max_iterations", 1000001)]:
+        with pytest.raises(ValueError, match=key):
+            piola.World(**{key: bad})
+    piola.World(max_dt=1.0, cg_tolerance=0.5, collision_interval=1.0)  # the ends allowed
+
+
 def test_advance_to_the_past_is_refused_with_the_times():
     w = piola.World()
     w.add_solid(ball(0.04))

@@ -22,35 +22,41 @@ piola_status piola_world_create(const piola_world_def *def, piola_world **out) {
   for (int k = 0; k < 3; ++k)
     if (!piola__track_ok(&def->gravity[k], -INFINITY))
       return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "gravity[%d] must be finite m/s^2", k);
-  if (!(def->max_dt > 0) || !isfinite(def->max_dt))
-    return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "max_dt must be > 0 s, got %g", def->max_dt);
+  /* the ranges of the scene's keys (scene-format.md, "Integrator"), so that a world built
+   * through the library or Python refuses what a scene file would */
+  if (!(def->max_dt > 0 && def->max_dt <= 1))
+    return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "max_dt must be in (0, 1] s, got %g",
+                      def->max_dt);
   if (!(def->cfl > 0 && def->cfl <= 2))
     return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "cfl must be in (0, 2], got %g", def->cfl);
-  if (!(def->cg_tolerance > 0) || !isfinite(def->cg_tolerance))
-    return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "cg_tolerance must be > 0, got %g",
+  if (!(def->cg_tolerance > 0 && def->cg_tolerance < 1))
+    return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "cg_tolerance must be in (0, 1), got %g",
                       def->cg_tolerance);
-  if (def->cg_max_iterations < 1)
-    return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "cg_max_iterations must be >= 1, got %d",
+  if (def->cg_max_iterations < 1 || def->cg_max_iterations > 1000000)
+    return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT,
+                      "cg_max_iterations must be in [1, 1000000], got %d",
                       (int)def->cg_max_iterations);
-  if (!(def->collision_interval >= 0) || !isfinite(def->collision_interval))
-    return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "collision_interval must be >= 0 s, got %g",
-                      def->collision_interval);
+  if (!(def->collision_interval >= 0 && def->collision_interval <= 1))
+    return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT,
+                      "collision_interval must be in [0, 1] s, got %g", def->collision_interval);
   if ((int)def->integrator < 0 || def->integrator >= PIOLA_INTEGRATOR_COUNT)
     return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "integrator: unknown type %d", (int)def->integrator);
   if (!(def->implicit_dt > 0) || !isfinite(def->implicit_dt))
     return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "integrator dt must be > 0 s, got %g",
                       def->implicit_dt);
-  if (!(def->newton_tolerance > 0) || !isfinite(def->newton_tolerance))
-    return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "newton_tolerance must be > 0, got %g",
+  if (!(def->newton_tolerance > 0 && def->newton_tolerance < 1))
+    return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "newton_tolerance must be in (0, 1), got %g",
                       def->newton_tolerance);
-  if (def->newton_max_iterations < 1)
-    return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "newton_max_iterations must be >= 1, got %d",
+  if (def->newton_max_iterations < 1 || def->newton_max_iterations > 1000000)
+    return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT,
+                      "newton_max_iterations must be in [1, 1000000], got %d",
                       (int)def->newton_max_iterations);
   if (!(def->linear_tolerance > 0 && def->linear_tolerance < 1))
     return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "linear_tolerance must be in (0, 1), got %g",
                       def->linear_tolerance);
-  if (def->linear_max_iterations < 1)
-    return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "linear_max_iterations must be >= 1, got %d",
+  if (def->linear_max_iterations < 1 || def->linear_max_iterations > 1000000)
+    return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT,
+                      "linear_max_iterations must be in [1, 1000000], got %d",
                       (int)def->linear_max_iterations);
   if ((int)def->preconditioner < 0 || def->preconditioner >= PIOLA_PRECONDITIONER_COUNT)
     return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "unknown preconditioner %d",

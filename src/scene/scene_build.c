@@ -45,8 +45,30 @@ piola_status piola__scene_read_goal_mesh(const scene_solid_desc *d, const piola_
   return PIOLA_OK;
 }
 
+/* Index selectors can only be checked against the mesh: the first index past its
+ * vertex_count fails, naming the scene key (KIND[i].fixed[c] or .driven[c]). */
+static piola_status check_index_selectors(const char *label, const char *kind, int32_t i,
+                                          const scene_solid_desc *d, int32_t vertex_count) {
+  for (int32_t c = 0; c < d->constraint_count; ++c) {
+    const piola_selector *sel = &d->constraints[c].selector;
+    if (sel->type != PIOLA_SELECT_INDICES) continue;
+    for (int32_t k = 0; k < sel->index_count; ++k)
+      if (sel->indices[k] >= vertex_count) {
+        const int fixed = c < d->fixed_count;
+        return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT,
+                          "%s: %s[%d].%s[%d].indices[%d]: vertex %d is out of range (the mesh has "
+                          "%d vertices)",
+                          label, kind, (int)i, fixed ? "fixed" : "driven",
+                          (int)(fixed ? c : c - d->fixed_count), (int)k, (int)sel->indices[k],
+                          (int)vertex_count);
+      }
+  }
+  return PIOLA_OK;
+}
+
 /* Shells: read or generate the triangle mesh, place it, add the shell. */
-static piola_status build_shell(piola_world *world, const scene_shell_desc *d) {
+static piola_status build_shell(piola_world *world, const scene_shell_desc *d, const char *label,
+                                int32_t index) {
   piola_tri_mesh mesh;
   memset(&mesh, 0, sizeof mesh);
   piola_status st;
@@ -63,7 +85,12 @@ static piola_status build_shell(piola_world *world, const scene_shell_desc *d) {
     st = PIOLA_FAIL(PIOLA_ERROR_PARSE, "the mesh has no triangles");
   if (st != PIOLA_OK) {
     piola_tri_mesh_free(&mesh);
-    return PIOLA_FAIL(st, "mesh: %s", piola_last_error());
+    return PIOLA_FAIL(st, "%s: shells[%d]: mesh: %s", label, (int)index, piola_last_error());
+  }
+  st = check_index_selectors(label, "shells", index, &d->base, mesh.vertex_count);
+  if (st != PIOLA_OK) {
+    piola_tri_mesh_free(&mesh);
+    return st;
   }
   mat3 r = euler_xyz_degrees(d->base.rotate_degrees);
   for (int32_t i = 0; i < mesh.vertex_count; ++i) {
@@ -84,7 +111,9 @@ static piola_status build_shell(piola_world *world, const scene_shell_desc *d) {
   def.constraint_count = d->base.constraint_count;
   st = piola_world_add_shell(world, &def, NULL);
   piola_tri_mesh_free(&mesh);
-  return st;
+  return st == PIOLA_OK
+             ? st
+             : PIOLA_FAIL(st, "%s: shells[%d]: %s", label, (int)index, piola_last_error());
 }
 
 /* Bones: the obstacle part as for obstacles, then the attachments (solids are in). */
@@ -152,22 +181,11 @@ piola_status piola__scene_build(const scene_desc *desc, const char *label,
       piola_world_destroy(world);
       return PIOLA_FAIL(st, "%s: solids[%d].mesh: %s", label, (int)i, piola_last_error());
     }
-    /* index selectors can only be checked against the mesh: name the scene key */
-    for (int32_t c = 0; c < d->constraint_count; ++c) {
-      const piola_selector *sel = &d->constraints[c].selector;
-      if (sel->type != PIOLA_SELECT_INDICES) continue;
-      for (int32_t k = 0; k < sel->index_count; ++k)
-        if (sel->indices[k] >= mesh.vertex_count) {
-          int fixed = c < d->fixed_count;
-          piola_status bad = PIOLA_FAIL(
-              PIOLA_ERROR_INVALID_ARGUMENT,
-              "%s: solids[%d].%s[%d].indices[%d]: vertex %d is out of range (the mesh has %d vertices)",
-              label, (int)i, fixed ? "fixed" : "driven", (int)(fixed ? c : c - d->fixed_count), (int)k,
-              (int)sel->indices[k], (int)mesh.vertex_count);
-          piola_tet_mesh_free(&mesh);
-          piola_world_destroy(world);
-          return bad;
-        }
+    st = check_index_selectors(label, "solids", i, d, mesh.vertex_count);
+    if (st != PIOLA_OK) {
+      piola_tet_mesh_free(&mesh);
+      piola_world_destroy(world);
+      return st;
     }
     place(&mesh, d);
     piola_solid_def def = d->def;
@@ -227,10 +245,10 @@ piola_status piola__scene_build(const scene_desc *desc, const char *label,
   }
   piola_world_set_work_split_planner(world, planner);
   for (int32_t i = 0; i < desc->shell_count; ++i) {
-    piola_status st = build_shell(world, &desc->shells[i]);
+    piola_status st = build_shell(world, &desc->shells[i], label, i);
     if (st != PIOLA_OK) {
       piola_world_destroy(world);
-      return PIOLA_FAIL(st, "%s: shells[%d]: %s", label, (int)i, piola_last_error());
+      return st;
     }
   }
   for (int32_t i = 0; i < desc->obstacle_count; ++i) {

@@ -168,6 +168,7 @@ static piola_status parse_shell(scene_parser *p, const cJSON *obj, int index, sc
   PIOLA_TRY(piola__scene_parse_self_collision(p, obj, &d->def.self_collision));
   PIOLA_TRY(piola__json_opt_vec3(p, obj, "velocity", ANY, &d->base.def.velocity));
   PIOLA_TRY(piola__scene_parse_constraints(p, obj, "fixed", 0, &d->base));
+  d->base.fixed_count = d->base.constraint_count;
   PIOLA_TRY(piola__scene_parse_constraints(p, obj, "driven", 1, &d->base));
   return PIOLA_OK;
 }

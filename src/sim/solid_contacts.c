@@ -64,10 +64,10 @@ static void triangle_boxes(const world_body *other, double reach, piola__box *bo
 }
 
 /* Node i of s against other's surface (tree over its triangles, candidates scratch): puts
- * it `gap` outside the nearest triangle when it is closer than that or inside. Returns 1
- * when it did. */
+ * it `gap` outside the nearest triangle when it is closer than that or inside (a node held
+ * already: see below; thickness is the pair's). Returns 1 when it did. */
 static int hold_outside(world_body *s, int32_t i, world_body *other, const piola__bvh *tree,
-                        piola__index_list *candidates, double gap, double mu,
+                        piola__index_list *candidates, double gap, double thickness, double mu,
                         double *surface_velocity, double *surface_mu, uint8_t mark) {
   const piola_tri_mesh *surface = other->boundary;
   const vec3 x = vec3_load(s->x + 3 * i);
@@ -99,10 +99,15 @@ static int hold_outside(world_body *s, int32_t i, world_body *other, const piola
   /* inside where the offset clearly points into the solid (on an edge or a corner it can be
    * perpendicular to the face's normal, a rounding residue of either sign) */
   const int inside = side < -1e-9 * dn * face_norm;
-  /* a node held already stays where it is held unless it has come clearly closer (each
-   * call's nearest triangle can differ by a rounding, and so would the hold) */
-  const double closer = s->colliding[i] == mark ? (1.0 - 1e-3) * gap : gap;
-  if (!inside && !(dn < closer)) return 0;
+  /* a node held already is put out again only once it has come within the thickness of a
+   * solid solved before it, where the collision pass would act, or half the thickness into
+   * one solved after it, whose own solve keeps the gap. Held along one triangle's normal, it
+   * slides along that triangle's offset plane, and in a dent of the other surface that takes
+   * it towards the next triangle: put out at every approach, nodes of
+   * examples/solids_stack.json went from triangle to triangle of the dent at every Newton
+   * iteration, up to 128 times in a frame, and the steps did not converge */
+  const double least = gap > 0 ? thickness : -0.5 * thickness;
+  if (s->colliding[i] == mark ? !((inside ? -dn : dn) < least) : !inside && !(dn < gap)) return 0;
   vec3 normal;
   if (dn > 0 && (inside || side > 1e-9 * dn * face_norm))
     normal = vec3_scale(d, (inside ? -1.0 : 1.0) / dn);
@@ -139,10 +144,8 @@ int32_t piola__solid_contacts_with_solids(piola_world *w, world_body *s, uint8_t
      * the gap, each against the other's surface, pushed the lower of two boxes at rest on
      * each other into a dent wherever a node of its top came within the gap of a face of
      * the upper box (1.6 J in single frames) */
-    const double gap =
-        other > s
-            ? 0.0
-            : HELD_GAP * 0.5 * (s->self_collision.thickness + other->self_collision.thickness);
+    const double thickness = 0.5 * (s->self_collision.thickness + other->self_collision.thickness);
+    const double gap = other > s ? 0.0 : HELD_GAP * thickness;
     const double mu = 0.5 * (s->self_collision.friction + other->self_collision.friction);
     /* a node is searched for as deep inside as the two bodies' motions in this step can have
      * taken it (its own move and the other's largest; one solved later has not moved yet),
@@ -165,8 +168,8 @@ int32_t piola__solid_contacts_with_solids(piola_world *w, world_body *s, uint8_t
       if (x[0] + move < whole.lo[0] || x[0] - move > whole.hi[0] || x[1] + move < whole.lo[1] ||
           x[1] - move > whole.hi[1] || x[2] + move < whole.lo[2] || x[2] - move > whole.hi[2])
         continue;
-      moved += hold_outside(s, i, other, &tree, &candidates, gap, mu, surface_velocity, surface_mu,
-                            mark);
+      moved += hold_outside(s, i, other, &tree, &candidates, gap, thickness, mu, surface_velocity,
+                            surface_mu, mark);
     }
   }
   piola__bvh_free(&tree);

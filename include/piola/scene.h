@@ -94,6 +94,13 @@ PIOLA_API piola_vec3 piola_scene_desc_gravity(const piola_scene_desc *desc, doub
  * same meshes from any folder. The copy is not validated beyond being JSON. */
 PIOLA_API piola_status piola_scene_copy_resolved(const char *scene_path, const char *out_path);
 
+/* A key (FNV-1a 64) of the files the scene at scene_path names: the meshes of solids,
+ * shells, obstacles and bones, plastic goal meshes and fracture cut meshes, each by its
+ * resolved path and its bytes, in the scene's order. `piola run` folds it into its
+ * checkpoints' scene key, so that --resume refuses a run whose obstacle or goal mesh has
+ * been edited since (file-formats.md, "Checkpoints"). */
+PIOLA_API piola_status piola_scene_inputs_key(const char *scene_path, uint64_t *key);
+
 #ifdef __cplusplus
 }
 #endif

@@ -10,6 +10,7 @@
 
 #include "cli/run_split_checkpoints.h"
 #include "piola/checkpoint.h"
+#include "piola/scene.h"
 
 int run_scene_key(const char *scene_path, const piola_world *world, uint64_t *key) {
   /* the scene was just loaded from this path, so it is a regular file of a sane size */
@@ -35,8 +36,19 @@ int run_scene_key(const char *scene_path, const piola_world *world, uint64_t *ke
             scene_path);
     return 0;
   }
-  *key = piola_world_scene_key(world, bytes, n);
-  free(bytes);
+  /* the files the scene names, appended to its bytes: a mesh obstacle or a plastic goal
+   * edited between a kill and --resume would otherwise go on from the old frames */
+  uint64_t inputs = 0;
+  char *all = bytes ? realloc(bytes, n + sizeof inputs) : NULL;
+  if (!all || piola_scene_inputs_key(scene_path, &inputs) != PIOLA_OK) {
+    free(all ? all : bytes);
+    fprintf(stderr, "piola run: %s: cannot read the files the scene names for its checkpoint key\n",
+            scene_path);
+    return 0;
+  }
+  memcpy(all + n, &inputs, sizeof inputs);
+  *key = piola_world_scene_key(world, all, n + sizeof inputs);
+  free(all);
   return 1;
 }
 

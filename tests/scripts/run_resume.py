@@ -246,5 +246,31 @@ open(f"{mesh_dir}/oct.node", "w").write("\n".join(node) + "\n")
 r = subprocess.run([PIOLA, "run", mesh_scene, "-o", out, "--resume"], capture_output=True, text=True)
 check(r.returncode == 2 and "another scene" in r.stderr, "a changed mesh file is refused: " + r.stderr.strip())
 
+# a mesh obstacle's file edited under the same scene text: the solid's mesh is the same, so
+# only the key of the files the scene names (piola_scene_inputs_key) tells the runs apart
+shutil.copy(f"{data_dir}/surface/sphere.obj", f"{mesh_dir}/bowl.obj")
+obstacle_scene = os.path.join(mesh_dir, "obstacle.json")
+with open(obstacle_scene, "w") as f:
+    f.write('{"fps": 30, "frames": 2, "solids": [{"mesh": "oct.node", "transform": {"translate": [0, 0, 5]}}], '
+            '"obstacles": [{"type": "mesh", "path": "bowl.obj"}]}')
+out = os.path.join(work, "obstacleout")
+r = subprocess.run([PIOLA, "run", obstacle_scene, "-o", out], capture_output=True, text=True)
+check(r.returncode == 0, "a run with a mesh obstacle: " + r.stderr[-200:])
+r = subprocess.run([PIOLA, "run", obstacle_scene, "-o", out, "--resume", "--frames", "3"],
+                   capture_output=True, text=True)
+check(r.returncode == 0, "the unchanged scene and files resume: " + r.stderr[-200:])
+with open(f"{mesh_dir}/bowl.obj") as f:
+    lines = f.read().splitlines()
+with open(f"{mesh_dir}/bowl.obj", "w") as f:  # the obstacle moved down by 1 mm
+    for line in lines:
+        fields = line.split()
+        if fields and fields[0] == "v":
+            line = "v %s %s %r" % (fields[1], fields[2], float(fields[3]) - 1e-3)
+        f.write(line + "\n")
+r = subprocess.run([PIOLA, "run", obstacle_scene, "-o", out, "--resume", "--frames", "4"],
+                   capture_output=True, text=True)
+check(r.returncode == 2 and "another scene" in r.stderr,
+      "an edited obstacle mesh is refused: " + r.stderr.strip())
+
 shutil.rmtree(work)
 finish()

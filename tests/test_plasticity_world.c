@@ -22,15 +22,33 @@ static double span(const piola_world *w, int32_t a, int32_t b) {
   return sqrt(d2);
 }
 
+/* A world without gravity stepped by Newmark at 2 ms, or by backward Euler at one step per
+ * 1/30 s frame. */
+static piola_world *weightless_world_of(piola_integrator_type integrator) {
+  if (integrator == PIOLA_INTEGRATOR_NEWMARK) return weightless_world(2e-3);
+  piola_world_def wd = piola_default_world_def();
+  for (int k = 0; k < 3; ++k) wd.gravity[k] = piola_track_constant(0);
+  wd.integrator = integrator;
+  wd.implicit_dt = 1.0 / 30;
+  piola_world *w = NULL;
+  assert_int_equal(piola_world_create(&wd, &w), PIOLA_OK);
+  return w;
+}
+
 /* Released from a uniform stretch s = 1.3 along x (past the yield strain 0.05), a damped bar
  * settles at length s e^-gamma (the return mapping by hand: log Fp = log s - gamma); the same
- * bar without plasticity returns to its rest length. */
+ * bar without plasticity returns to its rest length. Backward Euler too: its first step, a
+ * whole frame, relaxes most of the stretch, so the start's flow is only seen because the
+ * state at t = 0 is return-mapped before it (a 2% set instead of 24% without). */
 static void stretched_bar_keeps_its_permanent_set(void **state) {
   (void)state;
   piola_tet_mesh mesh = block_mesh(6, 1, 1, 0.6, 0.1, 0.1);
   const double s = 1.3, gamma = 0.05;
-  for (int plastic = 0; plastic < 2; ++plastic) {
-    piola_world *w = weightless_world(2e-3);
+  const piola_integrator_type integrators[2] = {PIOLA_INTEGRATOR_NEWMARK,
+                                                PIOLA_INTEGRATOR_BACKWARD_EULER};
+  for (int k = 0; k < 4; ++k) {
+    const int plastic = k % 2;
+    piola_world *w = weightless_world_of(integrators[k / 2]);
     piola_solid_def sd = piola_default_solid_def();
     sd.mesh = &mesh;
     sd.material.model = PIOLA_MODEL_ROTATED_LINEAR;

@@ -358,6 +358,138 @@ static void test_value_colors_and_color_bar(void **state) {
   test_sphere_free(&s);
 }
 
+/* A field uniform up to rounding (1 + 1e-15 noise, as det F of a uniformly stretched cube)
+ * is one value: every face takes the middle colour, exactly as a field of 0.5 in 0..1 does,
+ * and the bar shows that colour alone, not a ramp stretched over the noise. The same holds
+ * for a negative field whose range the renderer chooses itself. Values beyond the tolerance
+ * band take the end colours. */
+static void test_uniform_field_is_one_colour(void **state) {
+  (void)state;
+  assert_true(piola__render_range_is_uniform(0, 0));
+  assert_true(piola__render_range_is_uniform(1 - 1e-15, 1 + 1e-15));
+  assert_true(piola__render_range_is_uniform(-2e3 * (1 + 1e-10), -2e3));
+  assert_false(piola__render_range_is_uniform(1, 1 + 1e-5));
+  assert_false(piola__render_range_is_uniform(-1e-3, 1e-3));
+  assert_true(piola__render_range_position(1 + 3e-16, 1 - 1e-15, 1 + 1e-15) == 0.5);
+  assert_true(piola__render_range_position(0.5, 1 - 1e-15, 1 + 1e-15) == 0);
+  assert_true(piola__render_range_position(2, 1 - 1e-15, 1 + 1e-15) == 1);
+  assert_true(piola__render_range_position(0.25, 0, 1) == 0.25);
+
+  piola_render_def def = axis_camera(3, 40);
+  def.color = PIOLA_RENDER_COLOR_VALUE;
+  def.value_label = "det_f";
+  test_sphere s = test_uv_sphere(96, 48, 0.5, 0, 0, 0);
+  piola_render_mesh m = sphere_mesh(&s);
+  double *values = malloc((size_t)s.triangle_count * sizeof *values);
+  double lo = INFINITY, hi = -INFINITY;
+  uint32_t seed = 12345;
+  for (int32_t t = 0; t < s.triangle_count; ++t) {
+    seed = seed * 1664525u + 1013904223u;
+    values[t] = 1.0 + 1e-15 * ((double)(seed >> 8) / (double)(1u << 24) - 0.5);
+    lo = fmin(lo, values[t]), hi = fmax(hi, values[t]);
+  }
+  assert_true(hi > lo); /* the noise is there: a plain map would stretch over it */
+  m.values = values;
+  def.value_min = lo, def.value_max = hi;
+  piola_renderer *r;
+  piola_image noisy = {0}, middle = {0}, negative = {0};
+  assert_int_equal(piola_renderer_create(&def, &r), PIOLA_OK);
+  assert_int_equal(piola_renderer_render(r, &m, &noisy), PIOLA_OK);
+  piola_renderer_destroy(r);
+  keep("value_uniform", &noisy);
+  /* reference: every face at 0.5 of a 0..1 range, the middle of the map */
+  double *halves = malloc((size_t)s.triangle_count * sizeof *halves);
+  for (int32_t t = 0; t < s.triangle_count; ++t) halves[t] = 0.5;
+  m.values = halves;
+  def.value_min = 0, def.value_max = 1;
+  assert_int_equal(piola_renderer_create(&def, &r), PIOLA_OK);
+  assert_int_equal(piola_renderer_render(r, &m, &middle), PIOLA_OK);
+  piola_renderer_destroy(r);
+  /* a negative field with the renderer's own range (min to 99th percentile) */
+  for (int32_t t = 0; t < s.triangle_count; ++t) halves[t] = -values[t];
+  def.value_min = def.value_max = 0;
+  assert_int_equal(piola_renderer_create(&def, &r), PIOLA_OK);
+  assert_int_equal(piola_renderer_render(r, &m, &negative), PIOLA_OK);
+  piola_renderer_destroy(r);
+  int W = noisy.width, H = noisy.height;
+  double f = 0.5 * H / tan(20 * M_PI / 180), rpx = f * tan(asin(0.5 / 3));
+  int bar_x = W / 2 + (int)rpx + 4;
+  long differ = 0, differ_negative = 0;
+  for (int y = 0; y < H; ++y)
+    for (int x = 0; x < bar_x; ++x) {
+      differ += !same_rgb(&noisy, &middle, x, y);
+      differ_negative += !same_rgb(&negative, &middle, x, y);
+    }
+  assert_int_equal(differ, 0);
+  assert_int_equal(differ_negative, 0);
+  /* the bar: the middle colour over its whole height, neither end of the map */
+  render_rgb c0 = piola__render_colormap(0), c_mid = piola__render_colormap(0.5),
+             c1 = piola__render_colormap(1);
+  assert_true(count_near(&noisy, bar_x, c_mid, 1) >= 10L * (H / 2));
+  assert_int_equal(count_near(&noisy, bar_x, c0, 3), 0);
+  assert_int_equal(count_near(&noisy, bar_x, c1, 3), 0);
+  assert_true(count_near(&middle, bar_x, c0, 3) >= 10);
+  piola_image_free(&noisy);
+  piola_image_free(&middle);
+  piola_image_free(&negative);
+  free(halves);
+  free(values);
+  test_sphere_free(&s);
+}
+
+/* The bitmap font draws letters in the case they are given: field names such as
+ * "energy_density" read in lowercase throughout (no "eNeRGY_DeNSITY" from a lowercase 'e'
+ * among capitals), every lowercase letter has a glyph of its own, and short lowercase letters
+ * leave the top two rows (the ascender zone) empty while every capital reaches the top. */
+static bool glyph_rows(char c, uint8_t rows[7]) {
+  piola_image img = {0};
+  assert_int_equal(piola__image_resize(&img, 5, 7), PIOLA_OK);
+  memset(img.rgb, 0, 3 * 5 * 7);
+  char text[2] = {c, 0};
+  piola__render_text(&img, 0, 0, 1, text, 255, 255, 255);
+  bool ink = false;
+  for (int y = 0; y < 7; ++y) {
+    rows[y] = 0;
+    for (int x = 0; x < 5; ++x)
+      if (img.rgb[3 * (y * 5 + x)]) rows[y] |= (uint8_t)(0x10 >> x), ink = true;
+  }
+  piola_image_free(&img);
+  return ink;
+}
+
+static void test_font_keeps_the_case_of_letters(void **state) {
+  (void)state;
+  for (char c = 'a'; c <= 'z'; ++c) {
+    uint8_t lower[7], upper[7];
+    assert_true(glyph_rows(c, lower));
+    assert_true(glyph_rows((char)(c - 'a' + 'A'), upper));
+    assert_true(upper[0] != 0);
+    assert_true(memcmp(lower, upper, sizeof lower) != 0);
+  }
+  for (const char *c = "acemnorsuvwxz_"; *c; ++c) {
+    uint8_t rows[7];
+    assert_true(glyph_rows(*c, rows));
+    assert_true(rows[0] == 0 && rows[1] == 0);
+  }
+  /* a caption is its letters side by side, each in its own case */
+  const char *caption = "energy_density";
+  int n = (int)strlen(caption), w = piola__render_text_width(caption, 1);
+  assert_int_equal(w, 6 * n - 1);
+  piola_image img = {0};
+  assert_int_equal(piola__image_resize(&img, w, 7), PIOLA_OK);
+  memset(img.rgb, 0, 3 * (size_t)w * 7);
+  piola__render_text(&img, 0, 0, 1, caption, 255, 255, 255);
+  for (int i = 0; i < n; ++i) {
+    uint8_t rows[7];
+    glyph_rows(caption[i], rows);
+    for (int y = 0; y < 7; ++y)
+      for (int x = 0; x < 5; ++x)
+        assert_int_equal(img.rgb[3 * ((size_t)y * (size_t)w + (size_t)(6 * i + x))] != 0,
+                         (rows[y] & (0x10 >> x)) != 0);
+  }
+  piola_image_free(&img);
+}
+
 /* The automatic camera frames the box: the object is inside the image, away from its
  * border, and fills a fair part of it. */
 static void test_auto_camera_frames_the_object(void **state) {
@@ -708,6 +840,8 @@ int main(void) {
       cmocka_unit_test(test_ground_fills_the_view_below_the_horizon),
       cmocka_unit_test(test_inverted_highlight_present_exactly_when_flagged),
       cmocka_unit_test(test_value_colors_and_color_bar),
+      cmocka_unit_test(test_uniform_field_is_one_colour),
+      cmocka_unit_test(test_font_keeps_the_case_of_letters),
       cmocka_unit_test(test_auto_camera_frames_the_object),
       cmocka_unit_test(test_mesh_and_moving_obstacles),
       cmocka_unit_test(test_shadow_of_a_sphere_on_the_ground),

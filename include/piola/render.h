@@ -86,7 +86,10 @@ typedef struct piola_render_def {
   int32_t supersample;  /* 1..4: antialiasing by rendering s x s samples per pixel and
                            averaging them (s^2 times the cost). Default 1 */
   /* Colour-map range of PIOLA_RENDER_COLOR_VALUE; value_min >= value_max chooses the range
-   * from each frame's values (0 to their 99th percentile). */
+   * from each frame's values (the smaller of 0 and their minimum, to their 99th percentile).
+   * A range no wider than 1e-6 max(|min|, |max|) is one value, the field uniform up to
+   * rounding: faces within that of its centre take the middle colour, the rest an end colour,
+   * and the bar shows that colour with the value (docs/rendering.md). */
   double value_min, value_max;
   const char *value_label; /* caption above the colour bar (copied), or NULL */
 } piola_render_def;

@@ -242,7 +242,13 @@ static void pool_range(value_pool *p, double *lo, double *hi) {
   *lo = p->v[(size_t)floor(0.02 * (double)(p->n - 1))];
   *hi = p->v[(size_t)ceil(0.98 * (double)(p->n - 1))];
   if (!(*hi > *lo)) *lo = p->v[0], *hi = p->v[p->n - 1];
-  if (!(*hi > *lo)) *hi = *lo + 1;
+  /* all values equal, V: a range 1e-7 |V| either side, which the renderer draws as the one
+   * value V (render.h); V = 0 stays 0..0, which it reads as choosing each frame's range,
+   * again the one value 0 where every face is 0 */
+  if (!(*hi > *lo)) {
+    const double v = *lo;
+    *lo = v - 1e-7 * fabs(v), *hi = v + 1e-7 * fabs(v);
+  }
 }
 
 static void mesh_bounds(const piola_render_mesh *m, piola_vec3 *lo, piola_vec3 *hi) {
@@ -303,7 +309,7 @@ static int plan_stress(const render_options *o, render_plan *p, int first_frame)
     if (piola_render_frame_has_field(lf.vtu, names[k])) p->value_field = names[k];
   bool has_displacement = lf.vtu && piola_render_frame_has_rest_positions(lf.vtu);
   render_cli_frame_free(&lf);
-  snprintf(p->label, sizeof p->label, "STRESS (PA)");
+  snprintf(p->label, sizeof p->label, "von Mises stress (Pa)");
   if (p->value_field) return -1;
   int32_t n = 0;
   if (!p->use_scene) {
@@ -476,7 +482,7 @@ int cli_render(int argc, char **argv) {
   p.value_field = o.field;
   if (!p.value_field && strcmp(o.color, "energy") == 0) {
     p.value_field = "energy_density";
-    snprintf(p.label, sizeof p.label, "ENERGY DENSITY (J/M^3)");
+    snprintf(p.label, sizeof p.label, "energy density (J/m^3)");
   }
   if (p.value_field || strcmp(o.color, "stress") == 0) {
     if (!p.vtu) {

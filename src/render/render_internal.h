@@ -115,10 +115,22 @@ void piola__render_ray_pass(const piola_renderer *r, const render_camera *cam, d
 piola_status piola__render_triangles(const render_camera *cam, const piola_render_mesh *mesh,
                                      const float *face_rgb, float *depth, uint8_t *rgb);
 
-/* Colour map (0..1 -> a perceptually ordered blue-green-yellow ramp, never red). */
+/* Colour map (0..1 -> viridis: dark purple, blue, teal, green, yellow; never red). */
 render_rgb piola__render_colormap(double s);
 
-/* Vertical colour bar at the right edge with labels of the range [lo, hi]. */
+/* A colour range [lo, hi] no wider than this fraction of max(|lo|, |hi|) is rounding noise
+ * around one value (color_bar.c says why this much). */
+#define RENDER_UNIFORM_TOLERANCE 1e-6
+/* Whether [lo, hi] (lo <= hi) is one value: hi - lo <= RENDER_UNIFORM_TOLERANCE max(|lo|,
+ * |hi|), which includes lo == hi. */
+bool piola__render_range_is_uniform(double lo, double hi);
+/* Where value v falls on the colour map for the range [lo, hi]: (v - lo) / (hi - lo), or for
+ * a uniform range 0.5 (the middle) within the tolerance of its centre, 0 below, 1 above. */
+double piola__render_range_position(double v, double lo, double hi);
+
+/* Vertical colour bar at the right edge with labels of the range [lo, hi] (hi, middle, lo,
+ * with as many digits as tell them apart), or for a uniform range the middle colour and one
+ * label, the value. */
 void piola__render_color_bar(piola_image *image, double lo, double hi, const char *label);
 
 /* Text in the built-in 5x7 bitmap font; scale is the pixel size of one font dot. Unknown

@@ -232,7 +232,8 @@ static int compare_double(const void *a, const void *b) {
 }
 
 /* 0 and the 99th percentile of the finite values: energy densities are heavy-tailed (a few
- * crushed elements dwarf the rest), and a max-scaled map would show nothing else. */
+ * crushed elements dwarf the rest), and a max-scaled map would show nothing else. Values
+ * that are all equal give lo == hi, a uniform range (one colour); no finite value gives 0..1. */
 static void auto_range(const double *v, int32_t n, double *lo, double *hi) {
   double *s = malloc((size_t)(n > 0 ? n : 1) * sizeof *s);
   int32_t m = 0;
@@ -250,7 +251,6 @@ static void auto_range(const double *v, int32_t n, double *lo, double *hi) {
     *lo = mn < 0 ? mn : 0;
     *hi = s[(int32_t)floor(0.99 * (m - 1))];
     if (!(*hi > *lo)) *hi = s[m - 1];
-    if (!(*hi > *lo)) *hi = *lo + 1;
   }
   free(s);
 }
@@ -356,7 +356,8 @@ static piola_status render_once(piola_renderer *r, const piola_render_mesh *mesh
     for (int32_t t = 0; t < nt; ++t) {
       float *c = face_rgb + 3 * (size_t)t;
       if (r->def.color == PIOLA_RENDER_COLOR_VALUE) {
-        render_rgb m = piola__render_colormap((mesh->values[t] - lo) / (hi - lo));
+        render_rgb m =
+            piola__render_colormap(piola__render_range_position(mesh->values[t], lo, hi));
         c[0] = m.r, c[1] = m.g, c[2] = m.b;
       } else if (r->def.color == PIOLA_RENDER_COLOR_INVERTED) {
         bool inv = mesh->inverted && mesh->inverted[t];

@@ -26,6 +26,11 @@ static piola_status parse_top(scene_parser *p, const cJSON *root, scene_desc *ou
   else
     PIOLA_TRY(piola__json_required(p, root, "solids"));
   PIOLA_TRY(piola__scene_parse_solids(p, piola__json_get(root, "solids"), out));
+  if (out->solid_count == 0 && out->shell_count == 0) {
+    piola__json_push_key(p, "shells");
+    return piola__json_fail(p, PIOLA_ERROR_PARSE,
+                            "is empty and there are no solids: nothing to simulate");
+  }
   if ((v = piola__json_get(root, "obstacles"))) PIOLA_TRY(piola__scene_parse_obstacles(p, v, out));
   if ((v = piola__json_get(root, "bones"))) PIOLA_TRY(piola__scene_parse_bones(p, v, out));
   return PIOLA_OK;

@@ -52,6 +52,7 @@ expect_bad obstacle '{"solids": [{"mesh": {"generate": "box", "half_extents": [0
 expect_bad missing_mesh '{"solids": [{"mesh": "no_such_mesh.veg"}]}' "solids[0].mesh"
 expect_bad bad_index '{"solids": [{"mesh": {"generate": "box", "half_extents": [0.1, 0.1, 0.1], "cell_size": 0.1}, "fixed": [{"indices": [100000]}]}]}' \
   "solids[0].fixed[0].indices[0]: vertex 100000 is out of range"
+expect_bad empty_shells '{"shells": []}' "shells: is empty and there are no solids"
 # a shell's driven selector after a fixed one: named by its own key, not by its place in the
 # shell's combined constraint list
 expect_bad shell_driven_index '{"shells": [{"mesh": {"generate": "rectangle", "size": [0.2, 0.2], "resolution": [4, 4]}, "fixed": [{"indices": [0]}], "driven": [{"indices": [1], "motion": {"velocity": [0, 0, 1]}}, {"indices": [999], "motion": {"velocity": [0, 0, 1]}}]}]}' \

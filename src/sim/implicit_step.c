@@ -1067,27 +1067,62 @@ static piola_status newton_iterate(const newton_problem *problem, int accept_unc
     pb.friction_held = 1, pb.kinetic = 1, pb.contacts_moved = 1, pb.slip_rounds = 0;
     return newton_iterate(&pb, accept_unconverged, stats);
   }
+  /* the body's energy at the converged iterate, whose forces are the last update's, and
+   * that iterate's positions, to fall back on (see below) */
+  const int energy_checked =
+      !pb.quasistatic && !pb.friction_held && converged && !piola__implicit_split_of(s);
+  const double energy_before = energy_checked ? total_energy(&pb, s->x, s->v) : NAN;
+  double *kept = energy_checked ? malloc(sizeof(double) * 2 * (size_t)m) : NULL;
+  if (energy_checked && !kept)
+    return PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "implicit step: out of memory");
+  if (kept) memcpy(kept, s->x, sizeof(double) * (size_t)m);
   if (!pb.quasistatic && !pb.friction_held && piola__newton_contact_friction(&pb) > 0) {
-    PIOLA_TRY(update(&pb));
+    piola_status updated = update(&pb);
+    /* friction only takes energy away; moves that stored more in the elements than they
+     * took from the motion (a stiff cloth on a frictional sphere: 0.25 J of stretch in a
+     * 0.2 J body, with moves below the altitude rule's) are answered by the rest of the
+     * body. Not a split solid: see piola__newton_friction_moves_deform */
+    const int energy_rose =
+        updated == PIOLA_OK && kept && !(total_energy(&pb, s->x, s->v) <= energy_before);
     /* Friction moved nodes after the solve, and the rest of the body has not answered. Where
-     * the moves could flatten or invert tets, or where it stopped nodes of a body that may be
-     * sliding as a whole (piola__newton_body_may_slide), the step is solved once more: the nodes
-     * friction stopped held where it put them (the hold supplies all of their friction), the others
-     * pushed by the force it applied to them (docs/time-stepping.md, "Friction after the
-     * solve") */
-    if (piola__newton_friction_moves_deform(&pb)) {
+     * the moves could flatten or invert tets, or raised the body's energy, the step is solved
+     * once more: the nodes friction stopped held where it put them (the hold supplies all of
+     * their friction), the others pushed by the force it applied to them
+     * (docs/time-stepping.md, "Friction after the solve") */
+    if (updated == PIOLA_OK && (energy_rose || piola__newton_friction_moves_deform(&pb))) {
       for (int32_t i = 0; i < n; ++i)
         if (st->hit[i] == 2) s->colliding[i] = HELD_BY_FRICTION; /* stopped */
       pb.friction_held = 1, pb.contacts_moved = 1;
-      return newton_iterate(&pb, accept_unconverged, stats);
+      if (kept) memcpy(kept + m, s->v, sizeof(double) * (size_t)m); /* friction's velocities */
+      piola_status resolved = newton_iterate(&pb, accept_unconverged, stats);
+      /* where the holds stored energy too (a dented torus shell landing: 1.36 J of stretch
+       * against 0.05 J before it), friction acts on the velocities alone in this step: the
+       * positions of the first solve, its velocities limited as friction limited them. The
+       * body's energy then falls, its kinetic energy being all that changed */
+      if (energy_rose && resolved == PIOLA_OK &&
+          !(total_energy(&pb, s->x, s->v) <= energy_before)) {
+        memcpy(s->x, kept, sizeof(double) * (size_t)m);
+        memcpy(s->v, kept + m, sizeof(double) * (size_t)m);
+        for (int32_t i = 0; i < n; ++i)
+          if (s->flags[i] != NODE_FREE)
+            piola__body_constrained_state(s, i, pb.t1, s->x + 3 * i, s->v + 3 * i);
+        resolved = update(&pb);
+      }
+      free(kept);
+      return resolved;
     }
+    free(kept);
+    PIOLA_TRY(updated);
   } else if (pb.kinetic && converged && pb.slip_rounds < FRICTION_SLIP_ROUNDS &&
              piola__newton_next_friction_round(&pb)) {
     /* holds beyond Coulomb's cone slip, slips friction reverses are held, the kinetic
      * friction follows the normal forces: solved again */
+    free(kept); /* NULL: friction_held is set on this path */
     pb.slip_rounds++;
     PIOLA_TRY(update(&pb));
     return newton_iterate(&pb, accept_unconverged, stats); /* its forces are those of x */
+  } else {
+    free(kept);
   }
   int32_t colliding = 0;
   for (int32_t i = 0; i < n; ++i) {

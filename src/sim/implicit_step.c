@@ -566,6 +566,13 @@ static double residual_dot_step(const newton_problem *pb) {
  * update, which must be at x) and gravity's potential at t1. Collective on a split solid
  * (the elastic energy's sum, the same bits on every process), so every process keeps the
  * same thing. */
+/* Friction's moves may raise a shell's energy by this fraction of its kinetic and elastic
+ * energy before they call for a second solve: resting contact raises it by a few tenths of
+ * a percent a step, which a second solve would answer at a third more CG iterations; the
+ * moves that matter (a stiff cloth landing on a frictional sphere) stored several times the
+ * body's energy. */
+#define FRICTION_ENERGY_RISE 0.1
+
 static double total_energy(const newton_problem *pb, const double *x, const double *v) {
   world_body *s = pb->s;
   double kinetic = 0, work = 0;
@@ -578,6 +585,17 @@ static double total_energy(const newton_problem *pb, const double *x, const doub
   const double elastic = s->kind == PIOLA_BODY_SOLID ? piola__elastic_body_total_energy(s->solid)
                                                      : piola__body_stats(s).elastic_energy;
   return 0.5 * kinetic + elastic - work;
+}
+
+/* The body's kinetic energy and its elastic energy of the last update (J): the part of
+ * total_energy that does not depend on where gravity's potential is zero. */
+static double motion_and_strain_energy(const newton_problem *pb) {
+  world_body *s = pb->s;
+  double kinetic = 0;
+  for (int64_t j = 0; j < 3 * (int64_t)s->n; ++j) kinetic += s->mass[j / 3] * s->v[j] * s->v[j];
+  const double elastic = s->kind == PIOLA_BODY_SOLID ? piola__elastic_body_total_energy(s->solid)
+                                                     : piola__body_stats(s).elastic_energy;
+  return 0.5 * kinetic + elastic;
 }
 
 /* How far a Newton try got: the fraction of the way, on a log scale, from its first
@@ -1070,20 +1088,25 @@ static piola_status newton_iterate(const newton_problem *problem, int accept_unc
   /* the body's energy at the converged iterate, whose forces are the last update's, and
    * that iterate's positions, to fall back on (see below) */
   const int energy_checked =
-      !pb.quasistatic && !pb.friction_held && converged && !piola__implicit_split_of(s);
+      !pb.quasistatic && !pb.friction_held && converged && s->kind == PIOLA_BODY_SHELL;
   const double energy_before = energy_checked ? total_energy(&pb, s->x, s->v) : NAN;
+  const double energy_allowed =
+      energy_checked ? energy_before + FRICTION_ENERGY_RISE * motion_and_strain_energy(&pb) : NAN;
   double *kept = energy_checked ? malloc(sizeof(double) * 2 * (size_t)m) : NULL;
   if (energy_checked && !kept)
     return PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "implicit step: out of memory");
   if (kept) memcpy(kept, s->x, sizeof(double) * (size_t)m);
   if (!pb.quasistatic && !pb.friction_held && piola__newton_contact_friction(&pb) > 0) {
     piola_status updated = update(&pb);
-    /* friction only takes energy away; moves that stored more in the elements than they
-     * took from the motion (a stiff cloth on a frictional sphere: 0.25 J of stretch in a
-     * 0.2 J body, with moves below the altitude rule's) are answered by the rest of the
-     * body. Not a split solid: see piola__newton_friction_moves_deform */
+    /* friction only takes energy away; a shell's moves that stored more in its membrane
+     * than they took from the motion (a stiff cloth on a frictional sphere: 0.25 J of
+     * stretch in a 0.2 J body, with moves below the altitude rule's) are answered by the
+     * rest of the body. Solids keep the altitude rule alone: with this check a block landing
+     * on a frictional plane, solved three ways (tests/test_incomplete_cholesky.c), went
+     * through the second solve in all three and ended 3-5 um apart instead of 1e-8 m, not
+     * understood yet */
     const int energy_rose =
-        updated == PIOLA_OK && kept && !(total_energy(&pb, s->x, s->v) <= energy_before);
+        updated == PIOLA_OK && kept && !(total_energy(&pb, s->x, s->v) <= energy_allowed);
     /* Friction moved nodes after the solve, and the rest of the body has not answered. Where
      * the moves could flatten or invert tets, or raised the body's energy, the step is solved
      * once more: the nodes friction stopped held where it put them (the hold supplies all of
@@ -1100,7 +1123,7 @@ static piola_status newton_iterate(const newton_problem *problem, int accept_unc
        * positions of the first solve, its velocities limited as friction limited them. The
        * body's energy then falls, its kinetic energy being all that changed */
       if (energy_rose && resolved == PIOLA_OK &&
-          !(total_energy(&pb, s->x, s->v) <= energy_before)) {
+          !(total_energy(&pb, s->x, s->v) <= energy_allowed)) {
         memcpy(s->x, kept, sizeof(double) * (size_t)m);
         memcpy(s->v, kept + m, sizeof(double) * (size_t)m);
         for (int32_t i = 0; i < n; ++i)

@@ -801,6 +801,37 @@ static void test_fitted_planes_are_a_finite_floor(void **state) {
   piola_image_free(&unbounded);
 }
 
+/* An obstacle added after the camera was fitted to the bodies alone (piola render without
+ * --frame-obstacles) is not cut by the fallback floor: a sphere under a sheet at 0.3 m
+ * lowers the floor from the sheet to the sphere's bottom; a plane or a far obstacle does
+ * not. */
+static void test_fallback_floor_passes_under_obstacles(void **state) {
+  (void)state;
+  piola_render_def def = piola_default_render_def();
+  piola_renderer *r;
+  assert_int_equal(piola_renderer_create(&def, &r), PIOLA_OK);
+  piola_renderer_fit_camera(r, (piola_vec3){-0.3, -0.3, 0.3}, (piola_vec3){0.3, 0.3, 0.31});
+  assert_true(fabs(r->ground_height - 0.3) < 1e-12);
+  piola_obstacle_def far = piola_default_obstacle_def();
+  far.type = PIOLA_OBSTACLE_SPHERE;
+  far.center = (piola_vec3){30, 0, -5};
+  far.radius = 0.2;
+  assert_int_equal(piola_renderer_add_obstacle(r, &far), PIOLA_OK);
+  piola_obstacle_def plane = piola_default_obstacle_def();
+  plane.type = PIOLA_OBSTACLE_PLANE;
+  plane.center = (piola_vec3){0, 0, -1};
+  plane.axis = (piola_vec3){0, 0, 1};
+  assert_int_equal(piola_renderer_add_obstacle(r, &plane), PIOLA_OK);
+  assert_true(fabs(r->ground_height - 0.3) < 1e-12);
+  piola_obstacle_def ball = piola_default_obstacle_def();
+  ball.type = PIOLA_OBSTACLE_SPHERE;
+  ball.center = (piola_vec3){0, 0, 0.1};
+  ball.radius = 0.2;
+  assert_int_equal(piola_renderer_add_obstacle(r, &ball), PIOLA_OK);
+  assert_true(fabs(r->ground_height - (-0.1)) < 1e-9);
+  piola_renderer_destroy(r);
+}
+
 static void test_bad_arguments_are_refused(void **state) {
   (void)state;
   piola_renderer *r = NULL;
@@ -849,6 +880,7 @@ int main(void) {
       cmocka_unit_test(test_deterministic_for_any_thread_count),
       cmocka_unit_test(test_mesh_lying_on_an_obstacle_is_not_pierced),
       cmocka_unit_test(test_fitted_planes_are_a_finite_floor),
+      cmocka_unit_test(test_fallback_floor_passes_under_obstacles),
       cmocka_unit_test(test_bad_arguments_are_refused),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);

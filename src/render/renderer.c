@@ -103,6 +103,24 @@ void piola_renderer_destroy(piola_renderer *r) {
   free(r);
 }
 
+/* Where the camera was fitted to the bodies alone (before the obstacles were added), the
+ * fallback floor through their lowest point would cut through a bounded obstacle under
+ * them and hide it (a cloth draped over a sphere showed no sphere): the floor goes down to
+ * the bottom of the bounding sphere (at t = 0) of each bounded obstacle of comparable size
+ * near the bodies, the ones piola_renderer_fit_camera frames. */
+static void lower_floor_below(piola_renderer *r, const piola_obstacle *o) {
+  if (piola_obstacle_shape_type(o) == PIOLA_OBSTACLE_PLANE) return;
+  const double radius = 0.5 * r->scene_size;
+  vec3 c0;
+  double b;
+  piola_obstacle_bounding_sphere(o, &c0, &b);
+  if (!(b < 2 * radius)) return;
+  piola_obstacle_pose pose = piola_obstacle_pose_at(o, 0);
+  vec3 c = vec3_add(mat3_mul_vec(pose.rotation, c0), pose.translation);
+  if (!(vec3_norm(vec3_sub(c, r->floor_center)) < 3 * radius)) return;
+  r->ground_height = fmin(r->ground_height, vec3_dot(c, r->def.up) - b);
+}
+
 piola_status piola_renderer_add_obstacle(piola_renderer *r, const piola_obstacle_def *def) {
   if (!r || !def) return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "renderer: NULL argument");
   if (r->obstacle_count == r->obstacle_capacity) {
@@ -134,6 +152,7 @@ piola_status piola_renderer_add_obstacle(piola_renderer *r, const piola_obstacle
   }
   r->obstacle_meshes[r->obstacle_count] = copy;
   r->obstacles[r->obstacle_count++] = o;
+  if (isfinite(r->floor_half_size)) lower_floor_below(r, o);
   return PIOLA_OK;
 }
 

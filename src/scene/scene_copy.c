@@ -2,25 +2,35 @@
  * one in its output folder so `piola render DIR` finds the obstacles from anywhere. */
 #include <cjson/cJSON.h>
 #include <limits.h>
+#include <stdbool.h>
 #include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
+#include "common/fnv1a.h"
 #include "common/status_report.h"
 #include "piola/files.h"
 #include "piola/scene.h"
 #include "scene/scene_desc.h"
 
+/* The path item names, made absolute against folder when relative, into buf; false where
+ * item is no path (a generator object, an empty string). */
+static bool resolved_path(const cJSON *item, const char *folder, char *buf, size_t size) {
+  if (!cJSON_IsString(item) || !item->valuestring || !item->valuestring[0]) return false;
+  if (item->valuestring[0] == '/')
+    snprintf(buf, size, "%s", item->valuestring);
+  else
+    snprintf(buf, size, "%s/%s", folder, item->valuestring);
+  return true;
+}
+
 /* Makes a relative path string absolute against folder. */
 static void make_absolute(cJSON *item, const char *folder, void *unused) {
   (void)unused;
-  if (!cJSON_IsString(item) || !item->valuestring || item->valuestring[0] == '/' ||
-      !item->valuestring[0])
-    return;
   char buf[PATH_MAX + 512];
-  snprintf(buf, sizeof buf, "%s/%s", folder, item->valuestring);
-  cJSON_SetValuestring(item, buf);
+  if (resolved_path(item, folder, buf, sizeof buf) && item->valuestring[0] != '/')
+    cJSON_SetValuestring(item, buf);
 }
 
 typedef void (*path_visitor)(cJSON *item, const char *folder, void *context);
@@ -65,30 +75,20 @@ static piola_status read_scene_json(const char *scene_path, cJSON **root, char f
   return PIOLA_OK;
 }
 
-static uint64_t fnv1a(uint64_t h, const void *data, size_t n) {
-  const unsigned char *p = data;
-  for (size_t i = 0; i < n; ++i) h = (h ^ p[i]) * 0x100000001b3ull;
-  return h;
-}
-
 /* Folds the path and the bytes of the file it names (resolved against folder) into the key;
  * an unreadable file by its path alone (the scene's build has refused it already). */
 static void hash_file(cJSON *item, const char *folder, void *context) {
   uint64_t *key = context;
-  if (!cJSON_IsString(item) || !item->valuestring || !item->valuestring[0]) return;
   char path[PATH_MAX + 512];
-  if (item->valuestring[0] == '/')
-    snprintf(path, sizeof path, "%s", item->valuestring);
-  else
-    snprintf(path, sizeof path, "%s/%s", folder, item->valuestring);
-  *key = fnv1a(*key, path, strlen(path) + 1);
+  if (!resolved_path(item, folder, path, sizeof path)) return;
+  *key = piola__fnv1a(*key, path, strlen(path) + 1);
   char *bytes;
   size_t len;
   if (piola_read_file(path, (size_t)1 << 31, &bytes, &len) != PIOLA_OK) {
     piola_clear_error();
     return;
   }
-  *key = fnv1a(*key, bytes, len);
+  *key = piola__fnv1a(*key, bytes, len);
   free(bytes);
 }
 
@@ -98,7 +98,7 @@ piola_status piola_scene_inputs_key(const char *scene_path, uint64_t *key) {
   cJSON *root;
   char folder[PATH_MAX];
   PIOLA_TRY(read_scene_json(scene_path, &root, folder));
-  *key = 0xcbf29ce484222325ull;
+  *key = PIOLA_FNV_OFFSET;
   visit_paths(root, hash_file, folder, key);
   cJSON_Delete(root);
   return PIOLA_OK;

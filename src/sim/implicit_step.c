@@ -154,7 +154,7 @@ void piola__implicit_state_free(struct implicit_state *st) {
   free(st->prediction), free(st->residual), free(st->step), free(st->base), free(st->damping);
   for (int k = 0; k < 4; ++k) free(st->cg[k]);
   free(st->scratch_v), free(st->surface_v), free(st->surface_mu), free(st->friction);
-  free(st->hit);
+  free(st->friction_free), free(st->hit);
   free(st);
 }
 
@@ -170,11 +170,12 @@ static piola_status implicit_state_make(world_body *s, piola_preconditioner_type
   st->surface_v = malloc(v3);
   st->surface_mu = malloc(sizeof(double) * (size_t)(s->n > 0 ? s->n : 1));
   st->friction = malloc(v3);
+  if (s->kind == PIOLA_BODY_SHELL) st->friction_free = malloc(2 * v3);
   for (int k = 0; k < 4; ++k) st->cg[k] = malloc(v3);
   st->hit = malloc((size_t)(s->n > 0 ? s->n : 1));
   int ok = st->prediction && st->residual && st->step && st->base && st->damping && st->scratch_v &&
            st->surface_v && st->surface_mu && st->friction && st->hit && st->cg[0] && st->cg[1] &&
-           st->cg[2] && st->cg[3];
+           st->cg[2] && st->cg[3] && (s->kind != PIOLA_BODY_SHELL || st->friction_free);
   if (ok && piola__body_stiffness_init(s, &st->matrix) != PIOLA_OK) ok = 0;
   if (ok && preconditioner == PIOLA_PRECONDITIONER_INCOMPLETE_CHOLESKY &&
       s->kind == PIOLA_BODY_SOLID &&
@@ -562,41 +563,34 @@ static double residual_dot_step(const newton_problem *pb) {
   return slope;
 }
 
+/* The body's kinetic energy at velocities v and its elastic energy of the last update (J):
+ * the part of total_energy below that does not depend on where gravity's potential is zero.
+ * Collective on a split solid (the elastic energy's sum, the same bits on every process). */
+static double motion_and_strain_energy(const newton_problem *pb, const double *v) {
+  world_body *s = pb->s;
+  double kinetic = 0;
+  for (int64_t j = 0; j < 3 * (int64_t)s->n; ++j) kinetic += s->mass[j / 3] * v[j] * v[j];
+  const double elastic = s->kind == PIOLA_BODY_SOLID ? piola__elastic_body_total_energy(s->solid)
+                                                     : piola__body_stats(s).elastic_energy;
+  return 0.5 * kinetic + elastic;
+}
+
 /* The body's total energy (J) at positions x with velocities v: kinetic, elastic (of the last
- * update, which must be at x) and gravity's potential at t1. Collective on a split solid
- * (the elastic energy's sum, the same bits on every process), so every process keeps the
- * same thing. */
+ * update, which must be at x) and gravity's potential at t1, so that every process of a
+ * split solid keeps the same thing. */
+static double total_energy(const newton_problem *pb, const double *x, const double *v) {
+  const world_body *s = pb->s;
+  double work = 0;
+  for (int64_t j = 0; j < 3 * (int64_t)s->n; ++j) work += s->mass[j / 3] * pb->g1[j % 3] * x[j];
+  return motion_and_strain_energy(pb, v) - work;
+}
+
 /* Friction's moves may raise a shell's energy by this fraction of its kinetic and elastic
  * energy before they call for a second solve: resting contact raises it by a few tenths of
  * a percent a step, which a second solve would answer at a third more CG iterations; the
  * moves that matter (a stiff cloth landing on a frictional sphere) stored several times the
  * body's energy. */
 #define FRICTION_ENERGY_RISE 0.1
-
-static double total_energy(const newton_problem *pb, const double *x, const double *v) {
-  world_body *s = pb->s;
-  double kinetic = 0, work = 0;
-  for (int32_t i = 0; i < s->n; ++i)
-    for (int k = 0; k < 3; ++k) {
-      const int64_t j = 3 * (int64_t)i + k;
-      kinetic += s->mass[i] * v[j] * v[j];
-      work += s->mass[i] * pb->g1[k] * x[j];
-    }
-  const double elastic = s->kind == PIOLA_BODY_SOLID ? piola__elastic_body_total_energy(s->solid)
-                                                     : piola__body_stats(s).elastic_energy;
-  return 0.5 * kinetic + elastic - work;
-}
-
-/* The body's kinetic energy and its elastic energy of the last update (J): the part of
- * total_energy that does not depend on where gravity's potential is zero. */
-static double motion_and_strain_energy(const newton_problem *pb) {
-  world_body *s = pb->s;
-  double kinetic = 0;
-  for (int64_t j = 0; j < 3 * (int64_t)s->n; ++j) kinetic += s->mass[j / 3] * s->v[j] * s->v[j];
-  const double elastic = s->kind == PIOLA_BODY_SOLID ? piola__elastic_body_total_energy(s->solid)
-                                                     : piola__body_stats(s).elastic_energy;
-  return 0.5 * kinetic + elastic;
-}
 
 /* How far a Newton try got: the fraction of the way, on a log scale, from its first
  * residual phi_first to the stop target2 that its last residual phi went; 0 for none (or
@@ -1085,19 +1079,18 @@ static piola_status newton_iterate(const newton_problem *problem, int accept_unc
     pb.friction_held = 1, pb.kinetic = 1, pb.contacts_moved = 1, pb.slip_rounds = 0;
     return newton_iterate(&pb, accept_unconverged, stats);
   }
-  /* the body's energy at the converged iterate, whose forces are the last update's, and
-   * that iterate's positions, to fall back on (see below) */
+  /* the most energy friction may leave a shell (see below), from the converged iterate,
+   * whose forces are the last update's, and that iterate's positions to fall back on */
   const int energy_checked =
       !pb.quasistatic && !pb.friction_held && converged && s->kind == PIOLA_BODY_SHELL;
-  const double energy_before = energy_checked ? total_energy(&pb, s->x, s->v) : NAN;
-  const double energy_allowed =
-      energy_checked ? energy_before + FRICTION_ENERGY_RISE * motion_and_strain_energy(&pb) : NAN;
-  double *kept = energy_checked ? malloc(sizeof(double) * 2 * (size_t)m) : NULL;
-  if (energy_checked && !kept)
-    return PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "implicit step: out of memory");
+  const double energy_allowed = energy_checked
+                                    ? total_energy(&pb, s->x, s->v) +
+                                          FRICTION_ENERGY_RISE * motion_and_strain_energy(&pb, s->v)
+                                    : NAN;
+  double *kept = energy_checked ? st->friction_free : NULL;
   if (kept) memcpy(kept, s->x, sizeof(double) * (size_t)m);
   if (!pb.quasistatic && !pb.friction_held && piola__newton_contact_friction(&pb) > 0) {
-    piola_status updated = update(&pb);
+    PIOLA_TRY(update(&pb));
     /* friction only takes energy away; a shell's moves that stored more in its membrane
      * than they took from the motion (a stiff cloth on a frictional sphere: 0.25 J of
      * stretch in a 0.2 J body, with moves below the altitude rule's) are answered by the
@@ -1105,14 +1098,13 @@ static piola_status newton_iterate(const newton_problem *problem, int accept_unc
      * on a frictional plane, solved three ways (tests/test_incomplete_cholesky.c), went
      * through the second solve in all three and ended 3-5 um apart instead of 1e-8 m, not
      * understood yet */
-    const int energy_rose =
-        updated == PIOLA_OK && kept && !(total_energy(&pb, s->x, s->v) <= energy_allowed);
+    const int energy_rose = kept && !(total_energy(&pb, s->x, s->v) <= energy_allowed);
     /* Friction moved nodes after the solve, and the rest of the body has not answered. Where
      * the moves could flatten or invert tets, or raised the body's energy, the step is solved
      * once more: the nodes friction stopped held where it put them (the hold supplies all of
      * their friction), the others pushed by the force it applied to them
      * (docs/time-stepping.md, "Friction after the solve") */
-    if (updated == PIOLA_OK && (energy_rose || piola__newton_friction_moves_deform(&pb))) {
+    if (energy_rose || piola__newton_friction_moves_deform(&pb)) {
       for (int32_t i = 0; i < n; ++i)
         if (st->hit[i] == 2) s->colliding[i] = HELD_BY_FRICTION; /* stopped */
       pb.friction_held = 1, pb.contacts_moved = 1;
@@ -1131,21 +1123,15 @@ static piola_status newton_iterate(const newton_problem *problem, int accept_unc
             piola__body_constrained_state(s, i, pb.t1, s->x + 3 * i, s->v + 3 * i);
         resolved = update(&pb);
       }
-      free(kept);
       return resolved;
     }
-    free(kept);
-    PIOLA_TRY(updated);
   } else if (pb.kinetic && converged && pb.slip_rounds < FRICTION_SLIP_ROUNDS &&
              piola__newton_next_friction_round(&pb)) {
     /* holds beyond Coulomb's cone slip, slips friction reverses are held, the kinetic
      * friction follows the normal forces: solved again */
-    free(kept); /* NULL: friction_held is set on this path */
     pb.slip_rounds++;
     PIOLA_TRY(update(&pb));
     return newton_iterate(&pb, accept_unconverged, stats); /* its forces are those of x */
-  } else {
-    free(kept);
   }
   int32_t colliding = 0;
   for (int32_t i = 0; i < n; ++i) {

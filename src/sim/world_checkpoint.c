@@ -27,22 +27,13 @@
 #include "plasticity/plastic_state.h"
 #include "shell/shell_body_internal.h"
 #include "sim/fracture_internal.h"
+#include "common/fnv1a.h"
 #include "sim/fracture_restore.h"
 #include "sim/world_internal.h"
 
 enum { HEADER_BYTES = 48 };
 static const char magic[8] = {'P', 'I', 'O', 'L', 'A', 'C', 'K', 'P'};
 static const uint32_t byte_order_mark = 0x01020304u;
-
-static uint64_t fnv1a(uint64_t h, const void *data, size_t n) {
-  const unsigned char *p = data;
-  for (size_t i = 0; i < n; ++i) {
-    h ^= p[i];
-    h *= 0x100000001b3ull;
-  }
-  return h;
-}
-#define FNV_OFFSET 0xcbf29ce484222325ull
 
 int piola_world_checkpoint_supported(const piola_world *w, const char **why) {
   (void)w; /* every part of a world is covered */
@@ -51,25 +42,25 @@ int piola_world_checkpoint_supported(const piola_world *w, const char **why) {
 }
 
 uint64_t piola_world_scene_key(const piola_world *w, const void *scene, size_t length) {
-  uint64_t h = FNV_OFFSET;
-  if (scene) h = fnv1a(h, scene, length);
+  uint64_t h = PIOLA_FNV_OFFSET;
+  if (scene) h = piola__fnv1a(h, scene, length);
   for (int32_t i = 0; w && i < w->body_count; ++i) {
     const world_body *b = &w->bodies[i];
     int32_t kind = (int32_t)b->kind;
-    h = fnv1a(h, &kind, sizeof kind);
+    h = piola__fnv1a(h, &kind, sizeof kind);
     switch (b->kind) {
       case PIOLA_BODY_SOLID: {
         const piola_elastic_body *e = b->solid;
-        h = fnv1a(h, e->rest_positions, 3 * (size_t)e->vertex_count * sizeof(double));
-        h = fnv1a(h, e->tets, 4 * (size_t)e->tet_count * sizeof(int32_t));
-        h = fnv1a(h, e->masses, (size_t)e->vertex_count * sizeof(double));
+        h = piola__fnv1a(h, e->rest_positions, 3 * (size_t)e->vertex_count * sizeof(double));
+        h = piola__fnv1a(h, e->tets, 4 * (size_t)e->tet_count * sizeof(int32_t));
+        h = piola__fnv1a(h, e->masses, (size_t)e->vertex_count * sizeof(double));
         break;
       }
       case PIOLA_BODY_SHELL: {
         const piola_shell_body *sh = b->shell;
-        h = fnv1a(h, sh->rest_positions, 3 * (size_t)sh->vertex_count * sizeof(double));
-        h = fnv1a(h, sh->triangle_indices, 3 * (size_t)sh->triangle_count * sizeof(int32_t));
-        h = fnv1a(h, sh->masses, (size_t)sh->vertex_count * sizeof(double));
+        h = piola__fnv1a(h, sh->rest_positions, 3 * (size_t)sh->vertex_count * sizeof(double));
+        h = piola__fnv1a(h, sh->triangle_indices, 3 * (size_t)sh->triangle_count * sizeof(int32_t));
+        h = piola__fnv1a(h, sh->masses, (size_t)sh->vertex_count * sizeof(double));
         break;
       }
       case PIOLA_BODY_NONE:
@@ -77,7 +68,7 @@ uint64_t piola_world_scene_key(const piola_world *w, const void *scene, size_t l
     }
   }
   int32_t counts[2] = {w ? w->body_count : 0, w ? w->obstacle_count : 0};
-  return fnv1a(h, counts, sizeof counts);
+  return piola__fnv1a(h, counts, sizeof counts);
 }
 
 /* ------------------------------------------------------------------ the byte stream */
@@ -681,7 +672,7 @@ piola_status piola_world_checkpoint_write(const piola_world *world, const char *
   put_u64(h + 32, (uint64_t)(s.length - HEADER_BYTES));
   put_u32(h + 40, (uint32_t)(world->obstacle_count));
   put_u32(h + 44, split_tag(world));
-  uint64_t sum = fnv1a(FNV_OFFSET, s.data, s.length);
+  uint64_t sum = piola__fnv1a(PIOLA_FNV_OFFSET, s.data, s.length);
   put(&s, &sum, sizeof sum);
   if (s.failed) {
     free(s.data);
@@ -763,7 +754,7 @@ piola_status piola_world_checkpoint_read(piola_world *world, const char *path, u
   else if (get_u64(h + 32) != s.length - HEADER_BYTES - 8)
     st = PIOLA_FAIL(PIOLA_ERROR_PARSE, "%s: %zu bytes, the header says %llu (a truncated file)",
                     path, s.length, (unsigned long long)get_u64(h + 32) + HEADER_BYTES + 8);
-  else if (fnv1a(FNV_OFFSET, s.data, s.length - 8) != get_u64(s.data + s.length - 8))
+  else if (piola__fnv1a(PIOLA_FNV_OFFSET, s.data, s.length - 8) != get_u64(s.data + s.length - 8))
     st = PIOLA_FAIL(PIOLA_ERROR_PARSE, "%s: checksum mismatch (a damaged file)", path);
   else if (get_u64(h + 16) != scene_key)
     st = PIOLA_FAIL(PIOLA_ERROR_UNSUPPORTED,

@@ -74,6 +74,7 @@
 #include "sim/failed_step_velocity.h"
 #include "sim/implicit_problem.h"
 #include "sim/implicit_split.h"
+#include "sim/solid_contacts.h"
 #include "sim/world_internal.h"
 
 #define STANDARD_GRAVITY 9.81
@@ -707,6 +708,7 @@ static piola_status newton_body(piola_world *w, world_body *s, double t, double 
   struct implicit_state *st = s->implicit;
   st->multigrid_fresh = 0; /* a new step: the hierarchy is set up again */
   st->split_systems = 0;   /* likewise the split solver's preconditioner */
+  piola__solid_contacts_solve_begins(w);
   if (halvings == 0) st->failed_progress = -1;
   st->halvings = halvings;
   st->may_go_deeper = 0, st->went_deeper = 0;
@@ -1274,6 +1276,7 @@ static piola_status self_collide_and_resolve(piola_world *w, double dt, int clos
     (void)add_momentum(s, -1.0, added);
     newton_problem pb = problem_of(w, s, w->time, dt);
     pb.resolving = 1;
+    piola__solid_contacts_solve_begins(w); /* the pass moved the other bodies */
     const int64_t colliding = stats->colliding;
     piola_status st = newton_iterate(&pb, 1, stats);
     if (st == PIOLA_ERROR_NOT_CONVERGED) /* a kept try that is not finite */

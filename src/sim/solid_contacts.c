@@ -49,31 +49,95 @@ static double largest_move(const world_body *b) {
   return most;
 }
 
-/* The boxes of other's boundary triangles at its current positions, grown by reach. */
-static void triangle_boxes(const world_body *other, double reach, piola__box *boxes) {
+/* The other solids' boundary trees in the solve under way (world.solid_trees): one per
+ * solid, over its triangles' boxes at its positions, built at the first Newton iteration
+ * that needs it. The boxes are not grown by a pair's reach (which differs from pair to
+ * pair); a query grows its point by it instead, which finds the same triangles. */
+struct piola__solid_trees {
+  int32_t count;     /* solids with a slot */
+  piola__bvh *trees; /* per solid, by its index among the solids */
+  int64_t *built_in; /* per solid: the solve its tree was built in (-1: none) */
+  double *move;      /* per solid: its boundary's largest move in this step when built (m) */
+  piola__box *boxes; /* a build's scratch */
+  int32_t box_capacity;
+  piola__index_list candidates;
+};
+
+void piola__solid_contacts_solve_begins(piola_world *w) { w->implicit_solve++; }
+
+void piola__solid_contacts_free(piola_world *w) {
+  struct piola__solid_trees *c = w->solid_trees;
+  if (!c) return;
+  for (int32_t k = 0; k < c->count; ++k) piola__bvh_free(c->trees + k);
+  free(c->trees), free(c->built_in), free(c->move), free(c->boxes), free(c->candidates.items);
+  free(c);
+  w->solid_trees = NULL;
+}
+
+/* The tree over the boundary triangles of solid number k (other), built in this solve, and
+ * its boundary's largest move in this step in *move; NULL when memory runs out. */
+static const piola__bvh *solid_tree(piola_world *w, int32_t k, const world_body *other,
+                                    double *move) {
+  struct piola__solid_trees *c = w->solid_trees;
+  if (!c && !(c = w->solid_trees = calloc(1, sizeof *c))) return NULL;
+  if (k >= c->count) {
+    const int32_t count = w->kind_count[PIOLA_BODY_SOLID];
+    piola__bvh *trees = realloc(c->trees, sizeof *trees * (size_t)count);
+    if (!trees) return NULL;
+    c->trees = trees;
+    int64_t *built_in = realloc(c->built_in, sizeof *built_in * (size_t)count);
+    if (!built_in) return NULL;
+    c->built_in = built_in;
+    double *moves = realloc(c->move, sizeof *moves * (size_t)count);
+    if (!moves) return NULL;
+    c->move = moves;
+    for (int32_t j = c->count; j < count; ++j) c->trees[j] = (piola__bvh){0}, c->built_in[j] = -1;
+    c->count = count;
+  }
+  if (c->built_in[k] == w->implicit_solve) {
+    *move = c->move[k];
+    return c->trees + k;
+  }
   const piola_tri_mesh *surface = other->boundary;
-  for (int32_t t = 0; t < surface->triangle_count; ++t) {
-    piola__box *box = boxes + t;
+  const int32_t triangles = surface->triangle_count;
+  if (triangles > c->box_capacity) {
+    piola__box *grown = realloc(c->boxes, sizeof *grown * (size_t)triangles);
+    if (!grown) return NULL;
+    c->boxes = grown, c->box_capacity = triangles;
+  }
+  for (int32_t t = 0; t < triangles; ++t) {
+    piola__box *box = c->boxes + t;
     for (int a = 0; a < 3; ++a) box->lo[a] = INFINITY, box->hi[a] = -INFINITY;
-    for (int c = 0; c < 3; ++c) {
-      const double *p = other->x + 3 * surface->triangles[3 * t + c];
+    for (int corner = 0; corner < 3; ++corner) {
+      const double *p = other->x + 3 * surface->triangles[3 * t + corner];
       for (int a = 0; a < 3; ++a)
-        box->lo[a] = fmin(box->lo[a], p[a] - reach), box->hi[a] = fmax(box->hi[a], p[a] + reach);
+        box->lo[a] = fmin(box->lo[a], p[a]), box->hi[a] = fmax(box->hi[a], p[a]);
     }
   }
+  c->built_in[k] = -1;
+  if (piola__bvh_build(c->trees + k, c->boxes, triangles) != 0) return NULL;
+  c->built_in[k] = w->implicit_solve;
+  *move = c->move[k] = largest_move(other);
+  return c->trees + k;
+}
+
+/* The box around node x that can reach a triangle within `reach` of where x may have been
+ * in this step (move) */
+static piola__box search_box(const double x[3], double reach) {
+  return (piola__box){{x[0] - reach, x[1] - reach, x[2] - reach},
+                      {x[0] + reach, x[1] + reach, x[2] + reach}};
 }
 
 /* Node i of s against other's surface (tree over its triangles, candidates scratch): puts
  * it `gap` outside the nearest triangle when it is closer than that or inside (a node held
- * already: see below; thickness is the pair's). Returns 1 when it did. */
+ * already: see below; thickness is the pair's). Its search reaches the nearest triangle
+ * within `reach` of anywhere it may have been in this step. Returns 1 when it did. */
 static int hold_outside(world_body *s, int32_t i, world_body *other, const piola__bvh *tree,
-                        piola__index_list *candidates, double gap, double thickness, double mu,
-                        double *surface_velocity, double *surface_mu, uint8_t mark) {
+                        piola__index_list *candidates, double reach, double gap, double thickness,
+                        double mu, double *surface_velocity, double *surface_mu, uint8_t mark) {
   const piola_tri_mesh *surface = other->boundary;
   const vec3 x = vec3_load(s->x + 3 * i);
-  const double move = node_move(s, i);
-  const piola__box point = {{x.x - move, x.y - move, x.z - move},
-                            {x.x + move, x.y + move, x.z + move}};
+  const piola__box point = search_box(s->x + 3 * i, node_move(s, i) + reach);
   candidates->count = 0;
   if (piola__bvh_query(tree, &point, candidates) != 0) return 0;
   double best = INFINITY, weights[3] = {0, 0, 0};
@@ -131,14 +195,14 @@ int32_t piola__solid_contacts_with_solids(piola_world *w, world_body *s, uint8_t
                                           double *surface_velocity, double *surface_mu) {
   if (!takes_part(s)) return 0;
   int32_t moved = 0;
-  piola__bvh tree = {0};
-  piola__index_list candidates = {0};
-  piola__box *boxes = NULL;
-  int32_t box_capacity = 0;
   for (int32_t k = 0; k < w->kind_count[PIOLA_BODY_SOLID]; ++k) {
     world_body *other = piola__world_body_of(w, PIOLA_BODY_SOLID, k);
     if (other == s || !takes_part(other)) continue;
     if (piola__solid_boundary(other) != PIOLA_OK) break;
+    double other_move = 0;
+    const piola__bvh *tree = solid_tree(w, k, other, &other_move);
+    if (!tree) break;
+    if (tree->node_count == 0) continue;
     /* against a solid solved after this one, still at its step's start: only out of it, onto
      * its surface; that solid then keeps the gap from this one's end of step. Both keeping
      * the gap, each against the other's surface, pushed the lower of two boxes at rest on
@@ -152,28 +216,15 @@ int32_t piola__solid_contacts_with_solids(piola_world *w, world_body *s, uint8_t
      * not deeper: one is left to the collision pass. Projecting every node up to a boundary
      * edge deep (5 cm in examples/solids_stack.json) took some to the far side of a thin
      * part, and a run reached 38 kJ */
-    const double reach = gap + (other > s ? 0.0 : largest_move(other));
-    const int32_t triangles = other->boundary->triangle_count;
-    if (triangles > box_capacity) {
-      piola__box *grown = realloc(boxes, sizeof *boxes * (size_t)triangles);
-      if (!grown) break;
-      boxes = grown, box_capacity = triangles;
-    }
-    triangle_boxes(other, reach, boxes);
-    if (piola__bvh_build(&tree, boxes, triangles) != 0) break;
-    const piola__box whole = tree.nodes[0].box;
+    const double reach = gap + (other > s ? 0.0 : other_move);
+    const piola__box whole = tree->nodes[0].box;
     for (int32_t i = 0; i < s->n; ++i) {
       if (s->flags[i] != NODE_FREE || !(s->mass[i] > 0)) continue;
-      const double *x = s->x + 3 * i, move = node_move(s, i);
-      if (x[0] + move < whole.lo[0] || x[0] - move > whole.hi[0] || x[1] + move < whole.lo[1] ||
-          x[1] - move > whole.hi[1] || x[2] + move < whole.lo[2] || x[2] - move > whole.hi[2])
-        continue;
-      moved += hold_outside(s, i, other, &tree, &candidates, gap, thickness, mu, surface_velocity,
-                            surface_mu, mark);
+      const piola__box near = search_box(s->x + 3 * i, node_move(s, i) + reach);
+      if (!piola__boxes_overlap(&near, &whole)) continue;
+      moved += hold_outside(s, i, other, tree, &w->solid_trees->candidates, reach, gap, thickness,
+                            mu, surface_velocity, surface_mu, mark);
     }
   }
-  piola__bvh_free(&tree);
-  free(candidates.items);
-  free(boxes);
   return moved;
 }

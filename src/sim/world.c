@@ -6,6 +6,7 @@
 #include <string.h>
 
 #include "common/status_report.h"
+#include "sim/solid_contacts.h"
 #include "sim/world_internal.h"
 
 int piola__track_ok(const piola_track *t, double lo) {
@@ -90,6 +91,7 @@ void piola_world_destroy(piola_world *world) {
   piola__world_free_bodies(world);
   for (int32_t i = 0; i < world->obstacle_count; ++i) piola_obstacle_destroy(world->obstacles[i]);
   piola__world_contact_free(world);
+  piola__solid_contacts_free(world);
   piola__world_warnings_free(world);
   free(world->obstacles);
   free(world);

@@ -45,7 +45,7 @@ struct implicit_state {
   double *surface_v;  /* 3n: velocity of the solid surface a HELD_BY_SOLID node touches */
   double *surface_mu; /* n: a solid's HELD_BY_SOLID node: the pair's friction coefficient */
   double *friction;   /* 3n: the force friction applied to each node in the step, m dv / dt (N) */
-  double *friction_free; /* 6n, shells only: a converged iterate's positions before friction's
+  double *friction_free; /* 6n: a converged iterate's positions before friction's
                             moves, then the velocities friction left (newton_iterate) */
   uint8_t *hit;       /* n: nodes the obstacle projection moved */
 };

@@ -353,6 +353,11 @@ static void constraints_hold_and_drive_nodes_exactly(void **state) {
   }
   /* the middle of the bar follows about half way */
   assert_true(mid_lift > 0.02 && mid_lift < 0.08);
+  /* a box with a corner above the other is refused, as a scene file's is: it would select
+   * nothing, silently */
+  cons[0].selector.box_min.y = 2;
+  assert_int_equal(piola_world_add_solid(w, &sd, NULL), PIOLA_ERROR_INVALID_ARGUMENT);
+  assert_non_null(strstr(piola_last_error(), "constraints[0]: box_min must be <= box_max"));
   block_mesh_free(&mesh);
   piola_world_destroy(w);
 }

@@ -164,65 +164,109 @@ static void every_key_reaches_its_definition(void **state) {
 #define SOLID(x) "{\"solids\": [{\"mesh\": \"a.veg\"" x "}]}"
 
 static const bad_scene_case BAD[] = {
-    {SOLID(", \"material\": {\"poisson_ratio\": 0.7}"), "bad.json: solids[0].material.poisson_ratio: must be in (-1, 0.5)"},
-    {SOLID(", \"material\": {\"poison_ratio\": 0.3}"), "solids[0].material.poison_ratio: unknown key"},
-    {SOLID(", \"material\": {\"youngs_modulus\": -5}"), "solids[0].material.youngs_modulus: must be > 0"},
+    {SOLID(", \"material\": {\"poisson_ratio\": 0.7}"),
+     "bad.json: solids[0].material.poisson_ratio: must be in (-1, 0.5)"},
+    {SOLID(", \"material\": {\"poison_ratio\": 0.3}"),
+     "solids[0].material.poison_ratio: unknown key"},
+    {SOLID(", \"material\": {\"youngs_modulus\": -5}"),
+     "solids[0].material.youngs_modulus: must be > 0"},
     {SOLID(", \"material\": {\"model\": \"jelly\"}"), "solids[0].material.model: must be one of"},
-    {SOLID(", \"material\": {\"inversion\": {\"mode\": \"cubic\"}}"), "solids[0].material.inversion.mode"},
-    {SOLID(", \"material\": {\"inversion\": {\"threshold\": 1.5}}"), "solids[0].material.inversion.threshold"},
-    {SOLID(", \"material\": {\"stiffness_scale\": {\"keys\": [[0, 1], [0, 2]]}}"), "solids[0].material.stiffness_scale.keys[1]: times must increase"},
-    {SOLID(", \"material\": {\"stiffness_scale\": {\"keys\": [[0, 1], [1, -2]]}}"), "solids[0].material.stiffness_scale.keys[1]: must be >= 0"},
-    {SOLID(", \"material\": {\"stiffness_scale\": {\"keys\": [[0, 1, 3]]}}"), "solids[0].material.stiffness_scale.keys[0]: must be a pair"},
-    {SOLID(", \"material\": {\"stiffness_scale\": {\"kyes\": []}}"), "solids[0].material.stiffness_scale.kyes: unknown key"},
+    {SOLID(", \"material\": {\"inversion\": {\"mode\": \"cubic\"}}"),
+     "solids[0].material.inversion.mode"},
+    {SOLID(", \"material\": {\"inversion\": {\"threshold\": 1.5}}"),
+     "solids[0].material.inversion.threshold"},
+    {SOLID(", \"material\": {\"stiffness_scale\": {\"keys\": [[0, 1], [0, 2]]}}"),
+     "solids[0].material.stiffness_scale.keys[1]: times must increase"},
+    {SOLID(", \"material\": {\"stiffness_scale\": {\"keys\": [[0, 1], [1, -2]]}}"),
+     "solids[0].material.stiffness_scale.keys[1]: must be >= 0"},
+    {SOLID(", \"material\": {\"stiffness_scale\": {\"keys\": [[0, 1, 3]]}}"),
+     "solids[0].material.stiffness_scale.keys[0]: must be a pair"},
+    {SOLID(", \"material\": {\"stiffness_scale\": {\"kyes\": []}}"),
+     "solids[0].material.stiffness_scale.kyes: unknown key"},
     {SOLID(", \"density\": \"heavy\""), "solids[0].density: must be a number, got a string"},
     {SOLID(", \"density\": 0"), "solids[0].density: must be > 0"},
     {SOLID(", \"density\": {\"keys\": [[0, 1]]}"), "solids[0].density: must be a constant"},
     {SOLID(", \"damping\": {\"shear\": -1}"), "solids[0].damping.shear: must be >= 0"},
-    {SOLID(", \"velocity\": [1, 2]"), "solids[0].velocity: must be an array of 3 numbers, got an array of 2"},
+    {SOLID(", \"velocity\": [1, 2]"),
+     "solids[0].velocity: must be an array of 3 numbers, got an array of 2"},
     {SOLID(", \"velocity\": 1"), "solids[0].velocity: must be an array of 3 numbers, got a number"},
-    {SOLID(", \"driven\": [{\"indices\": [1], \"motion\": {\"velocity\": [0, 0, 1, 0]}}]"), "solids[0].driven[0].motion.velocity: must be an array of 3 numbers (or keyframes), got an array of 4"},
+    {SOLID(", \"driven\": [{\"indices\": [1], \"motion\": {\"velocity\": [0, 0, 1, 0]}}]"),
+     "solids[0].driven[0].motion.velocity: must be an array of 3 numbers (or keyframes), got an "
+     "array of 4"},
     {SOLID(", \"transform\": {\"scale\": 0}"), "solids[0].transform.scale: must be > 0"},
     {SOLID(", \"transform\": {\"rotate\": [0, 0, 0]}"), "solids[0].transform.rotate: unknown key"},
-    {SOLID(", \"fixed\": [{\"box\": [[0, 0, 0], [1, 1, 1]], \"sphere\": {\"radius\": 1}}]"), "solids[0].fixed[0]: needs exactly one of"},
-    {SOLID(", \"fixed\": [{\"box\": [[0, 0, 0], [-1, 1, 1]]}]"), "solids[0].fixed[0].box: the first corner"},
-    {SOLID(", \"fixed\": [{\"indices\": [0, -3]}]"), "solids[0].fixed[0].indices[1]: must be a vertex index"},
-    {SOLID(", \"fixed\": [{\"indices\": [1], \"motion\": {}}]"), "solids[0].fixed[0].motion: unknown key"},
+    {SOLID(", \"fixed\": [{\"box\": [[0, 0, 0], [1, 1, 1]], \"sphere\": {\"radius\": 1}}]"),
+     "solids[0].fixed[0]: needs exactly one of"},
+    {SOLID(", \"fixed\": [{\"box\": [[0, 0, 0], [-1, 1, 1]]}]"),
+     "solids[0].fixed[0].box: the first corner"},
+    {SOLID(", \"fixed\": [{\"indices\": [0, -3]}]"),
+     "solids[0].fixed[0].indices[1]: must be a vertex index"},
+    {SOLID(", \"fixed\": [{\"indices\": [1], \"motion\": {}}]"),
+     "solids[0].fixed[0].motion: unknown key"},
     {SOLID(", \"driven\": [{\"indices\": [1]}]"), "solids[0].driven[0].motion: is required"},
-    {SOLID(", \"driven\": [{\"indices\": [1], \"motion\": {\"velocity\": [0, 0, 1], \"angle\": 1}}]"), "solids[0].driven[0].motion: give either"},
-    {SOLID(", \"initial\": {\"matrix\": [[1, 0, 0], [0, 1, 0]]}"), "solids[0].initial.matrix: must be a 3x3 matrix"},
-    {SOLID(", \"initial\": {\"matrix\": [[1, 0, 0], [0, 1, 0], [0, \"x\", 0]]}"), "solids[0].initial.matrix[2][1]: must be a number"},
+    {SOLID(
+         ", \"driven\": [{\"indices\": [1], \"motion\": {\"velocity\": [0, 0, 1], \"angle\": 1}}]"),
+     "solids[0].driven[0].motion: give either"},
+    {SOLID(", \"initial\": {\"matrix\": [[1, 0, 0], [0, 1, 0]]}"),
+     "solids[0].initial.matrix: must be a 3x3 matrix"},
+    {SOLID(", \"initial\": {\"matrix\": [[1, 0, 0], [0, 1, 0], [0, \"x\", 0]]}"),
+     "solids[0].initial.matrix[2][1]: must be a number"},
     {SOLID(", \"initial\": {\"scramble\": -0.1}"), "solids[0].initial.scramble: must be >= 0"},
     {SOLID(", \"initial\": {\"seed\": 1.5}"), "solids[0].initial.seed: must be an integer"},
     {SOLID(", \"name\": 3"), "solids[0].name: must be a non-empty string"},
-    {"{\"solids\": [{\"mesh\": {\"generate\": \"sphere\", \"radius\": 1}}]}", "solids[0].mesh.cell_size: is required"},
-    {"{\"solids\": [{\"mesh\": {\"generate\": \"blob\", \"cell_size\": 1}}]}", "solids[0].mesh.generate: must be one of"},
-    {"{\"solids\": [{\"mesh\": {\"generate\": \"torus\", \"radius\": 1, \"minor_radius\": 2, \"cell_size\": 0.1}}]}", "solids[0].mesh.minor_radius: must be smaller"},
+    {"{\"solids\": [{\"mesh\": {\"generate\": \"sphere\", \"radius\": 1}}]}",
+     "solids[0].mesh.cell_size: is required"},
+    {"{\"solids\": [{\"mesh\": {\"generate\": \"blob\", \"cell_size\": 1}}]}",
+     "solids[0].mesh.generate: must be one of"},
+    {"{\"solids\": [{\"mesh\": {\"generate\": \"torus\", \"radius\": 1, \"minor_radius\": 2, "
+     "\"cell_size\": 0.1}}]}",
+     "solids[0].mesh.minor_radius: must be smaller"},
     {"{\"solids\": [{\"mesh\": 5}]}", "solids[0].mesh: must be a file path or a generator object"},
     {"{\"solids\": [{\"name\": \"a\"}]}", "solids[0].mesh: is required"},
-    {"{\"solids\": [{\"mesh\": \"a.veg\", \"name\": \"x\"}, {\"mesh\": \"a.veg\", \"name\": \"x\"}]}", "solids[1].name: \"x\" is already"},
+    {"{\"solids\": [{\"mesh\": \"a.veg\", \"name\": \"x\"}, {\"mesh\": \"a.veg\", \"name\": "
+     "\"x\"}]}",
+     "solids[1].name: \"x\" is already"},
     {"{\"solids\": []}", "solids: must be a non-empty array"},
     {"{\"fps\": 30}", "solids: is required"},
-    {"{\"fps\": \"30\", \"solids\": [{\"mesh\": \"a.veg\"}]}", "fps: must be a number, got a string"},
+    {"{\"fps\": \"30\", \"solids\": [{\"mesh\": \"a.veg\"}]}",
+     "fps: must be a number, got a string"},
     {"{\"fps\": -1, \"solids\": [{\"mesh\": \"a.veg\"}]}", "fps: must be in (0, 10000]"},
     {"{\"frames\": 2.5, \"solids\": [{\"mesh\": \"a.veg\"}]}", "frames: must be an integer"},
     {"{\"frame\": 2, \"solids\": [{\"mesh\": \"a.veg\"}]}", "frame: unknown key"},
     {"{\"fps\": 2, \"fps\": 3, \"solids\": [{\"mesh\": \"a.veg\"}]}", "fps: duplicate key"},
-    {"{\"gravity\": [0, 0], \"solids\": [{\"mesh\": \"a.veg\"}]}", "gravity: must be an array of 3"},
-    {"{\"integrator\": {\"cfl\": 0}, \"solids\": [{\"mesh\": \"a.veg\"}]}", "integrator.cfl: must be in (0, 2]"},
-    {"{\"integrator\": {\"max_dt\": -1}, \"solids\": [{\"mesh\": \"a.veg\"}]}", "integrator.max_dt"},
-    {"{\"integrator\": {\"cg_max_iterations\": 0}, \"solids\": [{\"mesh\": \"a.veg\"}]}", "integrator.cg_max_iterations"},
+    {"{\"gravity\": [0, 0], \"solids\": [{\"mesh\": \"a.veg\"}]}",
+     "gravity: must be an array of 3"},
+    {"{\"integrator\": {\"cfl\": 0}, \"solids\": [{\"mesh\": \"a.veg\"}]}",
+     "integrator.cfl: must be in (0, 2]"},
+    {"{\"integrator\": {\"max_dt\": -1}, \"solids\": [{\"mesh\": \"a.veg\"}]}",
+     "integrator.max_dt"},
+    {"{\"integrator\": {\"cg_max_iterations\": 0}, \"solids\": [{\"mesh\": \"a.veg\"}]}",
+     "integrator.cg_max_iterations"},
     /* the bounds and the refused value in full: %g printed "[1, 1e+06], got 1e+06" */
     {"{\"integrator\": {\"newton_max_iterations\": 1000001}, \"solids\": [{\"mesh\": \"a.veg\"}]}",
      "integrator.newton_max_iterations: must be in [1, 1000000], got 1000001"},
     {"{\"integrator\": {\"newton_tolerance\": 1.0000001}, \"solids\": [{\"mesh\": \"a.veg\"}]}",
      "integrator.newton_tolerance: must be in (0, 1), got 1.0000001"},
-    {"{\"solids\": [{\"mesh\": \"a.veg\"}], \"obstacles\": [{\"type\": \"cone\"}]}", "obstacles[0].type: must be one of"},
-    {"{\"solids\": [{\"mesh\": \"a.veg\"}], \"obstacles\": [{\"type\": \"plane\", \"point\": [0, 0, 0]}]}", "obstacles[0].normal: is required"},
-    {"{\"solids\": [{\"mesh\": \"a.veg\"}], \"obstacles\": [{\"type\": \"plane\", \"point\": [0, 0, 0], \"normal\": [0, 0, 0]}]}", "obstacles[0].normal: must be a nonzero vector"},
-    {"{\"solids\": [{\"mesh\": \"a.veg\"}], \"obstacles\": [{\"type\": \"sphere\", \"radius\": 1, \"normal\": [0, 0, 1]}]}", "obstacles[0].normal: unknown key"},
-    {"{\"solids\": [{\"mesh\": \"a.veg\"}], \"obstacles\": [{\"type\": \"sphere\", \"radius\": 1, \"friction\": -0.5}]}", "obstacles[0].friction: must be >= 0"},
-    {"{\"solids\": [{\"mesh\": \"a.veg\"}], \"obstacles\": [{\"type\": \"sphere\", \"radius\": 1, \"motion\": {\"speed\": 1}}]}", "obstacles[0].motion.speed: unknown key"},
-    {"{\"solids\": [{\"mesh\": \"a.veg\"}], \"obstacles\": [{\"type\": \"gear\", \"radius\": 1, \"half_length\": 1, \"teeth\": 2}]}", "obstacles[0].teeth: must be in [3, 10000]"},
+    {"{\"solids\": [{\"mesh\": \"a.veg\"}], \"obstacles\": [{\"type\": \"cone\"}]}",
+     "obstacles[0].type: must be one of"},
+    {"{\"solids\": [{\"mesh\": \"a.veg\"}], \"obstacles\": [{\"type\": \"plane\", \"point\": [0, "
+     "0, 0]}]}",
+     "obstacles[0].normal: is required"},
+    {"{\"solids\": [{\"mesh\": \"a.veg\"}], \"obstacles\": [{\"type\": \"plane\", \"point\": [0, "
+     "0, 0], \"normal\": [0, 0, 0]}]}",
+     "obstacles[0].normal: must be a nonzero vector"},
+    {"{\"solids\": [{\"mesh\": \"a.veg\"}], \"obstacles\": [{\"type\": \"sphere\", \"radius\": 1, "
+     "\"normal\": [0, 0, 1]}]}",
+     "obstacles[0].normal: unknown key"},
+    {"{\"solids\": [{\"mesh\": \"a.veg\"}], \"obstacles\": [{\"type\": \"sphere\", \"radius\": 1, "
+     "\"friction\": -0.5}]}",
+     "obstacles[0].friction: must be >= 0"},
+    {"{\"solids\": [{\"mesh\": \"a.veg\"}], \"obstacles\": [{\"type\": \"sphere\", \"radius\": 1, "
+     "\"motion\": {\"speed\": 1}}]}",
+     "obstacles[0].motion.speed: unknown key"},
+    {"{\"solids\": [{\"mesh\": \"a.veg\"}], \"obstacles\": [{\"type\": \"gear\", \"radius\": 1, "
+     "\"half_length\": 1, \"teeth\": 2}]}",
+     "obstacles[0].teeth: must be in [3, 100000]"},
     {"{\"solids\": [{\"mesh\": \"a.veg\"}],\n \"fps\": 3,,}", "bad.json: line 2, column"},
     {"[1, 2]", "(top level): must be an object"},
 };
@@ -325,6 +369,35 @@ static void starting_inside_an_obstacle_is_a_warning(void **state) {
   assert_null(strstr(w, "inf"));
 }
 
+/* The public description's getters name what is there, and nothing for an index outside it
+ * (they read past the arrays before: a stray name pointer, a garbage material, a crash). */
+static void description_getters_check_their_index(void **state) {
+  (void)state;
+  piola_scene_desc *d = NULL;
+  const char *json =
+      "{\"solids\": [{\"name\": \"ball\", \"mesh\": \"m/a.veg\"}],"
+      " \"obstacles\": [{\"type\": \"plane\", \"name\": \"floor\", \"point\": [0, 0, 0],"
+      " \"normal\": [0, 0, 1]}]}";
+  if (piola_scene_parse_string(json, "/base", "t", &d) != PIOLA_OK)
+    fail_msg("%s", piola_last_error());
+  assert_string_equal(piola_scene_desc_solid_name(d, 0), "ball");
+  assert_string_equal(piola_scene_desc_obstacle_name(d, 0), "floor");
+  assert_false(piola_scene_desc_obstacle_is_bone(d, 0));
+  const int32_t outside[] = {-1, 1, 7, INT32_MAX, INT32_MIN};
+  for (int k = 0; k < 5; ++k) {
+    const int32_t i = outside[k];
+    assert_null(piola_scene_desc_solid_name(d, i));
+    assert_true(piola_scene_desc_solid_material(d, i).youngs_modulus == 0);
+    const char *path = "x";
+    const piola_obstacle_def o = piola_scene_desc_obstacle(d, i, &path);
+    assert_null(path);
+    assert_true(o.mesh == NULL && o.friction == 0);
+    assert_null(piola_scene_desc_obstacle_name(d, i));
+    assert_false(piola_scene_desc_obstacle_is_bone(d, i));
+  }
+  piola_scene_desc_destroy(d);
+}
+
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(defaults_hold_when_keys_are_left_out),
@@ -332,6 +405,7 @@ int main(void) {
       cmocka_unit_test(bad_input_names_its_key_path),
       cmocka_unit_test(empty_selection_is_a_warning_naming_its_key),
       cmocka_unit_test(starting_inside_an_obstacle_is_a_warning),
+      cmocka_unit_test(description_getters_check_their_index),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -48,7 +48,7 @@ typedef struct piola_obstacle_def {
   double minor_radius;      /* m: torus tube radius */
   double half_length;       /* m: cylinder and gear half height, capsule segment half length */
   piola_vec3 half_extents;  /* m: box */
-  int tooth_count;          /* gear: number of teeth, >= 3 */
+  int tooth_count;          /* gear: number of teeth, 3 to 100000 */
   double tooth_depth;       /* m: gear: radial depth of the teeth, < radius */
   const piola_tri_mesh *mesh; /* mesh obstacle: a closed triangle surface, copied */
   double friction;          /* Coulomb coefficient mu, >= 0. Default 0 */

@@ -70,21 +70,23 @@ PIOLA_API piola_status piola_scene_build(const piola_scene_desc *desc, piola_sce
 PIOLA_API double piola_scene_desc_fps(const piola_scene_desc *desc);
 PIOLA_API int32_t piola_scene_desc_frames(const piola_scene_desc *desc);
 PIOLA_API int32_t piola_scene_desc_solid_count(const piola_scene_desc *desc);
-/* Solid i's name and material (0 <= i < solid_count). */
+/* Solid i's name and material (0 <= i < solid_count; another i gives NULL and a zeroed
+ * material). */
 PIOLA_API const char *piola_scene_desc_solid_name(const piola_scene_desc *desc, int32_t i);
 PIOLA_API piola_material_def piola_scene_desc_solid_material(const piola_scene_desc *desc,
                                                              int32_t i);
 /* Obstacles, then the shapes of the bones (whose attachments are left out). */
 PIOLA_API int32_t piola_scene_desc_obstacle_count(const piola_scene_desc *desc);
-/* Obstacle i's definition; for a mesh obstacle, def.mesh is NULL and *mesh_path (when not
- * NULL) receives its resolved surface file, else "". */
+/* Obstacle i's definition (0 <= i < obstacle_count); for a mesh obstacle, def.mesh is NULL
+ * and *mesh_path (when not NULL) receives its resolved surface file, else "". Another i
+ * gives a zeroed definition and a NULL *mesh_path. */
 PIOLA_API piola_obstacle_def piola_scene_desc_obstacle(const piola_scene_desc *desc, int32_t i,
                                                        const char **mesh_path);
 
 /* Obstacle i's `name` (default "obstacle<i>"), or for a bone (i >= the number of
- * obstacles) the bone's name. Valid while desc lives. */
+ * obstacles) the bone's name; NULL for an i out of range. Valid while desc lives. */
 PIOLA_API const char *piola_scene_desc_obstacle_name(const piola_scene_desc *desc, int32_t i);
-/* Whether entry i of the obstacle list is a bone's shape. */
+/* Whether entry i of the obstacle list is a bone's shape (false out of range). */
 PIOLA_API bool piola_scene_desc_obstacle_is_bone(const piola_scene_desc *desc, int32_t i);
 /* The scene's gravity (m/s^2) at time t (s). */
 PIOLA_API piola_vec3 piola_scene_desc_gravity(const piola_scene_desc *desc, double t);

@@ -148,7 +148,7 @@ PIOLA_API piola_world_def piola_default_world_def(void);
 
 /* Which nodes a constraint holds, chosen by their rest positions (world space). */
 typedef enum piola_selector_type {
-  PIOLA_SELECT_BOX = 0, /* box_min <= X <= box_max componentwise */
+  PIOLA_SELECT_BOX = 0, /* box_min <= X <= box_max componentwise (box_min <= box_max) */
   PIOLA_SELECT_SPHERE,  /* |X - center| <= radius */
   PIOLA_SELECT_INDICES, /* the listed vertex indices */
 } piola_selector_type;

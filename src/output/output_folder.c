@@ -72,10 +72,12 @@ piola_status piola_output_check_folder(const char *dir, bool force) {
     if (strcmp(e->d_name, ".") != 0 && strcmp(e->d_name, "..") != 0) empty = 0;
   closedir(d);
   if (!empty)
-    return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT,
-                      "%s is not empty (it may hold results of an earlier run); "
-                      "use --force (Python: force=True) to write into it",
-                      dir);
+    return PIOLA_FAIL(
+        PIOLA_ERROR_INVALID_ARGUMENT,
+        "%s is not empty (it may hold results of an earlier run); "
+        "use --force (Python: force=True; C: piola_output_check_folder's force) to write "
+        "into it",
+        dir);
   return PIOLA_OK;
 }
 

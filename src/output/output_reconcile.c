@@ -96,14 +96,15 @@ piola_status piola__output_reconcile(const char *dir, int32_t last_frame, int32_
     if (!vtu || stat(path, &st) != 0 || !S_ISREG(st.st_mode))
       return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT,
                         "%s: frame %d of the checkpoint's run is missing (frames/ or surface/); "
-                        "cannot resume, use --force to start over",
+                        "cannot resume, start over with --force (Python and C: force)",
                         dir, (int)k);
   }
   snprintf(path, sizeof path, "%s/stats.csv", dir);
   FILE *f = fopen(path, "rb");
   if (!f)
     return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT,
-                      "%s: %s; cannot resume, use --force to start over", path, strerror(errno));
+                      "%s: %s; cannot resume, start over with --force (Python and C: force)", path,
+                      strerror(errno));
   size_t cap = 4096, len = 0;
   char *kept = malloc(cap), line[1024];
   if (!kept) {
@@ -138,8 +139,8 @@ piola_status piola__output_reconcile(const char *dir, int32_t last_frame, int32_
   if (expect != last_frame + 1) {
     free(kept);
     return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT,
-                      "%s lists frames 0..%d, the checkpoint is at frame %d; cannot resume, use "
-                      "--force to start over",
+                      "%s lists frames 0..%d, the checkpoint is at frame %d; cannot resume, start "
+                      "over with --force (Python and C: force)",
                       path, (int)expect - 1, (int)last_frame);
   }
   piola__output_remove_strays(dir, last_frame);

@@ -143,11 +143,20 @@ double piola_scene_desc_fps(const piola_scene_desc *d) { return d->desc.fps; }
 int32_t piola_scene_desc_frames(const piola_scene_desc *d) { return d->desc.frames; }
 int32_t piola_scene_desc_solid_count(const piola_scene_desc *d) { return d->desc.solid_count; }
 
+/* Whether i names a solid of d, or an entry of its obstacle list (obstacles, then bones). */
+static bool is_solid(const piola_scene_desc *d, int32_t i) {
+  return i >= 0 && i < d->desc.solid_count;
+}
+static bool is_obstacle(const piola_scene_desc *d, int32_t i) {
+  return i >= 0 && i < d->desc.obstacle_count + d->desc.bone_count;
+}
+
 const char *piola_scene_desc_solid_name(const piola_scene_desc *d, int32_t i) {
-  return d->desc.solids[i].name;
+  return is_solid(d, i) ? d->desc.solids[i].name : NULL;
 }
 
 piola_material_def piola_scene_desc_solid_material(const piola_scene_desc *d, int32_t i) {
+  if (!is_solid(d, i)) return (piola_material_def){0};
   return d->desc.solids[i].def.material;
 }
 
@@ -158,6 +167,10 @@ int32_t piola_scene_desc_obstacle_count(const piola_scene_desc *d) {
 piola_obstacle_def piola_scene_desc_obstacle(const piola_scene_desc *d, int32_t i,
                                              const char **mesh_path) {
   const scene_desc *s = &d->desc;
+  if (!is_obstacle(d, i)) {
+    if (mesh_path) *mesh_path = NULL;
+    return (piola_obstacle_def){0};
+  }
   const scene_obstacle_desc *o =
       i < s->obstacle_count ? &s->obstacles[i] : &s->bones[i - s->obstacle_count].obstacle;
   if (mesh_path) *mesh_path = o->mesh_path;
@@ -166,11 +179,12 @@ piola_obstacle_def piola_scene_desc_obstacle(const piola_scene_desc *d, int32_t 
 
 const char *piola_scene_desc_obstacle_name(const piola_scene_desc *d, int32_t i) {
   const scene_desc *s = &d->desc;
+  if (!is_obstacle(d, i)) return NULL;
   return i < s->obstacle_count ? s->obstacles[i].name : s->bones[i - s->obstacle_count].name;
 }
 
 bool piola_scene_desc_obstacle_is_bone(const piola_scene_desc *d, int32_t i) {
-  return i >= d->desc.obstacle_count;
+  return is_obstacle(d, i) && i >= d->desc.obstacle_count;
 }
 
 piola_vec3 piola_scene_desc_gravity(const piola_scene_desc *d, double t) {

@@ -71,7 +71,7 @@ piola_status piola__scene_parse_obstacle(scene_parser *p, const cJSON *obj,
   PIOLA_TRY(piola__json_opt_number(p, obj, "half_length", POSITIVE, &o->half_length));
   PIOLA_TRY(piola__json_opt_vec3(p, obj, "half_extents", POSITIVE, &o->half_extents));
   int64_t teeth = 0;
-  PIOLA_TRY(piola__json_opt_int(p, obj, "teeth", 3, 10000, &teeth));
+  PIOLA_TRY(piola__json_opt_int(p, obj, "teeth", 3, 100000, &teeth));
   o->tooth_count = (int)teeth;
   if (o->type == PIOLA_OBSTACLE_GEAR) o->tooth_depth = 0.2 * o->radius;
   PIOLA_TRY(piola__json_opt_number(p, obj, "tooth_depth", POSITIVE, &o->tooth_depth));

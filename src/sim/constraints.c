@@ -37,6 +37,13 @@ piola_status piola__body_apply_constraints(world_body *s, const double *rest,
     if (sel->type == PIOLA_SELECT_SPHERE && !(sel->radius >= 0))
       return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "constraints[%d]: sphere radius must be >= 0 m",
                         (int)c);
+    /* as the scene files say: an inverted box would select nothing, silently */
+    if (sel->type == PIOLA_SELECT_BOX &&
+        !(sel->box_min.x <= sel->box_max.x && sel->box_min.y <= sel->box_max.y &&
+          sel->box_min.z <= sel->box_max.z))
+      return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT,
+                        "constraints[%d]: box_min must be <= box_max in every coordinate (m)",
+                        (int)c);
     uint8_t flag = con->driven ? NODE_DRIVEN : NODE_FIXED;
     int32_t motion = -1;
     if (con->driven) {

@@ -9,6 +9,7 @@
 #include <string.h>
 
 #include "common/status_report.h"
+#include "contact/proximity.h"
 #include "math/mat3.h"
 #include "shell/shell_stable_step.h"
 #include "sim/world_internal.h"
@@ -206,41 +207,6 @@ piola_world_shell_stats piola_world_shell_get_stats(const piola_world *world, in
 
 /* ------------------------------------------------------------------ one-way coupling */
 
-/* The closest point to p on triangle (a, b, c), with its barycentric weights (Voronoi
- * regions of the vertices, then the edges, then the face). */
-static vec3 closest_on_triangle(vec3 p, vec3 a, vec3 b, vec3 c, double w[3]) {
-  vec3 ab = vec3_sub(b, a), ac = vec3_sub(c, a), ap = vec3_sub(p, a);
-  double d1 = vec3_dot(ab, ap), d2 = vec3_dot(ac, ap);
-  if (d1 <= 0 && d2 <= 0) return w[0] = 1, w[1] = w[2] = 0, a;
-  vec3 bp = vec3_sub(p, b);
-  double d3 = vec3_dot(ab, bp), d4 = vec3_dot(ac, bp);
-  if (d3 >= 0 && d4 <= d3) return w[1] = 1, w[0] = w[2] = 0, b;
-  double vc = d1 * d4 - d3 * d2;
-  if (vc <= 0 && d1 >= 0 && d3 <= 0) {
-    double t = d1 / (d1 - d3);
-    w[0] = 1 - t, w[1] = t, w[2] = 0;
-    return vec3_add(a, vec3_scale(ab, t));
-  }
-  vec3 cp = vec3_sub(p, c);
-  double d5 = vec3_dot(ab, cp), d6 = vec3_dot(ac, cp);
-  if (d6 >= 0 && d5 <= d6) return w[2] = 1, w[0] = w[1] = 0, c;
-  double vb = d5 * d2 - d1 * d6;
-  if (vb <= 0 && d2 >= 0 && d6 <= 0) {
-    double t = d2 / (d2 - d6);
-    w[0] = 1 - t, w[1] = 0, w[2] = t;
-    return vec3_add(a, vec3_scale(ac, t));
-  }
-  double va = d3 * d6 - d5 * d4;
-  if (va <= 0 && (d4 - d3) >= 0 && (d5 - d6) >= 0) {
-    double t = (d4 - d3) / ((d4 - d3) + (d5 - d6));
-    w[0] = 0, w[1] = 1 - t, w[2] = t;
-    return vec3_add(b, vec3_scale(vec3_sub(c, b), t));
-  }
-  double denom = 1.0 / (va + vb + vc), v = vb * denom, u = vc * denom;
-  w[0] = 1 - v - u, w[1] = v, w[2] = u;
-  return vec3_add(a, vec3_add(vec3_scale(ab, v), vec3_scale(ac, u)));
-}
-
 int32_t piola__shell_collide_with_solids(piola_world *w, world_body *s, double t1, double dt,
                                          uint8_t mark, double *surface_velocity) {
   (void)t1;
@@ -276,9 +242,12 @@ int32_t piola__shell_collide_with_solids(piola_world *w, world_body *s, double t
             fmin(a.z, fmin(b.z, c.z)) > x.z + r || fmax(a.z, fmax(b.z, c.z)) < x.z - r)
           continue;
         double wt[3];
-        vec3 p = closest_on_triangle(x, a, b, c, wt);
-        double d2 = vec3_norm2(vec3_sub(x, p));
-        if (d2 < best) best = d2, best_t = t, best_p = p, weights[0] = wt[0], weights[1] = wt[1], weights[2] = wt[2];
+        const double d2 = piola__point_triangle_closest(x, a, b, c, wt);
+        if (d2 < best) {
+          best = d2, best_t = t, weights[0] = wt[0], weights[1] = wt[1], weights[2] = wt[2];
+          best_p =
+              vec3_add(vec3_add(vec3_scale(a, wt[0]), vec3_scale(b, wt[1])), vec3_scale(c, wt[2]));
+        }
       }
       if (best_t < 0) continue;
       const int32_t *tri = surface->triangles + 3 * best_t;

@@ -9,6 +9,7 @@
 #include <string.h>
 
 #include "common/status_report.h"
+#include "contact/bvh.h"
 #include "force/elastic_body_internal.h"
 #include "force/stiffness_matrix.h"
 #include "shell/shell_stiffness.h"
@@ -257,6 +258,8 @@ void piola__body_free_kind(world_body *b) {
       piola_elastic_body_destroy(b->solid);
       if (b->boundary) piola_tri_mesh_free(b->boundary);
       free(b->boundary);
+      if (b->boundary_tree) piola__bvh_free(b->boundary_tree);
+      free(b->boundary_tree), free(b->boundary_boxes);
       piola__fracture_free(b->fracture);
       return;
     case PIOLA_BODY_SHELL: piola_shell_body_destroy(b->shell); return;

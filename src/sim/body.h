@@ -53,6 +53,9 @@ typedef struct world_body {
   piola_track activation;            /* solids: muscle fibres' activation */
   piola_tri_mesh *boundary;  /* solids: boundary surface, built when a shell first needs it */
   double boundary_reach;     /* solids: longest boundary edge, m */
+  struct piola__bvh
+      *boundary_tree; /* solids: over boundary's triangles (piola__solid_boundary_tree) */
+  struct piola__box *boundary_boxes; /* solids: those triangles' boxes at its last fit */
   piola_shell_body *shell;   /* PIOLA_BODY_SHELL: the shell body */
   piola_shell_stats shell_stats; /* shells: of the last update */
   int collide_with_solids;   /* shells: one-way coupling to the solids' surfaces */
@@ -242,6 +245,11 @@ piola_body_stats piola__solid_stats(world_body *b);
 /* The boundary surface of solid b in b->boundary (its longest rest edge in boundary_reach),
  * built on the first call from the rest topology; positions are b->x. */
 piola_status piola__solid_boundary(world_body *b);
+/* The tree over solid b's boundary triangles (piola__solid_boundary first), fitted to its
+ * current positions: built on the first call and when `rebuild` is set, else refit (the
+ * same shape, the boxes of now: cheaper, and looser the more the body has deformed since
+ * the build). NULL when memory runs out. */
+const struct piola__bvh *piola__solid_boundary_tree(world_body *b, int rebuild);
 /* world_shells.c */
 piola_status piola__shell_update_forces(world_body *b, double t);
 double piola__shell_stable_dt(const piola_world *w, const world_body *b, double scale);

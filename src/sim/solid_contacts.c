@@ -49,17 +49,17 @@ static double largest_move(const world_body *b) {
   return most;
 }
 
-/* The other solids' boundary trees in the solve under way (world.solid_trees): one per
- * solid, over its triangles' boxes at its positions, built at the first Newton iteration
- * that needs it. The boxes are not grown by a pair's reach (which differs from pair to
- * pair); a query grows its point by it instead, which finds the same triangles. */
+/* What the solve under way knows of the other solids (world.solid_trees): each one's
+ * boundary tree (piola__solid_boundary_tree) is built once per solve, at the first Newton
+ * iteration that needs it, since the other solids stand still during the solve, with its
+ * boundary's largest move in the step. The tree's boxes are not grown by a pair's reach
+ * (which differs from pair to pair); a query grows its point by it instead, which finds the
+ * same triangles. */
 struct piola__solid_trees {
   int32_t count;     /* solids with a slot */
-  piola__bvh *trees; /* per solid, by its index among the solids */
-  int64_t *built_in; /* per solid: the solve its tree was built in (-1: none) */
-  double *move;      /* per solid: its boundary's largest move in this step when built (m) */
-  piola__box *boxes; /* a build's scratch */
-  int32_t box_capacity;
+  int64_t *built_in; /* per solid, by its index among the solids: the solve its tree was
+                        built in (-1: none) */
+  double *move;      /* per solid: its boundary's largest move in this step then (m) */
   piola__index_list candidates;
 };
 
@@ -68,57 +68,37 @@ void piola__solid_contacts_solve_begins(piola_world *w) { w->implicit_solve++; }
 void piola__solid_contacts_free(piola_world *w) {
   struct piola__solid_trees *c = w->solid_trees;
   if (!c) return;
-  for (int32_t k = 0; k < c->count; ++k) piola__bvh_free(c->trees + k);
-  free(c->trees), free(c->built_in), free(c->move), free(c->boxes), free(c->candidates.items);
+  free(c->built_in), free(c->move), free(c->candidates.items);
   free(c);
   w->solid_trees = NULL;
 }
 
 /* The tree over the boundary triangles of solid number k (other), built in this solve, and
  * its boundary's largest move in this step in *move; NULL when memory runs out. */
-static const piola__bvh *solid_tree(piola_world *w, int32_t k, const world_body *other,
-                                    double *move) {
+static const piola__bvh *solid_tree(piola_world *w, int32_t k, world_body *other, double *move) {
   struct piola__solid_trees *c = w->solid_trees;
   if (!c && !(c = w->solid_trees = calloc(1, sizeof *c))) return NULL;
   if (k >= c->count) {
     const int32_t count = w->kind_count[PIOLA_BODY_SOLID];
-    piola__bvh *trees = realloc(c->trees, sizeof *trees * (size_t)count);
-    if (!trees) return NULL;
-    c->trees = trees;
     int64_t *built_in = realloc(c->built_in, sizeof *built_in * (size_t)count);
     if (!built_in) return NULL;
     c->built_in = built_in;
     double *moves = realloc(c->move, sizeof *moves * (size_t)count);
     if (!moves) return NULL;
     c->move = moves;
-    for (int32_t j = c->count; j < count; ++j) c->trees[j] = (piola__bvh){0}, c->built_in[j] = -1;
+    for (int32_t j = c->count; j < count; ++j) c->built_in[j] = -1;
     c->count = count;
   }
   if (c->built_in[k] == w->implicit_solve) {
     *move = c->move[k];
-    return c->trees + k;
-  }
-  const piola_tri_mesh *surface = other->boundary;
-  const int32_t triangles = surface->triangle_count;
-  if (triangles > c->box_capacity) {
-    piola__box *grown = realloc(c->boxes, sizeof *grown * (size_t)triangles);
-    if (!grown) return NULL;
-    c->boxes = grown, c->box_capacity = triangles;
-  }
-  for (int32_t t = 0; t < triangles; ++t) {
-    piola__box *box = c->boxes + t;
-    for (int a = 0; a < 3; ++a) box->lo[a] = INFINITY, box->hi[a] = -INFINITY;
-    for (int corner = 0; corner < 3; ++corner) {
-      const double *p = other->x + 3 * surface->triangles[3 * t + corner];
-      for (int a = 0; a < 3; ++a)
-        box->lo[a] = fmin(box->lo[a], p[a]), box->hi[a] = fmax(box->hi[a], p[a]);
-    }
+    return other->boundary_tree;
   }
   c->built_in[k] = -1;
-  if (piola__bvh_build(c->trees + k, c->boxes, triangles) != 0) return NULL;
+  const piola__bvh *tree = piola__solid_boundary_tree(other, 1);
+  if (!tree) return NULL;
   c->built_in[k] = w->implicit_solve;
   *move = c->move[k] = largest_move(other);
-  return c->trees + k;
+  return tree;
 }
 
 /* The box around node x that can reach a triangle within `reach` of where x may have been

@@ -9,6 +9,7 @@
 #include <string.h>
 
 #include "common/status_report.h"
+#include "contact/bvh.h"
 #include "contact/proximity.h"
 #include "math/mat3.h"
 #include "shell/shell_stable_step.h"
@@ -211,42 +212,41 @@ int32_t piola__shell_collide_with_solids(piola_world *w, world_body *s, double t
                                          uint8_t mark, double *surface_velocity) {
   (void)t1;
   int32_t moved = 0;
+  piola__index_list candidates = {0};
   for (int32_t k = 0; k < w->kind_count[PIOLA_BODY_SOLID]; ++k) {
     world_body *solid = piola__world_body_of(w, PIOLA_BODY_SOLID, k);
     /* both in the collision surface: the two-way contact after the step handles the pair */
     if (s->self_collision.enabled && solid->self_collision.enabled) continue;
-    if (piola__solid_boundary(solid) != PIOLA_OK) return moved;
+    if (piola__solid_boundary(solid) != PIOLA_OK) break;
+    const piola__bvh *tree = piola__solid_boundary_tree(solid, 0);
+    if (!tree) break;
+    if (tree->node_count == 0) continue;
     const piola_tri_mesh *surface = solid->boundary;
     const double *sx = solid->x, *sv = solid->v;
-    /* the solid's current bounding box, grown by the search reach */
-    double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
-    for (int32_t i = 0; i < solid->n; ++i)
-      for (int a = 0; a < 3; ++a) lo[a] = fmin(lo[a], sx[3 * i + a]), hi[a] = fmax(hi[a], sx[3 * i + a]);
     const double reach = solid->boundary_reach;
+    const piola__box *whole = &tree->nodes[0].box;
     for (int32_t i = 0; i < s->n; ++i) {
       if (s->flags[i] != NODE_FREE) continue;
       vec3 x = vec3_load(s->x + 3 * i);
-      if (x.x < lo[0] - reach || x.x > hi[0] + reach || x.y < lo[1] - reach || x.y > hi[1] + reach ||
-          x.z < lo[2] - reach || x.z > hi[2] + reach)
-        continue;
+      const piola__box near = {{x.x - reach, x.y - reach, x.z - reach},
+                               {x.x + reach, x.y + reach, x.z + reach}};
+      if (!piola__boxes_overlap(&near, whole)) continue;
+      candidates.count = 0;
+      if (piola__bvh_query(tree, &near, &candidates) != 0) break;
       double best = reach * reach, weights[3] = {0, 0, 0};
       int32_t best_t = -1;
       vec3 best_p = x;
-      for (int32_t t = 0; t < surface->triangle_count; ++t) {
-        const int32_t *tri = surface->triangles + 3 * t;
-        vec3 a = vec3_load(sx + 3 * tri[0]), b = vec3_load(sx + 3 * tri[1]), c = vec3_load(sx + 3 * tri[2]);
-        /* cheap rejection: the triangle's box is farther than the best distance so far */
-        double r = sqrt(best);
-        if (fmin(a.x, fmin(b.x, c.x)) > x.x + r || fmax(a.x, fmax(b.x, c.x)) < x.x - r ||
-            fmin(a.y, fmin(b.y, c.y)) > x.y + r || fmax(a.y, fmax(b.y, c.y)) < x.y - r ||
-            fmin(a.z, fmin(b.z, c.z)) > x.z + r || fmax(a.z, fmax(b.z, c.z)) < x.z - r)
-          continue;
+      for (int64_t c = 0; c < candidates.count; ++c) {
+        const int32_t t = candidates.items[c], *tri = surface->triangles + 3 * t;
+        const vec3 a = vec3_load(sx + 3 * tri[0]), b = vec3_load(sx + 3 * tri[1]),
+                   cc = vec3_load(sx + 3 * tri[2]);
         double wt[3];
-        const double d2 = piola__point_triangle_closest(x, a, b, c, wt);
-        if (d2 < best) {
+        const double d2 = piola__point_triangle_closest(x, a, b, cc, wt);
+        /* of equally near triangles the first wins, whatever order the tree gives them in */
+        if (d2 < best || (d2 == best && t < best_t)) {
           best = d2, best_t = t, weights[0] = wt[0], weights[1] = wt[1], weights[2] = wt[2];
           best_p =
-              vec3_add(vec3_add(vec3_scale(a, wt[0]), vec3_scale(b, wt[1])), vec3_scale(c, wt[2]));
+              vec3_add(vec3_add(vec3_scale(a, wt[0]), vec3_scale(b, wt[1])), vec3_scale(cc, wt[2]));
         }
       }
       if (best_t < 0) continue;
@@ -282,5 +282,6 @@ int32_t piola__shell_collide_with_solids(piola_world *w, world_body *s, double t
       s->colliding[i] = mark;
     }
   }
+  free(candidates.items);
   return moved;
 }

@@ -7,6 +7,7 @@
 #include <string.h>
 
 #include "common/status_report.h"
+#include "contact/bvh.h"
 #include "force/elastic_body_internal.h"
 #include "force/stable_step.h"
 #include "math/mat3.h"
@@ -348,4 +349,38 @@ piola_status piola__solid_boundary(world_body *solid) {
   solid->boundary = surface;
   solid->boundary_reach = reach;
   return PIOLA_OK;
+}
+
+const piola__bvh *piola__solid_boundary_tree(world_body *solid, int rebuild) {
+  const piola_tri_mesh *surface = solid->boundary;
+  const int32_t triangles = surface->triangle_count;
+  if (!solid->boundary_boxes &&
+      !(solid->boundary_boxes =
+            malloc(sizeof *solid->boundary_boxes * (size_t)(triangles > 0 ? triangles : 1))))
+    return NULL;
+  if (!solid->boundary_tree) {
+    if (!(solid->boundary_tree = calloc(1, sizeof *solid->boundary_tree))) return NULL;
+    rebuild = 1;
+  }
+  for (int32_t t = 0; t < triangles; ++t) {
+    piola__box *box = solid->boundary_boxes + t;
+    const double *a = solid->x + 3 * surface->triangles[3 * t],
+                 *b = solid->x + 3 * surface->triangles[3 * t + 1],
+                 *c = solid->x + 3 * surface->triangles[3 * t + 2];
+    for (int k = 0; k < 3; ++k) { /* comparisons, not fmin: a call each without -ffast-math */
+      const double lo = a[k] < b[k] ? a[k] : b[k], hi = a[k] < b[k] ? b[k] : a[k];
+      box->lo[k] = c[k] < lo ? c[k] : lo;
+      box->hi[k] = c[k] > hi ? c[k] : hi;
+    }
+  }
+  if (rebuild) {
+    if (piola__bvh_build(solid->boundary_tree, solid->boundary_boxes, triangles) != 0) {
+      piola__bvh_free(solid->boundary_tree); /* built again next time */
+      free(solid->boundary_tree), solid->boundary_tree = NULL;
+      return NULL;
+    }
+  } else {
+    piola__bvh_refit(solid->boundary_tree, solid->boundary_boxes);
+  }
+  return solid->boundary_tree;
 }

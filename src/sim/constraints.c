@@ -24,7 +24,8 @@ piola_status piola__body_apply_constraints(world_body *s, const double *rest,
                                             const piola_constraint_def *constraints,
                                             int32_t count) {
   if (count < 0 || (count > 0 && !constraints))
-    return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "constraints: bad count %d", (int)count);
+    return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "%s '%s': constraints: bad count %d",
+                      piola__body_kind_name(s->kind), s->name, (int)count);
   int32_t driven = 0;
   for (int32_t c = 0; c < count; ++c) driven += constraints[c].driven ? 1 : 0;
   if (driven) {
@@ -35,15 +36,17 @@ piola_status piola__body_apply_constraints(world_body *s, const double *rest,
     const piola_constraint_def *con = &constraints[c];
     const piola_selector *sel = &con->selector;
     if (sel->type == PIOLA_SELECT_SPHERE && !(sel->radius >= 0))
-      return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "constraints[%d]: sphere radius must be >= 0 m",
-                        (int)c);
+      return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT,
+                        "%s '%s': constraints[%d]: sphere radius must be >= 0 m",
+                        piola__body_kind_name(s->kind), s->name, (int)c);
     /* as the scene files say: an inverted box would select nothing, silently */
     if (sel->type == PIOLA_SELECT_BOX &&
         !(sel->box_min.x <= sel->box_max.x && sel->box_min.y <= sel->box_max.y &&
           sel->box_min.z <= sel->box_max.z))
       return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT,
-                        "constraints[%d]: box_min must be <= box_max in every coordinate (m)",
-                        (int)c);
+                        "%s '%s': constraints[%d]: box_min must be <= box_max in every "
+                        "coordinate (m)",
+                        piola__body_kind_name(s->kind), s->name, (int)c);
     uint8_t flag = con->driven ? NODE_DRIVEN : NODE_FIXED;
     int32_t motion = -1;
     if (con->driven) {
@@ -52,13 +55,16 @@ piola_status piola__body_apply_constraints(world_body *s, const double *rest,
     }
     if (sel->type == PIOLA_SELECT_INDICES) {
       if (sel->index_count > 0 && !sel->indices)
-        return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "constraints[%d]: indices missing", (int)c);
+        return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "%s '%s': constraints[%d]: indices missing",
+                          piola__body_kind_name(s->kind), s->name, (int)c);
       for (int32_t k = 0; k < sel->index_count; ++k) {
         int32_t i = sel->indices[k];
         if (i < 0 || i >= s->n)
           return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT,
-                            "constraints[%d].indices[%d]: vertex %d is out of range [0, %d)", (int)c,
-                            (int)k, (int)i, (int)s->n);
+                            "%s '%s': constraints[%d].indices[%d]: vertex %d is out of range "
+                            "[0, %d)",
+                            piola__body_kind_name(s->kind), s->name, (int)c, (int)k, (int)i,
+                            (int)s->n);
         s->flags[i] = flag;
         s->motion_of[i] = motion;
       }

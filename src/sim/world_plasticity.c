@@ -20,7 +20,7 @@ piola_status piola__solid_plastic_create(world_body *s, const piola_solid_def *d
   s->plastic_stats = (piola_plastic_stats){0, 0, 1.0};
   if (!def->plasticity) return PIOLA_OK;
   piola_status st = piola_plastic_state_create(s->solid, def->plasticity, &s->plastic);
-  if (st != PIOLA_OK) return PIOLA_FAIL(st, "plasticity: %s", piola_last_error());
+  if (st != PIOLA_OK) return PIOLA_FAIL(st, "solid '%s': %s", s->name, piola_last_error());
   return PIOLA_OK;
 }
 

@@ -67,8 +67,14 @@ static piola_status check_shell_def(const piola_shell_def *def, int32_t id) {
   if (!def->mesh) return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "shell %d: mesh is required", (int)id);
   if (!piola__track_ok(&def->stiffness_scale, 0))
     return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "shell %d: stiffness_scale must be >= 0", (int)id);
-  if (!piola__track_ok(&def->shear_viscosity, 0) || !piola__track_ok(&def->bulk_viscosity, 0))
-    return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "shell %d: viscosities must be >= 0 Pa s", (int)id);
+  if (!piola__track_ok(&def->shear_viscosity, 0))
+    return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT,
+                      "shell %d: shear_viscosity must be finite and >= 0 Pa s at every key",
+                      (int)id);
+  if (!piola__track_ok(&def->bulk_viscosity, 0))
+    return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT,
+                      "shell %d: bulk_viscosity must be finite and >= 0 Pa s at every key",
+                      (int)id);
   if (!isfinite(def->velocity.x) || !isfinite(def->velocity.y) || !isfinite(def->velocity.z))
     return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "shell %d: velocity must be finite", (int)id);
   if (!(def->solid_friction >= 0) || !isfinite(def->solid_friction))

@@ -49,13 +49,13 @@ static double largest_move(const world_body *b) {
   return most;
 }
 
-/* What the solve under way knows of the other solids (world.solid_trees): each one's
+/* What the solve under way knows of the other solids (world.solid_solve): each one's
  * boundary tree (piola__solid_boundary_tree) is built once per solve, at the first Newton
  * iteration that needs it, since the other solids stand still during the solve, with its
  * boundary's largest move in the step. The tree's boxes are not grown by a pair's reach
  * (which differs from pair to pair); a query grows its point by it instead, which finds the
  * same triangles. */
-struct piola__solid_trees {
+struct piola__solid_solve {
   int32_t count;     /* solids with a slot */
   int64_t *built_in; /* per solid, by its index among the solids: the solve its tree was
                         built in (-1: none) */
@@ -66,18 +66,18 @@ struct piola__solid_trees {
 void piola__solid_contacts_solve_begins(piola_world *w) { w->implicit_solve++; }
 
 void piola__solid_contacts_free(piola_world *w) {
-  struct piola__solid_trees *c = w->solid_trees;
+  struct piola__solid_solve *c = w->solid_solve;
   if (!c) return;
   free(c->built_in), free(c->move), free(c->candidates.items);
   free(c);
-  w->solid_trees = NULL;
+  w->solid_solve = NULL;
 }
 
 /* The tree over the boundary triangles of solid number k (other), built in this solve, and
  * its boundary's largest move in this step in *move; NULL when memory runs out. */
 static const piola__bvh *solid_tree(piola_world *w, int32_t k, world_body *other, double *move) {
-  struct piola__solid_trees *c = w->solid_trees;
-  if (!c && !(c = w->solid_trees = calloc(1, sizeof *c))) return NULL;
+  struct piola__solid_solve *c = w->solid_solve;
+  if (!c && !(c = w->solid_solve = calloc(1, sizeof *c))) return NULL;
   if (k >= c->count) {
     const int32_t count = w->kind_count[PIOLA_BODY_SOLID];
     int64_t *built_in = realloc(c->built_in, sizeof *built_in * (size_t)count);
@@ -101,25 +101,24 @@ static const piola__bvh *solid_tree(piola_world *w, int32_t k, world_body *other
   return tree;
 }
 
-/* The box around node x that can reach a triangle within `reach` of where x may have been
- * in this step (move) */
+/* The box of the points within `reach` of x in every coordinate. */
 static piola__box search_box(const double x[3], double reach) {
   return (piola__box){{x[0] - reach, x[1] - reach, x[2] - reach},
                       {x[0] + reach, x[1] + reach, x[2] + reach}};
 }
 
 /* Node i of s against other's surface (tree over its triangles, candidates scratch): puts
- * it `gap` outside the nearest triangle when it is closer than that or inside (a node held
- * already: see below; thickness is the pair's). Its search reaches the nearest triangle
- * within `reach` of anywhere it may have been in this step. Returns 1 when it did. */
+ * it `gap` outside the nearest triangle that meets the box `near` when it is closer than that
+ * or inside (a node held already: see below; thickness is the pair's). Returns 1 when it
+ * did. */
 static int hold_outside(world_body *s, int32_t i, world_body *other, const piola__bvh *tree,
-                        piola__index_list *candidates, double reach, double gap, double thickness,
-                        double mu, double *surface_velocity, double *surface_mu, uint8_t mark) {
+                        piola__index_list *candidates, const piola__box *near, double gap,
+                        double thickness, double mu, double *surface_velocity, double *surface_mu,
+                        uint8_t mark) {
   const piola_tri_mesh *surface = other->boundary;
   const vec3 x = vec3_load(s->x + 3 * i);
-  const piola__box point = search_box(s->x + 3 * i, node_move(s, i) + reach);
   candidates->count = 0;
-  if (piola__bvh_query(tree, &point, candidates) != 0) return 0;
+  if (piola__bvh_query(tree, near, candidates) != 0) return 0;
   double best = INFINITY, weights[3] = {0, 0, 0};
   int32_t best_t = -1;
   for (int64_t k = 0; k < candidates->count; ++k) {
@@ -202,7 +201,7 @@ int32_t piola__solid_contacts_with_solids(piola_world *w, world_body *s, uint8_t
       if (s->flags[i] != NODE_FREE || !(s->mass[i] > 0)) continue;
       const piola__box near = search_box(s->x + 3 * i, node_move(s, i) + reach);
       if (!piola__boxes_overlap(&near, &whole)) continue;
-      moved += hold_outside(s, i, other, tree, &w->solid_trees->candidates, reach, gap, thickness,
+      moved += hold_outside(s, i, other, tree, &w->solid_solve->candidates, &near, gap, thickness,
                             mu, surface_velocity, surface_mu, mark);
     }
   }

@@ -50,10 +50,10 @@ struct piola_world {
   piola_obstacle **obstacles;
   int32_t obstacle_count, obstacle_capacity;
   struct world_contact *contact; /* self-collision of boundary surfaces (world_contact.c) */
-  /* the solids' boundary trees of the implicit solve under way (solid_contacts.c), and that
-   * solve's number: every solve (a try of a body's step, or its solve after the collision
-   * pass) takes the next one, piola__solid_contacts_solve_begins */
-  struct piola__solid_trees *solid_trees;
+  /* what the implicit solve under way knows of the other solids (solid_contacts.c), and
+   * that solve's number: every solve (a try of a body's step, or its solve after the
+   * collision pass) takes the next one, piola__solid_contacts_solve_begins */
+  struct piola__solid_solve *solid_solve;
   int64_t implicit_solve;
   /* the CFL bounds (min(max_dt, every body's bound)) of the start states of the last
    * STEP_BOUND_WINDOW Newmark steps, oldest overwritten first: a step is never longer than

@@ -362,6 +362,48 @@ static void constraints_hold_and_drive_nodes_exactly(void **state) {
   piola_world_destroy(w);
 }
 
+/* What a warning handler heard: calls, and the last kind and message. */
+typedef struct raised_log {
+  int calls;
+  piola_warning_kind kind;
+  const char *message;
+} raised_log;
+
+static void log_raised(void *context, piola_warning_kind kind, const char *message) {
+  raised_log *log = context;
+  log->calls++, log->kind = kind, log->message = message;
+}
+
+/* A warning handler hears each kind once, as it is raised, with the message the world keeps
+ * (piola run prints a warning raised inside a long frame then, not when the frame ends). */
+static void warning_handler_hears_each_kind_once(void **state) {
+  (void)state;
+  piola_world *w = make_world(-9.81, 1e-3);
+  raised_log log = {0, PIOLA_WARNING_KIND_COUNT, NULL};
+  piola_world_set_warning_handler(w, log_raised, &log);
+  piola_tet_mesh mesh = block_mesh(1, 1, 1, 0.1, 0.1, 0.1);
+  piola_constraint_def con;
+  memset(&con, 0, sizeof con);
+  con.selector.type = PIOLA_SELECT_SPHERE; /* far from the block: selects nothing */
+  con.selector.center = (piola_vec3){5, 5, 5};
+  con.selector.radius = 0.01;
+  con.motion = piola_default_rigid_motion_def();
+  piola_solid_def sd = piola_default_solid_def();
+  sd.mesh = &mesh;
+  sd.constraints = &con;
+  sd.constraint_count = 1;
+  assert_int_equal(piola_world_add_solid(w, &sd, NULL), PIOLA_OK);
+  assert_int_equal(log.calls, 1);
+  assert_int_equal(log.kind, PIOLA_WARNING_EMPTY_SELECTION);
+  assert_ptr_equal(log.message, piola_world_warning(w, PIOLA_WARNING_EMPTY_SELECTION));
+  assert_non_null(strstr(log.message, "selects no node"));
+  assert_int_equal(piola_world_add_solid(w, &sd, NULL), PIOLA_OK); /* the same kind: once */
+  assert_int_equal(log.calls, 1);
+  piola_world_set_warning_handler(w, NULL, NULL);
+  block_mesh_free(&mesh);
+  piola_world_destroy(w);
+}
+
 /* The initial deformation: a zero matrix collapses the free nodes to the rest centroid, and
  * the scramble is a fixed function of the seed. */
 static void initial_state_is_deformed_as_asked(void **state) {
@@ -412,6 +454,7 @@ int main(void) {
       cmocka_unit_test(real_mesh_block_sticks_on_an_incline),
       cmocka_unit_test(damped_real_mesh_block_slides_with_all_its_friction),
       cmocka_unit_test(constraints_hold_and_drive_nodes_exactly),
+      cmocka_unit_test(warning_handler_hears_each_kind_once),
       cmocka_unit_test(initial_state_is_deformed_as_asked),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);

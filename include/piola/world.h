@@ -309,6 +309,13 @@ typedef enum piola_warning_kind {
 
 /* The message of warning kind, or NULL while it has not been raised. */
 PIOLA_API const char *piola_world_warning(const piola_world *world, piola_warning_kind kind);
+
+/* Called once per warning kind, as it is first raised (in the middle of a step or a frame,
+ * on the thread that steps the world), with the message piola_world_warning then returns:
+ * a run stuck inside a long frame can say why before the frame ends. NULL: none. */
+typedef void piola_warning_handler(void *context, piola_warning_kind kind, const char *message);
+PIOLA_API void piola_world_set_warning_handler(piola_world *world, piola_warning_handler *handler,
+                                               void *context);
 PIOLA_API int32_t piola_world_solid_count(const piola_world *world);
 PIOLA_API int32_t piola_world_obstacle_count(const piola_world *world);
 

@@ -85,6 +85,22 @@ static void report_warnings(piola_output *out, const piola_world *world, bool wa
     fprintf(stderr, "piola run: warnings.txt: %s\n", piola_last_error());
 }
 
+/* What the warning handler needs to report a warning as it is raised. */
+typedef struct warning_report {
+  piola_output *out; /* NULL on MPI processes other than 0 */
+  const piola_world *world;
+  bool *warned;
+  bool tty;
+} warning_report;
+
+/* The world's warning handler: a warning raised inside a frame is printed then, not when
+ * the frame ends (a run stalled inside a frame by a tiny step said nothing of it). */
+static void report_raised_warning(void *context, piola_warning_kind kind, const char *message) {
+  (void)kind, (void)message;
+  const warning_report *r = context;
+  report_warnings(r->out, r->world, r->warned, r->tty);
+}
+
 static void progress(bool tty, int frame, int frames, double t, double elapsed, int substeps,
                      int inverted) {
   double eta = frame > 0 ? elapsed / frame * (frames - frame) : NAN;
@@ -279,6 +295,8 @@ static int run(int argc, char **argv, run_mpi *mpi) {
   bool tty = lead && isatty(STDERR_FILENO);
   bool warned[PIOLA_WARNING_KIND_COUNT] = {false};
   report_warnings(lead ? out : NULL, world, warned, false);
+  warning_report raised = {lead ? out : NULL, world, warned, tty};
+  piola_world_set_warning_handler(world, report_raised_warning, &raised);
   const double first_dt = piola_world_stable_dt(world); /* collective when split: all ask */
   if (lead)
     fprintf(stderr, "piola run: %s -> %s: %d frames at %g fps, %d solids, %d shells, %d obstacles, first dt %.3g s%s\n",
@@ -379,6 +397,7 @@ static int run(int argc, char **argv, run_mpi *mpi) {
     report_warnings(lead ? out : NULL, world, warned, tty);
     if (lead) progress(tty, frame, frames, piola_world_time(world), now_seconds() - sim_start, st.substeps, inverted);
   }
+  piola_world_set_warning_handler(world, NULL, NULL); /* `raised` ends with this function */
   double wall = now_seconds() - t_start;
   double sim_wall = now_seconds() - sim_start;
   int written = frames_written;

@@ -69,6 +69,8 @@ struct piola_world {
   int32_t deeper_steps_left;
   step_profile profile;       /* per-phase step timers, off unless a benchmark turns them on */
   char *warnings[PIOLA_WARNING_KIND_COUNT]; /* first message of each kind, or NULL */
+  piola_warning_handler *warning_handler;   /* told of each as it is raised (or NULL) */
+  void *warning_context;
   int start_checked; /* the first step's check of nodes inside obstacles ran (world_warnings.c) */
   int tangle_checked; /* the first collision pass's check of tangled solids ran (world_contact.c) */
   piola_work_split_planner split_planner; /* splits of solids added (plan NULL: none) */

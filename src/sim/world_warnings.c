@@ -33,6 +33,14 @@ void piola__world_warn(piola_world *w, piola_warning_kind kind, const char *form
   if (!copy) return; /* a warning is advisory: out of memory drops it, never the run */
   memcpy(copy, text, n);
   w->warnings[kind] = copy;
+  if (w->warning_handler) w->warning_handler(w->warning_context, kind, copy);
+}
+
+void piola_world_set_warning_handler(piola_world *world, piola_warning_handler *handler,
+                                     void *context) {
+  if (!world) return;
+  world->warning_handler = handler;
+  world->warning_context = context;
 }
 
 const char *piola_world_warning(const piola_world *world, piola_warning_kind kind) {

@@ -165,10 +165,10 @@ static piola_status check_initial_extent(const world_body *s, const double *rest
   const double size = piola__bounding_diagonal(s->n, rest);
   if (farthest <= INITIAL_EXTENT_LIMIT * size) return PIOLA_OK;
   return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT,
-                    "solid %d: its initial state (initial.matrix, initial.scramble) puts a node "
-                    "%g m from the rest centroid, more than %g times the solid's rest size "
-                    "(bounding-box diagonal %g m), where positions cannot hold its shape",
-                    (int)id, farthest, INITIAL_EXTENT_LIMIT, size);
+                    "solid %d ('%s'): its initial state (initial.matrix, initial.scramble) puts "
+                    "a node %g m from the rest centroid, more than %g times the solid's rest "
+                    "size (bounding-box diagonal %g m), where positions cannot hold its shape",
+                    (int)id, s->name, farthest, INITIAL_EXTENT_LIMIT, size);
 }
 
 /* Everything of a new solid after its slot in the table: the elastic body, the per-node

@@ -86,7 +86,7 @@ expect 2 'If a solid starts deformed (initial.scramble, initial.matrix), it is f
 # a start past what positions can hold (1e6 times the solid's size): refused, naming the keys
 for big in '"scramble": 1e100' '"scramble": 1e300' '"matrix": [[1e300, 0, 0], [0, 1, 0], [0, 0, 1]]'; do
   echo "{\"fps\": 30, \"frames\": 1, \"solids\": [{\"mesh\": $box, \"initial\": {$big}}]}" >huge_start.json
-  expect 2 "solids[0]: solid 0: its initial state (initial.matrix, initial.scramble) puts a node" -- "$PIOLA" run huge_start.json -o out_huge
+  expect 2 "solids[0]: solid 0 ('solid0'): its initial state (initial.matrix, initial.scramble) puts a node" -- "$PIOLA" run huge_start.json -o out_huge
   [[ -e out_huge ]] && fail "the refused huge start ($big) created its output folder"
 done
 # an implicit scene refused for a tiny integrator.dt: the hint is about integrator.dt, not the

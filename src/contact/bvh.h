@@ -59,6 +59,11 @@ void piola__bvh_free(piola__bvh *bvh);
 
 int piola__index_list_push(piola__index_list *list, int32_t value);
 
+/* The box of the points within r of x in every coordinate. */
+static inline piola__box piola__box_around(const double x[3], double r) {
+  return (piola__box){{x[0] - r, x[1] - r, x[2] - r}, {x[0] + r, x[1] + r, x[2] + r}};
+}
+
 static inline int piola__boxes_overlap(const piola__box *a, const piola__box *b) {
   return a->lo[0] <= b->hi[0] && b->lo[0] <= a->hi[0] && a->lo[1] <= b->hi[1] &&
          b->lo[1] <= a->hi[1] && a->lo[2] <= b->hi[2] && b->lo[2] <= a->hi[2];

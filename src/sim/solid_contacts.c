@@ -101,12 +101,6 @@ static const piola__bvh *solid_tree(piola_world *w, int32_t k, world_body *other
   return tree;
 }
 
-/* The box of the points within `reach` of x in every coordinate. */
-static piola__box search_box(const double x[3], double reach) {
-  return (piola__box){{x[0] - reach, x[1] - reach, x[2] - reach},
-                      {x[0] + reach, x[1] + reach, x[2] + reach}};
-}
-
 /* Node i of s against other's surface (tree over its triangles, candidates scratch): puts
  * it `gap` outside the nearest triangle that meets the box `near` when it is closer than that
  * or inside (a node held already: see below; thickness is the pair's). Returns 1 when it
@@ -199,7 +193,7 @@ int32_t piola__solid_contacts_with_solids(piola_world *w, world_body *s, uint8_t
     const piola__box whole = tree->nodes[0].box;
     for (int32_t i = 0; i < s->n; ++i) {
       if (s->flags[i] != NODE_FREE || !(s->mass[i] > 0)) continue;
-      const piola__box near = search_box(s->x + 3 * i, node_move(s, i) + reach);
+      const piola__box near = piola__box_around(s->x + 3 * i, node_move(s, i) + reach);
       if (!piola__boxes_overlap(&near, &whole)) continue;
       moved += hold_outside(s, i, other, tree, &w->solid_solve->candidates, &near, gap, thickness,
                             mu, surface_velocity, surface_mu, mark);

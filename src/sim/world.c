@@ -17,6 +17,18 @@ int piola__track_ok(const piola_track *t, double lo) {
   return 1;
 }
 
+piola_status piola__check_viscosities(const char *kind, int32_t id, const piola_track *shear,
+                                      const piola_track *bulk) {
+  const piola_track *tracks[2] = {shear, bulk};
+  static const char *const names[2] = {"shear_viscosity", "bulk_viscosity"};
+  for (int k = 0; k < 2; ++k)
+    if (!piola__track_ok(tracks[k], 0))
+      return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT,
+                        "%s %d: %s must be finite and >= 0 Pa s at every key", kind, (int)id,
+                        names[k]);
+  return PIOLA_OK;
+}
+
 piola_status piola_world_create(const piola_world_def *def, piola_world **out) {
   if (!def || !out) return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "world: NULL argument");
   *out = NULL;

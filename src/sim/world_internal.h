@@ -125,6 +125,10 @@ void piola__world_free_bodies(piola_world *w);
 
 /* True when every value of track t is finite and >= lo (world.c). */
 int piola__track_ok(const piola_track *t, double lo);
+/* PIOLA_OK when both viscosity tracks of body id (kind "solid" or "shell") are finite and
+ * >= 0, else an error naming the one that is not. */
+piola_status piola__check_viscosities(const char *kind, int32_t id, const piola_track *shear,
+                                      const piola_track *bulk);
 
 /* True when rest position p (3 doubles, m) lies in a box or sphere selector (index lists
  * select by index, not by position: false). Shared by constraints and bone attachments. */

@@ -67,14 +67,7 @@ static piola_status check_shell_def(const piola_shell_def *def, int32_t id) {
   if (!def->mesh) return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "shell %d: mesh is required", (int)id);
   if (!piola__track_ok(&def->stiffness_scale, 0))
     return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "shell %d: stiffness_scale must be >= 0", (int)id);
-  if (!piola__track_ok(&def->shear_viscosity, 0))
-    return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT,
-                      "shell %d: shear_viscosity must be finite and >= 0 Pa s at every key",
-                      (int)id);
-  if (!piola__track_ok(&def->bulk_viscosity, 0))
-    return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT,
-                      "shell %d: bulk_viscosity must be finite and >= 0 Pa s at every key",
-                      (int)id);
+  PIOLA_TRY(piola__check_viscosities("shell", id, &def->shear_viscosity, &def->bulk_viscosity));
   if (!isfinite(def->velocity.x) || !isfinite(def->velocity.y) || !isfinite(def->velocity.z))
     return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "shell %d: velocity must be finite", (int)id);
   if (!(def->solid_friction >= 0) || !isfinite(def->solid_friction))
@@ -234,8 +227,7 @@ int32_t piola__shell_collide_with_solids(piola_world *w, world_body *s, double t
     for (int32_t i = 0; i < s->n; ++i) {
       if (s->flags[i] != NODE_FREE) continue;
       vec3 x = vec3_load(s->x + 3 * i);
-      const piola__box near = {{x.x - reach, x.y - reach, x.z - reach},
-                               {x.x + reach, x.y + reach, x.z + reach}};
+      const piola__box near = piola__box_around(s->x + 3 * i, reach);
       if (!piola__boxes_overlap(&near, whole)) continue;
       candidates.count = 0;
       if (piola__bvh_query(tree, &near, &candidates) != 0) break;

@@ -121,14 +121,7 @@ static piola_status check_solid_def(const piola_solid_def *def, int32_t id) {
                       (int)id, def->density);
   if (!piola__track_ok(&def->stiffness_scale, 0))
     return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "solid %d: stiffness_scale must be >= 0", (int)id);
-  if (!piola__track_ok(&def->shear_viscosity, 0))
-    return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT,
-                      "solid %d: shear_viscosity must be finite and >= 0 Pa s at every key",
-                      (int)id);
-  if (!piola__track_ok(&def->bulk_viscosity, 0))
-    return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT,
-                      "solid %d: bulk_viscosity must be finite and >= 0 Pa s at every key",
-                      (int)id);
+  PIOLA_TRY(piola__check_viscosities("solid", id, &def->shear_viscosity, &def->bulk_viscosity));
   if (!(def->scramble_radius >= 0) || !isfinite(def->scramble_radius))
     return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "solid %d: scramble radius must be >= 0 m",
                       (int)id);

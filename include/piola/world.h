@@ -304,6 +304,12 @@ typedef enum piola_warning_kind {
                                           of two bodies with self-collision intersect:
                                           collision processing holds them hooked where they
                                           cross */
+  PIOLA_WARNING_UNDAMPED_TANGLE,       /* at the world's first step from t = 0 with
+                                          "newmark": an elastic solid with no damping starts
+                                          with an inverted or flat tet; nothing dissipates the
+                                          tangle's energy, so it does not settle, and a
+                                          non-conservative inversion extension can add
+                                          energy until the steps become tiny */
   PIOLA_WARNING_KIND_COUNT
 } piola_warning_kind;
 

@@ -597,7 +597,7 @@ piola_status piola_world_step(piola_world *w, double dt_limit, piola_step_stats 
   if (isnan(dt_limit))
     return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT,
                       "step: dt_limit is NaN (a limit in s, or <= 0 for none)");
-  piola__world_check_start_inside(w);
+  piola__world_check_start(w);
   PIOLA_TRY(piola__world_fracture_step(w));
   if (w->def.integrator != PIOLA_INTEGRATOR_NEWMARK)
     return piola__implicit_world_step(w, dt_limit, stats);

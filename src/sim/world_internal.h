@@ -71,7 +71,7 @@ struct piola_world {
   char *warnings[PIOLA_WARNING_KIND_COUNT]; /* first message of each kind, or NULL */
   piola_warning_handler *warning_handler;   /* told of each as it is raised (or NULL) */
   void *warning_context;
-  int start_checked; /* the first step's check of nodes inside obstacles ran (world_warnings.c) */
+  int start_checked;  /* the first step's checks of the start ran (world_warnings.c) */
   int tangle_checked; /* the first collision pass's check of tangled solids ran (world_contact.c) */
   piola_work_split_planner split_planner; /* splits of solids added (plan NULL: none) */
   piola_work_split_planner split_replanner; /* splits of split solids a cut rebuilt */
@@ -94,8 +94,10 @@ void piola__world_check_slivers(piola_world *w, const world_body *s);
  * "A tangled start"; checkpoints restore it), rebuilding the collision surface if it changed. */
 void piola__world_set_collision_waits(piola_world *w, world_body *s, int waits);
 /* Before the world's first step from t = 0: warns (PIOLA_WARNING_STARTS_INSIDE) when free nodes of
- * a body start inside an obstacle deeper than a percent of the body's size. Once per world. */
-void piola__world_check_start_inside(piola_world *w);
+ * a body start inside an obstacle deeper than a percent of the body's size, and
+ * (PIOLA_WARNING_UNDAMPED_TANGLE) when an undamped elastic solid starts tangled under the
+ * explicit integrator. Once per world. */
+void piola__world_check_start(piola_world *w);
 
 /* Diagonal (m) of the bounding box of n points x (3 n numbers); 0 for none. */
 double piola__bounding_diagonal(int32_t n, const double *x);

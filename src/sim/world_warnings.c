@@ -142,11 +142,57 @@ double piola__bounding_diagonal(int32_t n, const double *x) {
   return sqrt(d2);
 }
 
-void piola__world_check_start_inside(piola_world *w) {
+/* 1 when track is zero at every time (a constant 0, or keys all 0). */
+static int track_always_zero(const piola_track *track) {
+  if (track->key_count == 0) return track->value == 0.0;
+  for (int32_t k = 0; k < track->key_count; ++k)
+    if (track->values[k] != 0.0) return 0;
+  return 1;
+}
+
+/* An explicit step of an undamped elastic solid keeps its energy (the energy mode, up to the
+ * integrator's drift) or, with LINEAR and CLAMP, whose stress past the threshold is not a
+ * gradient, can add to it: Medit's unit ball collapsed to a point kept 510-560 tets inverted
+ * for 30 s with no damping, and corotated went from 2.1e4 J to 8.6e9 J by 4.4 s, where its
+ * state-aware steps fell to 7.6e-7 s (time-stepping.md, "What is not physics"). Plastic flow
+ * dissipates, so plastic solids are left out. */
+static void check_undamped_tangles(piola_world *w) {
+  if (w->def.integrator != PIOLA_INTEGRATOR_NEWMARK) return;
+  for (int32_t bi = 0; bi < w->body_count; ++bi) {
+    const world_body *s = &w->bodies[bi];
+    if (s->kind != PIOLA_BODY_SOLID || s->plastic || !track_always_zero(&s->shear_viscosity) ||
+        !track_always_zero(&s->bulk_viscosity))
+      continue;
+    double det = 0;
+    const int32_t tet = piola__solid_flat_or_inverted_tet(s, s->x, &det, 0.0);
+    if (tet < 0) continue;
+    const piola_elastic_body *e = s->solid;
+    int conservative = 1;
+    for (int32_t m = 0; m < e->material_count; ++m)
+      if (e->materials[m].inversion_mode != PIOLA_INVERSION_ENERGY) conservative = 0;
+    piola__world_warn(
+        w, PIOLA_WARNING_UNDAMPED_TANGLE,
+        "solid '%s' starts tangled (tet %d, numbered from 0 in file order, has det F = %.3g) "
+        "with no damping under \"newmark\": nothing dissipates the tangle's energy, so it "
+        "will not settle%s. Give it damping (\"damping\": {\"shear\": ..., \"bulk\": ...}, "
+        "Pa s; time-stepping.md, \"Recovery\", predicts the settling time) or use "
+        "\"integrator\": {\"type\": \"backward_euler\"} (time-stepping.md, \"What is not "
+        "physics\")",
+        s->name, (int)tet, det,
+        conservative ? ""
+                     : ", and its inversion extension, whose stress past the threshold is not "
+                       "the gradient of an energy, can add energy until the steps become "
+                       "tiny (\"inversion\": {\"mode\": \"energy\"} keeps it bounded)");
+    return;
+  }
+}
+
+void piola__world_check_start(piola_world *w) {
   if (w->start_checked) return;
   w->start_checked = 1;
   /* a resumed run continues one that was checked: its contacts are the run's own */
   if (w->time != 0.0) return;
+  check_undamped_tangles(w);
   for (int32_t bi = 0; bi < w->body_count; ++bi) {
     const world_body *b = &w->bodies[bi];
     const double size = piola__bounding_diagonal(b->n, b->x), limit = STARTS_INSIDE_DEPTH * size;

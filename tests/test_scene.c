@@ -398,6 +398,38 @@ static void description_getters_check_their_index(void **state) {
   piola_scene_desc_destroy(d);
 }
 
+/* Integrator keys of the other integrator are accepted with a warning naming them: a scene
+ * that sets `dt` and forgets `type` runs Newmark, and says so. */
+static const char *ignored_keys_warning(const char *integrator, char *text, size_t size) {
+  char json[2048];
+  snprintf(json, sizeof json, "{\"integrator\": {%s}, \"solids\": [{\"mesh\": \"%s\"}]}",
+           integrator, test_data_path("tetgen/octahedron.node"));
+  return scene_warning(json, PIOLA_WARNING_IGNORED_KEYS, 0, text, size);
+}
+
+static void other_integrators_keys_are_a_warning(void **state) {
+  (void)state;
+  char text[1024];
+  assert_non_null(strstr(
+      ignored_keys_warning("\"dt\": 0.01, \"preconditioner\": \"multigrid\"", text, sizeof text),
+      "scene: integrator.dt, integrator.preconditioner apply to "
+      "\"backward_euler\" and \"quasistatic\" only: the scene's integrator "
+      "is \"newmark\""));
+  assert_non_null(
+      strstr(ignored_keys_warning("\"type\": \"quasistatic\", \"cfl\": 0.3", text, sizeof text),
+             "scene: integrator.cfl applies to \"newmark\" only: the scene's "
+             "integrator is \"quasistatic\", which ignores it"));
+  /* each integrator's own keys, and the shared one, raise nothing */
+  assert_string_equal(ignored_keys_warning("\"type\": \"backward_euler\", \"dt\": 0.01, "
+                                           "\"newton_tolerance\": 1e-6, \"collision_interval\": 0",
+                                           text, sizeof text),
+                      "");
+  assert_string_equal(ignored_keys_warning("\"max_dt\": 1e-4, \"cfl\": 0.3, "
+                                           "\"cg_tolerance\": 1e-5, \"cg_max_iterations\": 50",
+                                           text, sizeof text),
+                      "");
+}
+
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(defaults_hold_when_keys_are_left_out),
@@ -406,6 +438,7 @@ int main(void) {
       cmocka_unit_test(empty_selection_is_a_warning_naming_its_key),
       cmocka_unit_test(starting_inside_an_obstacle_is_a_warning),
       cmocka_unit_test(description_getters_check_their_index),
+      cmocka_unit_test(other_integrators_keys_are_a_warning),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
 }

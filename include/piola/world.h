@@ -310,11 +310,20 @@ typedef enum piola_warning_kind {
                                           tangle's energy, so it does not settle, and a
                                           non-conservative inversion extension can add
                                           energy until the steps become tiny */
+  PIOLA_WARNING_IGNORED_KEYS,          /* the scene sets integrator keys that its integrator
+                                          does not use (raised by the scene reader when it
+                                          builds the world) */
   PIOLA_WARNING_KIND_COUNT
 } piola_warning_kind;
 
 /* The message of warning kind, or NULL while it has not been raised. */
 PIOLA_API const char *piola_world_warning(const piola_world *world, piola_warning_kind kind);
+
+/* Raises warning kind with message as the world raises its own (once per kind: nothing
+ * happens when kind was raised already; the handler is called), for a front end's findings
+ * about its input, such as the scene reader's PIOLA_WARNING_IGNORED_KEYS. */
+PIOLA_API void piola_world_raise_warning(piola_world *world, piola_warning_kind kind,
+                                         const char *message);
 
 /* Called once per warning kind, as it is first raised (in the middle of a step or a frame,
  * on the thread that steps the world), with the message piola_world_warning then returns:

@@ -1,6 +1,7 @@
 /* Scene building: read or generate each solid's mesh, place it by its transform, and add
  * solids and obstacles to a new world. Errors name the key path of the solid or obstacle. */
 #include <math.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -169,6 +170,19 @@ piola_status piola__scene_build(const scene_desc *desc, const char *label,
   if (piola_world_create(&desc->world, &world) != PIOLA_OK)
     return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "%s: integrator: %s", label, piola_last_error());
   piola_world_set_work_split_planner(world, planner);
+  if (desc->ignored_integrator_keys[0]) {
+    char text[1024];
+    const int newmark = desc->world.integrator == PIOLA_INTEGRATOR_NEWMARK;
+    const int several = strchr(desc->ignored_integrator_keys, ',') != NULL;
+    snprintf(text, sizeof text,
+             "%s: %s %s to %s only: the scene's integrator is \"%s\"%s, which ignores %s "
+             "(scene-format.md, \"integrator\")",
+             label, desc->ignored_integrator_keys, several ? "apply" : "applies",
+             newmark ? "\"backward_euler\" and \"quasistatic\"" : "\"newmark\"",
+             piola_integrator_type_name(desc->world.integrator),
+             newmark ? " (integrator.type, default \"newmark\")" : "", several ? "them" : "it");
+    piola_world_raise_warning(world, PIOLA_WARNING_IGNORED_KEYS, text);
+  }
   for (int32_t i = 0; i < desc->solid_count; ++i) {
     const scene_solid_desc *d = &desc->solids[i];
     piola_tet_mesh mesh;

@@ -104,6 +104,10 @@ typedef struct scene_desc {
   int32_t shell_count;
   scene_bone_desc *bones;         /* the `bones` key (scene_parse_bone.c) */
   int32_t bone_count;
+  /* the integrator keys the scene sets that its integrator does not use, as
+   * "integrator.dt, integrator.newton_tolerance" ("" for none; scene_parse_world.c): the
+   * build raises PIOLA_WARNING_IGNORED_KEYS with them */
+  char ignored_integrator_keys[320];
 } scene_desc;
 
 /* The folder of a file path: "." for a bare name, "/" for a file in the root (scene.c). */

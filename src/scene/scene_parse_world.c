@@ -1,6 +1,38 @@
 /* The world's keys: fps, frames, gravity and integrator settings. */
 
+#include <stdio.h>
+#include <string.h>
+
 #include "scene/scene_parse_sections.h"
+
+/* The integrator keys that apply to "newmark" only, and to the implicit integrators only
+ * (scene-format.md, `integrator`). */
+static const char *const newmark_keys[] = {"max_dt", "cfl", "cg_tolerance", "cg_max_iterations",
+                                           NULL};
+static const char *const implicit_keys[] = {"dt",
+                                            "newton_tolerance",
+                                            "newton_max_iterations",
+                                            "linear_tolerance",
+                                            "linear_max_iterations",
+                                            "preconditioner",
+                                            "linear_forcing",
+                                            "mpi_preconditioner",
+                                            NULL};
+
+/* Lists in out->ignored_integrator_keys the keys of `integrator` that its type does not use:
+ * a scene that sets `dt` and forgets `type` runs Newmark, and should hear so. */
+static void note_ignored_keys(const cJSON *integrator, scene_desc *out) {
+  const char *const *unused =
+      out->world.integrator == PIOLA_INTEGRATOR_NEWMARK ? implicit_keys : newmark_keys;
+  char *list = out->ignored_integrator_keys;
+  const size_t size = sizeof out->ignored_integrator_keys;
+  list[0] = '\0';
+  for (int k = 0; unused[k]; ++k) {
+    if (!piola__json_get(integrator, unused[k])) continue;
+    const size_t used = strlen(list);
+    snprintf(list + used, size - used, "%sintegrator.%s", used ? ", " : "", unused[k]);
+  }
+}
 
 piola_status piola__scene_parse_world(scene_parser *p, const cJSON *obj, scene_desc *out) {
   const cJSON *v;
@@ -73,6 +105,7 @@ piola_status piola__scene_parse_world(scene_parser *p, const cJSON *obj, scene_d
         return piola__json_fail(p, BAD_VALUE, "must be \"gamg\" or \"block_jacobi_icc\"");
       piola__json_pop(p, o2);
     }
+    note_ignored_keys(v, out);
     piola__json_pop(p, old);
   } else if (out->fps > 0) {
     out->world.implicit_dt = 1.0 / out->fps;

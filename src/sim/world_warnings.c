@@ -36,6 +36,10 @@ void piola__world_warn(piola_world *w, piola_warning_kind kind, const char *form
   if (w->warning_handler) w->warning_handler(w->warning_context, kind, copy);
 }
 
+void piola_world_raise_warning(piola_world *world, piola_warning_kind kind, const char *message) {
+  if (world && message) piola__world_warn(world, kind, "%s", message);
+}
+
 void piola_world_set_warning_handler(piola_world *world, piola_warning_handler *handler,
                                      void *context) {
   if (!world) return;

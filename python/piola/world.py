@@ -7,6 +7,7 @@ constraint flags are read-only views. A view keeps the world's
 memory alive: after World.close() every call raises ClosedError, and existing views keep
 the last state until they are dropped."""
 import numbers
+import warnings as _warnings
 
 import numpy as np
 
@@ -17,6 +18,12 @@ from .material import Material
 from .mesh import Mesh, read_mesh
 
 _DEFAULTS = _piola.defaults()
+
+
+class SimulationWarning(UserWarning):
+    """A condition a run survives but its user should hear about (docs/cli.md, "Warnings"):
+    issued through Python's warnings module by World.advance_to and World.step, once per
+    kind and world."""
 _AXIS_TYPES = ("cylinder", "capsule", "torus", "gear")
 
 
@@ -225,6 +232,7 @@ class World:
                  cg_max_iterations=None, collision_interval=None, *, _core=None, _owner=None):
         self._obstacles = []
         self._owner = _owner
+        self._issued = set()
         if _core is not None:
             self._core = _core
             return
@@ -280,11 +288,33 @@ class World:
         contacts, impacts, impact_zones, collision_steps, newton_iterations,
         linear_iterations, newton_failures, step_retries, energy_redos. A non-finite state raises
         SimulationError and leaves the state before the failing step."""
-        return self._core.advance_to(number(t, "t"))
+        t = number(t, "t")
+        try:
+            return self._core.advance_to(t)
+        finally:
+            self._issue_warnings()
 
     def step(self, dt_limit=None):
         """One step of min(stable dt, dt_limit) s; returns its stats."""
-        return self._core.step() if dt_limit is None else self._core.step(number(dt_limit, "dt_limit"))
+        limit = None if dt_limit is None else number(dt_limit, "dt_limit")
+        try:
+            return self._core.step() if limit is None else self._core.step(limit)
+        finally:
+            self._issue_warnings()
+
+    @property
+    def warnings(self):
+        """The messages of the warnings raised so far (while the world was built too), one
+        per kind, in the order of docs/cli.md's kinds."""
+        return self._core.warnings()
+
+    def _issue_warnings(self):
+        if self.closed:
+            return
+        for text in self._core.warnings():
+            if text not in self._issued:
+                self._issued.add(text)
+                _warnings.warn(text, SimulationWarning, stacklevel=3)
 
     # ---------------------------------------------------------------- building
     def add_solid(self, mesh, *, material=None, name=None, density=None, damping=None,

@@ -275,6 +275,22 @@ static PyObject *world_info(PyObject *self_obj, PyObject *unused) {
                        (int)piola_world_obstacle_count(w));
 }
 
+/* The messages of the warnings raised so far, in the order of their kinds. */
+static PyObject *world_warnings(PyObject *self_obj, PyObject *unused) {
+  (void)unused;
+  piola_world *w = pypiola_world_get(self_obj);
+  if (!w) return NULL;
+  PyObject *list = PyList_New(0);
+  for (int k = 0; list && k < PIOLA_WARNING_KIND_COUNT; ++k) {
+    const char *text = piola_world_warning(w, (piola_warning_kind)k);
+    if (!text) continue;
+    PyObject *item = PyUnicode_DecodeUTF8(text, (Py_ssize_t)strlen(text), "replace");
+    if (!item || PyList_Append(list, item) < 0) Py_CLEAR(list);
+    Py_XDECREF(item);
+  }
+  return list;
+}
+
 /* kind: 0 solid, 1 shell. Checks the index. */
 static piola_world *body_world(PyObject *self, int kind, int index) {
   piola_world *w = pypiola_world_get(self);
@@ -525,6 +541,7 @@ static PyObject *world_add_obstacle(PyObject *self_obj, PyObject *obstacle) {
 static PyMethodDef world_methods[] = {
     {"close", world_close, METH_NOARGS, "close(): later calls raise ClosedError"},
     {"info", world_info, METH_NOARGS, "info() -> {time, stable_dt, solids, shells, obstacles}"},
+    {"warnings", world_warnings, METH_NOARGS, "warnings() -> the messages raised so far"},
     {"advance_to", world_advance_to, METH_VARARGS, "advance_to(t) -> step stats"},
     {"step", world_step, METH_VARARGS, "step(dt_limit=inf) -> step stats"},
     {"body_name", world_body_name, METH_VARARGS, "body_name(kind, index)"},

@@ -1,6 +1,7 @@
 """Worlds from Python: physics through the views (momentum, gravity, energy), zero-copy and
 writable views, keyframed obstacles, driven nodes, the GIL, and misuse."""
 import threading
+import warnings
 
 import numpy as np
 import pytest
@@ -235,6 +236,28 @@ def test_scene_world_and_bodies(tmp_path):
     extra.velocities[:] = [0, 0, 3.0]
     assert sheet.stats()["kinetic_energy"] == pytest.approx(0.5 * sheet.masses.sum() * 4, rel=1e-12)
     assert extra.stats()["kinetic_energy"] == pytest.approx(0.5 * extra.masses.sum() * 9, rel=1e-12)
+
+
+def test_warnings_are_issued_once_through_pythons_warnings():
+    # a scene setting backward Euler's step without its type: read with a warning, run as Newmark
+    scene = piola.Scene({"integrator": {"dt": 0.01},
+                         "solids": [{"mesh": {"generate": "sphere", "radius": 0.1,
+                                              "cell_size": 0.05}}]})
+    w = scene.world
+    assert len(w.warnings) == 1 and "integrator.dt applies to" in w.warnings[0]
+    with pytest.warns(piola.SimulationWarning, match="integrator.dt applies to"):
+        w.advance_to(0.001)
+    # an undamped ball collapsed to a point: warned at its first step, and only once
+    w = piola.World(gravity=(0, 0, 0))
+    w.add_solid(ball(0.05), initial={"matrix": [[0, 0, 0], [0, 0, 0], [0, 0, 0]]})
+    assert w.warnings == []
+    with pytest.warns(piola.SimulationWarning, match="starts tangled .* with no damping") as got:
+        w.step()
+    assert len(got) == 1
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # raised before: not issued again
+        w.step()
+    assert len(w.warnings) == 1
 
 
 def test_stepping_releases_the_gil():

@@ -15,7 +15,8 @@
  * - Bodies placed through each other: the test across bodies agrees with the referee on
  *   random soups split in two; two balls overlapping, and a sheet through a ball, raise the
  *   "through each other" warning naming both; balls apart, or one without self_collision,
- *   raise none.
+ *   raise none. Balls 5 mm apart with a 10 mm thickness raise the "within thickness"
+ *   warning with their gap; 0.1 m apart, or through each other, they do not.
  * - An undamped solid collapsed to a point under the explicit step raises the "undamped
  *   tangle" warning (docs/cli.md), and what it says holds: after 1 s it is still tangled, its
  *   energy grown with the default extension and kept by the energy mode. Damped, under
@@ -154,6 +155,15 @@ static piola_world *two_bodies_world(const piola_tet_mesh *mesh, double gap, int
   return w;
 }
 
+/* The warning of kind after the first step, or NULL. */
+static char *warning_after_a_step(piola_world *w, piola_warning_kind kind) {
+  assert_int_equal(piola_world_step(w, 0, NULL), PIOLA_OK);
+  const char *text = piola_world_warning(w, kind);
+  char *copy = text ? strdup(text) : NULL;
+  piola_world_destroy(w);
+  return copy;
+}
+
 /* The warning after the first step, or NULL. */
 static char *through_each_other_after_a_step(piola_world *w) {
   assert_int_equal(piola_world_step(w, 0, NULL), PIOLA_OK);
@@ -179,6 +189,20 @@ static void bodies_through_each_other_are_named(void **state) {
   assert_non_null(sheet);
   assert_non_null(strstr(sheet, "solid 'first' and shell 'sheet'"));
   free(sheet);
+
+  /* apart, but closer than their thickness (0.01 m): the other warning, with the gap */
+  char *close =
+      warning_after_a_step(two_bodies_world(&mesh, 2.005, 1, 0), PIOLA_WARNING_WITHIN_THICKNESS);
+  assert_non_null(close);
+  assert_non_null(strstr(close, "solid 'second' and solid 'first' start 0.005 m apart") ||
+                  strstr(close, "solid 'first' and solid 'second' start 0.005 m apart"));
+  assert_non_null(strstr(close, "closer than their collision thickness 0.01 m"));
+  free(close);
+  /* a tenth of a radius apart, or through each other (the crossing's own warning): none */
+  assert_null(
+      warning_after_a_step(two_bodies_world(&mesh, 2.1, 1, 0), PIOLA_WARNING_WITHIN_THICKNESS));
+  assert_null(
+      warning_after_a_step(two_bodies_world(&mesh, 1.2, 1, 0), PIOLA_WARNING_WITHIN_THICKNESS));
   piola_tet_mesh_free(&mesh);
 }
 

@@ -313,6 +313,10 @@ typedef enum piola_warning_kind {
   PIOLA_WARNING_IGNORED_KEYS,          /* the scene sets integrator keys that its integrator
                                           does not use (raised by the scene reader when it
                                           builds the world) */
+  PIOLA_WARNING_WITHIN_THICKNESS,      /* at the world's first step from t = 0, a vertex of
+                                          a body with self-collision starts closer to another
+                                          body's surface than their collision thickness: the
+                                          first pass pushes them apart at once */
   PIOLA_WARNING_KIND_COUNT
 } piola_warning_kind;
 

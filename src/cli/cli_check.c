@@ -107,6 +107,15 @@ static void print_solid(const piola_world *world, int32_t s) {
   printf("\n");
 }
 
+/* Prints on stderr each warning the world has raised that warned[] does not mark yet, and
+ * marks it. */
+static void print_new_warnings(const piola_world *world, bool warned[]) {
+  for (int k = 0; k < PIOLA_WARNING_KIND_COUNT; ++k) {
+    const char *text = piola_world_warning(world, (piola_warning_kind)k);
+    if (text && !warned[k]) fprintf(stderr, "piola check: warning: %s\n", text), warned[k] = true;
+  }
+}
+
 int cli_check(int argc, char **argv) {
   const char *scene_path = NULL;
   long threads = 0;
@@ -191,10 +200,8 @@ int cli_check(int argc, char **argv) {
          "keyframed stiffness can change it)\n",
          steps_per_frame, steps_per_frame * frames);
   /* what the world warned of while it was built (slivers, empty selections, cfl) */
-  for (int k = 0; k < PIOLA_WARNING_KIND_COUNT; ++k) {
-    const char *text = piola_world_warning(world, (piola_warning_kind)k);
-    if (text) fprintf(stderr, "piola check: warning: %s\n", text);
-  }
+  bool warned[PIOLA_WARNING_KIND_COUNT] = {false};
+  print_new_warnings(world, warned);
   /* the run piola run would refuse is no valid run */
   if (!run_budget_ok("piola check", scene_path, world, frames, fps, max_steps, false)) {
     piola_scene_destroy(scene);
@@ -220,6 +227,9 @@ int cli_check(int argc, char **argv) {
         if (spent >= timing_seconds) break;
       }
     }
+    /* and what its first steps found (a start inside an obstacle, a tangle, bodies through
+     * each other or within their thickness), as piola run would say */
+    print_new_warnings(world, warned);
     if (rc == 0 && steps >= 2) {
       double per_step = spent / (steps - 1);
       double per_frame = per_step * steps_per_frame;

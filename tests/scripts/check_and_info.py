@@ -128,6 +128,20 @@ def main():
         spf = int(re.search(r"estimate: +(\d+) steps per frame", t).group(1))
         check(spf == math.ceil((1 / fps) / 0.007 - 1e-9), f"backward_euler: {spf} steps per frame of integrator.dt")
 
+        # the timing's steps are the run's first: their warnings are printed too
+        inside = dict(scene, obstacles=[{"type": "plane", "point": [0, 0, 3], "normal": [0, 0, 1]}])
+        with open(path, "w") as f:
+            json.dump(inside, f)
+        timed = subprocess.run([PIOLA, "check", path, "--timing-seconds", "0.1", "--threads", "1"],
+                               capture_output=True, text=True)
+        check(timed.returncode == 0 and "piola check: warning: solid 'slab':" in timed.stderr
+              and "start inside obstacle 0" in timed.stderr,
+              f"a solid half inside the plane is warned of after the timing's steps ({timed.stderr.strip()})")
+        untimed = subprocess.run([PIOLA, "check", path, "--timing-seconds", "0"], capture_output=True,
+                                 text=True)
+        check(untimed.returncode == 0 and "start inside" not in untimed.stderr,
+              "with --timing-seconds 0 no step is taken, and nothing is said of the start")
+
         scene["solids"][0]["material"]["poisson_ratio"] = 0.7
         with open(path, "w") as f:
             json.dump(scene, f)

@@ -382,6 +382,9 @@ int32_t piola_plastic_state_tet_count(const piola_plastic_state *s) { return s->
 const double *piola_plastic_state_fp_inverse(const piola_plastic_state *s) { return s->fp_inv; }
 const double *piola_plastic_state_plastic_strain(const piola_plastic_state *s) { return s->alpha; }
 
+/* The relative rounding of a log stretch measured again after the limit clamped it (above). */
+#define LIMIT_ROUNDING 1e-9
+
 void piola_plastic_state_measure(const piola_plastic_state *s, double *max_log_stretch, double *min_det_fp) {
   double largest = 0, min_det = INFINITY;
   for (int32_t t = 0; t < s->tet_count; ++t) {
@@ -395,6 +398,11 @@ void piola_plastic_state_measure(const piola_plastic_state *s, double *max_log_s
     double det = det33(a);
     min_det = fmin(min_det, det != 0 ? 1.0 / det : -INFINITY);
   }
+  /* the limit stores Fp^-1 = W Sigma' W^T with Sigma' clamped to e^+-limit exactly; measured
+   * again through an SVD a limited tet reads the limit plus a rounding (1e-15), which is the
+   * limit */
+  if (largest > s->params.limit && largest <= s->params.limit * (1 + LIMIT_ROUNDING))
+    largest = s->params.limit;
   if (max_log_stretch) *max_log_stretch = largest;
   if (min_det_fp) *min_det_fp = min_det;
 }

@@ -601,6 +601,9 @@ static void invalid_parameters_are_rejected_by_name(void **state) {
   d = base, d.youngs_modulus = NAN, expect_rejected(d, "youngs_modulus", "nan");
   d = base, d.youngs_modulus = INFINITY, expect_rejected(d, "youngs_modulus", "inf");
   d = base, d.poisson_ratio = 0.5, expect_rejected(d, "poisson_ratio", "0.5");
+  /* one rounding above the bound reads as above it, not as "got 0.5" */
+  d = base, d.poisson_ratio = nextafter(0.5, 1),
+  expect_rejected(d, "poisson_ratio", "got 0.5000000000000001");
   d = base, d.poisson_ratio = -1.0, expect_rejected(d, "poisson_ratio", "-1");
   d = base, d.poisson_ratio = NAN, expect_rejected(d, "poisson_ratio", "nan");
   d = base, d.inversion_threshold = -0.1, expect_rejected(d, "inversion.threshold", "-0.1");

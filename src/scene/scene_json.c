@@ -6,6 +6,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "common/number_text.h"
 #include "math/mat3.h"
 #include "scene/scene_desc.h"
 
@@ -76,31 +77,18 @@ const cJSON *piola__json_get(const cJSON *obj, const char *key) {
   return cJSON_GetObjectItemCaseSensitive(obj, key);
 }
 
-/* v as an integer when it is one, else in the fewest digits (up to 17) that read back as v:
- * %g's six digits printed the cap 1000000 as 1e+06 and a refused 1000001 as "got 1e+06",
- * inside the range */
-static const char *exact(char buf[32], double v) {
-  if (v == floor(v) && fabs(v) < 1e15) { /* integers as the docs write them */
-    snprintf(buf, 32, "%.0f", v);
-    return buf;
-  }
-  for (int digits = 6; digits <= 17; ++digits) {
-    snprintf(buf, 32, "%.*g", digits, v);
-    if (strtod(buf, NULL) == v) break;
-  }
-  return buf;
-}
-
 piola_status piola__json_check_range(scene_parser *p, double v, json_range r) {
   if (!isfinite(v)) return piola__json_fail(p, BAD_VALUE, "must be finite, got %g", v);
   int ok = (r.lo_open ? v > r.lo : v >= r.lo) && (r.hi_open ? v < r.hi : v <= r.hi);
   if (ok) return PIOLA_OK;
   char lo[32], hi[32], got[32];
   if (isinf(r.hi) && isfinite(r.lo))
-    return piola__json_fail(p, BAD_VALUE, "must be %s %s, got %s", r.lo_open ? ">" : ">=",
-                            exact(lo, r.lo), exact(got, v));
+    return piola__json_fail(p, BAD_VALUE, "must be %s %s, got %s",
+                            r.lo_open ? ">" : ">=", piola__number_text(lo, r.lo),
+                            piola__number_text(got, v));
   return piola__json_fail(p, BAD_VALUE, "must be in %c%s, %s%c, got %s", r.lo_open ? '(' : '[',
-                          exact(lo, r.lo), exact(hi, r.hi), r.hi_open ? ')' : ']', exact(got, v));
+                          piola__number_text(lo, r.lo), piola__number_text(hi, r.hi),
+                          r.hi_open ? ')' : ']', piola__number_text(got, v));
 }
 
 piola_status piola__json_number(scene_parser *p, const cJSON *v, json_range r, double *out) {

@@ -5,6 +5,7 @@
 
 #include <math.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 
 #include "piola/keyframes.h"
@@ -139,11 +140,86 @@ static void cloth_scene_builds_its_world(void **state) {
   piola_scene_destroy(scene);
 }
 
+static double det3(double m[3][3]) {
+  return m[0][0] * (m[1][1] * m[2][2] - m[1][2] * m[2][1]) -
+         m[0][1] * (m[1][0] * m[2][2] - m[1][2] * m[2][0]) +
+         m[0][2] * (m[1][0] * m[2][1] - m[1][1] * m[2][0]);
+}
+
+/* Cloth (16 cm, 8 x 8 cells) lying on a fixed solid box tilted 25 degrees, held by
+ * collide_with_solids with solid_friction mu, integrator "newmark" or "backward_euler": the
+ * sliding acceleration of its mean position down the slope over 0.1-0.4 s, fitted. */
+static double cloth_slide_acceleration(double mu, const char *integrator) {
+  const double angle = 25.0 * M_PI / 180.0;
+  char json[2048];
+  snprintf(json, sizeof json,
+           "{\"fps\": 30, \"integrator\": {\"type\": \"%s\"},\n"
+           " \"solids\": [{\"mesh\": {\"generate\": \"box\", \"half_extents\": [0.3, 0.3, 0.05],"
+           " \"cell_size\": 0.05}, \"transform\": {\"rotate_degrees\": [25, 0, 0]},"
+           " \"fixed\": [{\"box\": [[-1, -1, -1], [1, 1, 1]]}]}],\n"
+           " \"shells\": [{\"mesh\": {\"generate\": \"rectangle\", \"size\": [0.16, 0.16],"
+           " \"resolution\": [8, 8]}, \"transform\": {\"rotate_degrees\": [25, 0, 0],"
+           " \"translate\": [0, %.17g, %.17g]}, \"thickness\": 0.0005, \"density\": 300,"
+           " \"material\": {\"model\": \"corotated\", \"youngs_modulus\": 5e5},"
+           " \"damping\": {\"shear\": 0.2, \"bulk\": 0.2}, \"bending\": {\"stiffness\": 1e-5},"
+           " \"collide_with_solids\": true, \"solid_friction\": %.17g}]}",
+           integrator, -0.053 * sin(angle), 0.053 * cos(angle), mu);
+  piola_scene *scene = NULL;
+  if (piola_scene_load_string(json, ".", NULL, &scene) != PIOLA_OK)
+    fail_msg("%s", piola_last_error());
+  piola_world *w = piola_scene_world(scene);
+  const int32_t n = piola_shell_body_vertex_count(piola_world_shell_body(w, 0));
+  const double down[3] = {0, -cos(angle), -sin(angle)};
+  /* least squares of s(t) = c0 + c1 t + c2 t^2 over frames 3..12 */
+  double sums[5] = {0}, rhs[3] = {0};
+  for (int frame = 1; frame <= 12; ++frame) {
+    const double t = frame / 30.0;
+    assert_int_equal(piola_world_advance_to(w, t, NULL), PIOLA_OK);
+    if (frame < 3) continue;
+    const double *x = piola_world_shell_positions(w, 0);
+    double along = 0;
+    for (int32_t i = 0; i < n; ++i)
+      along += (x[3 * i] * down[0] + x[3 * i + 1] * down[1] + x[3 * i + 2] * down[2]) / n;
+    for (int k = 0; k < 5; ++k) sums[k] += pow(t, k);
+    for (int k = 0; k < 3; ++k) rhs[k] += pow(t, k) * along;
+  }
+  piola_scene_destroy(scene);
+  /* the normal equations by Cramer's rule: c2 = det(A with its last column rhs) / det(A) */
+  double a[3][3], b[3][3];
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < 3; ++c) a[r][c] = b[r][c] = sums[r + c];
+  for (int r = 0; r < 3; ++r) b[r][2] = rhs[r];
+  return 2.0 * det3(b) / det3(a);
+}
+
+/* A cloth held by a solid's surface (collide_with_solids) feels Coulomb friction with its
+ * solid_friction, as on an obstacle: with Newmark it slid at g (sin - mu/2 cos), the friction
+ * of the half of the normal impulse the collision step applies, until the friction after the
+ * final solve took the shell's coefficient and the solid's surface velocity (it took the
+ * nearest obstacle's, none here). */
+static void cloth_on_a_tilted_solid_slides_as_coulomb_says(void **state) {
+  (void)state;
+  const double angle = 25.0 * M_PI / 180.0, g = 9.81;
+  const double mus[2] = {0.2, 0.4};
+  const char *integrators[2] = {"newmark", "backward_euler"};
+  for (int k = 0; k < 2; ++k)
+    for (int j = 0; j < 2; ++j) {
+      const double a = cloth_slide_acceleration(mus[k], integrators[j]);
+      const double coulomb = g * (sin(angle) - mus[k] * cos(angle));
+      if (getenv("PIOLA_TEST_VERBOSE"))
+        print_message("%s, mu %g: %.4f m/s^2 (Coulomb %.4f)\n", integrators[j], mus[k], a, coulomb);
+      if (!(fabs(a - coulomb) < 0.01 * g))
+        fail_msg("%s, mu %g: slides at %.4f m/s^2, Coulomb says %.4f", integrators[j], mus[k], a,
+                 coulomb);
+    }
+}
+
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(every_shell_key_reaches_its_definition),
       cmocka_unit_test(bad_shell_input_names_its_key_path),
       cmocka_unit_test(cloth_scene_builds_its_world),
+      cmocka_unit_test(cloth_on_a_tilted_solid_slides_as_coulomb_says),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
 }

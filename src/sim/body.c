@@ -324,7 +324,7 @@ void piola__body_free(world_body *b) {
   free(b->flags), free(b->motion_of), free(b->motions);
   free(b->x_old), free(b->v_old), free(b->force_old), free(b->rhs), free(b->work), free(b->tmp);
   free(b->av_product), free(b->v_product);
-  free(b->colliding), free(b->normals), free(b->friction_spent);
+  free(b->colliding), free(b->normals), free(b->friction_spent), free(b->solid_surface_v);
   piola__implicit_state_free(b->implicit);
   memset(b, 0, sizeof *b);
 }

@@ -40,6 +40,12 @@ struct piola__stiffness_matrix; /* force/stiffness_matrix.h */
 /* Node flags (world_body.flags). */
 enum { NODE_FREE = 0, NODE_FIXED = 1, NODE_DRIVEN = 2 };
 
+/* Values of world_body.colliding: a node held along its normal by an obstacle, along the push
+ * of the self-collision pass (implicit steps: self_collide_and_resolve), or by a solid's
+ * surface (a shell's one-way coupling, collide_with_solids); or (implicit steps) held in all
+ * three directions where friction stopped it (newton_iterate's friction pass). */
+enum { HELD_BY_OBSTACLE = 1, HELD_BY_COLLISION = 2, HELD_BY_SOLID = 3, HELD_BY_FRICTION = 4 };
+
 typedef struct world_body {
   piola_body_kind kind;
   uint32_t slot;             /* its entry in the world's id slots (body_table.c) */
@@ -87,12 +93,17 @@ typedef struct world_body {
   double product_h;
   uint64_t product_generation;
   int product_valid;
-  uint8_t *colliding;
+  uint8_t *colliding; /* n: HELD_BY_* this step, 0 for a node nothing holds */
   double *normals;
   /* n: the normal impulse per unit mass (m/s) whose friction the explicit step's collision
-   * processing applied to each obstacle contact's motion, NAN for the other nodes; the
-   * friction after the final solve makes up the rest of the step's (integrator.c) */
+   * processing applied to each obstacle contact's motion (or a shell's coupling to a solid,
+   * to its velocity), NAN for the other nodes; the friction after the final solve makes up
+   * the rest of the step's (integrator.c) */
   double *friction_spent;
+  /* shells with collide_with_solids: 3n, the velocity of the solid surface point that holds
+   * each node the explicit step's coupling moved (mark SOLID_HELD in colliding), for the
+   * friction after the final solve (integrator.c); NULL for other bodies */
+  double *solid_surface_v;
   /* the state-aware step bound of the last update, a cache of a function of the update's
    * per-element state, valid until the next update. Solids (stable_step.h, world_solids.c):
    * max over tets of k_e / (rho h_e^2), 1/s^2, and the tet that attains it. Shells

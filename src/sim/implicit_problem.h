@@ -10,12 +10,6 @@
 #include "force/stiffness_multigrid.h"
 #include "sim/world_internal.h"
 
-/* Values of world_body.colliding during an implicit step: a node held along its normal by
- * an obstacle, along the push of the self-collision pass (see self_collide_and_resolve), or
- * by a solid's surface (a shell's one-way coupling, collide_with_solids); or held in all
- * three directions where friction stopped it (newton_iterate's friction pass). */
-enum { HELD_BY_OBSTACLE = 1, HELD_BY_COLLISION = 2, HELD_BY_SOLID = 3, HELD_BY_FRICTION = 4 };
-
 /* How many times a step with friction is solved again after its first solve with it
  * (piola__newton_next_friction_round): the sliding block of piola__newton_body_may_slide settles in
  * one to three */

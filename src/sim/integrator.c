@@ -169,7 +169,6 @@ static int32_t damping_solve(piola_world *w, world_body *s, double h, double t,
 static void friction_on_step_motion(const piola_world *w, world_body *s, double t1, double dt,
                                     const double *x_tilde) {
   for (int32_t i = 0; i < s->n; ++i) {
-    s->friction_spent[i] = NAN;
     if (!s->colliding[i] || s->flags[i] != NODE_FREE || !(s->mass[i] > 0)) continue;
     const double *nrm = s->normals + 3 * i;
     double *xi = s->x + 3 * i, *vi = s->v + 3 * i;
@@ -212,9 +211,14 @@ static void friction_on_step_motion(const piola_world *w, world_body *s, double 
  * (c the node's damping coefficient) and a damped block on an incline slid as if mu were
  * 3.5% smaller (docs/time-stepping.md, "Friction of the held normal impulse"). On an
  * obstacle contact of step 3 (friction_spent known) the difference joins this half's
- * impulse, so the velocity gets the friction of the whole held impulse. */
+ * impulse, so the velocity gets the friction of the whole held impulse.
+ *
+ * A shell node the coupling to solids held (HELD_BY_SOLID) takes the shell's
+ * solid_friction against the solid surface's velocity it touched: with the nearest
+ * obstacle's instead (zero friction where there was none), cloth on a tilted solid slid at
+ * g (sin - mu/2 cos), half its Coulomb friction. */
 static void contact_friction(const piola_world *w, world_body *s, double t1, double h,
-                             const double *g1, const double *av, int spent_known) {
+                             const double *g1, const double *av) {
   for (int32_t i = 0; i < s->n; ++i) {
     if (!s->colliding[i] || s->flags[i] != NODE_FREE) continue;
     const double *nrm = s->normals + 3 * i;
@@ -229,13 +233,18 @@ static void contact_friction(const piola_world *w, world_body *s, double t1, dou
       first += nrm[k] * (s->rhs[3 * i + k] - s->mass[i] * vi[k] - second);
     }
     double dvn = fmax(-push / s->mass[i], 0.0);
-    if (spent_known && isfinite(s->friction_spent[i]))
+    if (isfinite(s->friction_spent[i]))
       dvn += fmax(-first / s->mass[i], 0.0) - s->friction_spent[i];
     if (!(dvn > 0)) continue;
-    /* the obstacle the node touches: the one nearest to it */
-    piola_vec3 p = {s->x[3 * i], s->x[3 * i + 1], s->x[3 * i + 2]}, vo;
+    piola_vec3 vo;
     double mu;
-    piola__nearest_obstacle_motion(w->obstacles, w->obstacle_count, t1, p, &mu, &vo);
+    if (s->colliding[i] == HELD_BY_SOLID && s->solid_surface_v) {
+      const double *sv = s->solid_surface_v + 3 * i;
+      mu = s->solid_friction, vo = (piola_vec3){sv[0], sv[1], sv[2]};
+    } else { /* the obstacle the node touches: the one nearest to it */
+      piola_vec3 p = {s->x[3 * i], s->x[3 * i + 1], s->x[3 * i + 2]};
+      piola__nearest_obstacle_motion(w->obstacles, w->obstacle_count, t1, p, &mu, &vo);
+    }
     (void)piola__coulomb_limit(vi, vo, nrm, mu, dvn);
   }
 }
@@ -349,6 +358,7 @@ static piola_status step_body(piola_world *w, world_body *s, double t, double dt
 
   /* 3. collisions with x~ and v^n */
   int32_t colliding = 0;
+  for (int32_t i = 0; i < n; ++i) s->friction_spent[i] = NAN;
   if (w->obstacle_count > 0) {
     double *x_tilde = s->rhs; /* free until step 4's right-hand side is formed */
     memcpy(x_tilde, s->x, v3);
@@ -356,8 +366,7 @@ static piola_status step_body(piola_world *w, world_body *s, double t, double dt
                                         s->colliding, s->normals);
     if (colliding > 0) friction_on_step_motion(w, s, t1, dt, x_tilde);
   }
-  const int obstacle_contacts = colliding > 0;
-  colliding += piola__body_collide_in_step(w, s, t1, dt, 1, NULL);
+  colliding += piola__body_collide_in_step(w, s, t1, dt, HELD_BY_SOLID, s->solid_surface_v);
   for (int32_t i = 0; i < n; ++i) {
     if (s->flags[i] == NODE_FREE) continue;
     if (s->colliding[i]) colliding--;
@@ -443,7 +452,7 @@ static piola_status step_body(piola_world *w, world_body *s, double t, double dt
     s->product_valid = 1;
   }
   piola__step_profile_mark(&w->profile, STEP_PHASE_SOLVE2);
-  if (colliding > 0) contact_friction(w, s, t1, h, g1, av, obstacle_contacts);
+  if (colliding > 0) contact_friction(w, s, t1, h, g1, av);
   piola__step_profile_mark(&w->profile, STEP_PHASE_FRICTION);
   /* a state whose energies overflow has blown up even if each coordinate is still finite.
    * The elastic energy is not computed per step (world.c); the squared norm of the elastic

@@ -118,6 +118,8 @@ static piola_status fill_shell(piola_world *world, world_body *s, const piola_sh
   s->bulk_viscosity = def->bulk_viscosity;
   s->collide_with_solids = def->collide_with_solids;
   s->solid_friction = def->solid_friction;
+  if (s->collide_with_solids && !(s->solid_surface_v = malloc(3 * (size_t)n * sizeof(double))))
+    return PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "shell %d: out of memory", (int)id);
   s->self_collision = def->self_collision;
   PIOLA_TRY(piola__body_apply_constraints(s, rest, def->constraints, def->constraint_count));
   piola__world_check_selections(world, s, rest, def->constraints, def->constraint_count, id);
@@ -275,6 +277,8 @@ int32_t piola__shell_collide_with_solids(piola_world *w, world_body *s, double t
       vec3_store(s->v + 3 * i, vec3_add(vs, rel_new));
       vec3_store(s->x + 3 * i, best_p);
       vec3_store(s->normals + 3 * i, normal);
+      /* the projection's share of the friction just applied, as obstacles' (integrator.c) */
+      s->friction_spent[i] = dt > 0 ? dn / dt : 0.0;
       if (surface_velocity) vec3_store(surface_velocity + 3 * i, vs);
       if (!s->colliding[i]) ++moved;
       s->colliding[i] = mark;

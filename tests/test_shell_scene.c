@@ -148,8 +148,9 @@ static double det3(double m[3][3]) {
 
 /* Cloth (16 cm, 8 x 8 cells) lying on a fixed solid box tilted 25 degrees, held by
  * collide_with_solids with solid_friction mu, integrator "newmark" or "backward_euler": the
- * sliding acceleration of its mean position down the slope over 0.1-0.4 s, fitted. */
-static double cloth_slide_acceleration(double mu, const char *integrator) {
+ * sliding acceleration of its mean position down the slope over 0.1-0.4 s, fitted, and in
+ * *moved how far it went down the slope in that time (m). */
+static double cloth_slide_acceleration(double mu, const char *integrator, double *moved) {
   const double angle = 25.0 * M_PI / 180.0;
   char json[2048];
   snprintf(json, sizeof json,
@@ -182,6 +183,8 @@ static double cloth_slide_acceleration(double mu, const char *integrator) {
       along += (x[3 * i] * down[0] + x[3 * i + 1] * down[1] + x[3 * i + 2] * down[2]) / n;
     for (int k = 0; k < 5; ++k) sums[k] += pow(t, k);
     for (int k = 0; k < 3; ++k) rhs[k] += pow(t, k) * along;
+    if (frame == 3) *moved = -along;
+    if (frame == 12) *moved += along;
   }
   piola_scene_destroy(scene);
   /* the normal equations by Cramer's rule: c2 = det(A with its last column rhs) / det(A) */
@@ -193,18 +196,19 @@ static double cloth_slide_acceleration(double mu, const char *integrator) {
 }
 
 /* A cloth held by a solid's surface (collide_with_solids) feels Coulomb friction with its
- * solid_friction, as on an obstacle: with Newmark it slid at g (sin - mu/2 cos), the friction
- * of the half of the normal impulse the collision step applies, until the friction after the
- * final solve took the shell's coefficient and the solid's surface velocity (it took the
- * nearest obstacle's, none here). */
+ * solid_friction, as on an obstacle, and stays where mu > tan of the slope: with Newmark it slid at
+ * g (sin - mu/2 cos), the friction of the half of the normal impulse the collision step applies,
+ * until the friction after the final solve took the shell's coefficient and the solid's surface
+ * velocity (it took the nearest obstacle's, none here). */
 static void cloth_on_a_tilted_solid_slides_as_coulomb_says(void **state) {
   (void)state;
   const double angle = 25.0 * M_PI / 180.0, g = 9.81;
   const double mus[2] = {0.2, 0.4};
   const char *integrators[2] = {"newmark", "backward_euler"};
+  double moved = 0;
   for (int k = 0; k < 2; ++k)
     for (int j = 0; j < 2; ++j) {
-      const double a = cloth_slide_acceleration(mus[k], integrators[j]);
+      const double a = cloth_slide_acceleration(mus[k], integrators[j], &moved);
       const double coulomb = g * (sin(angle) - mus[k] * cos(angle));
       if (getenv("PIOLA_TEST_VERBOSE"))
         print_message("%s, mu %g: %.4f m/s^2 (Coulomb %.4f)\n", integrators[j], mus[k], a, coulomb);
@@ -212,6 +216,15 @@ static void cloth_on_a_tilted_solid_slides_as_coulomb_says(void **state) {
         fail_msg("%s, mu %g: slides at %.4f m/s^2, Coulomb says %.4f", integrators[j], mus[k], a,
                  coulomb);
     }
+  /* mu = 1 > tan 25 degrees: it stays. Backward Euler's friction after the solve took the
+   * holds that gave back the potential energy the frictionless solve had spent for a rise,
+   * and the cloth crept down at dt g sin 25 degrees (13.8 cm/s at one step per frame) */
+  for (int j = 0; j < 2; ++j) {
+    (void)cloth_slide_acceleration(1.0, integrators[j], &moved);
+    if (getenv("PIOLA_TEST_VERBOSE"))
+      print_message("%s, mu 1: moved %.3g m in 0.3 s\n", integrators[j], moved);
+    if (!(fabs(moved) < 1e-3)) fail_msg("%s, mu 1: crept %.4g m in 0.3 s", integrators[j], moved);
+  }
 }
 
 int main(void) {

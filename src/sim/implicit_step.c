@@ -564,16 +564,21 @@ static double residual_dot_step(const newton_problem *pb) {
   return slope;
 }
 
+/* The body's elastic energy of the last update (J). Collective on a split solid (the sum, the
+ * same bits on every process). */
+static double strain_energy(const newton_problem *pb) {
+  world_body *s = pb->s;
+  return s->kind == PIOLA_BODY_SOLID ? piola__elastic_body_total_energy(s->solid)
+                                     : piola__body_stats(s).elastic_energy;
+}
+
 /* The body's kinetic energy at velocities v and its elastic energy of the last update (J):
- * the part of total_energy below that does not depend on where gravity's potential is zero.
- * Collective on a split solid (the elastic energy's sum, the same bits on every process). */
+ * the part of total_energy below that does not depend on where gravity's potential is zero. */
 static double motion_and_strain_energy(const newton_problem *pb, const double *v) {
   world_body *s = pb->s;
   double kinetic = 0;
   for (int64_t j = 0; j < 3 * (int64_t)s->n; ++j) kinetic += s->mass[j / 3] * v[j] * v[j];
-  const double elastic = s->kind == PIOLA_BODY_SOLID ? piola__elastic_body_total_energy(s->solid)
-                                                     : piola__body_stats(s).elastic_energy;
-  return 0.5 * kinetic + elastic;
+  return 0.5 * kinetic + strain_energy(pb);
 }
 
 /* The body's total energy (J) at positions x with velocities v: kinetic, elastic (of the last
@@ -1084,10 +1089,10 @@ static piola_status newton_iterate(const newton_problem *problem, int accept_unc
   /* the most energy friction may leave the body (see below), from the converged iterate,
    * whose forces are the last update's, and that iterate's positions to fall back on */
   const int energy_checked = !pb.quasistatic && !pb.friction_held && converged;
-  const double energy_allowed = energy_checked
-                                    ? total_energy(&pb, s->x, s->v) +
-                                          FRICTION_ENERGY_RISE * motion_and_strain_energy(&pb, s->v)
-                                    : NAN;
+  const double rise =
+      energy_checked ? FRICTION_ENERGY_RISE * motion_and_strain_energy(&pb, s->v) : NAN;
+  const double energy_allowed = energy_checked ? total_energy(&pb, s->x, s->v) + rise : NAN;
+  const double strain_allowed = energy_checked ? strain_energy(&pb) + rise : NAN;
   double *kept = energy_checked ? st->friction_free : NULL;
   if (kept) memcpy(kept, s->x, sizeof(double) * (size_t)m);
   if (!pb.quasistatic && !pb.friction_held && piola__newton_contact_friction(&pb) > 0) {
@@ -1113,9 +1118,14 @@ static piola_status newton_iterate(const newton_problem *problem, int accept_unc
        * positions of the first solve, its velocities limited as friction limited them. The
        * body's energy then falls, its kinetic energy being all that changed. A second solve
        * that does not converge is halved as any other: taking the first solve's positions
-       * there instead let a box sliding on a box creep on (0.09 J left at rest) */
+       * there instead let a box sliding on a box creep on (0.09 J left at rest). Stored as
+       * strain: holds that keep a body where the step started give back the potential
+       * energy the frictionless solve spent, a rise that is no stored energy, and taking the
+       * first solve's positions there let a cloth that friction holds on a slope creep down
+       * it by a step of its acceleration each step */
       if (energy_rose && resolved == PIOLA_OK &&
-          !(total_energy(&pb, s->x, s->v) <= energy_allowed)) {
+          !(total_energy(&pb, s->x, s->v) <= energy_allowed) &&
+          !(strain_energy(&pb) <= strain_allowed)) {
         memcpy(s->x, kept, sizeof(double) * (size_t)m);
         memcpy(s->v, kept + m, sizeof(double) * (size_t)m);
         for (int32_t i = 0; i < n; ++i)

@@ -430,6 +430,31 @@ static void other_integrators_keys_are_a_warning(void **state) {
                       "");
 }
 
+/* A collision interval under an implicit integrator, with a body that self-collides, is a
+ * warning at the first step; with Newmark, or no body that self-collides, none. */
+static void implicit_collision_interval_is_a_warning(void **state) {
+  (void)state;
+  char text[1024], json[2048];
+  const char *cases[4][2] = {{"backward_euler", "true"},
+                             {"quasistatic", "true"},
+                             {"newmark", "true"},
+                             {"backward_euler", "false"}};
+  for (int k = 0; k < 4; ++k) {
+    snprintf(json, sizeof json,
+             "{\"integrator\": {\"type\": \"%s\", \"collision_interval\": 0.01},"
+             " \"solids\": [{\"name\": \"oct\", \"mesh\": \"%s\","
+             " \"self_collision\": {\"enabled\": %s}}]}",
+             cases[k][0], test_data_path("tetgen/octahedron.node"), cases[k][1]);
+    scene_warning(json, PIOLA_WARNING_IMPLICIT_INTERVAL, 1, text, sizeof text);
+    if (k < 2) {
+      assert_non_null(strstr(text, "integrator.collision_interval is 0.01 s with"));
+      assert_non_null(strstr(text, "solid 'oct' has self_collision"));
+    } else {
+      assert_string_equal(text, "");
+    }
+  }
+}
+
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(defaults_hold_when_keys_are_left_out),
@@ -439,6 +464,7 @@ int main(void) {
       cmocka_unit_test(starting_inside_an_obstacle_is_a_warning),
       cmocka_unit_test(description_getters_check_their_index),
       cmocka_unit_test(other_integrators_keys_are_a_warning),
+      cmocka_unit_test(implicit_collision_interval_is_a_warning),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
 }

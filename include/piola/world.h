@@ -317,6 +317,10 @@ typedef enum piola_warning_kind {
                                           a body with self-collision starts closer to another
                                           body's surface than their collision thickness: the
                                           first pass pushes them apart at once */
+  PIOLA_WARNING_IMPLICIT_INTERVAL,     /* at the world's first step from t = 0 with
+                                          "backward_euler" or "quasistatic": the collision
+                                          interval is above 0 and a body has self-collision;
+                                          frame-sized steps then pass through each other */
   PIOLA_WARNING_KIND_COUNT
 } piola_warning_kind;
 

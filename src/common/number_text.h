@@ -8,6 +8,8 @@
 #include <stdio.h>
 #include <stdlib.h>
 
+#include "common/status_report.h"
+
 /* v as an integer when it is one (below 1e15 in magnitude), else in the fewest significant
  * digits (6 to 17) that read back as v; written to buf, which is returned. */
 static inline const char *piola__number_text(char buf[32], double v) {
@@ -20,6 +22,14 @@ static inline const char *piola__number_text(char buf[32], double v) {
     if (strtod(buf, NULL) == v) break;
   }
   return buf;
+}
+
+/* PIOLA_ERROR_INVALID_ARGUMENT with the message "RULE, got VALUE", the value printed as
+ * piola__number_text prints it (rule: what the value must be, naming it). */
+static inline piola_status piola__refuse_value(const char *rule, double value) {
+  char got[32];
+  return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "%s, got %s", rule,
+                    piola__number_text(got, value));
 }
 
 #endif

@@ -10,6 +10,7 @@
 #ifndef PIOLA_CONTACT_BVH_H
 #define PIOLA_CONTACT_BVH_H
 
+#include <math.h>
 #include <stddef.h>
 #include <stdint.h>
 
@@ -62,6 +63,17 @@ int piola__index_list_push(piola__index_list *list, int32_t value);
 /* The box of the points within r of x in every coordinate. */
 static inline piola__box piola__box_around(const double x[3], double r) {
   return (piola__box){{x[0] - r, x[1] - r, x[2] - r}, {x[0] + r, x[1] + r, x[2] + r}};
+}
+
+/* The box of triangle tri (three vertex indices) of positions x (3 per vertex). */
+static inline piola__box piola__triangle_box(const double *x, const int32_t *tri) {
+  piola__box b = {{INFINITY, INFINITY, INFINITY}, {-INFINITY, -INFINITY, -INFINITY}};
+  for (int c = 0; c < 3; ++c)
+    for (int d = 0; d < 3; ++d) {
+      const double v = x[3 * (size_t)tri[c] + d];
+      b.lo[d] = fmin(b.lo[d], v), b.hi[d] = fmax(b.hi[d], v);
+    }
+  return b;
 }
 
 static inline int piola__boxes_overlap(const piola__box *a, const piola__box *b) {

@@ -7,16 +7,6 @@
 #include "contact/bvh.h"
 #include "contact/triangle_intersection.h"
 
-static piola__box triangle_box(const double *x, const int32_t *tri) {
-  piola__box b = {{INFINITY, INFINITY, INFINITY}, {-INFINITY, -INFINITY, -INFINITY}};
-  for (int c = 0; c < 3; ++c)
-    for (int d = 0; d < 3; ++d) {
-      const double v = x[3 * (size_t)tri[c] + d];
-      b.lo[d] = fmin(b.lo[d], v), b.hi[d] = fmax(b.hi[d], v);
-    }
-  return b;
-}
-
 static int share_vertex(const int32_t *a, const int32_t *b) {
   for (int p = 0; p < 3; ++p)
     for (int q = 0; q < 3; ++q)
@@ -35,7 +25,7 @@ static int first_intersection(const double *x, const int32_t *tris, const int32_
   piola__index_list near = {0};
   int found = -1;
   if (!boxes) goto done;
-  for (int32_t t = 0; t < count; ++t) boxes[t] = triangle_box(x, tris + 3 * (size_t)t);
+  for (int32_t t = 0; t < count; ++t) boxes[t] = piola__triangle_box(x, tris + 3 * (size_t)t);
   if (piola__bvh_build(&bvh, boxes, count) != 0) goto done;
   found = 0;
   for (int32_t a = 0; a < count && found == 0; ++a) {

@@ -79,11 +79,7 @@ piola_status piola_youngs_poisson_from_lame(double mu, double lambda, double *yo
   if (!isfinite(mu) || !isfinite(lambda))
     return PIOLA_FAIL(PIOLA_ERROR_NOT_FINITE,
                       "lame parameters must be finite, got mu = %g, lambda = %g", mu, lambda);
-  if (!(mu > 0.0)) {
-    char got[32];
-    return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "lame mu must be > 0 Pa, got %s",
-                      piola__number_text(got, mu));
-  }
+  if (!(mu > 0.0)) return piola__refuse_value("lame mu must be > 0 Pa", mu);
   /* nu > -1 <=> bulk modulus lambda + 2 mu / 3 > 0. */
   if (!(3.0 * lambda + 2.0 * mu > 0.0))
     return PIOLA_FAIL(
@@ -111,13 +107,10 @@ static piola_status ogden_init(const piola_material_def *def, double nu, piola_m
     n = 2;
     mus[0] = 2.0 * def->mooney_rivlin.c10, alphas[0] = 2.0;
     mus[1] = -2.0 * def->mooney_rivlin.c01, alphas[1] = -2.0;
-    if (!(def->mooney_rivlin.c10 + def->mooney_rivlin.c01 > 0.0)) {
-      char got[32];
-      return PIOLA_FAIL(
-          PIOLA_ERROR_INVALID_ARGUMENT,
-          "mooney_rivlin: c10 + c01 must be > 0 Pa (shear modulus 2 (c10 + c01)), got %s",
-          piola__number_text(got, def->mooney_rivlin.c10 + def->mooney_rivlin.c01));
-    }
+    if (!(def->mooney_rivlin.c10 + def->mooney_rivlin.c01 > 0.0))
+      return piola__refuse_value(
+          "mooney_rivlin: c10 + c01 must be > 0 Pa (shear modulus 2 (c10 + c01))",
+          def->mooney_rivlin.c10 + def->mooney_rivlin.c01);
   } else {
     n = def->ogden.term_count;
     if (n < 1 || n > PIOLA_OGDEN_MAX_TERMS)
@@ -135,12 +128,9 @@ static piola_status ogden_init(const piola_material_def *def, double nu, piola_m
   }
   double shear = 0.0, msum = 0.0;
   for (int p = 0; p < n; ++p) shear += 0.5 * mus[p] * alphas[p], msum += mus[p];
-  if (!(shear > 0.0)) {
-    char got[32];
-    return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT,
-                      "ogden: the shear modulus 1/2 sum mu_p alpha_p must be > 0 Pa, got %s",
-                      piola__number_text(got, shear));
-  }
+  if (!(shear > 0.0))
+    return piola__refuse_value("ogden: the shear modulus 1/2 sum mu_p alpha_p must be > 0 Pa",
+                               shear);
   m->mu = shear;
   m->lambda = 2.0 * shear * nu / (1.0 - 2.0 * nu);
   m->model_constants[OGDEN_COUNT] = n;
@@ -174,23 +164,12 @@ piola_status piola_material_init(const piola_material_def *def, piola_material *
   if (!own_shear) PIOLA_TRY(check_finite("youngs_modulus", e));
   PIOLA_TRY(check_finite("poisson_ratio", nu));
   PIOLA_TRY(check_finite("inversion.threshold", c));
-  if (!(e > 0.0) && !own_shear) {
-    char got[32];
-    return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "youngs_modulus must be > 0 Pa, got %s",
-                      piola__number_text(got, e));
-  }
-  if (!(nu > -1.0 && nu < 0.5)) {
-    char got[32];
-    return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "poisson_ratio must be in (-1, 0.5), got %s",
-                      piola__number_text(got, nu));
-  }
-  if (!(c > 0.0 && c < 1.0)) {
-    char got[32];
-    return PIOLA_FAIL(
-        PIOLA_ERROR_INVALID_ARGUMENT,
-        "inversion.threshold must be in (0, 1) (or 0 for the model's default), got %s",
-        piola__number_text(got, c));
-  }
+  if (!(e > 0.0) && !own_shear) return piola__refuse_value("youngs_modulus must be > 0 Pa", e);
+  if (!(nu > -1.0 && nu < 0.5))
+    return piola__refuse_value("poisson_ratio must be in (-1, 0.5)", nu);
+  if (!(c > 0.0 && c < 1.0))
+    return piola__refuse_value(
+        "inversion.threshold must be in (0, 1) (or 0 for the model's default)", c);
 
   piola_material m;
   memset(&m, 0, sizeof m);
@@ -222,17 +201,8 @@ piola_status piola_material_init(const piola_material_def *def, piola_material *
       return PIOLA_FAIL(
           PIOLA_ERROR_INVALID_ARGUMENT,
           "spline.compression_stretch must be in (inversion.threshold = %g, 1), got %g", c, a);
-    if (!(b > 1.0)) {
-      char got[32];
-      return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT,
-                        "spline.elongation_stretch must be > 1, got %s",
-                        piola__number_text(got, b));
-    }
-    if (!(st >= 1.0)) {
-      char got[32];
-      return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "spline.stiffening must be >= 1, got %s",
-                        piola__number_text(got, st));
-    }
+    if (!(b > 1.0)) return piola__refuse_value("spline.elongation_stretch must be > 1", b);
+    if (!(st >= 1.0)) return piola__refuse_value("spline.stiffening must be >= 1", st);
     double *s = m.spline_coefficients;
     s[SPLINE_K0] = 2.0 * m.mu; /* with the pressure term: 2 mu I + lambda 1 1^T at rest */
     s[SPLINE_DK] = (st - 1.0) * s[SPLINE_K0];

@@ -38,52 +38,30 @@ piola_status piola_world_create(const piola_world_def *def, piola_world **out) {
       return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "gravity[%d] must be finite m/s^2", k);
   /* the ranges of the scene's keys (scene-format.md, "Integrator"), so that a world built
    * through the library or Python refuses what a scene file would */
-  if (!(def->max_dt > 0 && def->max_dt <= 1)) {
-    char got[32];
-    return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "max_dt must be in (0, 1] s, got %s",
-                      piola__number_text(got, def->max_dt));
-  }
-  if (!(def->cfl > 0 && def->cfl <= 2)) {
-    char got[32];
-    return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "cfl must be in (0, 2], got %s",
-                      piola__number_text(got, def->cfl));
-  }
-  if (!(def->cg_tolerance > 0 && def->cg_tolerance < 1)) {
-    char got[32];
-    return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "cg_tolerance must be in (0, 1), got %s",
-                      piola__number_text(got, def->cg_tolerance));
-  }
+  if (!(def->max_dt > 0 && def->max_dt <= 1))
+    return piola__refuse_value("max_dt must be in (0, 1] s", def->max_dt);
+  if (!(def->cfl > 0 && def->cfl <= 2))
+    return piola__refuse_value("cfl must be in (0, 2]", def->cfl);
+  if (!(def->cg_tolerance > 0 && def->cg_tolerance < 1))
+    return piola__refuse_value("cg_tolerance must be in (0, 1)", def->cg_tolerance);
   if (def->cg_max_iterations < 1 || def->cg_max_iterations > 1000000)
     return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT,
                       "cg_max_iterations must be in [1, 1000000], got %d",
                       (int)def->cg_max_iterations);
-  if (!(def->collision_interval >= 0 && def->collision_interval <= 1)) {
-    char got[32];
-    return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT,
-                      "collision_interval must be in [0, 1] s, got %s",
-                      piola__number_text(got, def->collision_interval));
-  }
+  if (!(def->collision_interval >= 0 && def->collision_interval <= 1))
+    return piola__refuse_value("collision_interval must be in [0, 1] s", def->collision_interval);
   if ((int)def->integrator < 0 || def->integrator >= PIOLA_INTEGRATOR_COUNT)
     return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "integrator: unknown type %d", (int)def->integrator);
-  if (!(def->implicit_dt > 0) || !isfinite(def->implicit_dt)) {
-    char got[32];
-    return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "integrator dt must be > 0 s, got %s",
-                      piola__number_text(got, def->implicit_dt));
-  }
-  if (!(def->newton_tolerance > 0 && def->newton_tolerance < 1)) {
-    char got[32];
-    return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "newton_tolerance must be in (0, 1), got %s",
-                      piola__number_text(got, def->newton_tolerance));
-  }
+  if (!(def->implicit_dt > 0) || !isfinite(def->implicit_dt))
+    return piola__refuse_value("integrator dt must be > 0 s", def->implicit_dt);
+  if (!(def->newton_tolerance > 0 && def->newton_tolerance < 1))
+    return piola__refuse_value("newton_tolerance must be in (0, 1)", def->newton_tolerance);
   if (def->newton_max_iterations < 1 || def->newton_max_iterations > 1000000)
     return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT,
                       "newton_max_iterations must be in [1, 1000000], got %d",
                       (int)def->newton_max_iterations);
-  if (!(def->linear_tolerance > 0 && def->linear_tolerance < 1)) {
-    char got[32];
-    return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT, "linear_tolerance must be in (0, 1), got %s",
-                      piola__number_text(got, def->linear_tolerance));
-  }
+  if (!(def->linear_tolerance > 0 && def->linear_tolerance < 1))
+    return piola__refuse_value("linear_tolerance must be in (0, 1)", def->linear_tolerance);
   if (def->linear_max_iterations < 1 || def->linear_max_iterations > 1000000)
     return PIOLA_FAIL(PIOLA_ERROR_INVALID_ARGUMENT,
                       "linear_max_iterations must be in [1, 1000000], got %d",

@@ -284,14 +284,8 @@ static int32_t closest_within_thickness(const piola_world *w, const double *x, c
   for (int32_t v = 0; v < nv; ++v) owner[v] = -1; /* not on a surface */
   for (int32_t t = 0; t < nt; ++t) {
     const int32_t *c = tris + 3 * (size_t)t;
-    piola__box b = {{INFINITY, INFINITY, INFINITY}, {-INFINITY, -INFINITY, -INFINITY}};
-    for (int k = 0; k < 3; ++k) {
-      owner[c[k]] = group[t];
-      for (int d = 0; d < 3; ++d)
-        b.lo[d] = fmin(b.lo[d], x[3 * (size_t)c[k] + d]),
-        b.hi[d] = fmax(b.hi[d], x[3 * (size_t)c[k] + d]);
-    }
-    boxes[t] = b;
+    for (int k = 0; k < 3; ++k) owner[c[k]] = group[t];
+    boxes[t] = piola__triangle_box(x, c);
     widest = fmax(widest, w->bodies[group[t]].self_collision.thickness);
   }
   if (piola__bvh_build(&tree, boxes, nt) != 0) goto done;

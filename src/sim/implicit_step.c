@@ -20,13 +20,15 @@
  * step is accepted when it decreases by the Armijo fraction. With the projected Hessian the
  * Newton direction is a descent direction for it near a solution; far from one the
  * backtracking may fail, and then the step is undone and retried at half the size (the only
- * way the step shrinks). A quasistatic solid has no damping, and its g is the gradient of
- * the potential (elastic energy minus gravity's work) wherever the extension is not mixed, so
- * a step that decreases that potential by the Armijo fraction of g . d is accepted too: the
- * projected Hessian's direction always descends the potential, not always |g| (a bending
- * bar's projection is active: on the residual norm alone the first Newton steps of the
- * quasistatic bar of run_resume_examples.py were cut to 1/1024, and its first increment
- * failed 12 times; docs/time-stepping.md).
+ * way the step shrinks). A quasistatic body (solid or shell) has no damping, and its g is
+ * the gradient of the potential (elastic energy minus gravity's work) wherever the
+ * extension is not mixed, so a step that decreases that potential by the Armijo fraction of
+ * g . d is accepted too: the projected Hessian's direction always descends the potential,
+ * not always |g| (a bending bar's projection is active: on the residual norm alone the
+ * first Newton steps of the quasistatic bar of run_resume_examples.py were cut to 1/1024,
+ * and its first increment failed 12 times; a flat cloth pinned at two corners found no
+ * decrease of |g| at all along its first direction, every try, and never left its start;
+ * docs/time-stepping.md).
  *
  * The tail. The projected matrix is not the Jacobian where elements are compressed (the
  * fix clamps their negative rotation eigenvalues), and Newton on it converges only
@@ -544,18 +546,6 @@ static piola_status update(newton_problem *pb) {
   return piola__body_update_forces(pb->s, pb->t1);
 }
 
-/* Quasistatics of a solid: the potential whose gradient g is, elastic energy minus the
- * work of gravity, sum V0 psi - sum m_i g1 . x_i (J), at the last update. Collective on a
- * split (the energy's sum). */
-static double quasistatic_potential(const newton_problem *pb) {
-  const world_body *s = pb->s;
-  double work = 0;
-  for (int32_t i = 0; i < s->n; ++i)
-    work += s->mass[i] * (pb->g1[0] * s->x[3 * i] + pb->g1[1] * s->x[3 * i + 1] +
-                          pb->g1[2] * s->x[3 * i + 2]);
-  return piola__elastic_body_total_energy(s->solid) - work;
-}
-
 /* g . d, the potential's slope along the Newton direction (d is filtered, so held and
  * prescribed components do not count). */
 static double residual_dot_step(const newton_problem *pb) {
@@ -570,6 +560,19 @@ static double strain_energy(const newton_problem *pb) {
   world_body *s = pb->s;
   return s->kind == PIOLA_BODY_SOLID ? piola__elastic_body_total_energy(s->solid)
                                      : piola__body_stats(s).elastic_energy;
+}
+
+/* Quasistatics: the potential whose gradient g is, elastic energy minus the work of
+ * gravity, sum V0 psi - sum m_i g1 . x_i (J), at the last update; a shell's elastic energy is
+ * its membrane's and its hinges' bending energy. Collective on a split solid (the energy's
+ * sum). */
+static double quasistatic_potential(const newton_problem *pb) {
+  const world_body *s = pb->s;
+  double work = 0;
+  for (int32_t i = 0; i < s->n; ++i)
+    work += s->mass[i] *
+            (pb->g1[0] * s->x[3 * i] + pb->g1[1] * s->x[3 * i + 1] + pb->g1[2] * s->x[3 * i + 2]);
+  return strain_energy(pb) - work;
 }
 
 /* The body's kinetic energy at velocities v and its elastic energy of the last update (J):
@@ -939,13 +942,13 @@ static piola_status newton_iterate(const newton_problem *problem, int accept_unc
     phi_last = phi;
     PIOLA_TRY(newton_direction(&pb, eta, &tail_allowed, stats));
     const int limited = pb.quasistatic && limit_step(&pb, reach);
-    /* backtracking line search on |S g|^2, and for a quasistatic solid also on its
+    /* backtracking line search on |S g|^2, and for a quasistatic body also on its
      * potential: a step is accepted when either decreases by the Armijo fraction (see the
      * head of this file) */
     memcpy(st->base, s->x, sizeof(double) * (size_t)m);
     double potential = 0, slope = 0;
     int on_potential = 0;
-    if (pb.quasistatic && s->kind == PIOLA_BODY_SOLID) {
+    if (pb.quasistatic) {
       potential = quasistatic_potential(&pb);
       slope = residual_dot_step(&pb);
       on_potential = isfinite(potential) && slope < 0;

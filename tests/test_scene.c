@@ -455,6 +455,33 @@ static void implicit_collision_interval_is_a_warning(void **state) {
   }
 }
 
+/* Two bodies with self-collision under quasistatics are a warning at the first step; one
+ * body, or backward Euler, none. */
+static void quasistatic_contact_is_a_warning(void **state) {
+  (void)state;
+  char text[1024], json[2048];
+  const char *cases[3][2] = {
+      {"quasistatic", "true"}, {"quasistatic", "false"}, {"backward_euler", "true"}};
+  const char *oct = test_data_path("tetgen/octahedron.node");
+  for (int k = 0; k < 3; ++k) {
+    snprintf(json, sizeof json,
+             "{\"integrator\": {\"type\": \"%s\"},"
+             " \"solids\": [{\"name\": \"lower\", \"mesh\": \"%s\","
+             " \"self_collision\": {\"enabled\": true}},"
+             " {\"name\": \"upper\", \"mesh\": \"%s\","
+             " \"transform\": {\"translate\": [0, 0, 3]},"
+             " \"self_collision\": {\"enabled\": %s}}]}",
+             cases[k][0], oct, oct, cases[k][1]);
+    scene_warning(json, PIOLA_WARNING_QUASISTATIC_CONTACT, 1, text, sizeof text);
+    if (k == 0)
+      assert_non_null(strstr(text,
+                             "solid 'lower' and solid 'upper' have self_collision under "
+                             "\"quasistatic\""));
+    else
+      assert_string_equal(text, "");
+  }
+}
+
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(defaults_hold_when_keys_are_left_out),
@@ -465,6 +492,7 @@ int main(void) {
       cmocka_unit_test(description_getters_check_their_index),
       cmocka_unit_test(other_integrators_keys_are_a_warning),
       cmocka_unit_test(implicit_collision_interval_is_a_warning),
+      cmocka_unit_test(quasistatic_contact_is_a_warning),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
 }

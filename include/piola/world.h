@@ -321,6 +321,11 @@ typedef enum piola_warning_kind {
                                           "backward_euler" or "quasistatic": the collision
                                           interval is above 0 and a body has self-collision;
                                           frame-sized steps then pass through each other */
+  PIOLA_WARNING_QUASISTATIC_CONTACT,   /* at the world's first step from t = 0 with
+                                          "quasistatic": two or more bodies have
+                                          self-collision; bodies that rest on or press into
+                                          each other through it are not solved
+                                          quasistatically */
   PIOLA_WARNING_KIND_COUNT
 } piola_warning_kind;
 

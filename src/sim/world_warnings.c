@@ -212,6 +212,34 @@ static void check_implicit_interval(piola_world *w) {
   }
 }
 
+/* Quasistatics keeps bodies apart by the collision pass alone, after each body's solve:
+ * bodies resting on or pressing into each other through self-collision are not solved
+ * (a box dropped on another went 1.2 m along the ground; cloth_on_jelly.json run
+ * quasistatically crushed its block; time-stepping.md, "Solids against each other inside the
+ * solve"). One body's own folds are, so it takes two. */
+static void check_quasistatic_contact(piola_world *w) {
+  if (w->def.integrator != PIOLA_INTEGRATOR_QUASISTATIC) return;
+  const world_body *first = NULL;
+  for (int32_t bi = 0; bi < w->body_count; ++bi) {
+    const world_body *b = &w->bodies[bi];
+    if (!b->self_collision.enabled) continue;
+    if (!first) {
+      first = b;
+      continue;
+    }
+    piola__world_warn(w, PIOLA_WARNING_QUASISTATIC_CONTACT,
+                      "%s '%s' and %s '%s' have self_collision under \"quasistatic\": its "
+                      "collision pass alone keeps bodies apart there, so bodies that rest on "
+                      "or press into each other through it are not solved (they jump and "
+                      "crush); use \"backward_euler\", or fixed or driven nodes and obstacles "
+                      "for quasistatic contact (time-stepping.md, \"Solids against each other "
+                      "inside the solve\")",
+                      piola__body_kind_name(first->kind), first->name,
+                      piola__body_kind_name(b->kind), b->name);
+    return;
+  }
+}
+
 void piola__world_check_start(piola_world *w) {
   if (w->start_checked) return;
   w->start_checked = 1;
@@ -219,6 +247,7 @@ void piola__world_check_start(piola_world *w) {
   if (w->time != 0.0) return;
   check_undamped_tangles(w);
   check_implicit_interval(w);
+  check_quasistatic_contact(w);
   for (int32_t bi = 0; bi < w->body_count; ++bi) {
     const world_body *b = &w->bodies[bi];
     const double size = piola__bounding_diagonal(b->n, b->x), limit = STARTS_INSIDE_DEPTH * size;

@@ -841,6 +841,14 @@ static int limit_step(newton_problem *pb, double reach) {
   return 1;
 }
 
+/* 1 when a node of s that has mass is fixed, driven or held by a bone (a vertex in no
+ * element is held, but holds nothing). */
+static int held_by_nodes(const world_body *s) {
+  for (int32_t i = 0; i < s->n; ++i)
+    if (s->mass[i] > 0 && s->flags[i] != NODE_FREE) return 1;
+  return 0;
+}
+
 /* 1 when a free node of s is further than reach from where the step started. */
 static int moved_beyond(const world_body *s, double reach) {
   for (int32_t i = 0; i < s->n; ++i) {
@@ -865,15 +873,14 @@ static int moved_beyond(const world_body *s, double reach) {
 static const char *failure_advice(const newton_problem *pb) {
   if (!pb->quasistatic) return "";
   const world_body *s = pb->s;
+  if (held_by_nodes(s))
+    return ". A load a quasistatic body cannot take in one step (the whole of gravity at "
+           "once on a soft solid, a muscle's activation switched on at once, a large jump "
+           "of a driven node) converges when ramped: keyframe gravity (or the activation, "
+           "or the motion) up from 0 over a few frames (time-stepping.md, \"Quasistatics\")";
   int touching = 0;
-  for (int32_t i = 0; i < s->n; ++i) { /* a vertex in no element is held, but holds nothing */
-    if (s->mass[i] > 0 && s->flags[i] != NODE_FREE)
-      return ". A load a quasistatic body cannot take in one step (the whole of gravity at "
-             "once on a soft solid, a muscle's activation switched on at once, a large jump "
-             "of a driven node) converges when ramped: keyframe gravity (or the activation, "
-             "or the motion) up from 0 over a few frames (time-stepping.md, \"Quasistatics\")";
+  for (int32_t i = 0; i < s->n; ++i)
     if (s->mass[i] > 0 && s->colliding[i]) touching = 1;
-  }
   if (!touching)
     return ". A quasistatic body with nothing holding it (no fixed, driven or bone node, no "
            "obstacle contact) has no equilibrium under gravity: fix or drive a node, or use "
@@ -1055,8 +1062,11 @@ static piola_status newton_iterate(const newton_problem *problem, int accept_unc
     if (!accept_unconverged || !isfinite(phi)) return PIOLA_ERROR_NOT_CONVERGED;
     stats->newton_failures++;
     /* quasistatics: an iterate that took a node further than the body's size along its
-     * free directions is no result; the free nodes stay where the step started */
-    if (pb.quasistatic && moved_beyond(s, reach)) {
+     * free directions is no result; the free nodes stay where the step started. A body
+     * held at a node reaches up to twice its size by turning about it (a flat cloth pinned
+     * at two corners of an edge hangs with its far edge 1.03 times its diagonal from where
+     * it started), so there that is the limit */
+    if (pb.quasistatic && moved_beyond(s, held_by_nodes(s) ? 2.0 * reach : reach)) {
       for (int32_t i = 0; i < n; ++i)
         if (s->flags[i] == NODE_FREE) memcpy(s->x + 3 * i, s->x_old + 3 * i, sizeof(double) * 3);
       PIOLA_TRY(update(&pb));
@@ -1069,8 +1079,9 @@ static piola_status newton_iterate(const newton_problem *problem, int accept_unc
                       "(stats.csv newton_failures counts failed tries)%s",
                       piola__body_kind_name(s->kind), s->name,
                       pb.quasistatic ? "quasistatic" : "backward Euler", pb.t1,
-                      pb.quasistatic ? "unless it moved a node further than the body's size, "
-                                       "then the step's start"
+                      pb.quasistatic ? "unless it moved a node further than the body's size "
+                                       "(twice that for a body held at a node), then the "
+                                       "step's start"
                                      : "unless it held more energy than the step's start, "
                                        "time-stepping.md \"What a failed step keeps\"",
                       failure_advice(&pb));

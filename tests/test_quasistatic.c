@@ -24,6 +24,11 @@
  *    of the projected Hessian decreases the potential, not always |g| (implicit_step.c);
  *  - a failed step's warning gives its own integrator's rule for what it keeps, and its
  *    advice tells a held bar (ramp the load) from a free block (nothing holds it);
+ *  - a block pressed by a box obstacle that then stops stays where its last step left it:
+ *    the steps after take no Newton iteration. Its contact nodes lie on the box's face at
+ *    that equilibrium; not held from the start of a step, they were pushed into the box by
+ *    the first iteration and projected onto its side faces, and the block jumped between
+ *    states (elastic energy 0.60-0.81 J, tets inverted, 13-19 iterations a frame);
  *  - that potential, elastic energy (piola__elastic_body_total_energy) minus gravity's
  *    work, is the function the quasistatic residual is the gradient of: its central
  *    difference along a random direction at a bent, stretched state equals -(f + M g) . d
@@ -37,7 +42,9 @@
 
 #include "force/elastic_body_internal.h"
 #include "piola/mesh.h"
+#include "piola/scene.h"
 #include "piola/threads.h"
+#include "piola/world_bodies.h"
 #include "piola/world.h"
 
 typedef struct beam {
@@ -318,6 +325,44 @@ static void free_block_failure_says_nothing_holds_it(void **state) {
 }
 
 /* Pi(x) = sum V0 psi - sum m_i g . x_i after an update at x. */
+/* A 0.2 x 0.2 x 0.1 m block fixed at its bottom, pressed 1 cm by a box obstacle over five
+ * frames, then held: the next frames change nothing. */
+static void pressed_block_stays_when_the_press_stops(void **state) {
+  (void)state;
+  const char *json =
+      "{\"fps\": 30, \"gravity\": [0, 0, 0], \"integrator\": {\"type\": \"quasistatic\"},"
+      " \"solids\": [{\"name\": \"block\", \"mesh\": {\"generate\": \"box\", \"center\": [0, 0, "
+      "0.05], \"half_extents\": [0.1, 0.1, 0.05], \"cell_size\": 0.025},"
+      " \"material\": {\"model\": \"neohookean\", \"youngs_modulus\": 1e5, \"poisson_ratio\": 0.4},"
+      " \"fixed\": [{\"box\": [[-1, -1, -1], [1, 1, 0.0005]]}]}],"
+      " \"obstacles\": [{\"type\": \"box\", \"center\": [0.03, 0.02, 0.13], \"half_extents\": "
+      "[0.04, 0.03, 0.03], \"motion\": {\"translation\": [0, 0, {\"keys\": [[0, 0], "
+      "[0.16666666666666666, -0.01]]}]}}]}";
+  piola_scene *scene = NULL;
+  if (piola_scene_load_string(json, ".", NULL, &scene) != PIOLA_OK)
+    fail_msg("%s", piola_last_error());
+  piola_world *w = piola_scene_world(scene);
+  assert_int_equal(piola_world_advance_to(w, 5.0 / 30, NULL), PIOLA_OK);
+  const piola_body_id block = piola_world_body_of(w, PIOLA_BODY_SOLID, 0);
+  const int32_t n = piola_world_body_node_count(w, block);
+  double *pressed = malloc(sizeof(double) * 3 * (size_t)n);
+  memcpy(pressed, piola_world_body_positions(w, block), sizeof(double) * 3 * (size_t)n);
+  double depth = 0; /* the press reached the block */
+  for (int32_t i = 0; i < n; ++i) depth = fmax(depth, 0.1 - pressed[3 * i + 2]);
+  assert_true(depth > 0.005);
+  for (int f = 6; f <= 8; ++f) {
+    piola_step_stats st;
+    memset(&st, 0, sizeof st);
+    assert_int_equal(piola_world_advance_to(w, f / 30.0, &st), PIOLA_OK);
+    assert_int_equal(st.newton_iterations, 0);
+    assert_int_equal(st.newton_failures, 0);
+    const double *x = piola_world_body_positions(w, block);
+    for (int32_t j = 0; j < 3 * n; ++j) assert_close(x[j], pressed[j], 1e-12);
+  }
+  free(pressed);
+  piola_scene_destroy(scene);
+}
+
 static double potential_at(piola_elastic_body *body, const double *x, const double g[3],
                            double *forces) {
   piola_elastic_stats stats;
@@ -383,6 +428,7 @@ int main(void) {
       cmocka_unit_test(held_bar_failure_advises_a_ramp),
       cmocka_unit_test(backward_euler_failure_names_its_own_rule),
       cmocka_unit_test(free_block_failure_says_nothing_holds_it),
+      cmocka_unit_test(pressed_block_stays_when_the_press_stops),
       cmocka_unit_test(potential_gradient_is_the_residual),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);

@@ -73,6 +73,9 @@ typedef struct newton_problem {
  * its surface and holds their normal from then on. Returns the number of nodes newly held
  * (at least 1 when any node moved; -1 on error). */
 int32_t piola__newton_contacts(newton_problem *pb);
+/* Quasistatics, at a step's start: holds the free nodes that rest on an obstacle's surface
+ * (on it or just outside), put onto it. Returns how many (0 for backward Euler). */
+int32_t piola__newton_resting_contacts(newton_problem *pb);
 /* Releases held nodes whose contact force would pull them into the obstacle; on the
  * kinetic-friction path, friction-held nodes only with friction_held_too. Returns how many. */
 int32_t piola__newton_release_contacts(newton_problem *pb, int friction_held_too);

@@ -739,9 +739,9 @@ static piola_status newton_body(piola_world *w, world_body *s, double t, double 
 
   /* the prediction, and the first guess: the prediction plus a step of gravity, or for a
    * solid held by a constraint or whose step of gravity would take a node into an obstacle
-   * only GUESS_GRAVITY_FRACTION of it (backward Euler); the last equilibrium
-   * (quasistatics); prescribed nodes at t1. The contacts of the last step are cleared
-   * first: a resumed run has none, and must take the same guess. */
+   * only GUESS_GRAVITY_FRACTION of it (backward Euler); the last equilibrium, its nodes
+   * resting on obstacles held (quasistatics); prescribed nodes at t1. The contacts of the
+   * last step are cleared first: a resumed run has none, and must take the same guess. */
   memcpy(s->x_old, s->x, sizeof(double) * (size_t)m);
   memcpy(s->v_old, s->v, sizeof(double) * (size_t)m);
   memcpy(s->force_old, s->force, sizeof(double) * (size_t)m);
@@ -765,6 +765,7 @@ static piola_status newton_body(piola_world *w, world_body *s, double t, double 
     double vp[3];
     piola__body_constrained_state(s, i, pb.t1, s->x + 3 * i, vp);
   }
+  (void)piola__newton_resting_contacts(&pb);
   if (piola__newton_contacts(&pb) < 0)
     return PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "implicit step: out of memory");
   PIOLA_TRY(update(&pb));

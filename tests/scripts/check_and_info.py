@@ -127,6 +127,14 @@ def main():
               f"backward_euler: the step is integrator.dt and says so ({step and step.group(0)})")
         spf = int(re.search(r"estimate: +(\d+) steps per frame", t).group(1))
         check(spf == math.ceil((1 / fps) / 0.007 - 1e-9), f"backward_euler: {spf} steps per frame of integrator.dt")
+        # the timing stops at the scene's end (past it a body at rest costs an implicit step
+        # nothing), and an implicit integrator's first step counts
+        t = subprocess.run([PIOLA, "check", path, "--timing-seconds", "30", "--threads", "1"],
+                           capture_output=True, text=True).stdout
+        tm = re.search(r"timing: +(\d+) steps", t)
+        check(tm is not None and int(tm.group(1)) == math.ceil(frames / fps / 0.007 - 1e-9),
+              f"backward_euler: the timing takes the scene's {math.ceil(frames / fps / 0.007 - 1e-9)} steps, "
+              f"all counted ({tm and tm.group(0)})")
 
         # the timing's steps are the run's first: their warnings are printed too
         inside = dict(scene, obstacles=[{"type": "plane", "point": [0, 0, 3], "normal": [0, 0, 1]}])

@@ -11,13 +11,16 @@
  * ended 1e10 m away, no warning.
  *
  * medit/unit_ball.mesh (radius 1 m, E = 100 kPa) resting on a frictionless plane: it may
- * slide and turn along the plane at no cost, and its Newton steps fail. A step along those
- * free directions is as long as the regularization is small; the full steps shrank it to
- * 1e-22 of its first value and the ball ended its first frame 1e6 m away, its second 1e11 m.
- * No Newton iteration may now move a node further than the body's size, and a failed step
- * whose iterate did is not kept: after every frame each node is within the ball's bounding
- * diagonal of where it started, over the plane. The mesh's first vertex is in no tet (held,
- * massless): the advice is still that of a body held by contacts alone. */
+ * slide and turn along the plane at no cost, so -K + mu M is singular there but for mu. A
+ * step along those free directions is as long as the regularization is small; the full
+ * steps shrank it to 1e-22 of its first value and the ball ended its first frame 1e6 m away,
+ * its second 1e11 m. No Newton iteration may now move a node further than the body's size,
+ * and a failed step whose iterate did is not kept: after every frame each node is within the
+ * ball's bounding diagonal of where it started, over the plane. Its first try (the whole of
+ * its weight on one point of the plane at once) fails; its retry, whose load is the same,
+ * goes on from where that try stopped and converges (since 2026-12-08; before, every try
+ * failed and the last was kept, with a warning), and the next frames, at rest, take no
+ * Newton iteration. The mesh's first vertex is in no tet (held, massless). */
 #include "test_support.h"
 
 #include <math.h>
@@ -120,7 +123,10 @@ static void ball_resting_on_frictionless_plane(void **state) {
   const double size = 2 * sqrt(3.0); /* the bounding diagonal of a unit ball */
   piola_step_stats st = {0};
   for (int frame = 1; frame <= 3; ++frame) {
-    assert_int_equal(piola_world_advance_to(w, frame / 30.0, &st), PIOLA_OK);
+    piola_step_stats this_frame = {0};
+    assert_int_equal(piola_world_advance_to(w, frame / 30.0, &this_frame), PIOLA_OK);
+    st.newton_failures += this_frame.newton_failures;
+    if (frame > 1) assert_int_equal(this_frame.newton_iterations, 0); /* at rest */
     assert_true(real_mesh_solid_finite(w));
     const double *x = piola_world_solid_positions(w, 0);
     for (int32_t i = 0; i < mesh.vertex_count; ++i) {
@@ -132,10 +138,9 @@ static void ball_resting_on_frictionless_plane(void **state) {
       assert_true(x[3 * i + 2] >= bottom - 1e-9);
     }
   }
+  /* the first try fails, and its retry, from where it stopped, converges */
   assert_true(st.newton_failures > 0);
-  const char *text = piola_world_warning(w, PIOLA_WARNING_NEWTON_FAILED);
-  assert_non_null(text);
-  assert_non_null(strstr(text, "held by obstacle contacts alone has no equilibrium"));
+  assert_null(piola_world_warning(w, PIOLA_WARNING_NEWTON_FAILED));
   piola_tet_mesh_free(&mesh);
   piola_world_destroy(w);
 }

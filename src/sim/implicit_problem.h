@@ -42,6 +42,10 @@ struct implicit_state {
   double *friction_free; /* 6n: a converged iterate's positions before friction's
                             moves, then the velocities friction left (newton_iterate) */
   uint8_t *hit;       /* n: nodes the obstacle projection moved */
+  double *retry_guess; /* 3n: quasistatics: a failed try's last iterate, the first guess of its
+                          retry where the load is the same (newton_body) */
+  double retry_guess_t1; /* s: the time that try ended at */
+  int has_retry_guess;   /* retry_guess holds one for this step */
 };
 
 typedef struct newton_problem {

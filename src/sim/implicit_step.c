@@ -76,6 +76,7 @@
 #include "sim/failed_step_velocity.h"
 #include "sim/implicit_problem.h"
 #include "sim/implicit_split.h"
+#include "sim/obstacle_internal.h"
 #include "sim/solid_contacts.h"
 #include "sim/world_internal.h"
 
@@ -157,7 +158,7 @@ void piola__implicit_state_free(struct implicit_state *st) {
   free(st->prediction), free(st->residual), free(st->step), free(st->base), free(st->damping);
   for (int k = 0; k < 4; ++k) free(st->cg[k]);
   free(st->scratch_v), free(st->surface_v), free(st->surface_mu), free(st->friction);
-  free(st->friction_free), free(st->hit);
+  free(st->friction_free), free(st->hit), free(st->retry_guess);
   free(st);
 }
 
@@ -174,11 +175,12 @@ static piola_status implicit_state_make(world_body *s, piola_preconditioner_type
   st->surface_mu = malloc(sizeof(double) * (size_t)(s->n > 0 ? s->n : 1));
   st->friction = malloc(v3);
   st->friction_free = malloc(2 * v3);
+  st->retry_guess = malloc(v3);
   for (int k = 0; k < 4; ++k) st->cg[k] = malloc(v3);
   st->hit = malloc((size_t)(s->n > 0 ? s->n : 1));
   int ok = st->prediction && st->residual && st->step && st->base && st->damping && st->scratch_v &&
            st->surface_v && st->surface_mu && st->friction && st->hit && st->cg[0] && st->cg[1] &&
-           st->cg[2] && st->cg[3] && st->friction_free;
+           st->cg[2] && st->cg[3] && st->friction_free && st->retry_guess;
   if (ok && piola__body_stiffness_init(s, &st->matrix) != PIOLA_OK) ok = 0;
   if (ok && preconditioner == PIOLA_PRECONDITIONER_INCOMPLETE_CHOLESKY &&
       s->kind == PIOLA_BODY_SOLID &&
@@ -707,6 +709,8 @@ static newton_problem problem_of(piola_world *w, world_body *s, double t, double
 
 static piola_status newton_iterate(const newton_problem *problem, int accept_unconverged,
                                    piola_step_stats *stats);
+static int same_quasistatic_load(const piola_world *w, const world_body *s, double t_a,
+                                 double t_b);
 
 /* Newton's method for one body over [t, t + dt]. Returns PIOLA_OK when converged,
  * PIOLA_ERROR_NOT_CONVERGED when not (the caller undoes and halves), or another error. */
@@ -717,7 +721,7 @@ static piola_status newton_body(piola_world *w, world_body *s, double t, double 
   st->multigrid_fresh = 0; /* a new step: the hierarchy is set up again */
   st->split_systems = 0;   /* likewise the split solver's preconditioner */
   piola__solid_contacts_solve_begins(w);
-  if (halvings == 0) st->failed_progress = -1;
+  if (halvings == 0) st->failed_progress = -1, st->has_retry_guess = 0;
   st->halvings = halvings;
   st->may_go_deeper = 0, st->went_deeper = 0;
   const int accept_unconverged = halvings >= MAX_HALVINGS;
@@ -765,6 +769,10 @@ static piola_status newton_body(piola_world *w, world_body *s, double t, double 
     double vp[3];
     piola__body_constrained_state(s, i, pb.t1, s->x + 3 * i, vp);
   }
+  if (pb.quasistatic && halvings > 0 && st->has_retry_guess &&
+      same_quasistatic_load(w, s, st->retry_guess_t1, pb.t1))
+    for (int32_t i = 0; i < n; ++i)
+      if (s->flags[i] == NODE_FREE) memcpy(s->x + 3 * i, st->retry_guess + 3 * i, sizeof(double) * 3);
   (void)piola__newton_resting_contacts(&pb);
   if (piola__newton_contacts(&pb) < 0)
     return PIOLA_FAIL(PIOLA_ERROR_OUT_OF_MEMORY, "implicit step: out of memory");
@@ -862,6 +870,46 @@ static int moved_beyond(const world_body *s, double reach) {
     if (d2 > reach * reach) return 1;
   }
   return 0;
+}
+
+/* 1 when a failed quasistatic try's iterate is no result: a free node went further than the
+ * body's size (reach), or twice that for a body held at a node, which turning about it
+ * takes that far (a flat cloth pinned at two corners of an edge hangs with its far edge 1.03
+ * times its diagonal from where it started). */
+static int moved_beyond_kept_reach(const world_body *s, double reach) {
+  return moved_beyond(s, held_by_nodes(s) ? 2.0 * reach : reach);
+}
+
+/* 1 when the quasistatic problems of s ending at t_a and at t_b are the same: gravity, the
+ * body's activation and stiffness scale, its prescribed nodes' positions and every
+ * obstacle's pose, bit for bit. Halving a failed try then changes nothing but the time, so
+ * the retry goes on from the failed try's iterate instead of solving it again from the
+ * step's start. */
+static int same_quasistatic_load(const piola_world *w, const world_body *s, double t_a,
+                                 double t_b) {
+  for (int k = 0; k < 3; ++k)
+    if (piola_track_eval(&w->def.gravity[k], t_a) != piola_track_eval(&w->def.gravity[k], t_b))
+      return 0;
+  if (piola_track_eval(&s->activation, t_a) != piola_track_eval(&s->activation, t_b) ||
+      piola_track_eval(&s->stiffness_scale, t_a) != piola_track_eval(&s->stiffness_scale, t_b))
+    return 0;
+  for (int32_t i = 0; i < s->n; ++i) {
+    if (s->flags[i] == NODE_FREE) continue;
+    double xa[3], xb[3], v[3];
+    piola__body_constrained_state(s, i, t_a, xa, v);
+    piola__body_constrained_state(s, i, t_b, xb, v);
+    if (xa[0] != xb[0] || xa[1] != xb[1] || xa[2] != xb[2]) return 0;
+  }
+  for (int32_t o = 0; o < w->obstacle_count; ++o) {
+    if (!w->obstacles[o]) continue;
+    piola__rigid_state a, b;
+    piola__rigid_motion_state(&w->obstacles[o]->motion, t_a, &a);
+    piola__rigid_motion_state(&w->obstacles[o]->motion, t_b, &b);
+    if (memcmp(&a.rotation, &b.rotation, sizeof a.rotation) != 0 ||
+        memcmp(&a.translation, &b.translation, sizeof a.translation) != 0)
+      return 0;
+  }
+  return 1;
 }
 
 /* The Newton failure warning's advice for a quasistatic body (time-stepping.md,
@@ -1060,14 +1108,16 @@ static piola_status newton_iterate(const newton_problem *problem, int accept_unc
                           (st->halvings < MAX_HALVINGS || w->deeper_steps_left != 0);
       st->failed_progress = progress;
     }
+    /* quasistatics: where the retry's load is the failed try's, it goes on from here */
+    if (!accept_unconverged && pb.quasistatic && isfinite(phi) && !moved_beyond_kept_reach(s, reach)) {
+      memcpy(st->retry_guess, s->x, sizeof(double) * (size_t)m);
+      st->retry_guess_t1 = pb.t1, st->has_retry_guess = 1;
+    }
     if (!accept_unconverged || !isfinite(phi)) return PIOLA_ERROR_NOT_CONVERGED;
     stats->newton_failures++;
     /* quasistatics: an iterate that took a node further than the body's size along its
-     * free directions is no result; the free nodes stay where the step started. A body
-     * held at a node reaches up to twice its size by turning about it (a flat cloth pinned
-     * at two corners of an edge hangs with its far edge 1.03 times its diagonal from where
-     * it started), so there that is the limit */
-    if (pb.quasistatic && moved_beyond(s, held_by_nodes(s) ? 2.0 * reach : reach)) {
+     * free directions is no result; the free nodes stay where the step started */
+    if (pb.quasistatic && moved_beyond_kept_reach(s, reach)) {
       for (int32_t i = 0; i < n; ++i)
         if (s->flags[i] == NODE_FREE) memcpy(s->x + 3 * i, s->x_old + 3 * i, sizeof(double) * 3);
       PIOLA_TRY(update(&pb));

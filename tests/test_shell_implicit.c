@@ -112,6 +112,17 @@ static void hanging_strip_quasistatic(void **state) {
   }
 }
 
+/* The first two columns of nodes of a plate strip `length` long along x in nx cells, centred
+ * on the origin, fixed: the hinges between them hold the slope. */
+static piola_constraint_def clamped_end(double length, int nx) {
+  piola_constraint_def clamp;
+  memset(&clamp, 0, sizeof clamp);
+  clamp.selector.type = PIOLA_SELECT_BOX;
+  clamp.selector.box_min = (piola_vec3){-1, -1, -1};
+  clamp.selector.box_max = (piola_vec3){-0.5 * length + length / nx + 1e-9, 1, 1};
+  return clamp;
+}
+
 /* A plate strip along x, clamped at x = -L/2 (two columns of nodes, so that the hinges
  * there hold the slope) and bent by gravity (-z), stepped by `integrator` until t_end; the
  * mean tip deflection (m, downwards). */
@@ -137,11 +148,7 @@ static double plate_tip(piola_integrator_type integrator, double t_end, double d
   sd.bending.stiffness = 1.0;
   sd.bending.damping = damping;
   sd.shear_viscosity.value = damping > 0 ? 10.0 : 0.0;
-  piola_constraint_def clamp;
-  memset(&clamp, 0, sizeof clamp);
-  clamp.selector.type = PIOLA_SELECT_BOX;
-  clamp.selector.box_min = (piola_vec3){-1, -1, -1};
-  clamp.selector.box_max = (piola_vec3){-0.5 * length + length / nx + 1e-9, 1, 1};
+  piola_constraint_def clamp = clamped_end(length, nx);
   sd.constraints = &clamp;
   sd.constraint_count = 1;
   assert_int_equal(piola_world_add_shell(w, &sd, NULL), PIOLA_OK);
@@ -207,11 +214,7 @@ static void stiff_plate_quasistatic(void **state) {
   sd.density = 1000;
   sd.thickness = 1e-3;
   sd.bending.stiffness = stiffness;
-  piola_constraint_def clamp;
-  memset(&clamp, 0, sizeof clamp);
-  clamp.selector.type = PIOLA_SELECT_BOX;
-  clamp.selector.box_min = (piola_vec3){-1, -1, -1};
-  clamp.selector.box_max = (piola_vec3){-0.5 * length + length / nx + 1e-9, 1, 1};
+  piola_constraint_def clamp = clamped_end(length, nx);
   sd.constraints = &clamp;
   sd.constraint_count = 1;
   assert_int_equal(piola_world_add_shell(w, &sd, NULL), PIOLA_OK);

@@ -106,13 +106,10 @@ int32_t piola__newton_resting_contacts(newton_problem *pb) {
     if (!ob) continue;
     piola__rigid_state pose;
     piola__rigid_motion_state(&ob->motion, pb->t1, &pose);
-    const double reach = ob->bound_radius + gap;
     for (int32_t i = 0; i < s->n; ++i) {
       if (s->flags[i] != NODE_FREE || s->colliding[i] || !(s->mass[i] > 0)) continue;
       const vec3 p = {s->x[3 * i], s->x[3 * i + 1], s->x[3 * i + 2]};
-      /* the shape's bounding sphere, widened by the gap */
-      const vec3 p0 = mat3_transpose_mul_vec(pose.rotation, vec3_sub(p, pose.translation));
-      if (!(vec3_norm2(vec3_sub(p0, ob->bound_center)) < reach * reach)) continue;
+      if (!piola__obstacle_within_bound(ob, &pose, p, gap, NULL)) continue;
       vec3 normal;
       const double d = piola__obstacle_distance_posed(ob, &pose, p, &normal, NULL);
       if (!(d >= 0 && d <= gap)) continue;

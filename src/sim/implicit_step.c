@@ -564,17 +564,21 @@ static double strain_energy(const newton_problem *pb) {
                                      : piola__body_stats(s).elastic_energy;
 }
 
+/* The work of gravity at t1 from the origin to positions x, sum m_i g1 . x_i (J): minus
+ * gravity's potential, zero where the origin is. */
+static double gravity_work(const newton_problem *pb, const double *x) {
+  const world_body *s = pb->s;
+  double work = 0;
+  for (int64_t j = 0; j < 3 * (int64_t)s->n; ++j) work += s->mass[j / 3] * pb->g1[j % 3] * x[j];
+  return work;
+}
+
 /* Quasistatics: the potential whose gradient g is, elastic energy minus the work of
  * gravity, sum V0 psi - sum m_i g1 . x_i (J), at the last update; a shell's elastic energy is
  * its membrane's and its hinges' bending energy. Collective on a split solid (the energy's
  * sum). */
 static double quasistatic_potential(const newton_problem *pb) {
-  const world_body *s = pb->s;
-  double work = 0;
-  for (int32_t i = 0; i < s->n; ++i)
-    work += s->mass[i] *
-            (pb->g1[0] * s->x[3 * i] + pb->g1[1] * s->x[3 * i + 1] + pb->g1[2] * s->x[3 * i + 2]);
-  return strain_energy(pb) - work;
+  return strain_energy(pb) - gravity_work(pb, pb->s->x);
 }
 
 /* The body's kinetic energy at velocities v and its elastic energy of the last update (J):
@@ -590,10 +594,7 @@ static double motion_and_strain_energy(const newton_problem *pb, const double *v
  * update, which must be at x) and gravity's potential at t1, so that every process of a
  * split solid keeps the same thing. */
 static double total_energy(const newton_problem *pb, const double *x, const double *v) {
-  const world_body *s = pb->s;
-  double work = 0;
-  for (int64_t j = 0; j < 3 * (int64_t)s->n; ++j) work += s->mass[j / 3] * pb->g1[j % 3] * x[j];
-  return motion_and_strain_energy(pb, v) - work;
+  return motion_and_strain_energy(pb, v) - gravity_work(pb, x);
 }
 
 /* Friction's moves may raise a shell's energy by this fraction of its kinetic and elastic

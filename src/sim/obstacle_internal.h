@@ -37,13 +37,22 @@ double piola__obstacle_distance_posed(const piola_obstacle *obstacle,
                                       const piola__rigid_state *state, vec3 p, vec3 *normal,
                                       vec3 *velocity);
 
+/* False when p (world, at the pose of state) is further than margin (m) outside the
+ * obstacle's bounding sphere; *p0 (may be NULL) receives p in the t = 0 frame. */
+static inline bool piola__obstacle_within_bound(const piola_obstacle *obstacle,
+                                                const piola__rigid_state *state, vec3 p,
+                                                double margin, vec3 *p0) {
+  const vec3 q = mat3_transpose_mul_vec(state->rotation, vec3_sub(p, state->translation));
+  if (p0) *p0 = q;
+  const double reach = obstacle->bound_radius + margin;
+  return vec3_norm2(vec3_sub(q, obstacle->bound_center)) < reach * reach;
+}
+
 /* False when p (world, at the pose of state) is certainly outside the obstacle. */
 static inline bool piola__obstacle_may_contain(const piola_obstacle *obstacle,
                                                const piola__rigid_state *state, vec3 p) {
-  vec3 p0 = mat3_transpose_mul_vec(state->rotation, vec3_sub(p, state->translation));
-  if (vec3_norm2(vec3_sub(p0, obstacle->bound_center)) >=
-      obstacle->bound_radius * obstacle->bound_radius)
-    return false;
+  vec3 p0;
+  if (!piola__obstacle_within_bound(obstacle, state, p, 0.0, &p0)) return false;
   /* A mesh answers inside/outside by its winding number far more cheaply than its distance. */
   if (obstacle->type == PIOLA_OBSTACLE_MESH)
     return piola__mesh_obstacle_contains(&obstacle->shape.mesh, p0);
